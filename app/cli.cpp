@@ -1,0 +1,285 @@
+// cli.cpp - render / compare / demo-shots: everything the UI can make, made headless.
+#include "cli.h"
+
+#include "assets/demo.h"
+#include "assets/files.h"
+#include "assets/image_io.h"
+#include "assets/scene_io.h"
+#include "renderers/renderer.h"
+#include "ui/viewer.h"
+
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+
+namespace fs = std::filesystem;
+
+namespace cli {
+
+namespace {
+
+int fail(const std::string& msg) {
+    std::fprintf(stderr, "viewer: error: %s\n", msg.c_str());
+    return 1;
+}
+
+bool parseSize(const std::string& s, int& w, int& h, std::string& err) {
+    int a = 0, b = 0;
+    char x = 0, extra = 0;
+    if (std::sscanf(s.c_str(), "%d%c%d%c", &a, &x, &b, &extra) != 3 || (x != 'x' && x != 'X')) {
+        err = "--size '" + s + "': expected WIDTHxHEIGHT, e.g. 1920x1080";
+        return false;
+    }
+    if (a < 1 || b < 1 || a > assets::kMaxImageDimension || b > assets::kMaxImageDimension) {
+        err = "--size '" + s + "': each side must be 1.." + std::to_string(assets::kMaxImageDimension);
+        return false;
+    }
+    w = a;
+    h = b;
+    return true;
+}
+
+bool parseOnOff(const std::string& v, bool& out) {
+    if (v == "on" || v == "true" || v == "1") { out = true; return true; }
+    if (v == "off" || v == "false" || v == "0") { out = false; return true; }
+    return false;
+}
+
+std::optional<sg::Scene> loadSceneArg(const std::string& arg, std::string& err) {
+    if (arg.empty() || arg == "demo") return assets::makeDemoScene();
+    assets::LoadResult r = assets::loadScene(arg);
+    for (const auto& w : r.warnings) std::fprintf(stderr, "viewer: warning: %s\n", w.c_str());
+    if (!r.scene) err = r.error;
+    return std::move(r.scene);
+}
+
+// Applies command-line overrides to the scene's settings and camera. Returns "" or an error.
+std::string applyOverrides(const RenderArgs& a, sg::Scene& scene) {
+    sg::RenderSettings& s = scene.settings;
+    if (a.shading && !sg::parse(*a.shading, s.shading)) return "--shading '" + *a.shading + "': expected flat, gouraud or phong";
+    if (a.reflection && !sg::parse(*a.reflection, s.reflection)) return "--reflection '" + *a.reflection + "': expected phong or blinn";
+    if (a.fog && !sg::parse(*a.fog, s.fog)) return "--fog '" + *a.fog + "': expected off, linear, exp or exp2";
+    if (a.aa && !s.setAA(*a.aa)) return "--aa '" + *a.aa + "': expected none, msaa2, msaa4, msaa8, ssaa2, ssaa3 or ssaa4";
+    auto onOff = [](const std::optional<std::string>& v, bool& dst, const char* name) -> std::string {
+        if (v && !parseOnOff(*v, dst)) return std::string(name) + " '" + *v + "': expected on or off";
+        return {};
+    };
+    for (auto e : {onOff(a.shadows, s.shadows, "--shadows"), onOff(a.reflections, s.reflections, "--reflections"),
+                   onOff(a.culling, s.cullBackFaces, "--culling"), onOff(a.wireframe, s.wireframe, "--wireframe"),
+                   onOff(a.attenuation, s.attenuation, "--attenuation")})
+        if (!e.empty()) return e;
+    if (a.fogStart) s.fogStart = *a.fogStart;
+    if (a.fogEnd) s.fogEnd = *a.fogEnd;
+    if (a.fogDensity) s.fogDensity = *a.fogDensity;
+    if (a.tessellation) s.tessellation = *a.tessellation;
+    if (a.bounces) s.maxBounces = *a.bounces;
+    std::string err = s.validate();
+    if (!err.empty()) return "invalid settings: " + err;
+
+    std::vector<sg::NodeId> cams = scene.cameras();
+    if (a.camera >= 0) {
+        if (size_t(a.camera) >= cams.size())
+            return "--camera " + std::to_string(a.camera) + ": the scene has " + std::to_string(cams.size()) + " camera(s)";
+        scene.activeCamera = cams[a.camera];
+    }
+    if (a.projection || a.fovy || a.obliqueAngle || a.obliqueFactor) {
+        if (!scene.valid(scene.activeCamera) || !std::holds_alternative<sg::Camera>(scene.node(scene.activeCamera).payload)) {
+            if (cams.empty()) scene.addDefaultCamera();
+            else scene.activeCamera = cams.front();
+        }
+        auto& cam = std::get<sg::Camera>(scene.editPayload(scene.activeCamera));
+        if (a.projection) {
+            std::string p = *a.projection;
+            if (p == "cavalier" || p == "cabinet") {
+                sg::Projection preset = p == "cavalier" ? sg::Projection::cavalier() : sg::Projection::cabinet();
+                cam.projection.type = preset.type;
+                cam.projection.obliqueAngleDeg = preset.obliqueAngleDeg;
+                cam.projection.obliqueFactor = preset.obliqueFactor;
+            } else if (!sg::parse(p, cam.projection.type)) {
+                return "--projection '" + p + "': expected perspective, orthographic, oblique, cavalier or cabinet";
+            }
+        }
+        if (a.fovy) {
+            if (!(*a.fovy > 0.5f && *a.fovy < 179.5f)) return "--fovy must be in (0.5, 179.5) degrees";
+            cam.projection.fovyDeg = *a.fovy;
+        }
+        if (a.obliqueAngle) cam.projection.obliqueAngleDeg = *a.obliqueAngle;
+        if (a.obliqueFactor) {
+            if (!(*a.obliqueFactor >= 0.0f && *a.obliqueFactor <= 4.0f)) return "--oblique-factor must be in [0, 4]";
+            cam.projection.obliqueFactor = *a.obliqueFactor;
+        }
+    }
+    return {};
+}
+
+struct Shot {
+    std::string backend;
+    rnd::Framebuffer image;
+    rnd::RenderStats stats;
+};
+
+Shot renderWith(const std::string& backend, const sg::FrameInput& frame, int w, int h) {
+    Shot shot;
+    shot.backend = backend;
+    std::string err;
+    auto r = rnd::makeRenderer(backend, &err);
+    if (!r) {
+        shot.stats.error = err;
+        return shot;
+    }
+    auto t0 = std::chrono::steady_clock::now();
+    shot.stats = r->render(frame, w, h, shot.image);
+    if (shot.stats.milliseconds == 0)
+        shot.stats.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    return shot;
+}
+
+}  // namespace
+
+void addRenderOptions(CLI::App& cmd, RenderArgs& a, bool compare) {
+    cmd.add_option("scene", a.scene, "Scene file (.json .gltf .glb .obj .off .ply .stl) or 'demo'")->required();
+    if (compare) {
+        cmd.add_option("--out", a.out, "Output folder (created if missing)")->required();
+    } else {
+        cmd.add_option("--out", a.out, "Output PNG file")->required();
+        cmd.add_option("--backend", a.backend, "Backend: gl, raster or raycast")->capture_default_str();
+    }
+    cmd.add_option("--size", a.size, "Image size WIDTHxHEIGHT")->capture_default_str();
+    cmd.add_flag("--overwrite", a.overwrite, "Replace existing output files");
+    cmd.add_option("--camera", a.camera, "Use the scene's N-th camera (0-based; default: the active one)");
+    cmd.add_option("--shading", a.shading, "Shading model: flat, gouraud, phong");
+    cmd.add_option("--reflection", a.reflection, "Reflection model: phong, blinn");
+    cmd.add_option("--fog", a.fog, "Fog: off, linear, exp, exp2");
+    cmd.add_option("--fog-start", a.fogStart, "Linear fog start distance");
+    cmd.add_option("--fog-end", a.fogEnd, "Linear fog end distance");
+    cmd.add_option("--fog-density", a.fogDensity, "Exp/exp2 fog density");
+    cmd.add_option("--aa", a.aa, "Anti-aliasing: none, msaa2, msaa4, msaa8, ssaa2, ssaa3, ssaa4");
+    cmd.add_option("--projection", a.projection, "Projection: perspective, orthographic, oblique, cavalier, cabinet");
+    cmd.add_option("--fovy", a.fovy, "Perspective vertical field of view in degrees");
+    cmd.add_option("--oblique-angle", a.obliqueAngle, "Oblique receding-axis angle in degrees");
+    cmd.add_option("--oblique-factor", a.obliqueFactor, "Oblique foreshortening factor (1 cavalier, 0.5 cabinet)");
+    cmd.add_option("--shadows", a.shadows, "Ray caster shadow rays: on, off");
+    cmd.add_option("--reflections", a.reflections, "Ray caster mirror reflections: on, off");
+    cmd.add_option("--bounces", a.bounces, "Ray caster reflection depth limit");
+    cmd.add_option("--culling", a.culling, "Back-face culling: on, off");
+    cmd.add_option("--wireframe", a.wireframe, "Wireframe overlay: on, off");
+    cmd.add_option("--attenuation", a.attenuation, "Inverse-square light attenuation: on, off");
+    cmd.add_option("--tessellation", a.tessellation, "Tessellation resolution for implicit shapes (4..512)");
+}
+
+int runRender(const RenderArgs& a) {
+    int w = 0, h = 0;
+    std::string err;
+    if (!parseSize(a.size, w, h, err)) return fail(err);
+    fs::path out = a.out;
+    std::error_code ec;
+    if (!a.overwrite && fs::exists(fs::symlink_status(out, ec)))
+        return fail(out.string() + ": file exists (use --overwrite to replace it)");
+    auto scene = loadSceneArg(a.scene, err);
+    if (!scene) return fail(err);
+    err = applyOverrides(a, *scene);
+    if (!err.empty()) return fail(err);
+    sg::FrameInput frame = sg::flatten(*scene, float(w) / float(h));
+    Shot shot = renderWith(a.backend, frame, w, h);
+    if (!shot.stats.ok) return fail(a.backend + ": " + shot.stats.error);
+    err = assets::writePng(out, shot.image.width, shot.image.height, shot.image.color.data(), a.overwrite);
+    if (!err.empty()) return fail(err);
+    std::printf("%s: %dx%d, %s backend, %.1f ms\n", out.string().c_str(), w, h, a.backend.c_str(), shot.stats.milliseconds);
+    return 0;
+}
+
+int runCompare(const RenderArgs& a) {
+    int w = 0, h = 0;
+    std::string err;
+    if (!parseSize(a.size, w, h, err)) return fail(err);
+    auto scene = loadSceneArg(a.scene, err);
+    if (!scene) return fail(err);
+    err = applyOverrides(a, *scene);
+    if (!err.empty()) return fail(err);
+    fs::path dir = a.out;
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    if (!fs::is_directory(dir, ec)) return fail(dir.string() + ": cannot create output folder");
+    sg::FrameInput frame = sg::flatten(*scene, float(w) / float(h));
+
+    std::vector<Shot> shots;
+    nlohmann::json table;
+    table["scene"] = a.scene;
+    table["size"] = {w, h};
+    std::ostringstream md;
+    md << "| backend | ms | image |\n|---|---|---|\n";
+    int failures = 0;
+    for (const std::string& b : rnd::rendererNames()) {
+        Shot s = renderWith(b, frame, w, h);
+        if (!s.stats.ok) {
+            std::fprintf(stderr, "viewer: %s: %s\n", b.c_str(), s.stats.error.c_str());
+            table["backends"][b] = {{"error", s.stats.error}};
+            ++failures;
+            continue;
+        }
+        fs::path p = dir / (b + ".png");
+        err = assets::writePng(p, w, h, s.image.color.data(), a.overwrite);
+        if (!err.empty()) return fail(err);
+        table["backends"][b] = {{"ms", s.stats.milliseconds}, {"image", p.filename().string()}};
+        md << "| " << b << " | " << s.stats.milliseconds << " | " << p.filename().string() << " |\n";
+        std::printf("%s\n", p.string().c_str());
+        shots.push_back(std::move(s));
+    }
+    md << "\n| pair | mean abs (/255) | max | within 3/255 | PSNR dB | diff image |\n|---|---|---|---|---|---|\n";
+    for (size_t i = 0; i < shots.size(); ++i)
+        for (size_t j = i + 1; j < shots.size(); ++j) {
+            rnd::ImageDiff d = rnd::compareImages(shots[i].image, shots[j].image, 3);
+            std::string name = "diff-" + shots[i].backend + "-" + shots[j].backend + ".png";
+            rnd::Framebuffer img = rnd::diffImage(shots[i].image, shots[j].image, 3);
+            err = assets::writePng(dir / name, w, h, img.color.data(), a.overwrite);
+            if (!err.empty()) return fail(err);
+            table["pairs"].push_back({{"a", shots[i].backend}, {"b", shots[j].backend}, {"meanAbs", d.meanAbs},
+                                      {"maxAbs", d.maxAbs}, {"within3", d.fractionWithin},
+                                      {"psnr", std::isinf(d.psnr) ? 999.0 : d.psnr}, {"image", name}});
+            md << "| " << shots[i].backend << " vs " << shots[j].backend << " | " << d.meanAbs << " | " << d.maxAbs << " | "
+               << d.fractionWithin * 100 << "% | " << d.psnr << " | " << name << " |\n";
+            std::printf("%s\n", (dir / name).string().c_str());
+        }
+    err = assets::writeFileAtomic(dir / "compare.json", table.dump(2) + "\n", a.overwrite);
+    if (!err.empty()) return fail(err);
+    err = assets::writeFileAtomic(dir / "compare.md", md.str(), a.overwrite);
+    if (!err.empty()) return fail(err);
+    std::printf("%s\n%s\n", (dir / "compare.json").string().c_str(), (dir / "compare.md").string().c_str());
+    return failures == 0 ? 0 : 1;
+}
+
+int runDemoShots(const std::string& outDir, const std::string& size) {
+    int w = 0, h = 0;
+    std::string err;
+    if (!parseSize(size, w, h, err)) return fail(err);
+    fs::path dir = outDir;
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    if (!fs::is_directory(dir, ec)) return fail(dir.string() + ": cannot create output folder");
+    sg::Scene scene = assets::makeDemoScene();
+    sg::FrameInput frame = sg::flatten(scene, float(w) / float(h));
+    int ok = 0;
+    for (const std::string& b : rnd::rendererNames()) {
+        Shot s = renderWith(b, frame, w, h);
+        if (!s.stats.ok) {
+            std::fprintf(stderr, "viewer: %s backend: %s\n", b.c_str(), s.stats.error.c_str());
+            continue;
+        }
+        fs::path p = dir / ("demo-" + b + ".png");
+        err = assets::writePng(p, w, h, s.image.color.data(), /*overwrite=*/true);
+        if (!err.empty()) {
+            std::fprintf(stderr, "viewer: %s\n", err.c_str());
+            continue;
+        }
+        std::printf("demo rendered with %-8s -> %s (%.1f ms)\n", b.c_str(), p.string().c_str(), s.stats.milliseconds);
+        ++ok;
+    }
+    return ok > 0 ? 0 : 1;
+}
+
+int runWindow(const std::string& scene) { return ui::runViewer(scene); }
+
+}  // namespace cli

@@ -1,0 +1,31 @@
+// cli.h - the headless commands of the viewer executable.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <optional>
+#include <string>
+
+namespace cli {
+
+struct RenderArgs {
+    std::string scene;
+    std::string out;
+    std::string backend = "gl";
+    std::string size = "1280x720";
+    bool overwrite = false;
+    int camera = -1;                 // index into the scene's cameras, -1 = active
+    // Settings overrides (unset = the scene's own setting).
+    std::optional<std::string> shading, reflection, fog, aa, projection, shadows, reflections, culling,
+        wireframe, attenuation;
+    std::optional<float> fogStart, fogEnd, fogDensity, fovy, obliqueAngle, obliqueFactor;
+    std::optional<int> tessellation, bounces;
+};
+
+void addRenderOptions(CLI::App& cmd, RenderArgs& args, bool compare);
+int runRender(const RenderArgs& args);
+int runCompare(const RenderArgs& args);
+int runDemoShots(const std::string& outDir, const std::string& size);
+int runWindow(const std::string& scene);
+
+}  // namespace cli

@@ -1,0 +1,44 @@
+// scene_io.h - loading and saving scenes.
+//   loadScene: by extension: .json (native scene file), .gltf/.glb, .obj/.off/.ply/.stl.
+//   saveScene: the native JSON format (scene_json.cpp documents it).
+// Errors are one line naming the file and the reason (for JSON: also the JSON path, e.g.
+// "scene.json: /nodes/3/transform/translation: expected 3 numbers"). A failed load returns
+// no scene, so the caller's current scene stays untouched.
+#pragma once
+
+#include "scenegraph/scene.h"
+
+#include <atomic>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace assets {
+
+struct LoadOptions {
+    std::atomic<bool>* cancel = nullptr;     // polled during long loads
+    std::atomic<float>* progress = nullptr;  // 0..1
+};
+
+struct LoadResult {
+    std::optional<sg::Scene> scene;
+    std::string error;                       // set when !scene
+    std::vector<std::string> warnings;       // recoverable problems (missing texture, ...)
+};
+
+LoadResult loadScene(const std::filesystem::path& path, const LoadOptions& options = {});
+
+// Native JSON scene file.
+LoadResult loadSceneJson(const std::filesystem::path& path);
+LoadResult parseSceneJson(std::string_view text, const std::filesystem::path& pathForErrors);
+// Serialises the scene. Meshes that came from files are still written inline unless
+// `meshRefs` maps the mesh index to a file path relative to the scene file.
+std::string serializeSceneJson(const sg::Scene& scene);
+// Writes atomically; refuses to replace an existing file unless overwrite. "" on success.
+std::string saveSceneJson(const sg::Scene& scene, const std::filesystem::path& path, bool overwrite);
+
+// Which extensions loadScene understands (lower case, with dot).
+std::vector<std::string> supportedSceneExtensions();
+
+}  // namespace assets

@@ -1,0 +1,82 @@
+// image_io.cpp - the one place stb_image and stb_image_write are used. Decoding is limited to
+// PNG and JPEG with a dimension cap; Debian's libstb ships the implementations, so this file
+// only includes the headers.
+#include "assets/image_io.h"
+
+#include "assets/files.h"
+
+#include <stb_image.h>
+#include <stb_image_write.h>
+
+#include <cstring>
+
+namespace assets {
+
+namespace {
+bool isPng(const unsigned char* d, size_t n) {
+    static const unsigned char sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+    return n >= 8 && std::memcmp(d, sig, 8) == 0;
+}
+bool isJpeg(const unsigned char* d, size_t n) { return n >= 3 && d[0] == 0xFF && d[1] == 0xD8 && d[2] == 0xFF; }
+}  // namespace
+
+ImageLoad decodeImage(const void* data, size_t size, const std::string& name) {
+    ImageLoad r;
+    auto* d = static_cast<const unsigned char*>(data);
+    if (size > size_t(INT32_MAX)) { r.error = name + ": image data too large"; return r; }
+    if (!isPng(d, size) && !isJpeg(d, size)) { r.error = name + ": not a PNG or JPEG image"; return r; }
+    int w = 0, h = 0, comp = 0;
+    // Check the header's dimensions before decoding anything.
+    if (!stbi_info_from_memory(d, int(size), &w, &h, &comp)) {
+        r.error = name + ": cannot read image header (" + (stbi_failure_reason() ? stbi_failure_reason() : "corrupt") + ")";
+        return r;
+    }
+    if (w <= 0 || h <= 0 || w > kMaxImageDimension || h > kMaxImageDimension) {
+        r.error = name + ": image is " + std::to_string(w) + "x" + std::to_string(h) + ", limit " +
+                  std::to_string(kMaxImageDimension) + " per side";
+        return r;
+    }
+    unsigned char* pixels = stbi_load_from_memory(d, int(size), &w, &h, &comp, 4);
+    if (!pixels) {
+        r.error = name + ": cannot decode image (" + (stbi_failure_reason() ? stbi_failure_reason() : "corrupt") + ")";
+        return r;
+    }
+    auto t = std::make_shared<sg::Texture>();
+    t->name = name;
+    t->width = w;
+    t->height = h;
+    t->rgba.assign(pixels, pixels + size_t(w) * h * 4);
+    stbi_image_free(pixels);
+    r.texture = std::move(t);
+    return r;
+}
+
+ImageLoad loadImage(const std::filesystem::path& path) {
+    std::string bytes;
+    std::string err = readFileLimited(path, 256ull << 20, bytes);
+    if (!err.empty()) return {nullptr, err};
+    ImageLoad r = decodeImage(bytes.data(), bytes.size(), path.string());
+    if (r.texture) r.texture->sourcePath = path.string();
+    return r;
+}
+
+std::string encodePng(int w, int h, const uint8_t* rgba, std::string& out) {
+    if (w <= 0 || h <= 0) return "image has no pixels";
+    if (w > kMaxImageDimension || h > kMaxImageDimension)
+        return "image is " + std::to_string(w) + "x" + std::to_string(h) + ", limit " + std::to_string(kMaxImageDimension) + " per side";
+    out.clear();
+    auto sink = [](void* ctx, void* data, int size) {
+        static_cast<std::string*>(ctx)->append(static_cast<const char*>(data), size_t(size));
+    };
+    if (!stbi_write_png_to_func(sink, &out, w, h, 4, rgba, w * 4)) return "PNG encoding failed";
+    return {};
+}
+
+std::string writePng(const std::filesystem::path& path, int w, int h, const uint8_t* rgba, bool overwrite) {
+    std::string bytes;
+    std::string err = encodePng(w, h, rgba, bytes);
+    if (!err.empty()) return path.string() + ": " + err;
+    return writeFileAtomic(path, bytes, overwrite);
+}
+
+}  // namespace assets

@@ -1,0 +1,10 @@
+# Flags attached through an INTERFACE target instead of global CMAKE_CXX_FLAGS.
+add_library(viewer_options INTERFACE)
+target_compile_options(viewer_options INTERFACE -Wall -Wextra $<$<COMPILE_LANGUAGE:CXX>:-Wno-missing-field-initializers>)
+if(VIEWER_NATIVE)
+  target_compile_options(viewer_options INTERFACE -march=native)
+endif()
+if(VIEWER_SANITIZE)
+  target_compile_options(viewer_options INTERFACE -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
+  target_link_options(viewer_options INTERFACE -fsanitize=address,undefined)
+endif()

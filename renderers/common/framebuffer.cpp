@@ -1,0 +1,102 @@
+#include "renderers/framebuffer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+namespace rnd {
+
+void Framebuffer::resize(int w, int h) {
+    width = std::max(w, 0);
+    height = std::max(h, 0);
+    color.assign(size_t(width) * height * 4, 0);
+    depth.assign(size_t(width) * height, 1.0f);
+}
+
+void Framebuffer::clear(const uint8_t rgba[4], float d) {
+    for (size_t i = 0; i < color.size(); i += 4) std::copy(rgba, rgba + 4, &color[i]);
+    std::fill(depth.begin(), depth.end(), d);
+}
+
+std::string ImageDiff::describe() const {
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "mean %.3f/255, max %d/255, %.3f%% within tolerance, PSNR %.2f dB", meanAbs, maxAbs,
+                  fractionWithin * 100.0, psnr);
+    return buf;
+}
+
+ImageDiff compareImages(const Framebuffer& a, const Framebuffer& b, int tolerance) {
+    ImageDiff d;
+    if (a.width != b.width || a.height != b.height || a.width * a.height == 0) {
+        d.meanAbs = 255;
+        d.maxAbs = 255;
+        d.fractionWithin = 0;
+        return d;
+    }
+    size_t n = size_t(a.width) * a.height, within = 0;
+    double sum = 0, sq = 0;
+    for (size_t i = 0; i < n; ++i) {
+        int worst = 0;
+        for (int c = 0; c < 3; ++c) {
+            int diff = std::abs(int(a.color[i * 4 + c]) - int(b.color[i * 4 + c]));
+            sum += diff;
+            sq += double(diff) * diff;
+            worst = std::max(worst, diff);
+        }
+        d.maxAbs = std::max(d.maxAbs, worst);
+        if (worst <= tolerance) ++within;
+    }
+    d.meanAbs = sum / (3.0 * n);
+    d.fractionWithin = double(within) / n;
+    double mse = sq / (3.0 * n);
+    d.psnr = mse == 0 ? std::numeric_limits<double>::infinity() : 10.0 * std::log10(255.0 * 255.0 / mse);
+    return d;
+}
+
+Framebuffer diffImage(const Framebuffer& a, const Framebuffer& b, int threshold) {
+    Framebuffer out;
+    out.resize(a.width, a.height);
+    if (a.width != b.width || a.height != b.height) return out;
+    for (size_t i = 0; i < size_t(a.width) * a.height; ++i) {
+        int worst = 0;
+        for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(int(a.color[i * 4 + c]) - int(b.color[i * 4 + c])));
+        uint8_t* p = &out.color[i * 4];
+        if (worst <= threshold) {
+            // Below threshold: a dim grey copy of the first image for context.
+            uint8_t g = uint8_t((a.color[i * 4] + a.color[i * 4 + 1] + a.color[i * 4 + 2]) / 12);
+            p[0] = p[1] = p[2] = g;
+        } else {
+            // Heat map: red at small differences rising through yellow to white at 255.
+            float t = std::min(1.0f, worst / 64.0f);
+            p[0] = 255;
+            p[1] = uint8_t(255 * std::clamp(t * 1.5f - 0.25f, 0.0f, 1.0f));
+            p[2] = uint8_t(255 * std::clamp(t * 2.0f - 1.0f, 0.0f, 1.0f));
+        }
+        p[3] = 255;
+    }
+    return out;
+}
+
+Framebuffer downsample(const Framebuffer& src, int f) {
+    Framebuffer out;
+    if (f <= 1) return src;
+    out.resize(src.width / f, src.height / f);
+    for (int y = 0; y < out.height; ++y)
+        for (int x = 0; x < out.width; ++x) {
+            int acc[4] = {0, 0, 0, 0};
+            float dmin = 1.0f;
+            for (int sy = 0; sy < f; ++sy)
+                for (int sx = 0; sx < f; ++sx) {
+                    const uint8_t* p = src.pixel(x * f + sx, y * f + sy);
+                    for (int c = 0; c < 4; ++c) acc[c] += p[c];
+                    dmin = std::min(dmin, src.depth[size_t(y * f + sy) * src.width + x * f + sx]);
+                }
+            uint8_t* o = out.pixel(x, y);
+            for (int c = 0; c < 4; ++c) o[c] = uint8_t((acc[c] + f * f / 2) / (f * f));
+            out.depth[size_t(y) * out.width + x] = dmin;
+        }
+    return out;
+}
+
+}  // namespace rnd

@@ -1,0 +1,92 @@
+#include "renderers/shading.h"
+
+#include <algorithm>
+#include <cmath>
+#include <array>
+#include <limits>
+
+namespace rnd {
+
+using namespace sg;
+
+LightSample sampleLight(const DrawLight& light, const vec3& p) {
+    LightSample s;
+    if (light.type == LightType::Directional) {
+        s.toLight = -light.direction;
+        s.radiance = light.radiance;
+        s.distance = std::numeric_limits<float>::infinity();
+        return s;
+    }
+    vec3 d = light.position - p;
+    float dist2 = glm::dot(d, d);
+    s.distance = std::sqrt(dist2);
+    s.toLight = s.distance > 0 ? d / s.distance : vec3(0, 1, 0);
+    s.radiance = light.radiance;
+    if (light.inverseSquare) s.radiance /= std::max(dist2, 1e-8f);   // seeds 3.2: 1/r^2
+    if (light.type == LightType::Spot) {
+        float c = glm::dot(-s.toLight, light.direction);
+        float t = light.cosInner > light.cosOuter ? (c - light.cosOuter) / (light.cosInner - light.cosOuter) : (c >= light.cosOuter ? 1.0f : 0.0f);
+        t = std::clamp(t, 0.0f, 1.0f);
+        s.radiance *= t * t * (3.0f - 2.0f * t);   // smoothstep between the cones
+    }
+    return s;
+}
+
+vec3 shadeLight(const Material& m, const SurfacePoint& s, const vec3& v, const LightSample& l, ReflectionModel model) {
+    float nl = glm::dot(s.normal, l.toLight);
+    if (nl <= 0.0f) return vec3(0.0f);
+    float spec;
+    if (model == ReflectionModel::Phong) {
+        vec3 r = 2.0f * nl * s.normal - l.toLight;   // mirror direction of l about n
+        spec = std::max(glm::dot(r, v), 0.0f);
+    } else {
+        vec3 h = l.toLight + v;
+        float len = glm::length(h);
+        spec = len > 0 ? std::max(glm::dot(s.normal, h / len), 0.0f) : 0.0f;
+    }
+    spec = spec > 0.0f ? std::pow(spec, m.shininess) : 0.0f;
+    vec3 specColor = m.specularTinted ? s.albedo : m.specularColor;
+    return l.radiance * nl * (m.kd * s.albedo + m.ks * spec * specColor);
+}
+
+vec3 shade(const Material& m, const SurfacePoint& s, const vec3& eye, const FrameInput& f, const float* visible) {
+    if (m.unlit) return s.albedo + m.emissive;
+    vec3 v = eye - s.position;
+    float len = glm::length(v);
+    v = len > 0 ? v / len : vec3(0, 0, 1);
+    vec3 c = m.ka * s.albedo * f.ambientLight + m.emissive;
+    for (size_t i = 0; i < f.lights.size(); ++i) {
+        if (visible && visible[i] <= 0.0f) continue;
+        vec3 li = shadeLight(m, s, v, sampleLight(f.lights[i], s.position), f.settings.reflection);
+        c += visible ? visible[i] * li : li;
+    }
+    return c;
+}
+
+vec3 applyFog(const RenderSettings& s, const vec3& color, float d) {
+    if (s.fog == FogMode::Off) return color;
+    float vis = fogVisibility(s, d);
+    return vis * color + (1.0f - vis) * s.fogColor;
+}
+
+float encodeSRGB(float x) {
+    x = std::clamp(x, 0.0f, 1.0f);
+    return x <= 0.0031308f ? 12.92f * x : 1.055f * std::pow(x, 1.0f / 2.4f) - 0.055f;
+}
+
+float decodeSRGB(float x) {
+    return x <= 0.04045f ? x / 12.92f : std::pow((x + 0.055f) / 1.055f, 2.4f);
+}
+
+uint8_t toByteSRGB(float linear) { return uint8_t(encodeSRGB(linear) * 255.0f + 0.5f); }
+
+vec3 srgbBytesToLinear(const uint8_t* rgb) {
+    static const auto table = [] {
+        std::array<float, 256> t{};
+        for (int i = 0; i < 256; ++i) t[i] = decodeSRGB(i / 255.0f);
+        return t;
+    }();
+    return vec3(table[rgb[0]], table[rgb[1]], table[rgb[2]]);
+}
+
+}  // namespace rnd

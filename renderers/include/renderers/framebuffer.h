@@ -1,0 +1,36 @@
+// framebuffer.h - what every backend renders into: RGBA8 colour + float depth, any size.
+// Rows are stored top to bottom (row 0 is the top of the image, as in PNG files).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace rnd {
+
+struct Framebuffer {
+    int width = 0, height = 0;
+    std::vector<uint8_t> color;   // width*height*4, sRGB-encoded RGBA8 (display-ready)
+    std::vector<float> depth;     // width*height, window-space depth in [0,1] (1 = far / empty)
+
+    void resize(int w, int h);
+    void clear(const uint8_t rgba[4], float depthValue = 1.0f);
+    uint8_t* pixel(int x, int y) { return &color[(size_t(y) * width + x) * 4]; }
+    const uint8_t* pixel(int x, int y) const { return &color[(size_t(y) * width + x) * 4]; }
+};
+
+// Per-channel comparison of two images of the same size (alpha ignored).
+struct ImageDiff {
+    double meanAbs = 0;          // mean absolute difference per channel, in 0..255 units
+    int maxAbs = 0;              // largest channel difference
+    double fractionWithin = 1;   // fraction of pixels whose channels all differ by <= tolerance
+    double psnr = 0;             // dB (infinity when identical)
+    std::string describe() const;
+};
+ImageDiff compareImages(const Framebuffer& a, const Framebuffer& b, int tolerance);
+// Heat-map of |a - b| (black = equal, red/yellow = large); pixels above threshold highlighted.
+Framebuffer diffImage(const Framebuffer& a, const Framebuffer& b, int threshold = 0);
+// Box-filters a framebuffer down by an integer factor (SSAA resolve).
+Framebuffer downsample(const Framebuffer& src, int factor);
+
+}  // namespace rnd

@@ -1,0 +1,51 @@
+// shading.h - the one Phong evaluation shared by the CPU rasterizer and the ray caster (the
+// GL shaders mirror it line by line; tests hold the three to each other).
+//
+// Seeds, section 3.1 (with m = shininess):
+//   L_cam = ka * rho (x) L_ambient
+//         + sum_i  att_i * L_i * max(n.l_i, 0) (x) (kd * rho + ks * rho_spec * max(r_i.v, 0)^m)
+// Phong:  r_i = 2 (n.l_i) n - l_i ;  Blinn-Phong: (r_i.v) replaced by (n.h_i), h = (l+v)/|l+v|.
+// att_i = 1/d^2 for inverse-square lights, times the spot cone factor; plus emissive. Fog
+// then blends toward the fog colour: L = f(d) L_cam + (1 - f(d)) C_fog. Colours are linear;
+// the framebuffer stores sRGB (encodeSRGB), as GL does with an sRGB framebuffer.
+#pragma once
+
+#include "scenegraph/frame.h"
+
+#include <cstdint>
+
+namespace rnd {
+
+struct SurfacePoint {
+    sg::vec3 position;   // world
+    sg::vec3 normal;     // world, unit, facing the viewer for two-sided surfaces
+    sg::vec3 albedo;     // rho: base colour (x) texture (x) vertex colour
+};
+
+// Direction from surface toward the light (unit), the light's radiance reaching the point
+// (attenuation and spot cone applied) and the distance to the light (infinity for directional).
+struct LightSample {
+    sg::vec3 toLight;
+    sg::vec3 radiance;
+    float distance;
+};
+LightSample sampleLight(const sg::DrawLight& light, const sg::vec3& position);
+
+// Reflected radiance toward `toEye` (unit) from one light, without ambient.
+sg::vec3 shadeLight(const sg::Material& m, const SurfacePoint& s, const sg::vec3& toEye, const LightSample& l,
+                    sg::ReflectionModel model);
+
+// Full local model: ambient + emissive + all lights (no shadows). `lightVisible` (optional)
+// gives a per-light visibility factor in [0,1] (the ray caster's shadow rays).
+sg::vec3 shade(const sg::Material& m, const SurfacePoint& s, const sg::vec3& eye, const sg::FrameInput& f,
+               const float* lightVisible = nullptr);
+
+// Fog on eye-space distance d, then clamp.
+sg::vec3 applyFog(const sg::RenderSettings& s, const sg::vec3& color, float eyeDistance);
+
+float encodeSRGB(float linear);     // [0,1] -> [0,1]
+float decodeSRGB(float encoded);
+uint8_t toByteSRGB(float linear);   // clamp, encode, round
+sg::vec3 srgbBytesToLinear(const uint8_t* rgb);
+
+}  // namespace rnd

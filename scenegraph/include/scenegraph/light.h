@@ -1,0 +1,28 @@
+// light.h - light payload. A light sits at its node's world position and points down its
+// node's local -z axis (directional and spot), as in glTF's KHR_lights_punctual.
+#pragma once
+
+#include "scenegraph/math.h"
+
+#include <string_view>
+
+namespace sg {
+
+enum class LightType { Point, Directional, Spot };
+
+struct Light {
+    LightType type = LightType::Point;
+    vec3 color{1.0f};
+    float intensity = 1.0f;
+    // Inverse-square falloff 1/r^2 (seeds 3.2), applied when RenderSettings::attenuation is on.
+    bool inverseSquare = false;
+    float spotInnerDeg = 20.0f;   // full intensity inside
+    float spotOuterDeg = 30.0f;   // zero outside, smooth in between
+
+    bool operator==(const Light&) const = default;
+};
+
+std::string_view toString(LightType t);
+bool parse(std::string_view s, LightType& out);
+
+}  // namespace sg

@@ -1,0 +1,32 @@
+// material.h - the Phong material of the seeds:
+//   L_cam = ka * rho (x) L_ambient
+//         + sum_i L_i (n.l_i) (x) (kd * rho + ks * rho_spec * (r_i.v)^n)
+// rho is the base colour (times the diffuse texture), rho_spec white or tinted by rho.
+#pragma once
+
+#include "scenegraph/math.h"
+
+#include <string>
+
+namespace sg {
+
+struct Material {
+    std::string name = "default";
+    vec3 baseColor{0.8f, 0.8f, 0.8f};  // rho, linear RGB
+    float ka = 0.2f;                    // ambient coefficient
+    float kd = 0.8f;                    // diffuse coefficient
+    float ks = 0.3f;                    // specular coefficient
+    float shininess = 32.0f;            // Phong exponent n
+    bool specularTinted = false;        // false: white highlights; true: tinted by base colour
+    vec3 specularColor{1.0f};           // used when not tinted
+    int diffuseTexture = -1;            // index into Scene::textures, -1 = none
+    vec3 emissive{0.0f};
+    float alpha = 1.0f;
+    bool unlit = false;                 // colour = base colour (times texture), no lighting
+    bool doubleSided = true;
+    float reflectivity = 0.0f;          // mirror reflection weight (ray caster)
+
+    bool operator==(const Material&) const = default;
+};
+
+}  // namespace sg

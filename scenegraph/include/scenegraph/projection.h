@@ -1,0 +1,40 @@
+// projection.h - camera projection parameters and the matrices they produce.
+#pragma once
+
+#include "scenegraph/math.h"
+
+#include <string_view>
+
+namespace sg {
+
+enum class ProjectionType { Perspective, Orthographic, Oblique };
+
+struct Projection {
+    ProjectionType type = ProjectionType::Perspective;
+    float fovyDeg = 45.0f;       // perspective: total vertical angle of view
+    float zNear = 0.1f;
+    float zFar = 100.0f;
+    // Perspective: when true, the general frustum (l, r, b, t at zNear) is used instead of
+    // fovy and the viewport aspect.
+    bool useFrustum = false;
+    float left = -0.1f, right = 0.1f, bottom = -0.1f, top = 0.1f;
+    // Orthographic and oblique: half the visible height in view units; width from aspect.
+    float orthoHalfHeight = 2.0f;
+    // Oblique: receding-axis angle (degrees) and foreshortening factor.
+    float obliqueAngleDeg = 45.0f;
+    float obliqueFactor = 1.0f;   // 1 = cavalier, 0.5 = cabinet
+
+    bool operator==(const Projection&) const = default;
+
+    // Projection matrix for a viewport of the given aspect (width / height). focusDistance is
+    // the distance of the oblique projection's fixed plane in front of the camera.
+    mat4 matrix(float aspect, float focusDistance) const;
+
+    static Projection cavalier() { Projection p; p.type = ProjectionType::Oblique; p.obliqueFactor = 1.0f; p.obliqueAngleDeg = 45.0f; return p; }
+    static Projection cabinet() { Projection p; p.type = ProjectionType::Oblique; p.obliqueFactor = 0.5f; p.obliqueAngleDeg = 45.0f; return p; }
+};
+
+std::string_view toString(ProjectionType t);
+bool parse(std::string_view s, ProjectionType& out);
+
+}  // namespace sg

@@ -1,0 +1,69 @@
+// settings.h - RenderSettings: one plain struct read by all three backends, edited by the UI,
+// set from the command line and saved with the scene.
+#pragma once
+
+#include "scenegraph/math.h"
+
+#include <string>
+#include <string_view>
+
+namespace sg {
+
+enum class ShadingModel { Flat, Gouraud, Phong };
+enum class ReflectionModel { Phong, BlinnPhong };
+enum class FogMode { Off, Linear, Exp, Exp2 };
+enum class AAMode { None, MSAA, SSAA };
+
+struct RenderSettings {
+    ShadingModel shading = ShadingModel::Phong;
+    ReflectionModel reflection = ReflectionModel::Phong;
+
+    // Fog blends toward fogColor by visibility f(d) of the eye-space distance d:
+    // linear f = (end - d)/(end - start), exp f = e^(-density d), exp2 f = e^(-(density d)^2).
+    FogMode fog = FogMode::Off;
+    vec3 fogColor{0.6f, 0.65f, 0.7f};
+    float fogStart = 5.0f;
+    float fogEnd = 30.0f;
+    float fogDensity = 0.05f;
+
+    bool attenuation = true;       // honour Light::inverseSquare
+
+    // Anti-aliasing. MSAA: aaRate samples per pixel (2, 4, 8). SSAA: aaRate x aaRate samples
+    // per pixel (2 -> 4 spp, 4 -> 16 spp); the ray caster uses aaRate x aaRate jittered rays.
+    AAMode aa = AAMode::None;
+    int aaRate = 4;
+
+    bool cullBackFaces = false;
+    bool wireframe = false;
+    vec3 wireframeColor{0.05f, 0.05f, 0.05f};
+    vec3 background{0.08f, 0.09f, 0.11f};
+
+    // Ray caster only.
+    bool shadows = true;
+    bool reflections = false;
+    int maxBounces = 3;
+
+    // Tessellation of implicit shapes / CSG / parametric / grids for the rasterizers:
+    // grid resolution of marching cubes and segments of analytic tessellations.
+    int tessellation = 64;
+
+    bool operator==(const RenderSettings&) const = default;
+
+    // Returns an empty string when the settings are usable, else the reason.
+    std::string validate() const;
+    // Spelling used by the command line and the JSON file: none, msaa2/4/8, ssaa2/3/4.
+    std::string aaName() const;
+    bool setAA(std::string_view name);
+};
+
+std::string_view toString(ShadingModel m);
+std::string_view toString(ReflectionModel m);
+std::string_view toString(FogMode m);
+bool parse(std::string_view s, ShadingModel& out);
+bool parse(std::string_view s, ReflectionModel& out);
+bool parse(std::string_view s, FogMode& out);
+
+// Fog visibility f(d) in [0,1] (1 = no fog) as described above.
+float fogVisibility(const RenderSettings& s, float distance);
+
+}  // namespace sg

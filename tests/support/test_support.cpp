@@ -1,0 +1,53 @@
+#include "test_support.h"
+
+#include "assets/image_io.h"
+
+#include <cstdlib>
+
+namespace fs = std::filesystem;
+
+namespace testing_support {
+
+fs::path testdataDir() {
+    if (const char* env = std::getenv("VIEWER_TESTDATA")) return env;
+    return VIEWER_TESTDATA_DIR;
+}
+
+::testing::AssertionResult requireTestdata() {
+    std::error_code ec;
+    if (fs::is_directory(testdataDir(), ec)) return ::testing::AssertionSuccess();
+    return ::testing::AssertionFailure() << "test data folder " << testdataDir()
+                                         << " is absent: this test needs ../shared/testdata "
+                                            "(or set VIEWER_TESTDATA to its location)";
+}
+
+fs::path outputDir(const std::string& suite) {
+    fs::path p = fs::path(VIEWER_TEST_OUTPUT_DIR) / suite;
+    std::error_code ec;
+    fs::create_directories(p, ec);
+    return p;
+}
+
+void writeImage(const rnd::Framebuffer& img, const std::string& suite, const std::string& name) {
+    if (img.width <= 0 || img.height <= 0) return;
+    fs::path p = outputDir(suite) / (name + ".png");
+    assets::writePng(p, img.width, img.height, img.color.data(), true);
+}
+
+::testing::AssertionResult imagesClose(const rnd::Framebuffer& actual, const rnd::Framebuffer& expected,
+                                       const ImageTolerance& tol, const std::string& suite, const std::string& name) {
+    if (actual.width != expected.width || actual.height != expected.height)
+        return ::testing::AssertionFailure() << name << ": size " << actual.width << "x" << actual.height << " vs expected "
+                                             << expected.width << "x" << expected.height;
+    rnd::ImageDiff d = rnd::compareImages(actual, expected, tol.channelTolerance);
+    std::printf("[image] %s/%s: %s\n", suite.c_str(), name.c_str(), d.describe().c_str());
+    if (d.meanAbs <= tol.maxMeanAbs && d.fractionWithin >= tol.minFractionWithin) return ::testing::AssertionSuccess();
+    writeImage(actual, suite, name + "-actual");
+    writeImage(expected, suite, name + "-expected");
+    writeImage(rnd::diffImage(actual, expected, tol.channelTolerance), suite, name + "-diff");
+    return ::testing::AssertionFailure() << name << ": " << d.describe() << " (allowed: mean <= " << tol.maxMeanAbs
+                                         << ", within " << tol.channelTolerance << "/255 >= " << tol.minFractionWithin * 100
+                                         << "%); images written to " << outputDir(suite);
+}
+
+}  // namespace testing_support

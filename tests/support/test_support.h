@@ -1,0 +1,34 @@
+// test_support.h - helpers shared by the tests: where test data and outputs live, and image
+// comparison with tolerances that writes actual + expected + diff PNGs on failure.
+#pragma once
+
+#include "renderers/framebuffer.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+
+namespace testing_support {
+
+// ../shared/testdata (override with VIEWER_TESTDATA). Tests that need it call
+// requireTestdata(), which fails the test with a clear message when the folder is absent.
+std::filesystem::path testdataDir();
+::testing::AssertionResult requireTestdata();
+// Where tests write images (build/<preset>/test-output/<suite>/...).
+std::filesystem::path outputDir(const std::string& suite);
+
+struct ImageTolerance {
+    double maxMeanAbs = 1.0;        // mean absolute difference per channel (0..255 units)
+    double minFractionWithin = 0.995;
+    int channelTolerance = 3;       // per-pixel tolerance for the fraction
+};
+
+// Compares and reports the figures; on failure writes <name>-actual.png, <name>-expected.png
+// and <name>-diff.png into outputDir(suite).
+::testing::AssertionResult imagesClose(const rnd::Framebuffer& actual, const rnd::Framebuffer& expected,
+                                       const ImageTolerance& tol, const std::string& suite, const std::string& name);
+
+void writeImage(const rnd::Framebuffer& img, const std::string& suite, const std::string& name);
+
+}  // namespace testing_support
