@@ -26,7 +26,17 @@ ImageLoad decodeImage(const void* data, size_t size, const std::string& name) {
     if (size > size_t(INT32_MAX)) { r.error = name + ": image data too large"; return r; }
     if (!isPng(d, size) && !isJpeg(d, size)) { r.error = name + ": not a PNG or JPEG image"; return r; }
     int w = 0, h = 0, comp = 0;
-    // Check the header's dimensions before decoding anything.
+    // Check the header's dimensions before decoding anything. PNG: IHDR width/height are the
+    // big-endian words at bytes 16..23 (read directly: stb's own "too large" message is vague).
+    if (isPng(d, size) && size >= 24) {
+        auto be32 = [&](size_t o) { return uint32_t(d[o]) << 24 | uint32_t(d[o + 1]) << 16 | uint32_t(d[o + 2]) << 8 | d[o + 3]; };
+        uint32_t pw = be32(16), ph = be32(20);
+        if (pw > uint32_t(kMaxImageDimension) || ph > uint32_t(kMaxImageDimension)) {
+            r.error = name + ": image is " + std::to_string(pw) + "x" + std::to_string(ph) + ", limit " +
+                      std::to_string(kMaxImageDimension) + " per side";
+            return r;
+        }
+    }
     if (!stbi_info_from_memory(d, int(size), &w, &h, &comp)) {
         r.error = name + ": cannot read image header (" + (stbi_failure_reason() ? stbi_failure_reason() : "corrupt") + ")";
         return r;
