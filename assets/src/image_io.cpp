@@ -17,6 +17,10 @@ bool isPng(const unsigned char* d, size_t n) {
     static const unsigned char sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
     return n >= 8 && std::memcmp(d, sig, 8) == 0;
 }
+std::string failureReason() {
+    const char* why = stbi_failure_reason();
+    return why ? std::string(why) : std::string("corrupt data");
+}
 bool isJpeg(const unsigned char* d, size_t n) { return n >= 3 && d[0] == 0xFF && d[1] == 0xD8 && d[2] == 0xFF; }
 }  // namespace
 
@@ -38,7 +42,7 @@ ImageLoad decodeImage(const void* data, size_t size, const std::string& name) {
         }
     }
     if (!stbi_info_from_memory(d, int(size), &w, &h, &comp)) {
-        r.error = name + ": cannot read image header (" + (stbi_failure_reason() ? stbi_failure_reason() : "corrupt") + ")";
+        r.error = name + ": cannot read image header (" + failureReason() + ")";
         return r;
     }
     if (w <= 0 || h <= 0 || w > kMaxImageDimension || h > kMaxImageDimension) {
@@ -48,7 +52,7 @@ ImageLoad decodeImage(const void* data, size_t size, const std::string& name) {
     }
     unsigned char* pixels = stbi_load_from_memory(d, int(size), &w, &h, &comp, 4);
     if (!pixels) {
-        r.error = name + ": cannot decode image (" + (stbi_failure_reason() ? stbi_failure_reason() : "corrupt") + ")";
+        r.error = name + ": cannot decode image (" + failureReason() + ")";
         return r;
     }
     auto t = std::make_shared<sg::Texture>();

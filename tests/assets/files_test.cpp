@@ -9,6 +9,8 @@
 #include <csignal>
 #include <sys/resource.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 namespace fs = std::filesystem;
 
@@ -98,4 +100,39 @@ TEST(FilesTest, PngRoundTripAndCaps) {
     assets::ImageLoad h = assets::decodeImage(huge.data(), huge.size(), "huge.png");
     EXPECT_FALSE(h.texture);
     EXPECT_NE(h.error.find("65535x65535"), std::string::npos) << h.error;
+}
+
+// Kill the writer at random points, many times: the target is always either the complete old
+// file or the complete new one, never torn or empty.
+TEST(FilesTest, KilledWriterLeavesOldOrNewFile) {
+    fs::path dir = testing_support::outputDir("files") / "killed";
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    fs::path target = dir / "scene.json";
+    const std::string oldContent(200000, 'o');
+    const std::string newContent(3000000, 'n');
+    ASSERT_EQ(assets::writeFileAtomic(target, oldContent, false), "");
+    std::srand(12345);
+    int sawNew = 0;
+    for (int round = 0; round < 60; ++round) {
+        pid_t pid = fork();
+        ASSERT_GE(pid, 0);
+        if (pid == 0) {
+            assets::writeFileAtomic(target, newContent, true);
+            _exit(0);
+        }
+        usleep(useconds_t(std::rand() % 20000));
+        kill(pid, SIGKILL);
+        int status = 0;
+        waitpid(pid, &status, 0);
+        std::string content;
+        ASSERT_EQ(assets::readFileLimited(target, 1u << 24, content), "");
+        bool isOld = content == oldContent, isNew = content == newContent;
+        ASSERT_TRUE(isOld || isNew) << "round " << round << ": torn file of " << content.size() << " bytes";
+        if (isNew) {
+            ++sawNew;
+            ASSERT_EQ(assets::writeFileAtomic(target, oldContent, true), "");
+        }
+    }
+    std::printf("[killed writer] 60 rounds, %d completed before the kill\n", sawNew);
 }
