@@ -37,6 +37,8 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <sstream>
 
 namespace fs = std::filesystem;
@@ -723,6 +725,64 @@ json payloadJ(const sg::Payload& p) {
     return j;
 }
 
+// Pretty printer: objects one key per line, arrays of plain values on one line, floats in
+// their shortest form that reads back to the same float (the scene stores floats).
+void appendNumber(std::string& out, double d) {
+    float f = float(d);
+    char buf[32];
+    for (int prec = 6; prec <= 9; ++prec) {
+        std::snprintf(buf, sizeof buf, "%.*g", prec, double(f));
+        if (std::strtof(buf, nullptr) == f) break;
+    }
+    std::string s = buf;
+    if (s.find_first_of(".eEn") == std::string::npos) s += ".0";   // keep it a float in JSON terms
+    out += s;
+}
+
+void pretty(std::string& out, const json& j, int indent) {
+    auto pad = [&](int n) { out.append(size_t(n) * 2, ' '); };
+    switch (j.type()) {
+    case json::value_t::object: {
+        if (j.empty()) { out += "{}"; return; }
+        out += "{\n";
+        size_t i = 0;
+        for (auto it = j.begin(); it != j.end(); ++it, ++i) {
+            pad(indent + 1);
+            out += json(it.key()).dump();
+            out += ": ";
+            pretty(out, it.value(), indent + 1);
+            out += i + 1 < j.size() ? ",\n" : "\n";
+        }
+        pad(indent);
+        out += "}";
+        return;
+    }
+    case json::value_t::array: {
+        bool flatArray = std::all_of(j.begin(), j.end(), [](const json& e) { return e.is_primitive(); });
+        if (flatArray) {
+            out += "[";
+            for (size_t i = 0; i < j.size(); ++i) {
+                if (i) out += ", ";
+                pretty(out, j[i], indent);
+            }
+            out += "]";
+            return;
+        }
+        out += "[\n";
+        for (size_t i = 0; i < j.size(); ++i) {
+            pad(indent + 1);
+            pretty(out, j[i], indent + 1);
+            out += i + 1 < j.size() ? ",\n" : "\n";
+        }
+        pad(indent);
+        out += "]";
+        return;
+    }
+    case json::value_t::number_float: appendNumber(out, j.get<double>()); return;
+    default: out += j.dump(); return;
+    }
+}
+
 }  // namespace
 
 // --- public API -------------------------------------------------------------------------------
@@ -785,7 +845,9 @@ std::string serializeSceneJson(const sg::Scene& s) {
         j["nodes"].push_back(std::move(nj));
     }
     j["activeCamera"] = s.valid(s.activeCamera) ? json(indexOf[s.activeCamera]) : json(nullptr);
-    return j.dump(1) + "\n";
+    std::string out;
+    pretty(out, j, 0);
+    return out + "\n";
 }
 
 LoadResult parseSceneJson(std::string_view text, const fs::path& path) {
