@@ -14,11 +14,7 @@ exe="$bindir/fuzz_$t"
 corpus="$bindir/corpus_$t"; seeds="$bindir/seeds_$t"; artifacts="$bindir/artifacts_$t"
 mkdir -p "$corpus" "$seeds" "$artifacts"
 case "$t" in
-  scene_json) # seeds: the demo scene written by the viewer itself, plus small hand-made files
-              for v in "$bindir/../../app/viewer" "$root/build/release/app/viewer"; do
-                [ -x "$v" ] && { "$v" convert demo --out "$seeds/demo.json" --overwrite >/dev/null 2>&1 || true; break; }
-              done
-              echo '{"nodes":[{},{"parent":0,"implicit":{"type":"sphere"}}]}' > "$seeds/min.json" ;;
+  scene_json) cp "$root"/tests/fuzz/seeds/*.json "$seeds/" ;;
   gltf) pat='*.gltf' ;; glb) pat='*.glb' ;; obj) pat='*.obj' ;; ply) pat='*.ply' ;;
   off) pat='*.off' ;; stl) pat='*.[sS][tT][lL]' ;; image) pat='*.png' ;;
 esac

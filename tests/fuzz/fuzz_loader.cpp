@@ -16,7 +16,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const char* extension() {
+[[maybe_unused]] const char* extension() {
 #if defined(FUZZ_TARGET_SCENE_JSON)
     return ".json";
 #elif defined(FUZZ_TARGET_GLTF)
@@ -36,7 +36,7 @@ const char* extension() {
 #endif
 }
 
-const fs::path& workDir() {
+[[maybe_unused]] const fs::path& workDir() {
     static const fs::path dir = [] {
         fs::path d = fs::temp_directory_path() / ("viewer-fuzz-" FUZZ_NAME "-" + std::to_string(getpid()));
         fs::create_directories(d);
