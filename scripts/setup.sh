@@ -13,6 +13,9 @@ packages=(
   libgl1-mesa-dri libegl-mesa0 libegl-dev libgl-dev libosmesa6-dev xvfb xauth
 )
 
+# The fuzz preset also needs clang and its libFuzzer runtime.
+if [ "$preset" = fuzz ]; then packages+=(clang-14 libclang-rt-14-dev); fi
+
 missing=()
 for p in "${packages[@]}"; do
   if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
@@ -40,4 +43,8 @@ if [ ! -f "$builddir/CMakeCache.txt" ]; then
   cmake --preset "$preset" >/dev/null
 fi
 jobs="$(nproc 2>/dev/null || echo 2)"
-cmake --build "$builddir" -j "$jobs"
+if [ "$preset" = fuzz ]; then
+  cmake --build "$builddir" -j "$jobs" --target fuzz_all
+else
+  cmake --build "$builddir" -j "$jobs"
+fi
