@@ -198,10 +198,10 @@ FrameInput flatten(const Scene& scene, float aspect, NodeId cameraNode) {
         const Camera& c = std::get<Camera>(scene.node(cam).payload);
         f.camera = makeFrameCamera(scene.world(cam), c.projection, aspect, c.focusDistance);
     } else {
-        Scene tmp = scene;   // small cost, only for scenes without any camera
-        NodeId id = tmp.addDefaultCamera();
-        const Camera& c = std::get<Camera>(tmp.node(id).payload);
-        f.camera = makeFrameCamera(tmp.world(id), c.projection, aspect, c.focusDistance);
+        // No camera in the scene: frame the geometry (without copying the scene).
+        mat4 camWorld;
+        Camera c = scene.framingCamera(camWorld);
+        f.camera = makeFrameCamera(camWorld, c.projection, aspect, c.focusDistance);
     }
     return f;
 }

@@ -351,6 +351,8 @@ size_t updateWorldImpl(const Scene& s) {
 size_t Scene::updateWorld() const { return updateWorldImpl(*this); }
 
 const mat4& Scene::world(NodeId id) const {
+    static const mat4 kIdentity(1.0f);
+    if (!valid(id)) return kIdentity;   // removed or out-of-range ids have no slot
     if (!m_orderValid || m_allDirty || !m_dirtySlots.empty()) updateWorldImpl(*this);
     return m_worldM[m_slotOf[id]];
 }
@@ -379,12 +381,18 @@ Aabb Scene::localBounds(NodeId id) const {
 }
 
 Aabb Scene::worldBounds() const {
+    // Effective visibility in one pre-order pass (parents come first): asking
+    // effectiveVisible() per node walks all ancestors and is quadratic on deep chains.
+    const auto& order = depthFirstOrder();
+    std::vector<uint8_t> hidden(m_nodes.size(), 0);
     Aabb b;
-    for (NodeId id : depthFirstOrder()) {
-        if (!effectiveVisible(id)) continue;
+    for (NodeId id : order) {
+        const Node& n = m_nodes[id];
+        hidden[id] = !n.visible || (n.parent != kNoNode && hidden[n.parent]);
+        if (hidden[id]) continue;
         // Children of CSG nodes are part of the CSG solid; their bounds count too.
-        if (std::holds_alternative<ImplicitPayload>(m_nodes[id].payload)) {
-            const auto& shape = std::get<ImplicitPayload>(m_nodes[id].payload).shape;
+        if (std::holds_alternative<ImplicitPayload>(n.payload)) {
+            const auto& shape = std::get<ImplicitPayload>(n.payload).shape;
             if (shape.type == ImplicitType::Plane) continue;   // infinite: don't let it dominate framing
         }
         Aabb lb = localBounds(id);
@@ -406,7 +414,7 @@ const Material& Scene::material(int index) const {
     return materials[index];
 }
 
-NodeId Scene::addDefaultCamera() {
+Camera Scene::framingCamera(mat4& cameraWorld) const {
     Aabb b = worldBounds();
     if (b.empty()) b = {vec3(-1.0f), vec3(1.0f)};
     vec3 c = b.center();
@@ -417,9 +425,18 @@ NodeId Scene::addDefaultCamera() {
     cam.projection.zNear = std::max(dist - radius * 2.0f, dist * 0.01f);
     cam.projection.zFar = dist + radius * 2.0f;
     cam.projection.orthoHalfHeight = radius * 1.1f;
-    NodeId id = addNode("default camera", root(), cam);
     vec3 dir = glm::normalize(vec3(0.5f, 0.4f, 1.0f));
-    lookAt(id, c + dir * dist, c);
+    cam.focusDistance = dist;
+    cameraWorld = glm::inverse(sg::lookAt(c + dir * dist, c, vec3(0, 1, 0)));
+    return cam;
+}
+
+NodeId Scene::addDefaultCamera() {
+    mat4 camWorld;
+    Camera cam = framingCamera(camWorld);
+    NodeId id = addNode("default camera", root(), cam);
+    vec3 eye = vec3(camWorld[3]), c = eye - vec3(camWorld[2]) * cam.focusDistance;
+    lookAt(id, eye, c);
     activeCamera = id;
     return id;
 }

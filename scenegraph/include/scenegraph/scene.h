@@ -170,6 +170,8 @@ public:
 
     // Creates a camera node framing the visible geometry and makes it active. Returns it.
     NodeId addDefaultCamera();
+    // The camera addDefaultCamera() would add, and its world matrix, without editing the scene.
+    Camera framingCamera(mat4& cameraWorld) const;
 
 private:
     void markStructureDirty();
