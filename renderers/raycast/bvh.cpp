@@ -323,6 +323,10 @@ void Bvh4::build(const vec3* boxMin, const vec3* boxMax, size_t n, const BuildOp
 
 int Bvh4::depth() const { return m_nodes.empty() ? 0 : subtreeDepth(m_nodes, 0); }
 
+namespace {
+inline void setLane(TriPacket4& p, int k, const vec3& p0, const vec3& p1, const vec3& p2);
+}
+
 // --- TriangleBvh ------------------------------------------------------------------------------
 
 void TriangleBvh::build(const vec3* pos, const uint32_t* idx, size_t triCount, const Bvh4::BuildOptions& opt) {
@@ -362,9 +366,7 @@ void TriangleBvh::build(const vec3* pos, const uint32_t* idx, size_t triCount, c
             for (uint32_t k = 0; k < 4; ++k) {
                 if (k >= count) { p.prim[k] = ~0u; continue; }
                 uint32_t t = m_bvh.m_primIndex[first + k];
-                const vec3 &p0 = pos[idx[3 * t]], &p1 = pos[idx[3 * t + 1]], &p2 = pos[idx[3 * t + 2]];
-                vec3 e1 = p1 - p0, e2 = p2 - p0;
-                for (int a = 0; a < 3; ++a) { p.v0[a][k] = p0[a]; p.e1[a][k] = e1[a]; p.e2[a][k] = e2[a]; }
+                setLane(p, int(k), pos[idx[3 * t]], pos[idx[3 * t + 1]], pos[idx[3 * t + 2]]);
                 p.prim[k] = t;
             }
             c = Node4::kLeafBit | (uint32_t(m_packets.size()) << 3) | count;
@@ -373,39 +375,58 @@ void TriangleBvh::build(const vec3* pos, const uint32_t* idx, size_t triCount, c
 }
 
 namespace {
-// Moller-Trumbore on 4 triangles at once (seeds 2.4): returns the lane mask of hits in
-// (tmin, tmax) and their t, b1, b2.
+// Moller-Trumbore on 4 triangles at once (seeds 2.4), rewritten with the precomputed normal
+// N = e1 x e2 and s = o - p0, R = s x d (scalar triple products):
+//   det = -d.N,  b1 = e2.R / det,  b2 = -e1.R / det,  t = s.N / det.
+// Division-free: the comparisons use the sign-adjusted numerators against |det|; only lanes
+// that hit are divided. Returns the lane mask of hits in (tmin, tmax) and their t, b1, b2.
 inline int intersectPacket(const TriPacket4& p, const __m128 o[3], const __m128 d[3], __m128 tmin, __m128 tmax,
                            __m128& tOut, __m128& uOut, __m128& vOut) {
-    const __m128 e1x = _mm_load_ps(p.e1[0]), e1y = _mm_load_ps(p.e1[1]), e1z = _mm_load_ps(p.e1[2]);
-    const __m128 e2x = _mm_load_ps(p.e2[0]), e2y = _mm_load_ps(p.e2[1]), e2z = _mm_load_ps(p.e2[2]);
-    // pvec = d x e2
-    __m128 px = _mm_sub_ps(_mm_mul_ps(d[1], e2z), _mm_mul_ps(d[2], e2y));
-    __m128 py = _mm_sub_ps(_mm_mul_ps(d[2], e2x), _mm_mul_ps(d[0], e2z));
-    __m128 pz = _mm_sub_ps(_mm_mul_ps(d[0], e2y), _mm_mul_ps(d[1], e2x));
-    __m128 det = _mm_add_ps(_mm_add_ps(_mm_mul_ps(e1x, px), _mm_mul_ps(e1y, py)), _mm_mul_ps(e1z, pz));
-    // s = o - v0
-    __m128 sx = _mm_sub_ps(o[0], _mm_load_ps(p.v0[0]));
-    __m128 sy = _mm_sub_ps(o[1], _mm_load_ps(p.v0[1]));
-    __m128 sz = _mm_sub_ps(o[2], _mm_load_ps(p.v0[2]));
-    __m128 uu = _mm_add_ps(_mm_add_ps(_mm_mul_ps(sx, px), _mm_mul_ps(sy, py)), _mm_mul_ps(sz, pz));
-    // q = s x e1
-    __m128 qx = _mm_sub_ps(_mm_mul_ps(sy, e1z), _mm_mul_ps(sz, e1y));
-    __m128 qy = _mm_sub_ps(_mm_mul_ps(sz, e1x), _mm_mul_ps(sx, e1z));
-    __m128 qz = _mm_sub_ps(_mm_mul_ps(sx, e1y), _mm_mul_ps(sy, e1x));
-    __m128 vv = _mm_add_ps(_mm_add_ps(_mm_mul_ps(d[0], qx), _mm_mul_ps(d[1], qy)), _mm_mul_ps(d[2], qz));
-    __m128 tt = _mm_add_ps(_mm_add_ps(_mm_mul_ps(e2x, qx), _mm_mul_ps(e2y, qy)), _mm_mul_ps(e2z, qz));
-    __m128 inv = _mm_div_ps(_mm_set1_ps(1.0f), det);
-    __m128 u = _mm_mul_ps(uu, inv), v = _mm_mul_ps(vv, inv), t = _mm_mul_ps(tt, inv);
+    const __m128 nx = _mm_load_ps(p.n[0]), ny = _mm_load_ps(p.n[1]), nz = _mm_load_ps(p.n[2]);
+    const __m128 sx = _mm_sub_ps(o[0], _mm_load_ps(p.v0[0]));
+    const __m128 sy = _mm_sub_ps(o[1], _mm_load_ps(p.v0[1]));
+    const __m128 sz = _mm_sub_ps(o[2], _mm_load_ps(p.v0[2]));
+    // det = -d.N
+    __m128 det = _mm_add_ps(_mm_add_ps(_mm_mul_ps(d[0], nx), _mm_mul_ps(d[1], ny)), _mm_mul_ps(d[2], nz));
+    det = _mm_xor_ps(det, _mm_set1_ps(-0.0f));
+    const __m128 sign = _mm_and_ps(det, _mm_set1_ps(-0.0f));
+    const __m128 absDet = _mm_xor_ps(det, sign);
+    // R = s x d
+    const __m128 rx = _mm_sub_ps(_mm_mul_ps(sy, d[2]), _mm_mul_ps(sz, d[1]));
+    const __m128 ry = _mm_sub_ps(_mm_mul_ps(sz, d[0]), _mm_mul_ps(sx, d[2]));
+    const __m128 rz = _mm_sub_ps(_mm_mul_ps(sx, d[1]), _mm_mul_ps(sy, d[0]));
+    __m128 U = _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_load_ps(p.e2[0]), rx), _mm_mul_ps(_mm_load_ps(p.e2[1]), ry)),
+                          _mm_mul_ps(_mm_load_ps(p.e2[2]), rz));
+    __m128 V = _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_load_ps(p.e1[0]), rx), _mm_mul_ps(_mm_load_ps(p.e1[1]), ry)),
+                          _mm_mul_ps(_mm_load_ps(p.e1[2]), rz));
+    V = _mm_xor_ps(V, _mm_set1_ps(-0.0f));
+    __m128 T = _mm_add_ps(_mm_add_ps(_mm_mul_ps(sx, nx), _mm_mul_ps(sy, ny)), _mm_mul_ps(sz, nz));
+    U = _mm_xor_ps(U, sign);
+    V = _mm_xor_ps(V, sign);
+    T = _mm_xor_ps(T, sign);
     const __m128 zero = _mm_setzero_ps();
     __m128 ok = _mm_cmpneq_ps(det, zero);
-    ok = _mm_and_ps(ok, _mm_cmpge_ps(u, zero));
-    ok = _mm_and_ps(ok, _mm_cmpge_ps(v, zero));
-    ok = _mm_and_ps(ok, _mm_cmple_ps(_mm_add_ps(u, v), _mm_set1_ps(1.0f)));
-    ok = _mm_and_ps(ok, _mm_cmpgt_ps(t, tmin));
-    ok = _mm_and_ps(ok, _mm_cmplt_ps(t, tmax));
-    tOut = t; uOut = u; vOut = v;
-    return _mm_movemask_ps(ok);
+    ok = _mm_and_ps(ok, _mm_cmpge_ps(U, zero));
+    ok = _mm_and_ps(ok, _mm_cmpge_ps(V, zero));
+    ok = _mm_and_ps(ok, _mm_cmple_ps(_mm_add_ps(U, V), absDet));
+    ok = _mm_and_ps(ok, _mm_cmpgt_ps(T, _mm_mul_ps(absDet, tmin)));
+    ok = _mm_and_ps(ok, _mm_cmplt_ps(T, _mm_mul_ps(absDet, tmax)));
+    int mask = _mm_movemask_ps(ok);
+    if (mask) {
+        const __m128 inv = _mm_div_ps(_mm_set1_ps(1.0f), absDet);
+        tOut = _mm_mul_ps(T, inv);
+        uOut = _mm_mul_ps(U, inv);
+        vOut = _mm_mul_ps(V, inv);
+        // Division rounding may push t to tmax: re-check on the divided values.
+        mask &= _mm_movemask_ps(_mm_and_ps(_mm_cmplt_ps(tOut, tmax), _mm_cmpgt_ps(tOut, tmin)));
+    }
+    return mask;
+}
+
+// Packet lane k from triangle p0, p1, p2.
+inline void setLane(TriPacket4& p, int k, const vec3& p0, const vec3& p1, const vec3& p2) {
+    vec3 e1 = p1 - p0, e2 = p2 - p0, n = glm::cross(e1, e2);
+    for (int a = 0; a < 3; ++a) { p.v0[a][k] = p0[a]; p.e1[a][k] = e1[a]; p.e2[a][k] = e2[a]; p.n[a][k] = n[a]; }
 }
 }  // namespace
 
@@ -452,7 +473,7 @@ bool TriangleBvh::occluded(const Ray& ray) const {
     float tmax = ray.tmax;
     bool hitAny = false;
     const TriPacket4* packets = m_packets.data();
-    m_bvh.traverse(ray, tmax, [&](uint32_t first, uint32_t, float&) {
+    m_bvh.traverse<true>(ray, tmax, [&](uint32_t first, uint32_t, float&) {
         __m128 t, u, v;
         if (intersectPacket(packets[first], o, d, tmin, tmaxV, t, u, v)) { hitAny = true; return true; }
         return false;
@@ -469,9 +490,7 @@ bool intersectBruteForce(const vec3* pos, const uint32_t* idx, size_t triCount, 
     float tmax = ray.tmax;
     for (size_t t = 0; t < triCount; ++t) {
         TriPacket4 p{};
-        const vec3 &p0 = pos[idx[3 * t]], &p1 = pos[idx[3 * t + 1]], &p2 = pos[idx[3 * t + 2]];
-        vec3 e1 = p1 - p0, e2 = p2 - p0;
-        for (int a = 0; a < 3; ++a) { p.v0[a][0] = p0[a]; p.e1[a][0] = e1[a]; p.e2[a][0] = e2[a]; }
+        setLane(p, 0, pos[idx[3 * t]], pos[idx[3 * t + 1]], pos[idx[3 * t + 2]]);
         __m128 tv, u, v;
         int mask = intersectPacket(p, o, d, _mm_set1_ps(ray.tmin), _mm_set1_ps(tmax), tv, u, v) & 1;
         if (mask) {

@@ -23,7 +23,7 @@ inline RayPre::RayPre(const Ray& r) {
     nearZ = r.dir.z < 0 ? 1 : 0;
 }
 
-template <class LeafFn> void Bvh4::traverse(const Ray& ray, float& tmax, LeafFn&& leaf) const {
+template <bool AnyHit, class LeafFn> void Bvh4::traverse(const Ray& ray, float& tmax, LeafFn&& leaf) const {
     if (m_nodes.empty()) return;
     const RayPre pre(ray);
     const __m128 ox = _mm_set1_ps(pre.org[0]), oy = _mm_set1_ps(pre.org[1]), oz = _mm_set1_ps(pre.org[2]);
@@ -57,6 +57,11 @@ template <class LeafFn> void Bvh4::traverse(const Ray& ray, float& tmax, LeafFn&
                 int c0 = __builtin_ctz(mask);
                 mask &= mask - 1;
                 if (mask == 0) { cur = n.child[c0]; continue; }
+                if constexpr (AnyHit) {   // no ordering needed: push the rest as they come
+                    while (mask) { int c = __builtin_ctz(mask); mask &= mask - 1; stack[sp++] = {n.child[c], d[c]}; }
+                    cur = n.child[c0];
+                    continue;
+                }
                 int c1 = __builtin_ctz(mask);
                 mask &= mask - 1;
                 if (mask == 0) {

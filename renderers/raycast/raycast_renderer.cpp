@@ -124,9 +124,12 @@ struct Tracer {
                                vec3(dm.world * vec4(mesh.positions[i2], 1.0f))};
             p = w0 * P[0] + w1 * P[1] + w2 * P[2];
             if (hitPos) *hitPos = p;
+            // Outward geometric normal: the CCW side, the CW side for mirrored instances
+            // (as GL's glFrontFace(GL_CW) for them).
             vec3 gn = glm::cross(P[1] - P[0], P[2] - P[0]);
             float gl = glm::length(gn);
             gn = gl > 0 ? gn / gl : vec3(0, 1, 0);
+            if (dm.mirrored) gn = -gn;
             const bool back = glm::dot(gn, r.dir) > 0;   // seen from its back: flip (two-sided)
             ng = back ? -gn : gn;
             const bool hasN = mesh.normals.size() == mesh.positions.size();
@@ -150,10 +153,13 @@ struct Tracer {
                 if (back) Nv[k] = -Nv[k];
             }
             const ShadingModel model = f.settings.shading;
+            vec3 albedo = (w0 * albedoV[0] + w1 * albedoV[1] + w2 * albedoV[2]) * texColor;
             if (model == ShadingModel::Gouraud && !mat->unlit) {
                 // Lighting at the three vertices, interpolated with the hit's barycentrics
-                // (perspective-correct by construction); per-light terms are kept apart so a
-                // shadow ray at the hit can switch each light off.
+                // (perspective-correct by construction). As in the rasterizer, each vertex
+                // term is split into a part proportional to the albedo (A) and the rest (B),
+                // colour = A (x) albedo + B, so texture and vertex colours apply per hit; the
+                // per-light terms are kept apart so a shadow ray can switch a light off.
                 lightVisibility(p, ng, vis);
                 vec3 v[3];
                 for (int k = 0; k < 3; ++k) {
@@ -162,18 +168,21 @@ struct Tracer {
                     v[k] = l > 0 ? e / l : vec3(0, 0, 1);
                 }
                 const float wk[3] = {w0, w1, w2};
-                color = vec3(0.0f);
-                for (int k = 0; k < 3; ++k) color += wk[k] * (mat->ka * albedoV[k] * f.ambientLight + mat->emissive);
+                vec3 A = mat->ka * f.ambientLight, B = mat->emissive;
                 for (size_t li = 0; li < f.lights.size(); ++li) {
                     if (vis[li] <= 0.0f) continue;
-                    vec3 c(0.0f);
+                    vec3 a(0.0f), b(0.0f);
                     for (int k = 0; k < 3; ++k) {
-                        SurfacePoint sp{P[k], Nv[k], albedoV[k]};
-                        c += wk[k] * shadeLight(*mat, sp, v[k], sampleLight(f.lights[li], P[k]), f.settings.reflection);
+                        LightSample ls = sampleLight(f.lights[li], P[k]);
+                        vec3 b0 = shadeLight(*mat, SurfacePoint{P[k], Nv[k], vec3(0.0f)}, v[k], ls, f.settings.reflection);
+                        vec3 a1 = shadeLight(*mat, SurfacePoint{P[k], Nv[k], vec3(1.0f)}, v[k], ls, f.settings.reflection);
+                        a += wk[k] * (a1 - b0);
+                        b += wk[k] * b0;
                     }
-                    color += vis[li] * c;
+                    A += vis[li] * a;
+                    B += vis[li] * b;
                 }
-                color *= texColor;
+                color = A * albedo + B;
                 n = w0 * Nv[0] + w1 * Nv[1] + w2 * Nv[2];
                 n = glm::length(n) > 0 ? glm::normalize(n) : ng;
             } else {
@@ -183,7 +192,6 @@ struct Tracer {
                     float l = glm::length(n);
                     n = l > 1e-20f ? n / l : ng;
                 }
-                vec3 albedo = (w0 * albedoV[0] + w1 * albedoV[1] + w2 * albedoV[2]) * texColor;
                 if (!mat->unlit) lightVisibility(p, ng, vis);
                 color = shade(*mat, SurfacePoint{p, n, albedo}, eye, f, mat->unlit ? nullptr : vis);
             }

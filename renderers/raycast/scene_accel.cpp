@@ -187,7 +187,7 @@ bool SceneAccel::occluded(const Ray& r) const {
     float tmax = r.tmax;
     bool any = false;
     const std::vector<uint32_t>& prims = m_tlas.primIndex();
-    m_tlas.traverse(r, tmax, [&](uint32_t first, uint32_t count, float&) {
+    m_tlas.traverse<true>(r, tmax, [&](uint32_t first, uint32_t count, float&) {
         for (uint32_t k = 0; k < count; ++k) {
             const Instance& inst = m_instances[prims[first + k]];
             if (inst.isMesh) {
