@@ -14,10 +14,10 @@
 #include <tbb/parallel_reduce.h>
 #include <tbb/blocked_range.h>
 
-#include <xmmintrin.h>
-#include <emmintrin.h>
+#include <immintrin.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <atomic>
 #include <cstring>
 #include <memory>
@@ -167,19 +167,20 @@ bool splitRange(PrimRef* refs, const Range& r, Range& l, Range& rr, int nbins, i
 
 // --- node building ----------------------------------------------------------------------------
 
-struct Builder {
+template <int W> struct Builder {
+    using Node = NodeW<W>;
     PrimRef* refs;
-    Node4* nodes;
+    Node* nodes;
     std::atomic<uint32_t> nodeCount{0};
     int nbins, leafSize;
     bool parallel;
 
-    static void setEmpty(Node4& n, int i) {
+    static void setEmpty(Node& n, int i) {
         n.b[0][i] = n.b[2][i] = n.b[4][i] = std::numeric_limits<float>::infinity();
         n.b[1][i] = n.b[3][i] = n.b[5][i] = -std::numeric_limits<float>::infinity();
         n.child[i] = Node4::kEmpty;
     }
-    static void setBounds(Node4& n, int i, const Box& b) {
+    static void setBounds(Node& n, int i, const Box& b) {
         alignas(16) float lo[4], hi[4];
         _mm_store_ps(lo, b.lo);
         _mm_store_ps(hi, b.hi);
@@ -191,11 +192,11 @@ struct Builder {
 
     // Builds the subtree for r into node slot `index` (already allocated).
     void buildInner(uint32_t index, const Range& r, int depth) {
-        Range kids[4];
+        Range kids[W];
         int nk = 1;
         kids[0] = r;
         bool forceMedian = depth > 40;   // keeps the depth (and traversal stack) bounded
-        while (nk < 4) {
+        while (nk < W) {
             int best = -1;
             float bestArea = -1;
             for (int i = 0; i < nk; ++i)
@@ -209,9 +210,9 @@ struct Builder {
             kids[best] = a;
             kids[nk++] = b;
         }
-        Node4& node = nodes[index];
-        uint32_t childIndex[4];
-        for (int i = 0; i < 4; ++i) {
+        Node& node = nodes[index];
+        uint32_t childIndex[W];
+        for (int i = 0; i < W; ++i) {
             if (i >= nk) { setEmpty(node, i); continue; }
             setBounds(node, i, kids[i].bounds);
             if (kids[i].count() <= uint32_t(leafSize)) {
@@ -241,7 +242,7 @@ struct Builder {
     }
 };
 
-int subtreeDepth(const std::vector<Node4>& nodes, uint32_t ref) {
+template <int W> int subtreeDepth(const std::vector<NodeW<W>>& nodes, uint32_t ref) {
     if (ref & Node4::kLeafBit) return 0;
     int d = 0;
     for (uint32_t c : nodes[ref].child)
@@ -255,7 +256,8 @@ int subtreeDepth(const std::vector<Node4>& nodes, uint32_t ref) {
 
 namespace detail {
 // Builds from prepared refs (shared by Bvh4::build and TriangleBvh::build).
-void buildFromRefs(std::vector<PrimRef>& refs, const Bvh4::BuildOptions& opt, std::vector<Node4>& outNodes,
+template <int W>
+void buildFromRefs(std::vector<PrimRef>& refs, const Bvh4::BuildOptions& opt, std::vector<NodeW<W>>& outNodes,
                    std::vector<uint32_t>& outPrims, sg::Aabb& outBounds) {
     outNodes.clear();
     outPrims.clear();
@@ -288,14 +290,14 @@ void buildFromRefs(std::vector<PrimRef>& refs, const Bvh4::BuildOptions& opt, st
     }
 
     // Inner nodes <= primitives (every inner node has >= 2 children); +1 for a wrapped leaf.
-    std::unique_ptr<Node4[]> storage(new Node4[n + 1]);
-    Builder b{refs.data(), storage.get(), {}, nbins, leafSize, opt.parallel};
+    std::unique_ptr<NodeW<W>[]> storage(new NodeW<W>[n + 1]);
+    Builder<W> b{refs.data(), storage.get(), {}, nbins, leafSize, opt.parallel};
     b.nodeCount = 1;
     if (root.count() <= uint32_t(leafSize)) {
-        Node4& r = storage[0];
-        for (int i = 0; i < 4; ++i) Builder::setEmpty(r, i);
-        Builder::setBounds(r, 0, root.bounds);
-        r.child[0] = Builder::leafRef(root);
+        NodeW<W>& r = storage[0];
+        for (int i = 0; i < W; ++i) Builder<W>::setEmpty(r, i);
+        Builder<W>::setBounds(r, 0, root.bounds);
+        r.child[0] = Builder<W>::leafRef(root);
     } else {
         b.buildInner(0, root, 0);
     }
@@ -318,20 +320,48 @@ void Bvh4::build(const vec3* boxMin, const vec3* boxMax, size_t n, const BuildOp
         if (!(mn.x <= mx.x && mn.y <= mx.y && mn.z <= mx.z) || !sg::isFinite(mn) || !sg::isFinite(mx)) continue;
         refs.push_back(makeRef(mn, mx, uint32_t(i)));
     }
-    detail::buildFromRefs(refs, opt, m_nodes, m_primIndex, m_bounds);
+    detail::buildFromRefs<4>(refs, opt, m_nodes, m_primIndex, m_bounds);
 }
 
-int Bvh4::depth() const { return m_nodes.empty() ? 0 : subtreeDepth(m_nodes, 0); }
+int Bvh4::depth() const { return m_nodes.empty() ? 0 : subtreeDepth<4>(m_nodes, 0); }
 
 namespace {
-inline void setLane(TriPacket4& p, int k, const vec3& p0, const vec3& p1, const vec3& p2);
+// Packet lane k from triangle p0, p1, p2.
+// noinline: the AVX2 brute force must build lanes bit-identically to the (SSE-compiled) build.
+__attribute__((noinline)) void setLane(TriPacket4& p, int k, const vec3& p0, const vec3& p1, const vec3& p2) {
+    vec3 e1 = p1 - p0, e2 = p2 - p0, n = glm::cross(e1, e2);
+    for (int a = 0; a < 3; ++a) { p.v0[a][k] = p0[a]; p.e1[a][k] = e1[a]; p.e2[a][k] = e2[a]; p.n[a][k] = n[a]; }
 }
+}  // namespace
+
+namespace {
+// One packet per leaf, in node order; leaf refs are rewritten to packet indices.
+template <int W>
+void makePackets(std::vector<NodeW<W>>& nodes, const std::vector<uint32_t>& prims, const vec3* pos, const uint32_t* idx,
+                 std::vector<TriPacket4>& packets) {
+    packets.reserve(prims.size() / 2 + 1);
+    for (NodeW<W>& n : nodes)
+        for (uint32_t& c : n.child) {
+            if (c == NodeBits::kEmpty || !(c & NodeBits::kLeafBit)) continue;
+            uint32_t first = (c & ~NodeBits::kLeafBit) >> 3, count = c & 7u;
+            TriPacket4 p{};
+            for (uint32_t k = 0; k < 4; ++k) {
+                if (k >= count) { p.prim[k] = ~0u; continue; }
+                uint32_t t = prims[first + k];
+                setLane(p, int(k), pos[idx[3 * t]], pos[idx[3 * t + 1]], pos[idx[3 * t + 2]]);
+                p.prim[k] = t;
+            }
+            c = NodeBits::kLeafBit | (uint32_t(packets.size()) << 3) | count;
+            packets.push_back(p);
+        }
+}
+int kernelWidth();
+}  // namespace
 
 // --- TriangleBvh ------------------------------------------------------------------------------
 
 void TriangleBvh::build(const vec3* pos, const uint32_t* idx, size_t triCount, const Bvh4::BuildOptions& opt) {
     std::vector<PrimRef> refs(triCount);
-    std::atomic<size_t> valid{0};
     std::vector<uint8_t> ok(triCount);
     auto makeRange = [&](size_t b, size_t e) {
         for (size_t t = b; t < e; ++t) {
@@ -351,162 +381,68 @@ void TriangleBvh::build(const vec3* pos, const uint32_t* idx, size_t triCount, c
     for (size_t t = 0; t < triCount; ++t)
         if (ok[t]) refs[w++] = refs[t];
     refs.resize(w);
-    (void)valid;
 
     std::vector<uint32_t> prims;
-    detail::buildFromRefs(refs, opt, m_bvh.m_nodes, m_bvh.m_primIndex, m_bvh.m_bounds);
-    // One packet per leaf; rewrite leaf refs to packet indices.
+    m_nodes4.clear();
+    m_nodes8.clear();
     m_packets.clear();
-    m_packets.reserve(w / 2 + 1);
-    for (Node4& n : m_bvh.m_nodes)
-        for (uint32_t& c : n.child) {
-            if (c == Node4::kEmpty || !(c & Node4::kLeafBit)) continue;
-            uint32_t first = (c & ~Node4::kLeafBit) >> 3, count = c & 7u;
-            TriPacket4 p{};
-            for (uint32_t k = 0; k < 4; ++k) {
-                if (k >= count) { p.prim[k] = ~0u; continue; }
-                uint32_t t = m_bvh.m_primIndex[first + k];
-                setLane(p, int(k), pos[idx[3 * t]], pos[idx[3 * t + 1]], pos[idx[3 * t + 2]]);
-                p.prim[k] = t;
-            }
-            c = Node4::kLeafBit | (uint32_t(m_packets.size()) << 3) | count;
-            m_packets.push_back(p);
-        }
+    if (kernelWidth() == 8) {
+        detail::buildFromRefs<8>(refs, opt, m_nodes8, prims, m_bounds);
+        makePackets(m_nodes8, prims, pos, idx, m_packets);
+    } else {
+        detail::buildFromRefs<4>(refs, opt, m_nodes4, prims, m_bounds);
+        makePackets(m_nodes4, prims, pos, idx, m_packets);
+    }
 }
+
+// --- kernels: SSE and AVX2+FMA builds of tri_kernel.inl, chosen once at run time ------------
+
+namespace kern_sse {
+#define RT_FMA 0
+#include "raycast/tri_kernel.inl"
+#undef RT_FMA
+}  // namespace kern_sse
+
+#pragma GCC push_options
+#pragma GCC target("avx2,fma")
+namespace kern_avx2 {
+#define RT_FMA 1
+#include "raycast/tri_kernel.inl"
+#undef RT_FMA
+}  // namespace kern_avx2
+#pragma GCC pop_options
 
 namespace {
-// Moller-Trumbore on 4 triangles at once (seeds 2.4), rewritten with the precomputed normal
-// N = e1 x e2 and s = o - p0, R = s x d (scalar triple products):
-//   det = -d.N,  b1 = e2.R / det,  b2 = -e1.R / det,  t = s.N / det.
-// Division-free: the comparisons use the sign-adjusted numerators against |det|; only lanes
-// that hit are divided. Returns the lane mask of hits in (tmin, tmax) and their t, b1, b2.
-inline int intersectPacket(const TriPacket4& p, const __m128 o[3], const __m128 d[3], __m128 tmin, __m128 tmax,
-                           __m128& tOut, __m128& uOut, __m128& vOut) {
-    const __m128 nx = _mm_load_ps(p.n[0]), ny = _mm_load_ps(p.n[1]), nz = _mm_load_ps(p.n[2]);
-    const __m128 sx = _mm_sub_ps(o[0], _mm_load_ps(p.v0[0]));
-    const __m128 sy = _mm_sub_ps(o[1], _mm_load_ps(p.v0[1]));
-    const __m128 sz = _mm_sub_ps(o[2], _mm_load_ps(p.v0[2]));
-    // det = -d.N
-    __m128 det = _mm_add_ps(_mm_add_ps(_mm_mul_ps(d[0], nx), _mm_mul_ps(d[1], ny)), _mm_mul_ps(d[2], nz));
-    det = _mm_xor_ps(det, _mm_set1_ps(-0.0f));
-    const __m128 sign = _mm_and_ps(det, _mm_set1_ps(-0.0f));
-    const __m128 absDet = _mm_xor_ps(det, sign);
-    // R = s x d
-    const __m128 rx = _mm_sub_ps(_mm_mul_ps(sy, d[2]), _mm_mul_ps(sz, d[1]));
-    const __m128 ry = _mm_sub_ps(_mm_mul_ps(sz, d[0]), _mm_mul_ps(sx, d[2]));
-    const __m128 rz = _mm_sub_ps(_mm_mul_ps(sx, d[1]), _mm_mul_ps(sy, d[0]));
-    __m128 U = _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_load_ps(p.e2[0]), rx), _mm_mul_ps(_mm_load_ps(p.e2[1]), ry)),
-                          _mm_mul_ps(_mm_load_ps(p.e2[2]), rz));
-    __m128 V = _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_load_ps(p.e1[0]), rx), _mm_mul_ps(_mm_load_ps(p.e1[1]), ry)),
-                          _mm_mul_ps(_mm_load_ps(p.e1[2]), rz));
-    V = _mm_xor_ps(V, _mm_set1_ps(-0.0f));
-    __m128 T = _mm_add_ps(_mm_add_ps(_mm_mul_ps(sx, nx), _mm_mul_ps(sy, ny)), _mm_mul_ps(sz, nz));
-    U = _mm_xor_ps(U, sign);
-    V = _mm_xor_ps(V, sign);
-    T = _mm_xor_ps(T, sign);
-    const __m128 zero = _mm_setzero_ps();
-    __m128 ok = _mm_cmpneq_ps(det, zero);
-    ok = _mm_and_ps(ok, _mm_cmpge_ps(U, zero));
-    ok = _mm_and_ps(ok, _mm_cmpge_ps(V, zero));
-    ok = _mm_and_ps(ok, _mm_cmple_ps(_mm_add_ps(U, V), absDet));
-    ok = _mm_and_ps(ok, _mm_cmpgt_ps(T, _mm_mul_ps(absDet, tmin)));
-    ok = _mm_and_ps(ok, _mm_cmplt_ps(T, _mm_mul_ps(absDet, tmax)));
-    int mask = _mm_movemask_ps(ok);
-    if (mask) {
-        const __m128 inv = _mm_div_ps(_mm_set1_ps(1.0f), absDet);
-        tOut = _mm_mul_ps(T, inv);
-        uOut = _mm_mul_ps(U, inv);
-        vOut = _mm_mul_ps(V, inv);
-        // Division rounding may push t to tmax: re-check on the divided values.
-        mask &= _mm_movemask_ps(_mm_and_ps(_mm_cmplt_ps(tOut, tmax), _mm_cmpgt_ps(tOut, tmin)));
-    }
-    return mask;
-}
+const bool kUseAvx2 = [] {
+    if (const char* e = std::getenv("VIEWER_RAYCAST_SSE")) return !(e[0] == '1');   // force the SSE path
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+}();
+}  // namespace
 
-// Packet lane k from triangle p0, p1, p2.
-inline void setLane(TriPacket4& p, int k, const vec3& p0, const vec3& p1, const vec3& p2) {
-    vec3 e1 = p1 - p0, e2 = p2 - p0, n = glm::cross(e1, e2);
-    for (int a = 0; a < 3; ++a) { p.v0[a][k] = p0[a]; p.e1[a][k] = e1[a]; p.e2[a][k] = e2[a]; p.n[a][k] = n[a]; }
-}
+const char* kernelName() { return kUseAvx2 ? "avx2+fma bvh8" : "sse bvh4"; }
+namespace {
+int kernelWidth() { return kUseAvx2 ? 8 : 4; }
 }  // namespace
 
 bool TriangleBvh::intersect(const Ray& ray, TriHit& hit) const {
-    if (m_bvh.empty()) return false;
-    const __m128 o[3] = {_mm_set1_ps(ray.org.x), _mm_set1_ps(ray.org.y), _mm_set1_ps(ray.org.z)};
-    const __m128 d[3] = {_mm_set1_ps(ray.dir.x), _mm_set1_ps(ray.dir.y), _mm_set1_ps(ray.dir.z)};
-    const __m128 tmin = _mm_set1_ps(ray.tmin);
-    float tmax = ray.tmax;
-    bool found = false;
-    const TriPacket4* packets = m_packets.data();
-    m_bvh.traverse(ray, tmax, [&](uint32_t first, uint32_t, float& tm) {
-        const TriPacket4& p = packets[first];
-        __m128 t, u, v;
-        int mask = intersectPacket(p, o, d, tmin, _mm_set1_ps(tm), t, u, v);
-        if (mask) {
-            alignas(16) float ta[4], ua[4], va[4];
-            _mm_store_ps(ta, t);
-            _mm_store_ps(ua, u);
-            _mm_store_ps(va, v);
-            while (mask) {
-                int k = __builtin_ctz(mask);
-                mask &= mask - 1;
-                if (ta[k] < tm) {
-                    tm = ta[k];
-                    hit.t = ta[k];
-                    hit.prim = p.prim[k];
-                    hit.b1 = ua[k];
-                    hit.b2 = va[k];
-                    found = true;
-                }
-            }
-        }
-        return false;
-    });
-    return found;
+    if (m_packets.empty()) return false;
+    if (!m_nodes8.empty()) return kern_avx2::traceTriangles8<false>(m_nodes8.data(), m_packets.data(), ray, &hit);
+    return kUseAvx2 ? kern_avx2::traceTriangles<false>(m_nodes4.data(), m_packets.data(), ray, &hit)
+                    : kern_sse::traceTriangles<false>(m_nodes4.data(), m_packets.data(), ray, &hit);
 }
 
 bool TriangleBvh::occluded(const Ray& ray) const {
-    if (m_bvh.empty()) return false;
-    const __m128 o[3] = {_mm_set1_ps(ray.org.x), _mm_set1_ps(ray.org.y), _mm_set1_ps(ray.org.z)};
-    const __m128 d[3] = {_mm_set1_ps(ray.dir.x), _mm_set1_ps(ray.dir.y), _mm_set1_ps(ray.dir.z)};
-    const __m128 tmin = _mm_set1_ps(ray.tmin), tmaxV = _mm_set1_ps(ray.tmax);
-    float tmax = ray.tmax;
-    bool hitAny = false;
-    const TriPacket4* packets = m_packets.data();
-    m_bvh.traverse<true>(ray, tmax, [&](uint32_t first, uint32_t, float&) {
-        __m128 t, u, v;
-        if (intersectPacket(packets[first], o, d, tmin, tmaxV, t, u, v)) { hitAny = true; return true; }
-        return false;
-    });
-    return hitAny;
+    if (m_packets.empty()) return false;
+    if (!m_nodes8.empty()) return kern_avx2::traceTriangles8<true>(m_nodes8.data(), m_packets.data(), ray, nullptr);
+    return kUseAvx2 ? kern_avx2::traceTriangles<true>(m_nodes4.data(), m_packets.data(), ray, nullptr)
+                    : kern_sse::traceTriangles<true>(m_nodes4.data(), m_packets.data(), ray, nullptr);
 }
 
 // --- brute force ------------------------------------------------------------------------------
 
 bool intersectBruteForce(const vec3* pos, const uint32_t* idx, size_t triCount, const Ray& ray, TriHit& hit) {
-    const __m128 o[3] = {_mm_set1_ps(ray.org.x), _mm_set1_ps(ray.org.y), _mm_set1_ps(ray.org.z)};
-    const __m128 d[3] = {_mm_set1_ps(ray.dir.x), _mm_set1_ps(ray.dir.y), _mm_set1_ps(ray.dir.z)};
-    bool found = false;
-    float tmax = ray.tmax;
-    for (size_t t = 0; t < triCount; ++t) {
-        TriPacket4 p{};
-        setLane(p, 0, pos[idx[3 * t]], pos[idx[3 * t + 1]], pos[idx[3 * t + 2]]);
-        __m128 tv, u, v;
-        int mask = intersectPacket(p, o, d, _mm_set1_ps(ray.tmin), _mm_set1_ps(tmax), tv, u, v) & 1;
-        if (mask) {
-            alignas(16) float ta[4], ua[4], va[4];
-            _mm_store_ps(ta, tv);
-            _mm_store_ps(ua, u);
-            _mm_store_ps(va, v);
-            tmax = ta[0];
-            hit.t = ta[0];
-            hit.prim = uint32_t(t);
-            hit.b1 = ua[0];
-            hit.b2 = va[0];
-            found = true;
-        }
-    }
-    return found;
+    return kUseAvx2 ? kern_avx2::bruteForce(pos, idx, triCount, ray, hit) : kern_sse::bruteForce(pos, idx, triCount, ray, hit);
 }
 
 }  // namespace rnd::rt

@@ -43,15 +43,19 @@ struct RayPre {
     explicit RayPre(const Ray& r);
 };
 
-// 4-wide node: bounds of up to 4 children stored SoA (b[0]=minx, b[1]=maxx, b[2]=miny, ...).
-struct alignas(64) Node4 {
-    float b[6][4];
-    // >= 0: inner node index. Leaf: kLeafBit | (first << 3) | count, count in 1..4;
-    // kEmpty: unused slot (its bounds are empty so it is never entered).
-    uint32_t child[4];
+// W-wide node (W = 4 or 8): bounds of up to W children stored SoA (b[0]=minx, b[1]=maxx,
+// b[2]=miny, ...). child[i] >= 0: inner node index. Leaf: kLeafBit | (first << 3) | count,
+// count in 1..4; kEmpty: unused slot (its bounds are empty so it is never entered).
+struct NodeBits {
     static constexpr uint32_t kLeafBit = 0x80000000u;
     static constexpr uint32_t kEmpty = 0xffffffffu;
 };
+template <int W> struct alignas(64) NodeW : NodeBits {
+    float b[6][W];
+    uint32_t child[W];
+};
+using Node4 = NodeW<4>;
+using Node8 = NodeW<8>;
 
 // Generic BVH4 over axis-aligned boxes. After build(), primIndex lists the primitives in leaf
 // order; a leaf covers primIndex[first .. first+count).
@@ -80,7 +84,6 @@ public:
     template <bool AnyHit = false, class LeafFn> void traverse(const Ray& ray, float& tmax, LeafFn&& leaf) const;
 
 private:
-    friend class TriangleBvh;
     std::vector<Node4> m_nodes;   // m_nodes[0] is the root (a leaf root is wrapped in a node)
     std::vector<uint32_t> m_primIndex;
     sg::Aabb m_bounds;
@@ -93,7 +96,8 @@ struct alignas(16) TriPacket4 {
     uint32_t prim[4];   // ~0u = padding
 };
 
-// Triangle BVH: Bvh4 whose leaves are single TriPacket4s (leaf "first" = packet index).
+// Triangle BVH whose leaves are single TriPacket4s (leaf "first" = packet index). With the
+// AVX2+FMA kernel it is 8-wide (BVH8, one AVX box test per node), else 4-wide (BVH4, SSE).
 class TriangleBvh {
 public:
     void build(const sg::vec3* positions, const uint32_t* indices, size_t triangleCount,
@@ -106,15 +110,23 @@ public:
     // Any hit in (ray.tmin, ray.tmax).
     bool occluded(const Ray& ray) const;
 
-    bool empty() const { return m_bvh.empty(); }
-    const sg::Aabb& bounds() const { return m_bvh.bounds(); }
-    size_t memoryBytes() const { return m_bvh.memoryBytes() + m_packets.size() * sizeof(TriPacket4); }
-    const Bvh4& bvh() const { return m_bvh; }
+    bool empty() const { return m_packets.empty(); }
+    const sg::Aabb& bounds() const { return m_bounds; }
+    size_t memoryBytes() const {
+        return m_nodes4.size() * sizeof(Node4) + m_nodes8.size() * sizeof(Node8) + m_packets.size() * sizeof(TriPacket4);
+    }
+    int width() const { return m_nodes8.empty() ? 4 : 8; }
 
 private:
-    Bvh4 m_bvh;
+    std::vector<Node4> m_nodes4;
+    std::vector<Node8> m_nodes8;
     std::vector<TriPacket4> m_packets;
+    sg::Aabb m_bounds;
 };
+
+// Which triangle kernel runs: "avx2+fma" (picked at run time when the CPU has it) or "sse"
+// (forced with VIEWER_RAYCAST_SSE=1).
+const char* kernelName();
 
 // Brute-force reference (tests): closest hit over all triangles with the same test.
 bool intersectBruteForce(const sg::vec3* positions, const uint32_t* indices, size_t triangleCount, const Ray& ray,
