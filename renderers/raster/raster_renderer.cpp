@@ -1,19 +1,731 @@
-// Placeholder until the raster backend lands: reports a clear error instead of an image.
+// raster_renderer.cpp - the "raster" backend: our own CPU implementation of the pipeline of
+// the seeds (modelling, lighting, viewing, projection, clipping, scan conversion).
+//
+// Pipeline of one frame (tbb-parallel stages):
+//   1. gather     meshes + tessellated analytics -> DrawItems; textures -> SampledTextures
+//   2. vertices   object -> world -> eye -> clip (DrawMesh::world, normal, camera view/proj),
+//                 outcodes, window coordinates; Gouraud: front + back vertex colours
+//   3. triangles  chunks of triangles in submission order: clip in homogeneous space (near and
+//                 far exactly, x/y outside a guard band), perspective divide, viewport, fixed-
+//                 point setup, culling, binning into 64x64 tiles
+//   4. tiles      per tile, in parallel: rasterize the tile's triangles in order into a
+//                 visibility buffer (depth LESS + triangle id per pixel or per MSAA sample),
+//                 then shade each visible fragment once (deferred): perspective-correct
+//                 barycentrics -> attributes -> rnd::shade / applyFog -> sRGB bytes
+//   5. lines      Lines/Points meshes and the wireframe overlay with the DDA line rasterizer
+// SSAA renders at aaRate x the size and box-filters down; MSAA 4x keeps 4 samples per pixel
+// (coverage + depth per sample) and shades once per pixel and triangle at the pixel centre.
+//
+// Sections: [helpers] [draw items] [vertex stage] [triangle stage] [tile stage] [lines]
+//           [renderer]
 #include "raster/raster_renderer.h"
+
+#include "raster/raster_core.h"
+#include "raster/raster_texture.h"
+#include "renderers/shading.h"
+#include "renderers/tessellate.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <mutex>
+#include <unordered_map>
 
 namespace rnd {
 namespace {
+
+using namespace raster;
+using sg::mat3;
+using sg::mat4;
+using sg::vec2;
+using sg::vec3;
+using sg::vec4;
+
+// ---------------------------------------------------------------------------------------
+// [helpers]
+// ---------------------------------------------------------------------------------------
+
+// toByteSRGB without pow: the byte is the number of thresholds decode((b - 0.5)/255) that the
+// linear value reaches (b = 1..255), found by binary search.
+struct SrgbEncoder {
+    float thresholds[255];
+    SrgbEncoder() {
+        for (int b = 1; b < 256; ++b) thresholds[b - 1] = decodeSRGB((b - 0.5f) / 255.0f);
+    }
+    uint8_t operator()(float linear) const {
+        if (!(linear > thresholds[0])) return linear >= thresholds[0] ? 1 : 0;
+        return uint8_t(std::upper_bound(thresholds, thresholds + 255, linear) - thresholds);
+    }
+};
+const SrgbEncoder& srgbEncoder() {
+    static const SrgbEncoder e;
+    return e;
+}
+
+constexpr uint32_t kNoTri = 0xFFFFFFFFu;
+constexpr int kChunkBits = 20;   // triangle id = chunk << 20 | index in chunk
+
+// ---------------------------------------------------------------------------------------
+// [draw items]
+// ---------------------------------------------------------------------------------------
+
+struct DrawItem {
+    std::shared_ptr<const sg::Mesh> mesh;
+    mat4 world{1.0f};
+    mat3 normal{1.0f};
+    sg::Material material;
+    std::shared_ptr<const std::vector<uint16_t>> triMat;       // per-triangle material (CSG)
+    std::shared_ptr<const std::vector<sg::Material>> materials;
+    const SampledTexture* texture = nullptr;
+    bool mirrored = false;
+    bool perCorner = false;     // Gouraud with per-triangle materials: one vertex per corner
+    bool hasNormals = false;
+    bool hasUV = false;
+    bool hasColors = false;
+    uint64_t firstTri = 0;      // global index of its first triangle
+    uint32_t triCount = 0;
+
+    // Vertex stage outputs (one per vertex, or per corner when perCorner).
+    std::vector<vec4> clip;
+    std::vector<uint8_t> code;
+    std::vector<vec4> win;      // window x, y, z, 1/w (valid when code == 0)
+    std::vector<vec3> wpos, wnrm;
+    std::vector<vec3> gouraudA[2], gouraudB[2];   // front/back: colour = A * albedo + B
+
+    const sg::Material& materialOf(uint32_t tri) const {
+        if (triMat && materials && tri < triMat->size() && (*triMat)[tri] < materials->size()) return (*materials)[(*triMat)[tri]];
+        return material;
+    }
+    uint32_t meshIndex(uint32_t v) const { return perCorner ? mesh->indices[v] : v; }
+    uint32_t vertexOf(uint32_t tri, int k) const { return perCorner ? tri * 3 + k : mesh->indices[size_t(tri) * 3 + k]; }
+};
+
+// Gouraud at one vertex: split shade() into the part proportional to the albedo (A) and the
+// rest (B: emissive, untinted specular) so the fragment can apply texture and vertex colour:
+// colour = A (x) albedo + B, which equals shade() exactly where the albedo is constant.
+void gouraudTerms(const sg::Material& m, const vec3& p, const vec3& n, const sg::FrameInput& f, vec3& a, vec3& b) {
+    SurfacePoint s{p, n, vec3(0.0f)};
+    b = shade(m, s, f.camera.eye, f);
+    s.albedo = vec3(1.0f);
+    a = shade(m, s, f.camera.eye, f) - b;
+}
+
+// ---------------------------------------------------------------------------------------
+// [vertex stage]
+// ---------------------------------------------------------------------------------------
+
+void runVertexStage(DrawItem& d, const sg::FrameInput& f, int width, int height, bool gouraud) {
+    const sg::Mesh& m = *d.mesh;
+    size_t n = d.perCorner ? m.indices.size() : m.positions.size();
+    d.clip.resize(n);
+    d.code.resize(n);
+    d.win.resize(n);
+    d.wpos.resize(n);
+    d.wnrm.assign(n, vec3(0.0f));
+    if (gouraud)
+        for (int s = 0; s < 2; ++s) { d.gouraudA[s].resize(n); d.gouraudB[s].resize(n); }
+    const mat4 viewProj = f.camera.proj * f.camera.view;
+    const GuardBand g = guardBand(width, height);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t v = r.begin(); v != r.end(); ++v) {
+            uint32_t mi = d.meshIndex(uint32_t(v));
+            if (mi >= m.positions.size()) { d.code[v] = kClipNear; continue; }
+            vec4 w = d.world * vec4(m.positions[mi], 1.0f);     // modelling: object -> world
+            vec4 c = viewProj * w;                              // viewing + projection -> clip
+            d.wpos[v] = vec3(w);
+            d.clip[v] = c;
+            d.code[v] = outcode(c, g);
+            if (d.code[v] == 0) d.win[v] = toWindow(c, width, height);
+            if (d.hasNormals) {
+                vec3 nn = d.normal * m.normals[mi];             // normal matrix (inverse transpose)
+                float len = glm::length(nn);
+                d.wnrm[v] = len > 0 ? nn / len : vec3(0, 0, 1);
+            }
+            if (gouraud) {
+                const sg::Material& mat = d.perCorner ? d.materialOf(uint32_t(v / 3)) : d.material;
+                gouraudTerms(mat, d.wpos[v], d.wnrm[v], f, d.gouraudA[0][v], d.gouraudB[0][v]);
+                gouraudTerms(mat, d.wpos[v], -d.wnrm[v], f, d.gouraudA[1][v], d.gouraudB[1][v]);
+            }
+        }
+    });
+}
+
+// ---------------------------------------------------------------------------------------
+// [triangle stage]
+// ---------------------------------------------------------------------------------------
+
+// One scan-converted triangle (a whole input triangle or a piece of a clipped one).
+struct Tri {
+    TriSetup s;
+    float z[3], invW[3];     // per setup vertex
+    float zRef, zdx, zdy;    // window z at pixel centre (minX, minY) and per-pixel steps
+    uint32_t draw = 0, prim = 0;
+    int32_t clip = -1;       // index into Chunk::clipBary (bary of setup vertices), -1 = none
+    bool front = true;
+};
+
+struct Chunk {
+    uint64_t begin = 0, end = 0;                 // global triangle range
+    std::vector<Tri> tris;
+    std::vector<std::array<vec3, 3>> clipBary;
+    std::vector<uint32_t> tileStart, items;      // CSR: tiles -> triangle indices in order
+};
+
+struct FrameContext {
+    const sg::FrameInput* frame = nullptr;
+    int width = 0, height = 0;
+    int tilesX = 0, tilesY = 0;
+    bool msaa = false;
+    std::vector<DrawItem>* draws = nullptr;
+    std::vector<Chunk>* chunks = nullptr;
+};
+
+bool finishTri(Tri& t, const float z[3], const float iw[3]) {
+    for (int k = 0; k < 3; ++k) {
+        t.z[k] = z[t.s.order[k]];
+        t.invW[k] = iw[t.s.order[k]];
+    }
+    // z = (e1 z0 + e2 z1 + e0 z2) / area2, e_i linear in the fixed-point sample position.
+    double inv = 1.0 / double(t.s.area2);
+    double ax = (double(t.s.e[1].a) * t.z[0] + double(t.s.e[2].a) * t.z[1] + double(t.s.e[0].a) * t.z[2]) * inv;
+    double ay = (double(t.s.e[1].b) * t.z[0] + double(t.s.e[2].b) * t.z[1] + double(t.s.e[0].b) * t.z[2]) * inv;
+    int64_t px = int64_t(t.s.minX) * kSub + kHalf, py = int64_t(t.s.minY) * kSub + kHalf;
+    double zr = (double(t.s.e[1].at(px, py)) * t.z[0] + double(t.s.e[2].at(px, py)) * t.z[1] + double(t.s.e[0].at(px, py)) * t.z[2]) * inv;
+    t.zRef = float(zr);
+    t.zdx = float(ax * kSub);
+    t.zdy = float(ay * kSub);
+    return true;
+}
+
+void runTriangleStage(Chunk& ch, const FrameContext& fc) {
+    const std::vector<DrawItem>& draws = *fc.draws;
+    const auto& st = fc.frame->settings;
+    const GuardBand g = guardBand(fc.width, fc.height);
+    // First draw containing ch.begin.
+    size_t di = size_t(std::upper_bound(draws.begin(), draws.end(), ch.begin,
+                                        [](uint64_t v, const DrawItem& d) { return v < d.firstTri; }) - draws.begin()) - 1;
+    for (uint64_t gi = ch.begin; gi < ch.end; ++gi) {
+        while (gi >= draws[di].firstTri + draws[di].triCount) ++di;
+        const DrawItem& d = draws[di];
+        uint32_t t = uint32_t(gi - d.firstTri);
+        uint32_t v[3];
+        bool ok = true;
+        for (int k = 0; k < 3; ++k) {
+            v[k] = d.vertexOf(t, k);
+            ok = ok && v[k] < d.clip.size();
+        }
+        if (!ok) continue;
+        uint8_t c0 = d.code[v[0]], c1 = d.code[v[1]], c2 = d.code[v[2]];
+        if (c0 & c1 & c2) continue;   // all outside one plane
+        if ((c0 | c1 | c2) == 0) {
+            Tri tri;
+            float wx[3] = {d.win[v[0]].x, d.win[v[1]].x, d.win[v[2]].x};
+            float wy[3] = {d.win[v[0]].y, d.win[v[1]].y, d.win[v[2]].y};
+            if (!setupTriangle(wx, wy, fc.width, fc.height, tri.s, fc.msaa)) continue;
+            tri.front = tri.s.flipped == d.mirrored;   // CCW is front; mirrored instances: CW
+            if (st.cullBackFaces && !tri.front) continue;
+            float z[3] = {d.win[v[0]].z, d.win[v[1]].z, d.win[v[2]].z};
+            float iw[3] = {d.win[v[0]].w, d.win[v[1]].w, d.win[v[2]].w};
+            finishTri(tri, z, iw);
+            tri.draw = uint32_t(di);
+            tri.prim = t;
+            ch.tris.push_back(tri);
+            continue;
+        }
+        // Clip in homogeneous space, then fan-triangulate the polygon.
+        vec4 c[3] = {d.clip[v[0]], d.clip[v[1]], d.clip[v[2]]};
+        ClipVertex poly[9];
+        int n = clipTriangle(c, uint8_t(c0 | c1 | c2), g, poly);
+        if (n < 3) continue;
+        vec4 w[9];
+        for (int k = 0; k < n; ++k) w[k] = toWindow(poly[k].clip, fc.width, fc.height);
+        for (int k = 1; k + 1 < n; ++k) {
+            int idx[3] = {0, k, k + 1};
+            Tri tri;
+            float wx[3], wy[3], z[3], iw[3];
+            for (int q = 0; q < 3; ++q) { wx[q] = w[idx[q]].x; wy[q] = w[idx[q]].y; z[q] = w[idx[q]].z; iw[q] = w[idx[q]].w; }
+            if (!setupTriangle(wx, wy, fc.width, fc.height, tri.s, fc.msaa)) continue;
+            tri.front = tri.s.flipped == d.mirrored;
+            if (st.cullBackFaces && !tri.front) continue;
+            finishTri(tri, z, iw);
+            tri.draw = uint32_t(di);
+            tri.prim = t;
+            tri.clip = int32_t(ch.clipBary.size());
+            ch.clipBary.push_back({poly[idx[tri.s.order[0]]].bary, poly[idx[tri.s.order[1]]].bary, poly[idx[tri.s.order[2]]].bary});
+            ch.tris.push_back(tri);
+        }
+    }
+    // Bin into tiles (counting sort keeps submission order within each tile).
+    int nt = fc.tilesX * fc.tilesY;
+    ch.tileStart.assign(size_t(nt) + 1, 0);
+    for (const Tri& t : ch.tris)
+        for (int ty = t.s.minY / kTileSize; ty <= t.s.maxY / kTileSize; ++ty)
+            for (int tx = t.s.minX / kTileSize; tx <= t.s.maxX / kTileSize; ++tx) ++ch.tileStart[size_t(ty) * fc.tilesX + tx + 1];
+    for (int i = 0; i < nt; ++i) ch.tileStart[i + 1] += ch.tileStart[i];
+    ch.items.resize(ch.tileStart[nt]);
+    std::vector<uint32_t> fill(ch.tileStart.begin(), ch.tileStart.end() - 1);
+    for (uint32_t i = 0; i < ch.tris.size(); ++i) {
+        const Tri& t = ch.tris[i];
+        for (int ty = t.s.minY / kTileSize; ty <= t.s.maxY / kTileSize; ++ty)
+            for (int tx = t.s.minX / kTileSize; tx <= t.s.maxX / kTileSize; ++tx) ch.items[fill[size_t(ty) * fc.tilesX + tx]++] = i;
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// [tile stage]
+// ---------------------------------------------------------------------------------------
+
+// Rasterizes one triangle into the tile's visibility buffer (depth LESS). `samples` is 1 or 4
+// (MSAA: sample s of pixel p at index p*4 + s).
+void rasterizeIntoTile(const Tri& t, uint32_t id, int tx0, int ty0, int tx1, int ty1, int samples, float* depth, uint32_t* ids) {
+    int x0 = std::max(tx0, t.s.minX), x1 = std::min(tx1, t.s.maxX);
+    int y0 = std::max(ty0, t.s.minY), y1 = std::min(ty1, t.s.maxY);
+    if (x0 > x1 || y0 > y1) return;
+    const int tw = kTileSize;
+    const Edge& e0 = t.s.e[0];
+    const Edge& e1 = t.s.e[1];
+    const Edge& e2 = t.s.e[2];
+    if (samples == 1) {
+        int64_t px = int64_t(x0) * kSub + kHalf, py = int64_t(y0) * kSub + kHalf;
+        int64_t r0 = e0.at(px, py) - e0.bias, r1 = e1.at(px, py) - e1.bias, r2 = e2.at(px, py) - e2.bias;
+        const int64_t sx0 = e0.a * kSub, sx1 = e1.a * kSub, sx2 = e2.a * kSub;
+        const int64_t sy0 = e0.b * kSub, sy1 = e1.b * kSub, sy2 = e2.b * kSub;
+        for (int j = y0; j <= y1; ++j, r0 += sy0, r1 += sy1, r2 += sy2) {
+            int64_t a0 = r0, a1 = r1, a2 = r2;
+            float z = t.zRef + t.zdx * float(x0 - t.s.minX) + t.zdy * float(j - t.s.minY);
+            float* drow = depth + (j - ty0) * tw - tx0;
+            uint32_t* irow = ids + (j - ty0) * tw - tx0;
+            for (int i = x0; i <= x1; ++i, a0 += sx0, a1 += sx1, a2 += sx2, z += t.zdx) {
+                if ((a0 | a1 | a2) < 0) continue;
+                float zc = std::clamp(z, 0.0f, 1.0f);
+                if (zc < drow[i]) { drow[i] = zc; irow[i] = id; }
+            }
+        }
+        return;
+    }
+    for (int j = y0; j <= y1; ++j)
+        for (int i = x0; i <= x1; ++i) {
+            int p = ((j - ty0) * tw + (i - tx0)) * 4;
+            for (int s = 0; s < 4; ++s) {
+                int64_t px = int64_t(i) * kSub + kMsaa4X[s], py = int64_t(j) * kSub + kMsaa4Y[s];
+                if (e0.at(px, py) < e0.bias || e1.at(px, py) < e1.bias || e2.at(px, py) < e2.bias) continue;
+                float z = t.zRef + t.zdx * (float(i - t.s.minX) + float(kMsaa4X[s] - kHalf) / kSub) +
+                          t.zdy * (float(j - t.s.minY) + float(kMsaa4Y[s] - kHalf) / kSub);
+                z = std::clamp(z, 0.0f, 1.0f);
+                if (z < depth[p + s]) { depth[p + s] = z; ids[p + s] = id; }
+            }
+        }
+}
+
+// Shades the fragment of triangle t at the centre of pixel (i, j): returns linear colour
+// after fog.
+vec3 shadeFragment(const Tri& t, const Chunk& ch, const FrameContext& fc, int i, int j) {
+    const DrawItem& d = (*fc.draws)[t.draw];
+    const sg::FrameInput& f = *fc.frame;
+    int64_t px = int64_t(i) * kSub + kHalf, py = int64_t(j) * kSub + kHalf;
+    const double invA = 1.0 / double(t.s.area2);
+    // Screen-space barycentrics of the setup vertices (vertex (k+2)%3 <- edge k).
+    float l[3] = {float(double(t.s.e[1].at(px, py)) * invA), float(double(t.s.e[2].at(px, py)) * invA),
+                  float(double(t.s.e[0].at(px, py)) * invA)};
+    float dlx[3] = {float(t.s.e[1].a * kSub * invA), float(t.s.e[2].a * kSub * invA), float(t.s.e[0].a * kSub * invA)};
+    float dly[3] = {float(t.s.e[1].b * kSub * invA), float(t.s.e[2].b * kSub * invA), float(t.s.e[0].b * kSub * invA)};
+    // Perspective correction: interpolate lambda/w and divide by the interpolated 1/w.
+    float u[3], sum = 0;
+    for (int k = 0; k < 3; ++k) { u[k] = l[k] * t.invW[k]; sum += u[k]; }
+    float invSum = sum != 0 ? 1.0f / sum : 0.0f;
+    float b[3] = {u[0] * invSum, u[1] * invSum, u[2] * invSum};
+    // Weights of the input triangle's corners for each setup vertex.
+    vec3 W[3];
+    if (t.clip >= 0) {
+        const auto& cb = ch.clipBary[size_t(t.clip)];
+        W[0] = cb[0]; W[1] = cb[1]; W[2] = cb[2];
+    } else {
+        for (int k = 0; k < 3; ++k) { W[k] = vec3(0.0f); W[k][t.s.order[k]] = 1.0f; }
+    }
+    vec3 bo = b[0] * W[0] + b[1] * W[1] + b[2] * W[2];
+    uint32_t v[3] = {d.vertexOf(t.prim, 0), d.vertexOf(t.prim, 1), d.vertexOf(t.prim, 2)};
+    const sg::Mesh& m = *d.mesh;
+    uint32_t mi[3] = {d.meshIndex(v[0]), d.meshIndex(v[1]), d.meshIndex(v[2])};
+    vec3 pos = bo[0] * d.wpos[v[0]] + bo[1] * d.wpos[v[1]] + bo[2] * d.wpos[v[2]];
+    const sg::Material& mat = d.materialOf(t.prim);
+
+    vec3 albedo = mat.baseColor;
+    if (d.hasColors) albedo *= vec3(bo[0] * m.colors[mi[0]] + bo[1] * m.colors[mi[1]] + bo[2] * m.colors[mi[2]]);
+    if (d.texture && d.hasUV) {
+        vec2 uvc[3] = {m.uv0[mi[0]], m.uv0[mi[1]], m.uv0[mi[2]]};
+        vec2 uvk[3];
+        for (int k = 0; k < 3; ++k) uvk[k] = W[k][0] * uvc[0] + W[k][1] * uvc[1] + W[k][2] * uvc[2];
+        vec2 uv = b[0] * uvk[0] + b[1] * uvk[1] + b[2] * uvk[2];
+        // Analytic screen derivatives of the perspective-correct uv (for the mip level).
+        vec2 ddx(0.0f), ddy(0.0f);
+        for (int k = 0; k < 3; ++k) {
+            ddx += dlx[k] * t.invW[k] * (uvk[k] - uv);
+            ddy += dly[k] * t.invW[k] * (uvk[k] - uv);
+        }
+        albedo *= d.texture->sample(uv, ddx * invSum, ddy * invSum);
+    }
+
+    vec3 color;
+    const auto& st = f.settings;
+    if (st.shading == sg::ShadingModel::Gouraud && !d.gouraudA[0].empty()) {
+        int side = t.front ? 0 : 1;
+        vec3 A = bo[0] * d.gouraudA[side][v[0]] + bo[1] * d.gouraudA[side][v[1]] + bo[2] * d.gouraudA[side][v[2]];
+        vec3 B = bo[0] * d.gouraudB[side][v[0]] + bo[1] * d.gouraudB[side][v[1]] + bo[2] * d.gouraudB[side][v[2]];
+        color = A * albedo + B;
+    } else {
+        vec3 n;
+        if (st.shading == sg::ShadingModel::Flat || !d.hasNormals) {
+            // Face normal of the world-space triangle; outward = CCW side (CW for mirrored).
+            n = glm::cross(d.wpos[v[1]] - d.wpos[v[0]], d.wpos[v[2]] - d.wpos[v[0]]);
+            if (d.mirrored) n = -n;
+        } else {
+            n = bo[0] * d.wnrm[v[0]] + bo[1] * d.wnrm[v[1]] + bo[2] * d.wnrm[v[2]];
+        }
+        float len = glm::length(n);
+        n = len > 0 ? n / len : vec3(0, 0, 1);
+        if (!t.front) n = -n;   // two-sided: seen from the back
+        color = shade(mat, SurfacePoint{pos, n, albedo}, f.camera.eye, f);
+    }
+    if (st.fog != sg::FogMode::Off) {
+        vec3 pe = vec3(f.camera.view * vec4(pos, 1.0f));
+        color = applyFog(st, color, glm::length(pe));
+    }
+    return color;
+}
+
+struct TileBuffers {
+    std::vector<float> depth;
+    std::vector<uint32_t> ids;
+};
+
+const Tri& triById(const std::vector<Chunk>& chunks, uint32_t id) { return chunks[id >> kChunkBits].tris[id & ((1u << kChunkBits) - 1)]; }
+
+void renderTile(int tile, const FrameContext& fc, Framebuffer& target, TileBuffers& buf) {
+    const int tx = tile % fc.tilesX, ty = tile / fc.tilesX;
+    const int x0 = tx * kTileSize, y0 = ty * kTileSize;
+    const int x1 = std::min(x0 + kTileSize, fc.width) - 1, y1 = std::min(y0 + kTileSize, fc.height) - 1;
+    const int samples = fc.msaa ? 4 : 1;
+    const size_t n = size_t(kTileSize) * kTileSize * samples;
+    buf.depth.assign(n, 1.0f);
+    buf.ids.assign(n, kNoTri);
+    const auto& chunks = *fc.chunks;
+    for (size_t c = 0; c < chunks.size(); ++c) {
+        const Chunk& ch = chunks[c];
+        for (uint32_t k = ch.tileStart[tile]; k < ch.tileStart[tile + 1]; ++k) {
+            uint32_t idx = ch.items[k];
+            rasterizeIntoTile(ch.tris[idx], uint32_t(c << kChunkBits) | idx, x0, y0, x1, y1, samples, buf.depth.data(), buf.ids.data());
+        }
+    }
+    const auto& st = fc.frame->settings;
+    const SrgbEncoder& enc = srgbEncoder();
+    const vec3 bg = st.background;
+    const uint8_t bgBytes[3] = {enc(bg.x), enc(bg.y), enc(bg.z)};
+    for (int j = y0; j <= y1; ++j) {
+        int row = fc.height - 1 - j;   // framebuffer rows are top-down
+        for (int i = x0; i <= x1; ++i) {
+            size_t p = size_t(j - y0) * kTileSize + (i - x0);
+            uint8_t* out = target.pixel(i, row);
+            float* dOut = &target.depth[size_t(row) * fc.width + i];
+            out[3] = 255;
+            if (samples == 1) {
+                uint32_t id = buf.ids[p];
+                if (id == kNoTri) {
+                    out[0] = bgBytes[0]; out[1] = bgBytes[1]; out[2] = bgBytes[2];
+                    *dOut = 1.0f;
+                    continue;
+                }
+                vec3 c = shadeFragment(triById(chunks, id), chunks[id >> kChunkBits], fc, i, j);
+                out[0] = enc(c.x); out[1] = enc(c.y); out[2] = enc(c.z);
+                *dOut = buf.depth[p];
+                continue;
+            }
+            // MSAA: shade once per distinct triangle, average the samples in linear space.
+            vec3 acc(0.0f);
+            uint32_t done[4];
+            vec3 col[4];
+            int nd = 0;
+            float dmin = 1.0f;
+            for (int s = 0; s < 4; ++s) {
+                uint32_t id = buf.ids[p * 4 + s];
+                dmin = std::min(dmin, buf.depth[p * 4 + s]);
+                if (id == kNoTri) { acc += bg; continue; }
+                int q = 0;
+                while (q < nd && done[q] != id) ++q;
+                if (q == nd) {
+                    done[nd] = id;
+                    col[nd++] = glm::clamp(shadeFragment(triById(chunks, id), chunks[id >> kChunkBits], fc, i, j), 0.0f, 1.0f);
+                }
+                acc += col[q];
+            }
+            acc *= 0.25f;
+            out[0] = enc(acc.x); out[1] = enc(acc.y); out[2] = enc(acc.z);
+            *dOut = dmin;
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// [lines]
+// ---------------------------------------------------------------------------------------
+
+// Clips segment a-b (clip space) to near/far and the guard band; false when nothing is left.
+bool clipSegment(vec4& a, vec4& b, const GuardBand& g) {
+    float t0 = 0, t1 = 1;
+    auto clipPlane = [&](float da, float db) {
+        if (da < 0 && db < 0) return false;
+        if (da < 0) t0 = std::max(t0, da / (da - db));
+        else if (db < 0) t1 = std::min(t1, da / (da - db));
+        return t0 <= t1;
+    };
+    if (!clipPlane(a.z + a.w, b.z + b.w) || !clipPlane(a.w - a.z, b.w - b.z) || !clipPlane(a.x + g.gx * a.w, b.x + g.gx * b.w) ||
+        !clipPlane(g.gx * a.w - a.x, g.gx * b.w - b.x) || !clipPlane(a.y + g.gy * a.w, b.y + g.gy * b.w) ||
+        !clipPlane(g.gy * a.w - a.y, g.gy * b.w - b.y))
+        return false;
+    vec4 na = a + t0 * (b - a), nb = a + t1 * (b - a);
+    a = na;
+    b = nb;
+    return true;
+}
+
+void writeLinePixel(Framebuffer& fb, int i, int j, float z, const uint8_t rgb[3], float bias) {
+    int row = fb.height - 1 - j;
+    float& dst = fb.depth[size_t(row) * fb.width + i];
+    if (!(z < dst + bias)) return;
+    dst = std::min(dst, z);
+    uint8_t* p = fb.pixel(i, row);
+    p[0] = rgb[0]; p[1] = rgb[1]; p[2] = rgb[2]; p[3] = 255;
+}
+
+void drawSegment(Framebuffer& fb, vec4 a, vec4 b, const GuardBand& g, const uint8_t rgb[3], float bias) {
+    if (!clipSegment(a, b, g)) return;
+    vec4 wa = toWindow(a, fb.width, fb.height), wb = toWindow(b, fb.width, fb.height);
+    drawLineDDA(wa.x, wa.y, wb.x, wb.y, fb.width, fb.height, [&](int i, int j, float t) {
+        writeLinePixel(fb, i, j, std::clamp(wa.z + t * (wb.z - wa.z), 0.0f, 1.0f), rgb, bias);
+    });
+}
+
+void drawLinesAndWireframe(const std::vector<DrawItem>& lineDraws, const std::vector<DrawItem>& triDraws, const sg::FrameInput& f,
+                           Framebuffer& fb) {
+    const GuardBand g = guardBand(fb.width, fb.height);
+    const SrgbEncoder& enc = srgbEncoder();
+    for (const DrawItem& d : lineDraws) {
+        const sg::Mesh& m = *d.mesh;
+        // Unlit: base colour (x) vertex colour + emissive, fogged.
+        auto colorOf = [&](uint32_t mi, const vec4& clip) {
+            vec3 c = d.material.baseColor * (d.hasColors ? vec3(m.colors[mi]) : vec3(1.0f)) + d.material.emissive;
+            if (f.settings.fog != sg::FogMode::Off) {
+                vec3 pe = vec3(f.camera.view * vec4(d.wpos[mi], 1.0f));
+                c = applyFog(f.settings, c, glm::length(pe));
+            }
+            (void)clip;
+            return c;
+        };
+        size_t n = m.indices.empty() ? m.positions.size() : m.indices.size();
+        auto idx = [&](size_t k) { return m.indices.empty() ? uint32_t(k) : m.indices[k]; };
+        if (m.mode == sg::PrimitiveMode::Lines) {
+            for (size_t k = 0; k + 1 < n; k += 2) {
+                uint32_t ia = idx(k), ib = idx(k + 1);
+                if (ia >= d.clip.size() || ib >= d.clip.size()) continue;
+                vec3 c = 0.5f * (colorOf(ia, d.clip[ia]) + colorOf(ib, d.clip[ib]));
+                uint8_t rgb[3] = {enc(c.x), enc(c.y), enc(c.z)};
+                drawSegment(fb, d.clip[ia], d.clip[ib], g, rgb, 0.0f);
+            }
+        } else {
+            for (size_t k = 0; k < n; ++k) {
+                uint32_t ia = idx(k);
+                if (ia >= d.clip.size() || d.code[ia] != 0) continue;
+                vec4 w = toWindow(d.clip[ia], fb.width, fb.height);
+                int i = int(std::floor(w.x)), j = int(std::floor(w.y));
+                if (i < 0 || j < 0 || i >= fb.width || j >= fb.height) continue;
+                vec3 c = colorOf(ia, d.clip[ia]);
+                uint8_t rgb[3] = {enc(c.x), enc(c.y), enc(c.z)};
+                writeLinePixel(fb, i, j, std::clamp(w.z, 0.0f, 1.0f), rgb, 0.0f);
+            }
+        }
+    }
+    if (!f.settings.wireframe) return;
+    vec3 wc = f.settings.wireframeColor;
+    uint8_t rgb[3] = {enc(wc.x), enc(wc.y), enc(wc.z)};
+    for (const DrawItem& d : triDraws)
+        for (uint32_t t = 0; t < d.triCount; ++t) {
+            uint32_t v[3] = {d.vertexOf(t, 0), d.vertexOf(t, 1), d.vertexOf(t, 2)};
+            if (v[0] >= d.clip.size() || v[1] >= d.clip.size() || v[2] >= d.clip.size()) continue;
+            if (d.code[v[0]] & d.code[v[1]] & d.code[v[2]]) continue;
+            for (int k = 0; k < 3; ++k) drawSegment(fb, d.clip[v[k]], d.clip[v[(k + 1) % 3]], g, rgb, 2e-4f);
+        }
+}
+
+// ---------------------------------------------------------------------------------------
+// [renderer]
+// ---------------------------------------------------------------------------------------
+
 class RasterRenderer final : public Renderer {
 public:
     std::string_view name() const override { return "raster"; }
-    Capabilities capabilities() const override { return {}; }
-    RenderStats render(const sg::FrameInput&, int w, int h, Framebuffer& target, RenderControl*) override {
-        target.resize(w, h);
-        RenderStats s;
-        s.error = "the raster backend is not built yet";
-        return s;
+    Capabilities capabilities() const override {
+        Capabilities c;
+        c.progressive = true;
+        c.msaa = true;
+        c.ssaa = true;
+        c.maxMsaaSamples = 4;
+        return c;
     }
+
+    RenderStats render(const sg::FrameInput& frame, int width, int height, Framebuffer& target, RenderControl* control) override {
+        auto t0 = std::chrono::steady_clock::now();
+        RenderStats stats;
+        if (width <= 0 || height <= 0 || width > 32768 || height > 32768) {
+            target.resize(std::max(width, 0), std::max(height, 0));
+            stats.error = "raster: invalid target size " + std::to_string(width) + "x" + std::to_string(height);
+            return stats;
+        }
+        const auto& st = frame.settings;
+        if (control) control->progress = 0.0f;
+        if (st.aa == sg::AAMode::SSAA && st.aaRate > 1) {
+            int r = std::clamp(st.aaRate, 2, 4);
+            Framebuffer hi;
+            stats = renderSingle(frame, width * r, height * r, hi, false, control);
+            if (stats.ok) target = downsample(hi, r);
+            else target.resize(width, height);
+        } else {
+            stats = renderSingle(frame, width, height, target, st.aa == sg::AAMode::MSAA && st.aaRate > 1, control);
+        }
+        stats.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        return stats;
+    }
+
+private:
+    const SampledTexture* textureFor(const sg::TexturePtr& t) {
+        if (!t || t->width <= 0 || t->height <= 0) return nullptr;
+        auto& e = m_textures[t->id];
+        if (!e.tex || e.version != t->version) {
+            e.tex = std::make_unique<SampledTexture>(*t);
+            e.version = t->version;
+        }
+        e.lastFrame = m_frame;
+        return e.tex.get();
+    }
+
+    RenderStats renderSingle(const sg::FrameInput& frame, int width, int height, Framebuffer& target, bool msaa, RenderControl* control) {
+        RenderStats stats;
+        ++m_frame;
+        m_tess.nextFrame();
+        target.resize(width, height);
+        const auto& st = frame.settings;
+        const bool gouraud = st.shading == sg::ShadingModel::Gouraud;
+
+        // 1. gather
+        std::vector<DrawItem> draws, lineDraws;
+        auto addDraw = [&](std::shared_ptr<const sg::Mesh> mesh, const mat4& world, const mat3& normal, const sg::Material& mat,
+                           const sg::TexturePtr& tex, bool mirrored, const Tessellation* tess) {
+            if (!mesh || mesh->positions.empty()) return;
+            DrawItem d;
+            d.mesh = mesh;
+            d.world = world;
+            d.normal = normal;
+            d.material = mat;
+            d.mirrored = mirrored;
+            d.texture = textureFor(tex);
+            d.hasNormals = mesh->normals.size() == mesh->positions.size();
+            d.hasUV = mesh->uv0.size() == mesh->positions.size();
+            d.hasColors = mesh->colors.size() == mesh->positions.size();
+            if (tess && !tess->triangleMaterial.empty()) {
+                d.triMat = std::make_shared<std::vector<uint16_t>>(tess->triangleMaterial);
+                d.materials = std::make_shared<std::vector<sg::Material>>(tess->materials);
+            }
+            if (mesh->mode == sg::PrimitiveMode::Triangles) {
+                d.triCount = uint32_t(mesh->indices.size() / 3);
+                if (d.triCount == 0) return;
+                d.perCorner = gouraud && d.triMat;
+                draws.push_back(std::move(d));
+            } else {
+                lineDraws.push_back(std::move(d));
+            }
+        };
+        for (const auto& m : frame.meshes) addDraw(m.mesh, m.world, m.normal, m.material, m.texture, m.mirrored, nullptr);
+        int tessRes = std::clamp(st.tessellation, 3, 1024);
+        for (const auto& a : frame.analytics) {
+            const Tessellation& t = m_tess.get(a, tessRes);
+            if (t.worldSpace) addDraw(t.mesh, mat4(1.0f), mat3(1.0f), a.material, a.texture, false, &t);
+            else addDraw(t.mesh, a.world, a.normal, a.material, a.texture, glm::determinant(mat3(a.world)) < 0.0f, &t);
+        }
+        for (auto it = m_textures.begin(); it != m_textures.end();)
+            it = m_frame - it->second.lastFrame > 8 ? m_textures.erase(it) : std::next(it);
+
+        // 2. vertices
+        uint64_t total = 0;
+        for (auto& d : draws) { d.firstTri = total; total += d.triCount; }
+        stats.triangles = total;
+        tbb::parallel_for(size_t(0), draws.size(), [&](size_t i) { runVertexStage(draws[i], frame, width, height, gouraud); });
+        tbb::parallel_for(size_t(0), lineDraws.size(), [&](size_t i) { runVertexStage(lineDraws[i], frame, width, height, false); });
+
+        // 3. triangles
+        FrameContext fc;
+        fc.frame = &frame;
+        fc.width = width;
+        fc.height = height;
+        fc.tilesX = (width + kTileSize - 1) / kTileSize;
+        fc.tilesY = (height + kTileSize - 1) / kTileSize;
+        fc.msaa = msaa;
+        fc.draws = &draws;
+        uint64_t chunkSize = std::max<uint64_t>(4096, (total + 4000) / 4000);
+        if (chunkSize * 7 >= (1u << kChunkBits)) {
+            stats.error = "raster: too many triangles (" + std::to_string(total) + ")";
+            return stats;
+        }
+        std::vector<Chunk> chunks(size_t((total + chunkSize - 1) / chunkSize));
+        for (size_t c = 0; c < chunks.size(); ++c) {
+            chunks[c].begin = c * chunkSize;
+            chunks[c].end = std::min(total, (c + 1) * chunkSize);
+        }
+        fc.chunks = &chunks;
+        tbb::parallel_for(size_t(0), chunks.size(), [&](size_t c) { runTriangleStage(chunks[c], fc); });
+
+        // 4. tiles
+        const int tiles = fc.tilesX * fc.tilesY;
+        std::atomic<int> done{0};
+        std::atomic<bool> cancelled{false};
+        tbb::parallel_for(tbb::blocked_range<int>(0, tiles, 1), [&](const tbb::blocked_range<int>& r) {
+            thread_local TileBuffers buf;
+            for (int tile = r.begin(); tile != r.end(); ++tile) {
+                if (control && control->cancel.load(std::memory_order_relaxed)) { cancelled = true; continue; }
+                renderTile(tile, fc, target, buf);
+                int n = ++done;
+                if (control) {
+                    control->progress = float(n) / float(tiles);
+                    if (control->onTileDone) control->onTileDone();
+                }
+            }
+        });
+        if (cancelled) {
+            stats.cancelled = true;
+            stats.error = "raster: cancelled";
+            return stats;
+        }
+
+        // 5. lines, points, wireframe
+        drawLinesAndWireframe(lineDraws, draws, frame, target);
+        stats.ok = true;
+        return stats;
+    }
+
+    struct TextureEntry {
+        std::unique_ptr<SampledTexture> tex;
+        uint64_t version = 0;
+        uint64_t lastFrame = 0;
+    };
+    std::unordered_map<uint64_t, TextureEntry> m_textures;
+    TessellationCache m_tess;
+    uint64_t m_frame = 0;
 };
+
 }  // namespace
+
 std::unique_ptr<Renderer> makeRasterRenderer() { return std::make_unique<RasterRenderer>(); }
+
 }  // namespace rnd

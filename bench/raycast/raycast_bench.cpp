@@ -1,0 +1,393 @@
+// raycast_bench.cpp - our BVH4 traversal vs Embree 3 on the same scenes and the same rays.
+//
+//   ./build/release/bench/raycast/bench_raycast            # full run (sphere grids 10k/100k/1M + bunny)
+//   ./build/release/bench/raycast/bench_raycast --quick    # < 1 minute: fewer repetitions, 640x360 rays
+//   options: --scene NAME (run one scene), --testdata DIR
+//
+// Prints one line per scene and measure:
+//   bench: scene=<name> what=<metric> ours=<x> ref=<y> ratio=<ours/ref>
+// Metrics: build_1t / build_2t (Mtris/s; ours binned SAH BVH4, Embree RTC_BUILD_QUALITY_MEDIUM),
+// primary / shadow / incoherent rays on 1 and 2 threads (Mrays/s; our TriangleBvh::intersect /
+// occluded vs rtcIntersect1 / rtcOccluded1, one ray at a time, FTZ/DAZ on), and agreement_* (%
+// of rays where both agree: same hit/miss, and for hits the same primitive - or the same
+// distance for ties on shared edges - and distance within 1e-4 relative).
+// Timing: 1-thread figures use the thread's CPU clock (the machine is shared; wall time would
+// count other people's work), 2-thread figures and build times use wall time.
+// Ray classes: primary = 1280x720 pinhole camera rays; shadow = from each primary hit toward a
+// point light; incoherent = from each primary hit in a random cosine-weighted hemisphere
+// direction about the geometric normal.
+#include "raycast/bvh.h"
+
+#include "scenegraph/mesh.h"
+
+#include <embree3/rtcore.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <pmmintrin.h>
+#include <xmmintrin.h>
+
+#include <chrono>
+#include <ctime>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <functional>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+using namespace sg;
+using rnd::rt::Ray;
+using rnd::rt::TriHit;
+using rnd::rt::TriangleBvh;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
+
+void setFtzDaz() {
+    _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
+    _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+}
+
+struct Scene {
+    std::string name;
+    std::vector<vec3> pos;
+    std::vector<uint32_t> idx;
+    vec3 eye, target, light;
+    size_t tris() const { return idx.size() / 3; }
+};
+
+void append(Scene& s, const Mesh& m, const mat4& world) {
+    uint32_t base = uint32_t(s.pos.size());
+    for (const vec3& p : m.positions) s.pos.push_back(vec3(world * vec4(p, 1.0f)));
+    for (uint32_t i : m.indices) s.idx.push_back(base + i);
+}
+
+// n x n spheres (slices x stacks each) on a tessellated ground.
+Scene sphereGrid(const std::string& name, int n, int slices, int groundSub) {
+    Scene s;
+    s.name = name;
+    Mesh sphere = primitives::uvSphere(0.4f, slices, slices / 2);
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i)
+            append(s, sphere, glm::translate(mat4(1.0f), vec3(i - 0.5f * (n - 1), 0.4f, j - 0.5f * (n - 1))));
+    append(s, primitives::plane(0.5f * n + 2.0f, groundSub), mat4(1.0f));
+    float e = float(n);
+    s.eye = vec3(0.35f * e, 0.45f * e + 1.0f, 0.75f * e + 1.0f);
+    s.target = vec3(0, 0, 0);
+    s.light = vec3(-0.5f * e, 1.0f * e, 0.3f * e);
+    return s;
+}
+
+// Minimal OBJ reader: v and f (polygons fan-triangulated; v, v/vt, v//vn, v/vt/vn; negative
+// indices). Returns false with a message on failure.
+bool readObj(const std::string& path, Scene& s, std::string& err) {
+    std::ifstream in(path);
+    if (!in) { err = path + ": cannot open"; return false; }
+    std::string line;
+    std::vector<uint32_t> face;
+    while (std::getline(in, line)) {
+        if (line.size() < 2) continue;
+        if (line[0] == 'v' && line[1] == ' ') {
+            vec3 p;
+            if (std::sscanf(line.c_str() + 2, "%f %f %f", &p.x, &p.y, &p.z) == 3) s.pos.push_back(p);
+        } else if (line[0] == 'f' && line[1] == ' ') {
+            std::istringstream ls(line.substr(2));
+            std::string tok;
+            face.clear();
+            while (ls >> tok) {
+                long v = std::strtol(tok.c_str(), nullptr, 10);
+                if (v < 0) v = long(s.pos.size()) + v + 1;
+                if (v < 1 || size_t(v) > s.pos.size()) { err = path + ": face index out of range"; return false; }
+                face.push_back(uint32_t(v - 1));
+            }
+            for (size_t k = 2; k < face.size(); ++k) s.idx.insert(s.idx.end(), {face[0], face[k - 1], face[k]});
+        }
+    }
+    if (s.idx.empty()) { err = path + ": no faces"; return false; }
+    return true;
+}
+
+Scene bunny(const std::string& testdata, std::string& err) {
+    Scene s;
+    s.name = "bunny";
+    if (!readObj(testdata + "/meshes/common-3d-test-models/stanford-bunny/stanford-bunny.obj", s, err)) return s;
+    Aabb b;
+    for (const vec3& p : s.pos) b.extend(p);
+    vec3 c = b.center();
+    float r = glm::length(b.extent());
+    s.eye = c + vec3(0.3f, 0.25f, 1.0f) * r;
+    s.target = c;
+    s.light = c + vec3(-1.0f, 2.0f, 1.0f) * r;
+    return s;
+}
+
+struct RaySet {
+    std::vector<Ray> rays;
+};
+
+// --- Embree wrapper -----------------------------------------------------------------------------
+struct Embree {
+    RTCDevice device = nullptr;
+    RTCScene scene = nullptr;
+    explicit Embree(int threads) {
+        std::string cfg = "threads=" + std::to_string(threads);
+        device = rtcNewDevice(cfg.c_str());
+    }
+    ~Embree() {
+        if (scene) rtcReleaseScene(scene);
+        if (device) rtcReleaseDevice(device);
+    }
+    double build(const Scene& s) {
+        if (scene) rtcReleaseScene(scene);
+        auto t0 = Clock::now();
+        scene = rtcNewScene(device);
+        rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_MEDIUM);
+        RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+        rtcSetGeometryBuildQuality(g, RTC_BUILD_QUALITY_MEDIUM);
+        float* v = (float*)rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 12, s.pos.size());
+        std::memcpy(v, s.pos.data(), s.pos.size() * 12);
+        unsigned* ix = (unsigned*)rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 12, s.tris());
+        std::memcpy(ix, s.idx.data(), s.idx.size() * 4);
+        rtcCommitGeometry(g);
+        rtcAttachGeometry(scene, g);
+        rtcReleaseGeometry(g);
+        rtcCommitScene(scene);
+        return seconds(t0, Clock::now());
+    }
+    void intersect(const Ray& r, TriHit& h) const {
+        RTCIntersectContext ctx;
+        rtcInitIntersectContext(&ctx);
+        RTCRayHit rh;
+        rh.ray.org_x = r.org.x; rh.ray.org_y = r.org.y; rh.ray.org_z = r.org.z;
+        rh.ray.dir_x = r.dir.x; rh.ray.dir_y = r.dir.y; rh.ray.dir_z = r.dir.z;
+        rh.ray.tnear = r.tmin;
+        rh.ray.tfar = r.tmax;
+        rh.ray.mask = ~0u;
+        rh.ray.flags = 0;
+        rh.ray.time = 0;
+        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        rtcIntersect1(scene, &ctx, &rh);
+        if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) { h.t = rh.ray.tfar; h.prim = rh.hit.primID; h.b1 = rh.hit.u; h.b2 = rh.hit.v; }
+        else h = TriHit();
+    }
+    bool occluded(const Ray& r) const {
+        RTCIntersectContext ctx;
+        rtcInitIntersectContext(&ctx);
+        RTCRay ray;
+        ray.org_x = r.org.x; ray.org_y = r.org.y; ray.org_z = r.org.z;
+        ray.dir_x = r.dir.x; ray.dir_y = r.dir.y; ray.dir_z = r.dir.z;
+        ray.tnear = r.tmin;
+        ray.tfar = r.tmax;
+        ray.mask = ~0u;
+        ray.flags = 0;
+        ray.time = 0;
+        rtcOccluded1(scene, &ctx, &ray);
+        return ray.tfar < 0;
+    }
+};
+
+double threadCpuSeconds() {
+    timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
+// Runs fn(i) for i in [0, n) on `threads` threads, repeated until minSeconds; returns Mrays/s.
+// One thread: timed by the thread's CPU clock (this machine is shared, so wall time includes
+// other people's work); two threads: wall time.
+double measure(size_t n, int threads, double minSeconds, const std::function<void(size_t, size_t)>& fn) {
+    tbb::task_arena arena(threads);
+    size_t total = 0;
+    if (threads == 1) {
+        setFtzDaz();
+        double c0 = threadCpuSeconds(), el = 0;
+        do {
+            fn(0, n);
+            total += n;
+            el = threadCpuSeconds() - c0;
+        } while (el < minSeconds);
+        return double(total) / el * 1e-6;
+    }
+    auto t0 = Clock::now();
+    double el = 0;
+    do {
+        {
+            arena.execute([&] {
+                tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1024), [&](const tbb::blocked_range<size_t>& r) {
+                    setFtzDaz();
+                    fn(r.begin(), r.end());
+                });
+            });
+        }
+        total += n;
+        el = seconds(t0, Clock::now());
+    } while (el < minSeconds);
+    return double(total) / el * 1e-6;
+}
+
+void line(const std::string& scene, const std::string& what, double ours, double ref) {
+    std::printf("bench: scene=%s what=%s ours=%.4g ref=%.4g ratio=%.3f\n", scene.c_str(), what.c_str(), ours, ref, ref > 0 ? ours / ref : 0.0);
+    std::fflush(stdout);
+}
+
+bool sameHit(const TriHit& a, const TriHit& b) {
+    if (a.valid() != b.valid()) return false;
+    if (!a.valid()) return true;
+    float tol = 1e-4f * std::max(1.0f, a.t);
+    if (std::abs(a.t - b.t) > tol) return false;
+    return a.prim == b.prim || std::abs(a.t - b.t) <= 1e-6f * std::max(1.0f, a.t);
+}
+
+void runScene(const Scene& s, bool quick) {
+    const double minT = quick ? 0.0 : 0.4;
+    const int W = quick ? 640 : 1280, H = quick ? 360 : 720;
+    // --- build --------------------------------------------------------------------------
+    TriangleBvh bvh;
+    rnd::rt::Bvh4::BuildOptions single;
+    single.parallel = false;
+    double oursB1 = 1e30, oursB2 = 1e30, refB1 = 1e30, refB2 = 1e30;
+    int reps = quick ? 1 : 3;
+    Embree e1(1), e2(2);
+    for (int r = 0; r < reps; ++r) {
+        auto t0 = Clock::now();
+        bvh.build(s.pos.data(), s.idx.data(), s.tris(), single);
+        oursB1 = std::min(oursB1, seconds(t0, Clock::now()));
+        tbb::task_arena arena(2);
+        arena.execute([&] {
+            auto t1 = Clock::now();
+            bvh.build(s.pos.data(), s.idx.data(), s.tris());
+            oursB2 = std::min(oursB2, seconds(t1, Clock::now()));
+        });
+        refB1 = std::min(refB1, e1.build(s));
+        refB2 = std::min(refB2, e2.build(s));
+    }
+    const double mt = double(s.tris()) * 1e-6;
+    line(s.name, "build_1t_Mtris/s", mt / oursB1, mt / refB1);
+    line(s.name, "build_2t_Mtris/s", mt / oursB2, mt / refB2);
+    std::printf("bench: scene=%s info tris=%zu build_ms ours_1t=%.2f embree_1t=%.2f ours_2t=%.2f embree_2t=%.2f bvh_MB=%.1f\n",
+                s.name.c_str(), s.tris(), oursB1 * 1e3, refB1 * 1e3, oursB2 * 1e3, refB2 * 1e3, bvh.memoryBytes() / 1048576.0);
+
+    // --- rays ----------------------------------------------------------------------------
+    mat4 view = glm::lookAt(s.eye, s.target, vec3(0, 1, 0));
+    mat4 proj = glm::perspective(radians(45.0f), float(W) / H, 0.01f, 1000.0f);
+    mat4 inv = glm::inverse(proj * view);
+    std::vector<Ray> primary(size_t(W) * H);
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            vec4 a = inv * vec4(2.0f * (x + 0.5f) / W - 1, 2.0f * (y + 0.5f) / H - 1, -1, 1);
+            vec4 b = inv * vec4(2.0f * (x + 0.5f) / W - 1, 2.0f * (y + 0.5f) / H - 1, 1, 1);
+            Ray r;
+            r.org = s.eye;
+            r.dir = glm::normalize(vec3(b) / b.w - vec3(a) / a.w);
+            primary[size_t(y) * W + x] = r;
+        }
+    std::vector<TriHit> hits(primary.size()), refHits(primary.size());
+    for (size_t i = 0; i < primary.size(); ++i) { bvh.intersect(primary[i], hits[i]); e1.intersect(primary[i], refHits[i]); }
+    // Secondary rays from the (Embree) primary hits so both trace exactly the same rays.
+    std::vector<Ray> shadow, incoherent;
+    std::mt19937 rng(1);
+    std::uniform_real_distribution<float> U(0, 1);
+    for (size_t i = 0; i < primary.size(); ++i) {
+        const TriHit& h = refHits[i];
+        if (!h.valid()) continue;
+        const Ray& pr = primary[i];
+        vec3 p = pr.org + h.t * pr.dir;
+        const vec3 &p0 = s.pos[s.idx[3 * h.prim]], &p1 = s.pos[s.idx[3 * h.prim + 1]], &p2 = s.pos[s.idx[3 * h.prim + 2]];
+        vec3 n = glm::normalize(glm::cross(p1 - p0, p2 - p0));
+        if (glm::dot(n, pr.dir) > 0) n = -n;
+        float eps = 1e-4f * (1.0f + glm::length(p));
+        Ray sr;
+        sr.org = p + eps * n;
+        vec3 toL = s.light - sr.org;
+        sr.tmax = glm::length(toL);
+        sr.dir = toL / sr.tmax;
+        sr.tmax *= 0.9999f;
+        shadow.push_back(sr);
+        // cosine-weighted hemisphere about n
+        float r1 = U(rng), r2 = U(rng);
+        float phi = 2 * kPi * r1, sr2 = std::sqrt(r2);
+        vec3 t = std::abs(n.x) > 0.5f ? glm::normalize(glm::cross(n, vec3(0, 1, 0))) : glm::normalize(glm::cross(n, vec3(1, 0, 0)));
+        vec3 bt = glm::cross(n, t);
+        Ray ir;
+        ir.org = sr.org;
+        ir.dir = glm::normalize(std::cos(phi) * sr2 * t + std::sin(phi) * sr2 * bt + std::sqrt(std::max(0.0f, 1 - r2)) * n);
+        incoherent.push_back(ir);
+    }
+
+    // Agreement.
+    auto agreeClosest = [&](const std::vector<Ray>& rays) {
+        size_t ok = 0;
+        for (const Ray& r : rays) {
+            TriHit a, b;
+            bvh.intersect(r, a);
+            e1.intersect(r, b);
+            ok += sameHit(a, b);
+        }
+        return 100.0 * double(ok) / double(std::max<size_t>(rays.size(), 1));
+    };
+    size_t shOk = 0;
+    for (const Ray& r : shadow) shOk += bvh.occluded(r) == e1.occluded(r);
+    line(s.name, "agreement_primary_pct", agreeClosest(primary), 100.0);
+    line(s.name, "agreement_shadow_pct", 100.0 * double(shOk) / double(std::max<size_t>(shadow.size(), 1)), 100.0);
+    line(s.name, "agreement_incoherent_pct", agreeClosest(incoherent), 100.0);
+
+    // Throughput.
+    std::vector<TriHit> out(std::max(primary.size(), incoherent.size()));
+    std::vector<uint8_t> occ(shadow.size());
+    struct Cls { const char* name; const std::vector<Ray>* rays; bool shadow; };
+    const Cls classes[3] = {{"primary", &primary, false}, {"shadow", &shadow, true}, {"incoherent", &incoherent, false}};
+    for (const Cls& c : classes) {
+        const std::vector<Ray>& rays = *c.rays;
+        for (int threads : {1, 2}) {
+            double ours, ref;
+            const Embree& E = threads == 1 ? e1 : e2;
+            if (threads == 2) e2.build(s);
+            if (c.shadow) {
+                ours = measure(rays.size(), threads, minT, [&](size_t b, size_t e) { for (size_t i = b; i < e; ++i) occ[i] = bvh.occluded(rays[i]); });
+                ref = measure(rays.size(), threads, minT, [&](size_t b, size_t e) { for (size_t i = b; i < e; ++i) occ[i] = E.occluded(rays[i]); });
+            } else {
+                ours = measure(rays.size(), threads, minT, [&](size_t b, size_t e) { for (size_t i = b; i < e; ++i) bvh.intersect(rays[i], out[i]); });
+                ref = measure(rays.size(), threads, minT, [&](size_t b, size_t e) { for (size_t i = b; i < e; ++i) E.intersect(rays[i], out[i]); });
+            }
+            line(s.name, std::string(c.name) + "_" + std::to_string(threads) + "t_Mrays/s", ours, ref);
+        }
+    }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    bool quick = false;
+    std::string only, testdata = VIEWER_TESTDATA_DIR;
+    for (int i = 1; i < argc; ++i) {
+        std::string a = argv[i];
+        if (a == "--quick") quick = true;
+        else if (a == "--scene" && i + 1 < argc) only = argv[++i];
+        else if (a == "--testdata" && i + 1 < argc) testdata = argv[++i];
+        else { std::fprintf(stderr, "usage: %s [--quick] [--scene NAME] [--testdata DIR]\n", argv[0]); return 2; }
+    }
+    if (const char* env = std::getenv("VIEWER_TESTDATA")) testdata = env;
+    setFtzDaz();
+    struct Spec { std::string name; std::function<Scene()> make; };
+    std::string err;
+    std::vector<Spec> specs = {
+        {"spheres10k", [] { return sphereGrid("spheres10k", 4, 24, 32); }},
+        {"spheres100k", [] { return sphereGrid("spheres100k", 10, 32, 64); }},
+        {"spheres1M", [] { return sphereGrid("spheres1M", 16, 64, 128); }},
+        {"bunny", [&] { return bunny(testdata, err); }},
+    };
+    for (const Spec& sp : specs) {
+        if (!only.empty() && sp.name != only) continue;
+        Scene s = sp.make();
+        if (s.idx.empty()) { std::fprintf(stderr, "bench: scene=%s skipped: %s\n", sp.name.c_str(), err.c_str()); continue; }
+        runScene(s, quick);
+    }
+    return 0;
+}

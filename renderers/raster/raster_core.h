@@ -1,0 +1,225 @@
+// raster_core.h - the scan-conversion core of the CPU rasterizer ("raster" backend), shared by
+// the renderer and its tests: homogeneous clipping, fixed-point triangle setup with edge
+// functions and a top-left fill rule, coverage of one tile, and a DDA line rasterizer.
+//
+// Conventions (GL): window coordinates have their origin bottom-left, pixel (i, j) has its
+// centre at (i + 0.5, j + 0.5); window z = 0.5 * z_ndc + 0.5. Vertex positions are snapped to
+// 1/256 pixel (8 sub-pixel bits) and the edge functions are evaluated exactly in 64-bit
+// integers, so two triangles sharing an edge cover each pixel centre exactly once.
+//
+// Sections: 1. fixed-point triangle setup   2. coverage iteration   3. clipping   4. lines
+#pragma once
+
+#include "scenegraph/math.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+
+namespace rnd::raster {
+
+constexpr int kSubBits = 8;                 // sub-pixel precision
+constexpr int kSub = 1 << kSubBits;         // fixed-point units per pixel
+constexpr int kHalf = kSub / 2;             // pixel centre offset
+constexpr int kTileSize = 64;               // screen tiles rasterized in parallel
+constexpr float kGuardPixels = 8192.0f;     // guard band beyond the viewport (x, y)
+
+// GL standard 4x MSAA sample positions in fixed-point units from the pixel's lower-left corner
+// (y up). Same pattern as D3D's standard 4x, mirrored for the y-up window convention.
+constexpr int kMsaa4X[4] = {96, 224, 32, 160};
+constexpr int kMsaa4Y[4] = {224, 160, 96, 32};
+
+// ---------------------------------------------------------------------------------------
+// 1. Fixed-point triangle setup
+// ---------------------------------------------------------------------------------------
+
+// One edge function E(px, py) = a*px + b*py + c over fixed-point sample coordinates. A sample
+// is inside when E >= bias (bias = 0 on top/left edges, 1 otherwise: the top-left rule).
+struct Edge {
+    int64_t a = 0, b = 0, c = 0;
+    int64_t bias = 0;
+    int64_t at(int64_t px, int64_t py) const { return a * px + b * py + c; }
+};
+
+// A triangle ready for scan conversion: vertices in counter-clockwise order (window space,
+// y up), edges e[i] from v[i] to v[i+1]; the barycentric weight of vertex (i+2)%3 is
+// e[i](p) / area2. `flipped` says whether the input was clockwise (two vertices swapped).
+struct TriSetup {
+    int32_t x[3], y[3];          // fixed point
+    Edge e[3];
+    int64_t area2 = 0;           // twice the area in fixed units^2 (> 0)
+    int minX = 0, minY = 0, maxX = -1, maxY = -1;   // pixel bbox, inclusive, inside the viewport
+    bool flipped = false;
+    uint8_t order[3] = {0, 1, 2};   // input vertex index of each setup vertex
+};
+
+inline int32_t toFixed(float v) { return int32_t(std::lround(double(v) * kSub)); }
+
+// Sets up the triangle with window-space vertices (x, y) for a width x height viewport.
+// Returns false when it is degenerate (zero area) or its bounding box misses every pixel
+// centre (or sample, with `msaa`). Coordinates must lie within the guard band.
+inline bool setupTriangle(const float wx[3], const float wy[3], int width, int height, TriSetup& t, bool msaa = false) {
+    int32_t x[3], y[3];
+    for (int i = 0; i < 3; ++i) { x[i] = toFixed(wx[i]); y[i] = toFixed(wy[i]); }
+    int64_t area = int64_t(x[1] - x[0]) * (y[2] - y[0]) - int64_t(y[1] - y[0]) * (x[2] - x[0]);
+    if (area == 0) return false;
+    t.flipped = area < 0;
+    if (t.flipped) {   // make it counter-clockwise: swap vertices 1 and 2
+        std::swap(x[1], x[2]);
+        std::swap(y[1], y[2]);
+        t.order[0] = 0; t.order[1] = 2; t.order[2] = 1;
+        area = -area;
+    } else {
+        t.order[0] = 0; t.order[1] = 1; t.order[2] = 2;
+    }
+    t.area2 = area;
+    for (int i = 0; i < 3; ++i) { t.x[i] = x[i]; t.y[i] = y[i]; }
+    // Pixel bbox: samples at i*kSub + offset; with MSAA the offsets span [32, 224].
+    int32_t lo = msaa ? 32 : kHalf, hi = msaa ? 224 : kHalf;
+    int32_t fx0 = std::min({x[0], x[1], x[2]}), fx1 = std::max({x[0], x[1], x[2]});
+    int32_t fy0 = std::min({y[0], y[1], y[2]}), fy1 = std::max({y[0], y[1], y[2]});
+    // smallest i with i*kSub + hi >= fx0 ; largest i with i*kSub + lo <= fx1
+    auto ceilDiv = [](int64_t a, int64_t b) { return a >= 0 ? (a + b - 1) / b : -((-a) / b); };
+    auto floorDiv = [](int64_t a, int64_t b) { return a >= 0 ? a / b : -((-a + b - 1) / b); };
+    t.minX = int(std::max<int64_t>(0, ceilDiv(int64_t(fx0) - hi, kSub)));
+    t.maxX = int(std::min<int64_t>(width - 1, floorDiv(int64_t(fx1) - lo, kSub)));
+    t.minY = int(std::max<int64_t>(0, ceilDiv(int64_t(fy0) - hi, kSub)));
+    t.maxY = int(std::min<int64_t>(height - 1, floorDiv(int64_t(fy1) - lo, kSub)));
+    if (t.minX > t.maxX || t.minY > t.maxY) return false;
+    for (int i = 0; i < 3; ++i) {
+        int j = (i + 1) % 3;
+        int64_t dx = int64_t(x[j]) - x[i], dy = int64_t(y[j]) - y[i];
+        Edge& e = t.e[i];
+        e.a = -dy;
+        e.b = dx;
+        e.c = dy * x[i] - dx * y[i];
+        // Top-left rule (y up, CCW): left edges run downward, top edges run in -x.
+        bool topLeft = dy < 0 || (dy == 0 && dx < 0);
+        e.bias = topLeft ? 0 : 1;
+    }
+    return true;
+}
+
+// ---------------------------------------------------------------------------------------
+// 2. Coverage iteration
+// ---------------------------------------------------------------------------------------
+
+// Calls fn(i, j) for every pixel whose centre the triangle covers inside the rectangle
+// [x0, x1] x [y0, y1] (inclusive, pixels). Rows are walked with incremental edge values.
+template <class Fn>
+inline void forEachCoveredPixel(const TriSetup& t, int x0, int y0, int x1, int y1, Fn&& fn) {
+    x0 = std::max(x0, t.minX); x1 = std::min(x1, t.maxX);
+    y0 = std::max(y0, t.minY); y1 = std::min(y1, t.maxY);
+    if (x0 > x1 || y0 > y1) return;
+    int64_t px = int64_t(x0) * kSub + kHalf, py = int64_t(y0) * kSub + kHalf;
+    int64_t r0 = t.e[0].at(px, py) - t.e[0].bias, r1 = t.e[1].at(px, py) - t.e[1].bias, r2 = t.e[2].at(px, py) - t.e[2].bias;
+    const int64_t sx0 = t.e[0].a * kSub, sx1 = t.e[1].a * kSub, sx2 = t.e[2].a * kSub;
+    const int64_t sy0 = t.e[0].b * kSub, sy1 = t.e[1].b * kSub, sy2 = t.e[2].b * kSub;
+    for (int j = y0; j <= y1; ++j, r0 += sy0, r1 += sy1, r2 += sy2) {
+        int64_t e0 = r0, e1 = r1, e2 = r2;
+        for (int i = x0; i <= x1; ++i, e0 += sx0, e1 += sx1, e2 += sx2)
+            if ((e0 | e1 | e2) >= 0) fn(i, j);
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// 3. Clipping in homogeneous clip space
+// ---------------------------------------------------------------------------------------
+
+// Outcode bits: near (z < -w), far (z > w), and the four guard-band planes |x|,|y| <= g*w.
+// Triangles whose vertices have no bits set need no clipping; near and far are clipped
+// exactly, x and y only outside the guard band (the viewport scissor does the rest).
+enum : uint8_t { kClipNear = 1, kClipFar = 2, kClipLeft = 4, kClipRight = 8, kClipBottom = 16, kClipTop = 32 };
+
+struct GuardBand { float gx = 1, gy = 1; };
+inline GuardBand guardBand(int width, int height) {
+    return {1.0f + 2.0f * kGuardPixels / std::max(width, 1), 1.0f + 2.0f * kGuardPixels / std::max(height, 1)};
+}
+
+inline uint8_t outcode(const sg::vec4& c, const GuardBand& g) {
+    uint8_t o = 0;
+    if (!(c.z >= -c.w)) o |= kClipNear;   // also catches NaN
+    if (!(c.z <= c.w)) o |= kClipFar;
+    if (c.x < -g.gx * c.w) o |= kClipLeft;
+    if (c.x > g.gx * c.w) o |= kClipRight;
+    if (c.y < -g.gy * c.w) o |= kClipBottom;
+    if (c.y > g.gy * c.w) o |= kClipTop;
+    return o;
+}
+
+// A clipped polygon vertex: clip position and barycentric weights w.r.t. the input triangle.
+struct ClipVertex {
+    sg::vec4 clip;
+    sg::vec3 bary;
+};
+
+// Clips triangle (c0, c1, c2) against the planes in `planes` (outcode bits) with
+// Sutherland-Hodgman; writes up to 9 vertices to out and returns their count (0 = gone).
+inline int clipTriangle(const sg::vec4 c[3], uint8_t planes, const GuardBand& g, ClipVertex out[9]) {
+    ClipVertex bufA[9], bufB[9];
+    ClipVertex* in = bufA;
+    ClipVertex* res = bufB;
+    int n = 3;
+    in[0] = {c[0], {1, 0, 0}};
+    in[1] = {c[1], {0, 1, 0}};
+    in[2] = {c[2], {0, 0, 1}};
+    auto dist = [&](int plane, const sg::vec4& v) -> float {
+        switch (plane) {
+        case kClipNear: return v.z + v.w;
+        case kClipFar: return v.w - v.z;
+        case kClipLeft: return v.x + g.gx * v.w;
+        case kClipRight: return g.gx * v.w - v.x;
+        case kClipBottom: return v.y + g.gy * v.w;
+        default: return g.gy * v.w - v.y;
+        }
+    };
+    for (uint8_t plane = 1; plane <= kClipTop && n > 0; plane <<= 1) {
+        if (!(planes & plane)) continue;
+        int m = 0;
+        for (int i = 0; i < n; ++i) {
+            const ClipVertex& a = in[i];
+            const ClipVertex& b = in[(i + 1) % n];
+            float da = dist(plane, a.clip), db = dist(plane, b.clip);
+            if (da >= 0) res[m++] = a;
+            if ((da >= 0) != (db >= 0)) {
+                float t = da / (da - db);   // intersection, linear in clip space
+                res[m++] = {a.clip + t * (b.clip - a.clip), a.bary + t * (b.bary - a.bary)};
+            }
+            if (m >= 9) break;
+        }
+        std::swap(in, res);
+        n = m;
+    }
+    for (int i = 0; i < n; ++i) out[i] = in[i];
+    return n < 3 ? 0 : n;
+}
+
+// Window coordinates (x, y, z, 1/w) of a clip-space position for a width x height viewport.
+inline sg::vec4 toWindow(const sg::vec4& c, int width, int height) {
+    float iw = 1.0f / c.w;
+    return {(c.x * iw * 0.5f + 0.5f) * width, (c.y * iw * 0.5f + 0.5f) * height, c.z * iw * 0.5f + 0.5f, iw};
+}
+
+// ---------------------------------------------------------------------------------------
+// 4. Lines: DDA (seeds: "Digital Differential Analyzer") over window coordinates
+// ---------------------------------------------------------------------------------------
+
+// Calls fn(i, j, t) for the pixels of the segment a -> b (window coordinates), stepping one
+// pixel along the major axis; t in [0,1] is the position along the segment (for depth and
+// colour interpolation). Pixels outside [0,w) x [0,h) are skipped.
+template <class Fn>
+inline void drawLineDDA(float ax, float ay, float bx, float by, int width, int height, Fn&& fn) {
+    float dx = bx - ax, dy = by - ay;
+    float len = std::max(std::fabs(dx), std::fabs(dy));
+    if (!(len < 1e6f)) return;   // non-finite or absurd
+    int steps = std::max(1, int(std::ceil(len)));
+    float sx = dx / steps, sy = dy / steps;
+    float x = ax, y = ay;
+    for (int k = 0; k <= steps; ++k, x += sx, y += sy) {
+        int i = int(std::floor(x)), j = int(std::floor(y));
+        if (i >= 0 && j >= 0 && i < width && j < height) fn(i, j, float(k) / steps);
+    }
+}
+
+}  // namespace rnd::raster

@@ -1,0 +1,34 @@
+// raster_texture.h - texture sampling for the CPU rasterizer, following GL: sRGB texels are
+// decoded to linear before filtering (as GL_SRGB8_ALPHA8 textures are), texel centres at
+// +0.5, wrap modes REPEAT / CLAMP_TO_EDGE / MIRRORED_REPEAT, NEAREST, LINEAR, and
+// LINEAR_MIPMAP_LINEAR with a mip chain built like glGenerateMipmap (2x2 box in linear,
+// stored back as 8-bit sRGB). Texture rows are stored top-down in sg::Texture (row 0 = v 1);
+// levels here are kept bottom-up so that texel row r covers t in [r/h, (r+1)/h] as in GL.
+#pragma once
+
+#include "scenegraph/mesh.h"
+
+#include <memory>
+#include <vector>
+
+namespace rnd::raster {
+
+class SampledTexture {
+public:
+    explicit SampledTexture(const sg::Texture& t);
+    // Linear RGB at (u, v) with the screen-space derivatives of (u, v) (for the mip level).
+    sg::vec3 sample(sg::vec2 uv, sg::vec2 dUVdx, sg::vec2 dUVdy) const;
+    sg::vec3 sampleLevel(sg::vec2 uv, int level, bool bilinear) const;
+    int levels() const { return int(m_levels.size()); }
+
+private:
+    struct Level {
+        int w = 0, h = 0;
+        std::vector<sg::vec3> texels;   // linear RGB, bottom-up rows
+    };
+    std::vector<Level> m_levels;
+    sg::WrapMode m_wrapS, m_wrapT;
+    sg::FilterMode m_filter;
+};
+
+}  // namespace rnd::raster

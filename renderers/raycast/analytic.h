@@ -1,0 +1,99 @@
+// analytic.h - exact ray intersection with the analytic drawables (seeds 2.1-2.3, 2.6):
+// implicit shapes as solids (ray intervals inside the solid, with which surface bounds each
+// end), CSG by combining leaf intervals, parametric surfaces by Newton iteration from bounded
+// starts, density grids by marching + bisection on the trilinear field.
+//
+// Sections: Span (intervals), implicit shapes, CSG, parametric, density grid.
+// All functions take rays in the shape's local frame unless they say "world".
+#pragma once
+
+#include "raycast/bvh.h"
+#include "scenegraph/frame.h"
+
+#include <memory>
+#include <vector>
+
+namespace rnd::rt {
+
+// One end of an interval: distance, and which surface it lies on (for the normal).
+struct Bound {
+    float t = 0;
+    uint8_t tag = 0;       // kTagSurface: the curved surface (gradient); kTagFace + 2*axis + (positive): box face
+    uint8_t flip = 0;      // CSG: 1 = the normal points into the solid (carved face of a cutter)
+    int16_t leaf = -1;     // CSG leaf index (else -1)
+};
+constexpr uint8_t kTagSurface = 0;
+constexpr uint8_t kTagFace = 1;
+
+// [in, out] along the ray where the point is inside the solid (in.t may be -inf, out.t +inf).
+struct Span {
+    Bound in, out;
+};
+
+// Small fixed-capacity interval list (a torus gives 2, a quadric 2 after clipping, CSG more).
+struct SpanList {
+    static constexpr int kCapacity = 32;
+    Span s[kCapacity];
+    int n = 0;
+    void push(const Span& x) { if (n < kCapacity) s[n++] = x; }
+};
+
+// --- implicit shapes -----------------------------------------------------------------------
+
+// Intervals where the (local) ray is inside the solid, sorted, for t in (-inf, inf).
+// Plane: the half space y <= 0. Returns the number of spans.
+void implicitSpans(const sg::ImplicitShape& shape, const Ray& localRay, SpanList& out);
+// Outward local normal at local point p for a boundary with the given tag.
+sg::vec3 implicitNormal(const sg::ImplicitShape& shape, const sg::vec3& p, uint8_t tag);
+
+// Closest surface crossing in (ray.tmin, ray.tmax): the first span end in range.
+// Returns false when none; sets t and the bound.
+bool firstBoundary(const SpanList& spans, float tmin, float tmax, Bound& hit);
+
+// Real roots of sum c[i] t^i (degree <= 4) in [lo, hi], ascending (sign changes only, so a
+// tangent double root may be missed). Returns the count. Used for the torus quartic.
+int polyRoots(const double* c, int degree, double lo, double hi, double* roots);
+
+// --- CSG -------------------------------------------------------------------------------------
+
+// Intervals of the world-space ray inside the CSG tree (leaves intersected in their own frames).
+void csgSpans(const sg::CsgTree& tree, const Ray& worldRay, SpanList& out);
+
+// --- parametric surfaces --------------------------------------------------------------------
+
+// Precomputed sub-patches with bounding boxes (in a Bvh4) for Newton starts.
+class ParametricAccel {
+public:
+    explicit ParametricAccel(const sg::ParametricSurface& s);
+    // Closest hit of the local ray in (tmin, tmax): t and (u, v).
+    bool intersect(const Ray& localRay, float& t, float& u, float& v) const;
+    const sg::ParametricSurface& surface() const { return m_surface; }
+private:
+    sg::ParametricSurface m_surface;
+    int m_nu = 8, m_nv = 8;
+    std::vector<sg::vec3> m_boxMin, m_boxMax;
+    Bvh4 m_bvh;
+};
+
+// --- density grids ---------------------------------------------------------------------------
+
+// Min/max of the field per block of cells, to skip blocks that cannot hold the iso-surface.
+class GridAccel {
+public:
+    explicit GridAccel(std::shared_ptr<const sg::DensityGrid> g);
+    // First crossing of the iso-surface along the local ray in (tmin, tmax).
+    bool intersect(const Ray& localRay, float& t) const;
+    // Outward normal (-gradient: inside is value > iso).
+    sg::vec3 normal(const sg::vec3& p) const;
+    const sg::DensityGrid& grid() const { return *m_grid; }
+private:
+    std::shared_ptr<const sg::DensityGrid> m_grid;
+    bool m_valid = false;
+    static constexpr int kBlock = 4;
+    sg::ivec3 m_blocks{0};
+    std::vector<float> m_blockMin, m_blockMax;
+    sg::vec3 m_cell{1.0f};
+    bool blockMayCross(const sg::vec3& p) const;
+};
+
+}  // namespace rnd::rt

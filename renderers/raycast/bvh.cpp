@@ -1,0 +1,448 @@
+// bvh.cpp - BVH4 construction (binned SAH, top-down, oneTBB tasks for big subtrees) and the
+// triangle packet tests.
+//
+// Sections: PrimRef + binning, node building, Bvh4::build, TriangleBvh, brute force.
+//
+// Build: every primitive becomes a PrimRef (box + id). A node starts with its whole range as
+// one child and repeatedly splits the child with the largest surface area (binned SAH over all
+// three axes, 16 bins, cost counted in blocks of 4 primitives since leaves are 4-packets) until
+// it has 4 children or none can be split. Ranges of <= maxLeafSize primitives become leaves.
+#include "raycast/bvh.h"
+
+#include <tbb/task_group.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+#include <tbb/blocked_range.h>
+
+#include <immintrin.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <atomic>
+#include <cstring>
+#include <memory>
+
+namespace rnd::rt {
+
+using sg::vec3;
+
+namespace {
+
+// --- PrimRef + binning ----------------------------------------------------------------------
+
+struct alignas(16) PrimRef {
+    __m128 lo, hi;   // lo.w holds the primitive id (bit pattern)
+    uint32_t id() const { uint32_t i; float f = _mm_cvtss_f32(_mm_shuffle_ps(lo, lo, _MM_SHUFFLE(3, 3, 3, 3))); std::memcpy(&i, &f, 4); return i; }
+    __m128 center2() const { return _mm_add_ps(lo, hi); }   // 2 x centroid
+};
+
+inline PrimRef makeRef(const vec3& mn, const vec3& mx, uint32_t id) {
+    float f;
+    std::memcpy(&f, &id, 4);
+    return {_mm_setr_ps(mn.x, mn.y, mn.z, f), _mm_setr_ps(mx.x, mx.y, mx.z, 0.0f)};
+}
+
+struct Box {
+    __m128 lo = _mm_set1_ps(std::numeric_limits<float>::infinity());
+    __m128 hi = _mm_set1_ps(-std::numeric_limits<float>::infinity());
+    void extend(__m128 l, __m128 h) { lo = _mm_min_ps(lo, l); hi = _mm_max_ps(hi, h); }
+    void extend(const Box& b) { extend(b.lo, b.hi); }
+    float halfArea() const {
+        alignas(16) float e[4];
+        _mm_store_ps(e, _mm_sub_ps(hi, lo));
+        if (e[0] < 0 || e[1] < 0 || e[2] < 0) return 0.0f;
+        return e[0] * e[1] + e[1] * e[2] + e[2] * e[0];
+    }
+};
+
+struct Range {
+    uint32_t begin = 0, end = 0;
+    Box bounds;      // of the primitives
+    Box centroids;   // of 2 x centroids
+    uint32_t count() const { return end - begin; }
+};
+
+// Bounds and centroid bounds of refs[begin, end).
+void computeBounds(const PrimRef* refs, Range& r) {
+    Box b, c;
+    for (uint32_t i = r.begin; i < r.end; ++i) {
+        b.extend(refs[i].lo, refs[i].hi);
+        __m128 cc = refs[i].center2();
+        c.extend(cc, cc);
+    }
+    // lo.w contains ids: clear it so bounds stay meaningful in xyz (w is ignored anyway).
+    r.bounds = b;
+    r.centroids = c;
+}
+
+constexpr int kMaxBins = 32;
+
+inline int blocks(uint32_t n, int leafSize) { return int((n + uint32_t(leafSize) - 1) / uint32_t(leafSize)); }
+
+// Splits r into l and rr (binned SAH); returns false when r should stay a leaf.
+bool splitRange(PrimRef* refs, const Range& r, Range& l, Range& rr, int nbins, int leafSize, bool forceMedian) {
+    const uint32_t n = r.count();
+    alignas(16) float cmin[4], cmax[4];
+    _mm_store_ps(cmin, r.centroids.lo);
+    _mm_store_ps(cmax, r.centroids.hi);
+    float ext[3] = {cmax[0] - cmin[0], cmax[1] - cmin[1], cmax[2] - cmin[2]};
+
+    int bestAxis = -1, bestPos = 0;
+    float bestCost = std::numeric_limits<float>::infinity();
+    float scale[3];
+    if (!forceMedian) {
+        Box bins[3][kMaxBins];
+        uint32_t counts[3][kMaxBins] = {};
+        for (int a = 0; a < 3; ++a) scale[a] = ext[a] > 0 ? float(nbins) * 0.99999f / ext[a] : 0.0f;
+        const __m128 sc = _mm_setr_ps(scale[0], scale[1], scale[2], 0.0f);
+        const __m128 cm = r.centroids.lo;
+        const __m128i maxBin = _mm_set1_epi32(nbins - 1);
+        for (uint32_t i = r.begin; i < r.end; ++i) {
+            const PrimRef& p = refs[i];
+            __m128i bi = _mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(p.center2(), cm), sc));
+            // clamp to [0, nbins-1] (SSE2 has no min_epi32: compare and blend)
+            __m128i gt = _mm_cmpgt_epi32(bi, maxBin);
+            bi = _mm_or_si128(_mm_and_si128(gt, maxBin), _mm_andnot_si128(gt, bi));
+            bi = _mm_and_si128(bi, _mm_cmpgt_epi32(bi, _mm_set1_epi32(-1)));
+            alignas(16) int b[4];
+            _mm_store_si128(reinterpret_cast<__m128i*>(b), bi);
+            bins[0][b[0]].extend(p.lo, p.hi); ++counts[0][b[0]];
+            bins[1][b[1]].extend(p.lo, p.hi); ++counts[1][b[1]];
+            bins[2][b[2]].extend(p.lo, p.hi); ++counts[2][b[2]];
+        }
+        for (int a = 0; a < 3; ++a) {
+            if (!(ext[a] > 0)) continue;
+            float rightArea[kMaxBins];
+            uint32_t rightCount[kMaxBins];
+            Box acc;
+            uint32_t cnt = 0;
+            for (int i = nbins - 1; i > 0; --i) {
+                acc.extend(bins[a][i]);
+                cnt += counts[a][i];
+                rightArea[i] = acc.halfArea();
+                rightCount[i] = cnt;
+            }
+            acc = Box();
+            cnt = 0;
+            for (int i = 1; i < nbins; ++i) {
+                acc.extend(bins[a][i - 1]);
+                cnt += counts[a][i - 1];
+                if (cnt == 0 || rightCount[i] == 0) continue;
+                float cost = acc.halfArea() * float(blocks(cnt, leafSize)) + rightArea[i] * float(blocks(rightCount[i], leafSize));
+                if (cost < bestCost) { bestCost = cost; bestAxis = a; bestPos = i; }
+            }
+        }
+    }
+
+    uint32_t mid;
+    if (bestAxis >= 0) {
+        const float cm = cmin[bestAxis], s = scale[bestAxis];
+        const int a = bestAxis, pos = bestPos;
+        PrimRef* m = std::partition(refs + r.begin, refs + r.end, [&](const PrimRef& p) {
+            alignas(16) float c[4];
+            _mm_store_ps(c, p.center2());
+            int b = std::min(int((c[a] - cm) * s), nbins - 1);
+            return b < pos;
+        });
+        mid = uint32_t(m - refs);
+        if (mid == r.begin || mid == r.end) mid = r.begin + n / 2;   // numerical corner case
+    } else {
+        // All centroids coincide (or median forced): split by order along the widest axis.
+        int a = ext[0] >= ext[1] ? (ext[0] >= ext[2] ? 0 : 2) : (ext[1] >= ext[2] ? 1 : 2);
+        mid = r.begin + n / 2;
+        if (ext[a] > 0)
+            std::nth_element(refs + r.begin, refs + mid, refs + r.end, [a](const PrimRef& x, const PrimRef& y) {
+                alignas(16) float cx[4], cy[4];
+                _mm_store_ps(cx, x.center2());
+                _mm_store_ps(cy, y.center2());
+                return cx[a] < cy[a];
+            });
+    }
+    l.begin = r.begin; l.end = mid;
+    rr.begin = mid; rr.end = r.end;
+    computeBounds(refs, l);
+    computeBounds(refs, rr);
+    return true;
+}
+
+// --- node building ----------------------------------------------------------------------------
+
+template <int W> struct Builder {
+    using Node = NodeW<W>;
+    PrimRef* refs;
+    Node* nodes;
+    std::atomic<uint32_t> nodeCount{0};
+    int nbins, leafSize;
+    bool parallel;
+
+    static void setEmpty(Node& n, int i) {
+        n.b[0][i] = n.b[2][i] = n.b[4][i] = std::numeric_limits<float>::infinity();
+        n.b[1][i] = n.b[3][i] = n.b[5][i] = -std::numeric_limits<float>::infinity();
+        n.child[i] = Node4::kEmpty;
+    }
+    static void setBounds(Node& n, int i, const Box& b) {
+        alignas(16) float lo[4], hi[4];
+        _mm_store_ps(lo, b.lo);
+        _mm_store_ps(hi, b.hi);
+        n.b[0][i] = lo[0]; n.b[1][i] = hi[0];
+        n.b[2][i] = lo[1]; n.b[3][i] = hi[1];
+        n.b[4][i] = lo[2]; n.b[5][i] = hi[2];
+    }
+    static uint32_t leafRef(const Range& r) { return Node4::kLeafBit | (r.begin << 3) | r.count(); }
+
+    // Builds the subtree for r into node slot `index` (already allocated).
+    void buildInner(uint32_t index, const Range& r, int depth) {
+        Range kids[W];
+        int nk = 1;
+        kids[0] = r;
+        bool forceMedian = depth > 40;   // keeps the depth (and traversal stack) bounded
+        while (nk < W) {
+            int best = -1;
+            float bestArea = -1;
+            for (int i = 0; i < nk; ++i)
+                if (kids[i].count() > uint32_t(leafSize)) {
+                    float a = kids[i].bounds.halfArea();
+                    if (a > bestArea) { bestArea = a; best = i; }
+                }
+            if (best < 0) break;
+            Range a, b;
+            splitRange(refs, kids[best], a, b, nbins, leafSize, forceMedian);
+            kids[best] = a;
+            kids[nk++] = b;
+        }
+        Node& node = nodes[index];
+        uint32_t childIndex[W];
+        for (int i = 0; i < W; ++i) {
+            if (i >= nk) { setEmpty(node, i); continue; }
+            setBounds(node, i, kids[i].bounds);
+            if (kids[i].count() <= uint32_t(leafSize)) {
+                node.child[i] = leafRef(kids[i]);
+                childIndex[i] = ~0u;
+            } else {
+                childIndex[i] = nodeCount.fetch_add(1, std::memory_order_relaxed);
+                node.child[i] = childIndex[i];
+            }
+        }
+        bool spawn = false;
+        if (parallel)
+            for (int i = 0; i < nk; ++i) spawn |= childIndex[i] != ~0u && kids[i].count() > 4096;
+        if (spawn) {
+            tbb::task_group tg;
+            for (int i = 0; i < nk; ++i)
+                if (childIndex[i] != ~0u) {
+                    Range k = kids[i];
+                    uint32_t ci = childIndex[i];
+                    tg.run([this, ci, k, depth] { buildInner(ci, k, depth + 1); });
+                }
+            tg.wait();
+        } else {
+            for (int i = 0; i < nk; ++i)
+                if (childIndex[i] != ~0u) buildInner(childIndex[i], kids[i], depth + 1);
+        }
+    }
+};
+
+template <int W> int subtreeDepth(const std::vector<NodeW<W>>& nodes, uint32_t ref) {
+    if (ref & Node4::kLeafBit) return 0;
+    int d = 0;
+    for (uint32_t c : nodes[ref].child)
+        if (c != Node4::kEmpty) d = std::max(d, subtreeDepth(nodes, c));
+    return d + 1;
+}
+
+}  // namespace
+
+// --- Bvh4::build ------------------------------------------------------------------------------
+
+namespace detail {
+// Builds from prepared refs (shared by Bvh4::build and TriangleBvh::build).
+template <int W>
+void buildFromRefs(std::vector<PrimRef>& refs, const Bvh4::BuildOptions& opt, std::vector<NodeW<W>>& outNodes,
+                   std::vector<uint32_t>& outPrims, sg::Aabb& outBounds) {
+    outNodes.clear();
+    outPrims.clear();
+    outBounds = sg::Aabb();
+    const size_t n = refs.size();
+    if (n == 0) return;
+    const int leafSize = std::clamp(opt.maxLeafSize, 1, 4);
+    const int nbins = std::clamp(opt.bins, 2, kMaxBins);
+
+    Range root;
+    root.begin = 0;
+    root.end = uint32_t(n);
+    if (n > 65536) {
+        struct Acc { Box b, c; };
+        Acc acc = tbb::parallel_reduce(
+            tbb::blocked_range<size_t>(0, n, 16384), Acc{},
+            [&](const tbb::blocked_range<size_t>& br, Acc a) {
+                for (size_t i = br.begin(); i < br.end(); ++i) {
+                    a.b.extend(refs[i].lo, refs[i].hi);
+                    __m128 cc = refs[i].center2();
+                    a.c.extend(cc, cc);
+                }
+                return a;
+            },
+            [](Acc x, const Acc& y) { x.b.extend(y.b); x.c.extend(y.c); return x; });
+        root.bounds = acc.b;
+        root.centroids = acc.c;
+    } else {
+        computeBounds(refs.data(), root);
+    }
+
+    // Inner nodes <= primitives (every inner node has >= 2 children); +1 for a wrapped leaf.
+    std::unique_ptr<NodeW<W>[]> storage(new NodeW<W>[n + 1]);
+    Builder<W> b{refs.data(), storage.get(), {}, nbins, leafSize, opt.parallel};
+    b.nodeCount = 1;
+    if (root.count() <= uint32_t(leafSize)) {
+        NodeW<W>& r = storage[0];
+        for (int i = 0; i < W; ++i) Builder<W>::setEmpty(r, i);
+        Builder<W>::setBounds(r, 0, root.bounds);
+        r.child[0] = Builder<W>::leafRef(root);
+    } else {
+        b.buildInner(0, root, 0);
+    }
+    const uint32_t count = b.nodeCount.load();
+    outNodes.assign(storage.get(), storage.get() + count);
+    outPrims.resize(n);
+    for (size_t i = 0; i < n; ++i) outPrims[i] = refs[i].id();
+    alignas(16) float lo[4], hi[4];
+    _mm_store_ps(lo, root.bounds.lo);
+    _mm_store_ps(hi, root.bounds.hi);
+    outBounds = {vec3(lo[0], lo[1], lo[2]), vec3(hi[0], hi[1], hi[2])};
+}
+}  // namespace detail
+
+void Bvh4::build(const vec3* boxMin, const vec3* boxMax, size_t n, const BuildOptions& opt) {
+    std::vector<PrimRef> refs;
+    refs.reserve(n);
+    for (size_t i = 0; i < n; ++i) {
+        const vec3 &mn = boxMin[i], &mx = boxMax[i];
+        if (!(mn.x <= mx.x && mn.y <= mx.y && mn.z <= mx.z) || !sg::isFinite(mn) || !sg::isFinite(mx)) continue;
+        refs.push_back(makeRef(mn, mx, uint32_t(i)));
+    }
+    detail::buildFromRefs<4>(refs, opt, m_nodes, m_primIndex, m_bounds);
+}
+
+int Bvh4::depth() const { return m_nodes.empty() ? 0 : subtreeDepth<4>(m_nodes, 0); }
+
+namespace {
+// Packet lane k from triangle p0, p1, p2.
+// noinline: the AVX2 brute force must build lanes bit-identically to the (SSE-compiled) build.
+__attribute__((noinline)) void setLane(TriPacket4& p, int k, const vec3& p0, const vec3& p1, const vec3& p2) {
+    vec3 e1 = p1 - p0, e2 = p2 - p0, n = glm::cross(e1, e2);
+    for (int a = 0; a < 3; ++a) { p.v0[a][k] = p0[a]; p.e1[a][k] = e1[a]; p.e2[a][k] = e2[a]; p.n[a][k] = n[a]; }
+}
+}  // namespace
+
+namespace {
+// One packet per leaf, in node order; leaf refs are rewritten to packet indices.
+template <int W>
+void makePackets(std::vector<NodeW<W>>& nodes, const std::vector<uint32_t>& prims, const vec3* pos, const uint32_t* idx,
+                 std::vector<TriPacket4>& packets) {
+    packets.reserve(prims.size() / 2 + 1);
+    for (NodeW<W>& n : nodes)
+        for (uint32_t& c : n.child) {
+            if (c == NodeBits::kEmpty || !(c & NodeBits::kLeafBit)) continue;
+            uint32_t first = (c & ~NodeBits::kLeafBit) >> 3, count = c & 7u;
+            TriPacket4 p{};
+            for (uint32_t k = 0; k < 4; ++k) {
+                if (k >= count) { p.prim[k] = ~0u; continue; }
+                uint32_t t = prims[first + k];
+                setLane(p, int(k), pos[idx[3 * t]], pos[idx[3 * t + 1]], pos[idx[3 * t + 2]]);
+                p.prim[k] = t;
+            }
+            c = NodeBits::kLeafBit | (uint32_t(packets.size()) << 3) | count;
+            packets.push_back(p);
+        }
+}
+int kernelWidth();
+}  // namespace
+
+// --- TriangleBvh ------------------------------------------------------------------------------
+
+void TriangleBvh::build(const vec3* pos, const uint32_t* idx, size_t triCount, const Bvh4::BuildOptions& opt) {
+    std::vector<PrimRef> refs(triCount);
+    std::vector<uint8_t> ok(triCount);
+    auto makeRange = [&](size_t b, size_t e) {
+        for (size_t t = b; t < e; ++t) {
+            const vec3 &p0 = pos[idx[3 * t]], &p1 = pos[idx[3 * t + 1]], &p2 = pos[idx[3 * t + 2]];
+            vec3 mn = glm::min(p0, glm::min(p1, p2)), mx = glm::max(p0, glm::max(p1, p2));
+            ok[t] = sg::isFinite(mn) && sg::isFinite(mx);
+            refs[t] = makeRef(mn, mx, uint32_t(t));
+        }
+    };
+    if (opt.parallel && triCount > 65536)
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, triCount, 16384),
+                          [&](const tbb::blocked_range<size_t>& r) { makeRange(r.begin(), r.end()); });
+    else
+        makeRange(0, triCount);
+    // Drop non-finite triangles (keeps the tree sane on bad input).
+    size_t w = 0;
+    for (size_t t = 0; t < triCount; ++t)
+        if (ok[t]) refs[w++] = refs[t];
+    refs.resize(w);
+
+    std::vector<uint32_t> prims;
+    m_nodes4.clear();
+    m_nodes8.clear();
+    m_packets.clear();
+    if (kernelWidth() == 8) {
+        detail::buildFromRefs<8>(refs, opt, m_nodes8, prims, m_bounds);
+        makePackets(m_nodes8, prims, pos, idx, m_packets);
+    } else {
+        detail::buildFromRefs<4>(refs, opt, m_nodes4, prims, m_bounds);
+        makePackets(m_nodes4, prims, pos, idx, m_packets);
+    }
+}
+
+// --- kernels: SSE and AVX2+FMA builds of tri_kernel.inl, chosen once at run time ------------
+
+namespace kern_sse {
+#define RT_FMA 0
+#include "raycast/tri_kernel.inl"
+#undef RT_FMA
+}  // namespace kern_sse
+
+#pragma GCC push_options
+#pragma GCC target("avx2,fma")
+namespace kern_avx2 {
+#define RT_FMA 1
+#include "raycast/tri_kernel.inl"
+#undef RT_FMA
+}  // namespace kern_avx2
+#pragma GCC pop_options
+
+namespace {
+const bool kUseAvx2 = [] {
+    if (const char* e = std::getenv("VIEWER_RAYCAST_SSE")) return !(e[0] == '1');   // force the SSE path
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+}();
+}  // namespace
+
+const char* kernelName() { return kUseAvx2 ? "avx2+fma bvh8" : "sse bvh4"; }
+namespace {
+int kernelWidth() { return kUseAvx2 ? 8 : 4; }
+}  // namespace
+
+bool TriangleBvh::intersect(const Ray& ray, TriHit& hit) const {
+    if (m_packets.empty()) return false;
+    if (!m_nodes8.empty()) return kern_avx2::traceTriangles8<false>(m_nodes8.data(), m_packets.data(), ray, &hit);
+    return kUseAvx2 ? kern_avx2::traceTriangles<false>(m_nodes4.data(), m_packets.data(), ray, &hit)
+                    : kern_sse::traceTriangles<false>(m_nodes4.data(), m_packets.data(), ray, &hit);
+}
+
+bool TriangleBvh::occluded(const Ray& ray) const {
+    if (m_packets.empty()) return false;
+    if (!m_nodes8.empty()) return kern_avx2::traceTriangles8<true>(m_nodes8.data(), m_packets.data(), ray, nullptr);
+    return kUseAvx2 ? kern_avx2::traceTriangles<true>(m_nodes4.data(), m_packets.data(), ray, nullptr)
+                    : kern_sse::traceTriangles<true>(m_nodes4.data(), m_packets.data(), ray, nullptr);
+}
+
+// --- brute force ------------------------------------------------------------------------------
+
+bool intersectBruteForce(const vec3* pos, const uint32_t* idx, size_t triCount, const Ray& ray, TriHit& hit) {
+    return kUseAvx2 ? kern_avx2::bruteForce(pos, idx, triCount, ray, hit) : kern_sse::bruteForce(pos, idx, triCount, ray, hit);
+}
+
+}  // namespace rnd::rt

@@ -1,0 +1,137 @@
+// bvh.h - the ray caster's acceleration structure: a 4-wide bounding volume hierarchy (BVH4)
+// built with binned SAH, traversed front to back with SSE box tests (4 children at once), and
+// a triangle BVH whose leaves are packets of 4 precomputed triangles tested at once with SSE
+// (Moller-Trumbore, seeds 2.4). Used for the per-mesh BVHs (object space), for the top level
+// over instances (TLAS), and by the benchmark against Embree.
+//
+// Sections: Ray/Hit, Bvh4 (generic: boxes in, leaves of up to 4 primitive indices out),
+// TriangleBvh (Bvh4 + triangle packets, closest hit and any hit).
+//
+// What it is not: no packet/stream tracing, no motion blur, no spatial splits.
+#pragma once
+
+#include "scenegraph/math.h"
+
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+namespace rnd::rt {
+
+// A ray segment org + t*dir, t in [tmin, tmax]. dir need not be unit length.
+struct Ray {
+    sg::vec3 org{0.0f};
+    float tmin = 0.0f;
+    sg::vec3 dir{0, 0, -1};
+    float tmax = std::numeric_limits<float>::infinity();
+};
+
+// Closest hit: distance, primitive (triangle index in the mesh) and barycentrics (b1, b2) of
+// p = (1-b1-b2) p0 + b1 p1 + b2 p2.
+struct TriHit {
+    float t = std::numeric_limits<float>::infinity();
+    uint32_t prim = ~0u;
+    float b1 = 0, b2 = 0;
+    bool valid() const { return prim != ~0u; }
+};
+
+// Per-ray data the SIMD box test needs: reciprocal direction, origin * reciprocal and which
+// slab (min or max) is the near one per axis.
+struct RayPre {
+    float org[3], rdir[3], orgRdir[3];
+    int nearX, nearY, nearZ;   // offsets (0 or 1) into Node4::b[axis*2 + ...]
+    explicit RayPre(const Ray& r);
+};
+
+// W-wide node (W = 4 or 8): bounds of up to W children stored SoA (b[0]=minx, b[1]=maxx,
+// b[2]=miny, ...). child[i] >= 0: inner node index. Leaf: kLeafBit | (first << 3) | count,
+// count in 1..4; kEmpty: unused slot (its bounds are empty so it is never entered).
+struct NodeBits {
+    static constexpr uint32_t kLeafBit = 0x80000000u;
+    static constexpr uint32_t kEmpty = 0xffffffffu;
+};
+template <int W> struct alignas(64) NodeW : NodeBits {
+    float b[6][W];
+    uint32_t child[W];
+};
+using Node4 = NodeW<4>;
+using Node8 = NodeW<8>;
+
+// Generic BVH4 over axis-aligned boxes. After build(), primIndex lists the primitives in leaf
+// order; a leaf covers primIndex[first .. first+count).
+class Bvh4 {
+public:
+    struct BuildOptions {
+        int maxLeafSize = 4;       // 1..4
+        int bins = 16;             // SAH bins per axis
+        bool parallel = true;      // oneTBB tasks for big subtrees
+    };
+    // Boxes given as SoA-friendly min/max arrays; n = count. Empty/invalid boxes are skipped.
+    void build(const sg::vec3* boxMin, const sg::vec3* boxMax, size_t n, const BuildOptions& opt);
+    void build(const sg::vec3* boxMin, const sg::vec3* boxMax, size_t n) { build(boxMin, boxMax, n, BuildOptions{}); }
+
+    bool empty() const { return m_nodes.empty(); }
+    const sg::Aabb& bounds() const { return m_bounds; }
+    const std::vector<Node4>& nodes() const { return m_nodes; }
+    std::vector<Node4>& nodes() { return m_nodes; }
+    const std::vector<uint32_t>& primIndex() const { return m_primIndex; }
+    size_t memoryBytes() const { return m_nodes.size() * sizeof(Node4) + m_primIndex.size() * 4; }
+    int depth() const;
+
+    // Front-to-back traversal. leaf(first, count, tmax&) tests a leaf and may shrink tmax;
+    // returns true to stop the traversal (any-hit queries).
+    // AnyHit = true skips the front-to-back sort (any hit ends the query anyway).
+    template <bool AnyHit = false, class LeafFn> void traverse(const Ray& ray, float& tmax, LeafFn&& leaf) const;
+
+private:
+    std::vector<Node4> m_nodes;   // m_nodes[0] is the root (a leaf root is wrapped in a node)
+    std::vector<uint32_t> m_primIndex;
+    sg::Aabb m_bounds;
+};
+
+// Four triangles, SoA: vertex 0, the edges e1 = p1 - p0, e2 = p2 - p0 and the unnormalised
+// normal N = e1 x e2 (precomputed: the test then needs one cross product instead of two).
+struct alignas(16) TriPacket4 {
+    float v0[3][4], e1[3][4], e2[3][4], n[3][4];
+    uint32_t prim[4];   // ~0u = padding
+};
+
+// Triangle BVH whose leaves are single TriPacket4s (leaf "first" = packet index). With the
+// AVX2+FMA kernel it is 8-wide (BVH8, one AVX box test per node), else 4-wide (BVH4, SSE).
+class TriangleBvh {
+public:
+    void build(const sg::vec3* positions, const uint32_t* indices, size_t triangleCount,
+               const Bvh4::BuildOptions& opt);
+    void build(const sg::vec3* positions, const uint32_t* indices, size_t triangleCount) {
+        build(positions, indices, triangleCount, Bvh4::BuildOptions{});
+    }
+    // Closest hit in (ray.tmin, ray.tmax); returns true and fills hit when found.
+    bool intersect(const Ray& ray, TriHit& hit) const;
+    // Any hit in (ray.tmin, ray.tmax).
+    bool occluded(const Ray& ray) const;
+
+    bool empty() const { return m_packets.empty(); }
+    const sg::Aabb& bounds() const { return m_bounds; }
+    size_t memoryBytes() const {
+        return m_nodes4.size() * sizeof(Node4) + m_nodes8.size() * sizeof(Node8) + m_packets.size() * sizeof(TriPacket4);
+    }
+    int width() const { return m_nodes8.empty() ? 4 : 8; }
+
+private:
+    std::vector<Node4> m_nodes4;
+    std::vector<Node8> m_nodes8;
+    std::vector<TriPacket4> m_packets;
+    sg::Aabb m_bounds;
+};
+
+// Which triangle kernel runs: "avx2+fma" (picked at run time when the CPU has it) or "sse"
+// (forced with VIEWER_RAYCAST_SSE=1).
+const char* kernelName();
+
+// Brute-force reference (tests): closest hit over all triangles with the same test.
+bool intersectBruteForce(const sg::vec3* positions, const uint32_t* indices, size_t triangleCount, const Ray& ray,
+                         TriHit& hit);
+
+}  // namespace rnd::rt
+
+#include "raycast/bvh_traverse.inl"

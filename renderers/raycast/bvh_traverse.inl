@@ -1,0 +1,101 @@
+// bvh_traverse.inl - the templated BVH4 traversal (included by bvh.h). Ordered front-to-back:
+// the 4 child boxes are slab-tested at once with SSE (seeds 2.5.1: overlapping slab intervals
+// mean a hit), hit children are sorted by entry distance, the nearest is visited next and the
+// others pushed with their entry distance so they can be skipped once a closer hit is known.
+#pragma once
+
+#include <xmmintrin.h>
+
+namespace rnd::rt {
+
+inline RayPre::RayPre(const Ray& r) {
+    for (int a = 0; a < 3; ++a) {
+        float d = r.dir[a];
+        // A zero component would give 0 * inf = NaN in the slab test: nudge it (the slab
+        // interval then becomes +-huge, the right answer up to a vanishing angle).
+        if (std::abs(d) < 1e-30f) d = std::signbit(d) ? -1e-30f : 1e-30f;
+        org[a] = r.org[a];
+        rdir[a] = 1.0f / d;
+        orgRdir[a] = org[a] * rdir[a];
+    }
+    nearX = r.dir.x < 0 ? 1 : 0;
+    nearY = r.dir.y < 0 ? 1 : 0;
+    nearZ = r.dir.z < 0 ? 1 : 0;
+}
+
+template <bool AnyHit, class LeafFn> void Bvh4::traverse(const Ray& ray, float& tmax, LeafFn&& leaf) const {
+    if (m_nodes.empty()) return;
+    const RayPre pre(ray);
+    const __m128 ox = _mm_set1_ps(pre.org[0]), oy = _mm_set1_ps(pre.org[1]), oz = _mm_set1_ps(pre.org[2]);
+    const __m128 rx = _mm_set1_ps(pre.rdir[0]), ry = _mm_set1_ps(pre.rdir[1]), rz = _mm_set1_ps(pre.rdir[2]);
+    const int nx = pre.nearX, ny = 2 + pre.nearY, nz = 4 + pre.nearZ;
+    const int fx = 1 - pre.nearX, fy = 3 - pre.nearY, fz = 5 - pre.nearZ;
+    const __m128 tminV = _mm_set1_ps(ray.tmin);
+    // Slightly enlarged far distance so rays grazing a box edge are not lost to rounding.
+    const float kGrow = 1.0f + 4.0f * std::numeric_limits<float>::epsilon();
+
+    struct Entry { uint32_t ref; float t; };
+    Entry stack[256];
+    int sp = 0;
+    uint32_t cur = 0;   // root: node 0
+    for (;;) {
+        if (!(cur & Node4::kLeafBit)) {
+            const Node4& n = m_nodes[cur];
+            __m128 t0x = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(n.b[nx]), ox), rx);
+            __m128 t1x = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(n.b[fx]), ox), rx);
+            __m128 t0y = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(n.b[ny]), oy), ry);
+            __m128 t1y = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(n.b[fy]), oy), ry);
+            __m128 t0z = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(n.b[nz]), oz), rz);
+            __m128 t1z = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(n.b[fz]), oz), rz);
+            __m128 tn = _mm_max_ps(_mm_max_ps(t0x, t0y), _mm_max_ps(t0z, tminV));
+            __m128 tf = _mm_min_ps(_mm_min_ps(t1x, t1y), _mm_min_ps(t1z, _mm_set1_ps(tmax)));
+            tf = _mm_mul_ps(tf, _mm_set1_ps(kGrow));
+            int mask = _mm_movemask_ps(_mm_cmple_ps(tn, tf));
+            if (mask != 0) {
+                alignas(16) float d[4];
+                _mm_store_ps(d, tn);
+                int c0 = __builtin_ctz(mask);
+                mask &= mask - 1;
+                if (mask == 0) { cur = n.child[c0]; continue; }
+                if constexpr (AnyHit) {   // no ordering needed: push the rest as they come
+                    while (mask) { int c = __builtin_ctz(mask); mask &= mask - 1; stack[sp++] = {n.child[c], d[c]}; }
+                    cur = n.child[c0];
+                    continue;
+                }
+                int c1 = __builtin_ctz(mask);
+                mask &= mask - 1;
+                if (mask == 0) {
+                    if (d[c0] <= d[c1]) { stack[sp++] = {n.child[c1], d[c1]}; cur = n.child[c0]; }
+                    else { stack[sp++] = {n.child[c0], d[c0]}; cur = n.child[c1]; }
+                    continue;
+                }
+                // 3 or 4 hits: sort by entry distance (far first on the stack).
+                Entry e[4];
+                int k = 0;
+                e[k++] = {n.child[c0], d[c0]};
+                e[k++] = {n.child[c1], d[c1]};
+                while (mask) { int c = __builtin_ctz(mask); mask &= mask - 1; e[k++] = {n.child[c], d[c]}; }
+                for (int i = 1; i < k; ++i) {   // insertion sort, descending t
+                    Entry x = e[i];
+                    int j = i - 1;
+                    while (j >= 0 && e[j].t < x.t) { e[j + 1] = e[j]; --j; }
+                    e[j + 1] = x;
+                }
+                for (int i = 0; i < k - 1; ++i) stack[sp++] = e[i];
+                cur = e[k - 1].ref;
+                continue;
+            }
+        } else {
+            uint32_t first = (cur & ~Node4::kLeafBit) >> 3, count = cur & 7u;
+            if (leaf(first, count, tmax)) return;
+        }
+        // Pop the next entry that can still hold a closer hit.
+        for (;;) {
+            if (sp == 0) return;
+            const Entry& e = stack[--sp];
+            if (e.t <= tmax) { cur = e.ref; break; }
+        }
+    }
+}
+
+}  // namespace rnd::rt

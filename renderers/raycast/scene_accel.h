@@ -1,0 +1,80 @@
+// scene_accel.h - the two-level structure the ray caster traces against: one TriangleBvh per
+// mesh (object space, cached across frames by Mesh::id + version, so moving an instance never
+// rebuilds it), per-geometry accelerators for parametric surfaces and density grids (cached by
+// DrawAnalytic::geometryKey), and a top-level BVH4 (TLAS) over the world bounds of all
+// instances, rebuilt every frame (cheap: one box per instance). Rays are transformed into each
+// instance's object space with its inverse world matrix (t is preserved since the direction is
+// transformed unnormalised).
+#pragma once
+
+#include "raycast/analytic.h"
+#include "raycast/bvh.h"
+#include "scenegraph/frame.h"
+
+#include <memory>
+#include <mutex>
+#include <unordered_map>
+
+namespace rnd::rt {
+
+// What a ray hit. For meshes: instance = index into FrameInput::meshes, prim/b1/b2 from the
+// triangle test. For analytics: instance = index into FrameInput::analytics, normal = world
+// outward normal (not yet flipped toward the ray), csgLeaf/flip for CSG, (u, v) parametric.
+struct SceneHit {
+    enum class Kind : uint8_t { None, Mesh, Analytic };
+    Kind kind = Kind::None;
+    float t = std::numeric_limits<float>::infinity();
+    uint32_t instance = 0;
+    uint32_t prim = 0;
+    float b1 = 0, b2 = 0;
+    sg::vec3 normal{0, 1, 0};
+    int csgLeaf = -1;
+    float u = 0, v = 0;
+};
+
+class SceneAccel {
+public:
+    // Builds/fetches BLASes for this frame and rebuilds the TLAS. Not thread-safe; call before
+    // tracing. Returns the number of mesh BVHs (re)built this call.
+    int update(const sg::FrameInput& frame);
+    // Closest hit in (ray.tmin, ray.tmax). Thread-safe after update().
+    bool intersect(const Ray& worldRay, SceneHit& hit) const;
+    // Any hit in (ray.tmin, ray.tmax).
+    bool occluded(const Ray& worldRay) const;
+
+    size_t cachedMeshes() const { return m_meshes.size(); }
+    uint64_t buildsTotal() const { return m_buildsTotal; }
+
+private:
+    struct MeshEntry {
+        sg::MeshPtr mesh;   // keeps the data alive (the BVH refers to it by index only)
+        uint64_t version = 0;
+        TriangleBvh bvh;
+        uint64_t lastFrame = 0;
+    };
+    struct AnalyticEntry {
+        std::shared_ptr<ParametricAccel> param;
+        std::shared_ptr<GridAccel> grid;
+        uint64_t lastFrame = 0;
+    };
+    struct Instance {
+        bool isMesh = true;
+        uint32_t index = 0;          // into frame meshes / analytics
+        const TriangleBvh* bvh = nullptr;
+        const ParametricAccel* param = nullptr;
+        const GridAccel* grid = nullptr;
+        sg::mat4 invWorld{1.0f};
+    };
+
+    bool intersectInstance(const Instance& inst, const Ray& r, float tmax, SceneHit& hit) const;
+
+    const sg::FrameInput* m_frame = nullptr;
+    std::unordered_map<uint64_t, MeshEntry> m_meshes;          // by Mesh::id
+    std::unordered_map<uint64_t, AnalyticEntry> m_analytics;   // by geometryKey
+    std::vector<Instance> m_instances;
+    Bvh4 m_tlas;
+    uint64_t m_frameCounter = 0;
+    uint64_t m_buildsTotal = 0;
+};
+
+}  // namespace rnd::rt

@@ -1,0 +1,284 @@
+// tri_kernel.inl - the hot loops of TriangleBvh: BVH4 traversal fused with the 4-triangle
+// packet test. Included twice by bvh.cpp: once as plain SSE (namespace kern_sse, RT_FMA 0) and
+// once compiled for AVX2+FMA (namespace kern_avx2, RT_FMA 1) behind a run-time CPU check, so
+// the default build still runs on any x86-64 while FMA-capable CPUs get fused multiply-adds
+// (one instruction per slab plane and per dot-product term).
+//
+// Requires (in the including scope): Node4, TriPacket4, Ray, TriHit, RayPre.
+
+#if RT_FMA
+#define RT_MSUB(a, b, c) _mm_fmsub_ps((a), (b), (c))    // a*b - c
+#define RT_MADD(a, b, c) _mm_fmadd_ps((a), (b), (c))    // a*b + c
+#else
+#define RT_MSUB(a, b, c) _mm_sub_ps(_mm_mul_ps((a), (b)), (c))
+#define RT_MADD(a, b, c) _mm_add_ps(_mm_mul_ps((a), (b)), (c))
+#endif
+
+// Moller-Trumbore on 4 triangles at once (seeds 2.4), with the precomputed normal
+// N = e1 x e2, s = o - p0 and R = s x d (scalar triple products):
+//   det = -d.N,  b1 = e2.R / det,  b2 = -e1.R / det,  t = s.N / det.
+// Division-free: comparisons use the sign-adjusted numerators against |det|; only packets with
+// a hit pay for the division. Returns the lane mask of hits in (tmin, tmax) and t, b1, b2.
+inline int intersectPacket(const TriPacket4& p, const __m128 o[3], const __m128 d[3], __m128 tmin, __m128 tmax,
+                           __m128& tOut, __m128& uOut, __m128& vOut) {
+    const __m128 nx = _mm_load_ps(p.n[0]), ny = _mm_load_ps(p.n[1]), nz = _mm_load_ps(p.n[2]);
+    const __m128 sx = _mm_sub_ps(o[0], _mm_load_ps(p.v0[0]));
+    const __m128 sy = _mm_sub_ps(o[1], _mm_load_ps(p.v0[1]));
+    const __m128 sz = _mm_sub_ps(o[2], _mm_load_ps(p.v0[2]));
+    const __m128 negZero = _mm_set1_ps(-0.0f);
+    __m128 det = RT_MADD(d[2], nz, RT_MADD(d[1], ny, _mm_mul_ps(d[0], nx)));
+    det = _mm_xor_ps(det, negZero);   // det = -d.N
+    const __m128 sign = _mm_and_ps(det, negZero);
+    const __m128 absDet = _mm_xor_ps(det, sign);
+    const __m128 rx = RT_MSUB(sy, d[2], _mm_mul_ps(sz, d[1]));
+    const __m128 ry = RT_MSUB(sz, d[0], _mm_mul_ps(sx, d[2]));
+    const __m128 rz = RT_MSUB(sx, d[1], _mm_mul_ps(sy, d[0]));
+    __m128 U = RT_MADD(_mm_load_ps(p.e2[2]), rz, RT_MADD(_mm_load_ps(p.e2[1]), ry, _mm_mul_ps(_mm_load_ps(p.e2[0]), rx)));
+    __m128 V = RT_MADD(_mm_load_ps(p.e1[2]), rz, RT_MADD(_mm_load_ps(p.e1[1]), ry, _mm_mul_ps(_mm_load_ps(p.e1[0]), rx)));
+    __m128 T = RT_MADD(sz, nz, RT_MADD(sy, ny, _mm_mul_ps(sx, nx)));
+    U = _mm_xor_ps(U, sign);
+    V = _mm_xor_ps(V, _mm_xor_ps(sign, negZero));   // b2 = -e1.R / det
+    T = _mm_xor_ps(T, sign);
+    const __m128 zero = _mm_setzero_ps();
+    __m128 ok = _mm_cmpneq_ps(det, zero);
+    ok = _mm_and_ps(ok, _mm_cmpge_ps(U, zero));
+    ok = _mm_and_ps(ok, _mm_cmpge_ps(V, zero));
+    ok = _mm_and_ps(ok, _mm_cmple_ps(_mm_add_ps(U, V), absDet));
+    ok = _mm_and_ps(ok, _mm_cmpgt_ps(T, _mm_mul_ps(absDet, tmin)));
+    ok = _mm_and_ps(ok, _mm_cmplt_ps(T, _mm_mul_ps(absDet, tmax)));
+    int mask = _mm_movemask_ps(ok);
+    if (mask) {
+        const __m128 inv = _mm_div_ps(_mm_set1_ps(1.0f), absDet);
+        tOut = _mm_mul_ps(T, inv);
+        uOut = _mm_mul_ps(U, inv);
+        vOut = _mm_mul_ps(V, inv);
+        // Division rounding may land t on a bound: re-check on the divided values.
+        mask &= _mm_movemask_ps(_mm_and_ps(_mm_cmplt_ps(tOut, tmax), _mm_cmpgt_ps(tOut, tmin)));
+    }
+    return mask;
+}
+
+// Front-to-back BVH4 traversal with the packet test inlined. AnyHit: stop at the first hit
+// and skip the ordering. Returns true on a hit (closest hit written to *hit unless AnyHit).
+template <bool AnyHit>
+inline bool traceTriangles(const Node4* nodes, const TriPacket4* packets, const Ray& ray, TriHit* hit) {
+    const RayPre pre(ray);
+    const __m128 rx = _mm_set1_ps(pre.rdir[0]), ry = _mm_set1_ps(pre.rdir[1]), rz = _mm_set1_ps(pre.rdir[2]);
+    const __m128 orx = _mm_set1_ps(pre.orgRdir[0]), ory = _mm_set1_ps(pre.orgRdir[1]), orz = _mm_set1_ps(pre.orgRdir[2]);
+    const int nx = pre.nearX, ny = 2 + pre.nearY, nz = 4 + pre.nearZ;
+    const int fx = 1 - pre.nearX, fy = 3 - pre.nearY, fz = 5 - pre.nearZ;
+    const __m128 o[3] = {_mm_set1_ps(ray.org.x), _mm_set1_ps(ray.org.y), _mm_set1_ps(ray.org.z)};
+    const __m128 d[3] = {_mm_set1_ps(ray.dir.x), _mm_set1_ps(ray.dir.y), _mm_set1_ps(ray.dir.z)};
+    const __m128 tminV = _mm_set1_ps(ray.tmin);
+    // Far distances are enlarged a little: (b - o) / d is computed as b * (1/d) - o * (1/d),
+    // which can round either way; the margin keeps grazing rays inside their boxes.
+    const __m128 grow = _mm_set1_ps(1.0f + 8.0f * std::numeric_limits<float>::epsilon());
+    float tmax = ray.tmax;
+    __m128 tmaxV = _mm_set1_ps(tmax);
+    bool found = false;
+
+    struct Entry { uint32_t ref; float t; };
+    Entry stack[256];
+    int sp = 0;
+    uint32_t cur = 0;
+    for (;;) {
+        if (!(cur & Node4::kLeafBit)) {
+            const Node4& n = nodes[cur];
+            // t = b * rdir - org * rdir; the near/far planes per axis come from the ray's signs.
+            const __m128 t0x = RT_MSUB(_mm_load_ps(n.b[nx]), rx, orx), t1x = RT_MSUB(_mm_load_ps(n.b[fx]), rx, orx);
+            const __m128 t0y = RT_MSUB(_mm_load_ps(n.b[ny]), ry, ory), t1y = RT_MSUB(_mm_load_ps(n.b[fy]), ry, ory);
+            const __m128 t0z = RT_MSUB(_mm_load_ps(n.b[nz]), rz, orz), t1z = RT_MSUB(_mm_load_ps(n.b[fz]), rz, orz);
+            const __m128 tn = _mm_max_ps(_mm_max_ps(t0x, t0y), _mm_max_ps(t0z, tminV));
+            const __m128 tf = _mm_mul_ps(_mm_min_ps(_mm_min_ps(t1x, t1y), _mm_min_ps(t1z, tmaxV)), grow);
+            int mask = _mm_movemask_ps(_mm_cmple_ps(tn, tf));
+            if (mask != 0) {
+                alignas(16) float dist[4];
+                _mm_store_ps(dist, tn);
+                const int c0 = __builtin_ctz(mask);
+                mask &= mask - 1;
+                if (mask == 0) { cur = n.child[c0]; continue; }
+                if constexpr (AnyHit) {
+                    do { int c = __builtin_ctz(mask); mask &= mask - 1; stack[sp++] = {n.child[c], dist[c]}; } while (mask);
+                    cur = n.child[c0];
+                    continue;
+                }
+                const int c1 = __builtin_ctz(mask);
+                mask &= mask - 1;
+                if (mask == 0) {
+                    if (dist[c0] <= dist[c1]) { stack[sp++] = {n.child[c1], dist[c1]}; cur = n.child[c0]; }
+                    else { stack[sp++] = {n.child[c0], dist[c0]}; cur = n.child[c1]; }
+                    continue;
+                }
+                Entry e[4];
+                int k = 0;
+                e[k++] = {n.child[c0], dist[c0]};
+                e[k++] = {n.child[c1], dist[c1]};
+                while (mask) { int c = __builtin_ctz(mask); mask &= mask - 1; e[k++] = {n.child[c], dist[c]}; }
+                for (int i = 1; i < k; ++i) {   // insertion sort, far first
+                    Entry x = e[i];
+                    int j = i - 1;
+                    while (j >= 0 && e[j].t < x.t) { e[j + 1] = e[j]; --j; }
+                    e[j + 1] = x;
+                }
+                for (int i = 0; i < k - 1; ++i) stack[sp++] = e[i];
+                cur = e[k - 1].ref;
+                continue;
+            }
+        } else {
+            const TriPacket4& p = packets[(cur & ~Node4::kLeafBit) >> 3];
+            __m128 t, u, v;
+            int mask = intersectPacket(p, o, d, tminV, tmaxV, t, u, v);
+            if (mask) {
+                if constexpr (AnyHit) return true;
+                alignas(16) float ta[4], ua[4], va[4];
+                _mm_store_ps(ta, t);
+                _mm_store_ps(ua, u);
+                _mm_store_ps(va, v);
+                while (mask) {
+                    int k = __builtin_ctz(mask);
+                    mask &= mask - 1;
+                    if (ta[k] < tmax) {
+                        tmax = ta[k];
+                        hit->t = ta[k];
+                        hit->prim = p.prim[k];
+                        hit->b1 = ua[k];
+                        hit->b2 = va[k];
+                        found = true;
+                    }
+                }
+                tmaxV = _mm_set1_ps(tmax);
+            }
+        }
+        for (;;) {   // pop the next entry that can still hold a closer hit
+            if (sp == 0) return found;
+            const Entry& e = stack[--sp];
+            if (AnyHit || e.t <= tmax) { cur = e.ref; break; }
+        }
+    }
+}
+
+#if RT_FMA
+// The same traversal over 8-wide nodes: one AVX compare per node for 8 boxes (BVH8: fewer,
+// wider levels), leaves still 4-triangle SSE packets.
+template <bool AnyHit>
+inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const Ray& ray, TriHit* hit) {
+    const RayPre pre(ray);
+    const __m256 rx = _mm256_set1_ps(pre.rdir[0]), ry = _mm256_set1_ps(pre.rdir[1]), rz = _mm256_set1_ps(pre.rdir[2]);
+    const __m256 orx = _mm256_set1_ps(pre.orgRdir[0]), ory = _mm256_set1_ps(pre.orgRdir[1]), orz = _mm256_set1_ps(pre.orgRdir[2]);
+    const int nx = pre.nearX, ny = 2 + pre.nearY, nz = 4 + pre.nearZ;
+    const int fx = 1 - pre.nearX, fy = 3 - pre.nearY, fz = 5 - pre.nearZ;
+    const __m128 o[3] = {_mm_set1_ps(ray.org.x), _mm_set1_ps(ray.org.y), _mm_set1_ps(ray.org.z)};
+    const __m128 d[3] = {_mm_set1_ps(ray.dir.x), _mm_set1_ps(ray.dir.y), _mm_set1_ps(ray.dir.z)};
+    const __m128 tminV = _mm_set1_ps(ray.tmin);
+    const __m256 tmin8 = _mm256_set1_ps(ray.tmin);
+    const __m256 grow = _mm256_set1_ps(1.0f + 8.0f * std::numeric_limits<float>::epsilon());
+    float tmax = ray.tmax;
+    __m128 tmaxV = _mm_set1_ps(tmax);
+    __m256 tmax8 = _mm256_set1_ps(tmax);
+    bool found = false;
+
+    struct Entry { uint32_t ref; float t; };
+    Entry stack[512];
+    int sp = 0;
+    uint32_t cur = 0;
+    for (;;) {
+        if (!(cur & Node8::kLeafBit)) {
+            const Node8& n = nodes[cur];
+            const __m256 t0x = _mm256_fmsub_ps(_mm256_load_ps(n.b[nx]), rx, orx), t1x = _mm256_fmsub_ps(_mm256_load_ps(n.b[fx]), rx, orx);
+            const __m256 t0y = _mm256_fmsub_ps(_mm256_load_ps(n.b[ny]), ry, ory), t1y = _mm256_fmsub_ps(_mm256_load_ps(n.b[fy]), ry, ory);
+            const __m256 t0z = _mm256_fmsub_ps(_mm256_load_ps(n.b[nz]), rz, orz), t1z = _mm256_fmsub_ps(_mm256_load_ps(n.b[fz]), rz, orz);
+            const __m256 tn = _mm256_max_ps(_mm256_max_ps(t0x, t0y), _mm256_max_ps(t0z, tmin8));
+            const __m256 tf = _mm256_mul_ps(_mm256_min_ps(_mm256_min_ps(t1x, t1y), _mm256_min_ps(t1z, tmax8)), grow);
+            int mask = _mm256_movemask_ps(_mm256_cmp_ps(tn, tf, _CMP_LE_OQ));
+            if (mask != 0) {
+                alignas(32) float dist[8];
+                _mm256_store_ps(dist, tn);
+                const int c0 = __builtin_ctz(mask);
+                mask &= mask - 1;
+                if (mask == 0) { cur = n.child[c0]; continue; }
+                if constexpr (AnyHit) {
+                    do { int c = __builtin_ctz(mask); mask &= mask - 1; stack[sp++] = {n.child[c], dist[c]}; } while (mask);
+                    cur = n.child[c0];
+                    continue;
+                }
+                const int c1 = __builtin_ctz(mask);
+                mask &= mask - 1;
+                if (mask == 0) {
+                    if (dist[c0] <= dist[c1]) { stack[sp++] = {n.child[c1], dist[c1]}; cur = n.child[c0]; }
+                    else { stack[sp++] = {n.child[c0], dist[c0]}; cur = n.child[c1]; }
+                    continue;
+                }
+                Entry e[8];
+                int k = 0;
+                e[k++] = {n.child[c0], dist[c0]};
+                e[k++] = {n.child[c1], dist[c1]};
+                while (mask) { int c = __builtin_ctz(mask); mask &= mask - 1; e[k++] = {n.child[c], dist[c]}; }
+                for (int i = 1; i < k; ++i) {   // insertion sort, far first
+                    Entry x = e[i];
+                    int j = i - 1;
+                    while (j >= 0 && e[j].t < x.t) { e[j + 1] = e[j]; --j; }
+                    e[j + 1] = x;
+                }
+                for (int i = 0; i < k - 1; ++i) stack[sp++] = e[i];
+                cur = e[k - 1].ref;
+                continue;
+            }
+        } else {
+            const TriPacket4& p = packets[(cur & ~Node8::kLeafBit) >> 3];
+            __m128 t, u, v;
+            int mask = intersectPacket(p, o, d, tminV, tmaxV, t, u, v);
+            if (mask) {
+                if constexpr (AnyHit) return true;
+                alignas(16) float ta[4], ua[4], va[4];
+                _mm_store_ps(ta, t);
+                _mm_store_ps(ua, u);
+                _mm_store_ps(va, v);
+                while (mask) {
+                    int k = __builtin_ctz(mask);
+                    mask &= mask - 1;
+                    if (ta[k] < tmax) {
+                        tmax = ta[k];
+                        hit->t = ta[k];
+                        hit->prim = p.prim[k];
+                        hit->b1 = ua[k];
+                        hit->b2 = va[k];
+                        found = true;
+                    }
+                }
+                tmaxV = _mm_set1_ps(tmax);
+                tmax8 = _mm256_set1_ps(tmax);
+            }
+        }
+        for (;;) {
+            if (sp == 0) return found;
+            const Entry& e = stack[--sp];
+            if (AnyHit || e.t <= tmax) { cur = e.ref; break; }
+        }
+    }
+}
+#endif
+
+// Brute force over all triangles with the same packet test (tests).
+inline bool bruteForce(const sg::vec3* pos, const uint32_t* idx, size_t triCount, const Ray& ray, TriHit& hit) {
+    const __m128 o[3] = {_mm_set1_ps(ray.org.x), _mm_set1_ps(ray.org.y), _mm_set1_ps(ray.org.z)};
+    const __m128 d[3] = {_mm_set1_ps(ray.dir.x), _mm_set1_ps(ray.dir.y), _mm_set1_ps(ray.dir.z)};
+    bool found = false;
+    float tmax = ray.tmax;
+    for (size_t t = 0; t < triCount; ++t) {
+        TriPacket4 p{};
+        setLane(p, 0, pos[idx[3 * t]], pos[idx[3 * t + 1]], pos[idx[3 * t + 2]]);
+        __m128 tv, u, v;
+        if (intersectPacket(p, o, d, _mm_set1_ps(ray.tmin), _mm_set1_ps(tmax), tv, u, v) & 1) {
+            tmax = _mm_cvtss_f32(tv);
+            hit.t = tmax;
+            hit.prim = uint32_t(t);
+            hit.b1 = _mm_cvtss_f32(u);
+            hit.b2 = _mm_cvtss_f32(v);
+            found = true;
+        }
+    }
+    return found;
+}
+
+#undef RT_MSUB
+#undef RT_MADD

@@ -1,0 +1,139 @@
+// raycast_raster_agreement_test.cpp - RaycastRasterAgreementTest: the ray caster and the CPU
+// rasterizer render the same triangle scenes (shadows and reflections off, no AA) and must
+// agree on >= 99% of pixels within 4/255 per channel (silhouette edges may differ by a pixel).
+// Covers the three shading models, the three projections, fog, vertex colours, a mirrored
+// instance, back faces (two-sided lighting) and a magnified bilinear texture.
+#include "renderers/renderer.h"
+#include "scenegraph/frame.h"
+#include "test_support.h"
+
+#include <gtest/gtest.h>
+
+using namespace sg;
+using namespace rnd;
+
+namespace {
+
+constexpr int kW = 320, kH = 240;
+
+DrawMesh instance(std::shared_ptr<Mesh> m, const mat4& world, vec3 color) {
+    DrawMesh d;
+    d.mesh = std::move(m);
+    d.world = world;
+    d.normal = normalMatrix(world);
+    d.mirrored = glm::determinant(mat3(world)) < 0.0f;
+    d.material.baseColor = color;
+    return d;
+}
+
+FrameInput baseScene(const Projection& proj) {
+    FrameInput f;
+    f.settings.shadows = false;
+    f.settings.reflections = false;
+    f.settings.aa = AAMode::None;
+    auto sphere = std::make_shared<Mesh>(primitives::uvSphere(0.8f, 48, 24));
+    auto box = std::make_shared<Mesh>(primitives::box(vec3(0.5f)));
+    auto ground = std::make_shared<Mesh>(primitives::plane(4.0f, 8));
+    auto cyl = std::make_shared<Mesh>(primitives::cylinder(0.4f, 0.6f, 32, false));   // open: back faces visible
+    f.meshes.push_back(instance(sphere, glm::translate(mat4(1.0f), vec3(-0.9f, 0.8f, 0)), vec3(0.8f, 0.2f, 0.2f)));
+    f.meshes.push_back(instance(box, glm::rotate(glm::translate(mat4(1.0f), vec3(1.0f, 0.5f, 0.3f)), 0.6f, vec3(0, 1, 0)), vec3(0.2f, 0.6f, 0.9f)));
+    f.meshes.push_back(instance(ground, mat4(1.0f), vec3(0.7f, 0.7f, 0.6f)));
+    f.meshes.push_back(instance(cyl, glm::translate(mat4(1.0f), vec3(0.2f, 0.6f, 1.4f)), vec3(0.3f, 0.8f, 0.3f)));
+    // Mirrored instance (negative x scale): winding flips, shading must not.
+    f.meshes.push_back(instance(sphere, glm::scale(glm::translate(mat4(1.0f), vec3(0.2f, 0.5f, -1.5f)), vec3(-0.5f, 0.5f, 0.5f)), vec3(0.9f, 0.8f, 0.2f)));
+    f.meshes[1].material.ks = 0.6f;
+    f.meshes[1].material.shininess = 16.0f;
+    DrawLight l1;
+    l1.position = vec3(2.5f, 4.0f, 3.0f);
+    l1.radiance = vec3(0.9f);
+    DrawLight l2;
+    l2.type = LightType::Directional;
+    l2.direction = glm::normalize(vec3(-0.3f, -1.0f, -0.5f));
+    l2.radiance = vec3(0.3f, 0.3f, 0.4f);
+    f.lights = {l1, l2};
+    f.ambientLight = vec3(0.3f);
+    mat4 cam = glm::inverse(glm::lookAt(vec3(1.5f, 3.0f, 5.5f), vec3(0, 0.4f, 0), vec3(0, 1, 0)));
+    f.camera = makeFrameCamera(cam, proj, float(kW) / kH, 6.0f);
+    return f;
+}
+
+void expectAgree(const FrameInput& f, const std::string& name) {
+    auto ray = makeRenderer("raycast");
+    auto ras = makeRenderer("raster");
+    ASSERT_TRUE(ray && ras);
+    Framebuffer a, b;
+    RenderStats sa = ray->render(f, kW, kH, a);
+    RenderStats sb = ras->render(f, kW, kH, b);
+    ASSERT_TRUE(sa.ok) << sa.error;
+    ASSERT_TRUE(sb.ok) << sb.error;
+    testing_support::ImageTolerance tol;
+    tol.channelTolerance = 4;
+    tol.minFractionWithin = 0.99;
+    tol.maxMeanAbs = 2.0;
+    EXPECT_TRUE(testing_support::imagesClose(a, b, tol, "raycast_raster", name)) << name;
+    testing_support::writeImage(a, "raycast_raster", name + "-raycast");
+}
+
+Projection perspective() { return Projection{}; }
+Projection ortho() { Projection p; p.type = ProjectionType::Orthographic; p.orthoHalfHeight = 3.0f; return p; }
+
+}  // namespace
+
+TEST(RaycastRasterAgreementTest, PhongPerspective) { expectAgree(baseScene(perspective()), "phong-perspective"); }
+
+TEST(RaycastRasterAgreementTest, FlatPerspective) {
+    FrameInput f = baseScene(perspective());
+    f.settings.shading = ShadingModel::Flat;
+    expectAgree(f, "flat-perspective");
+}
+
+TEST(RaycastRasterAgreementTest, GouraudPerspective) {
+    FrameInput f = baseScene(perspective());
+    f.settings.shading = ShadingModel::Gouraud;
+    expectAgree(f, "gouraud-perspective");
+}
+
+TEST(RaycastRasterAgreementTest, BlinnPhongOrthographic) {
+    FrameInput f = baseScene(ortho());
+    f.settings.reflection = ReflectionModel::BlinnPhong;
+    expectAgree(f, "blinn-orthographic");
+}
+
+TEST(RaycastRasterAgreementTest, PhongOblique) { expectAgree(baseScene(Projection::cabinet()), "phong-oblique"); }
+
+TEST(RaycastRasterAgreementTest, FogAndAttenuation) {
+    FrameInput f = baseScene(perspective());
+    f.settings.fog = FogMode::Linear;
+    f.settings.fogStart = 3.0f;
+    f.settings.fogEnd = 12.0f;
+    f.lights[0].inverseSquare = true;
+    f.lights[0].radiance = vec3(20.0f);
+    expectAgree(f, "fog-attenuation");
+}
+
+TEST(RaycastRasterAgreementTest, VertexColoursAndTexture) {
+    FrameInput f = baseScene(perspective());
+    // Vertex colours on the sphere.
+    auto sphere = std::make_shared<Mesh>(primitives::uvSphere(0.8f, 48, 24));
+    sphere->colors.resize(sphere->positions.size());
+    for (size_t i = 0; i < sphere->positions.size(); ++i) sphere->colors[i] = vec4(0.5f + 0.5f * sphere->positions[i] / 0.8f, 1.0f);
+    f.meshes[0].mesh = sphere;
+    f.meshes[0].material.baseColor = vec3(1.0f);
+    // A magnified 4x4 texture on the ground (bilinear, LOD 0 on both).
+    auto tex = std::make_shared<Texture>();
+    tex->width = tex->height = 4;
+    tex->rgba.resize(4 * 4 * 4);
+    for (int y = 0; y < 4; ++y)
+        for (int x = 0; x < 4; ++x) {
+            uint8_t* p = &tex->rgba[size_t(y * 4 + x) * 4];
+            p[0] = uint8_t(60 + 60 * x);
+            p[1] = uint8_t(60 + 60 * y);
+            p[2] = uint8_t((x + y) % 2 ? 220 : 40);
+            p[3] = 255;
+        }
+    tex->filter = FilterMode::Bilinear;
+    tex->wrapS = tex->wrapT = WrapMode::ClampToEdge;
+    f.meshes[2].texture = tex;
+    f.meshes[2].material.baseColor = vec3(1.0f);
+    expectAgree(f, "vertex-colours-texture");
+}

@@ -1,0 +1,540 @@
+// raycast_test.cpp - RaycastTest: exact analytic hits (distance + normal), CSG carved faces,
+// parametric and grid surfaces, BVH4 closest hit == brute force on random soups, primary rays
+// lining up with FrameCamera::viewProj for all projections, and the renderer's contract
+// (progress, cancellation, BLAS caching across transform edits).
+#include "raycast/analytic.h"
+#include "raycast/bvh.h"
+#include "raycast/camera_rays.h"
+#include "raycast/scene_accel.h"
+#include "renderers/renderer.h"
+#include "scenegraph/frame.h"
+#include "test_support.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+using namespace sg;
+using namespace rnd;
+using namespace rnd::rt;
+
+namespace {
+
+Ray mkRay(vec3 o, vec3 d) {
+    Ray r;
+    r.org = o;
+    r.dir = d;
+    r.tmin = 0;
+    r.tmax = std::numeric_limits<float>::infinity();
+    return r;
+}
+
+// Closest hit on an implicit shape in its local frame: t and outward normal.
+bool hitImplicit(const ImplicitShape& s, const Ray& r, float& t, vec3& n) {
+    SpanList l;
+    implicitSpans(s, r, l);
+    Bound b;
+    if (!firstBoundary(l, r.tmin, r.tmax, b)) return false;
+    t = b.t;
+    n = implicitNormal(s, r.org + t * r.dir, b.tag);
+    return true;
+}
+
+void expectVec(const vec3& a, const vec3& b, float tol) {
+    EXPECT_NEAR(a.x, b.x, tol);
+    EXPECT_NEAR(a.y, b.y, tol);
+    EXPECT_NEAR(a.z, b.z, tol);
+}
+
+}  // namespace
+
+// --- implicit shapes ---------------------------------------------------------------------------
+
+TEST(RaycastTest, SphereHitDistanceAndNormal) {
+    ImplicitShape s;
+    s.type = ImplicitType::Sphere;
+    s.radius = 1.5f;
+    float t; vec3 n;
+    ASSERT_TRUE(hitImplicit(s, mkRay({0, 0, 5}, {0, 0, -1}), t, n));
+    EXPECT_NEAR(t, 3.5f, 1e-5f);
+    expectVec(n, {0, 0, 1}, 1e-5f);
+    // From inside: the exit point.
+    ASSERT_TRUE(hitImplicit(s, mkRay({0, 0, 0}, {1, 0, 0}), t, n));
+    EXPECT_NEAR(t, 1.5f, 1e-5f);
+    // Miss.
+    EXPECT_FALSE(hitImplicit(s, mkRay({0, 2, 5}, {0, 0, -1}), t, n));
+    // Off-centre: hit point lies on the sphere, normal = p / r.
+    Ray r = mkRay({0.3f, 0.7f, 5}, {0, 0, -2});
+    ASSERT_TRUE(hitImplicit(s, r, t, n));
+    vec3 p = r.org + t * r.dir;
+    EXPECT_NEAR(glm::length(p), 1.5f, 1e-5f);
+    expectVec(n, p / 1.5f, 1e-5f);
+}
+
+TEST(RaycastTest, QuadricSphereAndEllipsoid) {
+    ImplicitShape q;
+    q.type = ImplicitType::Quadric;   // default: x^2 + y^2 + z^2 - 1
+    q.quadricBounds = {vec3(-2), vec3(2)};
+    float t; vec3 n;
+    ASSERT_TRUE(hitImplicit(q, mkRay({0, 0, 5}, {0, 0, -1}), t, n));
+    EXPECT_NEAR(t, 4.0f, 1e-5f);
+    expectVec(n, {0, 0, 1}, 1e-5f);
+    // Ellipsoid x^2/4 + y^2 + z^2 = 1: semi-axis 2 along x.
+    q.quadric = mat4(1.0f);
+    q.quadric[0][0] = 0.25f;
+    q.quadric[3][3] = -1.0f;
+    q.quadricBounds = {vec3(-3), vec3(3)};
+    ASSERT_TRUE(hitImplicit(q, mkRay({5, 0, 0}, {-1, 0, 0}), t, n));
+    EXPECT_NEAR(t, 3.0f, 1e-5f);
+    expectVec(n, {1, 0, 0}, 1e-5f);
+    // Oblique ray: the normal is the normalised gradient (x/2, 2y, 2z) direction.
+    Ray r = mkRay({1, 0.5f, 5}, {0, 0, -1});
+    ASSERT_TRUE(hitImplicit(q, r, t, n));
+    vec3 p = r.org + t * r.dir;
+    EXPECT_NEAR(p.x * p.x / 4 + p.y * p.y + p.z * p.z, 1.0f, 1e-5f);
+    expectVec(n, glm::normalize(vec3(p.x / 4, p.y, p.z)), 1e-5f);
+    // Clipped by quadricBounds: a cylinder x^2 + z^2 = 1 (infinite in y) capped by the box.
+    ImplicitShape cyl;
+    cyl.type = ImplicitType::Quadric;
+    cyl.quadric = mat4(1.0f);
+    cyl.quadric[1][1] = 0.0f;
+    cyl.quadric[3][3] = -1.0f;
+    cyl.quadricBounds = {vec3(-2, -1, -2), vec3(2, 1, 2)};
+    ASSERT_TRUE(hitImplicit(cyl, mkRay({0, 5, 0}, {0, -1, 0}), t, n));
+    EXPECT_NEAR(t, 4.0f, 1e-5f);   // the box's top face y = 1
+    expectVec(n, {0, 1, 0}, 1e-5f);
+}
+
+TEST(RaycastTest, TorusIncludingHoleAndGrazing) {
+    ImplicitShape s;
+    s.type = ImplicitType::Torus;
+    s.majorRadius = 1.0f;
+    s.minorRadius = 0.25f;
+    float t; vec3 n;
+    // Along x through the middle: four crossings, first at x = -1.25.
+    ASSERT_TRUE(hitImplicit(s, mkRay({-5, 0, 0}, {1, 0, 0}), t, n));
+    EXPECT_NEAR(t, 3.75f, 1e-4f);
+    expectVec(n, {-1, 0, 0}, 1e-4f);
+    SpanList l;
+    implicitSpans(s, mkRay({-5, 0, 0}, {1, 0, 0}), l);
+    ASSERT_EQ(l.n, 2);
+    EXPECT_NEAR(l.s[0].out.t, 4.25f, 1e-4f);
+    EXPECT_NEAR(l.s[1].in.t, 5.75f, 1e-4f);
+    EXPECT_NEAR(l.s[1].out.t, 6.25f, 1e-4f);
+    // Straight down through the hole: no hit.
+    EXPECT_FALSE(hitImplicit(s, mkRay({0, 5, 0}, {0, -1, 0}), t, n));
+    // Down onto the top of the tube.
+    ASSERT_TRUE(hitImplicit(s, mkRay({1, 5, 0}, {0, -1, 0}), t, n));
+    EXPECT_NEAR(t, 4.75f, 1e-4f);
+    expectVec(n, {0, 1, 0}, 1e-4f);
+    // From the centre of the hole outward: the inner wall at x = 0.75, normal toward the axis.
+    ASSERT_TRUE(hitImplicit(s, mkRay({0, 0, 0}, {1, 0, 0}), t, n));
+    EXPECT_NEAR(t, 0.75f, 1e-4f);
+    expectVec(n, {-1, 0, 0}, 1e-4f);
+    // Grazing the top at height y = 0.249: hits near x = -1 - sqrt(r^2 - y^2).
+    float y = 0.249f;
+    ASSERT_TRUE(hitImplicit(s, mkRay({-5, y, 0}, {1, 0, 0}), t, n));
+    EXPECT_NEAR(-5 + t, -1.0f - std::sqrt(0.0625f - y * y), 2e-3f);
+    // Just above: miss.
+    EXPECT_FALSE(hitImplicit(s, mkRay({-5, 0.2501f, 0}, {1, 0, 0}), t, n));
+    // Random rays: every reported hit lies on the surface.
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> U(-1, 1);
+    int hits = 0;
+    for (int i = 0; i < 500; ++i) {
+        vec3 o(U(rng) * 4, U(rng) * 4, U(rng) * 4);
+        vec3 target(U(rng) * 1.3f, U(rng) * 0.3f, U(rng) * 1.3f);
+        Ray r = mkRay(o, target - o);
+        if (!hitImplicit(s, r, t, n)) continue;
+        ++hits;
+        EXPECT_NEAR(s.value(r.org + t * r.dir), 0.0f, 1e-3f);
+    }
+    EXPECT_GT(hits, 100);
+}
+
+TEST(RaycastTest, BoxCylinderConePlane) {
+    float t; vec3 n;
+    ImplicitShape box;
+    box.type = ImplicitType::Box;
+    box.halfExtents = vec3(0.5f, 1.0f, 2.0f);
+    ASSERT_TRUE(hitImplicit(box, mkRay({-5, 0.1f, 0.2f}, {1, 0, 0}), t, n));
+    EXPECT_NEAR(t, 4.5f, 1e-5f);
+    expectVec(n, {-1, 0, 0}, 0);
+    ASSERT_TRUE(hitImplicit(box, mkRay({0, 0, 9}, {0, 0, -1}), t, n));
+    EXPECT_NEAR(t, 7.0f, 1e-5f);
+    expectVec(n, {0, 0, 1}, 0);
+
+    ImplicitShape cyl;
+    cyl.type = ImplicitType::Cylinder;
+    cyl.radius = 0.5f;
+    cyl.halfHeight = 0.5f;
+    ASSERT_TRUE(hitImplicit(cyl, mkRay({0, 0, -5}, {0, 0, 1}), t, n));
+    EXPECT_NEAR(t, 4.5f, 1e-5f);
+    expectVec(n, {0, 0, -1}, 1e-5f);
+    ASSERT_TRUE(hitImplicit(cyl, mkRay({0.2f, 5, 0}, {0, -1, 0}), t, n));
+    EXPECT_NEAR(t, 4.5f, 1e-5f);   // top cap
+    expectVec(n, {0, 1, 0}, 0);
+    EXPECT_FALSE(hitImplicit(cyl, mkRay({0.6f, 5, 0}, {0, -1, 0}), t, n));
+
+    ImplicitShape cone;
+    cone.type = ImplicitType::Cone;
+    cone.radius = 0.5f;
+    cone.halfHeight = 0.5f;   // apex at y = 0.5, base radius 0.5 at y = -0.5
+    ASSERT_TRUE(hitImplicit(cone, mkRay({-5, 0, 0}, {1, 0, 0}), t, n));
+    EXPECT_NEAR(t, 4.75f, 1e-5f);   // radius 0.25 at y = 0
+    expectVec(n, glm::normalize(vec3(-1, 0.5f, 0)), 1e-5f);
+    ASSERT_TRUE(hitImplicit(cone, mkRay({0.1f, -5, 0}, {0, 1, 0}), t, n));
+    EXPECT_NEAR(t, 4.5f, 1e-5f);   // base cap
+    expectVec(n, {0, -1, 0}, 0);
+    EXPECT_FALSE(hitImplicit(cone, mkRay({-5, 0.6f, 0}, {1, 0, 0}), t, n));   // above the apex: the other nappe is clipped
+
+    ImplicitShape plane;
+    plane.type = ImplicitType::Plane;
+    ASSERT_TRUE(hitImplicit(plane, mkRay({3, 5, -2}, {0, -1, 0}), t, n));
+    EXPECT_NEAR(t, 5.0f, 1e-5f);
+    expectVec(n, {0, 1, 0}, 0);
+    ASSERT_TRUE(hitImplicit(plane, mkRay({3, -2, -2}, {0, 1, 0}), t, n));   // from below
+    EXPECT_NEAR(t, 2.0f, 1e-5f);
+    EXPECT_FALSE(hitImplicit(plane, mkRay({3, 2, -2}, {1, 0, 0}), t, n));
+}
+
+TEST(RaycastTest, PolyRootsQuartic) {
+    // (t-1)(t-2)(t-3)(t-4) = t^4 - 10t^3 + 35t^2 - 50t + 24
+    double c[5] = {24, -50, 35, -10, 1}, r[4];
+    ASSERT_EQ(polyRoots(c, 4, 0, 10, r), 4);
+    for (int i = 0; i < 4; ++i) EXPECT_NEAR(r[i], i + 1, 1e-9);
+    EXPECT_EQ(polyRoots(c, 4, 1.5, 3.5, r), 2);
+}
+
+// --- CSG ---------------------------------------------------------------------------------------
+
+namespace {
+FrameInput csgFrame(CsgOp op) {
+    auto tree = std::make_shared<CsgTree>();
+    CsgTree::Node a, b, root;
+    a.shape.type = ImplicitType::Box;
+    a.shape.halfExtents = vec3(1.0f);
+    a.material.name = "box";
+    a.material.baseColor = vec3(1, 0, 0);
+    b.shape.type = ImplicitType::Sphere;
+    b.shape.radius = 0.6f;
+    b.world = glm::translate(mat4(1.0f), vec3(1, 0, 0));
+    b.invWorld = glm::inverse(b.world);
+    b.normal = normalMatrix(b.world);
+    b.material.name = "cutter";
+    b.material.baseColor = vec3(0, 0, 1);
+    root.op = int(op);
+    root.children = {0, 1};
+    tree->nodes = {a, b, root};
+    tree->root = 2;
+    FrameInput f;
+    DrawAnalytic d;
+    d.kind = DrawAnalytic::Kind::Csg;
+    d.csg = tree;
+    d.worldBounds = {vec3(-1), vec3(1.6f)};
+    f.analytics.push_back(d);
+    return f;
+}
+}  // namespace
+
+TEST(RaycastTest, CsgDifferenceShowsCarvedFace) {
+    FrameInput f = csgFrame(CsgOp::Difference);
+    SceneAccel acc;
+    acc.update(f);
+    SceneHit h;
+    // Through the carved pocket: the sphere's inner surface at x = 0.4, normal flipped (+x),
+    // the cutter's material.
+    ASSERT_TRUE(acc.intersect(mkRay({5, 0, 0}, {-1, 0, 0}), h));
+    EXPECT_NEAR(h.t, 4.6f, 1e-4f);
+    expectVec(h.normal, {1, 0, 0}, 1e-4f);
+    ASSERT_GE(h.csgLeaf, 0);
+    EXPECT_EQ(f.analytics[0].csg->nodes[size_t(h.csgLeaf)].material.name, "cutter");
+    // Beside the pocket: the box face x = 1 with the box material.
+    ASSERT_TRUE(acc.intersect(mkRay({5, 0.8f, 0.8f}, {-1, 0, 0}), h));
+    EXPECT_NEAR(h.t, 4.0f, 1e-4f);
+    expectVec(h.normal, {1, 0, 0}, 1e-4f);
+    EXPECT_EQ(f.analytics[0].csg->nodes[size_t(h.csgLeaf)].material.name, "box");
+    // Oblique ray into the pocket: lands on the sphere, normal points to the sphere centre.
+    Ray r = mkRay({5, 0.2f, 0.1f}, {-1, 0, 0});
+    ASSERT_TRUE(acc.intersect(r, h));
+    vec3 p = r.org + h.t * r.dir;
+    EXPECT_NEAR(glm::length(p - vec3(1, 0, 0)), 0.6f, 1e-4f);
+    expectVec(h.normal, glm::normalize(vec3(1, 0, 0) - p), 1e-4f);
+}
+
+TEST(RaycastTest, CsgUnionAndIntersection) {
+    SceneHit h;
+    FrameInput u = csgFrame(CsgOp::Union);
+    SceneAccel a1;
+    a1.update(u);
+    ASSERT_TRUE(a1.intersect(mkRay({5, 0, 0}, {-1, 0, 0}), h));
+    EXPECT_NEAR(h.t, 3.4f, 1e-4f);   // sphere pokes out to x = 1.6
+    FrameInput in = csgFrame(CsgOp::Intersection);
+    SceneAccel a2;
+    a2.update(in);
+    ASSERT_TRUE(a2.intersect(mkRay({5, 0, 0}, {-1, 0, 0}), h));
+    EXPECT_NEAR(h.t, 4.0f, 1e-4f);   // box face inside the sphere
+    ASSERT_TRUE(a2.intersect(mkRay({-5, 0, 0}, {1, 0, 0}), h));
+    EXPECT_NEAR(h.t, 5.4f, 1e-4f);   // sphere surface inside the box
+    expectVec(h.normal, {-1, 0, 0}, 1e-4f);
+}
+
+// --- parametric + grid ---------------------------------------------------------------------------
+
+TEST(RaycastTest, ParametricBezierAndTorus) {
+    ParametricSurface s = ParametricSurface::defaultPatch();
+    ParametricAccel acc(s);
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<float> U(0.02f, 0.98f);
+    for (int i = 0; i < 50; ++i) {
+        float u = U(rng), v = U(rng);
+        vec3 P = s.evaluate(u, v);
+        Ray r = mkRay(P + vec3(0, 5, 0), {0, -1, 0});
+        float t, hu, hv;
+        ASSERT_TRUE(acc.intersect(r, t, hu, hv)) << u << " " << v;
+        EXPECT_NEAR(t, 5.0f, 1e-3f);
+        vec3 q = s.evaluate(hu, hv);
+        EXPECT_LT(glm::length(q - P), 2e-3f);
+    }
+    ParametricSurface tor;
+    tor.type = ParametricType::Torus;
+    tor.majorRadius = 1.0f;
+    tor.minorRadius = 0.3f;
+    ParametricAccel ta(tor);
+    float t, u, v;
+    ASSERT_TRUE(ta.intersect(mkRay({5, 0, 0}, {-1, 0, 0}), t, u, v));
+    EXPECT_NEAR(t, 3.7f, 1e-3f);
+    vec3 n = tor.normal(u, v);
+    EXPECT_NEAR(std::abs(n.x), 1.0f, 1e-3f);
+    EXPECT_FALSE(ta.intersect(mkRay({0, 5, 0}, {0, -1, 0}), t, u, v));   // the hole
+    ASSERT_TRUE(ta.intersect(mkRay({0, 5, 1}, {0, -1, 0}), t, u, v));
+    EXPECT_NEAR(t, 4.7f, 1e-3f);
+}
+
+TEST(RaycastTest, DensityGridSphereRadius) {
+    auto g = std::make_shared<DensityGrid>();
+    const int n = 48;
+    g->dims = ivec3(n);
+    g->bounds = {vec3(-1), vec3(1)};
+    g->isoValue = 0.5f;
+    g->values.resize(size_t(n) * n * n);
+    for (int z = 0; z < n; ++z)
+        for (int y = 0; y < n; ++y)
+            for (int x = 0; x < n; ++x) {
+                vec3 p = vec3(-1) + 2.0f * vec3(x, y, z) / float(n - 1);
+                g->values[(size_t(z) * n + y) * n + x] = 1.0f - glm::length(p);   // inside: value > 0.5 <=> |p| < 0.5
+            }
+    GridAccel acc(g);
+    float t;
+    ASSERT_TRUE(acc.intersect(mkRay({0, 0, -5}, {0, 0, 1}), t));
+    EXPECT_NEAR(t, 4.5f, 0.02f);
+    expectVec(acc.normal(vec3(0, 0, -0.5f)), {0, 0, -1}, 0.02f);
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> U(-0.3f, 0.3f);
+    for (int i = 0; i < 50; ++i) {
+        Ray r = mkRay({U(rng), U(rng), 3}, {U(rng) * 0.1f, U(rng) * 0.1f, -1});
+        ASSERT_TRUE(acc.intersect(r, t));
+        EXPECT_NEAR(glm::length(r.org + t * r.dir), 0.5f, 0.02f);
+    }
+    EXPECT_FALSE(acc.intersect(mkRay({0, 0.9f, -5}, {0, 0, 1}), t));
+}
+
+// --- BVH ------------------------------------------------------------------------------------------
+
+TEST(RaycastTest, BvhClosestHitEqualsBruteForce) {
+    for (int seed = 1; seed <= 4; ++seed) {
+        std::mt19937 rng(seed);
+        std::uniform_real_distribution<float> U(-1, 1);
+        const int ntri = seed == 4 ? 5 : 300 * seed * seed;
+        std::vector<vec3> pos;
+        std::vector<uint32_t> idx;
+        for (int t = 0; t < ntri; ++t) {
+            vec3 c(U(rng) * 5, U(rng) * 5, U(rng) * 5);
+            float s = seed == 3 ? 0.05f : 0.6f;   // seed 3: many tiny triangles
+            for (int k = 0; k < 3; ++k) {
+                pos.push_back(c + s * vec3(U(rng), U(rng), U(rng)));
+                idx.push_back(uint32_t(pos.size() - 1));
+            }
+        }
+        // A few degenerate triangles must not break anything.
+        pos.push_back(vec3(0)); pos.push_back(vec3(0)); pos.push_back(vec3(0));
+        idx.insert(idx.end(), {uint32_t(pos.size() - 3), uint32_t(pos.size() - 2), uint32_t(pos.size() - 1)});
+        const size_t count = idx.size() / 3;
+        TriangleBvh bvh;
+        bvh.build(pos.data(), idx.data(), count);
+        int hits = 0;
+        for (int i = 0; i < 3000; ++i) {
+            vec3 o(U(rng) * 8, U(rng) * 8, U(rng) * 8);
+            vec3 d = i % 3 == 0 ? vec3(U(rng), U(rng), U(rng)) : vec3(U(rng) * 5, U(rng) * 5, U(rng) * 5) - o;
+            if (i % 50 == 0) d = vec3(0, 0, i % 100 == 0 ? 1.0f : -1.0f);   // axis-aligned: zero components
+            Ray r = mkRay(o, d);
+            if (i % 7 == 0) r.tmax = 0.5f;
+            TriHit a, b;
+            bool ha = bvh.intersect(r, a), hb = intersectBruteForce(pos.data(), idx.data(), count, r, b);
+            ASSERT_EQ(ha, hb) << "seed " << seed << " ray " << i;
+            EXPECT_EQ(bvh.occluded(r), hb);
+            if (!ha) continue;
+            ++hits;
+            EXPECT_EQ(a.t, b.t);
+            if (a.prim != b.prim) {   // exact ties between two triangles may pick either
+                EXPECT_EQ(a.t, b.t);
+            } else {
+                EXPECT_EQ(a.b1, b.b1);
+                EXPECT_EQ(a.b2, b.b2);
+            }
+        }
+        if (ntri > 100) { EXPECT_GT(hits, seed == 3 ? 10 : 100); }
+    }
+}
+
+TEST(RaycastTest, BvhHandlesEmptyAndNonFinite) {
+    TriangleBvh bvh;
+    bvh.build(nullptr, nullptr, 0);
+    TriHit h;
+    EXPECT_FALSE(bvh.intersect(mkRay({0, 0, 0}, {0, 0, 1}), h));
+    std::vector<vec3> pos = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {NAN, 0, 0}, {1, 1, 1}, {0, 1, 1}};
+    std::vector<uint32_t> idx = {0, 1, 2, 3, 4, 5};
+    bvh.build(pos.data(), idx.data(), 2);
+    ASSERT_TRUE(bvh.intersect(mkRay({0.2f, 0.2f, 1}, {0, 0, -1}), h));
+    EXPECT_EQ(h.prim, 0u);
+}
+
+// --- camera rays / images -----------------------------------------------------------------------------
+
+TEST(RaycastTest, PrimaryRaysLineUpWithProjections) {
+    const int w = 320, h = 200;
+    Projection projs[3];
+    projs[0].type = ProjectionType::Perspective;
+    projs[1].type = ProjectionType::Orthographic;
+    projs[2] = Projection::cabinet();
+    mat4 camWorld = glm::inverse(glm::lookAt(vec3(3, 2, 6), vec3(0, 0, 0), vec3(0, 1, 0)));
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> U(-1, 1);
+    for (const Projection& p : projs) {
+        FrameCamera cam = makeFrameCamera(camWorld, p, float(w) / h, 5.0f);
+        CameraRays rays(cam, w, h);
+        for (int i = 0; i < 100; ++i) {
+            vec3 X(U(rng), U(rng), U(rng));
+            vec4 c = cam.viewProj * vec4(X, 1.0f);
+            vec2 win((0.5f * c.x / c.w + 0.5f) * w, (0.5f * c.y / c.w + 0.5f) * h);
+            Ray r = rays.ray(win.x, win.y);
+            // X lies on the ray: distance from the line
+            vec3 d = glm::normalize(r.dir);
+            vec3 off = X - r.org;
+            float dist = glm::length(off - glm::dot(off, d) * d);
+            EXPECT_LT(dist, 2e-4f) << toString(p.type);
+            // and its depth is the rasterizers' window z
+            EXPECT_NEAR(rays.depth(X), 0.5f * c.z / c.w + 0.5f, 1e-6f);
+        }
+        // Render: a small sphere at X appears at the projected pixel with the right depth.
+        vec3 X(0.4f, -0.3f, 0.2f);
+        FrameInput f;
+        f.camera = cam;
+        f.settings.shadows = false;
+        DrawAnalytic s;
+        s.kind = DrawAnalytic::Kind::Implicit;
+        s.implicit.type = ImplicitType::Sphere;
+        s.implicit.radius = 0.05f;
+        s.world = glm::translate(mat4(1.0f), X);
+        s.invWorld = glm::inverse(s.world);
+        s.normal = normalMatrix(s.world);
+        s.worldBounds = s.implicit.localBounds().transformed(s.world);
+        f.analytics.push_back(s);
+        auto r = makeRenderer("raycast");
+        Framebuffer fb;
+        ASSERT_TRUE(r->render(f, w, h, fb).ok);
+        vec2 win = rays.project(X);
+        int px = int(win.x), row = h - 1 - int(win.y);
+        float dep = fb.depth[size_t(row) * w + px];
+        EXPECT_LT(dep, 1.0f) << toString(p.type);
+        // The sphere's front is at most one radius nearer than its centre.
+        EXPECT_LE(dep, rays.depth(X) + 1e-6f);
+        EXPECT_EQ(fb.depth[size_t(row) * w + std::min(w - 1, px + 40)], 1.0f);
+    }
+}
+
+namespace {
+FrameInput triangleScene(int w, int h) {
+    FrameInput f;
+    auto mesh = std::make_shared<Mesh>(primitives::uvSphere(1.0f, 32, 16));
+    DrawMesh d;
+    d.mesh = mesh;
+    d.world = glm::translate(mat4(1.0f), vec3(0, 1, 0));
+    d.normal = normalMatrix(d.world);
+    f.meshes.push_back(d);
+    auto ground = std::make_shared<Mesh>(primitives::plane(5.0f, 4));
+    DrawMesh g;
+    g.mesh = ground;
+    f.meshes.push_back(g);
+    DrawLight l;
+    l.position = vec3(3, 5, 2);
+    f.lights.push_back(l);
+    f.camera = makeFrameCamera(glm::inverse(glm::lookAt(vec3(0, 3, 6), vec3(0, 0.5f, 0), vec3(0, 1, 0))), Projection{}, float(w) / h, 6.0f);
+    return f;
+}
+}  // namespace
+
+TEST(RaycastTest, RendersProgressCancelAndCaches) {
+    const int w = 160, h = 120;
+    FrameInput f = triangleScene(w, h);
+    auto r = makeRenderer("raycast");
+    ASSERT_TRUE(r);
+    EXPECT_TRUE(r->capabilities().progressive);
+    RenderControl ctl;
+    std::atomic<int> tiles{0};
+    ctl.onTileDone = [&] { ++tiles; };
+    Framebuffer fb;
+    RenderStats s = r->render(f, w, h, fb, &ctl);
+    ASSERT_TRUE(s.ok) << s.error;
+    EXPECT_FLOAT_EQ(ctl.progress.load(), 1.0f);
+    EXPECT_GT(tiles.load(), 1);
+    EXPECT_GT(s.rays, uint64_t(w * h));
+    // The sphere is in the middle of the image, lit (not background).
+    const uint8_t* c = fb.pixel(w / 2, h / 2 - 10);
+    EXPECT_GT(int(c[0]) + c[1] + c[2], 100);
+    testing_support::writeImage(fb, "raycast", "triangle-scene");
+
+    // Cancelled before it starts: reports cancelled, not ok.
+    RenderControl cancel;
+    cancel.cancel = true;
+    RenderStats sc = r->render(f, w, h, fb, &cancel);
+    EXPECT_FALSE(sc.ok);
+    EXPECT_TRUE(sc.cancelled);
+
+    // Bad size: a clear error, no crash.
+    RenderStats sb = r->render(f, 0, 10, fb);
+    EXPECT_FALSE(sb.ok);
+    EXPECT_FALSE(sb.error.empty());
+}
+
+TEST(RaycastTest, TransformEditDoesNotRebuildMeshBvh) {
+    FrameInput f = triangleScene(64, 64);
+    SceneAccel acc;
+    EXPECT_EQ(acc.update(f), 2);
+    f.meshes[0].world = glm::translate(mat4(1.0f), vec3(0, 3, 0));
+    EXPECT_EQ(acc.update(f), 0);   // moved instance: TLAS only
+    SceneHit h;
+    ASSERT_TRUE(acc.intersect(mkRay({0, 10, 0}, {0, -1, 0}), h));
+    EXPECT_NEAR(h.t, 6.0f, 0.02f);   // top of the moved sphere at y = 4
+    auto edited = std::make_shared<Mesh>(*f.meshes[0].mesh);
+    edited->touch();
+    f.meshes[0].mesh = edited;
+    EXPECT_EQ(acc.update(f), 1);   // new version: rebuilt
+}
+
+TEST(RaycastTest, AntiAliasingAndShadingModelsRun) {
+    const int w = 64, h = 48;
+    FrameInput f = triangleScene(w, h);
+    auto r = makeRenderer("raycast");
+    Framebuffer a, b;
+    for (ShadingModel m : {ShadingModel::Flat, ShadingModel::Gouraud, ShadingModel::Phong}) {
+        f.settings.shading = m;
+        f.settings.aa = AAMode::None;
+        ASSERT_TRUE(r->render(f, w, h, a).ok);
+        f.settings.aa = AAMode::SSAA;
+        f.settings.aaRate = 4;
+        ASSERT_TRUE(r->render(f, w, h, b).ok);
+        auto d = compareImages(a, b, 8);
+        EXPECT_GT(d.fractionWithin, 0.8) << d.describe();   // AA only changes edges
+    }
+}
