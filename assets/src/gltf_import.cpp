@@ -645,24 +645,24 @@ struct Converter {
         if (imageTried[size_t(ii)]) return decodedImage[size_t(ii)];
         imageTried[size_t(ii)] = 1;
         const tinygltf::Image& img = m.images[size_t(ii)];
-        std::string name = img.name.empty() ? (img.uri.empty() ? "image " + std::to_string(ii) : img.uri) : img.name;
+        std::string name = "image " + std::to_string(ii) + (img.uri.empty() || img.uri.rfind("data:", 0) == 0 ? "" : " ('" + img.uri + "')");
         auto it = ctx.imageBytes.find(ii);
         if (it == ctx.imageBytes.end()) {
-            warnOnce("image " + std::to_string(ii) + " ('" + name + "') could not be read; material uses no texture");
+            warnOnce(name + " could not be read; material uses no texture");
             return nullptr;
         }
         int w = 0, h = 0;
-        if (imageSize(it->second.data(), it->second.size(), w, h)) {
+        if (imageSize(it->second.data(), it->second.size(), w, h) && w <= kMaxImageDimension && h <= kMaxImageDimension) {
             uint64_t bytes = uint64_t(std::max(w, 0)) * uint64_t(std::max(h, 0)) * 4;
             if (textureBytes + bytes > kMaxTextureBytes) {
-                warnOnce("image " + std::to_string(ii) + " ('" + name + "'): texture budget of " + std::to_string(kMaxTextureBytes >> 20) + " MB exceeded; texture skipped");
+                warnOnce(name + ": texture budget of " + std::to_string(kMaxTextureBytes >> 20) + " MB exceeded; texture skipped");
                 return nullptr;
             }
         }
         ImageLoad r = decodeImage(it->second.data(), it->second.size(), name);
         std::vector<unsigned char>().swap(it->second);
         if (!r.texture) {
-            warnOnce("image " + std::to_string(ii) + ": " + r.error + "; material uses no texture");
+            warnOnce(r.error + "; material uses no texture");
             return nullptr;
         }
         textureBytes += r.texture->rgba.size();
@@ -1207,11 +1207,9 @@ LoadResult loadGltf(const fs::path& path, const LoadOptions& options) {
         return fail(why);
     }
     progress.set(0.3f);
-    if (!twarn.empty()) {
-        std::string w = oneLine(twarn);
-        if (!ctx.refused.empty()) w += " (" + ctx.refused.front() + ")";
-        result.warnings.push_back(file + ": " + w);
-    }
+    // Files we refused or could not read (images: the load goes on without them).
+    for (const std::string& why : ctx.refused) result.warnings.push_back(file + ": file not read: " + why);
+    if (!twarn.empty() && ctx.refused.empty()) result.warnings.push_back(file + ": " + oneLine(twarn));
     for (const auto& w : ctx.imageWarnings) result.warnings.push_back(file + ": " + w);
 
     // Required extensions we cannot honour make the file unloadable (the spec says so).

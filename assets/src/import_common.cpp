@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <climits>
+#include <cstdlib>
 #include <cstring>
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -101,6 +102,21 @@ int openConfined(const fs::path& root, const std::string& rootStr, const std::st
         return -1;
     }
     fs::path p = root / rel;
+    // Resolve symlinks first (realpath opens nothing) so that a link pointing out of the
+    // folder is refused without its target ever being opened.
+    {
+        char resolved[PATH_MAX + 1];
+        if (!::realpath(p.c_str(), resolved)) {
+            *why = sysErr("cannot open '" + rel + "'");
+            return -1;
+        }
+        std::string rs(resolved);
+        if (rs.compare(0, rootStr.size(), rootStr) != 0) {
+            *why = "'" + rel + "' resolves to '" + rs + "', outside the model's folder";
+            return -1;
+        }
+        p = rs;
+    }
     int fd = ::open(p.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK | O_NOCTTY);
     if (fd < 0) {
         *why = sysErr("cannot open '" + rel + "'");

@@ -788,6 +788,7 @@ LoadResult loadPly(const fs::path& path, const std::string& data, Ctx& ctx) {
         }
         std::vector<double> vals(e.props.size());
         bool truncated = false;
+        readOf = 0;
         for (uint64_t i = 0; i < e.count && !truncated; ++i) {
             ctx.poll(size_t(i), 0.0f, 0.95f, 0);
             for (size_t k = 0; k < e.props.size(); ++k) {
