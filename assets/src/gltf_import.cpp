@@ -1,10 +1,1276 @@
-// Placeholder until the glTF importer lands.
+// gltf_import.cpp - glTF 2.0 (.gltf with external or embedded buffers, .glb) through Debian's
+// tinygltf 2.7.0 (shared library: only the header's declarations are used here).
+//
+// Sections: 1. mapping to our scene (documentation)  2. limits  3. file access + image
+// callbacks, JSON pre-checks  4. validation  5. accessor reading  6. textures + materials
+// 7. meshes  8. nodes, cameras, lights  9. animations  10. loadGltf
+//
+// ---- 1. Mapping ----------------------------------------------------------------------------
+// Scenes: the default scene (`scene`), else scene 0; with no scenes at all, every root node
+//   (with a warning). LoadResult::sceneNames lists all scenes, loadedScene the chosen one.
+// Nodes: one sg node per glTF node, same hierarchy and names ("node N" when unnamed); TRS ->
+//   LocalTransform TRS (quaternion normalised), matrix -> LocalTransform Matrix.
+// Meshes: one sg::Mesh per glTF primitive, shared by all nodes instancing the glTF mesh. A
+//   node whose mesh has exactly one primitive (and no camera/light) carries the MeshInstance
+//   itself; otherwise each primitive becomes a child node "<node>#<i>". Cameras and lights of
+//   a node that already carries a payload become child nodes as well.
+//   Modes: TRIANGLES; TRIANGLE_STRIP / TRIANGLE_FAN -> triangles (strip winding alternates;
+//   degenerate strip/fan triangles are dropped); LINES / LINE_STRIP / LINE_LOOP -> Lines
+//   (segments); POINTS -> Points. Any accessor component type (normalised or not), byteStride
+//   and sparse accessors are read. Missing normals: indexed triangles get smooth area-weighted
+//   normals (Mesh::computeNormals), non-indexed ones flat normals (vertices are unshared).
+//   COLOR_0 (vec3/vec4; float or normalised ints) -> colors (linear); TEXCOORD_0/1 -> uv0/uv1,
+//   except that uv0 always holds the set the diffuse texture samples: a base colour texture
+//   with texCoord 1 swaps the two sets for that primitive. Morph targets and skins are ignored
+//   (warning).
+// Materials (glTF metallic-roughness -> our Phong material):
+//   baseColor  = baseColorFactor.rgb (linear), diffuseTexture = baseColorTexture (sRGB data,
+//                as our textures are), sampler wrapS/wrapT -> WrapMode; filters:
+//                min NEAREST or NEAREST_MIPMAP_NEAREST+mag NEAREST -> Nearest, min LINEAR ->
+//                Bilinear, mipmapped or unspecified -> Trilinear (unspecified + mag NEAREST ->
+//                Nearest).
+//   alpha_r    = roughness^2;  shininess = clamp(2 / alpha_r^2 - 2, 1, 2048)  (Blinn-Phong
+//                exponent matching a Beckmann/GGX lobe of that width)
+//   F0         = 0.04 for dielectrics, baseColor for metals; ks = clamp(mix(0.04, 1, metallic)
+//                + 0.25 * (1 - roughness) * (1 - metallic), 0, 1) (the second term keeps
+//                glossy dielectrics visibly shiny in a Phong model without environment light);
+//                specularTinted = metallic >= 0.5 (metal highlights take the base colour).
+//   kd         = 1 - 0.75 * metallic (metals keep a little diffuse so they are not black
+//                without reflections); ka = 0.2 (our default).
+//   emissive   = emissiveFactor (x KHR_materials_emissive_strength).
+//   alphaMode  OPAQUE -> alpha 1; BLEND -> alpha = baseColorFactor.a; MASK -> alpha 1
+//                (cut-outs are not supported); doubleSided -> Material::doubleSided.
+//   KHR_materials_unlit -> Material::unlit. KHR_materials_pbrSpecularGlossiness: diffuseFactor
+//                / diffuseTexture -> baseColor / texture, ks = max(specularFactor),
+//                specularColor = specularFactor / ks, roughness = 1 - glossiness as above.
+//   KHR_texture_transform on the base colour texture (offset, rotation, scale, texCoord) is
+//                applied to the UVs of each primitive using the material at import time
+//                (uv' = T * R * S * uv as in the extension), since our textures have no
+//                transform. Metallic-roughness, normal, occlusion and emissive textures are
+//                not used.
+// Cameras: perspective -> Projection Perspective (fovy = yfov, zNear, zFar; infinite zfar ->
+//   max(1000 * znear, 100)); orthographic -> Orthographic (orthoHalfHeight = ymag). The glTF
+//   aspectRatio is ignored (the viewport decides). The first camera met is made active.
+// Lights (KHR_lights_punctual): point/spot/directional with colour; intensity is taken 1:1 in
+//   our units: directional lux -> irradiance 1 lux = 1 unit; point/spot candela -> intensity
+//   with inverseSquare = true, so E = I / r^2 at distance r (again lux). Spot cone angles
+//   (radians from the axis) -> spotInnerDeg / spotOuterDeg. `range` is ignored.
+//   Scenes with neither cameras nor lights get Scene::addDefaultCamera and a directional key.
+// Animations: node translation/rotation/scale channels (LINEAR, STEP, CUBICSPLINE) become
+//   assets::AnimationClip (animation.h) in LoadResult::animations; "weights" channels
+//   (morphs) are skipped with a warning.
+//
+// Safety: the file is read by us (size limit), its JSON (the GLB JSON chunk) is limited in
+// size and nesting depth before tinygltf's recursive parser sees it; buffers and images are
+// read only through ConfinedDir (model folder only, regular files only, no working-directory
+// fallback); images are stored raw by our SetImageLoader callback and decoded later through
+// decodeImage (PNG/JPEG magic, dimension cap) only if a used material needs them, with a
+// texture byte budget. After parsing, validate() checks every index, every byte range
+// (overflow-checked), counts, finiteness, the node graph (cycles, double parents) and budgets
+// before anything is allocated from the file's numbers.
 #include "importers.h"
+#include "import_common.h"
+
+#include "assets/files.h"
+#include "assets/image_io.h"
+
+#include <tiny_gltf.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <unordered_map>
+
+namespace fs = std::filesystem;
 
 namespace assets::detail {
-LoadResult loadGltf(const std::filesystem::path& path, const LoadOptions&) {
-    LoadResult r;
-    r.error = path.string() + ": glTF import is not built yet";
-    return r;
+
+namespace {
+
+// ---- 2. Limits ---------------------------------------------------------------------------
+constexpr uint64_t kMaxFileBytes = 2ull << 30;        // .gltf/.glb itself
+constexpr uint64_t kMaxJsonBytes = 256ull << 20;      // JSON text
+constexpr size_t kMaxJsonDepth = 128;                 // real files stay below 20
+constexpr uint64_t kMaxResourceBytes = 2ull << 30;    // one external buffer or image file
+constexpr uint64_t kMaxTriangles = 50'000'000;
+constexpr uint64_t kMaxVertices = 100'000'000;        // sum over primitives (incl. lines/points)
+constexpr uint64_t kMaxNodes = 10'000'000;
+constexpr uint64_t kMaxTextureBytes = 2ull << 30;     // decoded RGBA8
+constexpr size_t kPollEvery = 1u << 16;
+
+// ---- 3. File access and image callbacks --------------------------------------------------
+struct Ctx {
+    explicit Ctx(const fs::path& folder) : dir(folder) {}
+    ConfinedDir dir;
+    std::vector<std::string> refused;                       // why a file was not read
+    std::map<int, std::vector<unsigned char>> imageBytes;   // image index -> raw file bytes
+    std::vector<std::string> imageWarnings;
+    tinygltf::Model* model = nullptr;
+};
+
+void addRefusal(Ctx& c, const std::string& why) {
+    if (std::find(c.refused.begin(), c.refused.end(), why) == c.refused.end()) c.refused.push_back(why);
 }
+
+bool fsFileExists(const std::string& path, void* ud) {
+    Ctx& c = *static_cast<Ctx*>(ud);
+    std::string rel;
+    // tinygltf also tries "./name" (the working directory): refused silently, the model-folder
+    // attempt already recorded why the name was not found.
+    if (!c.dir.relativeOf(path, rel, nullptr)) return false;
+    std::string why = c.dir.probe(rel);
+    if (!why.empty()) addRefusal(c, why);
+    return why.empty();
+}
+std::string fsExpand(const std::string& path, void*) { return path; }   // no ~ or $VAR expansion
+bool fsRead(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* ud) {
+    Ctx& c = *static_cast<Ctx*>(ud);
+    std::string why = c.dir.readAbsolute(path, kMaxResourceBytes, *out);
+    if (!why.empty()) {
+        addRefusal(c, why);
+        if (err) *err = why;
+        return false;
+    }
+    return true;
+}
+bool fsWrite(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
+    if (err) *err = "writing is disabled";
+    return false;
+}
+
+// Keeps the encoded bytes; decoding happens after validation, for used images only.
+bool storeImage(tinygltf::Image* image, const int idx, std::string*, std::string*, int, int,
+                const unsigned char* bytes, int size, void* ud) {
+    Ctx& c = *static_cast<Ctx*>(ud);
+    size_t n = size > 0 ? size_t(size) : 0;
+    if (image->bufferView >= 0) {
+        // tinygltf checked the view and buffer indices but not the byte range.
+        const tinygltf::Model& m = *c.model;
+        const auto& bv = m.bufferViews[size_t(image->bufferView)];
+        const auto& buf = m.buffers[size_t(bv.buffer)];
+        if (bv.byteOffset > buf.data.size() || bv.byteLength > buf.data.size() - bv.byteOffset) {
+            c.imageWarnings.push_back("image " + std::to_string(idx) + ": bufferView " + std::to_string(image->bufferView) +
+                                      " exceeds its buffer; texture skipped");
+            return true;
+        }
+        bytes = buf.data.data() + bv.byteOffset;
+        n = bv.byteLength;
+    }
+    if (!bytes || n == 0) {
+        c.imageWarnings.push_back("image " + std::to_string(idx) + ": no data; texture skipped");
+        return true;
+    }
+    c.imageBytes[idx].assign(bytes, bytes + n);
+    return true;
+}
+
+// Maximum nesting of {} / [] outside strings; stops counting past `limit`.
+size_t jsonDepth(const char* s, size_t n, size_t limit) {
+    size_t depth = 0, maxDepth = 0;
+    bool inString = false;
+    for (size_t i = 0; i < n; ++i) {
+        char ch = s[i];
+        if (inString) {
+            if (ch == '\\') ++i;
+            else if (ch == '"') inString = false;
+        } else if (ch == '"') {
+            inString = true;
+        } else if (ch == '{' || ch == '[') {
+            if (++depth > maxDepth) {
+                maxDepth = depth;
+                if (maxDepth > limit) return maxDepth;
+            }
+        } else if (ch == '}' || ch == ']') {
+            if (depth > 0) --depth;
+        }
+    }
+    return maxDepth;
+}
+
+std::string oneLine(std::string s) {
+    for (char& ch : s)
+        if (ch == '\n' || ch == '\r') ch = ' ';
+    while (!s.empty() && s.back() == ' ') s.pop_back();
+    size_t p;
+    while ((p = s.find("  ")) != std::string::npos) s.replace(p, 2, "; ");
+    if (s.size() > 400) s = s.substr(0, 400) + "...";
+    return s;
+}
+
+// ---- 4. Validation -----------------------------------------------------------------------
+int componentSize(int ct) {
+    switch (ct) {
+    case TINYGLTF_COMPONENT_TYPE_BYTE:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return 1;
+    case TINYGLTF_COMPONENT_TYPE_SHORT:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return 2;
+    case TINYGLTF_COMPONENT_TYPE_INT:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: return 4;
+    default: return 0;
+    }
+}
+int componentCount(int type) {
+    switch (type) {
+    case TINYGLTF_TYPE_SCALAR: return 1;
+    case TINYGLTF_TYPE_VEC2: return 2;
+    case TINYGLTF_TYPE_VEC3: return 3;
+    case TINYGLTF_TYPE_VEC4: return 4;
+    case TINYGLTF_TYPE_MAT2: return 4;
+    case TINYGLTF_TYPE_MAT3: return 9;
+    case TINYGLTF_TYPE_MAT4: return 16;
+    default: return 0;
+    }
+}
+// Bytes of one element, including the column padding of small-component matrices.
+size_t elementSize(const tinygltf::Accessor& a) {
+    size_t cs = size_t(componentSize(a.componentType));
+    auto col = [&](size_t rows) { return (rows * cs + 3) / 4 * 4; };
+    switch (a.type) {
+    case TINYGLTF_TYPE_MAT2: return cs < 4 ? 2 * col(2) : 4 * cs;
+    case TINYGLTF_TYPE_MAT3: return cs < 4 ? 3 * col(3) : 9 * cs;
+    case TINYGLTF_TYPE_MAT4: return 16 * cs;
+    default: return size_t(componentCount(a.type)) * cs;
+    }
+}
+size_t accessorStride(const tinygltf::Model& m, const tinygltf::Accessor& a) {
+    if (a.bufferView < 0) return elementSize(a);
+    size_t s = m.bufferViews[size_t(a.bufferView)].byteStride;
+    return s ? s : elementSize(a);
+}
+
+bool addOv(uint64_t a, uint64_t b, uint64_t& r) { return __builtin_add_overflow(a, b, &r); }
+bool mulOv(uint64_t a, uint64_t b, uint64_t& r) { return __builtin_mul_overflow(a, b, &r); }
+
+bool finiteAll(const std::vector<double>& v) {
+    return std::all_of(v.begin(), v.end(), [](double d) { return std::isfinite(d) && std::abs(d) < 1e30; });
+}
+
+const tinygltf::Value* extensionObject(const tinygltf::ExtensionMap& ext, const char* name) {
+    auto it = ext.find(name);
+    if (it == ext.end() || !it->second.IsObject()) return nullptr;
+    return &it->second;
+}
+double numberOr(const tinygltf::Value& obj, const char* key, double def) {
+    if (!obj.Has(key)) return def;
+    const tinygltf::Value& v = obj.Get(key);
+    if (!v.IsNumber()) return def;
+    double d = v.GetNumberAsDouble();
+    return std::isfinite(d) ? d : def;
+}
+bool numberArray(const tinygltf::Value& obj, const char* key, size_t n, double* out) {
+    if (!obj.Has(key)) return false;
+    const tinygltf::Value& v = obj.Get(key);
+    if (!v.IsArray() || v.ArrayLen() != n) return false;
+    for (size_t i = 0; i < n; ++i) {
+        const tinygltf::Value& e = v.Get(int(i));
+        if (!e.IsNumber() || !std::isfinite(e.GetNumberAsDouble())) return false;
+        out[i] = e.GetNumberAsDouble();
+    }
+    return true;
+}
+int nodeLight(const tinygltf::Node& n) {
+    const tinygltf::Value* e = extensionObject(n.extensions, "KHR_lights_punctual");
+    if (!e || !e->Has("light") || !e->Get("light").IsNumber()) return -1;
+    double d = e->Get("light").GetNumberAsDouble();
+    if (!(d >= 0 && d < 2e9)) return -2;   // invalid marker
+    return int(d);
+}
+
+// Range-checks one accessor (base data and sparse substitution). "" when valid.
+std::string checkAccessor(const tinygltf::Model& m, size_t i) {
+    const tinygltf::Accessor& a = m.accessors[i];
+    std::string id = "accessor " + std::to_string(i) + ": ";
+    if (!componentSize(a.componentType)) return id + "invalid componentType " + std::to_string(a.componentType);
+    if (!componentCount(a.type)) return id + "invalid type";
+    size_t es = elementSize(a);
+    if (a.bufferView >= 0) {
+        if (size_t(a.bufferView) >= m.bufferViews.size())
+            return id + "bufferView " + std::to_string(a.bufferView) + " does not exist (" + std::to_string(m.bufferViews.size()) + " bufferViews)";
+        const tinygltf::BufferView& bv = m.bufferViews[size_t(a.bufferView)];
+        uint64_t stride = bv.byteStride ? bv.byteStride : es;
+        if (bv.byteStride && bv.byteStride < es)
+            return id + "byteStride " + std::to_string(bv.byteStride) + " of bufferView " + std::to_string(a.bufferView) +
+                   " is smaller than the element size " + std::to_string(es);
+        if (a.count > 0) {
+            uint64_t end = 0;
+            if (mulOv(stride, uint64_t(a.count - 1), end) || addOv(end, a.byteOffset, end) || addOv(end, es, end) ||
+                end > bv.byteLength)
+                return id + "byteOffset+count*stride exceeds bufferView " + std::to_string(a.bufferView) + " (count " +
+                       std::to_string(a.count) + ", stride " + std::to_string(stride) + ", byteOffset " +
+                       std::to_string(a.byteOffset) + ", length " + std::to_string(bv.byteLength) + ")";
+        }
+    }
+    if (a.sparse.isSparse) {
+        const auto& s = a.sparse;
+        if (s.count < 1 || uint64_t(s.count) > a.count)
+            return id + "sparse count " + std::to_string(s.count) + " outside 1.." + std::to_string(a.count);
+        int ics = componentSize(s.indices.componentType);
+        if (s.indices.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+            s.indices.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+            s.indices.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+            return id + "sparse indices have an invalid componentType";
+        struct Part { int view; int offset; uint64_t bytes; const char* what; };
+        Part parts[2] = {{s.indices.bufferView, s.indices.byteOffset, uint64_t(s.count) * uint64_t(ics), "sparse indices"},
+                         {s.values.bufferView, s.values.byteOffset, uint64_t(s.count) * es, "sparse values"}};
+        for (const Part& p : parts) {
+            if (p.view < 0 || size_t(p.view) >= m.bufferViews.size())
+                return id + p.what + " bufferView " + std::to_string(p.view) + " does not exist";
+            if (p.offset < 0) return id + p.what + " byteOffset is negative";
+            uint64_t end;
+            if (addOv(uint64_t(p.offset), p.bytes, end) || end > m.bufferViews[size_t(p.view)].byteLength)
+                return id + p.what + " exceed bufferView " + std::to_string(p.view) + " (length " +
+                       std::to_string(m.bufferViews[size_t(p.view)].byteLength) + ")";
+        }
+    }
+    return {};
+}
+
+std::string checkTextureInfo(const tinygltf::Model& m, int index, const std::string& what) {
+    if (index >= 0 && size_t(index) >= m.textures.size())
+        return what + " texture " + std::to_string(index) + " does not exist (" + std::to_string(m.textures.size()) + " textures)";
+    if (index < -1) return what + " texture index " + std::to_string(index) + " is invalid";
+    return {};
+}
+
+// Everything the conversion relies on. Returns "" or the first problem.
+std::string validate(const tinygltf::Model& m, std::vector<std::string>& warnings) {
+    auto idx = [](const char* what, size_t i) { return std::string(what) + " " + std::to_string(i) + ": "; };
+    if (m.nodes.size() > kMaxNodes)
+        return std::to_string(m.nodes.size()) + " nodes exceed the budget of " + std::to_string(kMaxNodes);
+    for (size_t i = 0; i < m.bufferViews.size(); ++i) {
+        const auto& bv = m.bufferViews[i];
+        if (bv.buffer < 0 || size_t(bv.buffer) >= m.buffers.size())
+            return idx("bufferView", i) + "buffer " + std::to_string(bv.buffer) + " does not exist (" + std::to_string(m.buffers.size()) + " buffers)";
+        uint64_t end;
+        size_t have = m.buffers[size_t(bv.buffer)].data.size();
+        if (addOv(bv.byteOffset, bv.byteLength, end) || end > have)
+            return idx("bufferView", i) + "byteOffset+byteLength (" + std::to_string(bv.byteOffset) + "+" + std::to_string(bv.byteLength) +
+                   ") exceeds buffer " + std::to_string(bv.buffer) + " (" + std::to_string(have) + " bytes)";
+        if (bv.byteStride != 0 && (bv.byteStride < 4 || bv.byteStride > 252 || bv.byteStride % 4 != 0))
+            return idx("bufferView", i) + "byteStride " + std::to_string(bv.byteStride) + " outside 4..252 or not a multiple of 4";
+    }
+    for (size_t i = 0; i < m.accessors.size(); ++i) {
+        std::string e = checkAccessor(m, i);
+        if (!e.empty()) return e;
+    }
+    for (size_t i = 0; i < m.samplers.size(); ++i) {
+        const auto& s = m.samplers[i];
+        for (int w : {s.wrapS, s.wrapT})
+            if (w != TINYGLTF_TEXTURE_WRAP_REPEAT && w != TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE && w != TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT)
+                return idx("sampler", i) + "invalid wrap mode " + std::to_string(w);
+    }
+    for (size_t i = 0; i < m.textures.size(); ++i) {
+        const auto& t = m.textures[i];
+        if (t.source >= 0 && size_t(t.source) >= m.images.size())
+            return idx("texture", i) + "image " + std::to_string(t.source) + " does not exist (" + std::to_string(m.images.size()) + " images)";
+        if (t.sampler >= 0 && size_t(t.sampler) >= m.samplers.size())
+            return idx("texture", i) + "sampler " + std::to_string(t.sampler) + " does not exist (" + std::to_string(m.samplers.size()) + " samplers)";
+    }
+    for (size_t i = 0; i < m.materials.size(); ++i) {
+        const auto& mat = m.materials[i];
+        std::string e;
+        if (e.empty()) e = checkTextureInfo(m, mat.pbrMetallicRoughness.baseColorTexture.index, "baseColor");
+        if (e.empty()) e = checkTextureInfo(m, mat.pbrMetallicRoughness.metallicRoughnessTexture.index, "metallicRoughness");
+        if (e.empty()) e = checkTextureInfo(m, mat.normalTexture.index, "normal");
+        if (e.empty()) e = checkTextureInfo(m, mat.occlusionTexture.index, "occlusion");
+        if (e.empty()) e = checkTextureInfo(m, mat.emissiveTexture.index, "emissive");
+        if (const tinygltf::Value* sg = extensionObject(mat.extensions, "KHR_materials_pbrSpecularGlossiness")) {
+            if (sg->Has("diffuseTexture") && sg->Get("diffuseTexture").IsObject() && sg->Get("diffuseTexture").Has("index")) {
+                double d = numberOr(sg->Get("diffuseTexture"), "index", -1);
+                if (e.empty()) e = checkTextureInfo(m, d >= -1 && d < 2e9 ? int(d) : -2, "diffuse");
+            }
+        }
+        if (!e.empty()) return idx("material", i) + e;
+        if (mat.pbrMetallicRoughness.baseColorFactor.size() != 4 || !finiteAll(mat.pbrMetallicRoughness.baseColorFactor))
+            return idx("material", i) + "baseColorFactor must be 4 finite numbers";
+        if (!mat.emissiveFactor.empty() && (mat.emissiveFactor.size() != 3 || !finiteAll(mat.emissiveFactor)))
+            return idx("material", i) + "emissiveFactor must be 3 finite numbers";
+    }
+    for (size_t i = 0; i < m.cameras.size(); ++i) {
+        const auto& c = m.cameras[i];
+        if (c.type == "perspective") {
+            const auto& p = c.perspective;
+            if (!(p.yfov > 0 && p.yfov < sg::kPi && std::isfinite(p.yfov))) return idx("camera", i) + "yfov must be in (0, pi)";
+            if (!(p.znear > 0 && std::isfinite(p.znear))) return idx("camera", i) + "znear must be > 0";
+            if (p.zfar != 0 && !(p.zfar > p.znear && std::isfinite(p.zfar))) return idx("camera", i) + "zfar must be > znear";
+        } else if (c.type == "orthographic") {
+            const auto& o = c.orthographic;
+            if (!(o.ymag != 0 && std::isfinite(o.ymag) && std::isfinite(o.xmag))) return idx("camera", i) + "ymag must be finite and non-zero";
+            if (!(o.znear >= 0 && o.zfar > o.znear && std::isfinite(o.zfar))) return idx("camera", i) + "need 0 <= znear < zfar";
+        } else {
+            return idx("camera", i) + "unknown type '" + c.type + "'";
+        }
+    }
+    for (size_t i = 0; i < m.lights.size(); ++i) {
+        const auto& l = m.lights[i];
+        if (l.type != "point" && l.type != "spot" && l.type != "directional") return idx("light", i) + "unknown type '" + l.type + "'";
+        if (!l.color.empty() && (l.color.size() != 3 || !finiteAll(l.color))) return idx("light", i) + "color must be 3 finite numbers";
+        if (!std::isfinite(l.intensity) || l.intensity < 0) return idx("light", i) + "intensity must be finite and >= 0";
+        if (l.type == "spot" && !(std::isfinite(l.spot.innerConeAngle) && std::isfinite(l.spot.outerConeAngle) &&
+                                  l.spot.innerConeAngle >= 0 && l.spot.outerConeAngle <= sg::kPi / 2 + 1e-6))
+            return idx("light", i) + "invalid spot cone angles";
+    }
+    // Meshes and primitives.
+    for (size_t i = 0; i < m.meshes.size(); ++i) {
+        const auto& mesh = m.meshes[i];
+        for (size_t p = 0; p < mesh.primitives.size(); ++p) {
+            const auto& prim = mesh.primitives[p];
+            std::string id = "mesh " + std::to_string(i) + " primitive " + std::to_string(p) + ": ";
+            if (prim.mode < 0 || prim.mode > 6) return id + "invalid mode " + std::to_string(prim.mode);
+            if (prim.material >= 0 && size_t(prim.material) >= m.materials.size())
+                return id + "material " + std::to_string(prim.material) + " does not exist (" + std::to_string(m.materials.size()) + " materials)";
+            if (prim.material < -1) return id + "invalid material index";
+            if (prim.indices >= 0) {
+                if (size_t(prim.indices) >= m.accessors.size())
+                    return id + "indices accessor " + std::to_string(prim.indices) + " does not exist (" + std::to_string(m.accessors.size()) + " accessors)";
+                const auto& a = m.accessors[size_t(prim.indices)];
+                if (a.type != TINYGLTF_TYPE_SCALAR ||
+                    (a.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && a.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+                     a.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT))
+                    return id + "indices accessor " + std::to_string(prim.indices) + " must be unsigned byte/short/int scalars";
+            } else if (prim.indices < -1) {
+                return id + "invalid indices accessor";
+            }
+            int64_t count = -1;
+            std::string countFrom;
+            for (const auto& [name, ai] : prim.attributes) {
+                if (ai < 0 || size_t(ai) >= m.accessors.size())
+                    return id + "attribute " + name + ": accessor " + std::to_string(ai) + " does not exist (" + std::to_string(m.accessors.size()) + " accessors)";
+                const auto& a = m.accessors[size_t(ai)];
+                if (count < 0) {
+                    count = int64_t(a.count);
+                    countFrom = name;
+                } else if (int64_t(a.count) != count) {
+                    return id + "attribute " + name + " has " + std::to_string(a.count) + " elements but " + countFrom + " has " + std::to_string(count);
+                }
+                bool isFloat = a.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT;
+                bool normInt = a.normalized && (a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE || a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT);
+                if (name == "POSITION" || name == "NORMAL") {
+                    if (a.type != TINYGLTF_TYPE_VEC3) return id + name + " must be VEC3";
+                } else if (name == "TEXCOORD_0" || name == "TEXCOORD_1") {
+                    if (a.type != TINYGLTF_TYPE_VEC2) return id + name + " must be VEC2";
+                    if (!isFloat && !normInt) warnings.push_back(id + name + " uses non-normalized integers (read as plain numbers)");
+                } else if (name == "COLOR_0") {
+                    if (a.type != TINYGLTF_TYPE_VEC3 && a.type != TINYGLTF_TYPE_VEC4) return id + "COLOR_0 must be VEC3 or VEC4";
+                }
+            }
+            if (!prim.attributes.count("POSITION")) warnings.push_back(id + "no POSITION attribute; primitive skipped");
+        }
+    }
+    // Nodes: indices, finite transforms, tree structure.
+    std::vector<int32_t> parent(m.nodes.size(), -1);
+    for (size_t i = 0; i < m.nodes.size(); ++i) {
+        const auto& n = m.nodes[i];
+        std::string id = "node " + std::to_string(i) + ": ";
+        if (n.mesh >= 0 && size_t(n.mesh) >= m.meshes.size())
+            return id + "mesh " + std::to_string(n.mesh) + " does not exist (" + std::to_string(m.meshes.size()) + " meshes)";
+        if (n.camera >= 0 && size_t(n.camera) >= m.cameras.size())
+            return id + "camera " + std::to_string(n.camera) + " does not exist (" + std::to_string(m.cameras.size()) + " cameras)";
+        if (n.skin >= 0 && size_t(n.skin) >= m.skins.size())
+            return id + "skin " + std::to_string(n.skin) + " does not exist";
+        int li = nodeLight(n);
+        if (li == -2 || (li >= 0 && size_t(li) >= m.lights.size()))
+            return id + "light " + std::to_string(li) + " does not exist (" + std::to_string(m.lights.size()) + " lights)";
+        if (!n.matrix.empty() && (n.matrix.size() != 16 || !finiteAll(n.matrix))) return id + "matrix must be 16 finite numbers";
+        if (!n.matrix.empty() && (n.matrix[3] != 0 || n.matrix[7] != 0 || n.matrix[11] != 0 || n.matrix[15] != 1))
+            return id + "matrix is not affine (last row must be 0 0 0 1)";
+        if (!n.translation.empty() && (n.translation.size() != 3 || !finiteAll(n.translation))) return id + "translation must be 3 finite numbers";
+        if (!n.rotation.empty() && (n.rotation.size() != 4 || !finiteAll(n.rotation))) return id + "rotation must be 4 finite numbers";
+        if (!n.scale.empty() && (n.scale.size() != 3 || !finiteAll(n.scale))) return id + "scale must be 3 finite numbers";
+        for (int ch : n.children) {
+            if (ch < 0 || size_t(ch) >= m.nodes.size())
+                return id + "child " + std::to_string(ch) + " does not exist (" + std::to_string(m.nodes.size()) + " nodes)";
+            if (size_t(ch) == i) return id + "is its own child";
+            if (parent[size_t(ch)] >= 0)
+                return "node " + std::to_string(ch) + " has two parents (" + std::to_string(parent[size_t(ch)]) + " and " + std::to_string(i) + ")";
+            parent[size_t(ch)] = int32_t(i);
+        }
+    }
+    // With single parents, a cycle is a set of nodes whose parent chain never ends. Walk each
+    // chain once (state: 0 unknown, 1 on current walk, 2 reaches a root).
+    {
+        std::vector<uint8_t> state(m.nodes.size(), 0);
+        std::vector<size_t> walk;
+        for (size_t i = 0; i < m.nodes.size(); ++i) {
+            walk.clear();
+            size_t k = i;
+            while (state[k] == 0) {
+                state[k] = 1;
+                walk.push_back(k);
+                if (parent[k] < 0) break;
+                k = size_t(parent[k]);
+            }
+            if (state[k] == 1 && parent[k] >= 0) {
+                // k is on the current walk and has a parent on it too: a cycle.
+                return "node " + std::to_string(k) + ": node hierarchy contains a cycle";
+            }
+            for (size_t w : walk) state[w] = 2;
+        }
+    }
+    for (size_t i = 0; i < m.scenes.size(); ++i) {
+        std::vector<int> seen;
+        for (int r : m.scenes[i].nodes) {
+            if (r < 0 || size_t(r) >= m.nodes.size())
+                return idx("scene", i) + "node " + std::to_string(r) + " does not exist (" + std::to_string(m.nodes.size()) + " nodes)";
+            if (parent[size_t(r)] >= 0) return idx("scene", i) + "node " + std::to_string(r) + " is not a root node (its parent is " + std::to_string(parent[size_t(r)]) + ")";
+        }
+        seen = m.scenes[i].nodes;
+        std::sort(seen.begin(), seen.end());
+        if (std::adjacent_find(seen.begin(), seen.end()) != seen.end()) return idx("scene", i) + "lists a node twice";
+    }
+    if (m.defaultScene >= 0 && size_t(m.defaultScene) >= m.scenes.size())
+        return "scene " + std::to_string(m.defaultScene) + " (the default scene) does not exist (" + std::to_string(m.scenes.size()) + " scenes)";
+    for (size_t i = 0; i < m.skins.size(); ++i)
+        for (int j : m.skins[i].joints)
+            if (j < 0 || size_t(j) >= m.nodes.size()) return idx("skin", i) + "joint " + std::to_string(j) + " does not exist";
+    return {};
+}
+
+// ---- 5. Accessor reading -----------------------------------------------------------------
+float readComponent(const unsigned char* p, int ct, bool normalized) {
+    switch (ct) {
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: { float f; std::memcpy(&f, p, 4); return f; }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return normalized ? float(p[0]) / 255.0f : float(p[0]);
+    case TINYGLTF_COMPONENT_TYPE_BYTE: { float v = float(int8_t(p[0])); return normalized ? std::max(v / 127.0f, -1.0f) : v; }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: { uint16_t v; std::memcpy(&v, p, 2); return normalized ? float(v) / 65535.0f : float(v); }
+    case TINYGLTF_COMPONENT_TYPE_SHORT: { int16_t v; std::memcpy(&v, p, 2); return normalized ? std::max(float(v) / 32767.0f, -1.0f) : float(v); }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: { uint32_t v; std::memcpy(&v, p, 4); return normalized ? float(double(v) / 4294967295.0) : float(v); }
+    case TINYGLTF_COMPONENT_TYPE_INT: { int32_t v; std::memcpy(&v, p, 4); return normalized ? std::max(float(double(v) / 2147483647.0), -1.0f) : float(v); }
+    default: return 0.0f;
+    }
+}
+uint32_t readIndex(const unsigned char* p, int ct) {
+    switch (ct) {
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return p[0];
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: { uint16_t v; std::memcpy(&v, p, 2); return v; }
+    default: { uint32_t v; std::memcpy(&v, p, 4); return v; }
+    }
+}
+
+// Calls f(i, bytes) for every element (zeros when there is no bufferView), then again for the
+// sparse substitutions. Ranges were validated; sparse indices are checked here.
+template <class F>
+std::string forEachElement(const tinygltf::Model& m, size_t ai, const Progress& progress, F&& f) {
+    const tinygltf::Accessor& a = m.accessors[ai];
+    static const unsigned char zeros[64] = {};
+    if (a.bufferView >= 0) {
+        const auto& bv = m.bufferViews[size_t(a.bufferView)];
+        const unsigned char* base = m.buffers[size_t(bv.buffer)].data.data() + bv.byteOffset + a.byteOffset;
+        size_t stride = accessorStride(m, a);
+        for (size_t i = 0; i < a.count; ++i) {
+            if ((i & (kPollEvery - 1)) == kPollEvery - 1 && progress.cancelled()) return "cancelled";
+            f(i, base + i * stride);
+        }
+    } else {
+        for (size_t i = 0; i < a.count; ++i) f(i, zeros);
+    }
+    if (a.sparse.isSparse) {
+        const auto& s = a.sparse;
+        const auto& iv = m.bufferViews[size_t(s.indices.bufferView)];
+        const auto& vv = m.bufferViews[size_t(s.values.bufferView)];
+        const unsigned char* ip = m.buffers[size_t(iv.buffer)].data.data() + iv.byteOffset + size_t(s.indices.byteOffset);
+        const unsigned char* vp = m.buffers[size_t(vv.buffer)].data.data() + vv.byteOffset + size_t(s.values.byteOffset);
+        size_t ics = size_t(componentSize(s.indices.componentType)), es = elementSize(a);
+        for (size_t j = 0; j < size_t(s.count); ++j) {
+            uint32_t target = readIndex(ip + j * ics, s.indices.componentType);
+            if (target >= a.count)
+                return "accessor " + std::to_string(ai) + ": sparse index " + std::to_string(target) + " >= count " + std::to_string(a.count);
+            f(target, vp + j * es);
+        }
+    }
+    return {};
+}
+
+// Reads an accessor as floats, `n` components per element (the accessor's own count of
+// components must be >= n... exactly n for vectors; extra components are ignored).
+template <class Vec>
+std::string readVectors(const tinygltf::Model& m, size_t ai, int n, const Progress& progress, std::vector<Vec>& out, float fill = 0.0f) {
+    const tinygltf::Accessor& a = m.accessors[ai];
+    int have = componentCount(a.type);
+    int cs = componentSize(a.componentType);
+    out.assign(a.count, Vec(fill));
+    Vec* dst = out.data();
+    const int ct = a.componentType;
+    const bool norm = a.normalized;
+    const int use = std::min(have, n);
+    return forEachElement(m, ai, progress, [&](size_t i, const unsigned char* p) {
+        Vec v(fill);
+        for (int c = 0; c < use; ++c) v[c] = readComponent(p + size_t(c * cs), ct, norm);
+        dst[i] = v;
+    });
+}
+
+std::string readIndices(const tinygltf::Model& m, size_t ai, const Progress& progress, std::vector<uint32_t>& out) {
+    const tinygltf::Accessor& a = m.accessors[ai];
+    out.assign(a.count, 0);
+    const int ct = a.componentType;
+    uint32_t* dst = out.data();
+    return forEachElement(m, ai, progress, [&](size_t i, const unsigned char* p) { dst[i] = readIndex(p, ct); });
+}
+
+// ---- 6. Textures and materials -----------------------------------------------------------
+struct MaterialInfo {
+    int sgIndex = -1;
+    int texCoord = 0;             // which TEXCOORD set the diffuse texture samples
+    bool hasUvTransform = false;
+    sg::mat3 uvTransform{1.0f};
+};
+
+struct Converter {
+    Converter(const tinygltf::Model& model, Ctx& c, const Progress& p) : m(model), ctx(c), progress(p) {}
+    const tinygltf::Model& m;
+    Ctx& ctx;
+    const Progress& progress;
+    std::string file;
+    sg::Scene scene;
+    std::vector<std::string> warnings;
+    std::vector<int> textureOf;                  // glTF texture -> scene texture (-2 = not yet)
+    std::vector<sg::TexturePtr> decodedImage;    // glTF image -> decoded (null: failed/unused)
+    std::vector<int8_t> imageTried;
+    uint64_t textureBytes = 0;
+    std::vector<MaterialInfo> materials;         // glTF material -> ours
+    std::vector<std::vector<std::pair<int, int>>> meshPrims;   // glTF mesh -> (sg mesh, material) per primitive
+    std::vector<int8_t> meshDone;
+    uint64_t triangles = 0, vertices = 0;
+    std::vector<sg::NodeId> sgOf;                // glTF node -> sg node
+
+    std::string warnOnce(const std::string& w) {
+        if (std::find(warnings.begin(), warnings.end(), w) == warnings.end()) warnings.push_back(w);
+        return w;
+    }
+
+    sg::TexturePtr image(int ii) {
+        if (imageTried[size_t(ii)]) return decodedImage[size_t(ii)];
+        imageTried[size_t(ii)] = 1;
+        const tinygltf::Image& img = m.images[size_t(ii)];
+        std::string name = "image " + std::to_string(ii) + (img.uri.empty() || img.uri.rfind("data:", 0) == 0 ? "" : " ('" + img.uri + "')");
+        auto it = ctx.imageBytes.find(ii);
+        if (it == ctx.imageBytes.end()) {
+            warnOnce(name + " could not be read; material uses no texture");
+            return nullptr;
+        }
+        int w = 0, h = 0;
+        if (imageSize(it->second.data(), it->second.size(), w, h) && w <= kMaxImageDimension && h <= kMaxImageDimension) {
+            uint64_t bytes = uint64_t(std::max(w, 0)) * uint64_t(std::max(h, 0)) * 4;
+            if (textureBytes + bytes > kMaxTextureBytes) {
+                warnOnce(name + ": texture budget of " + std::to_string(kMaxTextureBytes >> 20) + " MB exceeded; texture skipped");
+                return nullptr;
+            }
+        }
+        ImageLoad r = decodeImage(it->second.data(), it->second.size(), name);
+        std::vector<unsigned char>().swap(it->second);
+        if (!r.texture) {
+            warnOnce(r.error + "; material uses no texture");
+            return nullptr;
+        }
+        textureBytes += r.texture->rgba.size();
+        if (!img.uri.empty() && img.uri.rfind("data:", 0) != 0) r.texture->sourcePath = (ctx.dir.root() / percentDecode(img.uri)).string();
+        decodedImage[size_t(ii)] = r.texture;
+        return r.texture;
+    }
+
+    int texture(int ti) {
+        if (ti < 0) return -1;
+        if (textureOf[size_t(ti)] != -2) return textureOf[size_t(ti)];
+        textureOf[size_t(ti)] = -1;
+        const tinygltf::Texture& t = m.textures[size_t(ti)];
+        if (t.source < 0) {
+            warnOnce("texture " + std::to_string(ti) + " has no PNG/JPEG source (other image formats are not supported)");
+            return -1;
+        }
+        sg::TexturePtr src = image(t.source);
+        if (!src) return -1;
+        auto tex = std::make_shared<sg::Texture>(*src);
+        tex->id = sg::newResourceId();
+        if (!t.name.empty()) tex->name = t.name;
+        if (t.sampler >= 0) {
+            const tinygltf::Sampler& s = m.samplers[size_t(t.sampler)];
+            auto wrap = [](int w) {
+                return w == TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE ? sg::WrapMode::ClampToEdge
+                       : w == TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT ? sg::WrapMode::MirroredRepeat : sg::WrapMode::Repeat;
+            };
+            tex->wrapS = wrap(s.wrapS);
+            tex->wrapT = wrap(s.wrapT);
+            int mn = s.minFilter, mg = s.magFilter;
+            if (mn == TINYGLTF_TEXTURE_FILTER_NEAREST || (mn == TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_NEAREST && mg == TINYGLTF_TEXTURE_FILTER_NEAREST) ||
+                (mn == -1 && mg == TINYGLTF_TEXTURE_FILTER_NEAREST))
+                tex->filter = sg::FilterMode::Nearest;
+            else if (mn == TINYGLTF_TEXTURE_FILTER_LINEAR)
+                tex->filter = sg::FilterMode::Bilinear;
+            else
+                tex->filter = sg::FilterMode::Trilinear;
+        }
+        scene.textures.push_back(std::move(tex));
+        textureOf[size_t(ti)] = int(scene.textures.size() - 1);
+        return textureOf[size_t(ti)];
+    }
+
+    static float shininessFromRoughness(float roughness) {
+        float a = std::clamp(roughness, 0.0f, 1.0f);
+        a = a * a;
+        if (a < 1e-3f) return 2048.0f;
+        return std::clamp(2.0f / (a * a) - 2.0f, 1.0f, 2048.0f);
+    }
+
+    void convertMaterials() {
+        materials.resize(m.materials.size());
+        for (size_t i = 0; i < m.materials.size(); ++i) {
+            const tinygltf::Material& gm = m.materials[i];
+            sg::Material mat;
+            mat.name = gm.name.empty() ? "material " + std::to_string(i) : gm.name;
+            const auto& pbr = gm.pbrMetallicRoughness;
+            sg::vec4 base(float(pbr.baseColorFactor[0]), float(pbr.baseColorFactor[1]), float(pbr.baseColorFactor[2]), float(pbr.baseColorFactor[3]));
+            base = glm::clamp(base, sg::vec4(0.0f), sg::vec4(1.0f));
+            float metallic = std::clamp(float(pbr.metallicFactor), 0.0f, 1.0f);
+            float roughness = std::clamp(float(pbr.roughnessFactor), 0.0f, 1.0f);
+            int texIndex = pbr.baseColorTexture.index;
+            int texCoord = pbr.baseColorTexture.texCoord;
+            const tinygltf::ExtensionMap* texExt = &pbr.baseColorTexture.extensions;
+            mat.baseColor = sg::vec3(base);
+            mat.kd = 1.0f - 0.75f * metallic;
+            mat.ka = 0.2f;
+            mat.ks = std::clamp(glm::mix(0.04f, 1.0f, metallic) + 0.25f * (1.0f - roughness) * (1.0f - metallic), 0.0f, 1.0f);
+            mat.shininess = shininessFromRoughness(roughness);
+            mat.specularTinted = metallic >= 0.5f;
+            mat.specularColor = sg::vec3(1.0f);
+            if (const tinygltf::Value* sgx = extensionObject(gm.extensions, "KHR_materials_pbrSpecularGlossiness")) {
+                double d[4] = {1, 1, 1, 1}, s[3] = {1, 1, 1};
+                numberArray(*sgx, "diffuseFactor", 4, d);
+                numberArray(*sgx, "specularFactor", 3, s);
+                float gloss = std::clamp(float(numberOr(*sgx, "glossinessFactor", 1.0)), 0.0f, 1.0f);
+                base = glm::clamp(sg::vec4(float(d[0]), float(d[1]), float(d[2]), float(d[3])), sg::vec4(0.0f), sg::vec4(1.0f));
+                mat.baseColor = sg::vec3(base);
+                sg::vec3 spec = glm::clamp(sg::vec3(float(s[0]), float(s[1]), float(s[2])), sg::vec3(0.0f), sg::vec3(1.0f));
+                float ks = std::max({spec.x, spec.y, spec.z});
+                mat.kd = 1.0f;
+                mat.ks = ks;
+                mat.specularColor = ks > 0 ? spec / ks : sg::vec3(1.0f);
+                mat.specularTinted = false;
+                mat.shininess = shininessFromRoughness(1.0f - gloss);
+                texIndex = -1;
+                if (sgx->Has("diffuseTexture") && sgx->Get("diffuseTexture").IsObject()) {
+                    const tinygltf::Value& dt = sgx->Get("diffuseTexture");
+                    texIndex = int(numberOr(dt, "index", -1));
+                    texCoord = int(numberOr(dt, "texCoord", 0));
+                    texExt = nullptr;
+                    if (dt.Has("extensions") && dt.Get("extensions").IsObject() && dt.Get("extensions").Has("KHR_texture_transform"))
+                        warnOnce("material " + std::to_string(i) + ": KHR_texture_transform on a specular-glossiness texture is ignored");
+                }
+            }
+            if (!gm.emissiveFactor.empty()) {
+                mat.emissive = sg::vec3(float(gm.emissiveFactor[0]), float(gm.emissiveFactor[1]), float(gm.emissiveFactor[2]));
+                if (const tinygltf::Value* es = extensionObject(gm.extensions, "KHR_materials_emissive_strength"))
+                    mat.emissive *= float(std::clamp(numberOr(*es, "emissiveStrength", 1.0), 0.0, 1e6));
+            }
+            mat.alpha = gm.alphaMode == "BLEND" ? base.a : 1.0f;
+            mat.doubleSided = gm.doubleSided;
+            mat.unlit = extensionObject(gm.extensions, "KHR_materials_unlit") != nullptr || gm.extensions.count("KHR_materials_unlit");
+            MaterialInfo info;
+            info.texCoord = texCoord == 1 ? 1 : 0;
+            if (texCoord > 1) warnOnce("material " + std::to_string(i) + ": texCoord " + std::to_string(texCoord) + " is not supported (using TEXCOORD_0)");
+            if (texIndex >= 0 && size_t(texIndex) < m.textures.size()) mat.diffuseTexture = texture(texIndex);
+            if (texExt) {
+                if (const tinygltf::Value* tt = extensionObject(*texExt, "KHR_texture_transform")) {
+                    double off[2] = {0, 0}, sc[2] = {1, 1};
+                    numberArray(*tt, "offset", 2, off);
+                    numberArray(*tt, "scale", 2, sc);
+                    float rot = float(numberOr(*tt, "rotation", 0.0));
+                    if (tt->Has("texCoord")) {
+                        int tc = int(numberOr(*tt, "texCoord", 0));
+                        info.texCoord = tc == 1 ? 1 : 0;
+                    }
+                    // Column-major: T * R * S with R = [cos sin; -sin cos] as in the extension.
+                    sg::mat3 T(1.0f), R(1.0f), S(1.0f);
+                    T[2] = sg::vec3(float(off[0]), float(off[1]), 1.0f);
+                    float c = std::cos(rot), s = std::sin(rot);
+                    R[0] = sg::vec3(c, -s, 0.0f);
+                    R[1] = sg::vec3(s, c, 0.0f);
+                    S[0][0] = float(sc[0]);
+                    S[1][1] = float(sc[1]);
+                    info.uvTransform = T * R * S;
+                    info.hasUvTransform = true;
+                }
+            }
+            scene.materials.push_back(std::move(mat));
+            info.sgIndex = int(scene.materials.size() - 1);
+            materials[i] = info;
+        }
+    }
+
+    // ---- 7. Meshes -----------------------------------------------------------------------
+    // Builds the sg::Mesh of one primitive; returns "" or an error; *skipped when the
+    // primitive has nothing to draw.
+    std::string buildPrimitive(size_t mi, size_t pi, sg::Mesh& mesh, bool& skipped) {
+        const tinygltf::Primitive& prim = m.meshes[mi].primitives[pi];
+        std::string id = "mesh " + std::to_string(mi) + " primitive " + std::to_string(pi) + ": ";
+        skipped = false;
+        auto attr = [&](const char* name) -> int {
+            auto it = prim.attributes.find(name);
+            return it == prim.attributes.end() ? -1 : it->second;
+        };
+        int pos = attr("POSITION");
+        if (pos < 0) { skipped = true; return {}; }
+        const size_t nv = m.accessors[size_t(pos)].count;
+        if (vertices + nv > kMaxVertices)
+            return id + "vertex budget exceeded (" + std::to_string(vertices + nv) + " > " + std::to_string(kMaxVertices) + ")";
+        int mode = prim.mode;
+        // Output primitive count before reading anything large.
+        size_t nIdx = prim.indices >= 0 ? m.accessors[size_t(prim.indices)].count : nv;
+        uint64_t tris = 0;
+        if (mode == TINYGLTF_MODE_TRIANGLES) tris = nIdx / 3;
+        else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP || mode == TINYGLTF_MODE_TRIANGLE_FAN) tris = nIdx >= 3 ? nIdx - 2 : 0;
+        if (triangles + tris > kMaxTriangles)
+            return id + "triangle budget exceeded (" + std::to_string(triangles + tris) + " > " + std::to_string(kMaxTriangles) + ")";
+        if (nIdx > 3 * kMaxTriangles) return id + "index count " + std::to_string(nIdx) + " exceeds the budget";
+        vertices += nv;
+
+        std::string e = readVectors(m, size_t(pos), 3, progress, mesh.positions);
+        if (!e.empty()) return e == "cancelled" ? e : id + e;
+        for (size_t i = 0; i < nv; ++i)
+            if (!sg::isFinite(mesh.positions[i])) return id + "POSITION " + std::to_string(i) + " is not finite";
+        if (int a = attr("NORMAL"); a >= 0) {
+            e = readVectors(m, size_t(a), 3, progress, mesh.normals);
+            if (!e.empty()) return e == "cancelled" ? e : id + e;
+            for (auto& n : mesh.normals) {
+                if (!sg::isFinite(n)) n = sg::vec3(0, 0, 1);
+            }
+        }
+        int uvA = attr("TEXCOORD_0"), uvB = attr("TEXCOORD_1");
+        if (uvA >= 0 && !(e = readVectors(m, size_t(uvA), 2, progress, mesh.uv0)).empty()) return e == "cancelled" ? e : id + e;
+        if (uvB >= 0 && !(e = readVectors(m, size_t(uvB), 2, progress, mesh.uv1)).empty()) return e == "cancelled" ? e : id + e;
+        if (int a = attr("COLOR_0"); a >= 0) {
+            e = readVectors(m, size_t(a), 4, progress, mesh.colors, 1.0f);
+            if (!e.empty()) return e == "cancelled" ? e : id + e;
+            if (m.accessors[size_t(a)].type == TINYGLTF_TYPE_VEC3)
+                for (auto& c : mesh.colors) c.a = 1.0f;
+        }
+        if (!prim.targets.empty()) warnOnce("morph targets are not supported (base shape shown)");
+        if (prim.attributes.count("JOINTS_0")) warnOnce("skinning is not supported (bind pose shown)");
+        // The UV set the diffuse texture samples goes to uv0; texture transform applied.
+        if (prim.material >= 0) {
+            const MaterialInfo& info = materials[size_t(prim.material)];
+            if (info.texCoord == 1 && !mesh.uv1.empty()) std::swap(mesh.uv0, mesh.uv1);
+            if (info.hasUvTransform)
+                for (auto& uv : mesh.uv0) uv = sg::vec2(info.uvTransform * sg::vec3(uv, 1.0f));
+        }
+
+        std::vector<uint32_t> src;
+        bool indexed = prim.indices >= 0;
+        if (indexed) {
+            e = readIndices(m, size_t(prim.indices), progress, src);
+            if (!e.empty()) return e == "cancelled" ? e : id + e;
+            for (size_t i = 0; i < src.size(); ++i)
+                if (src[i] >= nv)
+                    return id + "index " + std::to_string(i) + " is " + std::to_string(src[i]) + ", but there are only " + std::to_string(nv) + " vertices";
+        }
+        auto at = [&](size_t i) -> uint32_t { return indexed ? src[i] : uint32_t(i); };
+        auto& out = mesh.indices;
+        switch (mode) {
+        case TINYGLTF_MODE_POINTS:
+            mesh.mode = sg::PrimitiveMode::Points;
+            out.resize(nIdx);
+            for (size_t i = 0; i < nIdx; ++i) out[i] = at(i);
+            break;
+        case TINYGLTF_MODE_LINE:
+        case TINYGLTF_MODE_LINE_STRIP:
+        case TINYGLTF_MODE_LINE_LOOP:
+            mesh.mode = sg::PrimitiveMode::Lines;
+            if (mode == TINYGLTF_MODE_LINE) {
+                if (nIdx % 2) warnOnce(id + "odd LINES index count; last index ignored");
+                out.resize(nIdx / 2 * 2);
+                for (size_t i = 0; i < out.size(); ++i) out[i] = at(i);
+            } else if (nIdx >= 2) {
+                out.reserve(2 * nIdx);
+                for (size_t i = 0; i + 1 < nIdx; ++i) { out.push_back(at(i)); out.push_back(at(i + 1)); }
+                if (mode == TINYGLTF_MODE_LINE_LOOP) { out.push_back(at(nIdx - 1)); out.push_back(at(0)); }
+            }
+            break;
+        case TINYGLTF_MODE_TRIANGLES:
+            if (nIdx % 3) warnOnce(id + "index count is not a multiple of 3; last " + std::to_string(nIdx % 3) + " ignored");
+            out.resize(nIdx / 3 * 3);
+            if (indexed) std::copy(src.begin(), src.begin() + std::ptrdiff_t(out.size()), out.begin());
+            else for (size_t i = 0; i < out.size(); ++i) out[i] = uint32_t(i);
+            break;
+        case TINYGLTF_MODE_TRIANGLE_STRIP:
+        case TINYGLTF_MODE_TRIANGLE_FAN:
+            out.reserve(size_t(tris) * 3);
+            for (size_t i = 0; i + 2 < nIdx; ++i) {
+                uint32_t a, b, c;
+                if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+                    a = at(i);
+                    b = at(i + 1 + (i % 2));
+                    c = at(i + 2 - (i % 2));
+                } else {
+                    a = at(i + 1);
+                    b = at(i + 2);
+                    c = at(0);
+                }
+                if (a == b || b == c || a == c) continue;
+                out.push_back(a); out.push_back(b); out.push_back(c);
+            }
+            break;
+        }
+        if (mesh.mode == sg::PrimitiveMode::Triangles) {
+            triangles += out.size() / 3;
+            if (mesh.normals.empty()) {
+                if (!indexed && mode != TINYGLTF_MODE_TRIANGLES) unweld(mesh);   // flat normals for non-indexed strips/fans
+                mesh.computeNormals();
+            }
+        }
+        return {};
+    }
+
+    // Gives every triangle corner its own vertex (so computeNormals yields flat normals).
+    static void unweld(sg::Mesh& mesh) {
+        sg::Mesh o;
+        auto copy = [&](auto& dst, const auto& srcv) {
+            if (srcv.empty()) return;
+            dst.reserve(mesh.indices.size());
+            for (uint32_t i : mesh.indices) dst.push_back(srcv[i]);
+        };
+        copy(o.positions, mesh.positions);
+        copy(o.normals, mesh.normals);
+        copy(o.uv0, mesh.uv0);
+        copy(o.uv1, mesh.uv1);
+        copy(o.colors, mesh.colors);
+        mesh.positions = std::move(o.positions);
+        mesh.normals = std::move(o.normals);
+        mesh.uv0 = std::move(o.uv0);
+        mesh.uv1 = std::move(o.uv1);
+        mesh.colors = std::move(o.colors);
+        for (size_t i = 0; i < mesh.indices.size(); ++i) mesh.indices[i] = uint32_t(i);
+    }
+
+    std::string meshPrimitives(size_t mi, const std::vector<std::pair<int, int>>*& out) {
+        if (!meshDone[mi]) {
+            meshDone[mi] = 1;
+            const tinygltf::Mesh& gm = m.meshes[mi];
+            for (size_t pi = 0; pi < gm.primitives.size(); ++pi) {
+                if (progress.cancelled()) return "cancelled";
+                auto mesh = std::make_shared<sg::Mesh>();
+                bool skipped = false;
+                std::string e = buildPrimitive(mi, pi, *mesh, skipped);
+                if (!e.empty()) return e;
+                if (skipped) continue;
+                mesh->name = (gm.name.empty() ? "mesh " + std::to_string(mi) : gm.name) + (gm.primitives.size() > 1 ? "#" + std::to_string(pi) : "");
+                if (mesh->indices.empty()) {
+                    warnOnce("mesh " + std::to_string(mi) + " primitive " + std::to_string(pi) + ": nothing to draw");
+                    continue;
+                }
+                scene.meshes.push_back(std::move(mesh));
+                int mat = gm.primitives[pi].material >= 0 ? materials[size_t(gm.primitives[pi].material)].sgIndex : -1;
+                meshPrims[mi].push_back({int(scene.meshes.size() - 1), mat});
+            }
+        }
+        out = &meshPrims[mi];
+        return {};
+    }
+
+    // ---- 8. Nodes, cameras, lights --------------------------------------------------------
+    sg::Camera camera(int ci) const {
+        const tinygltf::Camera& c = m.cameras[size_t(ci)];
+        sg::Camera cam;
+        if (c.type == "perspective") {
+            cam.projection.type = sg::ProjectionType::Perspective;
+            cam.projection.fovyDeg = sg::degrees(float(c.perspective.yfov));
+            cam.projection.zNear = float(c.perspective.znear);
+            cam.projection.zFar = c.perspective.zfar > 0 ? float(c.perspective.zfar) : std::max(1000.0f * cam.projection.zNear, 100.0f);
+        } else {
+            cam.projection.type = sg::ProjectionType::Orthographic;
+            cam.projection.orthoHalfHeight = std::abs(float(c.orthographic.ymag));
+            cam.projection.zNear = float(c.orthographic.znear);
+            cam.projection.zFar = float(c.orthographic.zfar);
+        }
+        return cam;
+    }
+    sg::Light light(int li) const {
+        const tinygltf::Light& l = m.lights[size_t(li)];
+        sg::Light o;
+        o.type = l.type == "directional" ? sg::LightType::Directional : l.type == "spot" ? sg::LightType::Spot : sg::LightType::Point;
+        if (l.color.size() == 3) o.color = glm::max(sg::vec3(float(l.color[0]), float(l.color[1]), float(l.color[2])), sg::vec3(0.0f));
+        o.intensity = float(std::min(l.intensity, 1e6));
+        o.inverseSquare = o.type != sg::LightType::Directional;
+        if (o.type == sg::LightType::Spot) {
+            o.spotOuterDeg = sg::degrees(float(l.spot.outerConeAngle));
+            o.spotInnerDeg = std::min(sg::degrees(float(l.spot.innerConeAngle)), o.spotOuterDeg);
+        }
+        return o;
+    }
+
+    static sg::LocalTransform localOf(const tinygltf::Node& n) {
+        if (n.matrix.size() == 16) {
+            sg::mat4 mm;
+            for (int c = 0; c < 4; ++c)
+                for (int r = 0; r < 4; ++r) mm[c][r] = float(n.matrix[size_t(c * 4 + r)]);
+            return sg::LocalTransform::fromMatrix(mm);
+        }
+        sg::vec3 t(0.0f), s(1.0f);
+        sg::quat q(1, 0, 0, 0);
+        if (n.translation.size() == 3) t = sg::vec3(float(n.translation[0]), float(n.translation[1]), float(n.translation[2]));
+        if (n.scale.size() == 3) s = sg::vec3(float(n.scale[0]), float(n.scale[1]), float(n.scale[2]));
+        if (n.rotation.size() == 4) {
+            q = sg::quat(float(n.rotation[3]), float(n.rotation[0]), float(n.rotation[1]), float(n.rotation[2]));
+            float len = glm::length(q);
+            q = len > 1e-12f ? q / len : sg::quat(1, 0, 0, 0);
+        }
+        return sg::LocalTransform::fromTRS(t, q, s);
+    }
+
+    std::string buildNodes(const std::vector<int>& roots) {
+        sgOf.assign(m.nodes.size(), sg::kNoNode);
+        std::vector<std::pair<int, sg::NodeId>> stack;
+        for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.push_back({*it, scene.root()});
+        size_t done = 0, created = 0;
+        while (!stack.empty()) {
+            auto [gi, parent] = stack.back();
+            stack.pop_back();
+            if ((++done & 4095) == 0) {
+                if (progress.cancelled()) return "cancelled";
+                progress.set(0.5f + 0.4f * float(done) / float(std::max<size_t>(m.nodes.size(), 1)));
+            }
+            const tinygltf::Node& n = m.nodes[size_t(gi)];
+            std::string name = n.name.empty() ? "node " + std::to_string(gi) : n.name;
+            const std::vector<std::pair<int, int>>* prims = nullptr;
+            if (n.mesh >= 0) {
+                std::string e = meshPrimitives(size_t(n.mesh), prims);
+                if (!e.empty()) return e;
+            }
+            int li = nodeLight(n);
+            size_t payloads = (prims ? prims->size() : 0) + (n.camera >= 0) + (li >= 0);
+            if (++created + payloads > kMaxNodes) return "node budget of " + std::to_string(kMaxNodes) + " exceeded";
+            sg::NodeId id = scene.addNode(name, parent);
+            scene.setLocal(id, localOf(n));
+            sgOf[size_t(gi)] = id;
+            bool onNode = payloads == 1;
+            if (prims) {
+                for (size_t k = 0; k < prims->size(); ++k) {
+                    sg::MeshInstance inst{(*prims)[k].first, (*prims)[k].second};
+                    if (onNode) scene.setPayload(id, inst);
+                    else scene.addNode(name + "#" + std::to_string(k), id, inst), ++created;
+                }
+            }
+            if (n.camera >= 0) {
+                sg::NodeId cid = onNode ? id : scene.addNode(name + " camera", id);
+                scene.setPayload(cid, camera(n.camera));
+                if (!scene.valid(scene.activeCamera)) scene.activeCamera = cid;
+            }
+            if (li >= 0) {
+                sg::NodeId lid = onNode ? id : scene.addNode(name + " light", id);
+                scene.setPayload(lid, light(li));
+            }
+            for (auto it = n.children.rbegin(); it != n.children.rend(); ++it) stack.push_back({*it, id});
+        }
+        return {};
+    }
+
+    // ---- 9. Animations ---------------------------------------------------------------------
+    std::vector<AnimationClip> animations() {
+        std::vector<AnimationClip> clips;
+        for (size_t ai = 0; ai < m.animations.size(); ++ai) {
+            const tinygltf::Animation& ga = m.animations[ai];
+            AnimationClip clip;
+            clip.name = ga.name.empty() ? "animation " + std::to_string(ai) : ga.name;
+            float tmin = std::numeric_limits<float>::infinity(), tmax = 0.0f;
+            for (size_t ci = 0; ci < ga.channels.size(); ++ci) {
+                const auto& ch = ga.channels[ci];
+                std::string id = "animation " + std::to_string(ai) + " channel " + std::to_string(ci) + ": ";
+                AnimationChannel out;
+                if (ch.target_path == "translation") out.path = AnimationPath::Translation;
+                else if (ch.target_path == "rotation") out.path = AnimationPath::Rotation;
+                else if (ch.target_path == "scale") out.path = AnimationPath::Scale;
+                else { warnOnce(id + "'" + ch.target_path + "' animation is not supported; channel skipped"); continue; }
+                if (ch.sampler < 0 || size_t(ch.sampler) >= ga.samplers.size()) { warnOnce(id + "sampler does not exist; channel skipped"); continue; }
+                if (ch.target_node < 0 || size_t(ch.target_node) >= m.nodes.size()) { warnOnce(id + "target node does not exist; channel skipped"); continue; }
+                out.node = sgOf[size_t(ch.target_node)];
+                if (out.node == sg::kNoNode) continue;   // node not in the loaded scene
+                const auto& s = ga.samplers[size_t(ch.sampler)];
+                if (s.interpolation == "STEP") out.interpolation = AnimationInterpolation::Step;
+                else if (s.interpolation == "CUBICSPLINE") out.interpolation = AnimationInterpolation::CubicSpline;
+                else if (s.interpolation == "LINEAR" || s.interpolation.empty()) out.interpolation = AnimationInterpolation::Linear;
+                else { warnOnce(id + "unknown interpolation '" + s.interpolation + "'; channel skipped"); continue; }
+                if (s.input < 0 || size_t(s.input) >= m.accessors.size() || s.output < 0 || size_t(s.output) >= m.accessors.size()) {
+                    warnOnce(id + "sampler accessors do not exist; channel skipped");
+                    continue;
+                }
+                const auto& in = m.accessors[size_t(s.input)];
+                const auto& op = m.accessors[size_t(s.output)];
+                int want = out.path == AnimationPath::Rotation ? TINYGLTF_TYPE_VEC4 : TINYGLTF_TYPE_VEC3;
+                size_t perKey = out.interpolation == AnimationInterpolation::CubicSpline ? 3 : 1;
+                if (in.type != TINYGLTF_TYPE_SCALAR || in.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT || op.type != want ||
+                    in.count == 0 || op.count != in.count * perKey) {
+                    warnOnce(id + "sampler input/output accessors have the wrong type or count; channel skipped");
+                    continue;
+                }
+                std::vector<sg::vec4> t4;
+                if (!readVectors(m, size_t(s.input), 1, progress, t4).empty() || !readVectors(m, size_t(s.output), 4, progress, out.values).empty()) {
+                    warnOnce(id + "cannot read keyframes; channel skipped");
+                    continue;
+                }
+                out.times.resize(t4.size());
+                bool ok = true;
+                for (size_t k = 0; k < t4.size(); ++k) {
+                    out.times[k] = t4[k].x;
+                    if (!std::isfinite(out.times[k]) || (k > 0 && out.times[k] <= out.times[k - 1])) ok = false;
+                }
+                for (const auto& v : out.values)
+                    if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z) || !std::isfinite(v.w)) ok = false;
+                if (!ok) { warnOnce(id + "key times must be finite and increasing, values finite; channel skipped"); continue; }
+                tmin = std::min(tmin, out.times.front());
+                tmax = std::max(tmax, out.times.back());
+                clip.channels.push_back(std::move(out));
+            }
+            if (clip.channels.empty()) continue;
+            clip.start = std::isfinite(tmin) ? tmin : 0.0f;
+            clip.duration = tmax;
+            clips.push_back(std::move(clip));
+        }
+        return clips;
+    }
+};
+
+}  // namespace
+
+// ---- 10. loadGltf ----------------------------------------------------------------------------
+LoadResult loadGltf(const fs::path& path, const LoadOptions& options) {
+    LoadResult result;
+    const std::string file = fileNameOf(path);
+    Progress progress{options};
+    auto fail = [&](const std::string& why) {
+        result.scene.reset();
+        result.error = file + ": " + why;
+        return std::move(result);
+    };
+    std::string bytes;
+    std::string err = readFileLimited(path, kMaxFileBytes, bytes);
+    if (!err.empty()) {
+        result.error = err;
+        return result;
+    }
+    if (bytes.empty()) return fail("empty file");
+    progress.set(0.02f);
+
+    const bool binary = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
+    const char* json = bytes.data();
+    size_t jsonSize = bytes.size();
+    if (binary) {
+        if (bytes.size() < 20) return fail("GLB file is truncated (" + std::to_string(bytes.size()) + " bytes)");
+        uint32_t chunkLen = 0, chunkType = 0, total = 0;
+        std::memcpy(&total, bytes.data() + 8, 4);
+        std::memcpy(&chunkLen, bytes.data() + 12, 4);
+        std::memcpy(&chunkType, bytes.data() + 16, 4);
+        if (chunkType != 0x4E4F534Au) return fail("GLB: first chunk is not JSON");
+        if (uint64_t(chunkLen) + 20 > bytes.size()) return fail("GLB: JSON chunk length " + std::to_string(chunkLen) + " exceeds the file size " + std::to_string(bytes.size()));
+        if (total > bytes.size()) return fail("GLB: header length " + std::to_string(total) + " exceeds the file size " + std::to_string(bytes.size()) + " (truncated file?)");
+        json = bytes.data() + 20;
+        jsonSize = chunkLen;
+    } else if (path.extension() == ".glb" || path.extension() == ".GLB") {
+        return fail("not a GLB file (no 'glTF' magic)");
+    }
+    if (jsonSize > kMaxJsonBytes) return fail("JSON is " + std::to_string(jsonSize) + " bytes, limit " + std::to_string(kMaxJsonBytes));
+    if (size_t d = jsonDepth(json, jsonSize, kMaxJsonDepth); d > kMaxJsonDepth)
+        return fail("JSON nesting deeper than " + std::to_string(kMaxJsonDepth) + " levels");
+    if (bytes.size() > UINT32_MAX) return fail("file larger than 4 GB");
+
+    Ctx ctx(path.parent_path().empty() ? fs::path(".") : path.parent_path());
+    if (!ctx.dir.ok()) return fail(ctx.dir.error());
+    tinygltf::Model model;
+    ctx.model = &model;
+    tinygltf::TinyGLTF loader;
+    tinygltf::FsCallbacks cb{};
+    cb.FileExists = &fsFileExists;
+    cb.ExpandFilePath = &fsExpand;
+    cb.ReadWholeFile = &fsRead;
+    cb.WriteWholeFile = &fsWrite;
+    cb.user_data = &ctx;
+    loader.SetFsCallbacks(cb);
+    loader.SetImageLoader(&storeImage, &ctx);
+    std::string terr, twarn;
+    bool ok = false;
+    const std::string base = ctx.dir.root().string();
+    try {
+        if (binary)
+            ok = loader.LoadBinaryFromMemory(&model, &terr, &twarn, reinterpret_cast<const unsigned char*>(bytes.data()), unsigned(bytes.size()), base, 0);
+        else
+            ok = loader.LoadASCIIFromString(&model, &terr, &twarn, bytes.data(), unsigned(bytes.size()), base, 0);
+    } catch (const std::bad_alloc&) {
+        return fail("out of memory while parsing");
+    } catch (const std::exception& e) {
+        return fail(std::string("parse error: ") + e.what());
+    }
+    std::string().swap(bytes);
+    if (!ok) {
+        std::string why = oneLine(terr.empty() ? "tinygltf could not parse the file" : terr);
+        if (!ctx.refused.empty() && why.find("File not found") != std::string::npos) why = ctx.refused.front() + " (" + why + ")";
+        else if (!ctx.refused.empty() && why.find("read error") != std::string::npos) why = ctx.refused.front();
+        return fail(why);
+    }
+    progress.set(0.3f);
+    // Files we refused or could not read (images: the load goes on without them).
+    for (const std::string& why : ctx.refused) result.warnings.push_back(file + ": file not read: " + why);
+    if (!twarn.empty() && ctx.refused.empty()) result.warnings.push_back(file + ": " + oneLine(twarn));
+    for (const auto& w : ctx.imageWarnings) result.warnings.push_back(file + ": " + w);
+
+    // Required extensions we cannot honour make the file unloadable (the spec says so).
+    static const char* kSupported[] = {"KHR_materials_unlit", "KHR_texture_transform", "KHR_lights_punctual",
+                                       "KHR_materials_pbrSpecularGlossiness", "KHR_materials_emissive_strength"};
+    for (const std::string& ext : model.extensionsRequired)
+        if (std::none_of(std::begin(kSupported), std::end(kSupported), [&](const char* s) { return ext == s; }))
+            return fail("requires the unsupported extension " + ext);
+    if (model.asset.version.rfind("2.", 0) != 0) return fail("glTF version '" + model.asset.version + "' is not 2.x");
+
+    std::vector<std::string> vwarn;
+    std::string verr = validate(model, vwarn);
+    if (!verr.empty()) return fail(verr);
+    for (auto& w : vwarn) result.warnings.push_back(file + ": " + w);
+    if (progress.cancelled()) return fail("cancelled");
+
+    Converter conv(model, ctx, progress);
+    conv.file = file;
+    conv.scene.name = path.stem().string();
+    conv.textureOf.assign(model.textures.size(), -2);
+    conv.decodedImage.assign(model.images.size(), nullptr);
+    conv.imageTried.assign(model.images.size(), 0);
+    conv.meshPrims.resize(model.meshes.size());
+    conv.meshDone.assign(model.meshes.size(), 0);
+    try {
+        conv.convertMaterials();
+        progress.set(0.4f);
+        for (size_t i = 0; i < model.scenes.size(); ++i)
+            result.sceneNames.push_back(model.scenes[i].name.empty() ? "scene " + std::to_string(i) : model.scenes[i].name);
+        std::vector<int> roots;
+        if (!model.scenes.empty()) {
+            result.loadedScene = model.defaultScene >= 0 ? model.defaultScene : 0;
+            roots = model.scenes[size_t(result.loadedScene)].nodes;
+            if (model.scenes.size() > 1) {
+                std::string others;
+                for (size_t i = 0; i < model.scenes.size(); ++i)
+                    if (int(i) != result.loadedScene) others += (others.empty() ? "'" : ", '") + result.sceneNames[i] + "'";
+                result.warnings.push_back(file + ": loaded scene '" + result.sceneNames[size_t(result.loadedScene)] + "'; other scenes: " + others);
+            }
+        } else {
+            std::vector<uint8_t> isChild(model.nodes.size(), 0);
+            for (const auto& n : model.nodes)
+                for (int c : n.children) isChild[size_t(c)] = 1;
+            for (size_t i = 0; i < model.nodes.size(); ++i)
+                if (!isChild[i]) roots.push_back(int(i));
+            if (!roots.empty()) result.warnings.push_back(file + ": no scenes; loading all " + std::to_string(roots.size()) + " root nodes");
+            else result.warnings.push_back(file + ": the file contains no nodes");
+        }
+        std::string e = conv.buildNodes(roots);
+        if (!e.empty()) return e == "cancelled" ? fail("cancelled") : fail(e);
+        result.animations = conv.animations();
+        if (!model.skins.empty()) conv.warnOnce("skinning is not supported (bind pose shown)");
+    } catch (const std::bad_alloc&) {
+        return fail("out of memory while building the scene");
+    }
+    progress.set(0.95f);
+    addDefaultCameraAndLight(conv.scene);
+    for (auto& w : conv.warnings) result.warnings.push_back(file + ": " + w);
+    result.scene = std::move(conv.scene);
+    progress.set(1.0f);
+    return result;
+}
+
 }  // namespace assets::detail

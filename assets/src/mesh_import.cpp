@@ -1,10 +1,1025 @@
-// Placeholder until the OBJ/OFF/PLY/STL importer lands.
+// mesh_import.cpp - OBJ (+MTL), OFF, PLY (ASCII / binary, faces or tristrips, point clouds)
+// and STL (ASCII / binary) import.
+//
+// Sections: 1. why not OpenMesh  2. limits, text cursor  3. shared mesh building
+// 4. OBJ + MTL  5. OFF  6. PLY  7. STL  8. loadMeshFile
+//
+// ---- 1. Why our own parsers instead of OpenMesh 9.0 (Debian) --------------------------------
+// The guide prefers Debian's OpenMesh; these are small, bounded parsers of our own because
+// OpenMesh failed the requirements on this machine's test data (checked with read_mesh on a
+// PolyMesh_ArrayKernelT):
+//   * PLY: `tristrips` elements are "unsupported" (cow.ply / igea.ply load with 0 faces), and
+//     Box.ply (CR-only header line ends) fails to load at all.
+//   * STL: its half-edge kernel drops faces it cannot insert (Spider_ascii.stl: 1312 of 1368
+//     triangles, with "complex edge" messages on stderr), so counts do not match the file.
+//   * OFF read from memory (istream, the only way to keep the file access ours) yields 0
+//     vertices; reading by path would let it open FIFOs/devices itself.
+//   * Huge header counts throw std::bad_alloc, truncated files report success, faces with bad
+//     indices vanish silently, OBJ mtllib paths are followed anywhere (NOTES.md).
+// A viewer needs triangle soups, not a manifold half-edge structure, so the importer keeps
+// every face (polygons fan-triangulated), checks header counts against the file size before
+// allocating, reports truncation and dropped faces as warnings, polls cancel/progress, and
+// reads MTL files and textures only through ConfinedDir (model folder only).
+// Mapping: one node per material group (OBJ usemtl) or one node; normals from the file when
+// complete, else smooth area-weighted (Mesh::computeNormals; STL vertices are welded by exact
+// position first). Colours are taken as linear. MTL: Kd -> baseColor, Ks -> ks (max channel)
+// and specularColor (Ks / ks), Ns -> shininess (clamped 1..2048), d / Tr -> alpha, Ke ->
+// emissive, map_Kd -> diffuseTexture (PNG/JPEG via decodeImage; missing -> warning). An OBJ
+// without mtllib but with UVs picks up <stem>.png/.jpg or <stem>_texture.png/.jpg from its
+// folder (spot.obj ships that way).
 #include "importers.h"
+#include "import_common.h"
+
+#include "assets/files.h"
+#include "assets/image_io.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <unordered_map>
+
+namespace fs = std::filesystem;
 
 namespace assets::detail {
-LoadResult loadMeshFile(const std::filesystem::path& path, const LoadOptions&) {
-    LoadResult r;
-    r.error = path.string() + ": mesh import is not built yet";
+
+namespace {
+
+// ---- 2. Limits and a text cursor -----------------------------------------------------------
+constexpr uint64_t kMaxFileBytes = 4ull << 30;
+constexpr uint64_t kMaxTriangles = 50'000'000;
+constexpr uint64_t kMaxVertices = 100'000'000;
+constexpr uint64_t kMaxMtlBytes = 64ull << 20;
+constexpr uint64_t kMaxTextureFileBytes = 512ull << 20;
+constexpr size_t kPoll = 1u << 15;
+
+struct Fail {
+    std::string why;
+};
+
+// Reads whitespace-separated tokens; line-aware where the format needs it.
+struct Cursor {
+    const char* p;
+    const char* end;
+    bool atEnd() const { return p >= end; }
+    void skipBlanks() {
+        while (p < end && (*p == ' ' || *p == '\t' || *p == '\f' || *p == '\v')) ++p;
+    }
+    void skipWs() {
+        while (p < end && (std::isspace(static_cast<unsigned char>(*p)))) ++p;
+    }
+    void skipLine() {
+        while (p < end && *p != '\n' && *p != '\r') ++p;
+        while (p < end && (*p == '\n' || *p == '\r')) ++p;
+    }
+    bool atLineEnd() {
+        skipBlanks();
+        return p >= end || *p == '\n' || *p == '\r' || *p == '#';
+    }
+    std::string_view token() {   // within the line
+        skipBlanks();
+        const char* s = p;
+        while (p < end && !std::isspace(static_cast<unsigned char>(*p))) ++p;
+        return {s, size_t(p - s)};
+    }
+    std::string_view anyToken() {   // across lines
+        skipWs();
+        const char* s = p;
+        while (p < end && !std::isspace(static_cast<unsigned char>(*p))) ++p;
+        return {s, size_t(p - s)};
+    }
+    std::string_view restOfLine() {
+        skipBlanks();
+        const char* s = p;
+        while (p < end && *p != '\n' && *p != '\r') ++p;
+        const char* e = p;
+        while (e > s && std::isspace(static_cast<unsigned char>(e[-1]))) --e;
+        return {s, size_t(e - s)};
+    }
+};
+
+bool toFloat(std::string_view t, float& out) {
+    if (t.empty()) return false;
+    const char* b = t.data();
+    if (*b == '+') ++b;
+    auto r = std::from_chars(b, t.data() + t.size(), out);
+    return r.ec == std::errc() && r.ptr == t.data() + t.size();
+}
+bool toDouble(std::string_view t, double& out) {
+    if (t.empty()) return false;
+    const char* b = t.data();
+    if (*b == '+') ++b;
+    auto r = std::from_chars(b, t.data() + t.size(), out);
+    return r.ec == std::errc() && r.ptr == t.data() + t.size();
+}
+bool toInt64(std::string_view t, int64_t& out) {
+    if (t.empty()) return false;
+    const char* b = t.data();
+    if (*b == '+') ++b;
+    auto r = std::from_chars(b, t.data() + t.size(), out);
+    return r.ec == std::errc() && r.ptr == t.data() + t.size();
+}
+bool toUint64(std::string_view t, uint64_t& out) {
+    auto r = std::from_chars(t.data(), t.data() + t.size(), out);
+    return !t.empty() && r.ec == std::errc() && r.ptr == t.data() + t.size();
+}
+
+std::string lower(std::string_view s) {
+    std::string o(s);
+    for (char& c : o) c = char(std::tolower(static_cast<unsigned char>(c)));
+    return o;
+}
+
+// ---- 3. Shared mesh building ---------------------------------------------------------------
+struct Ctx {
+    const fs::path& path;
+    const Progress& progress;
+    std::vector<std::string> warnings;
+    uint64_t triangles = 0;
+    void poll(size_t i, float base, float span, size_t total) const {
+        if ((i & (kPoll - 1)) != 0) return;
+        if (progress.cancelled()) throw Fail{"cancelled"};
+        if (total) progress.set(base + span * float(double(i) / double(total)));
+    }
+    void countTriangles(uint64_t n) {
+        triangles += n;
+        if (triangles > kMaxTriangles)
+            throw Fail{"more than " + std::to_string(kMaxTriangles) + " triangles (budget)"};
+    }
+};
+
+// Fan-triangulates a polygon given by corner indices into `out`.
+void fan(const uint32_t* c, size_t n, std::vector<uint32_t>& out) {
+    for (size_t i = 1; i + 1 < n; ++i) {
+        out.push_back(c[0]);
+        out.push_back(c[i]);
+        out.push_back(c[i + 1]);
+    }
+}
+
+// Scene with one node per (mesh, material) and defaults.
+sg::Scene makeScene(const fs::path& path, std::vector<std::pair<sg::Mesh, int>>& parts, std::vector<sg::Material> materials,
+                    std::vector<std::shared_ptr<sg::Texture>> textures) {
+    sg::Scene s;
+    s.name = path.stem().string();
+    s.materials = std::move(materials);
+    s.textures = std::move(textures);
+    for (auto& [mesh, mat] : parts) {
+        if (mesh.mode == sg::PrimitiveMode::Triangles && mesh.normals.size() != mesh.positions.size()) mesh.computeNormals();
+        s.meshes.push_back(std::make_shared<sg::Mesh>(std::move(mesh)));
+        std::string name = s.meshes.back()->name.empty() ? s.name : s.meshes.back()->name;
+        s.addNode(name, s.root(), sg::MeshInstance{int(s.meshes.size() - 1), mat});
+    }
+    addDefaultCameraAndLight(s);
+    return s;
+}
+
+// ---- 4. OBJ + MTL --------------------------------------------------------------------------
+struct ObjMaterial {
+    sg::Material mat;
+    std::string texture;   // map_Kd, relative
+};
+
+std::shared_ptr<sg::Texture> loadTexture(const ConfinedDir& dir, const std::string& rel, Ctx& ctx, const std::string& file) {
+    std::vector<unsigned char> bytes;
+    std::string why = dir.read(rel, kMaxTextureFileBytes, bytes);
+    if (!why.empty()) {
+        ctx.warnings.push_back(file + ": texture '" + rel + "' not loaded: " + why);
+        return nullptr;
+    }
+    ImageLoad img = decodeImage(bytes.data(), bytes.size(), rel);
+    if (!img.texture) {
+        ctx.warnings.push_back(file + ": texture '" + rel + "' not loaded: " + img.error);
+        return nullptr;
+    }
+    img.texture->sourcePath = (dir.root() / rel).string();
+    img.texture->name = rel;
+    return img.texture;
+}
+
+std::string cleanRelPath(std::string_view s) {
+    std::string r(s);
+    std::replace(r.begin(), r.end(), '\\', '/');
+    while (r.rfind("./", 0) == 0) r = r.substr(2);
     return r;
 }
+
+void parseMtl(const ConfinedDir& dir, const std::string& rel, Ctx& ctx, const std::string& file,
+              std::map<std::string, ObjMaterial>& out) {
+    std::vector<unsigned char> bytes;
+    std::string why = dir.read(rel, kMaxMtlBytes, bytes);
+    if (!why.empty()) {
+        ctx.warnings.push_back(file + ": material library '" + rel + "' not read: " + why);
+        return;
+    }
+    Cursor c{reinterpret_cast<const char*>(bytes.data()), reinterpret_cast<const char*>(bytes.data()) + bytes.size()};
+    ObjMaterial* cur = nullptr;
+    auto vec3 = [&](sg::vec3& v) {
+        float x, y, z;
+        if (!toFloat(c.token(), x)) return false;
+        std::string_view t = c.token();
+        if (t.empty()) { v = sg::vec3(x); return true; }
+        if (!toFloat(t, y) || !toFloat(c.token(), z)) return false;
+        v = sg::vec3(x, y, z);
+        return true;
+    };
+    while (!c.atEnd()) {
+        std::string key = lower(c.token());
+        if (key == "newmtl") {
+            std::string name(c.restOfLine());
+            cur = &out[name];
+            cur->mat.name = name;
+        } else if (cur && key == "kd") {
+            sg::vec3 v;
+            if (vec3(v)) cur->mat.baseColor = glm::clamp(v, sg::vec3(0.0f), sg::vec3(1.0f));
+        } else if (cur && key == "ks") {
+            sg::vec3 v;
+            if (vec3(v)) {
+                v = glm::clamp(v, sg::vec3(0.0f), sg::vec3(1.0f));
+                float k = std::max({v.x, v.y, v.z});
+                cur->mat.ks = k;
+                cur->mat.specularColor = k > 0 ? v / k : sg::vec3(1.0f);
+            }
+        } else if (cur && key == "ke") {
+            sg::vec3 v;
+            if (vec3(v)) cur->mat.emissive = glm::max(v, sg::vec3(0.0f));
+        } else if (cur && key == "ns") {
+            float v;
+            if (toFloat(c.token(), v) && std::isfinite(v)) cur->mat.shininess = std::clamp(v, 1.0f, 2048.0f);
+        } else if (cur && (key == "d" || key == "tr")) {
+            float v;
+            if (toFloat(c.token(), v) && std::isfinite(v)) cur->mat.alpha = std::clamp(key == "d" ? v : 1.0f - v, 0.0f, 1.0f);
+        } else if (cur && key == "map_kd") {
+            // Options (-s 1 1 1, -o ...) may precede the name: the file name is the last token.
+            std::string_view last;
+            for (std::string_view t = c.token(); !t.empty(); t = c.token()) last = t;
+            cur->texture = cleanRelPath(last);
+        }
+        c.skipLine();
+    }
+}
+
+struct ObjCorner {
+    uint32_t v, vt, vn;   // 0-based, ~0u = absent
+};
+
+LoadResult loadObj(const fs::path& path, const std::string& text, Ctx& ctx) {
+    const std::string file = fileNameOf(path);
+    ConfinedDir dir(path.parent_path().empty() ? fs::path(".") : path.parent_path());
+    std::vector<sg::vec3> v, vn;
+    std::vector<sg::vec4> vc;   // vertex colours (x y z r g b)
+    std::vector<sg::vec2> vt;
+    std::vector<ObjCorner> corners;
+    struct Face { uint32_t first, count; int material; };
+    std::vector<Face> faces;
+    std::vector<uint32_t> linePoly;   // v indices of line segments (pairs)
+    std::vector<uint32_t> pointList;
+    std::vector<std::string> mtllibs;
+    std::vector<std::string> matNames;   // usemtl order
+    int curMat = -1;
+    size_t dropped = 0, badLines = 0;
+    bool anyColor = false;
+    Cursor c{text.data(), text.data() + text.size()};
+    size_t line = 0;
+    auto resolve = [](int64_t i, size_t n, uint32_t& out) {
+        if (i > 0 && uint64_t(i) <= n) { out = uint32_t(i - 1); return true; }
+        if (i < 0 && uint64_t(-i) <= n) { out = uint32_t(int64_t(n) + i); return true; }
+        return false;
+    };
+    while (!c.atEnd()) {
+        ctx.poll(++line, 0.0f, 0.7f, 0);
+        if ((line & (kPoll - 1)) == 0) ctx.progress.set(0.7f * float(double(c.p - text.data()) / double(text.size())));
+        std::string_view key = c.token();
+        if (key == "v") {
+            float x, y, z;
+            if (!toFloat(c.token(), x) || !toFloat(c.token(), y) || !toFloat(c.token(), z) || !std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) {
+                ++badLines;
+                v.push_back(sg::vec3(0.0f));
+                vc.push_back(sg::vec4(1.0f));
+            } else {
+                v.push_back({x, y, z});
+                float r, g, b;
+                std::string_view t = c.token();
+                if (!t.empty() && toFloat(t, r) && toFloat(c.token(), g) && toFloat(c.token(), b)) {
+                    anyColor = true;
+                    vc.push_back(sg::vec4(r, g, b, 1.0f));
+                } else {
+                    vc.push_back(sg::vec4(1.0f));
+                }
+            }
+            if (v.size() > kMaxVertices) throw Fail{"more than " + std::to_string(kMaxVertices) + " vertices (budget)"};
+        } else if (key == "vt") {
+            float s = 0, t = 0;
+            if (!toFloat(c.token(), s)) ++badLines;
+            std::string_view tt = c.token();
+            if (!tt.empty() && !toFloat(tt, t)) ++badLines;
+            vt.push_back({s, t});
+        } else if (key == "vn") {
+            float x, y, z;
+            if (!toFloat(c.token(), x) || !toFloat(c.token(), y) || !toFloat(c.token(), z)) { ++badLines; x = 0; y = 0; z = 1; }
+            vn.push_back({x, y, z});
+        } else if (key == "f" || key == "l" || key == "p") {
+            uint32_t first = uint32_t(corners.size());
+            bool ok = true;
+            size_t n = 0;
+            for (std::string_view t = c.token(); !t.empty(); t = c.token()) {
+                ObjCorner cr{~0u, ~0u, ~0u};
+                size_t s1 = t.find('/');
+                int64_t iv, it, in;
+                if (!toInt64(t.substr(0, s1), iv) || !resolve(iv, v.size(), cr.v)) ok = false;
+                if (s1 != std::string_view::npos) {
+                    std::string_view rest = t.substr(s1 + 1);
+                    size_t s2 = rest.find('/');
+                    std::string_view a = rest.substr(0, s2);
+                    if (!a.empty() && (!toInt64(a, it) || !resolve(it, vt.size(), cr.vt))) ok = false;
+                    if (s2 != std::string_view::npos) {
+                        std::string_view b = rest.substr(s2 + 1);
+                        if (!b.empty() && (!toInt64(b, in) || !resolve(in, vn.size(), cr.vn))) ok = false;
+                    }
+                }
+                corners.push_back(cr);
+                ++n;
+            }
+            if (!ok || n == 0 || (key == "f" && n < 3) || (key == "l" && n < 2)) {
+                ++dropped;
+                corners.resize(first);
+            } else if (key == "f") {
+                ctx.countTriangles(n - 2);
+                faces.push_back({first, uint32_t(n), curMat});
+            } else {
+                for (size_t i = 0; i < n; ++i) {
+                    if (key == "p") pointList.push_back(corners[first + i].v);
+                    else if (i + 1 < n) { linePoly.push_back(corners[first + i].v); linePoly.push_back(corners[first + i + 1].v); }
+                }
+                corners.resize(first);
+            }
+        } else if (key == "usemtl") {
+            std::string name(c.restOfLine());
+            auto it = std::find(matNames.begin(), matNames.end(), name);
+            curMat = int(it - matNames.begin());
+            if (it == matNames.end()) matNames.push_back(name);
+        } else if (key == "mtllib") {
+            for (std::string_view t = c.token(); !t.empty(); t = c.token()) mtllibs.push_back(cleanRelPath(t));
+        }
+        c.skipLine();
+    }
+    if (v.empty()) throw Fail{"no vertices"};
+    if (dropped) ctx.warnings.push_back(file + ": " + std::to_string(dropped) + " faces/lines with missing or out-of-range indices dropped");
+    if (badLines) ctx.warnings.push_back(file + ": " + std::to_string(badLines) + " malformed vertex lines (zero used)");
+
+    // Materials.
+    std::map<std::string, ObjMaterial> lib;
+    for (const std::string& m : mtllibs) parseMtl(dir, m, ctx, file, lib);
+    std::vector<sg::Material> materials;
+    std::vector<std::shared_ptr<sg::Texture>> textures;
+    std::map<std::string, int> texIndex;
+    auto textureFor = [&](const std::string& rel) -> int {
+        if (rel.empty()) return -1;
+        auto it = texIndex.find(rel);
+        if (it != texIndex.end()) return it->second;
+        int idx = -1;
+        if (auto t = loadTexture(dir, rel, ctx, file)) {
+            textures.push_back(t);
+            idx = int(textures.size() - 1);
+        }
+        texIndex[rel] = idx;
+        return idx;
+    };
+    for (const std::string& name : matNames) {
+        auto it = lib.find(name);
+        sg::Material m;
+        m.name = name;
+        if (it != lib.end()) {
+            m = it->second.mat;
+            m.diffuseTexture = textureFor(it->second.texture);
+        } else if (!mtllibs.empty()) {
+            ctx.warnings.push_back(file + ": material '" + name + "' not found in the material libraries; default used");
+        }
+        materials.push_back(m);
+    }
+    // OBJ without mtllib but with UVs: a texture named after the model next to it.
+    int implicitTexture = -1;
+    if (mtllibs.empty() && !vt.empty()) {
+        std::string stem = path.stem().string();
+        for (const std::string& cand : {stem + ".png", stem + ".jpg", stem + "_texture.png", stem + "_texture.jpg"}) {
+            if (dir.probe(cand).empty()) {
+                implicitTexture = textureFor(cand);
+                if (implicitTexture >= 0) {
+                    sg::Material m;
+                    m.name = stem;
+                    m.diffuseTexture = implicitTexture;
+                    materials.push_back(m);
+                    ctx.warnings.push_back(file + ": no mtllib; using texture '" + cand + "' found beside the model");
+                }
+                break;
+            }
+        }
+    }
+
+    // Build one mesh per material group, de-duplicating (v, vt, vn) corners. Faces without
+    // usemtl use the implicit texture material when there is one, else the default (-1).
+    const int implicitMat = implicitTexture >= 0 ? int(materials.size() - 1) : -1;
+    std::vector<std::vector<uint32_t>> byMaterial(materials.size() + 1);   // slot 0 = default
+    for (size_t fi = 0; fi < faces.size(); ++fi) {
+        int fm = faces[fi].material >= 0 ? faces[fi].material : implicitMat;
+        byMaterial[size_t(fm + 1)].push_back(uint32_t(fi));
+    }
+    std::vector<std::pair<sg::Mesh, int>> parts;
+    const bool simple = vt.empty() && vn.empty();
+    std::vector<uint32_t> tri;
+    size_t done = 0;
+    for (size_t g = 0; g < byMaterial.size(); ++g) {
+        if (byMaterial[g].empty()) continue;
+        const int mat = int(g) - 1;
+        sg::Mesh mesh;
+        std::vector<uint32_t> remap;
+        struct Key { uint32_t v, t, n; bool operator==(const Key&) const = default; };
+        struct KeyHash { size_t operator()(const Key& k) const { return (size_t(k.v) * 0x9E3779B97F4A7C15ull) ^ (size_t(k.t) * 0xC2B2AE3D27D4EB4Full) ^ k.n; } };
+        std::unordered_map<Key, uint32_t, KeyHash> map;
+        if (simple) remap.assign(v.size(), ~0u);
+        bool hasUv = false, hasN = true;
+        auto vertexOf = [&](const ObjCorner& cr) -> uint32_t {
+            uint32_t idx;
+            if (simple) {
+                if (remap[cr.v] != ~0u) return remap[cr.v];
+                idx = remap[cr.v] = uint32_t(mesh.positions.size());
+            } else {
+                auto [it, inserted] = map.try_emplace(Key{cr.v, cr.vt, cr.vn}, uint32_t(mesh.positions.size()));
+                if (!inserted) return it->second;
+                idx = it->second;
+            }
+            mesh.positions.push_back(v[cr.v]);
+            mesh.colors.push_back(vc[cr.v]);
+            mesh.uv0.push_back(cr.vt != ~0u ? vt[cr.vt] : sg::vec2(0.0f));
+            mesh.normals.push_back(cr.vn != ~0u ? vn[cr.vn] : sg::vec3(0.0f));
+            hasUv |= cr.vt != ~0u;
+            hasN &= cr.vn != ~0u;
+            return idx;
+        };
+        for (uint32_t fi : byMaterial[g]) {
+            ctx.poll(++done, 0.7f, 0.25f, faces.size());
+            const Face& f = faces[fi];
+            tri.clear();
+            for (uint32_t k = 0; k < f.count; ++k) tri.push_back(vertexOf(corners[f.first + k]));
+            fan(tri.data(), tri.size(), mesh.indices);
+        }
+        if (!hasUv) mesh.uv0.clear();
+        if (!hasN) mesh.normals.clear();
+        if (!anyColor) mesh.colors.clear();
+        mesh.name = mat >= 0 ? materials[size_t(mat)].name : path.stem().string();
+        parts.push_back({std::move(mesh), mat});
+    }
+    if (!linePoly.empty()) {
+        sg::Mesh lines;
+        lines.mode = sg::PrimitiveMode::Lines;
+        lines.name = path.stem().string() + " lines";
+        std::vector<uint32_t> remap(v.size(), ~0u);
+        for (uint32_t i : linePoly) {
+            if (remap[i] == ~0u) { remap[i] = uint32_t(lines.positions.size()); lines.positions.push_back(v[i]); if (anyColor) lines.colors.push_back(vc[i]); }
+            lines.indices.push_back(remap[i]);
+        }
+        parts.push_back({std::move(lines), -1});
+    }
+    if (parts.empty() || !pointList.empty()) {
+        // Vertices only (or explicit `p` elements): a point cloud.
+        sg::Mesh pts;
+        pts.mode = sg::PrimitiveMode::Points;
+        pts.name = path.stem().string() + " points";
+        pts.positions = v;
+        if (anyColor) pts.colors = vc;
+        if (!vn.empty() && vn.size() == v.size()) pts.normals = vn;
+        if (pointList.empty()) {
+            pts.indices.resize(v.size());
+            for (size_t i = 0; i < v.size(); ++i) pts.indices[i] = uint32_t(i);
+        } else {
+            pts.indices = pointList;
+        }
+        parts.push_back({std::move(pts), -1});
+    }
+    LoadResult r;
+    r.scene = makeScene(path, parts, std::move(materials), std::move(textures));
+    return r;
+}
+
+// ---- 5. OFF -------------------------------------------------------------------------------
+LoadResult loadOff(const fs::path& path, const std::string& text, Ctx& ctx) {
+    const std::string file = fileNameOf(path);
+    Cursor c{text.data(), text.data() + text.size()};
+    auto nextToken = [&]() {
+        // Skips comments (# to end of line).
+        for (;;) {
+            c.skipWs();
+            if (c.p < c.end && *c.p == '#') { c.skipLine(); continue; }
+            return c.anyToken();
+        }
+    };
+    std::string_view head = nextToken();
+    // Header keyword: [ST][C][N][4][n]OFF, optionally glued to the counts line.
+    if (head.size() < 3 || head.substr(head.size() - 3) != "OFF") throw Fail{"not an OFF file (no OFF header)"};
+    std::string_view prefix = head.substr(0, head.size() - 3);
+    bool hasTex = false, hasColor = false, hasNormal = false;
+    for (size_t i = 0; i < prefix.size(); ++i) {
+        if (prefix.substr(i, 2) == "ST") { hasTex = true; ++i; }
+        else if (prefix[i] == 'C') hasColor = true;
+        else if (prefix[i] == 'N') hasNormal = true;
+        else throw Fail{"unsupported OFF variant '" + std::string(head) + "' (4D, nD and binary OFF are not supported)"};
+    }
+    uint64_t nv, nf, ne;
+    std::string_view t1 = nextToken();
+    if (t1 == "BINARY") throw Fail{"binary OFF is not supported"};
+    if (!toUint64(t1, nv) || !toUint64(nextToken(), nf) || !toUint64(nextToken(), ne))
+        throw Fail{"malformed OFF header (expected vertex, face and edge counts)"};
+    // Each vertex needs at least 3 numbers ("0 0 0\n" = 6 bytes), each face "3 0 1 2\n" (8).
+    uint64_t remaining = uint64_t(c.end - c.p), need = 0;
+    if (nv > kMaxVertices) throw Fail{"header claims " + std::to_string(nv) + " vertices (budget " + std::to_string(kMaxVertices) + ")"};
+    if (__builtin_mul_overflow(nv, uint64_t(6), &need) || need > remaining + 1)
+        throw Fail{"header claims " + std::to_string(nv) + " vertices but the file has only " + std::to_string(remaining) + " bytes left"};
+    uint64_t needF = 0;
+    if (__builtin_mul_overflow(nf, uint64_t(8), &needF) || need + needF > remaining + 1 + 8)
+        throw Fail{"header claims " + std::to_string(nf) + " faces but the file has only " + std::to_string(remaining) + " bytes left"};
+    sg::Mesh mesh;
+    mesh.name = path.stem().string();
+    mesh.positions.reserve(size_t(nv));
+    bool truncated = false;
+    size_t perVertexExtra = (hasNormal ? 3 : 0) + (hasTex ? 2 : 0);
+    for (uint64_t i = 0; i < nv; ++i) {
+        ctx.poll(size_t(i), 0.0f, 0.5f, size_t(nv));
+        float x, y, z;
+        if (!toFloat(nextToken(), x) || !toFloat(nextToken(), y) || !toFloat(nextToken(), z)) { truncated = true; break; }
+        if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) throw Fail{"vertex " + std::to_string(i) + " is not finite"};
+        mesh.positions.push_back({x, y, z});
+        float extra[5];
+        for (size_t k = 0; k < perVertexExtra; ++k) toFloat(nextToken(), extra[k]);
+        if (hasNormal) mesh.normals.push_back({extra[0], extra[1], extra[2]});
+        if (hasTex) mesh.uv0.push_back({extra[hasNormal ? 3 : 0], extra[hasNormal ? 4 : 1]});
+        if (hasColor) {
+            // r g b [a], 0..1 floats or 0..255 ints; rest of the line.
+            float col[4] = {1, 1, 1, 1};
+            int n = 0;
+            while (n < 4 && !c.atLineEnd()) {
+                if (!toFloat(c.token(), col[n])) break;
+                ++n;
+            }
+            bool ints = n >= 3 && (col[0] > 1 || col[1] > 1 || col[2] > 1);
+            sg::vec4 cv(col[0], col[1], col[2], n == 4 ? col[3] : (ints ? 255.0f : 1.0f));
+            if (ints) cv /= 255.0f;
+            mesh.colors.push_back(cv);
+        }
+    }
+    size_t dropped = 0, facesRead = 0;
+    std::vector<uint32_t> poly;
+    if (!truncated) {
+        for (uint64_t f = 0; f < nf; ++f) {
+            ctx.poll(size_t(f), 0.5f, 0.45f, size_t(nf));
+            uint64_t k;
+            if (!toUint64(nextToken(), k)) { truncated = true; break; }
+            if (k > 1'000'000) throw Fail{"face " + std::to_string(f) + " claims " + std::to_string(k) + " corners"};
+            poly.clear();
+            bool ok = true;
+            for (uint64_t j = 0; j < k; ++j) {
+                int64_t idx;
+                if (!toInt64(nextToken(), idx)) { truncated = true; break; }
+                if (idx < 0 || uint64_t(idx) >= mesh.positions.size()) ok = false;
+                else poly.push_back(uint32_t(idx));
+            }
+            if (truncated) break;
+            while (!c.atLineEnd()) c.token();   // per-face colour
+            ++facesRead;
+            if (!ok || k < 3) { ++dropped; continue; }
+            ctx.countTriangles(k - 2);
+            fan(poly.data(), poly.size(), mesh.indices);
+        }
+    }
+    if (truncated)
+        ctx.warnings.push_back(file + ": file is truncated: read " + std::to_string(mesh.positions.size()) + " of " + std::to_string(nv) +
+                               " vertices and " + std::to_string(facesRead) + " of " + std::to_string(nf) + " faces");
+    if (dropped) ctx.warnings.push_back(file + ": " + std::to_string(dropped) + " faces with out-of-range indices or fewer than 3 corners dropped");
+    if (mesh.positions.empty()) throw Fail{"no vertices"};
+    if (mesh.normals.size() != mesh.positions.size()) mesh.normals.clear();
+    if (mesh.uv0.size() != mesh.positions.size()) mesh.uv0.clear();
+    if (mesh.colors.size() != mesh.positions.size()) mesh.colors.clear();
+    if (mesh.indices.empty()) {
+        mesh.mode = sg::PrimitiveMode::Points;
+        mesh.indices.resize(mesh.positions.size());
+        for (size_t i = 0; i < mesh.indices.size(); ++i) mesh.indices[i] = uint32_t(i);
+    }
+    std::vector<std::pair<sg::Mesh, int>> parts;
+    parts.push_back({std::move(mesh), -1});
+    LoadResult r;
+    r.scene = makeScene(path, parts, {}, {});
+    return r;
+}
+
+// ---- 6. PLY -------------------------------------------------------------------------------
+enum class PlyType : uint8_t { I8, U8, I16, U16, I32, U32, F32, F64, Invalid };
+PlyType plyType(std::string_view s) {
+    if (s == "char" || s == "int8") return PlyType::I8;
+    if (s == "uchar" || s == "uint8") return PlyType::U8;
+    if (s == "short" || s == "int16") return PlyType::I16;
+    if (s == "ushort" || s == "uint16") return PlyType::U16;
+    if (s == "int" || s == "int32") return PlyType::I32;
+    if (s == "uint" || s == "uint32") return PlyType::U32;
+    if (s == "float" || s == "float32") return PlyType::F32;
+    if (s == "double" || s == "float64") return PlyType::F64;
+    return PlyType::Invalid;
+}
+size_t plySize(PlyType t) {
+    switch (t) {
+    case PlyType::I8: case PlyType::U8: return 1;
+    case PlyType::I16: case PlyType::U16: return 2;
+    case PlyType::I32: case PlyType::U32: case PlyType::F32: return 4;
+    case PlyType::F64: return 8;
+    default: return 0;
+    }
+}
+struct PlyProperty {
+    std::string name;
+    PlyType type = PlyType::F32;
+    bool list = false;
+    PlyType countType = PlyType::U8;
+};
+struct PlyElement {
+    std::string name;
+    uint64_t count = 0;
+    std::vector<PlyProperty> props;
+};
+
+struct PlyReader {
+    const unsigned char* p;
+    const unsigned char* end;
+    int format;   // 0 ascii, 1 LE, 2 BE
+    Cursor text{nullptr, nullptr};
+
+    // Reads one scalar; false at end of data / malformed.
+    bool read(PlyType t, double& out) {
+        if (format == 0) {
+            std::string_view tok = text.anyToken();
+            return toDouble(tok, out);
+        }
+        size_t n = plySize(t);
+        if (size_t(end - p) < n) return false;
+        unsigned char b[8];
+        std::memcpy(b, p, n);
+        p += n;
+        if (format == 2) std::reverse(b, b + n);
+        switch (t) {
+        case PlyType::I8: out = double(int8_t(b[0])); break;
+        case PlyType::U8: out = double(b[0]); break;
+        case PlyType::I16: { int16_t v; std::memcpy(&v, b, 2); out = v; break; }
+        case PlyType::U16: { uint16_t v; std::memcpy(&v, b, 2); out = v; break; }
+        case PlyType::I32: { int32_t v; std::memcpy(&v, b, 4); out = v; break; }
+        case PlyType::U32: { uint32_t v; std::memcpy(&v, b, 4); out = v; break; }
+        case PlyType::F32: { float v; std::memcpy(&v, b, 4); out = v; break; }
+        case PlyType::F64: { double v; std::memcpy(&v, b, 8); out = v; break; }
+        default: return false;
+        }
+        return true;
+    }
+};
+
+LoadResult loadPly(const fs::path& path, const std::string& data, Ctx& ctx) {
+    const std::string file = fileNameOf(path);
+    // Header lines end in \n, \r\n or \r alone (Box.ply).
+    size_t pos = 0;
+    auto nextLine = [&](std::string& line) -> bool {
+        if (pos >= data.size()) return false;
+        size_t e = data.find_first_of("\r\n", pos);
+        if (e == std::string::npos) { line = data.substr(pos); pos = data.size(); return true; }
+        line = data.substr(pos, e - pos);
+        pos = e + 1;
+        if (data[e] == '\r' && pos < data.size() && data[pos] == '\n') ++pos;
+        return true;
+    };
+    std::string line;
+    if (!nextLine(line) || line.substr(0, 3) != "ply") throw Fail{"not a PLY file (no 'ply' magic)"};
+    int format = -1;
+    std::vector<PlyElement> elements;
+    bool endHeader = false;
+    size_t headerLines = 0;
+    while (nextLine(line)) {
+        if (++headerLines > 100000) throw Fail{"PLY header too long"};
+        Cursor c{line.data(), line.data() + line.size()};
+        std::string_view key = c.token();
+        if (key == "format") {
+            std::string_view f = c.token();
+            format = f == "ascii" ? 0 : f == "binary_little_endian" ? 1 : f == "binary_big_endian" ? 2 : -1;
+            if (format < 0) throw Fail{"unknown PLY format '" + std::string(f) + "'"};
+        } else if (key == "element") {
+            PlyElement e;
+            e.name = std::string(c.token());
+            if (!toUint64(c.token(), e.count)) throw Fail{"malformed element line '" + line + "'"};
+            elements.push_back(std::move(e));
+        } else if (key == "property") {
+            if (elements.empty()) throw Fail{"property before any element"};
+            PlyProperty pr;
+            std::string_view t = c.token();
+            if (t == "list") {
+                pr.list = true;
+                pr.countType = plyType(c.token());
+                pr.type = plyType(c.token());
+                if (pr.countType == PlyType::Invalid || pr.countType == PlyType::F32 || pr.countType == PlyType::F64)
+                    throw Fail{"invalid list count type in '" + line + "'"};
+            } else {
+                pr.type = plyType(t);
+            }
+            if (pr.type == PlyType::Invalid) throw Fail{"unknown property type in '" + line + "'"};
+            pr.name = std::string(c.token());
+            elements.back().props.push_back(std::move(pr));
+        } else if (key == "end_header") {
+            endHeader = true;
+            break;
+        }
+        // comment, obj_info: ignored
+    }
+    if (!endHeader) throw Fail{"PLY header has no end_header"};
+    if (format < 0) throw Fail{"PLY header has no format line"};
+    // Size check before allocating: every element needs at least this many bytes.
+    const uint64_t bodyBytes = data.size() - pos;
+    uint64_t need = 0;
+    for (const PlyElement& e : elements) {
+        uint64_t per = 0;
+        for (const PlyProperty& pr : e.props) per += format == 0 ? 2 : (pr.list ? plySize(pr.countType) : plySize(pr.type));
+        uint64_t bytes;
+        if (per == 0) continue;
+        if (__builtin_mul_overflow(per, e.count, &bytes) || __builtin_add_overflow(need, bytes, &need) || need > bodyBytes + 1)
+            throw Fail{"element '" + e.name + "' claims " + std::to_string(e.count) + " entries but the file has only " +
+                       std::to_string(bodyBytes) + " bytes after the header"};
+    }
+    PlyReader rd{reinterpret_cast<const unsigned char*>(data.data()) + pos, reinterpret_cast<const unsigned char*>(data.data()) + data.size(), format};
+    rd.text = Cursor{data.data() + pos, data.data() + data.size()};
+
+    sg::Mesh mesh;
+    mesh.name = path.stem().string();
+    bool haveNormals = false, haveColors = false, haveUv = false;
+    size_t dropped = 0;
+    std::string truncatedIn;
+    uint64_t readOf = 0, claimed = 0;
+    std::vector<uint32_t> poly;
+    std::vector<double> listVals;
+    size_t faceCount = 0;
+    for (const PlyElement& e : elements) {
+        const bool isVertex = e.name == "vertex";
+        const bool isFace = e.name == "face";
+        const bool isStrip = e.name == "tristrips";
+        int ix = -1, iy = -1, iz = -1, inx = -1, iny = -1, inz = -1, ir = -1, ig = -1, ib = -1, ia = -1, iu = -1, iv = -1, ilist = -1;
+        for (size_t k = 0; k < e.props.size(); ++k) {
+            const std::string& n = e.props[k].name;
+            int kk = int(k);
+            if (isVertex && !e.props[k].list) {
+                if (n == "x") ix = kk; else if (n == "y") iy = kk; else if (n == "z") iz = kk;
+                else if (n == "nx") inx = kk; else if (n == "ny") iny = kk; else if (n == "nz") inz = kk;
+                else if (n == "red" || n == "r" || n == "diffuse_red") ir = kk;
+                else if (n == "green" || n == "g" || n == "diffuse_green") ig = kk;
+                else if (n == "blue" || n == "b" || n == "diffuse_blue") ib = kk;
+                else if (n == "alpha" || n == "a") ia = kk;
+                else if (n == "s" || n == "u" || n == "texture_u" || n == "texture_s") iu = kk;
+                else if (n == "t" || n == "v" || n == "texture_v" || n == "texture_t") iv = kk;
+            }
+            if ((isFace || isStrip) && e.props[k].list && (n == "vertex_indices" || n == "vertex_index") && ilist < 0) ilist = kk;
+        }
+        if (isVertex) {
+            if (e.count > kMaxVertices) throw Fail{"element 'vertex' claims " + std::to_string(e.count) + " entries (budget " + std::to_string(kMaxVertices) + ")"};
+            if (ix < 0 || iy < 0 || iz < 0) throw Fail{"vertex element has no x, y, z properties"};
+            haveNormals = inx >= 0 && iny >= 0 && inz >= 0;
+            haveColors = ir >= 0 && ig >= 0 && ib >= 0;
+            haveUv = iu >= 0 && iv >= 0;
+            mesh.positions.reserve(size_t(e.count));
+        }
+        std::vector<double> vals(e.props.size());
+        bool truncated = false;
+        readOf = 0;
+        for (uint64_t i = 0; i < e.count && !truncated; ++i) {
+            ctx.poll(size_t(i), 0.0f, 0.95f, 0);
+            for (size_t k = 0; k < e.props.size(); ++k) {
+                const PlyProperty& pr = e.props[k];
+                if (!pr.list) {
+                    if (!rd.read(pr.type, vals[k])) { truncated = true; break; }
+                    continue;
+                }
+                double cnt;
+                if (!rd.read(pr.countType, cnt) || cnt < 0 || cnt > 1e9) { truncated = true; break; }
+                uint64_t n = uint64_t(cnt);
+                // A list cannot be longer than the remaining data.
+                uint64_t left = format == 0 ? uint64_t(rd.text.end - rd.text.p) : uint64_t(rd.end - rd.p);
+                if (n > left) { truncated = true; break; }
+                bool keep = int(k) == ilist;
+                if (keep) listVals.resize(size_t(n));
+                for (uint64_t j = 0; j < n; ++j) {
+                    double d;
+                    if (!rd.read(pr.type, d)) { truncated = true; break; }
+                    if (keep) listVals[size_t(j)] = d;
+                }
+                if (truncated) break;
+                if (!keep) continue;
+                if (isFace) {
+                    ++faceCount;
+                    poly.clear();
+                    bool ok = n >= 3;
+                    for (double d : listVals) {
+                        if (!(d >= 0 && d < double(mesh.positions.size()))) { ok = false; break; }
+                        poly.push_back(uint32_t(d));
+                    }
+                    if (!ok) { ++dropped; continue; }
+                    ctx.countTriangles(n - 2);
+                    fan(poly.data(), poly.size(), mesh.indices);
+                } else if (isStrip) {
+                    // Strips separated by -1; alternate winding; degenerate triangles skipped.
+                    size_t start = 0;
+                    for (size_t j = 0; j <= listVals.size(); ++j) {
+                        if (j < listVals.size() && listVals[j] >= 0) continue;
+                        for (size_t q = start; q + 2 < j; ++q) {
+                            double a = listVals[q], b = listVals[q + 1], c2 = listVals[q + 2];
+                            if (!(a < double(mesh.positions.size()) && b < double(mesh.positions.size()) && c2 < double(mesh.positions.size()))) { ++dropped; continue; }
+                            uint32_t ia2 = uint32_t(a), ib2 = uint32_t(b), ic2 = uint32_t(c2);
+                            if (ia2 == ib2 || ib2 == ic2 || ia2 == ic2) continue;
+                            ctx.countTriangles(1);
+                            if ((q - start) % 2 == 0) { mesh.indices.push_back(ia2); mesh.indices.push_back(ib2); mesh.indices.push_back(ic2); }
+                            else { mesh.indices.push_back(ib2); mesh.indices.push_back(ia2); mesh.indices.push_back(ic2); }
+                        }
+                        start = j + 1;
+                    }
+                }
+            }
+            if (truncated) break;
+            if (isVertex) {
+                sg::vec3 p(float(vals[size_t(ix)]), float(vals[size_t(iy)]), float(vals[size_t(iz)]));
+                if (!sg::isFinite(p)) throw Fail{"vertex " + std::to_string(i) + " is not finite"};
+                mesh.positions.push_back(p);
+                if (haveNormals) mesh.normals.push_back({float(vals[size_t(inx)]), float(vals[size_t(iny)]), float(vals[size_t(inz)])});
+                if (haveUv) mesh.uv0.push_back({float(vals[size_t(iu)]), float(vals[size_t(iv)])});
+                if (haveColors) {
+                    auto ch = [&](int k) {
+                        PlyType t = e.props[size_t(k)].type;
+                        double d = vals[size_t(k)];
+                        if (t == PlyType::U8 || t == PlyType::I8) d /= 255.0;
+                        else if (t == PlyType::U16 || t == PlyType::I16) d /= 65535.0;
+                        return float(std::clamp(d, 0.0, 1.0));
+                    };
+                    mesh.colors.push_back({ch(ir), ch(ig), ch(ib), ia >= 0 ? ch(ia) : 1.0f});
+                }
+            }
+            readOf = i + 1;
+        }
+        if (truncated) {
+            truncatedIn = e.name;
+            claimed = e.count;
+            break;
+        }
+    }
+    if (!truncatedIn.empty())
+        ctx.warnings.push_back(file + ": file is truncated in element '" + truncatedIn + "' (" + std::to_string(readOf) + " of " + std::to_string(claimed) + " read)");
+    if (dropped) ctx.warnings.push_back(file + ": " + std::to_string(dropped) + " faces with out-of-range indices or fewer than 3 corners dropped");
+    if (mesh.positions.empty()) throw Fail{"no vertices"};
+    (void)faceCount;
+    if (mesh.indices.empty()) {
+        mesh.mode = sg::PrimitiveMode::Points;
+        mesh.indices.resize(mesh.positions.size());
+        for (size_t i = 0; i < mesh.indices.size(); ++i) mesh.indices[i] = uint32_t(i);
+    }
+    std::vector<std::pair<sg::Mesh, int>> parts;
+    parts.push_back({std::move(mesh), -1});
+    LoadResult r;
+    r.scene = makeScene(path, parts, {}, {});
+    return r;
+}
+
+// ---- 7. STL -------------------------------------------------------------------------------
+// Welds corners with bit-identical positions (STL stores a triangle soup).
+void weldAndAdd(sg::Mesh& mesh, std::unordered_map<uint64_t, std::vector<uint32_t>>& buckets, const sg::vec3& p) {
+    uint32_t b[3];
+    std::memcpy(b, &p, 12);
+    uint64_t h = (uint64_t(b[0]) * 0x9E3779B97F4A7C15ull) ^ (uint64_t(b[1]) * 0xC2B2AE3D27D4EB4Full) ^ (uint64_t(b[2]) * 0x165667B19E3779F9ull);
+    auto& list = buckets[h];
+    for (uint32_t i : list)
+        if (std::memcmp(&mesh.positions[i], &p, 12) == 0) { mesh.indices.push_back(i); return; }
+    list.push_back(uint32_t(mesh.positions.size()));
+    mesh.indices.push_back(uint32_t(mesh.positions.size()));
+    mesh.positions.push_back(p);
+}
+
+LoadResult loadStl(const fs::path& path, const std::string& data, Ctx& ctx) {
+    const std::string file = fileNameOf(path);
+    sg::Mesh mesh;
+    mesh.name = path.stem().string();
+    std::unordered_map<uint64_t, std::vector<uint32_t>> buckets;
+    bool binary = false;
+    uint32_t n = 0;
+    if (data.size() >= 84) {
+        std::memcpy(&n, data.data() + 80, 4);
+        binary = 84 + 50ull * n == data.size();
+        if (!binary) {
+            // Not an exact binary size: ASCII if it looks like text starting with "solid".
+            size_t s = data.find_first_not_of(" \t\r\n");
+            bool text = s != std::string::npos && data.compare(s, 5, "solid") == 0 &&
+                        std::none_of(data.begin(), data.begin() + std::ptrdiff_t(std::min<size_t>(data.size(), 512)), [](char c) { return c == '\0'; });
+            binary = !text;
+        }
+    }
+    if (binary) {
+        uint64_t fits = (data.size() - 84) / 50;
+        if (n != fits) {
+            ctx.warnings.push_back(file + ": header claims " + std::to_string(n) + " triangles but the file holds " + std::to_string(fits) +
+                                   (n > fits ? " (truncated)" : " (extra data ignored)"));
+            n = uint32_t(std::min<uint64_t>(n, fits));
+        }
+        ctx.countTriangles(n);
+        mesh.positions.reserve(n);   // at most 3n after welding, typically n/2
+        mesh.indices.reserve(size_t(n) * 3);
+        buckets.reserve(size_t(n));
+        size_t bad = 0;
+        for (uint32_t i = 0; i < n; ++i) {
+            ctx.poll(i, 0.0f, 0.95f, n);
+            const char* f = data.data() + 84 + size_t(i) * 50;
+            float fl[9];
+            std::memcpy(fl, f + 12, 36);
+            sg::vec3 v[3] = {{fl[0], fl[1], fl[2]}, {fl[3], fl[4], fl[5]}, {fl[6], fl[7], fl[8]}};
+            if (!sg::isFinite(v[0]) || !sg::isFinite(v[1]) || !sg::isFinite(v[2])) { ++bad; continue; }
+            for (auto& p : v) weldAndAdd(mesh, buckets, p + sg::vec3(0.0f));   // +0 turns -0 into +0
+        }
+        if (bad) ctx.warnings.push_back(file + ": " + std::to_string(bad) + " triangles with non-finite coordinates dropped");
+    } else {
+        if (data.size() < 5) throw Fail{"file too short to be STL"};
+        Cursor c{data.data(), data.data() + data.size()};
+        std::string_view first = c.anyToken();
+        if (first != "solid") throw Fail{"not an STL file (neither binary nor starting with 'solid')"};
+        sg::vec3 tri[3];
+        int k = 0;
+        size_t bad = 0, count = 0;
+        while (!c.atEnd()) {
+            std::string_view t = c.anyToken();
+            if (t != "vertex") continue;
+            ctx.poll(++count, 0.0f, 0.0f, 0);
+            if ((count & (kPoll - 1)) == 0) ctx.progress.set(0.95f * float(double(c.p - data.data()) / double(data.size())));
+            float x, y, z;
+            if (!toFloat(c.anyToken(), x) || !toFloat(c.anyToken(), y) || !toFloat(c.anyToken(), z) || !std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) {
+                ++bad;
+                x = y = z = std::numeric_limits<float>::quiet_NaN();
+            }
+            tri[k++] = sg::vec3(x, y, z);
+            if (k == 3) {
+                k = 0;
+                if (!sg::isFinite(tri[0]) || !sg::isFinite(tri[1]) || !sg::isFinite(tri[2])) continue;
+                ctx.countTriangles(1);
+                for (auto& p : tri) weldAndAdd(mesh, buckets, p + sg::vec3(0.0f));
+            }
+        }
+        if (k != 0) ctx.warnings.push_back(file + ": file ends inside a facet (truncated?)");
+        if (bad) ctx.warnings.push_back(file + ": " + std::to_string(bad) + " malformed vertex lines; their facets dropped");
+    }
+    if (mesh.indices.empty()) throw Fail{"no triangles"};
+    std::vector<std::pair<sg::Mesh, int>> parts;
+    parts.push_back({std::move(mesh), -1});
+    LoadResult r;
+    r.scene = makeScene(path, parts, {}, {});
+    return r;
+}
+
+}  // namespace
+
+// ---- 8. loadMeshFile ----------------------------------------------------------------------
+LoadResult loadMeshFile(const fs::path& path, const LoadOptions& options) {
+    LoadResult result;
+    const std::string file = fileNameOf(path);
+    std::string ext = lower(path.extension().string());
+    std::string data;
+    std::string err = readFileLimited(path, kMaxFileBytes, data);
+    if (!err.empty()) {
+        result.error = err;
+        return result;
+    }
+    Progress progress{options};
+    Ctx ctx{path, progress, {}, 0};
+    try {
+        if (data.empty()) throw Fail{"empty file"};
+        if (data.size() >= 2 && ((uint8_t(data[0]) == 0xFE && uint8_t(data[1]) == 0xFF) || (uint8_t(data[0]) == 0xFF && uint8_t(data[1]) == 0xFE)))
+            throw Fail{"UTF-16 text is not supported (save the file as UTF-8/ASCII)"};
+        progress.set(0.0f);
+        if (ext == ".obj") result = loadObj(path, data, ctx);
+        else if (ext == ".off") result = loadOff(path, data, ctx);
+        else if (ext == ".ply") result = loadPly(path, data, ctx);
+        else if (ext == ".stl") result = loadStl(path, data, ctx);
+        else throw Fail{"unsupported mesh format '" + ext + "'"};
+    } catch (const Fail& f) {
+        result = {};
+        // Quoted file text may hold control bytes: keep the error one printable line.
+        std::string why = f.why.size() > 300 ? f.why.substr(0, 300) + "..." : f.why;
+        for (char& ch : why)
+            if (static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f) ch = '?';
+        result.error = file + ": " + why;
+        return result;
+    } catch (const std::bad_alloc&) {
+        result = {};
+        result.error = file + ": out of memory";
+        return result;
+    } catch (const std::exception& e) {
+        result = {};
+        result.error = file + ": " + e.what();
+        return result;
+    }
+    for (auto& w : ctx.warnings) result.warnings.push_back(std::move(w));
+    progress.set(1.0f);
+    return result;
+}
+
 }  // namespace assets::detail

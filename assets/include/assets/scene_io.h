@@ -6,6 +6,7 @@
 // no scene, so the caller's current scene stays untouched.
 #pragma once
 
+#include "assets/animation.h"
 #include "scenegraph/scene.h"
 
 #include <atomic>
@@ -25,6 +26,11 @@ struct LoadResult {
     std::optional<sg::Scene> scene;
     std::string error;                       // set when !scene
     std::vector<std::string> warnings;       // recoverable problems (missing texture, ...)
+    // glTF only (additive): node TRS animation clips (node ids refer to *scene), the names of
+    // all scenes in the file ("scene N" when unnamed) and which one was loaded (-1: none).
+    std::vector<AnimationClip> animations;
+    std::vector<std::string> sceneNames;
+    int loadedScene = -1;
 };
 
 LoadResult loadScene(const std::filesystem::path& path, const LoadOptions& options = {});
