@@ -534,8 +534,10 @@ void transformEditor(ViewerState& st, sg::NodeId id) {
     }
     ImGui::TextDisabled("   0.000      0.000      0.000      1.000");
     if (ImGui::SmallButton("Mirror X")) { m = m * glm::scale(sg::mat4(1.0f), sg::vec3(-1, 1, 1)); mch = true; }
+    record(st, "inspector/mirrorX");
     ImGui::SameLine();
     if (ImGui::SmallButton("Shear XY")) { sg::mat4 s(1.0f); s[1][0] = 0.25f; m = m * s; mch = true; }
+    record(st, "inspector/shear");
     ImGui::SameLine();
     if (ImGui::SmallButton("Identity")) { st.setLocal(id, sg::LocalTransform{}); }
     if (mch) {
@@ -1335,14 +1337,18 @@ void drawUi(ViewerState& st, const ViewportInput& view, double time, float dt) {
     float rightW = 0;
     if (ImGui::Begin("Properties", nullptr, panelFlags)) {
         if (ImGui::BeginTabBar("tabs")) {
-            if (ImGui::BeginTabItem("Inspector")) { drawInspector(st); ImGui::EndTabItem(); }
-            record(st, "tab/Inspector");
-            if (ImGui::BeginTabItem("Camera")) { drawCameraPanel(st); ImGui::EndTabItem(); }
-            record(st, "tab/Camera");
-            if (ImGui::BeginTabItem("Rendering")) { drawRenderingPanel(st); ImGui::EndTabItem(); }
-            record(st, "tab/Rendering");
-            if (ImGui::BeginTabItem("Compare")) { drawComparePanel(st); ImGui::EndTabItem(); }
-            record(st, "tab/Compare");
+            bool openInspector = ImGui::BeginTabItem("Inspector");
+            record(st, "tab/Inspector");   // the tab itself (before its contents)
+            if (openInspector) { drawInspector(st); ImGui::EndTabItem(); }
+            bool openCamera = ImGui::BeginTabItem("Camera");
+            record(st, "tab/Camera");   // the tab itself (before its contents)
+            if (openCamera) { drawCameraPanel(st); ImGui::EndTabItem(); }
+            bool openRendering = ImGui::BeginTabItem("Rendering");
+            record(st, "tab/Rendering");   // the tab itself (before its contents)
+            if (openRendering) { drawRenderingPanel(st); ImGui::EndTabItem(); }
+            bool openCompare = ImGui::BeginTabItem("Compare");
+            record(st, "tab/Compare");   // the tab itself (before its contents)
+            if (openCompare) { drawComparePanel(st); ImGui::EndTabItem(); }
             ImGui::EndTabBar();
         }
     }
