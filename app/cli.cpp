@@ -280,6 +280,16 @@ int runDemoShots(const std::string& outDir, const std::string& size) {
     return ok > 0 ? 0 : 1;
 }
 
+int runConvert(const std::string& sceneArg, const std::string& out, bool overwrite) {
+    std::string err;
+    auto scene = loadSceneArg(sceneArg, err);
+    if (!scene) return fail(err);
+    err = assets::saveSceneJson(*scene, out, overwrite);
+    if (!err.empty()) return fail(err);
+    std::printf("%s\n", out.c_str());
+    return 0;
+}
+
 int runWindow(const std::string& scene) { return ui::runViewer(scene); }
 
 }  // namespace cli

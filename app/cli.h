@@ -26,6 +26,7 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& args, bool compare);
 int runRender(const RenderArgs& args);
 int runCompare(const RenderArgs& args);
 int runDemoShots(const std::string& outDir, const std::string& size);
+int runConvert(const std::string& scene, const std::string& out, bool overwrite);
 int runWindow(const std::string& scene);
 
 }  // namespace cli

@@ -3,6 +3,7 @@
 //   viewer render SCENE --out shot.png   render one image offscreen with any backend/settings
 //   viewer compare SCENE --out DIR       render every backend, write images, diffs, a table
 //   viewer demo-shots --out DIR          the demo scene with every backend (./run headless)
+//   viewer convert SCENE --out x.json    save any scene in the native JSON format
 // SCENE is a file (.json .gltf .glb .obj .off .ply .stl) or the word "demo".
 #include "cli.h"
 #include "ui/viewer.h"
@@ -41,6 +42,13 @@ int main(int argc, char** argv) {
     CLI::App* compare = app.add_subcommand("compare", "Render SCENE with every backend; write images, pairwise diffs and a timing/difference table");
     cli::addRenderOptions(*compare, compareArgs, /*compare=*/true);
 
+    std::string convertIn, convertOut;
+    bool convertOverwrite = false;
+    CLI::App* convert = app.add_subcommand("convert", "Load SCENE (any supported format or 'demo') and save it as a native JSON scene");
+    convert->add_option("scene", convertIn, "Scene file or 'demo'")->required();
+    convert->add_option("--out", convertOut, "Output .json file")->required();
+    convert->add_flag("--overwrite", convertOverwrite, "Replace an existing output file");
+
     std::string demoOut = "out/demo";
     std::string demoSize = "960x540";
     CLI::App* demo = app.add_subcommand("demo-shots", "Render the demo scene with every backend into a folder");
@@ -56,6 +64,7 @@ int main(int argc, char** argv) {
     if (*render) return cli::runRender(renderArgs);
     if (*compare) return cli::runCompare(compareArgs);
     if (*demo) return cli::runDemoShots(demoOut, demoSize);
+    if (*convert) return cli::runConvert(convertIn, convertOut, convertOverwrite);
     windowOpts.scene = windowScene;
     if (!windowSize.empty() && std::sscanf(windowSize.c_str(), "%dx%d", &windowOpts.width, &windowOpts.height) != 2) {
         std::fprintf(stderr, "viewer: error: --window-size '%s': expected WIDTHxHEIGHT\n", windowSize.c_str());

@@ -8,3 +8,8 @@ if(VIEWER_SANITIZE)
   target_compile_options(viewer_options INTERFACE -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
   target_link_options(viewer_options INTERFACE -fsanitize=address,undefined)
 endif()
+if(VIEWER_FUZZ)
+  # Coverage instrumentation for libFuzzer on all our code; the fuzz targets add -fsanitize=fuzzer.
+  target_compile_options(viewer_options INTERFACE -fsanitize=fuzzer-no-link,address,undefined -fno-omit-frame-pointer -gline-tables-only)
+  target_link_options(viewer_options INTERFACE -fsanitize=address,undefined)
+endif()

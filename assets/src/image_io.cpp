@@ -17,6 +17,10 @@ bool isPng(const unsigned char* d, size_t n) {
     static const unsigned char sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
     return n >= 8 && std::memcmp(d, sig, 8) == 0;
 }
+std::string failureReason() {
+    const char* why = stbi_failure_reason();
+    return why ? std::string(why) : std::string("corrupt data");
+}
 bool isJpeg(const unsigned char* d, size_t n) { return n >= 3 && d[0] == 0xFF && d[1] == 0xD8 && d[2] == 0xFF; }
 }  // namespace
 
@@ -26,9 +30,19 @@ ImageLoad decodeImage(const void* data, size_t size, const std::string& name) {
     if (size > size_t(INT32_MAX)) { r.error = name + ": image data too large"; return r; }
     if (!isPng(d, size) && !isJpeg(d, size)) { r.error = name + ": not a PNG or JPEG image"; return r; }
     int w = 0, h = 0, comp = 0;
-    // Check the header's dimensions before decoding anything.
+    // Check the header's dimensions before decoding anything. PNG: IHDR width/height are the
+    // big-endian words at bytes 16..23 (read directly: stb's own "too large" message is vague).
+    if (isPng(d, size) && size >= 24) {
+        auto be32 = [&](size_t o) { return uint32_t(d[o]) << 24 | uint32_t(d[o + 1]) << 16 | uint32_t(d[o + 2]) << 8 | d[o + 3]; };
+        uint32_t pw = be32(16), ph = be32(20);
+        if (pw > uint32_t(kMaxImageDimension) || ph > uint32_t(kMaxImageDimension)) {
+            r.error = name + ": image is " + std::to_string(pw) + "x" + std::to_string(ph) + ", limit " +
+                      std::to_string(kMaxImageDimension) + " per side";
+            return r;
+        }
+    }
     if (!stbi_info_from_memory(d, int(size), &w, &h, &comp)) {
-        r.error = name + ": cannot read image header (" + (stbi_failure_reason() ? stbi_failure_reason() : "corrupt") + ")";
+        r.error = name + ": cannot read image header (" + failureReason() + ")";
         return r;
     }
     if (w <= 0 || h <= 0 || w > kMaxImageDimension || h > kMaxImageDimension) {
@@ -38,7 +52,7 @@ ImageLoad decodeImage(const void* data, size_t size, const std::string& name) {
     }
     unsigned char* pixels = stbi_load_from_memory(d, int(size), &w, &h, &comp, 4);
     if (!pixels) {
-        r.error = name + ": cannot decode image (" + (stbi_failure_reason() ? stbi_failure_reason() : "corrupt") + ")";
+        r.error = name + ": cannot decode image (" + failureReason() + ")";
         return r;
     }
     auto t = std::make_shared<sg::Texture>();

@@ -1,9 +1,915 @@
-// Placeholder: the native JSON format lands in the next commit.
+// scene_json.cpp - the native scene file (JSON, nlohmann-json).
+//
+// Format (version 1). Every array of numbers is plain JSON numbers; matrices are 16 numbers in
+// column-major order (as GLM stores them); quaternions are [x, y, z, w]; colours linear RGB.
+//   {
+//     "format": "sceneviewer", "version": 1, "name": "...",
+//     "ambientLight": [r,g,b], "activeCamera": <node index or null>,
+//     "settings":  { "shading": "flat|gouraud|phong", "reflection": "phong|blinn",
+//                    "fog": {"mode": "off|linear|exp|exp2", "color": [..], "start", "end", "density"},
+//                    "attenuation": bool, "aa": "none|msaa2|msaa4|msaa8|ssaa2|ssaa3|ssaa4",
+//                    "aaRate", "cullBackFaces", "wireframe", "wireframeColor", "background",
+//                    "shadows", "reflections", "maxBounces", "tessellation" },
+//     "textures":  [ {"name", "file": "relative/path.png"} | {"name", "png": "<base64 PNG>"},
+//                    + "wrapS"/"wrapT": "repeat|clamp|mirror", "filter": "nearest|bilinear|trilinear" ],
+//     "materials": [ {"name", "baseColor", "ka", "kd", "ks", "shininess", "specularTinted",
+//                     "specularColor", "diffuseTexture", "emissive", "alpha", "unlit",
+//                     "doubleSided", "reflectivity"} ],
+//     "meshes":    [ {"name", "file": "relative/model.obj"} |
+//                    {"name", "mode": "triangles|lines|points", "positions": [x,y,z,...],
+//                     "normals", "uv0", "uv1", "colors" (4 per vertex), "indices"} ],
+//     "nodes":     [ {"name", "parent": <index, absent for node 0 = root>, "visible",
+//                     "transform": {"translation", "rotation", "scale"} | {"matrix": [16]},
+//                     one optional payload:
+//                     "mesh": {"mesh", "material"} | "camera": {...} | "light": {...} |
+//                     "implicit": {...} | "csg": {"op", "material"} | "parametric": {...} |
+//                     "grid": {"dims", "values", "iso", "bounds", "material"} } ]
+//   }
+// Nodes are a flat array with parent indices (not nested), so arbitrarily deep graphs need no
+// recursion; parents may appear in any order, cycles are rejected.
+//
+// Sections: limits and helpers | reading | writing | public API
 #include "assets/scene_io.h"
 
+#include "assets/files.h"
+#include "assets/image_io.h"
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <sstream>
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
 namespace assets {
-LoadResult loadSceneJson(const std::filesystem::path& path) { LoadResult r; r.error = path.string() + ": JSON scenes not built yet"; return r; }
-LoadResult parseSceneJson(std::string_view, const std::filesystem::path& path) { return loadSceneJson(path); }
-std::string serializeSceneJson(const sg::Scene&) { return "{}"; }
-std::string saveSceneJson(const sg::Scene&, const std::filesystem::path& path, bool) { return path.string() + ": not built yet"; }
+
+// --- limits and helpers ---------------------------------------------------------------------
+
+namespace {
+
+constexpr uint64_t kMaxFileBytes = 1ull << 30;     // 1 GiB of JSON
+constexpr int kMaxNesting = 64;                    // our format needs < 10
+constexpr size_t kMaxNodes = 20'000'000;
+constexpr size_t kMaxVertices = 100'000'000;
+constexpr size_t kMaxIndices = 300'000'000;
+constexpr size_t kMaxGridValues = 512ull * 512 * 512;
+
+struct ParseError {
+    std::string path;   // JSON pointer, e.g. /nodes/3/transform
+    std::string message;
+};
+
+// Deepest bracket nesting outside strings; stops early past `limit`.
+int nestingDepth(std::string_view text, int limit) {
+    int depth = 0, maxDepth = 0;
+    bool inString = false, escape = false;
+    for (char c : text) {
+        if (inString) {
+            if (escape) escape = false;
+            else if (c == '\\') escape = true;
+            else if (c == '"') inString = false;
+            continue;
+        }
+        if (c == '"') inString = true;
+        else if (c == '[' || c == '{') {
+            maxDepth = std::max(maxDepth, ++depth);
+            if (maxDepth > limit) return maxDepth;
+        } else if (c == ']' || c == '}') --depth;
+    }
+    return maxDepth;
+}
+
+const char kB64[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+
+std::string base64Encode(std::string_view in) {
+    std::string out;
+    out.reserve((in.size() + 2) / 3 * 4);
+    size_t i = 0;
+    for (; i + 2 < in.size(); i += 3) {
+        uint32_t v = uint8_t(in[i]) << 16 | uint8_t(in[i + 1]) << 8 | uint8_t(in[i + 2]);
+        for (int k = 3; k >= 0; --k) out += kB64[(v >> (6 * k)) & 63];
+    }
+    if (i < in.size()) {
+        uint32_t v = uint8_t(in[i]) << 16 | (i + 1 < in.size() ? uint8_t(in[i + 1]) << 8 : 0);
+        out += kB64[(v >> 18) & 63];
+        out += kB64[(v >> 12) & 63];
+        out += i + 1 < in.size() ? kB64[(v >> 6) & 63] : '=';
+        out += '=';
+    }
+    return out;
+}
+
+bool base64Decode(std::string_view in, std::string& out) {
+    int8_t table[256];
+    std::fill(std::begin(table), std::end(table), int8_t(-1));
+    for (int i = 0; i < 64; ++i) table[uint8_t(kB64[i])] = int8_t(i);
+    out.clear();
+    uint32_t acc = 0;
+    int bits = 0;
+    for (char c : in) {
+        if (c == '=') break;
+        int8_t v = table[uint8_t(c)];
+        if (v < 0) return false;
+        acc = (acc << 6) | uint32_t(v);
+        bits += 6;
+        if (bits >= 8) {
+            bits -= 8;
+            out += char((acc >> bits) & 0xFF);
+        }
+    }
+    return true;
+}
+
+// Relative path inside `base`: no absolute paths, no "..", regular files only.
+std::string confinedPath(const fs::path& base, const std::string& rel, fs::path& out) {
+    fs::path p(rel);
+    if (rel.empty()) return "empty file reference";
+    if (p.is_absolute()) return "absolute file references are not allowed ('" + rel + "')";
+    for (const auto& part : p)
+        if (part == "..") return "file references must stay inside the scene's folder ('" + rel + "')";
+    out = base / p;
+    std::error_code ec;
+    fs::path canonBase = fs::weakly_canonical(base, ec), canon = fs::weakly_canonical(out, ec);
+    auto mismatch = std::mismatch(canonBase.begin(), canonBase.end(), canon.begin(), canon.end());
+    if (mismatch.first != canonBase.end()) return "file reference leaves the scene's folder through a link ('" + rel + "')";
+    return {};
+}
+
+// --- reading --------------------------------------------------------------------------------
+
+class Reader {
+public:
+    Reader(const json& root, fs::path baseDir, std::vector<std::string>& warnings)
+        : m_root(root), m_base(std::move(baseDir)), m_warnings(warnings) {}
+
+    sg::Scene read();
+
+private:
+    [[noreturn]] void fail(const std::string& path, const std::string& msg) { throw ParseError{path, msg}; }
+
+    const json& member(const json& obj, const std::string& path, const char* key) {
+        if (!obj.is_object()) fail(path, "expected an object");
+        auto it = obj.find(key);
+        if (it == obj.end()) fail(path, std::string("missing \"") + key + "\"");
+        return *it;
+    }
+    const json* optional(const json& obj, const char* key) {
+        auto it = obj.find(key);
+        return it == obj.end() || it->is_null() ? nullptr : &*it;
+    }
+    float number(const json& v, const std::string& path) {
+        if (!v.is_number()) fail(path, "expected a number");
+        double d = v.get<double>();
+        if (!std::isfinite(d) || std::abs(d) > 3.0e38) fail(path, "number is not finite");
+        return float(d);
+    }
+    int integer(const json& v, const std::string& path, long long lo, long long hi) {
+        if (!v.is_number_integer()) fail(path, "expected an integer");
+        long long x = v.get<long long>();
+        if (x < lo || x > hi) fail(path, "value " + std::to_string(x) + " out of range [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+        return int(x);
+    }
+    bool boolean(const json& v, const std::string& path) {
+        if (!v.is_boolean()) fail(path, "expected true or false");
+        return v.get<bool>();
+    }
+    std::string string(const json& v, const std::string& path) {
+        if (!v.is_string()) fail(path, "expected a string");
+        return v.get<std::string>();
+    }
+    template <int N>
+    glm::vec<N, float> vec(const json& v, const std::string& path) {
+        if (!v.is_array() || v.size() != N) fail(path, "expected " + std::to_string(N) + " numbers");
+        glm::vec<N, float> out;
+        for (int i = 0; i < N; ++i) out[i] = number(v[i], path + "/" + std::to_string(i));
+        return out;
+    }
+    sg::mat4 mat(const json& v, const std::string& path) {
+        if (!v.is_array() || v.size() != 16) fail(path, "expected 16 numbers (column-major 4x4)");
+        sg::mat4 m;
+        for (int i = 0; i < 16; ++i) m[i / 4][i % 4] = number(v[i], path + "/" + std::to_string(i));
+        return m;
+    }
+    template <class E>
+    E enumValue(const json& v, const std::string& path, const char* valid) {
+        std::string s = string(v, path);
+        E e{};
+        if (!sg::parse(s, e)) fail(path, "unknown value \"" + s + "\" (valid: " + valid + ")");
+        return e;
+    }
+    // Optional field helpers: leave `dst` alone when the key is absent.
+    void optFloat(const json& o, const std::string& p, const char* k, float& dst) { if (auto* v = optional(o, k)) dst = number(*v, p + "/" + k); }
+    void optBool(const json& o, const std::string& p, const char* k, bool& dst) { if (auto* v = optional(o, k)) dst = boolean(*v, p + "/" + k); }
+    void optVec3(const json& o, const std::string& p, const char* k, sg::vec3& dst) { if (auto* v = optional(o, k)) dst = vec<3>(*v, p + "/" + k); }
+    void optInt(const json& o, const std::string& p, const char* k, int& dst, long long lo, long long hi) { if (auto* v = optional(o, k)) dst = integer(*v, p + "/" + k, lo, hi); }
+
+    template <class T, int N>
+    void floatArray(const json& o, const std::string& p, const char* k, std::vector<T>& dst, size_t maxElems) {
+        const json* v = optional(o, k);
+        if (!v) return;
+        std::string path = p + "/" + k;
+        if (!v->is_array() || v->size() % N != 0) fail(path, "expected a flat array of " + std::to_string(N) + "-component values");
+        if (v->size() / N > maxElems) fail(path, "too many elements (" + std::to_string(v->size() / N) + ")");
+        dst.resize(v->size() / N);
+        for (size_t i = 0; i < dst.size(); ++i)
+            for (int c = 0; c < N; ++c) {
+                const json& x = (*v)[i * N + c];
+                if (!x.is_number()) fail(path + "/" + std::to_string(i * N + c), "expected a number");
+                double d = x.get<double>();
+                if (!std::isfinite(d) || std::abs(d) > 3.0e38) fail(path + "/" + std::to_string(i * N + c), "number is not finite");
+                if constexpr (N == 1) dst[i] = float(d);
+                else dst[i][c] = float(d);
+            }
+    }
+
+    void readSettings(const json& j, const std::string& p, sg::RenderSettings& s);
+    sg::Material readMaterial(const json& j, const std::string& p, size_t textureCount);
+    std::shared_ptr<sg::Texture> readTexture(const json& j, const std::string& p);
+    std::shared_ptr<sg::Mesh> readMesh(const json& j, const std::string& p);
+    sg::Payload readPayload(const json& j, const std::string& p, const sg::Scene& s);
+    sg::LocalTransform readTransform(const json& j, const std::string& p);
+    sg::ImplicitShape readImplicit(const json& j, const std::string& p);
+
+    const json& m_root;
+    fs::path m_base;
+    std::vector<std::string>& m_warnings;
+};
+
+void Reader::readSettings(const json& j, const std::string& p, sg::RenderSettings& s) {
+    if (!j.is_object()) fail(p, "expected an object");
+    if (auto* v = optional(j, "shading")) s.shading = enumValue<sg::ShadingModel>(*v, p + "/shading", "flat, gouraud, phong");
+    if (auto* v = optional(j, "reflection")) s.reflection = enumValue<sg::ReflectionModel>(*v, p + "/reflection", "phong, blinn");
+    if (auto* f = optional(j, "fog")) {
+        std::string fp = p + "/fog";
+        if (!f->is_object()) fail(fp, "expected an object");
+        if (auto* v = optional(*f, "mode")) s.fog = enumValue<sg::FogMode>(*v, fp + "/mode", "off, linear, exp, exp2");
+        optVec3(*f, fp, "color", s.fogColor);
+        optFloat(*f, fp, "start", s.fogStart);
+        optFloat(*f, fp, "end", s.fogEnd);
+        optFloat(*f, fp, "density", s.fogDensity);
+    }
+    optBool(j, p, "attenuation", s.attenuation);
+    if (auto* v = optional(j, "aa")) {
+        std::string a = string(*v, p + "/aa");
+        if (!s.setAA(a)) fail(p + "/aa", "unknown value \"" + a + "\" (valid: none, msaa2, msaa4, msaa8, ssaa2, ssaa3, ssaa4)");
+    }
+    if (s.aa == sg::AAMode::None) optInt(j, p, "aaRate", s.aaRate, 1, 8);
+    optBool(j, p, "cullBackFaces", s.cullBackFaces);
+    optBool(j, p, "wireframe", s.wireframe);
+    optVec3(j, p, "wireframeColor", s.wireframeColor);
+    optVec3(j, p, "background", s.background);
+    optBool(j, p, "shadows", s.shadows);
+    optBool(j, p, "reflections", s.reflections);
+    optInt(j, p, "maxBounces", s.maxBounces, 0, 16);
+    optInt(j, p, "tessellation", s.tessellation, 4, 512);
+    std::string err = s.validate();
+    if (!err.empty()) fail(p, err);
+}
+
+sg::Material Reader::readMaterial(const json& j, const std::string& p, size_t textureCount) {
+    if (!j.is_object()) fail(p, "expected an object");
+    sg::Material m;
+    if (auto* v = optional(j, "name")) m.name = string(*v, p + "/name");
+    optVec3(j, p, "baseColor", m.baseColor);
+    optFloat(j, p, "ka", m.ka);
+    optFloat(j, p, "kd", m.kd);
+    optFloat(j, p, "ks", m.ks);
+    optFloat(j, p, "shininess", m.shininess);
+    if (m.shininess < 0 || m.shininess > 1e5f) fail(p + "/shininess", "must be in [0, 100000]");
+    optBool(j, p, "specularTinted", m.specularTinted);
+    optVec3(j, p, "specularColor", m.specularColor);
+    optInt(j, p, "diffuseTexture", m.diffuseTexture, -1, (long long)textureCount - 1);
+    optVec3(j, p, "emissive", m.emissive);
+    optFloat(j, p, "alpha", m.alpha);
+    optBool(j, p, "unlit", m.unlit);
+    optBool(j, p, "doubleSided", m.doubleSided);
+    optFloat(j, p, "reflectivity", m.reflectivity);
+    return m;
+}
+
+std::shared_ptr<sg::Texture> Reader::readTexture(const json& j, const std::string& p) {
+    if (!j.is_object()) fail(p, "expected an object");
+    ImageLoad img;
+    if (auto* f = optional(j, "file")) {
+        fs::path full;
+        std::string why = confinedPath(m_base, string(*f, p + "/file"), full);
+        if (!why.empty()) fail(p + "/file", why);
+        img = loadImage(full);
+        if (!img.texture) {
+            // Recoverable: a missing texture becomes a magenta placeholder and a warning.
+            m_warnings.push_back(img.error + " (texture " + p + " replaced by a placeholder)");
+            auto t = std::make_shared<sg::Texture>();
+            t->width = t->height = 2;
+            t->rgba = {255, 0, 255, 255, 0, 0, 0, 255, 0, 0, 0, 255, 255, 0, 255, 255};
+            img.texture = t;
+        }
+        img.texture->sourcePath = string(*f, p + "/file");
+    } else if (auto* b = optional(j, "png")) {
+        std::string bytes;
+        if (!base64Decode(string(*b, p + "/png"), bytes)) fail(p + "/png", "invalid base64");
+        img = decodeImage(bytes.data(), bytes.size(), "embedded image");
+        if (!img.texture) fail(p + "/png", img.error);
+    } else {
+        fail(p, "a texture needs \"file\" or \"png\"");
+    }
+    auto t = img.texture;
+    if (auto* v = optional(j, "name")) t->name = string(*v, p + "/name");
+    auto wrap = [&](const char* key, sg::WrapMode& dst) {
+        if (auto* v = optional(j, key)) {
+            std::string s = string(*v, p + "/" + key);
+            if (s == "repeat") dst = sg::WrapMode::Repeat;
+            else if (s == "clamp") dst = sg::WrapMode::ClampToEdge;
+            else if (s == "mirror") dst = sg::WrapMode::MirroredRepeat;
+            else fail(p + "/" + key, "unknown wrap mode \"" + s + "\" (valid: repeat, clamp, mirror)");
+        }
+    };
+    wrap("wrapS", t->wrapS);
+    wrap("wrapT", t->wrapT);
+    if (auto* v = optional(j, "filter")) {
+        std::string s = string(*v, p + "/filter");
+        if (s == "nearest") t->filter = sg::FilterMode::Nearest;
+        else if (s == "bilinear") t->filter = sg::FilterMode::Bilinear;
+        else if (s == "trilinear") t->filter = sg::FilterMode::Trilinear;
+        else fail(p + "/filter", "unknown filter \"" + s + "\" (valid: nearest, bilinear, trilinear)");
+    }
+    return t;
+}
+
+std::shared_ptr<sg::Mesh> Reader::readMesh(const json& j, const std::string& p) {
+    if (!j.is_object()) fail(p, "expected an object");
+    auto m = std::make_shared<sg::Mesh>();
+    if (auto* f = optional(j, "file")) {
+        fs::path full;
+        std::string rel = string(*f, p + "/file");
+        std::string why = confinedPath(m_base, rel, full);
+        if (!why.empty()) fail(p + "/file", why);
+        std::string ext = full.extension().string();
+        std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+        if (ext == ".json") fail(p + "/file", "a mesh file reference must be a mesh (.obj .off .ply .stl .gltf .glb)");
+        LoadResult sub = loadScene(full);
+        if (!sub.scene) fail(p + "/file", sub.error);
+        for (auto& w : sub.warnings) m_warnings.push_back(w);
+        // Merge all meshes of the referenced file (baked with their node transforms).
+        const sg::Scene& s = *sub.scene;
+        for (sg::NodeId id : s.depthFirstOrder()) {
+            auto* mi = std::get_if<sg::MeshInstance>(&s.node(id).payload);
+            if (!mi || mi->mesh < 0 || size_t(mi->mesh) >= s.meshes.size()) continue;
+            const sg::Mesh& src = *s.meshes[mi->mesh];
+            if (src.mode != sg::PrimitiveMode::Triangles) continue;
+            sg::mat4 w = s.world(id);
+            sg::mat3 n = sg::normalMatrix(w);
+            uint32_t base = uint32_t(m->positions.size());
+            for (size_t i = 0; i < src.positions.size(); ++i) {
+                m->positions.push_back(sg::vec3(w * sg::vec4(src.positions[i], 1.0f)));
+                m->normals.push_back(src.normals.empty() ? sg::vec3(0, 1, 0) : glm::normalize(n * src.normals[i]));
+                m->uv0.push_back(src.uv0.empty() ? sg::vec2(0.0f) : src.uv0[i]);
+            }
+            for (uint32_t i : src.indices) m->indices.push_back(base + i);
+        }
+        m->name = rel;
+    } else {
+        if (auto* v = optional(j, "mode")) {
+            std::string s = string(*v, p + "/mode");
+            if (s == "triangles") m->mode = sg::PrimitiveMode::Triangles;
+            else if (s == "lines") m->mode = sg::PrimitiveMode::Lines;
+            else if (s == "points") m->mode = sg::PrimitiveMode::Points;
+            else fail(p + "/mode", "unknown mode \"" + s + "\" (valid: triangles, lines, points)");
+        }
+        floatArray<sg::vec3, 3>(j, p, "positions", m->positions, kMaxVertices);
+        floatArray<sg::vec3, 3>(j, p, "normals", m->normals, kMaxVertices);
+        floatArray<sg::vec2, 2>(j, p, "uv0", m->uv0, kMaxVertices);
+        floatArray<sg::vec2, 2>(j, p, "uv1", m->uv1, kMaxVertices);
+        floatArray<sg::vec4, 4>(j, p, "colors", m->colors, kMaxVertices);
+        if (auto* v = optional(j, "indices")) {
+            if (!v->is_array()) fail(p + "/indices", "expected an array of integers");
+            if (v->size() > kMaxIndices) fail(p + "/indices", "too many indices");
+            m->indices.resize(v->size());
+            for (size_t i = 0; i < v->size(); ++i) {
+                const json& x = (*v)[i];
+                if (!x.is_number_unsigned() || x.get<uint64_t>() > 0xFFFFFFFFull) fail(p + "/indices/" + std::to_string(i), "expected a non-negative 32-bit integer");
+                m->indices[i] = uint32_t(x.get<uint64_t>());
+            }
+        }
+        std::string err = m->validate();
+        if (!err.empty()) fail(p, err);
+    }
+    if (auto* v = optional(j, "name")) m->name = string(*v, p + "/name");
+    return m;
+}
+
+sg::LocalTransform Reader::readTransform(const json& j, const std::string& p) {
+    if (!j.is_object()) fail(p, "expected an object");
+    if (auto* m = optional(j, "matrix")) {
+        sg::mat4 mm = mat(*m, p + "/matrix");
+        if (mm[0][3] != 0 || mm[1][3] != 0 || mm[2][3] != 0 || mm[3][3] != 1)
+            fail(p + "/matrix", "must be affine (last row 0 0 0 1)");
+        return sg::LocalTransform::fromMatrix(mm);
+    }
+    sg::LocalTransform t;
+    optVec3(j, p, "translation", t.translation);
+    if (auto* r = optional(j, "rotation")) {
+        sg::vec4 q = vec<4>(*r, p + "/rotation");
+        float len = glm::length(q);
+        if (len < 1e-6f) fail(p + "/rotation", "quaternion has zero length");
+        t.rotation = sg::quat(q.w, q.x, q.y, q.z);
+        if (std::abs(len - 1.0f) > 1e-3f) t.rotation = glm::normalize(t.rotation);
+    }
+    optVec3(j, p, "scale", t.scale);
+    return t;
+}
+
+sg::ImplicitShape Reader::readImplicit(const json& j, const std::string& p) {
+    sg::ImplicitShape s;
+    s.type = enumValue<sg::ImplicitType>(member(j, p, "type"), p + "/type", "plane, sphere, box, cylinder, cone, torus, quadric");
+    optFloat(j, p, "radius", s.radius);
+    optVec3(j, p, "halfExtents", s.halfExtents);
+    optFloat(j, p, "halfHeight", s.halfHeight);
+    optFloat(j, p, "majorRadius", s.majorRadius);
+    optFloat(j, p, "minorRadius", s.minorRadius);
+    optFloat(j, p, "planeHalfSize", s.planeHalfSize);
+    if (auto* q = optional(j, "quadric")) s.quadric = mat(*q, p + "/quadric");
+    if (auto* b = optional(j, "bounds")) {
+        if (!b->is_array() || b->size() != 2) fail(p + "/bounds", "expected [[min], [max]]");
+        s.quadricBounds.min = vec<3>((*b)[0], p + "/bounds/0");
+        s.quadricBounds.max = vec<3>((*b)[1], p + "/bounds/1");
+    }
+    auto positive = [&](float v, const char* what) { if (!(v > 0.0f) || v > 1e6f) fail(p + "/" + what, "must be positive and below 1e6"); };
+    positive(s.radius, "radius");
+    positive(s.halfHeight, "halfHeight");
+    positive(s.majorRadius, "majorRadius");
+    positive(s.minorRadius, "minorRadius");
+    positive(s.planeHalfSize, "planeHalfSize");
+    for (int a = 0; a < 3; ++a) positive(s.halfExtents[a], "halfExtents");
+    if (s.quadricBounds.empty()) fail(p + "/bounds", "min must not exceed max");
+    return s;
+}
+
+sg::Payload Reader::readPayload(const json& j, const std::string& p, const sg::Scene& s) {
+    static const char* kinds[] = {"mesh", "camera", "light", "implicit", "csg", "parametric", "grid"};
+    const char* found = nullptr;
+    for (const char* k : kinds)
+        if (j.contains(k)) {
+            if (found) fail(p, std::string("a node has at most one payload (found \"") + found + "\" and \"" + k + "\")");
+            found = k;
+        }
+    for (auto it = j.begin(); it != j.end(); ++it) {
+        static const char* known[] = {"name", "parent", "visible", "transform", "mesh", "camera", "light", "implicit", "csg", "parametric", "grid"};
+        if (std::find_if(std::begin(known), std::end(known), [&](const char* k) { return it.key() == k; }) == std::end(known))
+            fail(p + "/" + it.key(), "unknown node field (valid payloads: mesh, camera, light, implicit, csg, parametric, grid)");
+    }
+    if (!found) return std::monostate{};
+    std::string kp = p + "/" + found;
+    const json& v = j[found];
+    if (!v.is_object()) fail(kp, "expected an object");
+    long long maxMat = (long long)s.materials.size() - 1;
+    std::string k = found;
+    if (k == "mesh") {
+        sg::MeshInstance mi;
+        mi.mesh = integer(member(v, kp, "mesh"), kp + "/mesh", 0, (long long)s.meshes.size() - 1);
+        optInt(v, kp, "material", mi.material, -1, maxMat);
+        return mi;
+    }
+    if (k == "camera") {
+        sg::Camera c;
+        sg::Projection& pr = c.projection;
+        if (auto* t = optional(v, "type")) pr.type = enumValue<sg::ProjectionType>(*t, kp + "/type", "perspective, orthographic, oblique");
+        optFloat(v, kp, "fovy", pr.fovyDeg);
+        optFloat(v, kp, "near", pr.zNear);
+        optFloat(v, kp, "far", pr.zFar);
+        optBool(v, kp, "useFrustum", pr.useFrustum);
+        if (auto* fr = optional(v, "frustum")) {
+            sg::vec4 f = vec<4>(*fr, kp + "/frustum");
+            pr.left = f[0]; pr.right = f[1]; pr.bottom = f[2]; pr.top = f[3];
+        }
+        optFloat(v, kp, "orthoHalfHeight", pr.orthoHalfHeight);
+        optFloat(v, kp, "obliqueAngle", pr.obliqueAngleDeg);
+        optFloat(v, kp, "obliqueFactor", pr.obliqueFactor);
+        optFloat(v, kp, "focusDistance", c.focusDistance);
+        if (!(pr.zNear > 0) || !(pr.zFar > pr.zNear)) fail(kp, "needs 0 < near < far");
+        if (!(pr.fovyDeg > 0.01f && pr.fovyDeg < 179.99f)) fail(kp + "/fovy", "must be in (0, 180) degrees");
+        if (!(pr.orthoHalfHeight > 0)) fail(kp + "/orthoHalfHeight", "must be positive");
+        if (pr.useFrustum && (!(pr.right > pr.left) || !(pr.top > pr.bottom))) fail(kp + "/frustum", "needs left < right and bottom < top");
+        return c;
+    }
+    if (k == "light") {
+        sg::Light l;
+        if (auto* t = optional(v, "type")) l.type = enumValue<sg::LightType>(*t, kp + "/type", "point, directional, spot");
+        optVec3(v, kp, "color", l.color);
+        optFloat(v, kp, "intensity", l.intensity);
+        optBool(v, kp, "inverseSquare", l.inverseSquare);
+        optFloat(v, kp, "spotInner", l.spotInnerDeg);
+        optFloat(v, kp, "spotOuter", l.spotOuterDeg);
+        return l;
+    }
+    if (k == "implicit") {
+        sg::ImplicitPayload ip;
+        ip.shape = readImplicit(v, kp);
+        optInt(v, kp, "material", ip.material, -1, maxMat);
+        return ip;
+    }
+    if (k == "csg") {
+        sg::CsgPayload cp;
+        cp.csg.op = enumValue<sg::CsgOp>(member(v, kp, "op"), kp + "/op", "union, intersection, difference");
+        optInt(v, kp, "material", cp.material, -1, maxMat);
+        return cp;
+    }
+    if (k == "parametric") {
+        sg::ParametricPayload pp;
+        pp.surface.type = enumValue<sg::ParametricType>(member(v, kp, "type"), kp + "/type", "torus, bezier");
+        optFloat(v, kp, "majorRadius", pp.surface.majorRadius);
+        optFloat(v, kp, "minorRadius", pp.surface.minorRadius);
+        if (auto* c = optional(v, "control")) {
+            std::vector<sg::vec3> pts;
+            floatArray<sg::vec3, 3>(v, kp, "control", pts, 16);
+            if (pts.size() != 16) fail(kp + "/control", "a bicubic patch needs 16 control points (48 numbers)");
+            std::copy(pts.begin(), pts.end(), pp.surface.control.begin());
+            (void)c;
+        } else if (pp.surface.type == sg::ParametricType::BezierPatch) {
+            fail(kp, "missing \"control\"");
+        }
+        optInt(v, kp, "material", pp.material, -1, maxMat);
+        return pp;
+    }
+    // grid
+    sg::GridPayload gp;
+    auto g = std::make_shared<sg::DensityGrid>();
+    g->dims = glm::ivec3(vec<3>(member(v, kp, "dims"), kp + "/dims"));
+    sg::vec3 dimsF = vec<3>(v["dims"], kp + "/dims");
+    for (int a = 0; a < 3; ++a)
+        if (dimsF[a] != std::floor(dimsF[a]) || dimsF[a] < 2 || dimsF[a] > 1024) fail(kp + "/dims", "each dimension must be an integer in [2, 1024]");
+    size_t count = size_t(g->dims.x) * g->dims.y * g->dims.z;
+    if (count > kMaxGridValues) fail(kp + "/dims", "grid too large (" + std::to_string(count) + " values)");
+    floatArray<float, 1>(v, kp, "values", g->values, kMaxGridValues);
+    if (g->values.size() != count) fail(kp + "/values", "expected " + std::to_string(count) + " values, found " + std::to_string(g->values.size()));
+    optFloat(v, kp, "iso", g->isoValue);
+    if (auto* b = optional(v, "bounds")) {
+        if (!b->is_array() || b->size() != 2) fail(kp + "/bounds", "expected [[min], [max]]");
+        g->bounds.min = vec<3>((*b)[0], kp + "/bounds/0");
+        g->bounds.max = vec<3>((*b)[1], kp + "/bounds/1");
+        for (int a = 0; a < 3; ++a)
+            if (!(g->bounds.max[a] > g->bounds.min[a])) fail(kp + "/bounds", "min must be below max");
+    }
+    gp.grid = std::move(g);
+    optInt(v, kp, "material", gp.material, -1, maxMat);
+    return gp;
+}
+
+sg::Scene Reader::read() {
+    const json& j = m_root;
+    if (!j.is_object()) fail("", "the top level must be an object");
+    if (auto* f = optional(j, "format"); f && string(*f, "/format") != "sceneviewer")
+        fail("/format", "not a scene-viewer scene file (format \"" + f->get<std::string>() + "\")");
+    if (auto* v = optional(j, "version")) {
+        int ver = integer(*v, "/version", 0, 1000000);
+        if (ver > 1) fail("/version", "file version " + std::to_string(ver) + " is newer than this viewer (1)");
+    }
+    sg::Scene s;
+    if (auto* v = optional(j, "name")) s.name = string(*v, "/name");
+    optVec3(j, "", "ambientLight", s.ambientLight);
+    if (auto* v = optional(j, "settings")) readSettings(*v, "/settings", s.settings);
+
+    auto array = [&](const char* key) -> const json* {
+        const json* v = optional(j, key);
+        if (v && !v->is_array()) fail(std::string("/") + key, "expected an array");
+        return v;
+    };
+    if (auto* a = array("textures"))
+        for (size_t i = 0; i < a->size(); ++i) s.textures.push_back(readTexture((*a)[i], "/textures/" + std::to_string(i)));
+    if (auto* a = array("materials"))
+        for (size_t i = 0; i < a->size(); ++i) s.materials.push_back(readMaterial((*a)[i], "/materials/" + std::to_string(i), s.textures.size()));
+    if (auto* a = array("meshes"))
+        for (size_t i = 0; i < a->size(); ++i) s.meshes.push_back(readMesh((*a)[i], "/meshes/" + std::to_string(i)));
+
+    const json* nodes = array("nodes");
+    if (!nodes || nodes->empty()) return s;   // an empty scene is valid
+    size_t n = nodes->size();
+    if (n > kMaxNodes) fail("/nodes", "too many nodes (" + std::to_string(n) + ")");
+    // Parents first: validate indices, detect cycles, then create nodes in an order where each
+    // parent exists before its children.
+    std::vector<int64_t> parent(n, -1);
+    for (size_t i = 0; i < n; ++i) {
+        std::string p = "/nodes/" + std::to_string(i);
+        const json& nj = (*nodes)[i];
+        if (!nj.is_object()) fail(p, "expected an object");
+        const json* pv = optional(nj, "parent");
+        if (i == 0) {
+            if (pv) fail(p + "/parent", "node 0 is the root and has no parent");
+            continue;
+        }
+        if (!pv) fail(p, "missing \"parent\" (only node 0, the root, has none)");
+        parent[i] = integer(*pv, p + "/parent", 0, (long long)n - 1);
+        if (size_t(parent[i]) == i) fail(p + "/parent", "a node cannot be its own parent");
+    }
+    // Children lists in file order, then an iterative walk from the root; nodes never reached
+    // are part of a cycle.
+    std::vector<std::vector<uint32_t>> children(n);
+    for (size_t i = 1; i < n; ++i) children[size_t(parent[i])].push_back(uint32_t(i));
+    std::vector<sg::NodeId> idOf(n, sg::kNoNode);
+    idOf[0] = s.root();
+    std::vector<uint32_t> stack{0};
+    size_t reached = 1;
+    while (!stack.empty()) {
+        uint32_t i = stack.back();
+        stack.pop_back();
+        for (uint32_t c : children[i]) {
+            idOf[c] = s.addNode("", idOf[i]);
+            ++reached;
+            stack.push_back(c);
+        }
+    }
+    if (reached != n) {
+        for (size_t i = 0; i < n; ++i)
+            if (idOf[i] == sg::kNoNode) fail("/nodes/" + std::to_string(i) + "/parent", "the parent chain forms a cycle");
+    }
+    for (size_t i = 0; i < n; ++i) {
+        std::string p = "/nodes/" + std::to_string(i);
+        const json& nj = (*nodes)[i];
+        sg::NodeId id = idOf[i];
+        if (auto* v = optional(nj, "name")) s.setName(id, string(*v, p + "/name"));
+        else if (i == 0) s.setName(id, "root");
+        if (auto* v = optional(nj, "visible")) s.setVisible(id, boolean(*v, p + "/visible"));
+        if (auto* v = optional(nj, "transform")) s.setLocal(id, readTransform(*v, p + "/transform"));
+        s.setPayload(id, readPayload(nj, p, s));
+    }
+    if (auto* v = optional(j, "activeCamera")) {
+        int c = integer(*v, "/activeCamera", 0, (long long)n - 1);
+        if (!std::holds_alternative<sg::Camera>(s.node(idOf[c]).payload)) fail("/activeCamera", "node " + std::to_string(c) + " is not a camera");
+        s.activeCamera = idOf[c];
+    }
+    return s;
+}
+
+// --- writing ----------------------------------------------------------------------------------
+
+json vecJ(const sg::vec3& v) { return json::array({v.x, v.y, v.z}); }
+json matJ(const sg::mat4& m) {
+    json a = json::array();
+    for (int i = 0; i < 16; ++i) a.push_back(m[i / 4][i % 4]);
+    return a;
+}
+template <class T, int N>
+json flat(const std::vector<T>& v) {
+    json a = json::array();
+    for (const T& x : v)
+        for (int c = 0; c < N; ++c) {
+            if constexpr (N == 1) a.push_back(x);
+            else a.push_back(x[c]);
+        }
+    return a;
+}
+const char* wrapName(sg::WrapMode w) { return w == sg::WrapMode::Repeat ? "repeat" : w == sg::WrapMode::ClampToEdge ? "clamp" : "mirror"; }
+const char* filterName(sg::FilterMode f) { return f == sg::FilterMode::Nearest ? "nearest" : f == sg::FilterMode::Bilinear ? "bilinear" : "trilinear"; }
+
+json implicitJ(const sg::ImplicitShape& s) {
+    json j = {{"type", sg::toString(s.type)}};
+    switch (s.type) {
+    case sg::ImplicitType::Plane: j["planeHalfSize"] = s.planeHalfSize; break;
+    case sg::ImplicitType::Sphere: j["radius"] = s.radius; break;
+    case sg::ImplicitType::Box: j["halfExtents"] = vecJ(s.halfExtents); break;
+    case sg::ImplicitType::Cylinder:
+    case sg::ImplicitType::Cone: j["radius"] = s.radius; j["halfHeight"] = s.halfHeight; break;
+    case sg::ImplicitType::Torus: j["majorRadius"] = s.majorRadius; j["minorRadius"] = s.minorRadius; break;
+    case sg::ImplicitType::Quadric:
+        j["quadric"] = matJ(s.quadric);
+        j["bounds"] = {vecJ(s.quadricBounds.min), vecJ(s.quadricBounds.max)};
+        break;
+    }
+    // Keep the parameters of the other types too, so switching type in the UI round-trips.
+    j["radius"] = s.radius;
+    j["halfExtents"] = vecJ(s.halfExtents);
+    j["halfHeight"] = s.halfHeight;
+    j["majorRadius"] = s.majorRadius;
+    j["minorRadius"] = s.minorRadius;
+    j["planeHalfSize"] = s.planeHalfSize;
+    j["quadric"] = matJ(s.quadric);
+    j["bounds"] = {vecJ(s.quadricBounds.min), vecJ(s.quadricBounds.max)};
+    return j;
+}
+
+json payloadJ(const sg::Payload& p) {
+    json j;
+    std::visit([&](const auto& v) {
+        using T = std::decay_t<decltype(v)>;
+        if constexpr (std::is_same_v<T, sg::MeshInstance>) {
+            j["mesh"] = {{"mesh", v.mesh}, {"material", v.material}};
+        } else if constexpr (std::is_same_v<T, sg::Camera>) {
+            const sg::Projection& pr = v.projection;
+            j["camera"] = {{"type", sg::toString(pr.type)}, {"fovy", pr.fovyDeg}, {"near", pr.zNear}, {"far", pr.zFar},
+                           {"useFrustum", pr.useFrustum}, {"frustum", {pr.left, pr.right, pr.bottom, pr.top}},
+                           {"orthoHalfHeight", pr.orthoHalfHeight}, {"obliqueAngle", pr.obliqueAngleDeg},
+                           {"obliqueFactor", pr.obliqueFactor}, {"focusDistance", v.focusDistance}};
+        } else if constexpr (std::is_same_v<T, sg::Light>) {
+            j["light"] = {{"type", sg::toString(v.type)}, {"color", vecJ(v.color)}, {"intensity", v.intensity},
+                          {"inverseSquare", v.inverseSquare}, {"spotInner", v.spotInnerDeg}, {"spotOuter", v.spotOuterDeg}};
+        } else if constexpr (std::is_same_v<T, sg::ImplicitPayload>) {
+            json s = implicitJ(v.shape);
+            s["material"] = v.material;
+            j["implicit"] = s;
+        } else if constexpr (std::is_same_v<T, sg::CsgPayload>) {
+            j["csg"] = {{"op", sg::toString(v.csg.op)}, {"material", v.material}};
+        } else if constexpr (std::is_same_v<T, sg::ParametricPayload>) {
+            std::vector<sg::vec3> pts(v.surface.control.begin(), v.surface.control.end());
+            j["parametric"] = {{"type", sg::toString(v.surface.type)}, {"majorRadius", v.surface.majorRadius},
+                               {"minorRadius", v.surface.minorRadius}, {"control", flat<sg::vec3, 3>(pts)},
+                               {"material", v.material}};
+        } else if constexpr (std::is_same_v<T, sg::GridPayload>) {
+            if (v.grid)
+                j["grid"] = {{"dims", {v.grid->dims.x, v.grid->dims.y, v.grid->dims.z}}, {"values", v.grid->values},
+                             {"iso", v.grid->isoValue}, {"bounds", {vecJ(v.grid->bounds.min), vecJ(v.grid->bounds.max)}},
+                             {"material", v.material}};
+        }
+    }, p);
+    return j;
+}
+
+// Pretty printer: objects one key per line, arrays of plain values on one line, floats in
+// their shortest form that reads back to the same float (the scene stores floats).
+void appendNumber(std::string& out, double d) {
+    float f = float(d);
+    char buf[32];
+    for (int prec = 6; prec <= 9; ++prec) {
+        std::snprintf(buf, sizeof buf, "%.*g", prec, double(f));
+        if (std::strtof(buf, nullptr) == f) break;
+    }
+    std::string s = buf;
+    if (s.find_first_of(".eEn") == std::string::npos) s += ".0";   // keep it a float in JSON terms
+    out += s;
+}
+
+void pretty(std::string& out, const json& j, int indent) {
+    auto pad = [&](int n) { out.append(size_t(n) * 2, ' '); };
+    switch (j.type()) {
+    case json::value_t::object: {
+        if (j.empty()) { out += "{}"; return; }
+        out += "{\n";
+        size_t i = 0;
+        for (auto it = j.begin(); it != j.end(); ++it, ++i) {
+            pad(indent + 1);
+            out += json(it.key()).dump();
+            out += ": ";
+            pretty(out, it.value(), indent + 1);
+            out += i + 1 < j.size() ? ",\n" : "\n";
+        }
+        pad(indent);
+        out += "}";
+        return;
+    }
+    case json::value_t::array: {
+        bool flatArray = std::all_of(j.begin(), j.end(), [](const json& e) { return e.is_primitive(); });
+        if (flatArray) {
+            out += "[";
+            for (size_t i = 0; i < j.size(); ++i) {
+                if (i) out += ", ";
+                pretty(out, j[i], indent);
+            }
+            out += "]";
+            return;
+        }
+        out += "[\n";
+        for (size_t i = 0; i < j.size(); ++i) {
+            pad(indent + 1);
+            pretty(out, j[i], indent + 1);
+            out += i + 1 < j.size() ? ",\n" : "\n";
+        }
+        pad(indent);
+        out += "]";
+        return;
+    }
+    case json::value_t::number_float: appendNumber(out, j.get<double>()); return;
+    default: out += j.dump(); return;
+    }
+}
+
+}  // namespace
+
+// --- public API -------------------------------------------------------------------------------
+
+std::string serializeSceneJson(const sg::Scene& s) {
+    json j;
+    j["format"] = "sceneviewer";
+    j["version"] = 1;
+    j["name"] = s.name;
+    j["ambientLight"] = vecJ(s.ambientLight);
+    const sg::RenderSettings& r = s.settings;
+    j["settings"] = {{"shading", sg::toString(r.shading)}, {"reflection", sg::toString(r.reflection)},
+                     {"fog", {{"mode", sg::toString(r.fog)}, {"color", vecJ(r.fogColor)}, {"start", r.fogStart}, {"end", r.fogEnd}, {"density", r.fogDensity}}},
+                     {"attenuation", r.attenuation}, {"aa", r.aaName()}, {"cullBackFaces", r.cullBackFaces},
+                     {"wireframe", r.wireframe}, {"wireframeColor", vecJ(r.wireframeColor)}, {"background", vecJ(r.background)},
+                     {"shadows", r.shadows}, {"reflections", r.reflections}, {"maxBounces", r.maxBounces},
+                     {"tessellation", r.tessellation}};
+    j["settings"]["aaRate"] = r.aaRate;   // kept while AA is off, so switching it back on restores it
+    j["textures"] = json::array();
+    for (const auto& t : s.textures) {
+        json tj = {{"name", t->name}, {"wrapS", wrapName(t->wrapS)}, {"wrapT", wrapName(t->wrapT)}, {"filter", filterName(t->filter)}};
+        std::string png;
+        encodePng(t->width, t->height, t->rgba.data(), png);
+        tj["png"] = base64Encode(png);
+        j["textures"].push_back(tj);
+    }
+    j["materials"] = json::array();
+    for (const auto& m : s.materials)
+        j["materials"].push_back({{"name", m.name}, {"baseColor", vecJ(m.baseColor)}, {"ka", m.ka}, {"kd", m.kd}, {"ks", m.ks},
+                                  {"shininess", m.shininess}, {"specularTinted", m.specularTinted},
+                                  {"specularColor", vecJ(m.specularColor)}, {"diffuseTexture", m.diffuseTexture},
+                                  {"emissive", vecJ(m.emissive)}, {"alpha", m.alpha}, {"unlit", m.unlit},
+                                  {"doubleSided", m.doubleSided}, {"reflectivity", m.reflectivity}});
+    j["meshes"] = json::array();
+    for (const auto& m : s.meshes) {
+        const char* mode = m->mode == sg::PrimitiveMode::Triangles ? "triangles" : m->mode == sg::PrimitiveMode::Lines ? "lines" : "points";
+        json mj = {{"name", m->name}, {"mode", mode}, {"positions", flat<sg::vec3, 3>(m->positions)}, {"indices", m->indices}};
+        if (!m->normals.empty()) mj["normals"] = flat<sg::vec3, 3>(m->normals);
+        if (!m->uv0.empty()) mj["uv0"] = flat<sg::vec2, 2>(m->uv0);
+        if (!m->uv1.empty()) mj["uv1"] = flat<sg::vec2, 2>(m->uv1);
+        if (!m->colors.empty()) mj["colors"] = flat<sg::vec4, 4>(m->colors);
+        j["meshes"].push_back(std::move(mj));
+    }
+    const auto& order = s.depthFirstOrder();
+    std::vector<int64_t> indexOf(s.idCapacity(), -1);
+    for (size_t i = 0; i < order.size(); ++i) indexOf[order[i]] = int64_t(i);
+    j["nodes"] = json::array();
+    for (sg::NodeId id : order) {
+        const sg::Node& n = s.node(id);
+        json nj = payloadJ(n.payload);
+        nj["name"] = n.name;
+        if (n.parent != sg::kNoNode) nj["parent"] = indexOf[n.parent];
+        if (!n.visible) nj["visible"] = false;
+        if (n.local.mode == sg::LocalTransform::Mode::Matrix) {
+            nj["transform"] = {{"matrix", matJ(n.local.matrix)}};
+        } else {
+            const sg::quat& q = n.local.rotation;
+            nj["transform"] = {{"translation", vecJ(n.local.translation)}, {"rotation", {q.x, q.y, q.z, q.w}}, {"scale", vecJ(n.local.scale)}};
+        }
+        j["nodes"].push_back(std::move(nj));
+    }
+    j["activeCamera"] = s.valid(s.activeCamera) ? json(indexOf[s.activeCamera]) : json(nullptr);
+    std::string out;
+    pretty(out, j, 0);
+    return out + "\n";
+}
+
+LoadResult parseSceneJson(std::string_view text, const fs::path& path) {
+    LoadResult r;
+    std::string file = path.string();
+    int depth = nestingDepth(text, kMaxNesting);
+    if (depth > kMaxNesting) {
+        r.error = file + ": JSON nested deeper than " + std::to_string(kMaxNesting) + " levels";
+        return r;
+    }
+    json j;
+    try {
+        j = json::parse(text.begin(), text.end(), nullptr, /*allow_exceptions=*/false);
+    } catch (const json::out_of_range& e) {   // thrown even without exceptions, e.g. 1e999
+        std::string what = e.what();
+        auto pos = what.find("number overflow");
+        r.error = file + ": number is not finite (" + (pos == std::string::npos ? what : what.substr(pos)) + ")";
+        return r;
+    }
+    if (j.is_discarded()) {
+        // Re-parse with exceptions for the position and reason of the syntax error.
+        try {
+            json again = json::parse(text.begin(), text.end());
+            (void)again;
+        } catch (const json::parse_error& e) {
+            std::string what = e.what();
+            auto pos = what.find("parse error");
+            r.error = file + ": JSON syntax error: " + (pos == std::string::npos ? what : what.substr(pos));
+            return r;
+        } catch (const json::exception& e) {   // e.g. 1e999: "number overflow"
+            std::string what = e.what();
+            auto pos = what.find("number overflow");
+            r.error = file + ": " + (pos == std::string::npos ? what : "number is not finite (" + what.substr(pos) + ")");
+            return r;
+        }
+        r.error = file + ": JSON syntax error";
+        return r;
+    }
+    try {
+        Reader reader(j, path.parent_path(), r.warnings);
+        r.scene = reader.read();
+    } catch (const ParseError& e) {
+        r.error = file + ": " + (e.path.empty() ? std::string("/") : e.path) + ": " + e.message;
+    } catch (const std::bad_alloc&) {
+        r.error = file + ": out of memory while loading";
+    }
+    return r;
+}
+
+LoadResult loadSceneJson(const fs::path& path) {
+    std::string text;
+    std::string err = readFileLimited(path, kMaxFileBytes, text);
+    if (!err.empty()) {
+        LoadResult r;
+        r.error = err;
+        return r;
+    }
+    return parseSceneJson(text, path);
+}
+
+std::string saveSceneJson(const sg::Scene& scene, const fs::path& path, bool overwrite) {
+    return writeFileAtomic(path, serializeSceneJson(scene), overwrite);
+}
+
 }  // namespace assets

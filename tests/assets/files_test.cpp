@@ -1,0 +1,138 @@
+// Atomic writes and unique names.
+#include "assets/files.h"
+#include "assets/image_io.h"
+#include "test_support.h"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <csignal>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+
+TEST(FilesTest, AtomicWriteCreatesAndRefusesToOverwrite) {
+    fs::path dir = testing_support::outputDir("files") / "atomic";
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    fs::path f = dir / "a.txt";
+    EXPECT_EQ(assets::writeFileAtomic(f, "one", false), "");
+    EXPECT_NE(assets::writeFileAtomic(f, "two", false), "");
+    std::string content;
+    EXPECT_EQ(assets::readFileLimited(f, 100, content), "");
+    EXPECT_EQ(content, "one");
+    EXPECT_EQ(assets::writeFileAtomic(f, "two", true), "");
+    EXPECT_EQ(assets::readFileLimited(f, 100, content), "");
+    EXPECT_EQ(content, "two");
+}
+
+TEST(FilesTest, MissingFolderGivesAClearError) {
+    std::string err = assets::writeFileAtomic("/nonexistent-folder/x.png", "data", false);
+    EXPECT_NE(err.find("/nonexistent-folder"), std::string::npos) << err;
+    err = assets::writeFileAtomic("/proc/self/new-file", "data", false);   // not creatable, even as root
+    EXPECT_NE(err, "");
+}
+
+// A full disk, simulated with a file-size limit (works as root too): the write fails with a
+// clear error, the old file stays intact and no temporary file is left behind.
+TEST(FilesTest, FullDiskKeepsTheOldFile) {
+    fs::path dir = testing_support::outputDir("files") / "fulldisk";
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    ASSERT_EQ(assets::writeFileAtomic(dir / "old.txt", "old", false), "");
+    struct rlimit saved {};
+    getrlimit(RLIMIT_FSIZE, &saved);
+    auto oldHandler = signal(SIGXFSZ, SIG_IGN);
+    struct rlimit small = saved;
+    small.rlim_cur = 4096;
+    ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &small), 0);
+    std::string err = assets::writeFileAtomic(dir / "old.txt", std::string(1 << 20, 'n'), true);
+    setrlimit(RLIMIT_FSIZE, &saved);
+    signal(SIGXFSZ, oldHandler);
+    EXPECT_NE(err.find("old.txt"), std::string::npos) << err;
+    std::string content;
+    assets::readFileLimited(dir / "old.txt", 100, content);
+    EXPECT_EQ(content, "old");
+    int files = 0;
+    for (auto& e : fs::directory_iterator(dir)) { (void)e; ++files; }
+    EXPECT_EQ(files, 1);
+}
+
+TEST(FilesTest, ReadLimitedRefusesDevicesAndLargeFiles) {
+    std::string out;
+    EXPECT_NE(assets::readFileLimited("/dev/zero", 1 << 20, out).find("not a regular file"), std::string::npos);
+    fs::path f = testing_support::outputDir("files") / "big.bin";
+    std::ofstream(f) << std::string(1000, 'x');
+    EXPECT_NE(assets::readFileLimited(f, 100, out).find("too large"), std::string::npos);
+}
+
+TEST(FilesTest, UniquePathNeverReturnsAnExistingFile) {
+    fs::path dir = testing_support::outputDir("files") / "unique";
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    fs::path p = dir / "shot.png";
+    EXPECT_EQ(assets::uniquePath(p), p);
+    std::ofstream(p) << "x";
+    EXPECT_EQ(assets::uniquePath(p), dir / "shot-1.png");
+    std::ofstream(dir / "shot-1.png") << "x";
+    EXPECT_EQ(assets::uniquePath(p), dir / "shot-2.png");
+}
+
+TEST(FilesTest, PngRoundTripAndCaps) {
+    std::vector<uint8_t> px(4 * 3 * 2);
+    for (size_t i = 0; i < px.size(); ++i) px[i] = uint8_t(i * 10);
+    std::string png;
+    ASSERT_EQ(assets::encodePng(3, 2, px.data(), png), "");
+    assets::ImageLoad img = assets::decodeImage(png.data(), png.size(), "mem.png");
+    ASSERT_TRUE(img.texture) << img.error;
+    EXPECT_EQ(img.texture->width, 3);
+    EXPECT_EQ(img.texture->rgba, px);
+    EXPECT_NE(assets::encodePng(20000, 10, px.data(), png), "");   // capped before stb overflows
+    // Not PNG/JPEG (a GIF header) and a PNG header claiming 65535x65535 are refused before decoding.
+    std::string gif = "GIF89a\x01\x00\x01\x00";
+    EXPECT_NE(assets::decodeImage(gif.data(), gif.size(), "x.gif").error.find("not a PNG or JPEG"), std::string::npos);
+    std::string huge = png;
+    huge[16] = huge[17] = huge[20] = huge[21] = 0;
+    huge[18] = huge[19] = huge[22] = huge[23] = char(0xFF);
+    assets::ImageLoad h = assets::decodeImage(huge.data(), huge.size(), "huge.png");
+    EXPECT_FALSE(h.texture);
+    EXPECT_NE(h.error.find("65535x65535"), std::string::npos) << h.error;
+}
+
+// Kill the writer at random points, many times: the target is always either the complete old
+// file or the complete new one, never torn or empty.
+TEST(FilesTest, KilledWriterLeavesOldOrNewFile) {
+    fs::path dir = testing_support::outputDir("files") / "killed";
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    fs::path target = dir / "scene.json";
+    const std::string oldContent(200000, 'o');
+    const std::string newContent(3000000, 'n');
+    ASSERT_EQ(assets::writeFileAtomic(target, oldContent, false), "");
+    std::srand(12345);
+    int sawNew = 0;
+    for (int round = 0; round < 60; ++round) {
+        pid_t pid = fork();
+        ASSERT_GE(pid, 0);
+        if (pid == 0) {
+            assets::writeFileAtomic(target, newContent, true);
+            _exit(0);
+        }
+        usleep(useconds_t(std::rand() % 20000));
+        kill(pid, SIGKILL);
+        int status = 0;
+        waitpid(pid, &status, 0);
+        std::string content;
+        ASSERT_EQ(assets::readFileLimited(target, 1u << 24, content), "");
+        bool isOld = content == oldContent, isNew = content == newContent;
+        ASSERT_TRUE(isOld || isNew) << "round " << round << ": torn file of " << content.size() << " bytes";
+        if (isNew) {
+            ++sawNew;
+            ASSERT_EQ(assets::writeFileAtomic(target, oldContent, true), "");
+        }
+    }
+    std::printf("[killed writer] 60 rounds, %d completed before the kill\n", sawNew);
+}
