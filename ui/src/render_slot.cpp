@@ -23,9 +23,14 @@ RenderSlot::~RenderSlot() {
     if (m_thread.joinable()) m_thread.join();
 }
 
+bool RenderSlot::needs(uint64_t key, bool interacting) const {
+    if (!m_renderer) return false;
+    return !(key == m_lastKey && (interacting || !m_lastPreviewOnly));
+}
+
 void RenderSlot::request(std::shared_ptr<const sg::FrameInput> frame, int width, int height, uint64_t key, bool interacting) {
     if (!m_renderer || width < 1 || height < 1) return;
-    if (key == m_lastKey && (interacting || !m_lastPreviewOnly)) return;   // nothing new to draw
+    if (!needs(key, interacting)) return;   // nothing new to draw
     m_lastKey = key;
     m_lastPreviewOnly = interacting;
     Job job{std::move(frame), width, height, key, interacting};

@@ -54,6 +54,8 @@ struct Texture {
     void upload(const rnd::Framebuffer& fb) {
         if (fb.width < 1 || fb.height < 1) return;
         if (!id) glGenTextures(1, &id);
+        glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);   // a backend may have left a PBO bound
+        glActiveTexture(GL_TEXTURE0);
         glBindTexture(GL_TEXTURE_2D, id);
         glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
         glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
@@ -84,6 +86,7 @@ std::string saveWindowPng(GLFWwindow* win, const fs::path& path) {
     if (w < 1 || h < 1) return "window has no size";
     std::vector<uint8_t> px(size_t(w) * h * 4), flipped(px.size());
     glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+    glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
     glReadBuffer(GL_BACK);
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
     glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, px.data());
@@ -140,11 +143,14 @@ public:
         uint64_t key = (st.sceneVersion * 1000003u) ^ (st.viewVersion * 7919u) ^ (uint64_t(w) << 40) ^ (uint64_t(h) << 20);
         for (const std::string& n : names) {
             BackendView& v = viewFor(n);
-            if (!base) base = std::make_shared<sg::FrameInput>(st.buildFrame(aspect));
+            sg::RenderSettings settings = st.settingsFor(n);
+            uint64_t k = key ^ std::hash<std::string>{}(settings.aaName());
+            bool preview = interacting && v.slot->backend() != "gl";
+            if (!v.slot->needs(k, preview)) continue;
+            if (!base) base = std::make_shared<sg::FrameInput>(st.buildFrame(aspect));   // flatten once per change
             auto frame = std::make_shared<sg::FrameInput>(*base);
-            frame->settings = st.settingsFor(n);
-            uint64_t k = key ^ std::hash<std::string>{}(frame->settings.aaName());
-            v.slot->request(std::move(frame), w, h, k, interacting && v.slot->backend() != "gl");
+            frame->settings = settings;
+            v.slot->request(std::move(frame), w, h, k, preview);
         }
         for (auto& [name, v] : views)
             if (v.slot->poll()) v.texture.upload(v.slot->image());
@@ -493,6 +499,7 @@ int runViewer(const ViewerOptions& opt) {
     double last = 0;
     int exitCode = 0;
     bool running = true;
+    std::string windowTitle;
     while (running) {
         bool busy = !v.shots.empty() || st.loadInProgress() || automated;
         for (auto& [n, bv] : v.views) busy |= bv.slot->status().rendering;
@@ -539,6 +546,8 @@ int runViewer(const ViewerOptions& opt) {
         glfwGetFramebufferSize(win, &fbw, &fbh);
         glBindFramebuffer(GL_FRAMEBUFFER, 0);
         glViewport(0, 0, fbw, fbh);
+        glDisable(GL_FRAMEBUFFER_SRGB);   // the UI colours and the images are already sRGB
+        glDisable(GL_DEPTH_TEST);
         glClearColor(0.08f, 0.09f, 0.10f, 1.0f);
         glClear(GL_COLOR_BUFFER_BIT);
         ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
@@ -554,6 +563,12 @@ int runViewer(const ViewerOptions& opt) {
         }
         glfwSwapBuffers(win);
         if (st.requests.quit) running = false;
+        // Window title: file name and the unsaved-changes marker.
+        std::string title = (st.scenePath.empty() ? st.scene.name : st.scenePath.filename().string()) + (st.dirty ? " *" : "") + " - Scene viewer";
+        if (title != windowTitle) {
+            windowTitle = title;
+            glfwSetWindowTitle(win, title.c_str());
+        }
     }
     v.pollScreenshots(true);
 

@@ -41,6 +41,8 @@ public:
     // Renders `frame` at width x height. `key` identifies the content (scene+view+size): an
     // unchanged key is ignored. interacting: render only the preview level (1/previewDivisor).
     void request(std::shared_ptr<const sg::FrameInput> frame, int width, int height, uint64_t key, bool interacting);
+    // True when request() with this key would start work (so callers can skip building frames).
+    bool needs(uint64_t key, bool interacting) const;
     // Runs synchronous work and collects finished images; returns true when image() changed.
     bool poll();
     // Last finished image (UI thread only; valid until the next poll()).
