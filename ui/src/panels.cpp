@@ -729,8 +729,10 @@ void drawCameraPanel(ViewerState& st) {
     matrixTable("view", fc.view);
     ImGui::Text("Projection (aspect %.3f)", aspect);
     matrixTable("proj", fc.proj);
-    ImGui::TextDisabled("Eye (%.2f, %.2f, %.2f)  pivot (%.2f, %.2f, %.2f)  distance %.3f", fc.eye.x, fc.eye.y, fc.eye.z, st.camera.pivot.x,
+    ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyle().Colors[ImGuiCol_TextDisabled]);
+    ImGui::TextWrapped("Eye (%.2f, %.2f, %.2f)  pivot (%.2f, %.2f, %.2f)  distance %.3f", fc.eye.x, fc.eye.y, fc.eye.z, st.camera.pivot.x,
                         st.camera.pivot.y, st.camera.pivot.z, st.camera.distance);
+    ImGui::PopStyleColor();
 }
 
 // --- 7. rendering panel ------------------------------------------------------------------------
@@ -1336,21 +1338,24 @@ void drawUi(ViewerState& st, const ViewportInput& view, double time, float dt) {
     ImGui::SetNextWindowSizeConstraints(ImVec2(px(220), bodyH), ImVec2(std::max(px(220), io.DisplaySize.x * 0.45f), bodyH));
     float rightW = 0;
     if (ImGui::Begin("Properties", nullptr, panelFlags)) {
+        ImGui::PushItemWidth(-px(150));   // room for the labels on the right
         if (ImGui::BeginTabBar("tabs")) {
-            bool openInspector = ImGui::BeginTabItem("Inspector");
+            bool openInspector = ImGui::BeginTabItem("Inspector", nullptr, st.requestedTab == "Inspector" ? ImGuiTabItemFlags_SetSelected : 0);
             record(st, "tab/Inspector");   // the tab itself (before its contents)
             if (openInspector) { drawInspector(st); ImGui::EndTabItem(); }
-            bool openCamera = ImGui::BeginTabItem("Camera");
+            bool openCamera = ImGui::BeginTabItem("Camera", nullptr, st.requestedTab == "Camera" ? ImGuiTabItemFlags_SetSelected : 0);
             record(st, "tab/Camera");   // the tab itself (before its contents)
             if (openCamera) { drawCameraPanel(st); ImGui::EndTabItem(); }
-            bool openRendering = ImGui::BeginTabItem("Rendering");
+            bool openRendering = ImGui::BeginTabItem("Rendering", nullptr, st.requestedTab == "Rendering" ? ImGuiTabItemFlags_SetSelected : 0);
             record(st, "tab/Rendering");   // the tab itself (before its contents)
             if (openRendering) { drawRenderingPanel(st); ImGui::EndTabItem(); }
-            bool openCompare = ImGui::BeginTabItem("Compare");
+            bool openCompare = ImGui::BeginTabItem("Compare", nullptr, st.requestedTab == "Compare" ? ImGuiTabItemFlags_SetSelected : 0);
             record(st, "tab/Compare");   // the tab itself (before its contents)
             if (openCompare) { drawComparePanel(st); ImGui::EndTabItem(); }
             ImGui::EndTabBar();
         }
+        st.requestedTab.clear();
+        ImGui::PopItemWidth();
     }
     rightW = ImGui::GetWindowWidth();
     ImGui::End();

@@ -298,6 +298,7 @@ private:
 //   view single|split|split3|difference
 //   orbit DX DY | zoom STEPS | fit
 //   select NODE-NAME
+//   tab Inspector|Camera|Rendering|Compare
 //   screenshot DIR        offscreen PNG per visible backend into DIR (as F12)
 //   window-shot PATH      PNG of the whole window (UI included)
 //   quit
@@ -364,6 +365,7 @@ public:
             if (cmd == "orbit") { float dx = 0, dy = 0; in >> dx >> dy; v.st.camera.orbit(dx, dy); v.st.markViewChanged(); continue; }
             if (cmd == "zoom") { float s = 0; in >> s; v.st.camera.zoom(s); v.st.markViewChanged(); continue; }
             if (cmd == "fit") { v.st.fitView(false); continue; }
+            if (cmd == "tab") { in >> v.st.requestedTab; continue; }
             if (cmd == "select") {
                 std::string name;
                 std::getline(in >> std::ws, name);

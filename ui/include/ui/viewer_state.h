@@ -92,6 +92,7 @@ struct ViewerState {
     std::map<std::string, std::string> aaOverride;
 
     Requests requests;
+    std::string requestedTab;                    // select this right-panel tab next frame
     std::vector<std::string> recentFiles;        // most recent first
     std::filesystem::path configDir;             // where recent.txt lives ("" = don't persist)
     std::map<std::string, ItemRect> itemRects;   // test hook, filled by panels
