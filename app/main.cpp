@@ -6,6 +6,7 @@
 //   viewer convert SCENE --out x.json    save any scene in the native JSON format
 // SCENE is a file (.json .gltf .glb .obj .off .ply .stl) or the word "demo".
 #include "cli.h"
+#include "ui/viewer.h"
 
 #include <CLI/CLI.hpp>
 
@@ -19,6 +20,18 @@ int main(int argc, char** argv) {
 
     std::string windowScene;
     app.add_option("scene", windowScene, "Scene file to open (.json .gltf .glb .obj .off .ply .stl) or 'demo'");
+    // Hidden window automation (tests, docs screenshots); see ui/src/viewer.cpp "automation":
+    //   viewer [SCENE] --automate script.txt
+    //   viewer [SCENE] --frames N [--screenshot window.png] [--backend raster] [--view split]
+    ui::ViewerOptions windowOpts;
+    std::string windowSize;
+    app.add_option("--automate", windowOpts.script, "Run a window automation script")->group("");
+    app.add_option("--frames", windowOpts.frames, "Run N frames, wait for the images, quit")->group("");
+    app.add_option("--screenshot", windowOpts.screenshot, "With --frames: PNG of the whole window")->group("");
+    app.add_option("--backend", windowOpts.backend, "Initial backend")->group("");
+    app.add_option("--view", windowOpts.view, "Initial view: single, split, split3, difference")->group("");
+    app.add_option("--window-size", windowSize, "Window size WxH")->group("");
+    app.add_option("--timeout", windowOpts.timeoutSeconds, "Automation time limit in seconds")->group("");
 
     cli::RenderArgs renderArgs;
     CLI::App* render = app.add_subcommand("render", "Render SCENE offscreen to a PNG (no window needed)");
@@ -52,5 +65,10 @@ int main(int argc, char** argv) {
     if (*compare) return cli::runCompare(compareArgs);
     if (*demo) return cli::runDemoShots(demoOut, demoSize);
     if (*convert) return cli::runConvert(convertIn, convertOut, convertOverwrite);
-    return cli::runWindow(windowScene);
+    windowOpts.scene = windowScene;
+    if (!windowSize.empty() && std::sscanf(windowSize.c_str(), "%dx%d", &windowOpts.width, &windowOpts.height) != 2) {
+        std::fprintf(stderr, "viewer: error: --window-size '%s': expected WIDTHxHEIGHT\n", windowSize.c_str());
+        return 1;
+    }
+    return ui::runViewer(windowOpts);
 }

@@ -1,11 +1,586 @@
-// Placeholder until the window lands.
+// viewer.cpp - the viewer window: GLFW + glad + Dear ImGui (GL3 backend) around a ViewerState.
+//
+// Sections:
+//   1. GL helpers (textures, window read-back)
+//   2. Viewer: slots per backend, per-frame render requests, difference image, screenshots
+//   3. automation (hidden command-line scripting for tests and docs)
+//   4. GLFW callbacks (file drop, close with unsaved changes)
+//   5. main loop
+//
+// Threads: the UI thread owns GLFW, GL, ImGui and the ViewerState. CPU backends render on
+// their RenderSlot worker threads; the GL backend renders on the UI thread with the window's
+// context current (into its own FBO). Scene loading runs in std::async (ViewerState).
 #include "ui/viewer.h"
 
+#include "assets/demo.h"
+#include "assets/image_io.h"
+#include "ui/panels.h"
+#include "ui/render_slot.h"
+#include "ui/viewer_state.h"
+
+#include <glad/gl.h>
+#include <GLFW/glfw3.h>
+#include <backends/imgui_impl_glfw.h>
+#include <backends/imgui_impl_opengl3.h>
+#include <imgui.h>
+
+#include <chrono>
 #include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <future>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <thread>
+
+namespace fs = std::filesystem;
+
+static_assert(ui::keys::F == GLFW_KEY_F && ui::keys::Num1 == GLFW_KEY_1 && ui::keys::Home == GLFW_KEY_HOME &&
+                  ui::keys::F12 == GLFW_KEY_F12 && ui::keys::Delete == GLFW_KEY_DELETE && ui::keys::W == GLFW_KEY_W &&
+                  ui::keys::F2 == GLFW_KEY_F2 && ui::keys::Q == GLFW_KEY_Q,
+              "panel key codes must match GLFW's");
 
 namespace ui {
-int runViewer(const std::string&) {
-    std::fprintf(stderr, "viewer: error: the interactive window is not built yet; use 'viewer render' or 'viewer demo-shots'\n");
-    return 1;
+
+// --- 1. GL helpers -----------------------------------------------------------------------------
+
+namespace {
+
+// A GL texture showing one Framebuffer (already sRGB-encoded bytes: shown as is).
+struct Texture {
+    GLuint id = 0;
+    int width = 0, height = 0;
+    void upload(const rnd::Framebuffer& fb) {
+        if (fb.width < 1 || fb.height < 1) return;
+        if (!id) glGenTextures(1, &id);
+        glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);   // a backend may have left a PBO bound
+        glActiveTexture(GL_TEXTURE0);
+        glBindTexture(GL_TEXTURE_2D, id);
+        glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+        glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+        if (fb.width != width || fb.height != height) {
+            glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+            glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+            glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+            glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+            glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, fb.width, fb.height, 0, GL_RGBA, GL_UNSIGNED_BYTE, fb.color.data());
+            width = fb.width;
+            height = fb.height;
+        } else {
+            glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, fb.width, fb.height, GL_RGBA, GL_UNSIGNED_BYTE, fb.color.data());
+        }
+    }
+    void release() {
+        if (id) glDeleteTextures(1, &id);
+        id = 0;
+        width = height = 0;
+    }
+    void* imguiId() const { return id ? reinterpret_cast<void*>(uintptr_t(id)) : nullptr; }
+};
+
+// Reads the default framebuffer (the whole window) into a PNG.
+std::string saveWindowPng(GLFWwindow* win, const fs::path& path) {
+    int w = 0, h = 0;
+    glfwGetFramebufferSize(win, &w, &h);
+    if (w < 1 || h < 1) return "window has no size";
+    std::vector<uint8_t> px(size_t(w) * h * 4), flipped(px.size());
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+    glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+    glReadBuffer(GL_BACK);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, px.data());
+    for (int y = 0; y < h; ++y) std::memcpy(&flipped[size_t(y) * w * 4], &px[size_t(h - 1 - y) * w * 4], size_t(w) * 4);
+    for (size_t i = 3; i < flipped.size(); i += 4) flipped[i] = 255;
+    std::error_code ec;
+    if (path.has_parent_path()) fs::create_directories(path.parent_path(), ec);
+    return assets::writePng(path, w, h, flipped.data(), /*overwrite=*/true);
 }
+
+}  // namespace
+
+// --- 2. Viewer ---------------------------------------------------------------------------------
+
+namespace {
+
+struct BackendView {
+    std::unique_ptr<RenderSlot> slot;
+    Texture texture;
+};
+
+// A screenshot in progress (CPU backends render it on a thread; GL right away).
+struct PendingShot {
+    std::string backend;
+    fs::path path;
+    std::future<std::string> result;   // "" or error
+};
+
+class Viewer {
+public:
+    ViewerState st;
+    std::map<std::string, BackendView> views;
+    Texture diffTexture;
+    uint64_t diffKey = ~uint64_t(0);
+    std::vector<PendingShot> shots;
+    fs::path shotDir = ".";
+    std::vector<std::string> droppedFiles;
+    double now = 0;
+
+    BackendView& viewFor(const std::string& name) {
+        BackendView& v = views[name];
+        if (!v.slot) v.slot = std::make_unique<RenderSlot>(name);
+        return v;
+    }
+
+    // Requests renders for the visible backends and uploads finished images.
+    void updateRenders() {
+        int w = st.viewportWidth, h = st.viewportHeight;
+        float aspect = float(w) / float(std::max(h, 1));
+        bool interacting = (now - st.lastInteraction) < 0.25 || ImGui::GetIO().MouseDown[0] || ImGui::GetIO().MouseDown[1] ||
+                           ImGui::GetIO().MouseDown[2];
+        std::vector<std::string> names = visibleBackends(st);
+        std::shared_ptr<sg::FrameInput> base;
+        uint64_t key = (st.sceneVersion * 1000003u) ^ (st.viewVersion * 7919u) ^ (uint64_t(w) << 40) ^ (uint64_t(h) << 20);
+        for (const std::string& n : names) {
+            BackendView& v = viewFor(n);
+            sg::RenderSettings settings = st.settingsFor(n);
+            uint64_t k = key ^ std::hash<std::string>{}(settings.aaName());
+            bool preview = interacting && v.slot->backend() != "gl";
+            if (!v.slot->needs(k, preview)) continue;
+            if (!base) base = std::make_shared<sg::FrameInput>(st.buildFrame(aspect));   // flatten once per change
+            auto frame = std::make_shared<sg::FrameInput>(*base);
+            frame->settings = settings;
+            v.slot->request(std::move(frame), w, h, k, preview);
+        }
+        for (auto& [name, v] : views)
+            if (v.slot->poll()) v.texture.upload(v.slot->image());
+    }
+
+    void updateDiff() {
+        st.haveDiff = false;
+        if (st.compare.mode != ViewMode::Difference) return;
+        std::vector<std::string> names = visibleBackends(st);
+        const RenderSlot& a = *viewFor(names[0]).slot;
+        const RenderSlot& b = *viewFor(names[1]).slot;
+        const rnd::Framebuffer& fa = a.image();
+        const rnd::Framebuffer& fb = b.image();
+        if (fa.width == 0 || fa.width != fb.width || fa.height != fb.height || a.status().level != 1 || b.status().level != 1) {
+            diffKey = ~uint64_t(0);
+            diffTexture.release();
+            return;
+        }
+        // Recompute when either image or the threshold changed (images identified by data pointer + stats time).
+        uint64_t k = uint64_t(uintptr_t(fa.color.data())) ^ (uint64_t(uintptr_t(fb.color.data())) << 1) ^ (uint64_t(st.compare.threshold) << 56) ^
+                     std::hash<double>{}(a.status().stats.milliseconds) ^ (std::hash<double>{}(b.status().stats.milliseconds) << 3) ^
+                     std::hash<std::string>{}(names[0] + "|" + names[1]);
+        if (k != diffKey) {
+            diffKey = k;
+            diffTexture.upload(rnd::diffImage(fa, fb, st.compare.threshold));
+            rnd::ImageDiff d = rnd::compareImages(fa, fb, st.compare.threshold);
+            m_lastDiff = d;
+        }
+        st.haveDiff = true;
+        st.diffMean = m_lastDiff.meanAbs;
+        st.diffMax = m_lastDiff.maxAbs;
+        st.diffPsnr = m_lastDiff.psnr;
+        st.diffWithin = m_lastDiff.fractionWithin;
+    }
+
+    ViewportInput viewportInput() {
+        ViewportInput in;
+        for (const std::string& n : visibleBackends(st)) {
+            BackendView& v = viewFor(n);
+            SlotView s;
+            s.texture = v.texture.imguiId();
+            s.width = v.texture.width;
+            s.height = v.texture.height;
+            s.status = v.slot->status();
+            in.slots.push_back(s);
+        }
+        if (st.compare.mode == ViewMode::Difference && st.haveDiff) {
+            in.diff.texture = diffTexture.imguiId();
+            in.diff.width = diffTexture.width;
+            in.diff.height = diffTexture.height;
+        }
+        return in;
+    }
+
+    // Starts offscreen screenshots of every visible backend at w x h (0 = viewport size).
+    void startScreenshots(int w, int h, const fs::path& dir) {
+        if (w < 1 || h < 1) {
+            w = st.viewportWidth;
+            h = st.viewportHeight;
+        }
+        float aspect = float(w) / float(h);
+        auto base = std::make_shared<sg::FrameInput>(st.buildFrame(aspect));
+        std::error_code ec;
+        fs::create_directories(dir, ec);
+        std::vector<std::string> names = visibleBackends(st);
+        std::sort(names.begin(), names.end());
+        names.erase(std::unique(names.begin(), names.end()), names.end());
+        for (const std::string& n : names) {
+            auto frame = std::make_shared<sg::FrameInput>(*base);
+            frame->settings = st.settingsFor(n);
+            fs::path path = screenshotPath(dir, n);
+            auto job = [n, frame, w, h, path]() -> std::string {
+                std::string err;
+                std::unique_ptr<rnd::Renderer> r = rnd::makeRenderer(n, &err);
+                if (!r) return err;
+                rnd::Framebuffer fb;
+                rnd::RenderStats s = r->render(*frame, w, h, fb, nullptr);
+                if (!s.ok) return n + ": " + (s.error.empty() ? "render failed" : s.error);
+                return assets::writePng(path, fb.width, fb.height, fb.color.data(), /*overwrite=*/false);
+            };
+            PendingShot p{n, path, {}};
+            if (n == "gl") {   // needs the window's context: here, now
+                std::promise<std::string> pr;
+                pr.set_value(job());
+                p.result = pr.get_future();
+            } else {
+                p.result = std::async(std::launch::async, job);
+            }
+            shots.push_back(std::move(p));
+        }
+        st.status = "Screenshot: rendering " + std::to_string(names.size()) + " image(s) at " + std::to_string(w) + "x" + std::to_string(h) + "...";
+    }
+
+    void pollScreenshots(bool wait) {
+        for (size_t i = 0; i < shots.size();) {
+            if (!wait && shots[i].result.wait_for(std::chrono::seconds(0)) != std::future_status::ready) {
+                ++i;
+                continue;
+            }
+            std::string err = shots[i].result.get();
+            if (err.empty()) st.status = "Saved " + shots[i].path.string();
+            else {
+                st.status = "Screenshot failed: " + err;
+                std::fprintf(stderr, "viewer: screenshot: %s\n", err.c_str());
+            }
+            lastShotErrors.push_back(err);
+            shots.erase(shots.begin() + i);
+        }
+    }
+
+    bool allIdle() {
+        if (st.loadInProgress() || !shots.empty()) return false;
+        for (const std::string& n : visibleBackends(st)) {
+            BackendView& v = viewFor(n);
+            SlotStatus s = v.slot->status();
+            if (s.rendering) return false;
+            if (s.error.empty() && (v.slot->image().width == 0 || s.level != 1)) return false;
+        }
+        return true;
+    }
+
+    void releaseGL() {
+        for (auto& [n, v] : views) {
+            v.slot.reset();   // joins workers; the GL renderer frees its objects with the context current
+            v.texture.release();
+        }
+        diffTexture.release();
+    }
+
+    std::vector<std::string> lastShotErrors;
+
+private:
+    rnd::ImageDiff m_lastDiff;
+};
+
+}  // namespace
+
+// --- 3. automation -----------------------------------------------------------------------------
+//
+// Script commands (one per line, '#' comments):
+//   frames N              run N frames
+//   wait                  until the visible backends have full-resolution images (or errors)
+//   key K                 press a key for one frame: 1 2 3 F Home F12 or a GLFW key code
+//   backend NAME          single view with that backend
+//   view single|split|split3|difference
+//   orbit DX DY | zoom STEPS | fit
+//   select NODE-NAME
+//   tab Inspector|Camera|Rendering|Compare
+//   screenshot DIR        offscreen PNG per visible backend into DIR (as F12)
+//   window-shot PATH      PNG of the whole window (UI included)
+//   quit
+
+namespace {
+
+class Automation {
+public:
+    std::vector<std::string> lines;
+    size_t pc = 0;
+    int waitFrames = 0;
+    bool waiting = false;
+    int pressKey = -1, releaseKey = -1;
+    bool failed = false;
+    std::string windowShot;   // set for one frame: taken after rendering
+
+    bool active() const { return pc < lines.size() || waitFrames > 0 || waiting; }
+
+    // Runs commands until one needs frames to pass. Returns false to quit.
+    bool step(Viewer& v, GLFWwindow* win) {
+        (void)win;
+        if (releaseKey >= 0) {
+            ImGui::GetIO().KeysDown[releaseKey] = false;
+            releaseKey = -1;
+        }
+        if (waitFrames > 0) {
+            --waitFrames;
+            return true;
+        }
+        if (waiting) {
+            v.pollScreenshots(false);
+            if (!v.allIdle()) return true;
+            waiting = false;
+            waitFrames = 2;   // let the UI show the final images
+            return true;
+        }
+        while (pc < lines.size()) {
+            std::istringstream in(lines[pc++]);
+            std::string cmd;
+            in >> cmd;
+            if (cmd.empty() || cmd[0] == '#') continue;
+            if (cmd == "frames") { in >> waitFrames; return true; }
+            if (cmd == "wait") { waiting = true; return true; }
+            if (cmd == "quit") return false;
+            if (cmd == "key") {
+                std::string k;
+                in >> k;
+                int code = k == "Home" ? GLFW_KEY_HOME : k == "F12" ? GLFW_KEY_F12 : k == "F" ? GLFW_KEY_F
+                         : k.size() == 1 && k[0] >= '1' && k[0] <= '9' ? GLFW_KEY_1 + (k[0] - '1') : std::atoi(k.c_str());
+                if (code > 0 && code < 512) {
+                    ImGui::GetIO().KeysDown[code] = true;
+                    releaseKey = code;
+                }
+                waitFrames = 1;
+                return true;
+            }
+            if (cmd == "backend") { std::string b; in >> b; v.st.setBackend(b); v.st.compare.mode = ViewMode::Single; continue; }
+            if (cmd == "view") {
+                std::string m;
+                in >> m;
+                applyView(v.st, m);
+                continue;
+            }
+            if (cmd == "orbit") { float dx = 0, dy = 0; in >> dx >> dy; v.st.camera.orbit(dx, dy); v.st.markViewChanged(); continue; }
+            if (cmd == "zoom") { float s = 0; in >> s; v.st.camera.zoom(s); v.st.markViewChanged(); continue; }
+            if (cmd == "fit") { v.st.fitView(false); continue; }
+            if (cmd == "tab") { in >> v.st.requestedTab; continue; }
+            if (cmd == "select") {
+                std::string name;
+                std::getline(in >> std::ws, name);
+                v.st.selectNode(v.st.scene.findByName(name));
+                continue;
+            }
+            if (cmd == "screenshot") {
+                std::string dir;
+                in >> dir;
+                v.startScreenshots(0, 0, dir.empty() ? "." : dir);
+                waiting = true;
+                return true;
+            }
+            if (cmd == "window-shot") { in >> windowShot; return true; }
+            std::fprintf(stderr, "viewer: automation: unknown command '%s' (line %zu)\n", cmd.c_str(), pc);
+            failed = true;
+            return false;
+        }
+        return false;   // script finished
+    }
+
+    static void applyView(ViewerState& st, const std::string& m) {
+        if (m == "single") st.compare.mode = ViewMode::Single;
+        else if (m == "split") { st.compare.mode = ViewMode::Split; st.compare.count = 2; st.compare.backends = {"gl", "raster", "raycast"}; }
+        else if (m == "split3") { st.compare.mode = ViewMode::Split; st.compare.count = 3; st.compare.dividers = {0.33f, 0.66f}; }
+        else if (m == "difference") { st.compare.mode = ViewMode::Difference; st.compare.backends = {"raster", "raycast", "gl"}; }
+    }
+};
+
+// --- 4. GLFW callbacks -------------------------------------------------------------------------
+
+void onDrop(GLFWwindow* w, int count, const char** paths) {
+    auto* v = static_cast<Viewer*>(glfwGetWindowUserPointer(w));
+    for (int i = 0; i < count; ++i) v->droppedFiles.emplace_back(paths[i]);
+}
+
+void onClose(GLFWwindow* w) {
+    auto* v = static_cast<Viewer*>(glfwGetWindowUserPointer(w));
+    if (!v->st.requestQuit()) glfwSetWindowShouldClose(w, GLFW_FALSE);   // the modal asks first
+}
+
+void onGlfwError(int code, const char* msg) { std::fprintf(stderr, "viewer: GLFW error %d: %s\n", code, msg); }
+
+}  // namespace
+
+// --- 5. main loop ------------------------------------------------------------------------------
+
+int runViewer(const std::string& scenePath) {
+    ViewerOptions o;
+    o.scene = scenePath;
+    return runViewer(o);
+}
+
+int runViewer(const ViewerOptions& opt) {
+    Automation automation;
+    if (!opt.script.empty()) {
+        std::ifstream in(opt.script);
+        if (!in) {
+            std::fprintf(stderr, "viewer: error: cannot read automation script '%s'\n", opt.script.c_str());
+            return 1;
+        }
+        for (std::string line; std::getline(in, line);) automation.lines.push_back(line);
+    } else if (opt.frames > 0 || !opt.screenshot.empty()) {
+        automation.lines = {"frames " + std::to_string(std::max(opt.frames, 1)), "wait"};
+        if (!opt.screenshot.empty()) automation.lines.push_back("window-shot " + opt.screenshot);
+        automation.lines.push_back("frames 1");
+        automation.lines.push_back("quit");
+    }
+    bool automated = !automation.lines.empty();
+
+    glfwSetErrorCallback(onGlfwError);
+    if (!glfwInit()) {
+        std::fprintf(stderr, "viewer: error: cannot open a window (no X display? try xvfb-run, or use 'viewer render' headless)\n");
+        return 1;
+    }
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
+    glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+    glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+    glfwWindowHint(GLFW_SCALE_TO_MONITOR, GLFW_TRUE);
+    GLFWwindow* win = glfwCreateWindow(std::max(opt.width, 320), std::max(opt.height, 240), "Scene viewer", nullptr, nullptr);
+    if (!win) {
+        std::fprintf(stderr, "viewer: error: cannot create a GL 3.3 core window\n");
+        glfwTerminate();
+        return 1;
+    }
+    glfwMakeContextCurrent(win);
+    glfwSwapInterval(automated ? 0 : 1);
+    if (!gladLoadGL(reinterpret_cast<GLADloadfunc>(glfwGetProcAddress))) {
+        std::fprintf(stderr, "viewer: error: cannot load OpenGL functions\n");
+        glfwDestroyWindow(win);
+        glfwTerminate();
+        return 1;
+    }
+
+    auto viewer = std::make_unique<Viewer>();
+    Viewer& v = *viewer;
+    ViewerState& st = v.st;
+    glfwSetWindowUserPointer(win, &v);
+    glfwSetDropCallback(win, onDrop);
+    glfwSetWindowCloseCallback(win, onClose);
+
+    // Config: imgui.ini (layout) and recent files in the per-user config folder.
+    st.configDir = defaultConfigDir();
+    std::error_code ec;
+    fs::create_directories(st.configDir, ec);
+    st.recentFiles = loadRecentFiles(st.configDir);
+    static std::string iniPath;
+    iniPath = (st.configDir / "imgui.ini").string();
+
+    IMGUI_CHECKVERSION();
+    ImGui::CreateContext();
+    ImGuiIO& io = ImGui::GetIO();
+    io.IniFilename = ec ? nullptr : iniPath.c_str();
+    float xs = 1.0f, ys = 1.0f;
+    glfwGetWindowContentScale(win, &xs, &ys);
+    setupStyle(std::max(xs, ys), "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf");
+    ImGui_ImplGlfw_InitForOpenGL(win, true);
+    ImGui_ImplOpenGL3_Init("#version 330");
+
+    // Initial scene: the demo, or the file (loaded off the UI thread).
+    if (opt.scene.empty() || opt.scene == "demo") {
+        st.setScene(assets::makeDemoScene(), {});
+        st.status = "Demo scene. Drop a file on the window or use File > Open.";
+    } else {
+        st.scene = sg::Scene{};
+        st.startLoad(opt.scene);
+    }
+    if (!opt.backend.empty()) st.setBackend(opt.backend);
+    if (!opt.view.empty()) Automation::applyView(st, opt.view);
+
+    auto start = std::chrono::steady_clock::now();
+    double last = 0;
+    int exitCode = 0;
+    bool running = true;
+    std::string windowTitle;
+    while (running) {
+        bool busy = !v.shots.empty() || st.loadInProgress() || automated;
+        for (auto& [n, bv] : v.views) busy |= bv.slot->status().rendering;
+        if (busy || (v.now - st.lastInteraction) < 0.5) glfwPollEvents();
+        else glfwWaitEventsTimeout(0.1);
+
+        v.now = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        float dt = float(std::clamp(v.now - last, 1e-4, 0.25));
+        last = v.now;
+        if (automated && v.now > opt.timeoutSeconds) {
+            std::fprintf(stderr, "viewer: automation: timed out after %.0f s\n", opt.timeoutSeconds);
+            exitCode = 3;
+            break;
+        }
+
+        // Events that arrived through callbacks.
+        if (!v.droppedFiles.empty()) {
+            st.requestOpen(v.droppedFiles.front());
+            v.droppedFiles.clear();
+        }
+        st.pollLoad();
+        v.pollScreenshots(false);
+        if (automated && !automation.step(v, win)) {
+            running = false;
+            if (automation.failed) exitCode = 2;
+        }
+
+        ImGui_ImplOpenGL3_NewFrame();
+        ImGui_ImplGlfw_NewFrame();
+        ImGui::NewFrame();
+        drawUi(st, v.viewportInput(), v.now, dt);
+        ImGui::Render();
+
+        // Renders after the UI decided viewport size, camera and settings for this frame.
+        v.updateRenders();
+        v.updateDiff();
+        if (st.requests.screenshot) {
+            st.requests.screenshot = false;
+            v.startScreenshots(st.requests.screenshotWidth, st.requests.screenshotHeight, v.shotDir);
+            st.requests.screenshotWidth = st.requests.screenshotHeight = 0;
+        }
+
+        int fbw = 0, fbh = 0;
+        glfwGetFramebufferSize(win, &fbw, &fbh);
+        glBindFramebuffer(GL_FRAMEBUFFER, 0);
+        glViewport(0, 0, fbw, fbh);
+        glDisable(GL_FRAMEBUFFER_SRGB);   // the UI colours and the images are already sRGB
+        glDisable(GL_DEPTH_TEST);
+        glClearColor(0.08f, 0.09f, 0.10f, 1.0f);
+        glClear(GL_COLOR_BUFFER_BIT);
+        ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+        if (!automation.windowShot.empty()) {
+            std::string err = saveWindowPng(win, automation.windowShot);
+            if (!err.empty()) {
+                std::fprintf(stderr, "viewer: window-shot: %s\n", err.c_str());
+                exitCode = 2;
+            } else {
+                std::printf("viewer: wrote %s\n", automation.windowShot.c_str());
+            }
+            automation.windowShot.clear();
+        }
+        glfwSwapBuffers(win);
+        if (st.requests.quit) running = false;
+        // Window title: file name and the unsaved-changes marker.
+        std::string title = (st.scenePath.empty() ? st.scene.name : st.scenePath.filename().string()) + (st.dirty ? " *" : "") + " - Scene viewer";
+        if (title != windowTitle) {
+            windowTitle = title;
+            glfwSetWindowTitle(win, title.c_str());
+        }
+    }
+    v.pollScreenshots(true);
+
+    v.releaseGL();
+    ImGui_ImplOpenGL3_Shutdown();
+    ImGui_ImplGlfw_Shutdown();
+    ImGui::DestroyContext();
+    glfwDestroyWindow(win);
+    glfwTerminate();
+    return exitCode;
+}
+
 }  // namespace ui

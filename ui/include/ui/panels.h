@@ -1,0 +1,57 @@
+// panels.h - the viewer's Dear ImGui panels and layout. They read and edit a ViewerState and
+// call ImGui; they never touch GLFW or GL (textures arrive as opaque ids), so tests run them
+// in headless ImGui frames (CreateContext, DisplaySize, fonts built, NewFrame ... Render).
+//
+// Layout (drawUi): main menu bar; left "Scene" panel (tree); right panel with tabs Inspector /
+// Camera / Rendering / Compare; the viewport in between (images, split wipe, difference,
+// stats overlay, camera mouse/keyboard input); a status bar; modal dialogs.
+#pragma once
+
+#include "ui/render_slot.h"
+#include "ui/viewer_state.h"
+
+#include <string>
+#include <vector>
+
+namespace ui {
+
+// Key codes the panels read from io.KeysDown (ImGui 1.86 uses the platform's codes; these
+// equal GLFW's, which viewer.cpp static_asserts).
+namespace keys {
+constexpr int Num1 = 49, Num2 = 50, Num3 = 51;
+constexpr int A = 65, D = 68, E = 69, F = 70, N = 78, O = 79, Q = 81, S = 83, W = 87;
+constexpr int Delete = 261, Home = 268, F2 = 291, F12 = 301;
+}  // namespace keys
+
+// One backend's picture for the viewport.
+struct SlotView {
+    void* texture = nullptr;      // ImTextureID (GL texture name), null when no image yet
+    int width = 0, height = 0;    // of the texture
+    SlotStatus status;
+};
+struct ViewportInput {
+    std::vector<SlotView> slots;  // single view: slot 0; split: count slots; difference: A, B
+    SlotView diff;                // the difference heat-map (difference view)
+};
+
+// UI scale (HiDPI): call once after creating the context, before building fonts.
+void setupStyle(float contentScale, const char* fontPath = nullptr);
+
+// The whole window, one frame. `time` in seconds, `dt` the frame time.
+void drawUi(ViewerState& st, const ViewportInput& view, double time, float dt);
+
+// The parts (drawUi calls them; tests may call them inside their own Begin/End).
+void drawMainMenu(ViewerState& st);
+void drawSceneTree(ViewerState& st);
+void drawInspector(ViewerState& st);
+void drawCameraPanel(ViewerState& st);
+void drawRenderingPanel(ViewerState& st);
+void drawComparePanel(ViewerState& st);
+void drawViewport(ViewerState& st, const ViewportInput& view, double time, float dt);
+void drawDialogs(ViewerState& st);
+void handleShortcuts(ViewerState& st);
+
+// Backends shown by the current view mode (the slots the window must render).
+std::vector<std::string> visibleBackends(const ViewerState& st);
+
+}  // namespace ui

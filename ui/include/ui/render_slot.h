@@ -1,0 +1,90 @@
+// render_slot.h - one backend rendering for the viewport without blocking the UI thread.
+//
+// A RenderSlot owns a renderer made by name. request() hands it a frame; the slot renders it
+// coarse-to-fine (1/4 resolution first, then full resolution once the user stops interacting)
+// and keeps the last finished image for display. CPU backends run on a worker thread
+// (std::thread) with RenderControl cancel/progress: a new request cancels the render in
+// flight and restarts. Backends that need the window's GL context ("gl") render synchronously
+// in poll(), on the UI thread, where the context is current.
+// No GL or ImGui here; the window uploads image() to a texture.
+#pragma once
+
+#include "renderers/renderer.h"
+
+#include <condition_variable>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+
+namespace ui {
+
+struct SlotStatus {
+    std::string backend;
+    bool rendering = false;       // a render is in flight
+    float progress = 0.0f;        // of the render in flight, 0..1
+    int level = 1;                // resolution divisor of the image shown (1 = full)
+    rnd::RenderStats stats;       // of the image shown (or the last failure)
+    std::string error;            // last render's error ("" when it worked)
+};
+
+class RenderSlot {
+public:
+    // threaded=false renders synchronously in poll() (forced for "gl").
+    explicit RenderSlot(std::string backend, bool threaded = true);
+    ~RenderSlot();
+    RenderSlot(const RenderSlot&) = delete;
+    RenderSlot& operator=(const RenderSlot&) = delete;
+
+    const std::string& backend() const { return m_backend; }
+    // Renders `frame` at width x height. `key` identifies the content (scene+view+size): an
+    // unchanged key is ignored. interacting: render only the preview level (1/previewDivisor).
+    void request(std::shared_ptr<const sg::FrameInput> frame, int width, int height, uint64_t key, bool interacting);
+    // True when request() with this key would start work (so callers can skip building frames).
+    bool needs(uint64_t key, bool interacting) const;
+    // Runs synchronous work and collects finished images; returns true when image() changed.
+    bool poll();
+    // Last finished image (UI thread only; valid until the next poll()).
+    const rnd::Framebuffer& image() const { return m_shown; }
+    SlotStatus status() const;
+    // Blocks until nothing is pending (tests, screenshots at exit).
+    void waitIdle();
+
+    int previewDivisor = 4;
+
+private:
+    struct Job {
+        std::shared_ptr<const sg::FrameInput> frame;
+        int width = 0, height = 0;
+        uint64_t key = 0;
+        bool previewOnly = false;
+    };
+    void workerLoop();
+    // Renders one job level by level; publishes each finished level. Returns false when cancelled.
+    void runJob(const Job& job);
+    void publish(rnd::Framebuffer&& fb, const rnd::RenderStats& st, int level);
+
+    std::string m_backend;
+    bool m_threaded;
+    std::unique_ptr<rnd::Renderer> m_renderer;
+    std::string m_makeError;
+
+    uint64_t m_lastKey = ~uint64_t(0);
+    bool m_lastPreviewOnly = false;
+
+    mutable std::mutex m_mutex;
+    std::condition_variable m_cv;
+    std::optional<Job> m_pending;
+    bool m_busy = false;
+    bool m_quit = false;
+    rnd::RenderControl* m_control = nullptr;   // of the render in flight (guarded by m_mutex)
+    bool m_haveNew = false;
+    rnd::Framebuffer m_finished;               // published by the worker
+    SlotStatus m_status;
+    std::thread m_thread;
+
+    rnd::Framebuffer m_shown;                  // UI thread
+};
+
+}  // namespace ui

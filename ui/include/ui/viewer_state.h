@@ -1,0 +1,172 @@
+// viewer_state.h - everything the viewer knows, as plain data plus actions (no GL, no ImGui).
+//
+// Sections: CompareConfig (split / wipe / difference views), Requests (things the window
+// must do: screenshots, quit, file dialogs), ViewerState (scene, selection, camera,
+// settings, dirty flag, load/save, unsaved-changes guard), config helpers (per-user config
+// folder, recent files, screenshot names).
+// The ImGui panels (panels.h) edit a ViewerState; the GLFW window (viewer.cpp) owns one, runs
+// the renderers for it and shows their images. Tests drive the state directly, or through
+// the panels in headless ImGui frames.
+#pragma once
+
+#include "assets/scene_io.h"
+#include "scenegraph/frame.h"
+#include "scenegraph/scene.h"
+#include "ui/orbit_camera.h"
+
+#include <array>
+#include <filesystem>
+#include <future>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace ui {
+
+// How the viewport shows backends.
+enum class ViewMode { Single, Split, Difference };
+
+struct CompareConfig {
+    ViewMode mode = ViewMode::Single;
+    int count = 2;                                      // backends in the split view (2 or 3)
+    std::array<std::string, 3> backends{"gl", "raster", "raycast"};
+    std::array<float, 2> dividers{0.5f, 0.75f};         // wipe positions, fractions of the width
+    int diffA = 0, diffB = 1;                           // slots compared in the difference view
+    int threshold = 8;                                  // diffImage highlight threshold (0..255)
+};
+
+// Work for the window: set by panels and shortcuts, consumed by viewer.cpp.
+struct Requests {
+    bool screenshot = false;          // F12: screenshot(s) of the current view
+    int screenshotWidth = 0, screenshotHeight = 0;   // 0 = viewport size
+    bool quit = false;                // confirmed quit
+    bool openDialog = false;          // show the file browser (open)
+    bool saveAsDialog = false;        // show the file browser (save as)
+    bool screenshotDialog = false;
+};
+
+// What the unsaved-changes confirmation is about.
+enum class PendingAction { None, Open, New, Quit };
+enum class ConfirmChoice { Save, Discard, Cancel };
+
+// Item rectangles recorded by the panels (name -> min/max in screen pixels), so tests can
+// click real ImGui widgets by position.
+struct ItemRect { float x0 = 0, y0 = 0, x1 = 0, y1 = 0; float cx() const { return 0.5f * (x0 + x1); } float cy() const { return 0.5f * (y0 + y1); } };
+
+struct ViewerState {
+    // --- scene and file ----------------------------------------------------------------
+    sg::Scene scene;
+    std::filesystem::path scenePath;     // empty for the demo / a new scene
+    bool dirty = false;                  // unsaved edits
+    uint64_t sceneVersion = 1;           // bumped on every scene edit (re-render)
+    uint64_t viewVersion = 1;            // bumped on camera moves (re-render)
+    std::vector<std::string> loadWarnings;
+
+    // --- selection and view ------------------------------------------------------------
+    sg::NodeId selected = sg::kNoNode;
+    std::string backend = "gl";          // the single view's backend
+    CompareConfig compare;
+    OrbitCamera camera;
+    sg::Projection fallbackProjection;   // used when the scene has no camera
+    float fallbackFocus = 5.0f;
+    int viewportWidth = 1, viewportHeight = 1;   // pixels, set by the viewport panel
+    double lastInteraction = -1e9;       // time (s) of the last camera drag/zoom/fly
+    bool flyMode = false;
+
+    // --- messages ----------------------------------------------------------------------
+    std::string status;                  // one line shown in the status bar
+    std::string errorPopup;              // shown in a modal until dismissed (e.g. load failure)
+
+    // --- unsaved-changes guard -------------------------------------------------------------
+    PendingAction pending = PendingAction::None;
+    std::filesystem::path pendingPath;
+    bool confirmOpen = false;            // the modal should be shown
+
+    // --- async load --------------------------------------------------------------------
+    std::future<assets::LoadResult> loading;
+    std::filesystem::path loadingPath;
+
+    // Per-backend anti-aliasing overrides for this session (backend -> "msaa4", ...); the
+    // scene's own setting (saved) applies to backends without one.
+    std::map<std::string, std::string> aaOverride;
+
+    Requests requests;
+    std::string requestedTab;                    // select this right-panel tab next frame
+    std::vector<std::string> recentFiles;        // most recent first
+    std::filesystem::path configDir;             // where recent.txt lives ("" = don't persist)
+    std::map<std::string, ItemRect> itemRects;   // test hook, filled by panels
+
+    // Comparison figures of the difference view (filled by the window).
+    bool haveDiff = false;
+    double diffMean = 0, diffPsnr = 0;
+    int diffMax = 0;
+    double diffWithin = 1;
+
+    // --- actions -----------------------------------------------------------------------
+    // Replaces the scene (after a load): resets selection, dirty flag and camera.
+    void setScene(sg::Scene s, std::filesystem::path path);
+    void markEdited();       // scene or settings changed: dirty + re-render
+    void markViewChanged();  // camera moved: re-render only
+
+    void selectNode(sg::NodeId id);
+    bool renameNode(sg::NodeId id, const std::string& name);
+    void setVisible(sg::NodeId id, bool visible);
+    // New nodes go under `parent` (the selection's parent-or-self when kNoNode). Return the id.
+    sg::NodeId addGroup(sg::NodeId parent = sg::kNoNode);
+    sg::NodeId addShape(sg::ImplicitType type, sg::NodeId parent = sg::kNoNode);
+    sg::NodeId addCsg(sg::CsgOp op, sg::NodeId parent = sg::kNoNode);
+    sg::NodeId addLight(sg::LightType type, sg::NodeId parent = sg::kNoNode);
+    sg::NodeId addCamera();   // at the current view
+    bool removeNode(sg::NodeId id);
+    sg::NodeId duplicateNode(sg::NodeId id);
+    // Re-parents keeping the world transform; on refusal returns false and sets status/error.
+    bool reparent(sg::NodeId id, sg::NodeId newParent, std::string* error = nullptr);
+    void setLocal(sg::NodeId id, const sg::LocalTransform& t);
+
+    void setBackend(const std::string& name);
+    // 0-based backend index (keys 1/2/3); ignores indices beyond the built backends.
+    void setBackendIndex(int index);
+
+    // Camera.
+    const sg::Projection& projection() const;   // the active scene camera's, or the fallback
+    sg::Projection& editProjection();           // marks edited when it is the scene's
+    float focusDistance() const;
+    void fitView(bool selectionOnly);           // F
+    void resetView();                           // Home: back to the active scene camera
+    void useSceneCamera(sg::NodeId cameraNode); // make active and look through it
+    void storeViewInCamera();                   // writes the orbit view into the active camera
+    sg::mat4 cameraWorld() const { return camera.world(); }
+    // The effective projection of the view (ortho zoom applied).
+    sg::Projection viewProjection() const;
+    // Flattened frame for the current view: sg::flatten, then the orbit camera.
+    sg::FrameInput buildFrame(float aspect) const;
+    // The settings a backend renders with (the scene's, plus its AA override).
+    sg::RenderSettings settingsFor(const std::string& backend) const;
+
+    // Files. requestX checks the dirty flag: when there are unsaved edits it opens the
+    // confirmation instead and returns false; confirm() then continues or cancels.
+    bool requestOpen(const std::filesystem::path& path);
+    bool requestNew();
+    bool requestQuit();
+    void confirm(ConfirmChoice choice);
+    void startLoad(const std::filesystem::path& path);   // std::async
+    bool loadInProgress() const { return loading.valid(); }
+    // Finishes a completed load (non-blocking); returns true when a load finished.
+    bool pollLoad(bool wait = false);
+    // Saves to scenePath (or `path`), writing the view into the active camera first.
+    // Returns "" or an error (also put in errorPopup).
+    std::string save(const std::filesystem::path& path = {});
+
+    void addRecent(const std::string& path);
+};
+
+// Per-user config folder: $XDG_CONFIG_HOME/sceneviewer, else $HOME/.config/sceneviewer.
+std::filesystem::path defaultConfigDir();
+std::vector<std::string> loadRecentFiles(const std::filesystem::path& configDir);
+std::string saveRecentFiles(const std::filesystem::path& configDir, const std::vector<std::string>& files);
+// dir/"<stem>-<backend>.png" or, when taken, the first free "-N" variant (assets::uniquePath).
+std::filesystem::path screenshotPath(const std::filesystem::path& dir, const std::string& backend,
+                                     const std::string& stem = "screenshot");
+
+}  // namespace ui

@@ -1,0 +1,1397 @@
+// panels.cpp - Dear ImGui panels of the viewer (see panels.h).
+//
+// Sections:
+//   1. helpers (item-rect recording, small widgets)
+//   2. style
+//   3. main menu
+//   4. scene tree (select, visibility, context menu, drag-and-drop re-parenting)
+//   5. inspector (transform TRS / matrix, world matrix, payloads, material)
+//   6. camera panel (projection, scene cameras, live matrices)
+//   7. rendering panel (RenderSettings)
+//   8. compare panel (split / wipe / difference)
+//   9. viewport (images, dividers, overlay, camera input)
+//  10. dialogs (unsaved changes, errors, file browser, screenshot)
+//  11. shortcuts and layout
+#include "ui/panels.h"
+
+#include "assets/scene_io.h"
+#include "renderers/renderer.h"
+
+#include <imgui.h>
+#include <imgui_stdlib.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+namespace fs = std::filesystem;
+
+namespace ui {
+
+// --- 1. helpers --------------------------------------------------------------------------------
+
+namespace {
+
+float g_scale = 1.0f;   // content scale (HiDPI)
+float px(float v) { return v * g_scale; }
+
+// Records the last item's rectangle under `key` (test hook: click widgets by position).
+void record(ViewerState& st, const std::string& key) {
+    ImVec2 a = ImGui::GetItemRectMin(), b = ImGui::GetItemRectMax();
+    st.itemRects[key] = ItemRect{a.x, a.y, b.x, b.y};
+}
+
+template <class E>
+bool enumCombo(ViewerState& st, const char* label, E& value, std::initializer_list<std::pair<E, const char*>> items) {
+    const char* preview = "?";
+    for (auto& [v, n] : items)
+        if (v == value) preview = n;
+    bool changed = false;
+    if (ImGui::BeginCombo(label, preview)) {
+        for (auto& [v, n] : items) {
+            if (ImGui::Selectable(n, v == value)) {
+                changed = v != value;
+                value = v;
+            }
+            record(st, std::string(label) + "/" + n);
+        }
+        ImGui::EndCombo();
+    }
+    record(st, label);
+    return changed;
+}
+
+// A read-only 4x4 matrix as four rows.
+void matrixTable(const char* id, const sg::mat4& m) {
+    if (ImGui::BeginTable(id, 4, ImGuiTableFlags_BordersInnerV | ImGuiTableFlags_SizingStretchSame)) {
+        for (int r = 0; r < 4; ++r) {
+            ImGui::TableNextRow();
+            for (int c = 0; c < 4; ++c) {
+                ImGui::TableSetColumnIndex(c);
+                ImGui::Text("%8.3f", m[c][r]);
+            }
+        }
+        ImGui::EndTable();
+    }
+}
+
+// A titled separator (ImGui 1.86 has no SeparatorText).
+void section(const char* title) {
+    ImGui::Spacing();
+    ImGui::TextColored(ImVec4(0.55f, 0.75f, 1.0f, 1.0f), "%s", title);
+    ImGui::Separator();
+}
+
+void helpMarker(const char* text) {
+    ImGui::SameLine();
+    ImGui::TextDisabled("(?)");
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", text);
+}
+
+const char* payloadIcon(const sg::Payload& p) {
+    switch (p.index()) {
+    case 0: return "[G]";
+    case 1: return "[M]";
+    case 2: return "[C]";
+    case 3: return "[L]";
+    case 4: return "[S]";
+    case 5: return "[B]";
+    case 6: return "[P]";
+    case 7: return "[V]";
+    default: return "[?]";
+    }
+}
+
+const std::pair<sg::ImplicitType, const char*> kShapes[] = {
+    {sg::ImplicitType::Sphere, "Sphere"}, {sg::ImplicitType::Box, "Box"},       {sg::ImplicitType::Cylinder, "Cylinder"},
+    {sg::ImplicitType::Cone, "Cone"},     {sg::ImplicitType::Torus, "Torus"},   {sg::ImplicitType::Plane, "Plane"},
+    {sg::ImplicitType::Quadric, "Quadric (hyperboloid)"}};
+
+// The "Add" menu items (shared by the toolbar popup and the context menu).
+void addMenuItems(ViewerState& st, sg::NodeId parent) {
+    if (ImGui::MenuItem("Group")) st.addGroup(parent);
+    ImGui::Separator();
+    for (auto& [t, name] : kShapes) {
+        if (ImGui::MenuItem(name)) st.addShape(t, parent);
+        record(st, std::string("add/") + name);
+    }
+    ImGui::Separator();
+    if (ImGui::MenuItem("CSG union")) st.addCsg(sg::CsgOp::Union, parent);
+    if (ImGui::MenuItem("CSG intersection")) st.addCsg(sg::CsgOp::Intersection, parent);
+    if (ImGui::MenuItem("CSG difference")) st.addCsg(sg::CsgOp::Difference, parent);
+    ImGui::Separator();
+    if (ImGui::MenuItem("Point light")) st.addLight(sg::LightType::Point, parent);
+    if (ImGui::MenuItem("Directional light")) st.addLight(sg::LightType::Directional, parent);
+    if (ImGui::MenuItem("Spot light")) st.addLight(sg::LightType::Spot, parent);
+    if (ImGui::MenuItem("Camera (at current view)")) st.addCamera();
+}
+
+// File browser state (UI-only).
+struct FileBrowser {
+    bool open = false;
+    bool saving = false;
+    bool justOpened = false;
+    fs::path dir;
+    std::string fileName;
+    std::string error;
+};
+FileBrowser g_browser;
+
+struct ScreenshotDialog {
+    bool open = false;
+    bool windowSize = true;
+    int width = 1920, height = 1080;
+};
+ScreenshotDialog g_shotDialog;
+
+bool g_showOverlay = true;
+bool g_showHelp = false;
+std::string g_renameBuffer;
+sg::NodeId g_renaming = sg::kNoNode;
+
+}  // namespace
+
+std::vector<std::string> visibleBackends(const ViewerState& st) {
+    switch (st.compare.mode) {
+    case ViewMode::Single: return {st.backend};
+    case ViewMode::Split: {
+        std::vector<std::string> v(st.compare.backends.begin(), st.compare.backends.begin() + std::clamp(st.compare.count, 2, 3));
+        return v;
+    }
+    case ViewMode::Difference:
+        return {st.compare.backends[std::clamp(st.compare.diffA, 0, 2)], st.compare.backends[std::clamp(st.compare.diffB, 0, 2)]};
+    }
+    return {st.backend};
+}
+
+// --- 2. style ----------------------------------------------------------------------------------
+
+void setupStyle(float scale, const char* fontPath) {
+    g_scale = std::clamp(scale, 0.5f, 4.0f);
+    ImGuiIO& io = ImGui::GetIO();
+    ImGui::StyleColorsDark();
+    ImGuiStyle& s = ImGui::GetStyle();
+    s.WindowRounding = 0.0f;
+    s.FrameRounding = 3.0f;
+    s.GrabRounding = 3.0f;
+    s.TabRounding = 3.0f;
+    s.ScrollbarRounding = 3.0f;
+    s.WindowBorderSize = 1.0f;
+    s.FramePadding = ImVec2(6, 4);
+    s.ItemSpacing = ImVec2(8, 5);
+    s.IndentSpacing = 14.0f;
+    ImVec4* c = s.Colors;
+    c[ImGuiCol_WindowBg] = ImVec4(0.13f, 0.14f, 0.16f, 1.0f);
+    c[ImGuiCol_ChildBg] = ImVec4(0.11f, 0.12f, 0.14f, 1.0f);
+    c[ImGuiCol_MenuBarBg] = ImVec4(0.10f, 0.11f, 0.13f, 1.0f);
+    c[ImGuiCol_Header] = ImVec4(0.22f, 0.36f, 0.56f, 0.70f);
+    c[ImGuiCol_HeaderHovered] = ImVec4(0.26f, 0.42f, 0.66f, 0.80f);
+    c[ImGuiCol_HeaderActive] = ImVec4(0.28f, 0.46f, 0.72f, 1.00f);
+    c[ImGuiCol_FrameBg] = ImVec4(0.19f, 0.20f, 0.23f, 1.0f);
+    c[ImGuiCol_TitleBgActive] = ImVec4(0.16f, 0.29f, 0.48f, 1.0f);
+    s.ScaleAllSizes(g_scale);
+    if (fontPath && fs::exists(fontPath)) {
+        ImFontConfig cfg;
+        cfg.OversampleH = 2;
+        io.Fonts->AddFontFromFileTTF(fontPath, std::round(15.0f * g_scale), &cfg);
+    } else {
+        ImFontConfig cfg;
+        cfg.SizePixels = std::round(13.0f * g_scale);
+        io.Fonts->AddFontDefault(&cfg);
+    }
+}
+
+// --- 3. main menu ------------------------------------------------------------------------------
+
+void drawMainMenu(ViewerState& st) {
+    if (!ImGui::BeginMainMenuBar()) return;
+    if (ImGui::BeginMenu("File")) {
+        if (ImGui::MenuItem("New", "Ctrl+N")) st.requestNew();
+        if (ImGui::MenuItem("Open...", "Ctrl+O")) st.requests.openDialog = true;
+        if (ImGui::BeginMenu("Open Recent", !st.recentFiles.empty())) {
+            for (const std::string& f : st.recentFiles)
+                if (ImGui::MenuItem(f.c_str())) st.requestOpen(f);
+            ImGui::EndMenu();
+        }
+        ImGui::Separator();
+        if (ImGui::MenuItem("Save", "Ctrl+S")) st.save();
+        if (ImGui::MenuItem("Save As...", "Ctrl+Shift+S")) st.requests.saveAsDialog = true;
+        ImGui::Separator();
+        if (ImGui::MenuItem("Screenshot", "F12")) st.requests.screenshot = true;
+        if (ImGui::MenuItem("Screenshot at resolution...")) st.requests.screenshotDialog = true;
+        ImGui::Separator();
+        if (ImGui::MenuItem("Quit", "Ctrl+Q")) st.requestQuit();
+        ImGui::EndMenu();
+    }
+    if (ImGui::BeginMenu("View")) {
+        if (ImGui::MenuItem("Fit to scene / selection", "F")) st.fitView(st.scene.valid(st.selected));
+        if (ImGui::MenuItem("Reset to scene camera", "Home")) st.resetView();
+        ImGui::Separator();
+        if (ImGui::MenuItem("Single backend", nullptr, st.compare.mode == ViewMode::Single)) st.compare.mode = ViewMode::Single;
+        if (ImGui::MenuItem("Split view (wipe)", nullptr, st.compare.mode == ViewMode::Split)) st.compare.mode = ViewMode::Split;
+        if (ImGui::MenuItem("Difference view", nullptr, st.compare.mode == ViewMode::Difference)) st.compare.mode = ViewMode::Difference;
+        ImGui::Separator();
+        ImGui::MenuItem("Stats overlay", nullptr, &g_showOverlay);
+        if (ImGui::BeginMenu("Scene cameras", !st.scene.cameras().empty())) {
+            for (sg::NodeId c : st.scene.cameras())
+                if (ImGui::MenuItem(st.scene.node(c).name.c_str(), nullptr, c == st.scene.activeCamera)) st.useSceneCamera(c);
+            ImGui::EndMenu();
+        }
+        ImGui::EndMenu();
+    }
+    if (ImGui::BeginMenu("Backend")) {
+        std::vector<std::string> names = rnd::rendererNames();
+        for (size_t i = 0; i < names.size(); ++i) {
+            std::string key = std::to_string(i + 1);
+            if (ImGui::MenuItem(names[i].c_str(), key.c_str(), st.backend == names[i])) {
+                st.setBackend(names[i]);
+                st.compare.mode = ViewMode::Single;
+            }
+        }
+        ImGui::EndMenu();
+    }
+    if (ImGui::BeginMenu("Help")) {
+        ImGui::MenuItem("Controls", nullptr, &g_showHelp);
+        ImGui::EndMenu();
+    }
+    // Right side: file name and dirty marker.
+    std::string title = (st.scenePath.empty() ? st.scene.name : st.scenePath.filename().string()) + (st.dirty ? " *" : "");
+    float w = ImGui::CalcTextSize(title.c_str()).x;
+    ImGui::SameLine(ImGui::GetWindowWidth() - w - px(12));
+    ImGui::TextDisabled("%s", title.c_str());
+    ImGui::EndMainMenuBar();
+}
+
+// --- 4. scene tree -----------------------------------------------------------------------------
+
+namespace {
+
+void nodeContextMenu(ViewerState& st, sg::NodeId id) {
+    if (!ImGui::BeginPopupContextItem()) return;
+    st.selectNode(id);
+    const sg::Node& n = st.scene.node(id);
+    if (ImGui::BeginMenu("Add child")) {
+        addMenuItems(st, id);
+        ImGui::EndMenu();
+    }
+    if (id != st.scene.root()) {
+        if (ImGui::MenuItem("Rename", "F2")) {
+            g_renaming = id;
+            g_renameBuffer = n.name;
+        }
+        if (ImGui::MenuItem("Duplicate", "Ctrl+D")) st.duplicateNode(id);
+        if (ImGui::MenuItem("Delete", "Del")) st.removeNode(id);
+        if (ImGui::MenuItem(n.visible ? "Hide" : "Show")) st.setVisible(id, !n.visible);
+    }
+    if (ImGui::MenuItem("Frame in view", "F")) st.fitView(true);
+    if (std::holds_alternative<sg::Camera>(n.payload) && ImGui::MenuItem("Look through")) st.useSceneCamera(id);
+    ImGui::EndPopup();
+}
+
+// Iterative-safe enough: depth is capped, deeper levels are listed flat under a marker.
+void drawNode(ViewerState& st, sg::NodeId id, int depth) {
+    const sg::Node& n = st.scene.node(id);
+    ImGui::PushID(int(id));
+    // Visibility toggle.
+    bool vis = n.visible;
+    ImGui::PushStyleVar(ImGuiStyleVar_FramePadding, ImVec2(1, 1));
+    if (id != st.scene.root()) {
+        if (ImGui::Checkbox("##vis", &vis)) st.setVisible(id, vis);
+        record(st, "tree/vis/" + n.name);
+        if (ImGui::IsItemHovered()) ImGui::SetTooltip("Show / hide");
+        ImGui::SameLine();
+    }
+    ImGui::PopStyleVar();
+
+    ImGuiTreeNodeFlags flags = ImGuiTreeNodeFlags_OpenOnArrow | ImGuiTreeNodeFlags_OpenOnDoubleClick | ImGuiTreeNodeFlags_SpanAvailWidth;
+    if (n.children.empty()) flags |= ImGuiTreeNodeFlags_Leaf;
+    if (depth < 2) flags |= ImGuiTreeNodeFlags_DefaultOpen;
+    if (id == st.selected) flags |= ImGuiTreeNodeFlags_Selected;
+    bool dim = !st.scene.effectiveVisible(id);
+    if (dim) ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyle().Colors[ImGuiCol_TextDisabled]);
+    std::string label = std::string(payloadIcon(n.payload)) + " " + n.name + (id == st.scene.activeCamera ? "  (active)" : "");
+    bool open;
+    if (g_renaming == id) {
+        open = ImGui::TreeNodeEx("##renaming", flags | ImGuiTreeNodeFlags_AllowItemOverlap, "%s", payloadIcon(n.payload));
+        ImGui::SameLine();
+        ImGui::SetKeyboardFocusHere();
+        ImGui::SetNextItemWidth(-1);
+        if (ImGui::InputText("##rename", &g_renameBuffer, ImGuiInputTextFlags_EnterReturnsTrue | ImGuiInputTextFlags_AutoSelectAll)) {
+            st.renameNode(id, g_renameBuffer);
+            g_renaming = sg::kNoNode;
+        } else if (ImGui::IsItemDeactivated() || ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Escape))) {
+            g_renaming = sg::kNoNode;
+        }
+    } else {
+        open = ImGui::TreeNodeEx("##node", flags, "%s", label.c_str());
+        record(st, "tree/" + n.name);
+        if (ImGui::IsItemClicked() && !ImGui::IsItemToggledOpen()) st.selectNode(id);
+        if (ImGui::IsItemHovered() && ImGui::IsMouseDoubleClicked(0) && n.children.empty() && id != st.scene.root()) {
+            g_renaming = id;
+            g_renameBuffer = n.name;
+        }
+    }
+    if (dim) ImGui::PopStyleColor();
+
+    // Drag source / drop target: re-parent keeping the world transform.
+    if (id != st.scene.root() && ImGui::BeginDragDropSource()) {
+        sg::NodeId payload = id;
+        ImGui::SetDragDropPayload("SG_NODE", &payload, sizeof(payload));
+        ImGui::Text("Move %s", n.name.c_str());
+        ImGui::EndDragDropSource();
+    }
+    if (ImGui::BeginDragDropTarget()) {
+        if (const ImGuiPayload* p = ImGui::AcceptDragDropPayload("SG_NODE")) {
+            sg::NodeId moved = *static_cast<const sg::NodeId*>(p->Data);
+            std::string err;
+            if (!st.reparent(moved, id, &err) && !err.empty()) st.errorPopup = "Cannot move '" + st.scene.node(moved).name + "' under '" + n.name + "':\n" + err;
+        }
+        ImGui::EndDragDropTarget();
+    }
+    nodeContextMenu(st, id);
+
+    if (open) {
+        // Copy: edits in the loop (context menu) may change the children vector.
+        std::vector<sg::NodeId> kids = st.scene.valid(id) ? st.scene.node(id).children : std::vector<sg::NodeId>{};
+        for (sg::NodeId c : kids) {
+            if (!st.scene.valid(c)) continue;
+            if (depth > 200) {
+                ImGui::TextDisabled("... (deeper levels not shown)");
+                break;
+            }
+            drawNode(st, c, depth + 1);
+        }
+        ImGui::TreePop();
+    }
+    ImGui::PopID();
+}
+
+}  // namespace
+
+void drawSceneTree(ViewerState& st) {
+    // Toolbar.
+    if (ImGui::Button("Add")) ImGui::OpenPopup("add_popup");
+    record(st, "tree/addButton");
+    if (ImGui::BeginPopup("add_popup")) {
+        addMenuItems(st, sg::kNoNode);
+        ImGui::EndPopup();
+    }
+    ImGui::SameLine();
+    bool canEdit = st.scene.valid(st.selected) && st.selected != st.scene.root();
+    ImGui::BeginDisabled(!canEdit);
+    if (ImGui::Button("Duplicate")) st.duplicateNode(st.selected);
+    ImGui::SameLine();
+    if (ImGui::Button("Delete")) st.removeNode(st.selected);
+    ImGui::EndDisabled();
+    ImGui::Separator();
+
+    ImGui::BeginChild("tree", ImVec2(0, 0), false);
+    drawNode(st, st.scene.root(), 0);
+    // Empty space below the tree: drop here to move under the root; click to deselect.
+    ImVec2 avail = ImGui::GetContentRegionAvail();
+    ImGui::InvisibleButton("##treeEmpty", ImVec2(std::max(avail.x, 1.0f), std::max(avail.y, px(20))));
+    if (ImGui::IsItemClicked()) st.selectNode(sg::kNoNode);
+    if (ImGui::BeginDragDropTarget()) {
+        if (const ImGuiPayload* p = ImGui::AcceptDragDropPayload("SG_NODE")) st.reparent(*static_cast<const sg::NodeId*>(p->Data), st.scene.root());
+        ImGui::EndDragDropTarget();
+    }
+    ImGui::EndChild();
+}
+
+// --- 5. inspector ------------------------------------------------------------------------------
+
+namespace {
+
+// Material editor for a payload's material index. Returns true when the index changed.
+bool materialEditor(ViewerState& st, int& index) {
+    bool indexChanged = false;
+    std::string preview = index < 0 || size_t(index) >= st.scene.materials.size()
+                              ? std::string("(default)")
+                              : std::to_string(index) + ": " + st.scene.materials[index].name;
+    if (ImGui::BeginCombo("Material", preview.c_str())) {
+        if (ImGui::Selectable("(default)", index < 0)) { index = -1; indexChanged = true; }
+        for (size_t i = 0; i < st.scene.materials.size(); ++i) {
+            std::string n = std::to_string(i) + ": " + st.scene.materials[i].name;
+            if (ImGui::Selectable(n.c_str(), int(i) == index)) { index = int(i); indexChanged = true; }
+        }
+        ImGui::EndCombo();
+    }
+    ImGui::SameLine();
+    if (ImGui::SmallButton("New")) {
+        sg::Material m = st.scene.material(index);
+        m.name = "material " + std::to_string(st.scene.materials.size());
+        st.scene.materials.push_back(m);
+        index = int(st.scene.materials.size()) - 1;
+        indexChanged = true;
+    }
+    if (index < 0 || size_t(index) >= st.scene.materials.size()) {
+        ImGui::TextDisabled("Default material (press New to edit a copy)");
+        return indexChanged;
+    }
+    sg::Material m = st.scene.materials[index];
+    bool ch = false;
+    ch |= ImGui::InputText("Name##mat", &m.name, ImGuiInputTextFlags_EnterReturnsTrue);
+    ch |= ImGui::ColorEdit3("Base colour", &m.baseColor.x, ImGuiColorEditFlags_Float);
+    ch |= ImGui::SliderFloat("ka (ambient)", &m.ka, 0.0f, 1.0f);
+    ch |= ImGui::SliderFloat("kd (diffuse)", &m.kd, 0.0f, 1.0f);
+    ch |= ImGui::SliderFloat("ks (specular)", &m.ks, 0.0f, 1.0f);
+    ch |= ImGui::SliderFloat("Shininess n", &m.shininess, 1.0f, 512.0f, "%.1f", ImGuiSliderFlags_Logarithmic);
+    ch |= ImGui::Checkbox("Specular tinted by base colour", &m.specularTinted);
+    ImGui::BeginDisabled(m.specularTinted);
+    ch |= ImGui::ColorEdit3("Specular colour", &m.specularColor.x, ImGuiColorEditFlags_Float);
+    ImGui::EndDisabled();
+    int tex = m.diffuseTexture;
+    if (ImGui::InputInt("Texture index", &tex)) {
+        m.diffuseTexture = std::clamp(tex, -1, int(st.scene.textures.size()) - 1);
+        ch = true;
+    }
+    helpMarker("-1 = none; index into the scene's textures");
+    ch |= ImGui::ColorEdit3("Emissive", &m.emissive.x, ImGuiColorEditFlags_Float);
+    ch |= ImGui::SliderFloat("Reflectivity", &m.reflectivity, 0.0f, 1.0f);
+    ch |= ImGui::Checkbox("Unlit", &m.unlit);
+    if (ch && !(m == st.scene.materials[index])) {
+        st.scene.materials[index] = m;
+        st.markEdited();
+    }
+    return indexChanged;
+}
+
+bool implicitEditor(ViewerState& st, sg::ImplicitShape& s) {
+    bool ch = enumCombo(st, "Shape", s.type,
+                        {{sg::ImplicitType::Sphere, "sphere"}, {sg::ImplicitType::Box, "box"}, {sg::ImplicitType::Cylinder, "cylinder"},
+                         {sg::ImplicitType::Cone, "cone"}, {sg::ImplicitType::Torus, "torus"}, {sg::ImplicitType::Plane, "plane"},
+                         {sg::ImplicitType::Quadric, "quadric"}});
+    switch (s.type) {
+    case sg::ImplicitType::Sphere: ch |= ImGui::DragFloat("Radius", &s.radius, 0.01f, 0.001f, 1e4f); break;
+    case sg::ImplicitType::Box: ch |= ImGui::DragFloat3("Half extents", &s.halfExtents.x, 0.01f, 0.001f, 1e4f); break;
+    case sg::ImplicitType::Cylinder:
+    case sg::ImplicitType::Cone:
+        ch |= ImGui::DragFloat("Radius", &s.radius, 0.01f, 0.001f, 1e4f);
+        ch |= ImGui::DragFloat("Half height", &s.halfHeight, 0.01f, 0.001f, 1e4f);
+        break;
+    case sg::ImplicitType::Torus:
+        ch |= ImGui::DragFloat("Major radius", &s.majorRadius, 0.01f, 0.001f, 1e4f);
+        ch |= ImGui::DragFloat("Minor radius", &s.minorRadius, 0.01f, 0.001f, 1e4f);
+        break;
+    case sg::ImplicitType::Plane: ch |= ImGui::DragFloat("Drawn half size", &s.planeHalfSize, 0.1f, 0.01f, 1e5f); break;
+    case sg::ImplicitType::Quadric:
+        ImGui::TextUnformatted("Q (x^T Q x = 0), rows:");
+        for (int r = 0; r < 4; ++r) {
+            float row[4] = {s.quadric[0][r], s.quadric[1][r], s.quadric[2][r], s.quadric[3][r]};
+            ImGui::PushID(r);
+            if (ImGui::DragFloat4("##q", row, 0.01f)) {
+                for (int c = 0; c < 4; ++c) s.quadric[c][r] = s.quadric[r][c] = row[c];   // keep Q symmetric
+                ch = true;
+            }
+            ImGui::PopID();
+        }
+        ch |= ImGui::DragFloat3("Clip min", &s.quadricBounds.min.x, 0.01f);
+        ch |= ImGui::DragFloat3("Clip max", &s.quadricBounds.max.x, 0.01f);
+        break;
+    }
+    return ch;
+}
+
+void transformEditor(ViewerState& st, sg::NodeId id) {
+    const sg::Node& n = st.scene.node(id);
+    sg::LocalTransform t = n.local;
+    bool trs = t.mode == sg::LocalTransform::Mode::TRS;
+    ImGui::Text("Mode: %s", trs ? "TRS (translate, rotate, scale)" : "Matrix (general affine)");
+    if (trs) {
+        sg::vec3 e = t.eulerDegrees();
+        bool ch = false;
+        ch |= ImGui::DragFloat3("Translation", &t.translation.x, 0.01f);
+        record(st, "inspector/translation");
+        if (ImGui::DragFloat3("Rotation (deg)", &e.x, 0.5f)) {
+            t.setEulerDegrees(e);
+            ch = true;
+        }
+        helpMarker("Euler angles applied X, then Y, then Z (R = Rz Ry Rx)");
+        ch |= ImGui::DragFloat3("Scale", &t.scale.x, 0.01f);
+        if (ch) st.setLocal(id, t);
+    } else {
+        if (ImGui::Button("Convert back to TRS")) {
+            sg::LocalTransform c = t;
+            if (c.tryMakeTRS()) st.setLocal(id, c);
+            else st.errorPopup = "This matrix has shear (or is not affine): it cannot be written as translate * rotate * scale.";
+        }
+        record(st, "inspector/toTRS");
+    }
+    ImGui::TextUnformatted("Local matrix (rows; editing switches to Matrix mode):");
+    sg::mat4 m = t.toMatrix();
+    bool mch = false;
+    for (int r = 0; r < 3; ++r) {
+        float row[4] = {m[0][r], m[1][r], m[2][r], m[3][r]};
+        ImGui::PushID(r);
+        ImGui::SetNextItemWidth(-1);
+        if (ImGui::DragFloat4("##row", row, 0.01f, 0, 0, "%.3f")) {
+            for (int c = 0; c < 4; ++c) m[c][r] = row[c];
+            mch = true;
+        }
+        record(st, "inspector/matrixRow" + std::to_string(r));
+        ImGui::PopID();
+    }
+    ImGui::TextDisabled("   0.000      0.000      0.000      1.000");
+    if (ImGui::SmallButton("Mirror X")) { m = m * glm::scale(sg::mat4(1.0f), sg::vec3(-1, 1, 1)); mch = true; }
+    record(st, "inspector/mirrorX");
+    ImGui::SameLine();
+    if (ImGui::SmallButton("Shear XY")) { sg::mat4 s(1.0f); s[1][0] = 0.25f; m = m * s; mch = true; }
+    record(st, "inspector/shear");
+    ImGui::SameLine();
+    if (ImGui::SmallButton("Identity")) { st.setLocal(id, sg::LocalTransform{}); }
+    if (mch) {
+        if (sg::isFinite(m) && sg::isInvertible(m)) st.setLocal(id, sg::LocalTransform::fromMatrix(m));
+        else st.status = "Matrix edit refused: singular or not finite";
+    }
+    if (ImGui::TreeNode("World matrix (read-only)")) {
+        matrixTable("world", st.scene.world(id));
+        ImGui::TreePop();
+    }
+}
+
+}  // namespace
+
+void drawInspector(ViewerState& st) {
+    sg::NodeId id = st.selected;
+    if (!st.scene.valid(id)) {
+        ImGui::TextDisabled("Select a node in the scene tree.");
+        ImGui::Spacing();
+        ImGui::Text("Scene: %s", st.scene.name.c_str());
+        ImGui::Text("Nodes: %zu   meshes: %zu   materials: %zu   textures: %zu", st.scene.nodeCount(), st.scene.meshes.size(),
+                    st.scene.materials.size(), st.scene.textures.size());
+        if (ImGui::ColorEdit3("Ambient light", &st.scene.ambientLight.x, ImGuiColorEditFlags_Float)) st.markEdited();
+        return;
+    }
+    const sg::Node& n = st.scene.node(id);
+    std::string name = n.name;
+    ImGui::SetNextItemWidth(-px(70));
+    if (ImGui::InputText("Name", &name, ImGuiInputTextFlags_EnterReturnsTrue)) st.renameNode(id, name);
+    record(st, "inspector/name");
+    ImGui::TextDisabled("%s  (id %u)", std::string(sg::payloadKind(n.payload)).c_str(), id);
+    if (id != st.scene.root()) {
+        ImGui::SameLine();
+        bool vis = n.visible;
+        if (ImGui::Checkbox("Visible", &vis)) st.setVisible(id, vis);
+        record(st, "inspector/visible");
+    }
+
+    if (id != st.scene.root() && ImGui::CollapsingHeader("Transform", ImGuiTreeNodeFlags_DefaultOpen)) transformEditor(st, id);
+
+    // Payload.
+    sg::Payload p = st.scene.node(id).payload;
+    bool ch = false;
+    if (auto* mi = std::get_if<sg::MeshInstance>(&p)) {
+        if (ImGui::CollapsingHeader("Mesh", ImGuiTreeNodeFlags_DefaultOpen)) {
+            if (mi->mesh >= 0 && size_t(mi->mesh) < st.scene.meshes.size() && st.scene.meshes[mi->mesh]) {
+                const sg::Mesh& mesh = *st.scene.meshes[mi->mesh];
+                ImGui::Text("Mesh %d: %zu vertices, %zu triangles", mi->mesh, mesh.positions.size(), mesh.indices.size() / 3);
+            } else {
+                ImGui::TextColored(ImVec4(1, 0.5f, 0.4f, 1), "Mesh index %d is missing", mi->mesh);
+            }
+        }
+        if (ImGui::CollapsingHeader("Material", ImGuiTreeNodeFlags_DefaultOpen)) ch |= materialEditor(st, mi->material);
+    } else if (auto* ip = std::get_if<sg::ImplicitPayload>(&p)) {
+        if (ImGui::CollapsingHeader("Implicit shape", ImGuiTreeNodeFlags_DefaultOpen)) ch |= implicitEditor(st, ip->shape);
+        if (ImGui::CollapsingHeader("Material", ImGuiTreeNodeFlags_DefaultOpen)) ch |= materialEditor(st, ip->material);
+    } else if (auto* cp = std::get_if<sg::CsgPayload>(&p)) {
+        if (ImGui::CollapsingHeader("CSG", ImGuiTreeNodeFlags_DefaultOpen)) {
+            ch |= enumCombo(st, "Operation", cp->csg.op,
+                            {{sg::CsgOp::Union, "union"}, {sg::CsgOp::Intersection, "intersection"}, {sg::CsgOp::Difference, "difference"}});
+            ImGui::TextDisabled("Children combine left to right (first child minus the others for difference).");
+            if (ImGui::Button("Add operand")) ImGui::OpenPopup("csg_add");
+            if (ImGui::BeginPopup("csg_add")) {
+                for (auto& [t, nm] : kShapes)
+                    if (ImGui::MenuItem(nm)) st.addShape(t, id);
+                ImGui::EndPopup();
+            }
+        }
+        if (ImGui::CollapsingHeader("Material", ImGuiTreeNodeFlags_DefaultOpen)) ch |= materialEditor(st, cp->material);
+    } else if (auto* lp = std::get_if<sg::Light>(&p)) {
+        if (ImGui::CollapsingHeader("Light", ImGuiTreeNodeFlags_DefaultOpen)) {
+            ch |= enumCombo(st, "Type", lp->type, {{sg::LightType::Point, "point"}, {sg::LightType::Directional, "directional"}, {sg::LightType::Spot, "spot"}});
+            ch |= ImGui::ColorEdit3("Colour", &lp->color.x, ImGuiColorEditFlags_Float);
+            ch |= ImGui::DragFloat("Intensity", &lp->intensity, 0.05f, 0.0f, 1e5f);
+            ch |= ImGui::Checkbox("Inverse-square falloff", &lp->inverseSquare);
+            if (lp->type == sg::LightType::Spot) {
+                ch |= ImGui::SliderFloat("Inner angle", &lp->spotInnerDeg, 0.0f, 90.0f);
+                ch |= ImGui::SliderFloat("Outer angle", &lp->spotOuterDeg, 0.0f, 90.0f);
+                lp->spotInnerDeg = std::min(lp->spotInnerDeg, lp->spotOuterDeg);
+            }
+            ImGui::TextDisabled("Lights point down their local -z axis.");
+        }
+    } else if (auto* cam = std::get_if<sg::Camera>(&p)) {
+        if (ImGui::CollapsingHeader("Camera", ImGuiTreeNodeFlags_DefaultOpen)) {
+            if (ImGui::Button("Look through this camera")) st.useSceneCamera(id);
+            ImGui::SameLine();
+            ImGui::TextDisabled("(projection: Camera tab)");
+            ch |= ImGui::DragFloat("Focus distance", &cam->focusDistance, 0.05f, 0.001f, 1e5f);
+        }
+    } else if (auto* pp = std::get_if<sg::ParametricPayload>(&p)) {
+        if (ImGui::CollapsingHeader("Parametric surface", ImGuiTreeNodeFlags_DefaultOpen)) {
+            ch |= enumCombo(st, "Surface", pp->surface.type, {{sg::ParametricType::Torus, "torus"}, {sg::ParametricType::BezierPatch, "bezier patch"}});
+            if (pp->surface.type == sg::ParametricType::Torus) {
+                ch |= ImGui::DragFloat("Major radius", &pp->surface.majorRadius, 0.01f, 0.001f, 1e4f);
+                ch |= ImGui::DragFloat("Minor radius", &pp->surface.minorRadius, 0.01f, 0.001f, 1e4f);
+            } else if (ImGui::TreeNode("Control points")) {
+                for (int i = 0; i < 16; ++i) {
+                    ImGui::PushID(i);
+                    ch |= ImGui::DragFloat3("##cp", &pp->surface.control[i].x, 0.01f);
+                    ImGui::PopID();
+                }
+                ImGui::TreePop();
+            }
+        }
+        if (ImGui::CollapsingHeader("Material", ImGuiTreeNodeFlags_DefaultOpen)) ch |= materialEditor(st, pp->material);
+    } else if (auto* gp = std::get_if<sg::GridPayload>(&p)) {
+        if (ImGui::CollapsingHeader("Density grid", ImGuiTreeNodeFlags_DefaultOpen) && gp->grid) {
+            ImGui::Text("%d x %d x %d samples", gp->grid->dims.x, gp->grid->dims.y, gp->grid->dims.z);
+            float iso = gp->grid->isoValue;
+            if (ImGui::SliderFloat("Iso value", &iso, 0.0f, 2.0f)) {
+                auto copy = std::make_shared<sg::DensityGrid>(*gp->grid);   // payloads share grids: copy on write
+                copy->isoValue = iso;
+                gp->grid = copy;
+                ch = true;
+            }
+        }
+        if (ImGui::CollapsingHeader("Material", ImGuiTreeNodeFlags_DefaultOpen)) ch |= materialEditor(st, gp->material);
+    }
+    if (ch && st.scene.valid(id) && !(p == st.scene.node(id).payload)) {
+        st.scene.setPayload(id, p);
+        st.markEdited();
+    }
+}
+
+// --- 6. camera panel ---------------------------------------------------------------------------
+
+void drawCameraPanel(ViewerState& st) {
+    std::vector<sg::NodeId> cams = st.scene.cameras();
+    std::string preview = st.scene.valid(st.scene.activeCamera) ? st.scene.node(st.scene.activeCamera).name : "(viewer camera)";
+    if (ImGui::BeginCombo("Scene camera", preview.c_str())) {
+        for (sg::NodeId c : cams)
+            if (ImGui::Selectable(st.scene.node(c).name.c_str(), c == st.scene.activeCamera)) st.useSceneCamera(c);
+        ImGui::EndCombo();
+    }
+    if (ImGui::Button("Fit (F)")) st.fitView(st.scene.valid(st.selected));
+    ImGui::SameLine();
+    if (ImGui::Button("Reset (Home)")) st.resetView();
+    ImGui::SameLine();
+    if (ImGui::Button("New camera here")) st.addCamera();
+    if (st.scene.valid(st.scene.activeCamera)) {
+        if (ImGui::Button("Store view in active camera")) st.storeViewInCamera();
+        helpMarker("Also done on save, so the scene reopens with this view.");
+    }
+    ImGui::TextDisabled(cams.empty() ? "No scene camera: edits apply to the viewer's own camera." : "Edits apply to the active scene camera.");
+
+    section("Projection");
+    sg::Projection p = st.projection();
+    bool ch = enumCombo(st, "Type", p.type,
+                        {{sg::ProjectionType::Perspective, "perspective"}, {sg::ProjectionType::Orthographic, "orthographic"},
+                         {sg::ProjectionType::Oblique, "oblique"}});
+    switch (p.type) {
+    case sg::ProjectionType::Perspective:
+        ch |= ImGui::Checkbox("General frustum (l, r, b, t)", &p.useFrustum);
+        if (p.useFrustum) {
+            ch |= ImGui::DragFloat2("Left / right", &p.left, 0.001f);
+            ch |= ImGui::DragFloat2("Bottom / top", &p.bottom, 0.001f);
+        } else {
+            ch |= ImGui::SliderFloat("Field of view y", &p.fovyDeg, 1.0f, 170.0f, "%.1f deg");
+        }
+        break;
+    case sg::ProjectionType::Orthographic: ch |= ImGui::DragFloat("Half height", &p.orthoHalfHeight, 0.01f, 0.001f, 1e5f); break;
+    case sg::ProjectionType::Oblique:
+        if (ImGui::Button("Cavalier")) { p.obliqueFactor = 1.0f; p.obliqueAngleDeg = 45.0f; ch = true; }
+        ImGui::SameLine();
+        if (ImGui::Button("Cabinet")) { p.obliqueFactor = 0.5f; p.obliqueAngleDeg = 45.0f; ch = true; }
+        ch |= ImGui::SliderFloat("Angle", &p.obliqueAngleDeg, 0.0f, 90.0f, "%.1f deg");
+        ch |= ImGui::SliderFloat("Factor", &p.obliqueFactor, 0.0f, 2.0f);
+        ch |= ImGui::DragFloat("Half height", &p.orthoHalfHeight, 0.01f, 0.001f, 1e5f);
+        break;
+    }
+    ch |= ImGui::DragFloatRange2("Near / far", &p.zNear, &p.zFar, 0.01f, 1e-4f, 1e6f, "%.3f", "%.3f", ImGuiSliderFlags_Logarithmic);
+    if (ch) {
+        p.zNear = std::max(p.zNear, 1e-4f);
+        p.zFar = std::max(p.zFar, p.zNear * 1.001f);
+        st.editProjection() = p;
+    }
+    ImGui::TextDisabled("Zoom factor %.3f  (orthographic / oblique)", st.camera.orthoScale);
+
+    section("Live matrices");
+    float aspect = float(std::max(st.viewportWidth, 1)) / float(std::max(st.viewportHeight, 1));
+    sg::FrameCamera fc = sg::makeFrameCamera(st.camera.world(), st.viewProjection(), aspect, st.camera.distance);
+    if (st.scene.valid(st.selected)) {
+        ImGui::Text("Model (world of '%s')", st.scene.node(st.selected).name.c_str());
+        matrixTable("model", st.scene.world(st.selected));
+    } else {
+        ImGui::TextDisabled("Model: select a node");
+    }
+    ImGui::TextUnformatted("View");
+    matrixTable("view", fc.view);
+    ImGui::Text("Projection (aspect %.3f)", aspect);
+    matrixTable("proj", fc.proj);
+    ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyle().Colors[ImGuiCol_TextDisabled]);
+    ImGui::TextWrapped("Eye (%.2f, %.2f, %.2f)  pivot (%.2f, %.2f, %.2f)  distance %.3f", fc.eye.x, fc.eye.y, fc.eye.z, st.camera.pivot.x,
+                        st.camera.pivot.y, st.camera.pivot.z, st.camera.distance);
+    ImGui::PopStyleColor();
+}
+
+// --- 7. rendering panel ------------------------------------------------------------------------
+
+void drawRenderingPanel(ViewerState& st) {
+    sg::RenderSettings s = st.scene.settings;
+    bool ch = false;
+    section("Shading");
+    int shading = int(s.shading);
+    const char* shadingNames[] = {"Flat", "Gouraud", "Phong"};
+    for (int i = 0; i < 3; ++i) {
+        if (i) ImGui::SameLine();
+        if (ImGui::RadioButton(shadingNames[i], &shading, i)) ch = true;
+        record(st, std::string("render/shading/") + shadingNames[i]);
+    }
+    s.shading = sg::ShadingModel(shading);
+    int refl = int(s.reflection);
+    if (ImGui::RadioButton("Phong (r.v)", &refl, 0)) ch = true;
+    record(st, "render/reflection/Phong");
+    ImGui::SameLine();
+    if (ImGui::RadioButton("Blinn-Phong (n.h)", &refl, 1)) ch = true;
+    record(st, "render/reflection/Blinn");
+    s.reflection = sg::ReflectionModel(refl);
+    ch |= ImGui::Checkbox("Light attenuation (1/r^2)", &s.attenuation);
+    record(st, "render/attenuation");
+    sg::vec3 amb = st.scene.ambientLight;
+    if (ImGui::ColorEdit3("Ambient light", &amb.x, ImGuiColorEditFlags_Float)) {
+        st.scene.ambientLight = amb;
+        st.markEdited();
+    }
+
+    section("Fog");
+    ch |= enumCombo(st, "Fog", s.fog, {{sg::FogMode::Off, "off"}, {sg::FogMode::Linear, "linear"}, {sg::FogMode::Exp, "exp"}, {sg::FogMode::Exp2, "exp2"}});
+    if (s.fog != sg::FogMode::Off) {
+        ch |= ImGui::ColorEdit3("Fog colour", &s.fogColor.x, ImGuiColorEditFlags_Float);
+        if (s.fog == sg::FogMode::Linear) ch |= ImGui::DragFloatRange2("Start / end", &s.fogStart, &s.fogEnd, 0.05f, 0.0f, 1e5f);
+        else ch |= ImGui::SliderFloat("Density", &s.fogDensity, 0.0f, 1.0f, "%.4f", ImGuiSliderFlags_Logarithmic);
+    }
+
+    section("Anti-aliasing");
+    const char* aaNames[] = {"none", "msaa2", "msaa4", "msaa8", "ssaa2", "ssaa3", "ssaa4"};
+    std::string cur = s.aaName();
+    if (ImGui::BeginCombo("Scene AA", cur.c_str())) {
+        for (const char* n : aaNames)
+            if (ImGui::Selectable(n, cur == n)) ch |= s.setAA(n);
+        ImGui::EndCombo();
+    }
+    helpMarker("Saved with the scene. The ray caster uses SSAA-style jittered rays for either mode.");
+    // Per-backend overrides (viewer session only).
+    for (const std::string& b : rnd::rendererNames()) {
+        auto it = st.aaOverride.find(b);
+        std::string ov = it == st.aaOverride.end() ? "(scene)" : it->second;
+        std::string label = "AA " + b;
+        if (ImGui::BeginCombo(label.c_str(), ov.c_str())) {
+            if (ImGui::Selectable("(scene)", it == st.aaOverride.end())) { st.aaOverride.erase(b); st.markViewChanged(); }
+            for (const char* n : aaNames)
+                if (ImGui::Selectable(n, ov == n)) { st.aaOverride[b] = n; st.markViewChanged(); }
+            ImGui::EndCombo();
+        }
+    }
+
+    section("Rasterizers");
+    ch |= ImGui::Checkbox("Wireframe", &s.wireframe);
+    record(st, "render/wireframe");
+    if (s.wireframe) {
+        ImGui::SameLine();
+        ch |= ImGui::ColorEdit3("##wirecol", &s.wireframeColor.x, ImGuiColorEditFlags_NoInputs | ImGuiColorEditFlags_Float);
+    }
+    ch |= ImGui::Checkbox("Cull back faces", &s.cullBackFaces);
+    record(st, "render/culling");
+    ch |= ImGui::SliderInt("Tessellation", &s.tessellation, 4, 256);
+    helpMarker("Segments / marching-cubes resolution for implicit shapes, CSG, parametric surfaces and grids");
+
+    section("Ray caster");
+    ch |= ImGui::Checkbox("Shadows", &s.shadows);
+    record(st, "render/shadows");
+    ImGui::SameLine();
+    ch |= ImGui::Checkbox("Reflections", &s.reflections);
+    record(st, "render/reflections");
+    ch |= ImGui::SliderInt("Max bounces", &s.maxBounces, 0, 16);
+
+    section("Background");
+    ch |= ImGui::ColorEdit3("Background", &s.background.x, ImGuiColorEditFlags_Float);
+
+    if (ch && !(s == st.scene.settings)) {
+        std::string err = s.validate();
+        if (err.empty()) {
+            st.scene.settings = s;
+            st.markEdited();
+        } else {
+            st.status = "Setting refused: " + err;
+        }
+    }
+}
+
+// --- 8. compare panel --------------------------------------------------------------------------
+
+void drawComparePanel(ViewerState& st) {
+    CompareConfig& c = st.compare;
+    int mode = int(c.mode);
+    ImGui::RadioButton("Single", &mode, 0);
+    record(st, "compare/single");
+    ImGui::SameLine();
+    ImGui::RadioButton("Split / wipe", &mode, 1);
+    record(st, "compare/split");
+    ImGui::SameLine();
+    ImGui::RadioButton("Difference", &mode, 2);
+    record(st, "compare/difference");
+    c.mode = ViewMode(mode);
+    std::vector<std::string> names = rnd::rendererNames();
+    auto backendCombo = [&](const char* label, std::string& value) {
+        if (ImGui::BeginCombo(label, value.c_str())) {
+            for (const auto& n : names)
+                if (ImGui::Selectable(n.c_str(), n == value)) value = n;
+            ImGui::EndCombo();
+        }
+    };
+    section("Backends (one shared camera)");
+    if (c.mode == ViewMode::Single) {
+        std::string b = st.backend;
+        backendCombo("Backend", b);
+        if (b != st.backend) st.setBackend(b);
+        ImGui::TextDisabled("Keys 1 / 2 / 3 switch backends.");
+    } else {
+        ImGui::SliderInt("Count", &c.count, 2, 3);
+        const char* labels[] = {"Left", "Middle / right", "Right"};
+        for (int i = 0; i < (c.mode == ViewMode::Split ? c.count : 3); ++i) backendCombo(labels[i], c.backends[i]);
+        if (c.mode == ViewMode::Split) {
+            ImGui::SliderFloat("Divider 1", &c.dividers[0], 0.0f, 1.0f);
+            if (c.count == 3) ImGui::SliderFloat("Divider 2", &c.dividers[1], 0.0f, 1.0f);
+            c.dividers[1] = std::max(c.dividers[1], c.dividers[0]);
+            ImGui::TextDisabled("Drag the dividers in the viewport.");
+        }
+    }
+    if (c.mode == ViewMode::Difference) {
+        section("Difference");
+        const char* slotNames[] = {"slot 1", "slot 2", "slot 3"};
+        ImGui::Combo("A", &c.diffA, slotNames, 3);
+        ImGui::Combo("B", &c.diffB, slotNames, 3);
+        ImGui::Text("%s  vs  %s", c.backends[c.diffA].c_str(), c.backends[c.diffB].c_str());
+        ImGui::SliderInt("Threshold", &c.threshold, 0, 255);
+        record(st, "compare/threshold");
+        if (st.haveDiff) {
+            ImGui::Text("Mean |a-b|  %.3f", st.diffMean);
+            ImGui::Text("Max  |a-b|  %d", st.diffMax);
+            ImGui::Text("PSNR        %s", std::isfinite(st.diffPsnr) ? (std::to_string(st.diffPsnr).substr(0, 6) + " dB").c_str() : "identical");
+            ImGui::Text("Within threshold  %.2f %%", 100.0 * st.diffWithin);
+        } else {
+            ImGui::TextDisabled("Waiting for both full-resolution images...");
+        }
+    }
+}
+
+// --- 9. viewport -------------------------------------------------------------------------------
+
+namespace {
+
+void centeredText(ImDrawList* dl, ImVec2 a, ImVec2 b, const std::string& text, ImU32 col) {
+    float wrap = std::max(b.x - a.x - px(24), px(50));
+    ImVec2 sz = ImGui::CalcTextSize(text.c_str(), nullptr, false, wrap);
+    ImVec2 p((a.x + b.x - sz.x) * 0.5f, (a.y + b.y - sz.y) * 0.5f);
+    dl->AddRectFilled(ImVec2(p.x - px(10), p.y - px(8)), ImVec2(p.x + sz.x + px(10), p.y + sz.y + px(8)), IM_COL32(20, 20, 24, 220), px(4));
+    dl->AddText(nullptr, 0.0f, p, col, text.c_str(), nullptr, wrap);
+}
+
+// Draws one backend's image over [a, b] showing the u-range [u0, u1] of the image.
+void drawSlotImage(ImDrawList* dl, const SlotView& v, ImVec2 a, ImVec2 b, float u0, float u1, ImVec2 full0, ImVec2 full1) {
+    if (v.texture && v.width > 0) {
+        dl->AddImage(v.texture, a, b, ImVec2(u0, 0), ImVec2(u1, 1));
+    } else {
+        dl->AddRectFilled(a, b, IM_COL32(24, 25, 29, 255));
+    }
+    (void)full0;
+    (void)full1;
+    std::string msg;
+    if (!v.status.error.empty()) msg = v.status.backend + ": " + v.status.error;
+    else if (!v.texture) msg = v.status.backend + ": rendering...";
+    if (!msg.empty()) centeredText(dl, a, b, msg, v.status.error.empty() ? IM_COL32(200, 200, 210, 255) : IM_COL32(255, 150, 120, 255));
+}
+
+std::string slotStats(const SlotView& v) {
+    char buf[256];
+    const rnd::RenderStats& s = v.status.stats;
+    std::string extra;
+    if (s.rays > 0 && s.milliseconds > 0) {
+        char r[64];
+        std::snprintf(r, sizeof r, "  %.2f Mrays/s", double(s.rays) / (s.milliseconds * 1000.0));
+        extra += r;
+    }
+    if (v.status.level > 1) extra += "  (1/" + std::to_string(v.status.level) + " res)";
+    if (v.status.rendering) extra += "  " + std::to_string(int(v.status.progress * 100)) + "%";
+    std::snprintf(buf, sizeof buf, "%-8s %7.1f ms  %6.1fk tris%s", v.status.backend.c_str(), s.milliseconds, double(s.triangles) / 1000.0, extra.c_str());
+    return buf;
+}
+
+void cameraInput(ViewerState& st, ImVec2 a, ImVec2 b, double time, float dt) {
+    ImGuiIO& io = ImGui::GetIO();
+    bool hovered = ImGui::IsItemHovered();
+    bool active = ImGui::IsItemActive();
+    const sg::Projection& proj = st.projection();
+    bool ortho = proj.type != sg::ProjectionType::Perspective;
+    bool moved = false;
+    // Divider drag (split view) takes precedence over the camera when grabbed near a divider.
+    static int dragDivider = -1;
+    if (st.compare.mode == ViewMode::Split && ImGui::IsItemClicked(ImGuiMouseButton_Left)) {
+        dragDivider = -1;
+        for (int i = 0; i < st.compare.count - 1; ++i) {
+            float x = a.x + st.compare.dividers[i] * (b.x - a.x);
+            if (std::abs(io.MousePos.x - x) < px(6)) dragDivider = i;
+        }
+    }
+    if (!io.MouseDown[0]) dragDivider = -1;
+    if (dragDivider >= 0 && active) {
+        float f = std::clamp((io.MousePos.x - a.x) / std::max(b.x - a.x, 1.0f), 0.0f, 1.0f);
+        st.compare.dividers[dragDivider] = f;
+        if (dragDivider == 0) st.compare.dividers[1] = std::max(st.compare.dividers[1], f);
+        else st.compare.dividers[0] = std::min(st.compare.dividers[0], f);
+        return;
+    }
+    if (active && (io.MouseDelta.x != 0 || io.MouseDelta.y != 0)) {
+        bool panning = io.MouseDown[2] || (io.MouseDown[0] && io.KeyShift);
+        if (io.MouseDown[1]) {
+            st.camera.look(io.MouseDelta.x, io.MouseDelta.y);
+            moved = true;
+        } else if (panning) {
+            st.camera.pan(io.MouseDelta.x, io.MouseDelta.y, st.camera.panScale(proj.fovyDeg, b.y - a.y, ortho, proj.orthoHalfHeight));
+            moved = true;
+        } else if (io.MouseDown[0]) {
+            st.camera.orbit(io.MouseDelta.x, io.MouseDelta.y);
+            moved = true;
+        }
+    }
+    if (hovered && io.MouseWheel != 0.0f) {
+        st.camera.zoom(io.MouseWheel);
+        moved = true;
+    }
+    // Fly mode: right mouse held + WASD (QE down/up), Shift = faster.
+    st.flyMode = active && io.MouseDown[1];
+    if (st.flyMode) {
+        float speed = std::max(st.camera.distance, 0.5f) * 0.8f * dt * (io.KeyShift ? 4.0f : 1.0f);
+        sg::vec3 o(0.0f);
+        if (ImGui::IsKeyDown(keys::W)) o.z += speed;
+        if (ImGui::IsKeyDown(keys::S)) o.z -= speed;
+        if (ImGui::IsKeyDown(keys::D)) o.x += speed;
+        if (ImGui::IsKeyDown(keys::A)) o.x -= speed;
+        if (ImGui::IsKeyDown(keys::E)) o.y += speed;
+        if (ImGui::IsKeyDown(keys::Q)) o.y -= speed;
+        if (o != sg::vec3(0.0f)) {
+            st.camera.fly(o);
+            moved = true;
+        }
+    }
+    if (moved) {
+        st.lastInteraction = time;
+        st.markViewChanged();
+    }
+}
+
+}  // namespace
+
+void drawViewport(ViewerState& st, const ViewportInput& view, double time, float dt) {
+    ImVec2 a = ImGui::GetCursorScreenPos();
+    ImVec2 avail = ImGui::GetContentRegionAvail();
+    avail.x = std::max(avail.x, 1.0f);
+    avail.y = std::max(avail.y, 1.0f);
+    ImVec2 b(a.x + avail.x, a.y + avail.y);
+    // Render at framebuffer pixels (HiDPI: DisplayFramebufferScale).
+    ImVec2 fbs = ImGui::GetIO().DisplayFramebufferScale;
+    st.viewportWidth = std::max(1, int(avail.x * fbs.x));
+    st.viewportHeight = std::max(1, int(avail.y * fbs.y));
+
+    ImGui::InvisibleButton("##viewport", avail, ImGuiButtonFlags_MouseButtonLeft | ImGuiButtonFlags_MouseButtonRight | ImGuiButtonFlags_MouseButtonMiddle);
+    record(st, "viewport");
+    cameraInput(st, a, b, time, dt);
+
+    ImDrawList* dl = ImGui::GetWindowDrawList();
+    dl->PushClipRect(a, b, true);
+    switch (st.compare.mode) {
+    case ViewMode::Single:
+        if (!view.slots.empty()) drawSlotImage(dl, view.slots[0], a, b, 0, 1, a, b);
+        break;
+    case ViewMode::Split: {
+        int n = std::min<int>(int(view.slots.size()), std::clamp(st.compare.count, 2, 3));
+        float edges[4] = {0.0f, st.compare.dividers[0], n == 3 ? st.compare.dividers[1] : 1.0f, 1.0f};
+        if (n == 2) edges[2] = 1.0f;
+        for (int i = 0; i < n; ++i) {
+            float u0 = edges[i], u1 = edges[i + 1];
+            if (u1 <= u0) continue;
+            ImVec2 p0(a.x + u0 * avail.x, a.y), p1(a.x + u1 * avail.x, b.y);
+            drawSlotImage(dl, view.slots[i], p0, p1, u0, u1, a, b);
+            // Backend label at the top of its region.
+            const std::string& name = view.slots[i].status.backend;
+            ImVec2 ts = ImGui::CalcTextSize(name.c_str());
+            ImVec2 lp(p0.x + (p1.x - p0.x - ts.x) * 0.5f, a.y + px(8));
+            dl->AddRectFilled(ImVec2(lp.x - px(6), lp.y - px(3)), ImVec2(lp.x + ts.x + px(6), lp.y + ts.y + px(3)), IM_COL32(0, 0, 0, 160), px(3));
+            dl->AddText(lp, IM_COL32(255, 255, 255, 255), name.c_str());
+        }
+        for (int i = 0; i + 1 < n; ++i) {
+            float x = a.x + st.compare.dividers[i] * avail.x;
+            dl->AddLine(ImVec2(x, a.y), ImVec2(x, b.y), IM_COL32(255, 255, 255, 200), px(2));
+            dl->AddCircleFilled(ImVec2(x, (a.y + b.y) * 0.5f), px(7), IM_COL32(255, 255, 255, 230));
+            dl->AddCircle(ImVec2(x, (a.y + b.y) * 0.5f), px(7), IM_COL32(40, 40, 40, 255), 0, px(1.5f));
+        }
+        break;
+    }
+    case ViewMode::Difference: {
+        SlotView d = view.diff;
+        if (!d.texture) {
+            // No diff yet: say why (an error of either side, or still rendering).
+            std::string msg = "Waiting for both images...";
+            for (const SlotView& s : view.slots)
+                if (!s.status.error.empty()) msg = s.status.backend + ": " + s.status.error;
+            dl->AddRectFilled(a, b, IM_COL32(24, 25, 29, 255));
+            centeredText(dl, a, b, msg, IM_COL32(255, 170, 140, 255));
+        } else {
+            dl->AddImage(d.texture, a, b);
+        }
+        if (view.slots.size() >= 2) {
+            char buf[256];
+            if (st.haveDiff)
+                std::snprintf(buf, sizeof buf, "|%s - %s|   mean %.2f   max %d   PSNR %.1f dB   within %d: %.1f%%", view.slots[0].status.backend.c_str(),
+                              view.slots[1].status.backend.c_str(), st.diffMean, st.diffMax, st.diffPsnr, st.compare.threshold, 100.0 * st.diffWithin);
+            else
+                std::snprintf(buf, sizeof buf, "|%s - %s|", view.slots[0].status.backend.c_str(), view.slots[1].status.backend.c_str());
+            ImVec2 ts = ImGui::CalcTextSize(buf);
+            ImVec2 lp(a.x + (avail.x - ts.x) * 0.5f, b.y - ts.y - px(12));
+            dl->AddRectFilled(ImVec2(lp.x - px(8), lp.y - px(4)), ImVec2(lp.x + ts.x + px(8), lp.y + ts.y + px(4)), IM_COL32(0, 0, 0, 180), px(3));
+            dl->AddText(lp, IM_COL32(255, 230, 160, 255), buf);
+        }
+        break;
+    }
+    }
+
+    // Stats overlay (top-left).
+    if (g_showOverlay) {
+        std::vector<std::string> lines;
+        for (const SlotView& v : view.slots) lines.push_back(slotStats(v));
+        char buf[128];
+        std::snprintf(buf, sizeof buf, "%d x %d   %s", st.viewportWidth, st.viewportHeight, st.flyMode ? "FLY (WASD QE)" : "");
+        lines.emplace_back(buf);
+        float h = ImGui::GetTextLineHeightWithSpacing();
+        float w = 0;
+        for (auto& l : lines) w = std::max(w, ImGui::CalcTextSize(l.c_str()).x);
+        ImVec2 o(a.x + px(10), a.y + (st.compare.mode == ViewMode::Split ? px(36) : px(10)));
+        dl->AddRectFilled(o, ImVec2(o.x + w + px(16), o.y + h * lines.size() + px(10)), IM_COL32(0, 0, 0, 150), px(4));
+        for (size_t i = 0; i < lines.size(); ++i) {
+            bool rendering = i < view.slots.size() && view.slots[i].status.rendering;
+            dl->AddText(ImVec2(o.x + px(8), o.y + px(5) + h * i), rendering ? IM_COL32(255, 220, 120, 255) : IM_COL32(220, 230, 240, 255),
+                        lines[i].c_str());
+        }
+        // Progress bars for renders in flight.
+        for (size_t i = 0; i < view.slots.size(); ++i) {
+            if (!view.slots[i].status.rendering) continue;
+            float y = b.y - px(4) - px(5) * i;
+            dl->AddRectFilled(ImVec2(a.x, y - px(3)), ImVec2(a.x + avail.x * view.slots[i].status.progress, y), IM_COL32(90, 170, 255, 220));
+        }
+    }
+    dl->PopClipRect();
+}
+
+// --- 10. dialogs -------------------------------------------------------------------------------
+
+namespace {
+
+void openBrowser(bool saving, const ViewerState& st) {
+    g_browser.open = true;
+    g_browser.justOpened = true;
+    g_browser.saving = saving;
+    g_browser.error.clear();
+    std::error_code ec;
+    fs::path start = st.scenePath.empty() ? fs::current_path(ec) : fs::absolute(st.scenePath, ec).parent_path();
+    if (g_browser.dir.empty() || !fs::is_directory(g_browser.dir, ec)) g_browser.dir = start;
+    g_browser.fileName = saving ? (st.scenePath.empty() ? st.scene.name + ".json" : st.scenePath.stem().string() + ".json") : "";
+}
+
+void drawFileBrowser(ViewerState& st) {
+    if (!g_browser.open) return;
+    const char* title = g_browser.saving ? "Save scene as###browser" : "Open scene###browser";
+    if (g_browser.justOpened) {
+        ImGui::OpenPopup(title);
+        g_browser.justOpened = false;
+    }
+    ImVec2 ds = ImGui::GetIO().DisplaySize;
+    ImGui::SetNextWindowSize(ImVec2(std::min(px(640), ds.x * 0.9f), std::min(px(480), ds.y * 0.9f)), ImGuiCond_Appearing);
+    ImGui::SetNextWindowPos(ImVec2(ds.x * 0.5f, ds.y * 0.5f), ImGuiCond_Appearing, ImVec2(0.5f, 0.5f));
+    bool keep = true;
+    if (!ImGui::BeginPopupModal(title, &keep)) {
+        if (!keep) g_browser.open = false;
+        return;
+    }
+    std::error_code ec;
+    std::string dirText = g_browser.dir.string();
+    if (ImGui::Button("Up")) g_browser.dir = g_browser.dir.parent_path();
+    ImGui::SameLine();
+    ImGui::SetNextItemWidth(-1);
+    if (ImGui::InputText("##dir", &dirText, ImGuiInputTextFlags_EnterReturnsTrue) && fs::is_directory(dirText, ec)) g_browser.dir = dirText;
+
+    std::vector<std::string> exts = assets::supportedSceneExtensions();
+    std::vector<fs::directory_entry> dirs, files;
+    for (fs::directory_iterator it(g_browser.dir, fs::directory_options::skip_permission_denied, ec), end; !ec && it != end; it.increment(ec)) {
+        const fs::directory_entry& e = *it;
+        std::string name = e.path().filename().string();
+        if (name.empty() || name[0] == '.') continue;
+        if (e.is_directory(ec)) dirs.push_back(e);
+        else {
+            std::string ext = e.path().extension().string();
+            std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+            if (std::find(exts.begin(), exts.end(), ext) != exts.end()) files.push_back(e);
+        }
+        if (dirs.size() + files.size() > 5000) break;
+    }
+    auto byName = [](const fs::directory_entry& x, const fs::directory_entry& y) { return x.path().filename() < y.path().filename(); };
+    std::sort(dirs.begin(), dirs.end(), byName);
+    std::sort(files.begin(), files.end(), byName);
+
+    float footer = ImGui::GetFrameHeightWithSpacing() * 2.5f;
+    fs::path chosen;
+    ImGui::BeginChild("entries", ImVec2(0, -footer), true);
+    for (const auto& d : dirs) {
+        std::string label = "[dir] " + d.path().filename().string();
+        if (ImGui::Selectable(label.c_str(), false, ImGuiSelectableFlags_AllowDoubleClick) && ImGui::IsMouseDoubleClicked(0)) g_browser.dir = d.path();
+    }
+    for (const auto& f : files) {
+        std::string name = f.path().filename().string();
+        if (ImGui::Selectable(name.c_str(), g_browser.fileName == name, ImGuiSelectableFlags_AllowDoubleClick)) {
+            g_browser.fileName = name;
+            if (ImGui::IsMouseDoubleClicked(0)) chosen = f.path();
+        }
+    }
+    ImGui::EndChild();
+    ImGui::SetNextItemWidth(-px(170));
+    bool enter = ImGui::InputText("##file", &g_browser.fileName, ImGuiInputTextFlags_EnterReturnsTrue);
+    ImGui::SameLine();
+    if (ImGui::Button(g_browser.saving ? "Save" : "Open", ImVec2(px(75), 0)) || enter) {
+        if (!g_browser.fileName.empty()) chosen = g_browser.dir / g_browser.fileName;
+    }
+    ImGui::SameLine();
+    if (ImGui::Button("Cancel", ImVec2(px(75), 0))) {
+        g_browser.open = false;
+        ImGui::CloseCurrentPopup();
+    }
+    ImGui::TextDisabled(g_browser.saving ? "Native JSON scene (.json)" : "Formats: .json .gltf .glb .obj .off .ply .stl");
+    if (!chosen.empty()) {
+        g_browser.open = false;
+        ImGui::CloseCurrentPopup();
+        if (g_browser.saving) st.save(chosen);
+        else st.requestOpen(chosen);
+    }
+    ImGui::EndPopup();
+}
+
+void drawScreenshotDialog(ViewerState& st) {
+    if (st.requests.screenshotDialog) {
+        st.requests.screenshotDialog = false;
+        g_shotDialog.open = true;
+        ImGui::OpenPopup("Screenshot");
+    }
+    if (!ImGui::BeginPopupModal("Screenshot", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) return;
+    ImGui::Checkbox("Window size", &g_shotDialog.windowSize);
+    ImGui::BeginDisabled(g_shotDialog.windowSize);
+    ImGui::InputInt("Width", &g_shotDialog.width);
+    ImGui::InputInt("Height", &g_shotDialog.height);
+    if (ImGui::SmallButton("1280x720")) { g_shotDialog.width = 1280; g_shotDialog.height = 720; }
+    ImGui::SameLine();
+    if (ImGui::SmallButton("1920x1080")) { g_shotDialog.width = 1920; g_shotDialog.height = 1080; }
+    ImGui::SameLine();
+    if (ImGui::SmallButton("3840x2160")) { g_shotDialog.width = 3840; g_shotDialog.height = 2160; }
+    ImGui::EndDisabled();
+    g_shotDialog.width = std::clamp(g_shotDialog.width, 1, 16384);
+    g_shotDialog.height = std::clamp(g_shotDialog.height, 1, 16384);
+    ImGui::TextDisabled("One PNG per backend shown, rendered offscreen;\nnamed screenshot-<backend>[-N].png, never overwriting.");
+    if (ImGui::Button("Take", ImVec2(px(90), 0))) {
+        st.requests.screenshot = true;
+        st.requests.screenshotWidth = g_shotDialog.windowSize ? 0 : g_shotDialog.width;
+        st.requests.screenshotHeight = g_shotDialog.windowSize ? 0 : g_shotDialog.height;
+        ImGui::CloseCurrentPopup();
+    }
+    ImGui::SameLine();
+    if (ImGui::Button("Cancel", ImVec2(px(90), 0))) ImGui::CloseCurrentPopup();
+    ImGui::EndPopup();
+}
+
+}  // namespace
+
+void drawDialogs(ViewerState& st) {
+    if (st.requests.openDialog) {
+        st.requests.openDialog = false;
+        openBrowser(false, st);
+    }
+    if (st.requests.saveAsDialog) {
+        st.requests.saveAsDialog = false;
+        openBrowser(true, st);
+    }
+    drawFileBrowser(st);
+    drawScreenshotDialog(st);
+
+    if (st.confirmOpen && !ImGui::IsPopupOpen("Unsaved changes")) ImGui::OpenPopup("Unsaved changes");
+    if (ImGui::BeginPopupModal("Unsaved changes", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
+        const char* what = st.pending == PendingAction::Quit ? "quitting" : st.pending == PendingAction::New ? "starting a new scene" : "opening another file";
+        ImGui::Text("The scene has unsaved changes.\nSave them before %s?", what);
+        ImGui::Spacing();
+        if (ImGui::Button("Save", ImVec2(px(90), 0))) { st.confirm(ConfirmChoice::Save); ImGui::CloseCurrentPopup(); }
+        record(st, "confirm/save");
+        ImGui::SameLine();
+        if (ImGui::Button("Discard", ImVec2(px(90), 0))) { st.confirm(ConfirmChoice::Discard); ImGui::CloseCurrentPopup(); }
+        record(st, "confirm/discard");
+        ImGui::SameLine();
+        if (ImGui::Button("Cancel", ImVec2(px(90), 0)) || ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Escape))) {
+            st.confirm(ConfirmChoice::Cancel);
+            ImGui::CloseCurrentPopup();
+        }
+        record(st, "confirm/cancel");
+        ImGui::EndPopup();
+    }
+
+    if (!st.errorPopup.empty() && !ImGui::IsPopupOpen("Error")) ImGui::OpenPopup("Error");
+    if (ImGui::BeginPopupModal("Error", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
+        ImGui::PushTextWrapPos(px(520));
+        ImGui::TextColored(ImVec4(1.0f, 0.6f, 0.5f, 1.0f), "%s", st.errorPopup.c_str());
+        ImGui::PopTextWrapPos();
+        if (ImGui::Button("OK", ImVec2(px(90), 0)) || ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Enter))) {
+            st.errorPopup.clear();
+            ImGui::CloseCurrentPopup();
+        }
+        ImGui::EndPopup();
+    }
+
+    if (g_showHelp) {
+        ImGui::SetNextWindowSize(ImVec2(px(420), 0), ImGuiCond_FirstUseEver);
+        if (ImGui::Begin("Controls", &g_showHelp)) {
+            ImGui::TextUnformatted(
+                "Left drag          orbit around the pivot\n"
+                "Middle / Shift+left drag   pan\n"
+                "Wheel              zoom\n"
+                "Right drag + WASD  fly (Q/E down/up, Shift faster)\n"
+                "F                  fit scene / selection\n"
+                "Home               reset to the scene camera\n"
+                "1 / 2 / 3          backend gl / raster / raycast\n"
+                "F12                screenshot\n"
+                "F2                 rename selection\n"
+                "Del, Ctrl+D        delete / duplicate selection\n"
+                "Ctrl+N/O/S/Q       new / open / save / quit\n"
+                "Drag tree nodes onto others to re-parent.\n"
+                "Drop files onto the window to open them.");
+        }
+        ImGui::End();
+    }
+}
+
+// --- 11. shortcuts and layout ------------------------------------------------------------------
+
+void handleShortcuts(ViewerState& st) {
+    ImGuiIO& io = ImGui::GetIO();
+    if (io.WantTextInput || st.flyMode) return;
+    if (ImGui::IsPopupOpen(nullptr, ImGuiPopupFlags_AnyPopupId)) return;
+    bool ctrl = io.KeyCtrl;
+    if (ctrl) {
+        if (ImGui::IsKeyPressed(keys::O, false)) st.requests.openDialog = true;
+        if (ImGui::IsKeyPressed(keys::S, false)) {
+            if (io.KeyShift) st.requests.saveAsDialog = true;
+            else st.save();
+        }
+        if (ImGui::IsKeyPressed(keys::N, false)) st.requestNew();
+        if (ImGui::IsKeyPressed(keys::Q, false)) st.requestQuit();
+        if (ImGui::IsKeyPressed(keys::D, false)) st.duplicateNode(st.selected);
+        return;
+    }
+    for (int i = 0; i < 3; ++i)
+        if (ImGui::IsKeyPressed(keys::Num1 + i, false)) {
+            st.setBackendIndex(i);
+            st.compare.mode = ViewMode::Single;
+        }
+    if (ImGui::IsKeyPressed(keys::F, false)) st.fitView(st.scene.valid(st.selected));
+    if (ImGui::IsKeyPressed(keys::Home, false)) st.resetView();
+    if (ImGui::IsKeyPressed(keys::F12, false)) st.requests.screenshot = true;
+    if (ImGui::IsKeyPressed(keys::Delete, false) && st.scene.valid(st.selected)) st.removeNode(st.selected);
+    if (ImGui::IsKeyPressed(keys::F2, false) && st.scene.valid(st.selected) && st.selected != st.scene.root()) {
+        g_renaming = st.selected;
+        g_renameBuffer = st.scene.node(st.selected).name;
+    }
+}
+
+void drawUi(ViewerState& st, const ViewportInput& view, double time, float dt) {
+    ImGuiIO& io = ImGui::GetIO();
+    drawMainMenu(st);
+    float menuH = ImGui::GetFrameHeight();
+    float statusH = ImGui::GetFrameHeight() + px(4);
+    float bodyH = std::max(io.DisplaySize.y - menuH - statusH, 50.0f);
+    const ImGuiWindowFlags panelFlags = ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoBringToFrontOnFocus;
+
+    // Left: scene tree (width resizable and persisted in imgui.ini).
+    ImGui::SetNextWindowPos(ImVec2(0, menuH), ImGuiCond_Always);
+    ImGui::SetNextWindowSize(ImVec2(px(260), bodyH), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowSizeConstraints(ImVec2(px(160), bodyH), ImVec2(std::max(px(160), io.DisplaySize.x * 0.45f), bodyH));
+    float leftW = 0;
+    if (ImGui::Begin("Scene", nullptr, panelFlags)) drawSceneTree(st);
+    leftW = ImGui::GetWindowWidth();
+    ImGui::End();
+
+    // Right: tabs.
+    ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x, menuH), ImGuiCond_Always, ImVec2(1.0f, 0.0f));
+    ImGui::SetNextWindowSize(ImVec2(px(380), bodyH), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowSizeConstraints(ImVec2(px(220), bodyH), ImVec2(std::max(px(220), io.DisplaySize.x * 0.45f), bodyH));
+    float rightW = 0;
+    if (ImGui::Begin("Properties", nullptr, panelFlags)) {
+        ImGui::PushItemWidth(-px(150));   // room for the labels on the right
+        if (ImGui::BeginTabBar("tabs")) {
+            bool openInspector = ImGui::BeginTabItem("Inspector", nullptr, st.requestedTab == "Inspector" ? ImGuiTabItemFlags_SetSelected : 0);
+            record(st, "tab/Inspector");   // the tab itself (before its contents)
+            if (openInspector) { drawInspector(st); ImGui::EndTabItem(); }
+            bool openCamera = ImGui::BeginTabItem("Camera", nullptr, st.requestedTab == "Camera" ? ImGuiTabItemFlags_SetSelected : 0);
+            record(st, "tab/Camera");   // the tab itself (before its contents)
+            if (openCamera) { drawCameraPanel(st); ImGui::EndTabItem(); }
+            bool openRendering = ImGui::BeginTabItem("Rendering", nullptr, st.requestedTab == "Rendering" ? ImGuiTabItemFlags_SetSelected : 0);
+            record(st, "tab/Rendering");   // the tab itself (before its contents)
+            if (openRendering) { drawRenderingPanel(st); ImGui::EndTabItem(); }
+            bool openCompare = ImGui::BeginTabItem("Compare", nullptr, st.requestedTab == "Compare" ? ImGuiTabItemFlags_SetSelected : 0);
+            record(st, "tab/Compare");   // the tab itself (before its contents)
+            if (openCompare) { drawComparePanel(st); ImGui::EndTabItem(); }
+            ImGui::EndTabBar();
+        }
+        st.requestedTab.clear();
+        ImGui::PopItemWidth();
+    }
+    rightW = ImGui::GetWindowWidth();
+    ImGui::End();
+
+    // Centre: viewport.
+    ImGui::SetNextWindowPos(ImVec2(leftW, menuH), ImGuiCond_Always);
+    ImGui::SetNextWindowSize(ImVec2(std::max(io.DisplaySize.x - leftW - rightW, 1.0f), bodyH), ImGuiCond_Always);
+    ImGui::PushStyleVar(ImGuiStyleVar_WindowPadding, ImVec2(0, 0));
+    ImGui::PushStyleVar(ImGuiStyleVar_WindowBorderSize, 0.0f);
+    if (ImGui::Begin("Viewport", nullptr,
+                     ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoBringToFrontOnFocus |
+                         ImGuiWindowFlags_NoScrollWithMouse))
+        drawViewport(st, view, time, dt);
+    ImGui::End();
+    ImGui::PopStyleVar(2);
+
+    // Bottom: status bar.
+    ImGui::SetNextWindowPos(ImVec2(0, io.DisplaySize.y - statusH), ImGuiCond_Always);
+    ImGui::SetNextWindowSize(ImVec2(io.DisplaySize.x, statusH), ImGuiCond_Always);
+    ImGui::PushStyleVar(ImGuiStyleVar_WindowPadding, ImVec2(px(8), px(2)));
+    if (ImGui::Begin("##status", nullptr, ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoBringToFrontOnFocus)) {
+        bool bad = st.status.rfind("Move refused", 0) == 0 || st.status.find("fail") != std::string::npos || st.status.find("refused") != std::string::npos;
+        if (bad) ImGui::TextColored(ImVec4(1.0f, 0.6f, 0.45f, 1.0f), "%s", st.status.c_str());
+        else ImGui::TextUnformatted(st.status.empty() ? "Ready" : st.status.c_str());
+        char right[160];
+        std::string mode = st.compare.mode == ViewMode::Single ? st.backend : st.compare.mode == ViewMode::Split ? "split view" : "difference view";
+        std::snprintf(right, sizeof right, "%s   %s   %.0f fps", mode.c_str(), st.loadInProgress() ? "loading..." : "", io.Framerate);
+        float w = ImGui::CalcTextSize(right).x;
+        ImGui::SameLine(io.DisplaySize.x - w - px(12));
+        ImGui::TextDisabled("%s", right);
+    }
+    ImGui::End();
+    ImGui::PopStyleVar();
+
+    drawDialogs(st);
+    handleShortcuts(st);
+}
+
+}  // namespace ui

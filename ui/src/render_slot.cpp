@@ -1,0 +1,151 @@
+// render_slot.cpp - coarse-to-fine, cancellable rendering for one viewport backend.
+#include "ui/render_slot.h"
+
+#include <chrono>
+
+namespace ui {
+
+RenderSlot::RenderSlot(std::string backend, bool threaded) : m_backend(std::move(backend)), m_threaded(threaded) {
+    m_renderer = rnd::makeRenderer(m_backend, &m_makeError);
+    if (m_renderer && (m_renderer->capabilities().needsGLContext || m_backend == "gl")) m_threaded = false;
+    m_status.backend = m_backend;
+    if (!m_renderer) m_status.error = m_makeError.empty() ? "unknown backend " + m_backend : m_makeError;
+    if (m_threaded && m_renderer) m_thread = std::thread([this] { workerLoop(); });
+}
+
+RenderSlot::~RenderSlot() {
+    {
+        std::lock_guard<std::mutex> lock(m_mutex);
+        m_quit = true;
+        if (m_control) m_control->cancel = true;
+    }
+    m_cv.notify_all();
+    if (m_thread.joinable()) m_thread.join();
+}
+
+bool RenderSlot::needs(uint64_t key, bool interacting) const {
+    if (!m_renderer) return false;
+    return !(key == m_lastKey && (interacting || !m_lastPreviewOnly));
+}
+
+void RenderSlot::request(std::shared_ptr<const sg::FrameInput> frame, int width, int height, uint64_t key, bool interacting) {
+    if (!m_renderer || width < 1 || height < 1) return;
+    if (!needs(key, interacting)) return;   // nothing new to draw
+    m_lastKey = key;
+    m_lastPreviewOnly = interacting;
+    Job job{std::move(frame), width, height, key, interacting};
+    std::lock_guard<std::mutex> lock(m_mutex);
+    m_pending = std::move(job);
+    if (m_control) m_control->cancel = true;   // restart with the new frame
+    m_cv.notify_all();
+}
+
+void RenderSlot::publish(rnd::Framebuffer&& fb, const rnd::RenderStats& st, int level) {
+    std::lock_guard<std::mutex> lock(m_mutex);
+    m_status.stats = st;
+    m_status.error = st.ok ? std::string() : (st.error.empty() ? "render failed" : st.error);
+    if (st.ok) {
+        m_finished = std::move(fb);
+        m_status.level = level;
+        m_haveNew = true;
+    }
+}
+
+void RenderSlot::runJob(const Job& job) {
+    int divisors[2] = {previewDivisor, 1};
+    int levels = job.previewOnly ? 1 : 2;
+    // A preview larger than ~1/16 of the pixels is pointless for tiny viewports.
+    if (previewDivisor <= 1 || (job.width / previewDivisor < 8)) { divisors[0] = 1; levels = 1; }
+    for (int i = 0; i < levels; ++i) {
+        int d = divisors[i];
+        int w = std::max(1, job.width / d), h = std::max(1, job.height / d);
+        rnd::RenderControl control;
+        {
+            std::lock_guard<std::mutex> lock(m_mutex);
+            if (m_pending || m_quit) return;   // superseded
+            m_control = &control;
+            m_status.rendering = true;
+            m_status.progress = 0.0f;
+        }
+        rnd::Framebuffer fb;
+        rnd::RenderStats st;
+        try {
+            st = m_renderer->render(*job.frame, w, h, fb, &control);
+        } catch (const std::exception& e) {
+            st.ok = false;
+            st.error = std::string("exception: ") + e.what();
+        }
+        {
+            std::lock_guard<std::mutex> lock(m_mutex);
+            m_control = nullptr;
+            m_status.rendering = false;
+        }
+        if (control.cancel || st.cancelled) return;
+        if (st.ok && (fb.width != w || fb.height != h || fb.color.size() != size_t(w) * h * 4)) {
+            st.ok = false;
+            st.error = "backend returned a " + std::to_string(fb.width) + "x" + std::to_string(fb.height) + " image";
+        }
+        publish(std::move(fb), st, d);
+        if (!st.ok) return;
+    }
+}
+
+void RenderSlot::workerLoop() {
+    for (;;) {
+        Job job;
+        {
+            std::unique_lock<std::mutex> lock(m_mutex);
+            m_cv.wait(lock, [&] { return m_quit || m_pending.has_value(); });
+            if (m_quit) return;
+            job = std::move(*m_pending);
+            m_pending.reset();
+            m_busy = true;
+        }
+        runJob(job);
+        {
+            std::lock_guard<std::mutex> lock(m_mutex);
+            m_busy = false;
+        }
+        m_cv.notify_all();
+    }
+}
+
+bool RenderSlot::poll() {
+    if (!m_threaded && m_renderer) {
+        std::optional<Job> job;
+        {
+            std::lock_guard<std::mutex> lock(m_mutex);
+            job.swap(m_pending);
+        }
+        if (job) {
+            // Synchronous (GL): full resolution right away, it is fast enough to be "instant".
+            job->previewOnly = false;
+            int keep = previewDivisor;
+            previewDivisor = 1;
+            runJob(*job);
+            previewDivisor = keep;
+        }
+    }
+    std::lock_guard<std::mutex> lock(m_mutex);
+    if (m_control) m_status.progress = m_control->progress.load();
+    if (!m_haveNew) return false;
+    m_haveNew = false;
+    std::swap(m_shown, m_finished);
+    return true;
+}
+
+SlotStatus RenderSlot::status() const {
+    std::lock_guard<std::mutex> lock(m_mutex);
+    return m_status;
+}
+
+void RenderSlot::waitIdle() {
+    if (!m_threaded) {
+        poll();
+        return;
+    }
+    std::unique_lock<std::mutex> lock(m_mutex);
+    m_cv.wait(lock, [&] { return m_quit || (!m_pending && !m_busy); });
+}
+
+}  // namespace ui

@@ -1,0 +1,469 @@
+// viewer_state.cpp - the viewer's pure state and actions (see viewer_state.h).
+//
+// Sections: scene + edits, backend, camera, files (guard, async load, save), config helpers.
+#include "ui/viewer_state.h"
+
+#include "assets/files.h"
+#include "renderers/renderer.h"
+
+#include <chrono>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+namespace fs = std::filesystem;
+
+namespace ui {
+
+// --- scene + edits --------------------------------------------------------------------------
+
+void ViewerState::setScene(sg::Scene s, fs::path path) {
+    scene = std::move(s);
+    scenePath = std::move(path);
+    dirty = false;
+    selected = sg::kNoNode;
+    ++sceneVersion;
+    resetView();
+}
+
+void ViewerState::markEdited() {
+    dirty = true;
+    ++sceneVersion;
+}
+
+void ViewerState::markViewChanged() { ++viewVersion; }
+
+void ViewerState::selectNode(sg::NodeId id) { selected = scene.valid(id) ? id : sg::kNoNode; }
+
+bool ViewerState::renameNode(sg::NodeId id, const std::string& name) {
+    if (!scene.valid(id) || name.empty() || scene.node(id).name == name) return false;
+    scene.setName(id, name);
+    markEdited();
+    return true;
+}
+
+void ViewerState::setVisible(sg::NodeId id, bool v) {
+    if (!scene.valid(id) || scene.node(id).visible == v) return;
+    scene.setVisible(id, v);
+    markEdited();
+}
+
+namespace {
+// Default parent for new nodes: the selection when it can hold children, else the root.
+sg::NodeId parentFor(const ViewerState& st, sg::NodeId parent) {
+    if (st.scene.valid(parent)) return parent;
+    sg::NodeId s = st.selected;
+    if (!st.scene.valid(s)) return st.scene.root();
+    const sg::Payload& p = st.scene.node(s).payload;
+    if (std::holds_alternative<std::monostate>(p) || std::holds_alternative<sg::CsgPayload>(p)) return s;
+    return st.scene.valid(st.scene.node(s).parent) ? st.scene.node(s).parent : st.scene.root();
+}
+std::string uniqueName(const sg::Scene& s, const std::string& base) {
+    if (s.findByName(base) == sg::kNoNode) return base;
+    for (int i = 2;; ++i) {
+        std::string n = base + " " + std::to_string(i);
+        if (s.findByName(n) == sg::kNoNode) return n;
+    }
+}
+}  // namespace
+
+sg::NodeId ViewerState::addGroup(sg::NodeId parent) {
+    sg::NodeId id = scene.addNode(uniqueName(scene, "group"), parentFor(*this, parent));
+    selected = id;
+    markEdited();
+    return id;
+}
+
+sg::NodeId ViewerState::addShape(sg::ImplicitType type, sg::NodeId parent) {
+    sg::ImplicitPayload p;
+    p.shape.type = type;
+    if (type == sg::ImplicitType::Quadric) {
+        // A one-sheet hyperboloid x^2 + z^2 - y^2 = 0.25, clipped to the unit box.
+        p.shape.quadric = sg::mat4(1, 0, 0, 0, 0, -1, 0, 0, 0, 0, 1, 0, 0, 0, 0, -0.25f);
+    }
+    sg::NodeId id = scene.addNode(uniqueName(scene, std::string(sg::toString(type))), parentFor(*this, parent), p);
+    selected = id;
+    markEdited();
+    return id;
+}
+
+sg::NodeId ViewerState::addCsg(sg::CsgOp op, sg::NodeId parent) {
+    sg::NodeId id = scene.addNode(uniqueName(scene, "csg " + std::string(sg::toString(op))), parentFor(*this, parent),
+                                  sg::CsgPayload{sg::CsgNode{op}, -1});
+    // Two operands so the node shows something right away.
+    sg::ImplicitShape a;
+    a.type = sg::ImplicitType::Box;
+    a.halfExtents = sg::vec3(0.6f);
+    sg::ImplicitShape b;
+    b.type = sg::ImplicitType::Sphere;
+    b.radius = 0.75f;
+    scene.addNode("box", id, sg::ImplicitPayload{a, -1});
+    scene.addNode("sphere", id, sg::ImplicitPayload{b, -1});
+    selected = id;
+    markEdited();
+    return id;
+}
+
+sg::NodeId ViewerState::addLight(sg::LightType type, sg::NodeId parent) {
+    sg::Light l;
+    l.type = type;
+    l.intensity = type == sg::LightType::Directional ? 1.0f : 10.0f;
+    l.inverseSquare = type != sg::LightType::Directional;
+    sg::NodeId id = scene.addNode(uniqueName(scene, std::string(sg::toString(type)) + " light"), parentFor(*this, parent), l);
+    sg::LocalTransform t = sg::LocalTransform::fromTRS(camera.pivot + sg::vec3(0, 3, 0));
+    t.setEulerDegrees(sg::vec3(-90, 0, 0));   // point down
+    scene.setLocal(id, t);
+    selected = id;
+    markEdited();
+    return id;
+}
+
+sg::NodeId ViewerState::addCamera() {
+    sg::Camera c;
+    c.projection = projection();
+    c.focusDistance = camera.distance;
+    sg::NodeId id = scene.addNode(uniqueName(scene, "camera"), scene.root(), c);
+    scene.setLocalMatrix(id, camera.world());
+    sg::LocalTransform t = scene.node(id).local;
+    if (t.tryMakeTRS()) scene.setLocal(id, t);
+    if (!scene.valid(scene.activeCamera)) scene.activeCamera = id;
+    selected = id;
+    markEdited();
+    return id;
+}
+
+bool ViewerState::removeNode(sg::NodeId id) {
+    if (!scene.valid(id) || id == scene.root()) return false;
+    bool hadActive = scene.valid(scene.activeCamera) && scene.isAncestor(id, scene.activeCamera);
+    if (!scene.removeNode(id)) return false;
+    if (hadActive) scene.activeCamera = sg::kNoNode;
+    if (!scene.valid(selected)) selected = sg::kNoNode;
+    markEdited();
+    return true;
+}
+
+sg::NodeId ViewerState::duplicateNode(sg::NodeId id) {
+    if (!scene.valid(id) || id == scene.root()) return sg::kNoNode;
+    sg::NodeId c = scene.duplicate(id);
+    if (scene.valid(c)) {
+        scene.setName(c, uniqueName(scene, scene.node(id).name + " copy"));
+        selected = c;
+        markEdited();
+    }
+    return c;
+}
+
+bool ViewerState::reparent(sg::NodeId id, sg::NodeId newParent, std::string* error) {
+    std::string err;
+    if (scene.valid(id) && scene.valid(newParent) && scene.node(id).parent == newParent) return false;   // no-op
+    if (!scene.reparent(id, newParent, /*keepWorld=*/true, &err)) {
+        if (err.empty()) err = "cannot move this node there";
+        status = "Move refused: " + err;
+        if (error) *error = err;
+        return false;
+    }
+    markEdited();
+    return true;
+}
+
+void ViewerState::setLocal(sg::NodeId id, const sg::LocalTransform& t) {
+    if (!scene.valid(id) || scene.node(id).local == t) return;
+    scene.setLocal(id, t);
+    markEdited();
+}
+
+// --- backend ---------------------------------------------------------------------------------
+
+void ViewerState::setBackend(const std::string& name) {
+    if (backend == name) return;
+    backend = name;
+    compare.backends[0] = name;
+    status = "Backend: " + name;
+}
+
+void ViewerState::setBackendIndex(int index) {
+    std::vector<std::string> names = rnd::rendererNames();
+    if (index >= 0 && size_t(index) < names.size()) setBackend(names[index]);
+}
+
+// --- camera ----------------------------------------------------------------------------------
+
+namespace {
+const sg::Camera* activeCam(const sg::Scene& s) {
+    if (!s.valid(s.activeCamera)) return nullptr;
+    return std::get_if<sg::Camera>(&s.node(s.activeCamera).payload);
+}
+}  // namespace
+
+const sg::Projection& ViewerState::projection() const {
+    const sg::Camera* c = activeCam(scene);
+    return c ? c->projection : fallbackProjection;
+}
+
+sg::Projection& ViewerState::editProjection() {
+    if (scene.valid(scene.activeCamera) && std::holds_alternative<sg::Camera>(scene.node(scene.activeCamera).payload)) {
+        markEdited();
+        return std::get<sg::Camera>(scene.editPayload(scene.activeCamera)).projection;
+    }
+    ++viewVersion;
+    return fallbackProjection;
+}
+
+float ViewerState::focusDistance() const {
+    const sg::Camera* c = activeCam(scene);
+    return c ? c->focusDistance : fallbackFocus;
+}
+
+sg::Projection ViewerState::viewProjection() const {
+    sg::Projection p = projection();
+    p.orthoHalfHeight *= camera.orthoScale;
+    // Keep the clip range around the pivot when the user zooms far out or in.
+    if (p.type == sg::ProjectionType::Perspective && !p.useFrustum) {
+        float ratio = camera.distance / std::max(focusDistance(), 1e-6f);
+        if (ratio > 1.0f) p.zFar *= ratio;
+        if (ratio < 1.0f) p.zNear = std::max(p.zNear * ratio, 1e-4f);
+    }
+    return p;
+}
+
+void ViewerState::fitView(bool selectionOnly) {
+    sg::Aabb b;
+    if (selectionOnly && scene.valid(selected)) {
+        // Bounds of the selected subtree.
+        for (sg::NodeId id : scene.depthFirstOrder())
+            if (scene.isAncestor(selected, id)) b.extend(scene.localBounds(id).transformed(scene.world(id)));
+        if (b.empty()) b = sg::Aabb{sg::vec3(scene.world(selected)[3]) - 0.5f, sg::vec3(scene.world(selected)[3]) + 0.5f};
+    }
+    if (b.empty()) b = scene.worldBounds();
+    float aspect = float(std::max(viewportWidth, 1)) / float(std::max(viewportHeight, 1));
+    camera.fit(b, projection().fovyDeg, aspect, projection().orthoHalfHeight);
+    markViewChanged();
+}
+
+void ViewerState::resetView() {
+    const sg::Camera* c = activeCam(scene);
+    if (c) {
+        camera.setFromWorld(scene.world(scene.activeCamera), c->focusDistance);
+    } else {
+        if (scene.cameras().empty()) {
+            camera = OrbitCamera{};
+            camera.yaw = std::atan2(0.5f, 1.0f);
+            camera.pitch = 0.35f;
+            float aspect = float(std::max(viewportWidth, 1)) / float(std::max(viewportHeight, 1));
+            camera.fit(scene.worldBounds(), fallbackProjection.fovyDeg, aspect, fallbackProjection.orthoHalfHeight);
+            sg::Aabb b = scene.worldBounds();
+            float r = b.empty() ? 2.0f : 0.5f * glm::length(b.extent());
+            fallbackProjection.zNear = std::max(camera.distance - 3.0f * r, camera.distance * 0.01f);
+            fallbackProjection.zFar = camera.distance + 3.0f * r;
+            fallbackFocus = camera.distance;
+        } else {
+            useSceneCamera(scene.cameras().front());
+            return;
+        }
+    }
+    markViewChanged();
+}
+
+void ViewerState::useSceneCamera(sg::NodeId id) {
+    if (!scene.valid(id) || !std::holds_alternative<sg::Camera>(scene.node(id).payload)) return;
+    if (scene.activeCamera != id) {
+        scene.activeCamera = id;
+        markEdited();
+    }
+    camera.setFromWorld(scene.world(id), std::get<sg::Camera>(scene.node(id).payload).focusDistance);
+    markViewChanged();
+}
+
+void ViewerState::storeViewInCamera() {
+    sg::NodeId id = scene.activeCamera;
+    if (!scene.valid(id) || !std::holds_alternative<sg::Camera>(scene.node(id).payload)) return;
+    sg::NodeId parent = scene.node(id).parent;
+    sg::mat4 parentWorld = scene.valid(parent) ? scene.world(parent) : sg::mat4(1.0f);
+    sg::LocalTransform t = sg::LocalTransform::fromMatrix(glm::inverse(parentWorld) * camera.world());
+    t.tryMakeTRS();
+    sg::Camera c = std::get<sg::Camera>(scene.node(id).payload);
+    float focus = camera.distance;
+    float ortho = c.projection.orthoHalfHeight * camera.orthoScale;
+    bool changed = !(scene.node(id).local == t) || c.focusDistance != focus || c.projection.orthoHalfHeight != ortho;
+    if (!changed) return;
+    scene.setLocal(id, t);
+    c.focusDistance = focus;
+    c.projection.orthoHalfHeight = ortho;
+    scene.setPayload(id, c);
+    camera.orthoScale = 1.0f;
+    markEdited();
+}
+
+sg::FrameInput ViewerState::buildFrame(float aspect) const {
+    sg::FrameInput f = sg::flatten(scene, aspect, scene.activeCamera);
+    f.camera = sg::makeFrameCamera(camera.world(), viewProjection(), aspect, camera.distance);
+    return f;
+}
+
+sg::RenderSettings ViewerState::settingsFor(const std::string& b) const {
+    sg::RenderSettings s = scene.settings;
+    auto it = aaOverride.find(b);
+    if (it != aaOverride.end()) s.setAA(it->second);
+    return s;
+}
+
+// --- files -----------------------------------------------------------------------------------
+
+bool ViewerState::requestOpen(const fs::path& path) {
+    if (dirty) {
+        pending = PendingAction::Open;
+        pendingPath = path;
+        confirmOpen = true;
+        return false;
+    }
+    startLoad(path);
+    return true;
+}
+
+bool ViewerState::requestNew() {
+    if (dirty) {
+        pending = PendingAction::New;
+        confirmOpen = true;
+        return false;
+    }
+    sg::Scene s;
+    setScene(std::move(s), {});
+    status = "New scene";
+    return true;
+}
+
+bool ViewerState::requestQuit() {
+    if (dirty) {
+        pending = PendingAction::Quit;
+        confirmOpen = true;
+        return false;
+    }
+    requests.quit = true;
+    return true;
+}
+
+void ViewerState::confirm(ConfirmChoice choice) {
+    PendingAction action = pending;
+    pending = PendingAction::None;
+    confirmOpen = false;
+    if (choice == ConfirmChoice::Cancel || action == PendingAction::None) {
+        status = "Cancelled";
+        return;
+    }
+    if (choice == ConfirmChoice::Save) {
+        if (scenePath.empty() || scenePath.extension() != ".json") {
+            // Needs a file name first: ask for one, then the user repeats the action.
+            requests.saveAsDialog = true;
+            status = "Choose where to save, then repeat the action";
+            return;
+        }
+        if (!save().empty()) return;   // failed: keep everything, the error is shown
+    }
+    dirty = false;
+    switch (action) {
+    case PendingAction::Open: startLoad(pendingPath); break;
+    case PendingAction::New: requestNew(); break;
+    case PendingAction::Quit: requests.quit = true; break;
+    case PendingAction::None: break;
+    }
+}
+
+void ViewerState::startLoad(const fs::path& path) {
+    if (loading.valid()) {
+        status = "Still loading " + loadingPath.filename().string();
+        return;
+    }
+    loadingPath = path;
+    status = "Loading " + path.string() + " ...";
+    loading = std::async(std::launch::async, [path] {
+        try {
+            return assets::loadScene(path);
+        } catch (const std::exception& e) {
+            assets::LoadResult r;
+            r.error = path.string() + ": " + e.what();
+            return r;
+        }
+    });
+}
+
+bool ViewerState::pollLoad(bool wait) {
+    if (!loading.valid()) return false;
+    if (!wait && loading.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return false;
+    assets::LoadResult r = loading.get();
+    loadWarnings = r.warnings;
+    if (!r.scene) {
+        errorPopup = "Could not open " + loadingPath.string() + ":\n" + (r.error.empty() ? "unknown error" : r.error);
+        status = "Open failed; the current scene is unchanged";
+        return true;
+    }
+    setScene(std::move(*r.scene), loadingPath);
+    addRecent(fs::absolute(loadingPath).lexically_normal().string());
+    status = "Opened " + loadingPath.string() + (r.warnings.empty() ? "" : " (" + std::to_string(r.warnings.size()) + " warnings)");
+    return true;
+}
+
+std::string ViewerState::save(const fs::path& path) {
+    fs::path target = path.empty() ? scenePath : path;
+    if (target.empty()) {
+        requests.saveAsDialog = true;
+        return "no file name";
+    }
+    if (target.extension() != ".json") target += ".json";   // imports are never overwritten
+    storeViewInCamera();
+    std::string err;
+    try {
+        err = assets::saveSceneJson(scene, target, /*overwrite=*/true);
+    } catch (const std::exception& e) {
+        err = target.string() + ": " + e.what();
+    }
+    if (!err.empty()) {
+        errorPopup = "Could not save:\n" + err;
+        status = "Save failed";
+        return err;
+    }
+    scenePath = target;
+    dirty = false;
+    addRecent(fs::absolute(target).lexically_normal().string());
+    status = "Saved " + target.string();
+    return {};
+}
+
+void ViewerState::addRecent(const std::string& path) {
+    std::erase(recentFiles, path);
+    recentFiles.insert(recentFiles.begin(), path);
+    if (recentFiles.size() > 10) recentFiles.resize(10);
+    if (!configDir.empty()) saveRecentFiles(configDir, recentFiles);
+}
+
+// --- config helpers --------------------------------------------------------------------------
+
+fs::path defaultConfigDir() {
+    if (const char* x = std::getenv("XDG_CONFIG_HOME"); x && *x) return fs::path(x) / "sceneviewer";
+    if (const char* h = std::getenv("HOME"); h && *h) return fs::path(h) / ".config" / "sceneviewer";
+    return fs::temp_directory_path() / "sceneviewer";
+}
+
+std::vector<std::string> loadRecentFiles(const fs::path& dir) {
+    std::vector<std::string> out;
+    std::string text;
+    if (!assets::readFileLimited(dir / "recent.txt", 1 << 20, text).empty()) return out;
+    std::istringstream in(text);
+    std::string line;
+    while (std::getline(in, line) && out.size() < 10)
+        if (!line.empty()) out.push_back(line);
+    return out;
+}
+
+std::string saveRecentFiles(const fs::path& dir, const std::vector<std::string>& files) {
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    std::string text;
+    for (const auto& f : files) text += f + "\n";
+    return assets::writeFileAtomic(dir / "recent.txt", text, /*overwrite=*/true);
+}
+
+fs::path screenshotPath(const fs::path& dir, const std::string& backend, const std::string& stem) {
+    return assets::uniquePath(dir / (stem + "-" + backend + ".png"));
+}
+
+}  // namespace ui
