@@ -142,6 +142,7 @@ struct GpuMesh {
     GLenum primitive = GL_TRIANGLES;
     std::vector<IndexRange> ranges;
     size_t triangles = 0;
+    vec3 centre{0.0f};    // centre of the local bounding box (front-to-back sorting)
     bool valid = false;   // false: the mesh failed validation and is skipped
     uint64_t lastUsed = 0;
 };
@@ -189,6 +190,8 @@ void uploadMesh(GpuMesh& g, const Mesh& mesh, const std::vector<uint16_t>* trian
         computed = std::move(tmp.normals);
         normals = &computed;
     }
+    Aabb box = mesh.bounds();
+    g.centre = box.empty() ? vec3(0.0f) : 0.5f * (box.min + box.max);
     std::vector<Vertex> verts(mesh.positions.size());
     for (size_t i = 0; i < verts.size(); ++i) {
         Vertex& v = verts[i];
@@ -428,7 +431,7 @@ public:
 
 private:
     std::string prepareContext(bool& madeCurrent);
-    std::string ensureGLObjects();
+    std::string ensureProgram(int shading);   // compiles on first use
     void forgetGLObjects();   // drops names without deleting (their context is gone or not current)
     void releaseAll();
     GpuMesh* meshFor(const Mesh& mesh, const std::vector<uint16_t>* triangleMaterial);
@@ -482,13 +485,10 @@ std::string GlRenderer::prepareContext(bool& madeCurrent) {
     return {};
 }
 
-std::string GlRenderer::ensureGLObjects() {
-    for (int s = 0; s < 3; ++s) {
-        if (m_programs[s].id) continue;
-        std::string err = buildProgram(s, m_programs[s]);
-        if (!err.empty()) return "gl backend: " + err;
-    }
-    return {};
+std::string GlRenderer::ensureProgram(int shading) {
+    if (m_programs[shading].id) return {};
+    std::string err = buildProgram(shading, m_programs[shading]);
+    return err.empty() ? err : "gl backend: " + err;
 }
 
 void GlRenderer::forgetGLObjects() {
@@ -637,7 +637,7 @@ RenderStats GlRenderer::render(const FrameInput& frame, int width, int height, F
 
     StateGuard guard;
     ++m_frame;
-    err = ensureGLObjects();
+    err = ensureProgram(int(frame.settings.shading));
     if (!err.empty()) {
         stats.error = err;
         return stats;
@@ -717,6 +717,17 @@ RenderStats GlRenderer::render(const FrameInput& frame, int width, int height, F
         it.texture = perTriangle ? nullptr : textureFor(a.texture);
         items.push_back(it);
     }
+
+    // Nearest first, so that llvmpipe's early depth test skips shading hidden fragments.
+    std::vector<float> distance(items.size());
+    for (size_t i = 0; i < items.size(); ++i)
+        distance[i] = glm::length(vec3(*items[i].world * vec4(items[i].gpu->centre, 1.0f)) - frame.camera.eye);
+    std::vector<uint32_t> order(items.size());
+    std::iota(order.begin(), order.end(), 0u);
+    std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return distance[a] < distance[b]; });
+    std::vector<DrawItem> sorted(items.size());
+    for (size_t i = 0; i < order.size(); ++i) sorted[i] = items[order[i]];
+    items.swap(sorted);
 
     const Program& prog = m_programs[int(s.shading)];
     glUseProgram(prog.id);
