@@ -331,3 +331,59 @@ TEST(GlCacheGLTest, InvalidMeshIsSkipped) {
     EXPECT_TRUE(st.ok) << st.error;
     EXPECT_EQ(fb.pixel(16, 16)[0], 0);
 }
+
+// Every pixel of a plane lit by a point (1/r^2), a spot (partly inside its cone falloff) and a
+// directional light, with fog, equals rnd::shade() + rnd::applyFog() evaluated on the CPU at
+// the same surface point: the shaders mirror renderers/common/shading.cpp. (A plane has one
+// normal, so flat and Phong shading are both exact; Gouraud is checked at the sphere centre.)
+TEST(GlShadingGLTest, PlaneMatchesSharedShadingFunctionEverywhere) {
+    const int W = 96, H = 72;
+    for (ShadingModel model : {ShadingModel::Phong, ShadingModel::Flat})
+        for (ReflectionModel refl : {ReflectionModel::Phong, ReflectionModel::BlinnPhong}) {
+            FrameInput f = makeFrame(W, H, Projection{}, vec3(0.6f, 0.4f, 4.0f), vec3(0.0f));
+            f.ambientLight = vec3(0.2f, 0.22f, 0.25f);
+            f.settings.shading = model;
+            f.settings.reflection = refl;
+            f.settings.fog = FogMode::Exp;
+            f.settings.fogDensity = 0.04f;
+            f.settings.fogColor = vec3(0.3f, 0.3f, 0.35f);
+            f.lights.push_back(point(vec3(1.0f, 1.0f, 1.5f), vec3(2.5f, 2.2f, 2.0f), true));
+            f.lights.push_back(spot(vec3(-1.0f, 0.5f, 2.0f), vec3(0.2f, -0.25f, -1.0f), vec3(1.2f, 1.0f, 0.6f), 10.0f, 25.0f));
+            f.lights.push_back(directional(vec3(0.2f, -0.3f, -1.0f), vec3(0.15f, 0.2f, 0.3f)));
+            Material m;
+            m.baseColor = vec3(0.7f, 0.6f, 0.5f);
+            m.ka = 0.3f;
+            m.kd = 0.6f;
+            m.ks = 0.4f;
+            m.shininess = 20.0f;
+            addMesh(f, quad(6.0f), m);
+            rnd::Framebuffer fb = render(f, W, H);
+
+            mat4 inv = glm::inverse(f.camera.viewProj);
+            double sum = 0;
+            int worst = 0, count = 0;
+            for (int row = 0; row < H; ++row)
+                for (int x = 0; x < W; ++x) {
+                    // Pixel centre -> NDC -> ray through the near and far planes -> z = 0 plane.
+                    float nx = 2.0f * (x + 0.5f) / W - 1.0f, ny = 2.0f * (H - 1 - row + 0.5f) / H - 1.0f;
+                    vec4 a = inv * vec4(nx, ny, -1.0f, 1.0f), b = inv * vec4(nx, ny, 1.0f, 1.0f);
+                    vec3 p0 = vec3(a) / a.w, p1 = vec3(b) / b.w;
+                    float t = p0.z / (p0.z - p1.z);
+                    vec3 p = p0 + t * (p1 - p0);
+                    rnd::SurfacePoint sp{p, vec3(0, 0, 1), m.baseColor};
+                    vec3 c = rnd::shade(m, sp, f.camera.eye, f);
+                    c = rnd::applyFog(f.settings, c, glm::length(vec3(f.camera.view * vec4(p, 1.0f))));
+                    for (int ch = 0; ch < 3; ++ch) {
+                        int d = std::abs(int(fb.pixel(x, row)[ch]) - int(rnd::toByteSRGB(c[ch])));
+                        worst = std::max(worst, d);
+                        sum += d;
+                        ++count;
+                    }
+                }
+            double mean = sum / count;
+            std::printf("[plane] %s/%s: mean %.3f max %d\n", std::string(toString(model)).c_str(),
+                        std::string(toString(refl)).c_str(), mean, worst);
+            EXPECT_LE(mean, 0.5) << toString(model) << " " << toString(refl);
+            EXPECT_LE(worst, 3) << toString(model) << " " << toString(refl);
+        }
+}
