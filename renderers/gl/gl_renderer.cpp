@@ -47,8 +47,8 @@ struct Program {
     GLuint id = 0;
     // Uniform locations.
     GLint model = -1, normalMatrix = -1, viewProj = -1, view = -1, pointSize = -1;
-    GLint numLights = -1, lightPos = -1, lightDir = -1, lightRad = -1, lightCone = -1;
-    GLint eye = -1, ambient = -1, reflection = -1;
+    GLint lightPos = -1, lightDir = -1, lightRad = -1, lightCone = -1;
+    GLint eye = -1, ambient = -1;
     GLint baseColor = -1, ka = -1, kd = -1, ks = -1, shininess = -1, specTinted = -1, specColor = -1, emissive = -1;
     GLint texture = -1, hasTexture = -1, unlit = -1, solid = -1, solidColor = -1;
     GLint fogMode = -1, fogColor = -1, fogParams = -1;
@@ -69,9 +69,33 @@ std::string compileShader(GLenum type, const std::string& src, GLuint& out) {
     return std::string(type == GL_VERTEX_SHADER ? "vertex" : "fragment") + " shader: " + msg;
 }
 
-std::string buildProgram(int shading, Program& p) {
-    std::string prefix = "#version 330 core\n#define SHADING " + std::to_string(shading) + "\n#define MAX_LIGHTS " +
-                         std::to_string(kMaxLights) + "\n";
+// Programs are specialised per frame setup (see lighting.glsl): the key is the shading model,
+// the reflection model and one letter per light (p/P point, d directional, s/S spot; upper
+// case = inverse square).
+std::string programKey(const FrameInput& f) {
+    std::string key;
+    key += char('0' + int(f.settings.shading));
+    key += char('0' + int(f.settings.reflection));
+    size_t n = std::min<size_t>(f.lights.size(), kMaxLights);
+    for (size_t i = 0; i < n; ++i) {
+        const DrawLight& l = f.lights[i];
+        char c = l.type == LightType::Point ? 'p' : l.type == LightType::Directional ? 'd' : 's';
+        if (l.inverseSquare && c != 'd') c = char(c - 'a' + 'A');
+        key += c;
+    }
+    return key;
+}
+
+std::string buildProgram(const std::string& key, Program& p) {
+    std::string calls;
+    for (size_t i = 2; i < key.size(); ++i) {
+        char c = char(key[i] | 0x20);
+        const char* type = c == 'p' ? "LIGHT_POINT" : c == 'd' ? "LIGHT_DIRECTIONAL" : "LIGHT_SPOT";
+        bool invSq = key[i] >= 'A' && key[i] <= 'Z';
+        calls += "addLight(" + std::to_string(i - 2) + ", " + type + ", " + (invSq ? "true" : "false") + ", n, p, v, mul, add); ";
+    }
+    std::string prefix = std::string("#version 330 core\n#define SHADING ") + key[0] + "\n#define REFLECTION " + key[1] +
+                         "\n#define MAX_LIGHTS " + std::to_string(kMaxLights) + "\n#define LIGHT_CALLS " + calls + "\n";
     std::string common = prefix + gl::kShader_lighting_glsl + "\n";
     GLuint vs = 0, fs = 0;
     std::string err = compileShader(GL_VERTEX_SHADER, common + gl::kShader_mesh_vert, vs);
@@ -101,14 +125,12 @@ std::string buildProgram(int shading, Program& p) {
     p.viewProj = loc("uViewProj");
     p.view = loc("uView");
     p.pointSize = loc("uPointSize");
-    p.numLights = loc("uNumLights");
     p.lightPos = loc("uLightPos");
     p.lightDir = loc("uLightDir");
     p.lightRad = loc("uLightRad");
     p.lightCone = loc("uLightCone");
     p.eye = loc("uEye");
     p.ambient = loc("uAmbient");
-    p.reflection = loc("uReflection");
     p.baseColor = loc("uBaseColor");
     p.ka = loc("uKa");
     p.kd = loc("uKd");
@@ -431,7 +453,7 @@ public:
 
 private:
     std::string prepareContext(bool& madeCurrent);
-    std::string ensureProgram(int shading);   // compiles on first use
+    const Program* programFor(const FrameInput& f, std::string& error);   // compiles on first use
     void forgetGLObjects();   // drops names without deleting (their context is gone or not current)
     void releaseAll();
     GpuMesh* meshFor(const Mesh& mesh, const std::vector<uint16_t>* triangleMaterial);
@@ -446,7 +468,7 @@ private:
     std::string m_contextDescription, m_platform;
     int m_maxSamples = 0, m_maxSize = 0;
 
-    Program m_programs[3];
+    std::unordered_map<std::string, Program> m_programs;   // by programKey()
     RenderTarget m_target, m_resolve;
     std::unordered_map<uint64_t, GpuMesh> m_meshes;       // by Mesh::id
     std::unordered_map<uint64_t, GpuTexture> m_textures;  // by Texture::id
@@ -485,14 +507,26 @@ std::string GlRenderer::prepareContext(bool& madeCurrent) {
     return {};
 }
 
-std::string GlRenderer::ensureProgram(int shading) {
-    if (m_programs[shading].id) return {};
-    std::string err = buildProgram(shading, m_programs[shading]);
-    return err.empty() ? err : "gl backend: " + err;
+const Program* GlRenderer::programFor(const FrameInput& f, std::string& error) {
+    std::string key = programKey(f);
+    auto it = m_programs.find(key);
+    if (it != m_programs.end()) return &it->second;
+    Program p;
+    error = buildProgram(key, p);
+    if (!error.empty()) {
+        error = "gl backend: " + error;
+        return nullptr;
+    }
+    // Light setups come and go while editing: keep a bounded number of programs.
+    if (m_programs.size() >= 64) {
+        for (auto& [k, old] : m_programs) glDeleteProgram(old.id);
+        m_programs.clear();
+    }
+    return &m_programs.emplace(key, p).first->second;
 }
 
 void GlRenderer::forgetGLObjects() {
-    for (auto& p : m_programs) p = Program{};
+    m_programs.clear();
     m_target = RenderTarget{};
     m_resolve = RenderTarget{};
     m_meshes.clear();
@@ -506,8 +540,7 @@ void GlRenderer::releaseAll() {
     bool madeCurrent = false;
     if (m_own && m_objectsContext && !gl::anyContextCurrent()) madeCurrent = m_own->makeCurrent(nullptr);
     if (m_loaded && gl::currentContextHandle() == m_objectsContext) {
-        for (auto& p : m_programs)
-            if (p.id) glDeleteProgram(p.id);
+        for (auto& [key, p] : m_programs) glDeleteProgram(p.id);
         m_target.release();
         m_resolve.release();
         for (auto& [id, m] : m_meshes) releaseMesh(m);
@@ -566,7 +599,6 @@ void GlRenderer::setFrameUniforms(const Program& p, const FrameInput& f, int ssa
     glUniformMatrix4fv(p.view, 1, GL_FALSE, &f.camera.view[0][0]);
     glUniform3fv(p.eye, 1, &f.camera.eye[0]);
     glUniform3fv(p.ambient, 1, &f.ambientLight[0]);
-    glUniform1i(p.reflection, s.reflection == ReflectionModel::BlinnPhong ? 1 : 0);
     glUniform1f(p.pointSize, 2.0f * float(ssaa));
     glUniform1i(p.texture, 0);
     glUniform1i(p.fogMode, int(s.fog));
@@ -578,14 +610,12 @@ void GlRenderer::setFrameUniforms(const Program& p, const FrameInput& f, int ssa
     int n = int(std::min<size_t>(f.lights.size(), kMaxLights));
     std::vector<vec4> pos(n), dir(n), rad(n), cone(n);
     for (int i = 0; i < n; ++i) {
-        const DrawLight& l = f.lights[i];
-        float type = l.type == LightType::Point ? 0.0f : l.type == LightType::Directional ? 1.0f : 2.0f;
-        pos[i] = vec4(l.position, type);
-        dir[i] = vec4(l.direction, l.inverseSquare ? 1.0f : 0.0f);
+        const DrawLight& l = f.lights[i];   // type and 1/r^2 are compiled in (programKey)
+        pos[i] = vec4(l.position, 0.0f);
+        dir[i] = vec4(l.direction, 0.0f);
         rad[i] = vec4(l.radiance, 0.0f);
         cone[i] = vec4(l.cosInner, l.cosOuter, 0.0f, 0.0f);
     }
-    glUniform1i(p.numLights, n);
     if (n > 0) {
         glUniform4fv(p.lightPos, n, &pos[0][0]);
         glUniform4fv(p.lightDir, n, &dir[0][0]);
@@ -637,8 +667,8 @@ RenderStats GlRenderer::render(const FrameInput& frame, int width, int height, F
 
     StateGuard guard;
     ++m_frame;
-    err = ensureProgram(int(frame.settings.shading));
-    if (!err.empty()) {
+    const Program* program = programFor(frame, err);
+    if (!program) {
         stats.error = err;
         return stats;
     }
@@ -729,7 +759,7 @@ RenderStats GlRenderer::render(const FrameInput& frame, int width, int height, F
     for (size_t i = 0; i < order.size(); ++i) sorted[i] = items[order[i]];
     items.swap(sorted);
 
-    const Program& prog = m_programs[int(s.shading)];
+    const Program& prog = *program;
     glUseProgram(prog.id);
     setFrameUniforms(prog, frame, ssaa);
     uint64_t triangles = 0;
