@@ -245,20 +245,31 @@ inline sg::vec4 toWindow(const sg::vec4& c, int width, int height) {
 // 4. Lines: DDA (seeds: "Digital Differential Analyzer") over window coordinates
 // ---------------------------------------------------------------------------------------
 
-// Calls fn(i, j, t) for the pixels of the segment a -> b (window coordinates), stepping one
-// pixel along the major axis; t in [0,1] is the position along the segment (for depth and
-// colour interpolation). Pixels outside [0,w) x [0,h) are skipped.
+// Calls fn(i, j, t) for the pixels of the segment a -> b (window coordinates): one pixel per
+// column (x-major) or row (y-major) whose centre lies in [start, end) along the major axis,
+// the minor coordinate stepped incrementally by the slope and sampled at that centre (GL's
+// diamond-exit rule for thin lines, approximately); t in [0,1] is the screen-space position
+// of the sample along the segment. Half-open, so joined segments do not repeat a pixel.
 template <class Fn>
 inline void drawLineDDA(float ax, float ay, float bx, float by, int width, int height, Fn&& fn) {
     float dx = bx - ax, dy = by - ay;
-    float len = std::max(std::fabs(dx), std::fabs(dy));
-    if (!(len < 1e6f)) return;   // non-finite or absurd
-    int steps = std::max(1, int(std::ceil(len)));
-    float sx = dx / steps, sy = dy / steps;
-    float x = ax, y = ay;
-    for (int k = 0; k <= steps; ++k, x += sx, y += sy) {
-        int i = int(std::floor(x)), j = int(std::floor(y));
-        if (i >= 0 && j >= 0 && i < width && j < height) fn(i, j, float(k) / steps);
+    if (!(std::fabs(dx) < 1e6f && std::fabs(dy) < 1e6f)) return;   // non-finite or absurd
+    const bool xMajor = std::fabs(dx) >= std::fabs(dy);
+    const float a0 = xMajor ? ax : ay, len = xMajor ? dx : dy;
+    const float b0 = xMajor ? ay : ax, d = xMajor ? dy : dx;
+    if (len == 0) return;
+    const float slope = d / len;
+    const int majorSize = xMajor ? width : height, minorSize = xMajor ? height : width;
+    int lo = int(std::ceil(std::min(a0, a0 + len) - 0.5f)), hi = int(std::ceil(std::max(a0, a0 + len) - 0.5f)) - 1;
+    lo = std::max(lo, 0);
+    hi = std::min(hi, majorSize - 1);
+    for (int k = lo; k <= hi; ++k) {
+        float c = k + 0.5f;
+        float t = (c - a0) / len;
+        int m = int(std::floor(b0 + (c - a0) * slope));
+        if (m < 0 || m >= minorSize) continue;
+        if (xMajor) fn(k, m, t);
+        else fn(m, k, t);
     }
 }
 

@@ -574,38 +574,66 @@ bool clipSegment(vec4& a, vec4& b, const GuardBand& g) {
     return true;
 }
 
-void writeLinePixel(Framebuffer& fb, int i, int j, float z, const uint8_t rgb[3], float bias) {
+void writeLinePixel(Framebuffer& fb, int i, int j, float z, const vec3& linear, float bias) {
     int row = fb.height - 1 - j;
     float& dst = fb.depth[size_t(row) * fb.width + i];
-    if (!(z < dst + bias)) return;
+    if (!(z < dst + bias)) return;   // LESS (wireframe: LEQUAL with a small offset)
     dst = std::min(dst, z);
+    const SrgbEncoder& enc = srgbEncoder();
     uint8_t* p = fb.pixel(i, row);
-    p[0] = rgb[0]; p[1] = rgb[1]; p[2] = rgb[2]; p[3] = 255;
+    p[0] = enc(linear.x); p[1] = enc(linear.y); p[2] = enc(linear.z); p[3] = 255;
 }
 
-void drawSegment(Framebuffer& fb, vec4 a, vec4 b, const GuardBand& g, const uint8_t rgb[3], float bias) {
-    if (!clipSegment(a, b, g)) return;
-    vec4 wa = toWindow(a, fb.width, fb.height), wb = toWindow(b, fb.width, fb.height);
+// End point of a line: clip position, unfogged linear colour, eye distance (for fog).
+struct LineEnd {
+    vec4 clip;
+    vec3 color;
+    float eyeDist;
+};
+
+// Draws segment a-b: clipped in clip space, DDA in window space; depth, colour and fog
+// distance interpolated perspective-correctly per pixel, fog applied per pixel (as GL does).
+void drawSegment(Framebuffer& fb, LineEnd a, LineEnd b, const GuardBand& g, const sg::RenderSettings& st, float bias) {
+    vec4 ca = a.clip, cb = b.clip;
+    float t0 = 0, t1 = 1;
+    {
+        vec4 ta = ca, tb = cb;
+        if (!clipSegment(ta, tb, g)) return;
+        // Recover the clip parameters to interpolate the attributes.
+        vec4 dd = cb - ca;
+        int axis = 0;
+        for (int k = 1; k < 4; ++k)
+            if (std::fabs(dd[k]) > std::fabs(dd[axis])) axis = k;
+        if (dd[axis] != 0) { t0 = (ta[axis] - ca[axis]) / dd[axis]; t1 = (tb[axis] - ca[axis]) / dd[axis]; }
+        ca = ta;
+        cb = tb;
+    }
+    auto lerp = [](const LineEnd& x, const LineEnd& y, float t) {
+        return LineEnd{x.clip + t * (y.clip - x.clip), x.color + t * (y.color - x.color), x.eyeDist + t * (y.eyeDist - x.eyeDist)};
+    };
+    LineEnd ea = lerp(a, b, t0), eb = lerp(a, b, t1);
+    vec4 wa = toWindow(ca, fb.width, fb.height), wb = toWindow(cb, fb.width, fb.height);
+    const bool fog = st.fog != sg::FogMode::Off;
     drawLineDDA(wa.x, wa.y, wb.x, wb.y, fb.width, fb.height, [&](int i, int j, float t) {
-        writeLinePixel(fb, i, j, std::clamp(wa.z + t * (wb.z - wa.z), 0.0f, 1.0f), rgb, bias);
+        float z = std::clamp(wa.z + t * (wb.z - wa.z), 0.0f, 1.0f);         // window z: screen-linear
+        float tp = t * wb.w / ((1 - t) * wa.w + t * wb.w);                  // perspective-correct
+        vec3 c = ea.color + tp * (eb.color - ea.color);
+        if (fog) c = applyFog(st, c, ea.eyeDist + tp * (eb.eyeDist - ea.eyeDist));
+        writeLinePixel(fb, i, j, z, c, bias);
     });
 }
 
 void drawLinesAndWireframe(const std::vector<DrawItem>& lineDraws, const std::vector<DrawItem>& triDraws, const sg::FrameInput& f,
-                           Framebuffer& fb) {
+                           Framebuffer& fb, float pointSize) {
     const GuardBand g = guardBand(fb.width, fb.height);
-    const SrgbEncoder& enc = srgbEncoder();
+    const auto& st = f.settings;
+    auto eyeDist = [&](const vec3& wpos) { return glm::length(vec3(f.camera.view * vec4(wpos, 1.0f))); };
     for (const DrawItem& d : lineDraws) {
         const sg::Mesh& m = *d.mesh;
-        // Unlit: base colour (x) vertex colour + emissive, fogged.
-        auto colorOf = [&](uint32_t mi, const vec4& clip) {
-            vec3 c = d.material.baseColor * (d.hasColors ? vec3(m.colors[mi]) : vec3(1.0f)) + d.material.emissive;
-            if (f.settings.fog != sg::FogMode::Off) {
-                vec3 pe = vec3(f.camera.view * vec4(d.wpos[mi], 1.0f));
-                c = applyFog(f.settings, c, glm::length(pe));
-            }
-            (void)clip;
-            return c;
+        // Unlit, as GL draws lines and points: base colour (x) vertex colour + emissive.
+        auto end = [&](uint32_t v) {
+            vec3 c = d.material.baseColor * (d.hasColors ? vec3(m.colors[v]) : vec3(1.0f)) + d.material.emissive;
+            return LineEnd{d.clip[v], c, eyeDist(d.wpos[v])};
         };
         size_t n = m.indices.empty() ? m.positions.size() : m.indices.size();
         auto idx = [&](size_t k) { return m.indices.empty() ? uint32_t(k) : m.indices[k]; };
@@ -613,32 +641,37 @@ void drawLinesAndWireframe(const std::vector<DrawItem>& lineDraws, const std::ve
             for (size_t k = 0; k + 1 < n; k += 2) {
                 uint32_t ia = idx(k), ib = idx(k + 1);
                 if (ia >= d.clip.size() || ib >= d.clip.size()) continue;
-                vec3 c = 0.5f * (colorOf(ia, d.clip[ia]) + colorOf(ib, d.clip[ib]));
-                uint8_t rgb[3] = {enc(c.x), enc(c.y), enc(c.z)};
-                drawSegment(fb, d.clip[ia], d.clip[ib], g, rgb, 0.0f);
+                drawSegment(fb, end(ia), end(ib), g, st, 0.0f);
             }
         } else {
+            // Points: squares of pointSize pixels centred on the vertex (GL point rules).
             for (size_t k = 0; k < n; ++k) {
                 uint32_t ia = idx(k);
                 if (ia >= d.clip.size() || d.code[ia] != 0) continue;
                 vec4 w = toWindow(d.clip[ia], fb.width, fb.height);
-                int i = int(std::floor(w.x)), j = int(std::floor(w.y));
-                if (i < 0 || j < 0 || i >= fb.width || j >= fb.height) continue;
-                vec3 c = colorOf(ia, d.clip[ia]);
-                uint8_t rgb[3] = {enc(c.x), enc(c.y), enc(c.z)};
-                writeLinePixel(fb, i, j, std::clamp(w.z, 0.0f, 1.0f), rgb, 0.0f);
+                LineEnd e = end(ia);
+                vec3 c = st.fog != sg::FogMode::Off ? applyFog(st, e.color, e.eyeDist) : e.color;
+                float h = 0.5f * pointSize;
+                int i0 = int(std::ceil(w.x - h - 0.5f)), i1 = int(std::ceil(w.x + h - 0.5f)) - 1;
+                int j0 = int(std::ceil(w.y - h - 0.5f)), j1 = int(std::ceil(w.y + h - 0.5f)) - 1;
+                for (int j = std::max(j0, 0); j <= std::min(j1, fb.height - 1); ++j)
+                    for (int i = std::max(i0, 0); i <= std::min(i1, fb.width - 1); ++i) writeLinePixel(fb, i, j, std::clamp(w.z, 0.0f, 1.0f), c, 0.0f);
             }
         }
     }
-    if (!f.settings.wireframe) return;
-    vec3 wc = f.settings.wireframeColor;
-    uint8_t rgb[3] = {enc(wc.x), enc(wc.y), enc(wc.z)};
+    if (!st.wireframe) return;
+    // Wireframe overlay: every triangle edge, depth LEQUAL with a small offset toward the
+    // viewer (GL: glPolygonOffset(-1, -1)), wireframe colour fogged like GL's overlay.
     for (const DrawItem& d : triDraws)
         for (uint32_t t = 0; t < d.triCount; ++t) {
             uint32_t v[3] = {d.vertexOf(t, 0), d.vertexOf(t, 1), d.vertexOf(t, 2)};
             if (v[0] >= d.clip.size() || v[1] >= d.clip.size() || v[2] >= d.clip.size()) continue;
             if (d.code[v[0]] & d.code[v[1]] & d.code[v[2]]) continue;
-            for (int k = 0; k < 3; ++k) drawSegment(fb, d.clip[v[k]], d.clip[v[(k + 1) % 3]], g, rgb, 2e-4f);
+            for (int k = 0; k < 3; ++k) {
+                LineEnd a{d.clip[v[k]], st.wireframeColor, eyeDist(d.wpos[v[k]])};
+                LineEnd b{d.clip[v[(k + 1) % 3]], st.wireframeColor, eyeDist(d.wpos[v[(k + 1) % 3]])};
+                drawSegment(fb, a, b, g, st, 2e-4f);
+            }
         }
 }
 
@@ -671,7 +704,7 @@ public:
         if (st.aa == sg::AAMode::SSAA && st.aaRate > 1) {
             int r = std::clamp(st.aaRate, 2, 4);
             Framebuffer hi;
-            stats = renderSingle(frame, width * r, height * r, hi, false, control);
+            stats = renderSingle(frame, width * r, height * r, hi, false, control, r);
             if (stats.ok) target = downsample(hi, r);
             else target.resize(width, height);
         } else {
@@ -693,7 +726,9 @@ private:
         return e.tex.get();
     }
 
-    RenderStats renderSingle(const sg::FrameInput& frame, int width, int height, Framebuffer& target, bool msaa, RenderControl* control) {
+    // pointScale: the SSAA factor (points are 2 pixels wide at the output resolution, like GL).
+    RenderStats renderSingle(const sg::FrameInput& frame, int width, int height, Framebuffer& target, bool msaa, RenderControl* control,
+                             int pointScale = 1) {
         RenderStats stats;
         auto t0frame = std::chrono::steady_clock::now();
         ++m_frame;
@@ -804,7 +839,7 @@ private:
 
         auto tTiles = std::chrono::steady_clock::now();
         // 5. lines, points, wireframe
-        drawLinesAndWireframe(lineDraws, draws, frame, target);
+        drawLinesAndWireframe(lineDraws, draws, frame, target, 2.0f * float(pointScale));
         if (m_timing) {
             size_t ntri = 0;
             for (const auto& c : chunks) ntri += c.tris.size();

@@ -591,7 +591,7 @@ TEST(RasterRendererTest, LinesPointsAndWireframe) {
     }
     EXPECT_GE(red, 2 * 19);   // two segments ~20 px long (1/3 of the view), 1 px wide
     EXPECT_LE(red, 2 * 22);
-    EXPECT_EQ(green, 1);
+    EXPECT_EQ(green, 4);   // points are 2x2 pixels, like GL with point size 2
     // Wireframe overlay over a quad draws the edge colour along the outline.
     auto q = quadMesh({-1, -1, -3}, {1, -1, -3}, {1, 1, -3}, {-1, 1, -3});
     FrameInput g;
