@@ -7,7 +7,8 @@
 //
 // Prints one line per scene and metric:
 //   bench: scene=<name> what=<metric> ours=<x> ref=<y> ratio=<ours/ref>
-// metrics: ms (median ms per frame), mpix_s (fill rate: covered pixels per second / 1e6).
+// metrics: ms (median wall ms per frame), cpu_ms (median process CPU ms per frame, all
+// threads), mpix_s (fill rate: covered pixels per wall second / 1e6).
 // Scenes: spheres10k / spheres100k / spheres1M (uv-sphere grids on a tessellated ground
 // plane) and bunny (stanford-bunny.obj from shared/testdata, read by a tiny OBJ reader below).
 // LP_NUM_THREADS is set before the GL context is created; tbb is limited to the same count.
@@ -17,6 +18,8 @@
 #include "scenegraph/scene.h"
 
 #include <tbb/global_control.h>
+
+#include <sys/resource.h>
 
 #include <algorithm>
 #include <chrono>
@@ -150,17 +153,32 @@ double median(std::vector<double> v) {
     return v[v.size() / 2];
 }
 
-// Median ms per frame (after one warm-up frame); NAN when the renderer fails.
-double timeFrames(rnd::Renderer& r, const FrameInput& f, int w, int h, int frames, rnd::Framebuffer& fb, std::string& err) {
+// Process CPU time (all threads, user + system) in ms.
+double cpuMs() {
+    rusage u{};
+    getrusage(RUSAGE_SELF, &u);
+    return (u.ru_utime.tv_sec + u.ru_stime.tv_sec) * 1e3 + (u.ru_utime.tv_usec + u.ru_stime.tv_usec) * 1e-3;
+}
+
+struct Timing {
+    double wallMs = NAN, cpuMs = NAN;   // medians per frame
+};
+
+// Median wall and CPU ms per frame (after one warm-up frame); NAN when the renderer fails.
+// CPU time (summed over the process's threads: ours and llvmpipe's) is the steadier figure on
+// a shared, loaded machine.
+Timing timeFrames(rnd::Renderer& r, const FrameInput& f, int w, int h, int frames, rnd::Framebuffer& fb, std::string& err) {
     rnd::RenderStats s = r.render(f, w, h, fb);   // warm-up: caches, textures, GL buffers
-    if (!s.ok) { err = s.error; return NAN; }
-    std::vector<double> t;
+    if (!s.ok) { err = s.error; return {}; }
+    std::vector<double> t, c;
     for (int i = 0; i < frames; ++i) {
         auto t0 = std::chrono::steady_clock::now();
+        double c0 = cpuMs();
         s = r.render(f, w, h, fb);
+        c.push_back(cpuMs() - c0);
         t.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     }
-    return median(t);
+    return {median(t), median(c)};
 }
 
 // Pixels not equal to the background (covered by geometry).
@@ -216,12 +234,14 @@ int main(int argc, char** argv) {
         FrameInput f = flatten(b.scene, float(w) / h);
         rnd::Framebuffer fbO, fbR;
         std::string eo, er;
-        double to = timeFrames(*ours, f, w, h, frames, fbO, eo);
-        double tr = ref ? timeFrames(*ref, f, w, h, frames, fbR, er) : NAN;
+        Timing o = timeFrames(*ours, f, w, h, frames, fbO, eo);
+        Timing r = ref ? timeFrames(*ref, f, w, h, frames, fbR, er) : Timing{};
+        double to = o.wallMs, tr = r.wallMs;
         if (!eo.empty()) std::fprintf(stderr, "bench: raster failed on %s: %s\n", b.name.c_str(), eo.c_str());
         if (!er.empty()) std::fprintf(stderr, "bench: gl failed on %s: %s\n", b.name.c_str(), er.c_str());
         double cov = coveredPixels(fbO);
         std::printf("bench: scene=%s what=ms ours=%.2f ref=%.2f ratio=%.3f\n", b.name.c_str(), to, tr, to / tr);
+        std::printf("bench: scene=%s what=cpu_ms ours=%.2f ref=%.2f ratio=%.3f\n", b.name.c_str(), o.cpuMs, r.cpuMs, o.cpuMs / r.cpuMs);
         std::printf("bench: scene=%s what=mpix_s ours=%.1f ref=%.1f ratio=%.3f\n", b.name.c_str(), cov / (to * 1e3), cov / (tr * 1e3),
                     tr / to);
         std::printf("# %s: %zu triangles, %.0f covered pixels\n", b.name.c_str(), b.triangles, cov);
