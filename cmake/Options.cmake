@@ -1,6 +1,10 @@
 # Flags attached through an INTERFACE target instead of global CMAKE_CXX_FLAGS.
 add_library(viewer_options INTERFACE)
 target_compile_options(viewer_options INTERFACE -Wall -Wextra $<$<COMPILE_LANGUAGE:CXX>:-Wno-missing-field-initializers>)
+# GCC 12 reports -Wrestrict false positives inside libstdc++'s std::string (GCC bug 105329).
+if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU" AND CMAKE_CXX_COMPILER_VERSION VERSION_LESS 13)
+  target_compile_options(viewer_options INTERFACE $<$<COMPILE_LANGUAGE:CXX>:-Wno-restrict>)
+endif()
 if(VIEWER_NATIVE)
   target_compile_options(viewer_options INTERFACE -march=native)
 endif()
