@@ -1,7 +1,8 @@
 // gl_renderer.cpp - the OpenGL 3.3+ core rasterization backend ("gl").
 //
 // Sections:
-//   1. Shader programs (embedded GLSL from shaders/, one program per shading model)
+//   1. Shader programs (embedded GLSL from shaders/, one program per shading model,
+//      reflection model and light setup, compiled on first use)
 //   2. GPU cache: meshes (incl. tessellations) and textures keyed by id + version
 //   3. Render targets: multisampled / single-sample FBOs, read-back
 //   4. State guard: restores the caller's GL state when we borrow its context
@@ -13,6 +14,8 @@
 // instances), fog on the eye-space distance. Gouraud lights the vertices with the albedo
 // factored out (colour = rho * mul + add, see lighting.glsl), so textures still apply per
 // fragment. Lines and points are drawn unlit (base colour x vertex colour + emissive).
+// Texture filters: nearest = GL_NEAREST, bilinear = GL_LINEAR without mipmaps, trilinear =
+// GL_LINEAR_MIPMAP_LINEAR. Draws are sorted nearest first (early depth test on llvmpipe).
 #include "gl/gl_renderer.h"
 
 #include "gl/gl_context.h"
