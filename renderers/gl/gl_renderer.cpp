@@ -1,7 +1,8 @@
 // gl_renderer.cpp - the OpenGL 3.3+ core rasterization backend ("gl").
 //
 // Sections:
-//   1. Shader programs (embedded GLSL from shaders/, one program per shading model)
+//   1. Shader programs (embedded GLSL from shaders/, one program per shading model,
+//      reflection model and light setup, compiled on first use)
 //   2. GPU cache: meshes (incl. tessellations) and textures keyed by id + version
 //   3. Render targets: multisampled / single-sample FBOs, read-back
 //   4. State guard: restores the caller's GL state when we borrow its context
@@ -13,6 +14,8 @@
 // instances), fog on the eye-space distance. Gouraud lights the vertices with the albedo
 // factored out (colour = rho * mul + add, see lighting.glsl), so textures still apply per
 // fragment. Lines and points are drawn unlit (base colour x vertex colour + emissive).
+// Texture filters: nearest = GL_NEAREST, bilinear = GL_LINEAR without mipmaps, trilinear =
+// GL_LINEAR_MIPMAP_LINEAR. Draws are sorted nearest first (early depth test on llvmpipe).
 #include "gl/gl_renderer.h"
 
 #include "gl/gl_context.h"
@@ -39,6 +42,7 @@ namespace {
 using namespace sg;
 
 constexpr int kMaxLights = 32;          // lights beyond this are ignored (uniform arrays)
+constexpr int kMaxUnrolledLights = 8;   // more lights: one generic program with a loop
 constexpr uint64_t kEvictAfterFrames = 120;
 
 // --- 1. Shader programs ----------------------------------------------------------------------
@@ -47,7 +51,7 @@ struct Program {
     GLuint id = 0;
     // Uniform locations.
     GLint model = -1, normalMatrix = -1, viewProj = -1, view = -1, pointSize = -1;
-    GLint lightPos = -1, lightDir = -1, lightRad = -1, lightCone = -1;
+    GLint numLights = -1, lightPos = -1, lightDir = -1, lightRad = -1, lightCone = -1;
     GLint eye = -1, ambient = -1;
     GLint baseColor = -1, ka = -1, kd = -1, ks = -1, shininess = -1, specTinted = -1, specColor = -1, emissive = -1;
     GLint texture = -1, hasTexture = -1, unlit = -1, solid = -1, solidColor = -1;
@@ -71,12 +75,14 @@ std::string compileShader(GLenum type, const std::string& src, GLuint& out) {
 
 // Programs are specialised per frame setup (see lighting.glsl): the key is the shading model,
 // the reflection model and one letter per light (p/P point, d directional, s/S spot; upper
-// case = inverse square).
+// case = inverse square), or '*' for the generic loop when there are many lights (a 30-light
+// unrolled program takes seconds to compile on llvmpipe).
 std::string programKey(const FrameInput& f) {
     std::string key;
     key += char('0' + int(f.settings.shading));
     key += char('0' + int(f.settings.reflection));
     size_t n = std::min<size_t>(f.lights.size(), kMaxLights);
+    if (n > size_t(kMaxUnrolledLights)) return key + '*';
     for (size_t i = 0; i < n; ++i) {
         const DrawLight& l = f.lights[i];
         char c = l.type == LightType::Point ? 'p' : l.type == LightType::Directional ? 'd' : 's';
@@ -88,7 +94,9 @@ std::string programKey(const FrameInput& f) {
 
 std::string buildProgram(const std::string& key, Program& p) {
     std::string calls;
-    for (size_t i = 2; i < key.size(); ++i) {
+    if (key.size() > 2 && key[2] == '*')
+        calls = "for (int i = 0; i < uNumLights; ++i) addLight(i, int(uLightPos[i].w + 0.5), uLightDir[i].w > 0.5, n, p, v, mul, add);";
+    for (size_t i = 2; i < key.size() && key[2] != '*'; ++i) {
         char c = char(key[i] | 0x20);
         const char* type = c == 'p' ? "LIGHT_POINT" : c == 'd' ? "LIGHT_DIRECTIONAL" : "LIGHT_SPOT";
         bool invSq = key[i] >= 'A' && key[i] <= 'Z';
@@ -125,6 +133,7 @@ std::string buildProgram(const std::string& key, Program& p) {
     p.viewProj = loc("uViewProj");
     p.view = loc("uView");
     p.pointSize = loc("uPointSize");
+    p.numLights = loc("uNumLights");
     p.lightPos = loc("uLightPos");
     p.lightDir = loc("uLightDir");
     p.lightRad = loc("uLightRad");
@@ -610,12 +619,14 @@ void GlRenderer::setFrameUniforms(const Program& p, const FrameInput& f, int ssa
     int n = int(std::min<size_t>(f.lights.size(), kMaxLights));
     std::vector<vec4> pos(n), dir(n), rad(n), cone(n);
     for (int i = 0; i < n; ++i) {
-        const DrawLight& l = f.lights[i];   // type and 1/r^2 are compiled in (programKey)
-        pos[i] = vec4(l.position, 0.0f);
-        dir[i] = vec4(l.direction, 0.0f);
+        const DrawLight& l = f.lights[i];   // type and 1/r^2: compiled in, or read by the loop
+        float type = l.type == LightType::Point ? 0.0f : l.type == LightType::Directional ? 1.0f : 2.0f;
+        pos[i] = vec4(l.position, type);
+        dir[i] = vec4(l.direction, l.inverseSquare ? 1.0f : 0.0f);
         rad[i] = vec4(l.radiance, 0.0f);
         cone[i] = vec4(l.cosInner, l.cosOuter, 0.0f, 0.0f);
     }
+    glUniform1i(p.numLights, n);
     if (n > 0) {
         glUniform4fv(p.lightPos, n, &pos[0][0]);
         glUniform4fv(p.lightDir, n, &dir[0][0]);

@@ -338,8 +338,10 @@ TEST(GlCacheGLTest, InvalidMeshIsSkipped) {
 // normal, so flat and Phong shading are both exact; Gouraud is checked at the sphere centre.)
 TEST(GlShadingGLTest, PlaneMatchesSharedShadingFunctionEverywhere) {
     const int W = 96, H = 72;
+    for (bool generic : {false, true})
     for (ShadingModel model : {ShadingModel::Phong, ShadingModel::Flat})
         for (ReflectionModel refl : {ReflectionModel::Phong, ReflectionModel::BlinnPhong}) {
+            if (generic && model == ShadingModel::Flat) continue;
             FrameInput f = makeFrame(W, H, Projection{}, vec3(0.6f, 0.4f, 4.0f), vec3(0.0f));
             f.ambientLight = vec3(0.2f, 0.22f, 0.25f);
             f.settings.shading = model;
@@ -350,6 +352,11 @@ TEST(GlShadingGLTest, PlaneMatchesSharedShadingFunctionEverywhere) {
             f.lights.push_back(point(vec3(1.0f, 1.0f, 1.5f), vec3(2.5f, 2.2f, 2.0f), true));
             f.lights.push_back(spot(vec3(-1.0f, 0.5f, 2.0f), vec3(0.2f, -0.25f, -1.0f), vec3(1.2f, 1.0f, 0.6f), 10.0f, 25.0f));
             f.lights.push_back(directional(vec3(0.2f, -0.3f, -1.0f), vec3(0.15f, 0.2f, 0.3f)));
+            // More than 8 lights switch to the generic program (a loop reading the types).
+            for (int i = 0; generic && i < 3; ++i) {
+                f.lights.push_back(point(vec3(-1.0f + i, 1.0f, 2.0f), vec3(0.3f), i % 2 == 0));
+                f.lights.push_back(spot(vec3(1.0f, -1.0f + i, 2.0f), vec3(-0.1f * i, 0.2f, -1.0f), vec3(0.4f), 15.0f, 30.0f));
+            }
             Material m;
             m.baseColor = vec3(0.7f, 0.6f, 0.5f);
             m.ka = 0.3f;
@@ -381,9 +388,32 @@ TEST(GlShadingGLTest, PlaneMatchesSharedShadingFunctionEverywhere) {
                     }
                 }
             double mean = sum / count;
-            std::printf("[plane] %s/%s: mean %.3f max %d\n", std::string(toString(model)).c_str(),
-                        std::string(toString(refl)).c_str(), mean, worst);
+            std::printf("[plane] %s/%s%s: mean %.3f max %d\n", std::string(toString(model)).c_str(),
+                        std::string(toString(refl)).c_str(), generic ? " (9 lights, generic program)" : "", mean, worst);
             EXPECT_LE(mean, 0.5) << toString(model) << " " << toString(refl);
             EXPECT_LE(worst, 3) << toString(model) << " " << toString(refl);
         }
+}
+
+// Up to 32 lights are shaded (one program per light setup); more are ignored, not an error.
+TEST(GlShadingGLTest, ManyLightsOfEachKind) {
+    const int W = 81, H = 61;
+    auto sphere = std::make_shared<const Mesh>(primitives::uvSphere(1.0f, 64, 32));
+    FrameInput f = makeFrame(W, H, Projection{}, vec3(0, 0, 5), vec3(0));
+    Material m;
+    m.ka = 0.0f;
+    m.ks = 0.0f;
+    addMesh(f, sphere, m);
+    // 30 dim directional lights head-on add up exactly like one bright one.
+    for (int i = 0; i < 30; ++i) f.lights.push_back(directional(vec3(0, 0, -1), vec3(0.02f)));
+    rnd::Framebuffer many = render(f, W, H);
+    EXPECT_TRUE(pixelNear(many, W / 2, H / 2, m.kd * m.baseColor * 0.6f));
+    for (int i = 0; i < 10; ++i) f.lights.push_back(point(vec3(0, 0, 3), vec3(1.0f), true));   // 40 > 32
+    for (int i = 0; i < 5; ++i) f.lights.push_back(spot(vec3(0, 0, 3), vec3(0, 0, -1), vec3(1.0f), 5.0f, 10.0f));
+    auto r = rnd::makeGlRenderer();
+    rnd::Framebuffer fb;
+    rnd::RenderStats st = r->render(f, W, H, fb);
+    EXPECT_TRUE(st.ok) << st.error;
+    // The first 32 count: 30 directional (0.6) + 2 points at distance 2 (2 x 1/4).
+    EXPECT_TRUE(pixelNear(fb, W / 2, H / 2, m.kd * m.baseColor * (0.6f + 0.5f)));
 }

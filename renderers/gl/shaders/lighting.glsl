@@ -9,13 +9,15 @@
 // fragment (rho = base colour * vertex colour * texel).
 //
 // The renderer compiles one program per light setup: its prefix defines MAX_LIGHTS,
-// REFLECTION (0 Phong, 1 Blinn-Phong) and LIGHT_CALLS, one addLight(i, type, inverseSquare,
-// ...) call per light with constant arguments. Unrolled calls with constant types let the
-// compiler drop the code of the other light types; a loop over a uniform light count costs
-// llvmpipe about 2x (measured, see bench/gl).
+// REFLECTION (0 Phong, 1 Blinn-Phong) and LIGHT_CALLS: for a few lights, one addLight(i,
+// type, inverseSquare, ...) call per light with constant arguments (the compiler drops the
+// code of the other light types; a loop over a uniform light count costs llvmpipe about 2x,
+// see bench/gl); for many lights a loop over uNumLights reading the type from the .w
+// components (one program for all, so it compiles once).
 
-uniform vec4 uLightPos[MAX_LIGHTS];    // xyz: world position
-uniform vec4 uLightDir[MAX_LIGHTS];    // xyz: world direction the light travels
+uniform int uNumLights;                // lights used by the loop form of LIGHT_CALLS
+uniform vec4 uLightPos[MAX_LIGHTS];    // xyz: world position; w: type (LIGHT_POINT ...)
+uniform vec4 uLightDir[MAX_LIGHTS];    // xyz: world direction the light travels; w: 1 = 1/r^2
 uniform vec4 uLightRad[MAX_LIGHTS];    // xyz: radiance (colour * intensity)
 uniform vec4 uLightCone[MAX_LIGHTS];   // x: cos inner, y: cos outer
 
