@@ -345,11 +345,52 @@ __attribute__((noinline)) void rasterizeIntoTile(const Tri& t, uint32_t id, int 
         }
 }
 
-// Interpolates the attributes of triangle t at the centre of pixel (i, j) and fills slot k of
-// the shading batch (Gouraud: the final colour, with no lights left to add). Returns the
-// eye-space distance for fog.
-__attribute__((noinline)) float prepareFragment(const Tri& t, const Chunk& ch, const FrameContext& fc, int i, int j, ShadeBatch& sb, size_t k) {
-    const DrawItem& d = (*fc.draws)[t.draw];
+// Per-triangle data of the fragment stage, fetched once per run of fragments of the same
+// triangle (consecutive pixels of a tile mostly share one).
+struct TriCache {
+    uint32_t id = kNoTri;
+    const Tri* t = nullptr;
+    const DrawItem* d = nullptr;
+    const sg::Material* mat = nullptr;
+    const std::array<vec3, 3>* cb = nullptr;   // clip barycentrics or null
+    uint32_t v[3] = {0, 0, 0};
+    vec3 p[3], pe[3], n[3];                    // world positions, eye positions, normals
+    bool faceNormal = false;                   // flat (or no normals): n[0] is the normal
+    bool gouraud = false;
+
+    void load(uint32_t newId, const Tri& tri, const Chunk& ch, const FrameContext& fc) {
+        id = newId;
+        t = &tri;
+        d = &(*fc.draws)[tri.draw];
+        mat = &d->materialOf(tri.prim);
+        cb = tri.clip >= 0 ? &ch.clipBary[size_t(tri.clip)] : nullptr;
+        const sg::FrameInput& f = *fc.frame;
+        for (int k = 0; k < 3; ++k) {
+            v[k] = d->vertexOf(tri.prim, k);
+            p[k] = d->wpos[v[k]];
+            pe[k] = vec3(f.camera.view * vec4(p[k], 1.0f));
+        }
+        gouraud = f.settings.shading == sg::ShadingModel::Gouraud && !d->gouraudA[0].empty();
+        faceNormal = f.settings.shading == sg::ShadingModel::Flat || !d->hasNormals;
+        if (faceNormal) {
+            // Face normal of the world-space triangle; outward = CCW side (CW for mirrored),
+            // flipped toward the viewer when seen from the back (two-sided).
+            vec3 nn = glm::cross(p[1] - p[0], p[2] - p[0]);
+            if (d->mirrored != !tri.front) nn = -nn;
+            float len = glm::length(nn);
+            n[0] = len > 0 ? nn / len : vec3(0, 0, 1);
+        } else {
+            for (int k = 0; k < 3; ++k) n[k] = tri.front ? d->wnrm[v[k]] : -d->wnrm[v[k]];
+        }
+    }
+};
+
+// Interpolates the attributes of the cached triangle at the centre of pixel (i, j) and fills
+// slot k of the shading batch (Gouraud: the final colour, with no lights left to add). Returns
+// the eye-space distance for fog.
+__attribute__((noinline)) float prepareFragment(const TriCache& tc, const FrameContext& fc, int i, int j, ShadeBatch& sb, size_t k) {
+    const Tri& t = *tc.t;
+    const DrawItem& d = *tc.d;
     const sg::FrameInput& f = *fc.frame;
     const float di = float(i - t.s.minX), dj = float(j - t.s.minY);
     // Perspective correction: lambda/w is linear in screen space; divide by the sum (1/w).
@@ -359,16 +400,16 @@ __attribute__((noinline)) float prepareFragment(const Tri& t, const Chunk& ch, c
     float b[3] = {u[0] * invSum, u[1] * invSum, u[2] * invSum};
     // Weights of the input triangle's corners.
     vec3 bo;
-    const std::array<vec3, 3>* cb = t.clip >= 0 ? &ch.clipBary[size_t(t.clip)] : nullptr;
+    const std::array<vec3, 3>* cb = tc.cb;
     if (cb) bo = b[0] * (*cb)[0] + b[1] * (*cb)[1] + b[2] * (*cb)[2];
     else { bo[t.s.order[0]] = b[0]; bo[t.s.order[1]] = b[1]; bo[t.s.order[2]] = b[2]; }
-    uint32_t v[3] = {d.vertexOf(t.prim, 0), d.vertexOf(t.prim, 1), d.vertexOf(t.prim, 2)};
-    const sg::Mesh& m = *d.mesh;
-    vec3 pos = bo[0] * d.wpos[v[0]] + bo[1] * d.wpos[v[1]] + bo[2] * d.wpos[v[2]];
-    const sg::Material& mat = d.materialOf(t.prim);
+    const uint32_t* v = tc.v;
+    vec3 pos = bo[0] * tc.p[0] + bo[1] * tc.p[1] + bo[2] * tc.p[2];
+    const sg::Material& mat = *tc.mat;
 
     vec3 albedo = mat.baseColor;
     if (d.hasColors || (d.texture && d.hasUV)) {
+        const sg::Mesh& m = *d.mesh;
         uint32_t mi[3] = {d.meshIndex(v[0]), d.meshIndex(v[1]), d.meshIndex(v[2])};
         if (d.hasColors) albedo *= vec3(bo[0] * m.colors[mi[0]] + bo[1] * m.colors[mi[1]] + bo[2] * m.colors[mi[2]]);
         if (d.texture && d.hasUV) {
@@ -390,39 +431,25 @@ __attribute__((noinline)) float prepareFragment(const Tri& t, const Chunk& ch, c
         }
     }
 
-    const auto& st = f.settings;
-    if (st.shading == sg::ShadingModel::Gouraud && !d.gouraudA[0].empty()) {
+    if (tc.gouraud) {
         int side = t.front ? 0 : 1;
         vec3 A = bo[0] * d.gouraudA[side][v[0]] + bo[1] * d.gouraudA[side][v[1]] + bo[2] * d.gouraudA[side][v[2]];
         vec3 B = bo[0] * d.gouraudB[side][v[0]] + bo[1] * d.gouraudB[side][v[1]] + bo[2] * d.gouraudB[side][v[2]];
-        sg::Material unlit;
-        unlit.unlit = true;
-        unlit.emissive = vec3(0.0f);
-        sb.set(k, unlit, pos, vec3(0, 0, 1), A * albedo + B, vec3(0.0f));
+        sb.setColor(k, A * albedo + B);
     } else {
         vec3 n;
-        if (st.shading == sg::ShadingModel::Flat || !d.hasNormals) {
-            // Face normal of the world-space triangle; outward = CCW side (CW for mirrored).
-            n = glm::cross(d.wpos[v[1]] - d.wpos[v[0]], d.wpos[v[2]] - d.wpos[v[0]]);
-            if (d.mirrored) n = -n;
+        if (tc.faceNormal) {
+            n = tc.n[0];
         } else {
-            n = bo[0] * d.wnrm[v[0]] + bo[1] * d.wnrm[v[1]] + bo[2] * d.wnrm[v[2]];
+            n = bo[0] * tc.n[0] + bo[1] * tc.n[1] + bo[2] * tc.n[2];
+            float len = glm::length(n);
+            n = len > 0 ? n / len : vec3(0, 0, 1);
         }
-        float len = glm::length(n);
-        n = len > 0 ? n / len : vec3(0, 0, 1);
-        if (!t.front) n = -n;   // two-sided: seen from the back
-        if (fc.referenceShading) {   // rnd::shade itself, one fragment at a time
-            vec3 c = shade(mat, SurfacePoint{pos, n, albedo}, f.camera.eye, f);
-            sg::Material unlit;
-            unlit.unlit = true;
-            unlit.emissive = vec3(0.0f);
-            sb.set(k, unlit, pos, n, c, vec3(0.0f));
-        } else {
-            sb.set(k, mat, pos, n, albedo, f.ambientLight);
-        }
+        if (fc.referenceShading) sb.setColor(k, shade(mat, SurfacePoint{pos, n, albedo}, f.camera.eye, f));   // rnd::shade itself
+        else sb.set(k, mat, pos, n, albedo, f.ambientLight);
     }
-    if (st.fog == sg::FogMode::Off) return 0.0f;
-    return glm::length(vec3(f.camera.view * vec4(pos, 1.0f)));
+    if (f.settings.fog == sg::FogMode::Off) return 0.0f;
+    return glm::length(bo[0] * tc.pe[0] + bo[1] * tc.pe[1] + bo[2] * tc.pe[2]);   // eye-space distance
 }
 
 struct TileBuffers {
@@ -510,10 +537,12 @@ void renderTile(int tile, const FrameContext& fc, Framebuffer& target, TileBuffe
     if (nf == 0) return;
     buf.batch.resize(nf);
     buf.fogDist.resize(nf);
+    TriCache tc;
     for (size_t k = 0; k < nf; ++k) {
         uint32_t id = buf.fragTri[k];
+        if (id != tc.id) tc.load(id, triById(chunks, id), chunks[id >> kChunkBits], fc);
         int p = buf.fragPixel[k];
-        buf.fogDist[k] = prepareFragment(triById(chunks, id), chunks[id >> kChunkBits], fc, x0 + p % kTileSize, y0 + p / kTileSize, buf.batch, k);
+        buf.fogDist[k] = prepareFragment(tc, fc, x0 + p % kTileSize, y0 + p / kTileSize, buf.batch, k);
     }
     int64_t tC = fc.timing ? nowNs() : 0;
     if (fc.timing) g_prepareNs += tC - tB;
