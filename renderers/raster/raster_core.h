@@ -170,14 +170,16 @@ inline void forEachCoveredPixelSimple(const TriSetup& t, int x0, int y0, int x1,
 // Outcode bits: near (z < -w), far (z > w), and the four guard-band planes |x|,|y| <= g*w.
 // Triangles whose vertices have no bits set need no clipping; near and far are clipped
 // exactly, x and y only outside the guard band (the viewport scissor does the rest).
-enum : uint8_t { kClipNear = 1, kClipFar = 2, kClipLeft = 4, kClipRight = 8, kClipBottom = 16, kClipTop = 32 };
+enum : uint8_t { kClipNear = 1, kClipFar = 2, kClipLeft = 4, kClipRight = 8, kClipBottom = 16, kClipTop = 32, kInvalid = 64 };
 
 struct GuardBand { float gx = 1, gy = 1; };
 inline GuardBand guardBand(int width, int height) {
     return {1.0f + 2.0f * kGuardPixels / std::max(width, 1), 1.0f + 2.0f * kGuardPixels / std::max(height, 1)};
 }
 
+// kInvalid marks a non-finite position: triangles using it are dropped, not clipped.
 inline uint8_t outcode(const sg::vec4& c, const GuardBand& g) {
+    if (!(std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z) && std::isfinite(c.w))) return kInvalid | kClipNear;
     uint8_t o = 0;
     if (!(c.z >= -c.w)) o |= kClipNear;   // also catches NaN
     if (!(c.z <= c.w)) o |= kClipFar;
@@ -214,7 +216,7 @@ inline int clipTriangle(const sg::vec4 c[3], uint8_t planes, const GuardBand& g,
         default: return g.gy * v.w - v.y;
         }
     };
-    for (uint8_t plane = 1; plane <= kClipTop && n > 0; plane <<= 1) {
+    for (uint8_t plane = 1; plane <= kClipTop && n > 0; plane = uint8_t(plane << 1)) {
         if (!(planes & plane)) continue;
         int m = 0;
         for (int i = 0; i < n; ++i) {

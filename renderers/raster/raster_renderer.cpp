@@ -253,6 +253,7 @@ void runTriangleStage(Chunk& ch, const FrameContext& fc) {
         if (!ok) continue;
         uint8_t c0 = d.code[v[0]], c1 = d.code[v[1]], c2 = d.code[v[2]];
         if (c0 & c1 & c2) continue;   // all outside one plane
+        if ((c0 | c1 | c2) & kInvalid) continue;   // non-finite vertex
         if ((c0 | c1 | c2) == 0) {
             Tri tri;
             float wx[3] = {d.win[v[0]].x, d.win[v[1]].x, d.win[v[2]].x};
@@ -669,7 +670,7 @@ void drawLinesAndWireframe(const std::vector<DrawItem>& lineDraws, const std::ve
         if (m.mode == sg::PrimitiveMode::Lines) {
             for (size_t k = 0; k + 1 < n; k += 2) {
                 uint32_t ia = idx(k), ib = idx(k + 1);
-                if (ia >= d.clip.size() || ib >= d.clip.size()) continue;
+                if (ia >= d.clip.size() || ib >= d.clip.size() || ((d.code[ia] | d.code[ib]) & kInvalid)) continue;
                 drawSegment(fb, end(ia), end(ib), g, st, 0.0f);
             }
         } else {
@@ -696,6 +697,7 @@ void drawLinesAndWireframe(const std::vector<DrawItem>& lineDraws, const std::ve
             uint32_t v[3] = {d.vertexOf(t, 0), d.vertexOf(t, 1), d.vertexOf(t, 2)};
             if (v[0] >= d.clip.size() || v[1] >= d.clip.size() || v[2] >= d.clip.size()) continue;
             if (d.code[v[0]] & d.code[v[1]] & d.code[v[2]]) continue;
+            if ((d.code[v[0]] | d.code[v[1]] | d.code[v[2]]) & kInvalid) continue;
             for (int k = 0; k < 3; ++k) {
                 LineEnd a{d.clip[v[k]], st.wireframeColor, eyeDist(d.wpos[v[k]])};
                 LineEnd b{d.clip[v[(k + 1) % 3]], st.wireframeColor, eyeDist(d.wpos[v[(k + 1) % 3]])};
