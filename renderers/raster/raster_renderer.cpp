@@ -702,6 +702,12 @@ void drawLinesAndWireframe(const std::vector<DrawItem>& lineDraws, const std::ve
             if (v[0] >= d.clip.size() || v[1] >= d.clip.size() || v[2] >= d.clip.size()) continue;
             if (d.code[v[0]] & d.code[v[1]] & d.code[v[2]]) continue;
             if ((d.code[v[0]] | d.code[v[1]] | d.code[v[2]]) & kInvalid) continue;
+            if (st.cullBackFaces && (d.code[v[0]] | d.code[v[1]] | d.code[v[2]]) == 0) {
+                // Culled faces draw no edges (GL culls polygons in line mode too).
+                vec2 a(d.win[v[0]]), b(d.win[v[1]]), c(d.win[v[2]]);
+                float area = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+                if ((area > 0) == d.mirrored) continue;
+            }
             for (int k = 0; k < 3; ++k) {
                 LineEnd a{d.clip[v[k]], st.wireframeColor, eyeDist(d.wpos[v[k]])};
                 LineEnd b{d.clip[v[(k + 1) % 3]], st.wireframeColor, eyeDist(d.wpos[v[(k + 1) % 3]])};
@@ -737,7 +743,7 @@ public:
         const auto& st = frame.settings;
         if (control) control->progress = 0.0f;
         if (st.aa == sg::AAMode::SSAA && st.aaRate > 1) {
-            int r = std::clamp(st.aaRate, 2, 4);
+            int r = std::clamp(st.aaRate, 2, 8);   // as the GL backend
             Framebuffer hi;
             stats = renderSingle(frame, width * r, height * r, hi, false, control, r);
             if (stats.ok) target = downsample(hi, r);
