@@ -180,7 +180,6 @@ void runVertexStage(DrawItem& d, const sg::FrameInput& f, int width, int height,
 // One scan-converted triangle (a whole input triangle or a piece of a clipped one).
 struct Tri {
     TriSetup s;
-    float z[3], invW[3];     // per setup vertex
     float zRef, zdx, zdy;    // window z at pixel centre (minX, minY) and per-pixel steps
     // u_k = lambda_k / w_k (screen-linear) at pixel centre (minX, minY) and per-pixel steps;
     // perspective-correct barycentrics are u_k / sum(u).
@@ -210,25 +209,26 @@ struct FrameContext {
 };
 
 bool finishTri(Tri& t, const float z[3], const float iw[3]) {
+    float tz[3], tw[3];   // per setup vertex
     for (int k = 0; k < 3; ++k) {
-        t.z[k] = z[t.s.order[k]];
-        t.invW[k] = iw[t.s.order[k]];
+        tz[k] = z[t.s.order[k]];
+        tw[k] = iw[t.s.order[k]];
     }
     // z = (e1 z0 + e2 z1 + e0 z2) / area2, e_i linear in the fixed-point sample position.
     double inv = 1.0 / double(t.s.area2);
-    double ax = (double(t.s.e[1].a) * t.z[0] + double(t.s.e[2].a) * t.z[1] + double(t.s.e[0].a) * t.z[2]) * inv;
-    double ay = (double(t.s.e[1].b) * t.z[0] + double(t.s.e[2].b) * t.z[1] + double(t.s.e[0].b) * t.z[2]) * inv;
+    double ax = (double(t.s.e[1].a) * tz[0] + double(t.s.e[2].a) * tz[1] + double(t.s.e[0].a) * tz[2]) * inv;
+    double ay = (double(t.s.e[1].b) * tz[0] + double(t.s.e[2].b) * tz[1] + double(t.s.e[0].b) * tz[2]) * inv;
     int64_t px = int64_t(t.s.minX) * kSub + kHalf, py = int64_t(t.s.minY) * kSub + kHalf;
-    double zr = (double(t.s.e[1].at(px, py)) * t.z[0] + double(t.s.e[2].at(px, py)) * t.z[1] + double(t.s.e[0].at(px, py)) * t.z[2]) * inv;
+    double zr = (double(t.s.e[1].at(px, py)) * tz[0] + double(t.s.e[2].at(px, py)) * tz[1] + double(t.s.e[0].at(px, py)) * tz[2]) * inv;
     t.zRef = float(zr);
     t.zdx = float(ax * kSub);
     t.zdy = float(ay * kSub);
     // Setup vertex (k+2)%3 <- edge k.
     for (int k = 0; k < 3; ++k) {
         const Edge& e = t.s.e[(k + 1) % 3];
-        t.uRef[k] = float(double(e.at(px, py)) * inv * t.invW[k]);
-        t.udx[k] = float(double(e.a) * kSub * inv * t.invW[k]);
-        t.udy[k] = float(double(e.b) * kSub * inv * t.invW[k]);
+        t.uRef[k] = float(double(e.at(px, py)) * inv * tw[k]);
+        t.udx[k] = float(double(e.a) * kSub * inv * tw[k]);
+        t.udy[k] = float(double(e.b) * kSub * inv * tw[k]);
     }
     return true;
 }
@@ -253,6 +253,7 @@ void runTriangleStage(Chunk& ch, const FrameContext& fc) {
         if (!ok) continue;
         uint8_t c0 = d.code[v[0]], c1 = d.code[v[1]], c2 = d.code[v[2]];
         if (c0 & c1 & c2) continue;   // all outside one plane
+        if ((c0 | c1 | c2) & kInvalid) continue;   // non-finite vertex
         if ((c0 | c1 | c2) == 0) {
             Tri tri;
             float wx[3] = {d.win[v[0]].x, d.win[v[1]].x, d.win[v[2]].x};
@@ -345,11 +346,52 @@ __attribute__((noinline)) void rasterizeIntoTile(const Tri& t, uint32_t id, int 
         }
 }
 
-// Interpolates the attributes of triangle t at the centre of pixel (i, j) and fills slot k of
-// the shading batch (Gouraud: the final colour, with no lights left to add). Returns the
-// eye-space distance for fog.
-__attribute__((noinline)) float prepareFragment(const Tri& t, const Chunk& ch, const FrameContext& fc, int i, int j, ShadeBatch& sb, size_t k) {
-    const DrawItem& d = (*fc.draws)[t.draw];
+// Per-triangle data of the fragment stage, fetched once per run of fragments of the same
+// triangle (consecutive pixels of a tile mostly share one).
+struct TriCache {
+    uint32_t id = kNoTri;
+    const Tri* t = nullptr;
+    const DrawItem* d = nullptr;
+    const sg::Material* mat = nullptr;
+    const std::array<vec3, 3>* cb = nullptr;   // clip barycentrics or null
+    uint32_t v[3] = {0, 0, 0};
+    vec3 p[3], pe[3], n[3];                    // world positions, eye positions, normals
+    bool faceNormal = false;                   // flat (or no normals): n[0] is the normal
+    bool gouraud = false;
+
+    void load(uint32_t newId, const Tri& tri, const Chunk& ch, const FrameContext& fc) {
+        id = newId;
+        t = &tri;
+        d = &(*fc.draws)[tri.draw];
+        mat = &d->materialOf(tri.prim);
+        cb = tri.clip >= 0 ? &ch.clipBary[size_t(tri.clip)] : nullptr;
+        const sg::FrameInput& f = *fc.frame;
+        for (int k = 0; k < 3; ++k) {
+            v[k] = d->vertexOf(tri.prim, k);
+            p[k] = d->wpos[v[k]];
+            if (f.settings.fog != sg::FogMode::Off) pe[k] = vec3(f.camera.view * vec4(p[k], 1.0f));
+        }
+        gouraud = f.settings.shading == sg::ShadingModel::Gouraud && !d->gouraudA[0].empty();
+        faceNormal = f.settings.shading == sg::ShadingModel::Flat || !d->hasNormals;
+        if (faceNormal) {
+            // Face normal of the world-space triangle; outward = CCW side (CW for mirrored),
+            // flipped toward the viewer when seen from the back (two-sided).
+            vec3 nn = glm::cross(p[1] - p[0], p[2] - p[0]);
+            if (d->mirrored != !tri.front) nn = -nn;
+            float len = glm::length(nn);
+            n[0] = len > 0 ? nn / len : vec3(0, 0, 1);
+        } else {
+            for (int k = 0; k < 3; ++k) n[k] = tri.front ? d->wnrm[v[k]] : -d->wnrm[v[k]];
+        }
+    }
+};
+
+// Interpolates the attributes of the cached triangle at the centre of pixel (i, j) and fills
+// slot k of the shading batch (Gouraud: the final colour, with no lights left to add). Returns
+// the eye-space distance for fog.
+__attribute__((noinline)) float prepareFragment(const TriCache& tc, const FrameContext& fc, int i, int j, ShadeBatch& sb, size_t k) {
+    const Tri& t = *tc.t;
+    const DrawItem& d = *tc.d;
     const sg::FrameInput& f = *fc.frame;
     const float di = float(i - t.s.minX), dj = float(j - t.s.minY);
     // Perspective correction: lambda/w is linear in screen space; divide by the sum (1/w).
@@ -359,16 +401,16 @@ __attribute__((noinline)) float prepareFragment(const Tri& t, const Chunk& ch, c
     float b[3] = {u[0] * invSum, u[1] * invSum, u[2] * invSum};
     // Weights of the input triangle's corners.
     vec3 bo;
-    const std::array<vec3, 3>* cb = t.clip >= 0 ? &ch.clipBary[size_t(t.clip)] : nullptr;
+    const std::array<vec3, 3>* cb = tc.cb;
     if (cb) bo = b[0] * (*cb)[0] + b[1] * (*cb)[1] + b[2] * (*cb)[2];
     else { bo[t.s.order[0]] = b[0]; bo[t.s.order[1]] = b[1]; bo[t.s.order[2]] = b[2]; }
-    uint32_t v[3] = {d.vertexOf(t.prim, 0), d.vertexOf(t.prim, 1), d.vertexOf(t.prim, 2)};
-    const sg::Mesh& m = *d.mesh;
-    vec3 pos = bo[0] * d.wpos[v[0]] + bo[1] * d.wpos[v[1]] + bo[2] * d.wpos[v[2]];
-    const sg::Material& mat = d.materialOf(t.prim);
+    const uint32_t* v = tc.v;
+    vec3 pos = bo[0] * tc.p[0] + bo[1] * tc.p[1] + bo[2] * tc.p[2];
+    const sg::Material& mat = *tc.mat;
 
     vec3 albedo = mat.baseColor;
     if (d.hasColors || (d.texture && d.hasUV)) {
+        const sg::Mesh& m = *d.mesh;
         uint32_t mi[3] = {d.meshIndex(v[0]), d.meshIndex(v[1]), d.meshIndex(v[2])};
         if (d.hasColors) albedo *= vec3(bo[0] * m.colors[mi[0]] + bo[1] * m.colors[mi[1]] + bo[2] * m.colors[mi[2]]);
         if (d.texture && d.hasUV) {
@@ -390,39 +432,25 @@ __attribute__((noinline)) float prepareFragment(const Tri& t, const Chunk& ch, c
         }
     }
 
-    const auto& st = f.settings;
-    if (st.shading == sg::ShadingModel::Gouraud && !d.gouraudA[0].empty()) {
+    if (tc.gouraud) {
         int side = t.front ? 0 : 1;
         vec3 A = bo[0] * d.gouraudA[side][v[0]] + bo[1] * d.gouraudA[side][v[1]] + bo[2] * d.gouraudA[side][v[2]];
         vec3 B = bo[0] * d.gouraudB[side][v[0]] + bo[1] * d.gouraudB[side][v[1]] + bo[2] * d.gouraudB[side][v[2]];
-        sg::Material unlit;
-        unlit.unlit = true;
-        unlit.emissive = vec3(0.0f);
-        sb.set(k, unlit, pos, vec3(0, 0, 1), A * albedo + B, vec3(0.0f));
+        sb.setColor(k, A * albedo + B);
     } else {
         vec3 n;
-        if (st.shading == sg::ShadingModel::Flat || !d.hasNormals) {
-            // Face normal of the world-space triangle; outward = CCW side (CW for mirrored).
-            n = glm::cross(d.wpos[v[1]] - d.wpos[v[0]], d.wpos[v[2]] - d.wpos[v[0]]);
-            if (d.mirrored) n = -n;
+        if (tc.faceNormal) {
+            n = tc.n[0];
         } else {
-            n = bo[0] * d.wnrm[v[0]] + bo[1] * d.wnrm[v[1]] + bo[2] * d.wnrm[v[2]];
+            n = bo[0] * tc.n[0] + bo[1] * tc.n[1] + bo[2] * tc.n[2];
+            float len = glm::length(n);
+            n = len > 0 ? n / len : vec3(0, 0, 1);
         }
-        float len = glm::length(n);
-        n = len > 0 ? n / len : vec3(0, 0, 1);
-        if (!t.front) n = -n;   // two-sided: seen from the back
-        if (fc.referenceShading) {   // rnd::shade itself, one fragment at a time
-            vec3 c = shade(mat, SurfacePoint{pos, n, albedo}, f.camera.eye, f);
-            sg::Material unlit;
-            unlit.unlit = true;
-            unlit.emissive = vec3(0.0f);
-            sb.set(k, unlit, pos, n, c, vec3(0.0f));
-        } else {
-            sb.set(k, mat, pos, n, albedo, f.ambientLight);
-        }
+        if (fc.referenceShading) sb.setColor(k, shade(mat, SurfacePoint{pos, n, albedo}, f.camera.eye, f));   // rnd::shade itself
+        else sb.set(k, mat, pos, n, albedo, f.ambientLight);
     }
-    if (st.fog == sg::FogMode::Off) return 0.0f;
-    return glm::length(vec3(f.camera.view * vec4(pos, 1.0f)));
+    if (f.settings.fog == sg::FogMode::Off) return 0.0f;
+    return glm::length(bo[0] * tc.pe[0] + bo[1] * tc.pe[1] + bo[2] * tc.pe[2]);   // eye-space distance
 }
 
 struct TileBuffers {
@@ -466,9 +494,14 @@ void renderTile(int tile, const FrameContext& fc, Framebuffer& target, TileBuffe
     const vec3 bg = st.background;
     const uint8_t bgBytes[3] = {enc(bg.x), enc(bg.y), enc(bg.z)};
     // Fragments: one per covered pixel (MSAA: per distinct triangle in the pixel).
-    buf.fragPixel.clear();
-    buf.fragTri.clear();
-    buf.fragCount.clear();
+    // Sized for the worst case (every sample its own triangle); filled by index, no push_back.
+    const size_t maxFrags = size_t(kTileSize) * kTileSize * samples;
+    if (buf.fragTri.size() < maxFrags) {
+        buf.fragPixel.resize(maxFrags);
+        buf.fragTri.resize(maxFrags);
+        buf.fragCount.resize(maxFrags);
+    }
+    size_t nf = 0;
     const int tw = x1 - x0 + 1, th = y1 - y0 + 1;
     for (int jj = 0; jj < th; ++jj)
         for (int ii = 0; ii < tw; ++ii) {
@@ -480,15 +513,15 @@ void renderTile(int tile, const FrameContext& fc, Framebuffer& target, TileBuffe
             if (samples == 1) {
                 *dOut = buf.depth[p];
                 if (buf.ids[p] == kNoTri) continue;
-                buf.fragPixel.push_back(uint16_t(p));
-                buf.fragTri.push_back(buf.ids[p]);
-                buf.fragCount.push_back(1);
+                buf.fragPixel[nf] = uint16_t(p);
+                buf.fragTri[nf] = buf.ids[p];
+                buf.fragCount[nf++] = 1;
                 continue;
             }
             float dmin = 1.0f;
             uint32_t seen[4];
             int nseen = 0;
-            size_t first = buf.fragTri.size();
+            size_t first = nf;
             for (int s = 0; s < 4; ++s) {
                 dmin = std::min(dmin, buf.depth[p * 4 + s]);
                 uint32_t id = buf.ids[p * 4 + s];
@@ -497,23 +530,24 @@ void renderTile(int tile, const FrameContext& fc, Framebuffer& target, TileBuffe
                 while (q < nseen && seen[q] != id) ++q;
                 if (q == nseen) {
                     seen[nseen++] = id;
-                    buf.fragPixel.push_back(uint16_t(p));
-                    buf.fragTri.push_back(id);
-                    buf.fragCount.push_back(1);
+                    buf.fragPixel[nf] = uint16_t(p);
+                    buf.fragTri[nf] = id;
+                    buf.fragCount[nf++] = 1;
                 } else {
                     ++buf.fragCount[first + q];
                 }
             }
             *dOut = dmin;
         }
-    const size_t nf = buf.fragTri.size();
     if (nf == 0) return;
     buf.batch.resize(nf);
     buf.fogDist.resize(nf);
+    TriCache tc;
     for (size_t k = 0; k < nf; ++k) {
         uint32_t id = buf.fragTri[k];
+        if (id != tc.id) tc.load(id, triById(chunks, id), chunks[id >> kChunkBits], fc);
         int p = buf.fragPixel[k];
-        buf.fogDist[k] = prepareFragment(triById(chunks, id), chunks[id >> kChunkBits], fc, x0 + p % kTileSize, y0 + p / kTileSize, buf.batch, k);
+        buf.fogDist[k] = prepareFragment(tc, fc, x0 + p % kTileSize, y0 + p / kTileSize, buf.batch, k);
     }
     int64_t tC = fc.timing ? nowNs() : 0;
     if (fc.timing) g_prepareNs += tC - tB;
@@ -640,7 +674,7 @@ void drawLinesAndWireframe(const std::vector<DrawItem>& lineDraws, const std::ve
         if (m.mode == sg::PrimitiveMode::Lines) {
             for (size_t k = 0; k + 1 < n; k += 2) {
                 uint32_t ia = idx(k), ib = idx(k + 1);
-                if (ia >= d.clip.size() || ib >= d.clip.size()) continue;
+                if (ia >= d.clip.size() || ib >= d.clip.size() || ((d.code[ia] | d.code[ib]) & kInvalid)) continue;
                 drawSegment(fb, end(ia), end(ib), g, st, 0.0f);
             }
         } else {
@@ -667,6 +701,13 @@ void drawLinesAndWireframe(const std::vector<DrawItem>& lineDraws, const std::ve
             uint32_t v[3] = {d.vertexOf(t, 0), d.vertexOf(t, 1), d.vertexOf(t, 2)};
             if (v[0] >= d.clip.size() || v[1] >= d.clip.size() || v[2] >= d.clip.size()) continue;
             if (d.code[v[0]] & d.code[v[1]] & d.code[v[2]]) continue;
+            if ((d.code[v[0]] | d.code[v[1]] | d.code[v[2]]) & kInvalid) continue;
+            if (st.cullBackFaces && (d.code[v[0]] | d.code[v[1]] | d.code[v[2]]) == 0) {
+                // Culled faces draw no edges (GL culls polygons in line mode too).
+                vec2 a(d.win[v[0]]), b(d.win[v[1]]), c(d.win[v[2]]);
+                float area = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+                if ((area > 0) == d.mirrored) continue;
+            }
             for (int k = 0; k < 3; ++k) {
                 LineEnd a{d.clip[v[k]], st.wireframeColor, eyeDist(d.wpos[v[k]])};
                 LineEnd b{d.clip[v[(k + 1) % 3]], st.wireframeColor, eyeDist(d.wpos[v[(k + 1) % 3]])};
@@ -702,7 +743,7 @@ public:
         const auto& st = frame.settings;
         if (control) control->progress = 0.0f;
         if (st.aa == sg::AAMode::SSAA && st.aaRate > 1) {
-            int r = std::clamp(st.aaRate, 2, 4);
+            int r = std::clamp(st.aaRate, 2, 8);   // as the GL backend
             Framebuffer hi;
             stats = renderSingle(frame, width * r, height * r, hi, false, control, r);
             if (stats.ok) target = downsample(hi, r);

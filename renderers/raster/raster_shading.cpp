@@ -26,24 +26,6 @@ void ShadeBatch::resize(size_t n) {
     }
 }
 
-void ShadeBatch::set(size_t i, const sg::Material& m, const sg::vec3& p, const sg::vec3& n, const sg::vec3& albedo, const sg::vec3& ambient) {
-    px[i] = p.x; py[i] = p.y; pz[i] = p.z;
-    nx[i] = n.x; ny[i] = n.y; nz[i] = n.z;
-    ar[i] = albedo.x; ag[i] = albedo.y; ab[i] = albedo.z;
-    if (m.unlit) {   // shade(): albedo + emissive, no lights
-        kd[i] = ks[i] = 0;
-        shin[i] = 1;
-        sr[i] = sg[i] = sb[i] = 0;
-        cr[i] = albedo.x + m.emissive.x; cg[i] = albedo.y + m.emissive.y; cb[i] = albedo.z + m.emissive.z;
-        return;
-    }
-    sg::vec3 s = m.specularTinted ? albedo : m.specularColor;
-    sr[i] = s.x; sg[i] = s.y; sb[i] = s.z;
-    kd[i] = m.kd; ks[i] = m.ks; shin[i] = m.shininess;
-    sg::vec3 c = m.ka * albedo * ambient + m.emissive;
-    cr[i] = c.x; cg[i] = c.y; cb[i] = c.z;
-}
-
 #if defined(__SSE2__)
 namespace {
 

@@ -26,7 +26,30 @@ struct ShadeBatch {
 
     void resize(size_t n);
     // Fills fragment i from a material, position, normal, albedo (as rnd::shade sees them).
-    void set(size_t i, const sg::Material& m, const sg::vec3& p, const sg::vec3& n, const sg::vec3& albedo, const sg::vec3& ambient);
+    void set(size_t i, const sg::Material& m, const sg::vec3& p, const sg::vec3& n, const sg::vec3& albedo, const sg::vec3& ambient) {
+        px[i] = p.x; py[i] = p.y; pz[i] = p.z;
+        nx[i] = n.x; ny[i] = n.y; nz[i] = n.z;
+        ar[i] = albedo.x; ag[i] = albedo.y; ab[i] = albedo.z;
+        if (m.unlit) {   // shade(): albedo + emissive, no lights
+            setColor(i, albedo + m.emissive);
+            return;
+        }
+        sg::vec3 s = m.specularTinted ? albedo : m.specularColor;
+        sr[i] = s.x; sg[i] = s.y; sb[i] = s.z;
+        kd[i] = m.kd; ks[i] = m.ks; shin[i] = m.shininess;
+        sg::vec3 c = m.ka * albedo * ambient + m.emissive;
+        cr[i] = c.x; cg[i] = c.y; cb[i] = c.z;
+    }
+    // A fragment whose colour is already final (unlit, Gouraud, reference shading).
+    void setColor(size_t i, const sg::vec3& c) {
+        px[i] = py[i] = pz[i] = 0;
+        nx[i] = nz[i] = 0;
+        ny[i] = 1;
+        ar[i] = ag[i] = ab[i] = sr[i] = sg[i] = sb[i] = 0;
+        kd[i] = ks[i] = 0;
+        shin[i] = 1;
+        cr[i] = c.x; cg[i] = c.y; cb[i] = c.z;
+    }
 };
 
 // Adds the contribution of every light in f to cr/cg/cb for fragments [0, n).

@@ -14,6 +14,7 @@
 
 #include <cmath>
 #include <memory>
+#include <limits>
 #include <random>
 
 using namespace sg;
@@ -604,4 +605,24 @@ TEST(RasterRendererTest, LinesPointsAndWireframe) {
     int dark = 0;
     for (size_t i = 0; i < wf.color.size(); i += 4) dark += wf.color[i] == 0 && wf.color[i + 2] == 0;
     EXPECT_GT(dark, 4 * 15);   // outline + diagonal
+}
+
+TEST(RasterRendererTest, BadGeometryIsSkippedNotCrashed) {
+    auto mesh = std::make_shared<Mesh>();
+    const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+    mesh->positions = {{0, 0, -3}, {1, 0, -3}, {nan, 1, -3}, {inf, 0, -3}, {1e30f, -1e30f, -3}, {0, 1, -3}, {0.5f, 0.5f, 1e-30f}};
+    mesh->indices = {0, 1, 2, 0, 3, 1, 0, 4, 5, 0, 1, 5, 0, 1, 6, 0, 1, 99};   // last: index out of range
+    FrameInput f;
+    f.meshes.push_back(drawOf(mesh, unlitMaterial(vec3(1.0f))));
+    f.settings.background = vec3(0.0f);
+    f.settings.wireframe = true;
+    Projection p;
+    f.camera = cameraAt(vec3(0), vec3(0, 0, -1), p, 1.0f);
+    RenderStats s;
+    Framebuffer fb = renderRaster(f, 64, 64, &s);
+    EXPECT_TRUE(s.ok) << s.error;
+    EXPECT_EQ(px(fb, 40, 36)[0], 255);   // the valid triangle (0, 1, 5) is drawn
+    // Degenerate sizes are reported, not crashed on.
+    Framebuffer empty;
+    EXPECT_FALSE(makeRenderer("raster")->render(f, 0, 10, empty).ok);
 }
