@@ -323,7 +323,7 @@ LoadResult loadObj(const fs::path& path, const std::string& text, Ctx& ctx) {
             uint32_t first = uint32_t(corners.size());
             bool ok = true;
             size_t n = 0;
-            for (std::string_view t = c.token(); !t.empty(); t = c.token()) {
+            for (std::string_view t = c.token(); !t.empty() && t[0] != '#'; t = c.token()) {
                 ObjCorner cr{~0u, ~0u, ~0u};
                 size_t s1 = t.find('/');
                 int64_t iv, it, in;

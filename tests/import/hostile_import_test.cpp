@@ -236,7 +236,9 @@ TEST(HostileImportTest, HostileImagesFallBack) {
     // Image URIs out of the folder, a FIFO, a non-PNG/JPEG file, a huge claimed PNG: the
     // model loads without the texture and says why.
     writeText(sb.model / "fake.png", "GIF89a not really an image");
-    std::string png("\x89PNG\r\n\x1a\n\0\0\0\x0dIHDR\x7f\xff\xff\xff\x7f\xff\xff\xff\x08\x06\0\0\0", 33);
+    const unsigned char pngBytes[] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n', 0, 0, 0, 13, 'I', 'H', 'D', 'R',
+                                      0x7f, 0xff, 0xff, 0xff, 0x7f, 0xff, 0xff, 0xff, 8, 6, 0, 0, 0, 0, 0, 0, 0};
+    std::string png(reinterpret_cast<const char*>(pngBytes), sizeof pngBytes);   // IHDR claims 2^31-1 squared
     writeText(sb.model / "huge.png", png);
     const std::pair<const char*, std::string> cases[] = {
         {"img_dotdot.gltf", "{\"uri\": \"../outside/secret.png\"}"},
