@@ -201,7 +201,7 @@ std::shared_ptr<sg::Texture> loadTexture(const ConfinedDir& dir, const std::stri
 std::string cleanRelPath(std::string_view s) {
     std::string r(s);
     std::replace(r.begin(), r.end(), '\\', '/');
-    while (r.rfind("./", 0) == 0) r = r.substr(2);
+    while (r.rfind("./", 0) == 0) r.erase(0, 2);
     return r;
 }
 
