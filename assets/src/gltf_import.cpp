@@ -60,6 +60,10 @@
 //   assets::AnimationClip (animation.h) in LoadResult::animations; "weights" channels
 //   (morphs) are skipped with a warning.
 //
+// Extensions honoured: KHR_materials_unlit, KHR_texture_transform, KHR_lights_punctual,
+// KHR_materials_pbrSpecularGlossiness, KHR_materials_emissive_strength, KHR_mesh_quantization
+// (any component type is read); other extensions in extensionsRequired refuse the file.
+//
 // Safety: the file is read by us (size limit), its JSON (the GLB JSON chunk) is limited in
 // size and nesting depth before tinygltf's recursive parser sees it; buffers and images are
 // read only through ConfinedDir (model folder only, regular files only, no working-directory
@@ -234,6 +238,15 @@ size_t elementSize(const tinygltf::Accessor& a) {
     default: return size_t(componentCount(a.type)) * cs;
     }
 }
+// Bytes the last element occupies (a padded matrix needs no padding after its last column).
+size_t elementExtent(const tinygltf::Accessor& a) {
+    size_t cs = size_t(componentSize(a.componentType));
+    if (cs < 4 && (a.type == TINYGLTF_TYPE_MAT2 || a.type == TINYGLTF_TYPE_MAT3)) {
+        size_t rows = a.type == TINYGLTF_TYPE_MAT2 ? 2 : 3;
+        return (rows - 1) * ((rows * cs + 3) / 4 * 4) + rows * cs;
+    }
+    return elementSize(a);
+}
 size_t accessorStride(const tinygltf::Model& m, const tinygltf::Accessor& a) {
     if (a.bufferView < 0) return elementSize(a);
     size_t s = m.bufferViews[size_t(a.bufferView)].byteStride;
@@ -295,7 +308,7 @@ std::string checkAccessor(const tinygltf::Model& m, size_t i) {
                    " is smaller than the element size " + std::to_string(es);
         if (a.count > 0) {
             uint64_t end = 0;
-            if (mulOv(stride, uint64_t(a.count - 1), end) || addOv(end, a.byteOffset, end) || addOv(end, es, end) ||
+            if (mulOv(stride, uint64_t(a.count - 1), end) || addOv(end, a.byteOffset, end) || addOv(end, elementExtent(a), end) ||
                 end > bv.byteLength)
                 return id + "byteOffset+count*stride exceeds bufferView " + std::to_string(a.bufferView) + " (count " +
                        std::to_string(a.count) + ", stride " + std::to_string(stride) + ", byteOffset " +
@@ -392,7 +405,7 @@ std::string validate(const tinygltf::Model& m, std::vector<std::string>& warning
         const auto& c = m.cameras[i];
         if (c.type == "perspective") {
             const auto& p = c.perspective;
-            if (!(p.yfov > 0 && p.yfov < sg::kPi && std::isfinite(p.yfov))) return idx("camera", i) + "yfov must be in (0, pi)";
+            if (!(p.yfov > 0 && std::isfinite(p.yfov))) return idx("camera", i) + "yfov must be > 0";
             if (!(p.znear > 0 && std::isfinite(p.znear))) return idx("camera", i) + "znear must be > 0";
             if (p.zfar != 0 && !(p.zfar > p.znear && std::isfinite(p.zfar))) return idx("camera", i) + "zfar must be > znear";
         } else if (c.type == "orthographic") {
@@ -974,7 +987,7 @@ struct Converter {
         sg::Camera cam;
         if (c.type == "perspective") {
             cam.projection.type = sg::ProjectionType::Perspective;
-            cam.projection.fovyDeg = sg::degrees(float(c.perspective.yfov));
+            cam.projection.fovyDeg = std::clamp(sg::degrees(float(c.perspective.yfov)), 0.01f, 179.0f);
             cam.projection.zNear = float(c.perspective.znear);
             cam.projection.zFar = c.perspective.zfar > 0 ? float(c.perspective.zfar) : std::max(1000.0f * cam.projection.zNear, 100.0f);
         } else {
@@ -1214,7 +1227,8 @@ LoadResult loadGltf(const fs::path& path, const LoadOptions& options) {
 
     // Required extensions we cannot honour make the file unloadable (the spec says so).
     static const char* kSupported[] = {"KHR_materials_unlit", "KHR_texture_transform", "KHR_lights_punctual",
-                                       "KHR_materials_pbrSpecularGlossiness", "KHR_materials_emissive_strength"};
+                                       "KHR_materials_pbrSpecularGlossiness", "KHR_materials_emissive_strength",
+                                       "KHR_mesh_quantization"};   // quantized attributes: any component type is read
     for (const std::string& ext : model.extensionsRequired)
         if (std::none_of(std::begin(kSupported), std::end(kSupported), [&](const char* s) { return ext == s; }))
             return fail("requires the unsupported extension " + ext);

@@ -201,7 +201,7 @@ std::shared_ptr<sg::Texture> loadTexture(const ConfinedDir& dir, const std::stri
 std::string cleanRelPath(std::string_view s) {
     std::string r(s);
     std::replace(r.begin(), r.end(), '\\', '/');
-    while (r.rfind("./", 0) == 0) r = r.substr(2);
+    while (r.rfind("./", 0) == 0) r.erase(0, 2);
     return r;
 }
 
@@ -323,7 +323,7 @@ LoadResult loadObj(const fs::path& path, const std::string& text, Ctx& ctx) {
             uint32_t first = uint32_t(corners.size());
             bool ok = true;
             size_t n = 0;
-            for (std::string_view t = c.token(); !t.empty(); t = c.token()) {
+            for (std::string_view t = c.token(); !t.empty() && t[0] != '#'; t = c.token()) {
                 ObjCorner cr{~0u, ~0u, ~0u};
                 size_t s1 = t.find('/');
                 int64_t iv, it, in;
@@ -791,6 +791,10 @@ LoadResult loadPly(const fs::path& path, const std::string& data, Ctx& ctx) {
         readOf = 0;
         for (uint64_t i = 0; i < e.count && !truncated; ++i) {
             ctx.poll(size_t(i), 0.0f, 0.95f, 0);
+            if ((i & (kPoll - 1)) == 0) {
+                size_t used = format == 0 ? size_t(rd.text.p - data.data()) : size_t(rd.p - reinterpret_cast<const unsigned char*>(data.data()));
+                ctx.progress.set(0.95f * float(double(used) / double(data.size())));
+            }
             for (size_t k = 0; k < e.props.size(); ++k) {
                 const PlyProperty& pr = e.props[k];
                 if (!pr.list) {
@@ -804,6 +808,7 @@ LoadResult loadPly(const fs::path& path, const std::string& data, Ctx& ctx) {
                 uint64_t left = format == 0 ? uint64_t(rd.text.end - rd.text.p) : uint64_t(rd.end - rd.p);
                 if (n > left) { truncated = true; break; }
                 bool keep = int(k) == ilist;
+                if (keep && n > (64u << 20)) throw Fail{"element '" + e.name + "' " + std::to_string(i) + " has a list of " + std::to_string(n) + " entries (limit 64M)"};
                 if (keep) listVals.resize(size_t(n));
                 for (uint64_t j = 0; j < n; ++j) {
                     double d;

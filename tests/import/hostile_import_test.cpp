@@ -5,6 +5,7 @@
 // holds the bait files).
 #include "import_test_util.h"
 
+#include "assets/animation.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>
@@ -236,7 +237,9 @@ TEST(HostileImportTest, HostileImagesFallBack) {
     // Image URIs out of the folder, a FIFO, a non-PNG/JPEG file, a huge claimed PNG: the
     // model loads without the texture and says why.
     writeText(sb.model / "fake.png", "GIF89a not really an image");
-    std::string png("\x89PNG\r\n\x1a\n\0\0\0\x0dIHDR\x7f\xff\xff\xff\x7f\xff\xff\xff\x08\x06\0\0\0", 33);
+    const unsigned char pngBytes[] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n', 0, 0, 0, 13, 'I', 'H', 'D', 'R',
+                                      0x7f, 0xff, 0xff, 0xff, 0x7f, 0xff, 0xff, 0xff, 8, 6, 0, 0, 0, 0, 0, 0, 0};
+    std::string png(reinterpret_cast<const char*>(pngBytes), sizeof pngBytes);   // IHDR claims 2^31-1 squared
     writeText(sb.model / "huge.png", png);
     const std::pair<const char*, std::string> cases[] = {
         {"img_dotdot.gltf", "{\"uri\": \"../outside/secret.png\"}"},
@@ -381,4 +384,126 @@ TEST(HostileImportTest, DevicesAndFifosAsModels) {
     ::mkfifo((sb.model / "pipe.ply").c_str(), 0600);
     assets::LoadResult r = quickLoad(sb.model / "pipe.ply");
     EXPECT_FALSE(r.scene);
+}
+
+// Features without sample files: lights, several scenes, animation samplers; and structural
+// errors (double parents, non-finite matrices, dangling light index).
+TEST(GltfGeneratedTest, LightsScenesAnimations) {
+    Sandbox sb("features");
+    Knobs k;
+    k.extra =
+        "\"extensionsUsed\": [\"KHR_lights_punctual\"],"
+        "\"extensions\": {\"KHR_lights_punctual\": {\"lights\": ["
+        "  {\"type\": \"point\", \"color\": [1, 0.5, 0.25], \"intensity\": 40},"
+        "  {\"type\": \"spot\", \"intensity\": 10, \"spot\": {\"innerConeAngle\": 0.2, \"outerConeAngle\": 0.4}},"
+        "  {\"type\": \"directional\", \"intensity\": 3}]}},"
+        "\"animations\": [{\"name\": \"move\", \"channels\": ["
+        "  {\"sampler\": 0, \"target\": {\"node\": 1, \"path\": \"translation\"}},"
+        "  {\"sampler\": 1, \"target\": {\"node\": 1, \"path\": \"scale\"}}],"
+        "  \"samplers\": [{\"input\": 2, \"output\": 3, \"interpolation\": \"STEP\"},"
+        "               {\"input\": 2, \"output\": 4, \"interpolation\": \"CUBICSPLINE\"}]}],";
+    std::string json = triangleGltf(k);
+    // Extra accessors for the animation (data appended to a second buffer, embedded).
+    float anim[2 + 6 + 18] = {0, 2,  0, 0, 0, 4, 0, 0,
+                              0, 0, 0, 1, 1, 1, 0, 0, 0,   0, 0, 0, 3, 3, 3, 0, 0, 0};
+    std::string bytes(reinterpret_cast<const char*>(anim), sizeof anim);
+    static const char* b64 = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    std::string enc;
+    for (size_t i = 0; i < bytes.size(); i += 3) {
+        uint32_t v = uint32_t(uint8_t(bytes[i])) << 16 | (i + 1 < bytes.size() ? uint32_t(uint8_t(bytes[i + 1])) << 8 : 0) |
+                     (i + 2 < bytes.size() ? uint8_t(bytes[i + 2]) : 0);
+        enc += b64[v >> 18 & 63];
+        enc += b64[v >> 12 & 63];
+        enc += i + 1 < bytes.size() ? b64[v >> 6 & 63] : '=';
+        enc += i + 2 < bytes.size() ? b64[v & 63] : '=';
+    }
+    auto replace = [&](const std::string& from, const std::string& to) {
+        size_t at = json.find(from);
+        ASSERT_NE(at, std::string::npos) << from;
+        json.replace(at, from.size(), to);
+    };
+    replace("\"byteLength\": 44}]", "\"byteLength\": 44}, {\"uri\": \"data:application/octet-stream;base64," + enc +
+                                      "\", \"byteLength\": " + std::to_string(bytes.size()) + "}]");
+    replace("\"byteLength\": 6}]", "\"byteLength\": 6}, {\"buffer\": 1, \"byteOffset\": 0, \"byteLength\": 8},"
+                                    " {\"buffer\": 1, \"byteOffset\": 8, \"byteLength\": 24}, {\"buffer\": 1, \"byteOffset\": 32, \"byteLength\": 72}]");
+    replace("\"type\": \"SCALAR\"}]", "\"type\": \"SCALAR\"},"
+            " {\"bufferView\": 2, \"componentType\": 5126, \"count\": 2, \"type\": \"SCALAR\"},"
+            " {\"bufferView\": 3, \"componentType\": 5126, \"count\": 2, \"type\": \"VEC3\"},"
+            " {\"bufferView\": 4, \"componentType\": 5126, \"count\": 6, \"type\": \"VEC3\"}]");
+    replace("\"nodes\": [{\"mesh\": 0}], \"scenes\": [{\"nodes\": [0]}], \"scene\": 0",
+            "\"nodes\": [{\"mesh\": 0}, {\"name\": \"mover\", \"children\": [2, 3, 4]},"
+            " {\"name\": \"p\", \"extensions\": {\"KHR_lights_punctual\": {\"light\": 0}}},"
+            " {\"name\": \"s\", \"extensions\": {\"KHR_lights_punctual\": {\"light\": 1}}},"
+            " {\"name\": \"d\", \"mesh\": 0, \"extensions\": {\"KHR_lights_punctual\": {\"light\": 2}}}],"
+            " \"scenes\": [{\"name\": \"first\", \"nodes\": [0]}, {\"name\": \"second\", \"nodes\": [0, 1]}], \"scene\": 1");
+    writeText(sb.model / "features.gltf", json);
+    assets::LoadResult r = quickLoad(sb.model / "features.gltf");
+    ASSERT_TRUE(r.scene) << r.error;
+    const sg::Scene& s = *r.scene;
+    ASSERT_EQ(r.sceneNames.size(), 2u);
+    EXPECT_EQ(r.sceneNames[0], "first");
+    EXPECT_EQ(r.loadedScene, 1);
+    EXPECT_EQ(countPayload(s, "light"), 3u);   // no default light added
+    int point = 0, spot = 0, dir = 0;
+    for (sg::NodeId id : s.depthFirstOrder()) {
+        auto* l = std::get_if<sg::Light>(&s.node(id).payload);
+        if (!l) continue;
+        if (l->type == sg::LightType::Point) {
+            ++point;
+            EXPECT_FLOAT_EQ(l->intensity, 40.0f);
+            EXPECT_EQ(l->color, sg::vec3(1, 0.5f, 0.25f));
+            EXPECT_TRUE(l->inverseSquare);
+        } else if (l->type == sg::LightType::Spot) {
+            ++spot;
+            EXPECT_NEAR(l->spotInnerDeg, sg::degrees(0.2f), 1e-4);
+            EXPECT_NEAR(l->spotOuterDeg, sg::degrees(0.4f), 1e-4);
+            EXPECT_TRUE(l->inverseSquare);
+        } else {
+            ++dir;
+            EXPECT_FALSE(l->inverseSquare);
+            EXPECT_EQ(s.node(s.node(id).parent).name, "d");   // node "d" also has a mesh: light is a child
+        }
+    }
+    EXPECT_EQ(point + spot + dir, 3);
+    EXPECT_EQ(countPayload(s, "camera"), 1u);   // default camera
+    ASSERT_EQ(r.animations.size(), 1u);
+    const assets::AnimationClip& clip = r.animations[0];
+    ASSERT_EQ(clip.channels.size(), 2u);
+    EXPECT_FLOAT_EQ(clip.duration, 2.0f);
+    sg::Scene copy = s;
+    sg::NodeId mover = copy.findByName("mover");
+    ASSERT_EQ(clip.channels[0].node, mover);
+    assets::applyAnimation(copy, clip, 1.0f);   // STEP: still key 0; cubic with zero tangents: halfway
+    EXPECT_EQ(copy.node(mover).local.translation, sg::vec3(0));
+    EXPECT_NEAR(copy.node(mover).local.scale.x, 2.0f, 1e-5);
+    assets::applyAnimation(copy, clip, 2.0f);
+    EXPECT_EQ(copy.node(mover).local.translation, sg::vec3(4, 0, 0));
+    EXPECT_NEAR(copy.node(mover).local.scale.y, 3.0f, 1e-5);
+}
+
+TEST(GltfGeneratedTest, StructuralErrors) {
+    Sandbox sb("structure");
+    struct Case { const char* file; const char* from; const char* to; const char* needle; };
+    const Case cases[] = {
+        {"twoparents.gltf", "\"nodes\": [{\"mesh\": 0}]", "\"nodes\": [{\"mesh\": 0, \"children\": [2]}, {\"children\": [2]}, {}]", "two parents"},
+        {"selfchild.gltf", "\"nodes\": [{\"mesh\": 0}]", "\"nodes\": [{\"mesh\": 0, \"children\": [0]}]", "own child"},
+        {"cycle.gltf", "\"nodes\": [{\"mesh\": 0}]", "\"nodes\": [{\"mesh\": 0}, {\"children\": [2]}, {\"children\": [1]}]", "cycle"},
+        {"nanmatrix.gltf", "\"nodes\": [{\"mesh\": 0}]", "\"nodes\": [{\"mesh\": 0, \"matrix\": [1,0,0,0, 0,1,0,0, 0,0,1,0, 1e35,0,0,1]}]", "matrix must be"},
+        {"badlight.gltf", "\"nodes\": [{\"mesh\": 0}]", "\"nodes\": [{\"mesh\": 0, \"extensions\": {\"KHR_lights_punctual\": {\"light\": 5}}}]", "light 5"},
+        {"badmesh.gltf", "\"nodes\": [{\"mesh\": 0}]", "\"nodes\": [{\"mesh\": 7}]", "mesh 7"},
+        {"badscene.gltf", "\"scene\": 0 }", "\"scene\": 3 }", "scene 3"},
+        {"badmaterial.gltf", "\"indices\": 1}", "\"indices\": 1, \"material\": 2}", "material 2"},
+        {"required.gltf", "\"asset\"", "\"extensionsRequired\": [\"KHR_draco_mesh_compression\"], \"asset\"", "KHR_draco_mesh_compression"},
+        {"stride.gltf", "\"byteLength\": 36}", "\"byteLength\": 36, \"byteStride\": 6}", "byteStride"},
+    };
+    for (const Case& c : cases) {
+        std::string json = triangleGltf(Knobs{});
+        size_t at = json.find(c.from);
+        ASSERT_NE(at, std::string::npos) << c.file;
+        json.replace(at, std::strlen(c.from), c.to);
+        writeText(sb.model / c.file, json);
+        assets::LoadResult r = quickLoad(sb.model / c.file);
+        EXPECT_FALSE(r.scene) << c.file;
+        EXPECT_NE(r.error.find(c.needle), std::string::npos) << c.file << ": " << r.error;
+    }
 }
