@@ -8,6 +8,8 @@
 
 #include <glm/gtx/matrix_decompose.hpp>
 
+#include <tbb/parallel_for.h>
+
 #if defined(__SSE2__)
 #include <immintrin.h>
 #endif
@@ -334,23 +336,79 @@ inline void mulAffine(const mat4& a, const mat4& b, mat4& out) {
     }
 #endif
 }
-}  // namespace
 
-size_t updateWorldImpl(const Scene& s) {
-    if (!s.m_orderValid) s.rebuildOrder();
-    const size_t n = s.m_order.size();
-    const int32_t* parent = s.m_parentSlot.data();
-    const mat4* local = s.m_localM.data();
-    mat4* world = s.m_worldM.data();
-    size_t count = 0;
-    auto updateRange = [&](size_t begin, size_t end) {
-        count += end - begin;
+// Updates dirty subtrees. A subtree is the contiguous slot range [root, root + size); its
+// children's subtrees are consecutive sub-ranges. Large subtrees are split over threads by
+// their children (TBB): every node's world is still parent x local computed the same way, so
+// the result does not depend on the number of threads. Chains and caterpillars are walked
+// iteratively; recursion only happens where at least two parts of >= kGrain nodes each run in
+// parallel, so its depth is at most n / kGrain.
+struct WorldUpdater {
+    static constexpr size_t kGrain = 16384;
+    const int32_t* parent;
+    const uint32_t* subtreeSize;
+    const mat4* local;
+    mat4* world;
+
+    void serial(size_t begin, size_t end) const {
         // Only the root (slot 0, always first in its range) has no parent: no branch in the loop.
         if (begin < end && parent[begin] < 0) {
             world[begin] = local[begin];
             ++begin;
         }
         for (size_t i = begin; i < end; ++i) mulAffine(world[parent[i]], local[i], world[i]);
+    }
+
+    void subtree(size_t begin, size_t end) const {
+        struct Part { size_t begin, end; bool tree; };
+        std::vector<Part> parts;
+        while (end - begin >= 2 * kGrain) {
+            serial(begin, begin + 1);
+            // Children subtrees: big ones are parts of their own, runs of small ones are batched.
+            parts.clear();
+            size_t heavy = 0;
+            for (size_t c = begin + 1; c < end; c += subtreeSize[c]) {
+                size_t ce = c + subtreeSize[c];
+                if (ce - c >= kGrain) {
+                    parts.push_back({c, ce, true});
+                    ++heavy;
+                } else if (!parts.empty() && !parts.back().tree && parts.back().end - parts.back().begin < kGrain) {
+                    parts.back().end = ce;
+                    if (ce - parts.back().begin >= kGrain) ++heavy;
+                } else {
+                    parts.push_back({c, ce, false});
+                }
+            }
+            if (heavy >= 2) {
+                tbb::parallel_for(size_t(0), parts.size(), [&](size_t k) {
+                    if (parts[k].tree) subtree(parts[k].begin, parts[k].end);
+                    else serial(parts[k].begin, parts[k].end);
+                });
+                return;
+            }
+            // At most one big part: the small ones here, then continue down the big one.
+            const Part* next = nullptr;
+            for (const Part& pt : parts) {
+                if (pt.tree) next = &pt;
+                else serial(pt.begin, pt.end);
+            }
+            if (!next) return;
+            begin = next->begin;
+            end = next->end;
+        }
+        serial(begin, end);
+    }
+};
+}  // namespace
+
+size_t updateWorldImpl(const Scene& s) {
+    if (!s.m_orderValid) s.rebuildOrder();
+    const size_t n = s.m_order.size();
+    WorldUpdater up{s.m_parentSlot.data(), s.m_subtreeSize.data(), s.m_localM.data(), s.m_worldM.data()};
+    size_t count = 0;
+    auto updateRange = [&](size_t begin, size_t end) {
+        count += end - begin;
+        up.subtree(begin, end);
     };
     if (s.m_allDirty) {
         updateRange(0, n);
