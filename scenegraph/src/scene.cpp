@@ -311,9 +311,10 @@ void Scene::rebuildOrder() const {
 
 namespace {
 // world = parent * local for affine matrices (last rows 0 0 0 1): 36 multiply-adds instead
-// of 64. SSE version: each output column is a0*b.x + a1*b.y + a2*b.z (+ a3), four lanes at
-// once; the scalar fallback does the same operations in the same order, so both give
-// bit-identical results (no FMA contraction without -march).
+// of 64. SSE version: each output column is (a0*b.x + a1*b.y) + (a2*b.z [+ a3]), four lanes
+// at once, summed as a tree to shorten the dependency chain parent -> child (deep chains are
+// latency bound); the scalar fallback does the same operations in the same order, so both
+// give bit-identical results (no FMA contraction without -march).
 inline void mulAffine(const mat4& a, const mat4& b, mat4& out) {
 #if defined(__SSE2__)
     const float* pa = &a[0][0];
@@ -322,17 +323,17 @@ inline void mulAffine(const mat4& a, const mat4& b, mat4& out) {
     const __m128 a0 = _mm_loadu_ps(pa), a1 = _mm_loadu_ps(pa + 4), a2 = _mm_loadu_ps(pa + 8), a3 = _mm_loadu_ps(pa + 12);
     for (int c = 0; c < 4; ++c) {
         const __m128 bc = _mm_loadu_ps(pb + 4 * c);
-        __m128 r = _mm_mul_ps(a0, _mm_shuffle_ps(bc, bc, 0x00));
-        r = _mm_add_ps(r, _mm_mul_ps(a1, _mm_shuffle_ps(bc, bc, 0x55)));
-        r = _mm_add_ps(r, _mm_mul_ps(a2, _mm_shuffle_ps(bc, bc, 0xAA)));
-        if (c == 3) r = _mm_add_ps(r, a3);
-        _mm_storeu_ps(po + 4 * c, r);
+        const __m128 r01 = _mm_add_ps(_mm_mul_ps(a0, _mm_shuffle_ps(bc, bc, 0x00)), _mm_mul_ps(a1, _mm_shuffle_ps(bc, bc, 0x55)));
+        __m128 r2 = _mm_mul_ps(a2, _mm_shuffle_ps(bc, bc, 0xAA));
+        if (c == 3) r2 = _mm_add_ps(r2, a3);
+        _mm_storeu_ps(po + 4 * c, _mm_add_ps(r01, r2));
     }
 #else
     for (int c = 0; c < 4; ++c) {
-        vec4 r = a[0] * b[c][0] + a[1] * b[c][1] + a[2] * b[c][2];
-        if (c == 3) r += a[3];
-        out[c] = r;
+        vec4 r01 = a[0] * b[c][0] + a[1] * b[c][1];
+        vec4 r2 = a[2] * b[c][2];
+        if (c == 3) r2 += a[3];
+        out[c] = r01 + r2;
     }
 #endif
 }
