@@ -98,19 +98,19 @@ FrameInput flatten(const Scene& scene, float aspect, NodeId cameraNode) {
     const auto& order = scene.depthFirstOrder();
     scene.updateWorld();
 
-    // Effective visibility and "inside a CSG node" flags, in one pass over the pre-order.
-    std::vector<uint8_t> hidden(scene.idCapacity(), 0), inCsg(scene.idCapacity(), 0);
+    // One pass over the pre-order (parents come first): per-id flags
+    // bit 0 = hidden (self or an ancestor), bit 1 = a CSG node or inside one.
+    // Groups and cameras are skipped before touching their world matrix (cache misses are
+    // most of the cost on large scenes).
+    std::vector<uint8_t> flags(scene.idCapacity(), 0);
     for (NodeId id : order) {
         const Node& n = scene.node(id);
-        bool parentHidden = n.parent != kNoNode && hidden[n.parent];
-        bool parentCsg = n.parent != kNoNode && (inCsg[n.parent] || std::holds_alternative<CsgPayload>(scene.node(n.parent).payload));
-        hidden[id] = parentHidden || !n.visible;
-        inCsg[id] = parentCsg;
-    }
-
-    for (NodeId id : order) {
-        const Node& n = scene.node(id);
-        if (hidden[id]) continue;
+        uint8_t pf = n.parent != kNoNode ? flags[n.parent] : 0;
+        bool hidden = (pf & 1) || !n.visible;
+        bool inCsg = (pf & 2) != 0;
+        flags[id] = uint8_t((hidden ? 1 : 0) | (inCsg || std::holds_alternative<CsgPayload>(n.payload) ? 2 : 0));
+        if (hidden) continue;
+        if (std::holds_alternative<std::monostate>(n.payload) || std::holds_alternative<Camera>(n.payload)) continue;
         const mat4& w = scene.world(id);
         if (auto* mi = std::get_if<MeshInstance>(&n.payload)) {
             if (mi->mesh < 0 || size_t(mi->mesh) >= scene.meshes.size() || !scene.meshes[mi->mesh]) continue;
@@ -135,7 +135,7 @@ FrameInput flatten(const Scene& scene, float aspect, NodeId cameraNode) {
             l.cosInner = std::cos(radians(std::min(lp->spotInnerDeg, lp->spotOuterDeg)));
             l.cosOuter = std::cos(radians(lp->spotOuterDeg));
             f.lights.push_back(l);
-        } else if (!inCsg[id]) {
+        } else if (!inCsg) {
             DrawAnalytic a;
             a.node = id;
             a.world = w;

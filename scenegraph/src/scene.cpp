@@ -8,6 +8,12 @@
 
 #include <glm/gtx/matrix_decompose.hpp>
 
+#include <tbb/parallel_for.h>
+
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
+
 #include <sstream>
 
 namespace sg {
@@ -304,30 +310,106 @@ void Scene::rebuildOrder() const {
 // --- world update ------------------------------------------------------------------------------
 
 namespace {
-// world = parent * local for affine matrices (last rows 0 0 0 1): 36 multiply-adds instead of 64.
+// world = parent * local for affine matrices (last rows 0 0 0 1): 36 multiply-adds instead
+// of 64. SSE version: each output column is (a0*b.x + a1*b.y) + (a2*b.z [+ a3]), four lanes
+// at once, summed as a tree to shorten the dependency chain parent -> child (deep chains are
+// latency bound); the scalar fallback does the same operations in the same order, so both
+// give bit-identical results (no FMA contraction without -march).
 inline void mulAffine(const mat4& a, const mat4& b, mat4& out) {
+#if defined(__SSE2__)
+    const float* pa = &a[0][0];
+    const float* pb = &b[0][0];
+    float* po = &out[0][0];
+    const __m128 a0 = _mm_loadu_ps(pa), a1 = _mm_loadu_ps(pa + 4), a2 = _mm_loadu_ps(pa + 8), a3 = _mm_loadu_ps(pa + 12);
     for (int c = 0; c < 4; ++c) {
-        vec4 r = a[0] * b[c][0] + a[1] * b[c][1] + a[2] * b[c][2];
-        if (c == 3) r += a[3];
-        out[c] = r;
+        const __m128 bc = _mm_loadu_ps(pb + 4 * c);
+        const __m128 r01 = _mm_add_ps(_mm_mul_ps(a0, _mm_shuffle_ps(bc, bc, 0x00)), _mm_mul_ps(a1, _mm_shuffle_ps(bc, bc, 0x55)));
+        __m128 r2 = _mm_mul_ps(a2, _mm_shuffle_ps(bc, bc, 0xAA));
+        if (c == 3) r2 = _mm_add_ps(r2, a3);
+        _mm_storeu_ps(po + 4 * c, _mm_add_ps(r01, r2));
     }
+#else
+    for (int c = 0; c < 4; ++c) {
+        vec4 r01 = a[0] * b[c][0] + a[1] * b[c][1];
+        vec4 r2 = a[2] * b[c][2];
+        if (c == 3) r2 += a[3];
+        out[c] = r01 + r2;
+    }
+#endif
 }
+
+// Updates dirty subtrees. A subtree is the contiguous slot range [root, root + size); its
+// children's subtrees are consecutive sub-ranges. Large subtrees are split over threads by
+// their children (TBB): every node's world is still parent x local computed the same way, so
+// the result does not depend on the number of threads. Chains and caterpillars are walked
+// iteratively; recursion only happens where at least two parts of >= kGrain nodes each run in
+// parallel, so its depth is at most n / kGrain.
+struct WorldUpdater {
+    static constexpr size_t kGrain = 16384;
+    const int32_t* parent;
+    const uint32_t* subtreeSize;
+    const mat4* local;
+    mat4* world;
+
+    void serial(size_t begin, size_t end) const {
+        // Only the root (slot 0, always first in its range) has no parent: no branch in the loop.
+        if (begin < end && parent[begin] < 0) {
+            world[begin] = local[begin];
+            ++begin;
+        }
+        for (size_t i = begin; i < end; ++i) mulAffine(world[parent[i]], local[i], world[i]);
+    }
+
+    void subtree(size_t begin, size_t end) const {
+        struct Part { size_t begin, end; bool tree; };
+        std::vector<Part> parts;
+        while (end - begin >= 2 * kGrain) {
+            serial(begin, begin + 1);
+            // Children subtrees: big ones are parts of their own, runs of small ones are batched.
+            parts.clear();
+            size_t heavy = 0;
+            for (size_t c = begin + 1; c < end; c += subtreeSize[c]) {
+                size_t ce = c + subtreeSize[c];
+                if (ce - c >= kGrain) {
+                    parts.push_back({c, ce, true});
+                    ++heavy;
+                } else if (!parts.empty() && !parts.back().tree && parts.back().end - parts.back().begin < kGrain) {
+                    parts.back().end = ce;
+                    if (ce - parts.back().begin >= kGrain) ++heavy;
+                } else {
+                    parts.push_back({c, ce, false});
+                }
+            }
+            if (heavy >= 2) {
+                tbb::parallel_for(size_t(0), parts.size(), [&](size_t k) {
+                    if (parts[k].tree) subtree(parts[k].begin, parts[k].end);
+                    else serial(parts[k].begin, parts[k].end);
+                });
+                return;
+            }
+            // At most one big part: the small ones here, then continue down the big one.
+            const Part* next = nullptr;
+            for (const Part& pt : parts) {
+                if (pt.tree) next = &pt;
+                else serial(pt.begin, pt.end);
+            }
+            if (!next) return;
+            begin = next->begin;
+            end = next->end;
+        }
+        serial(begin, end);
+    }
+};
 }  // namespace
 
 size_t updateWorldImpl(const Scene& s) {
     if (!s.m_orderValid) s.rebuildOrder();
     const size_t n = s.m_order.size();
-    const int32_t* parent = s.m_parentSlot.data();
-    const mat4* local = s.m_localM.data();
-    mat4* world = s.m_worldM.data();
+    WorldUpdater up{s.m_parentSlot.data(), s.m_subtreeSize.data(), s.m_localM.data(), s.m_worldM.data()};
     size_t count = 0;
     auto updateRange = [&](size_t begin, size_t end) {
-        for (size_t i = begin; i < end; ++i) {
-            int32_t p = parent[i];
-            if (p < 0) world[i] = local[i];
-            else mulAffine(world[p], local[i], world[i]);
-        }
         count += end - begin;
+        up.subtree(begin, end);
     };
     if (s.m_allDirty) {
         updateRange(0, n);

@@ -128,6 +128,49 @@ TEST(SceneTest, RandomEditsMatchBruteForce) {
     }
 }
 
+// Large trees take the multi-threaded path (subtrees of >= 16k nodes run in parallel):
+// random branching, a caterpillar (chain with a leaf on every link) and a root with two
+// long chains all match a straightforward parent-first recomputation.
+TEST(SceneTest, LargeTreesMatchSerialRecomputation) {
+    for (int shape = 0; shape < 3; ++shape) {
+        SCOPED_TRACE(shape);
+        Scene s;
+        std::mt19937 rng(11);
+        std::uniform_real_distribution<float> u(-1, 1);
+        std::vector<NodeId> ids{s.root()};
+        const int n = 70000;
+        NodeId chainA = s.root(), chainB = s.root(), link = s.root();
+        for (int i = 0; i < n; ++i) {
+            NodeId parent;
+            if (shape == 0) parent = ids[rng() % ids.size()];
+            else if (shape == 1) parent = link;   // even i: a leaf on the link, odd i: the next link
+            else parent = i % 2 ? chainA : chainB;
+            NodeId id = s.addNode({}, parent);
+            if (shape == 1 && i % 2 == 1) link = id;
+            if (shape == 2) (i % 2 ? chainA : chainB) = id;
+            LocalTransform lt = LocalTransform::fromTRS(vec3(u(rng), u(rng), u(rng)) * 1e-3f);
+            lt.setEulerDegrees(vec3(u(rng), u(rng), u(rng)));
+            s.setLocal(id, lt);
+            ids.push_back(id);
+        }
+        s.setLocal(s.root(), trs(vec3(1, 2, 3), vec3(10, 20, 30)));
+        EXPECT_EQ(s.updateWorld(), s.nodeCount());
+        std::vector<mat4> expect(s.idCapacity());
+        for (NodeId id : s.depthFirstOrder()) {
+            NodeId p = s.node(id).parent;
+            expect[id] = (p == kNoNode ? mat4(1.0f) : expect[p]) * s.node(id).local.toMatrix();
+        }
+        for (NodeId id : s.depthFirstOrder()) ASSERT_TRUE(matNear(s.world(id), expect[id], 1e-3f)) << "node " << id;
+        // A second full update gives bit-identical results (no dependence on scheduling).
+        std::vector<mat4> first;
+        for (NodeId id : s.depthFirstOrder()) first.push_back(s.world(id));
+        s.setLocal(s.root(), s.node(s.root()).local);
+        EXPECT_EQ(s.updateWorld(), s.nodeCount());
+        size_t k = 0;
+        for (NodeId id : s.depthFirstOrder()) ASSERT_EQ(s.world(id), first[k++]);
+    }
+}
+
 // --- structure -----------------------------------------------------------------------------
 
 TEST(SceneTest, ReparentKeepWorld) {

@@ -16,6 +16,7 @@
 #include <fstream>
 #include <map>
 #include <set>
+#include <sstream>
 #include <thread>
 
 using namespace sg;
@@ -164,7 +165,7 @@ std::vector<PrimitiveCase> primitiveCases() {
 TEST(TessellateTest, PrimitivesAreClosedOutwardAndOnTheSurface) {
     for (int res : {8, 17, 64}) {
         for (const PrimitiveCase& c : primitiveCases()) {
-            SCOPED_TRACE(std::string(c.name) + " res " + std::to_string(res));
+            SCOPED_TRACE(::testing::Message() << c.name << " res " << res);
             Tessellation t = rnd::tessellate(implicitDrawable(c.shape), res);
             expectValidMesh(t);
             const Mesh& m = *t.mesh;
@@ -263,7 +264,9 @@ TEST(TessellateTest, SgPrimitivesWindingMatchesNormals) {
                 ASSERT_GT(glm::dot(f, c.m.normals[k]), 0.0f) << "triangle " << i / 3;
             }
         }
-        if (c.volume > 0) EXPECT_NEAR(signedVolume(c.m) / c.volume, 1.0, 0.05);   // coarse: 32 segments
+        if (c.volume > 0) {
+            EXPECT_NEAR(signedVolume(c.m) / c.volume, 1.0, 0.05);   // coarse: 32 segments
+        }
     }
 }
 
@@ -528,7 +531,7 @@ TEST(TessellateTest, DemoSceneAnalyticsTessellate) {
         SCOPED_TRACE(s.node(a.node).name);
         expectValidMesh(t);
         EXPECT_GT(t.mesh->triangleCount(), 0u);
-        dumpObj(*t.mesh, "demo_" + std::to_string(a.node));
+        dumpObj(*t.mesh, (std::ostringstream() << "demo_" << a.node).str());
         bool closedKind = !(a.kind == DrawAnalytic::Kind::Parametric && a.parametric.type == ParametricType::BezierPatch) &&
                           !(a.kind == DrawAnalytic::Kind::Implicit && a.implicit.type == ImplicitType::Plane);
         if (closedKind) {

@@ -2,11 +2,16 @@
 // rasterizer so both draw exactly the same triangles:
 //   * implicit primitives (sphere, box, cylinder, cone, torus, plane): analytic tessellation
 //     with `resolution` segments;
-//   * quadrics, CSG trees and density grids: marching cubes on a resolution^3 grid over the
-//     bounds, vertices refined onto the surface, normals from the gradient;
+//   * quadrics, CSG trees and density grids: marching tetrahedra (each cube of a resolution^3
+//     grid over the bounds split into 6 tetrahedra; no ambiguous cases, so closed surfaces are
+//     watertight), vertices refined onto the exact surface, normals from the gradient (CSG:
+//     from the leaf the vertex lies on; crease vertices are duplicated per leaf);
 //   * parametric surfaces: a resolution x resolution (u, v) grid, normals dPdu x dPdv.
+// Triangles are counter-clockwise seen from outside; normals point outward. Analytic
+// primitives have bit-exact seams and poles (watertight after welding by position).
 // Meshes are in the drawable's local frame (apply DrawAnalytic::world), except CSG, whose
 // leaves carry their own transforms: CSG meshes are in world space (use identity).
+// Cost: the demo scene at resolution 64 takes ~0.1-0.2 s in total (bench_tessellate).
 #pragma once
 
 #include "scenegraph/frame.h"
