@@ -270,22 +270,25 @@ namespace {
 void nodeContextMenu(ViewerState& st, sg::NodeId id) {
     if (!ImGui::BeginPopupContextItem()) return;
     st.selectNode(id);
-    const sg::Node& n = st.scene.node(id);
+    // No Node references are held here: adding nodes may reallocate the scene's node array.
     if (ImGui::BeginMenu("Add child")) {
         addMenuItems(st, id);
         ImGui::EndMenu();
     }
-    if (id != st.scene.root()) {
+    if (st.scene.valid(id) && id != st.scene.root()) {
         if (ImGui::MenuItem("Rename", "F2")) {
             g_renaming = id;
-            g_renameBuffer = n.name;
+            g_renameBuffer = st.scene.node(id).name;
         }
         if (ImGui::MenuItem("Duplicate", "Ctrl+D")) st.duplicateNode(id);
+        bool visible = st.scene.valid(id) && st.scene.node(id).visible;
+        if (ImGui::MenuItem(visible ? "Hide" : "Show")) st.setVisible(id, !visible);
         if (ImGui::MenuItem("Delete", "Del")) st.removeNode(id);
-        if (ImGui::MenuItem(n.visible ? "Hide" : "Show")) st.setVisible(id, !n.visible);
     }
-    if (ImGui::MenuItem("Frame in view", "F")) st.fitView(true);
-    if (std::holds_alternative<sg::Camera>(n.payload) && ImGui::MenuItem("Look through")) st.useSceneCamera(id);
+    if (st.scene.valid(id)) {
+        if (ImGui::MenuItem("Frame in view", "F")) st.fitView(true);
+        if (std::holds_alternative<sg::Camera>(st.scene.node(id).payload) && ImGui::MenuItem("Look through")) st.useSceneCamera(id);
+    }
     ImGui::EndPopup();
 }
 
@@ -338,14 +341,15 @@ void drawNode(ViewerState& st, sg::NodeId id, int depth) {
     if (id != st.scene.root() && ImGui::BeginDragDropSource()) {
         sg::NodeId payload = id;
         ImGui::SetDragDropPayload("SG_NODE", &payload, sizeof(payload));
-        ImGui::Text("Move %s", n.name.c_str());
+        ImGui::Text("Move %s", st.scene.node(id).name.c_str());
         ImGui::EndDragDropSource();
     }
     if (ImGui::BeginDragDropTarget()) {
         if (const ImGuiPayload* p = ImGui::AcceptDragDropPayload("SG_NODE")) {
             sg::NodeId moved = *static_cast<const sg::NodeId*>(p->Data);
             std::string err;
-            if (!st.reparent(moved, id, &err) && !err.empty()) st.errorPopup = "Cannot move '" + st.scene.node(moved).name + "' under '" + n.name + "':\n" + err;
+            if (st.scene.valid(moved) && !st.reparent(moved, id, &err) && !err.empty())
+                st.errorPopup = "Cannot move '" + st.scene.node(moved).name + "' under '" + st.scene.node(id).name + "':\n" + err;
         }
         ImGui::EndDragDropTarget();
     }

@@ -131,6 +131,7 @@ bool RenderSlot::poll() {
     if (!m_haveNew) return false;
     m_haveNew = false;
     std::swap(m_shown, m_finished);
+    ++m_serial;
     return true;
 }
 

@@ -169,9 +169,8 @@ public:
             diffTexture.release();
             return;
         }
-        // Recompute when either image or the threshold changed (images identified by data pointer + stats time).
-        uint64_t k = uint64_t(uintptr_t(fa.color.data())) ^ (uint64_t(uintptr_t(fb.color.data())) << 1) ^ (uint64_t(st.compare.threshold) << 56) ^
-                     std::hash<double>{}(a.status().stats.milliseconds) ^ (std::hash<double>{}(b.status().stats.milliseconds) << 3) ^
+        // Recompute when either image, the pair or the threshold changed.
+        uint64_t k = (a.imageSerial() * 1000003u) ^ (b.imageSerial() * 7919u) ^ (uint64_t(st.compare.threshold) << 56) ^
                      std::hash<std::string>{}(names[0] + "|" + names[1]);
         if (k != diffKey) {
             diffKey = k;

@@ -47,6 +47,7 @@ public:
     bool poll();
     // Last finished image (UI thread only; valid until the next poll()).
     const rnd::Framebuffer& image() const { return m_shown; }
+    uint64_t imageSerial() const { return m_serial; }   // bumped whenever image() changes
     SlotStatus status() const;
     // Blocks until nothing is pending (tests, screenshots at exit).
     void waitIdle();
@@ -85,6 +86,7 @@ private:
     std::thread m_thread;
 
     rnd::Framebuffer m_shown;                  // UI thread
+    uint64_t m_serial = 0;
 };
 
 }  // namespace ui
