@@ -860,23 +860,24 @@ void drawComparePanel(ViewerState& st) {
         backendCombo("Backend", b);
         if (b != st.backend) st.setBackend(b);
         ImGui::TextDisabled("Keys 1 / 2 / 3 switch backends.");
-    } else {
+    } else if (c.mode == ViewMode::Split) {
         ImGui::SliderInt("Count", &c.count, 2, 3);
-        const char* labels[] = {"Left", "Middle / right", "Right"};
-        for (int i = 0; i < (c.mode == ViewMode::Split ? c.count : 3); ++i) backendCombo(labels[i], c.backends[i]);
-        if (c.mode == ViewMode::Split) {
-            ImGui::SliderFloat("Divider 1", &c.dividers[0], 0.0f, 1.0f);
-            if (c.count == 3) ImGui::SliderFloat("Divider 2", &c.dividers[1], 0.0f, 1.0f);
-            c.dividers[1] = std::max(c.dividers[1], c.dividers[0]);
-            ImGui::TextDisabled("Drag the dividers in the viewport.");
-        }
+        const char* labels[] = {"Left", c.count == 3 ? "Middle" : "Right", "Right"};
+        for (int i = 0; i < c.count; ++i) backendCombo(labels[i], c.backends[i]);
+        ImGui::SliderFloat("Divider 1", &c.dividers[0], 0.0f, 1.0f);
+        if (c.count == 3) ImGui::SliderFloat("Divider 2", &c.dividers[1], 0.0f, 1.0f);
+        c.dividers[1] = std::max(c.dividers[1], c.dividers[0]);
+        ImGui::TextDisabled("Drag the dividers in the viewport.");
+    } else {
+        c.diffA = std::clamp(c.diffA, 0, 2);
+        c.diffB = std::clamp(c.diffB, 0, 2);
+        if (c.diffA == c.diffB) c.diffB = (c.diffA + 1) % 3;
+        backendCombo("A", c.backends[c.diffA]);
+        backendCombo("B", c.backends[c.diffB]);
     }
     if (c.mode == ViewMode::Difference) {
         section("Difference");
-        const char* slotNames[] = {"slot 1", "slot 2", "slot 3"};
-        ImGui::Combo("A", &c.diffA, slotNames, 3);
-        ImGui::Combo("B", &c.diffB, slotNames, 3);
-        ImGui::Text("%s  vs  %s", c.backends[c.diffA].c_str(), c.backends[c.diffB].c_str());
+        ImGui::Text("|%s - %s| per pixel", c.backends[c.diffA].c_str(), c.backends[c.diffB].c_str());
         ImGui::SliderInt("Threshold", &c.threshold, 0, 255);
         record(st, "compare/threshold");
         if (st.haveDiff) {

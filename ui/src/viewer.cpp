@@ -389,8 +389,8 @@ public:
     static void applyView(ViewerState& st, const std::string& m) {
         if (m == "single") st.compare.mode = ViewMode::Single;
         else if (m == "split") { st.compare.mode = ViewMode::Split; st.compare.count = 2; st.compare.backends = {"gl", "raster", "raycast"}; }
-        else if (m == "split3") { st.compare.mode = ViewMode::Split; st.compare.count = 3; st.compare.dividers = {0.33f, 0.66f}; }
-        else if (m == "difference") { st.compare.mode = ViewMode::Difference; st.compare.backends = {"raster", "raycast", "gl"}; }
+        else if (m == "split3") { st.compare.mode = ViewMode::Split; st.compare.count = 3; st.compare.dividers = {0.33f, 0.66f}; st.compare.backends = {"gl", "raster", "raycast"}; }
+        else if (m == "difference") { st.compare.mode = ViewMode::Difference; st.compare.backends = {"raster", "raycast", "gl"}; st.compare.diffA = 0; st.compare.diffB = 1; }
     }
 };
 
