@@ -298,6 +298,7 @@ private:
 //   orbit DX DY | zoom STEPS | fit
 //   select NODE-NAME
 //   tab Inspector|Camera|Rendering|Compare
+//   stats                 print time / triangles / rays of the shown backends
 //   screenshot DIR        offscreen PNG per visible backend into DIR (as F12)
 //   window-shot PATH      PNG of the whole window (UI included)
 //   quit
@@ -365,6 +366,16 @@ public:
             if (cmd == "zoom") { float s = 0; in >> s; v.st.camera.zoom(s); v.st.markViewChanged(); continue; }
             if (cmd == "fit") { v.st.fitView(false); continue; }
             if (cmd == "tab") { in >> v.st.requestedTab; continue; }
+            if (cmd == "stats") {   // one line per shown backend: time, triangles, rays, error
+                for (const std::string& n : visibleBackends(v.st)) {
+                    SlotStatus s = v.viewFor(n).slot->status();
+                    std::printf("viewer: stats %s %dx%d level %d: %.1f ms, %llu triangles, %llu rays%s%s\n", n.c_str(), v.st.viewportWidth,
+                                v.st.viewportHeight, s.level, s.stats.milliseconds, (unsigned long long)s.stats.triangles,
+                                (unsigned long long)s.stats.rays, s.error.empty() ? "" : ", error: ", s.error.c_str());
+                }
+                std::fflush(stdout);
+                continue;
+            }
             if (cmd == "select") {
                 std::string name;
                 std::getline(in >> std::ws, name);
