@@ -798,6 +798,9 @@ void drawRenderingPanel(ViewerState& st) {
         }
     }
 
+    if (ImGui::Checkbox("GL on a worker thread", &st.glOnWorker)) st.markViewChanged();
+    helpMarker("The gl backend renders on its own thread with a headless context: the UI never waits, even with software GL.\nOff: it renders on the UI thread with the window's context.");
+
     section("Rasterizers");
     ch |= ImGui::Checkbox("Wireframe", &s.wireframe);
     record(st, "render/wireframe");

@@ -128,12 +128,21 @@ public:
 
     BackendView& viewFor(const std::string& name) {
         BackendView& v = views[name];
-        if (!v.slot) v.slot = std::make_unique<RenderSlot>(name);
+        if (!v.slot)
+            v.slot = std::make_unique<RenderSlot>(name, name == "gl" && st.glOnWorker ? RenderSlot::Threading::Worker : RenderSlot::Threading::Auto);
         return v;
     }
 
     // Requests renders for the visible backends and uploads finished images.
     void updateRenders() {
+        if (st.glOnWorker != m_glOnWorker) {   // where GL runs changed: a new slot
+            m_glOnWorker = st.glOnWorker;
+            auto it = views.find("gl");
+            if (it != views.end()) {
+                it->second.slot.reset();   // joins its worker first
+                it->second.slot = std::make_unique<RenderSlot>("gl", m_glOnWorker ? RenderSlot::Threading::Worker : RenderSlot::Threading::Auto);
+            }
+        }
         int w = st.viewportWidth, h = st.viewportHeight;
         float aspect = float(w) / float(std::max(h, 1));
         bool interacting = (now - st.lastInteraction) < 0.25 || ImGui::GetIO().MouseDown[0] || ImGui::GetIO().MouseDown[1] ||
@@ -145,7 +154,7 @@ public:
             BackendView& v = viewFor(n);
             sg::RenderSettings settings = st.settingsFor(n);
             uint64_t k = key ^ std::hash<std::string>{}(settings.aaName());
-            bool preview = interacting && v.slot->backend() != "gl";
+            bool preview = interacting && (v.slot->backend() != "gl" || st.glOnWorker);
             if (!v.slot->needs(k, preview)) continue;
             if (!base) base = std::make_shared<sg::FrameInput>(st.buildFrame(aspect));   // flatten once per change
             auto frame = std::make_shared<sg::FrameInput>(*base);
@@ -283,6 +292,7 @@ public:
 
 private:
     rnd::ImageDiff m_lastDiff;
+    bool m_glOnWorker = false;
 };
 
 }  // namespace
@@ -298,6 +308,7 @@ private:
 //   orbit DX DY | zoom STEPS | fit
 //   select NODE-NAME
 //   tab Inspector|Camera|Rendering|Compare
+//   gl-worker on|off      run the GL backend on a worker thread (own headless context)
 //   stats                 print time / triangles / rays of the shown backends
 //   screenshot DIR        offscreen PNG per visible backend into DIR (as F12)
 //   window-shot PATH      PNG of the whole window (UI included)
@@ -365,6 +376,7 @@ public:
             if (cmd == "orbit") { float dx = 0, dy = 0; in >> dx >> dy; v.st.camera.orbit(dx, dy); v.st.markViewChanged(); continue; }
             if (cmd == "zoom") { float s = 0; in >> s; v.st.camera.zoom(s); v.st.markViewChanged(); continue; }
             if (cmd == "fit") { v.st.fitView(false); continue; }
+            if (cmd == "gl-worker") { std::string on; in >> on; v.st.glOnWorker = on == "on"; continue; }
             if (cmd == "tab") { in >> v.st.requestedTab; continue; }
             if (cmd == "stats") {   // one line per shown backend: time, triangles, rays, error
                 for (const std::string& n : visibleBackends(v.st)) {

@@ -31,8 +31,12 @@ struct SlotStatus {
 
 class RenderSlot {
 public:
-    // threaded=false renders synchronously in poll() (forced for "gl").
-    explicit RenderSlot(std::string backend, bool threaded = true);
+    // Where the renderer runs: Auto = a worker thread, except for backends that need the
+    // caller's GL context ("gl"), which render synchronously in poll(); Worker = always a
+    // worker thread (the GL backend then makes its own headless context there); UiThread =
+    // always synchronously in poll().
+    enum class Threading { Auto, Worker, UiThread };
+    explicit RenderSlot(std::string backend, Threading threading = Threading::Auto);
     ~RenderSlot();
     RenderSlot(const RenderSlot&) = delete;
     RenderSlot& operator=(const RenderSlot&) = delete;
