@@ -170,8 +170,10 @@ std::vector<std::string> visibleBackends(const ViewerState& st) {
 void setupStyle(float scale, const char* fontPath) {
     g_scale = std::clamp(scale, 0.5f, 4.0f);
     ImGuiIO& io = ImGui::GetIO();
+    ImGui::GetStyle() = ImGuiStyle();   // sizes are scaled below: start from the defaults
     ImGui::StyleColorsDark();
     ImGuiStyle& s = ImGui::GetStyle();
+    io.Fonts->Clear();
     s.WindowRounding = 0.0f;
     s.FrameRounding = 3.0f;
     s.GrabRounding = 3.0f;

@@ -419,6 +419,9 @@ public:
 
 // --- 4. GLFW callbacks -------------------------------------------------------------------------
 
+// DejaVu Sans (Debian fonts-dejavu-core) when present; ImGui's built-in font otherwise.
+constexpr const char* kFontPath = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
+
 void onDrop(GLFWwindow* w, int count, const char** paths) {
     auto* v = static_cast<Viewer*>(glfwGetWindowUserPointer(w));
     for (int i = 0; i < count; ++i) v->droppedFiles.emplace_back(paths[i]);
@@ -428,6 +431,9 @@ void onClose(GLFWwindow* w) {
     auto* v = static_cast<Viewer*>(glfwGetWindowUserPointer(w));
     if (!v->st.requestQuit()) glfwSetWindowShouldClose(w, GLFW_FALSE);   // the modal asks first
 }
+
+float g_newContentScale = 0.0f;   // set by the callback, applied between frames
+void onContentScale(GLFWwindow*, float xs, float ys) { g_newContentScale = std::max(xs, ys); }
 
 void onGlfwError(int code, const char* msg) { std::fprintf(stderr, "viewer: GLFW error %d: %s\n", code, msg); }
 
@@ -489,6 +495,7 @@ int runViewer(const ViewerOptions& opt) {
     glfwSetWindowUserPointer(win, &v);
     glfwSetDropCallback(win, onDrop);
     glfwSetWindowCloseCallback(win, onClose);
+    glfwSetWindowContentScaleCallback(win, onContentScale);   // moved to a monitor of another DPI
 
     // Config: imgui.ini (layout) and recent files in the per-user config folder.
     st.configDir = defaultConfigDir();
@@ -504,7 +511,7 @@ int runViewer(const ViewerOptions& opt) {
     io.IniFilename = ec ? nullptr : iniPath.c_str();
     float xs = 1.0f, ys = 1.0f;
     glfwGetWindowContentScale(win, &xs, &ys);
-    setupStyle(std::max(xs, ys), "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf");
+    setupStyle(std::max(xs, ys), kFontPath);
     ImGui_ImplGlfw_InitForOpenGL(win, true);
     ImGui_ImplOpenGL3_Init("#version 330");
 
@@ -551,6 +558,12 @@ int runViewer(const ViewerOptions& opt) {
             if (automation.failed) exitCode = 2;
         }
 
+        if (g_newContentScale > 0.0f) {   // HiDPI change: rebuild fonts and style at the new scale
+            setupStyle(g_newContentScale, kFontPath);
+            ImGui_ImplOpenGL3_DestroyFontsTexture();
+            ImGui_ImplOpenGL3_CreateFontsTexture();
+            g_newContentScale = 0.0f;
+        }
         ImGui_ImplOpenGL3_NewFrame();
         ImGui_ImplGlfw_NewFrame();
         ImGui::NewFrame();
