@@ -170,8 +170,10 @@ std::vector<std::string> visibleBackends(const ViewerState& st) {
 void setupStyle(float scale, const char* fontPath) {
     g_scale = std::clamp(scale, 0.5f, 4.0f);
     ImGuiIO& io = ImGui::GetIO();
+    ImGui::GetStyle() = ImGuiStyle();   // sizes are scaled below: start from the defaults
     ImGui::StyleColorsDark();
     ImGuiStyle& s = ImGui::GetStyle();
+    io.Fonts->Clear();
     s.WindowRounding = 0.0f;
     s.FrameRounding = 3.0f;
     s.GrabRounding = 3.0f;
@@ -270,22 +272,25 @@ namespace {
 void nodeContextMenu(ViewerState& st, sg::NodeId id) {
     if (!ImGui::BeginPopupContextItem()) return;
     st.selectNode(id);
-    const sg::Node& n = st.scene.node(id);
+    // No Node references are held here: adding nodes may reallocate the scene's node array.
     if (ImGui::BeginMenu("Add child")) {
         addMenuItems(st, id);
         ImGui::EndMenu();
     }
-    if (id != st.scene.root()) {
+    if (st.scene.valid(id) && id != st.scene.root()) {
         if (ImGui::MenuItem("Rename", "F2")) {
             g_renaming = id;
-            g_renameBuffer = n.name;
+            g_renameBuffer = st.scene.node(id).name;
         }
         if (ImGui::MenuItem("Duplicate", "Ctrl+D")) st.duplicateNode(id);
+        bool visible = st.scene.valid(id) && st.scene.node(id).visible;
+        if (ImGui::MenuItem(visible ? "Hide" : "Show")) st.setVisible(id, !visible);
         if (ImGui::MenuItem("Delete", "Del")) st.removeNode(id);
-        if (ImGui::MenuItem(n.visible ? "Hide" : "Show")) st.setVisible(id, !n.visible);
     }
-    if (ImGui::MenuItem("Frame in view", "F")) st.fitView(true);
-    if (std::holds_alternative<sg::Camera>(n.payload) && ImGui::MenuItem("Look through")) st.useSceneCamera(id);
+    if (st.scene.valid(id)) {
+        if (ImGui::MenuItem("Frame in view", "F")) st.fitView(true);
+        if (std::holds_alternative<sg::Camera>(st.scene.node(id).payload) && ImGui::MenuItem("Look through")) st.useSceneCamera(id);
+    }
     ImGui::EndPopup();
 }
 
@@ -338,14 +343,15 @@ void drawNode(ViewerState& st, sg::NodeId id, int depth) {
     if (id != st.scene.root() && ImGui::BeginDragDropSource()) {
         sg::NodeId payload = id;
         ImGui::SetDragDropPayload("SG_NODE", &payload, sizeof(payload));
-        ImGui::Text("Move %s", n.name.c_str());
+        ImGui::Text("Move %s", st.scene.node(id).name.c_str());
         ImGui::EndDragDropSource();
     }
     if (ImGui::BeginDragDropTarget()) {
         if (const ImGuiPayload* p = ImGui::AcceptDragDropPayload("SG_NODE")) {
             sg::NodeId moved = *static_cast<const sg::NodeId*>(p->Data);
             std::string err;
-            if (!st.reparent(moved, id, &err) && !err.empty()) st.errorPopup = "Cannot move '" + st.scene.node(moved).name + "' under '" + n.name + "':\n" + err;
+            if (st.scene.valid(moved) && !st.reparent(moved, id, &err) && !err.empty())
+                st.errorPopup = "Cannot move '" + st.scene.node(moved).name + "' under '" + st.scene.node(id).name + "':\n" + err;
         }
         ImGui::EndDragDropTarget();
     }
@@ -794,6 +800,9 @@ void drawRenderingPanel(ViewerState& st) {
         }
     }
 
+    if (ImGui::Checkbox("GL on a worker thread", &st.glOnWorker)) st.markViewChanged();
+    helpMarker("The gl backend renders on its own thread with a headless context: the UI never waits, even with software GL.\nOff: it renders on the UI thread with the window's context.");
+
     section("Rasterizers");
     ch |= ImGui::Checkbox("Wireframe", &s.wireframe);
     record(st, "render/wireframe");
@@ -856,23 +865,24 @@ void drawComparePanel(ViewerState& st) {
         backendCombo("Backend", b);
         if (b != st.backend) st.setBackend(b);
         ImGui::TextDisabled("Keys 1 / 2 / 3 switch backends.");
-    } else {
+    } else if (c.mode == ViewMode::Split) {
         ImGui::SliderInt("Count", &c.count, 2, 3);
-        const char* labels[] = {"Left", "Middle / right", "Right"};
-        for (int i = 0; i < (c.mode == ViewMode::Split ? c.count : 3); ++i) backendCombo(labels[i], c.backends[i]);
-        if (c.mode == ViewMode::Split) {
-            ImGui::SliderFloat("Divider 1", &c.dividers[0], 0.0f, 1.0f);
-            if (c.count == 3) ImGui::SliderFloat("Divider 2", &c.dividers[1], 0.0f, 1.0f);
-            c.dividers[1] = std::max(c.dividers[1], c.dividers[0]);
-            ImGui::TextDisabled("Drag the dividers in the viewport.");
-        }
+        const char* labels[] = {"Left", c.count == 3 ? "Middle" : "Right", "Right"};
+        for (int i = 0; i < c.count; ++i) backendCombo(labels[i], c.backends[i]);
+        ImGui::SliderFloat("Divider 1", &c.dividers[0], 0.0f, 1.0f);
+        if (c.count == 3) ImGui::SliderFloat("Divider 2", &c.dividers[1], 0.0f, 1.0f);
+        c.dividers[1] = std::max(c.dividers[1], c.dividers[0]);
+        ImGui::TextDisabled("Drag the dividers in the viewport.");
+    } else {
+        c.diffA = std::clamp(c.diffA, 0, 2);
+        c.diffB = std::clamp(c.diffB, 0, 2);
+        if (c.diffA == c.diffB) c.diffB = (c.diffA + 1) % 3;
+        backendCombo("A", c.backends[c.diffA]);
+        backendCombo("B", c.backends[c.diffB]);
     }
     if (c.mode == ViewMode::Difference) {
         section("Difference");
-        const char* slotNames[] = {"slot 1", "slot 2", "slot 3"};
-        ImGui::Combo("A", &c.diffA, slotNames, 3);
-        ImGui::Combo("B", &c.diffB, slotNames, 3);
-        ImGui::Text("%s  vs  %s", c.backends[c.diffA].c_str(), c.backends[c.diffB].c_str());
+        ImGui::Text("|%s - %s| per pixel", c.backends[c.diffA].c_str(), c.backends[c.diffB].c_str());
         ImGui::SliderInt("Threshold", &c.threshold, 0, 255);
         record(st, "compare/threshold");
         if (st.haveDiff) {

@@ -5,9 +5,10 @@
 
 namespace ui {
 
-RenderSlot::RenderSlot(std::string backend, bool threaded) : m_backend(std::move(backend)), m_threaded(threaded) {
+RenderSlot::RenderSlot(std::string backend, Threading threading) : m_backend(std::move(backend)), m_threaded(threading != Threading::UiThread) {
     m_renderer = rnd::makeRenderer(m_backend, &m_makeError);
-    if (m_renderer && (m_renderer->capabilities().needsGLContext || m_backend == "gl")) m_threaded = false;
+    bool wantsContext = m_renderer && (m_renderer->capabilities().needsGLContext || m_backend == "gl");
+    if (threading == Threading::Auto && wantsContext) m_threaded = false;
     m_status.backend = m_backend;
     if (!m_renderer) m_status.error = m_makeError.empty() ? "unknown backend " + m_backend : m_makeError;
     if (m_threaded && m_renderer) m_thread = std::thread([this] { workerLoop(); });
@@ -131,6 +132,7 @@ bool RenderSlot::poll() {
     if (!m_haveNew) return false;
     m_haveNew = false;
     std::swap(m_shown, m_finished);
+    ++m_serial;
     return true;
 }
 

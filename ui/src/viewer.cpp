@@ -128,12 +128,21 @@ public:
 
     BackendView& viewFor(const std::string& name) {
         BackendView& v = views[name];
-        if (!v.slot) v.slot = std::make_unique<RenderSlot>(name);
+        if (!v.slot)
+            v.slot = std::make_unique<RenderSlot>(name, name == "gl" && st.glOnWorker ? RenderSlot::Threading::Worker : RenderSlot::Threading::Auto);
         return v;
     }
 
     // Requests renders for the visible backends and uploads finished images.
     void updateRenders() {
+        if (st.glOnWorker != m_glOnWorker) {   // where GL runs changed: a new slot
+            m_glOnWorker = st.glOnWorker;
+            auto it = views.find("gl");
+            if (it != views.end()) {
+                it->second.slot.reset();   // joins its worker first
+                it->second.slot = std::make_unique<RenderSlot>("gl", m_glOnWorker ? RenderSlot::Threading::Worker : RenderSlot::Threading::Auto);
+            }
+        }
         int w = st.viewportWidth, h = st.viewportHeight;
         float aspect = float(w) / float(std::max(h, 1));
         bool interacting = (now - st.lastInteraction) < 0.25 || ImGui::GetIO().MouseDown[0] || ImGui::GetIO().MouseDown[1] ||
@@ -145,7 +154,7 @@ public:
             BackendView& v = viewFor(n);
             sg::RenderSettings settings = st.settingsFor(n);
             uint64_t k = key ^ std::hash<std::string>{}(settings.aaName());
-            bool preview = interacting && v.slot->backend() != "gl";
+            bool preview = interacting && (v.slot->backend() != "gl" || st.glOnWorker);
             if (!v.slot->needs(k, preview)) continue;
             if (!base) base = std::make_shared<sg::FrameInput>(st.buildFrame(aspect));   // flatten once per change
             auto frame = std::make_shared<sg::FrameInput>(*base);
@@ -169,9 +178,8 @@ public:
             diffTexture.release();
             return;
         }
-        // Recompute when either image or the threshold changed (images identified by data pointer + stats time).
-        uint64_t k = uint64_t(uintptr_t(fa.color.data())) ^ (uint64_t(uintptr_t(fb.color.data())) << 1) ^ (uint64_t(st.compare.threshold) << 56) ^
-                     std::hash<double>{}(a.status().stats.milliseconds) ^ (std::hash<double>{}(b.status().stats.milliseconds) << 3) ^
+        // Recompute when either image, the pair or the threshold changed.
+        uint64_t k = (a.imageSerial() * 1000003u) ^ (b.imageSerial() * 7919u) ^ (uint64_t(st.compare.threshold) << 56) ^
                      std::hash<std::string>{}(names[0] + "|" + names[1]);
         if (k != diffKey) {
             diffKey = k;
@@ -284,6 +292,7 @@ public:
 
 private:
     rnd::ImageDiff m_lastDiff;
+    bool m_glOnWorker = false;
 };
 
 }  // namespace
@@ -299,6 +308,8 @@ private:
 //   orbit DX DY | zoom STEPS | fit
 //   select NODE-NAME
 //   tab Inspector|Camera|Rendering|Compare
+//   gl-worker on|off      run the GL backend on a worker thread (own headless context)
+//   stats                 print time / triangles / rays of the shown backends
 //   screenshot DIR        offscreen PNG per visible backend into DIR (as F12)
 //   window-shot PATH      PNG of the whole window (UI included)
 //   quit
@@ -365,7 +376,18 @@ public:
             if (cmd == "orbit") { float dx = 0, dy = 0; in >> dx >> dy; v.st.camera.orbit(dx, dy); v.st.markViewChanged(); continue; }
             if (cmd == "zoom") { float s = 0; in >> s; v.st.camera.zoom(s); v.st.markViewChanged(); continue; }
             if (cmd == "fit") { v.st.fitView(false); continue; }
+            if (cmd == "gl-worker") { std::string on; in >> on; v.st.glOnWorker = on == "on"; continue; }
             if (cmd == "tab") { in >> v.st.requestedTab; continue; }
+            if (cmd == "stats") {   // one line per shown backend: time, triangles, rays, error
+                for (const std::string& n : visibleBackends(v.st)) {
+                    SlotStatus s = v.viewFor(n).slot->status();
+                    std::printf("viewer: stats %s %dx%d level %d: %.1f ms, %llu triangles, %llu rays%s%s\n", n.c_str(), v.st.viewportWidth,
+                                v.st.viewportHeight, s.level, s.stats.milliseconds, (unsigned long long)s.stats.triangles,
+                                (unsigned long long)s.stats.rays, s.error.empty() ? "" : ", error: ", s.error.c_str());
+                }
+                std::fflush(stdout);
+                continue;
+            }
             if (cmd == "select") {
                 std::string name;
                 std::getline(in >> std::ws, name);
@@ -390,12 +412,15 @@ public:
     static void applyView(ViewerState& st, const std::string& m) {
         if (m == "single") st.compare.mode = ViewMode::Single;
         else if (m == "split") { st.compare.mode = ViewMode::Split; st.compare.count = 2; st.compare.backends = {"gl", "raster", "raycast"}; }
-        else if (m == "split3") { st.compare.mode = ViewMode::Split; st.compare.count = 3; st.compare.dividers = {0.33f, 0.66f}; }
-        else if (m == "difference") { st.compare.mode = ViewMode::Difference; st.compare.backends = {"raster", "raycast", "gl"}; }
+        else if (m == "split3") { st.compare.mode = ViewMode::Split; st.compare.count = 3; st.compare.dividers = {0.33f, 0.66f}; st.compare.backends = {"gl", "raster", "raycast"}; }
+        else if (m == "difference") { st.compare.mode = ViewMode::Difference; st.compare.backends = {"raster", "raycast", "gl"}; st.compare.diffA = 0; st.compare.diffB = 1; }
     }
 };
 
 // --- 4. GLFW callbacks -------------------------------------------------------------------------
+
+// DejaVu Sans (Debian fonts-dejavu-core) when present; ImGui's built-in font otherwise.
+constexpr const char* kFontPath = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
 
 void onDrop(GLFWwindow* w, int count, const char** paths) {
     auto* v = static_cast<Viewer*>(glfwGetWindowUserPointer(w));
@@ -406,6 +431,9 @@ void onClose(GLFWwindow* w) {
     auto* v = static_cast<Viewer*>(glfwGetWindowUserPointer(w));
     if (!v->st.requestQuit()) glfwSetWindowShouldClose(w, GLFW_FALSE);   // the modal asks first
 }
+
+float g_newContentScale = 0.0f;   // set by the callback, applied between frames
+void onContentScale(GLFWwindow*, float xs, float ys) { g_newContentScale = std::max(xs, ys); }
 
 void onGlfwError(int code, const char* msg) { std::fprintf(stderr, "viewer: GLFW error %d: %s\n", code, msg); }
 
@@ -467,6 +495,7 @@ int runViewer(const ViewerOptions& opt) {
     glfwSetWindowUserPointer(win, &v);
     glfwSetDropCallback(win, onDrop);
     glfwSetWindowCloseCallback(win, onClose);
+    glfwSetWindowContentScaleCallback(win, onContentScale);   // moved to a monitor of another DPI
 
     // Config: imgui.ini (layout) and recent files in the per-user config folder.
     st.configDir = defaultConfigDir();
@@ -482,7 +511,7 @@ int runViewer(const ViewerOptions& opt) {
     io.IniFilename = ec ? nullptr : iniPath.c_str();
     float xs = 1.0f, ys = 1.0f;
     glfwGetWindowContentScale(win, &xs, &ys);
-    setupStyle(std::max(xs, ys), "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf");
+    setupStyle(std::max(xs, ys), kFontPath);
     ImGui_ImplGlfw_InitForOpenGL(win, true);
     ImGui_ImplOpenGL3_Init("#version 330");
 
@@ -529,6 +558,12 @@ int runViewer(const ViewerOptions& opt) {
             if (automation.failed) exitCode = 2;
         }
 
+        if (g_newContentScale > 0.0f) {   // HiDPI change: rebuild fonts and style at the new scale
+            setupStyle(g_newContentScale, kFontPath);
+            ImGui_ImplOpenGL3_DestroyFontsTexture();
+            ImGui_ImplOpenGL3_CreateFontsTexture();
+            g_newContentScale = 0.0f;
+        }
         ImGui_ImplOpenGL3_NewFrame();
         ImGui_ImplGlfw_NewFrame();
         ImGui::NewFrame();

@@ -31,8 +31,12 @@ struct SlotStatus {
 
 class RenderSlot {
 public:
-    // threaded=false renders synchronously in poll() (forced for "gl").
-    explicit RenderSlot(std::string backend, bool threaded = true);
+    // Where the renderer runs: Auto = a worker thread, except for backends that need the
+    // caller's GL context ("gl"), which render synchronously in poll(); Worker = always a
+    // worker thread (the GL backend then makes its own headless context there); UiThread =
+    // always synchronously in poll().
+    enum class Threading { Auto, Worker, UiThread };
+    explicit RenderSlot(std::string backend, Threading threading = Threading::Auto);
     ~RenderSlot();
     RenderSlot(const RenderSlot&) = delete;
     RenderSlot& operator=(const RenderSlot&) = delete;
@@ -47,6 +51,7 @@ public:
     bool poll();
     // Last finished image (UI thread only; valid until the next poll()).
     const rnd::Framebuffer& image() const { return m_shown; }
+    uint64_t imageSerial() const { return m_serial; }   // bumped whenever image() changes
     SlotStatus status() const;
     // Blocks until nothing is pending (tests, screenshots at exit).
     void waitIdle();
@@ -85,6 +90,7 @@ private:
     std::thread m_thread;
 
     rnd::Framebuffer m_shown;                  // UI thread
+    uint64_t m_serial = 0;
 };
 
 }  // namespace ui

@@ -91,6 +91,10 @@ struct ViewerState {
     // scene's own setting (saved) applies to backends without one.
     std::map<std::string, std::string> aaOverride;
 
+    // Run the GL backend on a worker thread with its own headless context (never blocks the
+    // UI with software GL); off = on the UI thread with the window's context.
+    bool glOnWorker = false;
+
     Requests requests;
     std::string requestedTab;                    // select this right-panel tab next frame
     std::vector<std::string> recentFiles;        // most recent first
