@@ -497,6 +497,14 @@ int runViewer(const ViewerOptions& opt) {
     glfwSetWindowCloseCallback(win, onClose);
     glfwSetWindowContentScaleCallback(win, onContentScale);   // moved to a monitor of another DPI
 
+    // On a software GL (Mesa llvmpipe/softpipe) a GL frame of a big scene takes hundreds of
+    // milliseconds: render it on a worker thread with its own context so the UI never freezes.
+    // On a hardware GL the window's context on the UI thread is the fast path.
+    if (const char* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER))) {
+        std::string r = renderer;
+        st.glOnWorker = r.find("llvmpipe") != std::string::npos || r.find("softpipe") != std::string::npos;
+    }
+
     // Config: imgui.ini (layout) and recent files in the per-user config folder.
     st.configDir = defaultConfigDir();
     std::error_code ec;
