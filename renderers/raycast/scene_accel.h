@@ -49,6 +49,7 @@ private:
     struct MeshEntry {
         sg::MeshPtr mesh;   // keeps the data alive (the BVH refers to it by index only)
         uint64_t version = 0;
+        bool valid = false;   // Mesh::validate() passed
         TriangleBvh bvh;
         uint64_t lastFrame = 0;
     };

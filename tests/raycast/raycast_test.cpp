@@ -624,3 +624,20 @@ TEST(RaycastTest, ShadowRaysDarkenOccludedPoints) {
     int px = int(w.x), row = 96 - 1 - int(w.y);
     EXPECT_LT(int(with.pixel(px, row)[0]) + 10, int(without.pixel(px, row)[0]));
 }
+
+TEST(RaycastTest, BadMeshIsSkippedNotCrashed) {
+    FrameInput f = triangleScene(32, 32);
+    auto bad = std::make_shared<Mesh>(primitives::box(vec3(0.5f)));
+    bad->indices[5] = 100000;   // out of range
+    DrawMesh d;
+    d.mesh = bad;
+    f.meshes.push_back(d);
+    auto nanMesh = std::make_shared<Mesh>(primitives::box(vec3(0.5f)));
+    nanMesh->positions[0] = vec3(NAN);
+    d.mesh = nanMesh;
+    f.meshes.push_back(d);
+    auto r = makeRenderer("raycast");
+    Framebuffer fb;
+    RenderStats s = r->render(f, 32, 32, fb);
+    EXPECT_TRUE(s.ok) << s.error;
+}
