@@ -1,19 +1,818 @@
-// Placeholder until the gl backend lands: reports a clear error instead of an image.
+// gl_renderer.cpp - the OpenGL 3.3+ core rasterization backend ("gl").
+//
+// Sections:
+//   1. Shader programs (embedded GLSL from shaders/, one program per shading model)
+//   2. GPU cache: meshes (incl. tessellations) and textures keyed by id + version
+//   3. Render targets: multisampled / single-sample FBOs, read-back
+//   4. State guard: restores the caller's GL state when we borrow its context
+//   5. GlRenderer::render: context, frame uniforms, draws, wireframe, resolve, SSAA
+//
+// Conventions (shared with the CPU backends, see renderers/shading.h): lighting in linear
+// space in world coordinates, sRGB8_ALPHA8 targets with GL_FRAMEBUFFER_SRGB, sRGB textures
+// decoded on sampling, two-sided lighting by gl_FrontFacing (glFrontFace(GL_CW) for mirrored
+// instances), fog on the eye-space distance. Gouraud lights the vertices with the albedo
+// factored out (colour = rho * mul + add, see lighting.glsl), so textures still apply per
+// fragment. Lines and points are drawn unlit (base colour x vertex colour + emissive).
 #include "gl/gl_renderer.h"
 
+#include "gl/gl_context.h"
+#include "renderers/tessellate.h"
+
+#include <glad/gl.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstring>
+#include <numeric>
+#include <unordered_map>
+
+namespace rnd::gl {
+extern const char* const kShader_lighting_glsl;
+extern const char* const kShader_mesh_vert;
+extern const char* const kShader_mesh_frag;
+}  // namespace rnd::gl
+
 namespace rnd {
+
 namespace {
-class GlRenderer final : public Renderer {
-public:
-    std::string_view name() const override { return "gl"; }
-    Capabilities capabilities() const override { return {}; }
-    RenderStats render(const sg::FrameInput&, int w, int h, Framebuffer& target, RenderControl*) override {
-        target.resize(w, h);
-        RenderStats s;
-        s.error = "the gl backend is not built yet";
-        return s;
+
+using namespace sg;
+
+constexpr int kMaxLights = 32;          // lights beyond this are ignored (uniform arrays)
+constexpr uint64_t kEvictAfterFrames = 120;
+
+// --- 1. Shader programs ----------------------------------------------------------------------
+
+struct Program {
+    GLuint id = 0;
+    // Uniform locations.
+    GLint model = -1, normalMatrix = -1, viewProj = -1, view = -1, pointSize = -1;
+    GLint numLights = -1, lightPos = -1, lightDir = -1, lightRad = -1, lightCone = -1;
+    GLint eye = -1, ambient = -1, reflection = -1;
+    GLint baseColor = -1, ka = -1, kd = -1, ks = -1, shininess = -1, specTinted = -1, specColor = -1, emissive = -1;
+    GLint texture = -1, hasTexture = -1, unlit = -1, solid = -1, solidColor = -1;
+    GLint fogMode = -1, fogColor = -1, fogParams = -1;
+};
+
+std::string compileShader(GLenum type, const std::string& src, GLuint& out) {
+    out = glCreateShader(type);
+    const char* p = src.c_str();
+    glShaderSource(out, 1, &p, nullptr);
+    glCompileShader(out);
+    GLint ok = 0;
+    glGetShaderiv(out, GL_COMPILE_STATUS, &ok);
+    if (ok) return {};
+    char log[2048] = {};
+    glGetShaderInfoLog(out, sizeof log, nullptr, log);
+    std::string msg = log;
+    std::replace(msg.begin(), msg.end(), '\n', ' ');
+    return std::string(type == GL_VERTEX_SHADER ? "vertex" : "fragment") + " shader: " + msg;
+}
+
+std::string buildProgram(int shading, Program& p) {
+    std::string prefix = "#version 330 core\n#define SHADING " + std::to_string(shading) + "\n#define MAX_LIGHTS " +
+                         std::to_string(kMaxLights) + "\n";
+    std::string common = prefix + gl::kShader_lighting_glsl + "\n";
+    GLuint vs = 0, fs = 0;
+    std::string err = compileShader(GL_VERTEX_SHADER, common + gl::kShader_mesh_vert, vs);
+    if (err.empty()) err = compileShader(GL_FRAGMENT_SHADER, common + gl::kShader_mesh_frag, fs);
+    if (err.empty()) {
+        p.id = glCreateProgram();
+        glAttachShader(p.id, vs);
+        glAttachShader(p.id, fs);
+        glLinkProgram(p.id);
+        GLint ok = 0;
+        glGetProgramiv(p.id, GL_LINK_STATUS, &ok);
+        if (!ok) {
+            char log[2048] = {};
+            glGetProgramInfoLog(p.id, sizeof log, nullptr, log);
+            err = std::string("shader link: ") + log;
+            std::replace(err.begin(), err.end(), '\n', ' ');
+            glDeleteProgram(p.id);
+            p.id = 0;
+        }
+    }
+    if (vs) glDeleteShader(vs);
+    if (fs) glDeleteShader(fs);
+    if (!err.empty()) return err;
+    auto loc = [&](const char* n) { return glGetUniformLocation(p.id, n); };
+    p.model = loc("uModel");
+    p.normalMatrix = loc("uNormalMatrix");
+    p.viewProj = loc("uViewProj");
+    p.view = loc("uView");
+    p.pointSize = loc("uPointSize");
+    p.numLights = loc("uNumLights");
+    p.lightPos = loc("uLightPos");
+    p.lightDir = loc("uLightDir");
+    p.lightRad = loc("uLightRad");
+    p.lightCone = loc("uLightCone");
+    p.eye = loc("uEye");
+    p.ambient = loc("uAmbient");
+    p.reflection = loc("uReflection");
+    p.baseColor = loc("uBaseColor");
+    p.ka = loc("uKa");
+    p.kd = loc("uKd");
+    p.ks = loc("uKs");
+    p.shininess = loc("uShininess");
+    p.specTinted = loc("uSpecTinted");
+    p.specColor = loc("uSpecColor");
+    p.emissive = loc("uEmissive");
+    p.texture = loc("uTexture");
+    p.hasTexture = loc("uHasTexture");
+    p.unlit = loc("uUnlit");
+    p.solid = loc("uSolid");
+    p.solidColor = loc("uSolidColor");
+    p.fogMode = loc("uFogMode");
+    p.fogColor = loc("uFogColor");
+    p.fogParams = loc("uFogParams");
+    return {};
+}
+
+// --- 2. GPU cache ----------------------------------------------------------------------------
+
+// A run of indices drawn with one material (tessellations with per-triangle materials).
+struct IndexRange {
+    GLsizei first = 0, count = 0;
+    int material = -1;   // index into Tessellation::materials, -1 = the drawable's material
+};
+
+struct GpuMesh {
+    uint64_t version = 0;
+    GLuint vao = 0, vbo = 0, ebo = 0;
+    GLenum primitive = GL_TRIANGLES;
+    std::vector<IndexRange> ranges;
+    size_t triangles = 0;
+    bool valid = false;   // false: the mesh failed validation and is skipped
+    uint64_t lastUsed = 0;
+};
+
+struct GpuTexture {
+    uint64_t version = 0;
+    GLuint id = 0;
+    uint64_t lastUsed = 0;
+};
+
+// Interleaved vertex: position, normal, uv0, colour (missing attributes get defaults).
+struct Vertex {
+    float p[3], n[3], uv[2], c[4];
+};
+
+void releaseMesh(GpuMesh& m) {
+    if (m.vao) glDeleteVertexArrays(1, &m.vao);
+    if (m.vbo) glDeleteBuffers(1, &m.vbo);
+    if (m.ebo) glDeleteBuffers(1, &m.ebo);
+    m.vao = m.vbo = m.ebo = 0;
+}
+
+// Builds (or rebuilds) the buffers of `mesh`; triangleMaterial (optional) groups the
+// triangles into per-material index ranges.
+void uploadMesh(GpuMesh& g, const Mesh& mesh, const std::vector<uint16_t>* triangleMaterial) {
+    releaseMesh(g);
+    g.version = mesh.version;
+    g.ranges.clear();
+    g.triangles = 0;
+    g.valid = mesh.validate().empty() && !mesh.positions.empty();
+    if (!g.valid) return;
+
+    // Triangle meshes without normals get smooth ones (flat shading ignores them anyway).
+    const std::vector<vec3>* normals = &mesh.normals;
+    std::vector<vec3> computed;
+    if (mesh.normals.size() != mesh.positions.size() && mesh.mode == PrimitiveMode::Triangles) {
+        Mesh tmp;
+        tmp.positions = mesh.positions;
+        tmp.indices = mesh.indices;
+        if (tmp.indices.empty()) {
+            tmp.indices.resize(tmp.positions.size() / 3 * 3);
+            std::iota(tmp.indices.begin(), tmp.indices.end(), 0u);
+        }
+        tmp.computeNormals();
+        computed = std::move(tmp.normals);
+        normals = &computed;
+    }
+    std::vector<Vertex> verts(mesh.positions.size());
+    for (size_t i = 0; i < verts.size(); ++i) {
+        Vertex& v = verts[i];
+        const vec3& p = mesh.positions[i];
+        vec3 n = i < normals->size() ? (*normals)[i] : vec3(0, 0, 1);
+        vec2 uv = i < mesh.uv0.size() ? mesh.uv0[i] : vec2(0.0f);
+        vec4 c = i < mesh.colors.size() ? mesh.colors[i] : vec4(1.0f);
+        v = {{p.x, p.y, p.z}, {n.x, n.y, n.z}, {uv.x, uv.y}, {c.r, c.g, c.b, c.a}};
+    }
+
+    std::vector<uint32_t> indices = mesh.indices;
+    int per = mesh.mode == PrimitiveMode::Triangles ? 3 : mesh.mode == PrimitiveMode::Lines ? 2 : 1;
+    if (indices.empty()) {
+        indices.resize(mesh.positions.size() / per * per);
+        std::iota(indices.begin(), indices.end(), 0u);
+    }
+    indices.resize(indices.size() / per * per);
+    g.primitive = per == 3 ? GL_TRIANGLES : per == 2 ? GL_LINES : GL_POINTS;
+    size_t prims = indices.size() / per;
+    if (per == 3) g.triangles = prims;
+
+    if (triangleMaterial && per == 3 && triangleMaterial->size() == prims) {
+        // Stable sort of the triangles by material, one draw range per material.
+        std::vector<uint32_t> order(prims);
+        std::iota(order.begin(), order.end(), 0u);
+        std::stable_sort(order.begin(), order.end(),
+                         [&](uint32_t a, uint32_t b) { return (*triangleMaterial)[a] < (*triangleMaterial)[b]; });
+        std::vector<uint32_t> sorted(indices.size());
+        for (size_t t = 0; t < prims; ++t) {
+            std::copy_n(&indices[size_t(order[t]) * 3], 3, &sorted[t * 3]);
+            int m = (*triangleMaterial)[order[t]];
+            if (g.ranges.empty() || g.ranges.back().material != m) g.ranges.push_back({GLsizei(t * 3), 0, m});
+            g.ranges.back().count += 3;
+        }
+        indices = std::move(sorted);
+    } else {
+        g.ranges.push_back({0, GLsizei(indices.size()), -1});
+    }
+
+    glGenVertexArrays(1, &g.vao);
+    glBindVertexArray(g.vao);
+    glGenBuffers(1, &g.vbo);
+    glBindBuffer(GL_ARRAY_BUFFER, g.vbo);
+    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(verts.size() * sizeof(Vertex)), verts.data(), GL_STATIC_DRAW);
+    glGenBuffers(1, &g.ebo);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, g.ebo);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(indices.size() * sizeof(uint32_t)), indices.data(), GL_STATIC_DRAW);
+    auto attrib = [](GLuint loc, GLint n, size_t offset) {
+        glEnableVertexAttribArray(loc);
+        glVertexAttribPointer(loc, n, GL_FLOAT, GL_FALSE, sizeof(Vertex), reinterpret_cast<const void*>(offset));
+    };
+    attrib(0, 3, offsetof(Vertex, p));
+    attrib(1, 3, offsetof(Vertex, n));
+    attrib(2, 2, offsetof(Vertex, uv));
+    attrib(3, 4, offsetof(Vertex, c));
+    glBindVertexArray(0);
+}
+
+GLint glWrap(WrapMode w) {
+    switch (w) {
+    case WrapMode::Repeat: return GL_REPEAT;
+    case WrapMode::ClampToEdge: return GL_CLAMP_TO_EDGE;
+    case WrapMode::MirroredRepeat: return GL_MIRRORED_REPEAT;
+    }
+    return GL_REPEAT;
+}
+
+// Texture rows are stored top to bottom with row 0 at v = 1: upload them bottom row first so
+// that GL's t = v.
+bool uploadTexture(GpuTexture& g, const Texture& t) {
+    if (g.id) glDeleteTextures(1, &g.id);
+    g.id = 0;
+    g.version = t.version;
+    if (t.width <= 0 || t.height <= 0 || t.rgba.size() < size_t(t.width) * t.height * 4) return false;
+    std::vector<uint8_t> flipped(size_t(t.width) * t.height * 4);
+    size_t row = size_t(t.width) * 4;
+    for (int y = 0; y < t.height; ++y) std::memcpy(&flipped[size_t(y) * row], &t.rgba[size_t(t.height - 1 - y) * row], row);
+    glGenTextures(1, &g.id);
+    glBindTexture(GL_TEXTURE_2D, g.id);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_SRGB8_ALPHA8, t.width, t.height, 0, GL_RGBA, GL_UNSIGNED_BYTE, flipped.data());
+    glGenerateMipmap(GL_TEXTURE_2D);
+    GLint minF = t.filter == FilterMode::Nearest ? GL_NEAREST : t.filter == FilterMode::Bilinear ? GL_LINEAR : GL_LINEAR_MIPMAP_LINEAR;
+    GLint magF = t.filter == FilterMode::Nearest ? GL_NEAREST : GL_LINEAR;
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, minF);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, magF);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, glWrap(t.wrapS));
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, glWrap(t.wrapT));
+    return true;
+}
+
+// --- 3. Render targets -----------------------------------------------------------------------
+
+struct RenderTarget {
+    int width = 0, height = 0, samples = 0;
+    GLuint fbo = 0, color = 0, depth = 0;
+
+    void release() {
+        if (fbo) glDeleteFramebuffers(1, &fbo);
+        if (color) glDeleteRenderbuffers(1, &color);
+        if (depth) glDeleteRenderbuffers(1, &depth);
+        fbo = color = depth = 0;
+        width = height = samples = 0;
+    }
+    // (Re)creates the FBO when the size or sample count changed. Returns "" or the reason.
+    std::string ensure(int w, int h, int s) {
+        if (fbo && w == width && h == height && s == samples) return {};
+        release();
+        width = w;
+        height = h;
+        samples = s;
+        glGenRenderbuffers(1, &color);
+        glBindRenderbuffer(GL_RENDERBUFFER, color);
+        if (s > 1) glRenderbufferStorageMultisample(GL_RENDERBUFFER, s, GL_SRGB8_ALPHA8, w, h);
+        else glRenderbufferStorage(GL_RENDERBUFFER, GL_SRGB8_ALPHA8, w, h);
+        glGenRenderbuffers(1, &depth);
+        glBindRenderbuffer(GL_RENDERBUFFER, depth);
+        if (s > 1) glRenderbufferStorageMultisample(GL_RENDERBUFFER, s, GL_DEPTH_COMPONENT32F, w, h);
+        else glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, w, h);
+        glBindRenderbuffer(GL_RENDERBUFFER, 0);
+        glGenFramebuffers(1, &fbo);
+        glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+        glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, color);
+        glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth);
+        GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+        if (status != GL_FRAMEBUFFER_COMPLETE) {
+            char buf[160];
+            std::snprintf(buf, sizeof buf, "framebuffer %dx%d with %d samples is incomplete (status 0x%x)", w, h, s, status);
+            release();
+            return buf;
+        }
+        return {};
     }
 };
+
+// --- 4. State guard --------------------------------------------------------------------------
+// Saves what a caller drawing its own UI relies on, and puts it back on scope exit.
+class StateGuard {
+public:
+    StateGuard() {
+        glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &m_drawFbo);
+        glGetIntegerv(GL_READ_FRAMEBUFFER_BINDING, &m_readFbo);
+        glGetIntegerv(GL_VIEWPORT, m_viewport);
+        glGetIntegerv(GL_CURRENT_PROGRAM, &m_program);
+        glGetIntegerv(GL_VERTEX_ARRAY_BINDING, &m_vao);
+        glGetIntegerv(GL_ARRAY_BUFFER_BINDING, &m_arrayBuffer);
+        glGetIntegerv(GL_RENDERBUFFER_BINDING, &m_renderbuffer);
+        glGetIntegerv(GL_ACTIVE_TEXTURE, &m_activeTexture);
+        glActiveTexture(GL_TEXTURE0);
+        glGetIntegerv(GL_TEXTURE_BINDING_2D, &m_texture0);
+        glGetIntegerv(GL_PACK_ALIGNMENT, &m_pack);
+        glGetIntegerv(GL_UNPACK_ALIGNMENT, &m_unpack);
+        glGetIntegerv(GL_POLYGON_MODE, m_polygonMode);
+        glGetIntegerv(GL_FRONT_FACE, &m_frontFace);
+        glGetIntegerv(GL_CULL_FACE_MODE, &m_cullMode);
+        glGetIntegerv(GL_DEPTH_FUNC, &m_depthFunc);
+        glGetBooleanv(GL_DEPTH_WRITEMASK, &m_depthMask);
+        glGetBooleanv(GL_COLOR_WRITEMASK, m_colorMask);
+        glGetFloatv(GL_COLOR_CLEAR_VALUE, m_clearColor);
+        for (size_t i = 0; i < std::size(kCaps); ++i) m_enabled[i] = glIsEnabled(kCaps[i]);
+    }
+    ~StateGuard() {
+        for (size_t i = 0; i < std::size(kCaps); ++i) (m_enabled[i] ? glEnable : glDisable)(kCaps[i]);
+        glClearColor(m_clearColor[0], m_clearColor[1], m_clearColor[2], m_clearColor[3]);
+        glColorMask(m_colorMask[0], m_colorMask[1], m_colorMask[2], m_colorMask[3]);
+        glDepthMask(m_depthMask);
+        glDepthFunc(GLenum(m_depthFunc));
+        glCullFace(GLenum(m_cullMode));
+        glFrontFace(GLenum(m_frontFace));
+        glPolygonMode(GL_FRONT_AND_BACK, GLenum(m_polygonMode[0]));
+        glPixelStorei(GL_PACK_ALIGNMENT, m_pack);
+        glPixelStorei(GL_UNPACK_ALIGNMENT, m_unpack);
+        glActiveTexture(GL_TEXTURE0);
+        glBindTexture(GL_TEXTURE_2D, GLuint(m_texture0));
+        glActiveTexture(GLenum(m_activeTexture));
+        glBindRenderbuffer(GL_RENDERBUFFER, GLuint(m_renderbuffer));
+        glBindVertexArray(GLuint(m_vao));
+        glBindBuffer(GL_ARRAY_BUFFER, GLuint(m_arrayBuffer));
+        glUseProgram(GLuint(m_program));
+        glViewport(m_viewport[0], m_viewport[1], m_viewport[2], m_viewport[3]);
+        glBindFramebuffer(GL_DRAW_FRAMEBUFFER, GLuint(m_drawFbo));
+        glBindFramebuffer(GL_READ_FRAMEBUFFER, GLuint(m_readFbo));
+    }
+
+private:
+    static constexpr GLenum kCaps[] = {GL_DEPTH_TEST, GL_CULL_FACE, GL_BLEND, GL_SCISSOR_TEST, GL_STENCIL_TEST,
+                                       GL_FRAMEBUFFER_SRGB, GL_MULTISAMPLE, GL_POLYGON_OFFSET_FILL,
+                                       GL_POLYGON_OFFSET_LINE, GL_PROGRAM_POINT_SIZE};
+    GLint m_drawFbo = 0, m_readFbo = 0, m_viewport[4] = {}, m_program = 0, m_vao = 0, m_arrayBuffer = 0;
+    GLint m_renderbuffer = 0, m_activeTexture = GL_TEXTURE0, m_texture0 = 0, m_pack = 4, m_unpack = 4;
+    GLint m_polygonMode[2] = {GL_FILL, GL_FILL}, m_frontFace = GL_CCW, m_cullMode = GL_BACK, m_depthFunc = GL_LESS;
+    GLboolean m_depthMask = GL_TRUE, m_colorMask[4] = {GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE};
+    GLfloat m_clearColor[4] = {};
+    GLboolean m_enabled[std::size(kCaps)] = {};
+};
+
+// --- 5. GlRenderer ---------------------------------------------------------------------------
+
+// One draw: a cached GPU mesh with a transform and a material (per range for tessellations).
+struct DrawItem {
+    GpuMesh* gpu = nullptr;
+    const mat4* world = nullptr;
+    mat3 normal{1.0f};
+    bool mirrored = false;
+    const Material* material = nullptr;
+    const std::vector<Material>* rangeMaterials = nullptr;   // tessellation's per-range materials
+    GpuTexture* texture = nullptr;
+};
+
+class GlRenderer final : public Renderer {
+public:
+    ~GlRenderer() override { releaseAll(); }
+
+    std::string_view name() const override { return "gl"; }
+
+    Capabilities capabilities() const override {
+        Capabilities c;
+        c.msaa = true;
+        c.ssaa = true;
+        c.maxMsaaSamples = m_maxSamples > 0 ? m_maxSamples : 8;
+        c.needsGLContext = false;   // makes its own when none is current
+        return c;
+    }
+
+    RenderStats render(const FrameInput& frame, int width, int height, Framebuffer& target, RenderControl* control) override;
+
+    GlCacheCounters counters() const {
+        GlCacheCounters c;
+        c.meshUploads = m_meshUploads;
+        c.textureUploads = m_textureUploads;
+        c.meshesCached = m_meshes.size();
+        c.texturesCached = m_textures.size();
+        c.context = m_contextDescription;
+        c.platform = m_platform;
+        return c;
+    }
+
+private:
+    std::string prepareContext(bool& madeCurrent);
+    std::string ensureGLObjects();
+    void forgetGLObjects();   // drops names without deleting (their context is gone or not current)
+    void releaseAll();
+    GpuMesh* meshFor(const Mesh& mesh, const std::vector<uint16_t>* triangleMaterial);
+    GpuTexture* textureFor(const TexturePtr& t);
+    void setFrameUniforms(const Program& p, const FrameInput& f, int ssaa);
+    void setMaterial(const Program& p, const Material& m, bool hasTexture, bool unlit);
+    void evict();
+
+    std::unique_ptr<gl::GlContext> m_own;   // our headless context, made on first need
+    const void* m_objectsContext = nullptr; // the context our GL objects live in
+    bool m_loaded = false;
+    std::string m_contextDescription, m_platform;
+    int m_maxSamples = 0, m_maxSize = 0;
+
+    Program m_programs[3];
+    RenderTarget m_target, m_resolve;
+    std::unordered_map<uint64_t, GpuMesh> m_meshes;       // by Mesh::id
+    std::unordered_map<uint64_t, GpuTexture> m_textures;  // by Texture::id
+    TessellationCache m_tess;
+    uint64_t m_frame = 0, m_meshUploads = 0, m_textureUploads = 0;
+};
+
+std::string GlRenderer::prepareContext(bool& madeCurrent) {
+    madeCurrent = false;
+    if (!(m_own && m_own->isCurrent()) && !gl::anyContextCurrent()) {
+        if (!m_own) {
+            std::string err;
+            m_own = gl::createHeadlessContext("", &err);
+            if (!m_own) return err;
+        }
+        std::string err;
+        if (!m_own->makeCurrent(&err)) return err;
+        madeCurrent = true;
+    }
+    const void* handle = gl::currentContextHandle();
+    if (handle != m_objectsContext || !m_loaded) {
+        // A different context than last time: our objects are not valid in it.
+        forgetGLObjects();
+        std::string err = gl::loadGLFunctions();
+        if (!err.empty()) return err;
+        m_loaded = true;
+        m_objectsContext = handle;
+        m_contextDescription = gl::describeCurrentContext();
+        glGetIntegerv(GL_MAX_SAMPLES, &m_maxSamples);
+        GLint rb = 0, dims[2] = {0, 0};
+        glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &rb);
+        glGetIntegerv(GL_MAX_VIEWPORT_DIMS, dims);
+        m_maxSize = std::min({rb, dims[0], dims[1]});
+    }
+    m_platform = (m_own && m_own->isCurrent()) ? m_own->platform() : "caller";
+    return {};
+}
+
+std::string GlRenderer::ensureGLObjects() {
+    for (int s = 0; s < 3; ++s) {
+        if (m_programs[s].id) continue;
+        std::string err = buildProgram(s, m_programs[s]);
+        if (!err.empty()) return "gl backend: " + err;
+    }
+    return {};
+}
+
+void GlRenderer::forgetGLObjects() {
+    for (auto& p : m_programs) p = Program{};
+    m_target = RenderTarget{};
+    m_resolve = RenderTarget{};
+    m_meshes.clear();
+    m_textures.clear();
+    m_loaded = false;
+}
+
+void GlRenderer::releaseAll() {
+    // Delete our objects when their context can be made (or is) current; otherwise they die
+    // with their context.
+    bool madeCurrent = false;
+    if (m_own && m_objectsContext && !gl::anyContextCurrent()) madeCurrent = m_own->makeCurrent(nullptr);
+    if (m_loaded && gl::currentContextHandle() == m_objectsContext) {
+        for (auto& p : m_programs)
+            if (p.id) glDeleteProgram(p.id);
+        m_target.release();
+        m_resolve.release();
+        for (auto& [id, m] : m_meshes) releaseMesh(m);
+        for (auto& [id, t] : m_textures)
+            if (t.id) glDeleteTextures(1, &t.id);
+    }
+    forgetGLObjects();
+    if (madeCurrent) m_own->release();
+    m_own.reset();
+}
+
+GpuMesh* GlRenderer::meshFor(const Mesh& mesh, const std::vector<uint16_t>* triangleMaterial) {
+    GpuMesh& g = m_meshes[mesh.id];
+    if (g.version != mesh.version || (!g.vao && g.valid)) {
+        uploadMesh(g, mesh, triangleMaterial);
+        ++m_meshUploads;
+    }
+    g.lastUsed = m_frame;
+    return g.valid ? &g : nullptr;
+}
+
+GpuTexture* GlRenderer::textureFor(const TexturePtr& t) {
+    if (!t) return nullptr;
+    GpuTexture& g = m_textures[t->id];
+    if (g.version != t->version) {
+        uploadTexture(g, *t);
+        ++m_textureUploads;
+    }
+    g.lastUsed = m_frame;
+    return g.id ? &g : nullptr;
+}
+
+void GlRenderer::evict() {
+    for (auto it = m_meshes.begin(); it != m_meshes.end();) {
+        if (m_frame - it->second.lastUsed > kEvictAfterFrames) {
+            releaseMesh(it->second);
+            it = m_meshes.erase(it);
+        } else {
+            ++it;
+        }
+    }
+    for (auto it = m_textures.begin(); it != m_textures.end();) {
+        if (m_frame - it->second.lastUsed > kEvictAfterFrames) {
+            if (it->second.id) glDeleteTextures(1, &it->second.id);
+            it = m_textures.erase(it);
+        } else {
+            ++it;
+        }
+    }
+    m_tess.nextFrame(int(kEvictAfterFrames));
+}
+
+void GlRenderer::setFrameUniforms(const Program& p, const FrameInput& f, int ssaa) {
+    const RenderSettings& s = f.settings;
+    glUniformMatrix4fv(p.viewProj, 1, GL_FALSE, &f.camera.viewProj[0][0]);
+    glUniformMatrix4fv(p.view, 1, GL_FALSE, &f.camera.view[0][0]);
+    glUniform3fv(p.eye, 1, &f.camera.eye[0]);
+    glUniform3fv(p.ambient, 1, &f.ambientLight[0]);
+    glUniform1i(p.reflection, s.reflection == ReflectionModel::BlinnPhong ? 1 : 0);
+    glUniform1f(p.pointSize, 2.0f * float(ssaa));
+    glUniform1i(p.texture, 0);
+    glUniform1i(p.fogMode, int(s.fog));
+    glUniform3fv(p.fogColor, 1, &s.fogColor[0]);
+    glUniform3f(p.fogParams, s.fogStart, s.fogEnd, s.fogDensity);
+    glUniform3fv(p.solidColor, 1, &s.wireframeColor[0]);
+    glUniform1i(p.solid, 0);
+
+    int n = int(std::min<size_t>(f.lights.size(), kMaxLights));
+    std::vector<vec4> pos(n), dir(n), rad(n), cone(n);
+    for (int i = 0; i < n; ++i) {
+        const DrawLight& l = f.lights[i];
+        float type = l.type == LightType::Point ? 0.0f : l.type == LightType::Directional ? 1.0f : 2.0f;
+        pos[i] = vec4(l.position, type);
+        dir[i] = vec4(l.direction, l.inverseSquare ? 1.0f : 0.0f);
+        rad[i] = vec4(l.radiance, 0.0f);
+        cone[i] = vec4(l.cosInner, l.cosOuter, 0.0f, 0.0f);
+    }
+    glUniform1i(p.numLights, n);
+    if (n > 0) {
+        glUniform4fv(p.lightPos, n, &pos[0][0]);
+        glUniform4fv(p.lightDir, n, &dir[0][0]);
+        glUniform4fv(p.lightRad, n, &rad[0][0]);
+        glUniform4fv(p.lightCone, n, &cone[0][0]);
+    }
+}
+
+void GlRenderer::setMaterial(const Program& p, const Material& m, bool hasTexture, bool unlit) {
+    glUniform3fv(p.baseColor, 1, &m.baseColor[0]);
+    glUniform1f(p.ka, m.ka);
+    glUniform1f(p.kd, m.kd);
+    glUniform1f(p.ks, m.ks);
+    glUniform1f(p.shininess, m.shininess);
+    glUniform1i(p.specTinted, m.specularTinted ? 1 : 0);
+    glUniform3fv(p.specColor, 1, &m.specularColor[0]);
+    glUniform3fv(p.emissive, 1, &m.emissive[0]);
+    glUniform1i(p.hasTexture, hasTexture ? 1 : 0);
+    glUniform1i(p.unlit, (unlit || m.unlit) ? 1 : 0);
+}
+
+RenderStats GlRenderer::render(const FrameInput& frame, int width, int height, Framebuffer& target, RenderControl* control) {
+    auto t0 = std::chrono::steady_clock::now();
+    RenderStats stats;
+    target.resize(width, height);
+    if (width <= 0 || height <= 0) {
+        stats.error = "gl backend: image size " + std::to_string(width) + "x" + std::to_string(height) + " is empty";
+        return stats;
+    }
+    if (control && control->cancel) {
+        stats.cancelled = true;
+        stats.error = "cancelled";
+        return stats;
+    }
+
+    bool madeCurrent = false;
+    std::string err = prepareContext(madeCurrent);
+    if (!err.empty()) {
+        stats.error = "gl backend: " + err;
+        if (madeCurrent) m_own->release();
+        return stats;
+    }
+    struct ReleaseOnExit {
+        gl::GlContext* ctx;
+        ~ReleaseOnExit() {
+            if (ctx) ctx->release();
+        }
+    } releaseOnExit{madeCurrent ? m_own.get() : nullptr};
+
+    StateGuard guard;
+    ++m_frame;
+    err = ensureGLObjects();
+    if (!err.empty()) {
+        stats.error = err;
+        return stats;
+    }
+
+    // Anti-aliasing: MSAA clamps to what the driver allows; SSAA renders aaRate x larger.
+    const RenderSettings& s = frame.settings;
+    int samples = s.aa == AAMode::MSAA ? std::clamp(s.aaRate, 1, std::max(m_maxSamples, 1)) : 1;
+    int ssaa = s.aa == AAMode::SSAA ? std::clamp(s.aaRate, 1, 8) : 1;
+    int rw = width * ssaa, rh = height * ssaa;
+    if (rw > m_maxSize || rh > m_maxSize) {
+        stats.error = "gl backend: render size " + std::to_string(rw) + "x" + std::to_string(rh) +
+                      " exceeds the driver's limit of " + std::to_string(m_maxSize);
+        return stats;
+    }
+    err = m_target.ensure(rw, rh, samples > 1 ? samples : 0);
+    if (err.empty() && samples > 1) err = m_resolve.ensure(rw, rh, 0);
+    if (!err.empty()) {
+        stats.error = "gl backend: " + err;
+        return stats;
+    }
+
+    // Clear: the background is linear; the sRGB framebuffer encodes it.
+    glBindFramebuffer(GL_FRAMEBUFFER, m_target.fbo);
+    glViewport(0, 0, rw, rh);
+    glDisable(GL_SCISSOR_TEST);
+    glDisable(GL_BLEND);
+    glDisable(GL_STENCIL_TEST);
+    glEnable(GL_FRAMEBUFFER_SRGB);
+    if (samples > 1) glEnable(GL_MULTISAMPLE);
+    else glDisable(GL_MULTISAMPLE);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glDepthMask(GL_TRUE);
+    glClearColor(s.background.r, s.background.g, s.background.b, 1.0f);
+    glClearDepth(1.0);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glEnable(GL_PROGRAM_POINT_SIZE);
+    glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
+    if (s.cullBackFaces) {
+        glEnable(GL_CULL_FACE);
+        glCullFace(GL_BACK);
+    } else {
+        glDisable(GL_CULL_FACE);
+    }
+    glActiveTexture(GL_TEXTURE0);
+
+    // Collect the draws (uploads happen here, only for new or edited meshes and textures).
+    std::vector<DrawItem> items;
+    items.reserve(frame.meshes.size() + frame.analytics.size());
+    for (const DrawMesh& d : frame.meshes) {
+        if (!d.mesh) continue;
+        DrawItem it;
+        it.gpu = meshFor(*d.mesh, nullptr);
+        if (!it.gpu) continue;
+        it.world = &d.world;
+        it.normal = d.normal;
+        it.mirrored = d.mirrored;
+        it.material = &d.material;
+        it.texture = textureFor(d.texture);
+        items.push_back(it);
+    }
+    static const mat4 kIdentity(1.0f);
+    for (const DrawAnalytic& a : frame.analytics) {
+        const Tessellation& t = m_tess.get(a, s.tessellation);
+        if (!t.mesh || t.mesh->positions.empty()) continue;
+        bool perTriangle = !t.triangleMaterial.empty() && !t.materials.empty();
+        DrawItem it;
+        it.gpu = meshFor(*t.mesh, perTriangle ? &t.triangleMaterial : nullptr);
+        if (!it.gpu) continue;
+        it.world = t.worldSpace ? &kIdentity : &a.world;
+        it.normal = t.worldSpace ? mat3(1.0f) : a.normal;
+        it.mirrored = !t.worldSpace && glm::determinant(mat3(a.world)) < 0.0f;
+        it.material = &a.material;
+        it.rangeMaterials = perTriangle ? &t.materials : nullptr;
+        it.texture = perTriangle ? nullptr : textureFor(a.texture);
+        items.push_back(it);
+    }
+
+    const Program& prog = m_programs[int(s.shading)];
+    glUseProgram(prog.id);
+    setFrameUniforms(prog, frame, ssaa);
+    uint64_t triangles = 0;
+    auto drawAll = [&](bool wireframe) {
+        for (const DrawItem& it : items) {
+            if (wireframe && it.gpu->primitive != GL_TRIANGLES) continue;
+            glUniformMatrix4fv(prog.model, 1, GL_FALSE, &(*it.world)[0][0]);
+            glUniformMatrix3fv(prog.normalMatrix, 1, GL_FALSE, &it.normal[0][0]);
+            glFrontFace(it.mirrored ? GL_CW : GL_CCW);
+            if (!wireframe) {
+                glBindTexture(GL_TEXTURE_2D, it.texture ? it.texture->id : 0);
+                triangles += it.gpu->triangles;
+            }
+            glBindVertexArray(it.gpu->vao);
+            bool unlit = it.gpu->primitive != GL_TRIANGLES;
+            for (const IndexRange& r : it.gpu->ranges) {
+                if (!wireframe) {
+                    const Material* m = it.material;
+                    if (it.rangeMaterials && r.material >= 0 && size_t(r.material) < it.rangeMaterials->size())
+                        m = &(*it.rangeMaterials)[r.material];
+                    setMaterial(prog, *m, it.texture != nullptr, unlit);
+                }
+                glDrawElements(it.gpu->primitive, r.count, GL_UNSIGNED_INT,
+                               reinterpret_cast<const void*>(size_t(r.first) * sizeof(uint32_t)));
+            }
+        }
+    };
+    drawAll(false);
+
+    // Wireframe overlay: the same triangles as lines, pulled slightly toward the viewer.
+    if (s.wireframe) {
+        glUniform1i(prog.solid, 1);
+        glPolygonMode(GL_FRONT_AND_BACK, GL_LINE);
+        glEnable(GL_POLYGON_OFFSET_LINE);
+        glPolygonOffset(-1.0f, -1.0f);
+        glDepthFunc(GL_LEQUAL);
+        drawAll(true);
+        glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
+        glDisable(GL_POLYGON_OFFSET_LINE);
+        glUniform1i(prog.solid, 0);
+    }
+    glBindVertexArray(0);
+
+    // Resolve MSAA (reading a multisampled buffer directly would give an aliased image).
+    GLuint readFbo = m_target.fbo;
+    if (samples > 1) {
+        glBindFramebuffer(GL_READ_FRAMEBUFFER, m_target.fbo);
+        glBindFramebuffer(GL_DRAW_FRAMEBUFFER, m_resolve.fbo);
+        glBlitFramebuffer(0, 0, rw, rh, 0, 0, rw, rh, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+        glBlitFramebuffer(0, 0, rw, rh, 0, 0, rw, rh, GL_DEPTH_BUFFER_BIT, GL_NEAREST);
+        readFbo = m_resolve.fbo;
+    }
+
+    // Read back: GL rows are bottom-up, Framebuffer rows top-down.
+    Framebuffer full;
+    Framebuffer& out = ssaa > 1 ? full : target;
+    out.resize(rw, rh);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, readFbo);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    std::vector<uint8_t> rgba(size_t(rw) * rh * 4);
+    std::vector<float> depth(size_t(rw) * rh);
+    glReadPixels(0, 0, rw, rh, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+    glReadPixels(0, 0, rw, rh, GL_DEPTH_COMPONENT, GL_FLOAT, depth.data());
+    size_t rowBytes = size_t(rw) * 4;
+    for (int y = 0; y < rh; ++y) {
+        int src = rh - 1 - y;
+        std::memcpy(&out.color[size_t(y) * rowBytes], &rgba[size_t(src) * rowBytes], rowBytes);
+        std::memcpy(&out.depth[size_t(y) * rw], &depth[size_t(src) * rw], size_t(rw) * sizeof(float));
+    }
+    for (size_t i = 3; i < out.color.size(); i += 4) out.color[i] = 255;
+    if (ssaa > 1) target = downsample(full, ssaa);
+
+    GLenum glErr = glGetError();
+    evict();
+    if (glErr != GL_NO_ERROR) {
+        char buf[96];
+        std::snprintf(buf, sizeof buf, "gl backend: OpenGL error 0x%x during the frame", glErr);
+        stats.error = buf;
+        return stats;
+    }
+    if (control) control->progress = 1.0f;
+    stats.ok = true;
+    stats.triangles = triangles;
+    stats.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    return stats;
+}
+
 }  // namespace
+
 std::unique_ptr<Renderer> makeGlRenderer() { return std::make_unique<GlRenderer>(); }
+
+GlCacheCounters glCacheCounters(const Renderer& r) {
+    if (auto* g = dynamic_cast<const GlRenderer*>(&r)) return g->counters();
+    return {};
+}
+
 }  // namespace rnd

@@ -54,7 +54,8 @@ struct TriSetup {
     uint8_t order[3] = {0, 1, 2};   // input vertex index of each setup vertex
 };
 
-inline int32_t toFixed(float v) { return int32_t(std::lround(double(v) * kSub)); }
+// Round to nearest fixed-point unit (halves away from zero); inputs lie within the guard band.
+inline int32_t toFixed(float v) { float f = v * float(kSub); return int32_t(f + (f >= 0 ? 0.5f : -0.5f)); }
 
 // Sets up the triangle with window-space vertices (x, y) for a width x height viewport.
 // Returns false when it is degenerate (zero area) or its bounding box misses every pixel
@@ -106,21 +107,60 @@ inline bool setupTriangle(const float wx[3], const float wy[3], int width, int h
 // ---------------------------------------------------------------------------------------
 
 // Calls fn(i, j) for every pixel whose centre the triangle covers inside the rectangle
-// [x0, x1] x [y0, y1] (inclusive, pixels). Rows are walked with incremental edge values.
+// [x0, x1] x [y0, y1] (inclusive, pixels), row by row. Hierarchical: 8x8 blocks are first
+// tested against each edge at their extreme corners (reject the block when an edge is
+// negative everywhere, accept it whole when all edges are non-negative everywhere); only
+// partly covered blocks evaluate the edge functions per pixel, incrementally.
 template <class Fn>
 inline void forEachCoveredPixel(const TriSetup& t, int x0, int y0, int x1, int y1, Fn&& fn) {
+    constexpr int kB = 8;
     x0 = std::max(x0, t.minX); x1 = std::min(x1, t.maxX);
     y0 = std::max(y0, t.minY); y1 = std::min(y1, t.maxY);
     if (x0 > x1 || y0 > y1) return;
-    int64_t px = int64_t(x0) * kSub + kHalf, py = int64_t(y0) * kSub + kHalf;
-    int64_t r0 = t.e[0].at(px, py) - t.e[0].bias, r1 = t.e[1].at(px, py) - t.e[1].bias, r2 = t.e[2].at(px, py) - t.e[2].bias;
-    const int64_t sx0 = t.e[0].a * kSub, sx1 = t.e[1].a * kSub, sx2 = t.e[2].a * kSub;
-    const int64_t sy0 = t.e[0].b * kSub, sy1 = t.e[1].b * kSub, sy2 = t.e[2].b * kSub;
-    for (int j = y0; j <= y1; ++j, r0 += sy0, r1 += sy1, r2 += sy2) {
-        int64_t e0 = r0, e1 = r1, e2 = r2;
-        for (int i = x0; i <= x1; ++i, e0 += sx0, e1 += sx1, e2 += sx2)
-            if ((e0 | e1 | e2) >= 0) fn(i, j);
+    const Edge* e = t.e;
+    const int64_t sx[3] = {e[0].a * kSub, e[1].a * kSub, e[2].a * kSub};
+    const int64_t sy[3] = {e[0].b * kSub, e[1].b * kSub, e[2].b * kSub};
+    // Offsets from a block's first sample to the sample that maximises / minimises each edge.
+    int64_t hi[3], lo[3];
+    for (int k = 0; k < 3; ++k) {
+        hi[k] = std::max<int64_t>(sx[k], 0) * (kB - 1) + std::max<int64_t>(sy[k], 0) * (kB - 1);
+        lo[k] = std::min<int64_t>(sx[k], 0) * (kB - 1) + std::min<int64_t>(sy[k], 0) * (kB - 1);
     }
+    const bool small = (x1 - x0) < kB && (y1 - y0) < kB;
+    for (int by = small ? y0 : (y0 & ~(kB - 1)); by <= y1; by += kB) {
+        for (int bx = small ? x0 : (x0 & ~(kB - 1)); bx <= x1; bx += kB) {
+            int64_t px = int64_t(bx) * kSub + kHalf, py = int64_t(by) * kSub + kHalf;
+            int64_t b0 = e[0].at(px, py) - e[0].bias, b1 = e[1].at(px, py) - e[1].bias, b2 = e[2].at(px, py) - e[2].bias;
+            if (b0 + hi[0] < 0 || b1 + hi[1] < 0 || b2 + hi[2] < 0) continue;   // block outside an edge
+            int ia = std::max(bx, x0), ib = std::min(bx + kB - 1, x1);
+            int ja = std::max(by, y0), jb = std::min(by + kB - 1, y1);
+            if (b0 + lo[0] >= 0 && b1 + lo[1] >= 0 && b2 + lo[2] >= 0) {   // block fully inside
+                for (int j = ja; j <= jb; ++j)
+                    for (int i = ia; i <= ib; ++i) fn(i, j);
+                continue;
+            }
+            b0 += sx[0] * (ia - bx) + sy[0] * (ja - by);
+            b1 += sx[1] * (ia - bx) + sy[1] * (ja - by);
+            b2 += sx[2] * (ia - bx) + sy[2] * (ja - by);
+            for (int j = ja; j <= jb; ++j, b0 += sy[0], b1 += sy[1], b2 += sy[2]) {
+                int64_t a0 = b0, a1 = b1, a2 = b2;
+                for (int i = ia; i <= ib; ++i, a0 += sx[0], a1 += sx[1], a2 += sx[2])
+                    if ((a0 | a1 | a2) >= 0) fn(i, j);
+            }
+        }
+    }
+}
+
+// Reference version without blocks (tests compare the two).
+template <class Fn>
+inline void forEachCoveredPixelSimple(const TriSetup& t, int x0, int y0, int x1, int y1, Fn&& fn) {
+    x0 = std::max(x0, t.minX); x1 = std::min(x1, t.maxX);
+    y0 = std::max(y0, t.minY); y1 = std::min(y1, t.maxY);
+    for (int j = y0; j <= y1; ++j)
+        for (int i = x0; i <= x1; ++i) {
+            int64_t px = int64_t(i) * kSub + kHalf, py = int64_t(j) * kSub + kHalf;
+            if (t.e[0].at(px, py) >= t.e[0].bias && t.e[1].at(px, py) >= t.e[1].bias && t.e[2].at(px, py) >= t.e[2].bias) fn(i, j);
+        }
 }
 
 // ---------------------------------------------------------------------------------------
@@ -130,14 +170,16 @@ inline void forEachCoveredPixel(const TriSetup& t, int x0, int y0, int x1, int y
 // Outcode bits: near (z < -w), far (z > w), and the four guard-band planes |x|,|y| <= g*w.
 // Triangles whose vertices have no bits set need no clipping; near and far are clipped
 // exactly, x and y only outside the guard band (the viewport scissor does the rest).
-enum : uint8_t { kClipNear = 1, kClipFar = 2, kClipLeft = 4, kClipRight = 8, kClipBottom = 16, kClipTop = 32 };
+enum : uint8_t { kClipNear = 1, kClipFar = 2, kClipLeft = 4, kClipRight = 8, kClipBottom = 16, kClipTop = 32, kInvalid = 64 };
 
 struct GuardBand { float gx = 1, gy = 1; };
 inline GuardBand guardBand(int width, int height) {
     return {1.0f + 2.0f * kGuardPixels / std::max(width, 1), 1.0f + 2.0f * kGuardPixels / std::max(height, 1)};
 }
 
+// kInvalid marks a non-finite position: triangles using it are dropped, not clipped.
 inline uint8_t outcode(const sg::vec4& c, const GuardBand& g) {
+    if (!(std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z) && std::isfinite(c.w))) return kInvalid | kClipNear;
     uint8_t o = 0;
     if (!(c.z >= -c.w)) o |= kClipNear;   // also catches NaN
     if (!(c.z <= c.w)) o |= kClipFar;
@@ -174,7 +216,7 @@ inline int clipTriangle(const sg::vec4 c[3], uint8_t planes, const GuardBand& g,
         default: return g.gy * v.w - v.y;
         }
     };
-    for (uint8_t plane = 1; plane <= kClipTop && n > 0; plane <<= 1) {
+    for (uint8_t plane = 1; plane <= kClipTop && n > 0; plane = uint8_t(plane << 1)) {
         if (!(planes & plane)) continue;
         int m = 0;
         for (int i = 0; i < n; ++i) {
@@ -205,20 +247,31 @@ inline sg::vec4 toWindow(const sg::vec4& c, int width, int height) {
 // 4. Lines: DDA (seeds: "Digital Differential Analyzer") over window coordinates
 // ---------------------------------------------------------------------------------------
 
-// Calls fn(i, j, t) for the pixels of the segment a -> b (window coordinates), stepping one
-// pixel along the major axis; t in [0,1] is the position along the segment (for depth and
-// colour interpolation). Pixels outside [0,w) x [0,h) are skipped.
+// Calls fn(i, j, t) for the pixels of the segment a -> b (window coordinates): one pixel per
+// column (x-major) or row (y-major) whose centre lies in [start, end) along the major axis,
+// the minor coordinate stepped incrementally by the slope and sampled at that centre (GL's
+// diamond-exit rule for thin lines, approximately); t in [0,1] is the screen-space position
+// of the sample along the segment. Half-open, so joined segments do not repeat a pixel.
 template <class Fn>
 inline void drawLineDDA(float ax, float ay, float bx, float by, int width, int height, Fn&& fn) {
     float dx = bx - ax, dy = by - ay;
-    float len = std::max(std::fabs(dx), std::fabs(dy));
-    if (!(len < 1e6f)) return;   // non-finite or absurd
-    int steps = std::max(1, int(std::ceil(len)));
-    float sx = dx / steps, sy = dy / steps;
-    float x = ax, y = ay;
-    for (int k = 0; k <= steps; ++k, x += sx, y += sy) {
-        int i = int(std::floor(x)), j = int(std::floor(y));
-        if (i >= 0 && j >= 0 && i < width && j < height) fn(i, j, float(k) / steps);
+    if (!(std::fabs(dx) < 1e6f && std::fabs(dy) < 1e6f)) return;   // non-finite or absurd
+    const bool xMajor = std::fabs(dx) >= std::fabs(dy);
+    const float a0 = xMajor ? ax : ay, len = xMajor ? dx : dy;
+    const float b0 = xMajor ? ay : ax, d = xMajor ? dy : dx;
+    if (len == 0) return;
+    const float slope = d / len;
+    const int majorSize = xMajor ? width : height, minorSize = xMajor ? height : width;
+    int lo = int(std::ceil(std::min(a0, a0 + len) - 0.5f)), hi = int(std::ceil(std::max(a0, a0 + len) - 0.5f)) - 1;
+    lo = std::max(lo, 0);
+    hi = std::min(hi, majorSize - 1);
+    for (int k = lo; k <= hi; ++k) {
+        float c = k + 0.5f;
+        float t = (c - a0) / len;
+        int m = int(std::floor(b0 + (c - a0) * slope));
+        if (m < 0 || m >= minorSize) continue;
+        if (xMajor) fn(k, m, t);
+        else fn(m, k, t);
     }
 }
 

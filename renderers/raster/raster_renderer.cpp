@@ -21,6 +21,7 @@
 #include "raster/raster_renderer.h"
 
 #include "raster/raster_core.h"
+#include "raster/raster_shading.h"
 #include "raster/raster_texture.h"
 #include "renderers/shading.h"
 #include "renderers/tessellate.h"
@@ -33,6 +34,9 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <mutex>
 #include <unordered_map>
 
@@ -50,16 +54,30 @@ using sg::vec4;
 // [helpers]
 // ---------------------------------------------------------------------------------------
 
-// toByteSRGB without pow: the byte is the number of thresholds decode((b - 0.5)/255) that the
-// linear value reaches (b = 1..255), found by binary search.
+// toByteSRGB without pow, exactly: a table indexed by the float's exponent and top 8 mantissa
+// bits gives the byte at the start of the bucket; a bucket is narrower than the gap between
+// two byte thresholds decode((b + 0.5)/255) (checked: >= 0.39% vs <= 0.9% relative), so one
+// comparison finishes the job. Values below 2^-13 encode to 0, values >= 1 to 255.
 struct SrgbEncoder {
-    float thresholds[255];
+    static constexpr int kMinExp = -13;
+    float next[256];         // next[b]: smallest linear value that encodes to b + 1
+    uint8_t table[13 * 256];
     SrgbEncoder() {
-        for (int b = 1; b < 256; ++b) thresholds[b - 1] = decodeSRGB((b - 0.5f) / 255.0f);
+        for (int b = 0; b < 255; ++b) next[b] = decodeSRGB((b + 0.5f) / 255.0f);
+        next[255] = 2.0f;
+        for (int i = 0; i < 13 * 256; ++i) {
+            float x = std::ldexp(1.0f + (i % 256) / 256.0f, kMinExp + i / 256);
+            table[i] = toByteSRGB(x);
+        }
     }
-    uint8_t operator()(float linear) const {
-        if (!(linear > thresholds[0])) return linear >= thresholds[0] ? 1 : 0;
-        return uint8_t(std::upper_bound(thresholds, thresholds + 255, linear) - thresholds);
+    uint8_t operator()(float x) const {
+        if (!(x >= 0x1p-13f)) return 0;   // also NaN
+        if (x >= 1.0f) return 255;
+        uint32_t bits;
+        std::memcpy(&bits, &x, 4);
+        uint32_t idx = (bits - 0x39000000u) >> 15;   // 0x39000000 = bits of 2^-13
+        uint8_t b = table[idx];
+        return uint8_t(b + (x >= next[b]));
     }
 };
 const SrgbEncoder& srgbEncoder() {
@@ -164,6 +182,9 @@ struct Tri {
     TriSetup s;
     float z[3], invW[3];     // per setup vertex
     float zRef, zdx, zdy;    // window z at pixel centre (minX, minY) and per-pixel steps
+    // u_k = lambda_k / w_k (screen-linear) at pixel centre (minX, minY) and per-pixel steps;
+    // perspective-correct barycentrics are u_k / sum(u).
+    float uRef[3], udx[3], udy[3];
     uint32_t draw = 0, prim = 0;
     int32_t clip = -1;       // index into Chunk::clipBary (bary of setup vertices), -1 = none
     bool front = true;
@@ -174,6 +195,7 @@ struct Chunk {
     std::vector<Tri> tris;
     std::vector<std::array<vec3, 3>> clipBary;
     std::vector<uint32_t> tileStart, items;      // CSR: tiles -> triangle indices in order
+    std::vector<uint32_t> fill;                  // scratch for binning
 };
 
 struct FrameContext {
@@ -181,6 +203,8 @@ struct FrameContext {
     int width = 0, height = 0;
     int tilesX = 0, tilesY = 0;
     bool msaa = false;
+    bool referenceShading = false;
+    bool timing = false;             // VIEWER_RASTER_TIMING=1: print stage times to stderr   // call rnd::shade per fragment instead of the batch
     std::vector<DrawItem>* draws = nullptr;
     std::vector<Chunk>* chunks = nullptr;
 };
@@ -199,6 +223,13 @@ bool finishTri(Tri& t, const float z[3], const float iw[3]) {
     t.zRef = float(zr);
     t.zdx = float(ax * kSub);
     t.zdy = float(ay * kSub);
+    // Setup vertex (k+2)%3 <- edge k.
+    for (int k = 0; k < 3; ++k) {
+        const Edge& e = t.s.e[(k + 1) % 3];
+        t.uRef[k] = float(double(e.at(px, py)) * inv * t.invW[k]);
+        t.udx[k] = float(double(e.a) * kSub * inv * t.invW[k]);
+        t.udy[k] = float(double(e.b) * kSub * inv * t.invW[k]);
+    }
     return true;
 }
 
@@ -222,6 +253,7 @@ void runTriangleStage(Chunk& ch, const FrameContext& fc) {
         if (!ok) continue;
         uint8_t c0 = d.code[v[0]], c1 = d.code[v[1]], c2 = d.code[v[2]];
         if (c0 & c1 & c2) continue;   // all outside one plane
+        if ((c0 | c1 | c2) & kInvalid) continue;   // non-finite vertex
         if ((c0 | c1 | c2) == 0) {
             Tri tri;
             float wx[3] = {d.win[v[0]].x, d.win[v[1]].x, d.win[v[2]].x};
@@ -268,7 +300,8 @@ void runTriangleStage(Chunk& ch, const FrameContext& fc) {
             for (int tx = t.s.minX / kTileSize; tx <= t.s.maxX / kTileSize; ++tx) ++ch.tileStart[size_t(ty) * fc.tilesX + tx + 1];
     for (int i = 0; i < nt; ++i) ch.tileStart[i + 1] += ch.tileStart[i];
     ch.items.resize(ch.tileStart[nt]);
-    std::vector<uint32_t> fill(ch.tileStart.begin(), ch.tileStart.end() - 1);
+    ch.fill.assign(ch.tileStart.begin(), ch.tileStart.end() - 1);
+    std::vector<uint32_t>& fill = ch.fill;
     for (uint32_t i = 0; i < ch.tris.size(); ++i) {
         const Tri& t = ch.tris[i];
         for (int ty = t.s.minY / kTileSize; ty <= t.s.maxY / kTileSize; ++ty)
@@ -282,7 +315,7 @@ void runTriangleStage(Chunk& ch, const FrameContext& fc) {
 
 // Rasterizes one triangle into the tile's visibility buffer (depth LESS). `samples` is 1 or 4
 // (MSAA: sample s of pixel p at index p*4 + s).
-void rasterizeIntoTile(const Tri& t, uint32_t id, int tx0, int ty0, int tx1, int ty1, int samples, float* depth, uint32_t* ids) {
+__attribute__((noinline)) void rasterizeIntoTile(const Tri& t, uint32_t id, int tx0, int ty0, int tx1, int ty1, int samples, float* depth, uint32_t* ids) {
     int x0 = std::max(tx0, t.s.minX), x1 = std::min(tx1, t.s.maxX);
     int y0 = std::max(ty0, t.s.minY), y1 = std::min(ty1, t.s.maxY);
     if (x0 > x1 || y0 > y1) return;
@@ -291,21 +324,12 @@ void rasterizeIntoTile(const Tri& t, uint32_t id, int tx0, int ty0, int tx1, int
     const Edge& e1 = t.s.e[1];
     const Edge& e2 = t.s.e[2];
     if (samples == 1) {
-        int64_t px = int64_t(x0) * kSub + kHalf, py = int64_t(y0) * kSub + kHalf;
-        int64_t r0 = e0.at(px, py) - e0.bias, r1 = e1.at(px, py) - e1.bias, r2 = e2.at(px, py) - e2.bias;
-        const int64_t sx0 = e0.a * kSub, sx1 = e1.a * kSub, sx2 = e2.a * kSub;
-        const int64_t sy0 = e0.b * kSub, sy1 = e1.b * kSub, sy2 = e2.b * kSub;
-        for (int j = y0; j <= y1; ++j, r0 += sy0, r1 += sy1, r2 += sy2) {
-            int64_t a0 = r0, a1 = r1, a2 = r2;
-            float z = t.zRef + t.zdx * float(x0 - t.s.minX) + t.zdy * float(j - t.s.minY);
-            float* drow = depth + (j - ty0) * tw - tx0;
-            uint32_t* irow = ids + (j - ty0) * tw - tx0;
-            for (int i = x0; i <= x1; ++i, a0 += sx0, a1 += sx1, a2 += sx2, z += t.zdx) {
-                if ((a0 | a1 | a2) < 0) continue;
-                float zc = std::clamp(z, 0.0f, 1.0f);
-                if (zc < drow[i]) { drow[i] = zc; irow[i] = id; }
-            }
-        }
+        forEachCoveredPixel(t.s, x0, y0, x1, y1, [&](int i, int j) {
+            float z = t.zRef + t.zdx * float(i - t.s.minX) + t.zdy * float(j - t.s.minY);
+            z = std::clamp(z, 0.0f, 1.0f);
+            size_t p = size_t(j - ty0) * tw + (i - tx0);
+            if (z < depth[p]) { depth[p] = z; ids[p] = id; }
+        });
         return;
     }
     for (int j = y0; j <= y1; ++j)
@@ -322,90 +346,132 @@ void rasterizeIntoTile(const Tri& t, uint32_t id, int tx0, int ty0, int tx1, int
         }
 }
 
-// Shades the fragment of triangle t at the centre of pixel (i, j): returns linear colour
-// after fog.
-vec3 shadeFragment(const Tri& t, const Chunk& ch, const FrameContext& fc, int i, int j) {
-    const DrawItem& d = (*fc.draws)[t.draw];
+// Per-triangle data of the fragment stage, fetched once per run of fragments of the same
+// triangle (consecutive pixels of a tile mostly share one).
+struct TriCache {
+    uint32_t id = kNoTri;
+    const Tri* t = nullptr;
+    const DrawItem* d = nullptr;
+    const sg::Material* mat = nullptr;
+    const std::array<vec3, 3>* cb = nullptr;   // clip barycentrics or null
+    uint32_t v[3] = {0, 0, 0};
+    vec3 p[3], pe[3], n[3];                    // world positions, eye positions, normals
+    bool faceNormal = false;                   // flat (or no normals): n[0] is the normal
+    bool gouraud = false;
+
+    void load(uint32_t newId, const Tri& tri, const Chunk& ch, const FrameContext& fc) {
+        id = newId;
+        t = &tri;
+        d = &(*fc.draws)[tri.draw];
+        mat = &d->materialOf(tri.prim);
+        cb = tri.clip >= 0 ? &ch.clipBary[size_t(tri.clip)] : nullptr;
+        const sg::FrameInput& f = *fc.frame;
+        for (int k = 0; k < 3; ++k) {
+            v[k] = d->vertexOf(tri.prim, k);
+            p[k] = d->wpos[v[k]];
+            pe[k] = vec3(f.camera.view * vec4(p[k], 1.0f));
+        }
+        gouraud = f.settings.shading == sg::ShadingModel::Gouraud && !d->gouraudA[0].empty();
+        faceNormal = f.settings.shading == sg::ShadingModel::Flat || !d->hasNormals;
+        if (faceNormal) {
+            // Face normal of the world-space triangle; outward = CCW side (CW for mirrored),
+            // flipped toward the viewer when seen from the back (two-sided).
+            vec3 nn = glm::cross(p[1] - p[0], p[2] - p[0]);
+            if (d->mirrored != !tri.front) nn = -nn;
+            float len = glm::length(nn);
+            n[0] = len > 0 ? nn / len : vec3(0, 0, 1);
+        } else {
+            for (int k = 0; k < 3; ++k) n[k] = tri.front ? d->wnrm[v[k]] : -d->wnrm[v[k]];
+        }
+    }
+};
+
+// Interpolates the attributes of the cached triangle at the centre of pixel (i, j) and fills
+// slot k of the shading batch (Gouraud: the final colour, with no lights left to add). Returns
+// the eye-space distance for fog.
+__attribute__((noinline)) float prepareFragment(const TriCache& tc, const FrameContext& fc, int i, int j, ShadeBatch& sb, size_t k) {
+    const Tri& t = *tc.t;
+    const DrawItem& d = *tc.d;
     const sg::FrameInput& f = *fc.frame;
-    int64_t px = int64_t(i) * kSub + kHalf, py = int64_t(j) * kSub + kHalf;
-    const double invA = 1.0 / double(t.s.area2);
-    // Screen-space barycentrics of the setup vertices (vertex (k+2)%3 <- edge k).
-    float l[3] = {float(double(t.s.e[1].at(px, py)) * invA), float(double(t.s.e[2].at(px, py)) * invA),
-                  float(double(t.s.e[0].at(px, py)) * invA)};
-    float dlx[3] = {float(t.s.e[1].a * kSub * invA), float(t.s.e[2].a * kSub * invA), float(t.s.e[0].a * kSub * invA)};
-    float dly[3] = {float(t.s.e[1].b * kSub * invA), float(t.s.e[2].b * kSub * invA), float(t.s.e[0].b * kSub * invA)};
-    // Perspective correction: interpolate lambda/w and divide by the interpolated 1/w.
+    const float di = float(i - t.s.minX), dj = float(j - t.s.minY);
+    // Perspective correction: lambda/w is linear in screen space; divide by the sum (1/w).
     float u[3], sum = 0;
-    for (int k = 0; k < 3; ++k) { u[k] = l[k] * t.invW[k]; sum += u[k]; }
+    for (int q = 0; q < 3; ++q) { u[q] = t.uRef[q] + t.udx[q] * di + t.udy[q] * dj; sum += u[q]; }
     float invSum = sum != 0 ? 1.0f / sum : 0.0f;
     float b[3] = {u[0] * invSum, u[1] * invSum, u[2] * invSum};
-    // Weights of the input triangle's corners for each setup vertex.
-    vec3 W[3];
-    if (t.clip >= 0) {
-        const auto& cb = ch.clipBary[size_t(t.clip)];
-        W[0] = cb[0]; W[1] = cb[1]; W[2] = cb[2];
-    } else {
-        for (int k = 0; k < 3; ++k) { W[k] = vec3(0.0f); W[k][t.s.order[k]] = 1.0f; }
-    }
-    vec3 bo = b[0] * W[0] + b[1] * W[1] + b[2] * W[2];
-    uint32_t v[3] = {d.vertexOf(t.prim, 0), d.vertexOf(t.prim, 1), d.vertexOf(t.prim, 2)};
-    const sg::Mesh& m = *d.mesh;
-    uint32_t mi[3] = {d.meshIndex(v[0]), d.meshIndex(v[1]), d.meshIndex(v[2])};
-    vec3 pos = bo[0] * d.wpos[v[0]] + bo[1] * d.wpos[v[1]] + bo[2] * d.wpos[v[2]];
-    const sg::Material& mat = d.materialOf(t.prim);
+    // Weights of the input triangle's corners.
+    vec3 bo;
+    const std::array<vec3, 3>* cb = tc.cb;
+    if (cb) bo = b[0] * (*cb)[0] + b[1] * (*cb)[1] + b[2] * (*cb)[2];
+    else { bo[t.s.order[0]] = b[0]; bo[t.s.order[1]] = b[1]; bo[t.s.order[2]] = b[2]; }
+    const uint32_t* v = tc.v;
+    vec3 pos = bo[0] * tc.p[0] + bo[1] * tc.p[1] + bo[2] * tc.p[2];
+    const sg::Material& mat = *tc.mat;
 
     vec3 albedo = mat.baseColor;
-    if (d.hasColors) albedo *= vec3(bo[0] * m.colors[mi[0]] + bo[1] * m.colors[mi[1]] + bo[2] * m.colors[mi[2]]);
-    if (d.texture && d.hasUV) {
-        vec2 uvc[3] = {m.uv0[mi[0]], m.uv0[mi[1]], m.uv0[mi[2]]};
-        vec2 uvk[3];
-        for (int k = 0; k < 3; ++k) uvk[k] = W[k][0] * uvc[0] + W[k][1] * uvc[1] + W[k][2] * uvc[2];
-        vec2 uv = b[0] * uvk[0] + b[1] * uvk[1] + b[2] * uvk[2];
-        // Analytic screen derivatives of the perspective-correct uv (for the mip level).
-        vec2 ddx(0.0f), ddy(0.0f);
-        for (int k = 0; k < 3; ++k) {
-            ddx += dlx[k] * t.invW[k] * (uvk[k] - uv);
-            ddy += dly[k] * t.invW[k] * (uvk[k] - uv);
+    if (d.hasColors || (d.texture && d.hasUV)) {
+        const sg::Mesh& m = *d.mesh;
+        uint32_t mi[3] = {d.meshIndex(v[0]), d.meshIndex(v[1]), d.meshIndex(v[2])};
+        if (d.hasColors) albedo *= vec3(bo[0] * m.colors[mi[0]] + bo[1] * m.colors[mi[1]] + bo[2] * m.colors[mi[2]]);
+        if (d.texture && d.hasUV) {
+            vec2 uvc[3] = {m.uv0[mi[0]], m.uv0[mi[1]], m.uv0[mi[2]]};
+            vec2 uvk[3];   // uv at the setup vertices
+            for (int q = 0; q < 3; ++q) {
+                vec3 w = cb ? (*cb)[q] : vec3(t.s.order[q] == 0, t.s.order[q] == 1, t.s.order[q] == 2);
+                uvk[q] = w[0] * uvc[0] + w[1] * uvc[1] + w[2] * uvc[2];
+            }
+            vec2 uv = b[0] * uvk[0] + b[1] * uvk[1] + b[2] * uvk[2];
+            // Analytic screen derivatives of the perspective-correct uv (for the mip level):
+            // d(uv)/dx = sum_k du_k/dx (uv_k - uv) / sum(u).
+            vec2 ddx(0.0f), ddy(0.0f);
+            for (int q = 0; q < 3; ++q) {
+                ddx += t.udx[q] * (uvk[q] - uv);
+                ddy += t.udy[q] * (uvk[q] - uv);
+            }
+            albedo *= d.texture->sample(uv, ddx * invSum, ddy * invSum);
         }
-        albedo *= d.texture->sample(uv, ddx * invSum, ddy * invSum);
     }
 
-    vec3 color;
-    const auto& st = f.settings;
-    if (st.shading == sg::ShadingModel::Gouraud && !d.gouraudA[0].empty()) {
+    if (tc.gouraud) {
         int side = t.front ? 0 : 1;
         vec3 A = bo[0] * d.gouraudA[side][v[0]] + bo[1] * d.gouraudA[side][v[1]] + bo[2] * d.gouraudA[side][v[2]];
         vec3 B = bo[0] * d.gouraudB[side][v[0]] + bo[1] * d.gouraudB[side][v[1]] + bo[2] * d.gouraudB[side][v[2]];
-        color = A * albedo + B;
+        sb.setColor(k, A * albedo + B);
     } else {
         vec3 n;
-        if (st.shading == sg::ShadingModel::Flat || !d.hasNormals) {
-            // Face normal of the world-space triangle; outward = CCW side (CW for mirrored).
-            n = glm::cross(d.wpos[v[1]] - d.wpos[v[0]], d.wpos[v[2]] - d.wpos[v[0]]);
-            if (d.mirrored) n = -n;
+        if (tc.faceNormal) {
+            n = tc.n[0];
         } else {
-            n = bo[0] * d.wnrm[v[0]] + bo[1] * d.wnrm[v[1]] + bo[2] * d.wnrm[v[2]];
+            n = bo[0] * tc.n[0] + bo[1] * tc.n[1] + bo[2] * tc.n[2];
+            float len = glm::length(n);
+            n = len > 0 ? n / len : vec3(0, 0, 1);
         }
-        float len = glm::length(n);
-        n = len > 0 ? n / len : vec3(0, 0, 1);
-        if (!t.front) n = -n;   // two-sided: seen from the back
-        color = shade(mat, SurfacePoint{pos, n, albedo}, f.camera.eye, f);
+        if (fc.referenceShading) sb.setColor(k, shade(mat, SurfacePoint{pos, n, albedo}, f.camera.eye, f));   // rnd::shade itself
+        else sb.set(k, mat, pos, n, albedo, f.ambientLight);
     }
-    if (st.fog != sg::FogMode::Off) {
-        vec3 pe = vec3(f.camera.view * vec4(pos, 1.0f));
-        color = applyFog(st, color, glm::length(pe));
-    }
-    return color;
+    if (f.settings.fog == sg::FogMode::Off) return 0.0f;
+    return glm::length(bo[0] * tc.pe[0] + bo[1] * tc.pe[1] + bo[2] * tc.pe[2]);   // eye-space distance
 }
 
 struct TileBuffers {
     std::vector<float> depth;
     std::vector<uint32_t> ids;
+    std::vector<uint16_t> fragPixel;   // pixel index in the tile
+    std::vector<uint32_t> fragTri;
+    std::vector<uint8_t> fragCount;    // MSAA samples covered
+    std::vector<float> fogDist;
+    std::vector<vec3> accum;           // MSAA: linear colour sum per pixel
+    ShadeBatch batch;
 };
 
 const Tri& triById(const std::vector<Chunk>& chunks, uint32_t id) { return chunks[id >> kChunkBits].tris[id & ((1u << kChunkBits) - 1)]; }
 
+// Per-stage time of the tile stage (ns, summed over threads), for VIEWER_RASTER_TIMING.
+std::atomic<int64_t> g_rasterNs{0}, g_prepareNs{0}, g_lightNs{0}, g_outputNs{0};
+inline int64_t nowNs() { return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
+
 void renderTile(int tile, const FrameContext& fc, Framebuffer& target, TileBuffers& buf) {
+    int64_t tA = fc.timing ? nowNs() : 0;
     const int tx = tile % fc.tilesX, ty = tile / fc.tilesX;
     const int x0 = tx * kTileSize, y0 = ty * kTileSize;
     const int x1 = std::min(x0 + kTileSize, fc.width) - 1, y1 = std::min(y0 + kTileSize, fc.height) - 1;
@@ -421,52 +487,98 @@ void renderTile(int tile, const FrameContext& fc, Framebuffer& target, TileBuffe
             rasterizeIntoTile(ch.tris[idx], uint32_t(c << kChunkBits) | idx, x0, y0, x1, y1, samples, buf.depth.data(), buf.ids.data());
         }
     }
+    int64_t tB = fc.timing ? nowNs() : 0;
+    if (fc.timing) g_rasterNs += tB - tA;
     const auto& st = fc.frame->settings;
     const SrgbEncoder& enc = srgbEncoder();
     const vec3 bg = st.background;
     const uint8_t bgBytes[3] = {enc(bg.x), enc(bg.y), enc(bg.z)};
-    for (int j = y0; j <= y1; ++j) {
-        int row = fc.height - 1 - j;   // framebuffer rows are top-down
-        for (int i = x0; i <= x1; ++i) {
-            size_t p = size_t(j - y0) * kTileSize + (i - x0);
-            uint8_t* out = target.pixel(i, row);
-            float* dOut = &target.depth[size_t(row) * fc.width + i];
-            out[3] = 255;
+    // Fragments: one per covered pixel (MSAA: per distinct triangle in the pixel).
+    buf.fragPixel.clear();
+    buf.fragTri.clear();
+    buf.fragCount.clear();
+    const int tw = x1 - x0 + 1, th = y1 - y0 + 1;
+    for (int jj = 0; jj < th; ++jj)
+        for (int ii = 0; ii < tw; ++ii) {
+            int p = jj * kTileSize + ii;
+            int row = fc.height - 1 - (y0 + jj);
+            uint8_t* out = target.pixel(x0 + ii, row);
+            out[0] = bgBytes[0]; out[1] = bgBytes[1]; out[2] = bgBytes[2]; out[3] = 255;
+            float* dOut = &target.depth[size_t(row) * fc.width + x0 + ii];
             if (samples == 1) {
-                uint32_t id = buf.ids[p];
-                if (id == kNoTri) {
-                    out[0] = bgBytes[0]; out[1] = bgBytes[1]; out[2] = bgBytes[2];
-                    *dOut = 1.0f;
-                    continue;
-                }
-                vec3 c = shadeFragment(triById(chunks, id), chunks[id >> kChunkBits], fc, i, j);
-                out[0] = enc(c.x); out[1] = enc(c.y); out[2] = enc(c.z);
                 *dOut = buf.depth[p];
+                if (buf.ids[p] == kNoTri) continue;
+                buf.fragPixel.push_back(uint16_t(p));
+                buf.fragTri.push_back(buf.ids[p]);
+                buf.fragCount.push_back(1);
                 continue;
             }
-            // MSAA: shade once per distinct triangle, average the samples in linear space.
-            vec3 acc(0.0f);
-            uint32_t done[4];
-            vec3 col[4];
-            int nd = 0;
             float dmin = 1.0f;
+            uint32_t seen[4];
+            int nseen = 0;
+            size_t first = buf.fragTri.size();
             for (int s = 0; s < 4; ++s) {
-                uint32_t id = buf.ids[p * 4 + s];
                 dmin = std::min(dmin, buf.depth[p * 4 + s]);
-                if (id == kNoTri) { acc += bg; continue; }
+                uint32_t id = buf.ids[p * 4 + s];
+                if (id == kNoTri) continue;
                 int q = 0;
-                while (q < nd && done[q] != id) ++q;
-                if (q == nd) {
-                    done[nd] = id;
-                    col[nd++] = glm::clamp(shadeFragment(triById(chunks, id), chunks[id >> kChunkBits], fc, i, j), 0.0f, 1.0f);
+                while (q < nseen && seen[q] != id) ++q;
+                if (q == nseen) {
+                    seen[nseen++] = id;
+                    buf.fragPixel.push_back(uint16_t(p));
+                    buf.fragTri.push_back(id);
+                    buf.fragCount.push_back(1);
+                } else {
+                    ++buf.fragCount[first + q];
                 }
-                acc += col[q];
             }
-            acc *= 0.25f;
-            out[0] = enc(acc.x); out[1] = enc(acc.y); out[2] = enc(acc.z);
             *dOut = dmin;
         }
+    const size_t nf = buf.fragTri.size();
+    if (nf == 0) return;
+    buf.batch.resize(nf);
+    buf.fogDist.resize(nf);
+    TriCache tc;
+    for (size_t k = 0; k < nf; ++k) {
+        uint32_t id = buf.fragTri[k];
+        if (id != tc.id) tc.load(id, triById(chunks, id), chunks[id >> kChunkBits], fc);
+        int p = buf.fragPixel[k];
+        buf.fogDist[k] = prepareFragment(tc, fc, x0 + p % kTileSize, y0 + p / kTileSize, buf.batch, k);
     }
+    int64_t tC = fc.timing ? nowNs() : 0;
+    if (fc.timing) g_prepareNs += tC - tB;
+    shadeBatch(buf.batch, nf, *fc.frame);
+    if (fc.timing) g_lightNs += nowNs() - tC;
+    const bool fog = st.fog != sg::FogMode::Off;
+    const ShadeBatch& b = buf.batch;
+    if (samples == 1) {
+        for (size_t k = 0; k < nf; ++k) {
+            vec3 c(b.cr[k], b.cg[k], b.cb[k]);
+            if (fog) c = applyFog(st, c, buf.fogDist[k]);
+            int p = buf.fragPixel[k];
+            uint8_t* out = target.pixel(x0 + p % kTileSize, fc.height - 1 - (y0 + p / kTileSize));
+            out[0] = enc(c.x); out[1] = enc(c.y); out[2] = enc(c.z);
+        }
+        return;
+    }
+    // MSAA resolve: average the samples in linear space (background where uncovered).
+    buf.accum.assign(size_t(kTileSize) * kTileSize, vec3(0.0f));
+    std::vector<uint8_t> covered(size_t(kTileSize) * kTileSize, 0);
+    for (size_t k = 0; k < nf; ++k) {
+        vec3 c(b.cr[k], b.cg[k], b.cb[k]);
+        if (fog) c = applyFog(st, c, buf.fogDist[k]);
+        c = glm::clamp(c, 0.0f, 1.0f);
+        buf.accum[buf.fragPixel[k]] += float(buf.fragCount[k]) * c;
+        covered[buf.fragPixel[k]] += buf.fragCount[k];
+    }
+    for (int jj = 0; jj < th; ++jj)
+        for (int ii = 0; ii < tw; ++ii) {
+            int p = jj * kTileSize + ii;
+            if (!covered[p]) continue;
+            vec3 c = (buf.accum[p] + float(4 - covered[p]) * bg) * 0.25f;
+            uint8_t* out = target.pixel(x0 + ii, fc.height - 1 - (y0 + jj));
+            out[0] = enc(c.x); out[1] = enc(c.y); out[2] = enc(c.z);
+        }
 }
 
 // ---------------------------------------------------------------------------------------
@@ -492,71 +604,105 @@ bool clipSegment(vec4& a, vec4& b, const GuardBand& g) {
     return true;
 }
 
-void writeLinePixel(Framebuffer& fb, int i, int j, float z, const uint8_t rgb[3], float bias) {
+void writeLinePixel(Framebuffer& fb, int i, int j, float z, const vec3& linear, float bias) {
     int row = fb.height - 1 - j;
     float& dst = fb.depth[size_t(row) * fb.width + i];
-    if (!(z < dst + bias)) return;
+    if (!(z < dst + bias)) return;   // LESS (wireframe: LEQUAL with a small offset)
     dst = std::min(dst, z);
+    const SrgbEncoder& enc = srgbEncoder();
     uint8_t* p = fb.pixel(i, row);
-    p[0] = rgb[0]; p[1] = rgb[1]; p[2] = rgb[2]; p[3] = 255;
+    p[0] = enc(linear.x); p[1] = enc(linear.y); p[2] = enc(linear.z); p[3] = 255;
 }
 
-void drawSegment(Framebuffer& fb, vec4 a, vec4 b, const GuardBand& g, const uint8_t rgb[3], float bias) {
-    if (!clipSegment(a, b, g)) return;
-    vec4 wa = toWindow(a, fb.width, fb.height), wb = toWindow(b, fb.width, fb.height);
+// End point of a line: clip position, unfogged linear colour, eye distance (for fog).
+struct LineEnd {
+    vec4 clip;
+    vec3 color;
+    float eyeDist;
+};
+
+// Draws segment a-b: clipped in clip space, DDA in window space; depth, colour and fog
+// distance interpolated perspective-correctly per pixel, fog applied per pixel (as GL does).
+void drawSegment(Framebuffer& fb, LineEnd a, LineEnd b, const GuardBand& g, const sg::RenderSettings& st, float bias) {
+    vec4 ca = a.clip, cb = b.clip;
+    float t0 = 0, t1 = 1;
+    {
+        vec4 ta = ca, tb = cb;
+        if (!clipSegment(ta, tb, g)) return;
+        // Recover the clip parameters to interpolate the attributes.
+        vec4 dd = cb - ca;
+        int axis = 0;
+        for (int k = 1; k < 4; ++k)
+            if (std::fabs(dd[k]) > std::fabs(dd[axis])) axis = k;
+        if (dd[axis] != 0) { t0 = (ta[axis] - ca[axis]) / dd[axis]; t1 = (tb[axis] - ca[axis]) / dd[axis]; }
+        ca = ta;
+        cb = tb;
+    }
+    auto lerp = [](const LineEnd& x, const LineEnd& y, float t) {
+        return LineEnd{x.clip + t * (y.clip - x.clip), x.color + t * (y.color - x.color), x.eyeDist + t * (y.eyeDist - x.eyeDist)};
+    };
+    LineEnd ea = lerp(a, b, t0), eb = lerp(a, b, t1);
+    vec4 wa = toWindow(ca, fb.width, fb.height), wb = toWindow(cb, fb.width, fb.height);
+    const bool fog = st.fog != sg::FogMode::Off;
     drawLineDDA(wa.x, wa.y, wb.x, wb.y, fb.width, fb.height, [&](int i, int j, float t) {
-        writeLinePixel(fb, i, j, std::clamp(wa.z + t * (wb.z - wa.z), 0.0f, 1.0f), rgb, bias);
+        float z = std::clamp(wa.z + t * (wb.z - wa.z), 0.0f, 1.0f);         // window z: screen-linear
+        float tp = t * wb.w / ((1 - t) * wa.w + t * wb.w);                  // perspective-correct
+        vec3 c = ea.color + tp * (eb.color - ea.color);
+        if (fog) c = applyFog(st, c, ea.eyeDist + tp * (eb.eyeDist - ea.eyeDist));
+        writeLinePixel(fb, i, j, z, c, bias);
     });
 }
 
 void drawLinesAndWireframe(const std::vector<DrawItem>& lineDraws, const std::vector<DrawItem>& triDraws, const sg::FrameInput& f,
-                           Framebuffer& fb) {
+                           Framebuffer& fb, float pointSize) {
     const GuardBand g = guardBand(fb.width, fb.height);
-    const SrgbEncoder& enc = srgbEncoder();
+    const auto& st = f.settings;
+    auto eyeDist = [&](const vec3& wpos) { return glm::length(vec3(f.camera.view * vec4(wpos, 1.0f))); };
     for (const DrawItem& d : lineDraws) {
         const sg::Mesh& m = *d.mesh;
-        // Unlit: base colour (x) vertex colour + emissive, fogged.
-        auto colorOf = [&](uint32_t mi, const vec4& clip) {
-            vec3 c = d.material.baseColor * (d.hasColors ? vec3(m.colors[mi]) : vec3(1.0f)) + d.material.emissive;
-            if (f.settings.fog != sg::FogMode::Off) {
-                vec3 pe = vec3(f.camera.view * vec4(d.wpos[mi], 1.0f));
-                c = applyFog(f.settings, c, glm::length(pe));
-            }
-            (void)clip;
-            return c;
+        // Unlit, as GL draws lines and points: base colour (x) vertex colour + emissive.
+        auto end = [&](uint32_t v) {
+            vec3 c = d.material.baseColor * (d.hasColors ? vec3(m.colors[v]) : vec3(1.0f)) + d.material.emissive;
+            return LineEnd{d.clip[v], c, eyeDist(d.wpos[v])};
         };
         size_t n = m.indices.empty() ? m.positions.size() : m.indices.size();
         auto idx = [&](size_t k) { return m.indices.empty() ? uint32_t(k) : m.indices[k]; };
         if (m.mode == sg::PrimitiveMode::Lines) {
             for (size_t k = 0; k + 1 < n; k += 2) {
                 uint32_t ia = idx(k), ib = idx(k + 1);
-                if (ia >= d.clip.size() || ib >= d.clip.size()) continue;
-                vec3 c = 0.5f * (colorOf(ia, d.clip[ia]) + colorOf(ib, d.clip[ib]));
-                uint8_t rgb[3] = {enc(c.x), enc(c.y), enc(c.z)};
-                drawSegment(fb, d.clip[ia], d.clip[ib], g, rgb, 0.0f);
+                if (ia >= d.clip.size() || ib >= d.clip.size() || ((d.code[ia] | d.code[ib]) & kInvalid)) continue;
+                drawSegment(fb, end(ia), end(ib), g, st, 0.0f);
             }
         } else {
+            // Points: squares of pointSize pixels centred on the vertex (GL point rules).
             for (size_t k = 0; k < n; ++k) {
                 uint32_t ia = idx(k);
                 if (ia >= d.clip.size() || d.code[ia] != 0) continue;
                 vec4 w = toWindow(d.clip[ia], fb.width, fb.height);
-                int i = int(std::floor(w.x)), j = int(std::floor(w.y));
-                if (i < 0 || j < 0 || i >= fb.width || j >= fb.height) continue;
-                vec3 c = colorOf(ia, d.clip[ia]);
-                uint8_t rgb[3] = {enc(c.x), enc(c.y), enc(c.z)};
-                writeLinePixel(fb, i, j, std::clamp(w.z, 0.0f, 1.0f), rgb, 0.0f);
+                LineEnd e = end(ia);
+                vec3 c = st.fog != sg::FogMode::Off ? applyFog(st, e.color, e.eyeDist) : e.color;
+                float h = 0.5f * pointSize;
+                int i0 = int(std::ceil(w.x - h - 0.5f)), i1 = int(std::ceil(w.x + h - 0.5f)) - 1;
+                int j0 = int(std::ceil(w.y - h - 0.5f)), j1 = int(std::ceil(w.y + h - 0.5f)) - 1;
+                for (int j = std::max(j0, 0); j <= std::min(j1, fb.height - 1); ++j)
+                    for (int i = std::max(i0, 0); i <= std::min(i1, fb.width - 1); ++i) writeLinePixel(fb, i, j, std::clamp(w.z, 0.0f, 1.0f), c, 0.0f);
             }
         }
     }
-    if (!f.settings.wireframe) return;
-    vec3 wc = f.settings.wireframeColor;
-    uint8_t rgb[3] = {enc(wc.x), enc(wc.y), enc(wc.z)};
+    if (!st.wireframe) return;
+    // Wireframe overlay: every triangle edge, depth LEQUAL with a small offset toward the
+    // viewer (GL: glPolygonOffset(-1, -1)), wireframe colour fogged like GL's overlay.
     for (const DrawItem& d : triDraws)
         for (uint32_t t = 0; t < d.triCount; ++t) {
             uint32_t v[3] = {d.vertexOf(t, 0), d.vertexOf(t, 1), d.vertexOf(t, 2)};
             if (v[0] >= d.clip.size() || v[1] >= d.clip.size() || v[2] >= d.clip.size()) continue;
             if (d.code[v[0]] & d.code[v[1]] & d.code[v[2]]) continue;
-            for (int k = 0; k < 3; ++k) drawSegment(fb, d.clip[v[k]], d.clip[v[(k + 1) % 3]], g, rgb, 2e-4f);
+            if ((d.code[v[0]] | d.code[v[1]] | d.code[v[2]]) & kInvalid) continue;
+            for (int k = 0; k < 3; ++k) {
+                LineEnd a{d.clip[v[k]], st.wireframeColor, eyeDist(d.wpos[v[k]])};
+                LineEnd b{d.clip[v[(k + 1) % 3]], st.wireframeColor, eyeDist(d.wpos[v[(k + 1) % 3]])};
+                drawSegment(fb, a, b, g, st, 2e-4f);
+            }
         }
 }
 
@@ -589,7 +735,7 @@ public:
         if (st.aa == sg::AAMode::SSAA && st.aaRate > 1) {
             int r = std::clamp(st.aaRate, 2, 4);
             Framebuffer hi;
-            stats = renderSingle(frame, width * r, height * r, hi, false, control);
+            stats = renderSingle(frame, width * r, height * r, hi, false, control, r);
             if (stats.ok) target = downsample(hi, r);
             else target.resize(width, height);
         } else {
@@ -611,8 +757,11 @@ private:
         return e.tex.get();
     }
 
-    RenderStats renderSingle(const sg::FrameInput& frame, int width, int height, Framebuffer& target, bool msaa, RenderControl* control) {
+    // pointScale: the SSAA factor (points are 2 pixels wide at the output resolution, like GL).
+    RenderStats renderSingle(const sg::FrameInput& frame, int width, int height, Framebuffer& target, bool msaa, RenderControl* control,
+                             int pointScale = 1) {
         RenderStats stats;
+        auto t0frame = std::chrono::steady_clock::now();
         ++m_frame;
         m_tess.nextFrame();
         target.resize(width, height);
@@ -657,6 +806,8 @@ private:
         for (auto it = m_textures.begin(); it != m_textures.end();)
             it = m_frame - it->second.lastFrame > 8 ? m_textures.erase(it) : std::next(it);
 
+        auto tStart = std::chrono::steady_clock::now();
+        auto ms = [](auto a, auto b) { return std::chrono::duration<double, std::milli>(b - a).count(); };
         // 2. vertices
         uint64_t total = 0;
         for (auto& d : draws) { d.firstTri = total; total += d.triCount; }
@@ -664,6 +815,7 @@ private:
         tbb::parallel_for(size_t(0), draws.size(), [&](size_t i) { runVertexStage(draws[i], frame, width, height, gouraud); });
         tbb::parallel_for(size_t(0), lineDraws.size(), [&](size_t i) { runVertexStage(lineDraws[i], frame, width, height, false); });
 
+        auto tVert = std::chrono::steady_clock::now();
         // 3. triangles
         FrameContext fc;
         fc.frame = &frame;
@@ -672,20 +824,28 @@ private:
         fc.tilesX = (width + kTileSize - 1) / kTileSize;
         fc.tilesY = (height + kTileSize - 1) / kTileSize;
         fc.msaa = msaa;
+        fc.referenceShading = m_referenceShading;
+        fc.timing = m_timing;
         fc.draws = &draws;
         uint64_t chunkSize = std::max<uint64_t>(4096, (total + 4000) / 4000);
         if (chunkSize * 7 >= (1u << kChunkBits)) {
             stats.error = "raster: too many triangles (" + std::to_string(total) + ")";
             return stats;
         }
-        std::vector<Chunk> chunks(size_t((total + chunkSize - 1) / chunkSize));
+        // Chunks persist between frames so their buffers keep their capacity.
+        std::vector<Chunk>& chunks = m_chunks;
+        chunks.resize(size_t((total + chunkSize - 1) / chunkSize));
         for (size_t c = 0; c < chunks.size(); ++c) {
             chunks[c].begin = c * chunkSize;
             chunks[c].end = std::min(total, (c + 1) * chunkSize);
+            chunks[c].tris.clear();
+            chunks[c].clipBary.clear();
         }
         fc.chunks = &chunks;
         tbb::parallel_for(size_t(0), chunks.size(), [&](size_t c) { runTriangleStage(chunks[c], fc); });
 
+        auto tTri = std::chrono::steady_clock::now();
+        g_rasterNs = g_prepareNs = g_lightNs = 0;
         // 4. tiles
         const int tiles = fc.tilesX * fc.tilesY;
         std::atomic<int> done{0};
@@ -708,8 +868,16 @@ private:
             return stats;
         }
 
+        auto tTiles = std::chrono::steady_clock::now();
         // 5. lines, points, wireframe
-        drawLinesAndWireframe(lineDraws, draws, frame, target);
+        drawLinesAndWireframe(lineDraws, draws, frame, target, 2.0f * float(pointScale));
+        if (m_timing) {
+            size_t ntri = 0;
+            for (const auto& c : chunks) ntri += c.tris.size();
+            std::fprintf(stderr, "raster timing: gather %.2f vertices %.2f triangles %.2f (%zu set up) tiles %.2f [raster %.2f prepare %.2f light %.2f cpu-ms] lines %.2f ms\n",
+                         ms(t0frame, tStart), ms(tStart, tVert), ms(tVert, tTri), ntri, ms(tTri, tTiles), g_rasterNs * 1e-6, g_prepareNs * 1e-6,
+                         g_lightNs * 1e-6, ms(tTiles, std::chrono::steady_clock::now()));
+        }
         stats.ok = true;
         return stats;
     }
@@ -721,7 +889,12 @@ private:
     };
     std::unordered_map<uint64_t, TextureEntry> m_textures;
     TessellationCache m_tess;
+    std::vector<Chunk> m_chunks;
     uint64_t m_frame = 0;
+    // VIEWER_RASTER_REFERENCE_SHADING=1: shade every fragment with rnd::shade (slow; used to
+    // check the batched path).
+    bool m_timing = [] { const char* e = std::getenv("VIEWER_RASTER_TIMING"); return e && *e == '1'; }();
+    bool m_referenceShading = [] { const char* e = std::getenv("VIEWER_RASTER_REFERENCE_SHADING"); return e && *e == '1'; }();
 };
 
 }  // namespace

@@ -1,0 +1,251 @@
+// raster_bench.cpp - frame time of our CPU rasterizer ("raster") vs the GL backend on Mesa
+// llvmpipe, same scene, camera, shading, size and thread count.
+//
+//   cmake --build build/release -j2 --target bench_raster
+//   ./build/release/bench/raster/bench_raster [--quick] [--threads 2] [--frames 15]
+//        [--size 1280x720] [--shading phong|gouraud|flat] [--fog on|off] [--scenes a,b,...]
+//
+// Prints one line per scene and metric:
+//   bench: scene=<name> what=<metric> ours=<x> ref=<y> ratio=<ours/ref>
+// metrics: ms (median wall ms per frame), cpu_ms (median process CPU ms per frame, all
+// threads), mpix_s (fill rate: covered pixels per wall second / 1e6).
+// Scenes: spheres10k / spheres100k / spheres1M (uv-sphere grids on a tessellated ground
+// plane) and bunny (stanford-bunny.obj from shared/testdata, read by a tiny OBJ reader below).
+// LP_NUM_THREADS is set before the GL context is created; tbb is limited to the same count.
+// --quick: fewer frames and 960x540 (finishes well under a minute).
+#include "renderers/renderer.h"
+#include "scenegraph/frame.h"
+#include "scenegraph/scene.h"
+
+#include <tbb/global_control.h>
+
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#ifndef VIEWER_TESTDATA_DIR
+#define VIEWER_TESTDATA_DIR "../shared/testdata"
+#endif
+
+using namespace sg;
+
+namespace {
+
+// Minimal OBJ reader for the bench only: "v x y z" and "f a b c ..." (fan), 1-based or
+// negative indices, ignoring texture/normal references.
+bool readObj(const std::string& path, Mesh& m) {
+    std::ifstream in(path);
+    if (!in) return false;
+    std::string line;
+    while (std::getline(in, line)) {
+        std::istringstream ls(line);
+        std::string tag;
+        ls >> tag;
+        if (tag == "v") {
+            vec3 p;
+            ls >> p.x >> p.y >> p.z;
+            m.positions.push_back(p);
+        } else if (tag == "f") {
+            std::vector<uint32_t> f;
+            std::string tok;
+            while (ls >> tok) {
+                long i = std::strtol(tok.c_str(), nullptr, 10);
+                if (i < 0) i = long(m.positions.size()) + i + 1;
+                if (i < 1) return false;
+                f.push_back(uint32_t(i - 1));
+            }
+            for (size_t k = 1; k + 1 < f.size(); ++k) m.indices.insert(m.indices.end(), {f[0], f[k], f[k + 1]});
+        }
+    }
+    for (uint32_t i : m.indices)
+        if (i >= m.positions.size()) return false;
+    m.computeNormals();
+    return !m.indices.empty();
+}
+
+struct BenchScene {
+    std::string name;
+    Scene scene;
+    size_t triangles = 0;
+};
+
+// grid x grid spheres with `seg` slices (seg/2 stacks) on a ground plane.
+BenchScene sphereGrid(const std::string& name, int grid, int seg) {
+    BenchScene b;
+    b.name = name;
+    Scene& s = b.scene;
+    float spacing = 1.0f, extent = grid * spacing;
+    auto ground = std::make_shared<Mesh>(primitives::plane(extent, 64));
+    auto sphere = std::make_shared<Mesh>(primitives::uvSphere(0.4f * spacing, seg, seg / 2));
+    s.meshes = {ground, sphere};
+    Material mg;
+    mg.baseColor = vec3(0.5f, 0.5f, 0.45f);
+    Material ms;
+    ms.baseColor = vec3(0.8f, 0.3f, 0.2f);
+    ms.ks = 0.5f;
+    s.materials = {mg, ms};
+    s.addNode("ground", s.root(), MeshInstance{0, 0});
+    for (int i = 0; i < grid; ++i)
+        for (int j = 0; j < grid; ++j) {
+            NodeId n = s.addNode("sphere", s.root(), MeshInstance{1, 1});
+            s.setLocal(n, LocalTransform::fromTRS(vec3((i - (grid - 1) * 0.5f) * spacing, 0.4f * spacing, (j - (grid - 1) * 0.5f) * spacing)));
+        }
+    b.triangles = ground->triangleCount() + size_t(grid) * grid * sphere->triangleCount();
+    Camera cam;
+    cam.projection.fovyDeg = 50.0f;
+    cam.projection.zNear = 0.1f;
+    cam.projection.zFar = 4.0f * extent + 20.0f;
+    NodeId c = s.addNode("camera", s.root(), cam);
+    s.lookAt(c, vec3(0.0f, 0.55f * extent + 1.0f, 0.75f * extent + 1.5f), vec3(0.0f, 0.0f, 0.0f));
+    s.activeCamera = c;
+    NodeId key = s.addNode("key", s.root(), Light{LightType::Point, vec3(1.0f), 1.0f, false});
+    s.setLocal(key, LocalTransform::fromTRS(vec3(extent * 0.3f, extent, extent * 0.5f)));
+    NodeId sun = s.addNode("sun", s.root(), Light{LightType::Directional, vec3(0.6f, 0.7f, 0.9f), 0.4f, false});
+    s.lookAt(sun, vec3(-1, 2, 1), vec3(0));
+    s.ambientLight = vec3(0.3f);
+    return b;
+}
+
+bool bunnyScene(BenchScene& b) {
+    b.name = "bunny";
+    auto m = std::make_shared<Mesh>();
+    std::string path = std::string(VIEWER_TESTDATA_DIR) + "/meshes/common-3d-test-models/stanford-bunny/stanford-bunny.obj";
+    if (const char* env = std::getenv("VIEWER_TESTDATA")) path = std::string(env) + "/meshes/common-3d-test-models/stanford-bunny/stanford-bunny.obj";
+    if (!readObj(path, *m)) {
+        std::fprintf(stderr, "bench: %s: cannot read (skipping the bunny scene)\n", path.c_str());
+        return false;
+    }
+    Scene& s = b.scene;
+    Aabb bb = m->bounds();
+    auto ground = std::make_shared<Mesh>(primitives::plane(1.0f, 32));
+    s.meshes = {m, ground};
+    Material mb;
+    mb.baseColor = vec3(0.75f, 0.7f, 0.6f);
+    s.materials = {mb};
+    NodeId n = s.addNode("bunny", s.root(), MeshInstance{0, 0});
+    float scale = 2.0f / glm::length(bb.extent());
+    s.setLocal(n, LocalTransform::fromTRS(-bb.center() * scale + vec3(0, 0.5f * bb.extent().y * scale, 0), quat(1, 0, 0, 0), vec3(scale)));
+    s.addNode("ground", s.root(), MeshInstance{1, 0});
+    Camera cam;
+    cam.projection.zNear = 0.05f;
+    cam.projection.zFar = 20.0f;
+    NodeId c = s.addNode("camera", s.root(), cam);
+    s.lookAt(c, vec3(0.0f, 0.9f, 2.0f), vec3(0.0f, 0.45f, 0.0f));
+    s.activeCamera = c;
+    NodeId key = s.addNode("key", s.root(), Light{LightType::Point, vec3(1.0f), 1.0f, false});
+    s.setLocal(key, LocalTransform::fromTRS(vec3(1, 3, 2)));
+    b.triangles = m->triangleCount() + ground->triangleCount();
+    return true;
+}
+
+double median(std::vector<double> v) {
+    if (v.empty()) return NAN;
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
+}
+
+// Process CPU time (all threads, user + system) in ms.
+double cpuMs() {
+    rusage u{};
+    getrusage(RUSAGE_SELF, &u);
+    return (u.ru_utime.tv_sec + u.ru_stime.tv_sec) * 1e3 + (u.ru_utime.tv_usec + u.ru_stime.tv_usec) * 1e-3;
+}
+
+struct Timing {
+    double wallMs = NAN, cpuMs = NAN;   // medians per frame
+};
+
+// Median wall and CPU ms per frame (after one warm-up frame); NAN when the renderer fails.
+// CPU time (summed over the process's threads: ours and llvmpipe's) is the steadier figure on
+// a shared, loaded machine.
+Timing timeFrames(rnd::Renderer& r, const FrameInput& f, int w, int h, int frames, rnd::Framebuffer& fb, std::string& err) {
+    rnd::RenderStats s = r.render(f, w, h, fb);   // warm-up: caches, textures, GL buffers
+    if (!s.ok) { err = s.error; return {}; }
+    std::vector<double> t, c;
+    for (int i = 0; i < frames; ++i) {
+        auto t0 = std::chrono::steady_clock::now();
+        double c0 = cpuMs();
+        s = r.render(f, w, h, fb);
+        c.push_back(cpuMs() - c0);
+        t.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    }
+    return {median(t), median(c)};
+}
+
+// Pixels not equal to the background (covered by geometry).
+double coveredPixels(const rnd::Framebuffer& fb) {
+    size_t n = 0;
+    for (float d : fb.depth) n += d < 1.0f;
+    return double(n);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    bool quick = false;
+    int threads = 2, frames = 15, w = 1280, h = 720;
+    std::string shading = "phong", fog = "on", only;
+    for (int i = 1; i < argc; ++i) {
+        std::string a = argv[i];
+        auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
+        if (a == "--quick") quick = true;
+        else if (a == "--threads") threads = std::max(1, std::atoi(next().c_str()));
+        else if (a == "--frames") frames = std::max(1, std::atoi(next().c_str()));
+        else if (a == "--size") std::sscanf(next().c_str(), "%dx%d", &w, &h);
+        else if (a == "--shading") shading = next();
+        else if (a == "--fog") fog = next();
+        else if (a == "--scenes") only = next();
+        else { std::fprintf(stderr, "bench: unknown argument %s\n", a.c_str()); return 2; }
+    }
+    if (quick) { frames = std::min(frames, 5); if (w == 1280 && h == 720) { w = 960; h = 540; } }
+    // Same thread count for both: llvmpipe reads LP_NUM_THREADS when the context is created.
+    setenv("LP_NUM_THREADS", std::to_string(threads).c_str(), 1);
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
+
+    std::string err;
+    auto ours = rnd::makeRenderer("raster", &err);
+    auto ref = rnd::makeRenderer("gl", &err);
+    if (!ours) { std::fprintf(stderr, "bench: %s\n", err.c_str()); return 1; }
+
+    std::vector<BenchScene> scenes;
+    auto want = [&](const std::string& n) { return only.empty() || ("," + only + ",").find("," + n + ",") != std::string::npos; };
+    if (want("spheres10k")) scenes.push_back(sphereGrid("spheres10k", 4, 24));
+    if (want("spheres100k")) scenes.push_back(sphereGrid("spheres100k", 10, 32));
+    if (want("spheres1M") && !quick) scenes.push_back(sphereGrid("spheres1M", 32, 32));
+    if (want("spheres1M") && quick) scenes.push_back(sphereGrid("spheres1M", 32, 32));
+    if (want("bunny")) { BenchScene b; if (bunnyScene(b)) scenes.push_back(std::move(b)); }
+
+    std::printf("# raster vs gl(llvmpipe): %dx%d, %d threads, shading=%s fog=%s, median of %d frames\n", w, h, threads, shading.c_str(),
+                fog.c_str(), frames);
+    for (BenchScene& b : scenes) {
+        parse(shading, b.scene.settings.shading);
+        b.scene.settings.fog = fog == "on" ? FogMode::Linear : FogMode::Off;
+        b.scene.settings.fogStart = 2.0f;
+        b.scene.settings.fogEnd = 60.0f;
+        FrameInput f = flatten(b.scene, float(w) / h);
+        rnd::Framebuffer fbO, fbR;
+        std::string eo, er;
+        Timing o = timeFrames(*ours, f, w, h, frames, fbO, eo);
+        Timing r = ref ? timeFrames(*ref, f, w, h, frames, fbR, er) : Timing{};
+        double to = o.wallMs, tr = r.wallMs;
+        if (!eo.empty()) std::fprintf(stderr, "bench: raster failed on %s: %s\n", b.name.c_str(), eo.c_str());
+        if (!er.empty()) std::fprintf(stderr, "bench: gl failed on %s: %s\n", b.name.c_str(), er.c_str());
+        double cov = coveredPixels(fbO);
+        std::printf("bench: scene=%s what=ms ours=%.2f ref=%.2f ratio=%.3f\n", b.name.c_str(), to, tr, to / tr);
+        std::printf("bench: scene=%s what=cpu_ms ours=%.2f ref=%.2f ratio=%.3f\n", b.name.c_str(), o.cpuMs, r.cpuMs, o.cpuMs / r.cpuMs);
+        std::printf("bench: scene=%s what=mpix_s ours=%.1f ref=%.1f ratio=%.3f\n", b.name.c_str(), cov / (to * 1e3), cov / (tr * 1e3),
+                    tr / to);
+        std::printf("# %s: %zu triangles, %.0f covered pixels\n", b.name.c_str(), b.triangles, cov);
+        std::fflush(stdout);
+    }
+    return 0;
+}

@@ -1,0 +1,81 @@
+// lighting.glsl - the Phong model of renderers/common/shading.cpp, line by line (keep the two
+// in step). Shared by mesh.vert (Gouraud) and mesh.frag (flat, Phong). The prefix added by
+// the renderer defines MAX_LIGHTS.
+//
+// shade() is linear in the albedo rho, so it is evaluated as two terms:
+//   colour = rho * mul + add
+//   mul = ka * L_ambient + sum_i att_i L_i max(n.l_i,0) (kd + [tinted] ks spec_i)
+//   add = emissive        + sum_i att_i L_i max(n.l_i,0) [untinted] ks spec_i specularColor
+// which lets Gouraud evaluate the lights at the vertices and still apply the texture per
+// fragment (rho = base colour * vertex colour * texel).
+
+uniform int uNumLights;
+uniform vec4 uLightPos[MAX_LIGHTS];    // xyz: world position; w: type (0 point, 1 directional, 2 spot)
+uniform vec4 uLightDir[MAX_LIGHTS];    // xyz: world direction the light travels; w: 1 = inverse square
+uniform vec4 uLightRad[MAX_LIGHTS];    // xyz: radiance (colour * intensity)
+uniform vec4 uLightCone[MAX_LIGHTS];   // x: cos inner, y: cos outer
+
+uniform vec3 uEye;          // camera position, world
+uniform vec3 uAmbient;      // L_ambient
+uniform int uReflection;    // 0 Phong, 1 Blinn-Phong
+
+uniform vec3 uBaseColor;
+uniform float uKa;
+uniform float uKd;
+uniform float uKs;
+uniform float uShininess;
+uniform bool uSpecTinted;
+uniform vec3 uSpecColor;
+uniform vec3 uEmissive;
+
+// sampleLight(): direction toward the light and the radiance arriving at p.
+void sampleLight(int i, vec3 p, out vec3 toLight, out vec3 radiance) {
+    radiance = uLightRad[i].xyz;
+    int type = int(uLightPos[i].w + 0.5);
+    if (type == 1) {                                   // directional
+        toLight = -uLightDir[i].xyz;
+        return;
+    }
+    vec3 d = uLightPos[i].xyz - p;
+    float dist2 = dot(d, d);
+    float dist = sqrt(dist2);
+    toLight = dist > 0.0 ? d / dist : vec3(0.0, 1.0, 0.0);
+    if (uLightDir[i].w > 0.5) radiance /= max(dist2, 1e-8);   // seeds 3.2: 1/r^2
+    if (type == 2) {                                   // spot: smoothstep between the cones
+        float c = dot(-toLight, uLightDir[i].xyz);
+        float ci = uLightCone[i].x, co = uLightCone[i].y;
+        float t = ci > co ? (c - co) / (ci - co) : (c >= co ? 1.0 : 0.0);
+        t = clamp(t, 0.0, 1.0);
+        radiance *= t * t * (3.0 - 2.0 * t);
+    }
+}
+
+// The two albedo-linear terms of shade() at world position p with unit normal n (already
+// facing the viewer for two-sided surfaces).
+void lightTerms(vec3 n, vec3 p, out vec3 mul, out vec3 add) {
+    vec3 v = uEye - p;
+    float len = length(v);
+    v = len > 0.0 ? v / len : vec3(0.0, 0.0, 1.0);
+    mul = uKa * uAmbient;
+    add = uEmissive;
+    for (int i = 0; i < uNumLights; ++i) {
+        vec3 l, radiance;
+        sampleLight(i, p, l, radiance);
+        float nl = dot(n, l);
+        if (nl <= 0.0) continue;
+        float spec;
+        if (uReflection == 0) {
+            vec3 r = 2.0 * nl * n - l;                 // mirror direction of l about n
+            spec = max(dot(r, v), 0.0);
+        } else {
+            vec3 h = l + v;
+            float hl = length(h);
+            spec = hl > 0.0 ? max(dot(n, h / hl), 0.0) : 0.0;
+        }
+        spec = spec > 0.0 ? pow(spec, uShininess) : 0.0;
+        vec3 ln = radiance * nl;
+        mul += ln * uKd;
+        if (uSpecTinted) mul += ln * (uKs * spec);
+        else add += ln * (uKs * spec) * uSpecColor;
+    }
+}

@@ -1,0 +1,67 @@
+// mesh.frag - per-fragment part of every shading model, texture, unlit, fog, wireframe.
+// Prefix as in mesh.vert. Output is linear; the sRGB framebuffer encodes it.
+in vec3 vWorldPos;
+in vec3 vEyePos;
+in vec3 vNormal;
+in vec2 vUv;
+in vec4 vColor;
+#if SHADING == 1
+in vec3 vMulFront;
+in vec3 vAddFront;
+in vec3 vMulBack;
+in vec3 vAddBack;
+#endif
+
+uniform sampler2D uTexture;
+uniform bool uHasTexture;
+uniform bool uUnlit;        // colour = albedo + emissive (material unlit, lines, points)
+uniform bool uSolid;        // wireframe overlay: uSolidColor (fogged)
+uniform vec3 uSolidColor;
+uniform int uFogMode;       // 0 off, 1 linear, 2 exp, 3 exp2
+uniform vec3 uFogColor;
+uniform vec3 uFogParams;    // start, end, density
+
+out vec4 fragColor;
+
+// sg::fogVisibility(): f(d) in [0,1], 1 = no fog.
+float fogVisibility(float d) {
+    if (uFogMode == 1) return clamp((uFogParams.y - d) / (uFogParams.y - uFogParams.x), 0.0, 1.0);
+    if (uFogMode == 2) return exp(-uFogParams.z * d);
+    if (uFogMode == 3) { float x = uFogParams.z * d; return exp(-x * x); }
+    return 1.0;
+}
+
+void main() {
+    vec3 c;
+    if (uSolid) {
+        c = uSolidColor;
+    } else {
+        vec3 albedo = uBaseColor * vColor.rgb;
+        if (uHasTexture) albedo *= texture(uTexture, vUv).rgb;   // sRGB texture: decoded to linear
+        if (uUnlit) {
+            c = albedo + uEmissive;
+        } else {
+            vec3 mul, add;
+#if SHADING == 0
+            // Face normal of the world-space triangle; cross(dp/dx, dp/dy) always points to
+            // the side being seen, i.e. it is already flipped toward the viewer.
+            vec3 n = normalize(cross(dFdx(vWorldPos), dFdy(vWorldPos)));
+            lightTerms(n, vWorldPos, mul, add);
+#elif SHADING == 1
+            mul = gl_FrontFacing ? vMulFront : vMulBack;
+            add = gl_FrontFacing ? vAddFront : vAddBack;
+#else
+            float len = length(vNormal);
+            vec3 n = len > 0.0 ? vNormal / len : vec3(0.0, 0.0, 1.0);
+            if (!gl_FrontFacing) n = -n;                 // two-sided: seen from the back
+            lightTerms(n, vWorldPos, mul, add);
+#endif
+            c = albedo * mul + add;
+        }
+    }
+    if (uFogMode != 0) {
+        float f = fogVisibility(length(vEyePos));   // eye-space distance, not just z
+        c = f * c + (1.0 - f) * uFogColor;
+    }
+    fragColor = vec4(clamp(c, 0.0, 1.0), 1.0);
+}

@@ -1,0 +1,42 @@
+// mesh.vert - world-space transform for all shading models; Gouraud lights the vertices here
+// (front and back side, chosen per fragment by gl_FrontFacing). The renderer prepends
+// "#version 330 core", SHADING (0 flat, 1 Gouraud, 2 Phong), MAX_LIGHTS and lighting.glsl.
+layout(location = 0) in vec3 aPosition;
+layout(location = 1) in vec3 aNormal;
+layout(location = 2) in vec2 aUv;
+layout(location = 3) in vec4 aColor;
+
+uniform mat4 uModel;
+uniform mat3 uNormalMatrix;
+uniform mat4 uViewProj;
+uniform mat4 uView;
+uniform float uPointSize;
+
+out vec3 vWorldPos;
+out vec3 vEyePos;
+out vec3 vNormal;
+out vec2 vUv;
+out vec4 vColor;
+#if SHADING == 1
+out vec3 vMulFront;
+out vec3 vAddFront;
+out vec3 vMulBack;
+out vec3 vAddBack;
+#endif
+
+void main() {
+    vec4 world = uModel * vec4(aPosition, 1.0);
+    vWorldPos = world.xyz;
+    vEyePos = (uView * world).xyz;
+    vNormal = uNormalMatrix * aNormal;
+    vUv = aUv;
+    vColor = aColor;
+    gl_Position = uViewProj * world;
+    gl_PointSize = uPointSize;
+#if SHADING == 1
+    float len = length(vNormal);
+    vec3 n = len > 0.0 ? vNormal / len : vec3(0.0, 0.0, 1.0);
+    lightTerms(n, world.xyz, vMulFront, vAddFront);
+    lightTerms(-n, world.xyz, vMulBack, vAddBack);   // two-sided: seen from the back
+#endif
+}

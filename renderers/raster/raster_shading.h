@@ -1,0 +1,58 @@
+// raster_shading.h - the rasterizer's batched (SoA, SSE2) evaluation of rnd::shade() for many
+// fragments at once. It is the same formula as renderers/common/shading.cpp (Phong or
+// Blinn-Phong, specular times max(n.l, 0), 1/d^2 attenuation, smoothstep spot cones, ambient
+// and emissive) computed 4 fragments per instruction, with pow(s, m) as exp2(m log2 s) from
+// polynomials (relative error < 1e-5). tests/raster checks it against rnd::shade.
+#pragma once
+
+#include "scenegraph/frame.h"
+
+#include <cstddef>
+#include <vector>
+
+namespace rnd::raster {
+
+// Structure of arrays for n fragments (n padded to a multiple of 4 by resize()).
+struct ShadeBatch {
+    // inputs
+    std::vector<float> px, py, pz;      // world position
+    std::vector<float> nx, ny, nz;      // unit normal facing the viewer
+    std::vector<float> ar, ag, ab;      // albedo (kd term multiplies it)
+    std::vector<float> sr, sg, sb;      // specular colour (albedo when tinted)
+    std::vector<float> kd, ks, shin;    // coefficients; kd = ks = 0 for unlit
+    // in: ambient + emissive (ka * albedo * L_ambient + emissive); out: the shaded colour
+    std::vector<float> cr, cg, cb;
+    size_t size = 0;
+
+    void resize(size_t n);
+    // Fills fragment i from a material, position, normal, albedo (as rnd::shade sees them).
+    void set(size_t i, const sg::Material& m, const sg::vec3& p, const sg::vec3& n, const sg::vec3& albedo, const sg::vec3& ambient) {
+        px[i] = p.x; py[i] = p.y; pz[i] = p.z;
+        nx[i] = n.x; ny[i] = n.y; nz[i] = n.z;
+        ar[i] = albedo.x; ag[i] = albedo.y; ab[i] = albedo.z;
+        if (m.unlit) {   // shade(): albedo + emissive, no lights
+            setColor(i, albedo + m.emissive);
+            return;
+        }
+        sg::vec3 s = m.specularTinted ? albedo : m.specularColor;
+        sr[i] = s.x; sg[i] = s.y; sb[i] = s.z;
+        kd[i] = m.kd; ks[i] = m.ks; shin[i] = m.shininess;
+        sg::vec3 c = m.ka * albedo * ambient + m.emissive;
+        cr[i] = c.x; cg[i] = c.y; cb[i] = c.z;
+    }
+    // A fragment whose colour is already final (unlit, Gouraud, reference shading).
+    void setColor(size_t i, const sg::vec3& c) {
+        px[i] = py[i] = pz[i] = 0;
+        nx[i] = nz[i] = 0;
+        ny[i] = 1;
+        ar[i] = ag[i] = ab[i] = sr[i] = sg[i] = sb[i] = 0;
+        kd[i] = ks[i] = 0;
+        shin[i] = 1;
+        cr[i] = c.x; cg[i] = c.y; cb[i] = c.z;
+    }
+};
+
+// Adds the contribution of every light in f to cr/cg/cb for fragments [0, n).
+void shadeBatch(ShadeBatch& b, size_t n, const sg::FrameInput& f);
+
+}  // namespace rnd::raster
