@@ -454,7 +454,9 @@ GridAccel::GridAccel(std::shared_ptr<const DensityGrid> g) : m_grid(std::move(g)
 
 bool GridAccel::blockMayCross(const vec3& p) const {
     const DensityGrid& d = *m_grid;
-    ivec3 c = glm::clamp(ivec3((p - d.bounds.min) / m_cell), ivec3(0), d.dims - 2) / kBlock;
+    vec3 g = glm::clamp((p - d.bounds.min) / m_cell, vec3(0.0f), vec3(d.dims - 2));   // clamp before float->int
+    if (!isFinite(g)) g = vec3(0.0f);
+    ivec3 c = ivec3(g) / kBlock;
     c = glm::clamp(c, ivec3(0), m_blocks - 1);
     size_t i = (size_t(c.z) * m_blocks.y + c.y) * m_blocks.x + c.x;
     return m_blockMin[i] <= d.isoValue && m_blockMax[i] >= d.isoValue;

@@ -406,6 +406,7 @@ void buildFromRefs(std::vector<PrimRef>& refs, const Bvh4::BuildOptions& opt, st
 }  // namespace detail
 
 void Bvh4::build(const vec3* boxMin, const vec3* boxMax, size_t n, const BuildOptions& opt) {
+    if (n >= (size_t(1) << 28)) n = 0;   // leaf references hold (first << 3) in 31 bits
     std::vector<PrimRef> refs;
     refs.reserve(n);
     for (size_t i = 0; i < n; ++i) {
@@ -454,6 +455,8 @@ int kernelWidth();
 // --- TriangleBvh ------------------------------------------------------------------------------
 
 void TriangleBvh::build(const vec3* pos, const uint32_t* idx, size_t triCount, const Bvh4::BuildOptions& opt) {
+    // Leaf references hold (first << 3) in 31 bits: 2^28 primitives at most per BVH.
+    if (triCount >= (size_t(1) << 28)) triCount = 0;
 #ifdef BVH_TIMING
     double tProbe = cpuNow();
 #endif
