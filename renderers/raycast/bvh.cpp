@@ -527,18 +527,18 @@ namespace {
 int kernelWidth() { return kUseAvx2 ? 8 : 4; }
 }  // namespace
 
-bool TriangleBvh::intersect(const Ray& ray, TriHit& hit) const {
+bool TriangleBvh::intersect(const Ray& ray, TriHit& hit, bool cullBack) const {
     if (m_packets.empty()) return false;
-    if (!m_nodes8.empty()) return kern_avx2::traceTriangles8<false>(m_nodes8.data(), m_packets.data(), ray, &hit);
-    return kUseAvx2 ? kern_avx2::traceTriangles<false>(m_nodes4.data(), m_packets.data(), ray, &hit)
-                    : kern_sse::traceTriangles<false>(m_nodes4.data(), m_packets.data(), ray, &hit);
+    if (!m_nodes8.empty()) return kern_avx2::traceTriangles8<false>(m_nodes8.data(), m_packets.data(), ray, &hit, cullBack);
+    return kUseAvx2 ? kern_avx2::traceTriangles<false>(m_nodes4.data(), m_packets.data(), ray, &hit, cullBack)
+                    : kern_sse::traceTriangles<false>(m_nodes4.data(), m_packets.data(), ray, &hit, cullBack);
 }
 
 bool TriangleBvh::occluded(const Ray& ray) const {
     if (m_packets.empty()) return false;
-    if (!m_nodes8.empty()) return kern_avx2::traceTriangles8<true>(m_nodes8.data(), m_packets.data(), ray, nullptr);
-    return kUseAvx2 ? kern_avx2::traceTriangles<true>(m_nodes4.data(), m_packets.data(), ray, nullptr)
-                    : kern_sse::traceTriangles<true>(m_nodes4.data(), m_packets.data(), ray, nullptr);
+    if (!m_nodes8.empty()) return kern_avx2::traceTriangles8<true>(m_nodes8.data(), m_packets.data(), ray, nullptr, false);
+    return kUseAvx2 ? kern_avx2::traceTriangles<true>(m_nodes4.data(), m_packets.data(), ray, nullptr, false)
+                    : kern_sse::traceTriangles<true>(m_nodes4.data(), m_packets.data(), ray, nullptr, false);
 }
 
 // --- brute force ------------------------------------------------------------------------------

@@ -107,7 +107,7 @@ struct Tracer {
     vec3 trace(const rt::Ray& r, const vec3& eye, int bounce, vec3* hitPos) {
         ++rays;
         rt::SceneHit h;
-        if (!accel.intersect(r, h)) return f.settings.background;
+        if (!accel.intersect(r, h, f.settings.cullBackFaces)) return f.settings.background;
         vec3 p = r.org + h.t * r.dir;
         if (hitPos) *hitPos = p;
         vec3 dirN = glm::normalize(r.dir);

@@ -97,7 +97,7 @@ int SceneAccel::update(const FrameInput& f) {
     return built;
 }
 
-bool SceneAccel::intersectInstance(const Instance& inst, const Ray& wr, float tmax, SceneHit& hit) const {
+bool SceneAccel::intersectInstance(const Instance& inst, const Ray& wr, float tmax, SceneHit& hit, bool cull) const {
     Ray lr;
     lr.org = vec3(inst.invWorld * vec4(wr.org, 1.0f));
     lr.dir = mat3(inst.invWorld) * wr.dir;
@@ -105,7 +105,7 @@ bool SceneAccel::intersectInstance(const Instance& inst, const Ray& wr, float tm
     lr.tmax = tmax;
     if (inst.isMesh) {
         TriHit th;
-        if (!inst.bvh->intersect(lr, th)) return false;
+        if (!inst.bvh->intersect(lr, th, cull)) return false;
         hit.kind = SceneHit::Kind::Mesh;
         hit.t = th.t;
         hit.instance = inst.index;
@@ -168,7 +168,7 @@ bool SceneAccel::intersectInstance(const Instance& inst, const Ray& wr, float tm
     return true;
 }
 
-bool SceneAccel::intersect(const Ray& r, SceneHit& hit) const {
+bool SceneAccel::intersect(const Ray& r, SceneHit& hit, bool cullBackFaces) const {
     if (m_tlas.empty()) return false;
     float tmax = r.tmax;
     bool found = false;
@@ -176,7 +176,7 @@ bool SceneAccel::intersect(const Ray& r, SceneHit& hit) const {
     m_tlas.traverse(r, tmax, [&](uint32_t first, uint32_t count, float& tm) {
         for (uint32_t k = 0; k < count; ++k) {
             SceneHit h;
-            if (intersectInstance(m_instances[prims[first + k]], r, tm, h) && h.t < tm) {
+            if (intersectInstance(m_instances[prims[first + k]], r, tm, h, cullBackFaces) && h.t < tm) {
                 tm = h.t;
                 hit = h;
                 found = true;
