@@ -36,9 +36,11 @@ constexpr int kMsaa4Y[4] = {224, 160, 96, 32};
 
 // One edge function E(px, py) = a*px + b*py + c over fixed-point sample coordinates. A sample
 // is inside when E >= bias (bias = 0 on top/left edges, 1 otherwise: the top-left rule).
+// a and b are fixed-point coordinate differences (within the guard band they fit 32 bits).
 struct Edge {
-    int64_t a = 0, b = 0, c = 0;
-    int64_t bias = 0;
+    int32_t a = 0, b = 0;
+    int64_t c = 0;
+    int32_t bias = 0;
     int64_t at(int64_t px, int64_t py) const { return a * px + b * py + c; }
 };
 
@@ -92,8 +94,8 @@ inline bool setupTriangle(const float wx[3], const float wy[3], int width, int h
         int j = (i + 1) % 3;
         int64_t dx = int64_t(x[j]) - x[i], dy = int64_t(y[j]) - y[i];
         Edge& e = t.e[i];
-        e.a = -dy;
-        e.b = dx;
+        e.a = int32_t(-dy);
+        e.b = int32_t(dx);
         e.c = dy * x[i] - dx * y[i];
         // Top-left rule (y up, CCW): left edges run downward, top edges run in -x.
         bool topLeft = dy < 0 || (dy == 0 && dx < 0);
@@ -118,8 +120,8 @@ inline void forEachCoveredPixel(const TriSetup& t, int x0, int y0, int x1, int y
     y0 = std::max(y0, t.minY); y1 = std::min(y1, t.maxY);
     if (x0 > x1 || y0 > y1) return;
     const Edge* e = t.e;
-    const int64_t sx[3] = {e[0].a * kSub, e[1].a * kSub, e[2].a * kSub};
-    const int64_t sy[3] = {e[0].b * kSub, e[1].b * kSub, e[2].b * kSub};
+    const int64_t sx[3] = {int64_t(e[0].a) * kSub, int64_t(e[1].a) * kSub, int64_t(e[2].a) * kSub};
+    const int64_t sy[3] = {int64_t(e[0].b) * kSub, int64_t(e[1].b) * kSub, int64_t(e[2].b) * kSub};
     // Offsets from a block's first sample to the sample that maximises / minimises each edge.
     int64_t hi[3], lo[3];
     for (int k = 0; k < 3; ++k) {

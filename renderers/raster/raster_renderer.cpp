@@ -180,7 +180,6 @@ void runVertexStage(DrawItem& d, const sg::FrameInput& f, int width, int height,
 // One scan-converted triangle (a whole input triangle or a piece of a clipped one).
 struct Tri {
     TriSetup s;
-    float z[3], invW[3];     // per setup vertex
     float zRef, zdx, zdy;    // window z at pixel centre (minX, minY) and per-pixel steps
     // u_k = lambda_k / w_k (screen-linear) at pixel centre (minX, minY) and per-pixel steps;
     // perspective-correct barycentrics are u_k / sum(u).
@@ -210,25 +209,26 @@ struct FrameContext {
 };
 
 bool finishTri(Tri& t, const float z[3], const float iw[3]) {
+    float tz[3], tw[3];   // per setup vertex
     for (int k = 0; k < 3; ++k) {
-        t.z[k] = z[t.s.order[k]];
-        t.invW[k] = iw[t.s.order[k]];
+        tz[k] = z[t.s.order[k]];
+        tw[k] = iw[t.s.order[k]];
     }
     // z = (e1 z0 + e2 z1 + e0 z2) / area2, e_i linear in the fixed-point sample position.
     double inv = 1.0 / double(t.s.area2);
-    double ax = (double(t.s.e[1].a) * t.z[0] + double(t.s.e[2].a) * t.z[1] + double(t.s.e[0].a) * t.z[2]) * inv;
-    double ay = (double(t.s.e[1].b) * t.z[0] + double(t.s.e[2].b) * t.z[1] + double(t.s.e[0].b) * t.z[2]) * inv;
+    double ax = (double(t.s.e[1].a) * tz[0] + double(t.s.e[2].a) * tz[1] + double(t.s.e[0].a) * tz[2]) * inv;
+    double ay = (double(t.s.e[1].b) * tz[0] + double(t.s.e[2].b) * tz[1] + double(t.s.e[0].b) * tz[2]) * inv;
     int64_t px = int64_t(t.s.minX) * kSub + kHalf, py = int64_t(t.s.minY) * kSub + kHalf;
-    double zr = (double(t.s.e[1].at(px, py)) * t.z[0] + double(t.s.e[2].at(px, py)) * t.z[1] + double(t.s.e[0].at(px, py)) * t.z[2]) * inv;
+    double zr = (double(t.s.e[1].at(px, py)) * tz[0] + double(t.s.e[2].at(px, py)) * tz[1] + double(t.s.e[0].at(px, py)) * tz[2]) * inv;
     t.zRef = float(zr);
     t.zdx = float(ax * kSub);
     t.zdy = float(ay * kSub);
     // Setup vertex (k+2)%3 <- edge k.
     for (int k = 0; k < 3; ++k) {
         const Edge& e = t.s.e[(k + 1) % 3];
-        t.uRef[k] = float(double(e.at(px, py)) * inv * t.invW[k]);
-        t.udx[k] = float(double(e.a) * kSub * inv * t.invW[k]);
-        t.udy[k] = float(double(e.b) * kSub * inv * t.invW[k]);
+        t.uRef[k] = float(double(e.at(px, py)) * inv * tw[k]);
+        t.udx[k] = float(double(e.a) * kSub * inv * tw[k]);
+        t.udy[k] = float(double(e.b) * kSub * inv * tw[k]);
     }
     return true;
 }
@@ -369,7 +369,7 @@ struct TriCache {
         for (int k = 0; k < 3; ++k) {
             v[k] = d->vertexOf(tri.prim, k);
             p[k] = d->wpos[v[k]];
-            pe[k] = vec3(f.camera.view * vec4(p[k], 1.0f));
+            if (f.settings.fog != sg::FogMode::Off) pe[k] = vec3(f.camera.view * vec4(p[k], 1.0f));
         }
         gouraud = f.settings.shading == sg::ShadingModel::Gouraud && !d->gouraudA[0].empty();
         faceNormal = f.settings.shading == sg::ShadingModel::Flat || !d->hasNormals;
@@ -494,9 +494,14 @@ void renderTile(int tile, const FrameContext& fc, Framebuffer& target, TileBuffe
     const vec3 bg = st.background;
     const uint8_t bgBytes[3] = {enc(bg.x), enc(bg.y), enc(bg.z)};
     // Fragments: one per covered pixel (MSAA: per distinct triangle in the pixel).
-    buf.fragPixel.clear();
-    buf.fragTri.clear();
-    buf.fragCount.clear();
+    // Sized for the worst case (every sample its own triangle); filled by index, no push_back.
+    const size_t maxFrags = size_t(kTileSize) * kTileSize * samples;
+    if (buf.fragTri.size() < maxFrags) {
+        buf.fragPixel.resize(maxFrags);
+        buf.fragTri.resize(maxFrags);
+        buf.fragCount.resize(maxFrags);
+    }
+    size_t nf = 0;
     const int tw = x1 - x0 + 1, th = y1 - y0 + 1;
     for (int jj = 0; jj < th; ++jj)
         for (int ii = 0; ii < tw; ++ii) {
@@ -508,15 +513,15 @@ void renderTile(int tile, const FrameContext& fc, Framebuffer& target, TileBuffe
             if (samples == 1) {
                 *dOut = buf.depth[p];
                 if (buf.ids[p] == kNoTri) continue;
-                buf.fragPixel.push_back(uint16_t(p));
-                buf.fragTri.push_back(buf.ids[p]);
-                buf.fragCount.push_back(1);
+                buf.fragPixel[nf] = uint16_t(p);
+                buf.fragTri[nf] = buf.ids[p];
+                buf.fragCount[nf++] = 1;
                 continue;
             }
             float dmin = 1.0f;
             uint32_t seen[4];
             int nseen = 0;
-            size_t first = buf.fragTri.size();
+            size_t first = nf;
             for (int s = 0; s < 4; ++s) {
                 dmin = std::min(dmin, buf.depth[p * 4 + s]);
                 uint32_t id = buf.ids[p * 4 + s];
@@ -525,16 +530,15 @@ void renderTile(int tile, const FrameContext& fc, Framebuffer& target, TileBuffe
                 while (q < nseen && seen[q] != id) ++q;
                 if (q == nseen) {
                     seen[nseen++] = id;
-                    buf.fragPixel.push_back(uint16_t(p));
-                    buf.fragTri.push_back(id);
-                    buf.fragCount.push_back(1);
+                    buf.fragPixel[nf] = uint16_t(p);
+                    buf.fragTri[nf] = id;
+                    buf.fragCount[nf++] = 1;
                 } else {
                     ++buf.fragCount[first + q];
                 }
             }
             *dOut = dmin;
         }
-    const size_t nf = buf.fragTri.size();
     if (nf == 0) return;
     buf.batch.resize(nf);
     buf.fogDist.resize(nf);
@@ -698,6 +702,12 @@ void drawLinesAndWireframe(const std::vector<DrawItem>& lineDraws, const std::ve
             if (v[0] >= d.clip.size() || v[1] >= d.clip.size() || v[2] >= d.clip.size()) continue;
             if (d.code[v[0]] & d.code[v[1]] & d.code[v[2]]) continue;
             if ((d.code[v[0]] | d.code[v[1]] | d.code[v[2]]) & kInvalid) continue;
+            if (st.cullBackFaces && (d.code[v[0]] | d.code[v[1]] | d.code[v[2]]) == 0) {
+                // Culled faces draw no edges (GL culls polygons in line mode too).
+                vec2 a(d.win[v[0]]), b(d.win[v[1]]), c(d.win[v[2]]);
+                float area = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+                if ((area > 0) == d.mirrored) continue;
+            }
             for (int k = 0; k < 3; ++k) {
                 LineEnd a{d.clip[v[k]], st.wireframeColor, eyeDist(d.wpos[v[k]])};
                 LineEnd b{d.clip[v[(k + 1) % 3]], st.wireframeColor, eyeDist(d.wpos[v[(k + 1) % 3]])};
@@ -733,7 +743,7 @@ public:
         const auto& st = frame.settings;
         if (control) control->progress = 0.0f;
         if (st.aa == sg::AAMode::SSAA && st.aaRate > 1) {
-            int r = std::clamp(st.aaRate, 2, 4);
+            int r = std::clamp(st.aaRate, 2, 8);   // as the GL backend
             Framebuffer hi;
             stats = renderSingle(frame, width * r, height * r, hi, false, control, r);
             if (stats.ok) target = downsample(hi, r);
