@@ -345,9 +345,9 @@ ParametricAccel::ParametricAccel(const ParametricSurface& s) : m_surface(s) {
             for (int y = 0; y <= k; ++y)
                 for (int x = 0; x <= k; ++x)
                     b.extend(s.evaluate((i + float(x) / k) / m_nu, (j + float(y) / k) / m_nv));
-            // Pad: the surface bulges between samples; a quarter of the box size is ample
-            // for these subdivisions (curvature within one sub-patch is small).
-            vec3 pad = 0.25f * b.extent() + vec3(1e-4f * (glm::length(b.extent()) + 1e-3f));
+            // Pad: the surface bulges between the 5x5 samples; 10% of the box size is ample
+            // for these subdivisions (the sag of a sub-patch between samples is far smaller).
+            vec3 pad = 0.1f * b.extent() + vec3(0.02f * glm::length(b.extent()) + 1e-5f);
             m_boxMin[size_t(j) * m_nu + i] = b.min - pad;
             m_boxMax[size_t(j) * m_nu + i] = b.max + pad;
         }
@@ -372,16 +372,24 @@ bool ParametricAccel::intersect(const Ray& r, float& tOut, float& uOut, float& v
             if (!boxInterval(r, m_boxMin[patch], m_boxMax[patch], bt0, bt1)) continue;
             float scale = glm::length(m_boxMax[patch] - m_boxMin[patch]);
             // Newton on F(t, u, v) = o + t d - P(u, v) = 0 from a few starts in the patch.
+            // Newton from the patch centre first; the two other starts only when it fails
+            // (it converges from the centre for nearly all rays that hit this sub-patch).
             const float starts[3][2] = {{0.5f, 0.5f}, {0.25f, 0.25f}, {0.75f, 0.75f}};
+            bool patchHit = false;
             for (const auto& st : starts) {
+                if (patchHit) break;
                 float u = u0 + st[0] * (u1 - u0), v = v0 + st[1] * (v1 - v0);
                 float t = glm::dot(m_surface.evaluate(u, v) - r.org, r.dir) / dd;
                 bool ok = false;
-                for (int it = 0; it < 20; ++it) {
+                float prevErr = std::numeric_limits<float>::infinity();
+                for (int it = 0; it < 16; ++it) {
                     vec3 P = m_surface.evaluate(u, v), Pu, Pv;
                     m_surface.partials(u, v, Pu, Pv);
                     vec3 F = r.org + t * r.dir - P;
-                    if (glm::length(F) < 1e-6f * (scale + 1.0f)) { ok = true; break; }
+                    const float err = glm::length(F);
+                    if (err < 1e-6f * (scale + 1.0f)) { ok = true; break; }
+                    if (it >= 4 && err > 0.9f * prevErr) break;   // not converging: give up early
+                    prevErr = err;
                     // J = [d, -Pu, -Pv]; solve J x = -F by Cramer's rule.
                     vec3 c0 = r.dir, c1 = -Pu, c2 = -Pv;
                     float det = glm::dot(c0, glm::cross(c1, c2));
@@ -399,6 +407,7 @@ bool ParametricAccel::intersect(const Ray& r, float& tOut, float& uOut, float& v
                 if (u < u0 - eu || u > u1 + eu || v < v0 - ev || v > v1 + ev) continue;
                 if (m_surface.type == ParametricType::BezierPatch && (u < 0 || u > 1 || v < 0 || v > 1)) continue;
                 if (t > r.tmin && t < tm) {
+                    patchHit = true;
                     tm = t;
                     tOut = t;
                     uOut = std::clamp(u, 0.0f, 1.0f);
@@ -445,7 +454,9 @@ GridAccel::GridAccel(std::shared_ptr<const DensityGrid> g) : m_grid(std::move(g)
 
 bool GridAccel::blockMayCross(const vec3& p) const {
     const DensityGrid& d = *m_grid;
-    ivec3 c = glm::clamp(ivec3((p - d.bounds.min) / m_cell), ivec3(0), d.dims - 2) / kBlock;
+    vec3 g = glm::clamp((p - d.bounds.min) / m_cell, vec3(0.0f), vec3(d.dims - 2));   // clamp before float->int
+    if (!isFinite(g)) g = vec3(0.0f);
+    ivec3 c = ivec3(g) / kBlock;
     c = glm::clamp(c, ivec3(0), m_blocks - 1);
     size_t i = (size_t(c.z) * m_blocks.y + c.y) * m_blocks.x + c.x;
     return m_blockMin[i] <= d.isoValue && m_blockMax[i] >= d.isoValue;

@@ -8,6 +8,14 @@
 // three axes, 16 bins, cost counted in blocks of 4 primitives since leaves are 4-packets) until
 // it has 4 children or none can be split. Ranges of <= maxLeafSize primitives become leaves.
 #include "raycast/bvh.h"
+#ifdef BVH_TIMING
+#include <cstdio>
+#include <ctime>
+static double cpuNow() { timespec ts; clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts); return ts.tv_sec + 1e-9 * ts.tv_nsec; }
+#define PROBE(name) std::printf("  %s %.1f ms\n", name, (cpuNow() - tProbe) * 1e3), tProbe = cpuNow()
+#else
+#define PROBE(name)
+#endif
 
 #include <tbb/task_group.h>
 #include <tbb/parallel_for.h>
@@ -90,45 +98,71 @@ bool splitRange(PrimRef* refs, const Range& r, Range& l, Range& rr, int nbins, i
     int bestAxis = -1, bestPos = 0;
     float bestCost = std::numeric_limits<float>::infinity();
     float scale[3];
+    // Few primitives need few bins: the per-split fixed cost (clearing and sweeping the bins)
+    // otherwise dominates the many small splits near the leaves.
+    if (int(n) < nbins) nbins = std::max(4, int(n));
+    // Tiny ranges (a few leaves' worth): an object-median split on the widest centroid axis
+    // costs a fraction of a binned SAH evaluation and loses little quality this close to the
+    // leaves; the many splits down here otherwise dominate the build time.
+    if (n <= uint32_t(2 * leafSize)) forceMedian = true;
+    // Per axis and bin: primitive bounds (lo/hi) and counts.
+    // Left uninitialised beyond nbins on purpose (only [0, nbins) is touched).
+    __m128 blo[3][kMaxBins], bhi[3][kMaxBins];
+    uint32_t counts[3][kMaxBins];
     if (!forceMedian) {
-        Box bins[3][kMaxBins];
-        uint32_t counts[3][kMaxBins] = {};
+        const __m128 inf = _mm_set1_ps(std::numeric_limits<float>::infinity()), ninf = _mm_set1_ps(-std::numeric_limits<float>::infinity());
+        for (int a = 0; a < 3; ++a)
+            for (int b = 0; b < nbins; ++b) { blo[a][b] = inf; bhi[a][b] = ninf; counts[a][b] = 0; }
         for (int a = 0; a < 3; ++a) scale[a] = ext[a] > 0 ? float(nbins) * 0.99999f / ext[a] : 0.0f;
         const __m128 sc = _mm_setr_ps(scale[0], scale[1], scale[2], 0.0f);
         const __m128 cm = r.centroids.lo;
         const __m128i maxBin = _mm_set1_epi32(nbins - 1);
         for (uint32_t i = r.begin; i < r.end; ++i) {
             const PrimRef& p = refs[i];
-            __m128i bi = _mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(p.center2(), cm), sc));
+            const __m128 c = p.center2();
+            __m128i bi = _mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(c, cm), sc));
             // clamp to [0, nbins-1] (SSE2 has no min_epi32: compare and blend)
             __m128i gt = _mm_cmpgt_epi32(bi, maxBin);
             bi = _mm_or_si128(_mm_and_si128(gt, maxBin), _mm_andnot_si128(gt, bi));
             bi = _mm_and_si128(bi, _mm_cmpgt_epi32(bi, _mm_set1_epi32(-1)));
             alignas(16) int b[4];
             _mm_store_si128(reinterpret_cast<__m128i*>(b), bi);
-            bins[0][b[0]].extend(p.lo, p.hi); ++counts[0][b[0]];
-            bins[1][b[1]].extend(p.lo, p.hi); ++counts[1][b[1]];
-            bins[2][b[2]].extend(p.lo, p.hi); ++counts[2][b[2]];
+            for (int a = 0; a < 3; ++a) {
+                const int k = b[a];
+                blo[a][k] = _mm_min_ps(blo[a][k], p.lo);
+                bhi[a][k] = _mm_max_ps(bhi[a][k], p.hi);
+                ++counts[a][k];
+            }
         }
+        auto halfArea = [](__m128 lo, __m128 hi) {
+            __m128 e = _mm_max_ps(_mm_sub_ps(hi, lo), _mm_setzero_ps());
+            __m128 e2 = _mm_shuffle_ps(e, e, _MM_SHUFFLE(3, 0, 2, 1));   // (y, z, x)
+            alignas(16) float m[4];
+            _mm_store_ps(m, _mm_mul_ps(e, e2));
+            return m[0] + m[1] + m[2];
+        };
         for (int a = 0; a < 3; ++a) {
             if (!(ext[a] > 0)) continue;
             float rightArea[kMaxBins];
             uint32_t rightCount[kMaxBins];
-            Box acc;
+            __m128 lo = _mm_set1_ps(std::numeric_limits<float>::infinity()), hi = _mm_set1_ps(-std::numeric_limits<float>::infinity());
             uint32_t cnt = 0;
             for (int i = nbins - 1; i > 0; --i) {
-                acc.extend(bins[a][i]);
+                lo = _mm_min_ps(lo, blo[a][i]);
+                hi = _mm_max_ps(hi, bhi[a][i]);
                 cnt += counts[a][i];
-                rightArea[i] = acc.halfArea();
+                rightArea[i] = halfArea(lo, hi);
                 rightCount[i] = cnt;
             }
-            acc = Box();
+            lo = _mm_set1_ps(std::numeric_limits<float>::infinity());
+            hi = _mm_set1_ps(-std::numeric_limits<float>::infinity());
             cnt = 0;
             for (int i = 1; i < nbins; ++i) {
-                acc.extend(bins[a][i - 1]);
+                lo = _mm_min_ps(lo, blo[a][i - 1]);
+                hi = _mm_max_ps(hi, bhi[a][i - 1]);
                 cnt += counts[a][i - 1];
                 if (cnt == 0 || rightCount[i] == 0) continue;
-                float cost = acc.halfArea() * float(blocks(cnt, leafSize)) + rightArea[i] * float(blocks(rightCount[i], leafSize));
+                float cost = halfArea(lo, hi) * float(blocks(cnt, leafSize)) + rightArea[i] * float(blocks(rightCount[i], leafSize));
                 if (cost < bestCost) { bestCost = cost; bestAxis = a; bestPos = i; }
             }
         }
@@ -138,14 +172,40 @@ bool splitRange(PrimRef* refs, const Range& r, Range& l, Range& rr, int nbins, i
     if (bestAxis >= 0) {
         const float cm = cmin[bestAxis], s = scale[bestAxis];
         const int a = bestAxis, pos = bestPos;
-        PrimRef* m = std::partition(refs + r.begin, refs + r.end, [&](const PrimRef& p) {
+        // Two-pointer partition that also gathers the children's centroid bounds (their
+        // primitive bounds come from the bins), so no further pass over the primitives.
+        auto goesLeft = [&](const PrimRef& p) {
             alignas(16) float c[4];
             _mm_store_ps(c, p.center2());
-            int b = std::min(int((c[a] - cm) * s), nbins - 1);
-            return b < pos;
-        });
-        mid = uint32_t(m - refs);
-        if (mid == r.begin || mid == r.end) mid = r.begin + n / 2;   // numerical corner case
+            return std::min(int((c[a] - cm) * s), nbins - 1) < pos;
+        };
+        Box lc, rc;
+        PrimRef* lo = refs + r.begin;
+        PrimRef* hi = refs + r.end;
+        for (;;) {
+            while (lo < hi && goesLeft(*lo)) { __m128 c = lo->center2(); lc.extend(c, c); ++lo; }
+            while (lo < hi && !goesLeft(*(hi - 1))) { --hi; __m128 c = hi->center2(); rc.extend(c, c); }
+            if (lo >= hi) break;
+            --hi;
+            std::swap(*lo, *hi);
+            __m128 c0 = lo->center2(), c1 = hi->center2();
+            lc.extend(c0, c0);
+            rc.extend(c1, c1);
+            ++lo;
+        }
+        mid = uint32_t(lo - refs);
+        if (mid != r.begin && mid != r.end) {
+            l = Range();
+            rr = Range();
+            l.begin = r.begin; l.end = mid;
+            rr.begin = mid; rr.end = r.end;
+            for (int i = 0; i < pos; ++i) l.bounds.extend(blo[a][i], bhi[a][i]);
+            for (int i = pos; i < nbins; ++i) rr.bounds.extend(blo[a][i], bhi[a][i]);
+            l.centroids = lc;
+            rr.centroids = rc;
+            return true;
+        }
+        mid = r.begin + n / 2;   // numerical corner case: fall through to bounds by a pass
     } else {
         // All centroids coincide (or median forced): split by order along the widest axis.
         int a = ext[0] >= ext[1] ? (ext[0] >= ext[2] ? 0 : 2) : (ext[1] >= ext[2] ? 1 : 2);
@@ -299,10 +359,43 @@ void buildFromRefs(std::vector<PrimRef>& refs, const Bvh4::BuildOptions& opt, st
         Builder<W>::setBounds(r, 0, root.bounds);
         r.child[0] = Builder<W>::leafRef(root);
     } else {
+#ifdef BVH_TIMING
+        double tProbe = cpuNow();
+#endif
         b.buildInner(0, root, 0);
+        PROBE("inner");
     }
     const uint32_t count = b.nodeCount.load();
-    outNodes.assign(storage.get(), storage.get() + count);
+    // Lay the nodes out in depth-first order (the parallel build interleaves subtrees built
+    // by different threads): a parent's first child follows it, which helps the caches.
+    outNodes.resize(count);
+    {
+        std::vector<uint32_t> stack{0};
+        uint32_t next = 0;
+        std::vector<uint32_t> newIndex(count, ~0u);
+        // Pass 1: assign new indices in DFS preorder.
+        while (!stack.empty()) {
+            uint32_t old = stack.back();
+            stack.pop_back();
+            newIndex[old] = next++;
+            const NodeW<W>& nd = storage[old];
+            for (int i = W - 1; i >= 0; --i) {
+                uint32_t c = nd.child[i];
+                if (c != NodeBits::kEmpty && !(c & NodeBits::kLeafBit)) stack.push_back(c);
+            }
+        }
+        // Pass 2: copy and remap child links.
+        for (uint32_t old = 0; old < count; ++old) {
+            if (newIndex[old] == ~0u) continue;
+            NodeW<W> nd = storage[old];
+            for (int i = 0; i < W; ++i) {
+                uint32_t c = nd.child[i];
+                if (c != NodeBits::kEmpty && !(c & NodeBits::kLeafBit)) nd.child[i] = newIndex[c];
+            }
+            outNodes[newIndex[old]] = nd;
+        }
+        outNodes.resize(next);
+    }
     outPrims.resize(n);
     for (size_t i = 0; i < n; ++i) outPrims[i] = refs[i].id();
     alignas(16) float lo[4], hi[4];
@@ -313,6 +406,7 @@ void buildFromRefs(std::vector<PrimRef>& refs, const Bvh4::BuildOptions& opt, st
 }  // namespace detail
 
 void Bvh4::build(const vec3* boxMin, const vec3* boxMax, size_t n, const BuildOptions& opt) {
+    if (n >= (size_t(1) << 28)) n = 0;   // leaf references hold (first << 3) in 31 bits
     std::vector<PrimRef> refs;
     refs.reserve(n);
     for (size_t i = 0; i < n; ++i) {
@@ -361,6 +455,11 @@ int kernelWidth();
 // --- TriangleBvh ------------------------------------------------------------------------------
 
 void TriangleBvh::build(const vec3* pos, const uint32_t* idx, size_t triCount, const Bvh4::BuildOptions& opt) {
+    // Leaf references hold (first << 3) in 31 bits: 2^28 primitives at most per BVH.
+    if (triCount >= (size_t(1) << 28)) triCount = 0;
+#ifdef BVH_TIMING
+    double tProbe = cpuNow();
+#endif
     std::vector<PrimRef> refs(triCount);
     std::vector<uint8_t> ok(triCount);
     auto makeRange = [&](size_t b, size_t e) {
@@ -381,6 +480,7 @@ void TriangleBvh::build(const vec3* pos, const uint32_t* idx, size_t triCount, c
     for (size_t t = 0; t < triCount; ++t)
         if (ok[t]) refs[w++] = refs[t];
     refs.resize(w);
+    PROBE("refs");
 
     std::vector<uint32_t> prims;
     m_nodes4.clear();
@@ -388,7 +488,9 @@ void TriangleBvh::build(const vec3* pos, const uint32_t* idx, size_t triCount, c
     m_packets.clear();
     if (kernelWidth() == 8) {
         detail::buildFromRefs<8>(refs, opt, m_nodes8, prims, m_bounds);
+        PROBE("tree");
         makePackets(m_nodes8, prims, pos, idx, m_packets);
+        PROBE("packets");
     } else {
         detail::buildFromRefs<4>(refs, opt, m_nodes4, prims, m_bounds);
         makePackets(m_nodes4, prims, pos, idx, m_packets);
@@ -425,18 +527,18 @@ namespace {
 int kernelWidth() { return kUseAvx2 ? 8 : 4; }
 }  // namespace
 
-bool TriangleBvh::intersect(const Ray& ray, TriHit& hit) const {
+bool TriangleBvh::intersect(const Ray& ray, TriHit& hit, bool cullBack) const {
     if (m_packets.empty()) return false;
-    if (!m_nodes8.empty()) return kern_avx2::traceTriangles8<false>(m_nodes8.data(), m_packets.data(), ray, &hit);
-    return kUseAvx2 ? kern_avx2::traceTriangles<false>(m_nodes4.data(), m_packets.data(), ray, &hit)
-                    : kern_sse::traceTriangles<false>(m_nodes4.data(), m_packets.data(), ray, &hit);
+    if (!m_nodes8.empty()) return kern_avx2::traceTriangles8<false>(m_nodes8.data(), m_packets.data(), ray, &hit, cullBack);
+    return kUseAvx2 ? kern_avx2::traceTriangles<false>(m_nodes4.data(), m_packets.data(), ray, &hit, cullBack)
+                    : kern_sse::traceTriangles<false>(m_nodes4.data(), m_packets.data(), ray, &hit, cullBack);
 }
 
 bool TriangleBvh::occluded(const Ray& ray) const {
     if (m_packets.empty()) return false;
-    if (!m_nodes8.empty()) return kern_avx2::traceTriangles8<true>(m_nodes8.data(), m_packets.data(), ray, nullptr);
-    return kUseAvx2 ? kern_avx2::traceTriangles<true>(m_nodes4.data(), m_packets.data(), ray, nullptr)
-                    : kern_sse::traceTriangles<true>(m_nodes4.data(), m_packets.data(), ray, nullptr);
+    if (!m_nodes8.empty()) return kern_avx2::traceTriangles8<true>(m_nodes8.data(), m_packets.data(), ray, nullptr, false);
+    return kUseAvx2 ? kern_avx2::traceTriangles<true>(m_nodes4.data(), m_packets.data(), ray, nullptr, false)
+                    : kern_sse::traceTriangles<true>(m_nodes4.data(), m_packets.data(), ray, nullptr, false);
 }
 
 // --- brute force ------------------------------------------------------------------------------

@@ -106,7 +106,10 @@ public:
         build(positions, indices, triangleCount, Bvh4::BuildOptions{});
     }
     // Closest hit in (ray.tmin, ray.tmax); returns true and fills hit when found.
-    bool intersect(const Ray& ray, TriHit& hit) const;
+    // cullBack: ignore triangles seen from their back (CW from the ray's side, in the BVH's
+    // own frame; for an instance traced in object space this is the world-space back side
+    // for mirrored transforms too, since mirroring flips both the winding and the cross product).
+    bool intersect(const Ray& ray, TriHit& hit, bool cullBack = false) const;
     // Any hit in (ray.tmin, ray.tmax).
     bool occluded(const Ray& ray) const;
 

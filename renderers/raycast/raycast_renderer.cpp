@@ -51,8 +51,13 @@ int wrapCoord(int i, int n, WrapMode m) {
 vec3 sampleTexture(const Texture& tex, vec2 uv) {
     if (tex.width <= 0 || tex.height <= 0 || tex.rgba.size() < size_t(tex.width) * tex.height * 4) return vec3(1.0f);
     if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) return vec3(1.0f);
-    // Keep coordinates in a range where float->int is safe (wrapping is periodic anyway).
-    uv = glm::clamp(uv, vec2(-1e6f), vec2(1e6f));
+    // Reduce to a range where float->int is safe: repeat and mirrored repeat are periodic
+    // with period 2 (mirror) dividing evenly into 1 (repeat), clamping only needs [-1, 2].
+    auto reduce = [](float t, WrapMode m) {
+        if (m == WrapMode::ClampToEdge) return std::clamp(t, -1.0f, 2.0f);
+        return t - 2.0f * std::floor(0.5f * t);   // in [0, 2)
+    };
+    uv = vec2(reduce(uv.x, tex.wrapS), reduce(uv.y, tex.wrapT));
     float x = uv.x * tex.width - 0.5f, y = (1.0f - uv.y) * tex.height - 0.5f;
     auto texel = [&](int i, int j) {
         i = wrapCoord(i, tex.width, tex.wrapS);
@@ -102,7 +107,7 @@ struct Tracer {
     vec3 trace(const rt::Ray& r, const vec3& eye, int bounce, vec3* hitPos) {
         ++rays;
         rt::SceneHit h;
-        if (!accel.intersect(r, h)) return f.settings.background;
+        if (!accel.intersect(r, h, f.settings.cullBackFaces)) return f.settings.background;
         vec3 p = r.org + h.t * r.dir;
         if (hitPos) *hitPos = p;
         vec3 dirN = glm::normalize(r.dir);
@@ -313,6 +318,7 @@ public:
                                 sum += c;
                             }
                         sum /= float(sx * sy);
+                        if (!isFinite(sum)) sum = vec3(1, 0, 1);   // never feed NaN to the byte conversion
                         uint8_t* px = target.pixel(x, row);
                         px[0] = toByteSRGB(sum.x);
                         px[1] = toByteSRGB(sum.y);

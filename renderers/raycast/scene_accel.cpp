@@ -1,6 +1,8 @@
 // scene_accel.cpp - two-level BVH: cached per-mesh BLASes + per-frame TLAS over instances.
 #include "raycast/scene_accel.h"
 
+#include <tbb/parallel_for.h>
+
 namespace rnd::rt {
 
 using namespace sg;
@@ -17,19 +19,22 @@ int SceneAccel::update(const FrameInput& f) {
     for (uint32_t i = 0; i < f.meshes.size(); ++i) {
         const DrawMesh& d = f.meshes[i];
         if (!d.mesh || d.mesh->mode != PrimitiveMode::Triangles || d.mesh->triangleCount() == 0) continue;
-        if (!d.mesh->validate().empty()) continue;   // bad indices: skip rather than crash
         MeshEntry& e = m_meshes[d.mesh->id];
         if (e.mesh != d.mesh || e.version != d.mesh->version) {
             e.mesh = d.mesh;
             e.version = d.mesh->version;
-            toBuild.push_back(&e);
+            e.valid = d.mesh->validate().empty();   // bad indices: never traced (no crash)
+            e.bvh = TriangleBvh();
+            if (e.valid) toBuild.push_back(&e);
         }
         e.lastFrame = m_frameCounter;
     }
-    for (MeshEntry* e : toBuild) {
+    // Missing BVHs are built in parallel (each big one also splits its build into tasks).
+    tbb::parallel_for(size_t(0), toBuild.size(), [&](size_t i) {
+        MeshEntry* e = toBuild[i];
         e->bvh.build(e->mesh->positions.data(), e->mesh->indices.data(), e->mesh->triangleCount());
-        ++built;
-    }
+    });
+    built = int(toBuild.size());
     m_buildsTotal += uint64_t(built);
     for (auto it = m_meshes.begin(); it != m_meshes.end();)   // drop meshes unused for a while
         it = m_frameCounter - it->second.lastFrame > 8 ? m_meshes.erase(it) : std::next(it);
@@ -38,7 +43,7 @@ int SceneAccel::update(const FrameInput& f) {
         const DrawMesh& d = f.meshes[i];
         if (!d.mesh) continue;
         auto it = m_meshes.find(d.mesh->id);
-        if (it == m_meshes.end() || it->second.bvh.empty() || it->second.mesh != d.mesh) continue;
+        if (it == m_meshes.end() || !it->second.valid || it->second.bvh.empty() || it->second.mesh != d.mesh) continue;
         if (!isInvertible(d.world)) continue;
         Instance inst;
         inst.isMesh = true;
@@ -92,7 +97,7 @@ int SceneAccel::update(const FrameInput& f) {
     return built;
 }
 
-bool SceneAccel::intersectInstance(const Instance& inst, const Ray& wr, float tmax, SceneHit& hit) const {
+bool SceneAccel::intersectInstance(const Instance& inst, const Ray& wr, float tmax, SceneHit& hit, bool cull) const {
     Ray lr;
     lr.org = vec3(inst.invWorld * vec4(wr.org, 1.0f));
     lr.dir = mat3(inst.invWorld) * wr.dir;
@@ -100,7 +105,7 @@ bool SceneAccel::intersectInstance(const Instance& inst, const Ray& wr, float tm
     lr.tmax = tmax;
     if (inst.isMesh) {
         TriHit th;
-        if (!inst.bvh->intersect(lr, th)) return false;
+        if (!inst.bvh->intersect(lr, th, cull)) return false;
         hit.kind = SceneHit::Kind::Mesh;
         hit.t = th.t;
         hit.instance = inst.index;
@@ -163,7 +168,7 @@ bool SceneAccel::intersectInstance(const Instance& inst, const Ray& wr, float tm
     return true;
 }
 
-bool SceneAccel::intersect(const Ray& r, SceneHit& hit) const {
+bool SceneAccel::intersect(const Ray& r, SceneHit& hit, bool cullBackFaces) const {
     if (m_tlas.empty()) return false;
     float tmax = r.tmax;
     bool found = false;
@@ -171,7 +176,7 @@ bool SceneAccel::intersect(const Ray& r, SceneHit& hit) const {
     m_tlas.traverse(r, tmax, [&](uint32_t first, uint32_t count, float& tm) {
         for (uint32_t k = 0; k < count; ++k) {
             SceneHit h;
-            if (intersectInstance(m_instances[prims[first + k]], r, tm, h) && h.t < tm) {
+            if (intersectInstance(m_instances[prims[first + k]], r, tm, h, cullBackFaces) && h.t < tm) {
                 tm = h.t;
                 hit = h;
                 found = true;

@@ -37,8 +37,10 @@ public:
     // Builds/fetches BLASes for this frame and rebuilds the TLAS. Not thread-safe; call before
     // tracing. Returns the number of mesh BVHs (re)built this call.
     int update(const sg::FrameInput& frame);
-    // Closest hit in (ray.tmin, ray.tmax). Thread-safe after update().
-    bool intersect(const Ray& worldRay, SceneHit& hit) const;
+    // Closest hit in (ray.tmin, ray.tmax). Thread-safe after update(). cullBackFaces skips
+    // mesh triangles seen from their back (RenderSettings::cullBackFaces; analytic solids are
+    // closed, so culling would not change what they show).
+    bool intersect(const Ray& worldRay, SceneHit& hit, bool cullBackFaces = false) const;
     // Any hit in (ray.tmin, ray.tmax).
     bool occluded(const Ray& worldRay) const;
 
@@ -49,6 +51,7 @@ private:
     struct MeshEntry {
         sg::MeshPtr mesh;   // keeps the data alive (the BVH refers to it by index only)
         uint64_t version = 0;
+        bool valid = false;   // Mesh::validate() passed
         TriangleBvh bvh;
         uint64_t lastFrame = 0;
     };
@@ -66,7 +69,7 @@ private:
         sg::mat4 invWorld{1.0f};
     };
 
-    bool intersectInstance(const Instance& inst, const Ray& r, float tmax, SceneHit& hit) const;
+    bool intersectInstance(const Instance& inst, const Ray& r, float tmax, SceneHit& hit, bool cull = false) const;
 
     const sg::FrameInput* m_frame = nullptr;
     std::unordered_map<uint64_t, MeshEntry> m_meshes;          // by Mesh::id

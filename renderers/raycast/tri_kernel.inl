@@ -19,8 +19,10 @@
 //   det = -d.N,  b1 = e2.R / det,  b2 = -e1.R / det,  t = s.N / det.
 // Division-free: comparisons use the sign-adjusted numerators against |det|; only packets with
 // a hit pay for the division. Returns the lane mask of hits in (tmin, tmax) and t, b1, b2.
+// cullBack: only triangles whose CCW side faces the ray (det > 0) count. In object space
+// this is the front side for mirrored instances too (see TriangleBvh::intersect).
 inline int intersectPacket(const TriPacket4& p, const __m128 o[3], const __m128 d[3], __m128 tmin, __m128 tmax,
-                           __m128& tOut, __m128& uOut, __m128& vOut) {
+                           __m128& tOut, __m128& uOut, __m128& vOut, bool cullBack = false) {
     const __m128 nx = _mm_load_ps(p.n[0]), ny = _mm_load_ps(p.n[1]), nz = _mm_load_ps(p.n[2]);
     const __m128 sx = _mm_sub_ps(o[0], _mm_load_ps(p.v0[0]));
     const __m128 sy = _mm_sub_ps(o[1], _mm_load_ps(p.v0[1]));
@@ -40,7 +42,7 @@ inline int intersectPacket(const TriPacket4& p, const __m128 o[3], const __m128 
     V = _mm_xor_ps(V, _mm_xor_ps(sign, negZero));   // b2 = -e1.R / det
     T = _mm_xor_ps(T, sign);
     const __m128 zero = _mm_setzero_ps();
-    __m128 ok = _mm_cmpneq_ps(det, zero);
+    __m128 ok = cullBack ? _mm_cmpgt_ps(det, zero) : _mm_cmpneq_ps(det, zero);
     ok = _mm_and_ps(ok, _mm_cmpge_ps(U, zero));
     ok = _mm_and_ps(ok, _mm_cmpge_ps(V, zero));
     ok = _mm_and_ps(ok, _mm_cmple_ps(_mm_add_ps(U, V), absDet));
@@ -61,7 +63,7 @@ inline int intersectPacket(const TriPacket4& p, const __m128 o[3], const __m128 
 // Front-to-back BVH4 traversal with the packet test inlined. AnyHit: stop at the first hit
 // and skip the ordering. Returns true on a hit (closest hit written to *hit unless AnyHit).
 template <bool AnyHit>
-inline bool traceTriangles(const Node4* nodes, const TriPacket4* packets, const Ray& ray, TriHit* hit) {
+inline bool traceTriangles(const Node4* nodes, const TriPacket4* packets, const Ray& ray, TriHit* hit, bool cullBack) {
     const RayPre pre(ray);
     const __m128 rx = _mm_set1_ps(pre.rdir[0]), ry = _mm_set1_ps(pre.rdir[1]), rz = _mm_set1_ps(pre.rdir[2]);
     const __m128 orx = _mm_set1_ps(pre.orgRdir[0]), ory = _mm_set1_ps(pre.orgRdir[1]), orz = _mm_set1_ps(pre.orgRdir[2]);
@@ -127,7 +129,7 @@ inline bool traceTriangles(const Node4* nodes, const TriPacket4* packets, const 
         } else {
             const TriPacket4& p = packets[(cur & ~Node4::kLeafBit) >> 3];
             __m128 t, u, v;
-            int mask = intersectPacket(p, o, d, tminV, tmaxV, t, u, v);
+            int mask = intersectPacket(p, o, d, tminV, tmaxV, t, u, v, cullBack);
             if (mask) {
                 if constexpr (AnyHit) return true;
                 alignas(16) float ta[4], ua[4], va[4];
@@ -161,7 +163,7 @@ inline bool traceTriangles(const Node4* nodes, const TriPacket4* packets, const 
 // The same traversal over 8-wide nodes: one AVX compare per node for 8 boxes (BVH8: fewer,
 // wider levels), leaves still 4-triangle SSE packets.
 template <bool AnyHit>
-inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const Ray& ray, TriHit* hit) {
+inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const Ray& ray, TriHit* hit, bool cullBack) {
     const RayPre pre(ray);
     const __m256 rx = _mm256_set1_ps(pre.rdir[0]), ry = _mm256_set1_ps(pre.rdir[1]), rz = _mm256_set1_ps(pre.rdir[2]);
     const __m256 orx = _mm256_set1_ps(pre.orgRdir[0]), ory = _mm256_set1_ps(pre.orgRdir[1]), orz = _mm256_set1_ps(pre.orgRdir[2]);
@@ -226,7 +228,7 @@ inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const
         } else {
             const TriPacket4& p = packets[(cur & ~Node8::kLeafBit) >> 3];
             __m128 t, u, v;
-            int mask = intersectPacket(p, o, d, tminV, tmaxV, t, u, v);
+            int mask = intersectPacket(p, o, d, tminV, tmaxV, t, u, v, cullBack);
             if (mask) {
                 if constexpr (AnyHit) return true;
                 alignas(16) float ta[4], ua[4], va[4];

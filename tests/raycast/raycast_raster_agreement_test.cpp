@@ -137,3 +137,15 @@ TEST(RaycastRasterAgreementTest, VertexColoursAndTexture) {
     f.meshes[2].material.baseColor = vec3(1.0f);
     expectAgree(f, "vertex-colours-texture");
 }
+
+TEST(RaycastRasterAgreementTest, BackFaceCulling) {
+    // Looking into the open cylinder: without culling its inside (back faces) shows; with
+    // culling both backends show the floor through it. The mirrored sphere must not vanish.
+    for (bool cull : {false, true}) {
+        FrameInput f = baseScene(perspective());
+        f.settings.cullBackFaces = cull;
+        f.camera = makeFrameCamera(glm::inverse(glm::lookAt(vec3(0.4f, 4.0f, 3.0f), vec3(0.2f, 0.3f, 1.2f), vec3(0, 1, 0))),
+                                   perspective(), float(kW) / kH, 4.0f);
+        expectAgree(f, cull ? "cull-on" : "cull-off");
+    }
+}

@@ -538,3 +538,106 @@ TEST(RaycastTest, AntiAliasingAndShadingModelsRun) {
         EXPECT_GT(d.fractionWithin, 0.8) << d.describe();   // AA only changes edges
     }
 }
+
+// --- shadows and reflections ---------------------------------------------------------------------
+
+namespace {
+// Mirror floor (y = 0, black unless it reflects) and a red unlit sphere at (0, 1, -3); the
+// camera at (0, 1, 3) looks at the origin, whose mirror ray goes straight to the sphere.
+FrameInput mirrorScene() {
+    FrameInput f;
+    f.settings.shadows = false;
+    auto ground = std::make_shared<Mesh>(primitives::plane(10.0f, 1));
+    DrawMesh g;
+    g.mesh = ground;
+    g.material.ka = g.material.kd = g.material.ks = 0.0f;
+    g.material.reflectivity = 1.0f;
+    f.meshes.push_back(g);
+    DrawAnalytic s;
+    s.kind = DrawAnalytic::Kind::Implicit;
+    s.implicit.type = ImplicitType::Sphere;
+    s.implicit.radius = 0.5f;
+    s.world = glm::translate(mat4(1.0f), vec3(0, 1, -3));
+    s.invWorld = glm::inverse(s.world);
+    s.normal = normalMatrix(s.world);
+    s.worldBounds = s.implicit.localBounds().transformed(s.world);
+    s.material.unlit = true;
+    s.material.baseColor = vec3(1, 0, 0);
+    f.analytics.push_back(s);
+    f.settings.background = vec3(0.0f);
+    f.camera = makeFrameCamera(glm::inverse(glm::lookAt(vec3(0, 1, 3), vec3(0, 0, 0), vec3(0, 1, 0))), Projection{}, 1.0f, 3.0f);
+    return f;
+}
+}  // namespace
+
+TEST(RaycastTest, MirrorReflectionShowsTheSphere) {
+    FrameInput f = mirrorScene();
+    auto r = makeRenderer("raycast");
+    Framebuffer on, off;
+    f.settings.reflections = true;
+    ASSERT_TRUE(r->render(f, 65, 65, on).ok);
+    f.settings.reflections = false;
+    ASSERT_TRUE(r->render(f, 65, 65, off).ok);
+    const uint8_t* a = on.pixel(32, 32);
+    const uint8_t* b = off.pixel(32, 32);
+    EXPECT_GT(a[0], 200);   // red sphere seen in the mirror
+    EXPECT_LT(a[1], 30);
+    EXPECT_LT(b[0], 30);    // without reflections the floor is black
+    f.settings.reflections = true;
+    f.settings.maxBounces = 0;   // no bounce allowed: black again
+    ASSERT_TRUE(r->render(f, 65, 65, on).ok);
+    EXPECT_LT(on.pixel(32, 32)[0], 30);
+}
+
+TEST(RaycastTest, ShadowRaysDarkenOccludedPoints) {
+    FrameInput f;
+    auto ground = std::make_shared<Mesh>(primitives::plane(5.0f, 1));
+    DrawMesh g;
+    g.mesh = ground;
+    g.material.ka = 0.0f;
+    f.meshes.push_back(g);
+    auto box = std::make_shared<Mesh>(primitives::box(vec3(0.5f)));
+    DrawMesh b;
+    b.mesh = box;
+    b.world = glm::translate(mat4(1.0f), vec3(0, 1.5f, 0));
+    b.normal = normalMatrix(b.world);
+    f.meshes.push_back(b);
+    DrawLight l;
+    l.position = vec3(0, 5, 0);
+    f.lights.push_back(l);
+    f.camera = makeFrameCamera(glm::inverse(glm::lookAt(vec3(0, 2.5f, 6), vec3(0, 0, 0), vec3(0, 1, 0))), Projection{}, 1.0f, 6.0f);
+    auto r = makeRenderer("raycast");
+    Framebuffer with, without;
+    f.settings.shadows = true;
+    ASSERT_TRUE(r->render(f, 96, 96, with).ok);
+    f.settings.shadows = false;
+    ASSERT_TRUE(r->render(f, 96, 96, without).ok);
+    // Compare the sums over the image: the shadow removes light from part of the floor only.
+    testing_support::writeImage(with, "raycast", "shadow-on");
+    testing_support::writeImage(without, "raycast", "shadow-off");
+    long sw = 0, so = 0;
+    for (size_t i = 0; i < with.color.size(); i += 4) { sw += with.color[i]; so += without.color[i]; }
+    EXPECT_LT(sw, so);
+    // The floor right in front of the box's foot is in its shadow (light straight above).
+    rt::CameraRays rays(f.camera, 96, 96);
+    vec2 w = rays.project(vec3(0, 0, 0.45f));
+    int px = int(w.x), row = 96 - 1 - int(w.y);
+    EXPECT_LT(int(with.pixel(px, row)[0]) + 10, int(without.pixel(px, row)[0]));
+}
+
+TEST(RaycastTest, BadMeshIsSkippedNotCrashed) {
+    FrameInput f = triangleScene(32, 32);
+    auto bad = std::make_shared<Mesh>(primitives::box(vec3(0.5f)));
+    bad->indices[5] = 100000;   // out of range
+    DrawMesh d;
+    d.mesh = bad;
+    f.meshes.push_back(d);
+    auto nanMesh = std::make_shared<Mesh>(primitives::box(vec3(0.5f)));
+    nanMesh->positions[0] = vec3(NAN);
+    d.mesh = nanMesh;
+    f.meshes.push_back(d);
+    auto r = makeRenderer("raycast");
+    Framebuffer fb;
+    RenderStats s = r->render(f, 32, 32, fb);
+    EXPECT_TRUE(s.ok) << s.error;
+}
