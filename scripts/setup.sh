@@ -10,7 +10,7 @@ packages=(
   build-essential cmake pkg-config python3 python3-glad
   libglfw3-dev libimgui-dev libglm-dev libtinygltf-dev libopenmesh-dev libstb-dev
   libtbb-dev libcli11-dev nlohmann-json3-dev libgtest-dev libgmock-dev libbenchmark-dev libembree-dev
-  libgl1-mesa-dri libegl-mesa0 libegl-dev libgl-dev libosmesa6-dev xvfb xauth
+  libgl1-mesa-dri libegl-mesa0 libegl-dev libgl-dev libosmesa6-dev xvfb xauth fonts-dejavu-core
 )
 
 # The fuzz preset also needs clang and its libFuzzer runtime.
