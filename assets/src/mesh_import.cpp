@@ -848,7 +848,7 @@ LoadResult loadPly(const fs::path& path, const std::string& data, Ctx& ctx) {
             }
             if (truncated) break;
             if (isVertex) {
-                sg::vec3 p(float(vals[size_t(ix)]), float(vals[size_t(iy)]), float(vals[size_t(iz)]));
+                sg::vec3 p{float(vals[size_t(ix)]), float(vals[size_t(iy)]), float(vals[size_t(iz)])};
                 if (!sg::isFinite(p)) throw Fail{"vertex " + std::to_string(i) + " is not finite"};
                 mesh.positions.push_back(p);
                 if (haveNormals) mesh.normals.push_back({float(vals[size_t(inx)]), float(vals[size_t(iny)]), float(vals[size_t(inz)])});
