@@ -146,8 +146,10 @@ public:
         }
         int w = st.viewportWidth, h = st.viewportHeight;
         float aspect = float(w) / float(std::max(h, 1));
+        // A playing animation changes the scene every frame: previews only, like a camera drag
+        // (full resolution follows when it pauses).
         bool interacting = (now - st.lastInteraction) < 0.25 || ImGui::GetIO().MouseDown[0] || ImGui::GetIO().MouseDown[1] ||
-                           ImGui::GetIO().MouseDown[2];
+                           ImGui::GetIO().MouseDown[2] || st.animationPlaying;
         std::vector<std::string> names = visibleBackends(st);
         std::shared_ptr<sg::FrameInput> base;
         uint64_t key = (st.sceneVersion * 1000003u) ^ (st.viewVersion * 7919u) ^ (uint64_t(w) << 40) ^ (uint64_t(h) << 20);
