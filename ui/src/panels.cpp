@@ -1316,6 +1316,7 @@ void drawDialogs(ViewerState& st) {
                 "Home               reset to the scene camera\n"
                 "1 / 2 / 3          backend gl / raster / raycast\n"
                 "F12                screenshot\n"
+                "Space              play / pause the animation (viewport)\n"
                 "F2                 rename selection\n"
                 "Del, Ctrl+D        delete / duplicate selection\n"
                 "Ctrl+N/O/S/Q       new / open / save / quit\n"
