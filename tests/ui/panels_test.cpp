@@ -230,3 +230,74 @@ TEST(PanelsTest, SplitViewDividerDrags) {
     EXPECT_EQ(h.st.camera.yaw, yaw);   // the divider took the drag, not the camera
     EXPECT_EQ(visibleBackends(h.st).size(), 2u);
 }
+
+namespace {
+// A clip moving the demo's crate along x: (0,0,0) at t=0 to (4,0,0) at t=2.
+assets::AnimationClip crateClip(const sg::Scene& s) {
+    assets::AnimationClip clip;
+    clip.name = "crate slide";
+    clip.start = 0.0f;
+    clip.duration = 2.0f;
+    assets::AnimationChannel ch;
+    ch.node = s.findByName("crate");
+    ch.path = assets::AnimationPath::Translation;
+    ch.times = {0.0f, 2.0f};
+    ch.values = {sg::vec4(0.0f), sg::vec4(4, 0, 0, 0)};
+    clip.channels.push_back(ch);
+    return clip;
+}
+}  // namespace
+
+TEST(PanelsTest, AnimationBarOnlyWithClipsPlayButtonAndSpaceToggle) {
+    Headless h;
+    EXPECT_EQ(h.st.itemRects.count("anim/play"), 0u);   // the demo has no clips: no bar
+    h.st.animations.push_back(crateClip(h.st.scene));
+    h.frame();
+    ASSERT_NO_THROW(h.rect("anim/play"));
+    EXPECT_NO_THROW(h.rect("anim/time"));
+    EXPECT_NO_THROW(h.rect("anim/loop"));
+    EXPECT_NO_THROW(h.rect("anim/clip"));
+    ASSERT_FALSE(h.st.animationPlaying);
+    h.click("anim/play");
+    EXPECT_TRUE(h.st.animationPlaying);
+    h.st.advanceAnimation(1.0);   // the window's main loop does this every frame
+    sg::NodeId crate = h.st.scene.findByName("crate");
+    EXPECT_NEAR(h.st.scene.node(crate).local.translation.x, 2.0f, 1e-5f);
+    h.click("anim/play");         // now "Pause"
+    EXPECT_FALSE(h.st.animationPlaying);
+    bool loop = h.st.animationLoop;
+    h.click("anim/loop");
+    EXPECT_NE(h.st.animationLoop, loop);
+    // Space toggles while the viewport has focus (a click in it gives it focus).
+    h.click("viewport");
+    h.press(keys::Space);
+    EXPECT_TRUE(h.st.animationPlaying);
+    h.press(keys::Space);
+    EXPECT_FALSE(h.st.animationPlaying);
+    // Scrub: a click at the slider's left end goes to the clip start.
+    const ItemRect r = h.rect("anim/time");
+    h.moveTo(r.x0 + 2.0f, r.cy());
+    ImGui::GetIO().MouseDown[0] = true;
+    h.frame();
+    ImGui::GetIO().MouseDown[0] = false;
+    h.frame();
+    EXPECT_NEAR(h.st.animationTime, 0.0, 0.05);
+    EXPECT_NEAR(h.st.scene.node(crate).local.translation.x, 2.0f * float(h.st.animationTime), 1e-4f);
+    EXPECT_FALSE(h.st.dirty);
+}
+
+TEST(PanelsTest, LoadShowsProgressAndCancelButtonKeepsScene) {
+    Headless h;
+    size_t nodes = h.st.scene.nodeCount();
+    EXPECT_EQ(h.st.itemRects.count("status/cancelLoad"), 0u);
+    // The panels never finish loads (the main loop's pollLoad does), so the bar stays up.
+    h.st.startLoad("/nonexistent/dir/scene.obj");
+    h.frame();
+    ASSERT_NO_THROW(h.rect("status/loadProgress"));
+    h.click("status/cancelLoad");
+    EXPECT_TRUE(h.st.loadCancelRequested());
+    ASSERT_TRUE(h.st.pollLoad(true));
+    EXPECT_EQ(h.st.scene.nodeCount(), nodes);
+    EXPECT_TRUE(h.st.errorPopup.empty());
+    EXPECT_NE(h.st.status.find("scene.obj cancelled"), std::string::npos) << h.st.status;
+}

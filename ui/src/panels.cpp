@@ -5,7 +5,7 @@
 //   2. style
 //   3. main menu
 //   4. scene tree (select, visibility, context menu, drag-and-drop re-parenting)
-//   5. inspector (transform TRS / matrix, world matrix, payloads, material)
+//   5. inspector (transform TRS / matrix, world matrix, payloads, material), animation bar
 //   6. camera panel (projection, scene cameras, live matrices)
 //   7. rendering panel (RenderSettings)
 //   8. compare panel (split / wipe / difference)
@@ -668,6 +668,37 @@ void drawInspector(ViewerState& st) {
     }
 }
 
+void drawAnimationPanel(ViewerState& st) {
+    if (st.animations.empty()) return;
+    section("Animation");
+    const assets::AnimationClip* cur = st.currentAnimation();
+    auto clipName = [&](int i) {
+        const std::string& n = st.animations[size_t(i)].name;
+        return n.empty() ? "clip " + std::to_string(i) : n;
+    };
+    if (ImGui::BeginCombo("Clip", cur ? clipName(st.animationClip).c_str() : "-")) {
+        for (int i = 0; i < int(st.animations.size()); ++i) {
+            ImGui::PushID(i);
+            if (ImGui::Selectable(clipName(i).c_str(), i == st.animationClip) && i != st.animationClip) st.selectAnimation(i);
+            ImGui::PopID();
+        }
+        ImGui::EndCombo();
+    }
+    record(st, "anim/clip");
+    if (!cur) return;
+    if (ImGui::Button(st.animationPlaying ? "Pause###animPlay" : "Play###animPlay", ImVec2(px(64), 0))) st.toggleAnimation();
+    record(st, "anim/play");
+    ImGui::SameLine();
+    ImGui::Checkbox("Loop", &st.animationLoop);
+    record(st, "anim/loop");
+    ImGui::SameLine();
+    ImGui::TextDisabled("(Space in the viewport)");
+    float t = float(st.animationTime);
+    float t0 = cur->start, t1 = float(st.animationEnd());
+    if (ImGui::SliderFloat("Time", &t, t0, std::max(t1, t0 + 1e-3f), "%.2f s")) st.setAnimationTime(t);
+    record(st, "anim/time");
+}
+
 // --- 6. camera panel ---------------------------------------------------------------------------
 
 void drawCameraPanel(ViewerState& st) {
@@ -1017,6 +1048,9 @@ void drawViewport(ViewerState& st, const ViewportInput& view, double time, float
     ImGui::InvisibleButton("##viewport", avail, ImGuiButtonFlags_MouseButtonLeft | ImGuiButtonFlags_MouseButtonRight | ImGuiButtonFlags_MouseButtonMiddle);
     record(st, "viewport");
     cameraInput(st, a, b, time, dt);
+    // Space: play / pause the animation while the viewport has focus (not while typing).
+    if (!st.animations.empty() && ImGui::IsWindowFocused() && !ImGui::GetIO().WantTextInput && ImGui::IsKeyPressed(keys::Space, false))
+        st.toggleAnimation();
 
     ImDrawList* dl = ImGui::GetWindowDrawList();
     dl->PushClipRect(a, b, true);
@@ -1282,6 +1316,7 @@ void drawDialogs(ViewerState& st) {
                 "Home               reset to the scene camera\n"
                 "1 / 2 / 3          backend gl / raster / raycast\n"
                 "F12                screenshot\n"
+                "Space              play / pause the animation (viewport)\n"
                 "F2                 rename selection\n"
                 "Del, Ctrl+D        delete / duplicate selection\n"
                 "Ctrl+N/O/S/Q       new / open / save / quit\n"
@@ -1349,6 +1384,7 @@ void drawUi(ViewerState& st, const ViewportInput& view, double time, float dt) {
     float rightW = 0;
     if (ImGui::Begin("Properties", nullptr, panelFlags)) {
         ImGui::PushItemWidth(-px(150));   // room for the labels on the right
+        drawAnimationPanel(st);           // only when the scene has clips
         if (ImGui::BeginTabBar("tabs")) {
             bool openInspector = ImGui::BeginTabItem("Inspector", nullptr, st.requestedTab == "Inspector" ? ImGuiTabItemFlags_SetSelected : 0);
             record(st, "tab/Inspector");   // the tab itself (before its contents)
@@ -1388,6 +1424,19 @@ void drawUi(ViewerState& st, const ViewportInput& view, double time, float dt) {
     ImGui::PushStyleVar(ImGuiStyleVar_WindowPadding, ImVec2(px(8), px(2)));
     if (ImGui::Begin("##status", nullptr, ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoBringToFrontOnFocus)) {
         bool bad = st.status.rfind("Move refused", 0) == 0 || st.status.find("fail") != std::string::npos || st.status.find("refused") != std::string::npos;
+        if (st.loadInProgress()) {   // progress of the load (off the UI thread) and its Cancel
+            float f = st.loadProgress();
+            char label[32];
+            std::snprintf(label, sizeof label, "%.0f%%", 100.0f * f);
+            ImGui::ProgressBar(f, ImVec2(px(180), 0), label);
+            record(st, "status/loadProgress");
+            ImGui::SameLine();
+            ImGui::BeginDisabled(st.loadCancelRequested());
+            if (ImGui::Button("Cancel##load")) st.cancelLoad();
+            ImGui::EndDisabled();
+            record(st, "status/cancelLoad");
+            ImGui::SameLine();
+        }
         if (bad) ImGui::TextColored(ImVec4(1.0f, 0.6f, 0.45f, 1.0f), "%s", st.status.c_str());
         else ImGui::TextUnformatted(st.status.empty() ? "Ready" : st.status.c_str());
         char right[160];

@@ -9,7 +9,8 @@
 //
 // Threads: the UI thread owns GLFW, GL, ImGui and the ViewerState. CPU backends render on
 // their RenderSlot worker threads; the GL backend renders on the UI thread with the window's
-// context current (into its own FBO). Scene loading runs in std::async (ViewerState).
+// context current (into its own FBO). Scene loading runs in std::async (ViewerState), with
+// progress and cancel in the status bar. Animations advance once per frame on the UI thread.
 #include "ui/viewer.h"
 
 #include "assets/demo.h"
@@ -38,7 +39,7 @@ namespace fs = std::filesystem;
 
 static_assert(ui::keys::F == GLFW_KEY_F && ui::keys::Num1 == GLFW_KEY_1 && ui::keys::Home == GLFW_KEY_HOME &&
                   ui::keys::F12 == GLFW_KEY_F12 && ui::keys::Delete == GLFW_KEY_DELETE && ui::keys::W == GLFW_KEY_W &&
-                  ui::keys::F2 == GLFW_KEY_F2 && ui::keys::Q == GLFW_KEY_Q,
+                  ui::keys::F2 == GLFW_KEY_F2 && ui::keys::Q == GLFW_KEY_Q && ui::keys::Space == GLFW_KEY_SPACE,
               "panel key codes must match GLFW's");
 
 namespace ui {
@@ -145,8 +146,10 @@ public:
         }
         int w = st.viewportWidth, h = st.viewportHeight;
         float aspect = float(w) / float(std::max(h, 1));
+        // A playing animation changes the scene every frame: previews only, like a camera drag
+        // (full resolution follows when it pauses).
         bool interacting = (now - st.lastInteraction) < 0.25 || ImGui::GetIO().MouseDown[0] || ImGui::GetIO().MouseDown[1] ||
-                           ImGui::GetIO().MouseDown[2];
+                           ImGui::GetIO().MouseDown[2] || st.animationPlaying;
         std::vector<std::string> names = visibleBackends(st);
         std::shared_ptr<sg::FrameInput> base;
         uint64_t key = (st.sceneVersion * 1000003u) ^ (st.viewVersion * 7919u) ^ (uint64_t(w) << 40) ^ (uint64_t(h) << 20);
@@ -309,6 +312,7 @@ private:
 //   select NODE-NAME
 //   tab Inspector|Camera|Rendering|Compare
 //   gl-worker on|off      run the GL backend on a worker thread (own headless context)
+//   anim play|pause|time T   animation of the loaded file: play, pause, or pose at T seconds
 //   stats                 print time / triangles / rays of the shown backends
 //   screenshot DIR        offscreen PNG per visible backend into DIR (as F12)
 //   window-shot PATH      PNG of the whole window (UI included)
@@ -378,6 +382,13 @@ public:
             if (cmd == "fit") { v.st.fitView(false); continue; }
             if (cmd == "gl-worker") { std::string on; in >> on; v.st.glOnWorker = on == "on"; continue; }
             if (cmd == "tab") { in >> v.st.requestedTab; continue; }
+            if (cmd == "anim") {
+                std::string what;
+                in >> what;
+                if (what == "play" || what == "pause") v.st.setAnimationPlaying(what == "play");
+                else if (what == "time") { double t = 0; in >> t; v.st.setAnimationTime(t); }
+                continue;
+            }
             if (cmd == "stats") {   // one line per shown backend: time, triangles, rays, error
                 for (const std::string& n : visibleBackends(v.st)) {
                     SlotStatus s = v.viewFor(n).slot->status();
@@ -540,7 +551,7 @@ int runViewer(const ViewerOptions& opt) {
     bool running = true;
     std::string windowTitle;
     while (running) {
-        bool busy = !v.shots.empty() || st.loadInProgress() || automated;
+        bool busy = !v.shots.empty() || st.loadInProgress() || st.animationPlaying || automated;
         for (auto& [n, bv] : v.views) busy |= bv.slot->status().rendering;
         if (busy || (v.now - st.lastInteraction) < 0.5) glfwPollEvents();
         else glfwWaitEventsTimeout(0.1);
@@ -560,6 +571,7 @@ int runViewer(const ViewerOptions& opt) {
             v.droppedFiles.clear();
         }
         st.pollLoad();
+        st.advanceAnimation(dt);
         v.pollScreenshots(false);
         if (automated && !automation.step(v, win)) {
             running = false;
@@ -616,6 +628,7 @@ int runViewer(const ViewerOptions& opt) {
         }
     }
     v.pollScreenshots(true);
+    st.cancelLoad();   // a load still running stops soon instead of finishing for nobody
 
     v.releaseGL();
     ImGui_ImplOpenGL3_Shutdown();

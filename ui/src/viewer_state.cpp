@@ -1,12 +1,14 @@
 // viewer_state.cpp - the viewer's pure state and actions (see viewer_state.h).
 //
-// Sections: scene + edits, backend, camera, files (guard, async load, save), config helpers.
+// Sections: scene + edits, backend, camera, files (guard, async load with progress/cancel,
+// save), animation playback, config helpers.
 #include "ui/viewer_state.h"
 
 #include "assets/files.h"
 #include "renderers/renderer.h"
 
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -22,6 +24,10 @@ void ViewerState::setScene(sg::Scene s, fs::path path) {
     scenePath = std::move(path);
     dirty = false;
     selected = sg::kNoNode;
+    animations.clear();   // a load puts its clips back after this
+    animationClip = 0;
+    animationTime = 0.0;
+    animationPlaying = false;
     ++sceneVersion;
     resetView();
 }
@@ -375,9 +381,13 @@ void ViewerState::startLoad(const fs::path& path) {
     }
     loadingPath = path;
     status = "Loading " + path.string() + " ...";
-    loading = std::async(std::launch::async, [path] {
+    loadControl = std::make_shared<LoadControl>();
+    loading = std::async(std::launch::async, [path, control = loadControl] {
         try {
-            return assets::loadScene(path);
+            assets::LoadOptions options;
+            options.cancel = &control->cancel;
+            options.progress = &control->progress;
+            return assets::loadScene(path, options);
         } catch (const std::exception& e) {
             assets::LoadResult r;
             r.error = path.string() + ": " + e.what();
@@ -390,6 +400,10 @@ bool ViewerState::pollLoad(bool wait) {
     if (!loading.valid()) return false;
     if (!wait && loading.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return false;
     assets::LoadResult r = loading.get();
+    if (loadCancelRequested()) {   // whatever the importer returned: the user said no
+        status = "Loading " + loadingPath.filename().string() + " cancelled; the current scene is unchanged";
+        return true;
+    }
     loadWarnings = r.warnings;
     if (!r.scene) {
         errorPopup = "Could not open " + loadingPath.string() + ":\n" + (r.error.empty() ? "unknown error" : r.error);
@@ -397,9 +411,18 @@ bool ViewerState::pollLoad(bool wait) {
         return true;
     }
     setScene(std::move(*r.scene), loadingPath);
+    animations = std::move(r.animations);
+    if (!animations.empty()) animationTime = animations.front().start;
     addRecent(fs::absolute(loadingPath).lexically_normal().string());
-    status = "Opened " + loadingPath.string() + (r.warnings.empty() ? "" : " (" + std::to_string(r.warnings.size()) + " warnings)");
+    status = "Opened " + loadingPath.string() + (r.warnings.empty() ? "" : " (" + std::to_string(r.warnings.size()) + " warnings)") +
+             (animations.empty() ? "" : ", " + std::to_string(animations.size()) + " animation(s): Space plays");
     return true;
+}
+
+void ViewerState::cancelLoad() {
+    if (!loading.valid() || !loadControl || loadControl->cancel.load()) return;
+    loadControl->cancel = true;
+    status = "Cancelling loading " + loadingPath.filename().string() + " ...";
 }
 
 std::string ViewerState::save(const fs::path& path) {
@@ -433,6 +456,70 @@ void ViewerState::addRecent(const std::string& path) {
     recentFiles.insert(recentFiles.begin(), path);
     if (recentFiles.size() > 10) recentFiles.resize(10);
     if (!configDir.empty()) saveRecentFiles(configDir, recentFiles);
+}
+
+// --- animation playback ----------------------------------------------------------------------
+
+namespace {
+// Writes the clip's pose at t into the scene: a re-render, not an edit (dirty untouched).
+void applyPose(ViewerState& st, const assets::AnimationClip& clip, double t) {
+    assets::applyAnimation(st.scene, clip, float(t));
+    ++st.sceneVersion;
+}
+}  // namespace
+
+const assets::AnimationClip* ViewerState::currentAnimation() const {
+    if (animationClip < 0 || size_t(animationClip) >= animations.size()) return nullptr;
+    return &animations[size_t(animationClip)];
+}
+
+double ViewerState::animationEnd() const {
+    const assets::AnimationClip* c = currentAnimation();
+    return c ? std::max(double(c->duration), double(c->start)) : 0.0;
+}
+
+void ViewerState::selectAnimation(int index) {
+    if (index < 0 || size_t(index) >= animations.size()) return;
+    animationClip = index;
+    animationPlaying = false;
+    animationTime = animations[size_t(index)].start;
+    applyPose(*this, animations[size_t(index)], animationTime);
+    status = "Animation: " + (animations[size_t(index)].name.empty() ? "clip " + std::to_string(index) : animations[size_t(index)].name);
+}
+
+void ViewerState::setAnimationPlaying(bool play) {
+    const assets::AnimationClip* c = currentAnimation();
+    if (!c) {
+        animationPlaying = false;
+        return;
+    }
+    if (play && !animationLoop && animationTime >= animationEnd()) animationTime = c->start;   // replay
+    animationPlaying = play;
+    applyPose(*this, *c, animationTime);
+}
+
+void ViewerState::setAnimationTime(double t) {
+    const assets::AnimationClip* c = currentAnimation();
+    if (!c || !std::isfinite(t)) return;
+    animationTime = std::clamp(t, double(c->start), animationEnd());
+    applyPose(*this, *c, animationTime);
+}
+
+void ViewerState::advanceAnimation(double dt) {
+    const assets::AnimationClip* c = currentAnimation();
+    if (!c || !animationPlaying) return;
+    double start = c->start, end = animationEnd(), length = end - start;
+    double t = animationTime + (std::isfinite(dt) ? std::max(dt, 0.0) : 0.0);
+    if (t > end) {
+        if (animationLoop && length > 0.0) {
+            t = start + std::fmod(t - start, length);
+        } else {   // not looping (or a single-key clip): stop at the end
+            t = end;
+            animationPlaying = false;
+        }
+    }
+    animationTime = std::clamp(t, start, end);
+    applyPose(*this, *c, animationTime);
 }
 
 // --- config helpers --------------------------------------------------------------------------

@@ -2,9 +2,10 @@
 // call ImGui; they never touch GLFW or GL (textures arrive as opaque ids), so tests run them
 // in headless ImGui frames (CreateContext, DisplaySize, fonts built, NewFrame ... Render).
 //
-// Layout (drawUi): main menu bar; left "Scene" panel (tree); right panel with tabs Inspector /
-// Camera / Rendering / Compare; the viewport in between (images, split wipe, difference,
-// stats overlay, camera mouse/keyboard input); a status bar; modal dialogs.
+// Layout (drawUi): main menu bar; left "Scene" panel (tree); right panel with the animation
+// bar (scenes with clips only) above tabs Inspector / Camera / Rendering / Compare; the viewport in between (images, split wipe, difference,
+// stats overlay, camera mouse/keyboard input); a status bar (with load progress + Cancel);
+// modal dialogs.
 #pragma once
 
 #include "ui/render_slot.h"
@@ -18,7 +19,7 @@ namespace ui {
 // Key codes the panels read from io.KeysDown (ImGui 1.86 uses the platform's codes; these
 // equal GLFW's, which viewer.cpp static_asserts).
 namespace keys {
-constexpr int Num1 = 49, Num2 = 50, Num3 = 51;
+constexpr int Space = 32, Num1 = 49, Num2 = 50, Num3 = 51;
 constexpr int A = 65, D = 68, E = 69, F = 70, N = 78, O = 79, Q = 81, S = 83, W = 87;
 constexpr int Delete = 261, Home = 268, F2 = 291, F12 = 301;
 }  // namespace keys
@@ -44,6 +45,8 @@ void drawUi(ViewerState& st, const ViewportInput& view, double time, float dt);
 void drawMainMenu(ViewerState& st);
 void drawSceneTree(ViewerState& st);
 void drawInspector(ViewerState& st);
+// Clip combo, Play/Pause, loop, time slider; draws nothing when the scene has no clips.
+void drawAnimationPanel(ViewerState& st);
 void drawCameraPanel(ViewerState& st);
 void drawRenderingPanel(ViewerState& st);
 void drawComparePanel(ViewerState& st);

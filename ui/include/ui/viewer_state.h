@@ -1,9 +1,10 @@
 // viewer_state.h - everything the viewer knows, as plain data plus actions (no GL, no ImGui).
 //
 // Sections: CompareConfig (split / wipe / difference views), Requests (things the window
-// must do: screenshots, quit, file dialogs), ViewerState (scene, selection, camera,
-// settings, dirty flag, load/save, unsaved-changes guard), config helpers (per-user config
-// folder, recent files, screenshot names).
+// must do: screenshots, quit, file dialogs), LoadControl (cancel flag + progress shared with
+// the loader thread), ViewerState (scene, selection, camera, settings, dirty flag, load/save
+// with progress and cancel, unsaved-changes guard, node TRS animation playback), config
+// helpers (per-user config folder, recent files, screenshot names).
 // The ImGui panels (panels.h) edit a ViewerState; the GLFW window (viewer.cpp) owns one, runs
 // the renderers for it and shows their images. Tests drive the state directly, or through
 // the panels in headless ImGui frames.
@@ -15,9 +16,11 @@
 #include "ui/orbit_camera.h"
 
 #include <array>
+#include <atomic>
 #include <filesystem>
 #include <future>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -54,6 +57,14 @@ enum class ConfirmChoice { Save, Discard, Cancel };
 // click real ImGui widgets by position.
 struct ItemRect { float x0 = 0, y0 = 0, x1 = 0, y1 = 0; float cx() const { return 0.5f * (x0 + x1); } float cy() const { return 0.5f * (y0 + y1); } };
 
+// Shared between the UI thread and one asynchronous load (the task holds a shared_ptr, so
+// the flags live as long as either side needs them): the UI sets `cancel`, the importer polls
+// it and reports `progress` (0..1).
+struct LoadControl {
+    std::atomic<bool> cancel{false};
+    std::atomic<float> progress{0.0f};
+};
+
 struct ViewerState {
     // --- scene and file ----------------------------------------------------------------
     sg::Scene scene;
@@ -86,6 +97,16 @@ struct ViewerState {
     // --- async load --------------------------------------------------------------------
     std::future<assets::LoadResult> loading;
     std::filesystem::path loadingPath;
+    std::shared_ptr<LoadControl> loadControl;   // of the current / last load
+
+    // --- animation (glTF node TRS clips of the loaded file) --------------------------------
+    // Playing changes node locals and re-renders (sceneVersion) but is not an edit: the dirty
+    // flag is untouched. Clips come with a load and are dropped by setScene (new scene, demo).
+    std::vector<assets::AnimationClip> animations;
+    int animationClip = 0;               // index into animations
+    double animationTime = 0.0;          // seconds, within [clip.start, clip end]
+    bool animationPlaying = false;
+    bool animationLoop = true;           // wrap at the end (else stop there)
 
     // Per-backend anti-aliasing overrides for this session (backend -> "msaa4", ...); the
     // scene's own setting (saved) applies to backends without one.
@@ -154,8 +175,14 @@ struct ViewerState {
     bool requestNew();
     bool requestQuit();
     void confirm(ConfirmChoice choice);
-    void startLoad(const std::filesystem::path& path);   // std::async
+    // std::async with a fresh LoadControl (progress + cancel).
+    void startLoad(const std::filesystem::path& path);
     bool loadInProgress() const { return loading.valid(); }
+    // Asks the running load to stop; pollLoad then keeps the current scene and reports
+    // "Loading X cancelled" (also when the importer finished before it saw the request).
+    void cancelLoad();
+    bool loadCancelRequested() const { return loadControl && loadControl->cancel.load(); }
+    float loadProgress() const { return loadControl ? loadControl->progress.load() : 0.0f; }
     // Finishes a completed load (non-blocking); returns true when a load finished.
     bool pollLoad(bool wait = false);
     // Saves to scenePath (or `path`), writing the view into the active camera first.
@@ -163,6 +190,17 @@ struct ViewerState {
     std::string save(const std::filesystem::path& path = {});
 
     void addRecent(const std::string& path);
+
+    // Animation playback. The clip's time range is [start, end] with end = its latest key.
+    const assets::AnimationClip* currentAnimation() const;
+    double animationEnd() const;                 // latest key time of the current clip
+    void selectAnimation(int index);             // stops, rewinds to the clip start, applies
+    void setAnimationPlaying(bool play);         // play at the end of a non-looping clip rewinds
+    void toggleAnimation() { setAnimationPlaying(!animationPlaying); }
+    void setAnimationTime(double t);             // scrub: clamps to the clip range and applies
+    // Called every frame: when playing, advances by dt (wrapping when looping, else stopping at
+    // the end) and applies the clip.
+    void advanceAnimation(double dt);
 };
 
 // Per-user config folder: $XDG_CONFIG_HOME/sceneviewer, else $HOME/.config/sceneviewer.
