@@ -166,7 +166,14 @@ sg::Scene makeScene(const fs::path& path, std::vector<std::pair<sg::Mesh, int>>&
     s.materials = std::move(materials);
     s.textures = std::move(textures);
     for (auto& [mesh, mat] : parts) {
-        if (mesh.mode == sg::PrimitiveMode::Triangles && mesh.normals.size() != mesh.positions.size()) mesh.computeNormals();
+        // An attribute that does not cover every vertex (e.g. a PLY file with two vertex
+        // elements of different layouts) is dropped rather than handed out inconsistent.
+        const size_t n = mesh.positions.size();
+        if (mesh.normals.size() != n) mesh.normals.clear();
+        if (mesh.uv0.size() != n) mesh.uv0.clear();
+        if (mesh.uv1.size() != n) mesh.uv1.clear();
+        if (mesh.colors.size() != n) mesh.colors.clear();
+        if (mesh.mode == sg::PrimitiveMode::Triangles && mesh.normals.empty()) mesh.computeNormals();
         s.meshes.push_back(std::make_shared<sg::Mesh>(std::move(mesh)));
         std::string name = s.meshes.back()->name.empty() ? s.name : s.meshes.back()->name;
         s.addNode(name, s.root(), sg::MeshInstance{int(s.meshes.size() - 1), mat});

@@ -63,7 +63,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         sg::FrameInput f = sg::flatten(*r.scene, 1.5f);
         size_t tris = 0;
         for (const auto& m : f.meshes) {
-            if (!m.mesh->validate().empty()) __builtin_trap();   // loaders must hand out valid meshes
+            std::string why = m.mesh->validate();
+            if (!why.empty()) {   // loaders must hand out valid meshes
+                std::fprintf(stderr, "invalid mesh from the loader: %s\n", why.c_str());
+                __builtin_trap();
+            }
             tris += m.mesh->triangleCount();
         }
         (void)tris;
