@@ -21,7 +21,10 @@ case "$t" in
   off) pat='*.off' ;; stl) pat='*.[sS][tT][lL]' ;; image) pat='*.png' ;;
 esac
 if [ -n "${pat:-}" ] && [ -d "$data" ]; then
-  find "$data" -iname "$pat" -size -300k 2>/dev/null | head -200 | while read -r f; do cp "$f" "$seeds/" 2>/dev/null || true; done
+  # Sorted, for a deterministic seed set; with pipefail the pipeline may report SIGPIPE once
+  # head has its 200 names, which is not an error.
+  { find "$data" -iname "$pat" -size -300k 2>/dev/null | sort | head -200 |
+      while read -r f; do cp "$f" "$seeds/" 2>/dev/null || true; done; } || true
 fi
 export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=0:allocator_may_return_null=1}"
 export UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}"
