@@ -92,16 +92,21 @@ std::string readFileLimited(const fs::path& path, uint64_t maxBytes, std::string
         return path.string() + ": file too large (" + std::to_string(st.st_size) + " bytes, limit " + std::to_string(maxBytes) + ")";
     }
     out.resize(size_t(st.st_size));
+    out.resize(readFully(fd, out.data(), out.size()));
+    ::close(fd);
+    return {};
+}
+
+size_t readFully(int fd, void* buffer, size_t n) {
+    auto* p = static_cast<char*>(buffer);
     size_t done = 0;
-    while (done < out.size()) {
-        ssize_t r = ::read(fd, out.data() + done, out.size() - done);
+    while (done < n) {
+        ssize_t r = ::read(fd, p + done, n - done);
         if (r < 0 && errno == EINTR) continue;
         if (r <= 0) break;
         done += size_t(r);
     }
-    ::close(fd);
-    out.resize(done);
-    return {};
+    return done;
 }
 
 fs::path uniquePath(const fs::path& path) {

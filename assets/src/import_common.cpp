@@ -1,6 +1,8 @@
 // import_common.cpp - see import_common.h.
 #include "import_common.h"
 
+#include "assets/files.h"
+
 #include <algorithm>
 #include <cerrno>
 #include <climits>
@@ -177,15 +179,8 @@ std::string ConfinedDir::read(const std::string& rel, uint64_t maxBytes, std::ve
         return "'" + rel + "' is too large (" + std::to_string(st.st_size) + " bytes, limit " + std::to_string(maxBytes) + ")";
     }
     out.resize(size_t(st.st_size));
-    size_t done = 0;
-    while (done < out.size()) {
-        ssize_t r = ::read(fd, out.data() + done, out.size() - done);
-        if (r < 0 && errno == EINTR) continue;
-        if (r <= 0) break;
-        done += size_t(r);
-    }
+    out.resize(readFully(fd, out.data(), out.size()));
     ::close(fd);
-    out.resize(done);
     return {};
 }
 

@@ -99,27 +99,18 @@ struct Cursor {
     }
 };
 
-bool toFloat(std::string_view t, float& out) {
+// Whole-token number parse (from_chars, which rejects a leading '+': skip it for signed types).
+template <class T>
+bool parseNumber(std::string_view t, T& out) {
     if (t.empty()) return false;
     const char* b = t.data();
     if (*b == '+') ++b;
     auto r = std::from_chars(b, t.data() + t.size(), out);
     return r.ec == std::errc() && r.ptr == t.data() + t.size();
 }
-bool toDouble(std::string_view t, double& out) {
-    if (t.empty()) return false;
-    const char* b = t.data();
-    if (*b == '+') ++b;
-    auto r = std::from_chars(b, t.data() + t.size(), out);
-    return r.ec == std::errc() && r.ptr == t.data() + t.size();
-}
-bool toInt64(std::string_view t, int64_t& out) {
-    if (t.empty()) return false;
-    const char* b = t.data();
-    if (*b == '+') ++b;
-    auto r = std::from_chars(b, t.data() + t.size(), out);
-    return r.ec == std::errc() && r.ptr == t.data() + t.size();
-}
+bool toFloat(std::string_view t, float& out) { return parseNumber(t, out); }
+bool toDouble(std::string_view t, double& out) { return parseNumber(t, out); }
+bool toInt64(std::string_view t, int64_t& out) { return parseNumber(t, out); }
 bool toUint64(std::string_view t, uint64_t& out) {
     auto r = std::from_chars(t.data(), t.data() + t.size(), out);
     return !t.empty() && r.ec == std::errc() && r.ptr == t.data() + t.size();

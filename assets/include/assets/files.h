@@ -19,6 +19,10 @@ std::string writeFileAtomic(const std::filesystem::path& path, std::string_view 
 // Reads a regular file of at most maxBytes. Returns an error string or "" and fills `out`.
 std::string readFileLimited(const std::filesystem::path& path, uint64_t maxBytes, std::string& out);
 
+// Reads up to n bytes from an open descriptor, retrying on EINTR and short reads; returns the
+// number of bytes read (fewer at end of file or on error).
+size_t readFully(int fd, void* buffer, size_t n);
+
 // A path that does not exist yet: base + "-N" + ext with the smallest free N (N from 1), or
 // `path` itself when free. Used for screenshots named without overwriting.
 std::filesystem::path uniquePath(const std::filesystem::path& path);
