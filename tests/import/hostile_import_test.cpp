@@ -344,6 +344,72 @@ TEST(HostileImportTest, TruncatedAndBadIndexMeshes) {
     EXPECT_NE(r.warnings.front().find("truncated"), std::string::npos);
 }
 
+// The native scene format refers to mesh and texture files relative to the scene file: the
+// same corpus as for glTF buffers, plus references that are themselves fine but lead on (a
+// mesh whose MTL or buffer points out, a symlinked subfolder) and scenes referring to scenes.
+TEST(HostileImportTest, SceneJsonFileReferencesStayInside) {
+    Sandbox sb("scenejson");
+    writeText(sb.outside / "secret.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    writeText(sb.outside / "secret.png", "not read");
+    std::error_code ec;
+    fs::create_symlink(sb.outside / "secret.obj", sb.model / "link.obj", ec);
+    fs::create_symlink(sb.outside / "secret.png", sb.model / "link.png", ec);
+    fs::create_symlink(sb.outside, sb.model / "linkdir", ec);
+    fs::create_symlink("/dev/zero", sb.model / "zero.obj", ec);
+    ::mkfifo((sb.model / "fifo.obj").c_str(), 0600);
+    ::mkfifo((sb.model / "fifo.png").c_str(), 0600);
+    fs::create_directories(sb.model / "sub");
+    // Fine by themselves, but they point out of their own folder.
+    writeText(sb.model / "sub" / "mtl.obj", "mtllib ../../outside/secret.mtl\nusemtl red\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    Knobs k;
+    k.bufferUri = "../outside/secret.bin";
+    writeText(sb.model / "out.gltf", triangleGltf(k));
+    const std::string tri = R"({"format": "sceneviewer", "version": 1, "nodes": [{"name": "root"}], "meshes": [{"name": "t", "positions": [0,0,0, 1,0,0, 0,1,0], "indices": [0,1,2]}]})";
+    writeText(sb.model / "inner.json", tri);
+    sb.outsideEvents();   // our own writes above
+
+    auto scene = [](const std::string& section, const std::string& file) {
+        return R"({"format": "sceneviewer", "version": 1, ")" + section + R"(": [{"name": "x", "file": ")" + file +
+               R"("}], "nodes": [{"name": "root"}]})";
+    };
+    struct Case { const char* section; std::string file; const char* needle; };   // needle "" = loads
+    const Case cases[] = {
+        {"meshes", "../outside/secret.obj", "inside the scene's folder"},
+        {"meshes", "sub/../../outside/secret.obj", "inside the scene's folder"},
+        {"meshes", (sb.outside / "secret.obj").string(), "absolute"},
+        {"meshes", "/dev/zero", "absolute"},
+        {"meshes", "%2e%2e%2foutside%2fsecret.obj", "no such file"},   // no percent-decoding here
+        {"meshes", "..\\\\outside\\\\secret.obj", "no such file"},
+        {"meshes", "link.obj", "through a link"},
+        {"meshes", "linkdir/secret.obj", "through a link"},
+        {"meshes", "zero.obj", "through a link"},
+        {"meshes", "fifo.obj", "not a regular file"},
+        {"meshes", "sub", "is a folder"},
+        {"meshes", "inner.json", "must be a mesh"},
+        {"meshes", "out.gltf", "'..'"},
+        {"meshes", "sub/mtl.obj", ""},   // loads; the MTL outside is not read (a warning)
+        {"textures", "../outside/secret.png", "inside the scene's folder"},
+        {"textures", (sb.outside / "secret.png").string(), "absolute"},
+        {"textures", "link.png", "through a link"},
+        {"textures", "linkdir/secret.png", "through a link"},
+        {"textures", "fifo.png", ""},    // a placeholder and a warning naming the reason
+    };
+    int i = 0;
+    for (const Case& c : cases) {
+        fs::path file = sb.model / ("scene" + std::to_string(i++) + ".json");
+        writeText(file, scene(c.section, c.file));
+        assets::LoadResult r = quickLoad(file);
+        if (*c.needle) {
+            EXPECT_FALSE(r.scene) << c.file;
+            EXPECT_NE(r.error.find(c.needle), std::string::npos) << c.file << ": " << r.error;
+        } else {
+            EXPECT_TRUE(r.scene) << c.file << ": " << r.error;
+            EXPECT_FALSE(r.warnings.empty()) << c.file;
+        }
+    }
+    EXPECT_EQ(sb.outsideEvents(), 0) << "a file outside the scene's folder was opened";
+}
+
 TEST(HostileImportTest, MtlPointingElsewhere) {
     Sandbox sb("mtl");
     const char* libs[] = {"../outside/secret.mtl", "../../dev/zero", "/dev/zero", "/etc/passwd", "link.mtl",
@@ -407,16 +473,7 @@ TEST(GltfGeneratedTest, LightsScenesAnimations) {
     float anim[2 + 6 + 18] = {0, 2,  0, 0, 0, 4, 0, 0,
                               0, 0, 0, 1, 1, 1, 0, 0, 0,   0, 0, 0, 3, 3, 3, 0, 0, 0};
     std::string bytes(reinterpret_cast<const char*>(anim), sizeof anim);
-    static const char* b64 = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    std::string enc;
-    for (size_t i = 0; i < bytes.size(); i += 3) {
-        uint32_t v = uint32_t(uint8_t(bytes[i])) << 16 | (i + 1 < bytes.size() ? uint32_t(uint8_t(bytes[i + 1])) << 8 : 0) |
-                     (i + 2 < bytes.size() ? uint8_t(bytes[i + 2]) : 0);
-        enc += b64[v >> 18 & 63];
-        enc += b64[v >> 12 & 63];
-        enc += i + 1 < bytes.size() ? b64[v >> 6 & 63] : '=';
-        enc += i + 2 < bytes.size() ? b64[v & 63] : '=';
-    }
+    std::string enc = testing_support::base64Encode(bytes);
     auto replace = [&](const std::string& from, const std::string& to) {
         size_t at = json.find(from);
         ASSERT_NE(at, std::string::npos) << from;

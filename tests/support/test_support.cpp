@@ -50,4 +50,19 @@ void writeImage(const rnd::Framebuffer& img, const std::string& suite, const std
                                          << "%); images written to " << outputDir(suite);
 }
 
+std::string base64Encode(std::string_view bytes) {
+    static const char* b64 = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    std::string enc;
+    for (size_t i = 0; i < bytes.size(); i += 3) {
+        uint32_t v = uint32_t(uint8_t(bytes[i])) << 16;
+        if (i + 1 < bytes.size()) v |= uint32_t(uint8_t(bytes[i + 1])) << 8;
+        if (i + 2 < bytes.size()) v |= uint8_t(bytes[i + 2]);
+        enc += b64[(v >> 18) & 63];
+        enc += b64[(v >> 12) & 63];
+        enc += i + 1 < bytes.size() ? b64[(v >> 6) & 63] : '=';
+        enc += i + 2 < bytes.size() ? b64[v & 63] : '=';
+    }
+    return enc;
+}
+
 }  // namespace testing_support

@@ -8,6 +8,7 @@
 
 #include <filesystem>
 #include <string>
+#include <string_view>
 
 namespace testing_support {
 
@@ -30,5 +31,8 @@ struct ImageTolerance {
                                        const ImageTolerance& tol, const std::string& suite, const std::string& name);
 
 void writeImage(const rnd::Framebuffer& img, const std::string& suite, const std::string& name);
+
+// Standard base64 with padding (for data URIs and embedded PNGs in generated files).
+std::string base64Encode(std::string_view bytes);
 
 }  // namespace testing_support

@@ -32,18 +32,7 @@ ViewerState demoState() {
 }
 
 std::string base64(const std::vector<unsigned char>& data) {
-    static const char* k = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    std::string out;
-    for (size_t i = 0; i < data.size(); i += 3) {
-        uint32_t v = uint32_t(data[i]) << 16;
-        if (i + 1 < data.size()) v |= uint32_t(data[i + 1]) << 8;
-        if (i + 2 < data.size()) v |= uint32_t(data[i + 2]);
-        out += k[(v >> 18) & 63];
-        out += k[(v >> 12) & 63];
-        out += i + 1 < data.size() ? k[(v >> 6) & 63] : '=';
-        out += i + 2 < data.size() ? k[v & 63] : '=';
-    }
-    return out;
+    return testing_support::base64Encode(std::string_view(reinterpret_cast<const char*>(data.data()), data.size()));
 }
 
 // One triangle on node "mover" and two clips over the same keys (LINEAR "slide", STEP "step").

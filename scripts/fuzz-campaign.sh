@@ -1,0 +1,85 @@
+#!/usr/bin/env bash
+# scripts/fuzz-campaign.sh CPU_SECONDS [JOBS] [TARGET...]
+# The long fuzzing run of issue 8: every target (default: all eight) runs until it has used
+# CPU_SECONDS of CPU time (not wall time: the runs are niced so the machine stays usable, and
+# a target that gets less CPU simply runs longer). JOBS targets run at once (default: nproc).
+# A crash, timeout or out-of-memory input is kept in artifacts_TARGET and the target restarts
+# (at most 20 times) until its CPU budget is spent. The corpus in the build folder is kept
+# between runs. Results: build/fuzz/tests/fuzz/campaign/TARGET.result, and a Markdown table in
+# build/fuzz/tests/fuzz/campaign/summary.md (what README.md quotes).
+# Build first:  scripts/setup.sh fuzz   (or cmake --preset fuzz && cmake --build build/fuzz --target fuzz_all)
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+bindir="${FUZZ_BINDIR:-$root/build/fuzz/tests/fuzz}"
+data="${VIEWER_TESTDATA_DIR:-$root/../shared/testdata}"
+out="$bindir/campaign"
+ticks=$(getconf CLK_TCK)
+
+cpu_of() { # user+system CPU seconds of a live process, or empty when it is gone
+  local s
+  s=$(cat "/proc/$1/stat" 2>/dev/null) || return 0
+  s=${s##*) }  # fields after the command name
+  # shellcheck disable=SC2086
+  set -- $s
+  echo $(( (${12} + ${13}) / ticks ))
+}
+
+one() {
+  local t="$1" budget="$2" exe="$bindir/fuzz_$1"
+  [ -x "$exe" ] || { echo "fuzz-campaign: $exe not built (scripts/setup.sh fuzz)" >&2; return 1; }
+  # Seed corpus exactly as scripts/fuzz.sh makes it.
+  "$root/scripts/fuzz.sh" "$t" 1 "$bindir" "$data" > /dev/null 2>&1 || true
+  local corpus="$bindir/corpus_$t" seeds="$bindir/seeds_$t" artifacts="$bindir/artifacts_$t"
+  mkdir -p "$corpus" "$seeds" "$artifacts"
+  export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=0:allocator_may_return_null=1}"
+  export UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}"
+  local used=0 execs=0 restarts=0 wall0 cov="" log rc pid c last
+  wall0=$(date +%s)
+  : > "$out/$t.log"
+  while [ "$used" -lt "$budget" ] && [ "$restarts" -le 20 ]; do
+    log="$out/$t.run$restarts.log"
+    nice -n 19 "$exe" "$corpus" "$seeds" -max_total_time=100000000 -timeout=10 \
+      -rss_limit_mb=2048 -max_len=1048576 -artifact_prefix="$artifacts/" \
+      -print_final_stats=1 > "$log" 2>&1 &
+    pid=$!
+    last=0
+    while kill -0 "$pid" 2>/dev/null; do
+      sleep 5
+      c=$(cpu_of "$pid"); [ -n "$c" ] && last=$c
+      if [ $(( used + last )) -ge "$budget" ]; then kill -INT "$pid" 2>/dev/null || true; fi
+    done
+    set +e; wait "$pid"; rc=$?; set -e
+    used=$(( used + last ))
+    execs=$(( execs + $(grep -o 'number_of_executed_units: [0-9]*' "$log" | awk '{s+=$2} END {print s+0}') ))
+    c=$(grep -o 'cov: [0-9]* ft: [0-9]*' "$log" | tail -n 1 || true); [ -n "$c" ] && cov="$c"
+    cat "$log" >> "$out/$t.log"
+    # 72 is libFuzzer's exit code when interrupted (our budget stop); anything else is a finding.
+    if [ "$rc" -ne 72 ] && [ "$rc" -ne 0 ]; then restarts=$(( restarts + 1 )); else break; fi
+  done
+  local n_crash n_timeout n_oom files
+  n_crash=$(find "$artifacts" -name 'crash-*' | wc -l)
+  n_timeout=$(find "$artifacts" -name 'timeout-*' | wc -l)
+  n_oom=$(find "$artifacts" -name 'oom-*' -o -name 'leak-*' | wc -l)
+  files=$(find "$corpus" -type f | wc -l)
+  printf '| %s | %d | %d | %d | %s | %d | %d | %d | %d |\n' "$t" "$used" \
+    $(( $(date +%s) - wall0 )) "$execs" "${cov:-?}" "$files" "$n_crash" "$n_timeout" "$n_oom" \
+    > "$out/$t.result"
+  cat "$out/$t.result"
+}
+
+if [ "${1:-}" = --one ]; then mkdir -p "$out"; one "$2" "$3"; exit; fi
+
+budget="${1:?usage: fuzz-campaign.sh CPU_SECONDS [JOBS] [TARGET...]}"
+jobs="${2:-$(nproc)}"
+shift; [ $# -gt 0 ] && shift
+targets=("$@"); [ ${#targets[@]} -gt 0 ] || targets=(scene_json gltf glb obj ply off stl image)
+mkdir -p "$out"
+printf '%s\n' "${targets[@]}" | xargs -P "$jobs" -I{} "$0" --one {} "$budget"
+{
+  echo "Fuzzing campaign $(date -u +%Y-%m-%d), $budget CPU-seconds per target, clang $(clang-14 --version | head -n 1 | grep -o '[0-9][0-9.]*' | head -n 1), -fsanitize=fuzzer,address,undefined"
+  echo
+  echo "| target | CPU s | wall s | inputs run | coverage (edges, features) | corpus files | crashes | timeouts | OOM/leaks |"
+  echo "|---|---|---|---|---|---|---|---|---|"
+  for t in "${targets[@]}"; do cat "$out/$t.result"; done
+} > "$out/summary.md"
+cat "$out/summary.md"
