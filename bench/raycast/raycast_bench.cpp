@@ -1,18 +1,23 @@
-// raycast_bench.cpp - our BVH4 traversal vs Embree 3 on the same scenes and the same rays.
+// raycast_bench.cpp - our BVH4/BVH8 traversal vs Embree 3 on the same scenes and the same rays.
 //
 //   ./build/release/bench/raycast/bench_raycast            # full run (sphere grids 10k/100k/1M + bunny)
 //   ./build/release/bench/raycast/bench_raycast --quick    # < 1 minute: fewer repetitions, 640x360 rays
-//   options: --scene NAME (run one scene), --testdata DIR
+//   options: --scene NAME (run one scene), --testdata DIR, --build-only (only the 1-thread
+//   builds, ours and Embree alternating --reps N times, medians; also for profilers, e.g.
+//   valgrind --tool=callgrind --toggle-collect='rnd::rt::TriangleBvh::build*')
 //
 // Prints one line per scene and measure:
 //   bench: scene=<name> what=<metric> ours=<x> ref=<y> ratio=<ours/ref>
-// Metrics: build_1t / build_2t (Mtris/s; ours binned SAH BVH4, Embree RTC_BUILD_QUALITY_MEDIUM),
+// Metrics: build_1t / build_2t (Mtris/s; ours binned SAH BVH8 (AVX2) or BVH4, Embree RTC_BUILD_QUALITY_MEDIUM),
 // primary / shadow / incoherent rays on 1 and 2 threads (Mrays/s; our TriangleBvh::intersect /
 // occluded vs rtcIntersect1 / rtcOccluded1, one ray at a time, FTZ/DAZ on), and agreement_* (%
 // of rays where both agree: same hit/miss, and for hits the same primitive - or the same
 // distance for ties on shared edges - and distance within 1e-4 relative).
 // Timing: 1-thread figures (rays and build) use the thread's CPU clock (the machine is shared; wall time would
-// count other people's work), 2-thread figures and build times use wall time.
+// count other people's work), 2-thread figures use wall time. Builds: medians of 3 (--quick) or 5
+// alternating runs; 1-thread builds run inside a 1-thread TBB arena (see measureBuilds: before
+// that, Embree's threads=1 build borrowed idle TBB workers and was timed on one thread while
+// using two). BENCH_DEBUG=1 prints each 1-thread build's thread CPU, wall and process CPU time.
 // Ray classes: primary = 1280x720 pinhole camera rays; shadow = from each primary hit toward a
 // point light; incoherent = from each primary hit in a random cosine-weighted hemisphere
 // direction about the geometric normal.
@@ -28,9 +33,11 @@
 #include <pmmintrin.h>
 #include <xmmintrin.h>
 
+#include <algorithm>
 #include <chrono>
 #include <ctime>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <functional>
@@ -247,40 +254,69 @@ bool sameHit(const TriHit& a, const TriHit& b) {
     return a.prim == b.prim || std::abs(a.t - b.t) <= 1e-6f * std::max(1.0f, a.t);
 }
 
+// Build times (seconds, medians over `reps`, the builders alternating). One thread: ours with
+// parallel=false and Embree's threads=1 device, each inside a 1-thread task arena and timed by
+// the thread's CPU clock. (Without the arena Embree's "threads=1" build borrows idle TBB workers
+// left by an earlier parallel build: process CPU twice its wall time, an inflated reference.)
+// Two threads: wall time.
+struct BuildTimes { double ours1 = 0, ref1 = 0, ours2 = 0, ref2 = 0; };
+BuildTimes measureBuilds(const Scene& s, TriangleBvh& bvh, int reps, bool twoThreads = true) {
+    rnd::rt::Bvh4::BuildOptions single;
+    single.parallel = false;
+    std::vector<double> o1, r1, o2, r2;
+    Embree e1(1), e2(2);
+    tbb::task_arena one(1), two(2);
+    auto cpu = [&](const std::function<void()>& fn) {
+        double c = 0;
+        one.execute([&] {
+            timespec p0, p1;
+            clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &p0);
+            auto w0 = Clock::now();
+            double c0 = threadCpuSeconds();
+            fn();
+            c = threadCpuSeconds() - c0;
+            clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &p1);
+            if (std::getenv("BENCH_DEBUG"))
+                std::printf("  1t build: thread cpu %.1f ms, wall %.1f ms, process cpu %.1f ms\n", c * 1e3, seconds(w0, Clock::now()) * 1e3,
+                            (p1.tv_sec - p0.tv_sec) * 1e3 + (p1.tv_nsec - p0.tv_nsec) * 1e-6);
+        });
+        return c;
+    };
+    for (int r = 0; r < reps; ++r) {
+        o1.push_back(cpu([&] { bvh.build(s.pos.data(), s.idx.data(), s.tris(), single); }));
+        r1.push_back(cpu([&] { e1.build(s); }));
+        if (!twoThreads) continue;
+        two.execute([&] {
+            auto t1 = Clock::now();
+            bvh.build(s.pos.data(), s.idx.data(), s.tris());
+            o2.push_back(seconds(t1, Clock::now()));
+        });
+        r2.push_back(e2.build(s));
+    }
+    auto median = [](std::vector<double>& v) {
+        if (v.empty()) return 0.0;
+        std::sort(v.begin(), v.end());
+        return v[v.size() / 2];
+    };
+    return {median(o1), median(r1), median(o2), median(r2)};
+}
+
 void runScene(const Scene& s, bool quick) {
     const double minT = quick ? 0.0 : 0.4;
     const int W = quick ? 640 : 1280, H = quick ? 360 : 720;
     // --- build --------------------------------------------------------------------------
     TriangleBvh bvh;
-    rnd::rt::Bvh4::BuildOptions single;
-    single.parallel = false;
-    double oursB1 = 1e30, oursB2 = 1e30, refB1 = 1e30, refB2 = 1e30;
-    int reps = quick ? 1 : 3;
-    Embree e1(1), e2(2);
-    for (int r = 0; r < reps; ++r) {
-        double c0 = threadCpuSeconds();
-        bvh.build(s.pos.data(), s.idx.data(), s.tris(), single);
-        oursB1 = std::min(oursB1, threadCpuSeconds() - c0);
-        tbb::task_arena arena(2);
-        arena.execute([&] {
-            auto t1 = Clock::now();
-            bvh.build(s.pos.data(), s.idx.data(), s.tris());
-            oursB2 = std::min(oursB2, seconds(t1, Clock::now()));
-        });
-        {   // Embree with threads=1 builds on the calling thread: its CPU clock applies too
-            double c1 = threadCpuSeconds();
-            e1.build(s);
-            refB1 = std::min(refB1, threadCpuSeconds() - c1);
-        }
-        refB2 = std::min(refB2, e2.build(s));
-    }
+    const BuildTimes bt = measureBuilds(s, bvh, quick ? 3 : 5);
+    const double oursB1 = bt.ours1, refB1 = bt.ref1, oursB2 = bt.ours2, refB2 = bt.ref2;
     const double mt = double(s.tris()) * 1e-6;
     line(s.name, "build_1t_Mtris/s", mt / oursB1, mt / refB1);
     line(s.name, "build_2t_Mtris/s", mt / oursB2, mt / refB2);
     std::printf("bench: scene=%s info tris=%zu build_ms ours_1t=%.2f embree_1t=%.2f ours_2t=%.2f embree_2t=%.2f bvh_MB=%.1f\n",
                 s.name.c_str(), s.tris(), oursB1 * 1e3, refB1 * 1e3, oursB2 * 1e3, refB2 * 1e3, bvh.memoryBytes() / 1048576.0);
 
-    // --- rays ----------------------------------------------------------------------------
+    // --- rays (ours traced on the tree of the last, parallel, build: what the renderer uses)
+    Embree e1(1), e2(2);
+    e1.build(s);
     mat4 view = glm::lookAt(s.eye, s.target, vec3(0, 1, 0));
     mat4 proj = glm::perspective(radians(45.0f), float(W) / H, 0.01f, 1000.0f);
     mat4 inv = glm::inverse(proj * view);
@@ -370,14 +406,17 @@ void runScene(const Scene& s, bool quick) {
 }  // namespace
 
 int main(int argc, char** argv) {
-    bool quick = false;
+    bool quick = false, buildOnly = false;
+    int reps = 1;
     std::string only, testdata = VIEWER_TESTDATA_DIR;
     for (int i = 1; i < argc; ++i) {
         std::string a = argv[i];
         if (a == "--quick") quick = true;
         else if (a == "--scene" && i + 1 < argc) only = argv[++i];
         else if (a == "--testdata" && i + 1 < argc) testdata = argv[++i];
-        else { std::fprintf(stderr, "usage: %s [--quick] [--scene NAME] [--testdata DIR]\n", argv[0]); return 2; }
+        else if (a == "--build-only") buildOnly = true;
+        else if (a == "--reps" && i + 1 < argc) reps = std::max(1, std::atoi(argv[++i]));
+        else { std::fprintf(stderr, "usage: %s [--quick] [--scene NAME] [--testdata DIR] [--build-only [--reps N]]\n", argv[0]); return 2; }
     }
     if (const char* env = std::getenv("VIEWER_TESTDATA")) testdata = env;
     setFtzDaz();
@@ -393,6 +432,13 @@ int main(int argc, char** argv) {
         if (!only.empty() && sp.name != only) continue;
         Scene s = sp.make();
         if (s.idx.empty()) { std::fprintf(stderr, "bench: scene=%s skipped: %s\n", sp.name.c_str(), err.c_str()); continue; }
+        if (buildOnly) {
+            TriangleBvh bvh;
+            const BuildTimes bt = measureBuilds(s, bvh, reps, /*twoThreads=*/false);
+            const double mt = double(s.tris()) * 1e-6;
+            line(s.name, "build_1t_Mtris/s", mt / bt.ours1, mt / bt.ref1);
+            continue;
+        }
         runScene(s, quick);
     }
     return 0;

@@ -23,6 +23,7 @@ static double cpuNow() { timespec ts; clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts
 #include <tbb/blocked_range.h>
 
 #include <immintrin.h>
+#include <sys/mman.h>
 
 #include <algorithm>
 #include <cstdlib>
@@ -34,7 +35,38 @@ namespace rnd::rt {
 
 using sg::vec3;
 
+// --- big allocations ------------------------------------------------------------------------
+
 namespace {
+constexpr size_t kHugeMin = size_t(4) << 20, kHugePage = size_t(2) << 20, kPage = 4096;
+size_t pageRound(size_t b) { return (b + kPage - 1) & ~(kPage - 1); }
+}  // namespace
+
+void* hugeAlloc(size_t bytes) {
+    if (bytes < kHugeMin) return ::operator new(bytes, std::align_val_t(64));
+    // Map 2 MB more than needed, keep a 2 MB aligned window, give the rest back.
+    const size_t len = pageRound(bytes), span = len + kHugePage;
+    void* m = ::mmap(nullptr, span, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (m == MAP_FAILED) throw std::bad_alloc();
+    uintptr_t base = reinterpret_cast<uintptr_t>(m), aligned = (base + kHugePage - 1) & ~(kHugePage - 1);
+    if (aligned > base) ::munmap(m, aligned - base);
+    if (base + span > aligned + len) ::munmap(reinterpret_cast<void*>(aligned + len), base + span - (aligned + len));
+    ::madvise(reinterpret_cast<void*>(aligned), len, MADV_HUGEPAGE);   // advice only: may fail harmlessly
+    return reinterpret_cast<void*>(aligned);
+}
+
+void hugeFree(void* p, size_t bytes) noexcept {
+    if (!p) return;
+    if (bytes < kHugeMin) ::operator delete(p, std::align_val_t(64));
+    else ::munmap(p, pageRound(bytes));
+}
+
+namespace {
+
+struct HugeDeleter {
+    size_t bytes;
+    void operator()(void* p) const noexcept { hugeFree(p, bytes); }
+};
 
 // --- PrimRef + binning ----------------------------------------------------------------------
 
@@ -101,45 +133,80 @@ bool splitRange(PrimRef* refs, const Range& r, Range& l, Range& rr, int nbins, i
     // Few primitives need few bins: the per-split fixed cost (clearing and sweeping the bins)
     // otherwise dominates the many small splits near the leaves.
     if (int(n) < nbins) nbins = std::max(4, int(n));
+    // Big ranges get twice the bins (up to 32): the few top-level splits decide most of the
+    // tree's quality (1M triangles: shadow rays ~5% faster, build ~4% slower).
+    if (n >= 1024) nbins = std::min(2 * nbins, kMaxBins);
     // Tiny ranges (a few leaves' worth): an object-median split on the widest centroid axis
     // costs a fraction of a binned SAH evaluation and loses little quality this close to the
     // leaves; the many splits down here otherwise dominate the build time.
     if (n <= uint32_t(2 * leafSize)) forceMedian = true;
-    // Per axis and bin: primitive bounds (lo/hi) and counts.
-    // Left uninitialised beyond nbins on purpose (only [0, nbins) is touched).
-    __m128 blo[3][kMaxBins], bhi[3][kMaxBins];
-    uint32_t counts[3][kMaxBins];
+    // Per axis and bin: primitive bounds (lo/hi side by side: one address per update) and
+    // counts. Left uninitialised beyond nbins on purpose (only [0, nbins) is touched).
+    // Neighbouring primitives usually fall into the same bins, so each update waits for the
+    // previous one's store: big ranges bin even and odd primitives into two sets (two
+    // independent dependency chains) merged afterwards.
+    struct Bin { __m128 lo, hi; };
+    Bin bins[3][kMaxBins], bins1[3][kMaxBins];
+    uint32_t counts[3][kMaxBins], counts1[3][kMaxBins];
     if (!forceMedian) {
+        const bool twoSets = n >= 256;
         const __m128 inf = _mm_set1_ps(std::numeric_limits<float>::infinity()), ninf = _mm_set1_ps(-std::numeric_limits<float>::infinity());
         for (int a = 0; a < 3; ++a)
-            for (int b = 0; b < nbins; ++b) { blo[a][b] = inf; bhi[a][b] = ninf; counts[a][b] = 0; }
+            for (int b = 0; b < nbins; ++b) {
+                bins[a][b].lo = inf; bins[a][b].hi = ninf; counts[a][b] = 0;
+                if (twoSets) { bins1[a][b].lo = inf; bins1[a][b].hi = ninf; counts1[a][b] = 0; }
+            }
         for (int a = 0; a < 3; ++a) scale[a] = ext[a] > 0 ? float(nbins) * 0.99999f / ext[a] : 0.0f;
         const __m128 sc = _mm_setr_ps(scale[0], scale[1], scale[2], 0.0f);
         const __m128 cm = r.centroids.lo;
-        const __m128i maxBin = _mm_set1_epi32(nbins - 1);
-        for (uint32_t i = r.begin; i < r.end; ++i) {
-            const PrimRef& p = refs[i];
-            const __m128 c = p.center2();
-            __m128i bi = _mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(c, cm), sc));
-            // clamp to [0, nbins-1] (SSE2 has no min_epi32: compare and blend)
-            __m128i gt = _mm_cmpgt_epi32(bi, maxBin);
-            bi = _mm_or_si128(_mm_and_si128(gt, maxBin), _mm_andnot_si128(gt, bi));
-            bi = _mm_and_si128(bi, _mm_cmpgt_epi32(bi, _mm_set1_epi32(-1)));
-            alignas(16) int b[4];
-            _mm_store_si128(reinterpret_cast<__m128i*>(b), bi);
+        const __m128 zero = _mm_setzero_ps(), maxBin = _mm_set1_ps(float(nbins - 1));
+        // Bin index per axis, clamped in float before the conversion (max first: NaN -> 0).
+        auto binOf = [&](const PrimRef& p) {
+            return _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(_mm_mul_ps(_mm_sub_ps(p.center2(), cm), sc), zero), maxBin));
+        };
+        auto add = [](Bin (*set)[kMaxBins], uint32_t (*cnt)[kMaxBins], const PrimRef& p, const int* b) {
             for (int a = 0; a < 3; ++a) {
-                const int k = b[a];
-                blo[a][k] = _mm_min_ps(blo[a][k], p.lo);
-                bhi[a][k] = _mm_max_ps(bhi[a][k], p.hi);
-                ++counts[a][k];
+                Bin& x = set[a][b[a]];
+                x.lo = _mm_min_ps(x.lo, p.lo);
+                x.hi = _mm_max_ps(x.hi, p.hi);
+                ++cnt[a][b[a]];
+            }
+        };
+        uint32_t i = r.begin;
+        if (twoSets) {
+            for (; i + 1 < r.end; i += 2) {
+                alignas(16) int b0[4], b1[4];
+                _mm_store_si128(reinterpret_cast<__m128i*>(b0), binOf(refs[i]));
+                _mm_store_si128(reinterpret_cast<__m128i*>(b1), binOf(refs[i + 1]));
+                add(bins, counts, refs[i], b0);
+                add(bins1, counts1, refs[i + 1], b1);
             }
         }
+        for (; i < r.end; ++i) {
+            alignas(16) int b0[4];
+            _mm_store_si128(reinterpret_cast<__m128i*>(b0), binOf(refs[i]));
+            add(bins, counts, refs[i], b0);
+        }
+        if (twoSets)
+            for (int a = 0; a < 3; ++a)
+                for (int b = 0; b < nbins; ++b) {
+                    bins[a][b].lo = _mm_min_ps(bins[a][b].lo, bins1[a][b].lo);
+                    bins[a][b].hi = _mm_max_ps(bins[a][b].hi, bins1[a][b].hi);
+                    counts[a][b] += counts1[a][b];
+                }
         auto halfArea = [](__m128 lo, __m128 hi) {
             __m128 e = _mm_max_ps(_mm_sub_ps(hi, lo), _mm_setzero_ps());
             __m128 e2 = _mm_shuffle_ps(e, e, _MM_SHUFFLE(3, 0, 2, 1));   // (y, z, x)
-            alignas(16) float m[4];
-            _mm_store_ps(m, _mm_mul_ps(e, e2));
-            return m[0] + m[1] + m[2];
+            __m128 m = _mm_mul_ps(e, e2);                                  // (xy, yz, zx, w*w)
+            // xy + yz + zx in registers: ((xy + yz) + zx), the same order as before.
+            __m128 s01 = _mm_add_ss(m, _mm_shuffle_ps(m, m, _MM_SHUFFLE(1, 1, 1, 1)));
+            return _mm_cvtss_f32(_mm_add_ss(s01, _mm_movehl_ps(m, m)));
+        };
+        // Leaf blocks: a shift for the usual power-of-two leaf sizes (an integer division per
+        // candidate split otherwise costs more than the rest of the sweep).
+        const int leafShift = leafSize == 4 ? 2 : leafSize == 2 ? 1 : leafSize == 1 ? 0 : -1;
+        auto blocksOf = [&](uint32_t c) {
+            return leafShift >= 0 ? float((c + uint32_t(leafSize) - 1) >> leafShift) : float(blocks(c, leafSize));
         };
         for (int a = 0; a < 3; ++a) {
             if (!(ext[a] > 0)) continue;
@@ -148,8 +215,8 @@ bool splitRange(PrimRef* refs, const Range& r, Range& l, Range& rr, int nbins, i
             __m128 lo = _mm_set1_ps(std::numeric_limits<float>::infinity()), hi = _mm_set1_ps(-std::numeric_limits<float>::infinity());
             uint32_t cnt = 0;
             for (int i = nbins - 1; i > 0; --i) {
-                lo = _mm_min_ps(lo, blo[a][i]);
-                hi = _mm_max_ps(hi, bhi[a][i]);
+                lo = _mm_min_ps(lo, bins[a][i].lo);
+                hi = _mm_max_ps(hi, bins[a][i].hi);
                 cnt += counts[a][i];
                 rightArea[i] = halfArea(lo, hi);
                 rightCount[i] = cnt;
@@ -158,11 +225,11 @@ bool splitRange(PrimRef* refs, const Range& r, Range& l, Range& rr, int nbins, i
             hi = _mm_set1_ps(-std::numeric_limits<float>::infinity());
             cnt = 0;
             for (int i = 1; i < nbins; ++i) {
-                lo = _mm_min_ps(lo, blo[a][i - 1]);
-                hi = _mm_max_ps(hi, bhi[a][i - 1]);
+                lo = _mm_min_ps(lo, bins[a][i - 1].lo);
+                hi = _mm_max_ps(hi, bins[a][i - 1].hi);
                 cnt += counts[a][i - 1];
                 if (cnt == 0 || rightCount[i] == 0) continue;
-                float cost = halfArea(lo, hi) * float(blocks(cnt, leafSize)) + rightArea[i] * float(blocks(rightCount[i], leafSize));
+                float cost = halfArea(lo, hi) * blocksOf(cnt) + rightArea[i] * blocksOf(rightCount[i]);
                 if (cost < bestCost) { bestCost = cost; bestAxis = a; bestPos = i; }
             }
         }
@@ -174,10 +241,13 @@ bool splitRange(PrimRef* refs, const Range& r, Range& l, Range& rr, int nbins, i
         const int a = bestAxis, pos = bestPos;
         // Two-pointer partition that also gathers the children's centroid bounds (their
         // primitive bounds come from the bins), so no further pass over the primitives.
+        // Bin index < pos, i.e. trunc(clamp((c - cm) * s, 0, nbins - 1)) < pos, is (c - cm) * s
+        // < pos for the finite centroids here (the same float operations as the binning, so
+        // both agree exactly); one SIMD compare, lane a.
+        const __m128 cmv = _mm_set1_ps(cm), sv = _mm_set1_ps(s), posv = _mm_set1_ps(float(pos));
+        const int laneBit = 1 << a;
         auto goesLeft = [&](const PrimRef& p) {
-            alignas(16) float c[4];
-            _mm_store_ps(c, p.center2());
-            return std::min(int((c[a] - cm) * s), nbins - 1) < pos;
+            return (_mm_movemask_ps(_mm_cmplt_ps(_mm_mul_ps(_mm_sub_ps(p.center2(), cmv), sv), posv)) & laneBit) != 0;
         };
         Box lc, rc;
         PrimRef* lo = refs + r.begin;
@@ -199,8 +269,8 @@ bool splitRange(PrimRef* refs, const Range& r, Range& l, Range& rr, int nbins, i
             rr = Range();
             l.begin = r.begin; l.end = mid;
             rr.begin = mid; rr.end = r.end;
-            for (int i = 0; i < pos; ++i) l.bounds.extend(blo[a][i], bhi[a][i]);
-            for (int i = pos; i < nbins; ++i) rr.bounds.extend(blo[a][i], bhi[a][i]);
+            for (int i = 0; i < pos; ++i) l.bounds.extend(bins[a][i].lo, bins[a][i].hi);
+            for (int i = pos; i < nbins; ++i) rr.bounds.extend(bins[a][i].lo, bins[a][i].hi);
             l.centroids = lc;
             rr.centroids = rc;
             return true;
@@ -232,6 +302,7 @@ template <int W> struct Builder {
     PrimRef* refs;
     Node* nodes;
     std::atomic<uint32_t> nodeCount{0};
+    std::atomic<bool> spawned{false};   // subtrees built by tasks interleave their nodes
     int nbins, leafSize;
     bool parallel;
 
@@ -287,6 +358,7 @@ template <int W> struct Builder {
         if (parallel)
             for (int i = 0; i < nk; ++i) spawn |= childIndex[i] != ~0u && kids[i].count() > 4096;
         if (spawn) {
+            spawned.store(true, std::memory_order_relaxed);
             tbb::task_group tg;
             for (int i = 0; i < nk; ++i)
                 if (childIndex[i] != ~0u) {
@@ -316,13 +388,12 @@ template <int W> int subtreeDepth(const std::vector<NodeW<W>>& nodes, uint32_t r
 
 namespace detail {
 // Builds from prepared refs (shared by Bvh4::build and TriangleBvh::build).
-template <int W>
-void buildFromRefs(std::vector<PrimRef>& refs, const Bvh4::BuildOptions& opt, std::vector<NodeW<W>>& outNodes,
+template <int W, class NodeVec>
+void buildFromRefs(PrimRef* refs, size_t n, const Bvh4::BuildOptions& opt, NodeVec& outNodes,
                    std::vector<uint32_t>& outPrims, sg::Aabb& outBounds) {
     outNodes.clear();
     outPrims.clear();
     outBounds = sg::Aabb();
-    const size_t n = refs.size();
     if (n == 0) return;
     const int leafSize = std::clamp(opt.maxLeafSize, 1, 4);
     const int nbins = std::clamp(opt.bins, 2, kMaxBins);
@@ -346,12 +417,13 @@ void buildFromRefs(std::vector<PrimRef>& refs, const Bvh4::BuildOptions& opt, st
         root.bounds = acc.b;
         root.centroids = acc.c;
     } else {
-        computeBounds(refs.data(), root);
+        computeBounds(refs, root);
     }
 
     // Inner nodes <= primitives (every inner node has >= 2 children); +1 for a wrapped leaf.
-    std::unique_ptr<NodeW<W>[]> storage(new NodeW<W>[n + 1]);
-    Builder<W> b{refs.data(), storage.get(), {}, nbins, leafSize, opt.parallel};
+    const size_t storageBytes = (n + 1) * sizeof(NodeW<W>);
+    std::unique_ptr<NodeW<W>[], HugeDeleter> storage(static_cast<NodeW<W>*>(hugeAlloc(storageBytes)), HugeDeleter{storageBytes});
+    Builder<W> b{refs, storage.get(), {}, {}, nbins, leafSize, opt.parallel};
     b.nodeCount = 1;
     if (root.count() <= uint32_t(leafSize)) {
         NodeW<W>& r = storage[0];
@@ -366,19 +438,28 @@ void buildFromRefs(std::vector<PrimRef>& refs, const Bvh4::BuildOptions& opt, st
         PROBE("inner");
     }
     const uint32_t count = b.nodeCount.load();
-    // Lay the nodes out in depth-first order (the parallel build interleaves subtrees built
-    // by different threads): a parent's first child follows it, which helps the caches.
-    outNodes.resize(count);
-    {
-        std::vector<uint32_t> stack{0};
-        uint32_t next = 0;
+    // Layout: each node's inner children side by side (the traversal tests a node's child
+    // boxes at once and then usually visits siblings next), groups in depth-first order. A
+    // serial build allocates exactly so (measured on 1M triangles, 1 thread: coherent rays
+    // ~8-15% faster than a plain depth-first preorder); subtrees built by parallel tasks
+    // interleave, so those are laid out again in the same order.
+    if (!b.spawned.load()) {
+        outNodes.assign(storage.get(), storage.get() + count);
+    } else {
+        outNodes.resize(count);
         std::vector<uint32_t> newIndex(count, ~0u);
-        // Pass 1: assign new indices in DFS preorder.
+        std::vector<uint32_t> stack{0};
+        newIndex[0] = 0;
+        uint32_t next = 1;
+        // Pass 1: number the children of each node together, visiting nodes depth first.
         while (!stack.empty()) {
             uint32_t old = stack.back();
             stack.pop_back();
-            newIndex[old] = next++;
             const NodeW<W>& nd = storage[old];
+            for (int i = 0; i < W; ++i) {
+                uint32_t c = nd.child[i];
+                if (c != NodeBits::kEmpty && !(c & NodeBits::kLeafBit)) newIndex[c] = next++;
+            }
             for (int i = W - 1; i >= 0; --i) {
                 uint32_t c = nd.child[i];
                 if (c != NodeBits::kEmpty && !(c & NodeBits::kLeafBit)) stack.push_back(c);
@@ -414,7 +495,7 @@ void Bvh4::build(const vec3* boxMin, const vec3* boxMax, size_t n, const BuildOp
         if (!(mn.x <= mx.x && mn.y <= mx.y && mn.z <= mx.z) || !sg::isFinite(mn) || !sg::isFinite(mx)) continue;
         refs.push_back(makeRef(mn, mx, uint32_t(i)));
     }
-    detail::buildFromRefs<4>(refs, opt, m_nodes, m_primIndex, m_bounds);
+    detail::buildFromRefs<4>(refs.data(), refs.size(), opt, m_nodes, m_primIndex, m_bounds);
 }
 
 int Bvh4::depth() const { return m_nodes.empty() ? 0 : subtreeDepth<4>(m_nodes, 0); }
@@ -422,17 +503,22 @@ int Bvh4::depth() const { return m_nodes.empty() ? 0 : subtreeDepth<4>(m_nodes, 
 namespace {
 // Packet lane k from triangle p0, p1, p2.
 // noinline: the AVX2 brute force must build lanes bit-identically to the (SSE-compiled) build.
-__attribute__((noinline)) void setLane(TriPacket4& p, int k, const vec3& p0, const vec3& p1, const vec3& p2) {
+// (The builder inlines setLaneInline: it is compiled for the baseline target, so no FMA
+// contraction can make the two differ.)
+inline __attribute__((always_inline)) void setLaneInline(TriPacket4& p, int k, const vec3& p0, const vec3& p1, const vec3& p2) {
     vec3 e1 = p1 - p0, e2 = p2 - p0, n = glm::cross(e1, e2);
     for (int a = 0; a < 3; ++a) { p.v0[a][k] = p0[a]; p.e1[a][k] = e1[a]; p.e2[a][k] = e2[a]; p.n[a][k] = n[a]; }
+}
+__attribute__((noinline)) void setLane(TriPacket4& p, int k, const vec3& p0, const vec3& p1, const vec3& p2) {
+    setLaneInline(p, k, p0, p1, p2);
 }
 }  // namespace
 
 namespace {
 // One packet per leaf, in node order; leaf refs are rewritten to packet indices.
 template <int W>
-void makePackets(std::vector<NodeW<W>>& nodes, const std::vector<uint32_t>& prims, const vec3* pos, const uint32_t* idx,
-                 std::vector<TriPacket4>& packets) {
+void makePackets(HugeVector<NodeW<W>>& nodes, const std::vector<uint32_t>& prims, const vec3* pos, const uint32_t* idx,
+                 HugeVector<TriPacket4>& packets) {
     packets.reserve(prims.size() / 2 + 1);
     for (NodeW<W>& n : nodes)
         for (uint32_t& c : n.child) {
@@ -442,7 +528,7 @@ void makePackets(std::vector<NodeW<W>>& nodes, const std::vector<uint32_t>& prim
             for (uint32_t k = 0; k < 4; ++k) {
                 if (k >= count) { p.prim[k] = ~0u; continue; }
                 uint32_t t = prims[first + k];
-                setLane(p, int(k), pos[idx[3 * t]], pos[idx[3 * t + 1]], pos[idx[3 * t + 2]]);
+                setLaneInline(p, int(k), pos[idx[3 * t]], pos[idx[3 * t + 1]], pos[idx[3 * t + 2]]);
                 p.prim[k] = t;
             }
             c = NodeBits::kLeafBit | (uint32_t(packets.size()) << 3) | count;
@@ -460,26 +546,42 @@ void TriangleBvh::build(const vec3* pos, const uint32_t* idx, size_t triCount, c
 #ifdef BVH_TIMING
     double tProbe = cpuNow();
 #endif
-    std::vector<PrimRef> refs(triCount);
-    std::vector<uint8_t> ok(triCount);
+    // Refs without zero-filling (every slot is written), compacted in place only when some
+    // triangle has a non-finite coordinate (keeps the tree sane on bad input).
+    const size_t refBytes = std::max<size_t>(triCount, 1) * sizeof(PrimRef);
+    std::unique_ptr<PrimRef[], HugeDeleter> refs(static_cast<PrimRef*>(hugeAlloc(refBytes)), HugeDeleter{refBytes});
+    std::atomic<bool> allFinite{true};
     auto makeRange = [&](size_t b, size_t e) {
+        const __m128 zero = _mm_setzero_ps();
+        bool finite = true;
         for (size_t t = b; t < e; ++t) {
             const vec3 &p0 = pos[idx[3 * t]], &p1 = pos[idx[3 * t + 1]], &p2 = pos[idx[3 * t + 2]];
-            vec3 mn = glm::min(p0, glm::min(p1, p2)), mx = glm::max(p0, glm::max(p1, p2));
-            ok[t] = sg::isFinite(mn) && sg::isFinite(mx);
-            refs[t] = makeRef(mn, mx, uint32_t(t));
+            __m128 a = _mm_setr_ps(p0.x, p0.y, p0.z, 0), c = _mm_setr_ps(p1.x, p1.y, p1.z, 0), d = _mm_setr_ps(p2.x, p2.y, p2.z, 0);
+            __m128 mn = _mm_min_ps(a, _mm_min_ps(c, d)), mx = _mm_max_ps(a, _mm_max_ps(c, d));
+            // x - x is 0 exactly for finite x (NaN otherwise); a NaN coordinate may also be
+            // dropped by min/max, so check the vertices themselves.
+            __m128 all = _mm_add_ps(_mm_add_ps(_mm_sub_ps(a, a), _mm_sub_ps(c, c)), _mm_sub_ps(d, d));
+            finite &= _mm_movemask_ps(_mm_cmpeq_ps(all, zero)) == 0xF;
+            // lo = (min.xyz, id bits): tmp = (min.z, min.z, id, id), then pick x, y from min.
+            __m128 idv = _mm_castsi128_ps(_mm_cvtsi32_si128(int(uint32_t(t))));
+            __m128 tmp = _mm_shuffle_ps(mn, idv, _MM_SHUFFLE(0, 0, 2, 2));
+            refs[t].lo = _mm_shuffle_ps(mn, tmp, _MM_SHUFFLE(2, 0, 1, 0));
+            refs[t].hi = mx;
         }
+        if (!finite) allFinite.store(false, std::memory_order_relaxed);
     };
     if (opt.parallel && triCount > 65536)
         tbb::parallel_for(tbb::blocked_range<size_t>(0, triCount, 16384),
                           [&](const tbb::blocked_range<size_t>& r) { makeRange(r.begin(), r.end()); });
     else
         makeRange(0, triCount);
-    // Drop non-finite triangles (keeps the tree sane on bad input).
-    size_t w = 0;
-    for (size_t t = 0; t < triCount; ++t)
-        if (ok[t]) refs[w++] = refs[t];
-    refs.resize(w);
+    size_t refCount = triCount;
+    if (!allFinite.load()) {
+        size_t w = 0;
+        for (size_t t = 0; t < triCount; ++t)
+            if (sg::isFinite(pos[idx[3 * t]]) && sg::isFinite(pos[idx[3 * t + 1]]) && sg::isFinite(pos[idx[3 * t + 2]])) refs[w++] = refs[t];
+        refCount = w;
+    }
     PROBE("refs");
 
     std::vector<uint32_t> prims;
@@ -487,12 +589,12 @@ void TriangleBvh::build(const vec3* pos, const uint32_t* idx, size_t triCount, c
     m_nodes8.clear();
     m_packets.clear();
     if (kernelWidth() == 8) {
-        detail::buildFromRefs<8>(refs, opt, m_nodes8, prims, m_bounds);
+        detail::buildFromRefs<8>(refs.get(), refCount, opt, m_nodes8, prims, m_bounds);
         PROBE("tree");
         makePackets(m_nodes8, prims, pos, idx, m_packets);
         PROBE("packets");
     } else {
-        detail::buildFromRefs<4>(refs, opt, m_nodes4, prims, m_bounds);
+        detail::buildFromRefs<4>(refs.get(), refCount, opt, m_nodes4, prims, m_bounds);
         makePackets(m_nodes4, prims, pos, idx, m_packets);
     }
 }

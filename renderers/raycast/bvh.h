@@ -12,11 +12,28 @@
 
 #include "scenegraph/math.h"
 
+#include <cstddef>
 #include <cstdint>
 #include <limits>
 #include <vector>
 
 namespace rnd::rt {
+
+// Memory for big arrays (BVH build buffers, nodes, triangle packets): from 4 MB up, a 2 MB
+// aligned anonymous mapping with transparent huge pages requested (MADV_HUGEPAGE), so a
+// 1M-triangle build takes tens of page faults instead of tens of thousands (Embree does the
+// same); smaller sizes come from operator new. hugeFree must get the size given to hugeAlloc.
+void* hugeAlloc(size_t bytes);
+void hugeFree(void* p, size_t bytes) noexcept;
+template <class T> struct HugePageAllocator {
+    using value_type = T;
+    HugePageAllocator() = default;
+    template <class U> HugePageAllocator(const HugePageAllocator<U>&) {}
+    T* allocate(size_t n) { return static_cast<T*>(hugeAlloc(n * sizeof(T))); }
+    void deallocate(T* p, size_t n) noexcept { hugeFree(p, n * sizeof(T)); }
+    template <class U> bool operator==(const HugePageAllocator<U>&) const { return true; }
+};
+template <class T> using HugeVector = std::vector<T, HugePageAllocator<T>>;
 
 // A ray segment org + t*dir, t in [tmin, tmax]. dir need not be unit length.
 struct Ray {
@@ -121,9 +138,9 @@ public:
     int width() const { return m_nodes8.empty() ? 4 : 8; }
 
 private:
-    std::vector<Node4> m_nodes4;
-    std::vector<Node8> m_nodes8;
-    std::vector<TriPacket4> m_packets;
+    HugeVector<Node4> m_nodes4;
+    HugeVector<Node8> m_nodes8;
+    HugeVector<TriPacket4> m_packets;
     sg::Aabb m_bounds;
 };
 
