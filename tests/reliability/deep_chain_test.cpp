@@ -24,6 +24,15 @@
 namespace {
 
 using namespace sg;
+
+// Both executables may run at once (ctest -j): each writes its files to its own folder.
+#ifdef DEEP_CHAIN_GL
+#define DEEP_SUITE DeepChainGLTest
+constexpr const char* kOutSuite = "deep_chain_gl";
+#else
+#define DEEP_SUITE DeepChainTest
+constexpr const char* kOutSuite = "deep_chain";
+#endif
 namespace fs = std::filesystem;
 
 constexpr int kDepth = 1'000'000;
@@ -169,7 +178,7 @@ void loadAndRender(const fs::path& path, bool hasControl) {
         rnd::RenderStats st = renderer->render(f, kW, kH, fb);
         ASSERT_TRUE(st.ok) << name << ": " << st.error;
         std::printf("[ deep ] %s render %.2f s\n", name, secondsSince(t0));
-        testing_support::writeImage(fb, "deep_chain", path.filename().string() + "-" + name);
+        testing_support::writeImage(fb, kOutSuite, path.filename().string() + "-" + name);
         EXPECT_TRUE(pixelIs(fb, rx, ry, kRed)) << name << ": the leaf at the end of the chain is missing";
         EXPECT_FALSE(pixelIs(fb, kW - 1 - rx, ry, kRed)) << name << ": leaf drawn without the halfway offset";
         if (hasControl) {
@@ -179,18 +188,13 @@ void loadAndRender(const fs::path& path, bool hasControl) {
 }
 
 fs::path scratch(const std::string& file) {
-    fs::path dir = testing_support::outputDir("deep_chain");
+    fs::path dir = testing_support::outputDir(kOutSuite);
     fs::create_directories(dir);
     fs::path p = dir / file;
     fs::remove(p);
     return p;
 }
 
-#ifdef DEEP_CHAIN_GL
-#define DEEP_SUITE DeepChainGLTest
-#else
-#define DEEP_SUITE DeepChainTest
-#endif
 
 TEST(DEEP_SUITE, NativeJsonLoadsAndRenders) {
     fs::path path = scratch("deep-chain.json");
