@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <fstream>
 #include <csignal>
 #include <sys/resource.h>
@@ -55,6 +56,53 @@ TEST(FilesTest, FullDiskKeepsTheOldFile) {
     EXPECT_NE(err.find("old.txt"), std::string::npos) << err;
     std::string content;
     assets::readFileLimited(dir / "old.txt", 100, content);
+    EXPECT_EQ(content, "old");
+    int files = 0;
+    for (auto& e : fs::directory_iterator(dir)) { (void)e; ++files; }
+    EXPECT_EQ(files, 1);
+}
+
+// A read-only folder: the replacement cannot be created, the error names the file, the old file
+// stays. Root ignores folder permissions, so as root the write runs in a child process that
+// has dropped to the unprivileged uid 65534 first.
+TEST(FilesTest, ReadOnlyFolderKeepsTheOldFile) {
+    fs::path dir = testing_support::outputDir("files") / "readonly";
+    ::chmod(dir.c_str(), 0755);   // an earlier run that stopped half way
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const fs::path f = dir / "old.txt";
+    ASSERT_EQ(assets::writeFileAtomic(f, "old", false), "");
+    ASSERT_EQ(::chmod(dir.c_str(), 0555), 0);
+    std::string err;
+    if (::geteuid() == 0) {
+        int fds[2];
+        ASSERT_EQ(::pipe(fds), 0);
+        pid_t pid = ::fork();
+        ASSERT_GE(pid, 0);
+        if (pid == 0) {
+            ::close(fds[0]);
+            if (::setgid(65534) != 0 || ::setuid(65534) != 0) _exit(2);
+            std::string e = assets::writeFileAtomic(f, "new", true);
+            ssize_t w = ::write(fds[1], e.data(), e.size());
+            _exit(w == ssize_t(e.size()) ? 0 : 3);
+        }
+        ::close(fds[1]);
+        char buf[1024];
+        ssize_t r;
+        while ((r = ::read(fds[0], buf, sizeof buf)) > 0) err.append(buf, size_t(r));
+        ::close(fds[0]);
+        int status = 0;
+        ::waitpid(pid, &status, 0);
+        EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "child status " << status;
+    } else {
+        err = assets::writeFileAtomic(f, "new", true);
+    }
+    ::chmod(dir.c_str(), 0755);
+    EXPECT_NE(err.find("old.txt"), std::string::npos) << err;
+    EXPECT_EQ(err.find('\n'), std::string::npos) << err;
+    std::printf("  read-only folder -> %s\n", err.c_str());
+    std::string content;
+    EXPECT_EQ(assets::readFileLimited(f, 100, content), "");
     EXPECT_EQ(content, "old");
     int files = 0;
     for (auto& e : fs::directory_iterator(dir)) { (void)e; ++files; }
