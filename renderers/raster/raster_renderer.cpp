@@ -22,7 +22,7 @@
 
 #include "raster/raster_core.h"
 #include "raster/raster_shading.h"
-#include "raster/raster_texture.h"
+#include "renderers/texture_sampler.h"
 #include "renderers/shading.h"
 #include "renderers/tessellate.h"
 

@@ -2,7 +2,7 @@
 // shared Phong shading (renderers/shading.h), shadow rays, optional mirror reflections and
 // stratified supersampling; tile-parallel (oneTBB), progressive and cancellable.
 //
-// Sections: texture sampling, Tracer (hit shading: meshes flat/Gouraud/Phong, analytics),
+// Sections: texture footprint, Tracer (hit shading: meshes flat/Gouraud/Phong, analytics),
 // RaycastRenderer::render (tiles, AA, progress, cancellation).
 //
 // Conventions followed (see renderers/renderer.h and the brief): primary rays come from
@@ -15,6 +15,7 @@
 #include "raycast/camera_rays.h"
 #include "raycast/scene_accel.h"
 #include "renderers/shading.h"
+#include "renderers/texture_sampler.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -25,6 +26,8 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <memory>
+#include <unordered_map>
 
 namespace rnd {
 
@@ -32,44 +35,28 @@ using namespace sg;
 
 namespace {
 
-// --- texture sampling ---------------------------------------------------------------------------
+// --- texture footprint ------------------------------------------------------------------------
 
-int wrapCoord(int i, int n, WrapMode m) {
-    switch (m) {
-    case WrapMode::ClampToEdge: return std::clamp(i, 0, n - 1);
-    case WrapMode::MirroredRepeat: {
-        int p = 2 * n;
-        int k = ((i % p) + p) % p;
-        return k < n ? k : p - 1 - k;
-    }
-    case WrapMode::Repeat:
-    default: return ((i % n) + n) % n;
-    }
-}
+// Where a camera ray came from: its window position, so the rays through the neighbouring
+// pixels (ray differentials) can be made when a textured surface needs its uv derivatives.
+struct PixelFootprint {
+    const rt::CameraRays* cam = nullptr;
+    float wx = 0, wy = 0;
+};
 
-// Bilinear (or nearest) lookup at uv, linear colour. Row 0 of the texture is v = 1.
-vec3 sampleTexture(const Texture& tex, vec2 uv) {
-    if (tex.width <= 0 || tex.height <= 0 || tex.rgba.size() < size_t(tex.width) * tex.height * 4) return vec3(1.0f);
-    if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) return vec3(1.0f);
-    // Reduce to a range where float->int is safe: repeat and mirrored repeat are periodic
-    // with period 2 (mirror) dividing evenly into 1 (repeat), clamping only needs [-1, 2].
-    auto reduce = [](float t, WrapMode m) {
-        if (m == WrapMode::ClampToEdge) return std::clamp(t, -1.0f, 2.0f);
-        return t - 2.0f * std::floor(0.5f * t);   // in [0, 2)
-    };
-    uv = vec2(reduce(uv.x, tex.wrapS), reduce(uv.y, tex.wrapT));
-    float x = uv.x * tex.width - 0.5f, y = (1.0f - uv.y) * tex.height - 0.5f;
-    auto texel = [&](int i, int j) {
-        i = wrapCoord(i, tex.width, tex.wrapS);
-        j = wrapCoord(j, tex.height, tex.wrapT);
-        return srgbBytesToLinear(&tex.rgba[(size_t(j) * tex.width + i) * 4]);
-    };
-    if (tex.filter == FilterMode::Nearest) return texel(int(std::floor(x + 0.5f)), int(std::floor(y + 0.5f)));
-    int x0 = int(std::floor(x)), y0 = int(std::floor(y));
-    float fx = x - float(x0), fy = y - float(y0);
-    vec3 a = glm::mix(texel(x0, y0), texel(x0 + 1, y0), fx);
-    vec3 b = glm::mix(texel(x0, y0 + 1), texel(x0 + 1, y0 + 1), fx);
-    return glm::mix(a, b, fy);
+// uv at the point where ray r meets the plane of triangle P (barycentrics of that point, even
+// outside the triangle: derivatives only need the plane). False for rays along the plane.
+bool uvOnPlane(const rt::Ray& r, const vec3 P[3], const vec2 uv[3], vec2& out) {
+    const vec3 e1 = P[1] - P[0], e2 = P[2] - P[0], n = glm::cross(e1, e2);
+    const float denom = glm::dot(r.dir, n);
+    if (!(std::abs(denom) > 1e-30f)) return false;
+    const vec3 q = r.org + (glm::dot(P[0] - r.org, n) / denom) * r.dir - P[0];
+    const float d00 = glm::dot(e1, e1), d01 = glm::dot(e1, e2), d11 = glm::dot(e2, e2);
+    const float d20 = glm::dot(q, e1), d21 = glm::dot(q, e2), det = d00 * d11 - d01 * d01;
+    if (!(std::abs(det) > 0)) return false;
+    const float b1 = (d11 * d20 - d01 * d21) / det, b2 = (d00 * d21 - d01 * d20) / det;
+    out = (1.0f - b1 - b2) * uv[0] + b1 * uv[1] + b2 * uv[2];
+    return std::isfinite(out.x) && std::isfinite(out.y);
 }
 
 // --- Tracer --------------------------------------------------------------------------------------
@@ -77,6 +64,7 @@ vec3 sampleTexture(const Texture& tex, vec2 uv) {
 struct Tracer {
     const FrameInput& f;
     const rt::SceneAccel& accel;
+    const std::vector<const SampledTexture*>& textures;   // per f.meshes entry, null if none
     uint64_t rays = 0;
 
     static float offsetScale(const vec3& p) {
@@ -104,7 +92,8 @@ struct Tracer {
 
     // Radiance along the ray (linear), depth of the first hit (window z via the camera) when
     // depthOut is given; eye = where the viewer is for this ray (camera eye or bounce origin).
-    vec3 trace(const rt::Ray& r, const vec3& eye, int bounce, vec3* hitPos) {
+    // footprint: for camera rays (texture mip selection), null for reflected rays.
+    vec3 trace(const rt::Ray& r, const vec3& eye, int bounce, vec3* hitPos, const PixelFootprint* footprint = nullptr) {
         ++rays;
         rt::SceneHit h;
         if (!accel.intersect(r, h, f.settings.cullBackFaces)) return f.settings.background;
@@ -148,7 +137,16 @@ struct Tracer {
                 albedoV[2] *= vec3(mesh.colors[i2]);
             }
             vec3 texColor(1.0f);
-            if (dm.texture && hasUV) texColor = sampleTexture(*dm.texture, w0 * mesh.uv0[i0] + w1 * mesh.uv0[i1] + w2 * mesh.uv0[i2]);
+            if (const SampledTexture* tex = textures[h.instance]; tex && hasUV) {
+                const vec2 UV[3] = {mesh.uv0[i0], mesh.uv0[i1], mesh.uv0[i2]};
+                const vec2 uv = w0 * UV[0] + w1 * UV[1] + w2 * UV[2];
+                vec2 uvX, uvY;
+                if (footprint && uvOnPlane(footprint->cam->ray(footprint->wx + 1.0f, footprint->wy), P, UV, uvX) &&
+                    uvOnPlane(footprint->cam->ray(footprint->wx, footprint->wy + 1.0f), P, UV, uvY))
+                    texColor = tex->sample(uv, uvX - uv, uvY - uv);
+                else
+                    texColor = tex->sampleLevel(uv, 0, tex->filter() != FilterMode::Nearest);
+            }
             vec3 Nv[3];
             for (int k = 0; k < 3; ++k) {
                 uint32_t idx = k == 0 ? i0 : k == 1 ? i1 : i2;
@@ -270,6 +268,22 @@ public:
         const unsigned csr = _mm_getcsr();
         m_accel.update(f);
         stats.triangles = f.triangleCount();
+        // Samplers (mip chains) per texture, cached by id + version; one pointer per mesh.
+        ++m_frame;
+        std::vector<const SampledTexture*> textures(f.meshes.size(), nullptr);
+        for (size_t i = 0; i < f.meshes.size(); ++i) {
+            const TexturePtr& t = f.meshes[i].texture;
+            if (!t || t->width <= 0 || t->height <= 0 || t->rgba.size() < size_t(t->width) * t->height * 4) continue;
+            TextureEntry& e = m_textures[t->id];
+            if (!e.tex || e.version != t->version) {
+                e.tex = std::make_unique<SampledTexture>(*t);
+                e.version = t->version;
+            }
+            e.lastFrame = m_frame;
+            textures[i] = e.tex.get();
+        }
+        for (auto it = m_textures.begin(); it != m_textures.end();)   // drop textures no longer drawn
+            it = it->second.lastFrame + 8 < m_frame ? m_textures.erase(it) : std::next(it);
 
         int sx = 1, sy = 1;   // strata per pixel
         if (f.settings.aa == AAMode::SSAA) sx = sy = std::clamp(f.settings.aaRate, 1, 8);
@@ -290,7 +304,7 @@ public:
             _mm_setcsr(old | 0x8040);   // FTZ | DAZ in this worker
             for (int ti = range.begin(); ti != range.end(); ++ti) {
                 if (control && control->cancel.load(std::memory_order_relaxed)) { cancelled = true; break; }
-                Tracer tr{f, m_accel};
+                Tracer tr{f, m_accel, textures, 0};
                 const int x0 = (ti % tx) * tile, y0 = (ti / tx) * tile;   // y0: framebuffer row (top-down)
                 const int x1 = std::min(x0 + tile, w), y1 = std::min(y0 + tile, h);
                 for (int row = y0; row < y1; ++row) {
@@ -310,7 +324,8 @@ public:
                                 vec3 hp;
                                 vec3 hpInit(std::numeric_limits<float>::quiet_NaN());
                                 hp = hpInit;
-                                vec3 c = tr.trace(r, f.camera.eye, 0, &hp);
+                                const PixelFootprint fp{&cam, float(x) + ox, float(wy) + oy};
+                                vec3 c = tr.trace(r, f.camera.eye, 0, &hp, &fp);
                                 if (!std::isnan(hp.x)) {
                                     c = applyFog(f.settings, c, glm::length(vec3(f.camera.view * vec4(hp, 1.0f))));
                                     depth = std::min(depth, std::clamp(cam.depth(hp), 0.0f, 1.0f));
@@ -347,7 +362,14 @@ public:
     }
 
 private:
+    struct TextureEntry {
+        std::unique_ptr<SampledTexture> tex;
+        uint64_t version = 0;
+        uint64_t lastFrame = 0;
+    };
     rt::SceneAccel m_accel;
+    std::unordered_map<uint64_t, TextureEntry> m_textures;
+    uint64_t m_frame = 0;
 };
 
 }  // namespace

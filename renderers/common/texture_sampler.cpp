@@ -1,11 +1,11 @@
-#include "raster/raster_texture.h"
+#include "renderers/texture_sampler.h"
 
 #include "renderers/shading.h"
 
 #include <algorithm>
 #include <cmath>
 
-namespace rnd::raster {
+namespace rnd {
 
 using sg::vec2;
 using sg::vec3;
@@ -106,4 +106,4 @@ vec3 SampledTexture::sample(vec2 uv, vec2 ddx, vec2 ddy) const {
     return c0 * (1 - f) + sampleLevel(uv, l0 + 1, true) * f;
 }
 
-}  // namespace rnd::raster
+}  // namespace rnd

@@ -1,4 +1,5 @@
-// raster_texture.h - texture sampling for the CPU rasterizer, following GL: sRGB texels are
+// texture_sampler.h - texture sampling for the CPU backends (rasterizer and ray caster, so
+// both filter exactly alike), following GL: sRGB texels are
 // decoded to linear before filtering (as GL_SRGB8_ALPHA8 textures are), texel centres at
 // +0.5, wrap modes REPEAT / CLAMP_TO_EDGE / MIRRORED_REPEAT, NEAREST, LINEAR, and
 // LINEAR_MIPMAP_LINEAR with a mip chain built like glGenerateMipmap (2x2 box in linear,
@@ -11,7 +12,7 @@
 #include <memory>
 #include <vector>
 
-namespace rnd::raster {
+namespace rnd {
 
 class SampledTexture {
 public:
@@ -20,6 +21,7 @@ public:
     sg::vec3 sample(sg::vec2 uv, sg::vec2 dUVdx, sg::vec2 dUVdy) const;
     sg::vec3 sampleLevel(sg::vec2 uv, int level, bool bilinear) const;
     int levels() const { return int(m_levels.size()); }
+    sg::FilterMode filter() const { return m_filter; }
 
 private:
     struct Level {
@@ -31,4 +33,4 @@ private:
     sg::FilterMode m_filter;
 };
 
-}  // namespace rnd::raster
+}  // namespace rnd
