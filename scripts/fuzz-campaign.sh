@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# scripts/fuzz-campaign.sh CPU_SECONDS [JOBS] [TARGET...]
+# scripts/fuzz-campaign.sh CPU_SECONDS [JOBS] [TARGET...]   (or --summary CPU_SECONDS [TARGET...])
 # The long fuzzing run of issue 8: every target (default: all eight) runs until it has used
 # CPU_SECONDS of CPU time (not wall time: the runs are niced so the machine stays usable, and
 # a target that gets less CPU simply runs longer). JOBS targets run at once (default: nproc).
@@ -37,9 +37,9 @@ one() {
   mkdir -p "$corpus" "$seeds" "$artifacts"
   export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=0:allocator_may_return_null=1}"
   export UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}"
-  local used=0 execs=0 restarts=0 wall0 cov="" log rc pid c last
+  local used=0 restarts=0 wall0 log rc pid c last a
   wall0=$(date +%s)
-  : > "$out/$t.log"
+  rm -f "$out/$t".run*.log "$out/$t.cpu" "$out/$t.result"
   while [ "$used" -lt "$budget" ] && [ "$restarts" -le 20 ]; do
     log="$out/$t.run$restarts.log"
     nice -n 19 "$exe" "$corpus" "$seeds" -max_total_time=100000000 -timeout=120 \
@@ -54,10 +54,7 @@ one() {
     done
     set +e; wait "$pid"; rc=$?; set -e
     used=$(( used + last ))
-    execs=$(( execs + $(grep -o 'number_of_executed_units: [0-9]*' "$log" | awk '{s+=$2} END {print s+0}') ))
-    c=$(grep -o 'cov: [0-9]* ft: [0-9]*' "$log" | tail -n 1 || true); [ -n "$c" ] && cov="$c"
-    cat "$log" >> "$out/$t.log"
-    local a
+    echo "run $restarts cpu_s $last rc $rc wall_s $(( $(date +%s) - wall0 ))" >> "$out/$t.cpu"
     for a in "$artifacts"/timeout-*; do
       [ -e "$a" ] || continue
       if (ulimit -t 20; "$exe" "$a" > /dev/null 2>&1); then
@@ -67,31 +64,57 @@ one() {
     # 72 is libFuzzer's exit code when interrupted (our budget stop); anything else is a finding.
     if [ "$rc" -ne 72 ] && [ "$rc" -ne 0 ]; then restarts=$(( restarts + 1 )); else break; fi
   done
-  local n_crash n_timeout n_oom n_slow files
-  n_crash=$(find "$artifacts" -name 'crash-*' | wc -l)
-  n_timeout=$(find "$artifacts" -name 'timeout-*' | wc -l)
-  n_oom=$(find "$artifacts" -name 'oom-*' -o -name 'leak-*' | wc -l)
-  n_slow=$(find "$bindir/slow_$t" -type f 2>/dev/null | wc -l)
-  files=$(find "$corpus" -type f | wc -l)
-  printf '| %s | %d | %d | %d | %s | %d | %d | %d (+%d slow) | %d |\n' "$t" "$used" \
-    $(( $(date +%s) - wall0 )) "$execs" "${cov:-?}" "$files" "$n_crash" "$n_timeout" "$n_slow" "$n_oom" \
-    > "$out/$t.result"
+  summarize "$t" "$budget"
+}
+
+count() { # number of files matching find arguments, 0 when the folder is missing
+  if [ -d "$1" ]; then find "$@" -type f 2>/dev/null | wc -l; else echo 0; fi
+}
+
+# The result row of one target, from what its runs left: campaign/TARGET.cpu (CPU seconds per
+# run), the run logs (inputs, coverage), the corpus and the artifacts.
+summarize() {
+  local t="$1" budget="$2" cpu wall execs cov logs
+  local corpus="$bindir/corpus_$t" artifacts="$bindir/artifacts_$t"
+  logs=("$out/$t".run*.log)
+  if [ -f "$out/$t.cpu" ]; then
+    cpu=$(awk '{s+=$4} END {print s+0}' "$out/$t.cpu")
+    wall=$(tail -n 1 "$out/$t.cpu" | awk '{print $8}')
+  else   # runs from before .cpu files existed: a budget stop means the budget was used
+    cpu="?"; wall="?"
+    grep -q 'run interrupted' "${logs[-1]}" 2>/dev/null && cpu=">=$budget"
+  fi
+  execs=$(cat "${logs[@]}" 2>/dev/null | grep -o 'number_of_executed_units: [0-9]*' | awk '{s+=$2} END {print s+0}' || true)
+  cov=$(cat "${logs[@]}" 2>/dev/null | grep -o 'cov: [0-9]* ft: [0-9]*' | tail -n 1 || true)
+  printf '| %s | %s | %s | %s | %s | %s | %s | %s (+%s slow) | %s |\n' "$t" "$cpu" "$wall" "$execs" "${cov:-?}" \
+    "$(count "$corpus")" "$(count "$artifacts" -name 'crash-*')" "$(count "$artifacts" -name 'timeout-*')" \
+    "$(count "$bindir/slow_$t")" "$(count "$artifacts" \( -name 'oom-*' -o -name 'leak-*' \))" > "$out/$t.result"
   cat "$out/$t.result"
 }
 
-if [ "${1:-}" = --one ]; then mkdir -p "$out"; one "$2" "$3"; exit; fi
+table() { # Markdown summary of the given targets
+  local budget="$1"; shift
+  echo "Fuzzing campaign $(date -u +%Y-%m-%d), $budget CPU-seconds per target, clang $(clang-14 --version | head -n 1 | grep -o '[0-9][0-9.]*' | head -n 1), -fsanitize=fuzzer,address,undefined, inputs up to 128 KiB"
+  echo
+  echo "| target | CPU s | wall s | inputs run | coverage (edges, features) | corpus files | crashes | hangs (+ slow, not hangs) | OOM/leaks |"
+  echo "|---|---|---|---|---|---|---|---|---|"
+  local t
+  for t in "$@"; do [ -f "$out/$t.result" ] || summarize "$t" "$budget" > /dev/null; cat "$out/$t.result"; done
+}
 
-budget="${1:?usage: fuzz-campaign.sh CPU_SECONDS [JOBS] [TARGET...]}"
+if [ "${1:-}" = --one ]; then mkdir -p "$out"; one "$2" "$3"; exit; fi
+# --summary CPU_SECONDS [TARGET...]: only (re)write the table from what the runs left.
+if [ "${1:-}" = --summary ]; then
+  budget="$2"; shift 2
+  targets=("$@"); [ ${#targets[@]} -gt 0 ] || targets=(scene_json gltf glb obj ply off stl image)
+  table "$budget" "${targets[@]}" | tee "$out/summary.md"
+  exit
+fi
+
+budget="${1:?usage: fuzz-campaign.sh CPU_SECONDS [JOBS] [TARGET...] | --summary CPU_SECONDS [TARGET...]}"
 jobs="${2:-$(nproc)}"
 shift; [ $# -gt 0 ] && shift
 targets=("$@"); [ ${#targets[@]} -gt 0 ] || targets=(scene_json gltf glb obj ply off stl image)
 mkdir -p "$out"
-printf '%s\n' "${targets[@]}" | xargs -P "$jobs" -I{} "$0" --one {} "$budget"
-{
-  echo "Fuzzing campaign $(date -u +%Y-%m-%d), $budget CPU-seconds per target, clang $(clang-14 --version | head -n 1 | grep -o '[0-9][0-9.]*' | head -n 1), -fsanitize=fuzzer,address,undefined"
-  echo
-  echo "| target | CPU s | wall s | inputs run | coverage (edges, features) | corpus files | crashes | hangs (+ slow, not hangs) | OOM/leaks |"
-  echo "|---|---|---|---|---|---|---|---|---|"
-  for t in "${targets[@]}"; do cat "$out/$t.result"; done
-} > "$out/summary.md"
-cat "$out/summary.md"
+printf '%s\n' "${targets[@]}" | xargs -P "$jobs" -I{} "$0" --one {} "$budget" || true
+table "$budget" "${targets[@]}" | tee "$out/summary.md"
