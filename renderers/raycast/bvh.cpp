@@ -38,7 +38,20 @@ using sg::vec3;
 // --- big allocations ------------------------------------------------------------------------
 
 namespace {
-constexpr size_t kHugeMin = size_t(4) << 20, kHugePage = size_t(2) << 20, kPage = 4096;
+// Under AddressSanitizer everything comes from operator new, so the sanitizer keeps watching
+// these buffers (it does not put redzones around mappings).
+#if defined(__SANITIZE_ADDRESS__)
+constexpr size_t kHugeMin = ~size_t(0);
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+constexpr size_t kHugeMin = ~size_t(0);
+#else
+constexpr size_t kHugeMin = size_t(4) << 20;
+#endif
+#else
+constexpr size_t kHugeMin = size_t(4) << 20;
+#endif
+constexpr size_t kHugePage = size_t(2) << 20, kPage = 4096;
 size_t pageRound(size_t b) { return (b + kPage - 1) & ~(kPage - 1); }
 }  // namespace
 
