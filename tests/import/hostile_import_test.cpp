@@ -6,6 +6,8 @@
 #include "import_test_util.h"
 
 #include "assets/animation.h"
+#include "assets/image_io.h"
+#include "assets/scene_io.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>
@@ -16,7 +18,10 @@
 #include <unistd.h>
 
 #include <cstring>
+#include <chrono>
+#include <cstdlib>
 #include <fstream>
+#include <vector>
 
 namespace fs = std::filesystem;
 using namespace import_test;
@@ -188,6 +193,80 @@ TEST(HostileImportTest, DeepJsonNesting) {
     r = quickLoad(sb.model / "deep.glb");
     EXPECT_FALSE(r.scene);
     EXPECT_NE(r.error.find("nesting"), std::string::npos) << r.error;
+}
+
+// The bar for hostile headers: refused in under 1 s using under 100 MB. Peak memory is
+// the rise of the process's resident high-water mark during the load (reset first through
+// /proc/self/clear_refs). Under AddressSanitizer (shadow memory, redzones, slower code) the
+// bars are 5 s and 300 MB.
+namespace {
+long statusKB(const char* key) {
+    std::ifstream f("/proc/self/status");
+    std::string line;
+    const size_t n = std::strlen(key);
+    while (std::getline(f, line))
+        if (line.compare(0, n, key) == 0) return std::atol(line.c_str() + n);
+    return -1;
+}
+#if defined(__SANITIZE_ADDRESS__)
+constexpr double kMaxSeconds = 5.0, kMaxMB = 300.0;
+#else
+constexpr double kMaxSeconds = 1.0, kMaxMB = 100.0;
+#endif
+struct Cost { double seconds = 0, peakMB = 0; std::string error; };
+template <class F> Cost measure(F&& load) {
+    Cost c;
+    {
+        std::ofstream clear("/proc/self/clear_refs");
+        clear << "5";
+        clear.flush();
+        if (!clear.good()) { ADD_FAILURE() << "cannot reset the peak RSS through /proc/self/clear_refs"; return c; }
+    }
+    const long before = statusKB("VmRSS:");
+    auto t0 = std::chrono::steady_clock::now();
+    c.error = load();
+    c.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    c.peakMB = double(statusKB("VmHWM:") - before) / 1024.0;
+    return c;
+}
+template <class F> void expectCheap(const std::string& what, F&& load) {
+    Cost c = measure(load);
+    std::printf("  %-34s refused in %.3f s, peak +%.1f MB: %s\n", what.c_str(), c.seconds, c.peakMB, c.error.c_str());
+    EXPECT_FALSE(c.error.empty()) << what << " was not refused";
+    EXPECT_LT(c.seconds, kMaxSeconds) << what;
+    EXPECT_LT(c.peakMB, kMaxMB) << what;
+}
+}  // namespace
+
+TEST(HostileImportTest, HostileHeadersRefusedQuicklyAndCheaply) {
+    Sandbox sb("cheap");
+    Knobs k;
+    k.positionCount = "1000000000";
+    k.positionView = "";   // no data behind it: only the count speaks
+    writeText(sb.model / "acc1e9.gltf", triangleGltf(k));
+    writeText(sb.model / "huge.off", "OFF\n2000000000 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+    writeText(sb.model / "deep.gltf", "{\"asset\": {\"version\": \"2.0\"}, \"extras\": " + std::string(100000, '[') + std::string(100000, ']') + "}");
+    writeText(sb.model / "deep.json", "{\"format\": \"sceneviewer\", \"version\": 1, \"x\": " + std::string(100000, '[') + std::string(100000, ']') + "}");
+    // A valid 1x1 PNG whose IHDR then claims 65535 x 65535 (the CRC no longer matches either).
+    std::string png;
+    const uint8_t px[4] = {1, 2, 3, 255};
+    ASSERT_EQ(assets::encodePng(1, 1, px, png), "");
+    png[16] = png[17] = png[20] = png[21] = 0;
+    png[18] = png[19] = png[22] = png[23] = char(0xFF);
+    writeText(sb.model / "huge.png", png);
+    auto scene = [&](const char* f) { return [&sb, f] { return assets::loadScene(sb.model / f).error; }; };
+    expectCheap("glTF accessor of 1e9 elements", scene("acc1e9.gltf"));
+    expectCheap("OFF header with 2e9 vertices", scene("huge.off"));
+    expectCheap("glTF with 100k-deep JSON nesting", scene("deep.gltf"));
+    expectCheap("scene file with 100k-deep nesting", scene("deep.json"));
+    expectCheap("PNG header of 65535x65535", [&] { return assets::loadImage(sb.model / "huge.png").error; });
+    // The measure itself sees memory: touching 150 MB shows up as at least 140 MB.
+    Cost touch = measure([] {
+        std::vector<char> v(size_t(150) << 20);
+        std::memset(v.data(), 1, v.size());
+        return std::string(v[v.size() / 2] == 1 ? "touched" : "");
+    });
+    EXPECT_GT(touch.peakMB, 140.0) << "the peak-memory measure does not work here";
 }
 
 TEST(HostileImportTest, PathTraversalInBufferUris) {
