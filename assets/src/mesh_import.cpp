@@ -784,6 +784,9 @@ LoadResult loadPly(const fs::path& path, const std::string& data, Ctx& ctx) {
             haveUv = iu >= 0 && iv >= 0;
             mesh.positions.reserve(size_t(e.count));
         }
+        // An element without properties holds no data whatever its count (found by fuzzing:
+        // "element x 3000000000000001839" with no properties spun for hours).
+        if (e.props.empty()) continue;
         std::vector<double> vals(e.props.size());
         bool truncated = false;
         readOf = 0;

@@ -1,9 +1,11 @@
-// Every input a fuzzer ever crashed on stays here (tests/import/regressions) and must load
-// into valid meshes or fail with a one-line error naming the file.
+// Every input a fuzzer ever crashed or hung on stays here (tests/import/regressions) and must
+// load into valid meshes or fail with a one-line error naming the file, within seconds.
 #include "assets/scene_io.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>
+
+#include <chrono>
 
 namespace fs = std::filesystem;
 
@@ -14,7 +16,9 @@ TEST(FuzzRegressionTest, CrashInputsLoadValidMeshesOrFailClearly) {
         if (!e.is_regular_file()) continue;
         ++files;
         SCOPED_TRACE(e.path().filename().string());
+        auto t0 = std::chrono::steady_clock::now();
         assets::LoadResult r = assets::loadScene(e.path());
+        EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 10.0) << "hang";
         if (!r.scene) {
             EXPECT_NE(r.error.find(e.path().filename().string()), std::string::npos) << r.error;
             continue;
