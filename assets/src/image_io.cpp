@@ -40,6 +40,18 @@ ImageLoad decodeImage(const void* data, size_t size, const std::string& name) {
                       std::to_string(kMaxImageDimension) + " per side";
             return r;
         }
+        // Every chunk must fit in the data: stb_image grows its IDAT buffer to a chunk's claimed
+        // length before reading it (found by fuzzing: a 76-byte PNG asked for 2 GB).
+        for (size_t o = 8; o + 8 <= size;) {
+            const uint32_t len = be32(o);
+            if (uint64_t(len) + 12 > size - o) {
+                r.error = name + ": corrupt PNG: a chunk claims " + std::to_string(len) + " bytes but only " +
+                          std::to_string(size - o) + " remain";
+                return r;
+            }
+            if (std::memcmp(d + o + 4, "IEND", 4) == 0) break;
+            o += size_t(len) + 12;
+        }
     }
     if (!stbi_info_from_memory(d, int(size), &w, &h, &comp)) {
         r.error = name + ": cannot read image header (" + failureReason() + ")";
