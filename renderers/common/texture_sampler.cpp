@@ -106,4 +106,20 @@ vec3 SampledTexture::sample(vec2 uv, vec2 ddx, vec2 ddy) const {
     return c0 * (1 - f) + sampleLevel(uv, l0 + 1, true) * f;
 }
 
+const SampledTexture* SamplerCache::get(const sg::TexturePtr& t) {
+    if (!t || t->width <= 0 || t->height <= 0 || t->rgba.size() < size_t(t->width) * size_t(t->height) * 4) return nullptr;
+    Entry& e = m_entries[t->id];
+    if (!e.tex || e.version != t->version) {
+        e.tex = std::make_unique<SampledTexture>(*t);
+        e.version = t->version;
+    }
+    e.lastFrame = m_frame;
+    return e.tex.get();
+}
+
+void SamplerCache::endFrame() {
+    for (auto it = m_entries.begin(); it != m_entries.end();)
+        it = m_frame - it->second.lastFrame > 8 ? m_entries.erase(it) : std::next(it);
+}
+
 }  // namespace rnd

@@ -756,23 +756,13 @@ public:
     }
 
 private:
-    const SampledTexture* textureFor(const sg::TexturePtr& t) {
-        if (!t || t->width <= 0 || t->height <= 0) return nullptr;
-        auto& e = m_textures[t->id];
-        if (!e.tex || e.version != t->version) {
-            e.tex = std::make_unique<SampledTexture>(*t);
-            e.version = t->version;
-        }
-        e.lastFrame = m_frame;
-        return e.tex.get();
-    }
 
     // pointScale: the SSAA factor (points are 2 pixels wide at the output resolution, like GL).
     RenderStats renderSingle(const sg::FrameInput& frame, int width, int height, Framebuffer& target, bool msaa, RenderControl* control,
                              int pointScale = 1) {
         RenderStats stats;
         auto t0frame = std::chrono::steady_clock::now();
-        ++m_frame;
+        m_samplers.beginFrame();
         m_tess.nextFrame();
         target.resize(width, height);
         const auto& st = frame.settings;
@@ -789,7 +779,7 @@ private:
             d.normal = normal;
             d.material = mat;
             d.mirrored = mirrored;
-            d.texture = textureFor(tex);
+            d.texture = m_samplers.get(tex);
             d.hasNormals = mesh->normals.size() == mesh->positions.size();
             d.hasUV = mesh->uv0.size() == mesh->positions.size();
             d.hasColors = mesh->colors.size() == mesh->positions.size();
@@ -813,8 +803,7 @@ private:
             if (t.worldSpace) addDraw(t.mesh, mat4(1.0f), mat3(1.0f), a.material, a.texture, false, &t);
             else addDraw(t.mesh, a.world, a.normal, a.material, a.texture, glm::determinant(mat3(a.world)) < 0.0f, &t);
         }
-        for (auto it = m_textures.begin(); it != m_textures.end();)
-            it = m_frame - it->second.lastFrame > 8 ? m_textures.erase(it) : std::next(it);
+        m_samplers.endFrame();
 
         auto tStart = std::chrono::steady_clock::now();
         auto ms = [](auto a, auto b) { return std::chrono::duration<double, std::milli>(b - a).count(); };
@@ -892,15 +881,9 @@ private:
         return stats;
     }
 
-    struct TextureEntry {
-        std::unique_ptr<SampledTexture> tex;
-        uint64_t version = 0;
-        uint64_t lastFrame = 0;
-    };
-    std::unordered_map<uint64_t, TextureEntry> m_textures;
+    SamplerCache m_samplers;
     TessellationCache m_tess;
     std::vector<Chunk> m_chunks;
-    uint64_t m_frame = 0;
     // VIEWER_RASTER_REFERENCE_SHADING=1: shade every fragment with rnd::shade (slow; used to
     // check the batched path).
     bool m_timing = [] { const char* e = std::getenv("VIEWER_RASTER_TIMING"); return e && *e == '1'; }();

@@ -26,8 +26,6 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <memory>
-#include <unordered_map>
 
 namespace rnd {
 
@@ -269,21 +267,10 @@ public:
         m_accel.update(f);
         stats.triangles = f.triangleCount();
         // Samplers (mip chains) per texture, cached by id + version; one pointer per mesh.
-        ++m_frame;
+        m_samplers.beginFrame();
         std::vector<const SampledTexture*> textures(f.meshes.size(), nullptr);
-        for (size_t i = 0; i < f.meshes.size(); ++i) {
-            const TexturePtr& t = f.meshes[i].texture;
-            if (!t || t->width <= 0 || t->height <= 0 || t->rgba.size() < size_t(t->width) * t->height * 4) continue;
-            TextureEntry& e = m_textures[t->id];
-            if (!e.tex || e.version != t->version) {
-                e.tex = std::make_unique<SampledTexture>(*t);
-                e.version = t->version;
-            }
-            e.lastFrame = m_frame;
-            textures[i] = e.tex.get();
-        }
-        for (auto it = m_textures.begin(); it != m_textures.end();)   // drop textures no longer drawn
-            it = it->second.lastFrame + 8 < m_frame ? m_textures.erase(it) : std::next(it);
+        for (size_t i = 0; i < f.meshes.size(); ++i) textures[i] = m_samplers.get(f.meshes[i].texture);
+        m_samplers.endFrame();
 
         int sx = 1, sy = 1;   // strata per pixel
         if (f.settings.aa == AAMode::SSAA) sx = sy = std::clamp(f.settings.aaRate, 1, 8);
@@ -362,14 +349,8 @@ public:
     }
 
 private:
-    struct TextureEntry {
-        std::unique_ptr<SampledTexture> tex;
-        uint64_t version = 0;
-        uint64_t lastFrame = 0;
-    };
     rt::SceneAccel m_accel;
-    std::unordered_map<uint64_t, TextureEntry> m_textures;
-    uint64_t m_frame = 0;
+    SamplerCache m_samplers;
 };
 
 }  // namespace

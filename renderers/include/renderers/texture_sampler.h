@@ -9,7 +9,9 @@
 
 #include "scenegraph/mesh.h"
 
+#include <cstdint>
 #include <memory>
+#include <unordered_map>
 #include <vector>
 
 namespace rnd {
@@ -31,6 +33,25 @@ private:
     std::vector<Level> m_levels;
     sg::WrapMode m_wrapS, m_wrapT;
     sg::FilterMode m_filter;
+};
+
+// Samplers (mip chains) per texture, rebuilt when a texture's version changes, shared by the
+// CPU backends: beginFrame(), get() for each texture drawn, endFrame() drops samplers unused
+// for 8 frames. get() returns null for empty or inconsistent textures.
+class SamplerCache {
+public:
+    void beginFrame() { ++m_frame; }
+    const SampledTexture* get(const sg::TexturePtr& t);
+    void endFrame();
+
+private:
+    struct Entry {
+        std::unique_ptr<SampledTexture> tex;
+        uint64_t version = 0;
+        uint64_t lastFrame = 0;
+    };
+    std::unordered_map<uint64_t, Entry> m_entries;
+    uint64_t m_frame = 0;
 };
 
 }  // namespace rnd
