@@ -13,6 +13,7 @@
 // occluded vs rtcIntersect1 / rtcOccluded1, one ray at a time, FTZ/DAZ on), and agreement_* (%
 // of rays where both agree: same hit/miss, and for hits the same primitive - or the same
 // distance for ties on shared edges - and distance within 1e-4 relative).
+// Ray throughput: ours and Embree alternate 3 (--quick) or 5 times per measure, medians.
 // Timing: 1-thread figures (rays and build) use the thread's CPU clock (the machine is shared; wall time would
 // count other people's work), 2-thread figures use wall time. Builds: medians of 3 (--quick) or 5
 // alternating runs; 1-thread builds run inside a 1-thread TBB arena (see measureBuilds: before
@@ -44,6 +45,7 @@
 #include <random>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 using namespace sg;
@@ -239,6 +241,20 @@ double measure(size_t n, int threads, double minSeconds, const std::function<voi
     return double(total) / el * 1e-6;
 }
 
+// Ours and the reference measured alternately `reps` times (the machine's speed drifts by
+// +-10% over seconds: alternating exposes both to the same drift); medians of each.
+std::pair<double, double> measurePair(size_t n, int threads, double minSeconds, int reps, const std::function<void(size_t, size_t)>& ours,
+                                      const std::function<void(size_t, size_t)>& ref) {
+    std::vector<double> o, r;
+    for (int i = 0; i < reps; ++i) {
+        o.push_back(measure(n, threads, minSeconds, ours));
+        r.push_back(measure(n, threads, minSeconds, ref));
+    }
+    std::sort(o.begin(), o.end());
+    std::sort(r.begin(), r.end());
+    return {o[o.size() / 2], r[r.size() / 2]};
+}
+
 void line(const std::string& scene, const std::string& what, double ours, double ref) {
     const char* fmt = what.rfind("agreement", 0) == 0 ? "bench: scene=%s what=%s ours=%.4f ref=%.4f ratio=%.5f\n"
                                                       : "bench: scene=%s what=%s ours=%.4g ref=%.4g ratio=%.3f\n";
@@ -261,7 +277,7 @@ bool sameHit(const TriHit& a, const TriHit& b) {
 // Two threads: wall time.
 struct BuildTimes { double ours1 = 0, ref1 = 0, ours2 = 0, ref2 = 0; };
 BuildTimes measureBuilds(const Scene& s, TriangleBvh& bvh, int reps, bool twoThreads = true) {
-    rnd::rt::Bvh4::BuildOptions single;
+    rnd::rt::Bvh4::BuildOptions single = TriangleBvh::defaultOptions();
     single.parallel = false;
     std::vector<double> o1, r1, o2, r2;
     Embree e1(1), e2(2);
@@ -302,7 +318,8 @@ BuildTimes measureBuilds(const Scene& s, TriangleBvh& bvh, int reps, bool twoThr
 }
 
 void runScene(const Scene& s, bool quick) {
-    const double minT = quick ? 0.0 : 0.4;
+    const double minT = quick ? 0.0 : 0.25;
+    const int reps = quick ? 3 : 5;   // alternating ours/Embree passes per measure (medians)
     const int W = quick ? 640 : 1280, H = quick ? 360 : 720;
     // --- build --------------------------------------------------------------------------
     TriangleBvh bvh;
@@ -313,6 +330,12 @@ void runScene(const Scene& s, bool quick) {
     line(s.name, "build_2t_Mtris/s", mt / oursB2, mt / refB2);
     std::printf("bench: scene=%s info tris=%zu build_ms ours_1t=%.2f embree_1t=%.2f ours_2t=%.2f embree_2t=%.2f bvh_MB=%.1f\n",
                 s.name.c_str(), s.tris(), oursB1 * 1e3, refB1 * 1e3, oursB2 * 1e3, refB2 * 1e3, bvh.memoryBytes() / 1048576.0);
+    {
+        const TriangleBvh::Stats st = bvh.stats();
+        std::printf("bench: scene=%s info width=%d nodes=%zu children_per_node=%.2f packets=%zu tris_per_packet=%.2f depth=%d\n",
+                    s.name.c_str(), bvh.width(), st.nodes, st.nodes ? double(st.childSlots) / double(st.nodes) : 0.0,
+                    st.packets, st.packets ? double(st.lanes) / double(st.packets) : 0.0, st.depth);
+    }
 
     // --- rays (ours traced on the tree of the last, parallel, build: what the renderer uses)
     Embree e1(1), e2(2);
@@ -392,11 +415,13 @@ void runScene(const Scene& s, bool quick) {
             const Embree& E = threads == 1 ? e1 : e2;
             if (threads == 2) e2.build(s);
             if (c.shadow) {
-                ours = measure(rays.size(), threads, minT, [&](size_t b, size_t e) { for (size_t i = b; i < e; ++i) occ[i] = bvh.occluded(rays[i]); });
-                ref = measure(rays.size(), threads, minT, [&](size_t b, size_t e) { for (size_t i = b; i < e; ++i) occ[i] = E.occluded(rays[i]); });
+                std::tie(ours, ref) = measurePair(
+                    rays.size(), threads, minT, reps, [&](size_t b, size_t e) { for (size_t i = b; i < e; ++i) occ[i] = bvh.occluded(rays[i]); },
+                    [&](size_t b, size_t e) { for (size_t i = b; i < e; ++i) occ[i] = E.occluded(rays[i]); });
             } else {
-                ours = measure(rays.size(), threads, minT, [&](size_t b, size_t e) { for (size_t i = b; i < e; ++i) bvh.intersect(rays[i], out[i]); });
-                ref = measure(rays.size(), threads, minT, [&](size_t b, size_t e) { for (size_t i = b; i < e; ++i) E.intersect(rays[i], out[i]); });
+                std::tie(ours, ref) = measurePair(
+                    rays.size(), threads, minT, reps, [&](size_t b, size_t e) { for (size_t i = b; i < e; ++i) bvh.intersect(rays[i], out[i]); },
+                    [&](size_t b, size_t e) { for (size_t i = b; i < e; ++i) E.intersect(rays[i], out[i]); });
             }
             line(s.name, std::string(c.name) + "_" + std::to_string(threads) + "t_Mrays/s", ours, ref);
         }

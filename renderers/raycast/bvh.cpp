@@ -5,8 +5,11 @@
 //
 // Build: every primitive becomes a PrimRef (box + id). A node starts with its whole range as
 // one child and repeatedly splits the child with the largest surface area (binned SAH over all
-// three axes, 16 bins, cost counted in blocks of 4 primitives since leaves are 4-packets) until
-// it has 4 children or none can be split. Ranges of <= maxLeafSize primitives become leaves.
+// three axes, 16 bins (32 for big ranges), cost counted in blocks of 4 primitives since leaves
+// are 4-packets) until it has W (4 or 8) children or none can be split. Ranges of <= maxLeafSize
+// primitives become leaves; so do ranges of up to maxLeafBlocks blocks whose SAH cost as one
+// leaf (halfArea * blocks) is no more than that of the best split plus one node visit
+// (traversalCost * halfArea): Embree's leaf rule, with fewer and fuller nodes near the leaves.
 #include "raycast/bvh.h"
 #ifdef BVH_TIMING
 #include <cstdio>
@@ -132,8 +135,10 @@ constexpr int kMaxBins = 32;
 
 inline int blocks(uint32_t n, int leafSize) { return int((n + uint32_t(leafSize) - 1) / uint32_t(leafSize)); }
 
-// Splits r into l and rr (binned SAH); returns false when r should stay a leaf.
-bool splitRange(PrimRef* refs, const Range& r, Range& l, Range& rr, int nbins, int leafSize, bool forceMedian) {
+// Splits r into l and rr (binned SAH, or an object median for tiny ranges); *cost gets the
+// split's SAH cost sum(halfArea(child) * blocks(child)), in the units of a leaf's cost
+// halfArea * blocks (blocks of leafSize primitives: one packet test each).
+void splitRange(PrimRef* refs, const Range& r, Range& l, Range& rr, int nbins, int leafSize, bool forceMedian, float* cost) {
     const uint32_t n = r.count();
     alignas(16) float cmin[4], cmax[4];
     _mm_store_ps(cmin, r.centroids.lo);
@@ -286,7 +291,8 @@ bool splitRange(PrimRef* refs, const Range& r, Range& l, Range& rr, int nbins, i
             for (int i = pos; i < nbins; ++i) rr.bounds.extend(bins[a][i].lo, bins[a][i].hi);
             l.centroids = lc;
             rr.centroids = rc;
-            return true;
+            *cost = bestCost;
+            return;
         }
         mid = r.begin + n / 2;   // numerical corner case: fall through to bounds by a pass
     } else {
@@ -305,18 +311,30 @@ bool splitRange(PrimRef* refs, const Range& r, Range& l, Range& rr, int nbins, i
     rr.begin = mid; rr.end = r.end;
     computeBounds(refs, l);
     computeBounds(refs, rr);
-    return true;
+    *cost = l.bounds.halfArea() * float(blocks(l.count(), leafSize)) + rr.bounds.halfArea() * float(blocks(rr.count(), leafSize));
 }
 
 // --- node building ----------------------------------------------------------------------------
+
+// A leaf as the builder makes it: refs[first, first + count). Inner nodes refer to leaves as
+// kLeafBit | leaf index; the callers turn that into their own leaf encoding afterwards
+// (Bvh4: primitive range, TriangleBvh: packet range).
+struct LeafRec { uint32_t first, count; };
 
 template <int W> struct Builder {
     using Node = NodeW<W>;
     PrimRef* refs;
     Node* nodes;
+    LeafRec* leaves;
     std::atomic<uint32_t> nodeCount{0};
+    std::atomic<uint32_t> leafCount{0};
     std::atomic<bool> spawned{false};   // subtrees built by tasks interleave their nodes
     int nbins, leafSize;
+    // Ranges of more than leafSize but at most maxLeaf primitives become one leaf of several
+    // blocks when the SAH says so: halfArea * blocks <= travCost * halfArea + split cost
+    // (a node visit costs travCost block tests). maxLeaf == leafSize: always split.
+    int maxLeaf;
+    float travCost;
     bool parallel;
 
     static void setEmpty(Node& n, int i) {
@@ -332,35 +350,64 @@ template <int W> struct Builder {
         n.b[2][i] = lo[1]; n.b[3][i] = hi[1];
         n.b[4][i] = lo[2]; n.b[5][i] = hi[2];
     }
-    static uint32_t leafRef(const Range& r) { return Node4::kLeafBit | (r.begin << 3) | r.count(); }
+    uint32_t makeLeaf(const Range& r) {
+        const uint32_t i = leafCount.fetch_add(1, std::memory_order_relaxed);
+        leaves[i] = {r.begin, r.count()};
+        return Node4::kLeafBit | i;
+    }
+
+    // A child range under construction: whether it stays a leaf, and its split when the
+    // leaf test already computed it.
+    struct Kid {
+        Range r, a, b;
+        bool leaf = false, hasSplit = false;
+    };
+    void decide(Kid& k, bool forceMedian) {
+        const uint32_t n = k.r.count();
+        k.hasSplit = false;
+        k.leaf = n <= uint32_t(leafSize);
+        if (k.leaf || n > uint32_t(maxLeaf)) return;
+        float cost;
+        splitRange(refs, k.r, k.a, k.b, nbins, leafSize, forceMedian, &cost);
+        const float area = k.r.bounds.halfArea();
+        k.leaf = area * float(blocks(n, leafSize)) <= travCost * area + cost;
+        k.hasSplit = !k.leaf;
+    }
 
     // Builds the subtree for r into node slot `index` (already allocated).
     void buildInner(uint32_t index, const Range& r, int depth) {
-        Range kids[W];
+        Kid kids[W];
         int nk = 1;
-        kids[0] = r;
+        kids[0].r = r;
         bool forceMedian = depth > 40;   // keeps the depth (and traversal stack) bounded
         while (nk < W) {
+            // Split the child with the largest surface area that is not a leaf.
             int best = -1;
             float bestArea = -1;
             for (int i = 0; i < nk; ++i)
-                if (kids[i].count() > uint32_t(leafSize)) {
-                    float a = kids[i].bounds.halfArea();
+                if (!kids[i].leaf) {
+                    float a = kids[i].r.bounds.halfArea();
                     if (a > bestArea) { bestArea = a; best = i; }
                 }
             if (best < 0) break;
+            Kid& k = kids[best];
             Range a, b;
-            splitRange(refs, kids[best], a, b, nbins, leafSize, forceMedian);
-            kids[best] = a;
-            kids[nk++] = b;
+            if (k.hasSplit) { a = k.a; b = k.b; }
+            else { float cost; splitRange(refs, k.r, a, b, nbins, leafSize, forceMedian, &cost); }
+            kids[best] = Kid{};
+            kids[best].r = a;
+            kids[nk].r = b;
+            decide(kids[best], forceMedian);
+            decide(kids[nk], forceMedian);
+            ++nk;
         }
         Node& node = nodes[index];
         uint32_t childIndex[W];
         for (int i = 0; i < W; ++i) {
             if (i >= nk) { setEmpty(node, i); continue; }
-            setBounds(node, i, kids[i].bounds);
-            if (kids[i].count() <= uint32_t(leafSize)) {
-                node.child[i] = leafRef(kids[i]);
+            setBounds(node, i, kids[i].r.bounds);
+            if (kids[i].leaf) {
+                node.child[i] = makeLeaf(kids[i].r);
                 childIndex[i] = ~0u;
             } else {
                 childIndex[i] = nodeCount.fetch_add(1, std::memory_order_relaxed);
@@ -369,20 +416,20 @@ template <int W> struct Builder {
         }
         bool spawn = false;
         if (parallel)
-            for (int i = 0; i < nk; ++i) spawn |= childIndex[i] != ~0u && kids[i].count() > 4096;
+            for (int i = 0; i < nk; ++i) spawn |= childIndex[i] != ~0u && kids[i].r.count() > 4096;
         if (spawn) {
             spawned.store(true, std::memory_order_relaxed);
             tbb::task_group tg;
             for (int i = 0; i < nk; ++i)
                 if (childIndex[i] != ~0u) {
-                    Range k = kids[i];
+                    Range k = kids[i].r;
                     uint32_t ci = childIndex[i];
                     tg.run([this, ci, k, depth] { buildInner(ci, k, depth + 1); });
                 }
             tg.wait();
         } else {
             for (int i = 0; i < nk; ++i)
-                if (childIndex[i] != ~0u) buildInner(childIndex[i], kids[i], depth + 1);
+                if (childIndex[i] != ~0u) buildInner(childIndex[i], kids[i].r, depth + 1);
         }
     }
 };
@@ -402,10 +449,12 @@ template <int W> int subtreeDepth(const std::vector<NodeW<W>>& nodes, uint32_t r
 namespace detail {
 // Builds from prepared refs (shared by Bvh4::build and TriangleBvh::build).
 template <int W, class NodeVec>
-void buildFromRefs(PrimRef* refs, size_t n, const Bvh4::BuildOptions& opt, NodeVec& outNodes,
-                   std::vector<uint32_t>& outPrims, sg::Aabb& outBounds) {
+// Leaves come out as kLeafBit | index into outLeaves.
+void buildFromRefs(PrimRef* refs, size_t n, const Bvh4::BuildOptions& opt, int maxLeaf, NodeVec& outNodes,
+                   std::vector<uint32_t>& outPrims, std::vector<LeafRec>& outLeaves, sg::Aabb& outBounds) {
     outNodes.clear();
     outPrims.clear();
+    outLeaves.clear();
     outBounds = sg::Aabb();
     if (n == 0) return;
     const int leafSize = std::clamp(opt.maxLeafSize, 1, 4);
@@ -436,13 +485,17 @@ void buildFromRefs(PrimRef* refs, size_t n, const Bvh4::BuildOptions& opt, NodeV
     // Inner nodes <= primitives (every inner node has >= 2 children); +1 for a wrapped leaf.
     const size_t storageBytes = (n + 1) * sizeof(NodeW<W>);
     std::unique_ptr<NodeW<W>[], HugeDeleter> storage(static_cast<NodeW<W>*>(hugeAlloc(storageBytes)), HugeDeleter{storageBytes});
-    Builder<W> b{refs, storage.get(), {}, {}, nbins, leafSize, opt.parallel};
+    // Leaves <= primitives.
+    const size_t leafBytes = n * sizeof(LeafRec);
+    std::unique_ptr<LeafRec[], HugeDeleter> leaves(static_cast<LeafRec*>(hugeAlloc(leafBytes)), HugeDeleter{leafBytes});
+    Builder<W> b{refs, storage.get(), leaves.get(), {}, {}, {}, nbins, leafSize, std::max(maxLeaf, leafSize),
+                 std::max(opt.traversalCost, 0.0f), opt.parallel};
     b.nodeCount = 1;
     if (root.count() <= uint32_t(leafSize)) {
         NodeW<W>& r = storage[0];
         for (int i = 0; i < W; ++i) Builder<W>::setEmpty(r, i);
         Builder<W>::setBounds(r, 0, root.bounds);
-        r.child[0] = Builder<W>::leafRef(root);
+        r.child[0] = b.makeLeaf(root);
     } else {
 #ifdef BVH_TIMING
         double tProbe = cpuNow();
@@ -490,6 +543,7 @@ void buildFromRefs(PrimRef* refs, size_t n, const Bvh4::BuildOptions& opt, NodeV
         }
         outNodes.resize(next);
     }
+    outLeaves.assign(leaves.get(), leaves.get() + b.leafCount.load());
     outPrims.resize(n);
     for (size_t i = 0; i < n; ++i) outPrims[i] = refs[i].id();
     alignas(16) float lo[4], hi[4];
@@ -508,7 +562,17 @@ void Bvh4::build(const vec3* boxMin, const vec3* boxMax, size_t n, const BuildOp
         if (!(mn.x <= mx.x && mn.y <= mx.y && mn.z <= mx.z) || !sg::isFinite(mn) || !sg::isFinite(mx)) continue;
         refs.push_back(makeRef(mn, mx, uint32_t(i)));
     }
-    detail::buildFromRefs<4>(refs.data(), refs.size(), opt, m_nodes, m_primIndex, m_bounds);
+    // Leaves of up to 7 primitives (the count has 3 bits).
+    const int leafSize = std::clamp(opt.maxLeafSize, 1, 4);
+    const int maxLeaf = std::min(leafSize * std::max(opt.maxLeafBlocks, 1), 7);
+    std::vector<LeafRec> leaves;
+    detail::buildFromRefs<4>(refs.data(), refs.size(), opt, maxLeaf, m_nodes, m_primIndex, leaves, m_bounds);
+    for (Node4& nd : m_nodes)
+        for (uint32_t& c : nd.child)
+            if (c != NodeBits::kEmpty && (c & NodeBits::kLeafBit)) {
+                const LeafRec& l = leaves[c & ~NodeBits::kLeafBit];
+                c = NodeBits::kLeafBit | (l.first << 3) | l.count;
+            }
 }
 
 int Bvh4::depth() const { return m_nodes.empty() ? 0 : subtreeDepth<4>(m_nodes, 0); }
@@ -528,24 +592,28 @@ __attribute__((noinline)) void setLane(TriPacket4& p, int k, const vec3& p0, con
 }  // namespace
 
 namespace {
-// One packet per leaf, in node order; leaf refs are rewritten to packet indices.
+// Each leaf's triangles as consecutive packets, leaves in node order; leaf refs become
+// kLeafBit | (first packet << 3) | packet count.
 template <int W>
-void makePackets(HugeVector<NodeW<W>>& nodes, const std::vector<uint32_t>& prims, const vec3* pos, const uint32_t* idx,
-                 HugeVector<TriPacket4>& packets) {
+void makePackets(HugeVector<NodeW<W>>& nodes, const std::vector<uint32_t>& prims, const std::vector<LeafRec>& leaves,
+                 const vec3* pos, const uint32_t* idx, HugeVector<TriPacket4>& packets) {
     packets.reserve(prims.size() / 2 + 1);
     for (NodeW<W>& n : nodes)
         for (uint32_t& c : n.child) {
             if (c == NodeBits::kEmpty || !(c & NodeBits::kLeafBit)) continue;
-            uint32_t first = (c & ~NodeBits::kLeafBit) >> 3, count = c & 7u;
-            TriPacket4 p{};
-            for (uint32_t k = 0; k < 4; ++k) {
-                if (k >= count) { p.prim[k] = ~0u; continue; }
-                uint32_t t = prims[first + k];
-                setLaneInline(p, int(k), pos[idx[3 * t]], pos[idx[3 * t + 1]], pos[idx[3 * t + 2]]);
-                p.prim[k] = t;
+            const LeafRec& l = leaves[c & ~NodeBits::kLeafBit];
+            const uint32_t firstPacket = uint32_t(packets.size());
+            for (uint32_t base = 0; base < l.count; base += 4) {
+                TriPacket4 p{};
+                for (uint32_t k = 0; k < 4; ++k) {
+                    if (base + k >= l.count) { p.prim[k] = ~0u; continue; }
+                    uint32_t t = prims[l.first + base + k];
+                    setLaneInline(p, int(k), pos[idx[3 * t]], pos[idx[3 * t + 1]], pos[idx[3 * t + 2]]);
+                    p.prim[k] = t;
+                }
+                packets.push_back(p);
             }
-            c = NodeBits::kLeafBit | (uint32_t(packets.size()) << 3) | count;
-            packets.push_back(p);
+            c = NodeBits::kLeafBit | (firstPacket << 3) | (uint32_t(packets.size()) - firstPacket);
         }
 }
 int kernelWidth();
@@ -598,18 +666,50 @@ void TriangleBvh::build(const vec3* pos, const uint32_t* idx, size_t triCount, c
     PROBE("refs");
 
     std::vector<uint32_t> prims;
+    std::vector<LeafRec> leaves;
+    // Leaves of up to 7 packets (the count has 3 bits).
+    const int maxLeaf = 4 * std::clamp(opt.maxLeafBlocks, 1, 7);
     m_nodes4.clear();
     m_nodes8.clear();
     m_packets.clear();
     if (kernelWidth() == 8) {
-        detail::buildFromRefs<8>(refs.get(), refCount, opt, m_nodes8, prims, m_bounds);
+        detail::buildFromRefs<8>(refs.get(), refCount, opt, maxLeaf, m_nodes8, prims, leaves, m_bounds);
         PROBE("tree");
-        makePackets(m_nodes8, prims, pos, idx, m_packets);
+        makePackets(m_nodes8, prims, leaves, pos, idx, m_packets);
         PROBE("packets");
     } else {
-        detail::buildFromRefs<4>(refs.get(), refCount, opt, m_nodes4, prims, m_bounds);
-        makePackets(m_nodes4, prims, pos, idx, m_packets);
+        detail::buildFromRefs<4>(refs.get(), refCount, opt, maxLeaf, m_nodes4, prims, leaves, m_bounds);
+        makePackets(m_nodes4, prims, leaves, pos, idx, m_packets);
     }
+}
+
+namespace {
+template <int W> void addStats(const HugeVector<NodeW<W>>& nodes, TriangleBvh::Stats& s) {
+    s.nodes = nodes.size();
+    for (const NodeW<W>& n : nodes)
+        for (uint32_t c : n.child) {
+            s.childSlots += c != NodeBits::kEmpty;
+            if (c != NodeBits::kEmpty && (c & NodeBits::kLeafBit)) s.maxLeafPackets = std::max(s.maxLeafPackets, int(c & 7u));
+        }
+    std::vector<std::pair<uint32_t, int>> stack{{0u, 1}};
+    while (!stack.empty()) {
+        auto [i, d] = stack.back();
+        stack.pop_back();
+        s.depth = std::max(s.depth, d);
+        for (uint32_t c : nodes[i].child)
+            if (c != NodeBits::kEmpty && !(c & NodeBits::kLeafBit)) stack.push_back({c, d + 1});
+    }
+}
+}  // namespace
+
+TriangleBvh::Stats TriangleBvh::stats() const {
+    Stats s;
+    if (!m_nodes8.empty()) addStats(m_nodes8, s);
+    else if (!m_nodes4.empty()) addStats(m_nodes4, s);
+    s.packets = m_packets.size();
+    for (const TriPacket4& p : m_packets)
+        for (uint32_t id : p.prim) s.lanes += id != ~0u;
+    return s;
 }
 
 // --- kernels: SSE and AVX2+FMA builds of tri_kernel.inl, chosen once at run time ------------

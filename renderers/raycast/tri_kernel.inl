@@ -60,7 +60,53 @@ inline int intersectPacket(const TriPacket4& p, const __m128 o[3], const __m128 
     return mask;
 }
 
-// Front-to-back BVH4 traversal with the packet test inlined. AnyHit: stop at the first hit
+#if RT_FMA
+// intersectPacket on two packets at once (AVX: lanes 0-3 from a, 4-7 from b). Same
+// arithmetic lane by lane, so the same hits. Returns the 8-bit hit mask.
+inline __m256 loadPair(const float* x, const float* y) {
+    return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(x)), _mm_load_ps(y), 1);
+}
+inline int intersectPacketPair(const TriPacket4& a, const TriPacket4& b, const __m256 o[3], const __m256 d[3], __m256 tmin,
+                               __m256 tmax, __m256& tOut, __m256& uOut, __m256& vOut, bool cullBack) {
+    const auto ld = loadPair;
+    const __m256 nx = ld(a.n[0], b.n[0]), ny = ld(a.n[1], b.n[1]), nz = ld(a.n[2], b.n[2]);
+    const __m256 sx = _mm256_sub_ps(o[0], ld(a.v0[0], b.v0[0]));
+    const __m256 sy = _mm256_sub_ps(o[1], ld(a.v0[1], b.v0[1]));
+    const __m256 sz = _mm256_sub_ps(o[2], ld(a.v0[2], b.v0[2]));
+    const __m256 negZero = _mm256_set1_ps(-0.0f);
+    __m256 det = _mm256_fmadd_ps(d[2], nz, _mm256_fmadd_ps(d[1], ny, _mm256_mul_ps(d[0], nx)));
+    det = _mm256_xor_ps(det, negZero);
+    const __m256 sign = _mm256_and_ps(det, negZero);
+    const __m256 absDet = _mm256_xor_ps(det, sign);
+    const __m256 rx = _mm256_fmsub_ps(sy, d[2], _mm256_mul_ps(sz, d[1]));
+    const __m256 ry = _mm256_fmsub_ps(sz, d[0], _mm256_mul_ps(sx, d[2]));
+    const __m256 rz = _mm256_fmsub_ps(sx, d[1], _mm256_mul_ps(sy, d[0]));
+    __m256 U = _mm256_fmadd_ps(ld(a.e2[2], b.e2[2]), rz, _mm256_fmadd_ps(ld(a.e2[1], b.e2[1]), ry, _mm256_mul_ps(ld(a.e2[0], b.e2[0]), rx)));
+    __m256 V = _mm256_fmadd_ps(ld(a.e1[2], b.e1[2]), rz, _mm256_fmadd_ps(ld(a.e1[1], b.e1[1]), ry, _mm256_mul_ps(ld(a.e1[0], b.e1[0]), rx)));
+    __m256 T = _mm256_fmadd_ps(sz, nz, _mm256_fmadd_ps(sy, ny, _mm256_mul_ps(sx, nx)));
+    U = _mm256_xor_ps(U, sign);
+    V = _mm256_xor_ps(V, _mm256_xor_ps(sign, negZero));
+    T = _mm256_xor_ps(T, sign);
+    const __m256 zero = _mm256_setzero_ps();
+    __m256 ok = cullBack ? _mm256_cmp_ps(det, zero, _CMP_GT_OQ) : _mm256_cmp_ps(det, zero, _CMP_NEQ_UQ);
+    ok = _mm256_and_ps(ok, _mm256_cmp_ps(U, zero, _CMP_GE_OQ));
+    ok = _mm256_and_ps(ok, _mm256_cmp_ps(V, zero, _CMP_GE_OQ));
+    ok = _mm256_and_ps(ok, _mm256_cmp_ps(_mm256_add_ps(U, V), absDet, _CMP_LE_OQ));
+    ok = _mm256_and_ps(ok, _mm256_cmp_ps(T, _mm256_mul_ps(absDet, tmin), _CMP_GT_OQ));
+    ok = _mm256_and_ps(ok, _mm256_cmp_ps(T, _mm256_mul_ps(absDet, tmax), _CMP_LT_OQ));
+    int mask = _mm256_movemask_ps(ok);
+    if (mask) {
+        const __m256 inv = _mm256_div_ps(_mm256_set1_ps(1.0f), absDet);
+        tOut = _mm256_mul_ps(T, inv);
+        uOut = _mm256_mul_ps(U, inv);
+        vOut = _mm256_mul_ps(V, inv);
+        mask &= _mm256_movemask_ps(_mm256_and_ps(_mm256_cmp_ps(tOut, tmax, _CMP_LT_OQ), _mm256_cmp_ps(tOut, tmin, _CMP_GT_OQ)));
+    }
+    return mask;
+}
+#endif
+
+// Front-to-back BVH4 traversal with the packet test inlined (a leaf is 1-7 consecutive packets). AnyHit: stop at the first hit
 // and skip the ordering. Returns true on a hit (closest hit written to *hit unless AnyHit).
 template <bool AnyHit>
 inline bool traceTriangles(const Node4* nodes, const TriPacket4* packets, const Ray& ray, TriHit* hit, bool cullBack) {
@@ -127,10 +173,12 @@ inline bool traceTriangles(const Node4* nodes, const TriPacket4* packets, const 
                 continue;
             }
         } else {
-            const TriPacket4& p = packets[(cur & ~Node4::kLeafBit) >> 3];
-            __m128 t, u, v;
-            int mask = intersectPacket(p, o, d, tminV, tmaxV, t, u, v, cullBack);
-            if (mask) {
+            const TriPacket4* p = packets + ((cur & ~Node4::kLeafBit) >> 3);
+            const TriPacket4* end = p + (cur & 7u);
+            for (; p != end; ++p) {
+                __m128 t, u, v;
+                int mask = intersectPacket(*p, o, d, tminV, tmaxV, t, u, v, cullBack);
+                if (!mask) continue;
                 if constexpr (AnyHit) return true;
                 alignas(16) float ta[4], ua[4], va[4];
                 _mm_store_ps(ta, t);
@@ -142,7 +190,7 @@ inline bool traceTriangles(const Node4* nodes, const TriPacket4* packets, const 
                     if (ta[k] < tmax) {
                         tmax = ta[k];
                         hit->t = ta[k];
-                        hit->prim = p.prim[k];
+                        hit->prim = p->prim[k];
                         hit->b1 = ua[k];
                         hit->b2 = va[k];
                         found = true;
@@ -173,6 +221,8 @@ inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const
     const __m128 d[3] = {_mm_set1_ps(ray.dir.x), _mm_set1_ps(ray.dir.y), _mm_set1_ps(ray.dir.z)};
     const __m128 tminV = _mm_set1_ps(ray.tmin);
     const __m256 tmin8 = _mm256_set1_ps(ray.tmin);
+    const __m256 o8[3] = {_mm256_set1_ps(ray.org.x), _mm256_set1_ps(ray.org.y), _mm256_set1_ps(ray.org.z)};
+    const __m256 d8[3] = {_mm256_set1_ps(ray.dir.x), _mm256_set1_ps(ray.dir.y), _mm256_set1_ps(ray.dir.z)};
     const __m256 grow = _mm256_set1_ps(1.0f + 8.0f * std::numeric_limits<float>::epsilon());
     float tmax = ray.tmax;
     __m128 tmaxV = _mm_set1_ps(tmax);
@@ -226,10 +276,36 @@ inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const
                 continue;
             }
         } else {
-            const TriPacket4& p = packets[(cur & ~Node8::kLeafBit) >> 3];
-            __m128 t, u, v;
-            int mask = intersectPacket(p, o, d, tminV, tmaxV, t, u, v, cullBack);
-            if (mask) {
+            const TriPacket4* p = packets + ((cur & ~Node8::kLeafBit) >> 3);
+            const TriPacket4* end = p + (cur & 7u);
+            for (; p + 1 < end; p += 2) {   // two packets per AVX test
+                __m256 t, u, v;
+                int mask = intersectPacketPair(p[0], p[1], o8, d8, tmin8, tmax8, t, u, v, cullBack);
+                if (!mask) continue;
+                if constexpr (AnyHit) return true;
+                alignas(32) float ta[8], ua[8], va[8];
+                _mm256_store_ps(ta, t);
+                _mm256_store_ps(ua, u);
+                _mm256_store_ps(va, v);
+                while (mask) {
+                    int k = __builtin_ctz(mask);
+                    mask &= mask - 1;
+                    if (ta[k] < tmax) {
+                        tmax = ta[k];
+                        hit->t = ta[k];
+                        hit->prim = p[k >> 2].prim[k & 3];
+                        hit->b1 = ua[k];
+                        hit->b2 = va[k];
+                        found = true;
+                    }
+                }
+                tmaxV = _mm_set1_ps(tmax);
+                tmax8 = _mm256_set1_ps(tmax);
+            }
+            for (; p != end; ++p) {
+                __m128 t, u, v;
+                int mask = intersectPacket(*p, o, d, tminV, tmaxV, t, u, v, cullBack);
+                if (!mask) continue;
                 if constexpr (AnyHit) return true;
                 alignas(16) float ta[4], ua[4], va[4];
                 _mm_store_ps(ta, t);
@@ -241,7 +317,7 @@ inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const
                     if (ta[k] < tmax) {
                         tmax = ta[k];
                         hit->t = ta[k];
-                        hit->prim = p.prim[k];
+                        hit->prim = p->prim[k];
                         hit->b1 = ua[k];
                         hit->b2 = va[k];
                         found = true;

@@ -360,30 +360,43 @@ TEST(RaycastTest, BvhClosestHitEqualsBruteForce) {
         pos.push_back(vec3(0)); pos.push_back(vec3(0)); pos.push_back(vec3(0));
         idx.insert(idx.end(), {uint32_t(pos.size() - 3), uint32_t(pos.size() - 2), uint32_t(pos.size() - 1)});
         const size_t count = idx.size() / 3;
-        TriangleBvh bvh;
-        bvh.build(pos.data(), idx.data(), count);
-        int hits = 0;
-        for (int i = 0; i < 3000; ++i) {
-            vec3 o(U(rng) * 8, U(rng) * 8, U(rng) * 8);
-            vec3 d = i % 3 == 0 ? vec3(U(rng), U(rng), U(rng)) : vec3(U(rng) * 5, U(rng) * 5, U(rng) * 5) - o;
-            if (i % 50 == 0) d = vec3(0, 0, i % 100 == 0 ? 1.0f : -1.0f);   // axis-aligned: zero components
-            Ray r = mkRay(o, d);
-            if (i % 7 == 0) r.tmax = 0.5f;
-            TriHit a, b;
-            bool ha = bvh.intersect(r, a), hb = intersectBruteForce(pos.data(), idx.data(), count, r, b);
-            ASSERT_EQ(ha, hb) << "seed " << seed << " ray " << i;
-            EXPECT_EQ(bvh.occluded(r), hb);
-            if (!ha) continue;
-            ++hits;
-            EXPECT_EQ(a.t, b.t);
-            if (a.prim != b.prim) {   // exact ties between two triangles may pick either
+        // Default leaves (SAH-chosen, up to 4 packets), single-packet leaves, and leaves of up
+        // to 7 packets with node visits made expensive (many multi-packet leaves).
+        Bvh4::BuildOptions opts[3] = {TriangleBvh::defaultOptions(), {}, TriangleBvh::defaultOptions()};
+        opts[1].maxLeafBlocks = 1;
+        opts[2].maxLeafBlocks = 7;
+        opts[2].traversalCost = 20.0f;
+        opts[2].parallel = false;
+        for (const Bvh4::BuildOptions& opt : opts) {
+            TriangleBvh bvh;
+            bvh.build(pos.data(), idx.data(), count, opt);
+            const TriangleBvh::Stats st = bvh.stats();
+            EXPECT_LE(st.maxLeafPackets, opt.maxLeafBlocks);
+            if (ntri > 100 && opt.maxLeafBlocks == 7) { EXPECT_GE(st.maxLeafPackets, 3) << "seed " << seed; }
+            EXPECT_EQ(st.lanes, count) << "every triangle in exactly one lane";
+            int hits = 0;
+            for (int i = 0; i < 3000; ++i) {
+                vec3 o(U(rng) * 8, U(rng) * 8, U(rng) * 8);
+                vec3 d = i % 3 == 0 ? vec3(U(rng), U(rng), U(rng)) : vec3(U(rng) * 5, U(rng) * 5, U(rng) * 5) - o;
+                if (i % 50 == 0) d = vec3(0, 0, i % 100 == 0 ? 1.0f : -1.0f);   // axis-aligned: zero components
+                Ray r = mkRay(o, d);
+                if (i % 7 == 0) r.tmax = 0.5f;
+                TriHit a, b;
+                bool ha = bvh.intersect(r, a), hb = intersectBruteForce(pos.data(), idx.data(), count, r, b);
+                ASSERT_EQ(ha, hb) << "seed " << seed << " ray " << i;
+                EXPECT_EQ(bvh.occluded(r), hb);
+                if (!ha) continue;
+                ++hits;
                 EXPECT_EQ(a.t, b.t);
-            } else {
-                EXPECT_EQ(a.b1, b.b1);
-                EXPECT_EQ(a.b2, b.b2);
+                if (a.prim != b.prim) {   // exact ties between two triangles may pick either
+                    EXPECT_EQ(a.t, b.t);
+                } else {
+                    EXPECT_EQ(a.b1, b.b1);
+                    EXPECT_EQ(a.b2, b.b2);
+                }
             }
+            if (ntri > 100) { EXPECT_GT(hits, seed == 3 ? 10 : 100); }
         }
-        if (ntri > 100) { EXPECT_GT(hits, seed == 3 ? 10 : 100); }
     }
 }
 
