@@ -2,7 +2,9 @@
 //
 //   ./build/release/bench/raycast/bench_raycast            # full run (sphere grids 10k/100k/1M + bunny)
 //   ./build/release/bench/raycast/bench_raycast --quick    # < 1 minute: fewer repetitions, 640x360 rays
-//   options: --scene NAME (run one scene), --testdata DIR, --build-only (only the 1-thread
+//   options: --scene NAME (run one scene), --testdata DIR, --rays CLASS (only that ray class's
+//   throughput, e.g. for valgrind --tool=callgrind --toggle-collect='*TriangleBvh::intersect*'
+//   --toggle-collect=rtcIntersect1), --build-only (only the 1-thread
 //   builds, ours and Embree alternating --reps N times, medians; also for profilers, e.g.
 //   valgrind --tool=callgrind --toggle-collect='rnd::rt::TriangleBvh::build*')
 //
@@ -317,7 +319,8 @@ BuildTimes measureBuilds(const Scene& s, TriangleBvh& bvh, int reps, bool twoThr
     return {median(o1), median(r1), median(o2), median(r2)};
 }
 
-void runScene(const Scene& s, bool quick) {
+// rayClass: "" for all three ray classes, else only that one's throughput (profiling).
+void runScene(const Scene& s, bool quick, const std::string& rayClass) {
     const double minT = quick ? 0.0 : 0.25;
     const int reps = quick ? 3 : 5;   // alternating ours/Embree passes per measure (medians)
     const int W = quick ? 640 : 1280, H = quick ? 360 : 720;
@@ -409,6 +412,7 @@ void runScene(const Scene& s, bool quick) {
     struct Cls { const char* name; const std::vector<Ray>* rays; bool shadow; };
     const Cls classes[3] = {{"primary", &primary, false}, {"shadow", &shadow, true}, {"incoherent", &incoherent, false}};
     for (const Cls& c : classes) {
+        if (!rayClass.empty() && rayClass != c.name) continue;
         const std::vector<Ray>& rays = *c.rays;
         for (int threads : {1, 2}) {
             double ours, ref;
@@ -433,15 +437,16 @@ void runScene(const Scene& s, bool quick) {
 int main(int argc, char** argv) {
     bool quick = false, buildOnly = false;
     int reps = 1;
-    std::string only, testdata = VIEWER_TESTDATA_DIR;
+    std::string only, rayClass, testdata = VIEWER_TESTDATA_DIR;
     for (int i = 1; i < argc; ++i) {
         std::string a = argv[i];
         if (a == "--quick") quick = true;
         else if (a == "--scene" && i + 1 < argc) only = argv[++i];
         else if (a == "--testdata" && i + 1 < argc) testdata = argv[++i];
         else if (a == "--build-only") buildOnly = true;
+        else if (a == "--rays" && i + 1 < argc) rayClass = argv[++i];
         else if (a == "--reps" && i + 1 < argc) reps = std::max(1, std::atoi(argv[++i]));
-        else { std::fprintf(stderr, "usage: %s [--quick] [--scene NAME] [--testdata DIR] [--build-only [--reps N]]\n", argv[0]); return 2; }
+        else { std::fprintf(stderr, "usage: %s [--quick] [--scene NAME] [--testdata DIR] [--rays primary|shadow|incoherent] [--build-only [--reps N]]\n", argv[0]); return 2; }
     }
     if (const char* env = std::getenv("VIEWER_TESTDATA")) testdata = env;
     setFtzDaz();
@@ -464,7 +469,7 @@ int main(int argc, char** argv) {
             line(s.name, "build_1t_Mtris/s", mt / bt.ours1, mt / bt.ref1);
             continue;
         }
-        runScene(s, quick);
+        runScene(s, quick, rayClass);
     }
     return 0;
 }
