@@ -106,6 +106,25 @@ inline int intersectPacketPair(const TriPacket4& a, const TriPacket4& b, const _
 }
 #endif
 
+// The closest of the hit lanes in `mask` (lane k: triangle k & 3 of packet p[k >> 2]) if it is
+// closer than tmax: shrinks tmax, fills *hit, returns true.
+inline bool closestLane(int mask, const float* ta, const float* ua, const float* va, const TriPacket4* p, float& tmax, TriHit* hit) {
+    bool found = false;
+    while (mask) {
+        const int k = __builtin_ctz(mask);
+        mask &= mask - 1;
+        if (ta[k] < tmax) {
+            tmax = ta[k];
+            hit->t = ta[k];
+            hit->prim = p[k >> 2].prim[k & 3];
+            hit->b1 = ua[k];
+            hit->b2 = va[k];
+            found = true;
+        }
+    }
+    return found;
+}
+
 // Front-to-back BVH4 traversal with the packet test inlined (a leaf is 1-7 consecutive packets). AnyHit: stop at the first hit
 // and skip the ordering. Returns true on a hit (closest hit written to *hit unless AnyHit).
 template <bool AnyHit>
@@ -184,18 +203,7 @@ inline bool traceTriangles(const Node4* nodes, const TriPacket4* packets, const 
                 _mm_store_ps(ta, t);
                 _mm_store_ps(ua, u);
                 _mm_store_ps(va, v);
-                while (mask) {
-                    int k = __builtin_ctz(mask);
-                    mask &= mask - 1;
-                    if (ta[k] < tmax) {
-                        tmax = ta[k];
-                        hit->t = ta[k];
-                        hit->prim = p->prim[k];
-                        hit->b1 = ua[k];
-                        hit->b2 = va[k];
-                        found = true;
-                    }
-                }
+                found |= closestLane(mask, ta, ua, va, p, tmax, hit);
                 tmaxV = _mm_set1_ps(tmax);
             }
         }
@@ -287,18 +295,7 @@ inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const
                 _mm256_store_ps(ta, t);
                 _mm256_store_ps(ua, u);
                 _mm256_store_ps(va, v);
-                while (mask) {
-                    int k = __builtin_ctz(mask);
-                    mask &= mask - 1;
-                    if (ta[k] < tmax) {
-                        tmax = ta[k];
-                        hit->t = ta[k];
-                        hit->prim = p[k >> 2].prim[k & 3];
-                        hit->b1 = ua[k];
-                        hit->b2 = va[k];
-                        found = true;
-                    }
-                }
+                found |= closestLane(mask, ta, ua, va, p, tmax, hit);
                 tmaxV = _mm_set1_ps(tmax);
                 tmax8 = _mm256_set1_ps(tmax);
             }
@@ -311,18 +308,7 @@ inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const
                 _mm_store_ps(ta, t);
                 _mm_store_ps(ua, u);
                 _mm_store_ps(va, v);
-                while (mask) {
-                    int k = __builtin_ctz(mask);
-                    mask &= mask - 1;
-                    if (ta[k] < tmax) {
-                        tmax = ta[k];
-                        hit->t = ta[k];
-                        hit->prim = p->prim[k];
-                        hit->b1 = ua[k];
-                        hit->b2 = va[k];
-                        found = true;
-                    }
-                }
+                found |= closestLane(mask, ta, ua, va, p, tmax, hit);
                 tmaxV = _mm_set1_ps(tmax);
                 tmax8 = _mm256_set1_ps(tmax);
             }
