@@ -148,6 +148,9 @@ struct Embree {
     RTCScene scene = nullptr;
     explicit Embree(int threads) {
         std::string cfg = "threads=" + std::to_string(threads);
+        // BENCH_EMBREE_CONFIG appends to Embree's device configuration, e.g. "isa=avx2" to
+        // compare against Embree's AVX2 kernels on a CPU where it would pick AVX-512.
+        if (const char* extra = std::getenv("BENCH_EMBREE_CONFIG")) cfg += std::string(",") + extra;
         device = rtcNewDevice(cfg.c_str());
     }
     ~Embree() {
