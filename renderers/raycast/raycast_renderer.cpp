@@ -8,8 +8,10 @@
 // Conventions followed (see renderers/renderer.h and the brief): primary rays come from
 // CameraRays (unprojecting pixel centres, so images line up with the rasterizers); depth is
 // window z; two-sided lighting flips normals of back-facing triangles (geometric normal
-// pointing along the ray); fog uses |p_eye|. Textures: bilinear, LOD 0 only (no mip-mapping),
-// texels decoded from sRGB before filtering; analytic surfaces are untextured.
+// pointing along the ray); fog uses |p_eye|. Textures: the rasterizer's sampler (mip chains,
+// nearest/bilinear/trilinear), the level chosen from ray differentials - for camera rays and
+// for mirror-reflected ones - texels decoded from sRGB before filtering; analytic surfaces
+// are untextured.
 #include "raycast/raycast_renderer.h"
 
 #include "raycast/camera_rays.h"
@@ -35,12 +37,40 @@ namespace {
 
 // --- texture footprint ------------------------------------------------------------------------
 
-// Where a camera ray came from: its window position, so the rays through the neighbouring
-// pixels (ray differentials) can be made when a textured surface needs its uv derivatives.
+// The rays through the neighbouring pixels (one to the right, one up) that go with a ray: its
+// ray differentials, from which a textured hit gets its uv derivatives and so its mip level.
+// Camera rays keep only their window position (the neighbours are made when a texture needs
+// them); reflected rays carry their neighbours, reflected at the same mirror.
 struct PixelFootprint {
     const rt::CameraRays* cam = nullptr;
     float wx = 0, wy = 0;
+    bool carried = false;
+    rt::Ray rx, ry;
+    bool neighbours(rt::Ray& x, rt::Ray& y) const {
+        if (carried) { x = rx; y = ry; return true; }
+        if (!cam) return false;
+        x = cam->ray(wx + 1.0f, wy);
+        y = cam->ray(wx, wy + 1.0f);
+        return true;
+    }
 };
+
+// A neighbouring ray reflected where it meets the mirror's plane (point p, plane normal ng)
+// about the same shading normal n as the main ray: exact for flat mirrors; for curved ones it
+// leaves out the curvature (the footprint grows less than it should: a finer level, never a
+// coarser one). False for rays along the plane.
+bool reflectNeighbour(const rt::Ray& a, const vec3& p, const vec3& ng, const vec3& n, rt::Ray& out) {
+    const float den = glm::dot(a.dir, ng);
+    if (!(std::abs(den) > 1e-30f)) return false;
+    const float t = glm::dot(p - a.org, ng) / den;
+    if (!std::isfinite(t)) return false;
+    const vec3 d = glm::normalize(a.dir);
+    out.org = a.org + t * a.dir;
+    out.dir = d - 2.0f * glm::dot(d, n) * n;
+    out.tmin = 0.0f;
+    out.tmax = std::numeric_limits<float>::infinity();
+    return isFinite(out.org) && isFinite(out.dir);
+}
 
 // uv at the point where ray r meets the plane of triangle P (barycentrics of that point, even
 // outside the triangle: derivatives only need the plane). False for rays along the plane.
@@ -90,7 +120,7 @@ struct Tracer {
 
     // Radiance along the ray (linear), depth of the first hit (window z via the camera) when
     // depthOut is given; eye = where the viewer is for this ray (camera eye or bounce origin).
-    // footprint: for camera rays (texture mip selection), null for reflected rays.
+    // footprint: the ray's differentials (texture mip selection); null: textures at level 0.
     vec3 trace(const rt::Ray& r, const vec3& eye, int bounce, vec3* hitPos, const PixelFootprint* footprint = nullptr) {
         ++rays;
         rt::SceneHit h;
@@ -139,8 +169,8 @@ struct Tracer {
                 const vec2 UV[3] = {mesh.uv0[i0], mesh.uv0[i1], mesh.uv0[i2]};
                 const vec2 uv = w0 * UV[0] + w1 * UV[1] + w2 * UV[2];
                 vec2 uvX, uvY;
-                if (footprint && uvOnPlane(footprint->cam->ray(footprint->wx + 1.0f, footprint->wy), P, UV, uvX) &&
-                    uvOnPlane(footprint->cam->ray(footprint->wx, footprint->wy + 1.0f), P, UV, uvY))
+                rt::Ray nx, ny;
+                if (footprint && footprint->neighbours(nx, ny) && uvOnPlane(nx, P, UV, uvX) && uvOnPlane(ny, P, UV, uvY))
                     texColor = tex->sample(uv, uvX - uv, uvY - uv);
                 else
                     texColor = tex->sampleLevel(uv, 0, tex->filter() != FilterMode::Nearest);
@@ -215,7 +245,11 @@ struct Tracer {
             rr.dir = rd;
             rr.tmin = 0.0f;
             rr.tmax = std::numeric_limits<float>::infinity();
-            vec3 refl = trace(rr, p, bounce + 1, nullptr);
+            PixelFootprint rf;
+            rt::Ray nx, ny;
+            rf.carried = footprint && footprint->neighbours(nx, ny) && reflectNeighbour(nx, p, ng, n, rf.rx) &&
+                         reflectNeighbour(ny, p, ng, n, rf.ry);
+            vec3 refl = trace(rr, p, bounce + 1, nullptr, rf.carried ? &rf : nullptr);
             color = glm::mix(color, refl, std::clamp(mat->reflectivity, 0.0f, 1.0f));
         }
         return color;
