@@ -109,9 +109,12 @@ vec3 SampledTexture::sample(vec2 uv, vec2 ddx, vec2 ddy) const {
 const SampledTexture* SamplerCache::get(const sg::TexturePtr& t) {
     if (!t || t->width <= 0 || t->height <= 0 || t->rgba.size() < size_t(t->width) * size_t(t->height) * 4) return nullptr;
     Entry& e = m_entries[t->id];
-    if (!e.tex || e.version != t->version) {
+    if (!e.tex || e.version != t->version || e.filter != t->filter || e.wrapS != t->wrapS || e.wrapT != t->wrapT) {
         e.tex = std::make_unique<SampledTexture>(*t);
         e.version = t->version;
+        e.filter = t->filter;
+        e.wrapS = t->wrapS;
+        e.wrapT = t->wrapT;
     }
     e.lastFrame = m_frame;
     return e.tex.get();

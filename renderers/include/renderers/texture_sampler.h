@@ -35,7 +35,8 @@ private:
     sg::FilterMode m_filter;
 };
 
-// Samplers (mip chains) per texture, rebuilt when a texture's version changes, shared by the
+// Samplers (mip chains) per texture, rebuilt when a texture's version or its filter/wrap modes
+// change (a copy of a texture keeps its id), shared by the
 // CPU backends: beginFrame(), get() for each texture drawn, endFrame() drops samplers unused
 // for 8 frames. get() returns null for empty or inconsistent textures.
 class SamplerCache {
@@ -48,6 +49,8 @@ private:
     struct Entry {
         std::unique_ptr<SampledTexture> tex;
         uint64_t version = 0;
+        sg::FilterMode filter{};   // sampling state baked into the sampler: a change rebuilds it
+        sg::WrapMode wrapS{}, wrapT{};
         uint64_t lastFrame = 0;
     };
     std::unordered_map<uint64_t, Entry> m_entries;
