@@ -374,11 +374,12 @@ template <int W> struct Builder {
         k.hasSplit = !k.leaf;
     }
 
-    // Builds the subtree for r into node slot `index` (already allocated).
-    void buildInner(uint32_t index, const Range& r, int depth) {
+    // Builds the subtree for `root` (not a leaf; its split may already be known from the
+    // parent's leaf test) into node slot `index` (already allocated).
+    void buildInner(uint32_t index, const Kid& root, int depth) {
         Kid kids[W];
         int nk = 1;
-        kids[0].r = r;
+        kids[0] = root;
         bool forceMedian = depth > 40;   // keeps the depth (and traversal stack) bounded
         while (nk < W) {
             // Split the child with the largest surface area that is not a leaf.
@@ -422,14 +423,14 @@ template <int W> struct Builder {
             tbb::task_group tg;
             for (int i = 0; i < nk; ++i)
                 if (childIndex[i] != ~0u) {
-                    Range k = kids[i].r;
-                    uint32_t ci = childIndex[i];
+                    const Kid k = kids[i];
+                    const uint32_t ci = childIndex[i];
                     tg.run([this, ci, k, depth] { buildInner(ci, k, depth + 1); });
                 }
             tg.wait();
         } else {
             for (int i = 0; i < nk; ++i)
-                if (childIndex[i] != ~0u) buildInner(childIndex[i], kids[i].r, depth + 1);
+                if (childIndex[i] != ~0u) buildInner(childIndex[i], kids[i], depth + 1);
         }
     }
 };
@@ -500,7 +501,9 @@ void buildFromRefs(PrimRef* refs, size_t n, const Bvh4::BuildOptions& opt, int m
 #ifdef BVH_TIMING
         double tProbe = cpuNow();
 #endif
-        b.buildInner(0, root, 0);
+        typename Builder<W>::Kid rootKid;
+        rootKid.r = root;
+        b.buildInner(0, rootKid, 0);
         PROBE("inner");
     }
     const uint32_t count = b.nodeCount.load();

@@ -125,8 +125,9 @@ inline bool closestLane(int mask, const float* ta, const float* ua, const float*
     return found;
 }
 
-// Front-to-back BVH4 traversal with the packet test inlined (a leaf is 1-7 consecutive packets). AnyHit: stop at the first hit
-// and skip the ordering. Returns true on a hit (closest hit written to *hit unless AnyHit).
+// Front-to-back BVH4 traversal with the packet test inlined (a leaf is 1-7 consecutive
+// packets). AnyHit: stop at the first hit and skip the ordering. Returns true on a hit (closest
+// hit written to *hit unless AnyHit).
 template <bool AnyHit>
 inline bool traceTriangles(const Node4* nodes, const TriPacket4* packets, const Ray& ray, TriHit* hit, bool cullBack) {
     const RayPre pre(ray);

@@ -76,6 +76,22 @@ void expectAgree(const FrameInput& f, const std::string& name) {
     testing_support::writeImage(a, "raycast_raster", name + "-raycast");
 }
 
+// A 64x64 checker of 4-texel squares, trilinear, repeating (for minification tests).
+std::shared_ptr<Texture> checkerTexture() {
+    auto tex = std::make_shared<Texture>();
+    tex->width = tex->height = 64;
+    tex->rgba.resize(64 * 64 * 4);
+    for (int y = 0; y < 64; ++y)
+        for (int x = 0; x < 64; ++x) {
+            uint8_t* p = &tex->rgba[size_t(y * 64 + x) * 4];
+            p[0] = p[1] = p[2] = (x / 4 + y / 4) % 2 ? 250 : 10;
+            p[3] = 255;
+        }
+    tex->filter = FilterMode::Trilinear;
+    tex->wrapS = tex->wrapT = WrapMode::Repeat;
+    return tex;
+}
+
 Projection perspective() { return Projection{}; }
 Projection ortho() { Projection p; p.type = ProjectionType::Orthographic; p.orthoHalfHeight = 3.0f; return p; }
 
@@ -150,17 +166,7 @@ TEST(RaycastRasterAgreementTest, MinifiedTextureUsesMipLevels) {
     auto ground = std::make_shared<Mesh>(*f.meshes[2].mesh);
     for (vec2& uv : ground->uv0) uv *= 16.0f;
     f.meshes[2].mesh = ground;
-    auto tex = std::make_shared<Texture>();
-    tex->width = tex->height = 64;
-    tex->rgba.resize(64 * 64 * 4);
-    for (int y = 0; y < 64; ++y)
-        for (int x = 0; x < 64; ++x) {
-            uint8_t* p = &tex->rgba[size_t(y * 64 + x) * 4];
-            p[0] = p[1] = p[2] = (x / 4 + y / 4) % 2 ? 250 : 10;
-            p[3] = 255;
-        }
-    tex->filter = FilterMode::Trilinear;
-    tex->wrapS = tex->wrapT = WrapMode::Repeat;
+    auto tex = checkerTexture();
     f.meshes[2].texture = tex;
     f.meshes[2].material.baseColor = vec3(1.0f);
     expectAgree(f, "minified-texture");
@@ -198,17 +204,7 @@ TEST(RaycastRasterAgreementTest, BackFaceCulling) {
 // Both sample the same mip chain at (nearly) the same levels; at level 0 the reflection aliases
 // into moire (checked: the ceiling is minified enough for that to show).
 TEST(RaycastTest, ReflectedTextureMatchesMirroredCamera) {
-    auto tex = std::make_shared<Texture>();
-    tex->width = tex->height = 64;
-    tex->rgba.resize(64 * 64 * 4);
-    for (int y = 0; y < 64; ++y)
-        for (int x = 0; x < 64; ++x) {
-            uint8_t* p = &tex->rgba[size_t(y * 64 + x) * 4];
-            p[0] = p[1] = p[2] = (x / 4 + y / 4) % 2 ? 250 : 10;
-            p[3] = 255;
-        }
-    tex->filter = FilterMode::Trilinear;
-    tex->wrapS = tex->wrapT = WrapMode::Repeat;
+    auto tex = checkerTexture();
     auto ceilingMesh = std::make_shared<Mesh>(primitives::plane(100.0f, 1));
     for (vec2& uv : ceilingMesh->uv0) uv *= 100.0f;   // 2 units per repeat, squares of 1/8
     // The ceiling at y = 2 facing down (rotated half a turn about x).
