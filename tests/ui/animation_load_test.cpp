@@ -12,6 +12,8 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <charconv>
 #include <chrono>
 #include <cstring>
@@ -253,8 +255,13 @@ fs::path bigObj() {
             num(idx(x, y + 1));
             text += '\n';
         }
+    // CTest runs each test in its own process and several at once: write a private copy and
+    // rename it into place, so no test ever reads a file another one is still writing.
     fs::path p = testing_support::outputDir("ui") / "big-grid.obj";
-    std::ofstream(p, std::ios::binary) << text;
+    fs::path tmp = p;
+    tmp += "." + std::to_string(::getpid()) + ".tmp";
+    std::ofstream(tmp, std::ios::binary) << text;
+    fs::rename(tmp, p);
     path = p;
     return path;
 }
