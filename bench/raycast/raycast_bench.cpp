@@ -6,7 +6,9 @@
 //   throughput, e.g. for valgrind --tool=callgrind --toggle-collect='*TriangleBvh::intersect*'
 //   --toggle-collect=rtcIntersect1), --build-only (only the 1-thread
 //   builds, ours and Embree alternating --reps N times, medians; also for profilers, e.g.
-//   valgrind --tool=callgrind --toggle-collect='rnd::rt::TriangleBvh::build*')
+//   valgrind --tool=callgrind --toggle-collect='rnd::rt::TriangleBvh::build*'), --pairs N (ours/Embree
+//   alternations per ray measure), --leaf-packets N / --trav-cost X (our build options, for
+//   trying other trees; default TriangleBvh::defaultOptions())
 //
 // Prints one line per scene and measure:
 //   bench: scene=<name> what=<metric> ours=<x> ref=<y> ratio=<ours/ref>
@@ -15,7 +17,8 @@
 // occluded vs rtcIntersect1 / rtcOccluded1, one ray at a time, FTZ/DAZ on), and agreement_* (%
 // of rays where both agree: same hit/miss, and for hits the same primitive - or the same
 // distance for ties on shared edges - and distance within 1e-4 relative).
-// Ray throughput: ours and Embree alternate 3 (--quick) or 5 times per measure, medians.
+// Ray throughput: ours and Embree alternate 3 (--quick) or 5 times per measure; ours/ref are the
+// medians, ratio the median of the per-pair ratios (robust to the machine's drift).
 // Timing: 1-thread figures (rays and build) use the thread's CPU clock (the machine is shared; wall time would
 // count other people's work), 2-thread figures use wall time. Builds: medians of 3 (--quick) or 5
 // alternating runs; 1-thread builds run inside a 1-thread TBB arena (see measureBuilds: before
@@ -247,23 +250,31 @@ double measure(size_t n, int threads, double minSeconds, const std::function<voi
 }
 
 // Ours and the reference measured alternately `reps` times (the machine's speed drifts by
-// +-10% over seconds: alternating exposes both to the same drift); medians of each.
-std::pair<double, double> measurePair(size_t n, int threads, double minSeconds, int reps, const std::function<void(size_t, size_t)>& ours,
-                                      const std::function<void(size_t, size_t)>& ref) {
-    std::vector<double> o, r;
+// +-10% over seconds: alternating exposes both to the same drift). Returns the medians of each
+// and the median of the per-pair ratios ours_i / ref_i: each pair ran within a second, so its
+// ratio is the least drift-sensitive figure (the ratio of medians mixes different moments).
+struct PairResult { double ours, ref, ratio; };
+PairResult measurePair(size_t n, int threads, double minSeconds, int reps, const std::function<void(size_t, size_t)>& ours,
+                       const std::function<void(size_t, size_t)>& ref) {
+    std::vector<double> o, r, q;
     for (int i = 0; i < reps; ++i) {
         o.push_back(measure(n, threads, minSeconds, ours));
         r.push_back(measure(n, threads, minSeconds, ref));
+        q.push_back(o.back() / r.back());
     }
-    std::sort(o.begin(), o.end());
-    std::sort(r.begin(), r.end());
-    return {o[o.size() / 2], r[r.size() / 2]};
+    auto median = [](std::vector<double>& v) {
+        std::sort(v.begin(), v.end());
+        return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+    };
+    return {median(o), median(r), median(q)};
 }
 
-void line(const std::string& scene, const std::string& what, double ours, double ref) {
+// ratio < 0: ours / ref.
+void line(const std::string& scene, const std::string& what, double ours, double ref, double ratio = -1) {
     const char* fmt = what.rfind("agreement", 0) == 0 ? "bench: scene=%s what=%s ours=%.4f ref=%.4f ratio=%.5f\n"
                                                       : "bench: scene=%s what=%s ours=%.4g ref=%.4g ratio=%.3f\n";
-    std::printf(fmt, scene.c_str(), what.c_str(), ours, ref, ref > 0 ? ours / ref : 0.0);
+    if (ratio < 0) ratio = ref > 0 ? ours / ref : 0.0;
+    std::printf(fmt, scene.c_str(), what.c_str(), ours, ref, ratio);
     std::fflush(stdout);
 }
 
@@ -281,8 +292,12 @@ bool sameHit(const TriHit& a, const TriHit& b) {
 // left by an earlier parallel build: process CPU twice its wall time, an inflated reference.)
 // Two threads: wall time.
 struct BuildTimes { double ours1 = 0, ref1 = 0, ours2 = 0, ref2 = 0; };
+// Our build options: TriangleBvh::defaultOptions() unless --leaf-packets / --trav-cost say otherwise.
+rnd::rt::Bvh4::BuildOptions g_options = TriangleBvh::defaultOptions();
+int g_pairs = 0;   // --pairs: ours/Embree alternations per ray measure (0: 3 quick, 5 full)
+
 BuildTimes measureBuilds(const Scene& s, TriangleBvh& bvh, int reps, bool twoThreads = true) {
-    rnd::rt::Bvh4::BuildOptions single = TriangleBvh::defaultOptions();
+    rnd::rt::Bvh4::BuildOptions single = g_options;
     single.parallel = false;
     std::vector<double> o1, r1, o2, r2;
     Embree e1(1), e2(2);
@@ -309,7 +324,7 @@ BuildTimes measureBuilds(const Scene& s, TriangleBvh& bvh, int reps, bool twoThr
         if (!twoThreads) continue;
         two.execute([&] {
             auto t1 = Clock::now();
-            bvh.build(s.pos.data(), s.idx.data(), s.tris());
+            bvh.build(s.pos.data(), s.idx.data(), s.tris(), g_options);
             o2.push_back(seconds(t1, Clock::now()));
         });
         r2.push_back(e2.build(s));
@@ -325,7 +340,7 @@ BuildTimes measureBuilds(const Scene& s, TriangleBvh& bvh, int reps, bool twoThr
 // rayClass: "" for all three ray classes, else only that one's throughput (profiling).
 void runScene(const Scene& s, bool quick, const std::string& rayClass) {
     const double minT = quick ? 0.0 : 0.25;
-    const int reps = quick ? 3 : 5;   // alternating ours/Embree passes per measure (medians)
+    const int reps = g_pairs > 0 ? g_pairs : quick ? 3 : 5;   // alternating ours/Embree passes per measure (medians)
     const int W = quick ? 640 : 1280, H = quick ? 360 : 720;
     // --- build --------------------------------------------------------------------------
     TriangleBvh bvh;
@@ -338,9 +353,11 @@ void runScene(const Scene& s, bool quick, const std::string& rayClass) {
                 s.name.c_str(), s.tris(), oursB1 * 1e3, refB1 * 1e3, oursB2 * 1e3, refB2 * 1e3, bvh.memoryBytes() / 1048576.0);
     {
         const TriangleBvh::Stats st = bvh.stats();
-        std::printf("bench: scene=%s info width=%d nodes=%zu children_per_node=%.2f packets=%zu tris_per_packet=%.2f depth=%d\n",
-                    s.name.c_str(), bvh.width(), st.nodes, st.nodes ? double(st.childSlots) / double(st.nodes) : 0.0,
-                    st.packets, st.packets ? double(st.lanes) / double(st.packets) : 0.0, st.depth);
+        std::printf("bench: scene=%s info width=%d nodes=%zu children_per_node=%.2f leaves=%zu packets=%zu tris_per_packet=%.2f "
+                    "depth=%d sah=%.2f (nodes %.2f, leaves %.2f)\n",
+                    s.name.c_str(), bvh.width(), st.nodes, st.nodes ? double(st.childSlots) / double(st.nodes) : 0.0, st.leaves,
+                    st.packets, st.packets ? double(st.lanes) / double(st.packets) : 0.0, st.depth, st.sahNodes + st.sahLeaves,
+                    st.sahNodes, st.sahLeaves);
     }
 
     // --- rays (ours traced on the tree of the last, parallel, build: what the renderer uses)
@@ -418,19 +435,19 @@ void runScene(const Scene& s, bool quick, const std::string& rayClass) {
         if (!rayClass.empty() && rayClass != c.name) continue;
         const std::vector<Ray>& rays = *c.rays;
         for (int threads : {1, 2}) {
-            double ours, ref;
+            PairResult m;
             const Embree& E = threads == 1 ? e1 : e2;
             if (threads == 2) e2.build(s);
             if (c.shadow) {
-                std::tie(ours, ref) = measurePair(
+                m = measurePair(
                     rays.size(), threads, minT, reps, [&](size_t b, size_t e) { for (size_t i = b; i < e; ++i) occ[i] = bvh.occluded(rays[i]); },
                     [&](size_t b, size_t e) { for (size_t i = b; i < e; ++i) occ[i] = E.occluded(rays[i]); });
             } else {
-                std::tie(ours, ref) = measurePair(
+                m = measurePair(
                     rays.size(), threads, minT, reps, [&](size_t b, size_t e) { for (size_t i = b; i < e; ++i) bvh.intersect(rays[i], out[i]); },
                     [&](size_t b, size_t e) { for (size_t i = b; i < e; ++i) E.intersect(rays[i], out[i]); });
             }
-            line(s.name, std::string(c.name) + "_" + std::to_string(threads) + "t_Mrays/s", ours, ref);
+            line(s.name, std::string(c.name) + "_" + std::to_string(threads) + "t_Mrays/s", m.ours, m.ref, m.ratio);
         }
     }
 }
@@ -449,7 +466,10 @@ int main(int argc, char** argv) {
         else if (a == "--build-only") buildOnly = true;
         else if (a == "--rays" && i + 1 < argc) rayClass = argv[++i];
         else if (a == "--reps" && i + 1 < argc) reps = std::max(1, std::atoi(argv[++i]));
-        else { std::fprintf(stderr, "usage: %s [--quick] [--scene NAME] [--testdata DIR] [--rays primary|shadow|incoherent] [--build-only [--reps N]]\n", argv[0]); return 2; }
+        else if (a == "--pairs" && i + 1 < argc) g_pairs = std::max(1, std::atoi(argv[++i]));
+        else if (a == "--leaf-packets" && i + 1 < argc) g_options.maxLeafBlocks = std::clamp(std::atoi(argv[++i]), 1, 7);
+        else if (a == "--trav-cost" && i + 1 < argc) g_options.traversalCost = std::max(0.0f, float(std::atof(argv[++i])));
+        else { std::fprintf(stderr, "usage: %s [--quick] [--scene NAME] [--testdata DIR] [--rays primary|shadow|incoherent] [--build-only [--reps N]] [--pairs N] [--leaf-packets N] [--trav-cost X]\n", argv[0]); return 2; }
     }
     if (const char* env = std::getenv("VIEWER_TESTDATA")) testdata = env;
     setFtzDaz();
@@ -461,6 +481,10 @@ int main(int argc, char** argv) {
         {"spheres1M", [] { return sphereGrid("spheres1M", 16, 64, 128); }},
         {"bunny", [&] { return bunny(testdata, err); }},
     };
+    if (!only.empty() && std::none_of(specs.begin(), specs.end(), [&](const Spec& sp) { return sp.name == only; })) {
+        std::fprintf(stderr, "bench: unknown scene '%s' (spheres10k, spheres100k, spheres1M, bunny)\n", only.c_str());
+        return 2;
+    }
     for (const Spec& sp : specs) {
         if (!only.empty() && sp.name != only) continue;
         Scene s = sp.make();

@@ -112,10 +112,12 @@ private:
 
 // Four triangles, SoA: vertex 0, the edges e1 = p1 - p0, e2 = p2 - p0 and the unnormalised
 // normal N = e1 x e2 (precomputed: the test then needs one cross product instead of two).
-struct alignas(16) TriPacket4 {
+// Exactly three cache lines, aligned to them; the triangle ids live in a separate array (read
+// only on a hit), which keeps a leaf of k packets at 3k lines instead of about 4k.
+struct alignas(64) TriPacket4 {
     float v0[3][4], e1[3][4], e2[3][4], n[3][4];
-    uint32_t prim[4];   // ~0u = padding
 };
+static_assert(sizeof(TriPacket4) == 192);
 
 // Triangle BVH whose leaves are runs of 1-7 TriPacket4s (leaf "first" = packet index; leaves of
 // more than one packet where the SAH prefers them to another node level). With the
@@ -129,7 +131,10 @@ public:
     }
     // Leaves of up to 4 packets where the SAH (a node visit costs 2 packet tests) prefers them
     // to another level. Measured on the 1M-triangle benchmark scene against 1-packet leaves:
-    // 1/3 of the nodes, primary rays +15-20%, shadow +20%, build +10%.
+    // 1/3 of the nodes, primary rays +15-20%, shadow +20%, build +10%. Rechecked after nodes
+    // were filled before the leaf test: a node visit costing 1 packet test gives SAH 18.0
+    // instead of 18.9 but 1.8x the nodes, and rays were no faster (primary 0.82-0.95 of
+    // Embree against 0.97-0.98).
     static Bvh4::BuildOptions defaultOptions() {
         Bvh4::BuildOptions o;
         o.maxLeafBlocks = 4;
@@ -147,19 +152,26 @@ public:
     bool empty() const { return m_packets.empty(); }
     const sg::Aabb& bounds() const { return m_bounds; }
     size_t memoryBytes() const {
-        return m_nodes4.size() * sizeof(Node4) + m_nodes8.size() * sizeof(Node8) + m_packets.size() * sizeof(TriPacket4);
+        return m_nodes4.size() * sizeof(Node4) + m_nodes8.size() * sizeof(Node8) + m_packets.size() * sizeof(TriPacket4) + m_prims.size() * 4;
     }
     int width() const { return m_nodes8.empty() ? 4 : 8; }
 
-    // Shape of the tree (benchmark output, tests): inner nodes, packets, filled triangle lanes,
-    // used child slots, the depth and the most packets in one leaf.
-    struct Stats { size_t nodes = 0, packets = 0, lanes = 0, childSlots = 0; int depth = 0, maxLeafPackets = 0; };
+    // Shape of the tree (benchmark output, tests): inner nodes, leaves, packets, filled triangle
+    // lanes, used child slots, the depth, the most packets in one leaf, and the SAH cost as
+    // Embree's statistics (verbose=2) print it: sum of node areas (node visits) and of leaf
+    // areas times their packets (packet tests), both relative to the root's area.
+    struct Stats {
+        size_t nodes = 0, leaves = 0, packets = 0, lanes = 0, childSlots = 0;
+        int depth = 0, maxLeafPackets = 0;
+        double sahNodes = 0, sahLeaves = 0;
+    };
     Stats stats() const;
 
 private:
     HugeVector<Node4> m_nodes4;
     HugeVector<Node8> m_nodes8;
     HugeVector<TriPacket4> m_packets;
+    HugeVector<uint32_t> m_prims;   // 4 per packet: triangle index per lane, ~0u = empty lane
     sg::Aabb m_bounds;
 };
 

@@ -106,9 +106,9 @@ inline int intersectPacketPair(const TriPacket4& a, const TriPacket4& b, const _
 }
 #endif
 
-// The closest of the hit lanes in `mask` (lane k: triangle k & 3 of packet p[k >> 2]) if it is
-// closer than tmax: shrinks tmax, fills *hit, returns true.
-inline bool closestLane(int mask, const float* ta, const float* ua, const float* va, const TriPacket4* p, float& tmax, TriHit* hit) {
+// The closest of the hit lanes in `mask` (lane k: triangle ids[k], ids = the packets' ids, 4
+// each) if it is closer than tmax: shrinks tmax, fills *hit, returns true.
+inline bool closestLane(int mask, const float* ta, const float* ua, const float* va, const uint32_t* ids, float& tmax, TriHit* hit) {
     bool found = false;
     while (mask) {
         const int k = __builtin_ctz(mask);
@@ -116,7 +116,7 @@ inline bool closestLane(int mask, const float* ta, const float* ua, const float*
         if (ta[k] < tmax) {
             tmax = ta[k];
             hit->t = ta[k];
-            hit->prim = p[k >> 2].prim[k & 3];
+            hit->prim = ids[k];
             hit->b1 = ua[k];
             hit->b2 = va[k];
             found = true;
@@ -125,11 +125,45 @@ inline bool closestLane(int mask, const float* ta, const float* ua, const float*
     return found;
 }
 
+// Child ordering keys: the entry distance's bit pattern above the child reference. Distances
+// here are >= tmin >= 0, and non-negative floats order like their bits, so keys order by
+// distance (a negative tmin would only change the visiting order, never the result).
+inline uint64_t sortKey(float t, uint32_t ref) {
+    uint32_t b;
+    std::memcpy(&b, &t, 4);
+    return (uint64_t(b) << 32) | ref;
+}
+inline float keyDistance(uint64_t key) {
+    const uint32_t b = uint32_t(key >> 32);
+    float t;
+    std::memcpy(&t, &b, 4);
+    return t;
+}
+// Sorts key[0..k) (3 <= k <= 8) by decreasing key: sorting networks (compare-exchanges are a
+// compare and two conditional moves), k > 4 padded with zero keys to the 19-exchange network
+// for 8.
+inline void sortFarFirst(uint64_t* key, int k) {
+    auto cx = [key](int a, int b) {
+        const uint64_t x = key[a], y = key[b];
+        key[a] = x > y ? x : y;
+        key[b] = x > y ? y : x;
+    };
+    if (k == 3) { cx(0, 1); cx(1, 2); cx(0, 1); return; }
+    if (k == 4) { cx(0, 1); cx(2, 3); cx(0, 2); cx(1, 3); cx(1, 2); return; }
+    for (int i = k; i < 8; ++i) key[i] = 0;
+    cx(0, 2); cx(1, 3); cx(4, 6); cx(5, 7);
+    cx(0, 4); cx(1, 5); cx(2, 6); cx(3, 7);
+    cx(0, 1); cx(2, 3); cx(4, 5); cx(6, 7);
+    cx(2, 4); cx(3, 5);
+    cx(1, 4); cx(3, 6);
+    cx(1, 2); cx(3, 4); cx(5, 6);
+}
+
 // Front-to-back BVH4 traversal with the packet test inlined (a leaf is 1-7 consecutive
 // packets). AnyHit: stop at the first hit and skip the ordering. Returns true on a hit (closest
 // hit written to *hit unless AnyHit).
 template <bool AnyHit>
-inline bool traceTriangles(const Node4* nodes, const TriPacket4* packets, const Ray& ray, TriHit* hit, bool cullBack) {
+inline bool traceTriangles(const Node4* nodes, const TriPacket4* packets, const uint32_t* prims, const Ray& ray, TriHit* hit, bool cullBack) {
     const RayPre pre(ray);
     const __m128 rx = _mm_set1_ps(pre.rdir[0]), ry = _mm_set1_ps(pre.rdir[1]), rz = _mm_set1_ps(pre.rdir[2]);
     const __m128 orx = _mm_set1_ps(pre.orgRdir[0]), ory = _mm_set1_ps(pre.orgRdir[1]), orz = _mm_set1_ps(pre.orgRdir[2]);
@@ -177,19 +211,15 @@ inline bool traceTriangles(const Node4* nodes, const TriPacket4* packets, const 
                     else { stack[sp++] = {n.child[c0], dist[c0]}; cur = n.child[c1]; }
                     continue;
                 }
-                Entry e[4];
+                // Three or four: sorted far first without branches (see sortFarFirst).
+                uint64_t key[8];
                 int k = 0;
-                e[k++] = {n.child[c0], dist[c0]};
-                e[k++] = {n.child[c1], dist[c1]};
-                while (mask) { int c = __builtin_ctz(mask); mask &= mask - 1; e[k++] = {n.child[c], dist[c]}; }
-                for (int i = 1; i < k; ++i) {   // insertion sort, far first
-                    Entry x = e[i];
-                    int j = i - 1;
-                    while (j >= 0 && e[j].t < x.t) { e[j + 1] = e[j]; --j; }
-                    e[j + 1] = x;
-                }
-                for (int i = 0; i < k - 1; ++i) stack[sp++] = e[i];
-                cur = e[k - 1].ref;
+                key[k++] = sortKey(dist[c0], n.child[c0]);
+                key[k++] = sortKey(dist[c1], n.child[c1]);
+                while (mask) { int c = __builtin_ctz(mask); mask &= mask - 1; key[k++] = sortKey(dist[c], n.child[c]); }
+                sortFarFirst(key, k);
+                for (int i = 0; i < k - 1; ++i) stack[sp++] = {uint32_t(key[i]), keyDistance(key[i])};
+                cur = uint32_t(key[k - 1]);
                 continue;
             }
         } else {
@@ -204,7 +234,7 @@ inline bool traceTriangles(const Node4* nodes, const TriPacket4* packets, const 
                 _mm_store_ps(ta, t);
                 _mm_store_ps(ua, u);
                 _mm_store_ps(va, v);
-                found |= closestLane(mask, ta, ua, va, p, tmax, hit);
+                found |= closestLane(mask, ta, ua, va, prims + 4 * (p - packets), tmax, hit);
                 tmaxV = _mm_set1_ps(tmax);
             }
         }
@@ -220,7 +250,7 @@ inline bool traceTriangles(const Node4* nodes, const TriPacket4* packets, const 
 // The same traversal over 8-wide nodes: one AVX compare per node for 8 boxes (BVH8: fewer,
 // wider levels), leaves still 4-triangle SSE packets.
 template <bool AnyHit>
-inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const Ray& ray, TriHit* hit, bool cullBack) {
+inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const uint32_t* prims, const Ray& ray, TriHit* hit, bool cullBack) {
     const RayPre pre(ray);
     const __m256 rx = _mm256_set1_ps(pre.rdir[0]), ry = _mm256_set1_ps(pre.rdir[1]), rz = _mm256_set1_ps(pre.rdir[2]);
     const __m256 orx = _mm256_set1_ps(pre.orgRdir[0]), ory = _mm256_set1_ps(pre.orgRdir[1]), orz = _mm256_set1_ps(pre.orgRdir[2]);
@@ -269,19 +299,16 @@ inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const
                     else { stack[sp++] = {n.child[c0], dist[c0]}; cur = n.child[c1]; }
                     continue;
                 }
-                Entry e[8];
+                // Three or more: sorted far first by a network on (distance bits : ref) keys,
+                // without data-dependent branches (an insertion sort mispredicts here).
+                uint64_t key[8];
                 int k = 0;
-                e[k++] = {n.child[c0], dist[c0]};
-                e[k++] = {n.child[c1], dist[c1]};
-                while (mask) { int c = __builtin_ctz(mask); mask &= mask - 1; e[k++] = {n.child[c], dist[c]}; }
-                for (int i = 1; i < k; ++i) {   // insertion sort, far first
-                    Entry x = e[i];
-                    int j = i - 1;
-                    while (j >= 0 && e[j].t < x.t) { e[j + 1] = e[j]; --j; }
-                    e[j + 1] = x;
-                }
-                for (int i = 0; i < k - 1; ++i) stack[sp++] = e[i];
-                cur = e[k - 1].ref;
+                key[k++] = sortKey(dist[c0], n.child[c0]);
+                key[k++] = sortKey(dist[c1], n.child[c1]);
+                while (mask) { int c = __builtin_ctz(mask); mask &= mask - 1; key[k++] = sortKey(dist[c], n.child[c]); }
+                sortFarFirst(key, k);
+                for (int i = 0; i < k - 1; ++i) stack[sp++] = {uint32_t(key[i]), keyDistance(key[i])};
+                cur = uint32_t(key[k - 1]);
                 continue;
             }
         } else {
@@ -296,7 +323,7 @@ inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const
                 _mm256_store_ps(ta, t);
                 _mm256_store_ps(ua, u);
                 _mm256_store_ps(va, v);
-                found |= closestLane(mask, ta, ua, va, p, tmax, hit);
+                found |= closestLane(mask, ta, ua, va, prims + 4 * (p - packets), tmax, hit);
                 tmaxV = _mm_set1_ps(tmax);
                 tmax8 = _mm256_set1_ps(tmax);
             }
@@ -309,7 +336,7 @@ inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const
                 _mm_store_ps(ta, t);
                 _mm_store_ps(ua, u);
                 _mm_store_ps(va, v);
-                found |= closestLane(mask, ta, ua, va, p, tmax, hit);
+                found |= closestLane(mask, ta, ua, va, prims + 4 * (p - packets), tmax, hit);
                 tmaxV = _mm_set1_ps(tmax);
                 tmax8 = _mm256_set1_ps(tmax);
             }

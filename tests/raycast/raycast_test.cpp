@@ -372,7 +372,10 @@ TEST(RaycastTest, BvhClosestHitEqualsBruteForce) {
             bvh.build(pos.data(), idx.data(), count, opt);
             const TriangleBvh::Stats st = bvh.stats();
             EXPECT_LE(st.maxLeafPackets, opt.maxLeafBlocks);
-            if (ntri > 100 && opt.maxLeafBlocks == 7) { EXPECT_GE(st.maxLeafPackets, 3) << "seed " << seed; }
+            // Nodes are filled first (any child of more than one packet is split while a node
+            // has room), so big leaves appear one level down: 2 packets at 300 triangles,
+            // more (a pair test plus a single one) from 1200 on.
+            if (ntri > 100 && opt.maxLeafBlocks == 7) { EXPECT_GE(st.maxLeafPackets, ntri >= 1000 ? 3 : 2) << "seed " << seed; }
             EXPECT_EQ(st.lanes, count) << "every triangle in exactly one lane";
             int hits = 0;
             for (int i = 0; i < 3000; ++i) {
