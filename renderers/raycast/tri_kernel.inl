@@ -207,8 +207,11 @@ inline bool traceTriangles(const Node4* nodes, const TriPacket4* packets, const 
                 const int c1 = __builtin_ctz(mask);
                 mask &= mask - 1;
                 if (mask == 0) {
-                    if (dist[c0] <= dist[c1]) { stack[sp++] = {n.child[c1], dist[c1]}; cur = n.child[c0]; }
-                    else { stack[sp++] = {n.child[c0], dist[c0]}; cur = n.child[c1]; }
+                    // Two: push the far one, go on with the near one (selects, not branches).
+                    const uint64_t k0 = sortKey(dist[c0], n.child[c0]), k1 = sortKey(dist[c1], n.child[c1]);
+                    const uint64_t kFar = k0 > k1 ? k0 : k1, kNear = k0 > k1 ? k1 : k0;
+                    stack[sp++] = {uint32_t(kFar), keyDistance(kFar)};
+                    cur = uint32_t(kNear);
                     continue;
                 }
                 // Three or four: sorted far first without branches (see sortFarFirst).
@@ -248,7 +251,7 @@ inline bool traceTriangles(const Node4* nodes, const TriPacket4* packets, const 
 
 #if RT_FMA
 // The same traversal over 8-wide nodes: one AVX compare per node for 8 boxes (BVH8: fewer,
-// wider levels), leaves still 4-triangle SSE packets.
+// wider levels); leaf packets tested two at a time (8 lanes).
 template <bool AnyHit>
 inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const uint32_t* prims, const Ray& ray, TriHit* hit, bool cullBack) {
     const RayPre pre(ray);
@@ -256,15 +259,11 @@ inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const
     const __m256 orx = _mm256_set1_ps(pre.orgRdir[0]), ory = _mm256_set1_ps(pre.orgRdir[1]), orz = _mm256_set1_ps(pre.orgRdir[2]);
     const int nx = pre.nearX, ny = 2 + pre.nearY, nz = 4 + pre.nearZ;
     const int fx = 1 - pre.nearX, fy = 3 - pre.nearY, fz = 5 - pre.nearZ;
-    const __m128 o[3] = {_mm_set1_ps(ray.org.x), _mm_set1_ps(ray.org.y), _mm_set1_ps(ray.org.z)};
-    const __m128 d[3] = {_mm_set1_ps(ray.dir.x), _mm_set1_ps(ray.dir.y), _mm_set1_ps(ray.dir.z)};
-    const __m128 tminV = _mm_set1_ps(ray.tmin);
     const __m256 tmin8 = _mm256_set1_ps(ray.tmin);
     const __m256 o8[3] = {_mm256_set1_ps(ray.org.x), _mm256_set1_ps(ray.org.y), _mm256_set1_ps(ray.org.z)};
     const __m256 d8[3] = {_mm256_set1_ps(ray.dir.x), _mm256_set1_ps(ray.dir.y), _mm256_set1_ps(ray.dir.z)};
     const __m256 grow = _mm256_set1_ps(1.0f + 8.0f * std::numeric_limits<float>::epsilon());
     float tmax = ray.tmax;
-    __m128 tmaxV = _mm_set1_ps(tmax);
     __m256 tmax8 = _mm256_set1_ps(tmax);
     bool found = false;
 
@@ -295,8 +294,11 @@ inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const
                 const int c1 = __builtin_ctz(mask);
                 mask &= mask - 1;
                 if (mask == 0) {
-                    if (dist[c0] <= dist[c1]) { stack[sp++] = {n.child[c1], dist[c1]}; cur = n.child[c0]; }
-                    else { stack[sp++] = {n.child[c0], dist[c0]}; cur = n.child[c1]; }
+                    // Two: push the far one, go on with the near one (selects, not branches).
+                    const uint64_t k0 = sortKey(dist[c0], n.child[c0]), k1 = sortKey(dist[c1], n.child[c1]);
+                    const uint64_t kFar = k0 > k1 ? k0 : k1, kNear = k0 > k1 ? k1 : k0;
+                    stack[sp++] = {uint32_t(kFar), keyDistance(kFar)};
+                    cur = uint32_t(kNear);
                     continue;
                 }
                 // Three or more: sorted far first by a network on (distance bits : ref) keys,
@@ -314,9 +316,10 @@ inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const
         } else {
             const TriPacket4* p = packets + ((cur & ~Node8::kLeafBit) >> 3);
             const TriPacket4* end = p + (cur & 7u);
-            for (; p + 1 < end; p += 2) {   // two packets per AVX test
+            for (; p < end; p += 2) {   // two packets per AVX test; a last odd one paired with itself
+                const bool two = p + 1 < end;
                 __m256 t, u, v;
-                int mask = intersectPacketPair(p[0], p[1], o8, d8, tmin8, tmax8, t, u, v, cullBack);
+                int mask = intersectPacketPair(p[0], p[two ? 1 : 0], o8, d8, tmin8, tmax8, t, u, v, cullBack) & (two ? 0xFF : 0x0F);
                 if (!mask) continue;
                 if constexpr (AnyHit) return true;
                 alignas(32) float ta[8], ua[8], va[8];
@@ -324,20 +327,6 @@ inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const
                 _mm256_store_ps(ua, u);
                 _mm256_store_ps(va, v);
                 found |= closestLane(mask, ta, ua, va, prims + 4 * (p - packets), tmax, hit);
-                tmaxV = _mm_set1_ps(tmax);
-                tmax8 = _mm256_set1_ps(tmax);
-            }
-            for (; p != end; ++p) {
-                __m128 t, u, v;
-                int mask = intersectPacket(*p, o, d, tminV, tmaxV, t, u, v, cullBack);
-                if (!mask) continue;
-                if constexpr (AnyHit) return true;
-                alignas(16) float ta[4], ua[4], va[4];
-                _mm_store_ps(ta, t);
-                _mm_store_ps(ua, u);
-                _mm_store_ps(va, v);
-                found |= closestLane(mask, ta, ua, va, prims + 4 * (p - packets), tmax, hit);
-                tmaxV = _mm_set1_ps(tmax);
                 tmax8 = _mm256_set1_ps(tmax);
             }
         }
