@@ -159,6 +159,29 @@ inline void sortFarFirst(uint64_t* key, int k) {
     cx(1, 2); cx(3, 4); cx(5, 6);
 }
 
+// A traversal stack entry: node or leaf reference and its entry distance.
+struct StackEntry { uint32_t ref; float t; };
+
+// Front-to-back order for a node with two or more hit children: c0, c1 and those left in
+// `mask` (entry distances in dist). Pushes all but the nearest onto the stack, far first, and
+// returns the nearest. Selects and sorting networks only: no branch depends on the distances.
+inline uint32_t pushFarReturnNear(const uint32_t* child, const float* dist, int c0, int c1, int mask, StackEntry* stack, int& sp) {
+    const uint64_t k0 = sortKey(dist[c0], child[c0]), k1 = sortKey(dist[c1], child[c1]);
+    if (mask == 0) {
+        const uint64_t kFar = k0 > k1 ? k0 : k1, kNear = k0 > k1 ? k1 : k0;
+        stack[sp++] = {uint32_t(kFar), keyDistance(kFar)};
+        return uint32_t(kNear);
+    }
+    uint64_t key[8];
+    int k = 0;
+    key[k++] = k0;
+    key[k++] = k1;
+    while (mask) { const int c = __builtin_ctz(mask); mask &= mask - 1; key[k++] = sortKey(dist[c], child[c]); }
+    sortFarFirst(key, k);
+    for (int i = 0; i < k - 1; ++i) stack[sp++] = {uint32_t(key[i]), keyDistance(key[i])};
+    return uint32_t(key[k - 1]);
+}
+
 // Front-to-back BVH4 traversal with the packet test inlined (a leaf is 1-7 consecutive
 // packets). AnyHit: stop at the first hit and skip the ordering. Returns true on a hit (closest
 // hit written to *hit unless AnyHit).
@@ -179,8 +202,7 @@ inline bool traceTriangles(const Node4* nodes, const TriPacket4* packets, const 
     __m128 tmaxV = _mm_set1_ps(tmax);
     bool found = false;
 
-    struct Entry { uint32_t ref; float t; };
-    Entry stack[256];
+    StackEntry stack[256];
     int sp = 0;
     uint32_t cur = 0;
     for (;;) {
@@ -206,23 +228,7 @@ inline bool traceTriangles(const Node4* nodes, const TriPacket4* packets, const 
                 }
                 const int c1 = __builtin_ctz(mask);
                 mask &= mask - 1;
-                if (mask == 0) {
-                    // Two: push the far one, go on with the near one (selects, not branches).
-                    const uint64_t k0 = sortKey(dist[c0], n.child[c0]), k1 = sortKey(dist[c1], n.child[c1]);
-                    const uint64_t kFar = k0 > k1 ? k0 : k1, kNear = k0 > k1 ? k1 : k0;
-                    stack[sp++] = {uint32_t(kFar), keyDistance(kFar)};
-                    cur = uint32_t(kNear);
-                    continue;
-                }
-                // Three or four: sorted far first without branches (see sortFarFirst).
-                uint64_t key[8];
-                int k = 0;
-                key[k++] = sortKey(dist[c0], n.child[c0]);
-                key[k++] = sortKey(dist[c1], n.child[c1]);
-                while (mask) { int c = __builtin_ctz(mask); mask &= mask - 1; key[k++] = sortKey(dist[c], n.child[c]); }
-                sortFarFirst(key, k);
-                for (int i = 0; i < k - 1; ++i) stack[sp++] = {uint32_t(key[i]), keyDistance(key[i])};
-                cur = uint32_t(key[k - 1]);
+                cur = pushFarReturnNear(n.child, dist, c0, c1, mask, stack, sp);
                 continue;
             }
         } else {
@@ -243,7 +249,7 @@ inline bool traceTriangles(const Node4* nodes, const TriPacket4* packets, const 
         }
         for (;;) {   // pop the next entry that can still hold a closer hit
             if (sp == 0) return found;
-            const Entry& e = stack[--sp];
+            const StackEntry& e = stack[--sp];
             if (AnyHit || e.t <= tmax) { cur = e.ref; break; }
         }
     }
@@ -267,8 +273,7 @@ inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const
     __m256 tmax8 = _mm256_set1_ps(tmax);
     bool found = false;
 
-    struct Entry { uint32_t ref; float t; };
-    Entry stack[512];
+    StackEntry stack[512];
     int sp = 0;
     uint32_t cur = 0;
     for (;;) {
@@ -293,24 +298,7 @@ inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const
                 }
                 const int c1 = __builtin_ctz(mask);
                 mask &= mask - 1;
-                if (mask == 0) {
-                    // Two: push the far one, go on with the near one (selects, not branches).
-                    const uint64_t k0 = sortKey(dist[c0], n.child[c0]), k1 = sortKey(dist[c1], n.child[c1]);
-                    const uint64_t kFar = k0 > k1 ? k0 : k1, kNear = k0 > k1 ? k1 : k0;
-                    stack[sp++] = {uint32_t(kFar), keyDistance(kFar)};
-                    cur = uint32_t(kNear);
-                    continue;
-                }
-                // Three or more: sorted far first by a network on (distance bits : ref) keys,
-                // without data-dependent branches (an insertion sort mispredicts here).
-                uint64_t key[8];
-                int k = 0;
-                key[k++] = sortKey(dist[c0], n.child[c0]);
-                key[k++] = sortKey(dist[c1], n.child[c1]);
-                while (mask) { int c = __builtin_ctz(mask); mask &= mask - 1; key[k++] = sortKey(dist[c], n.child[c]); }
-                sortFarFirst(key, k);
-                for (int i = 0; i < k - 1; ++i) stack[sp++] = {uint32_t(key[i]), keyDistance(key[i])};
-                cur = uint32_t(key[k - 1]);
+                cur = pushFarReturnNear(n.child, dist, c0, c1, mask, stack, sp);
                 continue;
             }
         } else {
@@ -332,7 +320,7 @@ inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const
         }
         for (;;) {
             if (sp == 0) return found;
-            const Entry& e = stack[--sp];
+            const StackEntry& e = stack[--sp];
             if (AnyHit || e.t <= tmax) { cur = e.ref; break; }
         }
     }
