@@ -249,6 +249,13 @@ double measure(size_t n, int threads, double minSeconds, const std::function<voi
     return double(total) / el * 1e-6;
 }
 
+// Median of v (sorts it); 0 for an empty v.
+double median(std::vector<double>& v) {
+    if (v.empty()) return 0.0;
+    std::sort(v.begin(), v.end());
+    return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+}
+
 // Ours and the reference measured alternately `reps` times (the machine's speed drifts by
 // +-10% over seconds: alternating exposes both to the same drift). Returns the medians of each
 // and the median of the per-pair ratios ours_i / ref_i: each pair ran within a second, so its
@@ -262,10 +269,6 @@ PairResult measurePair(size_t n, int threads, double minSeconds, int reps, const
         r.push_back(measure(n, threads, minSeconds, ref));
         q.push_back(o.back() / r.back());
     }
-    auto median = [](std::vector<double>& v) {
-        std::sort(v.begin(), v.end());
-        return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
-    };
     return {median(o), median(r), median(q)};
 }
 
@@ -329,11 +332,6 @@ BuildTimes measureBuilds(const Scene& s, TriangleBvh& bvh, int reps, bool twoThr
         });
         r2.push_back(e2.build(s));
     }
-    auto median = [](std::vector<double>& v) {
-        if (v.empty()) return 0.0;
-        std::sort(v.begin(), v.end());
-        return v[v.size() / 2];
-    };
     return {median(o1), median(r1), median(o2), median(r2)};
 }
 
@@ -481,6 +479,10 @@ int main(int argc, char** argv) {
         {"spheres1M", [] { return sphereGrid("spheres1M", 16, 64, 128); }},
         {"bunny", [&] { return bunny(testdata, err); }},
     };
+    if (!rayClass.empty() && rayClass != "primary" && rayClass != "shadow" && rayClass != "incoherent") {
+        std::fprintf(stderr, "bench: unknown ray class '%s' (primary, shadow, incoherent)\n", rayClass.c_str());
+        return 2;
+    }
     if (!only.empty() && std::none_of(specs.begin(), specs.end(), [&](const Spec& sp) { return sp.name == only; })) {
         std::fprintf(stderr, "bench: unknown scene '%s' (spheres10k, spheres100k, spheres1M, bunny)\n", only.c_str());
         return 2;
