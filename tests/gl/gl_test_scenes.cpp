@@ -65,21 +65,6 @@ Material unlit(const vec3& color) {
     return m;
 }
 
-std::shared_ptr<Texture> checker(int size, int checks, const vec3& a, const vec3& b) {
-    auto t = std::make_shared<Texture>();
-    t->width = t->height = size;
-    t->rgba.resize(size_t(size) * size * 4);
-    for (int y = 0; y < size; ++y)
-        for (int x = 0; x < size; ++x) {
-            bool odd = ((x * checks / size) + (y * checks / size)) % 2;
-            vec3 c = odd ? a : b;
-            uint8_t* p = &t->rgba[(size_t(y) * size + x) * 4];
-            for (int i = 0; i < 3; ++i) p[i] = uint8_t(std::clamp(c[i], 0.0f, 1.0f) * 255.0f + 0.5f);
-            p[3] = 255;
-        }
-    return t;
-}
-
 namespace {
 
 Material phong(const vec3& color, float ks, float shininess) {

@@ -4,6 +4,7 @@
 
 #include "renderers/framebuffer.h"
 #include "scenegraph/frame.h"
+#include "test_support.h"
 
 #include <string>
 #include <vector>
@@ -22,7 +23,7 @@ sg::DrawLight point(const sg::vec3& position, const sg::vec3& radiance, bool inv
 sg::DrawLight spot(const sg::vec3& position, const sg::vec3& direction, const sg::vec3& radiance, float innerDeg,
                    float outerDeg);
 sg::Material unlit(const sg::vec3& color);
-std::shared_ptr<sg::Texture> checker(int size, int checks, const sg::vec3& a, const sg::vec3& b);
+using testing_support::checker;   // tests/support: shared by the GL, raster and ray-caster tests
 
 // The baseline scenes: name -> frame at the given size.
 std::vector<std::string> baselineNames();

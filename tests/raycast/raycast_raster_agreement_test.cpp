@@ -78,15 +78,7 @@ void expectAgree(const FrameInput& f, const std::string& name) {
 
 // A 64x64 checker of 4-texel squares, trilinear, repeating (for minification tests).
 std::shared_ptr<Texture> checkerTexture() {
-    auto tex = std::make_shared<Texture>();
-    tex->width = tex->height = 64;
-    tex->rgba.resize(64 * 64 * 4);
-    for (int y = 0; y < 64; ++y)
-        for (int x = 0; x < 64; ++x) {
-            uint8_t* p = &tex->rgba[size_t(y * 64 + x) * 4];
-            p[0] = p[1] = p[2] = (x / 4 + y / 4) % 2 ? 250 : 10;
-            p[3] = 255;
-        }
+    auto tex = testing_support::checker(64, 16, vec3(250.0f / 255.0f), vec3(10.0f / 255.0f));
     tex->filter = FilterMode::Trilinear;
     tex->wrapS = tex->wrapT = WrapMode::Repeat;
     return tex;

@@ -2,6 +2,7 @@
 
 #include "assets/image_io.h"
 
+#include <algorithm>
 #include <cstdlib>
 
 namespace fs = std::filesystem;
@@ -63,6 +64,21 @@ std::string base64Encode(std::string_view bytes) {
         enc += i + 2 < bytes.size() ? b64[v & 63] : '=';
     }
     return enc;
+}
+
+std::shared_ptr<sg::Texture> checker(int size, int checks, const sg::vec3& a, const sg::vec3& b) {
+    auto t = std::make_shared<sg::Texture>();
+    t->width = t->height = size;
+    t->rgba.resize(size_t(size) * size * 4);
+    for (int y = 0; y < size; ++y)
+        for (int x = 0; x < size; ++x) {
+            const bool odd = ((x * checks / size) + (y * checks / size)) % 2;
+            const sg::vec3 c = odd ? a : b;
+            uint8_t* p = &t->rgba[(size_t(y) * size + x) * 4];
+            for (int i = 0; i < 3; ++i) p[i] = uint8_t(std::clamp(c[i], 0.0f, 1.0f) * 255.0f + 0.5f);
+            p[3] = 255;
+        }
+    return t;
 }
 
 }  // namespace testing_support

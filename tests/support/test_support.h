@@ -3,10 +3,12 @@
 #pragma once
 
 #include "renderers/framebuffer.h"
+#include "scenegraph/mesh.h"
 
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <string_view>
 
@@ -31,6 +33,10 @@ struct ImageTolerance {
                                        const ImageTolerance& tol, const std::string& suite, const std::string& name);
 
 void writeImage(const rnd::Framebuffer& img, const std::string& suite, const std::string& name);
+
+// A size x size RGBA texture of checks x checks squares: colour a where the square's x + y is
+// odd, b elsewhere (0..1, rounded to 8 bits). Default sampling settings.
+std::shared_ptr<sg::Texture> checker(int size, int checks, const sg::vec3& a, const sg::vec3& b);
 
 // Standard base64 with padding (for data URIs and embedded PNGs in generated files).
 std::string base64Encode(std::string_view bytes);
