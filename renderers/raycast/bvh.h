@@ -54,8 +54,17 @@ struct TriHit {
 
 // Per-ray data the SIMD box test needs: reciprocal direction, origin * reciprocal and which
 // slab (min or max) is the near one per axis.
+// The triangle kernels compute slab distances with one fused multiply-subtract,
+// t = b * rdir - org * rdir. That loses bits to cancellation when the origin is far from the
+// box (the rounding of org * rdir is absolute, about 2^-24 |org * rdir|), and their boxes may
+// have zero thickness (flat, axis-aligned geometry), so margins folded into the constants keep
+// every box conservative at no cost per node: near planes use orgRdirNear = org * rdir + E, far
+// planes rdirFar = rdir * g and orgRdirFar = (org * rdir - E) * g, with E = 2^-20 |org * rdir|
+// (at least 4x the absolute rounding of either side) and g = 1 + 2^-20 (the relative errors of
+// both sides of tn <= tf, as in Ize, "Robust BVH Ray Traversal", JCGT 2013).
 struct RayPre {
     float org[3], rdir[3], orgRdir[3];
+    float orgRdirNear[3], rdirFar[3], orgRdirFar[3];
     int nearX, nearY, nearZ;   // offsets (0 or 1) into Node4::b[axis*2 + ...]
     explicit RayPre(const Ray& r);
 };

@@ -17,6 +17,10 @@ inline RayPre::RayPre(const Ray& r) {
         org[a] = r.org[a];
         rdir[a] = 1.0f / d;
         orgRdir[a] = org[a] * rdir[a];
+        const float g = 1.0f + 0x1p-20f, e = std::abs(orgRdir[a]) * 0x1p-20f;
+        orgRdirNear[a] = orgRdir[a] + e;
+        rdirFar[a] = rdir[a] * g;
+        orgRdirFar[a] = (orgRdir[a] - e) * g;
     }
     nearX = r.dir.x < 0 ? 1 : 0;
     nearY = r.dir.y < 0 ? 1 : 0;

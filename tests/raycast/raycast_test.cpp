@@ -403,6 +403,49 @@ TEST(RaycastTest, BvhClosestHitEqualsBruteForce) {
     }
 }
 
+// Boxes of flat, axis-aligned geometry have zero thickness, and the box test's slab distances
+// (b * (1/d) - o * (1/d)) lose bits to cancellation when the ray starts far away: rays that
+// skim such a ground at shallow angles, from far off, or that run exactly along a grid line
+// must still find the same triangle as the brute force (no hit lost in the BVH's margins).
+TEST(RaycastTest, BvhKeepsGrazingRaysOnFlatFarGeometry) {
+    const int n = 64;
+    const vec3 base(1000.0f, 0.0f, -500.0f);   // far from the origin: large o * (1/d) terms
+    std::vector<vec3> pos;
+    std::vector<uint32_t> idx;
+    for (int j = 0; j <= n; ++j)
+        for (int i = 0; i <= n; ++i) pos.push_back(base + vec3(float(i), 0.0f, float(j)));
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+            const uint32_t a = uint32_t(j * (n + 1) + i), b = a + 1, c = a + uint32_t(n + 1), d = c + 1;
+            idx.insert(idx.end(), {a, c, b, b, c, d});
+        }
+    const size_t count = idx.size() / 3;
+    TriangleBvh bvh;
+    bvh.build(pos.data(), idx.data(), count);
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> U(0, 1);
+    int hits = 0;
+    for (int k = 0; k < 4000; ++k) {
+        // A target on the ground (every 4th exactly on a grid line), approached from up to
+        // 3000 units away at 0.05 to 5 degrees above the ground.
+        vec3 target = base + vec3(1 + U(rng) * (n - 2), 0.0f, 1 + U(rng) * (n - 2));
+        if (k % 4 == 0) target.x = std::floor(target.x);
+        const float elev = glm::radians(0.05f + 4.95f * U(rng) * U(rng)), az = 6.2831853f * U(rng);
+        const float dist = k % 2 ? 3000.0f * U(rng) : 20.0f * U(rng) + 1.0f;
+        const vec3 dir(std::cos(elev) * std::cos(az), -std::sin(elev), std::cos(elev) * std::sin(az));
+        Ray r = mkRay(target - dist * dir, dir);
+        if (k % 8 == 0) r.dir = glm::normalize(vec3(0.0f, -1e-3f, 1.0f));   // along the grid line x = target.x
+        TriHit a, b;
+        const bool ha = bvh.intersect(r, a), hb = intersectBruteForce(pos.data(), idx.data(), count, r, b);
+        ASSERT_EQ(ha, hb) << "ray " << k << " from " << r.org.x << " " << r.org.y << " " << r.org.z;
+        EXPECT_EQ(bvh.occluded(r), hb) << "ray " << k;
+        if (!ha) continue;
+        ++hits;
+        EXPECT_EQ(a.t, b.t) << "ray " << k;
+    }
+    EXPECT_GT(hits, 3000);
+}
+
 TEST(RaycastTest, BvhHandlesEmptyAndNonFinite) {
     TriangleBvh bvh;
     bvh.build(nullptr, nullptr, 0);
