@@ -298,6 +298,11 @@ struct BuildTimes { double ours1 = 0, ref1 = 0, ours2 = 0, ref2 = 0; };
 // Our build options: TriangleBvh::defaultOptions() unless --leaf-packets / --trav-cost say otherwise.
 rnd::rt::Bvh4::BuildOptions g_options = TriangleBvh::defaultOptions();
 int g_pairs = 0;   // --pairs: ours/Embree alternations per ray measure (0: 3 quick, 5 full)
+// --against LEAF,COST: the throughput reference is our own traversal on a second tree built
+// with these maxLeafBlocks / traversalCost, alternated with the first in one process (tree
+// tuning: differences of 1-2% that separate runs against Embree cannot resolve).
+bool g_againstTree = false;
+rnd::rt::Bvh4::BuildOptions g_againstOptions = TriangleBvh::defaultOptions();
 
 BuildTimes measureBuilds(const Scene& s, TriangleBvh& bvh, int reps, bool twoThreads = true) {
     rnd::rt::Bvh4::BuildOptions single = g_options;
@@ -425,6 +430,15 @@ void runScene(const Scene& s, bool quick, const std::string& rayClass) {
     line(s.name, "agreement_incoherent_pct", agreeClosest(incoherent), 100.0);
 
     // Throughput.
+    TriangleBvh treeB;
+    if (g_againstTree) {
+        treeB.build(s.pos.data(), s.idx.data(), s.tris(), g_againstOptions);
+        const TriangleBvh::Stats st = treeB.stats();
+        std::printf("bench: scene=%s info reference = our tree B (leaf packets %d, visit cost %.2f): nodes=%zu leaves=%zu sah=%.2f "
+                    "(nodes %.2f, leaves %.2f)\n",
+                    s.name.c_str(), g_againstOptions.maxLeafBlocks, g_againstOptions.traversalCost, st.nodes, st.leaves,
+                    st.sahNodes + st.sahLeaves, st.sahNodes, st.sahLeaves);
+    }
     std::vector<TriHit> out(std::max(primary.size(), incoherent.size()));
     std::vector<uint8_t> occ(shadow.size());
     struct Cls { const char* name; const std::vector<Ray>* rays; bool shadow; };
@@ -436,7 +450,15 @@ void runScene(const Scene& s, bool quick, const std::string& rayClass) {
             PairResult m;
             const Embree& E = threads == 1 ? e1 : e2;
             if (threads == 2) e2.build(s);
-            if (c.shadow) {
+            if (g_againstTree && c.shadow) {
+                m = measurePair(
+                    rays.size(), threads, minT, reps, [&](size_t b, size_t e) { for (size_t i = b; i < e; ++i) occ[i] = bvh.occluded(rays[i]); },
+                    [&](size_t b, size_t e) { for (size_t i = b; i < e; ++i) occ[i] = treeB.occluded(rays[i]); });
+            } else if (g_againstTree) {
+                m = measurePair(
+                    rays.size(), threads, minT, reps, [&](size_t b, size_t e) { for (size_t i = b; i < e; ++i) bvh.intersect(rays[i], out[i]); },
+                    [&](size_t b, size_t e) { for (size_t i = b; i < e; ++i) treeB.intersect(rays[i], out[i]); });
+            } else if (c.shadow) {
                 m = measurePair(
                     rays.size(), threads, minT, reps, [&](size_t b, size_t e) { for (size_t i = b; i < e; ++i) occ[i] = bvh.occluded(rays[i]); },
                     [&](size_t b, size_t e) { for (size_t i = b; i < e; ++i) occ[i] = E.occluded(rays[i]); });
@@ -467,7 +489,18 @@ int main(int argc, char** argv) {
         else if (a == "--pairs" && i + 1 < argc) g_pairs = std::max(1, std::atoi(argv[++i]));
         else if (a == "--leaf-packets" && i + 1 < argc) g_options.maxLeafBlocks = std::clamp(std::atoi(argv[++i]), 1, 7);
         else if (a == "--trav-cost" && i + 1 < argc) g_options.traversalCost = std::max(0.0f, float(std::atof(argv[++i])));
-        else { std::fprintf(stderr, "usage: %s [--quick] [--scene NAME] [--testdata DIR] [--rays primary|shadow|incoherent] [--build-only [--reps N]] [--pairs N] [--leaf-packets N] [--trav-cost X]\n", argv[0]); return 2; }
+        else if (a == "--against" && i + 1 < argc) {
+            int leaf = 0;
+            float cost = 0;
+            if (std::sscanf(argv[++i], "%d,%f", &leaf, &cost) != 2 || leaf < 1 || leaf > 7 || !(cost >= 0)) {
+                std::fprintf(stderr, "bench: --against wants LEAF,COST (leaf packets 1-7, visit cost >= 0), got '%s'\n", argv[i]);
+                return 2;
+            }
+            g_againstTree = true;
+            g_againstOptions.maxLeafBlocks = leaf;
+            g_againstOptions.traversalCost = cost;
+        }
+        else { std::fprintf(stderr, "usage: %s [--quick] [--scene NAME] [--testdata DIR] [--rays primary|shadow|incoherent] [--build-only [--reps N]] [--pairs N] [--leaf-packets N] [--trav-cost X] [--against LEAF,COST]\n", argv[0]); return 2; }
     }
     if (const char* env = std::getenv("VIEWER_TESTDATA")) testdata = env;
     setFtzDaz();
