@@ -697,6 +697,8 @@ void TriangleBvh::build(const vec3* pos, const uint32_t* idx, size_t triCount, c
         detail::buildFromRefs<4>(refs.get(), refCount, opt, maxLeaf, m_nodes4, prims, leaves, m_bounds);
         makePackets(m_nodes4, prims, leaves, pos, idx, m_packets, m_prims);
     }
+    for (int a = 0; a < 3; ++a)
+        m_absMax[a] = m_packets.empty() ? 0.0f : std::max(std::abs(m_bounds.min[a]), std::abs(m_bounds.max[a]));
 }
 
 namespace {
@@ -773,16 +775,16 @@ int kernelWidth() { return kUseAvx2 ? 8 : 4; }
 
 bool TriangleBvh::intersect(const Ray& ray, TriHit& hit, bool cullBack) const {
     if (m_packets.empty()) return false;
-    if (!m_nodes8.empty()) return kern_avx2::traceTriangles8<false>(m_nodes8.data(), m_packets.data(), m_prims.data(), ray, &hit, cullBack);
-    return kUseAvx2 ? kern_avx2::traceTriangles<false>(m_nodes4.data(), m_packets.data(), m_prims.data(), ray, &hit, cullBack)
-                    : kern_sse::traceTriangles<false>(m_nodes4.data(), m_packets.data(), m_prims.data(), ray, &hit, cullBack);
+    if (!m_nodes8.empty()) return kern_avx2::traceTriangles8<false>(m_nodes8.data(), m_packets.data(), m_prims.data(), m_absMax, ray, &hit, cullBack);
+    return kUseAvx2 ? kern_avx2::traceTriangles<false>(m_nodes4.data(), m_packets.data(), m_prims.data(), m_absMax, ray, &hit, cullBack)
+                    : kern_sse::traceTriangles<false>(m_nodes4.data(), m_packets.data(), m_prims.data(), m_absMax, ray, &hit, cullBack);
 }
 
 bool TriangleBvh::occluded(const Ray& ray) const {
     if (m_packets.empty()) return false;
-    if (!m_nodes8.empty()) return kern_avx2::traceTriangles8<true>(m_nodes8.data(), m_packets.data(), m_prims.data(), ray, nullptr, false);
-    return kUseAvx2 ? kern_avx2::traceTriangles<true>(m_nodes4.data(), m_packets.data(), m_prims.data(), ray, nullptr, false)
-                    : kern_sse::traceTriangles<true>(m_nodes4.data(), m_packets.data(), m_prims.data(), ray, nullptr, false);
+    if (!m_nodes8.empty()) return kern_avx2::traceTriangles8<true>(m_nodes8.data(), m_packets.data(), m_prims.data(), m_absMax, ray, nullptr, false);
+    return kUseAvx2 ? kern_avx2::traceTriangles<true>(m_nodes4.data(), m_packets.data(), m_prims.data(), m_absMax, ray, nullptr, false)
+                    : kern_sse::traceTriangles<true>(m_nodes4.data(), m_packets.data(), m_prims.data(), m_absMax, ray, nullptr, false);
 }
 
 // --- brute force ------------------------------------------------------------------------------

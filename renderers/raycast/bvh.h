@@ -54,19 +54,21 @@ struct TriHit {
 
 // Per-ray data the SIMD box test needs: reciprocal direction, origin * reciprocal and which
 // slab (min or max) is the near one per axis.
-// The triangle kernels compute slab distances with one fused multiply-subtract,
-// t = b * rdir - org * rdir. That loses bits to cancellation when the origin is far from the
-// box (the rounding of org * rdir is absolute, about 2^-24 |org * rdir|), and their boxes may
-// have zero thickness (flat, axis-aligned geometry), so margins folded into the constants keep
-// every box conservative at no cost per node: near planes use orgRdirNear = org * rdir + E, far
-// planes rdirFar = rdir * g and orgRdirFar = (org * rdir - E) * g, with E = 2^-20 |org * rdir|
-// (at least 4x the absolute rounding of either side) and g = 1 + 2^-20 (the relative errors of
-// both sides of tn <= tf, as in Ize, "Robust BVH Ray Traversal", JCGT 2013).
+// The triangle kernels compute a slab distance with one fused multiply-subtract,
+// t = b * rdir - org * rdir. Its rounding error is absolute, not relative to t: about 2^-24
+// (|b| + |org|) |rdir| from rdir, org * rdir and the result, which matters when the origin or
+// the box is far from the world origin, and their boxes may have zero thickness (flat,
+// axis-aligned geometry). So the origin terms carry a margin E = 2^-20 (|org| + max |b|) |rdir|
+// per axis (4x that error; max |b| over the tree's bounds): near planes use orgRdirNear =
+// org * rdir + E, far planes orgRdirFar = org * rdir - E. Every computed slab interval then
+// contains the exact one, at no cost per node (the margin lives in constants).
 struct RayPre {
-    float org[3], rdir[3], orgRdir[3];
-    float orgRdirNear[3], rdirFar[3], orgRdirFar[3];
+    alignas(16) float org[4], rdir[4], orgRdir[4];   // lane 3 unused
+    alignas(16) float orgRdirNear[4], orgRdirFar[4];
     int nearX, nearY, nearZ;   // offsets (0 or 1) into Node4::b[axis*2 + ...]
-    explicit RayPre(const Ray& r);
+    // boxAbsMax: max |coordinate| per axis (x, y, z, unused) of the boxes to be tested; nullptr
+    // leaves the margins without that term (for traversals that do not use them).
+    RayPre(const Ray& r, const float* boxAbsMax);
 };
 
 // W-wide node (W = 4 or 8): bounds of up to W children stored SoA (b[0]=minx, b[1]=maxx,
@@ -182,6 +184,7 @@ private:
     HugeVector<TriPacket4> m_packets;
     HugeVector<uint32_t> m_prims;   // 4 per packet: triangle index per lane, ~0u = empty lane
     sg::Aabb m_bounds;
+    float m_absMax[4] = {0, 0, 0, 0};   // max |coordinate| per axis of m_bounds (RayPre margins)
 };
 
 // Which triangle kernel runs: "avx2+fma" (picked at run time when the CPU has it) or "sse"

@@ -4,32 +4,41 @@
 // others pushed with their entry distance so they can be skipped once a closer hit is known.
 #pragma once
 
+#include <cstddef>
 #include <xmmintrin.h>
 
 namespace rnd::rt {
 
-inline RayPre::RayPre(const Ray& r) {
-    for (int a = 0; a < 3; ++a) {
-        float d = r.dir[a];
-        // A zero component would give 0 * inf = NaN in the slab test: nudge it (the slab
-        // interval then becomes +-huge, the right answer up to a vanishing angle).
-        if (std::abs(d) < 1e-30f) d = std::signbit(d) ? -1e-30f : 1e-30f;
-        org[a] = r.org[a];
-        rdir[a] = 1.0f / d;
-        orgRdir[a] = org[a] * rdir[a];
-        const float g = 1.0f + 0x1p-20f, e = std::abs(orgRdir[a]) * 0x1p-20f;
-        orgRdirNear[a] = orgRdir[a] + e;
-        rdirFar[a] = rdir[a] * g;
-        orgRdirFar[a] = (orgRdir[a] - e) * g;
-    }
-    nearX = r.dir.x < 0 ? 1 : 0;
-    nearY = r.dir.y < 0 ? 1 : 0;
-    nearZ = r.dir.z < 0 ? 1 : 0;
+inline RayPre::RayPre(const Ray& r, const float* boxAbsMax) {
+    // All three axes at once (lane 3 holds tmin / tmax and is ignored): this runs once per ray,
+    // which is a few percent of a ray's work on small scenes.
+    static_assert(sizeof(Ray) == 32 && offsetof(Ray, dir) == 16, "Ray: org, tmin, dir, tmax packed");
+    const __m128 o = _mm_loadu_ps(&r.org.x);
+    __m128 d = _mm_loadu_ps(&r.dir.x);
+    const __m128 signBit = _mm_set1_ps(-0.0f);
+    // A zero component would give 0 * inf = NaN in the slab test: nudge it to +-1e-30 (the slab
+    // interval then becomes +-huge, the right answer up to a vanishing angle).
+    const __m128 tiny = _mm_cmplt_ps(_mm_andnot_ps(signBit, d), _mm_set1_ps(1e-30f));
+    d = _mm_or_ps(_mm_andnot_ps(tiny, d), _mm_and_ps(tiny, _mm_or_ps(_mm_and_ps(d, signBit), _mm_set1_ps(1e-30f))));
+    const __m128 rd = _mm_div_ps(_mm_set1_ps(1.0f), d);
+    const __m128 ord = _mm_mul_ps(o, rd);
+    // E = 2^-20 (|org| + max |b|) |rdir| per axis (see the struct's comment).
+    const __m128 absB = boxAbsMax ? _mm_loadu_ps(boxAbsMax) : _mm_setzero_ps();
+    const __m128 e = _mm_mul_ps(_mm_mul_ps(_mm_add_ps(_mm_andnot_ps(signBit, o), absB), _mm_andnot_ps(signBit, rd)), _mm_set1_ps(0x1p-20f));
+    _mm_store_ps(org, o);
+    _mm_store_ps(rdir, rd);
+    _mm_store_ps(orgRdir, ord);
+    _mm_store_ps(orgRdirNear, _mm_add_ps(ord, e));
+    _mm_store_ps(orgRdirFar, _mm_sub_ps(ord, e));
+    const int neg = _mm_movemask_ps(d);
+    nearX = neg & 1;
+    nearY = (neg >> 1) & 1;
+    nearZ = (neg >> 2) & 1;
 }
 
 template <bool AnyHit, class LeafFn> void Bvh4::traverse(const Ray& ray, float& tmax, LeafFn&& leaf) const {
     if (m_nodes.empty()) return;
-    const RayPre pre(ray);
+    const RayPre pre(ray, nullptr);   // only org and rdir: this test is (b - org) * rdir
     const __m128 ox = _mm_set1_ps(pre.org[0]), oy = _mm_set1_ps(pre.org[1]), oz = _mm_set1_ps(pre.org[2]);
     const __m128 rx = _mm_set1_ps(pre.rdir[0]), ry = _mm_set1_ps(pre.rdir[1]), rz = _mm_set1_ps(pre.rdir[2]);
     const int nx = pre.nearX, ny = 2 + pre.nearY, nz = 4 + pre.nearZ;

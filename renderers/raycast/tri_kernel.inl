@@ -186,8 +186,8 @@ inline uint32_t pushFarReturnNear(const uint32_t* child, const float* dist, int 
 // packets). AnyHit: stop at the first hit and skip the ordering. Returns true on a hit (closest
 // hit written to *hit unless AnyHit).
 template <bool AnyHit>
-inline bool traceTriangles(const Node4* nodes, const TriPacket4* packets, const uint32_t* prims, const Ray& ray, TriHit* hit, bool cullBack) {
-    const RayPre pre(ray);
+inline bool traceTriangles(const Node4* nodes, const TriPacket4* packets, const uint32_t* prims, const float* absMax, const Ray& ray, TriHit* hit, bool cullBack) {
+    const RayPre pre(ray, absMax);
     const __m128 rx = _mm_set1_ps(pre.rdir[0]), ry = _mm_set1_ps(pre.rdir[1]), rz = _mm_set1_ps(pre.rdir[2]);
     const __m128 orx = _mm_set1_ps(pre.orgRdirNear[0]), ory = _mm_set1_ps(pre.orgRdirNear[1]), orz = _mm_set1_ps(pre.orgRdirNear[2]);
     const int nx = pre.nearX, ny = 2 + pre.nearY, nz = 4 + pre.nearZ;
@@ -195,8 +195,7 @@ inline bool traceTriangles(const Node4* nodes, const TriPacket4* packets, const 
     const __m128 o[3] = {_mm_set1_ps(ray.org.x), _mm_set1_ps(ray.org.y), _mm_set1_ps(ray.org.z)};
     const __m128 d[3] = {_mm_set1_ps(ray.dir.x), _mm_set1_ps(ray.dir.y), _mm_set1_ps(ray.dir.z)};
     const __m128 tminV = _mm_set1_ps(ray.tmin);
-    // Near (orx...) and far planes: constants with the rounding margins folded in (see RayPre).
-    const __m128 rxf = _mm_set1_ps(pre.rdirFar[0]), ryf = _mm_set1_ps(pre.rdirFar[1]), rzf = _mm_set1_ps(pre.rdirFar[2]);
+    // Near (orx...) and far planes: origin terms with the rounding margins folded in (see RayPre).
     const __m128 orxf = _mm_set1_ps(pre.orgRdirFar[0]), oryf = _mm_set1_ps(pre.orgRdirFar[1]), orzf = _mm_set1_ps(pre.orgRdirFar[2]);
     float tmax = ray.tmax;
     __m128 tmaxV = _mm_set1_ps(tmax);
@@ -210,9 +209,9 @@ inline bool traceTriangles(const Node4* nodes, const TriPacket4* packets, const 
             const Node4& n = nodes[cur];
             // t = b * rdir - org * rdir (with RayPre's margins); the near/far planes per axis
             // come from the ray's signs.
-            const __m128 t0x = RT_MSUB(_mm_load_ps(n.b[nx]), rx, orx), t1x = RT_MSUB(_mm_load_ps(n.b[fx]), rxf, orxf);
-            const __m128 t0y = RT_MSUB(_mm_load_ps(n.b[ny]), ry, ory), t1y = RT_MSUB(_mm_load_ps(n.b[fy]), ryf, oryf);
-            const __m128 t0z = RT_MSUB(_mm_load_ps(n.b[nz]), rz, orz), t1z = RT_MSUB(_mm_load_ps(n.b[fz]), rzf, orzf);
+            const __m128 t0x = RT_MSUB(_mm_load_ps(n.b[nx]), rx, orx), t1x = RT_MSUB(_mm_load_ps(n.b[fx]), rx, orxf);
+            const __m128 t0y = RT_MSUB(_mm_load_ps(n.b[ny]), ry, ory), t1y = RT_MSUB(_mm_load_ps(n.b[fy]), ry, oryf);
+            const __m128 t0z = RT_MSUB(_mm_load_ps(n.b[nz]), rz, orz), t1z = RT_MSUB(_mm_load_ps(n.b[fz]), rz, orzf);
             const __m128 tn = _mm_max_ps(_mm_max_ps(t0x, t0y), _mm_max_ps(t0z, tminV));
             const __m128 tf = _mm_min_ps(_mm_min_ps(t1x, t1y), _mm_min_ps(t1z, tmaxV));
             int mask = _mm_movemask_ps(_mm_cmple_ps(tn, tf));
@@ -260,8 +259,8 @@ inline bool traceTriangles(const Node4* nodes, const TriPacket4* packets, const 
 // The same traversal over 8-wide nodes: one AVX compare per node for 8 boxes (BVH8: fewer,
 // wider levels); leaf packets tested two at a time (8 lanes).
 template <bool AnyHit>
-inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const uint32_t* prims, const Ray& ray, TriHit* hit, bool cullBack) {
-    const RayPre pre(ray);
+inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const uint32_t* prims, const float* absMax, const Ray& ray, TriHit* hit, bool cullBack) {
+    const RayPre pre(ray, absMax);
     const __m256 rx = _mm256_set1_ps(pre.rdir[0]), ry = _mm256_set1_ps(pre.rdir[1]), rz = _mm256_set1_ps(pre.rdir[2]);
     const __m256 orx = _mm256_set1_ps(pre.orgRdirNear[0]), ory = _mm256_set1_ps(pre.orgRdirNear[1]), orz = _mm256_set1_ps(pre.orgRdirNear[2]);
     const int nx = pre.nearX, ny = 2 + pre.nearY, nz = 4 + pre.nearZ;
@@ -272,7 +271,6 @@ inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const
     // Near and far planes: constants with the rounding margins folded in (see RayPre), which
     // keeps a multiply off each node visit's dependency chain (in-process A/B against scaling
     // tf by 1 + 8 eps: primary rays on 1M triangles 1-3% faster).
-    const __m256 rxf = _mm256_set1_ps(pre.rdirFar[0]), ryf = _mm256_set1_ps(pre.rdirFar[1]), rzf = _mm256_set1_ps(pre.rdirFar[2]);
     const __m256 orxf = _mm256_set1_ps(pre.orgRdirFar[0]), oryf = _mm256_set1_ps(pre.orgRdirFar[1]), orzf = _mm256_set1_ps(pre.orgRdirFar[2]);
     float tmax = ray.tmax;
     __m256 tmax8 = _mm256_set1_ps(tmax);
@@ -284,9 +282,9 @@ inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const
     for (;;) {
         if (!(cur & Node8::kLeafBit)) {
             const Node8& n = nodes[cur];
-            const __m256 t0x = _mm256_fmsub_ps(_mm256_load_ps(n.b[nx]), rx, orx), t1x = _mm256_fmsub_ps(_mm256_load_ps(n.b[fx]), rxf, orxf);
-            const __m256 t0y = _mm256_fmsub_ps(_mm256_load_ps(n.b[ny]), ry, ory), t1y = _mm256_fmsub_ps(_mm256_load_ps(n.b[fy]), ryf, oryf);
-            const __m256 t0z = _mm256_fmsub_ps(_mm256_load_ps(n.b[nz]), rz, orz), t1z = _mm256_fmsub_ps(_mm256_load_ps(n.b[fz]), rzf, orzf);
+            const __m256 t0x = _mm256_fmsub_ps(_mm256_load_ps(n.b[nx]), rx, orx), t1x = _mm256_fmsub_ps(_mm256_load_ps(n.b[fx]), rx, orxf);
+            const __m256 t0y = _mm256_fmsub_ps(_mm256_load_ps(n.b[ny]), ry, ory), t1y = _mm256_fmsub_ps(_mm256_load_ps(n.b[fy]), ry, oryf);
+            const __m256 t0z = _mm256_fmsub_ps(_mm256_load_ps(n.b[nz]), rz, orz), t1z = _mm256_fmsub_ps(_mm256_load_ps(n.b[fz]), rz, orzf);
             const __m256 tn = _mm256_max_ps(_mm256_max_ps(t0x, t0y), _mm256_max_ps(t0z, tmin8));
             const __m256 tf = _mm256_min_ps(_mm256_min_ps(t1x, t1y), _mm256_min_ps(t1z, tmax8));
             int mask = _mm256_movemask_ps(_mm256_cmp_ps(tn, tf, _CMP_LE_OQ));

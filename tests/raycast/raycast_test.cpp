@@ -404,9 +404,10 @@ TEST(RaycastTest, BvhClosestHitEqualsBruteForce) {
 }
 
 // Boxes of flat, axis-aligned geometry have zero thickness, and the box test's slab distances
-// (b * (1/d) - o * (1/d)) lose bits to cancellation when the ray starts far away: rays that
-// skim such a ground at shallow angles, from far off, or that run exactly along a grid line
-// must still find the same triangle as the brute force (no hit lost in the BVH's margins).
+// (b * (1/d) - o * (1/d)) lose bits to cancellation when the ray or the box is far from the
+// world origin: rays that skim such a ground at shallow angles, from far off, from the world
+// origin to the far ground, or exactly along a grid line must still find the same triangle as
+// the brute force (no hit lost in the BVH's margins).
 TEST(RaycastTest, BvhKeepsGrazingRaysOnFlatFarGeometry) {
     const int n = 64;
     const vec3 base(1000.0f, 0.0f, -500.0f);   // far from the origin: large o * (1/d) terms
@@ -435,6 +436,10 @@ TEST(RaycastTest, BvhKeepsGrazingRaysOnFlatFarGeometry) {
         const vec3 dir(std::cos(elev) * std::cos(az), -std::sin(elev), std::cos(elev) * std::sin(az));
         Ray r = mkRay(target - dist * dir, dir);
         if (k % 8 == 0) r.dir = glm::normalize(vec3(0.0f, -1e-3f, 1.0f));   // along the grid line x = target.x
+        if (k % 8 == 4) {   // from near the world origin (to a grid line): the ground is ~1100 units away
+            r.org = vec3(0.0f, 3.0f * U(rng), 0.0f);
+            r.dir = glm::normalize(target - r.org);
+        }
         TriHit a, b;
         const bool ha = bvh.intersect(r, a), hb = intersectBruteForce(pos.data(), idx.data(), count, r, b);
         ASSERT_EQ(ha, hb) << "ray " << k << " from " << r.org.x << " " << r.org.y << " " << r.org.z;
