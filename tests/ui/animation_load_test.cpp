@@ -68,7 +68,10 @@ fs::path writeAnimatedGltf() {
     {"name": "step", "channels": [{"sampler": 0, "target": {"node": 0, "path": "translation"}}],
      "samplers": [{"input": 1, "output": 2, "interpolation": "STEP"}]}]
 })";
-    fs::path path = testing_support::outputDir("ui") / "animated.gltf";
+    // One file per test: ctest -j runs these tests as separate processes at once, and a shared
+    // file could be read while another test is rewriting it (seen: "animated.gltf: empty file").
+    const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    fs::path path = testing_support::outputDir("ui") / ("animated-" + test + ".gltf");
     std::ofstream(path, std::ios::binary) << json;
     return path;
 }
@@ -157,6 +160,7 @@ TEST(ViewerStateAnimTest, PlayInterpolatesPauseStopsScrubSetsNeverDirty) {
 TEST(ViewerStateAnimTest, LoopWrapsAndOneShotStopsAtTheEnd) {
     ViewerState st = animatedState();
     sg::NodeId mover = st.scene.findByName("mover");
+    ASSERT_TRUE(st.scene.valid(mover));
     ASSERT_TRUE(st.animationLoop);
     st.setAnimationPlaying(true);
     st.advanceAnimation(2.5);   // 2.5 s in a 2 s loop: t = 0.5
@@ -180,6 +184,7 @@ TEST(ViewerStateAnimTest, LoopWrapsAndOneShotStopsAtTheEnd) {
 TEST(ViewerStateAnimTest, SelectingAClipRewindsAndUsesItsInterpolation) {
     ViewerState st = animatedState();
     sg::NodeId mover = st.scene.findByName("mover");
+    ASSERT_TRUE(st.scene.valid(mover));
     st.setAnimationTime(1.0);
     EXPECT_NEAR(localT(st, mover).x, 2.0f, 1e-5f);
     st.setAnimationPlaying(true);
