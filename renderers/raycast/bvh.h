@@ -35,7 +35,8 @@ template <class T> struct HugePageAllocator {
 };
 template <class T> using HugeVector = std::vector<T, HugePageAllocator<T>>;
 
-// A ray segment org + t*dir, t in [tmin, tmax]. dir need not be unit length.
+// A ray segment org + t*dir, t in [tmin, tmax]. dir need not be unit length. TriangleBvh
+// treats a negative (or NaN) tmin as 0: its box test relies on tmin >= 0 (see traceTriangles8).
 struct Ray {
     sg::vec3 org{0.0f};
     float tmin = 0.0f;

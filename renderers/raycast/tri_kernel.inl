@@ -194,7 +194,7 @@ inline bool traceTriangles(const Node4* nodes, const TriPacket4* packets, const 
     const int fx = 1 - pre.nearX, fy = 3 - pre.nearY, fz = 5 - pre.nearZ;
     const __m128 o[3] = {_mm_set1_ps(ray.org.x), _mm_set1_ps(ray.org.y), _mm_set1_ps(ray.org.z)};
     const __m128 d[3] = {_mm_set1_ps(ray.dir.x), _mm_set1_ps(ray.dir.y), _mm_set1_ps(ray.dir.z)};
-    const __m128 tminV = _mm_set1_ps(ray.tmin);
+    const __m128 tminV = _mm_set1_ps(ray.tmin > 0.0f ? ray.tmin : 0.0f);   // see Ray: a negative (or NaN) tmin acts as 0
     // Near (orx...) and far planes: origin terms with the rounding margins folded in (see RayPre).
     const __m128 orxf = _mm_set1_ps(pre.orgRdirFar[0]), oryf = _mm_set1_ps(pre.orgRdirFar[1]), orzf = _mm_set1_ps(pre.orgRdirFar[2]);
     float tmax = ray.tmax;
@@ -265,7 +265,9 @@ inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const
     const __m256 orx = _mm256_set1_ps(pre.orgRdirNear[0]), ory = _mm256_set1_ps(pre.orgRdirNear[1]), orz = _mm256_set1_ps(pre.orgRdirNear[2]);
     const int nx = pre.nearX, ny = 2 + pre.nearY, nz = 4 + pre.nearZ;
     const int fx = 1 - pre.nearX, fy = 3 - pre.nearY, fz = 5 - pre.nearZ;
-    const __m256 tmin8 = _mm256_set1_ps(ray.tmin);
+    const float tmin = ray.tmin > 0.0f ? ray.tmin : 0.0f;   // see Ray: a negative (or NaN) tmin acts as 0
+    const __m256 tmin8 = _mm256_set1_ps(tmin);
+    const __m256i tmin8i = _mm256_castps_si256(tmin8);
     const __m256 o8[3] = {_mm256_set1_ps(ray.org.x), _mm256_set1_ps(ray.org.y), _mm256_set1_ps(ray.org.z)};
     const __m256 d8[3] = {_mm256_set1_ps(ray.dir.x), _mm256_set1_ps(ray.dir.y), _mm256_set1_ps(ray.dir.z)};
     // Near and far planes: constants with the rounding margins folded in (see RayPre), which
@@ -285,12 +287,19 @@ inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const
             const __m256 t0x = _mm256_fmsub_ps(_mm256_load_ps(n.b[nx]), rx, orx), t1x = _mm256_fmsub_ps(_mm256_load_ps(n.b[fx]), rx, orxf);
             const __m256 t0y = _mm256_fmsub_ps(_mm256_load_ps(n.b[ny]), ry, ory), t1y = _mm256_fmsub_ps(_mm256_load_ps(n.b[fy]), ry, oryf);
             const __m256 t0z = _mm256_fmsub_ps(_mm256_load_ps(n.b[nz]), rz, orz), t1z = _mm256_fmsub_ps(_mm256_load_ps(n.b[fz]), rz, orzf);
-            const __m256 tn = _mm256_max_ps(_mm256_max_ps(t0x, t0y), _mm256_max_ps(t0z, tmin8));
-            const __m256 tf = _mm256_min_ps(_mm256_min_ps(t1x, t1y), _mm256_min_ps(t1z, tmax8));
-            int mask = _mm256_movemask_ps(_mm256_cmp_ps(tn, tf, _CMP_LE_OQ));
+            // Entry/exit distances combined as integers (1-cycle max/min/compare instead of
+            // 4-cycle float ones on the node-to-node dependency chain, as Embree does on AVX2).
+            // Exact here: tmin >= +0, and non-negative floats order like their bit patterns;
+            // a negative exit distance is a negative integer, below any non-negative entry
+            // distance, so boxes behind the ray still miss. tn >= tmin >= 0 stays a float.
+            const __m256i tn = _mm256_max_epi32(_mm256_max_epi32(_mm256_castps_si256(t0x), _mm256_castps_si256(t0y)),
+                                                _mm256_max_epi32(_mm256_castps_si256(t0z), tmin8i));
+            const __m256i tf = _mm256_min_epi32(_mm256_min_epi32(_mm256_castps_si256(t1x), _mm256_castps_si256(t1y)),
+                                                _mm256_min_epi32(_mm256_castps_si256(t1z), _mm256_castps_si256(tmax8)));
+            int mask = ~_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpgt_epi32(tn, tf))) & 0xFF;
             if (mask != 0) {
                 alignas(32) float dist[8];
-                _mm256_store_ps(dist, tn);
+                _mm256_store_si256(reinterpret_cast<__m256i*>(dist), tn);
                 const int c0 = __builtin_ctz(mask);
                 mask &= mask - 1;
                 if (mask == 0) { cur = n.child[c0]; continue; }

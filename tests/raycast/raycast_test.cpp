@@ -384,6 +384,7 @@ TEST(RaycastTest, BvhClosestHitEqualsBruteForce) {
                 if (i % 50 == 0) d = vec3(0, 0, i % 100 == 0 ? 1.0f : -1.0f);   // axis-aligned: zero components
                 Ray r = mkRay(o, d);
                 if (i % 7 == 0) r.tmax = 0.5f;
+                if (i % 11 == 0) r.tmin = 0.2f;   // segments starting past the origin
                 TriHit a, b;
                 bool ha = bvh.intersect(r, a), hb = intersectBruteForce(pos.data(), idx.data(), count, r, b);
                 ASSERT_EQ(ha, hb) << "seed " << seed << " ray " << i;
@@ -399,6 +400,20 @@ TEST(RaycastTest, BvhClosestHitEqualsBruteForce) {
                 }
             }
             if (ntri > 100) { EXPECT_GT(hits, seed == 3 ? 10 : 100); }
+            // A negative tmin acts as 0 (the box test needs tmin >= 0): the same hits as the
+            // brute force with tmin = 0, never a triangle behind the origin.
+            for (int i = 0; i < 500; ++i) {
+                const vec3 o(U(rng) * 8, U(rng) * 8, U(rng) * 8);
+                Ray r = mkRay(o, vec3(U(rng) * 5, U(rng) * 5, U(rng) * 5) - o);
+                r.tmin = i % 2 ? -3.0f : -std::numeric_limits<float>::infinity();
+                Ray r0 = r;
+                r0.tmin = 0.0f;
+                TriHit a, b;
+                const bool ha = bvh.intersect(r, a), hb = intersectBruteForce(pos.data(), idx.data(), count, r0, b);
+                ASSERT_EQ(ha, hb) << "seed " << seed << " negative-tmin ray " << i;
+                EXPECT_EQ(bvh.occluded(r), hb);
+                if (ha) { EXPECT_EQ(a.t, b.t); EXPECT_GE(a.t, 0.0f); }
+            }
         }
     }
 }
