@@ -691,12 +691,24 @@ void TriangleBvh::build(const vec3* pos, const uint32_t* idx, size_t triCount, c
     m_nodes8.clear();
     m_packets.clear();
     m_prims.clear();
-    if (kernelWidth() == 8) {
+    bool wide = kernelWidth() == 8;
+    if (wide) {
         detail::buildFromRefs<8>(refs.get(), refCount, opt, maxLeaf, m_nodes8, prims, leaves, m_bounds);
         PROBE("tree");
-        makePackets(m_nodes8, prims, leaves, pos, idx, m_packets, m_prims);
-        PROBE("packets");
-    } else {
+        // Inner children by byte offset (see bvh.h), which must stay below the leaf bit.
+        static_assert(sizeof(Node8) << 23 == size_t(1) << 31);
+        if (m_nodes8.size() <= std::min<uint32_t>(opt.maxWideNodes, 1u << 23)) {
+            makePackets(m_nodes8, prims, leaves, pos, idx, m_packets, m_prims);
+            for (Node8& nd : m_nodes8)
+                for (uint32_t& c : nd.child)
+                    if (c != NodeBits::kEmpty && !(c & NodeBits::kLeafBit)) c *= uint32_t(sizeof(Node8));
+            PROBE("packets");
+        } else {   // too many nodes to address that way: a BVH4 (same kernels, 4-wide nodes)
+            m_nodes8 = {};
+            wide = false;
+        }
+    }
+    if (!wide) {
         detail::buildFromRefs<4>(refs.get(), refCount, opt, maxLeaf, m_nodes4, prims, leaves, m_bounds);
         makePackets(m_nodes4, prims, leaves, pos, idx, m_packets, m_prims);
     }
@@ -705,7 +717,8 @@ void TriangleBvh::build(const vec3* pos, const uint32_t* idx, size_t triCount, c
 }
 
 namespace {
-template <int W> void addStats(const HugeVector<NodeW<W>>& nodes, const sg::Aabb& bounds, TriangleBvh::Stats& s) {
+// refScale: what an inner child reference is in units of nodes (BVH8: byte offsets).
+template <int W> void addStats(const HugeVector<NodeW<W>>& nodes, uint32_t refScale, const sg::Aabb& bounds, TriangleBvh::Stats& s) {
     s.nodes = nodes.size();
     auto halfArea = [](float dx, float dy, float dz) { return dx < 0 || dy < 0 || dz < 0 ? 0.0 : double(dx) * dy + double(dy) * dz + double(dz) * dx; };
     const sg::vec3 e = bounds.max - bounds.min;
@@ -732,15 +745,15 @@ template <int W> void addStats(const HugeVector<NodeW<W>>& nodes, const sg::Aabb
         stack.pop_back();
         s.depth = std::max(s.depth, d);
         for (uint32_t c : nodes[i].child)
-            if (c != NodeBits::kEmpty && !(c & NodeBits::kLeafBit)) stack.push_back({c, d + 1});
+            if (c != NodeBits::kEmpty && !(c & NodeBits::kLeafBit)) stack.push_back({c / refScale, d + 1});
     }
 }
 }  // namespace
 
 TriangleBvh::Stats TriangleBvh::stats() const {
     Stats s;
-    if (!m_nodes8.empty()) addStats(m_nodes8, m_bounds, s);
-    else if (!m_nodes4.empty()) addStats(m_nodes4, m_bounds, s);
+    if (!m_nodes8.empty()) addStats(m_nodes8, uint32_t(sizeof(Node8)), m_bounds, s);
+    else if (!m_nodes4.empty()) addStats(m_nodes4, 1, m_bounds, s);
     s.packets = m_packets.size();
     for (uint32_t id : m_prims) s.lanes += id != ~0u;
     return s;

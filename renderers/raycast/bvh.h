@@ -73,7 +73,9 @@ struct RayPre {
 };
 
 // W-wide node (W = 4 or 8): bounds of up to W children stored SoA (b[0]=minx, b[1]=maxx,
-// b[2]=miny, ...). child[i] >= 0: inner node index. Leaf: kLeafBit | (first << 3) | count,
+// b[2]=miny, ...). child[i] >= 0: inner node index (TriangleBvh's BVH8: the node's byte
+// offset, index * sizeof(Node8), so the traversal adds no arithmetic between loading a child
+// reference and loading the child's bounds). Leaf: kLeafBit | (first << 3) | count,
 // count in 1..7 (Bvh4: primitives, TriangleBvh: packets); kEmpty: unused slot (its bounds are empty so it is never entered).
 struct NodeBits {
     static constexpr uint32_t kLeafBit = 0x80000000u;
@@ -98,6 +100,10 @@ public:
         float traversalCost = 1.0f;   // SAH cost of a node visit, in block tests
         int bins = 16;             // SAH bins per axis
         bool parallel = true;      // oneTBB tasks for big subtrees
+        // TriangleBvh's BVH8 refers to inner nodes by byte offset in 31 bits: at most 2^23
+        // nodes (about 270M triangles with the default leaves). A tree with more nodes than
+        // this (capped at 2^23) is built as a BVH4 instead; tests lower it to reach that path.
+        uint32_t maxWideNodes = 1u << 23;
     };
     // Boxes given as SoA-friendly min/max arrays; n = count. Empty/invalid boxes are skipped.
     void build(const sg::vec3* boxMin, const sg::vec3* boxMax, size_t n, const BuildOptions& opt);

@@ -256,6 +256,11 @@ inline bool traceTriangles(const Node4* nodes, const TriPacket4* packets, const 
 }
 
 #if RT_FMA
+// Byte address of bounds plane k (0..5: minx, maxx, miny, ...) of the node at byte offset 0;
+// the plane of the node at byte offset ref is then planeBase + ref.
+inline const char* planeBase(const char* nodeBytes, int k) { return nodeBytes + offsetof(Node8, b) + size_t(k) * sizeof(Node8::b[0]); }
+inline __m256 loadPlane(const char* base, uint32_t ref) { return _mm256_load_ps(reinterpret_cast<const float*>(base + ref)); }
+
 // The same traversal over 8-wide nodes: one AVX compare per node for 8 boxes (BVH8: fewer,
 // wider levels); leaf packets tested two at a time (8 lanes).
 template <bool AnyHit>
@@ -278,15 +283,26 @@ inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const
     __m256 tmax8 = _mm256_set1_ps(tmax);
     bool found = false;
 
+    // Inner children are byte offsets into nodes, and each of the six planes this ray reads
+    // gets its own base pointer: a plane's address is base + ref, so no arithmetic sits
+    // between loading a child reference and loading the child's bounds.
+    const char* const nodeBytes = reinterpret_cast<const char*>(nodes);
+    const char *pnx = planeBase(nodeBytes, nx), *pfx = planeBase(nodeBytes, fx), *pny = planeBase(nodeBytes, ny);
+    const char *pfy = planeBase(nodeBytes, fy), *pnz = planeBase(nodeBytes, nz), *pfz = planeBase(nodeBytes, fz);
+    // Opaque to the optimiser: otherwise it folds base + ref back into (nodes + ref) + offset,
+    // which puts an add on the chain again.
+    asm("" : "+r"(pnx), "+r"(pfx), "+r"(pny), "+r"(pfy), "+r"(pnz), "+r"(pfz));
+    const auto ld = loadPlane;
+
     StackEntry stack[512];
     int sp = 0;
     uint32_t cur = 0;
     for (;;) {
         if (!(cur & Node8::kLeafBit)) {
-            const Node8& n = nodes[cur];
-            const __m256 t0x = _mm256_fmsub_ps(_mm256_load_ps(n.b[nx]), rx, orx), t1x = _mm256_fmsub_ps(_mm256_load_ps(n.b[fx]), rx, orxf);
-            const __m256 t0y = _mm256_fmsub_ps(_mm256_load_ps(n.b[ny]), ry, ory), t1y = _mm256_fmsub_ps(_mm256_load_ps(n.b[fy]), ry, oryf);
-            const __m256 t0z = _mm256_fmsub_ps(_mm256_load_ps(n.b[nz]), rz, orz), t1z = _mm256_fmsub_ps(_mm256_load_ps(n.b[fz]), rz, orzf);
+            const Node8& n = *reinterpret_cast<const Node8*>(nodeBytes + cur);
+            const __m256 t0x = _mm256_fmsub_ps(ld(pnx, cur), rx, orx), t1x = _mm256_fmsub_ps(ld(pfx, cur), rx, orxf);
+            const __m256 t0y = _mm256_fmsub_ps(ld(pny, cur), ry, ory), t1y = _mm256_fmsub_ps(ld(pfy, cur), ry, oryf);
+            const __m256 t0z = _mm256_fmsub_ps(ld(pnz, cur), rz, orz), t1z = _mm256_fmsub_ps(ld(pfz, cur), rz, orzf);
             // Entry/exit distances combined as integers (1-cycle max/min/compare instead of
             // 4-cycle float ones on the node-to-node dependency chain, as Embree does on AVX2).
             // Exact here: tmin >= +0, and non-negative floats order like their bit patterns;
@@ -296,11 +312,12 @@ inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const
                                                 _mm256_max_epi32(_mm256_castps_si256(t0z), tmin8i));
             const __m256i tf = _mm256_min_epi32(_mm256_min_epi32(_mm256_castps_si256(t1x), _mm256_castps_si256(t1y)),
                                                 _mm256_min_epi32(_mm256_castps_si256(t1z), _mm256_castps_si256(tmax8)));
-            int mask = ~_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpgt_epi32(tn, tf))) & 0xFF;
+            // movemask of 8 lanes sets bits 0-7 only: ^ 0xFF is the complement (one op).
+            unsigned mask = unsigned(_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpgt_epi32(tn, tf)))) ^ 0xFFu;
             if (mask != 0) {
                 alignas(32) float dist[8];
                 _mm256_store_si256(reinterpret_cast<__m256i*>(dist), tn);
-                const int c0 = __builtin_ctz(mask);
+                const unsigned c0 = unsigned(__builtin_ctz(mask));   // unsigned: no sign extension before the child load
                 mask &= mask - 1;
                 if (mask == 0) { cur = n.child[c0]; continue; }
                 if constexpr (AnyHit) {
@@ -310,7 +327,7 @@ inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const
                 }
                 const int c1 = __builtin_ctz(mask);
                 mask &= mask - 1;
-                cur = pushFarReturnNear(n.child, dist, c0, c1, mask, stack, sp);
+                cur = pushFarReturnNear(n.child, dist, int(c0), c1, int(mask), stack, sp);
                 continue;
             }
         } else {

@@ -362,15 +362,19 @@ TEST(RaycastTest, BvhClosestHitEqualsBruteForce) {
         const size_t count = idx.size() / 3;
         // Default leaves (SAH-chosen, up to 4 packets), single-packet leaves, and leaves of up
         // to 7 packets with node visits made expensive (many multi-packet leaves).
-        Bvh4::BuildOptions opts[3] = {TriangleBvh::defaultOptions(), {}, TriangleBvh::defaultOptions()};
+        // Last: a BVH8 allowed too few nodes, which must come out as a BVH4.
+        Bvh4::BuildOptions opts[4] = {TriangleBvh::defaultOptions(), {}, TriangleBvh::defaultOptions(), TriangleBvh::defaultOptions()};
         opts[1].maxLeafBlocks = 1;
         opts[2].maxLeafBlocks = 7;
         opts[2].traversalCost = 20.0f;
         opts[2].parallel = false;
+        opts[3].maxWideNodes = 1;
         for (const Bvh4::BuildOptions& opt : opts) {
             TriangleBvh bvh;
             bvh.build(pos.data(), idx.data(), count, opt);
             const TriangleBvh::Stats st = bvh.stats();
+            if (opt.maxWideNodes == 1 && ntri > 100) { EXPECT_EQ(bvh.width(), 4) << "seed " << seed; }
+            if (opt.maxWideNodes > 1) { EXPECT_EQ(bvh.width(), std::string(kernelName()) == "sse bvh4" ? 4 : 8); }
             EXPECT_LE(st.maxLeafPackets, opt.maxLeafBlocks);
             // Nodes are filled first (any child of more than one packet is split while a node
             // has room), so big leaves appear one level down: 2 packets at 300 triangles,
