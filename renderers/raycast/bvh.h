@@ -15,6 +15,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <utility>
 #include <vector>
 
 namespace rnd::rt {
@@ -31,6 +32,10 @@ template <class T> struct HugePageAllocator {
     template <class U> HugePageAllocator(const HugePageAllocator<U>&) {}
     T* allocate(size_t n) { return static_cast<T*>(hugeAlloc(n * sizeof(T))); }
     void deallocate(T* p, size_t n) noexcept { hugeFree(p, n * sizeof(T)); }
+    // resize() default-initialises (no zero fill): the builders write every element they keep,
+    // and the first write then also faults the page in, on whichever thread fills it.
+    template <class U> void construct(U* p) noexcept { ::new (static_cast<void*>(p)) U; }
+    template <class U, class... A> void construct(U* p, A&&... a) { ::new (static_cast<void*>(p)) U(std::forward<A>(a)...); }
     template <class U> bool operator==(const HugePageAllocator<U>&) const { return true; }
 };
 template <class T> using HugeVector = std::vector<T, HugePageAllocator<T>>;
