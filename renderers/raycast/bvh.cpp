@@ -371,34 +371,30 @@ template <int W> struct Builder {
         const uint32_t n = k.r.count();
         k.leaf = n <= uint32_t(leafSize);
         if (k.leaf || n > uint32_t(maxLeaf)) return;
-        if (!k.hasSplit) {
-            splitRange(refs, k.r, k.a, k.b, nbins, leafSize, forceMedian, &k.cost);
-            k.hasSplit = true;
-        }
+        ensureSplit(k, forceMedian);
         const float area = k.r.bounds.halfArea();
         k.leaf = area * float(blocks(n, leafSize)) <= travCost * area + k.cost;
     }
 
-    // Splits, in parallel, every child of more than 1024 primitives that has no split yet.
-    // None of it is speculative: a child of more than leafSize primitives is split either in
-    // this node's fill loop or as the root of its own subtree, which reuses the split; and the
-    // children's ranges are disjoint. Without it, filling the root node of a 1M-triangle BVH8
-    // (about 3n of binning and partitioning) ran on one thread: 40 of the 163 ms of a 2-thread
-    // build.
+    // Computes k's split unless it is known (kept in k for the fill loop, decide() and the
+    // child's own subtree).
+    void ensureSplit(Kid& k, bool forceMedian) {
+        if (k.hasSplit) return;
+        splitRange(refs, k.r, k.a, k.b, nbins, leafSize, forceMedian, &k.cost);
+        k.hasSplit = true;
+    }
+
+    // Splits, in parallel, every child of more than 1024 primitives that has no split yet
+    // (when there are two or more). None of it is speculative: a child of more than leafSize
+    // primitives is split either in this node's fill loop or as the root of its own subtree,
+    // which reuses the split; and the children's ranges are disjoint. Without it, filling the
+    // root node of a 1M-triangle BVH8 (about 3n of binning and partitioning) ran on one
+    // thread: 40 of the 163 ms of a 2-thread build.
     void presplit(Kid* kids, int nk, bool forceMedian) {
         int todo[W], nt = 0;
         for (int i = 0; i < nk; ++i)
             if (!kids[i].hasSplit && kids[i].r.count() > 1024) todo[nt++] = i;
-        auto one = [&](int i) {
-            Kid& k = kids[i];
-            splitRange(refs, k.r, k.a, k.b, nbins, leafSize, forceMedian, &k.cost);
-            k.hasSplit = true;
-        };
-        if (nt < 2) {
-            if (nt == 1) one(todo[0]);
-            return;
-        }
-        tbb::parallel_for(0, nt, [&](int j) { one(todo[j]); });
+        if (nt >= 2) tbb::parallel_for(0, nt, [&](int j) { ensureSplit(kids[todo[j]], forceMedian); });
     }
 
     // Builds the subtree for `root` (not a leaf; its split may already be known from the
@@ -426,9 +422,8 @@ template <int W> struct Builder {
             if (best < 0) break;
             Kid& k = kids[best];
             if (!k.hasSplit && parallel) presplit(kids, nk, forceMedian);
-            Range a, b;
-            if (k.hasSplit) { a = k.a; b = k.b; }
-            else { float cost; splitRange(refs, k.r, a, b, nbins, leafSize, forceMedian, &cost); }
+            ensureSplit(k, forceMedian);
+            const Range a = k.a, b = k.b;
             kids[best] = Kid{};
             kids[best].r = a;
             kids[nk] = Kid{};
@@ -585,12 +580,11 @@ void buildFromRefs(PrimRef* refs, size_t n, const Bvh4::BuildOptions& opt, int m
     }
     outLeaves.assign(leaves.get(), leaves.get() + b.leafCount.load());
     outPrims.resize(n);
+    auto copyIds = [&](size_t begin, size_t end) { for (size_t i = begin; i < end; ++i) outPrims[i] = refs[i].id(); };
     if (opt.parallel && n > 65536)
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 16384), [&](const tbb::blocked_range<size_t>& r) {
-            for (size_t i = r.begin(); i < r.end(); ++i) outPrims[i] = refs[i].id();
-        });
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 16384), [&](const tbb::blocked_range<size_t>& r) { copyIds(r.begin(), r.end()); });
     else
-        for (size_t i = 0; i < n; ++i) outPrims[i] = refs[i].id();
+        copyIds(0, n);
     alignas(16) float lo[4], hi[4];
     _mm_store_ps(lo, root.bounds.lo);
     _mm_store_ps(hi, root.bounds.hi);

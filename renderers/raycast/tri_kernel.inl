@@ -292,7 +292,6 @@ inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const
     // Opaque to the optimiser: otherwise it folds base + ref back into (nodes + ref) + offset,
     // which puts an add on the chain again.
     asm("" : "+r"(pnx), "+r"(pfx), "+r"(pny), "+r"(pfy), "+r"(pnz), "+r"(pfz));
-    const auto ld = loadPlane;
 
     StackEntry stack[512];
     int sp = 0;
@@ -300,9 +299,9 @@ inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const
     for (;;) {
         if (!(cur & Node8::kLeafBit)) {
             const Node8& n = *reinterpret_cast<const Node8*>(nodeBytes + cur);
-            const __m256 t0x = _mm256_fmsub_ps(ld(pnx, cur), rx, orx), t1x = _mm256_fmsub_ps(ld(pfx, cur), rx, orxf);
-            const __m256 t0y = _mm256_fmsub_ps(ld(pny, cur), ry, ory), t1y = _mm256_fmsub_ps(ld(pfy, cur), ry, oryf);
-            const __m256 t0z = _mm256_fmsub_ps(ld(pnz, cur), rz, orz), t1z = _mm256_fmsub_ps(ld(pfz, cur), rz, orzf);
+            const __m256 t0x = _mm256_fmsub_ps(loadPlane(pnx, cur), rx, orx), t1x = _mm256_fmsub_ps(loadPlane(pfx, cur), rx, orxf);
+            const __m256 t0y = _mm256_fmsub_ps(loadPlane(pny, cur), ry, ory), t1y = _mm256_fmsub_ps(loadPlane(pfy, cur), ry, oryf);
+            const __m256 t0z = _mm256_fmsub_ps(loadPlane(pnz, cur), rz, orz), t1z = _mm256_fmsub_ps(loadPlane(pfz, cur), rz, orzf);
             // Entry/exit distances combined as integers (1-cycle max/min/compare instead of
             // 4-cycle float ones on the node-to-node dependency chain, as Embree does on AVX2).
             // Exact here: tmin >= +0, and non-negative floats order like their bit patterns;
