@@ -179,6 +179,53 @@ TEST(ViewerStateTest, UnsavedChangesAreNeverLostWithoutAsking) {
     EXPECT_TRUE(st.requests.quit);
 }
 
+// Regression (first-hour issue, item 1): edit, Open a file that fails, answer Discard. The load
+// fails, so the document must stay exactly as it was: edits, dirty flag, and Quit still asks.
+TEST(ViewerStateTest, DiscardThenFailedOrCancelledLoadKeepsEditsAndDirtyFlag) {
+    ViewerState st = demoState();
+    sg::NodeId added = st.addShape(sg::ImplicitType::Sphere);
+    ASSERT_TRUE(st.dirty);
+    size_t nodes = st.scene.nodeCount();
+
+    EXPECT_FALSE(st.requestOpen("/nonexistent/dir/broken.gltf"));
+    st.confirm(ConfirmChoice::Discard);
+    EXPECT_TRUE(st.dirty) << "Discard alone must not clear the flag: nothing has replaced the scene yet";
+    ASSERT_TRUE(st.loadInProgress());
+    EXPECT_TRUE(st.pollLoad(/*wait=*/true));
+    EXPECT_FALSE(st.errorPopup.empty());
+    EXPECT_TRUE(st.dirty);
+    EXPECT_EQ(st.scene.nodeCount(), nodes);
+    EXPECT_TRUE(st.scene.valid(added));
+    st.errorPopup.clear();
+
+    // Quit still asks.
+    EXPECT_FALSE(st.requestQuit());
+    EXPECT_TRUE(st.confirmOpen);
+    st.confirm(ConfirmChoice::Cancel);
+    EXPECT_FALSE(st.requests.quit);
+
+    // Same after a cancelled load (cancel before the importer even starts reading).
+    fs::path good = testing_support::outputDir("ui") / "discard-cancel.obj";
+    {
+        std::ofstream out(good);
+        out << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    }
+    EXPECT_FALSE(st.requestOpen(good));
+    st.confirm(ConfirmChoice::Discard);
+    st.cancelLoad();
+    EXPECT_TRUE(st.pollLoad(/*wait=*/true));
+    EXPECT_TRUE(st.dirty);
+    EXPECT_EQ(st.scene.nodeCount(), nodes);
+
+    // A load that succeeds after Discard replaces the scene and starts clean.
+    EXPECT_FALSE(st.requestOpen(good));
+    st.confirm(ConfirmChoice::Discard);
+    EXPECT_TRUE(st.pollLoad(/*wait=*/true));
+    EXPECT_TRUE(st.errorPopup.empty()) << st.errorPopup;
+    EXPECT_FALSE(st.dirty);
+    EXPECT_EQ(st.scenePath, good);
+}
+
 TEST(ViewerStateTest, FailedLoadKeepsCurrentSceneAndShowsError) {
     ViewerState st = demoState();
     size_t nodes = st.scene.nodeCount();

@@ -332,10 +332,13 @@ bool ViewerState::requestNew() {
         confirmOpen = true;
         return false;
     }
-    sg::Scene s;
-    setScene(std::move(s), {});
-    status = "New scene";
+    newScene();
     return true;
+}
+
+void ViewerState::newScene() {
+    setScene(sg::Scene{}, {});
+    status = "New scene";
 }
 
 bool ViewerState::requestQuit() {
@@ -365,10 +368,12 @@ void ViewerState::confirm(ConfirmChoice choice) {
         }
         if (!save().empty()) return;   // failed: keep everything, the error is shown
     }
-    dirty = false;
+    // The dirty flag stays as it is: only a scene that actually replaces this one (setScene
+    // after a successful load, a new scene) clears it. A failed or cancelled load after
+    // "Discard" leaves the document exactly as it was, unsaved edits and '*' included.
     switch (action) {
     case PendingAction::Open: startLoad(pendingPath); break;
-    case PendingAction::New: requestNew(); break;
+    case PendingAction::New: newScene(); break;
     case PendingAction::Quit: requests.quit = true; break;
     case PendingAction::None: break;
     }

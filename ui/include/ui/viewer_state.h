@@ -174,7 +174,11 @@ struct ViewerState {
     bool requestOpen(const std::filesystem::path& path);
     bool requestNew();
     bool requestQuit();
+    // Answers the confirmation. Discard does not clear the dirty flag by itself: a pending
+    // Open keeps it until the loaded scene replaces this one, so a failed or cancelled load
+    // leaves the document (edits and dirty flag) exactly as it was.
     void confirm(ConfirmChoice choice);
+    void newScene();   // replaces the scene by an empty one without asking
     // std::async with a fresh LoadControl (progress + cancel).
     void startLoad(const std::filesystem::path& path);
     bool loadInProgress() const { return loading.valid(); }
