@@ -43,8 +43,14 @@ bool parseSize(const std::string& s, int& w, int& h, std::string& err) {
 }
 
 bool parseOnOff(const std::string& v, bool& out) {
-    if (v == "on" || v == "true" || v == "1") { out = true; return true; }
-    if (v == "off" || v == "false" || v == "0") { out = false; return true; }
+    if (v == "on" || v == "true" || v == "1") {
+        out = true;
+        return true;
+    }
+    if (v == "off" || v == "false" || v == "0") {
+        out = false;
+        return true;
+    }
     return false;
 }
 
@@ -87,8 +93,10 @@ std::string applyOverrides(const RenderArgs& a, sg::Scene& scene) {
     }
     if (a.projection || a.fovy || a.obliqueAngle || a.obliqueFactor) {
         if (!scene.valid(scene.activeCamera) || !std::holds_alternative<sg::Camera>(scene.node(scene.activeCamera).payload)) {
-            if (cams.empty()) scene.addDefaultCamera();
-            else scene.activeCamera = cams.front();
+            if (cams.empty())
+                scene.addDefaultCamera();
+            else
+                scene.activeCamera = cams.front();
         }
         auto& cam = std::get<sg::Camera>(scene.editPayload(scene.activeCamera));
         if (a.projection) {
@@ -137,7 +145,7 @@ Shot renderWith(const std::string& backend, const sg::FrameInput& frame, int w, 
     return shot;
 }
 
-}  // namespace
+}   // namespace
 
 void addRenderOptions(CLI::App& cmd, RenderArgs& a, bool compare) {
     cmd.add_option("scene", a.scene, "Scene file (.json .gltf .glb .obj .off .ply .stl) or 'demo'")->required();
@@ -176,8 +184,7 @@ int runRender(const RenderArgs& a) {
     if (!parseSize(a.size, w, h, err)) return fail(err);
     fs::path out = a.out;
     std::error_code ec;
-    if (!a.overwrite && fs::exists(fs::symlink_status(out, ec)))
-        return fail(out.string() + ": file exists (use --overwrite to replace it)");
+    if (!a.overwrite && fs::exists(fs::symlink_status(out, ec))) return fail(out.string() + ": file exists (use --overwrite to replace it)");
     auto scene = loadSceneArg(a.scene, err);
     if (!scene) return fail(err);
     err = applyOverrides(a, *scene);
@@ -236,11 +243,15 @@ int runCompare(const RenderArgs& a) {
             rnd::Framebuffer img = rnd::diffImage(shots[i].image, shots[j].image, 3);
             err = assets::writePng(dir / name, w, h, img.color.data(), a.overwrite);
             if (!err.empty()) return fail(err);
-            table["pairs"].push_back({{"a", shots[i].backend}, {"b", shots[j].backend}, {"meanAbs", d.meanAbs},
-                                      {"maxAbs", d.maxAbs}, {"within3", d.fractionWithin},
-                                      {"psnr", std::isinf(d.psnr) ? 999.0 : d.psnr}, {"image", name}});
-            md << "| " << shots[i].backend << " vs " << shots[j].backend << " | " << d.meanAbs << " | " << d.maxAbs << " | "
-               << d.fractionWithin * 100 << "% | " << d.psnr << " | " << name << " |\n";
+            table["pairs"].push_back({{"a", shots[i].backend},
+                                      {"b", shots[j].backend},
+                                      {"meanAbs", d.meanAbs},
+                                      {"maxAbs", d.maxAbs},
+                                      {"within3", d.fractionWithin},
+                                      {"psnr", std::isinf(d.psnr) ? 999.0 : d.psnr},
+                                      {"image", name}});
+            md << "| " << shots[i].backend << " vs " << shots[j].backend << " | " << d.meanAbs << " | " << d.maxAbs << " | " << d.fractionWithin * 100
+               << "% | " << d.psnr << " | " << name << " |\n";
             std::printf("%s\n", (dir / name).string().c_str());
         }
     err = assets::writeFileAtomic(dir / "compare.json", table.dump(2) + "\n", a.overwrite);
@@ -292,4 +303,4 @@ int runConvert(const std::string& sceneArg, const std::string& out, bool overwri
 
 int runWindow(const std::string& scene) { return ui::runViewer(scene); }
 
-}  // namespace cli
+}   // namespace cli

@@ -14,10 +14,9 @@ struct RenderArgs {
     std::string backend = "gl";
     std::string size = "1280x720";
     bool overwrite = false;
-    int camera = -1;                 // index into the scene's cameras, -1 = active
+    int camera = -1;   // index into the scene's cameras, -1 = active
     // Settings overrides (unset = the scene's own setting).
-    std::optional<std::string> shading, reflection, fog, aa, projection, shadows, reflections, culling,
-        wireframe, attenuation;
+    std::optional<std::string> shading, reflection, fog, aa, projection, shadows, reflections, culling, wireframe, attenuation;
     std::optional<float> fogStart, fogEnd, fogDensity, fovy, obliqueAngle, obliqueFactor;
     std::optional<int> tessellation, bounces;
 };
@@ -29,4 +28,4 @@ int runDemoShots(const std::string& outDir, const std::string& size);
 int runConvert(const std::string& scene, const std::string& out, bool overwrite);
 int runWindow(const std::string& scene);
 
-}  // namespace cli
+}   // namespace cli

@@ -13,8 +13,9 @@
 #include <cstdio>
 
 int main(int argc, char** argv) {
-    CLI::App app{"Scene-graph viewer: GL rasterization, CPU rasterizer and CPU ray caster side by side.\n"
-                 "Without a subcommand, opens the viewer window on SCENE (default: the bundled demo)."};
+    CLI::App app{
+        "Scene-graph viewer: GL rasterization, CPU rasterizer and CPU ray caster side by side.\n"
+        "Without a subcommand, opens the viewer window on SCENE (default: the bundled demo)."};
     app.set_help_all_flag("--help-all", "Print help for all subcommands");
     app.require_subcommand(0, 1);
 
@@ -57,9 +58,7 @@ int main(int argc, char** argv) {
 
     try {
         app.parse(argc, argv);
-    } catch (const CLI::ParseError& e) {
-        return app.exit(e);
-    }
+    } catch (const CLI::ParseError& e) { return app.exit(e); }
 
     if (*render) return cli::runRender(renderArgs);
     if (*compare) return cli::runCompare(compareArgs);

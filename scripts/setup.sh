@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Shared by ./run and ./test: install missing Debian packages, configure, build.
-# Usage: scripts/setup.sh [preset]   (default: release)
+# Usage: scripts/setup.sh [preset]   (default: release); scripts/setup.sh --packages-only installs and stops
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 preset="${1:-release}"
@@ -10,7 +10,7 @@ packages=(
   build-essential cmake pkg-config python3 python3-glad
   libglfw3-dev libimgui-dev libglm-dev libtinygltf-dev libopenmesh-dev libstb-dev
   libtbb-dev libcli11-dev nlohmann-json3-dev libgtest-dev libgmock-dev libbenchmark-dev libembree-dev
-  libgl1-mesa-dri libegl-mesa0 libegl-dev libgl-dev libosmesa6-dev xvfb xauth fonts-dejavu-core
+  libgl1-mesa-dri libegl-mesa0 libegl-dev libgl-dev libosmesa6-dev xvfb xauth fonts-dejavu-core clang-format
 )
 
 # The fuzz preset also needs clang and its libFuzzer runtime.
@@ -36,6 +36,8 @@ if [ ${#missing[@]} -gt 0 ]; then
   "${SUDO[@]}" apt-get update -qq
   "${SUDO[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
+
+[ "$preset" = "--packages-only" ] && exit 0
 
 cd "$root"
 builddir="build/$preset"

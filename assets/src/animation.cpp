@@ -12,7 +12,7 @@ sg::vec4 normalizeRot(const sg::vec4& v) {
     float l = glm::length(v);
     return l > 1e-20f ? v / l : sg::vec4(0, 0, 0, 1);
 }
-}  // namespace
+}   // namespace
 
 sg::vec4 sampleChannel(const AnimationChannel& ch, float t) {
     const size_t n = ch.times.size();
@@ -28,8 +28,7 @@ sg::vec4 sampleChannel(const AnimationChannel& ch, float t) {
     float dt = t1 - t0;
     float u = dt > 0.0f ? (t - t0) / dt : 0.0f;
     switch (ch.interpolation) {
-    case AnimationInterpolation::Step:
-        return rot ? normalizeRot(value(k)) : value(k);
+    case AnimationInterpolation::Step: return rot ? normalizeRot(value(k)) : value(k);
     case AnimationInterpolation::Linear:
         if (rot) return fromQuat(glm::normalize(glm::slerp(toQuat(normalizeRot(value(k))), toQuat(normalizeRot(value(k + 1))), u)));
         return glm::mix(value(k), value(k + 1), u);
@@ -59,4 +58,4 @@ void applyAnimation(sg::Scene& scene, const AnimationClip& clip, float t) {
     }
 }
 
-}  // namespace assets
+}   // namespace assets

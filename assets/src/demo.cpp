@@ -42,7 +42,7 @@ int addMesh(Scene& s, Mesh m) {
     s.meshes.push_back(std::make_shared<Mesh>(std::move(m)));
     return int(s.meshes.size() - 1);
 }
-}  // namespace
+}   // namespace
 
 Scene makeDemoScene() {
     Scene s;
@@ -195,4 +195,4 @@ Scene makeDemoScene() {
     return s;
 }
 
-}  // namespace assets
+}   // namespace assets

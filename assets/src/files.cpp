@@ -1,21 +1,19 @@
 #include "assets/files.h"
 
-#include <cerrno>
-#include <cstring>
 #include <fcntl.h>
-#include <random>
 #include <sys/stat.h>
 #include <unistd.h>
+#include <cerrno>
+#include <cstring>
+#include <random>
 
 namespace fs = std::filesystem;
 
 namespace assets {
 
 namespace {
-std::string sysError(const fs::path& p, const std::string& what) {
-    return p.string() + ": " + what + ": " + std::strerror(errno);
-}
-}  // namespace
+std::string sysError(const fs::path& p, const std::string& what) { return p.string() + ": " + what + ": " + std::strerror(errno); }
+}   // namespace
 
 std::string writeFileAtomic(const fs::path& path, std::string_view bytes, bool overwrite) {
     if (path.empty()) return "(empty path): no file name given";
@@ -54,8 +52,7 @@ std::string writeFileAtomic(const fs::path& path, std::string_view bytes, bool o
     if (!overwrite) {
         // link() fails if the target appeared meanwhile: never replace a file we were not allowed to.
         if (::link(tmp.c_str(), path.c_str()) != 0) {
-            std::string err = errno == EEXIST ? path.string() + ": file exists (use overwrite to replace it)"
-                                              : sysError(path, "cannot create file");
+            std::string err = errno == EEXIST ? path.string() + ": file exists (use overwrite to replace it)" : sysError(path, "cannot create file");
             ::unlink(tmp.c_str());
             return err;
         }
@@ -120,4 +117,4 @@ fs::path uniquePath(const fs::path& path) {
     return path;
 }
 
-}  // namespace assets
+}   // namespace assets

@@ -72,8 +72,8 @@
 // texture byte budget. After parsing, validate() checks every index, every byte range
 // (overflow-checked), counts, finiteness, the node graph (cycles, double parents) and budgets
 // before anything is allocated from the file's numbers.
-#include "importers.h"
 #include "import_common.h"
+#include "importers.h"
 
 #include "assets/files.h"
 #include "assets/image_io.h"
@@ -93,14 +93,14 @@ namespace assets::detail {
 namespace {
 
 // ---- 2. Limits ---------------------------------------------------------------------------
-constexpr uint64_t kMaxFileBytes = 2ull << 30;        // .gltf/.glb itself
-constexpr uint64_t kMaxJsonBytes = 256ull << 20;      // JSON text
-constexpr size_t kMaxJsonDepth = 128;                 // real files stay below 20
-constexpr uint64_t kMaxResourceBytes = 2ull << 30;    // one external buffer or image file
+constexpr uint64_t kMaxFileBytes = 2ull << 30;       // .gltf/.glb itself
+constexpr uint64_t kMaxJsonBytes = 256ull << 20;     // JSON text
+constexpr size_t kMaxJsonDepth = 128;                // real files stay below 20
+constexpr uint64_t kMaxResourceBytes = 2ull << 30;   // one external buffer or image file
 constexpr uint64_t kMaxTriangles = 50'000'000;
-constexpr uint64_t kMaxVertices = 100'000'000;        // sum over primitives (incl. lines/points)
+constexpr uint64_t kMaxVertices = 100'000'000;   // sum over primitives (incl. lines/points)
 constexpr uint64_t kMaxNodes = 10'000'000;
-constexpr uint64_t kMaxTextureBytes = 2ull << 30;     // decoded RGBA8
+constexpr uint64_t kMaxTextureBytes = 2ull << 30;   // decoded RGBA8
 constexpr size_t kPollEvery = 1u << 16;
 
 // ---- 3. File access and image callbacks --------------------------------------------------
@@ -144,8 +144,7 @@ bool fsWrite(std::string* err, const std::string&, const std::vector<unsigned ch
 }
 
 // Keeps the encoded bytes; decoding happens after validation, for used images only.
-bool storeImage(tinygltf::Image* image, const int idx, std::string*, std::string*, int, int,
-                const unsigned char* bytes, int size, void* ud) {
+bool storeImage(tinygltf::Image* image, const int idx, std::string*, std::string*, int, int, const unsigned char* bytes, int size, void* ud) {
     Ctx& c = *static_cast<Ctx*>(ud);
     size_t n = size > 0 ? size_t(size) : 0;
     if (image->bufferView >= 0) {
@@ -176,8 +175,10 @@ size_t jsonDepth(const char* s, size_t n, size_t limit) {
     for (size_t i = 0; i < n; ++i) {
         char ch = s[i];
         if (inString) {
-            if (ch == '\\') ++i;
-            else if (ch == '"') inString = false;
+            if (ch == '\\')
+                ++i;
+            else if (ch == '"')
+                inString = false;
         } else if (ch == '"') {
             inString = true;
         } else if (ch == '{' || ch == '[') {
@@ -310,9 +311,9 @@ std::string checkAccessor(const tinygltf::Model& m, size_t i) {
             uint64_t end = 0;
             if (mulOv(stride, uint64_t(a.count - 1), end) || addOv(end, a.byteOffset, end) || addOv(end, elementExtent(a), end) ||
                 end > bv.byteLength)
-                return id + "byteOffset+count*stride exceeds bufferView " + std::to_string(a.bufferView) + " (count " +
-                       std::to_string(a.count) + ", stride " + std::to_string(stride) + ", byteOffset " +
-                       std::to_string(a.byteOffset) + ", length " + std::to_string(bv.byteLength) + ")";
+                return id + "byteOffset+count*stride exceeds bufferView " + std::to_string(a.bufferView) + " (count " + std::to_string(a.count) +
+                       ", stride " + std::to_string(stride) + ", byteOffset " + std::to_string(a.byteOffset) + ", length " +
+                       std::to_string(bv.byteLength) + ")";
         }
     }
     if (a.sparse.isSparse) {
@@ -320,11 +321,15 @@ std::string checkAccessor(const tinygltf::Model& m, size_t i) {
         if (s.count < 1 || uint64_t(s.count) > a.count)
             return id + "sparse count " + std::to_string(s.count) + " outside 1.." + std::to_string(a.count);
         int ics = componentSize(s.indices.componentType);
-        if (s.indices.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
-            s.indices.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+        if (s.indices.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && s.indices.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
             s.indices.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
             return id + "sparse indices have an invalid componentType";
-        struct Part { int view; int offset; uint64_t bytes; const char* what; };
+        struct Part {
+            int view;
+            int offset;
+            uint64_t bytes;
+            const char* what;
+        };
         Part parts[2] = {{s.indices.bufferView, s.indices.byteOffset, uint64_t(s.count) * uint64_t(ics), "sparse indices"},
                          {s.values.bufferView, s.values.byteOffset, uint64_t(s.count) * es, "sparse values"}};
         for (const Part& p : parts) {
@@ -350,12 +355,12 @@ std::string checkTextureInfo(const tinygltf::Model& m, int index, const std::str
 // Everything the conversion relies on. Returns "" or the first problem.
 std::string validate(const tinygltf::Model& m, std::vector<std::string>& warnings) {
     auto idx = [](const char* what, size_t i) { return std::string(what) + " " + std::to_string(i) + ": "; };
-    if (m.nodes.size() > kMaxNodes)
-        return std::to_string(m.nodes.size()) + " nodes exceed the budget of " + std::to_string(kMaxNodes);
+    if (m.nodes.size() > kMaxNodes) return std::to_string(m.nodes.size()) + " nodes exceed the budget of " + std::to_string(kMaxNodes);
     for (size_t i = 0; i < m.bufferViews.size(); ++i) {
         const auto& bv = m.bufferViews[i];
         if (bv.buffer < 0 || size_t(bv.buffer) >= m.buffers.size())
-            return idx("bufferView", i) + "buffer " + std::to_string(bv.buffer) + " does not exist (" + std::to_string(m.buffers.size()) + " buffers)";
+            return idx("bufferView", i) + "buffer " + std::to_string(bv.buffer) + " does not exist (" + std::to_string(m.buffers.size()) +
+                   " buffers)";
         uint64_t end;
         size_t have = m.buffers[size_t(bv.buffer)].data.size();
         if (addOv(bv.byteOffset, bv.byteLength, end) || end > have)
@@ -379,7 +384,8 @@ std::string validate(const tinygltf::Model& m, std::vector<std::string>& warning
         if (t.source >= 0 && size_t(t.source) >= m.images.size())
             return idx("texture", i) + "image " + std::to_string(t.source) + " does not exist (" + std::to_string(m.images.size()) + " images)";
         if (t.sampler >= 0 && size_t(t.sampler) >= m.samplers.size())
-            return idx("texture", i) + "sampler " + std::to_string(t.sampler) + " does not exist (" + std::to_string(m.samplers.size()) + " samplers)";
+            return idx("texture", i) + "sampler " + std::to_string(t.sampler) + " does not exist (" + std::to_string(m.samplers.size()) +
+                   " samplers)";
     }
     for (size_t i = 0; i < m.materials.size(); ++i) {
         const auto& mat = m.materials[i];
@@ -421,8 +427,8 @@ std::string validate(const tinygltf::Model& m, std::vector<std::string>& warning
         if (l.type != "point" && l.type != "spot" && l.type != "directional") return idx("light", i) + "unknown type '" + l.type + "'";
         if (!l.color.empty() && (l.color.size() != 3 || !finiteAll(l.color))) return idx("light", i) + "color must be 3 finite numbers";
         if (!std::isfinite(l.intensity) || l.intensity < 0) return idx("light", i) + "intensity must be finite and >= 0";
-        if (l.type == "spot" && !(std::isfinite(l.spot.innerConeAngle) && std::isfinite(l.spot.outerConeAngle) &&
-                                  l.spot.innerConeAngle >= 0 && l.spot.outerConeAngle <= sg::kPi / 2 + 1e-6))
+        if (l.type == "spot" && !(std::isfinite(l.spot.innerConeAngle) && std::isfinite(l.spot.outerConeAngle) && l.spot.innerConeAngle >= 0 &&
+                                  l.spot.outerConeAngle <= sg::kPi / 2 + 1e-6))
             return idx("light", i) + "invalid spot cone angles";
     }
     // Meshes and primitives.
@@ -437,7 +443,8 @@ std::string validate(const tinygltf::Model& m, std::vector<std::string>& warning
             if (prim.material < -1) return id + "invalid material index";
             if (prim.indices >= 0) {
                 if (size_t(prim.indices) >= m.accessors.size())
-                    return id + "indices accessor " + std::to_string(prim.indices) + " does not exist (" + std::to_string(m.accessors.size()) + " accessors)";
+                    return id + "indices accessor " + std::to_string(prim.indices) + " does not exist (" + std::to_string(m.accessors.size()) +
+                           " accessors)";
                 const auto& a = m.accessors[size_t(prim.indices)];
                 if (a.type != TINYGLTF_TYPE_SCALAR ||
                     (a.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && a.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
@@ -450,16 +457,19 @@ std::string validate(const tinygltf::Model& m, std::vector<std::string>& warning
             std::string countFrom;
             for (const auto& [name, ai] : prim.attributes) {
                 if (ai < 0 || size_t(ai) >= m.accessors.size())
-                    return id + "attribute " + name + ": accessor " + std::to_string(ai) + " does not exist (" + std::to_string(m.accessors.size()) + " accessors)";
+                    return id + "attribute " + name + ": accessor " + std::to_string(ai) + " does not exist (" + std::to_string(m.accessors.size()) +
+                           " accessors)";
                 const auto& a = m.accessors[size_t(ai)];
                 if (count < 0) {
                     count = int64_t(a.count);
                     countFrom = name;
                 } else if (int64_t(a.count) != count) {
-                    return id + "attribute " + name + " has " + std::to_string(a.count) + " elements but " + countFrom + " has " + std::to_string(count);
+                    return id + "attribute " + name + " has " + std::to_string(a.count) + " elements but " + countFrom + " has " +
+                           std::to_string(count);
                 }
                 bool isFloat = a.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT;
-                bool normInt = a.normalized && (a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE || a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT);
+                bool normInt = a.normalized && (a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ||
+                                                a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT);
                 if (name == "POSITION" || name == "NORMAL") {
                     if (a.type != TINYGLTF_TYPE_VEC3) return id + name + " must be VEC3";
                 } else if (name == "TEXCOORD_0" || name == "TEXCOORD_1") {
@@ -481,8 +491,7 @@ std::string validate(const tinygltf::Model& m, std::vector<std::string>& warning
             return id + "mesh " + std::to_string(n.mesh) + " does not exist (" + std::to_string(m.meshes.size()) + " meshes)";
         if (n.camera >= 0 && size_t(n.camera) >= m.cameras.size())
             return id + "camera " + std::to_string(n.camera) + " does not exist (" + std::to_string(m.cameras.size()) + " cameras)";
-        if (n.skin >= 0 && size_t(n.skin) >= m.skins.size())
-            return id + "skin " + std::to_string(n.skin) + " does not exist";
+        if (n.skin >= 0 && size_t(n.skin) >= m.skins.size()) return id + "skin " + std::to_string(n.skin) + " does not exist";
         int li = nodeLight(n);
         if (li == -2 || (li >= 0 && size_t(li) >= m.lights.size()))
             return id + "light " + std::to_string(li) + " does not exist (" + std::to_string(m.lights.size()) + " lights)";
@@ -527,7 +536,9 @@ std::string validate(const tinygltf::Model& m, std::vector<std::string>& warning
         for (int r : m.scenes[i].nodes) {
             if (r < 0 || size_t(r) >= m.nodes.size())
                 return idx("scene", i) + "node " + std::to_string(r) + " does not exist (" + std::to_string(m.nodes.size()) + " nodes)";
-            if (parent[size_t(r)] >= 0) return idx("scene", i) + "node " + std::to_string(r) + " is not a root node (its parent is " + std::to_string(parent[size_t(r)]) + ")";
+            if (parent[size_t(r)] >= 0)
+                return idx("scene", i) + "node " + std::to_string(r) + " is not a root node (its parent is " + std::to_string(parent[size_t(r)]) +
+                       ")";
         }
         seen = m.scenes[i].nodes;
         std::sort(seen.begin(), seen.end());
@@ -544,21 +555,52 @@ std::string validate(const tinygltf::Model& m, std::vector<std::string>& warning
 // ---- 5. Accessor reading -----------------------------------------------------------------
 float readComponent(const unsigned char* p, int ct, bool normalized) {
     switch (ct) {
-    case TINYGLTF_COMPONENT_TYPE_FLOAT: { float f; std::memcpy(&f, p, 4); return f; }
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: {
+        float f;
+        std::memcpy(&f, p, 4);
+        return f;
+    }
     case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return normalized ? float(p[0]) / 255.0f : float(p[0]);
-    case TINYGLTF_COMPONENT_TYPE_BYTE: { float v = float(int8_t(p[0])); return normalized ? std::max(v / 127.0f, -1.0f) : v; }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: { uint16_t v; std::memcpy(&v, p, 2); return normalized ? float(v) / 65535.0f : float(v); }
-    case TINYGLTF_COMPONENT_TYPE_SHORT: { int16_t v; std::memcpy(&v, p, 2); return normalized ? std::max(float(v) / 32767.0f, -1.0f) : float(v); }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: { uint32_t v; std::memcpy(&v, p, 4); return normalized ? float(double(v) / 4294967295.0) : float(v); }
-    case TINYGLTF_COMPONENT_TYPE_INT: { int32_t v; std::memcpy(&v, p, 4); return normalized ? std::max(float(double(v) / 2147483647.0), -1.0f) : float(v); }
+    case TINYGLTF_COMPONENT_TYPE_BYTE: {
+        float v = float(int8_t(p[0]));
+        return normalized ? std::max(v / 127.0f, -1.0f) : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+        uint16_t v;
+        std::memcpy(&v, p, 2);
+        return normalized ? float(v) / 65535.0f : float(v);
+    }
+    case TINYGLTF_COMPONENT_TYPE_SHORT: {
+        int16_t v;
+        std::memcpy(&v, p, 2);
+        return normalized ? std::max(float(v) / 32767.0f, -1.0f) : float(v);
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
+        uint32_t v;
+        std::memcpy(&v, p, 4);
+        return normalized ? float(double(v) / 4294967295.0) : float(v);
+    }
+    case TINYGLTF_COMPONENT_TYPE_INT: {
+        int32_t v;
+        std::memcpy(&v, p, 4);
+        return normalized ? std::max(float(double(v) / 2147483647.0), -1.0f) : float(v);
+    }
     default: return 0.0f;
     }
 }
 uint32_t readIndex(const unsigned char* p, int ct) {
     switch (ct) {
     case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return p[0];
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: { uint16_t v; std::memcpy(&v, p, 2); return v; }
-    default: { uint32_t v; std::memcpy(&v, p, 4); return v; }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+        uint16_t v;
+        std::memcpy(&v, p, 2);
+        return v;
+    }
+    default: {
+        uint32_t v;
+        std::memcpy(&v, p, 4);
+        return v;
+    }
     }
 }
 
@@ -626,7 +668,7 @@ std::string readIndices(const tinygltf::Model& m, size_t ai, const Progress& pro
 // ---- 6. Textures and materials -----------------------------------------------------------
 struct MaterialInfo {
     int sgIndex = -1;
-    int texCoord = 0;             // which TEXCOORD set the diffuse texture samples
+    int texCoord = 0;   // which TEXCOORD set the diffuse texture samples
     bool hasUvTransform = false;
     sg::mat3 uvTransform{1.0f};
 };
@@ -639,15 +681,15 @@ struct Converter {
     std::string file;
     sg::Scene scene;
     std::vector<std::string> warnings;
-    std::vector<int> textureOf;                  // glTF texture -> scene texture (-2 = not yet)
-    std::vector<sg::TexturePtr> decodedImage;    // glTF image -> decoded (null: failed/unused)
+    std::vector<int> textureOf;                 // glTF texture -> scene texture (-2 = not yet)
+    std::vector<sg::TexturePtr> decodedImage;   // glTF image -> decoded (null: failed/unused)
     std::vector<int8_t> imageTried;
     uint64_t textureBytes = 0;
-    std::vector<MaterialInfo> materials;         // glTF material -> ours
+    std::vector<MaterialInfo> materials;                       // glTF material -> ours
     std::vector<std::vector<std::pair<int, int>>> meshPrims;   // glTF mesh -> (sg mesh, material) per primitive
     std::vector<int8_t> meshDone;
     uint64_t triangles = 0, vertices = 0;
-    std::vector<sg::NodeId> sgOf;                // glTF node -> sg node
+    std::vector<sg::NodeId> sgOf;   // glTF node -> sg node
 
     std::string warnOnce(const std::string& w) {
         if (std::find(warnings.begin(), warnings.end(), w) == warnings.end()) warnings.push_back(w);
@@ -701,13 +743,15 @@ struct Converter {
         if (t.sampler >= 0) {
             const tinygltf::Sampler& s = m.samplers[size_t(t.sampler)];
             auto wrap = [](int w) {
-                return w == TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE ? sg::WrapMode::ClampToEdge
-                       : w == TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT ? sg::WrapMode::MirroredRepeat : sg::WrapMode::Repeat;
+                return w == TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE     ? sg::WrapMode::ClampToEdge
+                       : w == TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT ? sg::WrapMode::MirroredRepeat
+                                                                    : sg::WrapMode::Repeat;
             };
             tex->wrapS = wrap(s.wrapS);
             tex->wrapT = wrap(s.wrapT);
             int mn = s.minFilter, mg = s.magFilter;
-            if (mn == TINYGLTF_TEXTURE_FILTER_NEAREST || (mn == TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_NEAREST && mg == TINYGLTF_TEXTURE_FILTER_NEAREST) ||
+            if (mn == TINYGLTF_TEXTURE_FILTER_NEAREST ||
+                (mn == TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_NEAREST && mg == TINYGLTF_TEXTURE_FILTER_NEAREST) ||
                 (mn == -1 && mg == TINYGLTF_TEXTURE_FILTER_NEAREST))
                 tex->filter = sg::FilterMode::Nearest;
             else if (mn == TINYGLTF_TEXTURE_FILTER_LINEAR)
@@ -782,7 +826,8 @@ struct Converter {
             mat.unlit = extensionObject(gm.extensions, "KHR_materials_unlit") != nullptr || gm.extensions.count("KHR_materials_unlit");
             MaterialInfo info;
             info.texCoord = texCoord == 1 ? 1 : 0;
-            if (texCoord > 1) warnOnce("material " + std::to_string(i) + ": texCoord " + std::to_string(texCoord) + " is not supported (using TEXCOORD_0)");
+            if (texCoord > 1)
+                warnOnce("material " + std::to_string(i) + ": texCoord " + std::to_string(texCoord) + " is not supported (using TEXCOORD_0)");
             if (texIndex >= 0 && size_t(texIndex) < m.textures.size()) mat.diffuseTexture = texture(texIndex);
             if (texExt) {
                 if (const tinygltf::Value* tt = extensionObject(*texExt, "KHR_texture_transform")) {
@@ -824,7 +869,10 @@ struct Converter {
             return it == prim.attributes.end() ? -1 : it->second;
         };
         int pos = attr("POSITION");
-        if (pos < 0) { skipped = true; return {}; }
+        if (pos < 0) {
+            skipped = true;
+            return {};
+        }
         const size_t nv = m.accessors[size_t(pos)].count;
         if (vertices + nv > kMaxVertices)
             return id + "vertex budget exceeded (" + std::to_string(vertices + nv) + " > " + std::to_string(kMaxVertices) + ")";
@@ -832,8 +880,10 @@ struct Converter {
         // Output primitive count before reading anything large.
         size_t nIdx = prim.indices >= 0 ? m.accessors[size_t(prim.indices)].count : nv;
         uint64_t tris = 0;
-        if (mode == TINYGLTF_MODE_TRIANGLES) tris = nIdx / 3;
-        else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP || mode == TINYGLTF_MODE_TRIANGLE_FAN) tris = nIdx >= 3 ? nIdx - 2 : 0;
+        if (mode == TINYGLTF_MODE_TRIANGLES)
+            tris = nIdx / 3;
+        else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP || mode == TINYGLTF_MODE_TRIANGLE_FAN)
+            tris = nIdx >= 3 ? nIdx - 2 : 0;
         if (triangles + tris > kMaxTriangles)
             return id + "triangle budget exceeded (" + std::to_string(triangles + tris) + " > " + std::to_string(kMaxTriangles) + ")";
         if (nIdx > 3 * kMaxTriangles) return id + "index count " + std::to_string(nIdx) + " exceeds the budget";
@@ -876,7 +926,8 @@ struct Converter {
             if (!e.empty()) return e == "cancelled" ? e : id + e;
             for (size_t i = 0; i < src.size(); ++i)
                 if (src[i] >= nv)
-                    return id + "index " + std::to_string(i) + " is " + std::to_string(src[i]) + ", but there are only " + std::to_string(nv) + " vertices";
+                    return id + "index " + std::to_string(i) + " is " + std::to_string(src[i]) + ", but there are only " + std::to_string(nv) +
+                           " vertices";
         }
         auto at = [&](size_t i) -> uint32_t { return indexed ? src[i] : uint32_t(i); };
         auto& out = mesh.indices;
@@ -896,15 +947,23 @@ struct Converter {
                 for (size_t i = 0; i < out.size(); ++i) out[i] = at(i);
             } else if (nIdx >= 2) {
                 out.reserve(2 * nIdx);
-                for (size_t i = 0; i + 1 < nIdx; ++i) { out.push_back(at(i)); out.push_back(at(i + 1)); }
-                if (mode == TINYGLTF_MODE_LINE_LOOP) { out.push_back(at(nIdx - 1)); out.push_back(at(0)); }
+                for (size_t i = 0; i + 1 < nIdx; ++i) {
+                    out.push_back(at(i));
+                    out.push_back(at(i + 1));
+                }
+                if (mode == TINYGLTF_MODE_LINE_LOOP) {
+                    out.push_back(at(nIdx - 1));
+                    out.push_back(at(0));
+                }
             }
             break;
         case TINYGLTF_MODE_TRIANGLES:
             if (nIdx % 3) warnOnce(id + "index count is not a multiple of 3; last " + std::to_string(nIdx % 3) + " ignored");
             out.resize(nIdx / 3 * 3);
-            if (indexed) std::copy(src.begin(), src.begin() + std::ptrdiff_t(out.size()), out.begin());
-            else for (size_t i = 0; i < out.size(); ++i) out[i] = uint32_t(i);
+            if (indexed)
+                std::copy(src.begin(), src.begin() + std::ptrdiff_t(out.size()), out.begin());
+            else
+                for (size_t i = 0; i < out.size(); ++i) out[i] = uint32_t(i);
             break;
         case TINYGLTF_MODE_TRIANGLE_STRIP:
         case TINYGLTF_MODE_TRIANGLE_FAN:
@@ -921,7 +980,9 @@ struct Converter {
                     c = at(0);
                 }
                 if (a == b || b == c || a == c) continue;
-                out.push_back(a); out.push_back(b); out.push_back(c);
+                out.push_back(a);
+                out.push_back(b);
+                out.push_back(c);
             }
             break;
         }
@@ -1060,8 +1121,10 @@ struct Converter {
             if (prims) {
                 for (size_t k = 0; k < prims->size(); ++k) {
                     sg::MeshInstance inst{(*prims)[k].first, (*prims)[k].second};
-                    if (onNode) scene.setPayload(id, inst);
-                    else scene.addNode(name + "#" + std::to_string(k), id, inst), ++created;
+                    if (onNode)
+                        scene.setPayload(id, inst);
+                    else
+                        scene.addNode(name + "#" + std::to_string(k), id, inst), ++created;
                 }
             }
             if (n.camera >= 0) {
@@ -1090,19 +1153,37 @@ struct Converter {
                 const auto& ch = ga.channels[ci];
                 std::string id = "animation " + std::to_string(ai) + " channel " + std::to_string(ci) + ": ";
                 AnimationChannel out;
-                if (ch.target_path == "translation") out.path = AnimationPath::Translation;
-                else if (ch.target_path == "rotation") out.path = AnimationPath::Rotation;
-                else if (ch.target_path == "scale") out.path = AnimationPath::Scale;
-                else { warnOnce(id + "'" + ch.target_path + "' animation is not supported; channel skipped"); continue; }
-                if (ch.sampler < 0 || size_t(ch.sampler) >= ga.samplers.size()) { warnOnce(id + "sampler does not exist; channel skipped"); continue; }
-                if (ch.target_node < 0 || size_t(ch.target_node) >= m.nodes.size()) { warnOnce(id + "target node does not exist; channel skipped"); continue; }
+                if (ch.target_path == "translation")
+                    out.path = AnimationPath::Translation;
+                else if (ch.target_path == "rotation")
+                    out.path = AnimationPath::Rotation;
+                else if (ch.target_path == "scale")
+                    out.path = AnimationPath::Scale;
+                else {
+                    warnOnce(id + "'" + ch.target_path + "' animation is not supported; channel skipped");
+                    continue;
+                }
+                if (ch.sampler < 0 || size_t(ch.sampler) >= ga.samplers.size()) {
+                    warnOnce(id + "sampler does not exist; channel skipped");
+                    continue;
+                }
+                if (ch.target_node < 0 || size_t(ch.target_node) >= m.nodes.size()) {
+                    warnOnce(id + "target node does not exist; channel skipped");
+                    continue;
+                }
                 out.node = sgOf[size_t(ch.target_node)];
                 if (out.node == sg::kNoNode) continue;   // node not in the loaded scene
                 const auto& s = ga.samplers[size_t(ch.sampler)];
-                if (s.interpolation == "STEP") out.interpolation = AnimationInterpolation::Step;
-                else if (s.interpolation == "CUBICSPLINE") out.interpolation = AnimationInterpolation::CubicSpline;
-                else if (s.interpolation == "LINEAR" || s.interpolation.empty()) out.interpolation = AnimationInterpolation::Linear;
-                else { warnOnce(id + "unknown interpolation '" + s.interpolation + "'; channel skipped"); continue; }
+                if (s.interpolation == "STEP")
+                    out.interpolation = AnimationInterpolation::Step;
+                else if (s.interpolation == "CUBICSPLINE")
+                    out.interpolation = AnimationInterpolation::CubicSpline;
+                else if (s.interpolation == "LINEAR" || s.interpolation.empty())
+                    out.interpolation = AnimationInterpolation::Linear;
+                else {
+                    warnOnce(id + "unknown interpolation '" + s.interpolation + "'; channel skipped");
+                    continue;
+                }
                 if (s.input < 0 || size_t(s.input) >= m.accessors.size() || s.output < 0 || size_t(s.output) >= m.accessors.size()) {
                     warnOnce(id + "sampler accessors do not exist; channel skipped");
                     continue;
@@ -1111,8 +1192,8 @@ struct Converter {
                 const auto& op = m.accessors[size_t(s.output)];
                 int want = out.path == AnimationPath::Rotation ? TINYGLTF_TYPE_VEC4 : TINYGLTF_TYPE_VEC3;
                 size_t perKey = out.interpolation == AnimationInterpolation::CubicSpline ? 3 : 1;
-                if (in.type != TINYGLTF_TYPE_SCALAR || in.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT || op.type != want ||
-                    in.count == 0 || op.count != in.count * perKey) {
+                if (in.type != TINYGLTF_TYPE_SCALAR || in.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT || op.type != want || in.count == 0 ||
+                    op.count != in.count * perKey) {
                     warnOnce(id + "sampler input/output accessors have the wrong type or count; channel skipped");
                     continue;
                 }
@@ -1129,7 +1210,10 @@ struct Converter {
                 }
                 for (const auto& v : out.values)
                     if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z) || !std::isfinite(v.w)) ok = false;
-                if (!ok) { warnOnce(id + "key times must be finite and increasing, values finite; channel skipped"); continue; }
+                if (!ok) {
+                    warnOnce(id + "key times must be finite and increasing, values finite; channel skipped");
+                    continue;
+                }
                 tmin = std::min(tmin, out.times.front());
                 tmax = std::max(tmax, out.times.back());
                 clip.channels.push_back(std::move(out));
@@ -1143,7 +1227,7 @@ struct Converter {
     }
 };
 
-}  // namespace
+}   // namespace
 
 // ---- 10. loadGltf ----------------------------------------------------------------------------
 LoadResult loadGltf(const fs::path& path, const LoadOptions& options) {
@@ -1174,8 +1258,11 @@ LoadResult loadGltf(const fs::path& path, const LoadOptions& options) {
         std::memcpy(&chunkLen, bytes.data() + 12, 4);
         std::memcpy(&chunkType, bytes.data() + 16, 4);
         if (chunkType != 0x4E4F534Au) return fail("GLB: first chunk is not JSON");
-        if (uint64_t(chunkLen) + 20 > bytes.size()) return fail("GLB: JSON chunk length " + std::to_string(chunkLen) + " exceeds the file size " + std::to_string(bytes.size()));
-        if (total > bytes.size()) return fail("GLB: header length " + std::to_string(total) + " exceeds the file size " + std::to_string(bytes.size()) + " (truncated file?)");
+        if (uint64_t(chunkLen) + 20 > bytes.size())
+            return fail("GLB: JSON chunk length " + std::to_string(chunkLen) + " exceeds the file size " + std::to_string(bytes.size()));
+        if (total > bytes.size())
+            return fail("GLB: header length " + std::to_string(total) + " exceeds the file size " + std::to_string(bytes.size()) +
+                        " (truncated file?)");
         json = bytes.data() + 20;
         jsonSize = chunkLen;
     } else if (path.extension() == ".glb" || path.extension() == ".GLB") {
@@ -1204,19 +1291,20 @@ LoadResult loadGltf(const fs::path& path, const LoadOptions& options) {
     const std::string base = ctx.dir.root().string();
     try {
         if (binary)
-            ok = loader.LoadBinaryFromMemory(&model, &terr, &twarn, reinterpret_cast<const unsigned char*>(bytes.data()), unsigned(bytes.size()), base, 0);
+            ok = loader.LoadBinaryFromMemory(&model, &terr, &twarn, reinterpret_cast<const unsigned char*>(bytes.data()), unsigned(bytes.size()),
+                                             base, 0);
         else
             ok = loader.LoadASCIIFromString(&model, &terr, &twarn, bytes.data(), unsigned(bytes.size()), base, 0);
-    } catch (const std::bad_alloc&) {
-        return fail("out of memory while parsing");
-    } catch (const std::exception& e) {
+    } catch (const std::bad_alloc&) { return fail("out of memory while parsing"); } catch (const std::exception& e) {
         return fail(std::string("parse error: ") + e.what());
     }
     std::string().swap(bytes);
     if (!ok) {
         std::string why = oneLine(terr.empty() ? "tinygltf could not parse the file" : terr);
-        if (!ctx.refused.empty() && why.find("File not found") != std::string::npos) why = ctx.refused.front() + " (" + why + ")";
-        else if (!ctx.refused.empty() && why.find("read error") != std::string::npos) why = ctx.refused.front();
+        if (!ctx.refused.empty() && why.find("File not found") != std::string::npos)
+            why = ctx.refused.front() + " (" + why + ")";
+        else if (!ctx.refused.empty() && why.find("read error") != std::string::npos)
+            why = ctx.refused.front();
         return fail(why);
     }
     progress.set(0.3f);
@@ -1226,8 +1314,11 @@ LoadResult loadGltf(const fs::path& path, const LoadOptions& options) {
     for (const auto& w : ctx.imageWarnings) result.warnings.push_back(file + ": " + w);
 
     // Required extensions we cannot honour make the file unloadable (the spec says so).
-    static const char* kSupported[] = {"KHR_materials_unlit", "KHR_texture_transform", "KHR_lights_punctual",
-                                       "KHR_materials_pbrSpecularGlossiness", "KHR_materials_emissive_strength",
+    static const char* kSupported[] = {"KHR_materials_unlit",
+                                       "KHR_texture_transform",
+                                       "KHR_lights_punctual",
+                                       "KHR_materials_pbrSpecularGlossiness",
+                                       "KHR_materials_emissive_strength",
                                        "KHR_mesh_quantization"};   // quantized attributes: any component type is read
     for (const std::string& ext : model.extensionsRequired)
         if (std::none_of(std::begin(kSupported), std::end(kSupported), [&](const char* s) { return ext == s; }))
@@ -1269,16 +1360,16 @@ LoadResult loadGltf(const fs::path& path, const LoadOptions& options) {
                 for (int c : n.children) isChild[size_t(c)] = 1;
             for (size_t i = 0; i < model.nodes.size(); ++i)
                 if (!isChild[i]) roots.push_back(int(i));
-            if (!roots.empty()) result.warnings.push_back(file + ": no scenes; loading all " + std::to_string(roots.size()) + " root nodes");
-            else result.warnings.push_back(file + ": the file contains no nodes");
+            if (!roots.empty())
+                result.warnings.push_back(file + ": no scenes; loading all " + std::to_string(roots.size()) + " root nodes");
+            else
+                result.warnings.push_back(file + ": the file contains no nodes");
         }
         std::string e = conv.buildNodes(roots);
         if (!e.empty()) return e == "cancelled" ? fail("cancelled") : fail(e);
         result.animations = conv.animations();
         if (!model.skins.empty()) conv.warnOnce("skinning is not supported (bind pose shown)");
-    } catch (const std::bad_alloc&) {
-        return fail("out of memory while building the scene");
-    }
+    } catch (const std::bad_alloc&) { return fail("out of memory while building the scene"); }
     progress.set(0.95f);
     addDefaultCameraAndLight(conv.scene);
     for (auto& w : conv.warnings) result.warnings.push_back(file + ": " + w);
@@ -1287,4 +1378,4 @@ LoadResult loadGltf(const fs::path& path, const LoadOptions& options) {
     return result;
 }
 
-}  // namespace assets::detail
+}   // namespace assets::detail

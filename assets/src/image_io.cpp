@@ -22,13 +22,19 @@ std::string failureReason() {
     return why ? std::string(why) : std::string("corrupt data");
 }
 bool isJpeg(const unsigned char* d, size_t n) { return n >= 3 && d[0] == 0xFF && d[1] == 0xD8 && d[2] == 0xFF; }
-}  // namespace
+}   // namespace
 
 ImageLoad decodeImage(const void* data, size_t size, const std::string& name) {
     ImageLoad r;
     auto* d = static_cast<const unsigned char*>(data);
-    if (size > size_t(INT32_MAX)) { r.error = name + ": image data too large"; return r; }
-    if (!isPng(d, size) && !isJpeg(d, size)) { r.error = name + ": not a PNG or JPEG image"; return r; }
+    if (size > size_t(INT32_MAX)) {
+        r.error = name + ": image data too large";
+        return r;
+    }
+    if (!isPng(d, size) && !isJpeg(d, size)) {
+        r.error = name + ": not a PNG or JPEG image";
+        return r;
+    }
     int w = 0, h = 0, comp = 0;
     // Check the header's dimensions before decoding anything. PNG: IHDR width/height are the
     // big-endian words at bytes 16..23 (read directly: stb's own "too large" message is vague).
@@ -36,8 +42,8 @@ ImageLoad decodeImage(const void* data, size_t size, const std::string& name) {
         auto be32 = [&](size_t o) { return uint32_t(d[o]) << 24 | uint32_t(d[o + 1]) << 16 | uint32_t(d[o + 2]) << 8 | d[o + 3]; };
         uint32_t pw = be32(16), ph = be32(20);
         if (pw > uint32_t(kMaxImageDimension) || ph > uint32_t(kMaxImageDimension)) {
-            r.error = name + ": image is " + std::to_string(pw) + "x" + std::to_string(ph) + ", limit " +
-                      std::to_string(kMaxImageDimension) + " per side";
+            r.error =
+                name + ": image is " + std::to_string(pw) + "x" + std::to_string(ph) + ", limit " + std::to_string(kMaxImageDimension) + " per side";
             return r;
         }
         // Every chunk must fit in the data: stb_image grows its IDAT buffer to a chunk's claimed
@@ -45,8 +51,7 @@ ImageLoad decodeImage(const void* data, size_t size, const std::string& name) {
         for (size_t o = 8; o + 8 <= size;) {
             const uint32_t len = be32(o);
             if (uint64_t(len) + 12 > size - o) {
-                r.error = name + ": corrupt PNG: a chunk claims " + std::to_string(len) + " bytes but only " +
-                          std::to_string(size - o) + " remain";
+                r.error = name + ": corrupt PNG: a chunk claims " + std::to_string(len) + " bytes but only " + std::to_string(size - o) + " remain";
                 return r;
             }
             if (std::memcmp(d + o + 4, "IEND", 4) == 0) break;
@@ -58,8 +63,7 @@ ImageLoad decodeImage(const void* data, size_t size, const std::string& name) {
         return r;
     }
     if (w <= 0 || h <= 0 || w > kMaxImageDimension || h > kMaxImageDimension) {
-        r.error = name + ": image is " + std::to_string(w) + "x" + std::to_string(h) + ", limit " +
-                  std::to_string(kMaxImageDimension) + " per side";
+        r.error = name + ": image is " + std::to_string(w) + "x" + std::to_string(h) + ", limit " + std::to_string(kMaxImageDimension) + " per side";
         return r;
     }
     unsigned char* pixels = stbi_load_from_memory(d, int(size), &w, &h, &comp, 4);
@@ -91,9 +95,7 @@ std::string encodePng(int w, int h, const uint8_t* rgba, std::string& out) {
     if (w > kMaxImageDimension || h > kMaxImageDimension)
         return "image is " + std::to_string(w) + "x" + std::to_string(h) + ", limit " + std::to_string(kMaxImageDimension) + " per side";
     out.clear();
-    auto sink = [](void* ctx, void* data, int size) {
-        static_cast<std::string*>(ctx)->append(static_cast<const char*>(data), size_t(size));
-    };
+    auto sink = [](void* ctx, void* data, int size) { static_cast<std::string*>(ctx)->append(static_cast<const char*>(data), size_t(size)); };
     if (!stbi_write_png_to_func(sink, &out, w, h, 4, rgba, w * 4)) return "PNG encoding failed";
     return {};
 }
@@ -105,4 +107,4 @@ std::string writePng(const std::filesystem::path& path, int w, int h, const uint
     return writeFileAtomic(path, bytes, overwrite);
 }
 
-}  // namespace assets
+}   // namespace assets

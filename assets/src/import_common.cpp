@@ -3,14 +3,14 @@
 
 #include "assets/files.h"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 #include <algorithm>
 #include <cerrno>
 #include <climits>
 #include <cstdlib>
 #include <cstring>
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 namespace fs = std::filesystem;
 
@@ -52,15 +52,14 @@ std::string checkOne(const std::string& rel) {
     while (start <= rel.size()) {
         size_t end = rel.find_first_of("/\\", start);
         if (end == std::string::npos) end = rel.size();
-        if (rel.compare(start, end - start, "..") == 0 && end - start == 2)
-            return "path '" + rel + "' leaves the model's folder ('..')";
+        if (rel.compare(start, end - start, "..") == 0 && end - start == 2) return "path '" + rel + "' leaves the model's folder ('..')";
         start = end + 1;
     }
     return {};
 }
 
 std::string sysErr(const std::string& what) { return what + ": " + std::strerror(errno); }
-}  // namespace
+}   // namespace
 
 std::string checkRelativeName(const std::string& rel) {
     std::string e = checkOne(rel);
@@ -96,8 +95,7 @@ bool ConfinedDir::relativeOf(const std::string& path, std::string& rel, std::str
 namespace {
 // Opens root/rel without following the final name into a non-regular file and verifies
 // where the opened file really lives. Returns fd >= 0 or -1 with *why set.
-int openConfined(const fs::path& root, const std::string& rootStr, const std::string& rel, std::string* why,
-                 struct stat* stOut) {
+int openConfined(const fs::path& root, const std::string& rootStr, const std::string& rel, std::string* why, struct stat* stOut) {
     std::string e = checkRelativeName(rel);
     if (!e.empty()) {
         *why = e;
@@ -165,7 +163,7 @@ int openConfined(const fs::path& root, const std::string& rootStr, const std::st
     *stOut = st;
     return fd;
 }
-}  // namespace
+}   // namespace
 
 std::string ConfinedDir::read(const std::string& rel, uint64_t maxBytes, std::vector<unsigned char>& out) const {
     out.clear();
@@ -223,8 +221,10 @@ bool addDefaultCameraAndLight(sg::Scene& scene) {
         scene.lookAt(id, c + glm::normalize(sg::vec3(0.3f, 0.8f, 1.0f)) * (2.0f * r), c);
         added = true;
     }
-    if (!hasCamera) scene.addDefaultCamera();
-    else if (!scene.valid(scene.activeCamera)) scene.activeCamera = scene.cameras().front();
+    if (!hasCamera)
+        scene.addDefaultCamera();
+    else if (!scene.valid(scene.activeCamera))
+        scene.activeCamera = scene.cameras().front();
     return added;
 }
 
@@ -243,8 +243,14 @@ bool imageSize(const unsigned char* d, size_t n, int& w, int& h) {
         while (i + 4 <= n) {
             if (d[i] != 0xFF) return false;
             unsigned char m = d[i + 1];
-            if (m == 0xFF) { ++i; continue; }
-            if (m == 0xD8 || m == 0x01 || (m >= 0xD0 && m <= 0xD7)) { i += 2; continue; }
+            if (m == 0xFF) {
+                ++i;
+                continue;
+            }
+            if (m == 0xD8 || m == 0x01 || (m >= 0xD0 && m <= 0xD7)) {
+                i += 2;
+                continue;
+            }
             size_t len = (size_t(d[i + 2]) << 8) | d[i + 3];
             if (len < 2) return false;
             bool sof = (m >= 0xC0 && m <= 0xCF) && m != 0xC4 && m != 0xC8 && m != 0xCC;
@@ -260,4 +266,4 @@ bool imageSize(const unsigned char* d, size_t n, int& w, int& h) {
     return false;
 }
 
-}  // namespace assets::detail
+}   // namespace assets::detail

@@ -67,4 +67,4 @@ bool imageSize(const unsigned char* data, size_t size, int& w, int& h);
 
 std::string fileNameOf(const std::filesystem::path& p);
 
-}  // namespace assets::detail
+}   // namespace assets::detail

@@ -8,4 +8,4 @@ namespace assets::detail {
 LoadResult loadGltf(const std::filesystem::path& path, const LoadOptions& options);
 LoadResult loadMeshFile(const std::filesystem::path& path, const LoadOptions& options);   // obj/off/ply/stl
 
-}  // namespace assets::detail
+}   // namespace assets::detail

@@ -27,8 +27,8 @@
 // emissive, map_Kd -> diffuseTexture (PNG/JPEG via decodeImage; missing -> warning). An OBJ
 // without mtllib but with UVs picks up <stem>.png/.jpg or <stem>_texture.png/.jpg from its
 // folder (spot.obj ships that way).
-#include "importers.h"
 #include "import_common.h"
+#include "importers.h"
 
 #include "assets/files.h"
 #include "assets/image_io.h"
@@ -135,8 +135,7 @@ struct Ctx {
     }
     void countTriangles(uint64_t n) {
         triangles += n;
-        if (triangles > kMaxTriangles)
-            throw Fail{"more than " + std::to_string(kMaxTriangles) + " triangles (budget)"};
+        if (triangles > kMaxTriangles) throw Fail{"more than " + std::to_string(kMaxTriangles) + " triangles (budget)"};
     }
 };
 
@@ -203,8 +202,7 @@ std::string cleanRelPath(std::string_view s) {
     return r;
 }
 
-void parseMtl(const ConfinedDir& dir, const std::string& rel, Ctx& ctx, const std::string& file,
-              std::map<std::string, ObjMaterial>& out) {
+void parseMtl(const ConfinedDir& dir, const std::string& rel, Ctx& ctx, const std::string& file, std::map<std::string, ObjMaterial>& out) {
     std::vector<unsigned char> bytes;
     std::string why = dir.read(rel, kMaxMtlBytes, bytes);
     if (!why.empty()) {
@@ -217,7 +215,10 @@ void parseMtl(const ConfinedDir& dir, const std::string& rel, Ctx& ctx, const st
         float x, y, z;
         if (!toFloat(c.token(), x)) return false;
         std::string_view t = c.token();
-        if (t.empty()) { v = sg::vec3(x); return true; }
+        if (t.empty()) {
+            v = sg::vec3(x);
+            return true;
+        }
         if (!toFloat(t, y) || !toFloat(c.token(), z)) return false;
         v = sg::vec3(x, y, z);
         return true;
@@ -269,7 +270,10 @@ LoadResult loadObj(const fs::path& path, const std::string& text, Ctx& ctx) {
     std::vector<sg::vec4> vc;   // vertex colours (x y z r g b)
     std::vector<sg::vec2> vt;
     std::vector<ObjCorner> corners;
-    struct Face { uint32_t first, count; int material; };
+    struct Face {
+        uint32_t first, count;
+        int material;
+    };
     std::vector<Face> faces;
     std::vector<uint32_t> linePoly;   // v indices of line segments (pairs)
     std::vector<uint32_t> pointList;
@@ -281,8 +285,14 @@ LoadResult loadObj(const fs::path& path, const std::string& text, Ctx& ctx) {
     Cursor c{text.data(), text.data() + text.size()};
     size_t line = 0;
     auto resolve = [](int64_t i, size_t n, uint32_t& out) {
-        if (i > 0 && uint64_t(i) <= n) { out = uint32_t(i - 1); return true; }
-        if (i < 0 && uint64_t(-i) <= n) { out = uint32_t(int64_t(n) + i); return true; }
+        if (i > 0 && uint64_t(i) <= n) {
+            out = uint32_t(i - 1);
+            return true;
+        }
+        if (i < 0 && uint64_t(-i) <= n) {
+            out = uint32_t(int64_t(n) + i);
+            return true;
+        }
         return false;
     };
     while (!c.atEnd()) {
@@ -291,7 +301,8 @@ LoadResult loadObj(const fs::path& path, const std::string& text, Ctx& ctx) {
         std::string_view key = c.token();
         if (key == "v") {
             float x, y, z;
-            if (!toFloat(c.token(), x) || !toFloat(c.token(), y) || !toFloat(c.token(), z) || !std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) {
+            if (!toFloat(c.token(), x) || !toFloat(c.token(), y) || !toFloat(c.token(), z) || !std::isfinite(x) || !std::isfinite(y) ||
+                !std::isfinite(z)) {
                 ++badLines;
                 v.push_back(sg::vec3(0.0f));
                 vc.push_back(sg::vec4(1.0f));
@@ -315,7 +326,12 @@ LoadResult loadObj(const fs::path& path, const std::string& text, Ctx& ctx) {
             vt.push_back({s, t});
         } else if (key == "vn") {
             float x, y, z;
-            if (!toFloat(c.token(), x) || !toFloat(c.token(), y) || !toFloat(c.token(), z)) { ++badLines; x = 0; y = 0; z = 1; }
+            if (!toFloat(c.token(), x) || !toFloat(c.token(), y) || !toFloat(c.token(), z)) {
+                ++badLines;
+                x = 0;
+                y = 0;
+                z = 1;
+            }
             vn.push_back({x, y, z});
         } else if (key == "f" || key == "l" || key == "p") {
             uint32_t first = uint32_t(corners.size());
@@ -347,8 +363,12 @@ LoadResult loadObj(const fs::path& path, const std::string& text, Ctx& ctx) {
                 faces.push_back({first, uint32_t(n), curMat});
             } else {
                 for (size_t i = 0; i < n; ++i) {
-                    if (key == "p") pointList.push_back(corners[first + i].v);
-                    else if (i + 1 < n) { linePoly.push_back(corners[first + i].v); linePoly.push_back(corners[first + i + 1].v); }
+                    if (key == "p")
+                        pointList.push_back(corners[first + i].v);
+                    else if (i + 1 < n) {
+                        linePoly.push_back(corners[first + i].v);
+                        linePoly.push_back(corners[first + i + 1].v);
+                    }
                 }
                 corners.resize(first);
             }
@@ -432,8 +452,13 @@ LoadResult loadObj(const fs::path& path, const std::string& text, Ctx& ctx) {
         const int mat = int(g) - 1;
         sg::Mesh mesh;
         std::vector<uint32_t> remap;
-        struct Key { uint32_t v, t, n; bool operator==(const Key&) const = default; };
-        struct KeyHash { size_t operator()(const Key& k) const { return (size_t(k.v) * 0x9E3779B97F4A7C15ull) ^ (size_t(k.t) * 0xC2B2AE3D27D4EB4Full) ^ k.n; } };
+        struct Key {
+            uint32_t v, t, n;
+            bool operator==(const Key&) const = default;
+        };
+        struct KeyHash {
+            size_t operator()(const Key& k) const { return (size_t(k.v) * 0x9E3779B97F4A7C15ull) ^ (size_t(k.t) * 0xC2B2AE3D27D4EB4Full) ^ k.n; }
+        };
         std::unordered_map<Key, uint32_t, KeyHash> map;
         if (simple) remap.assign(v.size(), ~0u);
         bool hasUv = false, hasN = true;
@@ -474,7 +499,11 @@ LoadResult loadObj(const fs::path& path, const std::string& text, Ctx& ctx) {
         lines.name = path.stem().string() + " lines";
         std::vector<uint32_t> remap(v.size(), ~0u);
         for (uint32_t i : linePoly) {
-            if (remap[i] == ~0u) { remap[i] = uint32_t(lines.positions.size()); lines.positions.push_back(v[i]); if (anyColor) lines.colors.push_back(vc[i]); }
+            if (remap[i] == ~0u) {
+                remap[i] = uint32_t(lines.positions.size());
+                lines.positions.push_back(v[i]);
+                if (anyColor) lines.colors.push_back(vc[i]);
+            }
             lines.indices.push_back(remap[i]);
         }
         parts.push_back({std::move(lines), -1});
@@ -508,7 +537,10 @@ LoadResult loadOff(const fs::path& path, const std::string& text, Ctx& ctx) {
         // Skips comments (# to end of line).
         for (;;) {
             c.skipWs();
-            if (c.p < c.end && *c.p == '#') { c.skipLine(); continue; }
+            if (c.p < c.end && *c.p == '#') {
+                c.skipLine();
+                continue;
+            }
             return c.anyToken();
         }
     };
@@ -518,10 +550,15 @@ LoadResult loadOff(const fs::path& path, const std::string& text, Ctx& ctx) {
     std::string_view prefix = head.substr(0, head.size() - 3);
     bool hasTex = false, hasColor = false, hasNormal = false;
     for (size_t i = 0; i < prefix.size(); ++i) {
-        if (prefix.substr(i, 2) == "ST") { hasTex = true; ++i; }
-        else if (prefix[i] == 'C') hasColor = true;
-        else if (prefix[i] == 'N') hasNormal = true;
-        else throw Fail{"unsupported OFF variant '" + std::string(head) + "' (4D, nD and binary OFF are not supported)"};
+        if (prefix.substr(i, 2) == "ST") {
+            hasTex = true;
+            ++i;
+        } else if (prefix[i] == 'C')
+            hasColor = true;
+        else if (prefix[i] == 'N')
+            hasNormal = true;
+        else
+            throw Fail{"unsupported OFF variant '" + std::string(head) + "' (4D, nD and binary OFF are not supported)"};
     }
     uint64_t nv, nf, ne;
     std::string_view t1 = nextToken();
@@ -544,7 +581,10 @@ LoadResult loadOff(const fs::path& path, const std::string& text, Ctx& ctx) {
     for (uint64_t i = 0; i < nv; ++i) {
         ctx.poll(size_t(i), 0.0f, 0.5f, size_t(nv));
         float x, y, z;
-        if (!toFloat(nextToken(), x) || !toFloat(nextToken(), y) || !toFloat(nextToken(), z)) { truncated = true; break; }
+        if (!toFloat(nextToken(), x) || !toFloat(nextToken(), y) || !toFloat(nextToken(), z)) {
+            truncated = true;
+            break;
+        }
         if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) throw Fail{"vertex " + std::to_string(i) + " is not finite"};
         mesh.positions.push_back({x, y, z});
         float extra[5];
@@ -571,20 +611,31 @@ LoadResult loadOff(const fs::path& path, const std::string& text, Ctx& ctx) {
         for (uint64_t f = 0; f < nf; ++f) {
             ctx.poll(size_t(f), 0.5f, 0.45f, size_t(nf));
             uint64_t k;
-            if (!toUint64(nextToken(), k)) { truncated = true; break; }
+            if (!toUint64(nextToken(), k)) {
+                truncated = true;
+                break;
+            }
             if (k > 1'000'000) throw Fail{"face " + std::to_string(f) + " claims " + std::to_string(k) + " corners"};
             poly.clear();
             bool ok = true;
             for (uint64_t j = 0; j < k; ++j) {
                 int64_t idx;
-                if (!toInt64(nextToken(), idx)) { truncated = true; break; }
-                if (idx < 0 || uint64_t(idx) >= mesh.positions.size()) ok = false;
-                else poly.push_back(uint32_t(idx));
+                if (!toInt64(nextToken(), idx)) {
+                    truncated = true;
+                    break;
+                }
+                if (idx < 0 || uint64_t(idx) >= mesh.positions.size())
+                    ok = false;
+                else
+                    poly.push_back(uint32_t(idx));
             }
             if (truncated) break;
             while (!c.atLineEnd()) c.token();   // per-face colour
             ++facesRead;
-            if (!ok || k < 3) { ++dropped; continue; }
+            if (!ok || k < 3) {
+                ++dropped;
+                continue;
+            }
             ctx.countTriangles(k - 2);
             fan(poly.data(), poly.size(), mesh.indices);
         }
@@ -624,9 +675,13 @@ PlyType plyType(std::string_view s) {
 }
 size_t plySize(PlyType t) {
     switch (t) {
-    case PlyType::I8: case PlyType::U8: return 1;
-    case PlyType::I16: case PlyType::U16: return 2;
-    case PlyType::I32: case PlyType::U32: case PlyType::F32: return 4;
+    case PlyType::I8:
+    case PlyType::U8: return 1;
+    case PlyType::I16:
+    case PlyType::U16: return 2;
+    case PlyType::I32:
+    case PlyType::U32:
+    case PlyType::F32: return 4;
     case PlyType::F64: return 8;
     default: return 0;
     }
@@ -664,12 +719,42 @@ struct PlyReader {
         switch (t) {
         case PlyType::I8: out = double(int8_t(b[0])); break;
         case PlyType::U8: out = double(b[0]); break;
-        case PlyType::I16: { int16_t v; std::memcpy(&v, b, 2); out = v; break; }
-        case PlyType::U16: { uint16_t v; std::memcpy(&v, b, 2); out = v; break; }
-        case PlyType::I32: { int32_t v; std::memcpy(&v, b, 4); out = v; break; }
-        case PlyType::U32: { uint32_t v; std::memcpy(&v, b, 4); out = v; break; }
-        case PlyType::F32: { float v; std::memcpy(&v, b, 4); out = v; break; }
-        case PlyType::F64: { double v; std::memcpy(&v, b, 8); out = v; break; }
+        case PlyType::I16: {
+            int16_t v;
+            std::memcpy(&v, b, 2);
+            out = v;
+            break;
+        }
+        case PlyType::U16: {
+            uint16_t v;
+            std::memcpy(&v, b, 2);
+            out = v;
+            break;
+        }
+        case PlyType::I32: {
+            int32_t v;
+            std::memcpy(&v, b, 4);
+            out = v;
+            break;
+        }
+        case PlyType::U32: {
+            uint32_t v;
+            std::memcpy(&v, b, 4);
+            out = v;
+            break;
+        }
+        case PlyType::F32: {
+            float v;
+            std::memcpy(&v, b, 4);
+            out = v;
+            break;
+        }
+        case PlyType::F64: {
+            double v;
+            std::memcpy(&v, b, 8);
+            out = v;
+            break;
+        }
         default: return false;
         }
         return true;
@@ -683,7 +768,11 @@ LoadResult loadPly(const fs::path& path, const std::string& data, Ctx& ctx) {
     auto nextLine = [&](std::string& line) -> bool {
         if (pos >= data.size()) return false;
         size_t e = data.find_first_of("\r\n", pos);
-        if (e == std::string::npos) { line = data.substr(pos); pos = data.size(); return true; }
+        if (e == std::string::npos) {
+            line = data.substr(pos);
+            pos = data.size();
+            return true;
+        }
         line = data.substr(pos, e - pos);
         pos = e + 1;
         if (data[e] == '\r' && pos < data.size() && data[pos] == '\n') ++pos;
@@ -741,10 +830,11 @@ LoadResult loadPly(const fs::path& path, const std::string& data, Ctx& ctx) {
         uint64_t bytes;
         if (per == 0) continue;
         if (__builtin_mul_overflow(per, e.count, &bytes) || __builtin_add_overflow(need, bytes, &need) || need > bodyBytes + 1)
-            throw Fail{"element '" + e.name + "' claims " + std::to_string(e.count) + " entries but the file has only " +
-                       std::to_string(bodyBytes) + " bytes after the header"};
+            throw Fail{"element '" + e.name + "' claims " + std::to_string(e.count) + " entries but the file has only " + std::to_string(bodyBytes) +
+                       " bytes after the header"};
     }
-    PlyReader rd{reinterpret_cast<const unsigned char*>(data.data()) + pos, reinterpret_cast<const unsigned char*>(data.data()) + data.size(), format};
+    PlyReader rd{reinterpret_cast<const unsigned char*>(data.data()) + pos, reinterpret_cast<const unsigned char*>(data.data()) + data.size(),
+                 format};
     rd.text = Cursor{data.data() + pos, data.data() + data.size()};
 
     sg::Mesh mesh;
@@ -765,19 +855,36 @@ LoadResult loadPly(const fs::path& path, const std::string& data, Ctx& ctx) {
             const std::string& n = e.props[k].name;
             int kk = int(k);
             if (isVertex && !e.props[k].list) {
-                if (n == "x") ix = kk; else if (n == "y") iy = kk; else if (n == "z") iz = kk;
-                else if (n == "nx") inx = kk; else if (n == "ny") iny = kk; else if (n == "nz") inz = kk;
-                else if (n == "red" || n == "r" || n == "diffuse_red") ir = kk;
-                else if (n == "green" || n == "g" || n == "diffuse_green") ig = kk;
-                else if (n == "blue" || n == "b" || n == "diffuse_blue") ib = kk;
-                else if (n == "alpha" || n == "a") ia = kk;
-                else if (n == "s" || n == "u" || n == "texture_u" || n == "texture_s") iu = kk;
-                else if (n == "t" || n == "v" || n == "texture_v" || n == "texture_t") iv = kk;
+                if (n == "x")
+                    ix = kk;
+                else if (n == "y")
+                    iy = kk;
+                else if (n == "z")
+                    iz = kk;
+                else if (n == "nx")
+                    inx = kk;
+                else if (n == "ny")
+                    iny = kk;
+                else if (n == "nz")
+                    inz = kk;
+                else if (n == "red" || n == "r" || n == "diffuse_red")
+                    ir = kk;
+                else if (n == "green" || n == "g" || n == "diffuse_green")
+                    ig = kk;
+                else if (n == "blue" || n == "b" || n == "diffuse_blue")
+                    ib = kk;
+                else if (n == "alpha" || n == "a")
+                    ia = kk;
+                else if (n == "s" || n == "u" || n == "texture_u" || n == "texture_s")
+                    iu = kk;
+                else if (n == "t" || n == "v" || n == "texture_v" || n == "texture_t")
+                    iv = kk;
             }
             if ((isFace || isStrip) && e.props[k].list && (n == "vertex_indices" || n == "vertex_index") && ilist < 0) ilist = kk;
         }
         if (isVertex) {
-            if (e.count > kMaxVertices) throw Fail{"element 'vertex' claims " + std::to_string(e.count) + " entries (budget " + std::to_string(kMaxVertices) + ")"};
+            if (e.count > kMaxVertices)
+                throw Fail{"element 'vertex' claims " + std::to_string(e.count) + " entries (budget " + std::to_string(kMaxVertices) + ")"};
             if (ix < 0 || iy < 0 || iz < 0) throw Fail{"vertex element has no x, y, z properties"};
             haveNormals = inx >= 0 && iny >= 0 && inz >= 0;
             haveColors = ir >= 0 && ig >= 0 && ib >= 0;
@@ -799,21 +906,34 @@ LoadResult loadPly(const fs::path& path, const std::string& data, Ctx& ctx) {
             for (size_t k = 0; k < e.props.size(); ++k) {
                 const PlyProperty& pr = e.props[k];
                 if (!pr.list) {
-                    if (!rd.read(pr.type, vals[k])) { truncated = true; break; }
+                    if (!rd.read(pr.type, vals[k])) {
+                        truncated = true;
+                        break;
+                    }
                     continue;
                 }
                 double cnt;
-                if (!rd.read(pr.countType, cnt) || cnt < 0 || cnt > 1e9) { truncated = true; break; }
+                if (!rd.read(pr.countType, cnt) || cnt < 0 || cnt > 1e9) {
+                    truncated = true;
+                    break;
+                }
                 uint64_t n = uint64_t(cnt);
                 // A list cannot be longer than the remaining data.
                 uint64_t left = format == 0 ? uint64_t(rd.text.end - rd.text.p) : uint64_t(rd.end - rd.p);
-                if (n > left) { truncated = true; break; }
+                if (n > left) {
+                    truncated = true;
+                    break;
+                }
                 bool keep = int(k) == ilist;
-                if (keep && n > (64u << 20)) throw Fail{"element '" + e.name + "' " + std::to_string(i) + " has a list of " + std::to_string(n) + " entries (limit 64M)"};
+                if (keep && n > (64u << 20))
+                    throw Fail{"element '" + e.name + "' " + std::to_string(i) + " has a list of " + std::to_string(n) + " entries (limit 64M)"};
                 if (keep) listVals.resize(size_t(n));
                 for (uint64_t j = 0; j < n; ++j) {
                     double d;
-                    if (!rd.read(pr.type, d)) { truncated = true; break; }
+                    if (!rd.read(pr.type, d)) {
+                        truncated = true;
+                        break;
+                    }
                     if (keep) listVals[size_t(j)] = d;
                 }
                 if (truncated) break;
@@ -823,10 +943,16 @@ LoadResult loadPly(const fs::path& path, const std::string& data, Ctx& ctx) {
                     poly.clear();
                     bool ok = n >= 3;
                     for (double d : listVals) {
-                        if (!(d >= 0 && d < double(mesh.positions.size()))) { ok = false; break; }
+                        if (!(d >= 0 && d < double(mesh.positions.size()))) {
+                            ok = false;
+                            break;
+                        }
                         poly.push_back(uint32_t(d));
                     }
-                    if (!ok) { ++dropped; continue; }
+                    if (!ok) {
+                        ++dropped;
+                        continue;
+                    }
                     ctx.countTriangles(n - 2);
                     fan(poly.data(), poly.size(), mesh.indices);
                 } else if (isStrip) {
@@ -836,12 +962,22 @@ LoadResult loadPly(const fs::path& path, const std::string& data, Ctx& ctx) {
                         if (j < listVals.size() && listVals[j] >= 0) continue;
                         for (size_t q = start; q + 2 < j; ++q) {
                             double a = listVals[q], b = listVals[q + 1], c2 = listVals[q + 2];
-                            if (!(a < double(mesh.positions.size()) && b < double(mesh.positions.size()) && c2 < double(mesh.positions.size()))) { ++dropped; continue; }
+                            if (!(a < double(mesh.positions.size()) && b < double(mesh.positions.size()) && c2 < double(mesh.positions.size()))) {
+                                ++dropped;
+                                continue;
+                            }
                             uint32_t ia2 = uint32_t(a), ib2 = uint32_t(b), ic2 = uint32_t(c2);
                             if (ia2 == ib2 || ib2 == ic2 || ia2 == ic2) continue;
                             ctx.countTriangles(1);
-                            if ((q - start) % 2 == 0) { mesh.indices.push_back(ia2); mesh.indices.push_back(ib2); mesh.indices.push_back(ic2); }
-                            else { mesh.indices.push_back(ib2); mesh.indices.push_back(ia2); mesh.indices.push_back(ic2); }
+                            if ((q - start) % 2 == 0) {
+                                mesh.indices.push_back(ia2);
+                                mesh.indices.push_back(ib2);
+                                mesh.indices.push_back(ic2);
+                            } else {
+                                mesh.indices.push_back(ib2);
+                                mesh.indices.push_back(ia2);
+                                mesh.indices.push_back(ic2);
+                            }
                         }
                         start = j + 1;
                     }
@@ -858,8 +994,10 @@ LoadResult loadPly(const fs::path& path, const std::string& data, Ctx& ctx) {
                     auto ch = [&](int k) {
                         PlyType t = e.props[size_t(k)].type;
                         double d = vals[size_t(k)];
-                        if (t == PlyType::U8 || t == PlyType::I8) d /= 255.0;
-                        else if (t == PlyType::U16 || t == PlyType::I16) d /= 65535.0;
+                        if (t == PlyType::U8 || t == PlyType::I8)
+                            d /= 255.0;
+                        else if (t == PlyType::U16 || t == PlyType::I16)
+                            d /= 65535.0;
                         return float(std::clamp(d, 0.0, 1.0));
                     };
                     mesh.colors.push_back({ch(ir), ch(ig), ch(ib), ia >= 0 ? ch(ia) : 1.0f});
@@ -874,7 +1012,8 @@ LoadResult loadPly(const fs::path& path, const std::string& data, Ctx& ctx) {
         }
     }
     if (!truncatedIn.empty())
-        ctx.warnings.push_back(file + ": file is truncated in element '" + truncatedIn + "' (" + std::to_string(readOf) + " of " + std::to_string(claimed) + " read)");
+        ctx.warnings.push_back(file + ": file is truncated in element '" + truncatedIn + "' (" + std::to_string(readOf) + " of " +
+                               std::to_string(claimed) + " read)");
     if (dropped) ctx.warnings.push_back(file + ": " + std::to_string(dropped) + " faces with out-of-range indices or fewer than 3 corners dropped");
     if (mesh.positions.empty()) throw Fail{"no vertices"};
     (void)faceCount;
@@ -898,7 +1037,10 @@ void weldAndAdd(sg::Mesh& mesh, std::unordered_map<uint64_t, std::vector<uint32_
     uint64_t h = (uint64_t(b[0]) * 0x9E3779B97F4A7C15ull) ^ (uint64_t(b[1]) * 0xC2B2AE3D27D4EB4Full) ^ (uint64_t(b[2]) * 0x165667B19E3779F9ull);
     auto& list = buckets[h];
     for (uint32_t i : list)
-        if (std::memcmp(&mesh.positions[i], &p, 12) == 0) { mesh.indices.push_back(i); return; }
+        if (std::memcmp(&mesh.positions[i], &p, 12) == 0) {
+            mesh.indices.push_back(i);
+            return;
+        }
     list.push_back(uint32_t(mesh.positions.size()));
     mesh.indices.push_back(uint32_t(mesh.positions.size()));
     mesh.positions.push_back(p);
@@ -917,8 +1059,9 @@ LoadResult loadStl(const fs::path& path, const std::string& data, Ctx& ctx) {
         if (!binary) {
             // Not an exact binary size: ASCII if it looks like text starting with "solid".
             size_t s = data.find_first_not_of(" \t\r\n");
-            bool text = s != std::string::npos && data.compare(s, 5, "solid") == 0 &&
-                        std::none_of(data.begin(), data.begin() + std::ptrdiff_t(std::min<size_t>(data.size(), 512)), [](char c) { return c == '\0'; });
+            bool text =
+                s != std::string::npos && data.compare(s, 5, "solid") == 0 &&
+                std::none_of(data.begin(), data.begin() + std::ptrdiff_t(std::min<size_t>(data.size(), 512)), [](char c) { return c == '\0'; });
             binary = !text;
         }
     }
@@ -940,7 +1083,10 @@ LoadResult loadStl(const fs::path& path, const std::string& data, Ctx& ctx) {
             float fl[9];
             std::memcpy(fl, f + 12, 36);
             sg::vec3 v[3] = {{fl[0], fl[1], fl[2]}, {fl[3], fl[4], fl[5]}, {fl[6], fl[7], fl[8]}};
-            if (!sg::isFinite(v[0]) || !sg::isFinite(v[1]) || !sg::isFinite(v[2])) { ++bad; continue; }
+            if (!sg::isFinite(v[0]) || !sg::isFinite(v[1]) || !sg::isFinite(v[2])) {
+                ++bad;
+                continue;
+            }
             for (auto& p : v) weldAndAdd(mesh, buckets, p + sg::vec3(0.0f));   // +0 turns -0 into +0
         }
         if (bad) ctx.warnings.push_back(file + ": " + std::to_string(bad) + " triangles with non-finite coordinates dropped");
@@ -958,7 +1104,8 @@ LoadResult loadStl(const fs::path& path, const std::string& data, Ctx& ctx) {
             ctx.poll(++count, 0.0f, 0.0f, 0);
             if ((count & (kPoll - 1)) == 0) ctx.progress.set(0.95f * float(double(c.p - data.data()) / double(data.size())));
             float x, y, z;
-            if (!toFloat(c.anyToken(), x) || !toFloat(c.anyToken(), y) || !toFloat(c.anyToken(), z) || !std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) {
+            if (!toFloat(c.anyToken(), x) || !toFloat(c.anyToken(), y) || !toFloat(c.anyToken(), z) || !std::isfinite(x) || !std::isfinite(y) ||
+                !std::isfinite(z)) {
                 ++bad;
                 x = y = z = std::numeric_limits<float>::quiet_NaN();
             }
@@ -981,7 +1128,7 @@ LoadResult loadStl(const fs::path& path, const std::string& data, Ctx& ctx) {
     return r;
 }
 
-}  // namespace
+}   // namespace
 
 // ---- 8. loadMeshFile ----------------------------------------------------------------------
 LoadResult loadMeshFile(const fs::path& path, const LoadOptions& options) {
@@ -1001,11 +1148,16 @@ LoadResult loadMeshFile(const fs::path& path, const LoadOptions& options) {
         if (data.size() >= 2 && ((uint8_t(data[0]) == 0xFE && uint8_t(data[1]) == 0xFF) || (uint8_t(data[0]) == 0xFF && uint8_t(data[1]) == 0xFE)))
             throw Fail{"UTF-16 text is not supported (save the file as UTF-8/ASCII)"};
         progress.set(0.0f);
-        if (ext == ".obj") result = loadObj(path, data, ctx);
-        else if (ext == ".off") result = loadOff(path, data, ctx);
-        else if (ext == ".ply") result = loadPly(path, data, ctx);
-        else if (ext == ".stl") result = loadStl(path, data, ctx);
-        else throw Fail{"unsupported mesh format '" + ext + "'"};
+        if (ext == ".obj")
+            result = loadObj(path, data, ctx);
+        else if (ext == ".off")
+            result = loadOff(path, data, ctx);
+        else if (ext == ".ply")
+            result = loadPly(path, data, ctx);
+        else if (ext == ".stl")
+            result = loadStl(path, data, ctx);
+        else
+            throw Fail{"unsupported mesh format '" + ext + "'"};
     } catch (const Fail& f) {
         result = {};
         // Quoted file text may hold control bytes: keep the error one printable line.
@@ -1028,4 +1180,4 @@ LoadResult loadMeshFile(const fs::path& path, const LoadOptions& options) {
     return result;
 }
 
-}  // namespace assets::detail
+}   // namespace assets::detail

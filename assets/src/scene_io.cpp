@@ -9,9 +9,7 @@ namespace fs = std::filesystem;
 
 namespace assets {
 
-std::vector<std::string> supportedSceneExtensions() {
-    return {".json", ".gltf", ".glb", ".obj", ".off", ".ply", ".stl"};
-}
+std::vector<std::string> supportedSceneExtensions() { return {".json", ".gltf", ".glb", ".obj", ".off", ".ply", ".stl"}; }
 
 LoadResult loadScene(const fs::path& path, const LoadOptions& options) {
     std::string ext = path.extension().string();
@@ -33,4 +31,4 @@ LoadResult loadScene(const fs::path& path, const LoadOptions& options) {
     return r;
 }
 
-}  // namespace assets
+}   // namespace assets

@@ -50,8 +50,8 @@ namespace assets {
 
 namespace {
 
-constexpr uint64_t kMaxFileBytes = 1ull << 30;     // 1 GiB of JSON
-constexpr int kMaxNesting = 64;                    // our format needs < 10
+constexpr uint64_t kMaxFileBytes = 1ull << 30;   // 1 GiB of JSON
+constexpr int kMaxNesting = 64;                  // our format needs < 10
 constexpr size_t kMaxNodes = 20'000'000;
 constexpr size_t kMaxVertices = 100'000'000;
 constexpr size_t kMaxIndices = 300'000'000;
@@ -68,16 +68,21 @@ int nestingDepth(std::string_view text, int limit) {
     bool inString = false, escape = false;
     for (char c : text) {
         if (inString) {
-            if (escape) escape = false;
-            else if (c == '\\') escape = true;
-            else if (c == '"') inString = false;
+            if (escape)
+                escape = false;
+            else if (c == '\\')
+                escape = true;
+            else if (c == '"')
+                inString = false;
             continue;
         }
-        if (c == '"') inString = true;
+        if (c == '"')
+            inString = true;
         else if (c == '[' || c == '{') {
             maxDepth = std::max(maxDepth, ++depth);
             if (maxDepth > limit) return maxDepth;
-        } else if (c == ']' || c == '}') --depth;
+        } else if (c == ']' || c == '}')
+            --depth;
     }
     return maxDepth;
 }
@@ -142,8 +147,7 @@ std::string confinedPath(const fs::path& base, const std::string& rel, fs::path&
 
 class Reader {
 public:
-    Reader(const json& root, fs::path baseDir, std::vector<std::string>& warnings)
-        : m_root(root), m_base(std::move(baseDir)), m_warnings(warnings) {}
+    Reader(const json& root, fs::path baseDir, std::vector<std::string>& warnings) : m_root(root), m_base(std::move(baseDir)), m_warnings(warnings) {}
 
     sg::Scene read();
 
@@ -201,10 +205,18 @@ private:
         return e;
     }
     // Optional field helpers: leave `dst` alone when the key is absent.
-    void optFloat(const json& o, const std::string& p, const char* k, float& dst) { if (auto* v = optional(o, k)) dst = number(*v, p + "/" + k); }
-    void optBool(const json& o, const std::string& p, const char* k, bool& dst) { if (auto* v = optional(o, k)) dst = boolean(*v, p + "/" + k); }
-    void optVec3(const json& o, const std::string& p, const char* k, sg::vec3& dst) { if (auto* v = optional(o, k)) dst = vec<3>(*v, p + "/" + k); }
-    void optInt(const json& o, const std::string& p, const char* k, int& dst, long long lo, long long hi) { if (auto* v = optional(o, k)) dst = integer(*v, p + "/" + k, lo, hi); }
+    void optFloat(const json& o, const std::string& p, const char* k, float& dst) {
+        if (auto* v = optional(o, k)) dst = number(*v, p + "/" + k);
+    }
+    void optBool(const json& o, const std::string& p, const char* k, bool& dst) {
+        if (auto* v = optional(o, k)) dst = boolean(*v, p + "/" + k);
+    }
+    void optVec3(const json& o, const std::string& p, const char* k, sg::vec3& dst) {
+        if (auto* v = optional(o, k)) dst = vec<3>(*v, p + "/" + k);
+    }
+    void optInt(const json& o, const std::string& p, const char* k, int& dst, long long lo, long long hi) {
+        if (auto* v = optional(o, k)) dst = integer(*v, p + "/" + k, lo, hi);
+    }
 
     template <class T, int N>
     void floatArray(const json& o, const std::string& p, const char* k, std::vector<T>& dst, size_t maxElems) {
@@ -220,8 +232,10 @@ private:
                 if (!x.is_number()) fail(path + "/" + std::to_string(i * N + c), "expected a number");
                 double d = x.get<double>();
                 if (!std::isfinite(d) || std::abs(d) > 3.0e38) fail(path + "/" + std::to_string(i * N + c), "number is not finite");
-                if constexpr (N == 1) dst[i] = float(d);
-                else dst[i][c] = float(d);
+                if constexpr (N == 1)
+                    dst[i] = float(d);
+                else
+                    dst[i][c] = float(d);
             }
     }
 
@@ -320,20 +334,28 @@ std::shared_ptr<sg::Texture> Reader::readTexture(const json& j, const std::strin
     auto wrap = [&](const char* key, sg::WrapMode& dst) {
         if (auto* v = optional(j, key)) {
             std::string s = string(*v, p + "/" + key);
-            if (s == "repeat") dst = sg::WrapMode::Repeat;
-            else if (s == "clamp") dst = sg::WrapMode::ClampToEdge;
-            else if (s == "mirror") dst = sg::WrapMode::MirroredRepeat;
-            else fail(p + "/" + key, "unknown wrap mode \"" + s + "\" (valid: repeat, clamp, mirror)");
+            if (s == "repeat")
+                dst = sg::WrapMode::Repeat;
+            else if (s == "clamp")
+                dst = sg::WrapMode::ClampToEdge;
+            else if (s == "mirror")
+                dst = sg::WrapMode::MirroredRepeat;
+            else
+                fail(p + "/" + key, "unknown wrap mode \"" + s + "\" (valid: repeat, clamp, mirror)");
         }
     };
     wrap("wrapS", t->wrapS);
     wrap("wrapT", t->wrapT);
     if (auto* v = optional(j, "filter")) {
         std::string s = string(*v, p + "/filter");
-        if (s == "nearest") t->filter = sg::FilterMode::Nearest;
-        else if (s == "bilinear") t->filter = sg::FilterMode::Bilinear;
-        else if (s == "trilinear") t->filter = sg::FilterMode::Trilinear;
-        else fail(p + "/filter", "unknown filter \"" + s + "\" (valid: nearest, bilinear, trilinear)");
+        if (s == "nearest")
+            t->filter = sg::FilterMode::Nearest;
+        else if (s == "bilinear")
+            t->filter = sg::FilterMode::Bilinear;
+        else if (s == "trilinear")
+            t->filter = sg::FilterMode::Trilinear;
+        else
+            fail(p + "/filter", "unknown filter \"" + s + "\" (valid: nearest, bilinear, trilinear)");
     }
     return t;
 }
@@ -373,10 +395,14 @@ std::shared_ptr<sg::Mesh> Reader::readMesh(const json& j, const std::string& p) 
     } else {
         if (auto* v = optional(j, "mode")) {
             std::string s = string(*v, p + "/mode");
-            if (s == "triangles") m->mode = sg::PrimitiveMode::Triangles;
-            else if (s == "lines") m->mode = sg::PrimitiveMode::Lines;
-            else if (s == "points") m->mode = sg::PrimitiveMode::Points;
-            else fail(p + "/mode", "unknown mode \"" + s + "\" (valid: triangles, lines, points)");
+            if (s == "triangles")
+                m->mode = sg::PrimitiveMode::Triangles;
+            else if (s == "lines")
+                m->mode = sg::PrimitiveMode::Lines;
+            else if (s == "points")
+                m->mode = sg::PrimitiveMode::Points;
+            else
+                fail(p + "/mode", "unknown mode \"" + s + "\" (valid: triangles, lines, points)");
         }
         floatArray<sg::vec3, 3>(j, p, "positions", m->positions, kMaxVertices);
         floatArray<sg::vec3, 3>(j, p, "normals", m->normals, kMaxVertices);
@@ -389,7 +415,8 @@ std::shared_ptr<sg::Mesh> Reader::readMesh(const json& j, const std::string& p) 
             m->indices.resize(v->size());
             for (size_t i = 0; i < v->size(); ++i) {
                 const json& x = (*v)[i];
-                if (!x.is_number_unsigned() || x.get<uint64_t>() > 0xFFFFFFFFull) fail(p + "/indices/" + std::to_string(i), "expected a non-negative 32-bit integer");
+                if (!x.is_number_unsigned() || x.get<uint64_t>() > 0xFFFFFFFFull)
+                    fail(p + "/indices/" + std::to_string(i), "expected a non-negative 32-bit integer");
                 m->indices[i] = uint32_t(x.get<uint64_t>());
             }
         }
@@ -404,8 +431,7 @@ sg::LocalTransform Reader::readTransform(const json& j, const std::string& p) {
     if (!j.is_object()) fail(p, "expected an object");
     if (auto* m = optional(j, "matrix")) {
         sg::mat4 mm = mat(*m, p + "/matrix");
-        if (mm[0][3] != 0 || mm[1][3] != 0 || mm[2][3] != 0 || mm[3][3] != 1)
-            fail(p + "/matrix", "must be affine (last row 0 0 0 1)");
+        if (mm[0][3] != 0 || mm[1][3] != 0 || mm[2][3] != 0 || mm[3][3] != 1) fail(p + "/matrix", "must be affine (last row 0 0 0 1)");
         return sg::LocalTransform::fromMatrix(mm);
     }
     sg::LocalTransform t;
@@ -436,7 +462,9 @@ sg::ImplicitShape Reader::readImplicit(const json& j, const std::string& p) {
         s.quadricBounds.min = vec<3>((*b)[0], p + "/bounds/0");
         s.quadricBounds.max = vec<3>((*b)[1], p + "/bounds/1");
     }
-    auto positive = [&](float v, const char* what) { if (!(v > 0.0f) || v > 1e6f) fail(p + "/" + what, "must be positive and below 1e6"); };
+    auto positive = [&](float v, const char* what) {
+        if (!(v > 0.0f) || v > 1e6f) fail(p + "/" + what, "must be positive and below 1e6");
+    };
     positive(s.radius, "radius");
     positive(s.halfHeight, "halfHeight");
     positive(s.majorRadius, "majorRadius");
@@ -482,7 +510,10 @@ sg::Payload Reader::readPayload(const json& j, const std::string& p, const sg::S
         optBool(v, kp, "useFrustum", pr.useFrustum);
         if (auto* fr = optional(v, "frustum")) {
             sg::vec4 f = vec<4>(*fr, kp + "/frustum");
-            pr.left = f[0]; pr.right = f[1]; pr.bottom = f[2]; pr.top = f[3];
+            pr.left = f[0];
+            pr.right = f[1];
+            pr.bottom = f[2];
+            pr.top = f[3];
         }
         optFloat(v, kp, "orthoHalfHeight", pr.orthoHalfHeight);
         optFloat(v, kp, "obliqueAngle", pr.obliqueAngleDeg);
@@ -628,8 +659,10 @@ sg::Scene Reader::read() {
         std::string p = "/nodes/" + std::to_string(i);
         const json& nj = (*nodes)[i];
         sg::NodeId id = idOf[i];
-        if (auto* v = optional(nj, "name")) s.setName(id, string(*v, p + "/name"));
-        else if (i == 0) s.setName(id, "root");
+        if (auto* v = optional(nj, "name"))
+            s.setName(id, string(*v, p + "/name"));
+        else if (i == 0)
+            s.setName(id, "root");
         if (auto* v = optional(nj, "visible")) s.setVisible(id, boolean(*v, p + "/visible"));
         if (auto* v = optional(nj, "transform")) s.setLocal(id, readTransform(*v, p + "/transform"));
         s.setPayload(id, readPayload(nj, p, s));
@@ -655,13 +688,17 @@ json flat(const std::vector<T>& v) {
     json a = json::array();
     for (const T& x : v)
         for (int c = 0; c < N; ++c) {
-            if constexpr (N == 1) a.push_back(x);
-            else a.push_back(x[c]);
+            if constexpr (N == 1)
+                a.push_back(x);
+            else
+                a.push_back(x[c]);
         }
     return a;
 }
 const char* wrapName(sg::WrapMode w) { return w == sg::WrapMode::Repeat ? "repeat" : w == sg::WrapMode::ClampToEdge ? "clamp" : "mirror"; }
-const char* filterName(sg::FilterMode f) { return f == sg::FilterMode::Nearest ? "nearest" : f == sg::FilterMode::Bilinear ? "bilinear" : "trilinear"; }
+const char* filterName(sg::FilterMode f) {
+    return f == sg::FilterMode::Nearest ? "nearest" : f == sg::FilterMode::Bilinear ? "bilinear" : "trilinear";
+}
 
 json implicitJ(const sg::ImplicitShape& s) {
     json j = {{"type", sg::toString(s.type)}};
@@ -670,8 +707,14 @@ json implicitJ(const sg::ImplicitShape& s) {
     case sg::ImplicitType::Sphere: j["radius"] = s.radius; break;
     case sg::ImplicitType::Box: j["halfExtents"] = vecJ(s.halfExtents); break;
     case sg::ImplicitType::Cylinder:
-    case sg::ImplicitType::Cone: j["radius"] = s.radius; j["halfHeight"] = s.halfHeight; break;
-    case sg::ImplicitType::Torus: j["majorRadius"] = s.majorRadius; j["minorRadius"] = s.minorRadius; break;
+    case sg::ImplicitType::Cone:
+        j["radius"] = s.radius;
+        j["halfHeight"] = s.halfHeight;
+        break;
+    case sg::ImplicitType::Torus:
+        j["majorRadius"] = s.majorRadius;
+        j["minorRadius"] = s.minorRadius;
+        break;
     case sg::ImplicitType::Quadric:
         j["quadric"] = matJ(s.quadric);
         j["bounds"] = {vecJ(s.quadricBounds.min), vecJ(s.quadricBounds.max)};
@@ -691,37 +734,49 @@ json implicitJ(const sg::ImplicitShape& s) {
 
 json payloadJ(const sg::Payload& p) {
     json j;
-    std::visit([&](const auto& v) {
-        using T = std::decay_t<decltype(v)>;
-        if constexpr (std::is_same_v<T, sg::MeshInstance>) {
-            j["mesh"] = {{"mesh", v.mesh}, {"material", v.material}};
-        } else if constexpr (std::is_same_v<T, sg::Camera>) {
-            const sg::Projection& pr = v.projection;
-            j["camera"] = {{"type", sg::toString(pr.type)}, {"fovy", pr.fovyDeg}, {"near", pr.zNear}, {"far", pr.zFar},
-                           {"useFrustum", pr.useFrustum}, {"frustum", {pr.left, pr.right, pr.bottom, pr.top}},
-                           {"orthoHalfHeight", pr.orthoHalfHeight}, {"obliqueAngle", pr.obliqueAngleDeg},
-                           {"obliqueFactor", pr.obliqueFactor}, {"focusDistance", v.focusDistance}};
-        } else if constexpr (std::is_same_v<T, sg::Light>) {
-            j["light"] = {{"type", sg::toString(v.type)}, {"color", vecJ(v.color)}, {"intensity", v.intensity},
-                          {"inverseSquare", v.inverseSquare}, {"spotInner", v.spotInnerDeg}, {"spotOuter", v.spotOuterDeg}};
-        } else if constexpr (std::is_same_v<T, sg::ImplicitPayload>) {
-            json s = implicitJ(v.shape);
-            s["material"] = v.material;
-            j["implicit"] = s;
-        } else if constexpr (std::is_same_v<T, sg::CsgPayload>) {
-            j["csg"] = {{"op", sg::toString(v.csg.op)}, {"material", v.material}};
-        } else if constexpr (std::is_same_v<T, sg::ParametricPayload>) {
-            std::vector<sg::vec3> pts(v.surface.control.begin(), v.surface.control.end());
-            j["parametric"] = {{"type", sg::toString(v.surface.type)}, {"majorRadius", v.surface.majorRadius},
-                               {"minorRadius", v.surface.minorRadius}, {"control", flat<sg::vec3, 3>(pts)},
-                               {"material", v.material}};
-        } else if constexpr (std::is_same_v<T, sg::GridPayload>) {
-            if (v.grid)
-                j["grid"] = {{"dims", {v.grid->dims.x, v.grid->dims.y, v.grid->dims.z}}, {"values", v.grid->values},
-                             {"iso", v.grid->isoValue}, {"bounds", {vecJ(v.grid->bounds.min), vecJ(v.grid->bounds.max)}},
-                             {"material", v.material}};
-        }
-    }, p);
+    std::visit(
+        [&](const auto& v) {
+            using T = std::decay_t<decltype(v)>;
+            if constexpr (std::is_same_v<T, sg::MeshInstance>) {
+                j["mesh"] = {{"mesh", v.mesh}, {"material", v.material}};
+            } else if constexpr (std::is_same_v<T, sg::Camera>) {
+                const sg::Projection& pr = v.projection;
+                j["camera"] = {{"type", sg::toString(pr.type)},
+                               {"fovy", pr.fovyDeg},
+                               {"near", pr.zNear},
+                               {"far", pr.zFar},
+                               {"useFrustum", pr.useFrustum},
+                               {"frustum", {pr.left, pr.right, pr.bottom, pr.top}},
+                               {"orthoHalfHeight", pr.orthoHalfHeight},
+                               {"obliqueAngle", pr.obliqueAngleDeg},
+                               {"obliqueFactor", pr.obliqueFactor},
+                               {"focusDistance", v.focusDistance}};
+            } else if constexpr (std::is_same_v<T, sg::Light>) {
+                j["light"] = {{"type", sg::toString(v.type)},     {"color", vecJ(v.color)},      {"intensity", v.intensity},
+                              {"inverseSquare", v.inverseSquare}, {"spotInner", v.spotInnerDeg}, {"spotOuter", v.spotOuterDeg}};
+            } else if constexpr (std::is_same_v<T, sg::ImplicitPayload>) {
+                json s = implicitJ(v.shape);
+                s["material"] = v.material;
+                j["implicit"] = s;
+            } else if constexpr (std::is_same_v<T, sg::CsgPayload>) {
+                j["csg"] = {{"op", sg::toString(v.csg.op)}, {"material", v.material}};
+            } else if constexpr (std::is_same_v<T, sg::ParametricPayload>) {
+                std::vector<sg::vec3> pts(v.surface.control.begin(), v.surface.control.end());
+                j["parametric"] = {{"type", sg::toString(v.surface.type)},
+                                   {"majorRadius", v.surface.majorRadius},
+                                   {"minorRadius", v.surface.minorRadius},
+                                   {"control", flat<sg::vec3, 3>(pts)},
+                                   {"material", v.material}};
+            } else if constexpr (std::is_same_v<T, sg::GridPayload>) {
+                if (v.grid)
+                    j["grid"] = {{"dims", {v.grid->dims.x, v.grid->dims.y, v.grid->dims.z}},
+                                 {"values", v.grid->values},
+                                 {"iso", v.grid->isoValue},
+                                 {"bounds", {vecJ(v.grid->bounds.min), vecJ(v.grid->bounds.max)}},
+                                 {"material", v.material}};
+            }
+        },
+        p);
     return j;
 }
 
@@ -743,7 +798,10 @@ void pretty(std::string& out, const json& j, int indent) {
     auto pad = [&](int n) { out.append(size_t(n) * 2, ' '); };
     switch (j.type()) {
     case json::value_t::object: {
-        if (j.empty()) { out += "{}"; return; }
+        if (j.empty()) {
+            out += "{}";
+            return;
+        }
         out += "{\n";
         size_t i = 0;
         for (auto it = j.begin(); it != j.end(); ++it, ++i) {
@@ -783,7 +841,7 @@ void pretty(std::string& out, const json& j, int indent) {
     }
 }
 
-}  // namespace
+}   // namespace
 
 // --- public API -------------------------------------------------------------------------------
 
@@ -794,12 +852,20 @@ std::string serializeSceneJson(const sg::Scene& s) {
     j["name"] = s.name;
     j["ambientLight"] = vecJ(s.ambientLight);
     const sg::RenderSettings& r = s.settings;
-    j["settings"] = {{"shading", sg::toString(r.shading)}, {"reflection", sg::toString(r.reflection)},
-                     {"fog", {{"mode", sg::toString(r.fog)}, {"color", vecJ(r.fogColor)}, {"start", r.fogStart}, {"end", r.fogEnd}, {"density", r.fogDensity}}},
-                     {"attenuation", r.attenuation}, {"aa", r.aaName()}, {"cullBackFaces", r.cullBackFaces},
-                     {"wireframe", r.wireframe}, {"wireframeColor", vecJ(r.wireframeColor)}, {"background", vecJ(r.background)},
-                     {"shadows", r.shadows}, {"reflections", r.reflections}, {"maxBounces", r.maxBounces},
-                     {"tessellation", r.tessellation}};
+    j["settings"] = {
+        {"shading", sg::toString(r.shading)},
+        {"reflection", sg::toString(r.reflection)},
+        {"fog", {{"mode", sg::toString(r.fog)}, {"color", vecJ(r.fogColor)}, {"start", r.fogStart}, {"end", r.fogEnd}, {"density", r.fogDensity}}},
+        {"attenuation", r.attenuation},
+        {"aa", r.aaName()},
+        {"cullBackFaces", r.cullBackFaces},
+        {"wireframe", r.wireframe},
+        {"wireframeColor", vecJ(r.wireframeColor)},
+        {"background", vecJ(r.background)},
+        {"shadows", r.shadows},
+        {"reflections", r.reflections},
+        {"maxBounces", r.maxBounces},
+        {"tessellation", r.tessellation}};
     j["settings"]["aaRate"] = r.aaRate;   // kept while AA is off, so switching it back on restores it
     j["textures"] = json::array();
     for (const auto& t : s.textures) {
@@ -811,11 +877,20 @@ std::string serializeSceneJson(const sg::Scene& s) {
     }
     j["materials"] = json::array();
     for (const auto& m : s.materials)
-        j["materials"].push_back({{"name", m.name}, {"baseColor", vecJ(m.baseColor)}, {"ka", m.ka}, {"kd", m.kd}, {"ks", m.ks},
-                                  {"shininess", m.shininess}, {"specularTinted", m.specularTinted},
-                                  {"specularColor", vecJ(m.specularColor)}, {"diffuseTexture", m.diffuseTexture},
-                                  {"emissive", vecJ(m.emissive)}, {"alpha", m.alpha}, {"unlit", m.unlit},
-                                  {"doubleSided", m.doubleSided}, {"reflectivity", m.reflectivity}});
+        j["materials"].push_back({{"name", m.name},
+                                  {"baseColor", vecJ(m.baseColor)},
+                                  {"ka", m.ka},
+                                  {"kd", m.kd},
+                                  {"ks", m.ks},
+                                  {"shininess", m.shininess},
+                                  {"specularTinted", m.specularTinted},
+                                  {"specularColor", vecJ(m.specularColor)},
+                                  {"diffuseTexture", m.diffuseTexture},
+                                  {"emissive", vecJ(m.emissive)},
+                                  {"alpha", m.alpha},
+                                  {"unlit", m.unlit},
+                                  {"doubleSided", m.doubleSided},
+                                  {"reflectivity", m.reflectivity}});
     j["meshes"] = json::array();
     for (const auto& m : s.meshes) {
         const char* mode = m->mode == sg::PrimitiveMode::Triangles ? "triangles" : m->mode == sg::PrimitiveMode::Lines ? "lines" : "points";
@@ -891,9 +966,7 @@ LoadResult parseSceneJson(std::string_view text, const fs::path& path) {
         r.scene = reader.read();
     } catch (const ParseError& e) {
         r.error = file + ": " + (e.path.empty() ? std::string("/") : e.path) + ": " + e.message;
-    } catch (const std::bad_alloc&) {
-        r.error = file + ": out of memory while loading";
-    }
+    } catch (const std::bad_alloc&) { r.error = file + ": out of memory while loading"; }
     return r;
 }
 
@@ -912,4 +985,4 @@ std::string saveSceneJson(const sg::Scene& scene, const fs::path& path, bool ove
     return writeFileAtomic(path, serializeSceneJson(scene), overwrite);
 }
 
-}  // namespace assets
+}   // namespace assets

@@ -91,8 +91,7 @@ void BM_GlLayers(benchmark::State& state) {
     s.meshes.push_back(std::make_shared<sg::Mesh>(sg::primitives::plane(20.0f, 1)));
     for (int i = 0; i < state.range(0); ++i) {
         sg::NodeId id = s.addNode("layer", s.root(), sg::MeshInstance{0, -1});
-        s.setLocal(id, sg::LocalTransform::fromTRS(sg::vec3(0, 0, -5.0f + 0.1f * i),
-                                                   glm::angleAxis(glm::radians(90.0f), sg::vec3(1, 0, 0))));
+        s.setLocal(id, sg::LocalTransform::fromTRS(sg::vec3(0, 0, -5.0f + 0.1f * i), glm::angleAxis(glm::radians(90.0f), sg::vec3(1, 0, 0))));
     }
     sg::LightType types[] = {sg::LightType::Directional, sg::LightType::Point, sg::LightType::Spot};
     for (int i = 0; i < state.range(1); ++i) s.addNode("light", s.root(), sg::Light{types[i % 3], sg::vec3(1.0f), 2.0f, i % 3 == 1});
@@ -103,6 +102,6 @@ void BM_GlLayers(benchmark::State& state) {
 }
 BENCHMARK(BM_GlLayers)->Args({0, 3})->Args({1, 0})->Args({1, 1})->Args({1, 3})->Args({4, 3})->Unit(benchmark::kMillisecond)->UseRealTime();
 
-}  // namespace
+}   // namespace
 
 BENCHMARK_MAIN();

@@ -40,7 +40,10 @@ long statusKb(const char* key) {
 }
 void writeFile(const fs::path& p, const void* data, size_t n) {
     FILE* f = std::fopen(p.c_str(), "wb");
-    if (!f) { std::perror(p.c_str()); std::exit(1); }
+    if (!f) {
+        std::perror(p.c_str());
+        std::exit(1);
+    }
     std::fwrite(data, 1, n, f);
     std::fclose(f);
 }
@@ -115,14 +118,18 @@ void genTris(const fs::path& dir) {
         std::fwrite(idx.data(), 1, ib, f);
         std::fclose(f);
     }
-    std::string j = "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"uri\":\"grid.bin\",\"byteLength\":" + std::to_string(pb + ib) + "}],"
-                    "\"bufferViews\":[{\"buffer\":0,\"byteLength\":" + std::to_string(pb) + "},{\"buffer\":0,\"byteOffset\":" + std::to_string(pb) +
-                    ",\"byteLength\":" + std::to_string(ib) + "}],"
-                    "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":" + std::to_string(size_t(n) * n) +
-                    ",\"type\":\"VEC3\",\"min\":[-1,-1,-1],\"max\":[1,1,1]},{\"bufferView\":1,\"componentType\":5125,\"count\":" +
-                    std::to_string(idx.size()) + ",\"type\":\"SCALAR\"}],"
-                    "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1}]}],"
-                    "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}],\"scene\":0}";
+    std::string j =
+        "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"uri\":\"grid.bin\",\"byteLength\":" + std::to_string(pb + ib) +
+        "}],"
+        "\"bufferViews\":[{\"buffer\":0,\"byteLength\":" +
+        std::to_string(pb) + "},{\"buffer\":0,\"byteOffset\":" + std::to_string(pb) + ",\"byteLength\":" + std::to_string(ib) +
+        "}],"
+        "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":" +
+        std::to_string(size_t(n) * n) +
+        ",\"type\":\"VEC3\",\"min\":[-1,-1,-1],\"max\":[1,1,1]},{\"bufferView\":1,\"componentType\":5125,\"count\":" + std::to_string(idx.size()) +
+        ",\"type\":\"SCALAR\"}],"
+        "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1}]}],"
+        "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}],\"scene\":0}";
     writeFile(dir / "tris-10M.gltf", j.data(), j.size());
 }
 
@@ -136,7 +143,10 @@ double cpuSeconds() {
 bool measure(const std::string& name, const fs::path& file, uint64_t extraBytes = 0) {
     std::fflush(stdout);
     pid_t pid = fork();
-    if (pid < 0) { std::perror("fork"); return false; }
+    if (pid < 0) {
+        std::perror("fork");
+        return false;
+    }
     if (pid > 0) {
         int status = 0;
         waitpid(pid, &status, 0);
@@ -166,7 +176,7 @@ bool measure(const std::string& name, const fs::path& file, uint64_t extraBytes 
     _exit(0);
 }
 
-}  // namespace
+}   // namespace
 
 int main(int argc, char** argv) {
     bool keep = false;
@@ -174,10 +184,16 @@ int main(int argc, char** argv) {
     fs::path dir;
     for (int i = 1; i < argc; ++i) {
         std::string a = argv[i];
-        if (a == "--keep") keep = true;
-        else if (a == "--only" && i + 1 < argc) only = argv[++i];
-        else if (a == "--dir" && i + 1 < argc) dir = argv[++i];
-        else { std::fprintf(stderr, "usage: bench_import [--keep] [--only nodes|tris|meshes] [--dir DIR]\n"); return 2; }
+        if (a == "--keep")
+            keep = true;
+        else if (a == "--only" && i + 1 < argc)
+            only = argv[++i];
+        else if (a == "--dir" && i + 1 < argc)
+            dir = argv[++i];
+        else {
+            std::fprintf(stderr, "usage: bench_import [--keep] [--only nodes|tris|meshes] [--dir DIR]\n");
+            return 2;
+        }
     }
     if (dir.empty()) dir = fs::temp_directory_path() / ("bench_import_" + std::to_string(::getpid()));
     fs::create_directories(dir);
@@ -185,7 +201,8 @@ int main(int argc, char** argv) {
     auto gen = [&](const char* what, auto&& f) {
         auto t0 = std::chrono::steady_clock::now();
         f(dir);
-        std::printf("bench: scene=%s what=generate_s ours=%.3f\n", what, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+        std::printf("bench: scene=%s what=generate_s ours=%.3f\n", what,
+                    std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     };
     if (only.empty() || only == "nodes") {
         gen("gltf-1M-nodes", genNodes);

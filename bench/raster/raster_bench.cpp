@@ -169,7 +169,10 @@ struct Timing {
 // a shared, loaded machine.
 Timing timeFrames(rnd::Renderer& r, const FrameInput& f, int w, int h, int frames, rnd::Framebuffer& fb, std::string& err) {
     rnd::RenderStats s = r.render(f, w, h, fb);   // warm-up: caches, textures, GL buffers
-    if (!s.ok) { err = s.error; return {}; }
+    if (!s.ok) {
+        err = s.error;
+        return {};
+    }
     std::vector<double> t, c;
     for (int i = 0; i < frames; ++i) {
         auto t0 = std::chrono::steady_clock::now();
@@ -188,7 +191,7 @@ double coveredPixels(const rnd::Framebuffer& fb) {
     return double(n);
 }
 
-}  // namespace
+}   // namespace
 
 int main(int argc, char** argv) {
     bool quick = false;
@@ -197,16 +200,32 @@ int main(int argc, char** argv) {
     for (int i = 1; i < argc; ++i) {
         std::string a = argv[i];
         auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
-        if (a == "--quick") quick = true;
-        else if (a == "--threads") threads = std::max(1, std::atoi(next().c_str()));
-        else if (a == "--frames") frames = std::max(1, std::atoi(next().c_str()));
-        else if (a == "--size") std::sscanf(next().c_str(), "%dx%d", &w, &h);
-        else if (a == "--shading") shading = next();
-        else if (a == "--fog") fog = next();
-        else if (a == "--scenes") only = next();
-        else { std::fprintf(stderr, "bench: unknown argument %s\n", a.c_str()); return 2; }
+        if (a == "--quick")
+            quick = true;
+        else if (a == "--threads")
+            threads = std::max(1, std::atoi(next().c_str()));
+        else if (a == "--frames")
+            frames = std::max(1, std::atoi(next().c_str()));
+        else if (a == "--size")
+            std::sscanf(next().c_str(), "%dx%d", &w, &h);
+        else if (a == "--shading")
+            shading = next();
+        else if (a == "--fog")
+            fog = next();
+        else if (a == "--scenes")
+            only = next();
+        else {
+            std::fprintf(stderr, "bench: unknown argument %s\n", a.c_str());
+            return 2;
+        }
     }
-    if (quick) { frames = std::min(frames, 5); if (w == 1280 && h == 720) { w = 960; h = 540; } }
+    if (quick) {
+        frames = std::min(frames, 5);
+        if (w == 1280 && h == 720) {
+            w = 960;
+            h = 540;
+        }
+    }
     // Same thread count for both: llvmpipe reads LP_NUM_THREADS when the context is created.
     setenv("LP_NUM_THREADS", std::to_string(threads).c_str(), 1);
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
@@ -214,7 +233,10 @@ int main(int argc, char** argv) {
     std::string err;
     auto ours = rnd::makeRenderer("raster", &err);
     auto ref = rnd::makeRenderer("gl", &err);
-    if (!ours) { std::fprintf(stderr, "bench: %s\n", err.c_str()); return 1; }
+    if (!ours) {
+        std::fprintf(stderr, "bench: %s\n", err.c_str());
+        return 1;
+    }
 
     std::vector<BenchScene> scenes;
     auto want = [&](const std::string& n) { return only.empty() || ("," + only + ",").find("," + n + ",") != std::string::npos; };
@@ -222,10 +244,13 @@ int main(int argc, char** argv) {
     if (want("spheres100k")) scenes.push_back(sphereGrid("spheres100k", 10, 32));
     if (want("spheres1M") && !quick) scenes.push_back(sphereGrid("spheres1M", 32, 32));
     if (want("spheres1M") && quick) scenes.push_back(sphereGrid("spheres1M", 32, 32));
-    if (want("bunny")) { BenchScene b; if (bunnyScene(b)) scenes.push_back(std::move(b)); }
+    if (want("bunny")) {
+        BenchScene b;
+        if (bunnyScene(b)) scenes.push_back(std::move(b));
+    }
 
-    std::printf("# raster vs gl(llvmpipe): %dx%d, %d threads, shading=%s fog=%s, median of %d frames\n", w, h, threads, shading.c_str(),
-                fog.c_str(), frames);
+    std::printf("# raster vs gl(llvmpipe): %dx%d, %d threads, shading=%s fog=%s, median of %d frames\n", w, h, threads, shading.c_str(), fog.c_str(),
+                frames);
     for (BenchScene& b : scenes) {
         parse(shading, b.scene.settings.shading);
         b.scene.settings.fog = fog == "on" ? FogMode::Linear : FogMode::Off;
@@ -242,8 +267,7 @@ int main(int argc, char** argv) {
         double cov = coveredPixels(fbO);
         std::printf("bench: scene=%s what=ms ours=%.2f ref=%.2f ratio=%.3f\n", b.name.c_str(), to, tr, to / tr);
         std::printf("bench: scene=%s what=cpu_ms ours=%.2f ref=%.2f ratio=%.3f\n", b.name.c_str(), o.cpuMs, r.cpuMs, o.cpuMs / r.cpuMs);
-        std::printf("bench: scene=%s what=mpix_s ours=%.1f ref=%.1f ratio=%.3f\n", b.name.c_str(), cov / (to * 1e3), cov / (tr * 1e3),
-                    tr / to);
+        std::printf("bench: scene=%s what=mpix_s ours=%.1f ref=%.1f ratio=%.3f\n", b.name.c_str(), cov / (to * 1e3), cov / (tr * 1e3), tr / to);
         std::printf("# %s: %zu triangles, %.0f covered pixels\n", b.name.c_str(), b.triangles, cov);
         std::fflush(stdout);
     }

@@ -41,10 +41,10 @@
 
 #include <algorithm>
 #include <chrono>
-#include <ctime>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <fstream>
 #include <functional>
 #include <random>
@@ -55,8 +55,8 @@
 
 using namespace sg;
 using rnd::rt::Ray;
-using rnd::rt::TriHit;
 using rnd::rt::TriangleBvh;
+using rnd::rt::TriHit;
 
 namespace {
 
@@ -88,8 +88,7 @@ Scene sphereGrid(const std::string& name, int n, int slices, int groundSub) {
     s.name = name;
     Mesh sphere = primitives::uvSphere(0.4f, slices, slices / 2);
     for (int j = 0; j < n; ++j)
-        for (int i = 0; i < n; ++i)
-            append(s, sphere, glm::translate(mat4(1.0f), vec3(i - 0.5f * (n - 1), 0.4f, j - 0.5f * (n - 1))));
+        for (int i = 0; i < n; ++i) append(s, sphere, glm::translate(mat4(1.0f), vec3(i - 0.5f * (n - 1), 0.4f, j - 0.5f * (n - 1))));
     append(s, primitives::plane(0.5f * n + 2.0f, groundSub), mat4(1.0f));
     float e = float(n);
     s.eye = vec3(0.35f * e, 0.45f * e + 1.0f, 0.75f * e + 1.0f);
@@ -102,7 +101,10 @@ Scene sphereGrid(const std::string& name, int n, int slices, int groundSub) {
 // indices). Returns false with a message on failure.
 bool readObj(const std::string& path, Scene& s, std::string& err) {
     std::ifstream in(path);
-    if (!in) { err = path + ": cannot open"; return false; }
+    if (!in) {
+        err = path + ": cannot open";
+        return false;
+    }
     std::string line;
     std::vector<uint32_t> face;
     while (std::getline(in, line)) {
@@ -117,13 +119,19 @@ bool readObj(const std::string& path, Scene& s, std::string& err) {
             while (ls >> tok) {
                 long v = std::strtol(tok.c_str(), nullptr, 10);
                 if (v < 0) v = long(s.pos.size()) + v + 1;
-                if (v < 1 || size_t(v) > s.pos.size()) { err = path + ": face index out of range"; return false; }
+                if (v < 1 || size_t(v) > s.pos.size()) {
+                    err = path + ": face index out of range";
+                    return false;
+                }
                 face.push_back(uint32_t(v - 1));
             }
             for (size_t k = 2; k < face.size(); ++k) s.idx.insert(s.idx.end(), {face[0], face[k - 1], face[k]});
         }
     }
-    if (s.idx.empty()) { err = path + ": no faces"; return false; }
+    if (s.idx.empty()) {
+        err = path + ": no faces";
+        return false;
+    }
     return true;
 }
 
@@ -181,8 +189,12 @@ struct Embree {
         RTCIntersectContext ctx;
         rtcInitIntersectContext(&ctx);
         RTCRayHit rh;
-        rh.ray.org_x = r.org.x; rh.ray.org_y = r.org.y; rh.ray.org_z = r.org.z;
-        rh.ray.dir_x = r.dir.x; rh.ray.dir_y = r.dir.y; rh.ray.dir_z = r.dir.z;
+        rh.ray.org_x = r.org.x;
+        rh.ray.org_y = r.org.y;
+        rh.ray.org_z = r.org.z;
+        rh.ray.dir_x = r.dir.x;
+        rh.ray.dir_y = r.dir.y;
+        rh.ray.dir_z = r.dir.z;
         rh.ray.tnear = r.tmin;
         rh.ray.tfar = r.tmax;
         rh.ray.mask = ~0u;
@@ -191,15 +203,24 @@ struct Embree {
         rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
         rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
         rtcIntersect1(scene, &ctx, &rh);
-        if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) { h.t = rh.ray.tfar; h.prim = rh.hit.primID; h.b1 = rh.hit.u; h.b2 = rh.hit.v; }
-        else h = TriHit();
+        if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) {
+            h.t = rh.ray.tfar;
+            h.prim = rh.hit.primID;
+            h.b1 = rh.hit.u;
+            h.b2 = rh.hit.v;
+        } else
+            h = TriHit();
     }
     bool occluded(const Ray& r) const {
         RTCIntersectContext ctx;
         rtcInitIntersectContext(&ctx);
         RTCRay ray;
-        ray.org_x = r.org.x; ray.org_y = r.org.y; ray.org_z = r.org.z;
-        ray.dir_x = r.dir.x; ray.dir_y = r.dir.y; ray.dir_z = r.dir.z;
+        ray.org_x = r.org.x;
+        ray.org_y = r.org.y;
+        ray.org_z = r.org.z;
+        ray.dir_x = r.dir.x;
+        ray.dir_y = r.dir.y;
+        ray.dir_z = r.dir.z;
         ray.tnear = r.tmin;
         ray.tfar = r.tmax;
         ray.mask = ~0u;
@@ -260,7 +281,9 @@ double median(std::vector<double>& v) {
 // +-10% over seconds: alternating exposes both to the same drift). Returns the medians of each
 // and the median of the per-pair ratios ours_i / ref_i: each pair ran within a second, so its
 // ratio is the least drift-sensitive figure (the ratio of medians mixes different moments).
-struct PairResult { double ours, ref, ratio; };
+struct PairResult {
+    double ours, ref, ratio;
+};
 PairResult measurePair(size_t n, int threads, double minSeconds, int reps, const std::function<void(size_t, size_t)>& ours,
                        const std::function<void(size_t, size_t)>& ref) {
     std::vector<double> o, r, q;
@@ -294,7 +317,9 @@ bool sameHit(const TriHit& a, const TriHit& b) {
 // the thread's CPU clock. (Without the arena Embree's "threads=1" build borrows idle TBB workers
 // left by an earlier parallel build: process CPU twice its wall time, an inflated reference.)
 // Two threads: wall time.
-struct BuildTimes { double ours1 = 0, ref1 = 0, ours2 = 0, ref2 = 0; };
+struct BuildTimes {
+    double ours1 = 0, ref1 = 0, ours2 = 0, ref2 = 0;
+};
 // Our build options: TriangleBvh::defaultOptions() unless --leaf-packets / --trav-cost say otherwise.
 rnd::rt::Bvh4::BuildOptions g_options = TriangleBvh::defaultOptions();
 int g_pairs = 0;   // --pairs: ours/Embree alternations per ray measure (0: 3 quick, 5 full)
@@ -352,15 +377,15 @@ void runScene(const Scene& s, bool quick, const std::string& rayClass) {
     const double mt = double(s.tris()) * 1e-6;
     line(s.name, "build_1t_Mtris/s", mt / oursB1, mt / refB1);
     line(s.name, "build_2t_Mtris/s", mt / oursB2, mt / refB2);
-    std::printf("bench: scene=%s info tris=%zu build_ms ours_1t=%.2f embree_1t=%.2f ours_2t=%.2f embree_2t=%.2f bvh_MB=%.1f\n",
-                s.name.c_str(), s.tris(), oursB1 * 1e3, refB1 * 1e3, oursB2 * 1e3, refB2 * 1e3, bvh.memoryBytes() / 1048576.0);
+    std::printf("bench: scene=%s info tris=%zu build_ms ours_1t=%.2f embree_1t=%.2f ours_2t=%.2f embree_2t=%.2f bvh_MB=%.1f\n", s.name.c_str(),
+                s.tris(), oursB1 * 1e3, refB1 * 1e3, oursB2 * 1e3, refB2 * 1e3, bvh.memoryBytes() / 1048576.0);
     {
         const TriangleBvh::Stats st = bvh.stats();
-        std::printf("bench: scene=%s info width=%d nodes=%zu children_per_node=%.2f leaves=%zu packets=%zu tris_per_packet=%.2f "
-                    "depth=%d sah=%.2f (nodes %.2f, leaves %.2f)\n",
-                    s.name.c_str(), bvh.width(), st.nodes, st.nodes ? double(st.childSlots) / double(st.nodes) : 0.0, st.leaves,
-                    st.packets, st.packets ? double(st.lanes) / double(st.packets) : 0.0, st.depth, st.sahNodes + st.sahLeaves,
-                    st.sahNodes, st.sahLeaves);
+        std::printf(
+            "bench: scene=%s info width=%d nodes=%zu children_per_node=%.2f leaves=%zu packets=%zu tris_per_packet=%.2f "
+            "depth=%d sah=%.2f (nodes %.2f, leaves %.2f)\n",
+            s.name.c_str(), bvh.width(), st.nodes, st.nodes ? double(st.childSlots) / double(st.nodes) : 0.0, st.leaves, st.packets,
+            st.packets ? double(st.lanes) / double(st.packets) : 0.0, st.depth, st.sahNodes + st.sahLeaves, st.sahNodes, st.sahLeaves);
     }
 
     // --- rays (ours traced on the tree of the last, parallel, build: what the renderer uses)
@@ -380,7 +405,10 @@ void runScene(const Scene& s, bool quick, const std::string& rayClass) {
             primary[size_t(y) * W + x] = r;
         }
     std::vector<TriHit> hits(primary.size()), refHits(primary.size());
-    for (size_t i = 0; i < primary.size(); ++i) { bvh.intersect(primary[i], hits[i]); e1.intersect(primary[i], refHits[i]); }
+    for (size_t i = 0; i < primary.size(); ++i) {
+        bvh.intersect(primary[i], hits[i]);
+        e1.intersect(primary[i], refHits[i]);
+    }
     // Secondary rays from the (Embree) primary hits so both trace exactly the same rays.
     std::vector<Ray> shadow, incoherent;
     std::mt19937 rng(1);
@@ -434,14 +462,19 @@ void runScene(const Scene& s, bool quick, const std::string& rayClass) {
     if (g_againstTree) {
         treeB.build(s.pos.data(), s.idx.data(), s.tris(), g_againstOptions);
         const TriangleBvh::Stats st = treeB.stats();
-        std::printf("bench: scene=%s info reference = our tree B (leaf packets %d, visit cost %.2f): nodes=%zu leaves=%zu sah=%.2f "
-                    "(nodes %.2f, leaves %.2f)\n",
-                    s.name.c_str(), g_againstOptions.maxLeafBlocks, g_againstOptions.traversalCost, st.nodes, st.leaves,
-                    st.sahNodes + st.sahLeaves, st.sahNodes, st.sahLeaves);
+        std::printf(
+            "bench: scene=%s info reference = our tree B (leaf packets %d, visit cost %.2f): nodes=%zu leaves=%zu sah=%.2f "
+            "(nodes %.2f, leaves %.2f)\n",
+            s.name.c_str(), g_againstOptions.maxLeafBlocks, g_againstOptions.traversalCost, st.nodes, st.leaves, st.sahNodes + st.sahLeaves,
+            st.sahNodes, st.sahLeaves);
     }
     std::vector<TriHit> out(std::max(primary.size(), incoherent.size()));
     std::vector<uint8_t> occ(shadow.size());
-    struct Cls { const char* name; const std::vector<Ray>* rays; bool shadow; };
+    struct Cls {
+        const char* name;
+        const std::vector<Ray>* rays;
+        bool shadow;
+    };
     const Cls classes[3] = {{"primary", &primary, false}, {"shadow", &shadow, true}, {"incoherent", &incoherent, false}};
     for (const Cls& c : classes) {
         if (!rayClass.empty() && rayClass != c.name) continue;
@@ -452,27 +485,47 @@ void runScene(const Scene& s, bool quick, const std::string& rayClass) {
             if (threads == 2) e2.build(s);
             if (g_againstTree && c.shadow) {
                 m = measurePair(
-                    rays.size(), threads, minT, reps, [&](size_t b, size_t e) { for (size_t i = b; i < e; ++i) occ[i] = bvh.occluded(rays[i]); },
-                    [&](size_t b, size_t e) { for (size_t i = b; i < e; ++i) occ[i] = treeB.occluded(rays[i]); });
+                    rays.size(), threads, minT, reps,
+                    [&](size_t b, size_t e) {
+                        for (size_t i = b; i < e; ++i) occ[i] = bvh.occluded(rays[i]);
+                    },
+                    [&](size_t b, size_t e) {
+                        for (size_t i = b; i < e; ++i) occ[i] = treeB.occluded(rays[i]);
+                    });
             } else if (g_againstTree) {
                 m = measurePair(
-                    rays.size(), threads, minT, reps, [&](size_t b, size_t e) { for (size_t i = b; i < e; ++i) bvh.intersect(rays[i], out[i]); },
-                    [&](size_t b, size_t e) { for (size_t i = b; i < e; ++i) treeB.intersect(rays[i], out[i]); });
+                    rays.size(), threads, minT, reps,
+                    [&](size_t b, size_t e) {
+                        for (size_t i = b; i < e; ++i) bvh.intersect(rays[i], out[i]);
+                    },
+                    [&](size_t b, size_t e) {
+                        for (size_t i = b; i < e; ++i) treeB.intersect(rays[i], out[i]);
+                    });
             } else if (c.shadow) {
                 m = measurePair(
-                    rays.size(), threads, minT, reps, [&](size_t b, size_t e) { for (size_t i = b; i < e; ++i) occ[i] = bvh.occluded(rays[i]); },
-                    [&](size_t b, size_t e) { for (size_t i = b; i < e; ++i) occ[i] = E.occluded(rays[i]); });
+                    rays.size(), threads, minT, reps,
+                    [&](size_t b, size_t e) {
+                        for (size_t i = b; i < e; ++i) occ[i] = bvh.occluded(rays[i]);
+                    },
+                    [&](size_t b, size_t e) {
+                        for (size_t i = b; i < e; ++i) occ[i] = E.occluded(rays[i]);
+                    });
             } else {
                 m = measurePair(
-                    rays.size(), threads, minT, reps, [&](size_t b, size_t e) { for (size_t i = b; i < e; ++i) bvh.intersect(rays[i], out[i]); },
-                    [&](size_t b, size_t e) { for (size_t i = b; i < e; ++i) E.intersect(rays[i], out[i]); });
+                    rays.size(), threads, minT, reps,
+                    [&](size_t b, size_t e) {
+                        for (size_t i = b; i < e; ++i) bvh.intersect(rays[i], out[i]);
+                    },
+                    [&](size_t b, size_t e) {
+                        for (size_t i = b; i < e; ++i) E.intersect(rays[i], out[i]);
+                    });
             }
             line(s.name, std::string(c.name) + "_" + std::to_string(threads) + "t_Mrays/s", m.ours, m.ref, m.ratio);
         }
     }
 }
 
-}  // namespace
+}   // namespace
 
 int main(int argc, char** argv) {
     bool quick = false, buildOnly = false;
@@ -480,15 +533,24 @@ int main(int argc, char** argv) {
     std::string only, rayClass, testdata = VIEWER_TESTDATA_DIR;
     for (int i = 1; i < argc; ++i) {
         std::string a = argv[i];
-        if (a == "--quick") quick = true;
-        else if (a == "--scene" && i + 1 < argc) only = argv[++i];
-        else if (a == "--testdata" && i + 1 < argc) testdata = argv[++i];
-        else if (a == "--build-only") buildOnly = true;
-        else if (a == "--rays" && i + 1 < argc) rayClass = argv[++i];
-        else if (a == "--reps" && i + 1 < argc) reps = std::max(1, std::atoi(argv[++i]));
-        else if (a == "--pairs" && i + 1 < argc) g_pairs = std::max(1, std::atoi(argv[++i]));
-        else if (a == "--leaf-packets" && i + 1 < argc) g_options.maxLeafBlocks = std::clamp(std::atoi(argv[++i]), 1, 7);
-        else if (a == "--trav-cost" && i + 1 < argc) g_options.traversalCost = std::max(0.0f, float(std::atof(argv[++i])));
+        if (a == "--quick")
+            quick = true;
+        else if (a == "--scene" && i + 1 < argc)
+            only = argv[++i];
+        else if (a == "--testdata" && i + 1 < argc)
+            testdata = argv[++i];
+        else if (a == "--build-only")
+            buildOnly = true;
+        else if (a == "--rays" && i + 1 < argc)
+            rayClass = argv[++i];
+        else if (a == "--reps" && i + 1 < argc)
+            reps = std::max(1, std::atoi(argv[++i]));
+        else if (a == "--pairs" && i + 1 < argc)
+            g_pairs = std::max(1, std::atoi(argv[++i]));
+        else if (a == "--leaf-packets" && i + 1 < argc)
+            g_options.maxLeafBlocks = std::clamp(std::atoi(argv[++i]), 1, 7);
+        else if (a == "--trav-cost" && i + 1 < argc)
+            g_options.traversalCost = std::max(0.0f, float(std::atof(argv[++i])));
         else if (a == "--against" && i + 1 < argc) {
             int leaf = 0;
             float cost = 0;
@@ -499,12 +561,20 @@ int main(int argc, char** argv) {
             g_againstTree = true;
             g_againstOptions.maxLeafBlocks = leaf;
             g_againstOptions.traversalCost = cost;
+        } else {
+            std::fprintf(stderr,
+                         "usage: %s [--quick] [--scene NAME] [--testdata DIR] [--rays primary|shadow|incoherent] [--build-only [--reps N]] [--pairs "
+                         "N] [--leaf-packets N] [--trav-cost X] [--against LEAF,COST]\n",
+                         argv[0]);
+            return 2;
         }
-        else { std::fprintf(stderr, "usage: %s [--quick] [--scene NAME] [--testdata DIR] [--rays primary|shadow|incoherent] [--build-only [--reps N]] [--pairs N] [--leaf-packets N] [--trav-cost X] [--against LEAF,COST]\n", argv[0]); return 2; }
     }
     if (const char* env = std::getenv("VIEWER_TESTDATA")) testdata = env;
     setFtzDaz();
-    struct Spec { std::string name; std::function<Scene()> make; };
+    struct Spec {
+        std::string name;
+        std::function<Scene()> make;
+    };
     std::string err;
     std::vector<Spec> specs = {
         {"spheres10k", [] { return sphereGrid("spheres10k", 4, 24, 32); }},
@@ -523,7 +593,10 @@ int main(int argc, char** argv) {
     for (const Spec& sp : specs) {
         if (!only.empty() && sp.name != only) continue;
         Scene s = sp.make();
-        if (s.idx.empty()) { std::fprintf(stderr, "bench: scene=%s skipped: %s\n", sp.name.c_str(), err.c_str()); continue; }
+        if (s.idx.empty()) {
+            std::fprintf(stderr, "bench: scene=%s skipped: %s\n", sp.name.c_str(), err.c_str());
+            continue;
+        }
         if (buildOnly) {
             TriangleBvh bvh;
             const BuildTimes bt = measureBuilds(s, bvh, reps, /*twoThreads=*/false);

@@ -57,8 +57,7 @@ BenchScene& benchScene(size_t n, bool chain) {
 
 void setPerNode(benchmark::State& st, size_t nodes) {
     // Seconds per node: printed as e.g. "3.2n" = 3.2 ns per node.
-    st.counters["per_node"] = benchmark::Counter(double(nodes) * double(st.iterations()),
-                                                 benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+    st.counters["per_node"] = benchmark::Counter(double(nodes) * double(st.iterations()), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
     st.counters["nodes"] = double(nodes);
 }
 
@@ -104,14 +103,24 @@ void BM_Flatten(benchmark::State& st, bool chain) {
 
 // Full updates of >= 32k nodes run on several threads: "Time" is wall time, "CPU" the whole
 // process's CPU time (all threads), per_node uses wall time.
-BENCHMARK_CAPTURE(BM_FullUpdate, random, false)->Arg(10000)->Arg(100000)->Arg(1000000)->Unit(benchmark::kMicrosecond)
-    ->UseRealTime()->MeasureProcessCPUTime();
-BENCHMARK_CAPTURE(BM_FullUpdate, chain, true)->Arg(10000)->Arg(100000)->Arg(1000000)->Unit(benchmark::kMicrosecond)
-    ->UseRealTime()->MeasureProcessCPUTime();
+BENCHMARK_CAPTURE(BM_FullUpdate, random, false)
+    ->Arg(10000)
+    ->Arg(100000)
+    ->Arg(1000000)
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime()
+    ->MeasureProcessCPUTime();
+BENCHMARK_CAPTURE(BM_FullUpdate, chain, true)
+    ->Arg(10000)
+    ->Arg(100000)
+    ->Arg(1000000)
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime()
+    ->MeasureProcessCPUTime();
 BENCHMARK_CAPTURE(BM_LeafUpdate, random, false)->Arg(10000)->Arg(100000)->Arg(1000000)->Unit(benchmark::kNanosecond);
 BENCHMARK_CAPTURE(BM_LeafUpdate, chain, true)->Arg(10000)->Arg(100000)->Arg(1000000)->Unit(benchmark::kNanosecond);
 BENCHMARK_CAPTURE(BM_Flatten, random, false)->Arg(10000)->Arg(100000)->Arg(1000000)->Unit(benchmark::kMillisecond);
 
-}  // namespace
+}   // namespace
 
 BENCHMARK_MAIN();

@@ -32,11 +32,12 @@ void BM_DemoDrawable(benchmark::State& st) {
     size_t tris = 0;
     for (auto _ : st) tris = rnd::tessellate(a, 64).mesh->triangleCount();
     static const char* kinds[] = {"implicit", "csg", "parametric", "grid"};
-    st.SetLabel(std::string(kinds[int(a.kind)]) + (a.kind == sg::DrawAnalytic::Kind::Implicit ? " " + std::string(sg::toString(a.implicit.type)) : ""));
+    st.SetLabel(std::string(kinds[int(a.kind)]) +
+                (a.kind == sg::DrawAnalytic::Kind::Implicit ? " " + std::string(sg::toString(a.implicit.type)) : ""));
     st.counters["triangles"] = double(tris);
 }
 BENCHMARK(BM_DemoDrawable)->DenseRange(0, 8)->Unit(benchmark::kMillisecond);
 
-}  // namespace
+}   // namespace
 
 BENCHMARK_MAIN();

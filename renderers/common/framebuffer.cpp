@@ -21,8 +21,7 @@ void Framebuffer::clear(const uint8_t rgba[4], float d) {
 
 std::string ImageDiff::describe() const {
     char buf[160];
-    std::snprintf(buf, sizeof buf, "mean %.3f/255, max %d/255, %.3f%% within tolerance, PSNR %.2f dB", meanAbs, maxAbs,
-                  fractionWithin * 100.0, psnr);
+    std::snprintf(buf, sizeof buf, "mean %.3f/255, max %d/255, %.3f%% within tolerance, PSNR %.2f dB", meanAbs, maxAbs, fractionWithin * 100.0, psnr);
     return buf;
 }
 
@@ -99,4 +98,4 @@ Framebuffer downsample(const Framebuffer& src, int f) {
     return out;
 }
 
-}  // namespace rnd
+}   // namespace rnd

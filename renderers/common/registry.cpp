@@ -21,4 +21,4 @@ std::unique_ptr<Renderer> makeRenderer(std::string_view name, std::string* error
     return nullptr;
 }
 
-}  // namespace rnd
+}   // namespace rnd

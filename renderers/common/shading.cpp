@@ -1,8 +1,8 @@
 #include "renderers/shading.h"
 
 #include <algorithm>
-#include <cmath>
 #include <array>
+#include <cmath>
 #include <limits>
 
 namespace rnd {
@@ -74,9 +74,7 @@ float encodeSRGB(float x) {
     return x <= 0.0031308f ? 12.92f * x : 1.055f * std::pow(x, 1.0f / 2.4f) - 0.055f;
 }
 
-float decodeSRGB(float x) {
-    return x <= 0.04045f ? x / 12.92f : std::pow((x + 0.055f) / 1.055f, 2.4f);
-}
+float decodeSRGB(float x) { return x <= 0.04045f ? x / 12.92f : std::pow((x + 0.055f) / 1.055f, 2.4f); }
 
 uint8_t toByteSRGB(float linear) { return uint8_t(encodeSRGB(linear) * 255.0f + 0.5f); }
 
@@ -89,4 +87,4 @@ vec3 srgbBytesToLinear(const uint8_t* rgb) {
     return vec3(table[rgb[0]], table[rgb[1]], table[rgb[2]]);
 }
 
-}  // namespace rnd
+}   // namespace rnd

@@ -27,13 +27,13 @@ namespace rnd {
 
 namespace {
 
+using sg::ivec3;
+using sg::kPi;
+using sg::mat3;
+using sg::mat4;
 using sg::vec2;
 using sg::vec3;
 using sg::vec4;
-using sg::mat3;
-using sg::mat4;
-using sg::ivec3;
-using sg::kPi;
 
 // --- 1. helpers -------------------------------------------------------------------------
 
@@ -55,12 +55,23 @@ struct Circle {
             double a = 2.0 * 3.14159265358979323846 * i / n;
             c[i] = clean(float(std::cos(a)));
             s[i] = clean(float(std::sin(a)));
-            if (4 * i == n) { c[i] = 0; s[i] = 1; }
-            if (2 * i == n) { c[i] = -1; s[i] = 0; }
-            if (4 * i == 3 * n) { c[i] = 0; s[i] = -1; }
+            if (4 * i == n) {
+                c[i] = 0;
+                s[i] = 1;
+            }
+            if (2 * i == n) {
+                c[i] = -1;
+                s[i] = 0;
+            }
+            if (4 * i == 3 * n) {
+                c[i] = 0;
+                s[i] = -1;
+            }
         }
-        c[0] = 1; s[0] = 0;
-        c[n] = c[0]; s[n] = s[0];
+        c[0] = 1;
+        s[0] = 0;
+        c[n] = c[0];
+        s[n] = s[0];
     }
 };
 
@@ -106,7 +117,10 @@ sg::Mesh sphereMesh(float r, int res) {
         double th = 3.14159265358979323846 * (1.0 - double(j) / stacks);   // polar angle from +y
         sy[j] = clean(float(std::sin(th)));
         cy[j] = clean(float(std::cos(th)));
-        if (2 * j == stacks) { sy[j] = 1; cy[j] = 0; }
+        if (2 * j == stacks) {
+            sy[j] = 1;
+            cy[j] = 0;
+        }
     }
     sy[0] = sy[stacks] = 0;
     cy[0] = -1;
@@ -140,9 +154,8 @@ sg::Mesh boxMesh(const vec3& h, int res) {
     std::vector<float> t = symmetricSteps(n);
     // Face normal, u axis, v axis with u x v = normal (counter-clockwise from outside).
     const vec3 axes[6][3] = {
-        {{1, 0, 0}, {0, 0, -1}, {0, 1, 0}}, {{-1, 0, 0}, {0, 0, 1}, {0, 1, 0}},
-        {{0, 1, 0}, {1, 0, 0}, {0, 0, -1}}, {{0, -1, 0}, {1, 0, 0}, {0, 0, 1}},
-        {{0, 0, 1}, {1, 0, 0}, {0, 1, 0}},  {{0, 0, -1}, {-1, 0, 0}, {0, 1, 0}},
+        {{1, 0, 0}, {0, 0, -1}, {0, 1, 0}}, {{-1, 0, 0}, {0, 0, 1}, {0, 1, 0}}, {{0, 1, 0}, {1, 0, 0}, {0, 0, -1}},
+        {{0, -1, 0}, {1, 0, 0}, {0, 0, 1}}, {{0, 0, 1}, {1, 0, 0}, {0, 1, 0}},  {{0, 0, -1}, {-1, 0, 0}, {0, 1, 0}},
     };
     for (const auto& f : axes)
         addGrid(m, n, n, [&](int i, int j, vec3& p, vec3& nn, vec2& uv) {
@@ -202,9 +215,9 @@ sg::Mesh coneMesh(float r, float hh, int res) {
     Circle phi(slices);
     Circle half(2 * slices);   // half steps for the apex normals
     float h = 2 * hh;
-    float ny = r / h;          // outward normal ~ radial + (r/h) y
+    float ny = r / h;   // outward normal ~ radial + (r/h) y
     addGrid(m, slices, stacks, [&](int i, int j, vec3& p, vec3& n, vec2& uv) {
-        float f = float(stacks - j) / float(stacks);          // radius fraction, 1 at the base
+        float f = float(stacks - j) / float(stacks);   // radius fraction, 1 at the base
         float y = j == stacks ? hh : (j == 0 ? -hh : -hh + h * float(j) / float(stacks));
         float rho = j == 0 ? r : r * f;
         p = vec3(rho * phi.s[i], y, rho * phi.c[i]);
@@ -282,14 +295,20 @@ struct Field {
     virtual float value(const vec3& p) const = 0;
     virtual vec3 normal(const vec3& p, int* part) const = 0;
     // Normal of a given part at p (for vertices shared by faces of different parts).
-    virtual vec3 partNormal(const vec3& p, int part) const { (void)part; return normal(p, nullptr); }
+    virtual vec3 partNormal(const vec3& p, int part) const {
+        (void)part;
+        return normal(p, nullptr);
+    }
 };
 
 struct QuadricField final : Field {
     const sg::ImplicitShape& s;
     explicit QuadricField(const sg::ImplicitShape& sh) : s(sh) {}
     float value(const vec3& p) const override { return s.value(p); }
-    vec3 normal(const vec3& p, int* part) const override { if (part) *part = 0; return s.normal(p); }
+    vec3 normal(const vec3& p, int* part) const override {
+        if (part) *part = 0;
+        return s.normal(p);
+    }
 };
 
 float boxDistance(const vec3& p, const sg::Aabb& b) {
@@ -331,7 +350,11 @@ struct CsgField final : Field {
                 scale[i] = det > 0 && std::isfinite(det) ? std::cbrt(det) : 1.0f;
             }
     }
-    struct Eval { float v; int leaf; bool flip; };
+    struct Eval {
+        float v;
+        int leaf;
+        bool flip;
+    };
     Eval eval(int i, const vec3& p) const {
         const sg::CsgTree::Node& n = t.nodes[i];
         if (n.op < 0) {
@@ -343,8 +366,12 @@ struct CsgField final : Field {
         for (size_t k = 1; k < n.children.size(); ++k) {
             Eval c = eval(n.children[k], p);
             switch (sg::CsgOp(n.op)) {
-            case sg::CsgOp::Union: if (c.v < r.v) r = c; break;
-            case sg::CsgOp::Intersection: if (c.v > r.v) r = c; break;
+            case sg::CsgOp::Union:
+                if (c.v < r.v) r = c;
+                break;
+            case sg::CsgOp::Intersection:
+                if (c.v > r.v) r = c;
+                break;
             case sg::CsgOp::Difference:
                 c.v = -c.v;
                 c.flip = !c.flip;
@@ -382,8 +409,12 @@ sg::Aabb csgBounds(const sg::CsgTree& t, int i) {
     if (sg::CsgOp(n.op) == sg::CsgOp::Difference) return b;
     for (size_t k = 1; k < n.children.size(); ++k) {
         sg::Aabb c = csgBounds(t, n.children[k]);
-        if (sg::CsgOp(n.op) == sg::CsgOp::Union) b.extend(c);
-        else { b.min = glm::max(b.min, c.min); b.max = glm::min(b.max, c.max); }
+        if (sg::CsgOp(n.op) == sg::CsgOp::Union)
+            b.extend(c);
+        else {
+            b.min = glm::max(b.min, c.min);
+            b.max = glm::min(b.max, c.max);
+        }
     }
     return b;
 }
@@ -439,7 +470,10 @@ MarchResult march(const Field& field, sg::Aabb bounds, int res) {
         if (fresh) edgeEnds.push_back(val[a] < 0 ? std::make_pair(a, b) : std::make_pair(b, a));
         return it->second;
     };
-    struct Poly { uint32_t v[4]; int n; };
+    struct Poly {
+        uint32_t v[4];
+        int n;
+    };
     std::vector<Poly> polys;
     const size_t offs[8] = {0, 1, nx, nx + 1, nx * ny, nx * ny + 1, nx * ny + nx, nx * ny + nx + 1};
     const vec3 cornerOff[8] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {0, 0, 1}, {1, 0, 1}, {0, 1, 1}, {1, 1, 1}};
@@ -501,7 +535,7 @@ MarchResult march(const Field& field, sg::Aabb bounds, int res) {
         for (size_t e = r.begin(); e < r.end(); ++e) {
             auto [ia, ib] = edgeEnds[e];
             vec3 a = posOf(ia), b = posOf(ib);
-            float fa = val[ia], fb = val[ib];          // fa < 0 <= fb
+            float fa = val[ia], fb = val[ib];   // fa < 0 <= fb
             float t = fa / (fa - fb);
             float ea = field.value(a), eb = field.value(b);
             if (ea < 0 && eb >= 0) {
@@ -513,13 +547,18 @@ MarchResult march(const Field& field, sg::Aabb bounds, int res) {
                     float tm = (ga * tb - gb * ta) / (ga - gb);
                     if (!(tm > ta && tm < tb)) tm = 0.5f * (ta + tb);
                     float gm = field.value(glm::mix(a, b, tm));
-                    if (gm == 0) { ta = tb = tm; break; }
+                    if (gm == 0) {
+                        ta = tb = tm;
+                        break;
+                    }
                     if (gm < 0) {
-                        ta = tm; ga = gm;
+                        ta = tm;
+                        ga = gm;
                         if (side == -1) gb *= 0.5f;
                         side = -1;
                     } else {
-                        tb = tm; gb = gm;
+                        tb = tm;
+                        gb = gm;
                         if (side == 1) ga *= 0.5f;
                         side = 1;
                     }
@@ -571,8 +610,10 @@ std::vector<int> marchedMesh(const Field& field, const sg::Aabb& bounds, int res
             for (size_t t = rr.begin(); t < rr.end(); ++t) {
                 const auto& tri = r.triangles[t];
                 int a = vertexPart[tri[0]], b = vertexPart[tri[1]], c = vertexPart[tri[2]];
-                if (a == b || a == c) triPart[t] = a;         // majority of the vertices
-                else if (b == c) triPart[t] = b;
+                if (a == b || a == c)
+                    triPart[t] = a;   // majority of the vertices
+                else if (b == c)
+                    triPart[t] = b;
                 else {
                     vec3 centroid = (m.positions[tri[0]] + m.positions[tri[1]] + m.positions[tri[2]]) / 3.0f;
                     field.normal(centroid, &triPart[t]);
@@ -598,7 +639,7 @@ std::vector<int> marchedMesh(const Field& field, const sg::Aabb& bounds, int res
     return triPart;
 }
 
-}  // namespace
+}   // namespace
 
 // --- 6. dispatch and cache -----------------------------------------------------------------------
 
@@ -669,4 +710,4 @@ size_t TessellationCache::size() const {
     return m_entries.size();
 }
 
-}  // namespace rnd
+}   // namespace rnd

@@ -14,7 +14,10 @@ namespace {
 
 int wrapIndex(int i, int n, sg::WrapMode m) {
     switch (m) {
-    case sg::WrapMode::Repeat: { int r = i % n; return r < 0 ? r + n : r; }
+    case sg::WrapMode::Repeat: {
+        int r = i % n;
+        return r < 0 ? r + n : r;
+    }
     case sg::WrapMode::ClampToEdge: return std::clamp(i, 0, n - 1);
     case sg::WrapMode::MirroredRepeat: {
         int p = 2 * n, r = i % p;
@@ -27,7 +30,7 @@ int wrapIndex(int i, int n, sg::WrapMode m) {
 
 uint8_t encodeByte(float linear) { return toByteSRGB(linear); }
 
-}  // namespace
+}   // namespace
 
 SampledTexture::SampledTexture(const sg::Texture& t) : m_wrapS(t.wrapS), m_wrapT(t.wrapT), m_filter(t.filter) {
     Level base;
@@ -52,8 +55,7 @@ SampledTexture::SampledTexture(const sg::Texture& t) : m_wrapS(t.wrapS), m_wrapT
             for (int x = 0; x < l.w; ++x) {
                 vec3 s(0.0f);
                 for (int dy = 0; dy < 2; ++dy)
-                    for (int dx = 0; dx < 2; ++dx)
-                        s += p.texels[size_t(std::min(2 * y + dy, p.h - 1)) * p.w + std::min(2 * x + dx, p.w - 1)];
+                    for (int dx = 0; dx < 2; ++dx) s += p.texels[size_t(std::min(2 * y + dy, p.h - 1)) * p.w + std::min(2 * x + dx, p.w - 1)];
                 s *= 0.25f;
                 uint8_t b[3] = {encodeByte(s.x), encodeByte(s.y), encodeByte(s.z)};
                 l.texels[size_t(y) * l.w + x] = srgbBytesToLinear(b);
@@ -67,7 +69,10 @@ vec3 SampledTexture::sampleLevel(vec2 uv, int level, bool bilinear) const {
     if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) return l.texels[0];
     float fx = uv.x * l.w, fy = uv.y * l.h;
     // Keep the coordinates in a range where int conversion is safe (wraps are periodic).
-    auto reduce = [](float f, int n) { float p = 2.0f * n; return std::fabs(f) > 1e6f ? f - p * std::floor(f / p) : f; };
+    auto reduce = [](float f, int n) {
+        float p = 2.0f * n;
+        return std::fabs(f) > 1e6f ? f - p * std::floor(f / p) : f;
+    };
     fx = reduce(fx, l.w);
     fy = reduce(fy, l.h);
     if (!bilinear) {
@@ -121,8 +126,7 @@ const SampledTexture* SamplerCache::get(const sg::TexturePtr& t) {
 }
 
 void SamplerCache::endFrame() {
-    for (auto it = m_entries.begin(); it != m_entries.end();)
-        it = m_frame - it->second.lastFrame > 8 ? m_entries.erase(it) : std::next(it);
+    for (auto it = m_entries.begin(); it != m_entries.end();) it = m_frame - it->second.lastFrame > 8 ? m_entries.erase(it) : std::next(it);
 }
 
-}  // namespace rnd
+}   // namespace rnd

@@ -26,7 +26,7 @@ namespace {
 std::mutex g_eglMutex;
 bool g_eglLibLoaded = false;   // libEGL found and its EGL 1.0 entry points loaded
 EGLDisplay g_eglDisplay = EGL_NO_DISPLAY;
-std::string g_eglError;        // why the display could not be made (sticky)
+std::string g_eglError;   // why the display could not be made (sticky)
 bool g_eglTried = false;
 
 // Loads libEGL's entry points (without a display). Caller holds g_eglMutex.
@@ -63,8 +63,7 @@ EGLDisplay surfacelessDisplay(std::string& error) {
     } else {
         const char* clientExt = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
         std::string ext = clientExt ? clientExt : "";
-        auto getPlatformDisplay =
-            reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
+        auto getPlatformDisplay = reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
         if (ext.find("EGL_MESA_platform_surfaceless") == std::string::npos || !getPlatformDisplay) {
             g_eglError = "EGL has no EGL_MESA_platform_surfaceless (not Mesa?)";
         } else {
@@ -114,8 +113,8 @@ std::unique_ptr<GlContext> createEgl(std::string& error) {
         error = "eglBindAPI(EGL_OPENGL_API) failed: " + eglErrorName(eglGetError());
         return nullptr;
     }
-    const EGLint configAttribs[] = {EGL_SURFACE_TYPE, EGL_PBUFFER_BIT, EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT,
-                                    EGL_RED_SIZE, 8, EGL_GREEN_SIZE, 8, EGL_BLUE_SIZE, 8, EGL_NONE};
+    const EGLint configAttribs[] = {
+        EGL_SURFACE_TYPE, EGL_PBUFFER_BIT, EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_RED_SIZE, 8, EGL_GREEN_SIZE, 8, EGL_BLUE_SIZE, 8, EGL_NONE};
     EGLConfig config = nullptr;
     EGLint count = 0;
     if (!eglChooseConfig(d, configAttribs, &config, 1, &count) || count < 1) {
@@ -123,8 +122,8 @@ std::unique_ptr<GlContext> createEgl(std::string& error) {
         config = EGL_NO_CONFIG_KHR;
     }
     // Ask for 3.3 core: Mesa answers with the highest core version it has (4.5 on llvmpipe).
-    const EGLint contextAttribs[] = {EGL_CONTEXT_MAJOR_VERSION, 3, EGL_CONTEXT_MINOR_VERSION, 3,
-                                     EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
+    const EGLint contextAttribs[] = {EGL_CONTEXT_MAJOR_VERSION,           3,       EGL_CONTEXT_MINOR_VERSION, 3, EGL_CONTEXT_OPENGL_PROFILE_MASK,
+                                     EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
     EGLContext c = eglCreateContext(d, config, EGL_NO_CONTEXT, contextAttribs);
     if (c == EGL_NO_CONTEXT) {
         error = "eglCreateContext(OpenGL 3.3 core) failed: " + eglErrorName(eglGetError());
@@ -182,7 +181,7 @@ std::unique_ptr<GlContext> createGlfw(std::string& error) {
     return std::make_unique<GlfwContext>(w);
 }
 
-}  // namespace
+}   // namespace
 
 // --- 4. createHeadlessContext ----------------------------------------------------------------
 std::unique_ptr<GlContext> createHeadlessContext(const std::string& requested, std::string* error) {
@@ -239,8 +238,10 @@ CurrentKind currentKind(const void** handle = nullptr) {
     }
     if (kind == CurrentKind::None) {
         // Without glfwInit this returns null (and records GLFW_NOT_INITIALIZED, which we clear).
-        if ((h = glfwGetCurrentContext())) kind = CurrentKind::Glfw;
-        else glfwGetError(nullptr);
+        if ((h = glfwGetCurrentContext()))
+            kind = CurrentKind::Glfw;
+        else
+            glfwGetError(nullptr);
     }
     if (kind == CurrentKind::None) {
         if (GetCurrentFn f = glxGetCurrentContextFn(); f && (h = f())) kind = CurrentKind::Glx;
@@ -252,7 +253,7 @@ CurrentKind currentKind(const void** handle = nullptr) {
 GLADapiproc eglLoad(const char* name) { return reinterpret_cast<GLADapiproc>(eglGetProcAddress(name)); }
 GLADapiproc glfwLoad(const char* name) { return reinterpret_cast<GLADapiproc>(glfwGetProcAddress(name)); }
 
-}  // namespace
+}   // namespace
 
 bool anyContextCurrent() { return currentKind() != CurrentKind::None; }
 
@@ -286,4 +287,4 @@ std::string describeCurrentContext() {
     return "OpenGL " + str(GL_VERSION) + ", " + str(GL_RENDERER);
 }
 
-}  // namespace rnd::gl
+}   // namespace rnd::gl

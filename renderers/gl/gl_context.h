@@ -45,4 +45,4 @@ std::string loadGLFunctions();
 // "OpenGL 4.5 (Core Profile) Mesa ..., llvmpipe" of the current context (after loading).
 std::string describeCurrentContext();
 
-}  // namespace rnd::gl
+}   // namespace rnd::gl

@@ -33,7 +33,7 @@ namespace rnd::gl {
 extern const char* const kShader_lighting_glsl;
 extern const char* const kShader_mesh_vert;
 extern const char* const kShader_mesh_frag;
-}  // namespace rnd::gl
+}   // namespace rnd::gl
 
 namespace rnd {
 
@@ -102,8 +102,8 @@ std::string buildProgram(const std::string& key, Program& p) {
         bool invSq = key[i] >= 'A' && key[i] <= 'Z';
         calls += "addLight(" + std::to_string(i - 2) + ", " + type + ", " + (invSq ? "true" : "false") + ", n, p, v, mul, add); ";
     }
-    std::string prefix = std::string("#version 330 core\n#define SHADING ") + key[0] + "\n#define REFLECTION " + key[1] +
-                         "\n#define MAX_LIGHTS " + std::to_string(kMaxLights) + "\n#define LIGHT_CALLS " + calls + "\n";
+    std::string prefix = std::string("#version 330 core\n#define SHADING ") + key[0] + "\n#define REFLECTION " + key[1] + "\n#define MAX_LIGHTS " +
+                         std::to_string(kMaxLights) + "\n#define LIGHT_CALLS " + calls + "\n";
     std::string common = prefix + gl::kShader_lighting_glsl + "\n";
     GLuint vs = 0, fs = 0;
     std::string err = compileShader(GL_VERTEX_SHADER, common + gl::kShader_mesh_vert, vs);
@@ -248,8 +248,7 @@ void uploadMesh(GpuMesh& g, const Mesh& mesh, const std::vector<uint16_t>* trian
         // Stable sort of the triangles by material, one draw range per material.
         std::vector<uint32_t> order(prims);
         std::iota(order.begin(), order.end(), 0u);
-        std::stable_sort(order.begin(), order.end(),
-                         [&](uint32_t a, uint32_t b) { return (*triangleMaterial)[a] < (*triangleMaterial)[b]; });
+        std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return (*triangleMaterial)[a] < (*triangleMaterial)[b]; });
         std::vector<uint32_t> sorted(indices.size());
         for (size_t t = 0; t < prims; ++t) {
             std::copy_n(&indices[size_t(order[t]) * 3], 3, &sorted[t * 3]);
@@ -336,12 +335,16 @@ struct RenderTarget {
         samples = s;
         glGenRenderbuffers(1, &color);
         glBindRenderbuffer(GL_RENDERBUFFER, color);
-        if (s > 1) glRenderbufferStorageMultisample(GL_RENDERBUFFER, s, GL_SRGB8_ALPHA8, w, h);
-        else glRenderbufferStorage(GL_RENDERBUFFER, GL_SRGB8_ALPHA8, w, h);
+        if (s > 1)
+            glRenderbufferStorageMultisample(GL_RENDERBUFFER, s, GL_SRGB8_ALPHA8, w, h);
+        else
+            glRenderbufferStorage(GL_RENDERBUFFER, GL_SRGB8_ALPHA8, w, h);
         glGenRenderbuffers(1, &depth);
         glBindRenderbuffer(GL_RENDERBUFFER, depth);
-        if (s > 1) glRenderbufferStorageMultisample(GL_RENDERBUFFER, s, GL_DEPTH_COMPONENT32F, w, h);
-        else glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, w, h);
+        if (s > 1)
+            glRenderbufferStorageMultisample(GL_RENDERBUFFER, s, GL_DEPTH_COMPONENT32F, w, h);
+        else
+            glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, w, h);
         glBindRenderbuffer(GL_RENDERBUFFER, 0);
         glGenFramebuffers(1, &fbo);
         glBindFramebuffer(GL_FRAMEBUFFER, fbo);
@@ -408,8 +411,8 @@ public:
     }
 
 private:
-    static constexpr GLenum kCaps[] = {GL_DEPTH_TEST, GL_CULL_FACE, GL_BLEND, GL_SCISSOR_TEST, GL_STENCIL_TEST,
-                                       GL_FRAMEBUFFER_SRGB, GL_MULTISAMPLE, GL_POLYGON_OFFSET_FILL,
+    static constexpr GLenum kCaps[] = {GL_DEPTH_TEST,          GL_CULL_FACE,         GL_BLEND,       GL_SCISSOR_TEST,
+                                       GL_STENCIL_TEST,        GL_FRAMEBUFFER_SRGB,  GL_MULTISAMPLE, GL_POLYGON_OFFSET_FILL,
                                        GL_POLYGON_OFFSET_LINE, GL_PROGRAM_POINT_SIZE};
     GLint m_drawFbo = 0, m_readFbo = 0, m_viewport[4] = {}, m_program = 0, m_vao = 0, m_arrayBuffer = 0;
     GLint m_renderbuffer = 0, m_activeTexture = GL_TEXTURE0, m_texture0 = 0, m_pack = 4, m_unpack = 4;
@@ -463,7 +466,7 @@ public:
 private:
     std::string prepareContext(bool& madeCurrent);
     const Program* programFor(const FrameInput& f, std::string& error);   // compiles on first use
-    void forgetGLObjects();   // drops names without deleting (their context is gone or not current)
+    void forgetGLObjects();                                               // drops names without deleting (their context is gone or not current)
     void releaseAll();
     GpuMesh* meshFor(const Mesh& mesh, const std::vector<uint16_t>* triangleMaterial);
     GpuTexture* textureFor(const TexturePtr& t);
@@ -471,16 +474,16 @@ private:
     void setMaterial(const Program& p, const Material& m, bool hasTexture, bool unlit);
     void evict();
 
-    std::unique_ptr<gl::GlContext> m_own;   // our headless context, made on first need
-    const void* m_objectsContext = nullptr; // the context our GL objects live in
+    std::unique_ptr<gl::GlContext> m_own;     // our headless context, made on first need
+    const void* m_objectsContext = nullptr;   // the context our GL objects live in
     bool m_loaded = false;
     std::string m_contextDescription, m_platform;
     int m_maxSamples = 0, m_maxSize = 0;
 
     std::unordered_map<std::string, Program> m_programs;   // by programKey()
     RenderTarget m_target, m_resolve;
-    std::unordered_map<uint64_t, GpuMesh> m_meshes;       // by Mesh::id
-    std::unordered_map<uint64_t, GpuTexture> m_textures;  // by Texture::id
+    std::unordered_map<uint64_t, GpuMesh> m_meshes;        // by Mesh::id
+    std::unordered_map<uint64_t, GpuTexture> m_textures;   // by Texture::id
     TessellationCache m_tess;
     uint64_t m_frame = 0, m_meshUploads = 0, m_textureUploads = 0;
 };
@@ -690,8 +693,8 @@ RenderStats GlRenderer::render(const FrameInput& frame, int width, int height, F
     int ssaa = s.aa == AAMode::SSAA ? std::clamp(s.aaRate, 1, 8) : 1;
     int rw = width * ssaa, rh = height * ssaa;
     if (rw > m_maxSize || rh > m_maxSize) {
-        stats.error = "gl backend: render size " + std::to_string(rw) + "x" + std::to_string(rh) +
-                      " exceeds the driver's limit of " + std::to_string(m_maxSize);
+        stats.error = "gl backend: render size " + std::to_string(rw) + "x" + std::to_string(rh) + " exceeds the driver's limit of " +
+                      std::to_string(m_maxSize);
         return stats;
     }
     err = m_target.ensure(rw, rh, samples > 1 ? samples : 0);
@@ -708,8 +711,10 @@ RenderStats GlRenderer::render(const FrameInput& frame, int width, int height, F
     glDisable(GL_BLEND);
     glDisable(GL_STENCIL_TEST);
     glEnable(GL_FRAMEBUFFER_SRGB);
-    if (samples > 1) glEnable(GL_MULTISAMPLE);
-    else glDisable(GL_MULTISAMPLE);
+    if (samples > 1)
+        glEnable(GL_MULTISAMPLE);
+    else
+        glDisable(GL_MULTISAMPLE);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     glDepthMask(GL_TRUE);
     glClearColor(s.background.r, s.background.g, s.background.b, 1.0f);
@@ -761,8 +766,7 @@ RenderStats GlRenderer::render(const FrameInput& frame, int width, int height, F
 
     // Nearest first, so that llvmpipe's early depth test skips shading hidden fragments.
     std::vector<float> distance(items.size());
-    for (size_t i = 0; i < items.size(); ++i)
-        distance[i] = glm::length(vec3(*items[i].world * vec4(items[i].gpu->centre, 1.0f)) - frame.camera.eye);
+    for (size_t i = 0; i < items.size(); ++i) distance[i] = glm::length(vec3(*items[i].world * vec4(items[i].gpu->centre, 1.0f)) - frame.camera.eye);
     std::vector<uint32_t> order(items.size());
     std::iota(order.begin(), order.end(), 0u);
     std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return distance[a] < distance[b]; });
@@ -789,12 +793,10 @@ RenderStats GlRenderer::render(const FrameInput& frame, int width, int height, F
             for (const IndexRange& r : it.gpu->ranges) {
                 if (!wireframe) {
                     const Material* m = it.material;
-                    if (it.rangeMaterials && r.material >= 0 && size_t(r.material) < it.rangeMaterials->size())
-                        m = &(*it.rangeMaterials)[r.material];
+                    if (it.rangeMaterials && r.material >= 0 && size_t(r.material) < it.rangeMaterials->size()) m = &(*it.rangeMaterials)[r.material];
                     setMaterial(prog, *m, it.texture != nullptr, unlit);
                 }
-                glDrawElements(it.gpu->primitive, r.count, GL_UNSIGNED_INT,
-                               reinterpret_cast<const void*>(size_t(r.first) * sizeof(uint32_t)));
+                glDrawElements(it.gpu->primitive, r.count, GL_UNSIGNED_INT, reinterpret_cast<const void*>(size_t(r.first) * sizeof(uint32_t)));
             }
         }
     };
@@ -858,7 +860,7 @@ RenderStats GlRenderer::render(const FrameInput& frame, int width, int height, F
     return stats;
 }
 
-}  // namespace
+}   // namespace
 
 std::unique_ptr<Renderer> makeGlRenderer() { return std::make_unique<GlRenderer>(); }
 
@@ -867,4 +869,4 @@ GlCacheCounters glCacheCounters(const Renderer& r) {
     return {};
 }
 
-}  // namespace rnd
+}   // namespace rnd

@@ -23,9 +23,9 @@ struct GlCacheCounters {
     uint64_t textureUploads = 0;   // textures built
     size_t meshesCached = 0;
     size_t texturesCached = 0;
-    std::string context;           // "OpenGL 4.5 (Core Profile) Mesa ..., llvmpipe ..." once rendered
-    std::string platform;          // "egl-surfaceless", "glfw-hidden" or "caller" (a context was current)
+    std::string context;    // "OpenGL 4.5 (Core Profile) Mesa ..., llvmpipe ..." once rendered
+    std::string platform;   // "egl-surfaceless", "glfw-hidden" or "caller" (a context was current)
 };
 GlCacheCounters glCacheCounters(const Renderer& r);
 
-}  // namespace rnd
+}   // namespace rnd

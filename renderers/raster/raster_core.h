@@ -19,11 +19,11 @@
 
 namespace rnd::raster {
 
-constexpr int kSubBits = 8;                 // sub-pixel precision
-constexpr int kSub = 1 << kSubBits;         // fixed-point units per pixel
-constexpr int kHalf = kSub / 2;             // pixel centre offset
-constexpr int kTileSize = 64;               // screen tiles rasterized in parallel
-constexpr float kGuardPixels = 8192.0f;     // guard band beyond the viewport (x, y)
+constexpr int kSubBits = 8;               // sub-pixel precision
+constexpr int kSub = 1 << kSubBits;       // fixed-point units per pixel
+constexpr int kHalf = kSub / 2;           // pixel centre offset
+constexpr int kTileSize = 64;             // screen tiles rasterized in parallel
+constexpr float kGuardPixels = 8192.0f;   // guard band beyond the viewport (x, y)
 
 // GL standard 4x MSAA sample positions in fixed-point units from the pixel's lower-left corner
 // (y up). Same pattern as D3D's standard 4x, mirrored for the y-up window convention.
@@ -48,36 +48,49 @@ struct Edge {
 // y up), edges e[i] from v[i] to v[i+1]; the barycentric weight of vertex (i+2)%3 is
 // e[i](p) / area2. `flipped` says whether the input was clockwise (two vertices swapped).
 struct TriSetup {
-    int32_t x[3], y[3];          // fixed point
+    int32_t x[3], y[3];   // fixed point
     Edge e[3];
-    int64_t area2 = 0;           // twice the area in fixed units^2 (> 0)
+    int64_t area2 = 0;                              // twice the area in fixed units^2 (> 0)
     int minX = 0, minY = 0, maxX = -1, maxY = -1;   // pixel bbox, inclusive, inside the viewport
     bool flipped = false;
     uint8_t order[3] = {0, 1, 2};   // input vertex index of each setup vertex
 };
 
 // Round to nearest fixed-point unit (halves away from zero); inputs lie within the guard band.
-inline int32_t toFixed(float v) { float f = v * float(kSub); return int32_t(f + (f >= 0 ? 0.5f : -0.5f)); }
+inline int32_t toFixed(float v) {
+    float f = v * float(kSub);
+    return int32_t(f + (f >= 0 ? 0.5f : -0.5f));
+}
 
 // Sets up the triangle with window-space vertices (x, y) for a width x height viewport.
 // Returns false when it is degenerate (zero area) or its bounding box misses every pixel
 // centre (or sample, with `msaa`). Coordinates must lie within the guard band.
 inline bool setupTriangle(const float wx[3], const float wy[3], int width, int height, TriSetup& t, bool msaa = false) {
     int32_t x[3], y[3];
-    for (int i = 0; i < 3; ++i) { x[i] = toFixed(wx[i]); y[i] = toFixed(wy[i]); }
+    for (int i = 0; i < 3; ++i) {
+        x[i] = toFixed(wx[i]);
+        y[i] = toFixed(wy[i]);
+    }
     int64_t area = int64_t(x[1] - x[0]) * (y[2] - y[0]) - int64_t(y[1] - y[0]) * (x[2] - x[0]);
     if (area == 0) return false;
     t.flipped = area < 0;
     if (t.flipped) {   // make it counter-clockwise: swap vertices 1 and 2
         std::swap(x[1], x[2]);
         std::swap(y[1], y[2]);
-        t.order[0] = 0; t.order[1] = 2; t.order[2] = 1;
+        t.order[0] = 0;
+        t.order[1] = 2;
+        t.order[2] = 1;
         area = -area;
     } else {
-        t.order[0] = 0; t.order[1] = 1; t.order[2] = 2;
+        t.order[0] = 0;
+        t.order[1] = 1;
+        t.order[2] = 2;
     }
     t.area2 = area;
-    for (int i = 0; i < 3; ++i) { t.x[i] = x[i]; t.y[i] = y[i]; }
+    for (int i = 0; i < 3; ++i) {
+        t.x[i] = x[i];
+        t.y[i] = y[i];
+    }
     // Pixel bbox: samples at i*kSub + offset; with MSAA the offsets span [32, 224].
     int32_t lo = msaa ? 32 : kHalf, hi = msaa ? 224 : kHalf;
     int32_t fx0 = std::min({x[0], x[1], x[2]}), fx1 = std::max({x[0], x[1], x[2]});
@@ -116,8 +129,10 @@ inline bool setupTriangle(const float wx[3], const float wy[3], int width, int h
 template <class Fn>
 inline void forEachCoveredPixel(const TriSetup& t, int x0, int y0, int x1, int y1, Fn&& fn) {
     constexpr int kB = 8;
-    x0 = std::max(x0, t.minX); x1 = std::min(x1, t.maxX);
-    y0 = std::max(y0, t.minY); y1 = std::min(y1, t.maxY);
+    x0 = std::max(x0, t.minX);
+    x1 = std::min(x1, t.maxX);
+    y0 = std::max(y0, t.minY);
+    y1 = std::min(y1, t.maxY);
     if (x0 > x1 || y0 > y1) return;
     const Edge* e = t.e;
     const int64_t sx[3] = {int64_t(e[0].a) * kSub, int64_t(e[1].a) * kSub, int64_t(e[2].a) * kSub};
@@ -156,8 +171,10 @@ inline void forEachCoveredPixel(const TriSetup& t, int x0, int y0, int x1, int y
 // Reference version without blocks (tests compare the two).
 template <class Fn>
 inline void forEachCoveredPixelSimple(const TriSetup& t, int x0, int y0, int x1, int y1, Fn&& fn) {
-    x0 = std::max(x0, t.minX); x1 = std::min(x1, t.maxX);
-    y0 = std::max(y0, t.minY); y1 = std::min(y1, t.maxY);
+    x0 = std::max(x0, t.minX);
+    x1 = std::min(x1, t.maxX);
+    y0 = std::max(y0, t.minY);
+    y1 = std::min(y1, t.maxY);
     for (int j = y0; j <= y1; ++j)
         for (int i = x0; i <= x1; ++i) {
             int64_t px = int64_t(i) * kSub + kHalf, py = int64_t(j) * kSub + kHalf;
@@ -174,7 +191,9 @@ inline void forEachCoveredPixelSimple(const TriSetup& t, int x0, int y0, int x1,
 // exactly, x and y only outside the guard band (the viewport scissor does the rest).
 enum : uint8_t { kClipNear = 1, kClipFar = 2, kClipLeft = 4, kClipRight = 8, kClipBottom = 16, kClipTop = 32, kInvalid = 64 };
 
-struct GuardBand { float gx = 1, gy = 1; };
+struct GuardBand {
+    float gx = 1, gy = 1;
+};
 inline GuardBand guardBand(int width, int height) {
     return {1.0f + 2.0f * kGuardPixels / std::max(width, 1), 1.0f + 2.0f * kGuardPixels / std::max(height, 1)};
 }
@@ -272,9 +291,11 @@ inline void drawLineDDA(float ax, float ay, float bx, float by, int width, int h
         float t = (c - a0) / len;
         int m = int(std::floor(b0 + (c - a0) * slope));
         if (m < 0 || m >= minorSize) continue;
-        if (xMajor) fn(k, m, t);
-        else fn(m, k, t);
+        if (xMajor)
+            fn(k, m, t);
+        else
+            fn(m, k, t);
     }
 }
 
-}  // namespace rnd::raster
+}   // namespace rnd::raster

@@ -22,9 +22,9 @@
 
 #include "raster/raster_core.h"
 #include "raster/raster_shading.h"
-#include "renderers/texture_sampler.h"
 #include "renderers/shading.h"
 #include "renderers/tessellate.h"
+#include "renderers/texture_sampler.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -60,7 +60,7 @@ using sg::vec4;
 // comparison finishes the job. Values below 2^-13 encode to 0, values >= 1 to 255.
 struct SrgbEncoder {
     static constexpr int kMinExp = -13;
-    float next[256];         // next[b]: smallest linear value that encodes to b + 1
+    float next[256];   // next[b]: smallest linear value that encodes to b + 1
     uint8_t table[13 * 256];
     SrgbEncoder() {
         for (int b = 0; b < 255; ++b) next[b] = decodeSRGB((b + 0.5f) / 255.0f);
@@ -97,21 +97,21 @@ struct DrawItem {
     mat4 world{1.0f};
     mat3 normal{1.0f};
     sg::Material material;
-    std::shared_ptr<const std::vector<uint16_t>> triMat;       // per-triangle material (CSG)
+    std::shared_ptr<const std::vector<uint16_t>> triMat;   // per-triangle material (CSG)
     std::shared_ptr<const std::vector<sg::Material>> materials;
     const SampledTexture* texture = nullptr;
     bool mirrored = false;
-    bool perCorner = false;     // Gouraud with per-triangle materials: one vertex per corner
+    bool perCorner = false;   // Gouraud with per-triangle materials: one vertex per corner
     bool hasNormals = false;
     bool hasUV = false;
     bool hasColors = false;
-    uint64_t firstTri = 0;      // global index of its first triangle
+    uint64_t firstTri = 0;   // global index of its first triangle
     uint32_t triCount = 0;
 
     // Vertex stage outputs (one per vertex, or per corner when perCorner).
     std::vector<vec4> clip;
     std::vector<uint8_t> code;
-    std::vector<vec4> win;      // window x, y, z, 1/w (valid when code == 0)
+    std::vector<vec4> win;   // window x, y, z, 1/w (valid when code == 0)
     std::vector<vec3> wpos, wnrm;
     std::vector<vec3> gouraudA[2], gouraudB[2];   // front/back: colour = A * albedo + B
 
@@ -146,21 +146,27 @@ void runVertexStage(DrawItem& d, const sg::FrameInput& f, int width, int height,
     d.wpos.resize(n);
     d.wnrm.assign(n, vec3(0.0f));
     if (gouraud)
-        for (int s = 0; s < 2; ++s) { d.gouraudA[s].resize(n); d.gouraudB[s].resize(n); }
+        for (int s = 0; s < 2; ++s) {
+            d.gouraudA[s].resize(n);
+            d.gouraudB[s].resize(n);
+        }
     const mat4 viewProj = f.camera.proj * f.camera.view;
     const GuardBand g = guardBand(width, height);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t v = r.begin(); v != r.end(); ++v) {
             uint32_t mi = d.meshIndex(uint32_t(v));
-            if (mi >= m.positions.size()) { d.code[v] = kClipNear; continue; }
-            vec4 w = d.world * vec4(m.positions[mi], 1.0f);     // modelling: object -> world
-            vec4 c = viewProj * w;                              // viewing + projection -> clip
+            if (mi >= m.positions.size()) {
+                d.code[v] = kClipNear;
+                continue;
+            }
+            vec4 w = d.world * vec4(m.positions[mi], 1.0f);   // modelling: object -> world
+            vec4 c = viewProj * w;                            // viewing + projection -> clip
             d.wpos[v] = vec3(w);
             d.clip[v] = c;
             d.code[v] = outcode(c, g);
             if (d.code[v] == 0) d.win[v] = toWindow(c, width, height);
             if (d.hasNormals) {
-                vec3 nn = d.normal * m.normals[mi];             // normal matrix (inverse transpose)
+                vec3 nn = d.normal * m.normals[mi];   // normal matrix (inverse transpose)
                 float len = glm::length(nn);
                 d.wnrm[v] = len > 0 ? nn / len : vec3(0, 0, 1);
             }
@@ -180,21 +186,21 @@ void runVertexStage(DrawItem& d, const sg::FrameInput& f, int width, int height,
 // One scan-converted triangle (a whole input triangle or a piece of a clipped one).
 struct Tri {
     TriSetup s;
-    float zRef, zdx, zdy;    // window z at pixel centre (minX, minY) and per-pixel steps
+    float zRef, zdx, zdy;   // window z at pixel centre (minX, minY) and per-pixel steps
     // u_k = lambda_k / w_k (screen-linear) at pixel centre (minX, minY) and per-pixel steps;
     // perspective-correct barycentrics are u_k / sum(u).
     float uRef[3], udx[3], udy[3];
     uint32_t draw = 0, prim = 0;
-    int32_t clip = -1;       // index into Chunk::clipBary (bary of setup vertices), -1 = none
+    int32_t clip = -1;   // index into Chunk::clipBary (bary of setup vertices), -1 = none
     bool front = true;
 };
 
 struct Chunk {
-    uint64_t begin = 0, end = 0;                 // global triangle range
+    uint64_t begin = 0, end = 0;   // global triangle range
     std::vector<Tri> tris;
     std::vector<std::array<vec3, 3>> clipBary;
-    std::vector<uint32_t> tileStart, items;      // CSR: tiles -> triangle indices in order
-    std::vector<uint32_t> fill;                  // scratch for binning
+    std::vector<uint32_t> tileStart, items;   // CSR: tiles -> triangle indices in order
+    std::vector<uint32_t> fill;               // scratch for binning
 };
 
 struct FrameContext {
@@ -203,7 +209,7 @@ struct FrameContext {
     int tilesX = 0, tilesY = 0;
     bool msaa = false;
     bool referenceShading = false;
-    bool timing = false;             // VIEWER_RASTER_TIMING=1: print stage times to stderr   // call rnd::shade per fragment instead of the batch
+    bool timing = false;   // VIEWER_RASTER_TIMING=1: print stage times to stderr   // call rnd::shade per fragment instead of the batch
     std::vector<DrawItem>* draws = nullptr;
     std::vector<Chunk>* chunks = nullptr;
 };
@@ -238,8 +244,9 @@ void runTriangleStage(Chunk& ch, const FrameContext& fc) {
     const auto& st = fc.frame->settings;
     const GuardBand g = guardBand(fc.width, fc.height);
     // First draw containing ch.begin.
-    size_t di = size_t(std::upper_bound(draws.begin(), draws.end(), ch.begin,
-                                        [](uint64_t v, const DrawItem& d) { return v < d.firstTri; }) - draws.begin()) - 1;
+    size_t di =
+        size_t(std::upper_bound(draws.begin(), draws.end(), ch.begin, [](uint64_t v, const DrawItem& d) { return v < d.firstTri; }) - draws.begin()) -
+        1;
     for (uint64_t gi = ch.begin; gi < ch.end; ++gi) {
         while (gi >= draws[di].firstTri + draws[di].triCount) ++di;
         const DrawItem& d = draws[di];
@@ -252,7 +259,7 @@ void runTriangleStage(Chunk& ch, const FrameContext& fc) {
         }
         if (!ok) continue;
         uint8_t c0 = d.code[v[0]], c1 = d.code[v[1]], c2 = d.code[v[2]];
-        if (c0 & c1 & c2) continue;   // all outside one plane
+        if (c0 & c1 & c2) continue;                // all outside one plane
         if ((c0 | c1 | c2) & kInvalid) continue;   // non-finite vertex
         if ((c0 | c1 | c2) == 0) {
             Tri tri;
@@ -280,7 +287,12 @@ void runTriangleStage(Chunk& ch, const FrameContext& fc) {
             int idx[3] = {0, k, k + 1};
             Tri tri;
             float wx[3], wy[3], z[3], iw[3];
-            for (int q = 0; q < 3; ++q) { wx[q] = w[idx[q]].x; wy[q] = w[idx[q]].y; z[q] = w[idx[q]].z; iw[q] = w[idx[q]].w; }
+            for (int q = 0; q < 3; ++q) {
+                wx[q] = w[idx[q]].x;
+                wy[q] = w[idx[q]].y;
+                z[q] = w[idx[q]].z;
+                iw[q] = w[idx[q]].w;
+            }
             if (!setupTriangle(wx, wy, fc.width, fc.height, tri.s, fc.msaa)) continue;
             tri.front = tri.s.flipped == d.mirrored;
             if (st.cullBackFaces && !tri.front) continue;
@@ -315,7 +327,8 @@ void runTriangleStage(Chunk& ch, const FrameContext& fc) {
 
 // Rasterizes one triangle into the tile's visibility buffer (depth LESS). `samples` is 1 or 4
 // (MSAA: sample s of pixel p at index p*4 + s).
-__attribute__((noinline)) void rasterizeIntoTile(const Tri& t, uint32_t id, int tx0, int ty0, int tx1, int ty1, int samples, float* depth, uint32_t* ids) {
+__attribute__((noinline)) void rasterizeIntoTile(const Tri& t, uint32_t id, int tx0, int ty0, int tx1, int ty1, int samples, float* depth,
+                                                 uint32_t* ids) {
     int x0 = std::max(tx0, t.s.minX), x1 = std::min(tx1, t.s.maxX);
     int y0 = std::max(ty0, t.s.minY), y1 = std::min(ty1, t.s.maxY);
     if (x0 > x1 || y0 > y1) return;
@@ -328,7 +341,10 @@ __attribute__((noinline)) void rasterizeIntoTile(const Tri& t, uint32_t id, int 
             float z = t.zRef + t.zdx * float(i - t.s.minX) + t.zdy * float(j - t.s.minY);
             z = std::clamp(z, 0.0f, 1.0f);
             size_t p = size_t(j - ty0) * tw + (i - tx0);
-            if (z < depth[p]) { depth[p] = z; ids[p] = id; }
+            if (z < depth[p]) {
+                depth[p] = z;
+                ids[p] = id;
+            }
         });
         return;
     }
@@ -341,7 +357,10 @@ __attribute__((noinline)) void rasterizeIntoTile(const Tri& t, uint32_t id, int 
                 float z = t.zRef + t.zdx * (float(i - t.s.minX) + float(kMsaa4X[s] - kHalf) / kSub) +
                           t.zdy * (float(j - t.s.minY) + float(kMsaa4Y[s] - kHalf) / kSub);
                 z = std::clamp(z, 0.0f, 1.0f);
-                if (z < depth[p + s]) { depth[p + s] = z; ids[p + s] = id; }
+                if (z < depth[p + s]) {
+                    depth[p + s] = z;
+                    ids[p + s] = id;
+                }
             }
         }
 }
@@ -355,8 +374,8 @@ struct TriCache {
     const sg::Material* mat = nullptr;
     const std::array<vec3, 3>* cb = nullptr;   // clip barycentrics or null
     uint32_t v[3] = {0, 0, 0};
-    vec3 p[3], pe[3], n[3];                    // world positions, eye positions, normals
-    bool faceNormal = false;                   // flat (or no normals): n[0] is the normal
+    vec3 p[3], pe[3], n[3];    // world positions, eye positions, normals
+    bool faceNormal = false;   // flat (or no normals): n[0] is the normal
     bool gouraud = false;
 
     void load(uint32_t newId, const Tri& tri, const Chunk& ch, const FrameContext& fc) {
@@ -396,14 +415,22 @@ __attribute__((noinline)) float prepareFragment(const TriCache& tc, const FrameC
     const float di = float(i - t.s.minX), dj = float(j - t.s.minY);
     // Perspective correction: lambda/w is linear in screen space; divide by the sum (1/w).
     float u[3], sum = 0;
-    for (int q = 0; q < 3; ++q) { u[q] = t.uRef[q] + t.udx[q] * di + t.udy[q] * dj; sum += u[q]; }
+    for (int q = 0; q < 3; ++q) {
+        u[q] = t.uRef[q] + t.udx[q] * di + t.udy[q] * dj;
+        sum += u[q];
+    }
     float invSum = sum != 0 ? 1.0f / sum : 0.0f;
     float b[3] = {u[0] * invSum, u[1] * invSum, u[2] * invSum};
     // Weights of the input triangle's corners.
     vec3 bo;
     const std::array<vec3, 3>* cb = tc.cb;
-    if (cb) bo = b[0] * (*cb)[0] + b[1] * (*cb)[1] + b[2] * (*cb)[2];
-    else { bo[t.s.order[0]] = b[0]; bo[t.s.order[1]] = b[1]; bo[t.s.order[2]] = b[2]; }
+    if (cb)
+        bo = b[0] * (*cb)[0] + b[1] * (*cb)[1] + b[2] * (*cb)[2];
+    else {
+        bo[t.s.order[0]] = b[0];
+        bo[t.s.order[1]] = b[1];
+        bo[t.s.order[2]] = b[2];
+    }
     const uint32_t* v = tc.v;
     vec3 pos = bo[0] * tc.p[0] + bo[1] * tc.p[1] + bo[2] * tc.p[2];
     const sg::Material& mat = *tc.mat;
@@ -446,8 +473,10 @@ __attribute__((noinline)) float prepareFragment(const TriCache& tc, const FrameC
             float len = glm::length(n);
             n = len > 0 ? n / len : vec3(0, 0, 1);
         }
-        if (fc.referenceShading) sb.setColor(k, shade(mat, SurfacePoint{pos, n, albedo}, f.camera.eye, f));   // rnd::shade itself
-        else sb.set(k, mat, pos, n, albedo, f.ambientLight);
+        if (fc.referenceShading)
+            sb.setColor(k, shade(mat, SurfacePoint{pos, n, albedo}, f.camera.eye, f));   // rnd::shade itself
+        else
+            sb.set(k, mat, pos, n, albedo, f.ambientLight);
     }
     if (f.settings.fog == sg::FogMode::Off) return 0.0f;
     return glm::length(bo[0] * tc.pe[0] + bo[1] * tc.pe[1] + bo[2] * tc.pe[2]);   // eye-space distance
@@ -458,9 +487,9 @@ struct TileBuffers {
     std::vector<uint32_t> ids;
     std::vector<uint16_t> fragPixel;   // pixel index in the tile
     std::vector<uint32_t> fragTri;
-    std::vector<uint8_t> fragCount;    // MSAA samples covered
+    std::vector<uint8_t> fragCount;   // MSAA samples covered
     std::vector<float> fogDist;
-    std::vector<vec3> accum;           // MSAA: linear colour sum per pixel
+    std::vector<vec3> accum;   // MSAA: linear colour sum per pixel
     ShadeBatch batch;
 };
 
@@ -508,7 +537,10 @@ void renderTile(int tile, const FrameContext& fc, Framebuffer& target, TileBuffe
             int p = jj * kTileSize + ii;
             int row = fc.height - 1 - (y0 + jj);
             uint8_t* out = target.pixel(x0 + ii, row);
-            out[0] = bgBytes[0]; out[1] = bgBytes[1]; out[2] = bgBytes[2]; out[3] = 255;
+            out[0] = bgBytes[0];
+            out[1] = bgBytes[1];
+            out[2] = bgBytes[2];
+            out[3] = 255;
             float* dOut = &target.depth[size_t(row) * fc.width + x0 + ii];
             if (samples == 1) {
                 *dOut = buf.depth[p];
@@ -561,7 +593,9 @@ void renderTile(int tile, const FrameContext& fc, Framebuffer& target, TileBuffe
             if (fog) c = applyFog(st, c, buf.fogDist[k]);
             int p = buf.fragPixel[k];
             uint8_t* out = target.pixel(x0 + p % kTileSize, fc.height - 1 - (y0 + p / kTileSize));
-            out[0] = enc(c.x); out[1] = enc(c.y); out[2] = enc(c.z);
+            out[0] = enc(c.x);
+            out[1] = enc(c.y);
+            out[2] = enc(c.z);
         }
         return;
     }
@@ -581,7 +615,9 @@ void renderTile(int tile, const FrameContext& fc, Framebuffer& target, TileBuffe
             if (!covered[p]) continue;
             vec3 c = (buf.accum[p] + float(4 - covered[p]) * bg) * 0.25f;
             uint8_t* out = target.pixel(x0 + ii, fc.height - 1 - (y0 + jj));
-            out[0] = enc(c.x); out[1] = enc(c.y); out[2] = enc(c.z);
+            out[0] = enc(c.x);
+            out[1] = enc(c.y);
+            out[2] = enc(c.z);
         }
 }
 
@@ -594,8 +630,10 @@ bool clipSegment(vec4& a, vec4& b, const GuardBand& g) {
     float t0 = 0, t1 = 1;
     auto clipPlane = [&](float da, float db) {
         if (da < 0 && db < 0) return false;
-        if (da < 0) t0 = std::max(t0, da / (da - db));
-        else if (db < 0) t1 = std::min(t1, da / (da - db));
+        if (da < 0)
+            t0 = std::max(t0, da / (da - db));
+        else if (db < 0)
+            t1 = std::min(t1, da / (da - db));
         return t0 <= t1;
     };
     if (!clipPlane(a.z + a.w, b.z + b.w) || !clipPlane(a.w - a.z, b.w - b.z) || !clipPlane(a.x + g.gx * a.w, b.x + g.gx * b.w) ||
@@ -615,7 +653,10 @@ void writeLinePixel(Framebuffer& fb, int i, int j, float z, const vec3& linear, 
     dst = std::min(dst, z);
     const SrgbEncoder& enc = srgbEncoder();
     uint8_t* p = fb.pixel(i, row);
-    p[0] = enc(linear.x); p[1] = enc(linear.y); p[2] = enc(linear.z); p[3] = 255;
+    p[0] = enc(linear.x);
+    p[1] = enc(linear.y);
+    p[2] = enc(linear.z);
+    p[3] = 255;
 }
 
 // End point of a line: clip position, unfogged linear colour, eye distance (for fog).
@@ -638,7 +679,10 @@ void drawSegment(Framebuffer& fb, LineEnd a, LineEnd b, const GuardBand& g, cons
         int axis = 0;
         for (int k = 1; k < 4; ++k)
             if (std::fabs(dd[k]) > std::fabs(dd[axis])) axis = k;
-        if (dd[axis] != 0) { t0 = (ta[axis] - ca[axis]) / dd[axis]; t1 = (tb[axis] - ca[axis]) / dd[axis]; }
+        if (dd[axis] != 0) {
+            t0 = (ta[axis] - ca[axis]) / dd[axis];
+            t1 = (tb[axis] - ca[axis]) / dd[axis];
+        }
         ca = ta;
         cb = tb;
     }
@@ -649,16 +693,16 @@ void drawSegment(Framebuffer& fb, LineEnd a, LineEnd b, const GuardBand& g, cons
     vec4 wa = toWindow(ca, fb.width, fb.height), wb = toWindow(cb, fb.width, fb.height);
     const bool fog = st.fog != sg::FogMode::Off;
     drawLineDDA(wa.x, wa.y, wb.x, wb.y, fb.width, fb.height, [&](int i, int j, float t) {
-        float z = std::clamp(wa.z + t * (wb.z - wa.z), 0.0f, 1.0f);         // window z: screen-linear
-        float tp = t * wb.w / ((1 - t) * wa.w + t * wb.w);                  // perspective-correct
+        float z = std::clamp(wa.z + t * (wb.z - wa.z), 0.0f, 1.0f);   // window z: screen-linear
+        float tp = t * wb.w / ((1 - t) * wa.w + t * wb.w);            // perspective-correct
         vec3 c = ea.color + tp * (eb.color - ea.color);
         if (fog) c = applyFog(st, c, ea.eyeDist + tp * (eb.eyeDist - ea.eyeDist));
         writeLinePixel(fb, i, j, z, c, bias);
     });
 }
 
-void drawLinesAndWireframe(const std::vector<DrawItem>& lineDraws, const std::vector<DrawItem>& triDraws, const sg::FrameInput& f,
-                           Framebuffer& fb, float pointSize) {
+void drawLinesAndWireframe(const std::vector<DrawItem>& lineDraws, const std::vector<DrawItem>& triDraws, const sg::FrameInput& f, Framebuffer& fb,
+                           float pointSize) {
     const GuardBand g = guardBand(fb.width, fb.height);
     const auto& st = f.settings;
     auto eyeDist = [&](const vec3& wpos) { return glm::length(vec3(f.camera.view * vec4(wpos, 1.0f))); };
@@ -689,7 +733,8 @@ void drawLinesAndWireframe(const std::vector<DrawItem>& lineDraws, const std::ve
                 int i0 = int(std::ceil(w.x - h - 0.5f)), i1 = int(std::ceil(w.x + h - 0.5f)) - 1;
                 int j0 = int(std::ceil(w.y - h - 0.5f)), j1 = int(std::ceil(w.y + h - 0.5f)) - 1;
                 for (int j = std::max(j0, 0); j <= std::min(j1, fb.height - 1); ++j)
-                    for (int i = std::max(i0, 0); i <= std::min(i1, fb.width - 1); ++i) writeLinePixel(fb, i, j, std::clamp(w.z, 0.0f, 1.0f), c, 0.0f);
+                    for (int i = std::max(i0, 0); i <= std::min(i1, fb.width - 1); ++i)
+                        writeLinePixel(fb, i, j, std::clamp(w.z, 0.0f, 1.0f), c, 0.0f);
             }
         }
     }
@@ -746,8 +791,10 @@ public:
             int r = std::clamp(st.aaRate, 2, 8);   // as the GL backend
             Framebuffer hi;
             stats = renderSingle(frame, width * r, height * r, hi, false, control, r);
-            if (stats.ok) target = downsample(hi, r);
-            else target.resize(width, height);
+            if (stats.ok)
+                target = downsample(hi, r);
+            else
+                target.resize(width, height);
         } else {
             stats = renderSingle(frame, width, height, target, st.aa == sg::AAMode::MSAA && st.aaRate > 1, control);
         }
@@ -756,7 +803,6 @@ public:
     }
 
 private:
-
     // pointScale: the SSAA factor (points are 2 pixels wide at the output resolution, like GL).
     RenderStats renderSingle(const sg::FrameInput& frame, int width, int height, Framebuffer& target, bool msaa, RenderControl* control,
                              int pointScale = 1) {
@@ -800,8 +846,10 @@ private:
         int tessRes = std::clamp(st.tessellation, 3, 1024);
         for (const auto& a : frame.analytics) {
             const Tessellation& t = m_tess.get(a, tessRes);
-            if (t.worldSpace) addDraw(t.mesh, mat4(1.0f), mat3(1.0f), a.material, a.texture, false, &t);
-            else addDraw(t.mesh, a.world, a.normal, a.material, a.texture, glm::determinant(mat3(a.world)) < 0.0f, &t);
+            if (t.worldSpace)
+                addDraw(t.mesh, mat4(1.0f), mat3(1.0f), a.material, a.texture, false, &t);
+            else
+                addDraw(t.mesh, a.world, a.normal, a.material, a.texture, glm::determinant(mat3(a.world)) < 0.0f, &t);
         }
         m_samplers.endFrame();
 
@@ -809,7 +857,10 @@ private:
         auto ms = [](auto a, auto b) { return std::chrono::duration<double, std::milli>(b - a).count(); };
         // 2. vertices
         uint64_t total = 0;
-        for (auto& d : draws) { d.firstTri = total; total += d.triCount; }
+        for (auto& d : draws) {
+            d.firstTri = total;
+            total += d.triCount;
+        }
         stats.triangles = total;
         tbb::parallel_for(size_t(0), draws.size(), [&](size_t i) { runVertexStage(draws[i], frame, width, height, gouraud); });
         tbb::parallel_for(size_t(0), lineDraws.size(), [&](size_t i) { runVertexStage(lineDraws[i], frame, width, height, false); });
@@ -852,7 +903,10 @@ private:
         tbb::parallel_for(tbb::blocked_range<int>(0, tiles, 1), [&](const tbb::blocked_range<int>& r) {
             thread_local TileBuffers buf;
             for (int tile = r.begin(); tile != r.end(); ++tile) {
-                if (control && control->cancel.load(std::memory_order_relaxed)) { cancelled = true; continue; }
+                if (control && control->cancel.load(std::memory_order_relaxed)) {
+                    cancelled = true;
+                    continue;
+                }
                 renderTile(tile, fc, target, buf);
                 int n = ++done;
                 if (control) {
@@ -873,7 +927,9 @@ private:
         if (m_timing) {
             size_t ntri = 0;
             for (const auto& c : chunks) ntri += c.tris.size();
-            std::fprintf(stderr, "raster timing: gather %.2f vertices %.2f triangles %.2f (%zu set up) tiles %.2f [raster %.2f prepare %.2f light %.2f cpu-ms] lines %.2f ms\n",
+            std::fprintf(stderr,
+                         "raster timing: gather %.2f vertices %.2f triangles %.2f (%zu set up) tiles %.2f [raster %.2f prepare %.2f light %.2f "
+                         "cpu-ms] lines %.2f ms\n",
                          ms(t0frame, tStart), ms(tStart, tVert), ms(tVert, tTri), ntri, ms(tTri, tTiles), g_rasterNs * 1e-6, g_prepareNs * 1e-6,
                          g_lightNs * 1e-6, ms(tTiles, std::chrono::steady_clock::now()));
         }
@@ -886,12 +942,18 @@ private:
     std::vector<Chunk> m_chunks;
     // VIEWER_RASTER_REFERENCE_SHADING=1: shade every fragment with rnd::shade (slow; used to
     // check the batched path).
-    bool m_timing = [] { const char* e = std::getenv("VIEWER_RASTER_TIMING"); return e && *e == '1'; }();
-    bool m_referenceShading = [] { const char* e = std::getenv("VIEWER_RASTER_REFERENCE_SHADING"); return e && *e == '1'; }();
+    bool m_timing = [] {
+        const char* e = std::getenv("VIEWER_RASTER_TIMING");
+        return e && *e == '1';
+    }();
+    bool m_referenceShading = [] {
+        const char* e = std::getenv("VIEWER_RASTER_REFERENCE_SHADING");
+        return e && *e == '1';
+    }();
 };
 
-}  // namespace
+}   // namespace
 
 std::unique_ptr<Renderer> makeRasterRenderer() { return std::make_unique<RasterRenderer>(); }
 
-}  // namespace rnd
+}   // namespace rnd

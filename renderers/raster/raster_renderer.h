@@ -5,4 +5,4 @@
 
 namespace rnd {
 std::unique_ptr<Renderer> makeRasterRenderer();
-}  // namespace rnd
+}   // namespace rnd

@@ -56,9 +56,9 @@ inline V log2v(V x) {
 // by the Taylor series of e^(f ln 2) to degree 7 (error < 2e-6).
 inline V exp2v(V y) {
     y = _mm_max_ps(y, set1(-126.0f));
-    __m128i i = _mm_cvttps_epi32(y);                               // toward zero
+    __m128i i = _mm_cvttps_epi32(y);   // toward zero
     V fi = _mm_cvtepi32_ps(i);
-    V gt = _mm_cmpgt_ps(fi, y);                                   // negative non-integers: floor = trunc - 1
+    V gt = _mm_cmpgt_ps(fi, y);   // negative non-integers: floor = trunc - 1
     i = _mm_sub_epi32(i, _mm_and_si128(_mm_castps_si128(gt), _mm_set1_epi32(1)));
     fi = _mm_cvtepi32_ps(i);
     V f = mul(sub(y, fi), set1(0.6931471805599453f));
@@ -74,7 +74,7 @@ inline V exp2v(V y) {
     return mul(p, scale);
 }
 
-}  // namespace
+}   // namespace
 
 void shadeBatch(ShadeBatch& b, size_t n, const sg::FrameInput& f) {
     const sg::vec3 eye = f.camera.eye;
@@ -103,7 +103,9 @@ void shadeBatch(ShadeBatch& b, size_t n, const sg::FrameInput& f) {
         for (const sg::DrawLight& L : f.lights) {
             V lx, ly, lz, rr = set1(L.radiance.x), rg = set1(L.radiance.y), rb = set1(L.radiance.z);
             if (L.type == sg::LightType::Directional) {
-                lx = set1(-L.direction.x); ly = set1(-L.direction.y); lz = set1(-L.direction.z);
+                lx = set1(-L.direction.x);
+                ly = set1(-L.direction.y);
+                lz = set1(-L.direction.z);
             } else {
                 V dx = sub(set1(L.position.x), px), dy = sub(set1(L.position.y), py), dz = sub(set1(L.position.z), pz);
                 V d2 = add(add(mul(dx, dx), mul(dy, dy)), mul(dz, dz));
@@ -115,16 +117,22 @@ void shadeBatch(ShadeBatch& b, size_t n, const sg::FrameInput& f) {
                 lz = sel(dpos, mul(dz, id), zero);
                 if (L.inverseSquare) {
                     V inv2 = _mm_div_ps(one, _mm_max_ps(d2, set1(1e-8f)));
-                    rr = mul(rr, inv2); rg = mul(rg, inv2); rb = mul(rb, inv2);
+                    rr = mul(rr, inv2);
+                    rg = mul(rg, inv2);
+                    rb = mul(rb, inv2);
                 }
                 if (L.type == sg::LightType::Spot) {
                     V c = sub(zero, add(add(mul(lx, set1(L.direction.x)), mul(ly, set1(L.direction.y))), mul(lz, set1(L.direction.z))));
                     V t;
-                    if (L.cosInner > L.cosOuter) t = mul(sub(c, set1(L.cosOuter)), set1(1.0f / (L.cosInner - L.cosOuter)));
-                    else t = _mm_and_ps(_mm_cmpge_ps(c, set1(L.cosOuter)), one);
+                    if (L.cosInner > L.cosOuter)
+                        t = mul(sub(c, set1(L.cosOuter)), set1(1.0f / (L.cosInner - L.cosOuter)));
+                    else
+                        t = _mm_and_ps(_mm_cmpge_ps(c, set1(L.cosOuter)), one);
                     t = _mm_min_ps(_mm_max_ps(t, zero), one);
                     V s = mul(mul(t, t), sub(set1(3.0f), mul(set1(2.0f), t)));
-                    rr = mul(rr, s); rg = mul(rg, s); rb = mul(rb, s);
+                    rr = mul(rr, s);
+                    rg = mul(rg, s);
+                    rb = mul(rb, s);
                 }
             }
             V nl = add(add(mul(nx, lx), mul(ny, ly)), mul(nz, lz));
@@ -135,7 +143,7 @@ void shadeBatch(ShadeBatch& b, size_t n, const sg::FrameInput& f) {
                 V two = mul(set1(2.0f), nl);
                 V rx = sub(mul(two, nx), lx), ry = sub(mul(two, ny), ly), rz = sub(mul(two, nz), lz);
                 s = _mm_max_ps(add(add(mul(rx, vx), mul(ry, vy)), mul(rz, vz)), zero);
-            } else {        // h = (l + v)/|l + v| ; s = max(n.h, 0)
+            } else {   // h = (l + v)/|l + v| ; s = max(n.h, 0)
                 V hx = add(lx, vx), hy = add(ly, vy), hz = add(lz, vz);
                 V hl = _mm_sqrt_ps(add(add(mul(hx, hx), mul(hy, hy)), mul(hz, hz)));
                 V hpos = _mm_cmpgt_ps(hl, zero);
@@ -161,7 +169,9 @@ void shadeBatch(ShadeBatch& b, size_t n, const sg::FrameInput& f) {
     for (size_t i = 0; i < n; ++i) {
         if (b.kd[i] == 0 && b.ks[i] == 0) continue;
         sg::Material m;
-        m.kd = b.kd[i]; m.ks = b.ks[i]; m.shininess = b.shin[i];
+        m.kd = b.kd[i];
+        m.ks = b.ks[i];
+        m.shininess = b.shin[i];
         m.specularColor = {b.sr[i], b.sg[i], b.sb[i]};
         SurfacePoint s{{b.px[i], b.py[i], b.pz[i]}, {b.nx[i], b.ny[i], b.nz[i]}, {b.ar[i], b.ag[i], b.ab[i]}};
         sg::vec3 v = f.camera.eye - s.position;
@@ -169,10 +179,12 @@ void shadeBatch(ShadeBatch& b, size_t n, const sg::FrameInput& f) {
         v = len > 0 ? v / len : sg::vec3(0, 0, 1);
         sg::vec3 c(b.cr[i], b.cg[i], b.cb[i]);
         for (const auto& L : f.lights) c += shadeLight(m, s, v, sampleLight(L, s.position), f.settings.reflection);
-        b.cr[i] = c.x; b.cg[i] = c.y; b.cb[i] = c.z;
+        b.cr[i] = c.x;
+        b.cg[i] = c.y;
+        b.cb[i] = c.z;
     }
 }
 
 #endif
 
-}  // namespace rnd::raster
+}   // namespace rnd::raster

@@ -15,11 +15,11 @@ namespace rnd::raster {
 // Structure of arrays for n fragments (n padded to a multiple of 4 by resize()).
 struct ShadeBatch {
     // inputs
-    std::vector<float> px, py, pz;      // world position
-    std::vector<float> nx, ny, nz;      // unit normal facing the viewer
-    std::vector<float> ar, ag, ab;      // albedo (kd term multiplies it)
-    std::vector<float> sr, sg, sb;      // specular colour (albedo when tinted)
-    std::vector<float> kd, ks, shin;    // coefficients; kd = ks = 0 for unlit
+    std::vector<float> px, py, pz;     // world position
+    std::vector<float> nx, ny, nz;     // unit normal facing the viewer
+    std::vector<float> ar, ag, ab;     // albedo (kd term multiplies it)
+    std::vector<float> sr, sg, sb;     // specular colour (albedo when tinted)
+    std::vector<float> kd, ks, shin;   // coefficients; kd = ks = 0 for unlit
     // in: ambient + emissive (ka * albedo * L_ambient + emissive); out: the shaded colour
     std::vector<float> cr, cg, cb;
     size_t size = 0;
@@ -27,18 +27,30 @@ struct ShadeBatch {
     void resize(size_t n);
     // Fills fragment i from a material, position, normal, albedo (as rnd::shade sees them).
     void set(size_t i, const sg::Material& m, const sg::vec3& p, const sg::vec3& n, const sg::vec3& albedo, const sg::vec3& ambient) {
-        px[i] = p.x; py[i] = p.y; pz[i] = p.z;
-        nx[i] = n.x; ny[i] = n.y; nz[i] = n.z;
-        ar[i] = albedo.x; ag[i] = albedo.y; ab[i] = albedo.z;
+        px[i] = p.x;
+        py[i] = p.y;
+        pz[i] = p.z;
+        nx[i] = n.x;
+        ny[i] = n.y;
+        nz[i] = n.z;
+        ar[i] = albedo.x;
+        ag[i] = albedo.y;
+        ab[i] = albedo.z;
         if (m.unlit) {   // shade(): albedo + emissive, no lights
             setColor(i, albedo + m.emissive);
             return;
         }
         sg::vec3 s = m.specularTinted ? albedo : m.specularColor;
-        sr[i] = s.x; sg[i] = s.y; sb[i] = s.z;
-        kd[i] = m.kd; ks[i] = m.ks; shin[i] = m.shininess;
+        sr[i] = s.x;
+        sg[i] = s.y;
+        sb[i] = s.z;
+        kd[i] = m.kd;
+        ks[i] = m.ks;
+        shin[i] = m.shininess;
         sg::vec3 c = m.ka * albedo * ambient + m.emissive;
-        cr[i] = c.x; cg[i] = c.y; cb[i] = c.z;
+        cr[i] = c.x;
+        cg[i] = c.y;
+        cb[i] = c.z;
     }
     // A fragment whose colour is already final (unlit, Gouraud, reference shading).
     void setColor(size_t i, const sg::vec3& c) {
@@ -48,11 +60,13 @@ struct ShadeBatch {
         ar[i] = ag[i] = ab[i] = sr[i] = sg[i] = sb[i] = 0;
         kd[i] = ks[i] = 0;
         shin[i] = 1;
-        cr[i] = c.x; cg[i] = c.y; cb[i] = c.z;
+        cr[i] = c.x;
+        cg[i] = c.y;
+        cb[i] = c.z;
     }
 };
 
 // Adds the contribution of every light in f to cr/cg/cb for fragments [0, n).
 void shadeBatch(ShadeBatch& b, size_t n, const sg::FrameInput& f);
 
-}  // namespace rnd::raster
+}   // namespace rnd::raster

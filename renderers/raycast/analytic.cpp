@@ -16,17 +16,30 @@ namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
-Bound bnd(float t, uint8_t tag) { Bound b; b.t = t; b.tag = tag; return b; }
+Bound bnd(float t, uint8_t tag) {
+    Bound b;
+    b.t = t;
+    b.tag = tag;
+    return b;
+}
 
 // Region of t where A t^2 + B t + C <= 0, as up to two spans (bounds tagged kTagSurface).
 void quadraticInside(double A, double B, double C, SpanList& out) {
     double scale = std::abs(A) + std::abs(B) + std::abs(C);
-    if (scale == 0) { out.push({bnd(-kInf, 0), bnd(kInf, 0)}); return; }
+    if (scale == 0) {
+        out.push({bnd(-kInf, 0), bnd(kInf, 0)});
+        return;
+    }
     if (std::abs(A) <= 1e-12 * scale) {   // linear
-        if (B == 0) { if (C <= 0) out.push({bnd(-kInf, 0), bnd(kInf, 0)}); return; }
+        if (B == 0) {
+            if (C <= 0) out.push({bnd(-kInf, 0), bnd(kInf, 0)});
+            return;
+        }
         float r = float(-C / B);
-        if (B > 0) out.push({bnd(-kInf, 0), bnd(r, 0)});
-        else out.push({bnd(r, 0), bnd(kInf, 0)});
+        if (B > 0)
+            out.push({bnd(-kInf, 0), bnd(r, 0)});
+        else
+            out.push({bnd(r, 0), bnd(kInf, 0)});
         return;
     }
     double disc = B * B - 4 * A * C;
@@ -38,7 +51,8 @@ void quadraticInside(double A, double B, double C, SpanList& out) {
     double q = -0.5 * (B + (B >= 0 ? sq : -sq));   // stable: no cancellation
     double r1 = q / A, r2 = q != 0 ? C / q : r1;
     if (r1 > r2) std::swap(r1, r2);
-    if (A > 0) out.push({bnd(float(r1), 0), bnd(float(r2), 0)});
+    if (A > 0)
+        out.push({bnd(float(r1), 0), bnd(float(r2), 0)});
     else {
         out.push({bnd(-kInf, 0), bnd(float(r1), 0)});
         out.push({bnd(float(r2), 0), bnd(kInf, 0)});
@@ -54,8 +68,10 @@ bool slab(int axis, float o, float d, float lo, float hi, Span& s) {
     }
     float t0 = (lo - o) / d, t1 = (hi - o) / d;
     uint8_t tagLo = uint8_t(kTagFace + 2 * axis), tagHi = uint8_t(kTagFace + 2 * axis + 1);
-    if (d > 0) s = {bnd(t0, tagLo), bnd(t1, tagHi)};
-    else s = {bnd(t1, tagHi), bnd(t0, tagLo)};
+    if (d > 0)
+        s = {bnd(t0, tagLo), bnd(t1, tagHi)};
+    else
+        s = {bnd(t1, tagHi), bnd(t0, tagLo)};
     return true;
 }
 
@@ -76,7 +92,10 @@ void clipBox(SpanList& io, const Ray& r, const vec3& lo, const vec3& hi, int axe
     for (int a = 0; a < 3 && io.n > 0; ++a) {
         if (!(axes & (1 << a))) continue;
         Span s;
-        if (!slab(a, r.org[a], r.dir[a], lo[a], hi[a], s)) { io.n = 0; return; }
+        if (!slab(a, r.org[a], r.dir[a], lo[a], hi[a], s)) {
+            io.n = 0;
+            return;
+        }
         clip(io, s);
     }
 }
@@ -97,7 +116,7 @@ double evalPoly(const double* c, int deg, double x) {
     return v;
 }
 
-}  // namespace
+}   // namespace
 
 // --- implicit shapes ------------------------------------------------------------------------
 
@@ -112,8 +131,10 @@ void implicitSpans(const ImplicitShape& sh, const Ray& r, SpanList& out) {
             return;
         }
         float t = -r.org.y / r.dir.y;
-        if (r.dir.y > 0) out.push({bnd(-kInf, 0), bnd(t, 0)});
-        else out.push({bnd(t, 0), bnd(kInf, 0)});
+        if (r.dir.y > 0)
+            out.push({bnd(-kInf, 0), bnd(t, 0)});
+        else
+            out.push({bnd(t, 0), bnd(kInf, 0)});
         return;
     }
     case ImplicitType::Sphere: {
@@ -138,8 +159,7 @@ void implicitSpans(const ImplicitShape& sh, const Ray& r, SpanList& out) {
         // x^2 + z^2 <= k^2 (h - y)^2, k = r / (2h), apex at y = +h, base at y = -h.
         double h = sh.halfHeight, k = sh.radius / (2.0 * std::max(h, 1e-20)), k2 = k * k;
         double a0 = h - oy;
-        quadraticInside(dx * dx + dz * dz - k2 * dy * dy, 2 * (ox * dx + oz * dz) + 2 * k2 * a0 * dy,
-                        ox * ox + oz * oz - k2 * a0 * a0, out);
+        quadraticInside(dx * dx + dz * dz - k2 * dy * dy, 2 * (ox * dx + oz * dz) + 2 * k2 * a0 * dy, ox * ox + oz * oz - k2 * a0 * a0, out);
         clipBox(out, r, vec3(0, -sh.halfHeight, 0), vec3(0, sh.halfHeight, 0), 2);
         return;
     }
@@ -171,8 +191,10 @@ void implicitSpans(const ImplicitShape& sh, const Ray& r, SpanList& out) {
         float start = t0;
         for (int i = 0; i < n; ++i) {
             float t = float(t0 + roots[i] / L);
-            if (inside) out.push({bnd(start, 0), bnd(t, 0)});
-            else start = t;
+            if (inside)
+                out.push({bnd(start, 0), bnd(t, 0)});
+            else
+                start = t;
             inside = !inside;
         }
         if (inside) out.push({bnd(start, 0), bnd(t1, 0)});
@@ -221,8 +243,14 @@ vec3 implicitNormal(const ImplicitShape& sh, const vec3& p, uint8_t tag) {
 bool firstBoundary(const SpanList& spans, float tmin, float tmax, Bound& hit) {
     for (int i = 0; i < spans.n; ++i) {
         const Span& s = spans.s[i];
-        if (s.in.t > tmin && s.in.t < tmax) { hit = s.in; return true; }
-        if (s.out.t > tmin && s.out.t < tmax) { hit = s.out; return true; }
+        if (s.in.t > tmin && s.in.t < tmax) {
+            hit = s.in;
+            return true;
+        }
+        if (s.out.t > tmin && s.out.t < tmax) {
+            hit = s.out;
+            return true;
+        }
         if (s.in.t >= tmax) return false;
     }
     return false;
@@ -233,7 +261,10 @@ int polyRoots(const double* c, int deg, double lo, double hi, double* roots) {
     if (deg <= 0 || !(lo <= hi)) return 0;
     if (deg == 1) {
         double x = -c[0] / c[1];
-        if (x >= lo && x <= hi) { roots[0] = x; return 1; }
+        if (x >= lo && x <= hi) {
+            roots[0] = x;
+            return 1;
+        }
         return 0;
     }
     // Critical points (roots of the derivative) split [lo, hi] into monotone pieces; each
@@ -263,11 +294,17 @@ int polyRoots(const double* c, int deg, double lo, double hi, double* roots) {
         for (int it = 0; it < 80; ++it) {
             double fx = evalPoly(c, deg, x);
             if (fx == 0) break;
-            if ((fx < 0) == (fa < 0)) a = x; else b = x;
+            if ((fx < 0) == (fa < 0))
+                a = x;
+            else
+                b = x;
             double dfx = evalPoly(dc, deg - 1, x);
             double xn = dfx != 0 ? x - fx / dfx : 0.5 * (a + b);
             if (!(xn > a && xn < b)) xn = 0.5 * (a + b);
-            if (std::abs(xn - x) <= 1e-14 * (1 + std::abs(x)) || b - a <= 1e-14 * (1 + std::abs(a))) { x = xn; break; }
+            if (std::abs(xn - x) <= 1e-14 * (1 + std::abs(x)) || b - a <= 1e-14 * (1 + std::abs(a))) {
+                x = xn;
+                break;
+            }
             x = xn;
         }
         roots[n++] = x;
@@ -279,15 +316,25 @@ int polyRoots(const double* c, int deg, double lo, double hi, double* roots) {
 
 namespace {
 
-struct Event { Bound b; bool fromB; bool enter; };
+struct Event {
+    Bound b;
+    bool fromB;
+    bool enter;
+};
 
 // Boolean of two sorted span lists by sweeping their ends (seeds 2.3: combine the intervals).
 // Difference: ends contributed by the cutter B get their normal flipped.
 void combine(const SpanList& A, const SpanList& B, CsgOp op, SpanList& out) {
     Event ev[2 * 2 * SpanList::kCapacity];
     int ne = 0;
-    for (int i = 0; i < A.n; ++i) { ev[ne++] = {A.s[i].in, false, true}; ev[ne++] = {A.s[i].out, false, false}; }
-    for (int i = 0; i < B.n; ++i) { ev[ne++] = {B.s[i].in, true, true}; ev[ne++] = {B.s[i].out, true, false}; }
+    for (int i = 0; i < A.n; ++i) {
+        ev[ne++] = {A.s[i].in, false, true};
+        ev[ne++] = {A.s[i].out, false, false};
+    }
+    for (int i = 0; i < B.n; ++i) {
+        ev[ne++] = {B.s[i].in, true, true};
+        ev[ne++] = {B.s[i].out, true, false};
+    }
     std::sort(ev, ev + ne, [](const Event& x, const Event& y) { return x.b.t < y.b.t; });
     bool inA = false, inB = false, inR = false;
     Bound start;
@@ -299,8 +346,10 @@ void combine(const SpanList& A, const SpanList& B, CsgOp op, SpanList& out) {
         if (r == inR) continue;
         Bound b = e.b;
         if (op == CsgOp::Difference && e.fromB) b.flip ^= 1;
-        if (r) start = b;
-        else out.push({start, b});
+        if (r)
+            start = b;
+        else
+            out.push({start, b});
         inR = r;
     }
 }
@@ -327,15 +376,20 @@ void csgRec(const CsgTree& tree, int index, const Ray& wr, SpanList& out, int de
     }
 }
 
-}  // namespace
+}   // namespace
 
 void csgSpans(const CsgTree& tree, const Ray& worldRay, SpanList& out) { csgRec(tree, tree.root, worldRay, out, 0); }
 
 // --- parametric -----------------------------------------------------------------------------------
 
 ParametricAccel::ParametricAccel(const ParametricSurface& s) : m_surface(s) {
-    if (s.type == ParametricType::Torus) { m_nu = 32; m_nv = 16; }
-    else { m_nu = 8; m_nv = 8; }
+    if (s.type == ParametricType::Torus) {
+        m_nu = 32;
+        m_nv = 16;
+    } else {
+        m_nu = 8;
+        m_nv = 8;
+    }
     const int k = 4;
     m_boxMin.resize(size_t(m_nu) * m_nv);
     m_boxMax.resize(size_t(m_nu) * m_nv);
@@ -343,8 +397,7 @@ ParametricAccel::ParametricAccel(const ParametricSurface& s) : m_surface(s) {
         for (int i = 0; i < m_nu; ++i) {
             Aabb b;
             for (int y = 0; y <= k; ++y)
-                for (int x = 0; x <= k; ++x)
-                    b.extend(s.evaluate((i + float(x) / k) / m_nu, (j + float(y) / k) / m_nv));
+                for (int x = 0; x <= k; ++x) b.extend(s.evaluate((i + float(x) / k) / m_nu, (j + float(y) / k) / m_nv));
             // Pad: the surface bulges between the 5x5 samples; 10% of the box size is ample
             // for these subdivisions (the sag of a sub-patch between samples is far smaller).
             vec3 pad = 0.1f * b.extent() + vec3(0.02f * glm::length(b.extent()) + 1e-5f);
@@ -387,7 +440,10 @@ bool ParametricAccel::intersect(const Ray& r, float& tOut, float& uOut, float& v
                     m_surface.partials(u, v, Pu, Pv);
                     vec3 F = r.org + t * r.dir - P;
                     const float err = glm::length(F);
-                    if (err < 1e-6f * (scale + 1.0f)) { ok = true; break; }
+                    if (err < 1e-6f * (scale + 1.0f)) {
+                        ok = true;
+                        break;
+                    }
                     if (it >= 4 && err > 0.9f * prevErr) break;   // not converging: give up early
                     prevErr = err;
                     // J = [d, -Pu, -Pv]; solve J x = -F by Cramer's rule.
@@ -398,7 +454,9 @@ bool ParametricAccel::intersect(const Ray& r, float& tOut, float& uOut, float& v
                     float dt = glm::dot(rhs, glm::cross(c1, c2)) / det;
                     float du = glm::dot(c0, glm::cross(rhs, c2)) / det;
                     float dv = glm::dot(c0, glm::cross(c1, rhs)) / det;
-                    t += dt; u += du; v += dv;
+                    t += dt;
+                    u += du;
+                    v += dv;
                     if (!std::isfinite(t + u + v)) break;
                     if (u < u0 - 1.0f / m_nu || u > u1 + 1.0f / m_nu || v < v0 - 1.0f / m_nv || v > v1 + 1.0f / m_nv) break;
                 }
@@ -425,8 +483,7 @@ bool ParametricAccel::intersect(const Ray& r, float& tOut, float& uOut, float& v
 
 GridAccel::GridAccel(std::shared_ptr<const DensityGrid> g) : m_grid(std::move(g)) {
     const DensityGrid& d = *m_grid;
-    m_valid = d.dims.x >= 2 && d.dims.y >= 2 && d.dims.z >= 2 &&
-              d.values.size() == size_t(d.dims.x) * d.dims.y * d.dims.z && !d.bounds.empty() &&
+    m_valid = d.dims.x >= 2 && d.dims.y >= 2 && d.dims.z >= 2 && d.values.size() == size_t(d.dims.x) * d.dims.y * d.dims.z && !d.bounds.empty() &&
               d.bounds.extent().x > 0 && d.bounds.extent().y > 0 && d.bounds.extent().z > 0;
     if (!m_valid) return;
     ivec3 cells = d.dims - 1;
@@ -491,7 +548,11 @@ bool GridAccel::intersect(const Ray& r, float& tOut) const {
             float a = ta, b = tb, fA = fa;
             for (int it = 0; it < 30; ++it) {
                 float m = 0.5f * (a + b), fm = f(m);
-                if ((fm > 0) == (fA > 0)) { a = m; fA = fm; } else b = m;
+                if ((fm > 0) == (fA > 0)) {
+                    a = m;
+                    fA = fm;
+                } else
+                    b = m;
             }
             tOut = 0.5f * (a + b);
             if (tOut <= r.tmin) tOut = b;
@@ -510,4 +571,4 @@ vec3 GridAccel::normal(const vec3& p) const {
     return l > 1e-30f && std::isfinite(l) ? g / l : vec3(0, 1, 0);
 }
 
-}  // namespace rnd::rt
+}   // namespace rnd::rt

@@ -18,9 +18,9 @@ namespace rnd::rt {
 // One end of an interval: distance, and which surface it lies on (for the normal).
 struct Bound {
     float t = 0;
-    uint8_t tag = 0;       // kTagSurface: the curved surface (gradient); kTagFace + 2*axis + (positive): box face
-    uint8_t flip = 0;      // CSG: 1 = the normal points into the solid (carved face of a cutter)
-    int16_t leaf = -1;     // CSG leaf index (else -1)
+    uint8_t tag = 0;     // kTagSurface: the curved surface (gradient); kTagFace + 2*axis + (positive): box face
+    uint8_t flip = 0;    // CSG: 1 = the normal points into the solid (carved face of a cutter)
+    int16_t leaf = -1;   // CSG leaf index (else -1)
 };
 constexpr uint8_t kTagSurface = 0;
 constexpr uint8_t kTagFace = 1;
@@ -35,7 +35,9 @@ struct SpanList {
     static constexpr int kCapacity = 32;
     Span s[kCapacity];
     int n = 0;
-    void push(const Span& x) { if (n < kCapacity) s[n++] = x; }
+    void push(const Span& x) {
+        if (n < kCapacity) s[n++] = x;
+    }
 };
 
 // --- implicit shapes -----------------------------------------------------------------------
@@ -68,6 +70,7 @@ public:
     // Closest hit of the local ray in (tmin, tmax): t and (u, v).
     bool intersect(const Ray& localRay, float& t, float& u, float& v) const;
     const sg::ParametricSurface& surface() const { return m_surface; }
+
 private:
     sg::ParametricSurface m_surface;
     int m_nu = 8, m_nv = 8;
@@ -86,6 +89,7 @@ public:
     // Outward normal (-gradient: inside is value > iso).
     sg::vec3 normal(const sg::vec3& p) const;
     const sg::DensityGrid& grid() const { return *m_grid; }
+
 private:
     std::shared_ptr<const sg::DensityGrid> m_grid;
     bool m_valid = false;
@@ -96,4 +100,4 @@ private:
     bool blockMayCross(const sg::vec3& p) const;
 };
 
-}  // namespace rnd::rt
+}   // namespace rnd::rt

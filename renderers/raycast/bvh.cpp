@@ -15,23 +15,27 @@
 #ifdef BVH_TIMING
 #include <cstdio>
 #include <ctime>
-static double cpuNow() { timespec ts; clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts); return ts.tv_sec + 1e-9 * ts.tv_nsec; }
+static double cpuNow() {
+    timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
 #define PROBE(name) std::printf("  %s %.1f ms\n", name, (cpuNow() - tProbe) * 1e3), tProbe = cpuNow()
 #else
 #define PROBE(name)
 #endif
 
-#include <tbb/task_group.h>
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
-#include <tbb/blocked_range.h>
+#include <tbb/task_group.h>
 
 #include <immintrin.h>
 #include <sys/mman.h>
 
 #include <algorithm>
-#include <cstdlib>
 #include <atomic>
+#include <cstdlib>
 #include <cstring>
 #include <memory>
 
@@ -57,7 +61,7 @@ constexpr size_t kHugeMin = size_t(4) << 20;
 #endif
 constexpr size_t kHugePage = size_t(2) << 20, kPage = 4096;
 size_t pageRound(size_t b) { return (b + kPage - 1) & ~(kPage - 1); }
-}  // namespace
+}   // namespace
 
 void* hugeAlloc(size_t bytes) {
     if (bytes < kHugeMin) return ::operator new(bytes, std::align_val_t(64));
@@ -74,8 +78,10 @@ void* hugeAlloc(size_t bytes) {
 
 void hugeFree(void* p, size_t bytes) noexcept {
     if (!p) return;
-    if (bytes < kHugeMin) ::operator delete(p, std::align_val_t(64));
-    else ::munmap(p, pageRound(bytes));
+    if (bytes < kHugeMin)
+        ::operator delete(p, std::align_val_t(64));
+    else
+        ::munmap(p, pageRound(bytes));
 }
 
 namespace {
@@ -89,7 +95,12 @@ struct HugeDeleter {
 
 struct alignas(16) PrimRef {
     __m128 lo, hi;   // lo.w holds the primitive id (bit pattern)
-    uint32_t id() const { uint32_t i; float f = _mm_cvtss_f32(_mm_shuffle_ps(lo, lo, _MM_SHUFFLE(3, 3, 3, 3))); std::memcpy(&i, &f, 4); return i; }
+    uint32_t id() const {
+        uint32_t i;
+        float f = _mm_cvtss_f32(_mm_shuffle_ps(lo, lo, _MM_SHUFFLE(3, 3, 3, 3)));
+        std::memcpy(&i, &f, 4);
+        return i;
+    }
     __m128 center2() const { return _mm_add_ps(lo, hi); }   // 2 x centroid
 };
 
@@ -102,7 +113,10 @@ inline PrimRef makeRef(const vec3& mn, const vec3& mx, uint32_t id) {
 struct Box {
     __m128 lo = _mm_set1_ps(std::numeric_limits<float>::infinity());
     __m128 hi = _mm_set1_ps(-std::numeric_limits<float>::infinity());
-    void extend(__m128 l, __m128 h) { lo = _mm_min_ps(lo, l); hi = _mm_max_ps(hi, h); }
+    void extend(__m128 l, __m128 h) {
+        lo = _mm_min_ps(lo, l);
+        hi = _mm_max_ps(hi, h);
+    }
     void extend(const Box& b) { extend(b.lo, b.hi); }
     float halfArea() const {
         alignas(16) float e[4];
@@ -164,7 +178,9 @@ void splitRange(PrimRef* refs, const Range& r, Range& l, Range& rr, int nbins, i
     // Neighbouring primitives usually fall into the same bins, so each update waits for the
     // previous one's store: big ranges bin even and odd primitives into two sets (two
     // independent dependency chains) merged afterwards.
-    struct Bin { __m128 lo, hi; };
+    struct Bin {
+        __m128 lo, hi;
+    };
     Bin bins[3][kMaxBins], bins1[3][kMaxBins];
     uint32_t counts[3][kMaxBins], counts1[3][kMaxBins];
     if (!forceMedian) {
@@ -172,8 +188,14 @@ void splitRange(PrimRef* refs, const Range& r, Range& l, Range& rr, int nbins, i
         const __m128 inf = _mm_set1_ps(std::numeric_limits<float>::infinity()), ninf = _mm_set1_ps(-std::numeric_limits<float>::infinity());
         for (int a = 0; a < 3; ++a)
             for (int b = 0; b < nbins; ++b) {
-                bins[a][b].lo = inf; bins[a][b].hi = ninf; counts[a][b] = 0;
-                if (twoSets) { bins1[a][b].lo = inf; bins1[a][b].hi = ninf; counts1[a][b] = 0; }
+                bins[a][b].lo = inf;
+                bins[a][b].hi = ninf;
+                counts[a][b] = 0;
+                if (twoSets) {
+                    bins1[a][b].lo = inf;
+                    bins1[a][b].hi = ninf;
+                    counts1[a][b] = 0;
+                }
             }
         for (int a = 0; a < 3; ++a) scale[a] = ext[a] > 0 ? float(nbins) * 0.99999f / ext[a] : 0.0f;
         const __m128 sc = _mm_setr_ps(scale[0], scale[1], scale[2], 0.0f);
@@ -183,7 +205,7 @@ void splitRange(PrimRef* refs, const Range& r, Range& l, Range& rr, int nbins, i
         auto binOf = [&](const PrimRef& p) {
             return _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(_mm_mul_ps(_mm_sub_ps(p.center2(), cm), sc), zero), maxBin));
         };
-        auto add = [](Bin (*set)[kMaxBins], uint32_t (*cnt)[kMaxBins], const PrimRef& p, const int* b) {
+        auto add = [](Bin(*set)[kMaxBins], uint32_t(*cnt)[kMaxBins], const PrimRef& p, const int* b) {
             for (int a = 0; a < 3; ++a) {
                 Bin& x = set[a][b[a]];
                 x.lo = _mm_min_ps(x.lo, p.lo);
@@ -216,7 +238,7 @@ void splitRange(PrimRef* refs, const Range& r, Range& l, Range& rr, int nbins, i
         auto halfArea = [](__m128 lo, __m128 hi) {
             __m128 e = _mm_max_ps(_mm_sub_ps(hi, lo), _mm_setzero_ps());
             __m128 e2 = _mm_shuffle_ps(e, e, _MM_SHUFFLE(3, 0, 2, 1));   // (y, z, x)
-            __m128 m = _mm_mul_ps(e, e2);                                  // (xy, yz, zx, w*w)
+            __m128 m = _mm_mul_ps(e, e2);                                // (xy, yz, zx, w*w)
             // xy + yz + zx in registers: ((xy + yz) + zx), the same order as before.
             __m128 s01 = _mm_add_ss(m, _mm_shuffle_ps(m, m, _MM_SHUFFLE(1, 1, 1, 1)));
             return _mm_cvtss_f32(_mm_add_ss(s01, _mm_movehl_ps(m, m)));
@@ -224,9 +246,7 @@ void splitRange(PrimRef* refs, const Range& r, Range& l, Range& rr, int nbins, i
         // Leaf blocks: a shift for the usual power-of-two leaf sizes (an integer division per
         // candidate split otherwise costs more than the rest of the sweep).
         const int leafShift = leafSize == 4 ? 2 : leafSize == 2 ? 1 : leafSize == 1 ? 0 : -1;
-        auto blocksOf = [&](uint32_t c) {
-            return leafShift >= 0 ? float((c + uint32_t(leafSize) - 1) >> leafShift) : float(blocks(c, leafSize));
-        };
+        auto blocksOf = [&](uint32_t c) { return leafShift >= 0 ? float((c + uint32_t(leafSize) - 1) >> leafShift) : float(blocks(c, leafSize)); };
         for (int a = 0; a < 3; ++a) {
             if (!(ext[a] > 0)) continue;
             float rightArea[kMaxBins];
@@ -249,7 +269,11 @@ void splitRange(PrimRef* refs, const Range& r, Range& l, Range& rr, int nbins, i
                 cnt += counts[a][i - 1];
                 if (cnt == 0 || rightCount[i] == 0) continue;
                 float cost = halfArea(lo, hi) * blocksOf(cnt) + rightArea[i] * blocksOf(rightCount[i]);
-                if (cost < bestCost) { bestCost = cost; bestAxis = a; bestPos = i; }
+                if (cost < bestCost) {
+                    bestCost = cost;
+                    bestAxis = a;
+                    bestPos = i;
+                }
             }
         }
     }
@@ -272,8 +296,16 @@ void splitRange(PrimRef* refs, const Range& r, Range& l, Range& rr, int nbins, i
         PrimRef* lo = refs + r.begin;
         PrimRef* hi = refs + r.end;
         for (;;) {
-            while (lo < hi && goesLeft(*lo)) { __m128 c = lo->center2(); lc.extend(c, c); ++lo; }
-            while (lo < hi && !goesLeft(*(hi - 1))) { --hi; __m128 c = hi->center2(); rc.extend(c, c); }
+            while (lo < hi && goesLeft(*lo)) {
+                __m128 c = lo->center2();
+                lc.extend(c, c);
+                ++lo;
+            }
+            while (lo < hi && !goesLeft(*(hi - 1))) {
+                --hi;
+                __m128 c = hi->center2();
+                rc.extend(c, c);
+            }
             if (lo >= hi) break;
             --hi;
             std::swap(*lo, *hi);
@@ -286,8 +318,10 @@ void splitRange(PrimRef* refs, const Range& r, Range& l, Range& rr, int nbins, i
         if (mid != r.begin && mid != r.end) {
             l = Range();
             rr = Range();
-            l.begin = r.begin; l.end = mid;
-            rr.begin = mid; rr.end = r.end;
+            l.begin = r.begin;
+            l.end = mid;
+            rr.begin = mid;
+            rr.end = r.end;
             for (int i = 0; i < pos; ++i) l.bounds.extend(bins[a][i].lo, bins[a][i].hi);
             for (int i = pos; i < nbins; ++i) rr.bounds.extend(bins[a][i].lo, bins[a][i].hi);
             l.centroids = lc;
@@ -308,8 +342,10 @@ void splitRange(PrimRef* refs, const Range& r, Range& l, Range& rr, int nbins, i
                 return cx[a] < cy[a];
             });
     }
-    l.begin = r.begin; l.end = mid;
-    rr.begin = mid; rr.end = r.end;
+    l.begin = r.begin;
+    l.end = mid;
+    rr.begin = mid;
+    rr.end = r.end;
     computeBounds(refs, l);
     computeBounds(refs, rr);
     *cost = l.bounds.halfArea() * float(blocks(l.count(), leafSize)) + rr.bounds.halfArea() * float(blocks(rr.count(), leafSize));
@@ -320,9 +356,12 @@ void splitRange(PrimRef* refs, const Range& r, Range& l, Range& rr, int nbins, i
 // A leaf as the builder makes it: refs[first, first + count). Inner nodes refer to leaves as
 // kLeafBit | leaf index; the callers turn that into their own leaf encoding afterwards
 // (Bvh4: primitive range, TriangleBvh: packet range).
-struct LeafRec { uint32_t first, count; };
+struct LeafRec {
+    uint32_t first, count;
+};
 
-template <int W> struct Builder {
+template <int W>
+struct Builder {
     using Node = NodeW<W>;
     PrimRef* refs;
     Node* nodes;
@@ -347,9 +386,12 @@ template <int W> struct Builder {
         alignas(16) float lo[4], hi[4];
         _mm_store_ps(lo, b.lo);
         _mm_store_ps(hi, b.hi);
-        n.b[0][i] = lo[0]; n.b[1][i] = hi[0];
-        n.b[2][i] = lo[1]; n.b[3][i] = hi[1];
-        n.b[4][i] = lo[2]; n.b[5][i] = hi[2];
+        n.b[0][i] = lo[0];
+        n.b[1][i] = hi[0];
+        n.b[2][i] = lo[1];
+        n.b[3][i] = hi[1];
+        n.b[4][i] = lo[2];
+        n.b[5][i] = hi[2];
     }
     uint32_t makeLeaf(const Range& r) {
         const uint32_t i = leafCount.fetch_add(1, std::memory_order_relaxed);
@@ -417,7 +459,10 @@ template <int W> struct Builder {
             for (int i = 0; i < nk; ++i)
                 if (kids[i].r.count() > uint32_t(leafSize)) {
                     float a = kids[i].r.bounds.halfArea();
-                    if (a > bestArea) { bestArea = a; best = i; }
+                    if (a > bestArea) {
+                        bestArea = a;
+                        best = i;
+                    }
                 }
             if (best < 0) break;
             Kid& k = kids[best];
@@ -434,7 +479,10 @@ template <int W> struct Builder {
         Node& node = nodes[index];
         uint32_t childIndex[W];
         for (int i = 0; i < W; ++i) {
-            if (i >= nk) { setEmpty(node, i); continue; }
+            if (i >= nk) {
+                setEmpty(node, i);
+                continue;
+            }
             setBounds(node, i, kids[i].r.bounds);
             if (kids[i].leaf) {
                 node.child[i] = makeLeaf(kids[i].r);
@@ -467,7 +515,8 @@ template <int W> struct Builder {
     }
 };
 
-template <int W> int subtreeDepth(const std::vector<NodeW<W>>& nodes, uint32_t ref) {
+template <int W>
+int subtreeDepth(const std::vector<NodeW<W>>& nodes, uint32_t ref) {
     if (ref & Node4::kLeafBit) return 0;
     int d = 0;
     for (uint32_t c : nodes[ref].child)
@@ -475,7 +524,7 @@ template <int W> int subtreeDepth(const std::vector<NodeW<W>>& nodes, uint32_t r
     return d + 1;
 }
 
-}  // namespace
+}   // namespace
 
 // --- Bvh4::build ------------------------------------------------------------------------------
 
@@ -483,8 +532,8 @@ namespace detail {
 // Builds from prepared refs (shared by Bvh4::build and TriangleBvh::build).
 template <int W, class NodeVec>
 // Leaves come out as kLeafBit | index into outLeaves.
-void buildFromRefs(PrimRef* refs, size_t n, const Bvh4::BuildOptions& opt, int maxLeaf, NodeVec& outNodes,
-                   std::vector<uint32_t>& outPrims, std::vector<LeafRec>& outLeaves, sg::Aabb& outBounds) {
+void buildFromRefs(PrimRef* refs, size_t n, const Bvh4::BuildOptions& opt, int maxLeaf, NodeVec& outNodes, std::vector<uint32_t>& outPrims,
+                   std::vector<LeafRec>& outLeaves, sg::Aabb& outBounds) {
     outNodes.clear();
     outPrims.clear();
     outLeaves.clear();
@@ -497,7 +546,9 @@ void buildFromRefs(PrimRef* refs, size_t n, const Bvh4::BuildOptions& opt, int m
     root.begin = 0;
     root.end = uint32_t(n);
     if (n > 65536) {
-        struct Acc { Box b, c; };
+        struct Acc {
+            Box b, c;
+        };
         Acc acc = tbb::parallel_reduce(
             tbb::blocked_range<size_t>(0, n, 16384), Acc{},
             [&](const tbb::blocked_range<size_t>& br, Acc a) {
@@ -508,7 +559,11 @@ void buildFromRefs(PrimRef* refs, size_t n, const Bvh4::BuildOptions& opt, int m
                 }
                 return a;
             },
-            [](Acc x, const Acc& y) { x.b.extend(y.b); x.c.extend(y.c); return x; });
+            [](Acc x, const Acc& y) {
+                x.b.extend(y.b);
+                x.c.extend(y.c);
+                return x;
+            });
         root.bounds = acc.b;
         root.centroids = acc.c;
     } else {
@@ -521,8 +576,8 @@ void buildFromRefs(PrimRef* refs, size_t n, const Bvh4::BuildOptions& opt, int m
     // Leaves <= primitives.
     const size_t leafBytes = n * sizeof(LeafRec);
     std::unique_ptr<LeafRec[], HugeDeleter> leaves(static_cast<LeafRec*>(hugeAlloc(leafBytes)), HugeDeleter{leafBytes});
-    Builder<W> b{refs, storage.get(), leaves.get(), {}, {}, {}, nbins, leafSize, std::max(maxLeaf, leafSize),
-                 std::max(opt.traversalCost, 0.0f), opt.parallel};
+    Builder<W> b{
+        refs, storage.get(), leaves.get(), {}, {}, {}, nbins, leafSize, std::max(maxLeaf, leafSize), std::max(opt.traversalCost, 0.0f), opt.parallel};
     b.nodeCount = 1;
     if (root.count() <= uint32_t(leafSize)) {
         NodeW<W>& r = storage[0];
@@ -580,7 +635,9 @@ void buildFromRefs(PrimRef* refs, size_t n, const Bvh4::BuildOptions& opt, int m
     }
     outLeaves.assign(leaves.get(), leaves.get() + b.leafCount.load());
     outPrims.resize(n);
-    auto copyIds = [&](size_t begin, size_t end) { for (size_t i = begin; i < end; ++i) outPrims[i] = refs[i].id(); };
+    auto copyIds = [&](size_t begin, size_t end) {
+        for (size_t i = begin; i < end; ++i) outPrims[i] = refs[i].id();
+    };
     if (opt.parallel && n > 65536)
         tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 16384), [&](const tbb::blocked_range<size_t>& r) { copyIds(r.begin(), r.end()); });
     else
@@ -590,7 +647,7 @@ void buildFromRefs(PrimRef* refs, size_t n, const Bvh4::BuildOptions& opt, int m
     _mm_store_ps(hi, root.bounds.hi);
     outBounds = {vec3(lo[0], lo[1], lo[2]), vec3(hi[0], hi[1], hi[2])};
 }
-}  // namespace detail
+}   // namespace detail
 
 void Bvh4::build(const vec3* boxMin, const vec3* boxMax, size_t n, const BuildOptions& opt) {
     if (n >= (size_t(1) << 28)) n = 0;   // leaf references hold (first << 3) in 31 bits
@@ -623,12 +680,15 @@ namespace {
 // contraction can make the two differ.)
 inline __attribute__((always_inline)) void setLaneInline(TriPacket4& p, int k, const vec3& p0, const vec3& p1, const vec3& p2) {
     vec3 e1 = p1 - p0, e2 = p2 - p0, n = glm::cross(e1, e2);
-    for (int a = 0; a < 3; ++a) { p.v0[a][k] = p0[a]; p.e1[a][k] = e1[a]; p.e2[a][k] = e2[a]; p.n[a][k] = n[a]; }
+    for (int a = 0; a < 3; ++a) {
+        p.v0[a][k] = p0[a];
+        p.e1[a][k] = e1[a];
+        p.e2[a][k] = e2[a];
+        p.n[a][k] = n[a];
+    }
 }
-__attribute__((noinline)) void setLane(TriPacket4& p, int k, const vec3& p0, const vec3& p1, const vec3& p2) {
-    setLaneInline(p, k, p0, p1, p2);
-}
-}  // namespace
+__attribute__((noinline)) void setLane(TriPacket4& p, int k, const vec3& p0, const vec3& p1, const vec3& p2) { setLaneInline(p, k, p0, p1, p2); }
+}   // namespace
 
 namespace {
 // Each leaf's triangles as consecutive packets, leaves in node order; leaf refs become
@@ -636,8 +696,8 @@ namespace {
 // packets (the same order as filling them one by one); the leaves are then filled in
 // parallel (2-thread 1M-triangle build: this was 18 ms of serial work).
 template <int W>
-void makePackets(HugeVector<NodeW<W>>& nodes, const std::vector<uint32_t>& prims, const std::vector<LeafRec>& leaves,
-                 const vec3* pos, const uint32_t* idx, HugeVector<TriPacket4>& packets, HugeVector<uint32_t>& ids, bool parallel) {
+void makePackets(HugeVector<NodeW<W>>& nodes, const std::vector<uint32_t>& prims, const std::vector<LeafRec>& leaves, const vec3* pos,
+                 const uint32_t* idx, HugeVector<TriPacket4>& packets, HugeVector<uint32_t>& ids, bool parallel) {
     std::vector<uint32_t> firstPacket(leaves.size(), ~0u);   // per leaf record (~0u: not referenced)
     uint32_t total = 0;
     for (NodeW<W>& n : nodes)
@@ -671,13 +731,12 @@ void makePackets(HugeVector<NodeW<W>>& nodes, const std::vector<uint32_t>& prims
         }
     };
     if (parallel && leaves.size() > 4096)
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, leaves.size(), 2048),
-                          [&](const tbb::blocked_range<size_t>& r) { fill(r.begin(), r.end()); });
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, leaves.size(), 2048), [&](const tbb::blocked_range<size_t>& r) { fill(r.begin(), r.end()); });
     else
         fill(0, leaves.size());
 }
 int kernelWidth();
-}  // namespace
+}   // namespace
 
 // --- TriangleBvh ------------------------------------------------------------------------------
 
@@ -754,15 +813,17 @@ void TriangleBvh::build(const vec3* pos, const uint32_t* idx, size_t triCount, c
         detail::buildFromRefs<4>(refs.get(), refCount, opt, maxLeaf, m_nodes4, prims, leaves, m_bounds);
         makePackets(m_nodes4, prims, leaves, pos, idx, m_packets, m_prims, opt.parallel);
     }
-    for (int a = 0; a < 3; ++a)
-        m_absMax[a] = m_packets.empty() ? 0.0f : std::max(std::abs(m_bounds.min[a]), std::abs(m_bounds.max[a]));
+    for (int a = 0; a < 3; ++a) m_absMax[a] = m_packets.empty() ? 0.0f : std::max(std::abs(m_bounds.min[a]), std::abs(m_bounds.max[a]));
 }
 
 namespace {
 // refScale: what an inner child reference is in units of nodes (BVH8: byte offsets).
-template <int W> void addStats(const HugeVector<NodeW<W>>& nodes, uint32_t refScale, const sg::Aabb& bounds, TriangleBvh::Stats& s) {
+template <int W>
+void addStats(const HugeVector<NodeW<W>>& nodes, uint32_t refScale, const sg::Aabb& bounds, TriangleBvh::Stats& s) {
     s.nodes = nodes.size();
-    auto halfArea = [](float dx, float dy, float dz) { return dx < 0 || dy < 0 || dz < 0 ? 0.0 : double(dx) * dy + double(dy) * dz + double(dz) * dx; };
+    auto halfArea = [](float dx, float dy, float dz) {
+        return dx < 0 || dy < 0 || dz < 0 ? 0.0 : double(dx) * dy + double(dy) * dz + double(dz) * dx;
+    };
     const sg::vec3 e = bounds.max - bounds.min;
     const double rootArea = halfArea(e.x, e.y, e.z);
     double nodeArea = rootArea, leafArea = 0;
@@ -780,7 +841,10 @@ template <int W> void addStats(const HugeVector<NodeW<W>>& nodes, uint32_t refSc
                 nodeArea += a;
             }
         }
-    if (rootArea > 0) { s.sahNodes = nodeArea / rootArea; s.sahLeaves = leafArea / rootArea; }
+    if (rootArea > 0) {
+        s.sahNodes = nodeArea / rootArea;
+        s.sahLeaves = leafArea / rootArea;
+    }
     std::vector<std::pair<uint32_t, int>> stack{{0u, 1}};
     while (!stack.empty()) {
         auto [i, d] = stack.back();
@@ -790,12 +854,14 @@ template <int W> void addStats(const HugeVector<NodeW<W>>& nodes, uint32_t refSc
             if (c != NodeBits::kEmpty && !(c & NodeBits::kLeafBit)) stack.push_back({c / refScale, d + 1});
     }
 }
-}  // namespace
+}   // namespace
 
 TriangleBvh::Stats TriangleBvh::stats() const {
     Stats s;
-    if (!m_nodes8.empty()) addStats(m_nodes8, uint32_t(sizeof(Node8)), m_bounds, s);
-    else if (!m_nodes4.empty()) addStats(m_nodes4, 1, m_bounds, s);
+    if (!m_nodes8.empty())
+        addStats(m_nodes8, uint32_t(sizeof(Node8)), m_bounds, s);
+    else if (!m_nodes4.empty())
+        addStats(m_nodes4, 1, m_bounds, s);
     s.packets = m_packets.size();
     for (uint32_t id : m_prims) s.lanes += id != ~0u;
     return s;
@@ -807,7 +873,7 @@ namespace kern_sse {
 #define RT_FMA 0
 #include "raycast/tri_kernel.inl"
 #undef RT_FMA
-}  // namespace kern_sse
+}   // namespace kern_sse
 
 #pragma GCC push_options
 #pragma GCC target("avx2,fma")
@@ -815,7 +881,7 @@ namespace kern_avx2 {
 #define RT_FMA 1
 #include "raycast/tri_kernel.inl"
 #undef RT_FMA
-}  // namespace kern_avx2
+}   // namespace kern_avx2
 #pragma GCC pop_options
 
 namespace {
@@ -824,12 +890,12 @@ const bool kUseAvx2 = [] {
     __builtin_cpu_init();
     return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
 }();
-}  // namespace
+}   // namespace
 
 const char* kernelName() { return kUseAvx2 ? "avx2+fma bvh8" : "sse bvh4"; }
 namespace {
 int kernelWidth() { return kUseAvx2 ? 8 : 4; }
-}  // namespace
+}   // namespace
 
 bool TriangleBvh::intersect(const Ray& ray, TriHit& hit, bool cullBack) const {
     if (m_packets.empty()) return false;
@@ -851,4 +917,4 @@ bool intersectBruteForce(const vec3* pos, const uint32_t* idx, size_t triCount, 
     return kUseAvx2 ? kern_avx2::bruteForce(pos, idx, triCount, ray, hit) : kern_sse::bruteForce(pos, idx, triCount, ray, hit);
 }
 
-}  // namespace rnd::rt
+}   // namespace rnd::rt

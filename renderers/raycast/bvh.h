@@ -26,19 +26,31 @@ namespace rnd::rt {
 // same); smaller sizes come from operator new. hugeFree must get the size given to hugeAlloc.
 void* hugeAlloc(size_t bytes);
 void hugeFree(void* p, size_t bytes) noexcept;
-template <class T> struct HugePageAllocator {
+template <class T>
+struct HugePageAllocator {
     using value_type = T;
     HugePageAllocator() = default;
-    template <class U> HugePageAllocator(const HugePageAllocator<U>&) {}
+    template <class U>
+    HugePageAllocator(const HugePageAllocator<U>&) {}
     T* allocate(size_t n) { return static_cast<T*>(hugeAlloc(n * sizeof(T))); }
     void deallocate(T* p, size_t n) noexcept { hugeFree(p, n * sizeof(T)); }
     // resize() default-initialises (no zero fill): the builders write every element they keep,
     // and the first write then also faults the page in, on whichever thread fills it.
-    template <class U> void construct(U* p) noexcept { ::new (static_cast<void*>(p)) U; }
-    template <class U, class... A> void construct(U* p, A&&... a) { ::new (static_cast<void*>(p)) U(std::forward<A>(a)...); }
-    template <class U> bool operator==(const HugePageAllocator<U>&) const { return true; }
+    template <class U>
+    void construct(U* p) noexcept {
+        ::new (static_cast<void*>(p)) U;
+    }
+    template <class U, class... A>
+    void construct(U* p, A&&... a) {
+        ::new (static_cast<void*>(p)) U(std::forward<A>(a)...);
+    }
+    template <class U>
+    bool operator==(const HugePageAllocator<U>&) const {
+        return true;
+    }
 };
-template <class T> using HugeVector = std::vector<T, HugePageAllocator<T>>;
+template <class T>
+using HugeVector = std::vector<T, HugePageAllocator<T>>;
 
 // A ray segment org + t*dir, t in [tmin, tmax]. dir need not be unit length. TriangleBvh
 // treats a negative (or NaN) tmin as 0: its box test relies on tmin >= 0 (see traceTriangles8).
@@ -86,7 +98,8 @@ struct NodeBits {
     static constexpr uint32_t kLeafBit = 0x80000000u;
     static constexpr uint32_t kEmpty = 0xffffffffu;
 };
-template <int W> struct alignas(64) NodeW : NodeBits {
+template <int W>
+struct alignas(64) NodeW : NodeBits {
     float b[6][W];
     uint32_t child[W];
 };
@@ -98,13 +111,13 @@ using Node8 = NodeW<8>;
 class Bvh4 {
 public:
     struct BuildOptions {
-        int maxLeafSize = 4;       // 1..4: primitives per block (TriangleBvh: always 4, a packet)
+        int maxLeafSize = 4;   // 1..4: primitives per block (TriangleBvh: always 4, a packet)
         // Leaves of up to this many blocks where the SAH prefers one leaf to a split
         // (Bvh4: at most 7 primitives in all; TriangleBvh: at most 7 packets).
         int maxLeafBlocks = 1;
         float traversalCost = 1.0f;   // SAH cost of a node visit, in block tests
-        int bins = 16;             // SAH bins per axis
-        bool parallel = true;      // oneTBB tasks for big subtrees
+        int bins = 16;                // SAH bins per axis
+        bool parallel = true;         // oneTBB tasks for big subtrees
         // TriangleBvh's BVH8 refers to inner nodes by byte offset in 31 bits: at most 2^23
         // nodes (about 270M triangles with the default leaves). A tree with more nodes than
         // this (capped at 2^23) is built as a BVH4 instead; tests lower it to reach that path.
@@ -125,7 +138,8 @@ public:
     // Front-to-back traversal. leaf(first, count, tmax&) tests a leaf and may shrink tmax;
     // returns true to stop the traversal (any-hit queries).
     // AnyHit = true skips the front-to-back sort (any hit ends the query anyway).
-    template <bool AnyHit = false, class LeafFn> void traverse(const Ray& ray, float& tmax, LeafFn&& leaf) const;
+    template <bool AnyHit = false, class LeafFn>
+    void traverse(const Ray& ray, float& tmax, LeafFn&& leaf) const;
 
 private:
     std::vector<Node4> m_nodes;   // m_nodes[0] is the root (a leaf root is wrapped in a node)
@@ -147,8 +161,7 @@ static_assert(sizeof(TriPacket4) == 192);
 // AVX2+FMA kernel it is 8-wide (BVH8, one AVX box test per node), else 4-wide (BVH4, SSE).
 class TriangleBvh {
 public:
-    void build(const sg::vec3* positions, const uint32_t* indices, size_t triangleCount,
-               const Bvh4::BuildOptions& opt);
+    void build(const sg::vec3* positions, const uint32_t* indices, size_t triangleCount, const Bvh4::BuildOptions& opt);
     void build(const sg::vec3* positions, const uint32_t* indices, size_t triangleCount) {
         build(positions, indices, triangleCount, defaultOptions());
     }
@@ -204,9 +217,8 @@ private:
 const char* kernelName();
 
 // Brute-force reference (tests): closest hit over all triangles with the same test.
-bool intersectBruteForce(const sg::vec3* positions, const uint32_t* indices, size_t triangleCount, const Ray& ray,
-                         TriHit& hit);
+bool intersectBruteForce(const sg::vec3* positions, const uint32_t* indices, size_t triangleCount, const Ray& ray, TriHit& hit);
 
-}  // namespace rnd::rt
+}   // namespace rnd::rt
 
 #include "raycast/bvh_traverse.inl"

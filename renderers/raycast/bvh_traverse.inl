@@ -4,8 +4,8 @@
 // others pushed with their entry distance so they can be skipped once a closer hit is known.
 #pragma once
 
-#include <cstddef>
 #include <xmmintrin.h>
+#include <cstddef>
 
 namespace rnd::rt {
 
@@ -36,7 +36,8 @@ inline RayPre::RayPre(const Ray& r, const float* boxAbsMax) {
     nearZ = (neg >> 2) & 1;
 }
 
-template <bool AnyHit, class LeafFn> void Bvh4::traverse(const Ray& ray, float& tmax, LeafFn&& leaf) const {
+template <bool AnyHit, class LeafFn>
+void Bvh4::traverse(const Ray& ray, float& tmax, LeafFn&& leaf) const {
     if (m_nodes.empty()) return;
     const RayPre pre(ray, nullptr);   // only org and rdir: this test is (b - org) * rdir
     const __m128 ox = _mm_set1_ps(pre.org[0]), oy = _mm_set1_ps(pre.org[1]), oz = _mm_set1_ps(pre.org[2]);
@@ -47,7 +48,10 @@ template <bool AnyHit, class LeafFn> void Bvh4::traverse(const Ray& ray, float& 
     // Slightly enlarged far distance so rays grazing a box edge are not lost to rounding.
     const float kGrow = 1.0f + 4.0f * std::numeric_limits<float>::epsilon();
 
-    struct Entry { uint32_t ref; float t; };
+    struct Entry {
+        uint32_t ref;
+        float t;
+    };
     Entry stack[256];
     int sp = 0;
     uint32_t cur = 0;   // root: node 0
@@ -69,17 +73,29 @@ template <bool AnyHit, class LeafFn> void Bvh4::traverse(const Ray& ray, float& 
                 _mm_store_ps(d, tn);
                 int c0 = __builtin_ctz(mask);
                 mask &= mask - 1;
-                if (mask == 0) { cur = n.child[c0]; continue; }
+                if (mask == 0) {
+                    cur = n.child[c0];
+                    continue;
+                }
                 if constexpr (AnyHit) {   // no ordering needed: push the rest as they come
-                    while (mask) { int c = __builtin_ctz(mask); mask &= mask - 1; stack[sp++] = {n.child[c], d[c]}; }
+                    while (mask) {
+                        int c = __builtin_ctz(mask);
+                        mask &= mask - 1;
+                        stack[sp++] = {n.child[c], d[c]};
+                    }
                     cur = n.child[c0];
                     continue;
                 }
                 int c1 = __builtin_ctz(mask);
                 mask &= mask - 1;
                 if (mask == 0) {
-                    if (d[c0] <= d[c1]) { stack[sp++] = {n.child[c1], d[c1]}; cur = n.child[c0]; }
-                    else { stack[sp++] = {n.child[c0], d[c0]}; cur = n.child[c1]; }
+                    if (d[c0] <= d[c1]) {
+                        stack[sp++] = {n.child[c1], d[c1]};
+                        cur = n.child[c0];
+                    } else {
+                        stack[sp++] = {n.child[c0], d[c0]};
+                        cur = n.child[c1];
+                    }
                     continue;
                 }
                 // 3 or 4 hits: sort by entry distance (far first on the stack).
@@ -87,11 +103,18 @@ template <bool AnyHit, class LeafFn> void Bvh4::traverse(const Ray& ray, float& 
                 int k = 0;
                 e[k++] = {n.child[c0], d[c0]};
                 e[k++] = {n.child[c1], d[c1]};
-                while (mask) { int c = __builtin_ctz(mask); mask &= mask - 1; e[k++] = {n.child[c], d[c]}; }
+                while (mask) {
+                    int c = __builtin_ctz(mask);
+                    mask &= mask - 1;
+                    e[k++] = {n.child[c], d[c]};
+                }
                 for (int i = 1; i < k; ++i) {   // insertion sort, descending t
                     Entry x = e[i];
                     int j = i - 1;
-                    while (j >= 0 && e[j].t < x.t) { e[j + 1] = e[j]; --j; }
+                    while (j >= 0 && e[j].t < x.t) {
+                        e[j + 1] = e[j];
+                        --j;
+                    }
                     e[j + 1] = x;
                 }
                 for (int i = 0; i < k - 1; ++i) stack[sp++] = e[i];
@@ -106,9 +129,12 @@ template <bool AnyHit, class LeafFn> void Bvh4::traverse(const Ray& ray, float& 
         for (;;) {
             if (sp == 0) return;
             const Entry& e = stack[--sp];
-            if (e.t <= tmax) { cur = e.ref; break; }
+            if (e.t <= tmax) {
+                cur = e.ref;
+                break;
+            }
         }
     }
 }
 
-}  // namespace rnd::rt
+}   // namespace rnd::rt

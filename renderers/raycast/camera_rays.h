@@ -43,4 +43,4 @@ private:
     float m_w, m_h;
 };
 
-}  // namespace rnd::rt
+}   // namespace rnd::rt

@@ -22,8 +22,8 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include <xmmintrin.h>
 #include <pmmintrin.h>
+#include <xmmintrin.h>
 
 #include <algorithm>
 #include <atomic>
@@ -47,7 +47,11 @@ struct PixelFootprint {
     bool carried = false;
     rt::Ray rx, ry;
     bool neighbours(rt::Ray& x, rt::Ray& y) const {
-        if (carried) { x = rx; y = ry; return true; }
+        if (carried) {
+            x = rx;
+            y = ry;
+            return true;
+        }
         if (!cam) return false;
         x = cam->ray(wx + 1.0f, wy);
         y = cam->ray(wx, wy + 1.0f);
@@ -95,9 +99,7 @@ struct Tracer {
     const std::vector<const SampledTexture*>& textures;   // per f.meshes entry, null if none
     uint64_t rays = 0;
 
-    static float offsetScale(const vec3& p) {
-        return 1e-4f * (1.0f + std::max(std::abs(p.x), std::max(std::abs(p.y), std::abs(p.z))));
-    }
+    static float offsetScale(const vec3& p) { return 1e-4f * (1.0f + std::max(std::abs(p.x), std::max(std::abs(p.y), std::abs(p.z)))); }
 
     // Shadow rays to every light from p (geometric normal ng facing the viewer side).
     void lightVisibility(const vec3& p, const vec3& ng, float* visible) {
@@ -134,7 +136,10 @@ struct Tracer {
         const size_t nl = std::min<size_t>(f.lights.size(), 64);
         std::vector<float> visHeap;
         float* vis = visible;
-        if (f.lights.size() > 64) { visHeap.resize(f.lights.size()); vis = visHeap.data(); }
+        if (f.lights.size() > 64) {
+            visHeap.resize(f.lights.size());
+            vis = visHeap.data();
+        }
 
         if (h.kind == rt::SceneHit::Kind::Mesh) {
             const DrawMesh& dm = f.meshes[h.instance];
@@ -217,7 +222,8 @@ struct Tracer {
                 n = w0 * Nv[0] + w1 * Nv[1] + w2 * Nv[2];
                 n = glm::length(n) > 0 ? glm::normalize(n) : ng;
             } else {
-                if (model == ShadingModel::Flat || !hasN) n = ng;
+                if (model == ShadingModel::Flat || !hasN)
+                    n = ng;
                 else {
                     n = w0 * Nv[0] + w1 * Nv[1] + w2 * Nv[2];
                     float l = glm::length(n);
@@ -247,8 +253,7 @@ struct Tracer {
             rr.tmax = std::numeric_limits<float>::infinity();
             PixelFootprint rf;
             rt::Ray nx, ny;
-            rf.carried = footprint && footprint->neighbours(nx, ny) && reflectNeighbour(nx, p, ng, n, rf.rx) &&
-                         reflectNeighbour(ny, p, ng, n, rf.ry);
+            rf.carried = footprint && footprint->neighbours(nx, ny) && reflectNeighbour(nx, p, ng, n, rf.rx) && reflectNeighbour(ny, p, ng, n, rf.ry);
             vec3 refl = trace(rr, p, bounce + 1, nullptr, rf.carried ? &rf : nullptr);
             color = glm::mix(color, refl, std::clamp(mat->reflectivity, 0.0f, 1.0f));
         }
@@ -257,12 +262,17 @@ struct Tracer {
 };
 
 uint32_t hash32(uint32_t x) {
-    x ^= x >> 16; x *= 0x7feb352dU;
-    x ^= x >> 15; x *= 0x846ca68bU;
+    x ^= x >> 16;
+    x *= 0x7feb352dU;
+    x ^= x >> 15;
+    x *= 0x846ca68bU;
     x ^= x >> 16;
     return x;
 }
-float rand01(uint32_t& s) { s = hash32(s + 0x9e3779b9u); return float(s >> 8) * (1.0f / 16777216.0f); }
+float rand01(uint32_t& s) {
+    s = hash32(s + 0x9e3779b9u);
+    return float(s >> 8) * (1.0f / 16777216.0f);
+}
 
 // --- RaycastRenderer --------------------------------------------------------------------------------
 
@@ -292,9 +302,15 @@ public:
         target.resize(w, h);
         const uint8_t bg[4] = {toByteSRGB(f.settings.background.x), toByteSRGB(f.settings.background.y), toByteSRGB(f.settings.background.z), 255};
         target.clear(bg, 1.0f);
-        if (std::string e = f.settings.validate(); !e.empty()) { stats.error = "raycast: " + e; return stats; }
+        if (std::string e = f.settings.validate(); !e.empty()) {
+            stats.error = "raycast: " + e;
+            return stats;
+        }
         rt::CameraRays cam(f.camera, w, h);
-        if (!cam.valid() || !isFinite(f.camera.eye)) { stats.error = "raycast: camera matrices are not invertible"; return stats; }
+        if (!cam.valid() || !isFinite(f.camera.eye)) {
+            stats.error = "raycast: camera matrices are not invertible";
+            return stats;
+        }
 
         // FTZ/DAZ: denormals in the traversal cost a lot and change nothing visible.
         const unsigned csr = _mm_getcsr();
@@ -307,7 +323,8 @@ public:
         m_samplers.endFrame();
 
         int sx = 1, sy = 1;   // strata per pixel
-        if (f.settings.aa == AAMode::SSAA) sx = sy = std::clamp(f.settings.aaRate, 1, 8);
+        if (f.settings.aa == AAMode::SSAA)
+            sx = sy = std::clamp(f.settings.aaRate, 1, 8);
         else if (f.settings.aa == AAMode::MSAA) {
             int r = std::clamp(f.settings.aaRate, 1, 16);   // as many samples as MSAA would take
             sx = r >= 4 ? (r >= 16 ? 4 : (r >= 8 ? 4 : 2)) : r;
@@ -324,7 +341,10 @@ public:
             const unsigned old = _mm_getcsr();
             _mm_setcsr(old | 0x8040);   // FTZ | DAZ in this worker
             for (int ti = range.begin(); ti != range.end(); ++ti) {
-                if (control && control->cancel.load(std::memory_order_relaxed)) { cancelled = true; break; }
+                if (control && control->cancel.load(std::memory_order_relaxed)) {
+                    cancelled = true;
+                    break;
+                }
                 Tracer tr{f, m_accel, textures, 0};
                 const int x0 = (ti % tx) * tile, y0 = (ti / tx) * tile;   // y0: framebuffer row (top-down)
                 const int x1 = std::min(x0 + tile, w), y1 = std::min(y0 + tile, h);
@@ -387,8 +407,8 @@ private:
     SamplerCache m_samplers;
 };
 
-}  // namespace
+}   // namespace
 
 std::unique_ptr<Renderer> makeRaycastRenderer() { return std::make_unique<RaycastRenderer>(); }
 
-}  // namespace rnd
+}   // namespace rnd

@@ -5,4 +5,4 @@
 
 namespace rnd {
 std::unique_ptr<Renderer> makeRaycastRenderer();
-}  // namespace rnd
+}   // namespace rnd

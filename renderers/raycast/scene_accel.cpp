@@ -201,10 +201,16 @@ bool SceneAccel::occluded(const Ray& r) const {
                 lr.dir = mat3(inst.invWorld) * r.dir;
                 lr.tmin = r.tmin;
                 lr.tmax = r.tmax;
-                if (inst.bvh->occluded(lr)) { any = true; return true; }
+                if (inst.bvh->occluded(lr)) {
+                    any = true;
+                    return true;
+                }
             } else {
                 SceneHit h;
-                if (intersectInstance(inst, r, r.tmax, h)) { any = true; return true; }
+                if (intersectInstance(inst, r, r.tmax, h)) {
+                    any = true;
+                    return true;
+                }
             }
         }
         return false;
@@ -212,4 +218,4 @@ bool SceneAccel::occluded(const Ray& r) const {
     return any;
 }
 
-}  // namespace rnd::rt
+}   // namespace rnd::rt

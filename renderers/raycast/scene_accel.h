@@ -62,7 +62,7 @@ private:
     };
     struct Instance {
         bool isMesh = true;
-        uint32_t index = 0;          // into frame meshes / analytics
+        uint32_t index = 0;   // into frame meshes / analytics
         const TriangleBvh* bvh = nullptr;
         const ParametricAccel* param = nullptr;
         const GridAccel* grid = nullptr;
@@ -80,4 +80,4 @@ private:
     uint64_t m_buildsTotal = 0;
 };
 
-}  // namespace rnd::rt
+}   // namespace rnd::rt

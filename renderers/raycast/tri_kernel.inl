@@ -7,8 +7,8 @@
 // Requires (in the including scope): Node4, TriPacket4, Ray, TriHit, RayPre.
 
 #if RT_FMA
-#define RT_MSUB(a, b, c) _mm_fmsub_ps((a), (b), (c))    // a*b - c
-#define RT_MADD(a, b, c) _mm_fmadd_ps((a), (b), (c))    // a*b + c
+#define RT_MSUB(a, b, c) _mm_fmsub_ps((a), (b), (c))   // a*b - c
+#define RT_MADD(a, b, c) _mm_fmadd_ps((a), (b), (c))   // a*b + c
 #else
 #define RT_MSUB(a, b, c) _mm_sub_ps(_mm_mul_ps((a), (b)), (c))
 #define RT_MADD(a, b, c) _mm_add_ps(_mm_mul_ps((a), (b)), (c))
@@ -21,8 +21,8 @@
 // a hit pay for the division. Returns the lane mask of hits in (tmin, tmax) and t, b1, b2.
 // cullBack: only triangles whose CCW side faces the ray (det > 0) count. In object space
 // this is the front side for mirrored instances too (see TriangleBvh::intersect).
-inline int intersectPacket(const TriPacket4& p, const __m128 o[3], const __m128 d[3], __m128 tmin, __m128 tmax,
-                           __m128& tOut, __m128& uOut, __m128& vOut, bool cullBack = false) {
+inline int intersectPacket(const TriPacket4& p, const __m128 o[3], const __m128 d[3], __m128 tmin, __m128 tmax, __m128& tOut, __m128& uOut,
+                           __m128& vOut, bool cullBack = false) {
     const __m128 nx = _mm_load_ps(p.n[0]), ny = _mm_load_ps(p.n[1]), nz = _mm_load_ps(p.n[2]);
     const __m128 sx = _mm_sub_ps(o[0], _mm_load_ps(p.v0[0]));
     const __m128 sy = _mm_sub_ps(o[1], _mm_load_ps(p.v0[1]));
@@ -63,11 +63,9 @@ inline int intersectPacket(const TriPacket4& p, const __m128 o[3], const __m128 
 #if RT_FMA
 // intersectPacket on two packets at once (AVX: lanes 0-3 from a, 4-7 from b). Same
 // arithmetic lane by lane, so the same hits. Returns the 8-bit hit mask.
-inline __m256 loadPair(const float* x, const float* y) {
-    return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(x)), _mm_load_ps(y), 1);
-}
-inline int intersectPacketPair(const TriPacket4& a, const TriPacket4& b, const __m256 o[3], const __m256 d[3], __m256 tmin,
-                               __m256 tmax, __m256& tOut, __m256& uOut, __m256& vOut, bool cullBack) {
+inline __m256 loadPair(const float* x, const float* y) { return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(x)), _mm_load_ps(y), 1); }
+inline int intersectPacketPair(const TriPacket4& a, const TriPacket4& b, const __m256 o[3], const __m256 d[3], __m256 tmin, __m256 tmax, __m256& tOut,
+                               __m256& uOut, __m256& vOut, bool cullBack) {
     const auto ld = loadPair;
     const __m256 nx = ld(a.n[0], b.n[0]), ny = ld(a.n[1], b.n[1]), nz = ld(a.n[2], b.n[2]);
     const __m256 sx = _mm256_sub_ps(o[0], ld(a.v0[0], b.v0[0]));
@@ -148,19 +146,47 @@ inline void sortFarFirst(uint64_t* key, int k) {
         key[a] = x > y ? x : y;
         key[b] = x > y ? y : x;
     };
-    if (k == 3) { cx(0, 1); cx(1, 2); cx(0, 1); return; }
-    if (k == 4) { cx(0, 1); cx(2, 3); cx(0, 2); cx(1, 3); cx(1, 2); return; }
+    if (k == 3) {
+        cx(0, 1);
+        cx(1, 2);
+        cx(0, 1);
+        return;
+    }
+    if (k == 4) {
+        cx(0, 1);
+        cx(2, 3);
+        cx(0, 2);
+        cx(1, 3);
+        cx(1, 2);
+        return;
+    }
     for (int i = k; i < 8; ++i) key[i] = 0;
-    cx(0, 2); cx(1, 3); cx(4, 6); cx(5, 7);
-    cx(0, 4); cx(1, 5); cx(2, 6); cx(3, 7);
-    cx(0, 1); cx(2, 3); cx(4, 5); cx(6, 7);
-    cx(2, 4); cx(3, 5);
-    cx(1, 4); cx(3, 6);
-    cx(1, 2); cx(3, 4); cx(5, 6);
+    cx(0, 2);
+    cx(1, 3);
+    cx(4, 6);
+    cx(5, 7);
+    cx(0, 4);
+    cx(1, 5);
+    cx(2, 6);
+    cx(3, 7);
+    cx(0, 1);
+    cx(2, 3);
+    cx(4, 5);
+    cx(6, 7);
+    cx(2, 4);
+    cx(3, 5);
+    cx(1, 4);
+    cx(3, 6);
+    cx(1, 2);
+    cx(3, 4);
+    cx(5, 6);
 }
 
 // A traversal stack entry: node or leaf reference and its entry distance.
-struct StackEntry { uint32_t ref; float t; };
+struct StackEntry {
+    uint32_t ref;
+    float t;
+};
 
 // Front-to-back order for a node with two or more hit children: c0, c1 and those left in
 // `mask` (entry distances in dist). Pushes all but the nearest onto the stack, far first, and
@@ -176,7 +202,11 @@ inline uint32_t pushFarReturnNear(const uint32_t* child, const float* dist, int 
     int k = 0;
     key[k++] = k0;
     key[k++] = k1;
-    while (mask) { const int c = __builtin_ctz(mask); mask &= mask - 1; key[k++] = sortKey(dist[c], child[c]); }
+    while (mask) {
+        const int c = __builtin_ctz(mask);
+        mask &= mask - 1;
+        key[k++] = sortKey(dist[c], child[c]);
+    }
     sortFarFirst(key, k);
     for (int i = 0; i < k - 1; ++i) stack[sp++] = {uint32_t(key[i]), keyDistance(key[i])};
     return uint32_t(key[k - 1]);
@@ -186,7 +216,8 @@ inline uint32_t pushFarReturnNear(const uint32_t* child, const float* dist, int 
 // packets). AnyHit: stop at the first hit and skip the ordering. Returns true on a hit (closest
 // hit written to *hit unless AnyHit).
 template <bool AnyHit>
-inline bool traceTriangles(const Node4* nodes, const TriPacket4* packets, const uint32_t* prims, const float* absMax, const Ray& ray, TriHit* hit, bool cullBack) {
+inline bool traceTriangles(const Node4* nodes, const TriPacket4* packets, const uint32_t* prims, const float* absMax, const Ray& ray, TriHit* hit,
+                           bool cullBack) {
     const RayPre pre(ray, absMax);
     const __m128 rx = _mm_set1_ps(pre.rdir[0]), ry = _mm_set1_ps(pre.rdir[1]), rz = _mm_set1_ps(pre.rdir[2]);
     const __m128 orx = _mm_set1_ps(pre.orgRdirNear[0]), ory = _mm_set1_ps(pre.orgRdirNear[1]), orz = _mm_set1_ps(pre.orgRdirNear[2]);
@@ -220,9 +251,16 @@ inline bool traceTriangles(const Node4* nodes, const TriPacket4* packets, const 
                 _mm_store_ps(dist, tn);
                 const int c0 = __builtin_ctz(mask);
                 mask &= mask - 1;
-                if (mask == 0) { cur = n.child[c0]; continue; }
+                if (mask == 0) {
+                    cur = n.child[c0];
+                    continue;
+                }
                 if constexpr (AnyHit) {
-                    do { int c = __builtin_ctz(mask); mask &= mask - 1; stack[sp++] = {n.child[c], dist[c]}; } while (mask);
+                    do {
+                        int c = __builtin_ctz(mask);
+                        mask &= mask - 1;
+                        stack[sp++] = {n.child[c], dist[c]};
+                    } while (mask);
                     cur = n.child[c0];
                     continue;
                 }
@@ -250,7 +288,10 @@ inline bool traceTriangles(const Node4* nodes, const TriPacket4* packets, const 
         for (;;) {   // pop the next entry that can still hold a closer hit
             if (sp == 0) return found;
             const StackEntry& e = stack[--sp];
-            if (AnyHit || e.t <= tmax) { cur = e.ref; break; }
+            if (AnyHit || e.t <= tmax) {
+                cur = e.ref;
+                break;
+            }
         }
     }
 }
@@ -264,7 +305,8 @@ inline __m256 loadPlane(const char* base, uint32_t ref) { return _mm256_load_ps(
 // The same traversal over 8-wide nodes: one AVX compare per node for 8 boxes (BVH8: fewer,
 // wider levels); leaf packets tested two at a time (8 lanes).
 template <bool AnyHit>
-inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const uint32_t* prims, const float* absMax, const Ray& ray, TriHit* hit, bool cullBack) {
+inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const uint32_t* prims, const float* absMax, const Ray& ray, TriHit* hit,
+                            bool cullBack) {
     const RayPre pre(ray, absMax);
     const __m256 rx = _mm256_set1_ps(pre.rdir[0]), ry = _mm256_set1_ps(pre.rdir[1]), rz = _mm256_set1_ps(pre.rdir[2]);
     const __m256 orx = _mm256_set1_ps(pre.orgRdirNear[0]), ory = _mm256_set1_ps(pre.orgRdirNear[1]), orz = _mm256_set1_ps(pre.orgRdirNear[2]);
@@ -318,9 +360,16 @@ inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const
                 _mm256_store_si256(reinterpret_cast<__m256i*>(dist), tn);
                 const unsigned c0 = unsigned(__builtin_ctz(mask));   // unsigned: no sign extension before the child load
                 mask &= mask - 1;
-                if (mask == 0) { cur = n.child[c0]; continue; }
+                if (mask == 0) {
+                    cur = n.child[c0];
+                    continue;
+                }
                 if constexpr (AnyHit) {
-                    do { int c = __builtin_ctz(mask); mask &= mask - 1; stack[sp++] = {n.child[c], dist[c]}; } while (mask);
+                    do {
+                        int c = __builtin_ctz(mask);
+                        mask &= mask - 1;
+                        stack[sp++] = {n.child[c], dist[c]};
+                    } while (mask);
                     cur = n.child[c0];
                     continue;
                 }
@@ -349,7 +398,10 @@ inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const
         for (;;) {
             if (sp == 0) return found;
             const StackEntry& e = stack[--sp];
-            if (AnyHit || e.t <= tmax) { cur = e.ref; break; }
+            if (AnyHit || e.t <= tmax) {
+                cur = e.ref;
+                break;
+            }
         }
     }
 }

@@ -83,13 +83,17 @@ Aabb csgBounds(const CsgTree& t, int i) {
     Aabb b = csgBounds(t, n.children[0]);
     for (size_t k = 1; k < n.children.size(); ++k) {
         Aabb c = csgBounds(t, n.children[k]);
-        if (CsgOp(n.op) == CsgOp::Union) b.extend(c);
-        else { b.min = glm::max(b.min, c.min); b.max = glm::min(b.max, c.max); }
+        if (CsgOp(n.op) == CsgOp::Union)
+            b.extend(c);
+        else {
+            b.min = glm::max(b.min, c.min);
+            b.max = glm::min(b.max, c.max);
+        }
     }
     return b;
 }
 
-}  // namespace
+}   // namespace
 
 FrameInput flatten(const Scene& scene, float aspect, NodeId cameraNode) {
     FrameInput f;
@@ -206,4 +210,4 @@ FrameInput flatten(const Scene& scene, float aspect, NodeId cameraNode) {
     return f;
 }
 
-}  // namespace sg
+}   // namespace sg

@@ -33,4 +33,4 @@ bool isInvertible(const mat4& m, float eps) {
     return std::isfinite(det) && std::abs(det) > eps;
 }
 
-}  // namespace sg
+}   // namespace sg

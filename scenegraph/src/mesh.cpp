@@ -56,9 +56,8 @@ Mesh box(const vec3& h) {
     m.name = "box";
     // One quad per face, outward normals, counter-clockwise seen from outside.
     const vec3 axes[6][3] = {
-        {{1, 0, 0}, {0, 0, -1}, {0, 1, 0}}, {{-1, 0, 0}, {0, 0, 1}, {0, 1, 0}},
-        {{0, 1, 0}, {1, 0, 0}, {0, 0, -1}}, {{0, -1, 0}, {1, 0, 0}, {0, 0, 1}},
-        {{0, 0, 1}, {1, 0, 0}, {0, 1, 0}},  {{0, 0, -1}, {-1, 0, 0}, {0, 1, 0}},
+        {{1, 0, 0}, {0, 0, -1}, {0, 1, 0}}, {{-1, 0, 0}, {0, 0, 1}, {0, 1, 0}}, {{0, 1, 0}, {1, 0, 0}, {0, 0, -1}},
+        {{0, -1, 0}, {1, 0, 0}, {0, 0, 1}}, {{0, 0, 1}, {1, 0, 0}, {0, 1, 0}},  {{0, 0, -1}, {-1, 0, 0}, {0, 1, 0}},
     };
     for (auto& f : axes) {
         vec3 n = f[0], u = f[1], v = f[2];
@@ -111,8 +110,10 @@ Mesh uvSphere(float r, int slices, int stacks) {
     for (int j = 0; j < stacks; ++j)
         for (int i = 0; i < slices; ++i) {
             uint32_t a = j * (slices + 1) + i, b = a + 1, c = a + slices + 1, d = c + 1;
-            if (j != 0) for (uint32_t k : {a, c, b}) m.indices.push_back(k);
-            if (j != stacks - 1) for (uint32_t k : {b, c, d}) m.indices.push_back(k);
+            if (j != 0)
+                for (uint32_t k : {a, c, b}) m.indices.push_back(k);
+            if (j != stacks - 1)
+                for (uint32_t k : {b, c, d}) m.indices.push_back(k);
         }
     return m;
 }
@@ -132,11 +133,14 @@ void addDisk(Mesh& m, float r, float y, int slices, bool up) {
     }
     for (int i = 0; i < slices; ++i) {
         uint32_t a = center + 1 + i, b = a + 1;
-        if (up) { m.indices.insert(m.indices.end(), {center, a, b}); }
-        else { m.indices.insert(m.indices.end(), {center, b, a}); }
+        if (up) {
+            m.indices.insert(m.indices.end(), {center, a, b});
+        } else {
+            m.indices.insert(m.indices.end(), {center, b, a});
+        }
     }
 }
-}  // namespace
+}   // namespace
 
 Mesh cylinder(float r, float hh, int slices, bool caps) {
     Mesh m;
@@ -209,5 +213,5 @@ Mesh torus(float R, float r, int nu, int nv) {
     return m;
 }
 
-}  // namespace primitives
-}  // namespace sg
+}   // namespace primitives
+}   // namespace sg

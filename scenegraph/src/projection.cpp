@@ -33,8 +33,11 @@ std::string_view toString(ProjectionType t) {
 
 bool parse(std::string_view s, ProjectionType& out) {
     for (auto t : {ProjectionType::Perspective, ProjectionType::Orthographic, ProjectionType::Oblique})
-        if (s == toString(t)) { out = t; return true; }
+        if (s == toString(t)) {
+            out = t;
+            return true;
+        }
     return false;
 }
 
-}  // namespace sg
+}   // namespace sg

@@ -77,10 +77,15 @@ bool LocalTransform::tryMakeTRS() {
     vec3 c0(m[0]), c1(m[1]), c2(m[2]);
     vec3 s(glm::length(c0), glm::length(c1), glm::length(c2));
     if (s.x < 1e-12f || s.y < 1e-12f || s.z < 1e-12f) return false;
-    c0 /= s.x; c1 /= s.y; c2 /= s.z;
+    c0 /= s.x;
+    c1 /= s.y;
+    c2 /= s.z;
     const float tol = 1e-4f;   // columns must be orthogonal: no shear
     if (std::abs(glm::dot(c0, c1)) > tol || std::abs(glm::dot(c0, c2)) > tol || std::abs(glm::dot(c1, c2)) > tol) return false;
-    if (glm::dot(glm::cross(c0, c1), c2) < 0) { s.z = -s.z; c2 = -c2; }   // mirror as negative scale
+    if (glm::dot(glm::cross(c0, c1), c2) < 0) {
+        s.z = -s.z;
+        c2 = -c2;
+    }   // mirror as negative scale
     mat3 rot(c0, c1, c2);
     LocalTransform t = fromTRS(vec3(m[3]), glm::normalize(glm::quat_cast(rot)), s);
     // Accept only if it reproduces the matrix.
@@ -198,7 +203,10 @@ bool Scene::isAncestor(NodeId ancestor, NodeId n) const {
 }
 
 bool Scene::reparent(NodeId id, NodeId newParent, bool keepWorld, std::string* error) {
-    auto fail = [&](const char* why) { if (error) *error = why; return false; };
+    auto fail = [&](const char* why) {
+        if (error) *error = why;
+        return false;
+    };
     if (!valid(id) || !valid(newParent)) return fail("invalid node");
     if (id == root()) return fail("the root cannot be moved");
     if (isAncestor(id, newParent)) return fail("a node cannot be moved under itself or its descendants");
@@ -226,15 +234,19 @@ NodeId Scene::findByName(std::string_view n) const {
 
 // --- per-node edits ------------------------------------------------------------------------
 
-void Scene::setName(NodeId id, std::string n) { if (valid(id)) m_nodes[id].name = std::move(n); }
+void Scene::setName(NodeId id, std::string n) {
+    if (valid(id)) m_nodes[id].name = std::move(n);
+}
 
-void Scene::setVisible(NodeId id, bool v) { if (valid(id)) m_nodes[id].visible = v; }
+void Scene::setVisible(NodeId id, bool v) {
+    if (valid(id)) m_nodes[id].visible = v;
+}
 
 void Scene::markDirty(NodeId id) {
     if (!m_orderValid) return;   // the rebuild reads every local transform anyway
     uint32_t slot = m_slotOf[id];
     m_localM[slot] = m_nodes[id].local.toMatrix();
-    if (m_allDirty) return;      // a full update is pending anyway
+    if (m_allDirty) return;   // a full update is pending anyway
     if (!m_dirty[slot]) {
         m_dirty[slot] = 1;
         m_dirtySlots.push_back(slot);
@@ -361,7 +373,10 @@ struct WorldUpdater {
     }
 
     void subtree(size_t begin, size_t end) const {
-        struct Part { size_t begin, end; bool tree; };
+        struct Part {
+            size_t begin, end;
+            bool tree;
+        };
         std::vector<Part> parts;
         while (end - begin >= 2 * kGrain) {
             serial(begin, begin + 1);
@@ -382,16 +397,20 @@ struct WorldUpdater {
             }
             if (heavy >= 2) {
                 tbb::parallel_for(size_t(0), parts.size(), [&](size_t k) {
-                    if (parts[k].tree) subtree(parts[k].begin, parts[k].end);
-                    else serial(parts[k].begin, parts[k].end);
+                    if (parts[k].tree)
+                        subtree(parts[k].begin, parts[k].end);
+                    else
+                        serial(parts[k].begin, parts[k].end);
                 });
                 return;
             }
             // At most one big part: the small ones here, then continue down the big one.
             const Part* next = nullptr;
             for (const Part& pt : parts) {
-                if (pt.tree) next = &pt;
-                else serial(pt.begin, pt.end);
+                if (pt.tree)
+                    next = &pt;
+                else
+                    serial(pt.begin, pt.end);
             }
             if (!next) return;
             begin = next->begin;
@@ -400,7 +419,7 @@ struct WorldUpdater {
         serial(begin, end);
     }
 };
-}  // namespace
+}   // namespace
 
 size_t updateWorldImpl(const Scene& s) {
     if (!s.m_orderValid) s.rebuildOrder();
@@ -532,7 +551,7 @@ bool near(const mat4& a, const mat4& b, float eps = 1e-5f) {
             if (std::abs(a[c][r] - b[c][r]) > eps * (1 + std::abs(a[c][r]))) return false;
     return true;
 }
-}  // namespace
+}   // namespace
 
 std::string sceneDifference(const Scene& a, const Scene& b) {
     std::ostringstream why;
@@ -543,15 +562,14 @@ std::string sceneDifference(const Scene& a, const Scene& b) {
     if (a.meshes.size() != b.meshes.size()) return "mesh count differs";
     for (size_t i = 0; i < a.meshes.size(); ++i) {
         const Mesh &x = *a.meshes[i], &y = *b.meshes[i];
-        if (x.name != y.name || x.mode != y.mode || x.positions != y.positions || x.normals != y.normals ||
-            x.uv0 != y.uv0 || x.uv1 != y.uv1 || x.colors != y.colors || x.indices != y.indices)
+        if (x.name != y.name || x.mode != y.mode || x.positions != y.positions || x.normals != y.normals || x.uv0 != y.uv0 || x.uv1 != y.uv1 ||
+            x.colors != y.colors || x.indices != y.indices)
             return "mesh " + std::to_string(i) + " (" + x.name + ") differs";
     }
     if (a.textures.size() != b.textures.size()) return "texture count differs";
     for (size_t i = 0; i < a.textures.size(); ++i) {
         const Texture &x = *a.textures[i], &y = *b.textures[i];
-        if (x.width != y.width || x.height != y.height || x.rgba != y.rgba || x.wrapS != y.wrapS ||
-            x.wrapT != y.wrapT || x.filter != y.filter)
+        if (x.width != y.width || x.height != y.height || x.rgba != y.rgba || x.wrapS != y.wrapS || x.wrapT != y.wrapT || x.filter != y.filter)
             return "texture " + std::to_string(i) + " differs";
     }
     const auto &oa = a.depthFirstOrder(), &ob = b.depthFirstOrder();
@@ -562,8 +580,7 @@ std::string sceneDifference(const Scene& a, const Scene& b) {
         const Node &x = a.node(oa[i]), &y = b.node(ob[i]);
         std::string where = "node '" + x.name + "': ";
         if (x.name != y.name) return where + "name differs ('" + y.name + "')";
-        if ((x.parent == kNoNode) != (y.parent == kNoNode) || (x.parent != kNoNode && mapAB[x.parent] != y.parent))
-            return where + "parent differs";
+        if ((x.parent == kNoNode) != (y.parent == kNoNode) || (x.parent != kNoNode && mapAB[x.parent] != y.parent)) return where + "parent differs";
         if (x.visible != y.visible) return where + "visibility differs";
         if (x.local.mode != y.local.mode) return where + "transform mode differs";
         if (!near(x.local.toMatrix(), y.local.toMatrix())) return where + "local transform differs";
@@ -574,4 +591,4 @@ std::string sceneDifference(const Scene& a, const Scene& b) {
     return {};
 }
 
-}  // namespace sg
+}   // namespace sg

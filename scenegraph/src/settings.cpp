@@ -28,11 +28,17 @@ std::string RenderSettings::aaName() const {
 }
 
 bool RenderSettings::setAA(std::string_view name) {
-    if (name == "none" || name == "off") { aa = AAMode::None; return true; }
+    if (name == "none" || name == "off") {
+        aa = AAMode::None;
+        return true;
+    }
     AAMode mode;
-    if (name.substr(0, 4) == "msaa") mode = AAMode::MSAA;
-    else if (name.substr(0, 4) == "ssaa") mode = AAMode::SSAA;
-    else return false;
+    if (name.substr(0, 4) == "msaa")
+        mode = AAMode::MSAA;
+    else if (name.substr(0, 4) == "ssaa")
+        mode = AAMode::SSAA;
+    else
+        return false;
     int rate = 0;
     auto rest = name.substr(4);
     auto [p, ec] = std::from_chars(rest.data(), rest.data() + rest.size(), rate);
@@ -64,17 +70,29 @@ std::string_view toString(FogMode m) {
 }
 bool parse(std::string_view s, ShadingModel& out) {
     for (auto m : {ShadingModel::Flat, ShadingModel::Gouraud, ShadingModel::Phong})
-        if (s == toString(m)) { out = m; return true; }
+        if (s == toString(m)) {
+            out = m;
+            return true;
+        }
     return false;
 }
 bool parse(std::string_view s, ReflectionModel& out) {
-    if (s == "phong") { out = ReflectionModel::Phong; return true; }
-    if (s == "blinn" || s == "blinn-phong") { out = ReflectionModel::BlinnPhong; return true; }
+    if (s == "phong") {
+        out = ReflectionModel::Phong;
+        return true;
+    }
+    if (s == "blinn" || s == "blinn-phong") {
+        out = ReflectionModel::BlinnPhong;
+        return true;
+    }
     return false;
 }
 bool parse(std::string_view s, FogMode& out) {
     for (auto m : {FogMode::Off, FogMode::Linear, FogMode::Exp, FogMode::Exp2})
-        if (s == toString(m)) { out = m; return true; }
+        if (s == toString(m)) {
+            out = m;
+            return true;
+        }
     return false;
 }
 
@@ -83,7 +101,10 @@ float fogVisibility(const RenderSettings& s, float d) {
     case FogMode::Off: return 1.0f;
     case FogMode::Linear: return std::clamp((s.fogEnd - d) / (s.fogEnd - s.fogStart), 0.0f, 1.0f);
     case FogMode::Exp: return std::exp(-s.fogDensity * d);
-    case FogMode::Exp2: { float x = s.fogDensity * d; return std::exp(-x * x); }
+    case FogMode::Exp2: {
+        float x = s.fogDensity * d;
+        return std::exp(-x * x);
+    }
     }
     return 1.0f;
 }
@@ -98,8 +119,11 @@ std::string_view toString(LightType t) {
 }
 bool parse(std::string_view s, LightType& out) {
     for (auto t : {LightType::Point, LightType::Directional, LightType::Spot})
-        if (s == toString(t)) { out = t; return true; }
+        if (s == toString(t)) {
+            out = t;
+            return true;
+        }
     return false;
 }
 
-}  // namespace sg
+}   // namespace sg

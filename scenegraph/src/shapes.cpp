@@ -19,10 +19,8 @@ vec3 safeNormalize(const vec3& v, const vec3& fallback = vec3(0, 1, 0)) {
     float l = glm::length(v);
     return l > 1e-30f && std::isfinite(l) ? v / l : fallback;
 }
-float coneRadiusAt(const ImplicitShape& s, float y) {
-    return s.radius * (s.halfHeight - y) / (2.0f * s.halfHeight);
-}
-}  // namespace
+float coneRadiusAt(const ImplicitShape& s, float y) { return s.radius * (s.halfHeight - y) / (2.0f * s.halfHeight); }
+}   // namespace
 
 Aabb ImplicitShape::localBounds() const {
     switch (type) {
@@ -118,7 +116,7 @@ void bernstein(float t, float b[4], float db[4]) {
     db[2] = 6 * t * s - 3 * t * t;
     db[3] = 3 * t * t;
 }
-}  // namespace
+}   // namespace
 
 vec3 ParametricSurface::evaluate(float u, float v) const {
     if (type == ParametricType::Torus) {
@@ -252,9 +250,12 @@ std::string_view toString(ImplicitType t) {
     return "?";
 }
 bool parse(std::string_view s, ImplicitType& out) {
-    for (auto t : {ImplicitType::Plane, ImplicitType::Sphere, ImplicitType::Box, ImplicitType::Cylinder,
-                   ImplicitType::Cone, ImplicitType::Torus, ImplicitType::Quadric})
-        if (s == toString(t)) { out = t; return true; }
+    for (auto t : {ImplicitType::Plane, ImplicitType::Sphere, ImplicitType::Box, ImplicitType::Cylinder, ImplicitType::Cone, ImplicitType::Torus,
+                   ImplicitType::Quadric})
+        if (s == toString(t)) {
+            out = t;
+            return true;
+        }
     return false;
 }
 std::string_view toString(CsgOp op) {
@@ -267,14 +268,23 @@ std::string_view toString(CsgOp op) {
 }
 bool parse(std::string_view s, CsgOp& out) {
     for (auto t : {CsgOp::Union, CsgOp::Intersection, CsgOp::Difference})
-        if (s == toString(t)) { out = t; return true; }
+        if (s == toString(t)) {
+            out = t;
+            return true;
+        }
     return false;
 }
 std::string_view toString(ParametricType t) { return t == ParametricType::Torus ? "torus" : "bezier"; }
 bool parse(std::string_view s, ParametricType& out) {
-    if (s == "torus") { out = ParametricType::Torus; return true; }
-    if (s == "bezier") { out = ParametricType::BezierPatch; return true; }
+    if (s == "torus") {
+        out = ParametricType::Torus;
+        return true;
+    }
+    if (s == "bezier") {
+        out = ParametricType::BezierPatch;
+        return true;
+    }
     return false;
 }
 
-}  // namespace sg
+}   // namespace sg

@@ -5,7 +5,7 @@ namespace sg {
 namespace {
 // Sets the seeds' entry (row r, column c); GLM is column-major: m[c][r].
 inline void set(mat4& m, int r, int c, float v) { m[c][r] = v; }
-}  // namespace
+}   // namespace
 
 mat4 translation(const vec3& t) {
     mat4 m(1.0f);
@@ -18,24 +18,30 @@ mat4 translation(const vec3& t) {
 mat4 rotationX(float phi) {
     mat4 m(1.0f);
     float c = std::cos(phi), s = std::sin(phi);
-    set(m, 1, 1, c); set(m, 1, 2, -s);
-    set(m, 2, 1, s); set(m, 2, 2, c);
+    set(m, 1, 1, c);
+    set(m, 1, 2, -s);
+    set(m, 2, 1, s);
+    set(m, 2, 2, c);
     return m;
 }
 
 mat4 rotationY(float phi) {
     mat4 m(1.0f);
     float c = std::cos(phi), s = std::sin(phi);
-    set(m, 0, 0, c);  set(m, 0, 2, s);
-    set(m, 2, 0, -s); set(m, 2, 2, c);
+    set(m, 0, 0, c);
+    set(m, 0, 2, s);
+    set(m, 2, 0, -s);
+    set(m, 2, 2, c);
     return m;
 }
 
 mat4 rotationZ(float phi) {
     mat4 m(1.0f);
     float c = std::cos(phi), s = std::sin(phi);
-    set(m, 0, 0, c); set(m, 0, 1, -s);
-    set(m, 1, 0, s); set(m, 1, 1, c);
+    set(m, 0, 0, c);
+    set(m, 0, 1, -s);
+    set(m, 1, 0, s);
+    set(m, 1, 1, c);
     return m;
 }
 
@@ -145,4 +151,4 @@ mat4 viewport(float x0, float y0, float w, float h) {
     return m;
 }
 
-}  // namespace sg
+}   // namespace sg

@@ -5,13 +5,13 @@
 
 #include <gtest/gtest.h>
 
-#include <cstdio>
-#include <fstream>
-#include <csignal>
 #include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <csignal>
+#include <cstdio>
+#include <fstream>
 
 namespace fs = std::filesystem;
 
@@ -58,7 +58,10 @@ TEST(FilesTest, FullDiskKeepsTheOldFile) {
     assets::readFileLimited(dir / "old.txt", 100, content);
     EXPECT_EQ(content, "old");
     int files = 0;
-    for (auto& e : fs::directory_iterator(dir)) { (void)e; ++files; }
+    for (auto& e : fs::directory_iterator(dir)) {
+        (void)e;
+        ++files;
+    }
     EXPECT_EQ(files, 1);
 }
 
@@ -105,7 +108,10 @@ TEST(FilesTest, ReadOnlyFolderKeepsTheOldFile) {
     EXPECT_EQ(assets::readFileLimited(f, 100, content), "");
     EXPECT_EQ(content, "old");
     int files = 0;
-    for (auto& e : fs::directory_iterator(dir)) { (void)e; ++files; }
+    for (auto& e : fs::directory_iterator(dir)) {
+        (void)e;
+        ++files;
+    }
     EXPECT_EQ(files, 1);
 }
 

@@ -20,7 +20,7 @@ fs::path tempDir(const std::string& name) {
 
 void writeText(const fs::path& p, const std::string& s) { std::ofstream(p, std::ios::binary) << s; }
 
-}  // namespace
+}   // namespace
 
 TEST(SceneJsonTest, DemoRoundTripInMemory) {
     sg::Scene demo = assets::makeDemoScene();
@@ -79,7 +79,10 @@ TEST(SceneJsonTest, SaveNeverOverwritesWithoutPermission) {
     EXPECT_TRUE(assets::loadScene(file).scene);
     // No temporary files left behind.
     int files = 0;
-    for (auto& e : fs::directory_iterator(dir)) { (void)e; ++files; }
+    for (auto& e : fs::directory_iterator(dir)) {
+        (void)e;
+        ++files;
+    }
     EXPECT_EQ(files, 1);
 }
 
@@ -113,28 +116,35 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"not_object", "[1, 2, 3]", "/", "top level must be an object"},
         BadCase{"wrong_format", R"({"format": "gltf"})", "/format", "not a scene-viewer scene"},
         BadCase{"unknown_payload", R"({"nodes": [{"name": "root"}, {"parent": 0, "teapot": {}}]})", "/nodes/1/teapot", "unknown node field"},
-        BadCase{"unknown_shape", R"({"nodes": [{}, {"parent": 0, "implicit": {"type": "blob"}}]})", "/nodes/1/implicit/type", "unknown value \"blob\""},
+        BadCase{"unknown_shape", R"({"nodes": [{}, {"parent": 0, "implicit": {"type": "blob"}}]})", "/nodes/1/implicit/type",
+                "unknown value \"blob\""},
         BadCase{"unknown_shading", R"({"settings": {"shading": "toon"}})", "/settings/shading", "valid: flat, gouraud, phong"},
         BadCase{"missing_mesh", R"({"nodes": [{}, {"parent": 0, "mesh": {"mesh": 3}}]})", "/nodes/1/mesh/mesh", "out of range"},
-        BadCase{"missing_material", R"({"materials": [{}], "nodes": [{}, {"parent": 0, "implicit": {"type": "sphere", "material": 5}}]})", "/nodes/1/implicit/material", "out of range"},
+        BadCase{"missing_material", R"({"materials": [{}], "nodes": [{}, {"parent": 0, "implicit": {"type": "sphere", "material": 5}}]})",
+                "/nodes/1/implicit/material", "out of range"},
         BadCase{"missing_texture_ref", R"({"materials": [{"diffuseTexture": 0}]})", "/materials/0/diffuseTexture", "out of range"},
         BadCase{"cycle", R"({"nodes": [{}, {"parent": 2}, {"parent": 1}]})", "/parent", "cycle"},
         BadCase{"self_parent", R"({"nodes": [{}, {"parent": 1}]})", "/nodes/1/parent", "own parent"},
         BadCase{"dangling_parent", R"({"nodes": [{}, {"parent": 7}]})", "/nodes/1/parent", "out of range"},
         BadCase{"non_finite", R"({"nodes": [{}, {"parent": 0, "transform": {"translation": [0, 1e999, 0]}}]})", "", "not finite"},
-        BadCase{"huge_number", R"({"nodes": [{}, {"parent": 0, "transform": {"translation": [0, 1e300, 0]}}]})", "/nodes/1/transform/translation/1", "not finite"},
-        BadCase{"non_affine", R"({"nodes": [{}, {"parent": 0, "transform": {"matrix": [1,0,0,1, 0,1,0,0, 0,0,1,0, 0,0,0,1]}}]})", "/nodes/1/transform/matrix", "affine"},
-        BadCase{"absurd_grid", R"({"nodes": [{}, {"parent": 0, "grid": {"dims": [100000, 100000, 100000], "values": []}}]})", "/nodes/1/grid/dims", "[2, 1024]"},
-        BadCase{"grid_count", R"({"nodes": [{}, {"parent": 0, "grid": {"dims": [2, 2, 2], "values": [1, 2, 3]}}]})", "/nodes/1/grid/values", "expected 8 values"},
+        BadCase{"huge_number", R"({"nodes": [{}, {"parent": 0, "transform": {"translation": [0, 1e300, 0]}}]})", "/nodes/1/transform/translation/1",
+                "not finite"},
+        BadCase{"non_affine", R"({"nodes": [{}, {"parent": 0, "transform": {"matrix": [1,0,0,1, 0,1,0,0, 0,0,1,0, 0,0,0,1]}}]})",
+                "/nodes/1/transform/matrix", "affine"},
+        BadCase{"absurd_grid", R"({"nodes": [{}, {"parent": 0, "grid": {"dims": [100000, 100000, 100000], "values": []}}]})", "/nodes/1/grid/dims",
+                "[2, 1024]"},
+        BadCase{"grid_count", R"({"nodes": [{}, {"parent": 0, "grid": {"dims": [2, 2, 2], "values": [1, 2, 3]}}]})", "/nodes/1/grid/values",
+                "expected 8 values"},
         BadCase{"bad_indices", R"({"meshes": [{"positions": [0,0,0, 1,0,0, 0,1,0], "indices": [0, 1, 9]}]})", "/meshes/0", "index 9 out of range"},
-        BadCase{"negative_radius", R"({"nodes": [{}, {"parent": 0, "implicit": {"type": "sphere", "radius": -1}}]})", "/nodes/1/implicit/radius", "positive"},
+        BadCase{"negative_radius", R"({"nodes": [{}, {"parent": 0, "implicit": {"type": "sphere", "radius": -1}}]})", "/nodes/1/implicit/radius",
+                "positive"},
         BadCase{"bad_camera", R"({"nodes": [{}, {"parent": 0, "camera": {"near": 5, "far": 1}}]})", "/nodes/1/camera", "0 < near < far"},
         BadCase{"active_not_camera", R"({"nodes": [{}], "activeCamera": 0})", "/activeCamera", "not a camera"},
-        BadCase{"two_payloads", R"({"meshes": [], "nodes": [{}, {"parent": 0, "light": {}, "csg": {"op": "union"}}]})", "/nodes/1", "at most one payload"},
+        BadCase{"two_payloads", R"({"meshes": [], "nodes": [{}, {"parent": 0, "light": {}, "csg": {"op": "union"}}]})", "/nodes/1",
+                "at most one payload"},
         BadCase{"absolute_mesh_file", R"({"meshes": [{"file": "/etc/passwd"}]})", "/meshes/0/file", "absolute"},
         BadCase{"escaping_mesh_file", R"({"meshes": [{"file": "../../secret.obj"}]})", "/meshes/0/file", "inside the scene's folder"},
-        BadCase{"newer_version", R"({"version": 7})", "/version", "newer"},
-        BadCase{"deep_nesting", deepNesting(100000), "", "nested deeper"}),
+        BadCase{"newer_version", R"({"version": 7})", "/version", "newer"}, BadCase{"deep_nesting", deepNesting(100000), "", "nested deeper"}),
     [](const ::testing::TestParamInfo<BadCase>& i) { return std::string(i.param.name); });
 
 TEST(SceneJsonTest, MissingFileAndFolderAreClearErrors) {

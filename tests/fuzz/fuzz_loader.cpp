@@ -6,11 +6,11 @@
 #include "assets/scene_io.h"
 #include "scenegraph/frame.h"
 
+#include <unistd.h>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <unistd.h>
 
 namespace fs = std::filesystem;
 
@@ -45,7 +45,7 @@ namespace {
     return dir;
 }
 
-}  // namespace
+}   // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
 #if defined(FUZZ_TARGET_IMAGE)

@@ -31,10 +31,9 @@ rnd::Framebuffer render(const FrameInput& f, int w, int h) {
     for (int c = 0; c < 3; ++c) {
         int want = rnd::toByteSRGB(linear[c]);
         if (std::abs(int(p[c]) - want) > tol)
-            return ::testing::AssertionFailure() << "pixel (" << x << "," << y << ") = (" << int(p[0]) << "," << int(p[1]) << ","
-                                                 << int(p[2]) << "), expected (" << int(rnd::toByteSRGB(linear.r)) << ","
-                                                 << int(rnd::toByteSRGB(linear.g)) << "," << int(rnd::toByteSRGB(linear.b))
-                                                 << ") +-" << tol;
+            return ::testing::AssertionFailure() << "pixel (" << x << "," << y << ") = (" << int(p[0]) << "," << int(p[1]) << "," << int(p[2])
+                                                 << "), expected (" << int(rnd::toByteSRGB(linear.r)) << "," << int(rnd::toByteSRGB(linear.g)) << ","
+                                                 << int(rnd::toByteSRGB(linear.b)) << ") +-" << tol;
     }
     return ::testing::AssertionSuccess();
 }
@@ -49,7 +48,7 @@ Mesh quad(float half) {
     return m;
 }
 
-}  // namespace
+}   // namespace
 
 // A unit sphere lit head-on, camera on the same axis: at the centre pixel n = l = v = r = h,
 // so n.l = 1 and the specular term is 1 for Phong and Blinn-Phong alike:
@@ -125,9 +124,7 @@ TEST(GlFogGLTest, PlaneAtKnownDistanceBlendsAsExpected) {
         rnd::Framebuffer fb = render(f, W, H);
         EXPECT_TRUE(pixelNear(fb, W / 2, H / 2, vis * color + (1.0f - vis) * fogColor)) << toString(mode);
         // Off-axis pixels are farther away (eye distance, not z): more fog toward the corners.
-        if (mode == FogMode::Linear) {
-            EXPECT_GT(fb.pixel(2, 2)[2], fb.pixel(W / 2, H / 2)[2]);
-        }
+        if (mode == FogMode::Linear) { EXPECT_GT(fb.pixel(2, 2)[2], fb.pixel(W / 2, H / 2)[2]); }
     }
 }
 
@@ -184,7 +181,7 @@ double columnCoverage(const rnd::Framebuffer& fb, int x) {
     return sum;
 }
 
-}  // namespace
+}   // namespace
 
 // Oblique projection of a unit cube facing the camera: the back face is shifted by
 // factor * depth along (cos a, sin a), so the silhouette's top edge left of the front face's
@@ -254,7 +251,7 @@ int intermediatePixels(const rnd::Framebuffer& fb) {
     return n;
 }
 
-}  // namespace
+}   // namespace
 
 // A white square rotated by 20 degrees on black: without AA every pixel is black or white;
 // MSAA and SSAA produce graded edge pixels.
@@ -273,8 +270,7 @@ TEST(GlAntiAliasingGLTest, MsaaAndSsaaSoftenEdges) {
     int msaa16 = intermediatePixels(render(*r, frame(AAMode::MSAA, 16), W, H));   // clamped to GL_MAX_SAMPLES
     int ssaa2 = intermediatePixels(render(*r, frame(AAMode::SSAA, 2), W, H));
     int ssaa4 = intermediatePixels(render(*r, frame(AAMode::SSAA, 4), W, H));
-    std::printf("[aa] intermediate edge pixels: none %d, msaa4 %d, msaa16(clamped) %d, ssaa2 %d, ssaa4 %d\n", none, msaa4,
-                msaa16, ssaa2, ssaa4);
+    std::printf("[aa] intermediate edge pixels: none %d, msaa4 %d, msaa16(clamped) %d, ssaa2 %d, ssaa4 %d\n", none, msaa4, msaa16, ssaa2, ssaa4);
     EXPECT_EQ(none, 0);
     EXPECT_GT(msaa4, 100);
     EXPECT_GT(msaa16, 100);
@@ -339,60 +335,60 @@ TEST(GlCacheGLTest, InvalidMeshIsSkipped) {
 TEST(GlShadingGLTest, PlaneMatchesSharedShadingFunctionEverywhere) {
     const int W = 96, H = 72;
     for (bool generic : {false, true})
-    for (ShadingModel model : {ShadingModel::Phong, ShadingModel::Flat})
-        for (ReflectionModel refl : {ReflectionModel::Phong, ReflectionModel::BlinnPhong}) {
-            if (generic && model == ShadingModel::Flat) continue;
-            FrameInput f = makeFrame(W, H, Projection{}, vec3(0.6f, 0.4f, 4.0f), vec3(0.0f));
-            f.ambientLight = vec3(0.2f, 0.22f, 0.25f);
-            f.settings.shading = model;
-            f.settings.reflection = refl;
-            f.settings.fog = FogMode::Exp;
-            f.settings.fogDensity = 0.04f;
-            f.settings.fogColor = vec3(0.3f, 0.3f, 0.35f);
-            f.lights.push_back(point(vec3(1.0f, 1.0f, 1.5f), vec3(2.5f, 2.2f, 2.0f), true));
-            f.lights.push_back(spot(vec3(-1.0f, 0.5f, 2.0f), vec3(0.2f, -0.25f, -1.0f), vec3(1.2f, 1.0f, 0.6f), 10.0f, 25.0f));
-            f.lights.push_back(directional(vec3(0.2f, -0.3f, -1.0f), vec3(0.15f, 0.2f, 0.3f)));
-            // More than 8 lights switch to the generic program (a loop reading the types).
-            for (int i = 0; generic && i < 3; ++i) {
-                f.lights.push_back(point(vec3(-1.0f + i, 1.0f, 2.0f), vec3(0.3f), i % 2 == 0));
-                f.lights.push_back(spot(vec3(1.0f, -1.0f + i, 2.0f), vec3(-0.1f * i, 0.2f, -1.0f), vec3(0.4f), 15.0f, 30.0f));
-            }
-            Material m;
-            m.baseColor = vec3(0.7f, 0.6f, 0.5f);
-            m.ka = 0.3f;
-            m.kd = 0.6f;
-            m.ks = 0.4f;
-            m.shininess = 20.0f;
-            addMesh(f, quad(6.0f), m);
-            rnd::Framebuffer fb = render(f, W, H);
-
-            mat4 inv = glm::inverse(f.camera.viewProj);
-            double sum = 0;
-            int worst = 0, count = 0;
-            for (int row = 0; row < H; ++row)
-                for (int x = 0; x < W; ++x) {
-                    // Pixel centre -> NDC -> ray through the near and far planes -> z = 0 plane.
-                    float nx = 2.0f * (x + 0.5f) / W - 1.0f, ny = 2.0f * (H - 1 - row + 0.5f) / H - 1.0f;
-                    vec4 a = inv * vec4(nx, ny, -1.0f, 1.0f), b = inv * vec4(nx, ny, 1.0f, 1.0f);
-                    vec3 p0 = vec3(a) / a.w, p1 = vec3(b) / b.w;
-                    float t = p0.z / (p0.z - p1.z);
-                    vec3 p = p0 + t * (p1 - p0);
-                    rnd::SurfacePoint sp{p, vec3(0, 0, 1), m.baseColor};
-                    vec3 c = rnd::shade(m, sp, f.camera.eye, f);
-                    c = rnd::applyFog(f.settings, c, glm::length(vec3(f.camera.view * vec4(p, 1.0f))));
-                    for (int ch = 0; ch < 3; ++ch) {
-                        int d = std::abs(int(fb.pixel(x, row)[ch]) - int(rnd::toByteSRGB(c[ch])));
-                        worst = std::max(worst, d);
-                        sum += d;
-                        ++count;
-                    }
+        for (ShadingModel model : {ShadingModel::Phong, ShadingModel::Flat})
+            for (ReflectionModel refl : {ReflectionModel::Phong, ReflectionModel::BlinnPhong}) {
+                if (generic && model == ShadingModel::Flat) continue;
+                FrameInput f = makeFrame(W, H, Projection{}, vec3(0.6f, 0.4f, 4.0f), vec3(0.0f));
+                f.ambientLight = vec3(0.2f, 0.22f, 0.25f);
+                f.settings.shading = model;
+                f.settings.reflection = refl;
+                f.settings.fog = FogMode::Exp;
+                f.settings.fogDensity = 0.04f;
+                f.settings.fogColor = vec3(0.3f, 0.3f, 0.35f);
+                f.lights.push_back(point(vec3(1.0f, 1.0f, 1.5f), vec3(2.5f, 2.2f, 2.0f), true));
+                f.lights.push_back(spot(vec3(-1.0f, 0.5f, 2.0f), vec3(0.2f, -0.25f, -1.0f), vec3(1.2f, 1.0f, 0.6f), 10.0f, 25.0f));
+                f.lights.push_back(directional(vec3(0.2f, -0.3f, -1.0f), vec3(0.15f, 0.2f, 0.3f)));
+                // More than 8 lights switch to the generic program (a loop reading the types).
+                for (int i = 0; generic && i < 3; ++i) {
+                    f.lights.push_back(point(vec3(-1.0f + i, 1.0f, 2.0f), vec3(0.3f), i % 2 == 0));
+                    f.lights.push_back(spot(vec3(1.0f, -1.0f + i, 2.0f), vec3(-0.1f * i, 0.2f, -1.0f), vec3(0.4f), 15.0f, 30.0f));
                 }
-            double mean = sum / count;
-            std::printf("[plane] %s/%s%s: mean %.3f max %d\n", std::string(toString(model)).c_str(),
-                        std::string(toString(refl)).c_str(), generic ? " (9 lights, generic program)" : "", mean, worst);
-            EXPECT_LE(mean, 0.5) << toString(model) << " " << toString(refl);
-            EXPECT_LE(worst, 3) << toString(model) << " " << toString(refl);
-        }
+                Material m;
+                m.baseColor = vec3(0.7f, 0.6f, 0.5f);
+                m.ka = 0.3f;
+                m.kd = 0.6f;
+                m.ks = 0.4f;
+                m.shininess = 20.0f;
+                addMesh(f, quad(6.0f), m);
+                rnd::Framebuffer fb = render(f, W, H);
+
+                mat4 inv = glm::inverse(f.camera.viewProj);
+                double sum = 0;
+                int worst = 0, count = 0;
+                for (int row = 0; row < H; ++row)
+                    for (int x = 0; x < W; ++x) {
+                        // Pixel centre -> NDC -> ray through the near and far planes -> z = 0 plane.
+                        float nx = 2.0f * (x + 0.5f) / W - 1.0f, ny = 2.0f * (H - 1 - row + 0.5f) / H - 1.0f;
+                        vec4 a = inv * vec4(nx, ny, -1.0f, 1.0f), b = inv * vec4(nx, ny, 1.0f, 1.0f);
+                        vec3 p0 = vec3(a) / a.w, p1 = vec3(b) / b.w;
+                        float t = p0.z / (p0.z - p1.z);
+                        vec3 p = p0 + t * (p1 - p0);
+                        rnd::SurfacePoint sp{p, vec3(0, 0, 1), m.baseColor};
+                        vec3 c = rnd::shade(m, sp, f.camera.eye, f);
+                        c = rnd::applyFog(f.settings, c, glm::length(vec3(f.camera.view * vec4(p, 1.0f))));
+                        for (int ch = 0; ch < 3; ++ch) {
+                            int d = std::abs(int(fb.pixel(x, row)[ch]) - int(rnd::toByteSRGB(c[ch])));
+                            worst = std::max(worst, d);
+                            sum += d;
+                            ++count;
+                        }
+                    }
+                double mean = sum / count;
+                std::printf("[plane] %s/%s%s: mean %.3f max %d\n", std::string(toString(model)).c_str(), std::string(toString(refl)).c_str(),
+                            generic ? " (9 lights, generic program)" : "", mean, worst);
+                EXPECT_LE(mean, 0.5) << toString(model) << " " << toString(refl);
+                EXPECT_LE(worst, 3) << toString(model) << " " << toString(refl);
+            }
 }
 
 // Up to 32 lights are shaded (one program per light setup); more are ignored, not an error.

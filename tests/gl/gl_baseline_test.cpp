@@ -16,9 +16,7 @@ namespace {
 
 constexpr int kWidth = 160, kHeight = 120;
 
-fs::path baselinePath(const std::string& name) {
-    return fs::path(VIEWER_SOURCE_DIR) / "tests" / "baselines" / "gl" / (name + ".png");
-}
+fs::path baselinePath(const std::string& name) { return fs::path(VIEWER_SOURCE_DIR) / "tests" / "baselines" / "gl" / (name + ".png"); }
 
 class GlBaselineGLTest : public ::testing::TestWithParam<std::string> {};
 
@@ -53,4 +51,4 @@ TEST_P(GlBaselineGLTest, MatchesBaseline) {
 INSTANTIATE_TEST_SUITE_P(Scenes, GlBaselineGLTest, ::testing::ValuesIn(gltest::baselineNames()),
                          [](const ::testing::TestParamInfo<std::string>& i) { return i.param; });
 
-}  // namespace
+}   // namespace

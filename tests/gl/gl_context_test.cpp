@@ -18,12 +18,16 @@ class ScopedEnv {
 public:
     ScopedEnv(const char* name, const char* value) : m_name(name) {
         if (const char* old = std::getenv(name)) m_old = old, m_had = true;
-        if (value) setenv(name, value, 1);
-        else unsetenv(name);
+        if (value)
+            setenv(name, value, 1);
+        else
+            unsetenv(name);
     }
     ~ScopedEnv() {
-        if (m_had) setenv(m_name.c_str(), m_old.c_str(), 1);
-        else unsetenv(m_name.c_str());
+        if (m_had)
+            setenv(m_name.c_str(), m_old.c_str(), 1);
+        else
+            unsetenv(m_name.c_str());
     }
 
 private:
@@ -38,7 +42,7 @@ FrameInput simpleFrame() {
     return f;
 }
 
-}  // namespace
+}   // namespace
 
 TEST(GlContextGLTest, EglSurfacelessGivesCore33OrNewer) {
     ASSERT_FALSE(rnd::gl::anyContextCurrent());

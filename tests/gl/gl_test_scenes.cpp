@@ -102,11 +102,11 @@ FrameInput shapes(int w, int h, const Projection& proj) {
     return f;
 }
 
-}  // namespace
+}   // namespace
 
 std::vector<std::string> baselineNames() {
-    return {"phong", "gouraud", "flat", "blinn_fog_exp2", "fog_linear", "wireframe_msaa4", "cavalier",
-            "orthographic", "ssaa2", "lines_points", "mirrored_culled", "texture_nearest_clamp"};
+    return {"phong",    "gouraud",      "flat",  "blinn_fog_exp2", "fog_linear",      "wireframe_msaa4",
+            "cavalier", "orthographic", "ssaa2", "lines_points",   "mirrored_culled", "texture_nearest_clamp"};
 }
 
 FrameInput baselineFrame(const std::string& name, int w, int h) {
@@ -183,4 +183,4 @@ FrameInput baselineFrame(const std::string& name, int w, int h) {
     return f;
 }
 
-}  // namespace gltest
+}   // namespace gltest

@@ -38,7 +38,7 @@ const sg::Mesh* meshOfNode(const sg::Scene& s, const std::string& name) {
     return mi ? s.meshes[size_t(mi->mesh)].get() : nullptr;
 }
 
-}  // namespace
+}   // namespace
 
 TEST(GltfImportTest, SampleModelsTriangleCounts) {
     ASSERT_TRUE(testing_support::requireTestdata());
@@ -163,8 +163,8 @@ TEST(GltfImportTest, MultiUvTexturesAndSamplers) {
     EXPECT_FALSE(r.scene->meshes[0]->uv1.empty());
     EXPECT_EQ(r.scene->cameras().size(), 1u);
 
-    for (const char* p : {"BoxTextured/glTF/BoxTextured.gltf", "BoxTextured/glTF-Binary/BoxTextured.glb",
-                          "BoxTextured/glTF-Embedded/BoxTextured.gltf"}) {
+    for (const char* p :
+         {"BoxTextured/glTF/BoxTextured.gltf", "BoxTextured/glTF-Binary/BoxTextured.glb", "BoxTextured/glTF-Embedded/BoxTextured.gltf"}) {
         SCOPED_TRACE(p);
         assets::LoadResult t = mustLoad(gltf(p));
         ASSERT_TRUE(t.scene);
@@ -172,10 +172,10 @@ TEST(GltfImportTest, MultiUvTexturesAndSamplers) {
         const sg::Texture& tex = *t.scene->textures[0];
         EXPECT_GT(tex.width, 0);
         EXPECT_EQ(tex.rgba.size(), size_t(tex.width) * tex.height * 4);
-        bool external = std::string(p) == "BoxTextured/glTF/BoxTextured.gltf";   // the assimp copy's sampler
+        bool external = std::string(p) == "BoxTextured/glTF/BoxTextured.gltf";                  // the assimp copy's sampler
         EXPECT_EQ(tex.wrapS, external ? sg::WrapMode::MirroredRepeat : sg::WrapMode::Repeat);   // 33648 / 10497
         EXPECT_EQ(tex.wrapT, external ? sg::WrapMode::ClampToEdge : sg::WrapMode::Repeat);      // 33071 / 10497
-        EXPECT_EQ(tex.filter, sg::FilterMode::Trilinear);      // NEAREST_MIPMAP_LINEAR
+        EXPECT_EQ(tex.filter, sg::FilterMode::Trilinear);                                       // NEAREST_MIPMAP_LINEAR
         ASSERT_EQ(t.scene->materials.size(), 1u);
         EXPECT_EQ(t.scene->materials[0].diffuseTexture, 0);
         EXPECT_TRUE(t.warnings.empty()) << t.warnings.front();
@@ -193,7 +193,10 @@ TEST(GltfImportTest, TextureTransformAppliedToUvs) {
     ASSERT_TRUE(offU && offV && offUV);
     auto uvBounds = [](const sg::Mesh& m) {
         sg::vec2 lo(1e9f), hi(-1e9f);
-        for (auto uv : m.uv0) { lo = glm::min(lo, uv); hi = glm::max(hi, uv); }
+        for (auto uv : m.uv0) {
+            lo = glm::min(lo, uv);
+            hi = glm::max(hi, uv);
+        }
         return std::make_pair(lo, hi);
     };
     // The three share one TEXCOORD_0 accessor; offsets (0.5,0), (0,0.5), (0.5,0.5).
@@ -225,13 +228,15 @@ TEST(GltfImportTest, UnlitAndSpecGlossMaterials) {
 TEST(GltfImportTest, PrimitiveModes) {
     ASSERT_TRUE(testing_support::requireTestdata());
     // Mesh_PrimitiveMode_NN: 00-06 non-indexed, 07-15 indexed; modes per MANIFEST.
-    struct Case { int n; sg::PrimitiveMode mode; size_t tris; };
-    const Case cases[] = {{0, sg::PrimitiveMode::Points, 0},    {1, sg::PrimitiveMode::Lines, 0},
-                          {2, sg::PrimitiveMode::Lines, 0},     {3, sg::PrimitiveMode::Lines, 0},
-                          {4, sg::PrimitiveMode::Triangles, 2}, {5, sg::PrimitiveMode::Triangles, 2},
-                          {6, sg::PrimitiveMode::Triangles, 2}, {7, sg::PrimitiveMode::Points, 0},
-                          {8, sg::PrimitiveMode::Lines, 0},     {9, sg::PrimitiveMode::Lines, 0},
-                          {10, sg::PrimitiveMode::Lines, 0},    {11, sg::PrimitiveMode::Triangles, 2},
+    struct Case {
+        int n;
+        sg::PrimitiveMode mode;
+        size_t tris;
+    };
+    const Case cases[] = {{0, sg::PrimitiveMode::Points, 0},    {1, sg::PrimitiveMode::Lines, 0},     {2, sg::PrimitiveMode::Lines, 0},
+                          {3, sg::PrimitiveMode::Lines, 0},     {4, sg::PrimitiveMode::Triangles, 2}, {5, sg::PrimitiveMode::Triangles, 2},
+                          {6, sg::PrimitiveMode::Triangles, 2}, {7, sg::PrimitiveMode::Points, 0},    {8, sg::PrimitiveMode::Lines, 0},
+                          {9, sg::PrimitiveMode::Lines, 0},     {10, sg::PrimitiveMode::Lines, 0},    {11, sg::PrimitiveMode::Triangles, 2},
                           {12, sg::PrimitiveMode::Triangles, 2}};
     for (const Case& c : cases) {
         char name[96];
@@ -244,12 +249,8 @@ TEST(GltfImportTest, PrimitiveModes) {
         EXPECT_EQ(m.mode, c.mode);
         EXPECT_EQ(m.triangleCount(), c.tris);
         EXPECT_EQ(m.validate(), "");
-        if (c.mode == sg::PrimitiveMode::Lines) {
-            EXPECT_GE(m.indices.size(), 2u);
-        }
-        if (c.mode == sg::PrimitiveMode::Triangles) {
-            EXPECT_EQ(m.normals.size(), m.positions.size());
-        }
+        if (c.mode == sg::PrimitiveMode::Lines) { EXPECT_GE(m.indices.size(), 2u); }
+        if (c.mode == sg::PrimitiveMode::Triangles) { EXPECT_EQ(m.normals.size(), m.positions.size()); }
     }
 }
 
@@ -337,7 +338,10 @@ TEST(GltfImportTest, InvalidCorpusNeverCrashes) {
         SCOPED_TRACE(e.path().string());
         double dt = 0;
         assets::LoadResult r = timedLoad(e.path(), 5.0, &dt);
-        if (dt > slowest) { slowest = dt; slowestName = e.path().filename().string(); }
+        if (dt > slowest) {
+            slowest = dt;
+            slowestName = e.path().filename().string();
+        }
         // Compare with the validator's verdict (informational: tinygltf-level parse rules and
         // our stricter/looser checks differ from the validator's in places).
         int validatorErrors = -1;
@@ -355,15 +359,18 @@ TEST(GltfImportTest, InvalidCorpusNeverCrashes) {
         }
     }
     EXPECT_GE(files, 200u);
-    std::printf("invalid-gltf: %zu files, %zu rejected with an error, %zu with validator errors loaded anyway, slowest %.3f s (%s)\n",
-                files, errors, acceptedInvalid, slowest, slowestName.c_str());
+    std::printf("invalid-gltf: %zu files, %zu rejected with an error, %zu with validator errors loaded anyway, slowest %.3f s (%s)\n", files, errors,
+                acceptedInvalid, slowest, slowestName.c_str());
 }
 
 // Specific negative files whose problems must be caught by our validation.
 TEST(GltfImportTest, KnownBadFilesRejected) {
     ASSERT_TRUE(testing_support::requireTestdata());
     fs::path dir = testing_support::testdataDir() / "invalid-gltf" / "assimp";
-    struct Case { const char* file; const char* needle; };
+    struct Case {
+        const char* file;
+        const char* needle;
+    };
     const Case cases[] = {
         {"RecursiveNodes/RecursiveNodes.gltf", "node"},
         {"IndexOutOfRange/IndexOutOfRange.gltf", "index"},

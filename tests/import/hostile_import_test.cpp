@@ -17,9 +17,9 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include <cstring>
 #include <chrono>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <vector>
 
@@ -43,21 +43,27 @@ struct Knobs {
     std::string positionCount = "3";
     std::string positionView = "\"bufferView\": 0,";
     std::string indexCount = "3";
-    std::string images;      // JSON array body
-    std::string extra;       // extra top-level members (with trailing comma)
+    std::string images;   // JSON array body
+    std::string extra;    // extra top-level members (with trailing comma)
 };
 std::string triangleGltf(const Knobs& k) {
-    std::string textures = k.images.empty() ? "" :
-        "\"textures\": [{\"source\": 0}], \"materials\": [{\"pbrMetallicRoughness\": {\"baseColorTexture\": {\"index\": 0}}}],";
-    return "{ \"asset\": {\"version\": \"2.0\"}, " + k.extra + textures +
-           (k.images.empty() ? "" : "\"images\": [" + k.images + "],") +
-           "\"buffers\": [{\"uri\": \"" + k.bufferUri + "\", \"byteLength\": 44}],"
+    std::string textures =
+        k.images.empty() ? ""
+                         : "\"textures\": [{\"source\": 0}], \"materials\": [{\"pbrMetallicRoughness\": {\"baseColorTexture\": {\"index\": 0}}}],";
+    return "{ \"asset\": {\"version\": \"2.0\"}, " + k.extra + textures + (k.images.empty() ? "" : "\"images\": [" + k.images + "],") +
+           "\"buffers\": [{\"uri\": \"" + k.bufferUri +
+           "\", \"byteLength\": 44}],"
            "\"bufferViews\": [{\"buffer\": 0, \"byteOffset\": 0, \"byteLength\": 36},"
            "                  {\"buffer\": 0, \"byteOffset\": 36, \"byteLength\": 6}],"
-           "\"accessors\": [{" + k.positionView + " \"componentType\": 5126, \"count\": " + k.positionCount + ", \"type\": \"VEC3\"},"
-           "                {\"bufferView\": 1, \"componentType\": 5123, \"count\": " + k.indexCount + ", \"type\": \"SCALAR\"}],"
+           "\"accessors\": [{" +
+           k.positionView + " \"componentType\": 5126, \"count\": " + k.positionCount +
+           ", \"type\": \"VEC3\"},"
+           "                {\"bufferView\": 1, \"componentType\": 5123, \"count\": " +
+           k.indexCount +
+           ", \"type\": \"SCALAR\"}],"
            "\"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0}, \"indices\": 1" +
-           (k.images.empty() ? "" : ", \"material\": 0") + "}]}],"
+           (k.images.empty() ? "" : ", \"material\": 0") +
+           "}]}],"
            "\"nodes\": [{\"mesh\": 0}], \"scenes\": [{\"nodes\": [0]}], \"scene\": 0 }";
 }
 
@@ -117,7 +123,7 @@ assets::LoadResult quickLoad(const fs::path& p) {
     return r;
 }
 
-}  // namespace
+}   // namespace
 
 TEST(HostileImportTest, SanityTriangleLoads) {
     Sandbox sb("sanity");
@@ -213,14 +219,21 @@ constexpr double kMaxSeconds = 5.0, kMaxMB = 300.0;
 #else
 constexpr double kMaxSeconds = 1.0, kMaxMB = 100.0;
 #endif
-struct Cost { double seconds = 0, peakMB = 0; std::string error; };
-template <class F> Cost measure(F&& load) {
+struct Cost {
+    double seconds = 0, peakMB = 0;
+    std::string error;
+};
+template <class F>
+Cost measure(F&& load) {
     Cost c;
     {
         std::ofstream clear("/proc/self/clear_refs");
         clear << "5";
         clear.flush();
-        if (!clear.good()) { ADD_FAILURE() << "cannot reset the peak RSS through /proc/self/clear_refs"; return c; }
+        if (!clear.good()) {
+            ADD_FAILURE() << "cannot reset the peak RSS through /proc/self/clear_refs";
+            return c;
+        }
     }
     const long before = statusKB("VmRSS:");
     auto t0 = std::chrono::steady_clock::now();
@@ -229,14 +242,15 @@ template <class F> Cost measure(F&& load) {
     c.peakMB = double(statusKB("VmHWM:") - before) / 1024.0;
     return c;
 }
-template <class F> void expectCheap(const std::string& what, F&& load) {
+template <class F>
+void expectCheap(const std::string& what, F&& load) {
     Cost c = measure(load);
     std::printf("  %-34s refused in %.3f s, peak +%.1f MB: %s\n", what.c_str(), c.seconds, c.peakMB, c.error.c_str());
     EXPECT_FALSE(c.error.empty()) << what << " was not refused";
     EXPECT_LT(c.seconds, kMaxSeconds) << what;
     EXPECT_LT(c.peakMB, kMaxMB) << what;
 }
-}  // namespace
+}   // namespace
 
 TEST(HostileImportTest, HostileHeadersRefusedQuicklyAndCheaply) {
     Sandbox sb("cheap");
@@ -246,7 +260,8 @@ TEST(HostileImportTest, HostileHeadersRefusedQuicklyAndCheaply) {
     writeText(sb.model / "acc1e9.gltf", triangleGltf(k));
     writeText(sb.model / "huge.off", "OFF\n2000000000 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
     writeText(sb.model / "deep.gltf", "{\"asset\": {\"version\": \"2.0\"}, \"extras\": " + std::string(100000, '[') + std::string(100000, ']') + "}");
-    writeText(sb.model / "deep.json", "{\"format\": \"sceneviewer\", \"version\": 1, \"x\": " + std::string(100000, '[') + std::string(100000, ']') + "}");
+    writeText(sb.model / "deep.json",
+              "{\"format\": \"sceneviewer\", \"version\": 1, \"x\": " + std::string(100000, '[') + std::string(100000, ']') + "}");
     // A valid 1x1 PNG whose IHDR then claims 65535 x 65535 (the CRC no longer matches either).
     std::string png;
     const uint8_t px[4] = {1, 2, 3, 255};
@@ -271,7 +286,11 @@ TEST(HostileImportTest, HostileHeadersRefusedQuicklyAndCheaply) {
 
 TEST(HostileImportTest, PathTraversalInBufferUris) {
     Sandbox sb("traversal");
-    struct Case { const char* file; std::string uri; const char* needle; };
+    struct Case {
+        const char* file;
+        std::string uri;
+        const char* needle;
+    };
     const Case cases[] = {
         {"dotdot.gltf", "../outside/secret.bin", "'..'"},
         {"dotdot2.gltf", "sub/../../outside/secret.bin", "'..'"},
@@ -316,8 +335,8 @@ TEST(HostileImportTest, HostileImagesFallBack) {
     // Image URIs out of the folder, a FIFO, a non-PNG/JPEG file, a huge claimed PNG: the
     // model loads without the texture and says why.
     writeText(sb.model / "fake.png", "GIF89a not really an image");
-    const unsigned char pngBytes[] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n', 0, 0, 0, 13, 'I', 'H', 'D', 'R',
-                                      0x7f, 0xff, 0xff, 0xff, 0x7f, 0xff, 0xff, 0xff, 8, 6, 0, 0, 0, 0, 0, 0, 0};
+    const unsigned char pngBytes[] = {0x89, 'P',  'N',  'G',  '\r', '\n', 0x1a, '\n', 0, 0, 0, 13, 'I', 'H', 'D', 'R', 0x7f,
+                                      0xff, 0xff, 0xff, 0x7f, 0xff, 0xff, 0xff, 8,    6, 0, 0, 0,  0,   0,   0,   0};
     std::string png(reinterpret_cast<const char*>(pngBytes), sizeof pngBytes);   // IHDR claims 2^31-1 squared
     writeText(sb.model / "huge.png", png);
     const std::pair<const char*, std::string> cases[] = {
@@ -340,8 +359,7 @@ TEST(HostileImportTest, HostileImagesFallBack) {
     // An image bufferView whose byteOffset lies far outside the buffer (crashed tinygltf's
     // own image path): a clear error from validation.
     std::string json = triangleGltf(Knobs{});
-    json.replace(json.find("\"bufferViews\": ["), 16,
-                 "\"images\": [{\"bufferView\": 2, \"mimeType\": \"image/png\"}], \"bufferViews\": [");
+    json.replace(json.find("\"bufferViews\": ["), 16, "\"images\": [{\"bufferView\": 2, \"mimeType\": \"image/png\"}], \"bufferViews\": [");
     json.replace(json.find("\"byteLength\": 6}"), 16, "\"byteLength\": 6}, {\"buffer\": 0, \"byteOffset\": 1000000000000000, \"byteLength\": 64}");
     writeText(sb.model / "img_offset.gltf", json);
     assets::LoadResult r = quickLoad(sb.model / "img_offset.gltf");
@@ -361,13 +379,16 @@ TEST(HostileImportTest, MeshHeaderCounts) {
     EXPECT_FALSE(r.scene);
     EXPECT_NE(r.error.find("2000000000 faces"), std::string::npos) << r.error;
 
-    writeText(sb.model / "huge.ply", "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\n"
-                                     "property float z\nend_header\n" + std::string(36, '\0'));
+    writeText(sb.model / "huge.ply",
+              "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\n"
+              "property float z\nend_header\n" +
+                  std::string(36, '\0'));
     r = quickLoad(sb.model / "huge.ply");
     EXPECT_FALSE(r.scene);
     EXPECT_NE(r.error.find("4000000000"), std::string::npos) << r.error;
-    writeText(sb.model / "hugeascii.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
-                                          "element face 4000000000\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+    writeText(sb.model / "hugeascii.ply",
+              "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+              "element face 4000000000\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
     r = quickLoad(sb.model / "hugeascii.ply");
     EXPECT_FALSE(r.scene);
     EXPECT_NE(r.error.find("4000000000"), std::string::npos) << r.error;
@@ -411,8 +432,9 @@ TEST(HostileImportTest, TruncatedAndBadIndexMeshes) {
     ASSERT_FALSE(r.warnings.empty());
     EXPECT_NE(r.warnings.front().find("2 faces"), std::string::npos) << r.warnings.front();
 
-    std::string ply = "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
-                      "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+    std::string ply =
+        "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+        "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
     float v[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
     ply.append(reinterpret_cast<const char*>(v), 36);
     ply += char(3);   // face list cut off
@@ -443,7 +465,8 @@ TEST(HostileImportTest, SceneJsonFileReferencesStayInside) {
     Knobs k;
     k.bufferUri = "../outside/secret.bin";
     writeText(sb.model / "out.gltf", triangleGltf(k));
-    const std::string tri = R"({"format": "sceneviewer", "version": 1, "nodes": [{"name": "root"}], "meshes": [{"name": "t", "positions": [0,0,0, 1,0,0, 0,1,0], "indices": [0,1,2]}]})";
+    const std::string tri =
+        R"({"format": "sceneviewer", "version": 1, "nodes": [{"name": "root"}], "meshes": [{"name": "t", "positions": [0,0,0, 1,0,0, 0,1,0], "indices": [0,1,2]}]})";
     writeText(sb.model / "inner.json", tri);
     sb.outsideEvents();   // our own writes above
 
@@ -451,7 +474,11 @@ TEST(HostileImportTest, SceneJsonFileReferencesStayInside) {
         return R"({"format": "sceneviewer", "version": 1, ")" + section + R"(": [{"name": "x", "file": ")" + file +
                R"("}], "nodes": [{"name": "root"}]})";
     };
-    struct Case { const char* section; std::string file; const char* needle; };   // needle "" = loads
+    struct Case {
+        const char* section;
+        std::string file;
+        const char* needle;
+    };   // needle "" = loads
     const Case cases[] = {
         {"meshes", "../outside/secret.obj", "inside the scene's folder"},
         {"meshes", "sub/../../outside/secret.obj", "inside the scene's folder"},
@@ -471,7 +498,7 @@ TEST(HostileImportTest, SceneJsonFileReferencesStayInside) {
         {"textures", (sb.outside / "secret.png").string(), "absolute"},
         {"textures", "link.png", "through a link"},
         {"textures", "linkdir/secret.png", "through a link"},
-        {"textures", "fifo.png", ""},    // a placeholder and a warning naming the reason
+        {"textures", "fifo.png", ""},   // a placeholder and a warning naming the reason
     };
     int i = 0;
     for (const Case& c : cases) {
@@ -491,7 +518,7 @@ TEST(HostileImportTest, SceneJsonFileReferencesStayInside) {
 
 TEST(HostileImportTest, MtlPointingElsewhere) {
     Sandbox sb("mtl");
-    const char* libs[] = {"../outside/secret.mtl", "../../dev/zero", "/dev/zero", "/etc/passwd", "link.mtl",
+    const char* libs[] = {"../outside/secret.mtl",   "../../dev/zero",           "/dev/zero", "/etc/passwd", "link.mtl",
                           "..\\outside\\secret.mtl", "%2e%2e/outside/secret.mtl"};
     int i = 0;
     for (const char* lib : libs) {
@@ -549,8 +576,7 @@ TEST(GltfGeneratedTest, LightsScenesAnimations) {
         "               {\"input\": 2, \"output\": 4, \"interpolation\": \"CUBICSPLINE\"}]}],";
     std::string json = triangleGltf(k);
     // Extra accessors for the animation (data appended to a second buffer, embedded).
-    float anim[2 + 6 + 18] = {0, 2,  0, 0, 0, 4, 0, 0,
-                              0, 0, 0, 1, 1, 1, 0, 0, 0,   0, 0, 0, 3, 3, 3, 0, 0, 0};
+    float anim[2 + 6 + 18] = {0, 2, 0, 0, 0, 4, 0, 0, 0, 0, 0, 1, 1, 1, 0, 0, 0, 0, 0, 0, 3, 3, 3, 0, 0, 0};
     std::string bytes(reinterpret_cast<const char*>(anim), sizeof anim);
     std::string enc = testing_support::base64Encode(bytes);
     auto replace = [&](const std::string& from, const std::string& to) {
@@ -559,10 +585,12 @@ TEST(GltfGeneratedTest, LightsScenesAnimations) {
         json.replace(at, from.size(), to);
     };
     replace("\"byteLength\": 44}]", "\"byteLength\": 44}, {\"uri\": \"data:application/octet-stream;base64," + enc +
-                                      "\", \"byteLength\": " + std::to_string(bytes.size()) + "}]");
-    replace("\"byteLength\": 6}]", "\"byteLength\": 6}, {\"buffer\": 1, \"byteOffset\": 0, \"byteLength\": 8},"
-                                    " {\"buffer\": 1, \"byteOffset\": 8, \"byteLength\": 24}, {\"buffer\": 1, \"byteOffset\": 32, \"byteLength\": 72}]");
-    replace("\"type\": \"SCALAR\"}]", "\"type\": \"SCALAR\"},"
+                                        "\", \"byteLength\": " + std::to_string(bytes.size()) + "}]");
+    replace("\"byteLength\": 6}]",
+            "\"byteLength\": 6}, {\"buffer\": 1, \"byteOffset\": 0, \"byteLength\": 8},"
+            " {\"buffer\": 1, \"byteOffset\": 8, \"byteLength\": 24}, {\"buffer\": 1, \"byteOffset\": 32, \"byteLength\": 72}]");
+    replace("\"type\": \"SCALAR\"}]",
+            "\"type\": \"SCALAR\"},"
             " {\"bufferView\": 2, \"componentType\": 5126, \"count\": 2, \"type\": \"SCALAR\"},"
             " {\"bufferView\": 3, \"componentType\": 5126, \"count\": 2, \"type\": \"VEC3\"},"
             " {\"bufferView\": 4, \"componentType\": 5126, \"count\": 6, \"type\": \"VEC3\"}]");
@@ -619,13 +647,20 @@ TEST(GltfGeneratedTest, LightsScenesAnimations) {
 
 TEST(GltfGeneratedTest, StructuralErrors) {
     Sandbox sb("structure");
-    struct Case { const char* file; const char* from; const char* to; const char* needle; };
+    struct Case {
+        const char* file;
+        const char* from;
+        const char* to;
+        const char* needle;
+    };
     const Case cases[] = {
         {"twoparents.gltf", "\"nodes\": [{\"mesh\": 0}]", "\"nodes\": [{\"mesh\": 0, \"children\": [2]}, {\"children\": [2]}, {}]", "two parents"},
         {"selfchild.gltf", "\"nodes\": [{\"mesh\": 0}]", "\"nodes\": [{\"mesh\": 0, \"children\": [0]}]", "own child"},
         {"cycle.gltf", "\"nodes\": [{\"mesh\": 0}]", "\"nodes\": [{\"mesh\": 0}, {\"children\": [2]}, {\"children\": [1]}]", "cycle"},
-        {"nanmatrix.gltf", "\"nodes\": [{\"mesh\": 0}]", "\"nodes\": [{\"mesh\": 0, \"matrix\": [1,0,0,0, 0,1,0,0, 0,0,1,0, 1e35,0,0,1]}]", "matrix must be"},
-        {"badlight.gltf", "\"nodes\": [{\"mesh\": 0}]", "\"nodes\": [{\"mesh\": 0, \"extensions\": {\"KHR_lights_punctual\": {\"light\": 5}}}]", "light 5"},
+        {"nanmatrix.gltf", "\"nodes\": [{\"mesh\": 0}]", "\"nodes\": [{\"mesh\": 0, \"matrix\": [1,0,0,0, 0,1,0,0, 0,0,1,0, 1e35,0,0,1]}]",
+         "matrix must be"},
+        {"badlight.gltf", "\"nodes\": [{\"mesh\": 0}]", "\"nodes\": [{\"mesh\": 0, \"extensions\": {\"KHR_lights_punctual\": {\"light\": 5}}}]",
+         "light 5"},
         {"badmesh.gltf", "\"nodes\": [{\"mesh\": 0}]", "\"nodes\": [{\"mesh\": 7}]", "mesh 7"},
         {"badscene.gltf", "\"scene\": 0 }", "\"scene\": 3 }", "scene 3"},
         {"badmaterial.gltf", "\"indices\": 1}", "\"indices\": 1, \"material\": 2}", "material 2"},

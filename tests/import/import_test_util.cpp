@@ -44,4 +44,4 @@ void writeText(const std::filesystem::path& p, const std::string& text) {
     f << text;
 }
 
-}  // namespace import_test
+}   // namespace import_test

@@ -19,4 +19,4 @@ assets::LoadResult timedLoad(const std::filesystem::path& p, double limitSeconds
 std::filesystem::path scratchDir(const std::string& name);
 void writeText(const std::filesystem::path& p, const std::string& text);
 
-}  // namespace import_test
+}   // namespace import_test

@@ -24,7 +24,7 @@ const sg::Mesh& onlyMesh(const assets::LoadResult& r) {
     EXPECT_EQ(r.scene->meshes.size(), 1u);
     return *r.scene->meshes.at(0);
 }
-}  // namespace
+}   // namespace
 
 // MANIFEST.md "tris" (fan-triangulated); -1: no count given; -2: may be refused (UTF-16).
 TEST(MeshImportTest, ManifestTriangleCounts) {
@@ -96,21 +96,15 @@ TEST(MeshImportTest, ManifestTriangleCounts) {
         SCOPED_TRACE(rel);
         assets::LoadResult r = timedLoad(meshes(rel), 5.0);
         if (tris == -2) {
-            if (!r.scene) {
-                EXPECT_NE(r.error.find(fs::path(rel).filename().string()), std::string::npos);
-            }
+            if (!r.scene) { EXPECT_NE(r.error.find(fs::path(rel).filename().string()), std::string::npos); }
             continue;
         }
         ASSERT_TRUE(r.scene) << r.error;
         for (const auto& m : r.scene->meshes) {
             EXPECT_EQ(m->validate(), "") << m->name;
-            if (m->mode == sg::PrimitiveMode::Triangles) {
-                EXPECT_EQ(m->normals.size(), m->positions.size());
-            }
+            if (m->mode == sg::PrimitiveMode::Triangles) { EXPECT_EQ(m->normals.size(), m->positions.size()); }
         }
-        if (tris >= 0) {
-            EXPECT_EQ(uniqueTriangles(*r.scene), size_t(tris));
-        }
+        if (tris >= 0) { EXPECT_EQ(uniqueTriangles(*r.scene), size_t(tris)); }
         EXPECT_TRUE(r.scene->valid(r.scene->activeCamera));
         EXPECT_EQ(countPayload(*r.scene, "light"), 1u);
     }
@@ -210,7 +204,8 @@ TEST(MeshImportTest, InvalidMeshesGiveClearErrors) {
             EXPECT_NE(r.error.find(e.path().filename().string()), std::string::npos) << r.error;
             EXPECT_EQ(r.error.find('\n'), std::string::npos);
         }
-        std::printf("%s -> %s\n", e.path().filename().string().c_str(), r.scene ? ("loaded, " + std::to_string(r.warnings.size()) + " warnings").c_str() : r.error.c_str());
+        std::printf("%s -> %s\n", e.path().filename().string().c_str(),
+                    r.scene ? ("loaded, " + std::to_string(r.warnings.size()) + " warnings").c_str() : r.error.c_str());
     }
 }
 
@@ -219,7 +214,8 @@ TEST(MeshImportTest, CancelHonoured) {
     std::atomic<bool> cancel{true};
     assets::LoadOptions o;
     o.cancel = &cancel;
-    for (const char* f : {"common-3d-test-models/igea/igea.ply", "common-3d-test-models/stanford-bunny/stanford-bunny.obj", "draco-testdata/STL/bunny.stl"}) {
+    for (const char* f :
+         {"common-3d-test-models/igea/igea.ply", "common-3d-test-models/stanford-bunny/stanford-bunny.obj", "draco-testdata/STL/bunny.stl"}) {
         assets::LoadResult r = assets::loadScene(meshes(f), o);
         EXPECT_FALSE(r.scene) << f;
         EXPECT_NE(r.error.find("cancelled"), std::string::npos) << r.error;

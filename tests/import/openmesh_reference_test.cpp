@@ -51,17 +51,21 @@ Counts viaOurs(const std::filesystem::path& p) {
     return c;
 }
 
-}  // namespace
+}   // namespace
 
 TEST(OpenMeshReferenceTest, OurParsersAgreeWithOpenMeshOnClassicMeshes) {
     ASSERT_TRUE(testing_support::requireTestdata());
     const auto dir = testing_support::testdataDir() / "meshes";
     const char* files[] = {
-        "common-3d-test-models/stanford-bunny/stanford-bunny.obj", "common-3d-test-models/teapot/teapot.obj",
-        "common-3d-test-models/suzanne/suzanne.obj",               "common-3d-test-models/cheburashka/cheburashka.off",
-        "common-3d-test-models/homer/homer.off",                   "common-3d-test-models/rocker-arm/rocker-arm.off",
+        "common-3d-test-models/stanford-bunny/stanford-bunny.obj",
+        "common-3d-test-models/teapot/teapot.obj",
+        "common-3d-test-models/suzanne/suzanne.obj",
+        "common-3d-test-models/cheburashka/cheburashka.off",
+        "common-3d-test-models/homer/homer.off",
+        "common-3d-test-models/rocker-arm/rocker-arm.off",
         "draco-testdata/test_generic.ply",   // (cube_att.ply: OpenMesh keeps 2 of its 12 triangles)
-        "draco-testdata/STL/test_sphere.stl",                      "assimp/PLY/cube_binary.ply",
+        "draco-testdata/STL/test_sphere.stl",
+        "assimp/PLY/cube_binary.ply",
     };
     for (const char* f : files) {
         SCOPED_TRACE(f);

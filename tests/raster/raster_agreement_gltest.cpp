@@ -92,17 +92,21 @@ std::vector<Case> referenceCases(int w, int h) {
             cases.push_back({"demo_" + std::string(toString(sm)) + "_" + std::string(toString(pt)), std::move(f)});
         }
     // Textures: filters x wraps, perspective and orthographic.
-    cases.push_back({"tex_trilinear_repeat", texturedFrame(w, h, FilterMode::Trilinear, WrapMode::Repeat, ProjectionType::Perspective, ShadingModel::Phong)});
-    cases.push_back({"tex_bilinear_mirror", texturedFrame(w, h, FilterMode::Bilinear, WrapMode::MirroredRepeat, ProjectionType::Perspective, ShadingModel::Gouraud)});
-    cases.push_back({"tex_nearest_clamp_ortho", texturedFrame(w, h, FilterMode::Nearest, WrapMode::ClampToEdge, ProjectionType::Orthographic, ShadingModel::Flat)});
-    cases.push_back({"tex_trilinear_oblique", texturedFrame(w, h, FilterMode::Trilinear, WrapMode::Repeat, ProjectionType::Oblique, ShadingModel::Phong)});
+    cases.push_back(
+        {"tex_trilinear_repeat", texturedFrame(w, h, FilterMode::Trilinear, WrapMode::Repeat, ProjectionType::Perspective, ShadingModel::Phong)});
+    cases.push_back({"tex_bilinear_mirror",
+                     texturedFrame(w, h, FilterMode::Bilinear, WrapMode::MirroredRepeat, ProjectionType::Perspective, ShadingModel::Gouraud)});
+    cases.push_back({"tex_nearest_clamp_ortho",
+                     texturedFrame(w, h, FilterMode::Nearest, WrapMode::ClampToEdge, ProjectionType::Orthographic, ShadingModel::Flat)});
+    cases.push_back(
+        {"tex_trilinear_oblique", texturedFrame(w, h, FilterMode::Trilinear, WrapMode::Repeat, ProjectionType::Oblique, ShadingModel::Phong)});
     // Near-plane clipping in all three projections.
     for (ProjectionType pt : {ProjectionType::Perspective, ProjectionType::Orthographic, ProjectionType::Oblique})
         cases.push_back({"nearplane_" + std::string(toString(pt)), nearPlaneFrame(w, h, pt)});
     return cases;
 }
 
-}  // namespace
+}   // namespace
 
 TEST(RasterAgreementGLTest, ReferenceScenesMatchGL) {
     std::string err;

@@ -13,8 +13,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <memory>
 #include <limits>
+#include <memory>
 #include <random>
 
 using namespace sg;
@@ -62,15 +62,17 @@ Framebuffer renderRaster(const FrameInput& f, int w, int h, RenderStats* statsOu
     EXPECT_TRUE(r);
     Framebuffer fb;
     RenderStats s = r->render(f, w, h, fb, control);
-    if (statsOut) *statsOut = s;
-    else EXPECT_TRUE(s.ok) << s.error;
+    if (statsOut)
+        *statsOut = s;
+    else
+        EXPECT_TRUE(s.ok) << s.error;
     return fb;
 }
 
 // Pixel (i, j) in window coordinates (y up).
 const uint8_t* px(const Framebuffer& fb, int i, int j) { return fb.pixel(i, fb.height - 1 - j); }
 
-}  // namespace
+}   // namespace
 
 // ---------------------------------------------------------------------------------------
 // scan conversion: fill rule, hierarchical vs simple traversal
@@ -102,7 +104,10 @@ TEST(RasterFillRuleTest, SharedEdgesCoverEachPixelExactlyOnce) {
             // Alternate winding to exercise the CW -> CCW swap.
             vec2 a = poly[k], b = poly[(k + 1) % n];
             float xs[3] = {c.x, a.x, b.x}, ys[3] = {c.y, a.y, b.y};
-            if (k % 2) { std::swap(xs[1], xs[2]); std::swap(ys[1], ys[2]); }
+            if (k % 2) {
+                std::swap(xs[1], xs[2]);
+                std::swap(ys[1], ys[2]);
+            }
             raster::TriSetup t;
             if (!raster::setupTriangle(xs, ys, W, H, t)) continue;
             raster::forEachCoveredPixel(t, 0, 0, W - 1, H - 1, [&](int i, int j) { ++count[j * W + i]; });
@@ -172,9 +177,7 @@ TEST(RasterFillRuleTest, TopLeftRuleOnPixelAlignedSquare) {
     for (int j = 0; j < 16; ++j)
         for (int i = 0; i < 16; ++i) {
             total += cov[j * 16 + i];
-            if (cov[j * 16 + i]) {
-                EXPECT_TRUE(i >= 1 && i <= 4 && j >= 2 && j <= 5) << i << "," << j;
-            }
+            if (cov[j * 16 + i]) { EXPECT_TRUE(i >= 1 && i <= 4 && j >= 2 && j <= 5) << i << "," << j; }
         }
     EXPECT_EQ(total, 16);
 }
@@ -204,7 +207,7 @@ bool expectedFloorHit(const FrameInput& f, int i, int j, int W, int H, const vec
     }
     return pos == 0 || neg == 0;
 }
-}  // namespace
+}   // namespace
 
 class RasterClipTest : public ::testing::TestWithParam<ProjectionType> {};
 
@@ -280,7 +283,10 @@ TEST(RasterInterpolationTest, PerspectiveCorrectUVOnTiltedQuad) {
     for (int r = 0; r < T; ++r)
         for (int i = 0; i < T; ++i) {
             uint8_t* p = &tex->rgba[(size_t(r) * T + i) * 4];
-            p[0] = uint8_t(i); p[1] = uint8_t(r); p[2] = 0; p[3] = 255;
+            p[0] = uint8_t(i);
+            p[1] = uint8_t(r);
+            p[2] = 0;
+            p[3] = 255;
         }
     // Quad receding in depth: from z = -2 (bottom) to z = -12 (top).
     vec3 a(-1.5f, -1, -2), b(1.5f, -1, -2), c(1.5f, 1.5f, -12), d(-1.5f, 1.5f, -12);
@@ -335,8 +341,10 @@ TEST(RasterDepthTest, NearerSurfaceWinsInEitherOrderAndFirstWinsTies) {
         FrameInput f;
         f.camera = cameraAt(vec3(0), vec3(0, 0, -1), p, 1.0f);
         DrawMesh n = drawOf(nearQ, unlitMaterial(vec3(1, 0, 0))), fr = drawOf(farQ, unlitMaterial(vec3(0, 0, 1)));
-        if (order == 0) f.meshes = {n, fr};
-        else f.meshes = {fr, n};
+        if (order == 0)
+            f.meshes = {n, fr};
+        else
+            f.meshes = {fr, n};
         Framebuffer fb = renderRaster(f, W, H);
         const uint8_t* c = px(fb, 32, 32);
         EXPECT_EQ(c[0], 255);
@@ -386,7 +394,7 @@ FrameInput sphereFrame(ShadingModel model, ReflectionModel refl) {
     f.camera = cameraAt(vec3(0, 0, 5), vec3(0), p, 1.0f);
     return f;
 }
-}  // namespace
+}   // namespace
 
 TEST(RasterShadingTest, CentreOfSphereMatchesThePhongFormulaPerModel) {
     const vec3 rho(0.6f, 0.3f, 0.2f);
@@ -399,8 +407,7 @@ TEST(RasterShadingTest, CentreOfSphereMatchesThePhongFormulaPerModel) {
             // Flat: the face normal of the pole triangles is tilted by ~1 degree.
             int tol = model == ShadingModel::Flat ? 3 : 1;
             for (int k = 0; k < 3; ++k)
-                EXPECT_NEAR(c[k], toByteSRGB(expected[k]), tol)
-                    << toString(model) << "/" << toString(refl) << " channel " << k;
+                EXPECT_NEAR(c[k], toByteSRGB(expected[k]), tol) << toString(model) << "/" << toString(refl) << " channel " << k;
         }
 }
 
@@ -494,7 +501,9 @@ TEST(RasterShadingTest, BatchedShadingMatchesRndShade) {
         for (size_t i = 0; i < n; ++i) {
             Material m;
             m.baseColor = vec3(P(rng), P(rng), P(rng));
-            m.ka = P(rng); m.kd = P(rng); m.ks = P(rng);
+            m.ka = P(rng);
+            m.kd = P(rng);
+            m.ks = P(rng);
             m.shininess = 1 + 127 * P(rng);
             m.specularTinted = i % 3 == 0;
             m.emissive = i % 5 == 0 ? vec3(0.1f, 0.0f, 0.2f) : vec3(0.0f);

@@ -42,7 +42,8 @@ FrameInput baseScene(const Projection& proj) {
     f.meshes.push_back(instance(ground, mat4(1.0f), vec3(0.7f, 0.7f, 0.6f)));
     f.meshes.push_back(instance(cyl, glm::translate(mat4(1.0f), vec3(0.2f, 0.6f, 1.4f)), vec3(0.3f, 0.8f, 0.3f)));
     // Mirrored instance (negative x scale): winding flips, shading must not.
-    f.meshes.push_back(instance(sphere, glm::scale(glm::translate(mat4(1.0f), vec3(0.2f, 0.5f, -1.5f)), vec3(-0.5f, 0.5f, 0.5f)), vec3(0.9f, 0.8f, 0.2f)));
+    f.meshes.push_back(
+        instance(sphere, glm::scale(glm::translate(mat4(1.0f), vec3(0.2f, 0.5f, -1.5f)), vec3(-0.5f, 0.5f, 0.5f)), vec3(0.9f, 0.8f, 0.2f)));
     f.meshes[1].material.ks = 0.6f;
     f.meshes[1].material.shininess = 16.0f;
     DrawLight l1;
@@ -85,9 +86,14 @@ std::shared_ptr<Texture> checkerTexture() {
 }
 
 Projection perspective() { return Projection{}; }
-Projection ortho() { Projection p; p.type = ProjectionType::Orthographic; p.orthoHalfHeight = 3.0f; return p; }
+Projection ortho() {
+    Projection p;
+    p.type = ProjectionType::Orthographic;
+    p.orthoHalfHeight = 3.0f;
+    return p;
+}
 
-}  // namespace
+}   // namespace
 
 TEST(RaycastRasterAgreementTest, PhongPerspective) { expectAgree(baseScene(perspective()), "phong-perspective"); }
 
@@ -183,8 +189,8 @@ TEST(RaycastRasterAgreementTest, BackFaceCulling) {
     for (bool cull : {false, true}) {
         FrameInput f = baseScene(perspective());
         f.settings.cullBackFaces = cull;
-        f.camera = makeFrameCamera(glm::inverse(glm::lookAt(vec3(0.4f, 4.0f, 3.0f), vec3(0.2f, 0.3f, 1.2f), vec3(0, 1, 0))),
-                                   perspective(), float(kW) / kH, 4.0f);
+        f.camera = makeFrameCamera(glm::inverse(glm::lookAt(vec3(0.4f, 4.0f, 3.0f), vec3(0.2f, 0.3f, 1.2f), vec3(0, 1, 0))), perspective(),
+                                   float(kW) / kH, 4.0f);
         expectAgree(f, cull ? "cull-on" : "cull-off");
     }
 }

@@ -46,7 +46,7 @@ void expectVec(const vec3& a, const vec3& b, float tol) {
     EXPECT_NEAR(a.z, b.z, tol);
 }
 
-}  // namespace
+}   // namespace
 
 // --- implicit shapes ---------------------------------------------------------------------------
 
@@ -54,7 +54,8 @@ TEST(RaycastTest, SphereHitDistanceAndNormal) {
     ImplicitShape s;
     s.type = ImplicitType::Sphere;
     s.radius = 1.5f;
-    float t; vec3 n;
+    float t;
+    vec3 n;
     ASSERT_TRUE(hitImplicit(s, mkRay({0, 0, 5}, {0, 0, -1}), t, n));
     EXPECT_NEAR(t, 3.5f, 1e-5f);
     expectVec(n, {0, 0, 1}, 1e-5f);
@@ -75,7 +76,8 @@ TEST(RaycastTest, QuadricSphereAndEllipsoid) {
     ImplicitShape q;
     q.type = ImplicitType::Quadric;   // default: x^2 + y^2 + z^2 - 1
     q.quadricBounds = {vec3(-2), vec3(2)};
-    float t; vec3 n;
+    float t;
+    vec3 n;
     ASSERT_TRUE(hitImplicit(q, mkRay({0, 0, 5}, {0, 0, -1}), t, n));
     EXPECT_NEAR(t, 4.0f, 1e-5f);
     expectVec(n, {0, 0, 1}, 1e-5f);
@@ -110,7 +112,8 @@ TEST(RaycastTest, TorusIncludingHoleAndGrazing) {
     s.type = ImplicitType::Torus;
     s.majorRadius = 1.0f;
     s.minorRadius = 0.25f;
-    float t; vec3 n;
+    float t;
+    vec3 n;
     // Along x through the middle: four crossings, first at x = -1.25.
     ASSERT_TRUE(hitImplicit(s, mkRay({-5, 0, 0}, {1, 0, 0}), t, n));
     EXPECT_NEAR(t, 3.75f, 1e-4f);
@@ -153,7 +156,8 @@ TEST(RaycastTest, TorusIncludingHoleAndGrazing) {
 }
 
 TEST(RaycastTest, BoxCylinderConePlane) {
-    float t; vec3 n;
+    float t;
+    vec3 n;
     ImplicitShape box;
     box.type = ImplicitType::Box;
     box.halfExtents = vec3(0.5f, 1.0f, 2.0f);
@@ -235,7 +239,7 @@ FrameInput csgFrame(CsgOp op) {
     f.analytics.push_back(d);
     return f;
 }
-}  // namespace
+}   // namespace
 
 TEST(RaycastTest, CsgDifferenceShowsCarvedFace) {
     FrameInput f = csgFrame(CsgOp::Difference);
@@ -357,7 +361,9 @@ TEST(RaycastTest, BvhClosestHitEqualsBruteForce) {
             }
         }
         // A few degenerate triangles must not break anything.
-        pos.push_back(vec3(0)); pos.push_back(vec3(0)); pos.push_back(vec3(0));
+        pos.push_back(vec3(0));
+        pos.push_back(vec3(0));
+        pos.push_back(vec3(0));
         idx.insert(idx.end(), {uint32_t(pos.size() - 3), uint32_t(pos.size() - 2), uint32_t(pos.size() - 1)});
         const size_t count = idx.size() / 3;
         // Default leaves (SAH-chosen, up to 4 packets), single-packet leaves, and leaves of up
@@ -416,7 +422,10 @@ TEST(RaycastTest, BvhClosestHitEqualsBruteForce) {
                 const bool ha = bvh.intersect(r, a), hb = intersectBruteForce(pos.data(), idx.data(), count, r0, b);
                 ASSERT_EQ(ha, hb) << "seed " << seed << " negative-tmin ray " << i;
                 EXPECT_EQ(bvh.occluded(r), hb);
-                if (ha) { EXPECT_EQ(a.t, b.t); EXPECT_GE(a.t, 0.0f); }
+                if (ha) {
+                    EXPECT_EQ(a.t, b.t);
+                    EXPECT_GE(a.t, 0.0f);
+                }
             }
         }
     }
@@ -555,7 +564,7 @@ FrameInput triangleScene(int w, int h) {
     f.camera = makeFrameCamera(glm::inverse(glm::lookAt(vec3(0, 3, 6), vec3(0, 0.5f, 0), vec3(0, 1, 0))), Projection{}, float(w) / h, 6.0f);
     return f;
 }
-}  // namespace
+}   // namespace
 
 TEST(RaycastTest, RendersProgressCancelAndCaches) {
     const int w = 160, h = 120;
@@ -651,7 +660,7 @@ FrameInput mirrorScene() {
     f.camera = makeFrameCamera(glm::inverse(glm::lookAt(vec3(0, 1, 3), vec3(0, 0, 0), vec3(0, 1, 0))), Projection{}, 1.0f, 3.0f);
     return f;
 }
-}  // namespace
+}   // namespace
 
 TEST(RaycastTest, MirrorReflectionShowsTheSphere) {
     FrameInput f = mirrorScene();
@@ -665,7 +674,7 @@ TEST(RaycastTest, MirrorReflectionShowsTheSphere) {
     const uint8_t* b = off.pixel(32, 32);
     EXPECT_GT(a[0], 200);   // red sphere seen in the mirror
     EXPECT_LT(a[1], 30);
-    EXPECT_LT(b[0], 30);    // without reflections the floor is black
+    EXPECT_LT(b[0], 30);   // without reflections the floor is black
     f.settings.reflections = true;
     f.settings.maxBounces = 0;   // no bounce allowed: black again
     ASSERT_TRUE(r->render(f, 65, 65, on).ok);
@@ -699,7 +708,10 @@ TEST(RaycastTest, ShadowRaysDarkenOccludedPoints) {
     testing_support::writeImage(with, "raycast", "shadow-on");
     testing_support::writeImage(without, "raycast", "shadow-off");
     long sw = 0, so = 0;
-    for (size_t i = 0; i < with.color.size(); i += 4) { sw += with.color[i]; so += without.color[i]; }
+    for (size_t i = 0; i < with.color.size(); i += 4) {
+        sw += with.color[i];
+        so += without.color[i];
+    }
     EXPECT_LT(sw, so);
     // The floor right in front of the box's foot is in its shadow (light straight above).
     rt::CameraRays rays(f.camera, 96, 96);

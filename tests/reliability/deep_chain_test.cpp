@@ -105,7 +105,8 @@ std::string deepGltf() {
     }
     j += R"({"name": "leaf", "mesh": 0}],)";
     j += R"("meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 0}]}],)";
-    j += R"("materials": [{"name": "red", "pbrMetallicRoughness": {"baseColorFactor": [1, 0, 0, 1]}, "extensions": {"KHR_materials_unlit": {}}, "doubleSided": true}],)";
+    j +=
+        R"("materials": [{"name": "red", "pbrMetallicRoughness": {"baseColorFactor": [1, 0, 0, 1]}, "extensions": {"KHR_materials_unlit": {}}, "doubleSided": true}],)";
     j += R"("extensionsUsed": ["KHR_materials_unlit"],)";
     j += R"("buffers": [{"byteLength": 60, "uri": "data:application/octet-stream;base64,)" + enc + R"("}],)";
     j += R"("bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 12}],)";
@@ -114,9 +115,7 @@ std::string deepGltf() {
     return j;
 }
 
-double secondsSince(std::chrono::steady_clock::time_point t0) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
+double secondsSince(std::chrono::steady_clock::time_point t0) { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); }
 
 // Where world point p lands in a kW x kH image (row 0 at the top).
 void project(const FrameInput& f, vec3 p, int& x, int& y) {
@@ -127,8 +126,7 @@ void project(const FrameInput& f, vec3 p, int& x, int& y) {
 
 bool pixelIs(const rnd::Framebuffer& fb, int x, int y, vec3 c) {
     const uint8_t* p = fb.pixel(x, y);
-    return std::abs(int(p[0]) - int(c.r * 255)) <= 2 && std::abs(int(p[1]) - int(c.g * 255)) <= 2 &&
-           std::abs(int(p[2]) - int(c.b * 255)) <= 2;
+    return std::abs(int(p[0]) - int(c.r * 255)) <= 2 && std::abs(int(p[1]) - int(c.g * 255)) <= 2 && std::abs(int(p[2]) - int(c.b * 255)) <= 2;
 }
 
 // Loads `path`, checks the chain's depth and the leaf's world position, renders with each
@@ -181,9 +179,7 @@ void loadAndRender(const fs::path& path, bool hasControl) {
         testing_support::writeImage(fb, kOutSuite, path.filename().string() + "-" + name);
         EXPECT_TRUE(pixelIs(fb, rx, ry, kRed)) << name << ": the leaf at the end of the chain is missing";
         EXPECT_FALSE(pixelIs(fb, kW - 1 - rx, ry, kRed)) << name << ": leaf drawn without the halfway offset";
-        if (hasControl) {
-            EXPECT_TRUE(pixelIs(fb, bx, by, kBlue)) << name;
-        }
+        if (hasControl) { EXPECT_TRUE(pixelIs(fb, bx, by, kBlue)) << name; }
     }
 }
 
@@ -194,7 +190,6 @@ fs::path scratch(const std::string& file) {
     fs::remove(p);
     return p;
 }
-
 
 TEST(DEEP_SUITE, NativeJsonLoadsAndRenders) {
     fs::path path = scratch("deep-chain.json");
@@ -217,4 +212,4 @@ TEST(DEEP_SUITE, GltfLoadsAndRenders) {
     fs::remove(path);
 }
 
-}  // namespace
+}   // namespace

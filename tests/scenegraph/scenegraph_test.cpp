@@ -47,7 +47,7 @@ struct SmallTree {
     }
 };
 
-}  // namespace
+}   // namespace
 
 // --- world matrices ------------------------------------------------------------------------
 
@@ -83,14 +83,14 @@ TEST(SceneTest, EditingOneNodeRecomputesExactlyItsSubtree) {
     EXPECT_EQ(s.updateWorld(), s.nodeCount());   // first update: everything
     EXPECT_EQ(s.updateWorld(), 0u);              // nothing changed
     s.setLocal(t.c, trs(vec3(1, 1, 1)));
-    EXPECT_EQ(s.updateWorld(), 1u);              // a leaf
+    EXPECT_EQ(s.updateWorld(), 1u);   // a leaf
     s.setLocal(t.a, trs(vec3(0, 1, 0)));
-    EXPECT_EQ(s.updateWorld(), 4u);              // a, b, c, d
+    EXPECT_EQ(s.updateWorld(), 4u);   // a, b, c, d
     s.setLocal(t.b, trs(vec3(0, 1, 0)));
-    s.setLocal(t.c, trs(vec3(0, 1, 0)));         // nested in b's subtree: counted once
+    s.setLocal(t.c, trs(vec3(0, 1, 0)));   // nested in b's subtree: counted once
     EXPECT_EQ(s.updateWorld(), 2u);
     s.setLocal(t.d, trs(vec3(0, 1, 0)));
-    s.setLocal(t.e, trs(vec3(0, 1, 0)));         // two disjoint subtrees
+    s.setLocal(t.e, trs(vec3(0, 1, 0)));   // two disjoint subtrees
     EXPECT_EQ(s.updateWorld(), 2u);
     s.setLocal(s.root(), trs(vec3(0, 0, 1)));
     EXPECT_EQ(s.updateWorld(), s.nodeCount());
@@ -123,7 +123,8 @@ TEST(SceneTest, RandomEditsMatchBruteForce) {
     };
     for (int round = 0; round < 20; ++round) {
         for (int k = 0; k < 5; ++k)
-            s.setLocal(ids[rng() % ids.size()], trs(vec3(u(rng), u(rng), u(rng)), vec3(90 * u(rng), 90 * u(rng), 90 * u(rng)), vec3(1 + 0.5f * u(rng))));
+            s.setLocal(ids[rng() % ids.size()],
+                       trs(vec3(u(rng), u(rng), u(rng)), vec3(90 * u(rng), 90 * u(rng), 90 * u(rng)), vec3(1 + 0.5f * u(rng))));
         check();
     }
 }
@@ -142,9 +143,12 @@ TEST(SceneTest, LargeTreesMatchSerialRecomputation) {
         NodeId chainA = s.root(), chainB = s.root(), link = s.root();
         for (int i = 0; i < n; ++i) {
             NodeId parent;
-            if (shape == 0) parent = ids[rng() % ids.size()];
-            else if (shape == 1) parent = link;   // even i: a leaf on the link, odd i: the next link
-            else parent = i % 2 ? chainA : chainB;
+            if (shape == 0)
+                parent = ids[rng() % ids.size()];
+            else if (shape == 1)
+                parent = link;   // even i: a leaf on the link, odd i: the next link
+            else
+                parent = i % 2 ? chainA : chainB;
             NodeId id = s.addNode({}, parent);
             if (shape == 1 && i % 2 == 1) link = id;
             if (shape == 2) (i % 2 ? chainA : chainB) = id;
@@ -205,9 +209,7 @@ TEST(SceneTest, ReparentKeepWorldUnderShearOrMirror) {
         ASSERT_TRUE(s.reparent(n, p, true));
         EXPECT_TRUE(matNear(s.world(n), before));
         // A sheared parent: the new local must carry the inverse shear, which TRS cannot.
-        if (parentLocal[2][0] != 0) {
-            EXPECT_EQ(s.node(n).local.mode, LocalTransform::Mode::Matrix);
-        }
+        if (parentLocal[2][0] != 0) { EXPECT_EQ(s.node(n).local.mode, LocalTransform::Mode::Matrix); }
         // Back under the root: the world still holds.
         ASSERT_TRUE(s.reparent(n, s.root(), true));
         EXPECT_TRUE(matNear(s.world(n), before));
@@ -255,7 +257,7 @@ TEST(SceneTest, RemoveAndDuplicateSubtrees) {
     EXPECT_FALSE(s.valid(t.c));
     EXPECT_TRUE(s.valid(cc));
     EXPECT_FALSE(s.removeNode(s.root()));
-    EXPECT_FALSE(s.removeNode(t.a));   // already gone
+    EXPECT_FALSE(s.removeNode(t.a));                  // already gone
     EXPECT_TRUE(matNear(s.world(t.c), mat4(1.0f)));   // removed ids: identity, not a crash
     EXPECT_TRUE(matNear(s.world(123456), mat4(1.0f)));
     EXPECT_EQ(s.duplicate(s.root()), kNoNode);
@@ -290,9 +292,7 @@ TEST(SceneTest, EulerQuaternionRoundTrip) {
         LocalTransform lt2;
         lt2.setEulerDegrees(back);
         EXPECT_TRUE(matNear(glm::mat4_cast(lt2.rotation), r)) << e.x << " " << e.y << " " << e.z;
-        if (std::abs(e.y) < 89) {
-            EXPECT_NEAR(glm::length(back - e), 0.0f, 1e-2f);
-        }
+        if (std::abs(e.y) < 89) { EXPECT_NEAR(glm::length(back - e), 0.0f, 1e-2f); }
     }
     // Gimbal lock: y = +-90 still reproduces the rotation.
     for (float y : {90.0f, -90.0f}) {
@@ -385,7 +385,7 @@ TEST(FlattenTest, LightsCamerasAndVisibility) {
     NodeId l = s.addNode("spot", g, spot);
     s.setLocal(l, trs(vec3(1, 2, 0), vec3(-90, 0, 0)));   // -z rotated by -90 about x -> -y
     NodeId dl = s.addNode("sun", s.root(), Light{LightType::Directional});
-    s.setLocal(dl, trs(vec3(0), vec3(0, 90, 0)));           // -z rotated by 90 about y -> -x
+    s.setLocal(dl, trs(vec3(0), vec3(0, 90, 0)));   // -z rotated by 90 about y -> -x
 
     FrameInput f = flatten(s, 2.0f);
     ASSERT_EQ(f.meshes.size(), 1u);
@@ -486,9 +486,7 @@ TEST(FlattenTest, CsgChildrenAreCollectedNotDrawn) {
     s.setLocal(sp, trs(vec3(0, 1.2f, 0)));
     FrameInput f2 = flatten(s, 1.0f);
     for (const auto& a : f2.analytics)
-        if (a.kind == DrawAnalytic::Kind::Csg) {
-            EXPECT_NE(a.geometryKey, key);
-        }
+        if (a.kind == DrawAnalytic::Kind::Csg) { EXPECT_NE(a.geometryKey, key); }
     // Hidden leaves drop out of the tree.
     s.setVisible(sp, false);
     FrameInput f3 = flatten(s, 1.0f);
@@ -545,7 +543,7 @@ TEST(SettingsTest, FogVisibilityFormulas) {
     EXPECT_FLOAT_EQ(fogVisibility(s, 5), 1.0f);
     EXPECT_FLOAT_EQ(fogVisibility(s, 15), 0.5f);   // (end - d)/(end - start)
     EXPECT_FLOAT_EQ(fogVisibility(s, 25), 0.0f);
-    EXPECT_FLOAT_EQ(fogVisibility(s, 0), 1.0f);    // clamped
+    EXPECT_FLOAT_EQ(fogVisibility(s, 0), 1.0f);   // clamped
     EXPECT_FLOAT_EQ(fogVisibility(s, 40), 0.0f);
     s.fog = FogMode::Exp;
     s.fogDensity = 0.1f;
@@ -584,8 +582,8 @@ TEST(ShapesTest, ImplicitValueAndNormal) {
     EXPECT_NEAR(glm::distance(s.normal(vec3(1, 0.3f, 0)), vec3(1, 0, 0)), 0.0f, 1e-6f);
     s.type = ImplicitType::Cone;
     s.radius = 1;
-    s.halfHeight = 1;   // apex at y = 1, base radius 1 at y = -1
-    EXPECT_NEAR(s.value(vec3(0.5f, 0, 0)), 0.0f, 1e-6f);      // on the slanted side
+    s.halfHeight = 1;                                      // apex at y = 1, base radius 1 at y = -1
+    EXPECT_NEAR(s.value(vec3(0.5f, 0, 0)), 0.0f, 1e-6f);   // on the slanted side
     EXPECT_LT(s.value(vec3(0, 0, 0)), 0.0f);
     EXPECT_GT(s.value(vec3(0, 1.5f, 0)), 0.0f);
     vec3 cn = s.normal(vec3(0.5f, 0, 0));
@@ -604,7 +602,7 @@ TEST(ShapesTest, ImplicitValueAndNormal) {
     s.type = ImplicitType::Quadric;   // default: unit sphere in [-1,1]^3
     EXPECT_LT(s.value(vec3(0.5f, 0, 0)), 0.0f);
     EXPECT_GT(s.value(vec3(0.8f, 0.8f, 0)), 0.0f);   // outside the sphere, inside the box
-    EXPECT_GT(s.value(vec3(0, 0, 1.2f)), 0.0f);       // clipped by the box
+    EXPECT_GT(s.value(vec3(0, 0, 1.2f)), 0.0f);      // clipped by the box
     EXPECT_NEAR(s.value(vec3(1, 0, 0)), 0.0f, 1e-6f);
     EXPECT_NEAR(glm::distance(s.normal(vec3(0, 0.6f, 0.8f)), vec3(0, 0.6f, 0.8f)), 0.0f, 1e-5f);
     // Normals agree with the numerical gradient direction away from edges.

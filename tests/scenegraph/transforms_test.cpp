@@ -2,8 +2,8 @@
 // where GLM has an equivalent, and known points landing where the seeds say: frustum corners
 // on the NDC cube, near -> z_ndc = -1, far -> +1, viewport corners, oblique shifts.
 // Seeds' entries are (row r, column c); GLM stores m[c][r].
-#include "scenegraph/projection.h"
 #include "scenegraph/transforms.h"
+#include "scenegraph/projection.h"
 
 #include <gtest/gtest.h>
 
@@ -29,7 +29,10 @@ float at(const mat4& m, int r, int c) { return m[c][r]; }
 mat4 rows(std::initializer_list<float> v) {
     mat4 m(0.0f);
     int i = 0;
-    for (float x : v) { m[i % 4][i / 4] = x; ++i; }
+    for (float x : v) {
+        m[i % 4][i / 4] = x;
+        ++i;
+    }
     return m;
 }
 
@@ -43,7 +46,7 @@ vec3 project(const mat4& m, const vec3& p) {
     return ::testing::AssertionFailure() << "(" << a.x << ", " << a.y << ", " << a.z << ") vs (" << b.x << ", " << b.y << ", " << b.z << ")";
 }
 
-}  // namespace
+}   // namespace
 
 TEST(TransformsTest, TranslationAndScaleEntries) {
     mat4 t = translation(vec3(2, -3, 4));
@@ -150,10 +153,8 @@ TEST(TransformsTest, PerspectiveFovyAspect) {
 TEST(TransformsTest, GeneralFrustum) {
     float l = -0.3f, r = 0.5f, b = -0.1f, t = 0.4f, n = 0.5f, f = 20.0f;
     mat4 m = frustum(l, r, b, t, n, f);
-    EXPECT_TRUE(matNear(m, rows({2 * n / (r - l), 0, (r + l) / (r - l), 0,
-                                 0, 2 * n / (t - b), (t + b) / (t - b), 0,
-                                 0, 0, -(f + n) / (f - n), -2 * f * n / (f - n),
-                                 0, 0, -1, 0})));
+    EXPECT_TRUE(matNear(m, rows({2 * n / (r - l), 0, (r + l) / (r - l), 0, 0, 2 * n / (t - b), (t + b) / (t - b), 0, 0, 0, -(f + n) / (f - n),
+                                 -2 * f * n / (f - n), 0, 0, -1, 0})));
     EXPECT_TRUE(matNear(m, glm::frustum(l, r, b, t, n, f)));
     // (l, b, -n) -> (-1, -1, -1), (r, t, -n) -> (1, 1, -1); far corners scaled by f/n -> z = +1.
     EXPECT_TRUE(vecNear(project(m, vec3(l, b, -n)), vec3(-1, -1, -1)));
@@ -167,10 +168,8 @@ TEST(TransformsTest, GeneralFrustum) {
 TEST(TransformsTest, Orthographic) {
     float l = -2, r = 3, b = -1, t = 1.5f, n = 0.5f, f = 10;
     mat4 m = orthographic(l, r, b, t, n, f);
-    EXPECT_TRUE(matNear(m, rows({2 / (r - l), 0, 0, -(r + l) / (r - l),
-                                 0, 2 / (t - b), 0, -(t + b) / (t - b),
-                                 0, 0, -2 / (f - n), -(f + n) / (f - n),
-                                 0, 0, 0, 1})));
+    EXPECT_TRUE(matNear(
+        m, rows({2 / (r - l), 0, 0, -(r + l) / (r - l), 0, 2 / (t - b), 0, -(t + b) / (t - b), 0, 0, -2 / (f - n), -(f + n) / (f - n), 0, 0, 0, 1})));
     EXPECT_TRUE(matNear(m, glm::ortho(l, r, b, t, n, f)));
     EXPECT_TRUE(vecNear(project(m, vec3(l, b, -n)), vec3(-1, -1, -1)));
     EXPECT_TRUE(vecNear(project(m, vec3(r, t, -f)), vec3(1, 1, 1)));

@@ -35,20 +35,20 @@ void writeImage(const rnd::Framebuffer& img, const std::string& suite, const std
     assets::writePng(p, img.width, img.height, img.color.data(), true);
 }
 
-::testing::AssertionResult imagesClose(const rnd::Framebuffer& actual, const rnd::Framebuffer& expected,
-                                       const ImageTolerance& tol, const std::string& suite, const std::string& name) {
+::testing::AssertionResult imagesClose(const rnd::Framebuffer& actual, const rnd::Framebuffer& expected, const ImageTolerance& tol,
+                                       const std::string& suite, const std::string& name) {
     if (actual.width != expected.width || actual.height != expected.height)
-        return ::testing::AssertionFailure() << name << ": size " << actual.width << "x" << actual.height << " vs expected "
-                                             << expected.width << "x" << expected.height;
+        return ::testing::AssertionFailure() << name << ": size " << actual.width << "x" << actual.height << " vs expected " << expected.width << "x"
+                                             << expected.height;
     rnd::ImageDiff d = rnd::compareImages(actual, expected, tol.channelTolerance);
     std::printf("[image] %s/%s: %s\n", suite.c_str(), name.c_str(), d.describe().c_str());
     if (d.meanAbs <= tol.maxMeanAbs && d.fractionWithin >= tol.minFractionWithin) return ::testing::AssertionSuccess();
     writeImage(actual, suite, name + "-actual");
     writeImage(expected, suite, name + "-expected");
     writeImage(rnd::diffImage(actual, expected, tol.channelTolerance), suite, name + "-diff");
-    return ::testing::AssertionFailure() << name << ": " << d.describe() << " (allowed: mean <= " << tol.maxMeanAbs
-                                         << ", within " << tol.channelTolerance << "/255 >= " << tol.minFractionWithin * 100
-                                         << "%); images written to " << outputDir(suite);
+    return ::testing::AssertionFailure() << name << ": " << d.describe() << " (allowed: mean <= " << tol.maxMeanAbs << ", within "
+                                         << tol.channelTolerance << "/255 >= " << tol.minFractionWithin * 100 << "%); images written to "
+                                         << outputDir(suite);
 }
 
 std::string base64Encode(std::string_view bytes) {
@@ -81,4 +81,4 @@ std::shared_ptr<sg::Texture> checker(int size, int checks, const sg::vec3& a, co
     return t;
 }
 
-}  // namespace testing_support
+}   // namespace testing_support

@@ -22,15 +22,15 @@ std::filesystem::path testdataDir();
 std::filesystem::path outputDir(const std::string& suite);
 
 struct ImageTolerance {
-    double maxMeanAbs = 1.0;        // mean absolute difference per channel (0..255 units)
+    double maxMeanAbs = 1.0;   // mean absolute difference per channel (0..255 units)
     double minFractionWithin = 0.995;
-    int channelTolerance = 3;       // per-pixel tolerance for the fraction
+    int channelTolerance = 3;   // per-pixel tolerance for the fraction
 };
 
 // Compares and reports the figures; on failure writes <name>-actual.png, <name>-expected.png
 // and <name>-diff.png into outputDir(suite).
-::testing::AssertionResult imagesClose(const rnd::Framebuffer& actual, const rnd::Framebuffer& expected,
-                                       const ImageTolerance& tol, const std::string& suite, const std::string& name);
+::testing::AssertionResult imagesClose(const rnd::Framebuffer& actual, const rnd::Framebuffer& expected, const ImageTolerance& tol,
+                                       const std::string& suite, const std::string& name);
 
 void writeImage(const rnd::Framebuffer& img, const std::string& suite, const std::string& name);
 
@@ -41,4 +41,4 @@ std::shared_ptr<sg::Texture> checker(int size, int checks, const sg::vec3& a, co
 // Standard base64 with padding (for data URIs and embedded PNGs in generated files).
 std::string base64Encode(std::string_view bytes);
 
-}  // namespace testing_support
+}   // namespace testing_support

@@ -18,8 +18,8 @@ static void writeObj(const Mesh& m, const std::string& path) {
     for (const vec3& p : m.positions) f << "v " << p.x << ' ' << p.y << ' ' << p.z << '\n';
     for (const vec3& n : m.normals) f << "vn " << n.x << ' ' << n.y << ' ' << n.z << '\n';
     for (size_t i = 0; i + 2 < m.indices.size(); i += 3)
-        f << "f " << m.indices[i] + 1 << "//" << m.indices[i] + 1 << ' ' << m.indices[i + 1] + 1 << "//"
-          << m.indices[i + 1] + 1 << ' ' << m.indices[i + 2] + 1 << "//" << m.indices[i + 2] + 1 << '\n';
+        f << "f " << m.indices[i] + 1 << "//" << m.indices[i] + 1 << ' ' << m.indices[i + 1] + 1 << "//" << m.indices[i + 1] + 1 << ' '
+          << m.indices[i + 2] + 1 << "//" << m.indices[i + 2] + 1 << '\n';
 }
 
 static void preview(const rnd::Tessellation& t, const mat4& world, const Material& mat, const std::string& path) {
@@ -71,7 +71,10 @@ static void preview(const rnd::Tessellation& t, const mat4& world, const Materia
 }
 
 int main(int argc, char** argv) {
-    if (argc < 2) { std::fprintf(stderr, "usage: tess_dump OUTDIR [resolution]\n"); return 2; }
+    if (argc < 2) {
+        std::fprintf(stderr, "usage: tess_dump OUTDIR [resolution]\n");
+        return 2;
+    }
     std::string dir = argv[1];
     int res = argc > 2 ? std::atoi(argv[2]) : 64;
     Scene s = assets::makeDemoScene();
@@ -81,7 +84,8 @@ int main(int argc, char** argv) {
         rnd::Tessellation t = rnd::tessellate(a, res);
         double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         std::string name = s.node(a.node).name;
-        for (char& ch : name) if (ch == ' ') ch = '_';
+        for (char& ch : name)
+            if (ch == ' ') ch = '_';
         std::printf("%-16s %8zu triangles %8.1f ms\n", name.c_str(), t.mesh->triangleCount(), ms);
         writeObj(*t.mesh, dir + "/" + name + ".obj");
         preview(t, t.worldSpace ? mat4(1.0f) : a.world, a.material, dir + "/" + name + ".png");

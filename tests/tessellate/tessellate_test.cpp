@@ -33,16 +33,16 @@ void dumpObj(const Mesh& m, const std::string& name) {
     for (const vec3& p : m.positions) f << "v " << p.x << ' ' << p.y << ' ' << p.z << '\n';
     for (const vec3& n : m.normals) f << "vn " << n.x << ' ' << n.y << ' ' << n.z << '\n';
     for (size_t i = 0; i + 2 < m.indices.size(); i += 3)
-        f << "f " << m.indices[i] + 1 << "//" << m.indices[i] + 1 << ' ' << m.indices[i + 1] + 1 << "//"
-          << m.indices[i + 1] + 1 << ' ' << m.indices[i + 2] + 1 << "//" << m.indices[i + 2] + 1 << '\n';
+        f << "f " << m.indices[i] + 1 << "//" << m.indices[i] + 1 << ' ' << m.indices[i + 1] + 1 << "//" << m.indices[i + 1] + 1 << ' '
+          << m.indices[i + 2] + 1 << "//" << m.indices[i + 2] + 1 << '\n';
 }
 
 struct Topology {
     size_t weldedVertices = 0;
-    size_t degenerate = 0;      // triangles with two welded corners equal
-    size_t badEdges = 0;        // undirected edges not used exactly twice in opposite directions
+    size_t degenerate = 0;   // triangles with two welded corners equal
+    size_t badEdges = 0;     // undirected edges not used exactly twice in opposite directions
     size_t edges = 0;
-    long euler = 0;             // V - E + F
+    long euler = 0;   // V - E + F
 };
 
 // Welds by exact position, then checks that every directed edge has exactly one twin.
@@ -59,7 +59,10 @@ Topology topology(const Mesh& m) {
     size_t faces = 0;
     for (size_t i = 0; i + 2 < m.indices.size(); i += 3) {
         uint32_t v[3] = {id[m.indices[i]], id[m.indices[i + 1]], id[m.indices[i + 2]]};
-        if (v[0] == v[1] || v[1] == v[2] || v[0] == v[2]) { ++t.degenerate; continue; }
+        if (v[0] == v[1] || v[1] == v[2] || v[0] == v[2]) {
+            ++t.degenerate;
+            continue;
+        }
         ++faces;
         for (int k = 0; k < 3; ++k) ++directed[{v[k], v[(k + 1) % 3]}];
     }
@@ -77,8 +80,7 @@ Topology topology(const Mesh& m) {
     Topology t = topology(m);
     if (m.indices.empty()) return ::testing::AssertionFailure() << "empty mesh";
     if (t.degenerate || t.badEdges)
-        return ::testing::AssertionFailure() << t.badEdges << " bad edges, " << t.degenerate << " degenerate triangles of "
-                                             << m.triangleCount();
+        return ::testing::AssertionFailure() << t.badEdges << " bad edges, " << t.degenerate << " degenerate triangles of " << m.triangleCount();
     return ::testing::AssertionSuccess();
 }
 
@@ -158,7 +160,7 @@ std::vector<PrimitiveCase> primitiveCases() {
     return c;
 }
 
-}  // namespace
+}   // namespace
 
 // --- analytic primitives ------------------------------------------------------------------
 
@@ -188,9 +190,7 @@ TEST(TessellateTest, PrimitivesAreClosedOutwardAndOnTheSurface) {
                 if (c.convex) {
                     ASSERT_GT(glm::dot(m.normals[i], p), 0.0f);
                     // Smooth normals equal the analytic ones (where those are defined everywhere).
-                    if (c.shape.type == ImplicitType::Sphere) {
-                        ASSERT_GT(glm::dot(m.normals[i], c.shape.normal(p * 0.999f)), 0.99f);
-                    }
+                    if (c.shape.type == ImplicitType::Sphere) { ASSERT_GT(glm::dot(m.normals[i], c.shape.normal(p * 0.999f)), 0.99f); }
                 }
             }
             if (c.convex) {
@@ -230,8 +230,7 @@ TEST(TessellateTest, PlaneFacesUpAndCoversItsSquare) {
     EXPECT_EQ(b.max, vec3(2.5f, 0, 2.5f));
     double area = 0;
     for (size_t i = 0; i + 2 < m.indices.size(); i += 3) {
-        vec3 f = glm::cross(m.positions[m.indices[i + 1]] - m.positions[m.indices[i]],
-                            m.positions[m.indices[i + 2]] - m.positions[m.indices[i]]);
+        vec3 f = glm::cross(m.positions[m.indices[i + 1]] - m.positions[m.indices[i]], m.positions[m.indices[i + 2]] - m.positions[m.indices[i]]);
         EXPECT_GT(f.y, 0.0f);
         area += 0.5 * glm::length(f);
     }
@@ -241,7 +240,11 @@ TEST(TessellateTest, PlaneFacesUpAndCoversItsSquare) {
 // The generators in sg::primitives (used by the demo scene): stored normals agree with the
 // triangle winding, and the closed ones enclose a positive volume.
 TEST(TessellateTest, SgPrimitivesWindingMatchesNormals) {
-    struct Case { const char* name; Mesh m; double volume; };
+    struct Case {
+        const char* name;
+        Mesh m;
+        double volume;
+    };
     std::vector<Case> cases;
     cases.push_back({"box", primitives::box(vec3(0.5f, 1, 2)), 8.0});
     cases.push_back({"plane", primitives::plane(2, 4), 0});
@@ -260,9 +263,7 @@ TEST(TessellateTest, SgPrimitivesWindingMatchesNormals) {
             uint32_t a = c.m.indices[i], b = c.m.indices[i + 1], d = c.m.indices[i + 2];
             vec3 f = glm::cross(c.m.positions[b] - c.m.positions[a], c.m.positions[d] - c.m.positions[a]);
             if (glm::length(f) < 1e-9f) continue;
-            for (uint32_t k : {a, b, d}) {
-                ASSERT_GT(glm::dot(f, c.m.normals[k]), 0.0f) << "triangle " << i / 3;
-            }
+            for (uint32_t k : {a, b, d}) { ASSERT_GT(glm::dot(f, c.m.normals[k]), 0.0f) << "triangle " << i / 3; }
         }
         if (c.volume > 0) {
             EXPECT_NEAR(signedVolume(c.m) / c.volume, 1.0, 0.05);   // coarse: 32 segments
@@ -384,10 +385,20 @@ struct CsgBuilder {
     }
 };
 
-ImplicitShape box(vec3 h) { ImplicitShape s; s.type = ImplicitType::Box; s.halfExtents = h; return s; }
-ImplicitShape sphere(float r) { ImplicitShape s; s.type = ImplicitType::Sphere; s.radius = r; return s; }
+ImplicitShape box(vec3 h) {
+    ImplicitShape s;
+    s.type = ImplicitType::Box;
+    s.halfExtents = h;
+    return s;
+}
+ImplicitShape sphere(float r) {
+    ImplicitShape s;
+    s.type = ImplicitType::Sphere;
+    s.radius = r;
+    return s;
+}
 
-}  // namespace
+}   // namespace
 
 TEST(TessellateTest, CsgBoxMinusSphereHasTheCuttersMaterialAndVolume) {
     // Box [-1,1]^3 minus a sphere of radius 0.6 centred on the top face: a hemispherical

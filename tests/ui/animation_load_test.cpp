@@ -88,7 +88,7 @@ ViewerState animatedState() {
 sg::vec3 localT(const ViewerState& st, sg::NodeId id) { return st.scene.node(id).local.translation; }
 sg::vec3 worldT(const ViewerState& st, sg::NodeId id) { return sg::vec3(st.scene.world(id)[3]); }
 
-}  // namespace
+}   // namespace
 
 TEST(ViewerStateAnimTest, LoadKeepsClipsAndNewSceneDropsThem) {
     ViewerState st = animatedState();
@@ -105,7 +105,7 @@ TEST(ViewerStateAnimTest, LoadKeepsClipsAndNewSceneDropsThem) {
     EXPECT_EQ(st.currentAnimation(), nullptr);
     st.setAnimationPlaying(true);   // nothing to play: stays stopped
     EXPECT_FALSE(st.animationPlaying);
-    st.advanceAnimation(0.5);        // and does nothing
+    st.advanceAnimation(0.5);   // and does nothing
 }
 
 TEST(ViewerStateAnimTest, PlayInterpolatesPauseStopsScrubSetsNeverDirty) {
@@ -173,7 +173,7 @@ TEST(ViewerStateAnimTest, LoopWrapsAndOneShotStopsAtTheEnd) {
     EXPECT_FALSE(st.animationPlaying);
     EXPECT_DOUBLE_EQ(st.animationTime, 2.0);
     EXPECT_NEAR(localT(st, mover).x, 4.0f, 1e-5f);
-    st.toggleAnimation();       // play again from the end: restarts at the clip start
+    st.toggleAnimation();   // play again from the end: restarts at the clip start
     EXPECT_TRUE(st.animationPlaying);
     EXPECT_DOUBLE_EQ(st.animationTime, 0.0);
     st.advanceAnimation(1.5);
@@ -271,7 +271,7 @@ fs::path bigObj() {
     return path;
 }
 
-}  // namespace
+}   // namespace
 
 TEST(ViewerStateLoadTest, CancelKeepsTheCurrentSceneAndSaysSo) {
     fs::path file = bigObj();

@@ -12,7 +12,7 @@ void expectNear(const sg::vec3& a, const sg::vec3& b, float eps = 1e-4f) {
     EXPECT_NEAR(a.y, b.y, eps);
     EXPECT_NEAR(a.z, b.z, eps);
 }
-}  // namespace
+}   // namespace
 
 TEST(OrbitCameraTest, OrbitKeepsDistanceToPivot) {
     OrbitCamera c;
@@ -55,7 +55,7 @@ TEST(OrbitCameraTest, PanMovesPivotInViewPlane) {
     sg::vec3 d = c.pivot - pivot0;
     EXPECT_GT(glm::length(d), 0.0f);
     EXPECT_NEAR(glm::dot(d, fwd), 0.0f, 1e-5f);   // in the view plane
-    expectNear(c.eye() - eye0, d);                  // eye moves with the pivot
+    expectNear(c.eye() - eye0, d);                // eye moves with the pivot
     EXPECT_NEAR(glm::length(d), s * std::sqrt(100.0f * 100.0f + 40.0f * 40.0f), 1e-4f);
     // Dragging right moves the scene right, i.e. the pivot to the camera's left.
     EXPECT_LT(glm::dot(d, c.right()), 0.0f);

@@ -5,8 +5,8 @@
 
 #include "assets/demo.h"
 
-#include <imgui.h>
 #include <gtest/gtest.h>
+#include <imgui.h>
 
 using namespace ui;
 
@@ -71,7 +71,7 @@ public:
     double t = 0;
 };
 
-}  // namespace
+}   // namespace
 
 TEST(PanelsTest, LayoutHasTreeTabsAndViewport) {
     Headless h;
@@ -246,7 +246,7 @@ assets::AnimationClip crateClip(const sg::Scene& s) {
     clip.channels.push_back(ch);
     return clip;
 }
-}  // namespace
+}   // namespace
 
 TEST(PanelsTest, AnimationBarOnlyWithClipsPlayButtonAndSpaceToggle) {
     Headless h;
@@ -263,7 +263,7 @@ TEST(PanelsTest, AnimationBarOnlyWithClipsPlayButtonAndSpaceToggle) {
     h.st.advanceAnimation(1.0);   // the window's main loop does this every frame
     sg::NodeId crate = h.st.scene.findByName("crate");
     EXPECT_NEAR(h.st.scene.node(crate).local.translation.x, 2.0f, 1e-5f);
-    h.click("anim/play");         // now "Pause"
+    h.click("anim/play");   // now "Pause"
     EXPECT_FALSE(h.st.animationPlaying);
     bool loop = h.st.animationLoop;
     h.click("anim/loop");

@@ -48,7 +48,7 @@ std::string readLog(const fs::path& dir) {
     return std::string(std::istreambuf_iterator<char>(in), {});
 }
 
-}  // namespace
+}   // namespace
 
 TEST(ViewerGLTest, SwitchesBackendsAndTakesScreenshots) {
     if (!haveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
@@ -76,8 +76,10 @@ TEST(ViewerGLTest, SwitchesBackendsAndTakesScreenshots) {
     EXPECT_TRUE(fs::exists(dir / "config" / "sceneviewer" / "imgui.ini")) << readLog(dir);
     // Backend screenshot: written when the gl backend works, else the log says why.
     fs::path shot = dir / "shots" / "screenshot-gl.png";
-    if (fs::exists(shot)) EXPECT_TRUE(pngHasContent(shot));
-    else EXPECT_NE(readLog(dir).find("screenshot"), std::string::npos) << readLog(dir);
+    if (fs::exists(shot))
+        EXPECT_TRUE(pngHasContent(shot));
+    else
+        EXPECT_NE(readLog(dir).find("screenshot"), std::string::npos) << readLog(dir);
 }
 
 TEST(ViewerGLTest, FailedOpenKeepsRunning) {

@@ -1,8 +1,8 @@
 // ViewerState actions (scene edits, reparent refusal, backend), the unsaved-changes guard,
 // asynchronous loading that keeps the scene on failure, screenshot naming, recent files, the
 // frame handed to the renderers and RenderSlot's threaded coarse-to-fine rendering.
-#include "ui/render_slot.h"
 #include "ui/viewer_state.h"
+#include "ui/render_slot.h"
 
 #include "assets/demo.h"
 #include "assets/files.h"
@@ -23,7 +23,7 @@ ViewerState demoState() {
     st.setScene(assets::makeDemoScene(), {});
     return st;
 }
-}  // namespace
+}   // namespace
 
 TEST(ViewerStateTest, SetSceneStartsCleanAndLooksThroughActiveCamera) {
     ViewerState st = demoState();

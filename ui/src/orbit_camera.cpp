@@ -9,10 +9,8 @@ namespace ui {
 namespace {
 constexpr float kMaxPitch = 89.0f * sg::kPi / 180.0f;
 // Direction from the pivot to the eye for a yaw/pitch.
-sg::vec3 offsetDir(float yaw, float pitch) {
-    return {std::cos(pitch) * std::sin(yaw), std::sin(pitch), std::cos(pitch) * std::cos(yaw)};
-}
-}  // namespace
+sg::vec3 offsetDir(float yaw, float pitch) { return {std::cos(pitch) * std::sin(yaw), std::sin(pitch), std::cos(pitch) * std::cos(yaw)}; }
+}   // namespace
 
 sg::vec3 OrbitCamera::eye() const { return pivot + distance * offsetDir(yaw, pitch); }
 sg::vec3 OrbitCamera::forward() const { return -offsetDir(yaw, pitch); }
@@ -30,7 +28,7 @@ sg::mat4 OrbitCamera::world() const {
 }
 
 void OrbitCamera::orbit(float dx, float dy, float rpp) {
-    yaw -= dx * rpp;                                      // drag right: scene turns right
+    yaw -= dx * rpp;                                               // drag right: scene turns right
     pitch = std::clamp(pitch + dy * rpp, -kMaxPitch, kMaxPitch);   // drag down: look from above
 }
 
@@ -86,4 +84,4 @@ void OrbitCamera::setFromWorld(const sg::mat4& w, float focus) {
     orthoScale = 1.0f;
 }
 
-}  // namespace ui
+}   // namespace ui

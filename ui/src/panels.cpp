@@ -103,10 +103,13 @@ const char* payloadIcon(const sg::Payload& p) {
     }
 }
 
-const std::pair<sg::ImplicitType, const char*> kShapes[] = {
-    {sg::ImplicitType::Sphere, "Sphere"}, {sg::ImplicitType::Box, "Box"},       {sg::ImplicitType::Cylinder, "Cylinder"},
-    {sg::ImplicitType::Cone, "Cone"},     {sg::ImplicitType::Torus, "Torus"},   {sg::ImplicitType::Plane, "Plane"},
-    {sg::ImplicitType::Quadric, "Quadric (hyperboloid)"}};
+const std::pair<sg::ImplicitType, const char*> kShapes[] = {{sg::ImplicitType::Sphere, "Sphere"},
+                                                            {sg::ImplicitType::Box, "Box"},
+                                                            {sg::ImplicitType::Cylinder, "Cylinder"},
+                                                            {sg::ImplicitType::Cone, "Cone"},
+                                                            {sg::ImplicitType::Torus, "Torus"},
+                                                            {sg::ImplicitType::Plane, "Plane"},
+                                                            {sg::ImplicitType::Quadric, "Quadric (hyperboloid)"}};
 
 // The "Add" menu items (shared by the toolbar popup and the context menu).
 void addMenuItems(ViewerState& st, sg::NodeId parent) {
@@ -150,7 +153,7 @@ bool g_showHelp = false;
 std::string g_renameBuffer;
 sg::NodeId g_renaming = sg::kNoNode;
 
-}  // namespace
+}   // namespace
 
 std::vector<std::string> visibleBackends(const ViewerState& st) {
     switch (st.compare.mode) {
@@ -373,7 +376,7 @@ void drawNode(ViewerState& st, sg::NodeId id, int depth) {
     ImGui::PopID();
 }
 
-}  // namespace
+}   // namespace
 
 void drawSceneTree(ViewerState& st) {
     // Toolbar.
@@ -412,14 +415,19 @@ namespace {
 // Material editor for a payload's material index. Returns true when the index changed.
 bool materialEditor(ViewerState& st, int& index) {
     bool indexChanged = false;
-    std::string preview = index < 0 || size_t(index) >= st.scene.materials.size()
-                              ? std::string("(default)")
-                              : std::to_string(index) + ": " + st.scene.materials[index].name;
+    std::string preview = index < 0 || size_t(index) >= st.scene.materials.size() ? std::string("(default)")
+                                                                                  : std::to_string(index) + ": " + st.scene.materials[index].name;
     if (ImGui::BeginCombo("Material", preview.c_str())) {
-        if (ImGui::Selectable("(default)", index < 0)) { index = -1; indexChanged = true; }
+        if (ImGui::Selectable("(default)", index < 0)) {
+            index = -1;
+            indexChanged = true;
+        }
         for (size_t i = 0; i < st.scene.materials.size(); ++i) {
             std::string n = std::to_string(i) + ": " + st.scene.materials[i].name;
-            if (ImGui::Selectable(n.c_str(), int(i) == index)) { index = int(i); indexChanged = true; }
+            if (ImGui::Selectable(n.c_str(), int(i) == index)) {
+                index = int(i);
+                indexChanged = true;
+            }
         }
         ImGui::EndCombo();
     }
@@ -465,8 +473,12 @@ bool materialEditor(ViewerState& st, int& index) {
 
 bool implicitEditor(ViewerState& st, sg::ImplicitShape& s) {
     bool ch = enumCombo(st, "Shape", s.type,
-                        {{sg::ImplicitType::Sphere, "sphere"}, {sg::ImplicitType::Box, "box"}, {sg::ImplicitType::Cylinder, "cylinder"},
-                         {sg::ImplicitType::Cone, "cone"}, {sg::ImplicitType::Torus, "torus"}, {sg::ImplicitType::Plane, "plane"},
+                        {{sg::ImplicitType::Sphere, "sphere"},
+                         {sg::ImplicitType::Box, "box"},
+                         {sg::ImplicitType::Cylinder, "cylinder"},
+                         {sg::ImplicitType::Cone, "cone"},
+                         {sg::ImplicitType::Torus, "torus"},
+                         {sg::ImplicitType::Plane, "plane"},
                          {sg::ImplicitType::Quadric, "quadric"}});
     switch (s.type) {
     case sg::ImplicitType::Sphere: ch |= ImGui::DragFloat("Radius", &s.radius, 0.01f, 0.001f, 1e4f); break;
@@ -519,8 +531,10 @@ void transformEditor(ViewerState& st, sg::NodeId id) {
     } else {
         if (ImGui::Button("Convert back to TRS")) {
             sg::LocalTransform c = t;
-            if (c.tryMakeTRS()) st.setLocal(id, c);
-            else st.errorPopup = "This matrix has shear (or is not affine): it cannot be written as translate * rotate * scale.";
+            if (c.tryMakeTRS())
+                st.setLocal(id, c);
+            else
+                st.errorPopup = "This matrix has shear (or is not affine): it cannot be written as translate * rotate * scale.";
         }
         record(st, "inspector/toTRS");
     }
@@ -539,16 +553,26 @@ void transformEditor(ViewerState& st, sg::NodeId id) {
         ImGui::PopID();
     }
     ImGui::TextDisabled("   0.000      0.000      0.000      1.000");
-    if (ImGui::SmallButton("Mirror X")) { m = m * glm::scale(sg::mat4(1.0f), sg::vec3(-1, 1, 1)); mch = true; }
+    if (ImGui::SmallButton("Mirror X")) {
+        m = m * glm::scale(sg::mat4(1.0f), sg::vec3(-1, 1, 1));
+        mch = true;
+    }
     record(st, "inspector/mirrorX");
     ImGui::SameLine();
-    if (ImGui::SmallButton("Shear XY")) { sg::mat4 s(1.0f); s[1][0] = 0.25f; m = m * s; mch = true; }
+    if (ImGui::SmallButton("Shear XY")) {
+        sg::mat4 s(1.0f);
+        s[1][0] = 0.25f;
+        m = m * s;
+        mch = true;
+    }
     record(st, "inspector/shear");
     ImGui::SameLine();
     if (ImGui::SmallButton("Identity")) { st.setLocal(id, sg::LocalTransform{}); }
     if (mch) {
-        if (sg::isFinite(m) && sg::isInvertible(m)) st.setLocal(id, sg::LocalTransform::fromMatrix(m));
-        else st.status = "Matrix edit refused: singular or not finite";
+        if (sg::isFinite(m) && sg::isInvertible(m))
+            st.setLocal(id, sg::LocalTransform::fromMatrix(m));
+        else
+            st.status = "Matrix edit refused: singular or not finite";
     }
     if (ImGui::TreeNode("World matrix (read-only)")) {
         matrixTable("world", st.scene.world(id));
@@ -556,7 +580,7 @@ void transformEditor(ViewerState& st, sg::NodeId id) {
     }
 }
 
-}  // namespace
+}   // namespace
 
 void drawInspector(ViewerState& st) {
     sg::NodeId id = st.selected;
@@ -615,7 +639,8 @@ void drawInspector(ViewerState& st) {
         if (ImGui::CollapsingHeader("Material", ImGuiTreeNodeFlags_DefaultOpen)) ch |= materialEditor(st, cp->material);
     } else if (auto* lp = std::get_if<sg::Light>(&p)) {
         if (ImGui::CollapsingHeader("Light", ImGuiTreeNodeFlags_DefaultOpen)) {
-            ch |= enumCombo(st, "Type", lp->type, {{sg::LightType::Point, "point"}, {sg::LightType::Directional, "directional"}, {sg::LightType::Spot, "spot"}});
+            ch |= enumCombo(st, "Type", lp->type,
+                            {{sg::LightType::Point, "point"}, {sg::LightType::Directional, "directional"}, {sg::LightType::Spot, "spot"}});
             ch |= ImGui::ColorEdit3("Colour", &lp->color.x, ImGuiColorEditFlags_Float);
             ch |= ImGui::DragFloat("Intensity", &lp->intensity, 0.05f, 0.0f, 1e5f);
             ch |= ImGui::Checkbox("Inverse-square falloff", &lp->inverseSquare);
@@ -635,7 +660,8 @@ void drawInspector(ViewerState& st) {
         }
     } else if (auto* pp = std::get_if<sg::ParametricPayload>(&p)) {
         if (ImGui::CollapsingHeader("Parametric surface", ImGuiTreeNodeFlags_DefaultOpen)) {
-            ch |= enumCombo(st, "Surface", pp->surface.type, {{sg::ParametricType::Torus, "torus"}, {sg::ParametricType::BezierPatch, "bezier patch"}});
+            ch |=
+                enumCombo(st, "Surface", pp->surface.type, {{sg::ParametricType::Torus, "torus"}, {sg::ParametricType::BezierPatch, "bezier patch"}});
             if (pp->surface.type == sg::ParametricType::Torus) {
                 ch |= ImGui::DragFloat("Major radius", &pp->surface.majorRadius, 0.01f, 0.001f, 1e4f);
                 ch |= ImGui::DragFloat("Minor radius", &pp->surface.minorRadius, 0.01f, 0.001f, 1e4f);
@@ -723,7 +749,8 @@ void drawCameraPanel(ViewerState& st) {
     section("Projection");
     sg::Projection p = st.projection();
     bool ch = enumCombo(st, "Type", p.type,
-                        {{sg::ProjectionType::Perspective, "perspective"}, {sg::ProjectionType::Orthographic, "orthographic"},
+                        {{sg::ProjectionType::Perspective, "perspective"},
+                         {sg::ProjectionType::Orthographic, "orthographic"},
                          {sg::ProjectionType::Oblique, "oblique"}});
     switch (p.type) {
     case sg::ProjectionType::Perspective:
@@ -737,9 +764,17 @@ void drawCameraPanel(ViewerState& st) {
         break;
     case sg::ProjectionType::Orthographic: ch |= ImGui::DragFloat("Half height", &p.orthoHalfHeight, 0.01f, 0.001f, 1e5f); break;
     case sg::ProjectionType::Oblique:
-        if (ImGui::Button("Cavalier")) { p.obliqueFactor = 1.0f; p.obliqueAngleDeg = 45.0f; ch = true; }
+        if (ImGui::Button("Cavalier")) {
+            p.obliqueFactor = 1.0f;
+            p.obliqueAngleDeg = 45.0f;
+            ch = true;
+        }
         ImGui::SameLine();
-        if (ImGui::Button("Cabinet")) { p.obliqueFactor = 0.5f; p.obliqueAngleDeg = 45.0f; ch = true; }
+        if (ImGui::Button("Cabinet")) {
+            p.obliqueFactor = 0.5f;
+            p.obliqueAngleDeg = 45.0f;
+            ch = true;
+        }
         ch |= ImGui::SliderFloat("Angle", &p.obliqueAngleDeg, 0.0f, 90.0f, "%.1f deg");
         ch |= ImGui::SliderFloat("Factor", &p.obliqueFactor, 0.0f, 2.0f);
         ch |= ImGui::DragFloat("Half height", &p.orthoHalfHeight, 0.01f, 0.001f, 1e5f);
@@ -768,7 +803,7 @@ void drawCameraPanel(ViewerState& st) {
     matrixTable("proj", fc.proj);
     ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyle().Colors[ImGuiCol_TextDisabled]);
     ImGui::TextWrapped("Eye (%.2f, %.2f, %.2f)  pivot (%.2f, %.2f, %.2f)  distance %.3f", fc.eye.x, fc.eye.y, fc.eye.z, st.camera.pivot.x,
-                        st.camera.pivot.y, st.camera.pivot.z, st.camera.distance);
+                       st.camera.pivot.y, st.camera.pivot.z, st.camera.distance);
     ImGui::PopStyleColor();
 }
 
@@ -802,11 +837,14 @@ void drawRenderingPanel(ViewerState& st) {
     }
 
     section("Fog");
-    ch |= enumCombo(st, "Fog", s.fog, {{sg::FogMode::Off, "off"}, {sg::FogMode::Linear, "linear"}, {sg::FogMode::Exp, "exp"}, {sg::FogMode::Exp2, "exp2"}});
+    ch |= enumCombo(st, "Fog", s.fog,
+                    {{sg::FogMode::Off, "off"}, {sg::FogMode::Linear, "linear"}, {sg::FogMode::Exp, "exp"}, {sg::FogMode::Exp2, "exp2"}});
     if (s.fog != sg::FogMode::Off) {
         ch |= ImGui::ColorEdit3("Fog colour", &s.fogColor.x, ImGuiColorEditFlags_Float);
-        if (s.fog == sg::FogMode::Linear) ch |= ImGui::DragFloatRange2("Start / end", &s.fogStart, &s.fogEnd, 0.05f, 0.0f, 1e5f);
-        else ch |= ImGui::SliderFloat("Density", &s.fogDensity, 0.0f, 1.0f, "%.4f", ImGuiSliderFlags_Logarithmic);
+        if (s.fog == sg::FogMode::Linear)
+            ch |= ImGui::DragFloatRange2("Start / end", &s.fogStart, &s.fogEnd, 0.05f, 0.0f, 1e5f);
+        else
+            ch |= ImGui::SliderFloat("Density", &s.fogDensity, 0.0f, 1.0f, "%.4f", ImGuiSliderFlags_Logarithmic);
     }
 
     section("Anti-aliasing");
@@ -824,15 +862,23 @@ void drawRenderingPanel(ViewerState& st) {
         std::string ov = it == st.aaOverride.end() ? "(scene)" : it->second;
         std::string label = "AA " + b;
         if (ImGui::BeginCombo(label.c_str(), ov.c_str())) {
-            if (ImGui::Selectable("(scene)", it == st.aaOverride.end())) { st.aaOverride.erase(b); st.markViewChanged(); }
+            if (ImGui::Selectable("(scene)", it == st.aaOverride.end())) {
+                st.aaOverride.erase(b);
+                st.markViewChanged();
+            }
             for (const char* n : aaNames)
-                if (ImGui::Selectable(n, ov == n)) { st.aaOverride[b] = n; st.markViewChanged(); }
+                if (ImGui::Selectable(n, ov == n)) {
+                    st.aaOverride[b] = n;
+                    st.markViewChanged();
+                }
             ImGui::EndCombo();
         }
     }
 
     if (ImGui::Checkbox("GL on a worker thread", &st.glOnWorker)) st.markViewChanged();
-    helpMarker("The gl backend renders on its own thread with a headless context: the UI never waits, even with software GL.\nOff: it renders on the UI thread with the window's context.");
+    helpMarker(
+        "The gl backend renders on its own thread with a headless context: the UI never waits, even with software GL.\nOff: it renders on the UI "
+        "thread with the window's context.");
 
     section("Rasterizers");
     ch |= ImGui::Checkbox("Wireframe", &s.wireframe);
@@ -949,8 +995,10 @@ void drawSlotImage(ImDrawList* dl, const SlotView& v, ImVec2 a, ImVec2 b, float 
     (void)full0;
     (void)full1;
     std::string msg;
-    if (!v.status.error.empty()) msg = v.status.backend + ": " + v.status.error;
-    else if (!v.texture) msg = v.status.backend + ": rendering...";
+    if (!v.status.error.empty())
+        msg = v.status.backend + ": " + v.status.error;
+    else if (!v.texture)
+        msg = v.status.backend + ": rendering...";
     if (!msg.empty()) centeredText(dl, a, b, msg, v.status.error.empty() ? IM_COL32(200, 200, 210, 255) : IM_COL32(255, 150, 120, 255));
 }
 
@@ -965,7 +1013,8 @@ std::string slotStats(const SlotView& v) {
     }
     if (v.status.level > 1) extra += "  (1/" + std::to_string(v.status.level) + " res)";
     if (v.status.rendering) extra += "  " + std::to_string(int(v.status.progress * 100)) + "%";
-    std::snprintf(buf, sizeof buf, "%-8s %7.1f ms  %6.1fk tris%s", v.status.backend.c_str(), s.milliseconds, double(s.triangles) / 1000.0, extra.c_str());
+    std::snprintf(buf, sizeof buf, "%-8s %7.1f ms  %6.1fk tris%s", v.status.backend.c_str(), s.milliseconds, double(s.triangles) / 1000.0,
+                  extra.c_str());
     return buf;
 }
 
@@ -989,8 +1038,10 @@ void cameraInput(ViewerState& st, ImVec2 a, ImVec2 b, double time, float dt) {
     if (dragDivider >= 0 && active) {
         float f = std::clamp((io.MousePos.x - a.x) / std::max(b.x - a.x, 1.0f), 0.0f, 1.0f);
         st.compare.dividers[dragDivider] = f;
-        if (dragDivider == 0) st.compare.dividers[1] = std::max(st.compare.dividers[1], f);
-        else st.compare.dividers[0] = std::min(st.compare.dividers[0], f);
+        if (dragDivider == 0)
+            st.compare.dividers[1] = std::max(st.compare.dividers[1], f);
+        else
+            st.compare.dividers[0] = std::min(st.compare.dividers[0], f);
         return;
     }
     if (active && (io.MouseDelta.x != 0 || io.MouseDelta.y != 0)) {
@@ -1032,7 +1083,7 @@ void cameraInput(ViewerState& st, ImVec2 a, ImVec2 b, double time, float dt) {
     }
 }
 
-}  // namespace
+}   // namespace
 
 void drawViewport(ViewerState& st, const ViewportInput& view, double time, float dt) {
     ImVec2 a = ImGui::GetCursorScreenPos();
@@ -1045,7 +1096,8 @@ void drawViewport(ViewerState& st, const ViewportInput& view, double time, float
     st.viewportWidth = std::max(1, int(avail.x * fbs.x));
     st.viewportHeight = std::max(1, int(avail.y * fbs.y));
 
-    ImGui::InvisibleButton("##viewport", avail, ImGuiButtonFlags_MouseButtonLeft | ImGuiButtonFlags_MouseButtonRight | ImGuiButtonFlags_MouseButtonMiddle);
+    ImGui::InvisibleButton("##viewport", avail,
+                           ImGuiButtonFlags_MouseButtonLeft | ImGuiButtonFlags_MouseButtonRight | ImGuiButtonFlags_MouseButtonMiddle);
     record(st, "viewport");
     cameraInput(st, a, b, time, dt);
     // Space: play / pause the animation while the viewport has focus (not while typing).
@@ -1097,8 +1149,9 @@ void drawViewport(ViewerState& st, const ViewportInput& view, double time, float
         if (view.slots.size() >= 2) {
             char buf[256];
             if (st.haveDiff)
-                std::snprintf(buf, sizeof buf, "|%s - %s|   mean %.2f   max %d   PSNR %.1f dB   within %d: %.1f%%", view.slots[0].status.backend.c_str(),
-                              view.slots[1].status.backend.c_str(), st.diffMean, st.diffMax, st.diffPsnr, st.compare.threshold, 100.0 * st.diffWithin);
+                std::snprintf(buf, sizeof buf, "|%s - %s|   mean %.2f   max %d   PSNR %.1f dB   within %d: %.1f%%",
+                              view.slots[0].status.backend.c_str(), view.slots[1].status.backend.c_str(), st.diffMean, st.diffMax, st.diffPsnr,
+                              st.compare.threshold, 100.0 * st.diffWithin);
             else
                 std::snprintf(buf, sizeof buf, "|%s - %s|", view.slots[0].status.backend.c_str(), view.slots[1].status.backend.c_str());
             ImVec2 ts = ImGui::CalcTextSize(buf);
@@ -1180,7 +1233,8 @@ void drawFileBrowser(ViewerState& st) {
         const fs::directory_entry& e = *it;
         std::string name = e.path().filename().string();
         if (name.empty() || name[0] == '.') continue;
-        if (e.is_directory(ec)) dirs.push_back(e);
+        if (e.is_directory(ec))
+            dirs.push_back(e);
         else {
             std::string ext = e.path().extension().string();
             std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
@@ -1197,7 +1251,8 @@ void drawFileBrowser(ViewerState& st) {
     ImGui::BeginChild("entries", ImVec2(0, -footer), true);
     for (const auto& d : dirs) {
         std::string label = "[dir] " + d.path().filename().string();
-        if (ImGui::Selectable(label.c_str(), false, ImGuiSelectableFlags_AllowDoubleClick) && ImGui::IsMouseDoubleClicked(0)) g_browser.dir = d.path();
+        if (ImGui::Selectable(label.c_str(), false, ImGuiSelectableFlags_AllowDoubleClick) && ImGui::IsMouseDoubleClicked(0))
+            g_browser.dir = d.path();
     }
     for (const auto& f : files) {
         std::string name = f.path().filename().string();
@@ -1222,8 +1277,10 @@ void drawFileBrowser(ViewerState& st) {
     if (!chosen.empty()) {
         g_browser.open = false;
         ImGui::CloseCurrentPopup();
-        if (g_browser.saving) st.save(chosen);
-        else st.requestOpen(chosen);
+        if (g_browser.saving)
+            st.save(chosen);
+        else
+            st.requestOpen(chosen);
     }
     ImGui::EndPopup();
 }
@@ -1239,11 +1296,20 @@ void drawScreenshotDialog(ViewerState& st) {
     ImGui::BeginDisabled(g_shotDialog.windowSize);
     ImGui::InputInt("Width", &g_shotDialog.width);
     ImGui::InputInt("Height", &g_shotDialog.height);
-    if (ImGui::SmallButton("1280x720")) { g_shotDialog.width = 1280; g_shotDialog.height = 720; }
+    if (ImGui::SmallButton("1280x720")) {
+        g_shotDialog.width = 1280;
+        g_shotDialog.height = 720;
+    }
     ImGui::SameLine();
-    if (ImGui::SmallButton("1920x1080")) { g_shotDialog.width = 1920; g_shotDialog.height = 1080; }
+    if (ImGui::SmallButton("1920x1080")) {
+        g_shotDialog.width = 1920;
+        g_shotDialog.height = 1080;
+    }
     ImGui::SameLine();
-    if (ImGui::SmallButton("3840x2160")) { g_shotDialog.width = 3840; g_shotDialog.height = 2160; }
+    if (ImGui::SmallButton("3840x2160")) {
+        g_shotDialog.width = 3840;
+        g_shotDialog.height = 2160;
+    }
     ImGui::EndDisabled();
     g_shotDialog.width = std::clamp(g_shotDialog.width, 1, 16384);
     g_shotDialog.height = std::clamp(g_shotDialog.height, 1, 16384);
@@ -1259,7 +1325,7 @@ void drawScreenshotDialog(ViewerState& st) {
     ImGui::EndPopup();
 }
 
-}  // namespace
+}   // namespace
 
 void drawDialogs(ViewerState& st) {
     if (st.requests.openDialog) {
@@ -1275,13 +1341,21 @@ void drawDialogs(ViewerState& st) {
 
     if (st.confirmOpen && !ImGui::IsPopupOpen("Unsaved changes")) ImGui::OpenPopup("Unsaved changes");
     if (ImGui::BeginPopupModal("Unsaved changes", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
-        const char* what = st.pending == PendingAction::Quit ? "quitting" : st.pending == PendingAction::New ? "starting a new scene" : "opening another file";
+        const char* what = st.pending == PendingAction::Quit  ? "quitting"
+                           : st.pending == PendingAction::New ? "starting a new scene"
+                                                              : "opening another file";
         ImGui::Text("The scene has unsaved changes.\nSave them before %s?", what);
         ImGui::Spacing();
-        if (ImGui::Button("Save", ImVec2(px(90), 0))) { st.confirm(ConfirmChoice::Save); ImGui::CloseCurrentPopup(); }
+        if (ImGui::Button("Save", ImVec2(px(90), 0))) {
+            st.confirm(ConfirmChoice::Save);
+            ImGui::CloseCurrentPopup();
+        }
         record(st, "confirm/save");
         ImGui::SameLine();
-        if (ImGui::Button("Discard", ImVec2(px(90), 0))) { st.confirm(ConfirmChoice::Discard); ImGui::CloseCurrentPopup(); }
+        if (ImGui::Button("Discard", ImVec2(px(90), 0))) {
+            st.confirm(ConfirmChoice::Discard);
+            ImGui::CloseCurrentPopup();
+        }
         record(st, "confirm/discard");
         ImGui::SameLine();
         if (ImGui::Button("Cancel", ImVec2(px(90), 0)) || ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Escape))) {
@@ -1337,8 +1411,10 @@ void handleShortcuts(ViewerState& st) {
     if (ctrl) {
         if (ImGui::IsKeyPressed(keys::O, false)) st.requests.openDialog = true;
         if (ImGui::IsKeyPressed(keys::S, false)) {
-            if (io.KeyShift) st.requests.saveAsDialog = true;
-            else st.save();
+            if (io.KeyShift)
+                st.requests.saveAsDialog = true;
+            else
+                st.save();
         }
         if (ImGui::IsKeyPressed(keys::N, false)) st.requestNew();
         if (ImGui::IsKeyPressed(keys::Q, false)) st.requestQuit();
@@ -1388,16 +1464,28 @@ void drawUi(ViewerState& st, const ViewportInput& view, double time, float dt) {
         if (ImGui::BeginTabBar("tabs")) {
             bool openInspector = ImGui::BeginTabItem("Inspector", nullptr, st.requestedTab == "Inspector" ? ImGuiTabItemFlags_SetSelected : 0);
             record(st, "tab/Inspector");   // the tab itself (before its contents)
-            if (openInspector) { drawInspector(st); ImGui::EndTabItem(); }
+            if (openInspector) {
+                drawInspector(st);
+                ImGui::EndTabItem();
+            }
             bool openCamera = ImGui::BeginTabItem("Camera", nullptr, st.requestedTab == "Camera" ? ImGuiTabItemFlags_SetSelected : 0);
             record(st, "tab/Camera");   // the tab itself (before its contents)
-            if (openCamera) { drawCameraPanel(st); ImGui::EndTabItem(); }
+            if (openCamera) {
+                drawCameraPanel(st);
+                ImGui::EndTabItem();
+            }
             bool openRendering = ImGui::BeginTabItem("Rendering", nullptr, st.requestedTab == "Rendering" ? ImGuiTabItemFlags_SetSelected : 0);
             record(st, "tab/Rendering");   // the tab itself (before its contents)
-            if (openRendering) { drawRenderingPanel(st); ImGui::EndTabItem(); }
+            if (openRendering) {
+                drawRenderingPanel(st);
+                ImGui::EndTabItem();
+            }
             bool openCompare = ImGui::BeginTabItem("Compare", nullptr, st.requestedTab == "Compare" ? ImGuiTabItemFlags_SetSelected : 0);
             record(st, "tab/Compare");   // the tab itself (before its contents)
-            if (openCompare) { drawComparePanel(st); ImGui::EndTabItem(); }
+            if (openCompare) {
+                drawComparePanel(st);
+                ImGui::EndTabItem();
+            }
             ImGui::EndTabBar();
         }
         st.requestedTab.clear();
@@ -1412,8 +1500,8 @@ void drawUi(ViewerState& st, const ViewportInput& view, double time, float dt) {
     ImGui::PushStyleVar(ImGuiStyleVar_WindowPadding, ImVec2(0, 0));
     ImGui::PushStyleVar(ImGuiStyleVar_WindowBorderSize, 0.0f);
     if (ImGui::Begin("Viewport", nullptr,
-                     ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoBringToFrontOnFocus |
-                         ImGuiWindowFlags_NoScrollWithMouse))
+                     ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings |
+                         ImGuiWindowFlags_NoBringToFrontOnFocus | ImGuiWindowFlags_NoScrollWithMouse))
         drawViewport(st, view, time, dt);
     ImGui::End();
     ImGui::PopStyleVar(2);
@@ -1422,8 +1510,11 @@ void drawUi(ViewerState& st, const ViewportInput& view, double time, float dt) {
     ImGui::SetNextWindowPos(ImVec2(0, io.DisplaySize.y - statusH), ImGuiCond_Always);
     ImGui::SetNextWindowSize(ImVec2(io.DisplaySize.x, statusH), ImGuiCond_Always);
     ImGui::PushStyleVar(ImGuiStyleVar_WindowPadding, ImVec2(px(8), px(2)));
-    if (ImGui::Begin("##status", nullptr, ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoBringToFrontOnFocus)) {
-        bool bad = st.status.rfind("Move refused", 0) == 0 || st.status.find("fail") != std::string::npos || st.status.find("refused") != std::string::npos;
+    if (ImGui::Begin(
+            "##status", nullptr,
+            ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoBringToFrontOnFocus)) {
+        bool bad =
+            st.status.rfind("Move refused", 0) == 0 || st.status.find("fail") != std::string::npos || st.status.find("refused") != std::string::npos;
         if (st.loadInProgress()) {   // progress of the load (off the UI thread) and its Cancel
             float f = st.loadProgress();
             char label[32];
@@ -1437,8 +1528,10 @@ void drawUi(ViewerState& st, const ViewportInput& view, double time, float dt) {
             record(st, "status/cancelLoad");
             ImGui::SameLine();
         }
-        if (bad) ImGui::TextColored(ImVec4(1.0f, 0.6f, 0.45f, 1.0f), "%s", st.status.c_str());
-        else ImGui::TextUnformatted(st.status.empty() ? "Ready" : st.status.c_str());
+        if (bad)
+            ImGui::TextColored(ImVec4(1.0f, 0.6f, 0.45f, 1.0f), "%s", st.status.c_str());
+        else
+            ImGui::TextUnformatted(st.status.empty() ? "Ready" : st.status.c_str());
         char right[160];
         std::string mode = st.compare.mode == ViewMode::Single ? st.backend : st.compare.mode == ViewMode::Split ? "split view" : "difference view";
         std::snprintf(right, sizeof right, "%s   %s   %.0f fps", mode.c_str(), st.loadInProgress() ? "loading..." : "", io.Framerate);
@@ -1453,4 +1546,4 @@ void drawUi(ViewerState& st, const ViewportInput& view, double time, float dt) {
     handleShortcuts(st);
 }
 
-}  // namespace ui
+}   // namespace ui

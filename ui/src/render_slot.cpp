@@ -56,7 +56,10 @@ void RenderSlot::runJob(const Job& job) {
     int divisors[2] = {previewDivisor, 1};
     int levels = job.previewOnly ? 1 : 2;
     // A preview larger than ~1/16 of the pixels is pointless for tiny viewports.
-    if (previewDivisor <= 1 || (job.width / previewDivisor < 8)) { divisors[0] = 1; levels = 1; }
+    if (previewDivisor <= 1 || (job.width / previewDivisor < 8)) {
+        divisors[0] = 1;
+        levels = 1;
+    }
     for (int i = 0; i < levels; ++i) {
         int d = divisors[i];
         int w = std::max(1, job.width / d), h = std::max(1, job.height / d);
@@ -150,4 +153,4 @@ void RenderSlot::waitIdle() {
     m_cv.wait(lock, [&] { return m_quit || (!m_pending && !m_busy); });
 }
 
-}  // namespace ui
+}   // namespace ui

@@ -19,10 +19,10 @@
 #include "ui/render_slot.h"
 #include "ui/viewer_state.h"
 
-#include <glad/gl.h>
 #include <GLFW/glfw3.h>
 #include <backends/imgui_impl_glfw.h>
 #include <backends/imgui_impl_opengl3.h>
+#include <glad/gl.h>
 #include <imgui.h>
 
 #include <chrono>
@@ -37,9 +37,9 @@
 
 namespace fs = std::filesystem;
 
-static_assert(ui::keys::F == GLFW_KEY_F && ui::keys::Num1 == GLFW_KEY_1 && ui::keys::Home == GLFW_KEY_HOME &&
-                  ui::keys::F12 == GLFW_KEY_F12 && ui::keys::Delete == GLFW_KEY_DELETE && ui::keys::W == GLFW_KEY_W &&
-                  ui::keys::F2 == GLFW_KEY_F2 && ui::keys::Q == GLFW_KEY_Q && ui::keys::Space == GLFW_KEY_SPACE,
+static_assert(ui::keys::F == GLFW_KEY_F && ui::keys::Num1 == GLFW_KEY_1 && ui::keys::Home == GLFW_KEY_HOME && ui::keys::F12 == GLFW_KEY_F12 &&
+                  ui::keys::Delete == GLFW_KEY_DELETE && ui::keys::W == GLFW_KEY_W && ui::keys::F2 == GLFW_KEY_F2 && ui::keys::Q == GLFW_KEY_Q &&
+                  ui::keys::Space == GLFW_KEY_SPACE,
               "panel key codes must match GLFW's");
 
 namespace ui {
@@ -98,7 +98,7 @@ std::string saveWindowPng(GLFWwindow* win, const fs::path& path) {
     return assets::writePng(path, w, h, flipped.data(), /*overwrite=*/true);
 }
 
-}  // namespace
+}   // namespace
 
 // --- 2. Viewer ---------------------------------------------------------------------------------
 
@@ -262,7 +262,8 @@ public:
                 continue;
             }
             std::string err = shots[i].result.get();
-            if (err.empty()) st.status = "Saved " + shots[i].path.string();
+            if (err.empty())
+                st.status = "Saved " + shots[i].path.string();
             else {
                 st.status = "Screenshot failed: " + err;
                 std::fprintf(stderr, "viewer: screenshot: %s\n", err.c_str());
@@ -298,7 +299,7 @@ private:
     bool m_glOnWorker = false;
 };
 
-}  // namespace
+}   // namespace
 
 // --- 3. automation -----------------------------------------------------------------------------
 //
@@ -355,14 +356,23 @@ public:
             std::string cmd;
             in >> cmd;
             if (cmd.empty() || cmd[0] == '#') continue;
-            if (cmd == "frames") { in >> waitFrames; return true; }
-            if (cmd == "wait") { waiting = true; return true; }
+            if (cmd == "frames") {
+                in >> waitFrames;
+                return true;
+            }
+            if (cmd == "wait") {
+                waiting = true;
+                return true;
+            }
             if (cmd == "quit") return false;
             if (cmd == "key") {
                 std::string k;
                 in >> k;
-                int code = k == "Home" ? GLFW_KEY_HOME : k == "F12" ? GLFW_KEY_F12 : k == "F" ? GLFW_KEY_F
-                         : k.size() == 1 && k[0] >= '1' && k[0] <= '9' ? GLFW_KEY_1 + (k[0] - '1') : std::atoi(k.c_str());
+                int code = k == "Home"                                   ? GLFW_KEY_HOME
+                           : k == "F12"                                  ? GLFW_KEY_F12
+                           : k == "F"                                    ? GLFW_KEY_F
+                           : k.size() == 1 && k[0] >= '1' && k[0] <= '9' ? GLFW_KEY_1 + (k[0] - '1')
+                                                                         : std::atoi(k.c_str());
                 if (code > 0 && code < 512) {
                     ImGui::GetIO().KeysDown[code] = true;
                     releaseKey = code;
@@ -370,23 +380,57 @@ public:
                 waitFrames = 1;
                 return true;
             }
-            if (cmd == "backend") { std::string b; in >> b; v.st.setBackend(b); v.st.compare.mode = ViewMode::Single; continue; }
+            if (cmd == "backend") {
+                std::string b;
+                in >> b;
+                v.st.setBackend(b);
+                v.st.compare.mode = ViewMode::Single;
+                continue;
+            }
             if (cmd == "view") {
                 std::string m;
                 in >> m;
                 applyView(v.st, m);
                 continue;
             }
-            if (cmd == "orbit") { float dx = 0, dy = 0; in >> dx >> dy; v.st.camera.orbit(dx, dy); v.st.markViewChanged(); continue; }
-            if (cmd == "zoom") { float s = 0; in >> s; v.st.camera.zoom(s); v.st.markViewChanged(); continue; }
-            if (cmd == "fit") { v.st.fitView(false); continue; }
-            if (cmd == "gl-worker") { std::string on; in >> on; v.st.glOnWorker = on == "on"; continue; }
-            if (cmd == "tab") { in >> v.st.requestedTab; continue; }
+            if (cmd == "orbit") {
+                float dx = 0, dy = 0;
+                in >> dx >> dy;
+                v.st.camera.orbit(dx, dy);
+                v.st.markViewChanged();
+                continue;
+            }
+            if (cmd == "zoom") {
+                float s = 0;
+                in >> s;
+                v.st.camera.zoom(s);
+                v.st.markViewChanged();
+                continue;
+            }
+            if (cmd == "fit") {
+                v.st.fitView(false);
+                continue;
+            }
+            if (cmd == "gl-worker") {
+                std::string on;
+                in >> on;
+                v.st.glOnWorker = on == "on";
+                continue;
+            }
+            if (cmd == "tab") {
+                in >> v.st.requestedTab;
+                continue;
+            }
             if (cmd == "anim") {
                 std::string what;
                 in >> what;
-                if (what == "play" || what == "pause") v.st.setAnimationPlaying(what == "play");
-                else if (what == "time") { double t = 0; in >> t; v.st.setAnimationTime(t); }
+                if (what == "play" || what == "pause")
+                    v.st.setAnimationPlaying(what == "play");
+                else if (what == "time") {
+                    double t = 0;
+                    in >> t;
+                    v.st.setAnimationTime(t);
+                }
                 continue;
             }
             if (cmd == "stats") {   // one line per shown backend: time, triangles, rays, error
@@ -412,7 +456,10 @@ public:
                 waiting = true;
                 return true;
             }
-            if (cmd == "window-shot") { in >> windowShot; return true; }
+            if (cmd == "window-shot") {
+                in >> windowShot;
+                return true;
+            }
             std::fprintf(stderr, "viewer: automation: unknown command '%s' (line %zu)\n", cmd.c_str(), pc);
             failed = true;
             return false;
@@ -421,10 +468,23 @@ public:
     }
 
     static void applyView(ViewerState& st, const std::string& m) {
-        if (m == "single") st.compare.mode = ViewMode::Single;
-        else if (m == "split") { st.compare.mode = ViewMode::Split; st.compare.count = 2; st.compare.backends = {"gl", "raster", "raycast"}; }
-        else if (m == "split3") { st.compare.mode = ViewMode::Split; st.compare.count = 3; st.compare.dividers = {0.33f, 0.66f}; st.compare.backends = {"gl", "raster", "raycast"}; }
-        else if (m == "difference") { st.compare.mode = ViewMode::Difference; st.compare.backends = {"raster", "raycast", "gl"}; st.compare.diffA = 0; st.compare.diffB = 1; }
+        if (m == "single")
+            st.compare.mode = ViewMode::Single;
+        else if (m == "split") {
+            st.compare.mode = ViewMode::Split;
+            st.compare.count = 2;
+            st.compare.backends = {"gl", "raster", "raycast"};
+        } else if (m == "split3") {
+            st.compare.mode = ViewMode::Split;
+            st.compare.count = 3;
+            st.compare.dividers = {0.33f, 0.66f};
+            st.compare.backends = {"gl", "raster", "raycast"};
+        } else if (m == "difference") {
+            st.compare.mode = ViewMode::Difference;
+            st.compare.backends = {"raster", "raycast", "gl"};
+            st.compare.diffA = 0;
+            st.compare.diffB = 1;
+        }
     }
 };
 
@@ -448,7 +508,7 @@ void onContentScale(GLFWwindow*, float xs, float ys) { g_newContentScale = std::
 
 void onGlfwError(int code, const char* msg) { std::fprintf(stderr, "viewer: GLFW error %d: %s\n", code, msg); }
 
-}  // namespace
+}   // namespace
 
 // --- 5. main loop ------------------------------------------------------------------------------
 
@@ -553,8 +613,10 @@ int runViewer(const ViewerOptions& opt) {
     while (running) {
         bool busy = !v.shots.empty() || st.loadInProgress() || st.animationPlaying || automated;
         for (auto& [n, bv] : v.views) busy |= bv.slot->status().rendering;
-        if (busy || (v.now - st.lastInteraction) < 0.5) glfwPollEvents();
-        else glfwWaitEventsTimeout(0.1);
+        if (busy || (v.now - st.lastInteraction) < 0.5)
+            glfwPollEvents();
+        else
+            glfwWaitEventsTimeout(0.1);
 
         v.now = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         float dt = float(std::clamp(v.now - last, 1e-4, 0.25));
@@ -639,4 +701,4 @@ int runViewer(const ViewerOptions& opt) {
     return exitCode;
 }
 
-}  // namespace ui
+}   // namespace ui

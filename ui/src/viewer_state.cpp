@@ -71,7 +71,7 @@ std::string uniqueName(const sg::Scene& s, const std::string& base) {
         if (s.findByName(n) == sg::kNoNode) return n;
     }
 }
-}  // namespace
+}   // namespace
 
 sg::NodeId ViewerState::addGroup(sg::NodeId parent) {
     sg::NodeId id = scene.addNode(uniqueName(scene, "group"), parentFor(*this, parent));
@@ -94,8 +94,8 @@ sg::NodeId ViewerState::addShape(sg::ImplicitType type, sg::NodeId parent) {
 }
 
 sg::NodeId ViewerState::addCsg(sg::CsgOp op, sg::NodeId parent) {
-    sg::NodeId id = scene.addNode(uniqueName(scene, "csg " + std::string(sg::toString(op))), parentFor(*this, parent),
-                                  sg::CsgPayload{sg::CsgNode{op}, -1});
+    sg::NodeId id =
+        scene.addNode(uniqueName(scene, "csg " + std::string(sg::toString(op))), parentFor(*this, parent), sg::CsgPayload{sg::CsgNode{op}, -1});
     // Two operands so the node shows something right away.
     sg::ImplicitShape a;
     a.type = sg::ImplicitType::Box;
@@ -199,7 +199,7 @@ const sg::Camera* activeCam(const sg::Scene& s) {
     if (!s.valid(s.activeCamera)) return nullptr;
     return std::get_if<sg::Camera>(&s.node(s.activeCamera).payload);
 }
-}  // namespace
+}   // namespace
 
 const sg::Projection& ViewerState::projection() const {
     const sg::Camera* c = activeCam(scene);
@@ -441,9 +441,7 @@ std::string ViewerState::save(const fs::path& path) {
     std::string err;
     try {
         err = assets::saveSceneJson(scene, target, /*overwrite=*/true);
-    } catch (const std::exception& e) {
-        err = target.string() + ": " + e.what();
-    }
+    } catch (const std::exception& e) { err = target.string() + ": " + e.what(); }
     if (!err.empty()) {
         errorPopup = "Could not save:\n" + err;
         status = "Save failed";
@@ -471,7 +469,7 @@ void applyPose(ViewerState& st, const assets::AnimationClip& clip, double t) {
     assets::applyAnimation(st.scene, clip, float(t));
     ++st.sceneVersion;
 }
-}  // namespace
+}   // namespace
 
 const assets::AnimationClip* ViewerState::currentAnimation() const {
     if (animationClip < 0 || size_t(animationClip) >= animations.size()) return nullptr;
@@ -558,4 +556,4 @@ fs::path screenshotPath(const fs::path& dir, const std::string& backend, const s
     return assets::uniquePath(dir / (stem + "-" + backend + ".png"));
 }
 
-}  // namespace ui
+}   // namespace ui

@@ -41,4 +41,4 @@ sg::vec4 sampleChannel(const AnimationChannel& channel, float t);
 // Applies all channels of the clip at time t to the scene's node locals.
 void applyAnimation(sg::Scene& scene, const AnimationClip& clip, float t);
 
-}  // namespace assets
+}   // namespace assets

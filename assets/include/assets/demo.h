@@ -11,4 +11,4 @@ sg::Scene makeDemoScene();
 // A procedural checker texture (used by the demo and tests).
 std::shared_ptr<sg::Texture> makeCheckerTexture(int size, int checks, sg::vec3 a, sg::vec3 b);
 
-}  // namespace assets
+}   // namespace assets

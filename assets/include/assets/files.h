@@ -27,4 +27,4 @@ size_t readFully(int fd, void* buffer, size_t n);
 // `path` itself when free. Used for screenshots named without overwriting.
 std::filesystem::path uniquePath(const std::filesystem::path& path);
 
-}  // namespace assets
+}   // namespace assets

@@ -22,4 +22,4 @@ ImageLoad loadImage(const std::filesystem::path& path);
 std::string writePng(const std::filesystem::path& path, int width, int height, const uint8_t* rgba, bool overwrite);
 std::string encodePng(int width, int height, const uint8_t* rgba, std::string& out);
 
-}  // namespace assets
+}   // namespace assets

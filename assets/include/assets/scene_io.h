@@ -18,14 +18,14 @@
 namespace assets {
 
 struct LoadOptions {
-    std::atomic<bool>* cancel = nullptr;     // polled during long loads
-    std::atomic<float>* progress = nullptr;  // 0..1
+    std::atomic<bool>* cancel = nullptr;      // polled during long loads
+    std::atomic<float>* progress = nullptr;   // 0..1
 };
 
 struct LoadResult {
     std::optional<sg::Scene> scene;
-    std::string error;                       // set when !scene
-    std::vector<std::string> warnings;       // recoverable problems (missing texture, ...)
+    std::string error;                   // set when !scene
+    std::vector<std::string> warnings;   // recoverable problems (missing texture, ...)
     // glTF only (additive): node TRS animation clips (node ids refer to *scene), the names of
     // all scenes in the file ("scene N" when unnamed) and which one was loaded (-1: none).
     std::vector<AnimationClip> animations;
@@ -47,4 +47,4 @@ std::string saveSceneJson(const sg::Scene& scene, const std::filesystem::path& p
 // Which extensions loadScene understands (lower case, with dot).
 std::vector<std::string> supportedSceneExtensions();
 
-}  // namespace assets
+}   // namespace assets

@@ -33,4 +33,4 @@ Framebuffer diffImage(const Framebuffer& a, const Framebuffer& b, int threshold 
 // Box-filters a framebuffer down by an integer factor (SSAA resolve).
 Framebuffer downsample(const Framebuffer& src, int factor);
 
-}  // namespace rnd
+}   // namespace rnd

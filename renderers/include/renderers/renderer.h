@@ -33,17 +33,17 @@ struct Capabilities {
 // Shared between the caller and a render in progress (possibly on another thread).
 struct RenderControl {
     std::atomic<bool> cancel{false};
-    std::atomic<float> progress{0.0f};            // 0..1
-    std::function<void()> onTileDone;             // optional, called from worker threads
+    std::atomic<float> progress{0.0f};   // 0..1
+    std::function<void()> onTileDone;    // optional, called from worker threads
 };
 
 struct RenderStats {
     bool ok = false;
     bool cancelled = false;
-    std::string error;            // one line, when !ok
+    std::string error;   // one line, when !ok
     double milliseconds = 0;
-    uint64_t triangles = 0;       // triangles submitted
-    uint64_t rays = 0;            // rays traced (ray caster)
+    uint64_t triangles = 0;   // triangles submitted
+    uint64_t rays = 0;        // rays traced (ray caster)
 };
 
 class Renderer {
@@ -53,8 +53,7 @@ public:
     virtual Capabilities capabilities() const = 0;
     // Renders the frame into `target` (resized to width x height). Thread-compatible: one
     // render at a time per renderer instance.
-    virtual RenderStats render(const sg::FrameInput& frame, int width, int height, Framebuffer& target,
-                               RenderControl* control = nullptr) = 0;
+    virtual RenderStats render(const sg::FrameInput& frame, int width, int height, Framebuffer& target, RenderControl* control = nullptr) = 0;
 };
 
 // Backend names in display order: {"gl", "raster", "raycast"} (those built).
@@ -63,4 +62,4 @@ std::vector<std::string> rendererNames();
 // lists the valid names.
 std::unique_ptr<Renderer> makeRenderer(std::string_view name, std::string* error = nullptr);
 
-}  // namespace rnd
+}   // namespace rnd

@@ -32,20 +32,18 @@ struct LightSample {
 LightSample sampleLight(const sg::DrawLight& light, const sg::vec3& position);
 
 // Reflected radiance toward `toEye` (unit) from one light, without ambient.
-sg::vec3 shadeLight(const sg::Material& m, const SurfacePoint& s, const sg::vec3& toEye, const LightSample& l,
-                    sg::ReflectionModel model);
+sg::vec3 shadeLight(const sg::Material& m, const SurfacePoint& s, const sg::vec3& toEye, const LightSample& l, sg::ReflectionModel model);
 
 // Full local model: ambient + emissive + all lights (no shadows). `lightVisible` (optional)
 // gives a per-light visibility factor in [0,1] (the ray caster's shadow rays).
-sg::vec3 shade(const sg::Material& m, const SurfacePoint& s, const sg::vec3& eye, const sg::FrameInput& f,
-               const float* lightVisible = nullptr);
+sg::vec3 shade(const sg::Material& m, const SurfacePoint& s, const sg::vec3& eye, const sg::FrameInput& f, const float* lightVisible = nullptr);
 
 // Fog on eye-space distance d, then clamp.
 sg::vec3 applyFog(const sg::RenderSettings& s, const sg::vec3& color, float eyeDistance);
 
-float encodeSRGB(float linear);     // [0,1] -> [0,1]
+float encodeSRGB(float linear);   // [0,1] -> [0,1]
 float decodeSRGB(float encoded);
 uint8_t toByteSRGB(float linear);   // clamp, encode, round
 sg::vec3 srgbBytesToLinear(const uint8_t* rgb);
 
-}  // namespace rnd
+}   // namespace rnd

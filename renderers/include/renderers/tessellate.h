@@ -24,7 +24,7 @@ namespace rnd {
 
 struct Tessellation {
     std::shared_ptr<const sg::Mesh> mesh;
-    bool worldSpace = false;          // true for CSG
+    bool worldSpace = false;   // true for CSG
     // Per-triangle material index into `materials` (CSG faces take the material of the leaf
     // they lie on); empty = whole mesh uses the drawable's material.
     std::vector<uint16_t> triangleMaterial;
@@ -40,11 +40,15 @@ public:
     const Tessellation& get(const sg::DrawAnalytic& a, int resolution);
     void nextFrame(int maxAgeFrames = 8);
     size_t size() const;
+
 private:
-    struct Entry { Tessellation t; uint64_t lastUsed = 0; };
+    struct Entry {
+        Tessellation t;
+        uint64_t lastUsed = 0;
+    };
     mutable std::mutex m_mutex;
     std::unordered_map<uint64_t, Entry> m_entries;
     uint64_t m_frame = 0;
 };
 
-}  // namespace rnd
+}   // namespace rnd

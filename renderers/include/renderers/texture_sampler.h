@@ -57,4 +57,4 @@ private:
     uint64_t m_frame = 0;
 };
 
-}  // namespace rnd
+}   // namespace rnd

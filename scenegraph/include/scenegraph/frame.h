@@ -15,27 +15,27 @@ struct DrawMesh {
     uint64_t nodeUid = 0;
     MeshPtr mesh;
     Material material;
-    TexturePtr texture;          // diffuse texture or null
+    TexturePtr texture;   // diffuse texture or null
     mat4 world{1.0f};
-    mat3 normal{1.0f};           // inverse transpose of world's 3x3
-    bool mirrored = false;       // det(world) < 0: winding flips
+    mat3 normal{1.0f};       // inverse transpose of world's 3x3
+    bool mirrored = false;   // det(world) < 0: winding flips
 };
 
 struct DrawLight {
     LightType type = LightType::Point;
-    vec3 position{0.0f};         // world (point, spot)
-    vec3 direction{0, 0, -1};    // world, unit: direction light travels (directional, spot)
-    vec3 radiance{1.0f};         // colour * intensity
-    bool inverseSquare = false;  // 1/r^2 applies (already combined with settings.attenuation)
+    vec3 position{0.0f};                      // world (point, spot)
+    vec3 direction{0, 0, -1};                 // world, unit: direction light travels (directional, spot)
+    vec3 radiance{1.0f};                      // colour * intensity
+    bool inverseSquare = false;               // 1/r^2 applies (already combined with settings.attenuation)
     float cosInner = 1.0f, cosOuter = 1.0f;   // spot cone
 };
 
 // CSG tree flattened into an array; leaves are implicit shapes in world space.
 struct CsgTree {
     struct Node {
-        int op = -1;             // -1 = leaf, else int(CsgOp)
+        int op = -1;   // -1 = leaf, else int(CsgOp)
         std::vector<int> children;
-        ImplicitShape shape;     // leaf
+        ImplicitShape shape;   // leaf
         mat4 world{1.0f}, invWorld{1.0f};
         mat3 normal{1.0f};
         Material material;
@@ -68,11 +68,11 @@ struct FrameCamera {
     Projection projection;
     float aspect = 1.0f;
     float focusDistance = 5.0f;
-    mat4 view{1.0f};             // world -> eye
-    mat4 viewInverse{1.0f};      // eye -> world (the camera node's world matrix)
-    mat4 proj{1.0f};             // eye -> clip
+    mat4 view{1.0f};          // world -> eye
+    mat4 viewInverse{1.0f};   // eye -> world (the camera node's world matrix)
+    mat4 proj{1.0f};          // eye -> clip
     mat4 viewProj{1.0f};
-    vec3 eye{0.0f};              // world position
+    vec3 eye{0.0f};   // world position
 };
 
 struct FrameInput {
@@ -91,4 +91,4 @@ FrameInput flatten(const Scene& scene, float aspect, NodeId cameraNode = kNoNode
 // Camera matrices from a world-space camera frame (used by the viewer's orbit camera).
 FrameCamera makeFrameCamera(const mat4& cameraWorld, const Projection& p, float aspect, float focusDistance);
 
-}  // namespace sg
+}   // namespace sg

@@ -25,4 +25,4 @@ struct Light {
 std::string_view toString(LightType t);
 bool parse(std::string_view s, LightType& out);
 
-}  // namespace sg
+}   // namespace sg

@@ -12,7 +12,7 @@ namespace sg {
 
 struct Material {
     std::string name = "default";
-    vec3 baseColor{0.8f, 0.8f, 0.8f};  // rho, linear RGB
+    vec3 baseColor{0.8f, 0.8f, 0.8f};   // rho, linear RGB
     float ka = 0.2f;                    // ambient coefficient
     float kd = 0.8f;                    // diffuse coefficient
     float ks = 0.3f;                    // specular coefficient
@@ -22,11 +22,11 @@ struct Material {
     int diffuseTexture = -1;            // index into Scene::textures, -1 = none
     vec3 emissive{0.0f};
     float alpha = 1.0f;
-    bool unlit = false;                 // colour = base colour (times texture), no lighting
+    bool unlit = false;   // colour = base colour (times texture), no lighting
     bool doubleSided = true;
-    float reflectivity = 0.0f;          // mirror reflection weight (ray caster)
+    float reflectivity = 0.0f;   // mirror reflection weight (ray caster)
 
     bool operator==(const Material&) const = default;
 };
 
-}  // namespace sg
+}   // namespace sg

@@ -3,8 +3,8 @@
 #pragma once
 
 #include <glm/glm.hpp>
-#include <glm/gtc/quaternion.hpp>
 #include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -12,14 +12,14 @@
 
 namespace sg {
 
-using glm::vec2;
-using glm::vec3;
-using glm::vec4;
+using glm::ivec2;
+using glm::ivec3;
 using glm::mat3;
 using glm::mat4;
 using glm::quat;
-using glm::ivec2;
-using glm::ivec3;
+using glm::vec2;
+using glm::vec3;
+using glm::vec4;
 
 constexpr float kPi = 3.14159265358979323846f;
 inline float radians(float deg) { return deg * (kPi / 180.0f); }
@@ -31,8 +31,16 @@ struct Aabb {
     vec3 max{-std::numeric_limits<float>::infinity()};
 
     bool empty() const { return min.x > max.x || min.y > max.y || min.z > max.z; }
-    void extend(const vec3& p) { min = glm::min(min, p); max = glm::max(max, p); }
-    void extend(const Aabb& b) { if (!b.empty()) { extend(b.min); extend(b.max); } }
+    void extend(const vec3& p) {
+        min = glm::min(min, p);
+        max = glm::max(max, p);
+    }
+    void extend(const Aabb& b) {
+        if (!b.empty()) {
+            extend(b.min);
+            extend(b.max);
+        }
+    }
     vec3 center() const { return 0.5f * (min + max); }
     vec3 extent() const { return max - min; }
     // Bounds of this box after an affine transform (all 8 corners).
@@ -50,4 +58,4 @@ mat3 normalMatrix(const mat4& world);
 // True when the 3x3 part is invertible enough to be used as a transform.
 bool isInvertible(const mat4& m, float eps = 1e-12f);
 
-}  // namespace sg
+}   // namespace sg

@@ -22,11 +22,11 @@ struct Mesh {
     std::string name;
     PrimitiveMode mode = PrimitiveMode::Triangles;
     std::vector<vec3> positions;
-    std::vector<vec3> normals;      // empty or one per position
-    std::vector<vec2> uv0;          // empty or one per position
+    std::vector<vec3> normals;   // empty or one per position
+    std::vector<vec2> uv0;       // empty or one per position
     std::vector<vec2> uv1;
-    std::vector<vec4> colors;       // empty or one per position (linear RGBA)
-    std::vector<uint32_t> indices;  // 3 per triangle (2 per line, 1 per point)
+    std::vector<vec4> colors;        // empty or one per position (linear RGBA)
+    std::vector<uint32_t> indices;   // 3 per triangle (2 per line, 1 per point)
 
     size_t triangleCount() const { return mode == PrimitiveMode::Triangles ? indices.size() / 3 : 0; }
     Aabb bounds() const;
@@ -56,12 +56,12 @@ using TexturePtr = std::shared_ptr<const Texture>;
 
 // Small generated meshes used by the demo scene, tests and tessellation of implicit shapes.
 namespace primitives {
-Mesh box(const vec3& halfExtents);                                   // 24 vertices, flat faces, uvs
-Mesh plane(float halfSize, int subdivisions);                        // y = 0, normal +y, uvs
-Mesh uvSphere(float radius, int slices, int stacks);                 // smooth normals, uvs
-Mesh cylinder(float radius, float halfHeight, int slices, bool caps); // axis y
-Mesh cone(float radius, float halfHeight, int slices, bool cap);      // apex at +halfHeight
+Mesh box(const vec3& halfExtents);                                      // 24 vertices, flat faces, uvs
+Mesh plane(float halfSize, int subdivisions);                           // y = 0, normal +y, uvs
+Mesh uvSphere(float radius, int slices, int stacks);                    // smooth normals, uvs
+Mesh cylinder(float radius, float halfHeight, int slices, bool caps);   // axis y
+Mesh cone(float radius, float halfHeight, int slices, bool cap);        // apex at +halfHeight
 Mesh torus(float majorRadius, float minorRadius, int majorSegments, int minorSegments);
-}  // namespace primitives
+}   // namespace primitives
 
-}  // namespace sg
+}   // namespace sg

@@ -11,7 +11,7 @@ enum class ProjectionType { Perspective, Orthographic, Oblique };
 
 struct Projection {
     ProjectionType type = ProjectionType::Perspective;
-    float fovyDeg = 45.0f;       // perspective: total vertical angle of view
+    float fovyDeg = 45.0f;   // perspective: total vertical angle of view
     float zNear = 0.1f;
     float zFar = 100.0f;
     // Perspective: when true, the general frustum (l, r, b, t at zNear) is used instead of
@@ -30,11 +30,23 @@ struct Projection {
     // the distance of the oblique projection's fixed plane in front of the camera.
     mat4 matrix(float aspect, float focusDistance) const;
 
-    static Projection cavalier() { Projection p; p.type = ProjectionType::Oblique; p.obliqueFactor = 1.0f; p.obliqueAngleDeg = 45.0f; return p; }
-    static Projection cabinet() { Projection p; p.type = ProjectionType::Oblique; p.obliqueFactor = 0.5f; p.obliqueAngleDeg = 45.0f; return p; }
+    static Projection cavalier() {
+        Projection p;
+        p.type = ProjectionType::Oblique;
+        p.obliqueFactor = 1.0f;
+        p.obliqueAngleDeg = 45.0f;
+        return p;
+    }
+    static Projection cabinet() {
+        Projection p;
+        p.type = ProjectionType::Oblique;
+        p.obliqueFactor = 0.5f;
+        p.obliqueAngleDeg = 45.0f;
+        return p;
+    }
 };
 
 std::string_view toString(ProjectionType t);
 bool parse(std::string_view s, ProjectionType& out);
 
-}  // namespace sg
+}   // namespace sg

@@ -85,13 +85,10 @@ struct ParametricPayload {
 struct GridPayload {
     std::shared_ptr<DensityGrid> grid;
     int material = -1;
-    bool operator==(const GridPayload& o) const {
-        return material == o.material && (grid == o.grid || (grid && o.grid && *grid == *o.grid));
-    }
+    bool operator==(const GridPayload& o) const { return material == o.material && (grid == o.grid || (grid && o.grid && *grid == *o.grid)); }
 };
 
-using Payload = std::variant<std::monostate, MeshInstance, Camera, Light, ImplicitPayload, CsgPayload,
-                             ParametricPayload, GridPayload>;
+using Payload = std::variant<std::monostate, MeshInstance, Camera, Light, ImplicitPayload, CsgPayload, ParametricPayload, GridPayload>;
 std::string_view payloadKind(const Payload& p);   // "group", "mesh", "camera", ...
 
 struct Node {
@@ -118,7 +115,7 @@ public:
     std::vector<std::shared_ptr<Mesh>> meshes;
     std::vector<Material> materials;
     std::vector<std::shared_ptr<Texture>> textures;
-    vec3 ambientLight{1.0f};       // L_indirect of the seeds (scaled per material by ka)
+    vec3 ambientLight{1.0f};   // L_indirect of the seeds (scaled per material by ka)
     RenderSettings settings;
     NodeId activeCamera = kNoNode;
 
@@ -158,9 +155,9 @@ public:
     // --- world matrices ------------------------------------------------------------------
     // Recomputes world matrices of dirty subtrees. Returns the number recomputed.
     size_t updateWorld() const;
-    const mat4& world(NodeId id) const;     // updates first if needed
+    const mat4& world(NodeId id) const;   // updates first if needed
     mat3 normalMatrixOf(NodeId id) const { return normalMatrix(world(id)); }
-    bool effectiveVisible(NodeId id) const;  // hidden if any ancestor is hidden
+    bool effectiveVisible(NodeId id) const;   // hidden if any ancestor is hidden
 
     // --- queries -------------------------------------------------------------------------
     Aabb localBounds(NodeId id) const;   // payload bounds in the node's frame (empty if none)
@@ -184,14 +181,14 @@ private:
 
     // Hot arrays in depth-first pre-order ("slots"); mutable: rebuilt/updated lazily.
     mutable bool m_orderValid = false;
-    mutable std::vector<NodeId> m_order;          // slot -> id
-    mutable std::vector<uint32_t> m_slotOf;       // id -> slot
-    mutable std::vector<int32_t> m_parentSlot;    // slot -> parent slot (-1 for root)
-    mutable std::vector<uint32_t> m_subtreeSize;  // slot -> size of subtree incl. itself
-    mutable std::vector<mat4> m_localM;           // slot -> local matrix
-    mutable std::vector<mat4> m_worldM;           // slot -> world matrix
-    mutable std::vector<uint8_t> m_dirty;         // slot -> local changed since last update
-    mutable std::vector<uint32_t> m_dirtySlots;   // slots marked dirty (unsorted, may repeat)
+    mutable std::vector<NodeId> m_order;           // slot -> id
+    mutable std::vector<uint32_t> m_slotOf;        // id -> slot
+    mutable std::vector<int32_t> m_parentSlot;     // slot -> parent slot (-1 for root)
+    mutable std::vector<uint32_t> m_subtreeSize;   // slot -> size of subtree incl. itself
+    mutable std::vector<mat4> m_localM;            // slot -> local matrix
+    mutable std::vector<mat4> m_worldM;            // slot -> world matrix
+    mutable std::vector<uint8_t> m_dirty;          // slot -> local changed since last update
+    mutable std::vector<uint32_t> m_dirtySlots;    // slots marked dirty (unsorted, may repeat)
     mutable bool m_allDirty = true;
     mutable size_t m_lastUpdated = 0;
     friend size_t updateWorldImpl(const Scene&);
@@ -201,4 +198,4 @@ private:
 // payloads, materials, mesh data, textures, settings. Node ids may differ.
 std::string sceneDifference(const Scene& a, const Scene& b);
 
-}  // namespace sg
+}   // namespace sg

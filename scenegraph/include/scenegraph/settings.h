@@ -26,7 +26,7 @@ struct RenderSettings {
     float fogEnd = 30.0f;
     float fogDensity = 0.05f;
 
-    bool attenuation = true;       // honour Light::inverseSquare
+    bool attenuation = true;   // honour Light::inverseSquare
 
     // Anti-aliasing. MSAA: aaRate samples per pixel (2, 4, 8). SSAA: aaRate x aaRate samples
     // per pixel (2 -> 4 spp, 4 -> 16 spp); the ray caster uses aaRate x aaRate jittered rays.
@@ -66,4 +66,4 @@ bool parse(std::string_view s, FogMode& out);
 // Fog visibility f(d) in [0,1] (1 = no fog) as described above.
 float fogVisibility(const RenderSettings& s, float distance);
 
-}  // namespace sg
+}   // namespace sg

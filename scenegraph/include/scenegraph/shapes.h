@@ -17,15 +17,15 @@ enum class ImplicitType { Plane, Sphere, Box, Cylinder, Cone, Torus, Quadric };
 
 struct ImplicitShape {
     ImplicitType type = ImplicitType::Sphere;
-    float radius = 1.0f;              // sphere, cylinder, cone (base radius)
-    vec3 halfExtents{0.5f};           // box
-    float halfHeight = 0.5f;          // cylinder, cone: extent along local y (capped solids)
-    float majorRadius = 1.0f;         // torus: ring radius (around local y)
-    float minorRadius = 0.25f;        // torus: tube radius
-    float planeHalfSize = 10.0f;      // plane y = 0: infinite for rays; rasterizers draw this square
+    float radius = 1.0f;           // sphere, cylinder, cone (base radius)
+    vec3 halfExtents{0.5f};        // box
+    float halfHeight = 0.5f;       // cylinder, cone: extent along local y (capped solids)
+    float majorRadius = 1.0f;      // torus: ring radius (around local y)
+    float minorRadius = 0.25f;     // torus: tube radius
+    float planeHalfSize = 10.0f;   // plane y = 0: infinite for rays; rasterizers draw this square
     // General quadric x^T Q x = 0 with x = (x, y, z, 1); inside where x^T Q x < 0.
     mat4 quadric{1.0f, 0, 0, 0, 0, 1.0f, 0, 0, 0, 0, 1.0f, 0, 0, 0, 0, -1.0f};
-    Aabb quadricBounds{vec3(-1.0f), vec3(1.0f)};  // quadrics are clipped to this box
+    Aabb quadricBounds{vec3(-1.0f), vec3(1.0f)};   // quadrics are clipped to this box
 
     bool operator==(const ImplicitShape&) const = default;
 
@@ -48,8 +48,8 @@ struct CsgNode {
 enum class ParametricType { Torus, BezierPatch };
 struct ParametricSurface {
     ParametricType type = ParametricType::BezierPatch;
-    float majorRadius = 1.0f, minorRadius = 0.3f;    // torus
-    std::array<vec3, 16> control{};                   // bicubic Bezier, row-major [v][u]
+    float majorRadius = 1.0f, minorRadius = 0.3f;   // torus
+    std::array<vec3, 16> control{};                 // bicubic Bezier, row-major [v][u]
 
     bool operator==(const ParametricSurface&) const = default;
 
@@ -58,7 +58,7 @@ struct ParametricSurface {
     void partials(float u, float v, vec3& dPdu, vec3& dPdv) const;
     vec3 normal(float u, float v) const;
     Aabb localBounds() const;
-    static ParametricSurface defaultPatch();  // a gentle hill over [-1,1]^2
+    static ParametricSurface defaultPatch();   // a gentle hill over [-1,1]^2
 };
 
 // Scalar density on a regular grid filling `bounds`; the surface is value == isoValue and
@@ -86,4 +86,4 @@ bool parse(std::string_view s, CsgOp& out);
 std::string_view toString(ParametricType t);
 bool parse(std::string_view s, ParametricType& out);
 
-}  // namespace sg
+}   // namespace sg

@@ -8,11 +8,11 @@
 namespace sg {
 
 mat4 translation(const vec3& t);
-mat4 rotationX(float phi);             // radians, positive = anticlockwise looking down -x
+mat4 rotationX(float phi);   // radians, positive = anticlockwise looking down -x
 mat4 rotationY(float phi);
 mat4 rotationZ(float phi);
 mat4 scaling(const vec3& s);
-mat4 mirrorX();                        // P_x: x -> -x
+mat4 mirrorX();   // P_x: x -> -x
 mat4 mirrorY();
 mat4 mirrorZ();
 // Shear H_ab(s): component a is offset by s times component b (a != b, 0=x,1=y,2=z).
@@ -31,8 +31,7 @@ mat4 orthographic(float l, float r, float b, float t, float zNear, float zFar);
 // receding along -z by depth d is drawn at `angle` (radians, from the screen x axis)
 // with length factor*d. factor 1 = cavalier, 0.5 = cabinet. zRef is the view-space z of the
 // plane that stays in place (the focus plane), so framing does not shift with depth.
-mat4 oblique(float l, float r, float b, float t, float zNear, float zFar, float angle, float factor,
-             float zRef);
+mat4 oblique(float l, float r, float b, float t, float zNear, float zFar, float angle, float factor, float zRef);
 // Shear part of the oblique projection alone (view space -> sheared view space).
 mat4 obliqueShear(float angle, float factor, float zRef);
 
@@ -40,4 +39,4 @@ mat4 obliqueShear(float angle, float factor, float zRef);
 // (y up, origin lower left, as in GL), z in [0,1].
 mat4 viewport(float x0, float y0, float w, float h);
 
-}  // namespace sg
+}   // namespace sg

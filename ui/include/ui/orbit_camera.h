@@ -49,4 +49,4 @@ public:
     void setFromWorld(const sg::mat4& cameraWorld, float focus);
 };
 
-}  // namespace ui
+}   // namespace ui

@@ -22,17 +22,17 @@ namespace keys {
 constexpr int Space = 32, Num1 = 49, Num2 = 50, Num3 = 51;
 constexpr int A = 65, D = 68, E = 69, F = 70, N = 78, O = 79, Q = 81, S = 83, W = 87;
 constexpr int Delete = 261, Home = 268, F2 = 291, F12 = 301;
-}  // namespace keys
+}   // namespace keys
 
 // One backend's picture for the viewport.
 struct SlotView {
-    void* texture = nullptr;      // ImTextureID (GL texture name), null when no image yet
-    int width = 0, height = 0;    // of the texture
+    void* texture = nullptr;     // ImTextureID (GL texture name), null when no image yet
+    int width = 0, height = 0;   // of the texture
     SlotStatus status;
 };
 struct ViewportInput {
-    std::vector<SlotView> slots;  // single view: slot 0; split: count slots; difference: A, B
-    SlotView diff;                // the difference heat-map (difference view)
+    std::vector<SlotView> slots;   // single view: slot 0; split: count slots; difference: A, B
+    SlotView diff;                 // the difference heat-map (difference view)
 };
 
 // UI scale (HiDPI): call once after creating the context, before building fonts.
@@ -57,4 +57,4 @@ void handleShortcuts(ViewerState& st);
 // Backends shown by the current view mode (the slots the window must render).
 std::vector<std::string> visibleBackends(const ViewerState& st);
 
-}  // namespace ui
+}   // namespace ui

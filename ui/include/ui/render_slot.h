@@ -22,11 +22,11 @@ namespace ui {
 
 struct SlotStatus {
     std::string backend;
-    bool rendering = false;       // a render is in flight
-    float progress = 0.0f;        // of the render in flight, 0..1
-    int level = 1;                // resolution divisor of the image shown (1 = full)
-    rnd::RenderStats stats;       // of the image shown (or the last failure)
-    std::string error;            // last render's error ("" when it worked)
+    bool rendering = false;   // a render is in flight
+    float progress = 0.0f;    // of the render in flight, 0..1
+    int level = 1;            // resolution divisor of the image shown (1 = full)
+    rnd::RenderStats stats;   // of the image shown (or the last failure)
+    std::string error;        // last render's error ("" when it worked)
 };
 
 class RenderSlot {
@@ -85,12 +85,12 @@ private:
     bool m_quit = false;
     rnd::RenderControl* m_control = nullptr;   // of the render in flight (guarded by m_mutex)
     bool m_haveNew = false;
-    rnd::Framebuffer m_finished;               // published by the worker
+    rnd::Framebuffer m_finished;   // published by the worker
     SlotStatus m_status;
     std::thread m_thread;
 
-    rnd::Framebuffer m_shown;                  // UI thread
+    rnd::Framebuffer m_shown;   // UI thread
     uint64_t m_serial = 0;
 };
 
-}  // namespace ui
+}   // namespace ui

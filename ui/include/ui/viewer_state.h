@@ -32,20 +32,20 @@ enum class ViewMode { Single, Split, Difference };
 
 struct CompareConfig {
     ViewMode mode = ViewMode::Single;
-    int count = 2;                                      // backends in the split view (2 or 3)
+    int count = 2;   // backends in the split view (2 or 3)
     std::array<std::string, 3> backends{"gl", "raster", "raycast"};
-    std::array<float, 2> dividers{0.5f, 0.75f};         // wipe positions, fractions of the width
-    int diffA = 0, diffB = 1;                           // slots compared in the difference view
-    int threshold = 8;                                  // diffImage highlight threshold (0..255)
+    std::array<float, 2> dividers{0.5f, 0.75f};   // wipe positions, fractions of the width
+    int diffA = 0, diffB = 1;                     // slots compared in the difference view
+    int threshold = 8;                            // diffImage highlight threshold (0..255)
 };
 
 // Work for the window: set by panels and shortcuts, consumed by viewer.cpp.
 struct Requests {
-    bool screenshot = false;          // F12: screenshot(s) of the current view
+    bool screenshot = false;                         // F12: screenshot(s) of the current view
     int screenshotWidth = 0, screenshotHeight = 0;   // 0 = viewport size
-    bool quit = false;                // confirmed quit
-    bool openDialog = false;          // show the file browser (open)
-    bool saveAsDialog = false;        // show the file browser (save as)
+    bool quit = false;                               // confirmed quit
+    bool openDialog = false;                         // show the file browser (open)
+    bool saveAsDialog = false;                       // show the file browser (save as)
     bool screenshotDialog = false;
 };
 
@@ -55,7 +55,11 @@ enum class ConfirmChoice { Save, Discard, Cancel };
 
 // Item rectangles recorded by the panels (name -> min/max in screen pixels), so tests can
 // click real ImGui widgets by position.
-struct ItemRect { float x0 = 0, y0 = 0, x1 = 0, y1 = 0; float cx() const { return 0.5f * (x0 + x1); } float cy() const { return 0.5f * (y0 + y1); } };
+struct ItemRect {
+    float x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+    float cx() const { return 0.5f * (x0 + x1); }
+    float cy() const { return 0.5f * (y0 + y1); }
+};
 
 // Shared between the UI thread and one asynchronous load (the task holds a shared_ptr, so
 // the flags live as long as either side needs them): the UI sets `cancel`, the importer polls
@@ -68,31 +72,31 @@ struct LoadControl {
 struct ViewerState {
     // --- scene and file ----------------------------------------------------------------
     sg::Scene scene;
-    std::filesystem::path scenePath;     // empty for the demo / a new scene
-    bool dirty = false;                  // unsaved edits
-    uint64_t sceneVersion = 1;           // bumped on every scene edit (re-render)
-    uint64_t viewVersion = 1;            // bumped on camera moves (re-render)
+    std::filesystem::path scenePath;   // empty for the demo / a new scene
+    bool dirty = false;                // unsaved edits
+    uint64_t sceneVersion = 1;         // bumped on every scene edit (re-render)
+    uint64_t viewVersion = 1;          // bumped on camera moves (re-render)
     std::vector<std::string> loadWarnings;
 
     // --- selection and view ------------------------------------------------------------
     sg::NodeId selected = sg::kNoNode;
-    std::string backend = "gl";          // the single view's backend
+    std::string backend = "gl";   // the single view's backend
     CompareConfig compare;
     OrbitCamera camera;
     sg::Projection fallbackProjection;   // used when the scene has no camera
     float fallbackFocus = 5.0f;
     int viewportWidth = 1, viewportHeight = 1;   // pixels, set by the viewport panel
-    double lastInteraction = -1e9;       // time (s) of the last camera drag/zoom/fly
+    double lastInteraction = -1e9;               // time (s) of the last camera drag/zoom/fly
     bool flyMode = false;
 
     // --- messages ----------------------------------------------------------------------
-    std::string status;                  // one line shown in the status bar
-    std::string errorPopup;              // shown in a modal until dismissed (e.g. load failure)
+    std::string status;       // one line shown in the status bar
+    std::string errorPopup;   // shown in a modal until dismissed (e.g. load failure)
 
     // --- unsaved-changes guard -------------------------------------------------------------
     PendingAction pending = PendingAction::None;
     std::filesystem::path pendingPath;
-    bool confirmOpen = false;            // the modal should be shown
+    bool confirmOpen = false;   // the modal should be shown
 
     // --- async load --------------------------------------------------------------------
     std::future<assets::LoadResult> loading;
@@ -103,10 +107,10 @@ struct ViewerState {
     // Playing changes node locals and re-renders (sceneVersion) but is not an edit: the dirty
     // flag is untouched. Clips come with a load and are dropped by setScene (new scene, demo).
     std::vector<assets::AnimationClip> animations;
-    int animationClip = 0;               // index into animations
-    double animationTime = 0.0;          // seconds, within [clip.start, clip end]
+    int animationClip = 0;        // index into animations
+    double animationTime = 0.0;   // seconds, within [clip.start, clip end]
     bool animationPlaying = false;
-    bool animationLoop = true;           // wrap at the end (else stop there)
+    bool animationLoop = true;   // wrap at the end (else stop there)
 
     // Per-backend anti-aliasing overrides for this session (backend -> "msaa4", ...); the
     // scene's own setting (saved) applies to backends without one.
@@ -131,8 +135,8 @@ struct ViewerState {
     // --- actions -----------------------------------------------------------------------
     // Replaces the scene (after a load): resets selection, dirty flag and camera.
     void setScene(sg::Scene s, std::filesystem::path path);
-    void markEdited();       // scene or settings changed: dirty + re-render
-    void markViewChanged();  // camera moved: re-render only
+    void markEdited();        // scene or settings changed: dirty + re-render
+    void markViewChanged();   // camera moved: re-render only
 
     void selectNode(sg::NodeId id);
     bool renameNode(sg::NodeId id, const std::string& name);
@@ -157,10 +161,10 @@ struct ViewerState {
     const sg::Projection& projection() const;   // the active scene camera's, or the fallback
     sg::Projection& editProjection();           // marks edited when it is the scene's
     float focusDistance() const;
-    void fitView(bool selectionOnly);           // F
-    void resetView();                           // Home: back to the active scene camera
-    void useSceneCamera(sg::NodeId cameraNode); // make active and look through it
-    void storeViewInCamera();                   // writes the orbit view into the active camera
+    void fitView(bool selectionOnly);             // F
+    void resetView();                             // Home: back to the active scene camera
+    void useSceneCamera(sg::NodeId cameraNode);   // make active and look through it
+    void storeViewInCamera();                     // writes the orbit view into the active camera
     sg::mat4 cameraWorld() const { return camera.world(); }
     // The effective projection of the view (ortho zoom applied).
     sg::Projection viewProjection() const;
@@ -197,11 +201,11 @@ struct ViewerState {
 
     // Animation playback. The clip's time range is [start, end] with end = its latest key.
     const assets::AnimationClip* currentAnimation() const;
-    double animationEnd() const;                 // latest key time of the current clip
-    void selectAnimation(int index);             // stops, rewinds to the clip start, applies
-    void setAnimationPlaying(bool play);         // play at the end of a non-looping clip rewinds
+    double animationEnd() const;           // latest key time of the current clip
+    void selectAnimation(int index);       // stops, rewinds to the clip start, applies
+    void setAnimationPlaying(bool play);   // play at the end of a non-looping clip rewinds
     void toggleAnimation() { setAnimationPlaying(!animationPlaying); }
-    void setAnimationTime(double t);             // scrub: clamps to the clip range and applies
+    void setAnimationTime(double t);   // scrub: clamps to the clip range and applies
     // Called every frame: when playing, advances by dt (wrapping when looping, else stopping at
     // the end) and applies the clip.
     void advanceAnimation(double dt);
@@ -212,7 +216,6 @@ std::filesystem::path defaultConfigDir();
 std::vector<std::string> loadRecentFiles(const std::filesystem::path& configDir);
 std::string saveRecentFiles(const std::filesystem::path& configDir, const std::vector<std::string>& files);
 // dir/"<stem>-<backend>.png" or, when taken, the first free "-N" variant (assets::uniquePath).
-std::filesystem::path screenshotPath(const std::filesystem::path& dir, const std::string& backend,
-                                     const std::string& stem = "screenshot");
+std::filesystem::path screenshotPath(const std::filesystem::path& dir, const std::string& backend, const std::string& stem = "screenshot");
 
-}  // namespace ui
+}   // namespace ui
