@@ -19,6 +19,7 @@
 #include "gl/gl_renderer.h"
 
 #include "gl/gl_context.h"
+#include "renderers/draw_list.h"
 #include "renderers/tessellate.h"
 
 #include <glad/gl.h>
@@ -73,6 +74,33 @@ std::string compileShader(GLenum type, const std::string& src, GLuint& out) {
     return std::string(type == GL_VERTEX_SHADER ? "vertex" : "fragment") + " shader: " + msg;
 }
 
+}   // namespace
+
+// Every settings enum value the shaders see, as a named constant with the C++ enum's own value
+// (SHADING_PHONG, FOG_EXP2, LIGHT_SPOT, ...): the shaders compare against these names only, so
+// reordering an enum cannot silently change what GLSL does, and a test checks that the shaders
+// handle every name. Names come from sg::toString (which -Wswitch keeps complete).
+std::string glslEnumDefines() {
+    std::string d;
+    auto upper = [](std::string_view v) {
+        std::string u(v);
+        for (char& c : u) c = (c >= 'a' && c <= 'z') ? char(c - 'a' + 'A') : (c == '-' ? '_' : c);
+        return u;
+    };
+    auto add = [&](const char* prefix, std::string_view name, int value) {
+        d += std::string("#define ") + prefix + upper(name) + " " + std::to_string(value) + "\n";
+    };
+    for (int v = 0; toString(sg::ShadingModel(v)) != "?"; ++v) add("SHADING_", toString(sg::ShadingModel(v)), v);
+    for (int v = 0; v <= int(sg::ReflectionModel::BlinnPhong); ++v) add("REFLECTION_", toString(sg::ReflectionModel(v)), v);
+    for (int v = 0; toString(sg::FogMode(v)) != "?"; ++v) add("FOG_", toString(sg::FogMode(v)), v);
+    for (int v = 0; toString(sg::LightType(v)) != "?"; ++v) add("LIGHT_", toString(sg::LightType(v)), v);
+    return d;
+}
+
+std::string glslSources() { return std::string(gl::kShader_lighting_glsl) + "\n" + gl::kShader_mesh_vert + "\n" + gl::kShader_mesh_frag; }
+
+namespace {
+
 // Programs are specialised per frame setup (see lighting.glsl): the key is the shading model,
 // the reflection model and one letter per light (p/P point, d directional, s/S spot; upper
 // case = inverse square), or '*' for the generic loop when there are many lights (a 30-light
@@ -102,8 +130,8 @@ std::string buildProgram(const std::string& key, Program& p) {
         bool invSq = key[i] >= 'A' && key[i] <= 'Z';
         calls += "addLight(" + std::to_string(i - 2) + ", " + type + ", " + (invSq ? "true" : "false") + ", n, p, v, mul, add); ";
     }
-    std::string prefix = std::string("#version 330 core\n#define SHADING ") + key[0] + "\n#define REFLECTION " + key[1] + "\n#define MAX_LIGHTS " +
-                         std::to_string(kMaxLights) + "\n#define LIGHT_CALLS " + calls + "\n";
+    std::string prefix = "#version 330 core\n" + glslEnumDefines() + "#define SHADING " + key[0] + "\n#define REFLECTION " + key[1] +
+                         "\n#define MAX_LIGHTS " + std::to_string(kMaxLights) + "\n#define LIGHT_CALLS " + calls + "\n";
     std::string common = prefix + gl::kShader_lighting_glsl + "\n";
     GLuint vs = 0, fs = 0;
     std::string err = compileShader(GL_VERTEX_SHADER, common + gl::kShader_mesh_vert, vs);
@@ -443,15 +471,23 @@ public:
 
     Capabilities capabilities() const override {
         Capabilities c;
-        c.msaa = true;
-        c.ssaa = true;
-        c.maxMsaaSamples = m_maxSamples > 0 ? m_maxSamples : 8;
-        c.needsGLContext = false;   // makes its own when none is current
+        c.affinity = ContextAffinity::CurrentGLContext;
+        c.wireframe = true;
+        c.pointsAndLines = true;
+        // MSAA sample counts: those of 2/4/8 the driver allows once a context was made (before
+        // that, all three; doRender reports a late reduction).
+        for (int n : {2, 4, 8})
+            if (m_maxSamples == 0 || n <= m_maxSamples) c.msaaSamples.push_back(n);
+        c.ssaaFactors = {2, 3, 4};
+        c.ssaaRendersLarger = true;
+        c.maxImageSize = m_maxSize > 0 ? m_maxSize : 16384;
         return c;
     }
 
-    RenderStats render(const FrameInput& frame, int width, int height, Framebuffer& target, RenderControl* control) override;
+protected:
+    RenderStats doRender(const FrameInput& frame, const RenderConfig& cfg, Framebuffer& target, RenderControl* control) override;
 
+public:
     GlCacheCounters counters() const {
         GlCacheCounters c;
         c.meshUploads = m_meshUploads;
@@ -471,6 +507,9 @@ private:
     GpuMesh* meshFor(const Mesh& mesh, const std::vector<uint16_t>* triangleMaterial);
     GpuTexture* textureFor(const TexturePtr& t);
     void setFrameUniforms(const Program& p, const FrameInput& f, int ssaa);
+    std::vector<DrawItem> collectDraws(const FrameInput& frame, int tessellation);   // uploads what is new
+    uint64_t drawAll(const Program& prog, const std::vector<DrawItem>& items, bool wireframe);
+    void readBack(GLuint fbo, int w, int h, Framebuffer& out);
     void setMaterial(const Program& p, const Material& m, bool hasTexture, bool unlit);
     void evict();
 
@@ -525,10 +564,7 @@ const Program* GlRenderer::programFor(const FrameInput& f, std::string& error) {
     if (it != m_programs.end()) return &it->second;
     Program p;
     error = buildProgram(key, p);
-    if (!error.empty()) {
-        error = "gl backend: " + error;
-        return nullptr;
-    }
+    if (!error.empty()) { return nullptr; }
     // Light setups come and go while editing: keep a bounded number of programs.
     if (m_programs.size() >= 64) {
         for (auto& [k, old] : m_programs) glDeleteProgram(old.id);
@@ -623,7 +659,7 @@ void GlRenderer::setFrameUniforms(const Program& p, const FrameInput& f, int ssa
     std::vector<vec4> pos(n), dir(n), rad(n), cone(n);
     for (int i = 0; i < n; ++i) {
         const DrawLight& l = f.lights[i];   // type and 1/r^2: compiled in, or read by the loop
-        float type = l.type == LightType::Point ? 0.0f : l.type == LightType::Directional ? 1.0f : 2.0f;
+        float type = float(int(l.type));    // LIGHT_POINT ... (glslEnumDefines)
         pos[i] = vec4(l.position, type);
         dir[i] = vec4(l.direction, l.inverseSquare ? 1.0f : 0.0f);
         rad[i] = vec4(l.radiance, 0.0f);
@@ -651,62 +687,83 @@ void GlRenderer::setMaterial(const Program& p, const Material& m, bool hasTextur
     glUniform1i(p.unlit, (unlit || m.unlit) ? 1 : 0);
 }
 
-RenderStats GlRenderer::render(const FrameInput& frame, int width, int height, Framebuffer& target, RenderControl* control) {
-    auto t0 = std::chrono::steady_clock::now();
-    RenderStats stats;
-    target.resize(width, height);
-    if (width <= 0 || height <= 0) {
-        stats.error = "gl backend: image size " + std::to_string(width) + "x" + std::to_string(height) + " is empty";
-        return stats;
+// Draws for the frame from the shared draw list (renderers/draw_list.h), nearest first so
+// that llvmpipe's early depth test skips shading hidden fragments. Uploads happen here, only
+// for new or edited meshes and textures.
+std::vector<DrawItem> GlRenderer::collectDraws(const FrameInput& frame, int tessellation) {
+    std::vector<DrawItem> items;
+    for (const PreparedDraw& p : prepareDraws(frame, tessellation, m_tess)) {
+        DrawItem it;
+        it.gpu = meshFor(*p.mesh, p.triangleMaterial);
+        if (!it.gpu) continue;
+        it.world = p.world;
+        it.normal = p.normal;
+        it.mirrored = p.mirrored;
+        it.material = p.material;
+        it.rangeMaterials = p.materials;
+        it.texture = textureFor(p.texture);
+        items.push_back(it);
     }
-    if (control && control->cancel) {
-        stats.cancelled = true;
-        stats.error = "cancelled";
-        return stats;
-    }
+    std::vector<float> distance(items.size());
+    for (size_t i = 0; i < items.size(); ++i) distance[i] = glm::length(vec3(*items[i].world * vec4(items[i].gpu->centre, 1.0f)) - frame.camera.eye);
+    std::vector<uint32_t> order(items.size());
+    std::iota(order.begin(), order.end(), 0u);
+    std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return distance[a] < distance[b]; });
+    std::vector<DrawItem> sorted(items.size());
+    for (size_t i = 0; i < order.size(); ++i) sorted[i] = items[order[i]];
+    return sorted;
+}
 
-    bool madeCurrent = false;
-    std::string err = prepareContext(madeCurrent);
-    if (!err.empty()) {
-        stats.error = "gl backend: " + err;
-        if (madeCurrent) m_own->release();
-        return stats;
-    }
-    struct ReleaseOnExit {
-        gl::GlContext* ctx;
-        ~ReleaseOnExit() {
-            if (ctx) ctx->release();
+// Draws every item (wireframe: the triangle meshes again as lines, no material changes).
+// Returns the triangles submitted.
+uint64_t GlRenderer::drawAll(const Program& prog, const std::vector<DrawItem>& items, bool wireframe) {
+    uint64_t triangles = 0;
+    for (const DrawItem& it : items) {
+        if (wireframe && it.gpu->primitive != GL_TRIANGLES) continue;
+        glUniformMatrix4fv(prog.model, 1, GL_FALSE, &(*it.world)[0][0]);
+        glUniformMatrix3fv(prog.normalMatrix, 1, GL_FALSE, &it.normal[0][0]);
+        glFrontFace(it.mirrored ? GL_CW : GL_CCW);
+        if (!wireframe) {
+            glBindTexture(GL_TEXTURE_2D, it.texture ? it.texture->id : 0);
+            triangles += it.gpu->triangles;
         }
-    } releaseOnExit{madeCurrent ? m_own.get() : nullptr};
-
-    StateGuard guard;
-    ++m_frame;
-    const Program* program = programFor(frame, err);
-    if (!program) {
-        stats.error = err;
-        return stats;
+        glBindVertexArray(it.gpu->vao);
+        bool unlit = it.gpu->primitive != GL_TRIANGLES;
+        for (const IndexRange& r : it.gpu->ranges) {
+            if (!wireframe) {
+                const Material* m = it.material;
+                if (it.rangeMaterials && r.material >= 0 && size_t(r.material) < it.rangeMaterials->size()) m = &(*it.rangeMaterials)[r.material];
+                setMaterial(prog, *m, it.texture != nullptr, unlit);
+            }
+            glDrawElements(it.gpu->primitive, r.count, GL_UNSIGNED_INT, reinterpret_cast<const void*>(size_t(r.first) * sizeof(uint32_t)));
+        }
     }
+    return triangles;
+}
 
-    // Anti-aliasing: MSAA clamps to what the driver allows; SSAA renders aaRate x larger.
-    const RenderSettings& s = frame.settings;
-    int samples = s.aa == AAMode::MSAA ? std::clamp(s.aaRate, 1, std::max(m_maxSamples, 1)) : 1;
-    int ssaa = s.aa == AAMode::SSAA ? std::clamp(s.aaRate, 1, 8) : 1;
-    int rw = width * ssaa, rh = height * ssaa;
-    if (rw > m_maxSize || rh > m_maxSize) {
-        stats.error = "gl backend: render size " + std::to_string(rw) + "x" + std::to_string(rh) + " exceeds the driver's limit of " +
-                      std::to_string(m_maxSize);
-        return stats;
+// Reads colour and depth of `fbo` into `out` (GL rows are bottom-up, Framebuffer rows top-down).
+void GlRenderer::readBack(GLuint fbo, int w, int h, Framebuffer& out) {
+    out.resize(w, h);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    std::vector<uint8_t> rgba(size_t(w) * h * 4);
+    std::vector<float> depth(size_t(w) * h);
+    glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+    glReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, depth.data());
+    size_t rowBytes = size_t(w) * 4;
+    for (int y = 0; y < h; ++y) {
+        int src = h - 1 - y;
+        std::memcpy(&out.color[size_t(y) * rowBytes], &rgba[size_t(src) * rowBytes], rowBytes);
+        std::memcpy(&out.depth[size_t(y) * w], &depth[size_t(src) * w], size_t(w) * sizeof(float));
     }
-    err = m_target.ensure(rw, rh, samples > 1 ? samples : 0);
-    if (err.empty() && samples > 1) err = m_resolve.ensure(rw, rh, 0);
-    if (!err.empty()) {
-        stats.error = "gl backend: " + err;
-        return stats;
-    }
+    for (size_t i = 3; i < out.color.size(); i += 4) out.color[i] = 255;
+}
 
-    // Clear: the background is linear; the sRGB framebuffer encodes it.
-    glBindFramebuffer(GL_FRAMEBUFFER, m_target.fbo);
-    glViewport(0, 0, rw, rh);
+// Sets the fixed-function state of a frame and clears the target (background is linear; the
+// sRGB framebuffer encodes it).
+void beginFrameState(const RenderSettings& s, GLuint fbo, int w, int h, int samples) {
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    glViewport(0, 0, w, h);
     glDisable(GL_SCISSOR_TEST);
     glDisable(GL_BLEND);
     glDisable(GL_STENCIL_TEST);
@@ -731,76 +788,61 @@ RenderStats GlRenderer::render(const FrameInput& frame, int width, int height, F
         glDisable(GL_CULL_FACE);
     }
     glActiveTexture(GL_TEXTURE0);
+}
 
-    // Collect the draws (uploads happen here, only for new or edited meshes and textures).
-    std::vector<DrawItem> items;
-    items.reserve(frame.meshes.size() + frame.analytics.size());
-    for (const DrawMesh& d : frame.meshes) {
-        if (!d.mesh) continue;
-        DrawItem it;
-        it.gpu = meshFor(*d.mesh, nullptr);
-        if (!it.gpu) continue;
-        it.world = &d.world;
-        it.normal = d.normal;
-        it.mirrored = d.mirrored;
-        it.material = &d.material;
-        it.texture = textureFor(d.texture);
-        items.push_back(it);
+RenderStats GlRenderer::doRender(const FrameInput& frame, const RenderConfig& cfg, Framebuffer& target, RenderControl* control) {
+    (void)control;   // one GL frame: not progressive; render() checked cancellation before
+    RenderStats stats;
+    bool madeCurrent = false;
+    std::string err = prepareContext(madeCurrent);
+    if (!err.empty()) {
+        stats.error = err;
+        if (madeCurrent) m_own->release();
+        return stats;
     }
-    static const mat4 kIdentity(1.0f);
-    for (const DrawAnalytic& a : frame.analytics) {
-        const Tessellation& t = m_tess.get(a, s.tessellation);
-        if (!t.mesh || t.mesh->positions.empty()) continue;
-        bool perTriangle = !t.triangleMaterial.empty() && !t.materials.empty();
-        DrawItem it;
-        it.gpu = meshFor(*t.mesh, perTriangle ? &t.triangleMaterial : nullptr);
-        if (!it.gpu) continue;
-        it.world = t.worldSpace ? &kIdentity : &a.world;
-        it.normal = t.worldSpace ? mat3(1.0f) : a.normal;
-        it.mirrored = !t.worldSpace && glm::determinant(mat3(a.world)) < 0.0f;
-        it.material = &a.material;
-        it.rangeMaterials = perTriangle ? &t.materials : nullptr;
-        it.texture = perTriangle ? nullptr : textureFor(a.texture);
-        items.push_back(it);
+    struct ReleaseOnExit {
+        gl::GlContext* ctx;
+        ~ReleaseOnExit() {
+            if (ctx) ctx->release();
+        }
+    } releaseOnExit{madeCurrent ? m_own.get() : nullptr};
+
+    StateGuard guard;
+    ++m_frame;
+    const Program* program = programFor(frame, err);
+    if (!program) {
+        stats.error = err;
+        return stats;
     }
 
-    // Nearest first, so that llvmpipe's early depth test skips shading hidden fragments.
-    std::vector<float> distance(items.size());
-    for (size_t i = 0; i < items.size(); ++i) distance[i] = glm::length(vec3(*items[i].world * vec4(items[i].gpu->centre, 1.0f)) - frame.camera.eye);
-    std::vector<uint32_t> order(items.size());
-    std::iota(order.begin(), order.end(), 0u);
-    std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return distance[a] < distance[b]; });
-    std::vector<DrawItem> sorted(items.size());
-    for (size_t i = 0; i < order.size(); ++i) sorted[i] = items[order[i]];
-    items.swap(sorted);
+    // Anti-aliasing as resolved (render_config.h); the driver's limits are known only now.
+    const RenderSettings& s = frame.settings;
+    int samples = cfg.msaaSamples;
+    if (samples > 1 && samples > m_maxSamples) {
+        int used = std::max(m_maxSamples, 1);
+        stats.config.notes.push_back("msaa" + std::to_string(samples) + " -> " + (used > 1 ? "msaa" + std::to_string(used) : std::string("none")) +
+                                     ": the driver allows " + std::to_string(m_maxSamples) + " samples");
+        samples = used;
+    }
+    const int ssaa = cfg.ssaaFactor;
+    const int rw = cfg.width * ssaa, rh = cfg.height * ssaa;
+    if (rw > m_maxSize || rh > m_maxSize) {
+        stats.error = "render size " + std::to_string(rw) + "x" + std::to_string(rh) + " exceeds the driver's limit of " + std::to_string(m_maxSize);
+        return stats;
+    }
+    err = m_target.ensure(rw, rh, samples > 1 ? samples : 0);
+    if (err.empty() && samples > 1) err = m_resolve.ensure(rw, rh, 0);
+    if (!err.empty()) {
+        stats.error = err;
+        return stats;
+    }
 
+    beginFrameState(s, m_target.fbo, rw, rh, samples);
+    const std::vector<DrawItem> items = collectDraws(frame, cfg.tessellation);
     const Program& prog = *program;
     glUseProgram(prog.id);
     setFrameUniforms(prog, frame, ssaa);
-    uint64_t triangles = 0;
-    auto drawAll = [&](bool wireframe) {
-        for (const DrawItem& it : items) {
-            if (wireframe && it.gpu->primitive != GL_TRIANGLES) continue;
-            glUniformMatrix4fv(prog.model, 1, GL_FALSE, &(*it.world)[0][0]);
-            glUniformMatrix3fv(prog.normalMatrix, 1, GL_FALSE, &it.normal[0][0]);
-            glFrontFace(it.mirrored ? GL_CW : GL_CCW);
-            if (!wireframe) {
-                glBindTexture(GL_TEXTURE_2D, it.texture ? it.texture->id : 0);
-                triangles += it.gpu->triangles;
-            }
-            glBindVertexArray(it.gpu->vao);
-            bool unlit = it.gpu->primitive != GL_TRIANGLES;
-            for (const IndexRange& r : it.gpu->ranges) {
-                if (!wireframe) {
-                    const Material* m = it.material;
-                    if (it.rangeMaterials && r.material >= 0 && size_t(r.material) < it.rangeMaterials->size()) m = &(*it.rangeMaterials)[r.material];
-                    setMaterial(prog, *m, it.texture != nullptr, unlit);
-                }
-                glDrawElements(it.gpu->primitive, r.count, GL_UNSIGNED_INT, reinterpret_cast<const void*>(size_t(r.first) * sizeof(uint32_t)));
-            }
-        }
-    };
-    drawAll(false);
+    stats.triangles = drawAll(prog, items, false);
 
     // Wireframe overlay: the same triangles as lines, pulled slightly toward the viewer.
     if (s.wireframe) {
@@ -809,7 +851,7 @@ RenderStats GlRenderer::render(const FrameInput& frame, int width, int height, F
         glEnable(GL_POLYGON_OFFSET_LINE);
         glPolygonOffset(-1.0f, -1.0f);
         glDepthFunc(GL_LEQUAL);
-        drawAll(true);
+        drawAll(prog, items, true);
         glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
         glDisable(GL_POLYGON_OFFSET_LINE);
         glUniform1i(prog.solid, 0);
@@ -825,38 +867,23 @@ RenderStats GlRenderer::render(const FrameInput& frame, int width, int height, F
         glBlitFramebuffer(0, 0, rw, rh, 0, 0, rw, rh, GL_DEPTH_BUFFER_BIT, GL_NEAREST);
         readFbo = m_resolve.fbo;
     }
-
-    // Read back: GL rows are bottom-up, Framebuffer rows top-down.
-    Framebuffer full;
-    Framebuffer& out = ssaa > 1 ? full : target;
-    out.resize(rw, rh);
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, readFbo);
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    std::vector<uint8_t> rgba(size_t(rw) * rh * 4);
-    std::vector<float> depth(size_t(rw) * rh);
-    glReadPixels(0, 0, rw, rh, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
-    glReadPixels(0, 0, rw, rh, GL_DEPTH_COMPONENT, GL_FLOAT, depth.data());
-    size_t rowBytes = size_t(rw) * 4;
-    for (int y = 0; y < rh; ++y) {
-        int src = rh - 1 - y;
-        std::memcpy(&out.color[size_t(y) * rowBytes], &rgba[size_t(src) * rowBytes], rowBytes);
-        std::memcpy(&out.depth[size_t(y) * rw], &depth[size_t(src) * rw], size_t(rw) * sizeof(float));
+    if (ssaa > 1) {
+        Framebuffer full;
+        readBack(readFbo, rw, rh, full);
+        target = downsample(full, ssaa);
+    } else {
+        readBack(readFbo, rw, rh, target);
     }
-    for (size_t i = 3; i < out.color.size(); i += 4) out.color[i] = 255;
-    if (ssaa > 1) target = downsample(full, ssaa);
 
     GLenum glErr = glGetError();
     evict();
     if (glErr != GL_NO_ERROR) {
         char buf[96];
-        std::snprintf(buf, sizeof buf, "gl backend: OpenGL error 0x%x during the frame", glErr);
+        std::snprintf(buf, sizeof buf, "OpenGL error 0x%x during the frame", glErr);
         stats.error = buf;
         return stats;
     }
-    if (control) control->progress = 1.0f;
     stats.ok = true;
-    stats.triangles = triangles;
-    stats.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     return stats;
 }
 

@@ -10,6 +10,7 @@
 #include "renderers/renderer.h"
 
 #include <cstdint>
+#include <string>
 
 namespace rnd {
 
@@ -27,5 +28,11 @@ struct GlCacheCounters {
     std::string platform;   // "egl-surfaceless", "glfw-hidden" or "caller" (a context was current)
 };
 GlCacheCounters glCacheCounters(const Renderer& r);
+
+// "#define SHADING_PHONG 2\n..." for every settings enum value the shaders see (shading and
+// reflection models, fog modes, light types), with the C++ enums' values; and the shader
+// sources, so a test can check that the shaders handle every one of them.
+std::string glslEnumDefines();
+std::string glslSources();
 
 }   // namespace rnd

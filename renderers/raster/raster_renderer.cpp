@@ -22,6 +22,7 @@
 
 #include "raster/raster_core.h"
 #include "raster/raster_shading.h"
+#include "renderers/draw_list.h"
 #include "renderers/shading.h"
 #include "renderers/tessellate.h"
 #include "renderers/texture_sampler.h"
@@ -771,40 +772,32 @@ public:
     Capabilities capabilities() const override {
         Capabilities c;
         c.progressive = true;
-        c.msaa = true;
-        c.ssaa = true;
-        c.maxMsaaSamples = 4;
+        c.wireframe = true;
+        c.pointsAndLines = true;
+        c.msaaSamples = {4};   // one fixed 4-sample pattern (raster_core.h)
+        c.ssaaFactors = {2, 3, 4};
+        c.ssaaRendersLarger = true;
+        c.maxImageSize = 32768;
         return c;
     }
 
-    RenderStats render(const sg::FrameInput& frame, int width, int height, Framebuffer& target, RenderControl* control) override {
-        auto t0 = std::chrono::steady_clock::now();
+protected:
+    RenderStats doRender(const sg::FrameInput& frame, const RenderConfig& cfg, Framebuffer& target, RenderControl* control) override {
         RenderStats stats;
-        if (width <= 0 || height <= 0 || width > 32768 || height > 32768) {
-            target.resize(std::max(width, 0), std::max(height, 0));
-            stats.error = "raster: invalid target size " + std::to_string(width) + "x" + std::to_string(height);
-            return stats;
-        }
-        const auto& st = frame.settings;
-        if (control) control->progress = 0.0f;
-        if (st.aa == sg::AAMode::SSAA && st.aaRate > 1) {
-            int r = std::clamp(st.aaRate, 2, 8);   // as the GL backend
+        const int r = cfg.ssaaFactor;
+        if (r > 1) {
             Framebuffer hi;
-            stats = renderSingle(frame, width * r, height * r, hi, false, control, r);
-            if (stats.ok)
-                target = downsample(hi, r);
-            else
-                target.resize(width, height);
+            stats = renderSingle(frame, cfg.width * r, cfg.height * r, cfg.tessellation, hi, false, control, r);
+            if (stats.ok) target = downsample(hi, r);
         } else {
-            stats = renderSingle(frame, width, height, target, st.aa == sg::AAMode::MSAA && st.aaRate > 1, control);
+            stats = renderSingle(frame, cfg.width, cfg.height, cfg.tessellation, target, cfg.msaaSamples > 1, control);
         }
-        stats.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         return stats;
     }
 
 private:
     // pointScale: the SSAA factor (points are 2 pixels wide at the output resolution, like GL).
-    RenderStats renderSingle(const sg::FrameInput& frame, int width, int height, Framebuffer& target, bool msaa, RenderControl* control,
+    RenderStats renderSingle(const sg::FrameInput& frame, int width, int height, int tessRes, Framebuffer& target, bool msaa, RenderControl* control,
                              int pointScale = 1) {
         RenderStats stats;
         auto t0frame = std::chrono::steady_clock::now();
@@ -814,42 +807,31 @@ private:
         const auto& st = frame.settings;
         const bool gouraud = st.shading == sg::ShadingModel::Gouraud;
 
-        // 1. gather
+        // 1. gather (the draw list shared with the GL backend)
         std::vector<DrawItem> draws, lineDraws;
-        auto addDraw = [&](std::shared_ptr<const sg::Mesh> mesh, const mat4& world, const mat3& normal, const sg::Material& mat,
-                           const sg::TexturePtr& tex, bool mirrored, const Tessellation* tess) {
-            if (!mesh || mesh->positions.empty()) return;
+        for (const PreparedDraw& p : prepareDraws(frame, tessRes, m_tess)) {
             DrawItem d;
-            d.mesh = mesh;
-            d.world = world;
-            d.normal = normal;
-            d.material = mat;
-            d.mirrored = mirrored;
-            d.texture = m_samplers.get(tex);
-            d.hasNormals = mesh->normals.size() == mesh->positions.size();
-            d.hasUV = mesh->uv0.size() == mesh->positions.size();
-            d.hasColors = mesh->colors.size() == mesh->positions.size();
-            if (tess && !tess->triangleMaterial.empty()) {
-                d.triMat = std::make_shared<std::vector<uint16_t>>(tess->triangleMaterial);
-                d.materials = std::make_shared<std::vector<sg::Material>>(tess->materials);
+            d.mesh = p.mesh;
+            d.world = *p.world;
+            d.normal = p.normal;
+            d.material = *p.material;
+            d.mirrored = p.mirrored;
+            d.texture = m_samplers.get(p.texture);
+            d.hasNormals = p.mesh->normals.size() == p.mesh->positions.size();
+            d.hasUV = p.mesh->uv0.size() == p.mesh->positions.size();
+            d.hasColors = p.mesh->colors.size() == p.mesh->positions.size();
+            if (p.triangleMaterial) {   // borrowed for this frame (the tessellation cache keeps them)
+                d.triMat = std::shared_ptr<const std::vector<uint16_t>>(std::shared_ptr<void>(), p.triangleMaterial);
+                d.materials = std::shared_ptr<const std::vector<sg::Material>>(std::shared_ptr<void>(), p.materials);
             }
-            if (mesh->mode == sg::PrimitiveMode::Triangles) {
-                d.triCount = uint32_t(mesh->indices.size() / 3);
-                if (d.triCount == 0) return;
+            if (p.mesh->mode == sg::PrimitiveMode::Triangles) {
+                d.triCount = uint32_t(p.mesh->indices.size() / 3);
+                if (d.triCount == 0) continue;
                 d.perCorner = gouraud && d.triMat;
                 draws.push_back(std::move(d));
             } else {
                 lineDraws.push_back(std::move(d));
             }
-        };
-        for (const auto& m : frame.meshes) addDraw(m.mesh, m.world, m.normal, m.material, m.texture, m.mirrored, nullptr);
-        int tessRes = std::clamp(st.tessellation, 3, 1024);
-        for (const auto& a : frame.analytics) {
-            const Tessellation& t = m_tess.get(a, tessRes);
-            if (t.worldSpace)
-                addDraw(t.mesh, mat4(1.0f), mat3(1.0f), a.material, a.texture, false, &t);
-            else
-                addDraw(t.mesh, a.world, a.normal, a.material, a.texture, glm::determinant(mat3(a.world)) < 0.0f, &t);
         }
         m_samplers.endFrame();
 
@@ -879,7 +861,7 @@ private:
         fc.draws = &draws;
         uint64_t chunkSize = std::max<uint64_t>(4096, (total + 4000) / 4000);
         if (chunkSize * 7 >= (1u << kChunkBits)) {
-            stats.error = "raster: too many triangles (" + std::to_string(total) + ")";
+            stats.error = "too many triangles (" + std::to_string(total) + ")";
             return stats;
         }
         // Chunks persist between frames so their buffers keep their capacity.
@@ -917,7 +899,7 @@ private:
         });
         if (cancelled) {
             stats.cancelled = true;
-            stats.error = "raster: cancelled";
+            stats.error = "cancelled";
             return stats;
         }
 

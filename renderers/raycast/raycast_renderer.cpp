@@ -285,30 +285,24 @@ public:
         c.exactImplicits = true;
         c.shadows = true;
         c.reflections = true;
-        c.msaa = true;
-        c.ssaa = true;
-        c.maxMsaaSamples = 8;
-        c.needsGLContext = false;
+        // MSAA n and SSAA f are both taken as stratified jittered rays per pixel: n rays
+        // (2 -> 2x1, 4 -> 2x2, 8 -> 4x2 strata) and f x f rays; each ray is shaded.
+        c.msaaSamples = {2, 4, 8};
+        c.ssaaFactors = {2, 3, 4};
+        c.maxImageSize = 16384;
         return c;
     }
 
-    RenderStats render(const FrameInput& f, int w, int h, Framebuffer& target, RenderControl* control) override {
-        auto t0 = std::chrono::steady_clock::now();
+protected:
+    RenderStats doRender(const FrameInput& f, const RenderConfig& cfg, Framebuffer& target, RenderControl* control) override {
         RenderStats stats;
-        if (w <= 0 || h <= 0 || w > 16384 || h > 16384) {
-            stats.error = "raycast: image size " + std::to_string(w) + "x" + std::to_string(h) + " is out of range 1..16384";
-            return stats;
-        }
+        const int w = cfg.width, h = cfg.height;
         target.resize(w, h);
         const uint8_t bg[4] = {toByteSRGB(f.settings.background.x), toByteSRGB(f.settings.background.y), toByteSRGB(f.settings.background.z), 255};
         target.clear(bg, 1.0f);
-        if (std::string e = f.settings.validate(); !e.empty()) {
-            stats.error = "raycast: " + e;
-            return stats;
-        }
         rt::CameraRays cam(f.camera, w, h);
         if (!cam.valid() || !isFinite(f.camera.eye)) {
-            stats.error = "raycast: camera matrices are not invertible";
+            stats.error = "camera matrices are not invertible";
             return stats;
         }
 
@@ -322,13 +316,11 @@ public:
         for (size_t i = 0; i < f.meshes.size(); ++i) textures[i] = m_samplers.get(f.meshes[i].texture);
         m_samplers.endFrame();
 
-        int sx = 1, sy = 1;   // strata per pixel
-        if (f.settings.aa == AAMode::SSAA)
-            sx = sy = std::clamp(f.settings.aaRate, 1, 8);
-        else if (f.settings.aa == AAMode::MSAA) {
-            int r = std::clamp(f.settings.aaRate, 1, 16);   // as many samples as MSAA would take
-            sx = r >= 4 ? (r >= 16 ? 4 : (r >= 8 ? 4 : 2)) : r;
-            sy = std::max(1, r / sx);
+        // Strata per pixel (see capabilities()).
+        int sx = cfg.ssaaFactor, sy = cfg.ssaaFactor;
+        if (cfg.msaaSamples > 1) {
+            sx = cfg.msaaSamples >= 4 ? (cfg.msaaSamples >= 8 ? 4 : 2) : cfg.msaaSamples;
+            sy = cfg.msaaSamples / sx;
         }
         const int tile = 32;
         const int tx = (w + tile - 1) / tile, ty = (h + tile - 1) / tile, ntiles = tx * ty;
@@ -397,8 +389,7 @@ public:
         stats.rays = rays.load();
         stats.cancelled = cancelled.load();
         stats.ok = !stats.cancelled;
-        if (stats.cancelled) stats.error = "raycast: cancelled";
-        stats.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        if (stats.cancelled) stats.error = "cancelled";
         return stats;
     }
 

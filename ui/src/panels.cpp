@@ -1012,10 +1012,29 @@ std::string slotStats(const SlotView& v) {
         extra += r;
     }
     if (v.status.level > 1) extra += "  (1/" + std::to_string(v.status.level) + " res)";
+    if (s.ok || !s.config.aaUsed.empty()) extra += "  " + s.config.describe();
     if (v.status.rendering) extra += "  " + std::to_string(int(v.status.progress * 100)) + "%";
     std::snprintf(buf, sizeof buf, "%-8s %7.1f ms  %6.1fk tris%s", v.status.backend.c_str(), s.milliseconds, double(s.triangles) / 1000.0,
                   extra.c_str());
     return buf;
+}
+
+// One line for the status bar: what the shown backends do not honour as asked (from their
+// last RenderStats: AA substitutions, features they do not draw), "" when all is honoured.
+std::string renderNotes(const ViewportInput& view) {
+    std::string line;
+    for (const SlotView& v : view.slots) {
+        const rnd::RenderConfig& c = v.status.stats.config;
+        std::string part;
+        for (const std::string& n : c.notes) part += (part.empty() ? "" : "; ") + n;
+        if (!c.unsupported.empty()) {
+            std::string list;
+            for (const std::string& u : c.unsupported) list += (list.empty() ? "" : ", ") + u;
+            part += (part.empty() ? "" : "; ") + std::string("does not draw ") + list;
+        }
+        if (!part.empty()) line += (line.empty() ? "" : "   ") + v.status.backend + ": " + part;
+    }
+    return line;
 }
 
 void cameraInput(ViewerState& st, ImVec2 a, ImVec2 b, double time, float dt) {
@@ -1532,6 +1551,11 @@ void drawUi(ViewerState& st, const ViewportInput& view, double time, float dt) {
             ImGui::TextColored(ImVec4(1.0f, 0.6f, 0.45f, 1.0f), "%s", st.status.c_str());
         else
             ImGui::TextUnformatted(st.status.empty() ? "Ready" : st.status.c_str());
+        if (std::string notes = renderNotes(view); !notes.empty()) {   // never a silent substitution
+            ImGui::SameLine(0, px(24));
+            ImGui::TextColored(ImVec4(0.95f, 0.8f, 0.4f, 1.0f), "%s", notes.c_str());
+            record(st, "status/renderNotes");
+        }
         char right[160];
         std::string mode = st.compare.mode == ViewMode::Single ? st.backend : st.compare.mode == ViewMode::Split ? "split view" : "difference view";
         std::snprintf(right, sizeof right, "%s   %s   %.0f fps", mode.c_str(), st.loadInProgress() ? "loading..." : "", io.Framerate);

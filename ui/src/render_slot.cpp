@@ -7,8 +7,10 @@ namespace ui {
 
 RenderSlot::RenderSlot(std::string backend, Threading threading) : m_backend(std::move(backend)), m_threaded(threading != Threading::UiThread) {
     m_renderer = rnd::makeRenderer(m_backend, &m_makeError);
-    bool wantsContext = m_renderer && (m_renderer->capabilities().needsGLContext || m_backend == "gl");
-    if (threading == Threading::Auto && wantsContext) m_threaded = false;
+    if (m_renderer) m_caps = m_renderer->capabilities();
+    // A backend that renders with the caller's GL context runs here (in poll(), on the UI
+    // thread that owns the window's context) unless a worker is asked for explicitly.
+    if (threading == Threading::Auto && m_renderer && m_caps.affinity == rnd::ContextAffinity::CurrentGLContext) m_threaded = false;
     m_status.backend = m_backend;
     if (!m_renderer) m_status.error = m_makeError.empty() ? "unknown backend " + m_backend : m_makeError;
     if (m_threaded && m_renderer) m_thread = std::thread([this] { workerLoop(); });

@@ -131,19 +131,24 @@ public:
 
     BackendView& viewFor(const std::string& name) {
         BackendView& v = views[name];
-        if (!v.slot)
-            v.slot = std::make_unique<RenderSlot>(name, name == "gl" && st.glOnWorker ? RenderSlot::Threading::Worker : RenderSlot::Threading::Auto);
+        if (!v.slot) v.slot = std::make_unique<RenderSlot>(name, slotThreading());
         return v;
     }
 
+    // Backends bound to the caller's GL context render on the UI thread with the window's
+    // context, or on a worker with their own when glOnWorker (software GL); others always on a
+    // worker (Auto).
+    RenderSlot::Threading slotThreading() const { return st.glOnWorker ? RenderSlot::Threading::Worker : RenderSlot::Threading::Auto; }
+    static bool contextBound(const RenderSlot& slot) { return slot.capabilities().affinity == rnd::ContextAffinity::CurrentGLContext; }
+
     // Requests renders for the visible backends and uploads finished images.
     void updateRenders() {
-        if (st.glOnWorker != m_glOnWorker) {   // where GL runs changed: a new slot
+        if (st.glOnWorker != m_glOnWorker) {   // where context-bound backends run changed: new slots
             m_glOnWorker = st.glOnWorker;
-            auto it = views.find("gl");
-            if (it != views.end()) {
-                it->second.slot.reset();   // joins its worker first
-                it->second.slot = std::make_unique<RenderSlot>("gl", m_glOnWorker ? RenderSlot::Threading::Worker : RenderSlot::Threading::Auto);
+            for (auto& [name, v] : views) {
+                if (!v.slot || !contextBound(*v.slot)) continue;
+                v.slot.reset();   // joins its worker first
+                v.slot = std::make_unique<RenderSlot>(name, slotThreading());
             }
         }
         int w = st.viewportWidth, h = st.viewportHeight;
@@ -159,7 +164,7 @@ public:
             BackendView& v = viewFor(n);
             sg::RenderSettings settings = st.settingsFor(n);
             uint64_t k = key ^ std::hash<std::string>{}(settings.aaName());
-            bool preview = interacting && (v.slot->backend() != "gl" || st.glOnWorker);
+            bool preview = interacting && v.slot->threaded();   // a synchronous render has no preview level
             if (!v.slot->needs(k, preview)) continue;
             if (!base) base = std::make_shared<sg::FrameInput>(st.buildFrame(aspect));   // flatten once per change
             auto frame = std::make_shared<sg::FrameInput>(*base);
@@ -235,17 +240,23 @@ public:
             auto frame = std::make_shared<sg::FrameInput>(*base);
             frame->settings = st.settingsFor(n);
             fs::path path = screenshotPath(dir, n);
-            auto job = [n, frame, w, h, path]() -> std::string {
-                std::string err;
-                std::unique_ptr<rnd::Renderer> r = rnd::makeRenderer(n, &err);
-                if (!r) return err;
+            std::string err;
+            std::shared_ptr<rnd::Renderer> r = rnd::makeRenderer(n, &err);
+            PendingShot p{n, path, {}};
+            if (!r) {
+                std::promise<std::string> pr;
+                pr.set_value(err);
+                p.result = pr.get_future();
+                shots.push_back(std::move(p));
+                continue;
+            }
+            auto job = [n, r, frame, w, h, path]() -> std::string {
                 rnd::Framebuffer fb;
                 rnd::RenderStats s = r->render(*frame, w, h, fb, nullptr);
-                if (!s.ok) return n + ": " + (s.error.empty() ? "render failed" : s.error);
+                if (!s.ok) return s.error.empty() ? n + ": render failed" : s.error;
                 return assets::writePng(path, fb.width, fb.height, fb.color.data(), /*overwrite=*/false);
             };
-            PendingShot p{n, path, {}};
-            if (n == "gl") {   // needs the window's context: here, now
+            if (r->capabilities().affinity == rnd::ContextAffinity::CurrentGLContext) {   // the window's context: here, now
                 std::promise<std::string> pr;
                 pr.set_value(job());
                 p.result = pr.get_future();

@@ -9,7 +9,7 @@
 // fragment (rho = base colour * vertex colour * texel).
 //
 // The renderer compiles one program per light setup: its prefix defines MAX_LIGHTS,
-// REFLECTION (0 Phong, 1 Blinn-Phong) and LIGHT_CALLS: for a few lights, one addLight(i,
+// REFLECTION (REFLECTION_PHONG or REFLECTION_BLINN) and LIGHT_CALLS: for a few lights, one addLight(i,
 // type, inverseSquare, ...) call per light with constant arguments (the compiler drops the
 // code of the other light types; a loop over a uniform light count costs llvmpipe about 2x,
 // see bench/gl); for many lights a loop over uNumLights reading the type from the .w
@@ -33,15 +33,19 @@ uniform bool uSpecTinted;
 uniform vec3 uSpecColor;
 uniform vec3 uEmissive;
 
-#define LIGHT_POINT 0
-#define LIGHT_DIRECTIONAL 1
-#define LIGHT_SPOT 2
+// LIGHT_POINT, LIGHT_DIRECTIONAL, LIGHT_SPOT, SHADING_*, REFLECTION_* and FOG_* are defined by the
+// renderer's prefix with the values of the C++ enums (glslEnumDefines() in gl_renderer.cpp).
 
 // sampleLight(): direction toward light i and the radiance arriving at p.
 void sampleLight(int i, int type, bool inverseSquare, vec3 p, out vec3 toLight, out vec3 radiance) {
     radiance = uLightRad[i].xyz;
     if (type == LIGHT_DIRECTIONAL) {
         toLight = -uLightDir[i].xyz;
+        return;
+    }
+    if (type != LIGHT_POINT && type != LIGHT_SPOT) {   // a type this shader does not know: no light
+        toLight = vec3(0.0, 1.0, 0.0);
+        radiance = vec3(0.0);
         return;
     }
     vec3 d = uLightPos[i].xyz - p;
@@ -64,13 +68,15 @@ void addLight(int i, int type, bool inverseSquare, vec3 n, vec3 p, vec3 v, inout
     sampleLight(i, type, inverseSquare, p, l, radiance);
     float nl = dot(n, l);
     if (nl <= 0.0) return;
-#if REFLECTION == 0
+#if REFLECTION == REFLECTION_PHONG
     vec3 r = 2.0 * nl * n - l;                         // mirror direction of l about n
     float spec = max(dot(r, v), 0.0);
-#else
+#elif REFLECTION == REFLECTION_BLINN
     vec3 h = l + v;
     float hl = length(h);
     float spec = hl > 0.0 ? max(dot(n, h / hl), 0.0) : 0.0;
+#else
+#error "REFLECTION: a sg::ReflectionModel value this shader does not handle"
 #endif
     spec = spec > 0.0 ? pow(spec, uShininess) : 0.0;
     vec3 ln = radiance * nl;

@@ -5,7 +5,7 @@ in vec3 vEyePos;
 in vec3 vNormal;
 in vec2 vUv;
 in vec4 vColor;
-#if SHADING == 1
+#if SHADING == SHADING_GOURAUD
 in vec3 vMulFront;
 in vec3 vAddFront;
 in vec3 vMulBack;
@@ -17,7 +17,7 @@ uniform bool uHasTexture;
 uniform bool uUnlit;        // colour = albedo + emissive (material unlit, lines, points)
 uniform bool uSolid;        // wireframe overlay: uSolidColor (fogged)
 uniform vec3 uSolidColor;
-uniform int uFogMode;       // 0 off, 1 linear, 2 exp, 3 exp2
+uniform int uFogMode;       // FOG_OFF, FOG_LINEAR, FOG_EXP, FOG_EXP2 (sg::FogMode values)
 uniform vec3 uFogColor;
 uniform vec3 uFogParams;    // start, end, density
 
@@ -25,9 +25,9 @@ out vec4 fragColor;
 
 // sg::fogVisibility(): f(d) in [0,1], 1 = no fog.
 float fogVisibility(float d) {
-    if (uFogMode == 1) return clamp((uFogParams.y - d) / (uFogParams.y - uFogParams.x), 0.0, 1.0);
-    if (uFogMode == 2) return exp(-uFogParams.z * d);
-    if (uFogMode == 3) { float x = uFogParams.z * d; return exp(-x * x); }
+    if (uFogMode == FOG_LINEAR) return clamp((uFogParams.y - d) / (uFogParams.y - uFogParams.x), 0.0, 1.0);
+    if (uFogMode == FOG_EXP) return exp(-uFogParams.z * d);
+    if (uFogMode == FOG_EXP2) { float x = uFogParams.z * d; return exp(-x * x); }
     return 1.0;
 }
 
@@ -42,24 +42,26 @@ void main() {
             c = albedo + uEmissive;
         } else {
             vec3 mul, add;
-#if SHADING == 0
+#if SHADING == SHADING_FLAT
             // Face normal of the world-space triangle; cross(dp/dx, dp/dy) always points to
             // the side being seen, i.e. it is already flipped toward the viewer.
             vec3 n = normalize(cross(dFdx(vWorldPos), dFdy(vWorldPos)));
             lightTerms(n, vWorldPos, mul, add);
-#elif SHADING == 1
+#elif SHADING == SHADING_GOURAUD
             mul = gl_FrontFacing ? vMulFront : vMulBack;
             add = gl_FrontFacing ? vAddFront : vAddBack;
-#else
+#elif SHADING == SHADING_PHONG
             float len = length(vNormal);
             vec3 n = len > 0.0 ? vNormal / len : vec3(0.0, 0.0, 1.0);
             if (!gl_FrontFacing) n = -n;                 // two-sided: seen from the back
             lightTerms(n, vWorldPos, mul, add);
+#else
+#error "SHADING: a sg::ShadingModel value this shader does not handle"
 #endif
             c = albedo * mul + add;
         }
     }
-    if (uFogMode != 0) {
+    if (uFogMode != FOG_OFF) {
         float f = fogVisibility(length(vEyePos));   // eye-space distance, not just z
         c = f * c + (1.0 - f) * uFogColor;
     }

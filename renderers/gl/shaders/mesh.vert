@@ -1,6 +1,6 @@
 // mesh.vert - world-space transform for all shading models; Gouraud lights the vertices here
 // (front and back side, chosen per fragment by gl_FrontFacing). The renderer prepends
-// "#version 330 core", SHADING (0 flat, 1 Gouraud, 2 Phong), MAX_LIGHTS and lighting.glsl.
+// "#version 330 core", SHADING (SHADING_FLAT, SHADING_GOURAUD or SHADING_PHONG), MAX_LIGHTS and lighting.glsl.
 layout(location = 0) in vec3 aPosition;
 layout(location = 1) in vec3 aNormal;
 layout(location = 2) in vec2 aUv;
@@ -17,7 +17,7 @@ out vec3 vEyePos;
 out vec3 vNormal;
 out vec2 vUv;
 out vec4 vColor;
-#if SHADING == 1
+#if SHADING == SHADING_GOURAUD
 out vec3 vMulFront;
 out vec3 vAddFront;
 out vec3 vMulBack;
@@ -33,7 +33,7 @@ void main() {
     vColor = aColor;
     gl_Position = uViewProj * world;
     gl_PointSize = uPointSize;
-#if SHADING == 1
+#if SHADING == SHADING_GOURAUD
     float len = length(vNormal);
     vec3 n = len > 0.0 ? vNormal / len : vec3(0.0, 0.0, 1.0);
     lightTerms(n, world.xyz, vMulFront, vAddFront);

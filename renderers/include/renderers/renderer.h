@@ -1,13 +1,20 @@
-// renderer.h - the interface every backend implements ("gl", "raster", "raycast").
+// renderer.h - the contract every backend implements ("gl", "raster", "raycast").
 //
-// A renderer takes one sg::FrameInput and renders it into a Framebuffer of any size. Slow
-// backends render progressively: they write finished tiles straight into the target, report
-// progress and check for cancellation between tiles, so callers may run render() on a worker
-// thread and show the target as it fills. Backends cache derived data (GPU buffers, BVHs,
-// tessellations) keyed by mesh/geometry id + version between calls.
+// A renderer takes one sg::FrameInput and renders it into a Framebuffer of any size.
+// Renderer::render() is the one entry point and is not virtual: it validates the settings,
+// checks the size against the backend's Capabilities, resolves one RenderConfig (AA mode and
+// the sample count actually used, SSAA factor, tessellation; see render_config.h), checks
+// for cancellation, calls the backend's doRender(), times the call and fills RenderStats with
+// what was asked and what was used. Backends implement name(), capabilities() and doRender().
+//
+// Slow backends render progressively: they write finished tiles straight into the target,
+// report progress and check for cancellation between tiles, so callers may run render() on a
+// worker thread and show the target as it fills. Backends cache derived data (GPU buffers,
+// BVHs, tessellations) keyed by mesh/geometry id + version between calls.
 #pragma once
 
 #include "renderers/framebuffer.h"
+#include "renderers/render_config.h"
 #include "scenegraph/frame.h"
 
 #include <atomic>
@@ -19,15 +26,28 @@
 
 namespace rnd {
 
+// Where render() may be called.
+enum class ContextAffinity {
+    AnyThread,          // needs nothing from the caller: any thread, any time
+    CurrentGLContext,   // renders with the GL context current on the calling thread (e.g. the
+                        // window's, so call it on the thread that owns it); with none current
+                        // it makes its own headless context, so a worker thread works too
+};
+
+// What a backend can do. The UI and the command line decide from these, never from names.
 struct Capabilities {
-    bool progressive = false;      // render() reports progress per tile and can be cancelled
-    bool exactImplicits = false;   // implicit shapes/CSG intersected analytically (vs tessellated)
-    bool shadows = false;          // honours RenderSettings::shadows
-    bool reflections = false;      // honours RenderSettings::reflections
-    bool msaa = false;
-    bool ssaa = false;
-    int maxMsaaSamples = 0;
-    bool needsGLContext = false;
+    ContextAffinity affinity = ContextAffinity::AnyThread;
+    bool progressive = false;         // render() reports progress per tile and can be cancelled
+    bool exactImplicits = false;      // implicit shapes/CSG intersected analytically (vs tessellated)
+    bool shadows = false;             // honours RenderSettings::shadows
+    bool reflections = false;         // honours RenderSettings::reflections
+    bool wireframe = false;           // draws RenderSettings::wireframe
+    bool pointsAndLines = false;      // draws meshes of PrimitiveMode::Points / Lines
+    bool depth = true;                // fills Framebuffer::depth (window depth in [0,1])
+    std::vector<int> msaaSamples;     // MSAA sample counts taken as asked, ascending ({} = no MSAA)
+    std::vector<int> ssaaFactors;     // SSAA factors taken as asked, ascending ({} = no SSAA)
+    bool ssaaRendersLarger = false;   // SSAA renders a factor x larger image (counts against maxImageSize)
+    int maxImageSize = 16384;         // largest width or height it renders
 };
 
 // Shared between the caller and a render in progress (possibly on another thread).
@@ -40,10 +60,11 @@ struct RenderControl {
 struct RenderStats {
     bool ok = false;
     bool cancelled = false;
-    std::string error;   // one line, when !ok
-    double milliseconds = 0;
-    uint64_t triangles = 0;   // triangles submitted
-    uint64_t rays = 0;        // rays traced (ray caster)
+    std::string error;         // one line starting with the backend's name, when !ok
+    double milliseconds = 0;   // the whole render() call
+    uint64_t triangles = 0;    // triangles submitted
+    uint64_t rays = 0;         // rays traced (ray caster)
+    RenderConfig config;       // what was asked and what was used, with notes
 };
 
 class Renderer {
@@ -51,9 +72,17 @@ public:
     virtual ~Renderer() = default;
     virtual std::string_view name() const = 0;
     virtual Capabilities capabilities() const = 0;
-    // Renders the frame into `target` (resized to width x height). Thread-compatible: one
-    // render at a time per renderer instance.
-    virtual RenderStats render(const sg::FrameInput& frame, int width, int height, Framebuffer& target, RenderControl* control = nullptr) = 0;
+
+    // Renders the frame into `target` (resized to width x height on success). Thread-compatible:
+    // one render at a time per renderer instance (see Capabilities::affinity for which thread).
+    // On failure returns ok = false with a one-line error and leaves `target` unspecified.
+    RenderStats render(const sg::FrameInput& frame, int width, int height, Framebuffer& target, RenderControl* control = nullptr);
+
+protected:
+    // The backend's part: render `frame` with `config` (size, AA, tessellation already resolved
+    // and valid for this backend) into `target`. Errors need not name the backend; render()
+    // prefixes it. May append to stats.config.notes (e.g. a driver limit found late).
+    virtual RenderStats doRender(const sg::FrameInput& frame, const RenderConfig& config, Framebuffer& target, RenderControl* control) = 0;
 };
 
 // Backend names in display order: {"gl", "raster", "raycast"} (those built).

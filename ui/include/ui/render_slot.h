@@ -31,10 +31,10 @@ struct SlotStatus {
 
 class RenderSlot {
 public:
-    // Where the renderer runs: Auto = a worker thread, except for backends that need the
-    // caller's GL context ("gl"), which render synchronously in poll(); Worker = always a
-    // worker thread (the GL backend then makes its own headless context there); UiThread =
-    // always synchronously in poll().
+    // Where the renderer runs: Auto = a worker thread, except for backends whose capabilities
+    // say they render with the caller's GL context (ContextAffinity::CurrentGLContext), which
+    // render synchronously in poll(); Worker = always a worker thread (such a backend then
+    // makes its own headless context there); UiThread = always synchronously in poll().
     enum class Threading { Auto, Worker, UiThread };
     explicit RenderSlot(std::string backend, Threading threading = Threading::Auto);
     ~RenderSlot();
@@ -42,6 +42,8 @@ public:
     RenderSlot& operator=(const RenderSlot&) = delete;
 
     const std::string& backend() const { return m_backend; }
+    const rnd::Capabilities& capabilities() const { return m_caps; }   // empty when the backend failed to make
+    bool threaded() const { return m_threaded; }                       // renders on a worker thread (else in poll())
     // Renders `frame` at width x height. `key` identifies the content (scene+view+size): an
     // unchanged key is ignored. interacting: render only the preview level (1/previewDivisor).
     void request(std::shared_ptr<const sg::FrameInput> frame, int width, int height, uint64_t key, bool interacting);
@@ -73,6 +75,7 @@ private:
     std::string m_backend;
     bool m_threaded;
     std::unique_ptr<rnd::Renderer> m_renderer;
+    rnd::Capabilities m_caps;
     std::string m_makeError;
 
     uint64_t m_lastKey = ~uint64_t(0);

@@ -1,0 +1,42 @@
+// draw_list.cpp - prepareDraws(): meshes + tessellated analytic shapes as one draw list.
+#include "renderers/draw_list.h"
+
+namespace rnd {
+
+std::vector<PreparedDraw> prepareDraws(const sg::FrameInput& frame, int tessellation, TessellationCache& cache) {
+    static const sg::mat4 kIdentity(1.0f);
+    std::vector<PreparedDraw> draws;
+    draws.reserve(frame.meshes.size() + frame.analytics.size());
+    for (const sg::DrawMesh& d : frame.meshes) {
+        if (!d.mesh || d.mesh->positions.empty()) continue;
+        PreparedDraw p;
+        p.mesh = d.mesh;
+        p.world = &d.world;
+        p.normal = d.normal;
+        p.mirrored = d.mirrored;
+        p.material = &d.material;
+        p.texture = d.texture;
+        p.node = d.node;
+        draws.push_back(std::move(p));
+    }
+    for (const sg::DrawAnalytic& a : frame.analytics) {
+        const Tessellation& t = cache.get(a, tessellation);
+        if (!t.mesh || t.mesh->positions.empty()) continue;
+        const bool perTriangle = !t.triangleMaterial.empty() && !t.materials.empty();
+        PreparedDraw p;
+        p.mesh = t.mesh;
+        p.world = t.worldSpace ? &kIdentity : &a.world;
+        p.normal = t.worldSpace ? sg::mat3(1.0f) : a.normal;
+        p.mirrored = !t.worldSpace && glm::determinant(sg::mat3(a.world)) < 0.0f;
+        p.material = &a.material;
+        p.texture = perTriangle ? nullptr : a.texture;
+        p.triangleMaterial = perTriangle ? &t.triangleMaterial : nullptr;
+        p.materials = perTriangle ? &t.materials : nullptr;
+        p.node = a.node;
+        p.analytic = true;
+        draws.push_back(std::move(p));
+    }
+    return draws;
+}
+
+}   // namespace rnd

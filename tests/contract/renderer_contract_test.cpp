@@ -1,0 +1,219 @@
+// The renderer contract: resolveRenderConfig() rules, Renderer::render() checks that are the
+// same for every backend, truthful capabilities, and the GLSL enum guard.
+#include "gl/gl_renderer.h"
+#include "renderers/render_config.h"
+#include "renderers/renderer.h"
+#include "scenegraph/scene.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <regex>
+#include <sstream>
+
+using namespace rnd;
+
+namespace {
+
+sg::FrameInput frameWith(const sg::RenderSettings& s) {
+    sg::Scene scene;
+    sg::ImplicitShape sphere;
+    sphere.type = sg::ImplicitType::Sphere;
+    scene.addNode("sphere", scene.root(), sg::ImplicitPayload{sphere, -1});
+    scene.addDefaultCamera();
+    scene.settings = s;
+    return sg::flatten(scene, 1.0f, scene.activeCamera);
+}
+
+Capabilities rasterLike() {
+    Capabilities c;
+    c.msaaSamples = {4};
+    c.ssaaFactors = {2, 3, 4};
+    c.ssaaRendersLarger = true;
+    c.maxImageSize = 1000;
+    return c;
+}
+
+RenderConfig resolve(const sg::RenderSettings& s, const Capabilities& c, int w = 64, int h = 48, std::string* err = nullptr) {
+    RenderConfig cfg;
+    std::string e;
+    bool ok = resolveRenderConfig(frameWith(s), c, w, h, cfg, &e);
+    if (err)
+        *err = e;
+    else
+        EXPECT_TRUE(ok) << e;
+    return cfg;
+}
+
+}   // namespace
+
+TEST(RenderConfigTest, HonouredSettingsHaveNoNotes) {
+    sg::RenderSettings s;
+    s.setAA("msaa4");
+    s.shadows = false;
+    RenderConfig c = resolve(s, rasterLike());
+    EXPECT_EQ(c.aa, sg::AAMode::MSAA);
+    EXPECT_EQ(c.msaaSamples, 4);
+    EXPECT_EQ(c.samplesPerPixel, 4);
+    EXPECT_EQ(c.aaAsked, "msaa4");
+    EXPECT_EQ(c.aaUsed, "msaa4");
+    EXPECT_TRUE(c.notes.empty());
+    EXPECT_TRUE(c.unsupported.empty());
+    EXPECT_EQ(c.tessellation, s.tessellation);
+    EXPECT_EQ(c.width, 64);
+    EXPECT_EQ(c.height, 48);
+}
+
+TEST(RenderConfigTest, SubstitutionsAreReportedNeverSilent) {
+    sg::RenderSettings s;
+    s.shadows = false;
+    s.setAA("msaa8");   // raster-like: only 4 samples
+    RenderConfig c = resolve(s, rasterLike());
+    EXPECT_EQ(c.msaaSamples, 4);
+    EXPECT_EQ(c.aaUsed, "msaa4");
+    ASSERT_EQ(c.notes.size(), 1u);
+    EXPECT_NE(c.notes[0].find("msaa8 -> msaa4"), std::string::npos) << c.notes[0];
+    EXPECT_NE(c.describe().find("asked msaa8"), std::string::npos) << c.describe();
+
+    s.setAA("msaa2");   // below the smallest supported count: the smallest one
+    c = resolve(s, rasterLike());
+    EXPECT_EQ(c.aaUsed, "msaa4");
+    EXPECT_EQ(c.notes.size(), 1u);
+
+    Capabilities none;   // no AA at all
+    s.setAA("ssaa3");
+    c = resolve(s, none);
+    EXPECT_EQ(c.aa, sg::AAMode::None);
+    EXPECT_EQ(c.samplesPerPixel, 1);
+    ASSERT_EQ(c.notes.size(), 1u);
+    EXPECT_NE(c.notes[0].find("ssaa3 -> none"), std::string::npos) << c.notes[0];
+
+    s.setAA("ssaa3");
+    c = resolve(s, rasterLike());
+    EXPECT_EQ(c.ssaaFactor, 3);
+    EXPECT_EQ(c.samplesPerPixel, 9);
+    EXPECT_TRUE(c.notes.empty());
+}
+
+TEST(RenderConfigTest, FeaturesNotDrawnAreListed) {
+    sg::RenderSettings s;
+    s.shadows = true;
+    s.reflections = true;
+    s.wireframe = true;
+    RenderConfig c = resolve(s, Capabilities{});
+    EXPECT_EQ(c.unsupported, (std::vector<std::string>{"shadows", "reflections", "wireframe"}));
+    Capabilities all;
+    all.shadows = all.reflections = all.wireframe = true;
+    EXPECT_TRUE(resolve(s, all).unsupported.empty());
+}
+
+TEST(RenderConfigTest, SizesAndSettingsAreCheckedOnce) {
+    sg::RenderSettings s;
+    std::string err;
+    RenderConfig c = resolve(s, rasterLike(), 0, 10, &err);
+    EXPECT_EQ(err, "image size 0x10 is out of range 1..1000");
+    resolve(s, rasterLike(), 1001, 10, &err);
+    EXPECT_EQ(err, "image size 1001x10 is out of range 1..1000");
+    s.setAA("ssaa4");   // 300 x 4 = 1200 > 1000 where SSAA renders a larger image
+    resolve(s, rasterLike(), 300, 10, &err);
+    EXPECT_NE(err.find("1200x40"), std::string::npos) << err;
+    Capabilities strata = rasterLike();
+    strata.ssaaRendersLarger = false;   // the ray caster's SSAA is rays, not a larger image
+    resolve(s, strata, 300, 10, &err);
+    EXPECT_EQ(err, "");
+    s = {};
+    s.fog = sg::FogMode::Linear;
+    s.fogStart = 10;
+    s.fogEnd = 5;
+    resolve(s, rasterLike(), 10, 10, &err);
+    EXPECT_EQ(err, "linear fog needs end > start");
+}
+
+// Every backend through the one entry point: same checks, errors that name the backend, and
+// capabilities that match what the stats say was used.
+class BackendContractTest : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(BackendContractTest, RenderChecksSettingsAndSizeTheSameWay) {
+    std::string err;
+    std::unique_ptr<Renderer> r = makeRenderer(GetParam(), &err);
+    ASSERT_TRUE(r) << err;
+    const std::string name = GetParam();
+    Framebuffer fb;
+    sg::RenderSettings bad;
+    bad.fog = sg::FogMode::Linear;
+    bad.fogStart = 10;
+    bad.fogEnd = 5;
+    RenderStats s = r->render(frameWith(bad), 32, 32, fb);
+    EXPECT_FALSE(s.ok);
+    EXPECT_EQ(s.error, name + ": linear fog needs end > start");
+
+    s = r->render(frameWith({}), 0, 10, fb);
+    EXPECT_FALSE(s.ok);
+    EXPECT_EQ(s.error, name + ": image size 0x10 is out of range 1.." + std::to_string(r->capabilities().maxImageSize));
+    int huge = r->capabilities().maxImageSize + 1;
+    s = r->render(frameWith({}), huge, 1, fb);
+    EXPECT_FALSE(s.ok);
+    EXPECT_EQ(s.error.rfind(name + ": image size ", 0), 0u) << s.error;
+
+    RenderControl cancelled;
+    cancelled.cancel = true;
+    s = r->render(frameWith({}), 16, 16, fb, &cancelled);
+    EXPECT_FALSE(s.ok);
+    EXPECT_TRUE(s.cancelled);
+    EXPECT_EQ(s.error, name + ": cancelled");
+}
+
+TEST_P(BackendContractTest, StatsSayWhatWasAskedAndUsed) {
+    std::string err;
+    std::unique_ptr<Renderer> r = makeRenderer(GetParam(), &err);
+    ASSERT_TRUE(r) << err;
+    for (const char* aa : {"none", "msaa2", "msaa4", "msaa8", "ssaa2", "ssaa3", "ssaa4"}) {
+        sg::RenderSettings s;
+        ASSERT_TRUE(s.setAA(aa));
+        s.shadows = false;
+        Framebuffer fb;
+        RenderStats st = r->render(frameWith(s), 40, 30, fb);
+        ASSERT_TRUE(st.ok) << aa << ": " << st.error;
+        EXPECT_EQ(fb.width, 40);
+        EXPECT_EQ(fb.height, 30);
+        EXPECT_GT(st.milliseconds, 0.0);
+        EXPECT_EQ(st.config.aaAsked, aa);
+        // Capabilities (asked after the render, when GL knows its driver) tell the truth: a
+        // mode is taken as asked exactly when the backend lists it, else a note says why.
+        Capabilities caps = r->capabilities();
+        const std::vector<int>& list = s.aa == sg::AAMode::MSAA ? caps.msaaSamples : caps.ssaaFactors;
+        bool listed = s.aa == sg::AAMode::None || std::find(list.begin(), list.end(), s.aaRate) != list.end();
+        EXPECT_EQ(st.config.aaUsed == st.config.aaAsked, listed) << GetParam() << " " << aa << " used " << st.config.aaUsed;
+        EXPECT_EQ(st.config.notes.empty(), listed) << GetParam() << " " << aa;
+        if (!listed) EXPECT_NE(st.config.notes[0].find(std::string(aa) + " -> "), std::string::npos) << st.config.notes[0];
+    }
+    // Shadows: asked by default; listed as not drawn exactly by the backends without them.
+    Framebuffer fb;
+    RenderStats st = r->render(frameWith({}), 16, 16, fb);
+    ASSERT_TRUE(st.ok) << st.error;
+    bool listed = std::find(st.config.unsupported.begin(), st.config.unsupported.end(), "shadows") != st.config.unsupported.end();
+    EXPECT_EQ(listed, !r->capabilities().shadows);
+}
+
+INSTANTIATE_TEST_SUITE_P(EveryBackend, BackendContractTest, ::testing::ValuesIn(rendererNames()), [](const auto& info) { return info.param; });
+
+// Every enum value handed to GLSL is a named constant with the C++ value, and the shaders
+// handle every one of them by name (a new enum value without shader code fails here).
+TEST(GlslEnumGuardTest, ShadersHandleEveryEnumValueByName) {
+    std::string defines = glslEnumDefines();
+    std::string src = glslSources();
+    // Code only: drop // comments.
+    std::string code;
+    std::istringstream in(src);
+    for (std::string line; std::getline(in, line);) code += line.substr(0, line.find("//")) + "\n";
+    std::regex def(R"(#define (\w+) (\d+))");
+    int count = 0;
+    for (auto it = std::sregex_iterator(defines.begin(), defines.end(), def); it != std::sregex_iterator(); ++it, ++count) {
+        std::string name = (*it)[1];
+        EXPECT_TRUE(std::regex_search(code, std::regex("\\b" + name + "\\b"))) << name << " is not handled by the shaders";
+    }
+    EXPECT_EQ(count, 3 + 2 + 4 + 3);   // shading, reflection, fog, light types
+    EXPECT_NE(defines.find("#define FOG_EXP2 " + std::to_string(int(sg::FogMode::Exp2))), std::string::npos) << defines;
+    EXPECT_NE(defines.find("#define SHADING_GOURAUD " + std::to_string(int(sg::ShadingModel::Gouraud))), std::string::npos) << defines;
+    EXPECT_NE(defines.find("#define LIGHT_SPOT " + std::to_string(int(sg::LightType::Spot))), std::string::npos) << defines;
+}
