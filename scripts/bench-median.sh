@@ -3,7 +3,7 @@
 # Runs a benchmark that prints `bench: scene=S what=W ours=X ref=Y ratio=R` lines N times and
 # prints one line per (scene, metric): the medians of ours, ref and ratio over the runs and the
 # range of the ratio. The machines here drift by 10-20% over minutes, so one run's ratio is
-# a sample; the median of several is what the README quotes. Raw output: $BENCH_LOG (default
+# a sample; the median of several is what docs/benchmarks.md quotes. Raw output: $BENCH_LOG (default
 # a temporary file, printed at the end).
 #   scripts/bench-median.sh 3 build/release/bench/raycast/bench_raycast
 set -euo pipefail

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # scripts/fuzz-campaign.sh CPU_SECONDS [JOBS] [TARGET...]   (or --summary CPU_SECONDS [TARGET...])
-# The long fuzzing run of issue 8: every target (default: all eight) runs until it has used
+# The long fuzzing run (docs/fuzzing.md): every target (default: all eight) runs until it has used
 # CPU_SECONDS of CPU time (not wall time: the runs are niced so the machine stays usable, and
 # a target that gets less CPU simply runs longer). JOBS targets run at once (default: nproc).
 # A crash, timeout or out-of-memory input is kept in artifacts_TARGET and the target restarts
@@ -10,7 +10,8 @@
 # time and the runs are niced, so each timeout input is run again on its own with a 20 s CPU
 # limit: only one that is still too slow counts as a hang; the others move to slow_TARGET.
 # Results: build/fuzz/tests/fuzz/campaign/TARGET.result, and a Markdown table in
-# build/fuzz/tests/fuzz/campaign/summary.md (what README.md quotes).
+# build/fuzz/tests/fuzz/campaign/summary.md: docs/fuzzing.md quotes it between its
+# campaign:begin/end markers (copied there by hand; this script never edits tracked files).
 # Build first:  scripts/setup.sh fuzz   (or cmake --preset fuzz && cmake --build build/fuzz --target fuzz_all)
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"

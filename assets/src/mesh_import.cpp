@@ -5,8 +5,8 @@
 // 4. OBJ + MTL  5. OFF  6. PLY  7. STL  8. loadMeshFile
 //
 // ---- 1. Why our own parsers instead of OpenMesh 9.0 (Debian) --------------------------------
-// The guide prefers Debian's OpenMesh; these are small, bounded parsers of our own because
-// OpenMesh failed the requirements on this machine's test data (checked with read_mesh on a
+// Debian's OpenMesh would be the obvious choice; these are small, bounded parsers of our own
+// because OpenMesh failed what a viewer needs on the test data (checked with read_mesh on a
 // PolyMesh_ArrayKernelT):
 //   * PLY: `tristrips` elements are "unsupported" (cow.ply / igea.ply load with 0 faces), and
 //     Box.ply (CR-only header line ends) fails to load at all.
@@ -15,7 +15,7 @@
 //   * OFF read from memory (istream, the only way to keep the file access ours) yields 0
 //     vertices; reading by path would let it open FIFOs/devices itself.
 //   * Huge header counts throw std::bad_alloc, truncated files report success, faces with bad
-//     indices vanish silently, OBJ mtllib paths are followed anywhere (NOTES.md).
+//     indices vanish silently, OBJ mtllib paths are followed anywhere.
 // A viewer needs triangle soups, not a manifold half-edge structure, so the importer keeps
 // every face (polygons fan-triangulated), checks header counts against the file size before
 // allocating, reports truncation and dropped faces as warnings, polls cancel/progress, and

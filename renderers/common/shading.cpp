@@ -22,7 +22,7 @@ LightSample sampleLight(const DrawLight& light, const vec3& p) {
     s.distance = std::sqrt(dist2);
     s.toLight = s.distance > 0 ? d / s.distance : vec3(0, 1, 0);
     s.radiance = light.radiance;
-    if (light.inverseSquare) s.radiance /= std::max(dist2, 1e-8f);   // seeds 3.2: 1/r^2
+    if (light.inverseSquare) s.radiance /= std::max(dist2, 1e-8f);   // docs/math.md: 1/r^2
     if (light.type == LightType::Spot) {
         float c = glm::dot(-s.toLight, light.direction);
         float t = light.cosInner > light.cosOuter ? (c - light.cosOuter) / (light.cosInner - light.cosOuter) : (c >= light.cosOuter ? 1.0f : 0.0f);

@@ -265,7 +265,7 @@ inline sg::vec4 toWindow(const sg::vec4& c, int width, int height) {
 }
 
 // ---------------------------------------------------------------------------------------
-// 4. Lines: DDA (seeds: "Digital Differential Analyzer") over window coordinates
+// 4. Lines: DDA ("Digital Differential Analyzer") over window coordinates
 // ---------------------------------------------------------------------------------------
 
 // Calls fn(i, j, t) for the pixels of the segment a -> b (window coordinates): one pixel per

@@ -1,5 +1,5 @@
 // raster_renderer.cpp - the "raster" backend: our own CPU implementation of the pipeline of
-// the seeds (modelling, lighting, viewing, projection, clipping, scan conversion).
+// docs/math.md (modelling, lighting, viewing, projection, clipping, scan conversion).
 //
 // Pipeline of one frame (tbb-parallel stages):
 //   1. gather     meshes + tessellated analytics -> DrawItems; textures -> SampledTextures

@@ -322,7 +322,7 @@ struct Event {
     bool enter;
 };
 
-// Boolean of two sorted span lists by sweeping their ends (seeds 2.3: combine the intervals).
+// Boolean of two sorted span lists by sweeping their ends (CSG: combine the intervals).
 // Difference: ends contributed by the cutter B get their normal flipped.
 void combine(const SpanList& A, const SpanList& B, CsgOp op, SpanList& out) {
     Event ev[2 * 2 * SpanList::kCapacity];

@@ -1,4 +1,4 @@
-// analytic.h - exact ray intersection with the analytic drawables (seeds 2.1-2.3, 2.6):
+// analytic.h - exact ray intersection with the analytic drawables (docs/math.md, ray casting):
 // implicit shapes as solids (ray intervals inside the solid, with which surface bounds each
 // end), CSG by combining leaf intervals, parametric surfaces by Newton iteration from bounded
 // starts, density grids by marching + bisection on the trilinear field.

@@ -1,7 +1,7 @@
 // bvh.h - the ray caster's acceleration structure: a 4-wide bounding volume hierarchy (BVH4)
 // built with binned SAH, traversed front to back with SSE box tests (4 children at once), and
 // a triangle BVH whose leaves are packets of 4 precomputed triangles tested at once with SSE
-// (Moller-Trumbore, seeds 2.4). Used for the per-mesh BVHs (object space), for the top level
+// (Moller-Trumbore, docs/math.md). Used for the per-mesh BVHs (object space), for the top level
 // over instances (TLAS), and by the benchmark against Embree.
 //
 // Sections: Ray/Hit, Bvh4 (generic: boxes in, leaves of up to 4 primitive indices out),

@@ -1,5 +1,5 @@
 // bvh_traverse.inl - the templated BVH4 traversal (included by bvh.h). Ordered front-to-back:
-// the 4 child boxes are slab-tested at once with SSE (seeds 2.5.1: overlapping slab intervals
+// the 4 child boxes are slab-tested at once with SSE (docs/math.md: overlapping slab intervals
 // mean a hit), hit children are sorted by entry distance, the nearest is visited next and the
 // others pushed with their entry distance so they can be skipped once a closer hit is known.
 #pragma once

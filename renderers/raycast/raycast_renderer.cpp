@@ -1,11 +1,11 @@
-// raycast_renderer.cpp - the "raycast" backend: CPU ray casting (seeds chapter 2) with the
+// raycast_renderer.cpp - the "raycast" backend: CPU ray casting (docs/math.md) with the
 // shared Phong shading (renderers/shading.h), shadow rays, optional mirror reflections and
 // stratified supersampling; tile-parallel (oneTBB), progressive and cancellable.
 //
 // Sections: texture footprint, Tracer (hit shading: meshes flat/Gouraud/Phong, analytics),
 // RaycastRenderer::render (tiles, AA, progress, cancellation).
 //
-// Conventions followed (see renderers/renderer.h and the brief): primary rays come from
+// Conventions shared with the rasterizers (docs/math.md): primary rays come from
 // CameraRays (unprojecting pixel centres, so images line up with the rasterizers); depth is
 // window z; two-sided lighting flips normals of back-facing triangles (geometric normal
 // pointing along the ray); fog uses |p_eye|. Textures: the rasterizer's sampler (mip chains,

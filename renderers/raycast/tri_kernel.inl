@@ -14,7 +14,7 @@
 #define RT_MADD(a, b, c) _mm_add_ps(_mm_mul_ps((a), (b)), (c))
 #endif
 
-// Moller-Trumbore on 4 triangles at once (seeds 2.4), with the precomputed normal
+// Moller-Trumbore on 4 triangles at once (docs/math.md), with the precomputed normal
 // N = e1 x e2, s = o - p0 and R = s x d (scalar triple products):
 //   det = -d.N,  b1 = e2.R / det,  b2 = -e1.R / det,  t = s.N / det.
 // Division-free: comparisons use the sign-adjusted numerators against |det|; only packets with

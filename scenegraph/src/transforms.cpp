@@ -3,7 +3,7 @@
 namespace sg {
 
 namespace {
-// Sets the seeds' entry (row r, column c); GLM is column-major: m[c][r].
+// Sets the entry (row r, column c) as written in docs/math.md; GLM is column-major: m[c][r].
 inline void set(mat4& m, int r, int c, float v) { m[c][r] = v; }
 }   // namespace
 
@@ -64,7 +64,7 @@ mat4 shear(int a, int b, float s) {
 }
 
 mat4 lookAt(const vec3& eye, const vec3& center, const vec3& up) {
-    // Camera basis in world coordinates (seeds): z^c points back from the target.
+    // Camera basis in world coordinates (docs/math.md, lookAt): z^c points back from the target.
     vec3 zc = glm::normalize(eye - center);
     vec3 xc = glm::cross(up, zc);
     float len = glm::length(xc);
@@ -89,7 +89,7 @@ mat4 lookAt(const vec3& eye, const vec3& center, const vec3& up) {
 }
 
 mat4 perspective(float fovy, float aspect, float n, float f) {
-    // f = cot(fovy/2); seeds: diag(f/aspect, f, (f+n)/(n-f)) with -1 in the last row.
+    // f = cot(fovy/2); docs/math.md: diag(f/aspect, f, (f+n)/(n-f)) with -1 in the last row.
     float ct = 1.0f / std::tan(0.5f * fovy);
     mat4 m(0.0f);
     set(m, 0, 0, ct / aspect);
@@ -140,7 +140,7 @@ mat4 oblique(float l, float r, float b, float t, float n, float f, float angle, 
 }
 
 mat4 viewport(float x0, float y0, float w, float h) {
-    // Seeds: x_w = (x_n + 1) w/2 + x0, y_w = (y_n + 1) h/2 + y0, z_w = (z_n + 1)/2.
+    // docs/math.md: x_w = (x_n + 1) w/2 + x0, y_w = (y_n + 1) h/2 + y0, z_w = (z_n + 1)/2.
     mat4 m(1.0f);
     set(m, 0, 0, 0.5f * w);
     set(m, 0, 3, x0 + 0.5f * w);

@@ -1,5 +1,5 @@
-// A 1M-deep chain of nodes (issue 8: "deep scene graphs load, update and render without stack
-// overflow"). The chain is written as a native JSON scene file and as a glTF file, loaded
+// A 1M-deep chain of nodes (deep scene graphs must load, update and render without stack
+// overflow). The chain is written as a native JSON scene file and as a glTF file, loaded
 // through assets::loadScene like the viewer does, and rendered by every backend. Nothing may
 // recurse per level: a 1M-deep recursion overflows the 8 MB main-thread stack (and the much
 // smaller worker-thread stacks) many times over.

@@ -1,7 +1,7 @@
-// transforms_test.cpp - the seed matrices (shared/seeds) element by element, against GLM
-// where GLM has an equivalent, and known points landing where the seeds say: frustum corners
+// transforms_test.cpp - the matrices of docs/math.md element by element, against GLM
+// where GLM has an equivalent, and known points landing where docs/math.md says: frustum corners
 // on the NDC cube, near -> z_ndc = -1, far -> +1, viewport corners, oblique shifts.
-// Seeds' entries are (row r, column c); GLM stores m[c][r].
+// docs/math.md writes entries as (row r, column c); GLM stores m[c][r].
 #include "scenegraph/transforms.h"
 #include "scenegraph/projection.h"
 
@@ -14,7 +14,7 @@ using namespace sg;
 
 namespace {
 
-// Seeds' entry (row r, column c).
+// Entry (row r, column c) as written in docs/math.md.
 float at(const mat4& m, int r, int c) { return m[c][r]; }
 
 ::testing::AssertionResult matNear(const mat4& a, const mat4& b, float eps = 1e-5f) {
@@ -25,7 +25,7 @@ float at(const mat4& m, int r, int c) { return m[c][r]; }
     return ::testing::AssertionSuccess();
 }
 
-// Seed matrices written row by row, as printed in the notes.
+// Matrices written row by row, as printed in docs/math.md.
 mat4 rows(std::initializer_list<float> v) {
     mat4 m(0.0f);
     int i = 0;
@@ -132,9 +132,9 @@ TEST(TransformsTest, LookAtBasisMatchesSeedsAndGlm) {
 TEST(TransformsTest, PerspectiveFovyAspect) {
     float fovy = radians(60.0f), aspect = 1.5f, n = 0.5f, f = 50.0f;
     mat4 p = perspective(fovy, aspect, n, f);
-    float ct = 1.0f / std::tan(fovy / 2);   // f = cot(fovy/2) in the seeds
-    // Seeds (004): diag(f/aspect, f, ...) with -1 in the last row. The third row carries the
-    // "flip z" of the notes: -(far+near)/(far-near), -2 far near/(far-near) (as in the frustum
+    float ct = 1.0f / std::tan(fovy / 2);   // F = cot(fovy/2) in docs/math.md
+    // docs/math.md: diag(F/aspect, F, ...) with -1 in the last row. The third row carries the
+    // "flip z": -(far+near)/(far-near), -2 far near/(far-near) (as in the frustum
     // form and OpenGL), so that near maps to -1 and far to +1.
     EXPECT_TRUE(matNear(p, rows({ct / aspect, 0, 0, 0, 0, ct, 0, 0, 0, 0, -(f + n) / (f - n), -2 * f * n / (f - n), 0, 0, -1, 0})));
     EXPECT_TRUE(matNear(p, glm::perspective(fovy, aspect, n, f)));

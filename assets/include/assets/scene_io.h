@@ -38,8 +38,8 @@ LoadResult loadScene(const std::filesystem::path& path, const LoadOptions& optio
 // Native JSON scene file.
 LoadResult loadSceneJson(const std::filesystem::path& path);
 LoadResult parseSceneJson(std::string_view text, const std::filesystem::path& pathForErrors);
-// Serialises the scene. Meshes that came from files are still written inline unless
-// `meshRefs` maps the mesh index to a file path relative to the scene file.
+// Serialises the scene. Every mesh is written inline (also one that was loaded from a file
+// reference) and every texture as an embedded PNG; file references are only read.
 std::string serializeSceneJson(const sg::Scene& scene);
 // Writes atomically; refuses to replace an existing file unless overwrite. "" on success.
 std::string saveSceneJson(const sg::Scene& scene, const std::filesystem::path& path, bool overwrite);

@@ -52,7 +52,7 @@ void sampleLight(int i, int type, bool inverseSquare, vec3 p, out vec3 toLight, 
     float dist2 = dot(d, d);
     float dist = sqrt(dist2);
     toLight = dist > 0.0 ? d / dist : vec3(0.0, 1.0, 0.0);
-    if (inverseSquare) radiance /= max(dist2, 1e-8);   // seeds 3.2: 1/r^2
+    if (inverseSquare) radiance /= max(dist2, 1e-8);   // docs/math.md: 1/r^2
     if (type == LIGHT_SPOT) {                          // smoothstep between the cones
         float c = dot(-toLight, uLightDir[i].xyz);
         float ci = uLightCone[i].x, co = uLightCone[i].y;

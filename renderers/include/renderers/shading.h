@@ -1,7 +1,7 @@
 // shading.h - the one Phong evaluation shared by the CPU rasterizer and the ray caster (the
 // GL shaders mirror it line by line; tests hold the three to each other).
 //
-// Seeds, section 3.1 (with m = shininess):
+// docs/math.md, illumination (with m = shininess):
 //   L_cam = ka * rho (x) L_ambient
 //         + sum_i  att_i * L_i * max(n.l_i, 0) (x) (kd * rho + ks * rho_spec * max(r_i.v, 0)^m)
 // Phong:  r_i = 2 (n.l_i) n - l_i ;  Blinn-Phong: (r_i.v) replaced by (n.h_i), h = (l+v)/|l+v|.

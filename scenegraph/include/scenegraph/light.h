@@ -14,7 +14,7 @@ struct Light {
     LightType type = LightType::Point;
     vec3 color{1.0f};
     float intensity = 1.0f;
-    // Inverse-square falloff 1/r^2 (seeds 3.2), applied when RenderSettings::attenuation is on.
+    // Inverse-square falloff 1/r^2 (docs/math.md), applied when RenderSettings::attenuation is on.
     bool inverseSquare = false;
     float spotInnerDeg = 20.0f;   // full intensity inside
     float spotOuterDeg = 30.0f;   // zero outside, smooth in between

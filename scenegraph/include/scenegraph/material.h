@@ -1,4 +1,4 @@
-// material.h - the Phong material of the seeds:
+// material.h - the Phong material (docs/math.md, illumination):
 //   L_cam = ka * rho (x) L_ambient
 //         + sum_i L_i (n.l_i) (x) (kd * rho + ks * rho_spec * (r_i.v)^n)
 // rho is the base colour (times the diffuse texture), rho_spec white or tinted by rho.

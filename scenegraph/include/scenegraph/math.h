@@ -1,5 +1,5 @@
 // math.h - the scene graph's vector/matrix vocabulary (GLM, column-major, right-handed,
-// camera looking down -z as in the seeds) plus a few small helpers.
+// camera looking down -z; conventions in docs/math.md) plus a few small helpers.
 #pragma once
 
 #include <glm/glm.hpp>

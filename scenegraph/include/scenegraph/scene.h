@@ -115,7 +115,7 @@ public:
     std::vector<std::shared_ptr<Mesh>> meshes;
     std::vector<Material> materials;
     std::vector<std::shared_ptr<Texture>> textures;
-    vec3 ambientLight{1.0f};   // L_indirect of the seeds (scaled per material by ka)
+    vec3 ambientLight{1.0f};   // L_ambient of docs/math.md (scaled per material by ka)
     RenderSettings settings;
     NodeId activeCamera = kNoNode;
 

@@ -1,6 +1,6 @@
-// transforms.h - the homogeneous 4x4 transforms of the lecture notes (shared/seeds), written
-// out element by element so tests can hold them to the formulas. Column-major storage:
-// m[col][row], so the seeds' matrix entry (row r, column c) is m[c][r].
+// transforms.h - the homogeneous 4x4 transforms of docs/math.md, written out element by
+// element so tests can hold them to the formulas. Column-major storage: m[col][row], so the
+// matrix entry (row r, column c) as written in docs/math.md is m[c][r].
 #pragma once
 
 #include "scenegraph/math.h"
@@ -16,7 +16,7 @@ mat4 mirrorX();   // P_x: x -> -x
 mat4 mirrorY();
 mat4 mirrorZ();
 // Shear H_ab(s): component a is offset by s times component b (a != b, 0=x,1=y,2=z).
-// H_xz(s) p = (px + s pz, py, pz), as in the seeds.
+// H_xz(s) p = (px + s pz, py, pz) (docs/math.md, model transforms).
 mat4 shear(int a, int b, float s);
 
 // View transform (world -> camera) of a camera at eye looking at center: camera looks
