@@ -1,4 +1,4 @@
-# Every dependency comes from Debian 12 packages (see scripts/deps.sh).
+# Every dependency comes from Debian 12 packages (installed by scripts/setup.sh).
 find_package(PkgConfig REQUIRED)
 find_package(Threads REQUIRED)
 find_package(glm REQUIRED)
