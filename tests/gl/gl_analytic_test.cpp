@@ -267,13 +267,13 @@ TEST(GlAntiAliasingGLTest, MsaaAndSsaaSoftenEdges) {
     auto r = rnd::makeGlRenderer();
     int none = intermediatePixels(render(*r, frame(AAMode::None, 1), W, H));
     int msaa4 = intermediatePixels(render(*r, frame(AAMode::MSAA, 4), W, H));
-    int msaa16 = intermediatePixels(render(*r, frame(AAMode::MSAA, 16), W, H));   // clamped to GL_MAX_SAMPLES
+    int msaa8 = intermediatePixels(render(*r, frame(AAMode::MSAA, 8), W, H));   // or fewer, with a note, on a driver without 8
     int ssaa2 = intermediatePixels(render(*r, frame(AAMode::SSAA, 2), W, H));
     int ssaa4 = intermediatePixels(render(*r, frame(AAMode::SSAA, 4), W, H));
-    std::printf("[aa] intermediate edge pixels: none %d, msaa4 %d, msaa16(clamped) %d, ssaa2 %d, ssaa4 %d\n", none, msaa4, msaa16, ssaa2, ssaa4);
+    std::printf("[aa] intermediate edge pixels: none %d, msaa4 %d, msaa8 %d, ssaa2 %d, ssaa4 %d\n", none, msaa4, msaa8, ssaa2, ssaa4);
     EXPECT_EQ(none, 0);
     EXPECT_GT(msaa4, 100);
-    EXPECT_GT(msaa16, 100);
+    EXPECT_GT(msaa8, 100);
     EXPECT_GT(ssaa2, 100);
     EXPECT_GT(ssaa4, 100);
     EXPECT_GT(rnd::glCacheCounters(*r).platform.size(), 0u);
