@@ -1,8 +1,10 @@
-#include "gl_test_scenes.h"
+#include "test_scenes.h"
 
 #include "scenegraph/transforms.h"
 
-namespace gltest {
+#include <cmath>
+
+namespace test_scenes {
 
 using namespace sg;
 
@@ -28,6 +30,25 @@ void addMesh(FrameInput& f, MeshPtr mesh, const Material& m, const mat4& world, 
 
 void addMesh(FrameInput& f, const Mesh& mesh, const Material& m, const mat4& world, TexturePtr texture) {
     addMesh(f, std::make_shared<const Mesh>(mesh), m, world, std::move(texture));
+}
+
+DrawMesh meshInstance(MeshPtr mesh, const mat4& world, const vec3& color) {
+    DrawMesh d;
+    d.mesh = std::move(mesh);
+    d.world = world;
+    d.normal = normalMatrix(world);
+    d.mirrored = glm::determinant(mat3(world)) < 0.0f;
+    d.material.baseColor = color;
+    return d;
+}
+
+Mesh quad(float half) {
+    Mesh m;
+    m.positions = {{-half, -half, 0}, {half, -half, 0}, {half, half, 0}, {-half, half, 0}};
+    m.normals.assign(4, vec3(0, 0, 1));
+    m.uv0 = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    m.indices = {0, 1, 2, 0, 2, 3};
+    return m;
 }
 
 DrawLight directional(const vec3& direction, const vec3& radiance) {
@@ -183,4 +204,86 @@ FrameInput baselineFrame(const std::string& name, int w, int h) {
     return f;
 }
 
-}   // namespace gltest
+FrameInput texturedFloorFrame(int w, int h, FilterMode filter, WrapMode wrap, ProjectionType proj, ShadingModel shading) {
+    Projection p;
+    p.type = proj;
+    p.orthoHalfHeight = 2.5f;
+    FrameInput f = makeFrame(w, h, p, vec3(0.3f, 1.6f, 4.0f), vec3(0, 0, -1));
+    auto tex = checker(64, 8, vec3(0.9f, 0.8f, 0.2f), vec3(0.1f, 0.2f, 0.6f));
+    tex->filter = filter;
+    tex->wrapS = tex->wrapT = wrap;
+    Mesh floor = primitives::plane(6.0f, 8);
+    for (auto& uv : floor.uv0) uv *= 4.0f;   // repeat 4x (wrap modes matter)
+    Material m;
+    m.baseColor = vec3(1.0f);
+    m.ks = 0.2f;
+    addMesh(f, floor, m, translation(vec3(0, -0.5f, -2)), tex);
+    Mesh box = primitives::box(vec3(0.6f));
+    addMesh(f, box, m, translation(vec3(-0.8f, 0.2f, 0.5f)) * rotationY(0.6f), tex);
+    f.lights.push_back(point(vec3(1, 3, 2), vec3(6.0f), true));
+    f.lights.push_back(directional(vec3(-0.3f, -1, -0.4f), vec3(0.3f)));
+    f.ambientLight = vec3(0.3f);
+    f.settings.shading = shading;
+    return f;
+}
+
+FrameInput nearPlaneFrame(int w, int h, ProjectionType proj) {
+    Projection p;
+    p.type = proj;
+    p.zNear = 0.3f;
+    p.zFar = 30.0f;
+    p.orthoHalfHeight = 3.0f;
+    FrameInput f = makeFrame(w, h, p, vec3(0, 0.5f, 0), vec3(0, 0.1f, -1));
+    Mesh tri;
+    tri.positions = {{-30, -1, 20}, {30, -1, 20}, {0, -1, -40}};
+    tri.normals = {{0, 1, 0}, {0, 1, 0}, {0, 1, 0}};
+    tri.indices = {0, 1, 2};   // counter-clockwise from above: lit side up
+    Material m;
+    m.baseColor = vec3(0.4f, 0.7f, 0.3f);
+    addMesh(f, tri, m);
+    f.lights.push_back(point(vec3(0, 3, -5), vec3(20.0f), true));
+    f.ambientLight = vec3(0.2f);
+    return f;
+}
+
+FrameInput triangleAgreementFrame(const Projection& proj, int w, int h) {
+    FrameInput f;
+    f.settings.shadows = false;
+    f.settings.reflections = false;
+    f.settings.aa = AAMode::None;
+    auto sphere = std::make_shared<Mesh>(primitives::uvSphere(0.8f, 48, 24));
+    auto box = std::make_shared<Mesh>(primitives::box(vec3(0.5f)));
+    auto ground = std::make_shared<Mesh>(primitives::plane(4.0f, 8));
+    auto cyl = std::make_shared<Mesh>(primitives::cylinder(0.4f, 0.6f, 32, false));   // open: back faces visible
+    f.meshes.push_back(meshInstance(sphere, glm::translate(mat4(1.0f), vec3(-0.9f, 0.8f, 0)), vec3(0.8f, 0.2f, 0.2f)));
+    f.meshes.push_back(
+        meshInstance(box, glm::rotate(glm::translate(mat4(1.0f), vec3(1.0f, 0.5f, 0.3f)), 0.6f, vec3(0, 1, 0)), vec3(0.2f, 0.6f, 0.9f)));
+    f.meshes.push_back(meshInstance(ground, mat4(1.0f), vec3(0.7f, 0.7f, 0.6f)));
+    f.meshes.push_back(meshInstance(cyl, glm::translate(mat4(1.0f), vec3(0.2f, 0.6f, 1.4f)), vec3(0.3f, 0.8f, 0.3f)));
+    // Mirrored instance (negative x scale): winding flips, shading must not.
+    f.meshes.push_back(
+        meshInstance(sphere, glm::scale(glm::translate(mat4(1.0f), vec3(0.2f, 0.5f, -1.5f)), vec3(-0.5f, 0.5f, 0.5f)), vec3(0.9f, 0.8f, 0.2f)));
+    f.meshes[1].material.ks = 0.6f;
+    f.meshes[1].material.shininess = 16.0f;
+    DrawLight l1;
+    l1.position = vec3(2.5f, 4.0f, 3.0f);
+    l1.radiance = vec3(0.9f);
+    DrawLight l2;
+    l2.type = LightType::Directional;
+    l2.direction = glm::normalize(vec3(-0.3f, -1.0f, -0.5f));
+    l2.radiance = vec3(0.3f, 0.3f, 0.4f);
+    f.lights = {l1, l2};
+    f.ambientLight = vec3(0.3f);
+    mat4 cam = glm::inverse(glm::lookAt(vec3(1.5f, 3.0f, 5.5f), vec3(0, 0.4f, 0), vec3(0, 1, 0)));
+    f.camera = makeFrameCamera(cam, proj, float(w) / float(h), 6.0f);
+    return f;
+}
+
+std::shared_ptr<Texture> minificationChecker() {
+    auto tex = checker(64, 16, vec3(250.0f / 255.0f), vec3(10.0f / 255.0f));
+    tex->filter = FilterMode::Trilinear;
+    tex->wrapS = tex->wrapT = WrapMode::Repeat;
+    return tex;
+}
+
+}   // namespace test_scenes
