@@ -286,4 +286,92 @@ std::shared_ptr<Texture> minificationChecker() {
     return tex;
 }
 
+// --- BackendConformance reference scenes.
+
+FrameInput litSphereFrame(int w, int h, ShadingModel shading, ReflectionModel reflection, SphereLight light, int slices) {
+    FrameInput f = makeFrame(w, h, Projection{}, vec3(0.0f, 0.0f, 3.2f), vec3(0.0f));
+    f.ambientLight = vec3(0.2f);
+    f.settings.shading = shading;
+    f.settings.reflection = reflection;
+    f.settings.aa = AAMode::None;
+    f.settings.shadows = false;
+    f.settings.reflections = false;
+    Material m;
+    m.baseColor = vec3(0.6f, 0.4f, 0.25f);
+    m.ka = 0.2f;
+    m.kd = 0.7f;
+    m.ks = 0.35f;
+    m.shininess = 24.0f;   // ka rho A + kd rho L + ks L <= 0.72: no channel ever clamps
+    const vec3 toLight = glm::normalize(vec3(-0.5f, 0.6f, 1.0f));
+    if (light == SphereLight::Directional)
+        f.lights.push_back(directional(-toLight, vec3(0.9f)));
+    else
+        f.lights.push_back(point(4.0f * toLight, vec3(0.9f), false));
+    addMesh(f, std::make_shared<const Mesh>(primitives::uvSphere(1.0f, slices, slices / 2)), m);
+    return f;
+}
+
+FrameInput fogPlaneFrame(int w, int h, FogMode mode) {
+    FrameInput f = makeFrame(w, h, Projection{}, vec3(0.0f, 0.6f, 3.0f), vec3(0.0f, -1.0f, -6.0f));
+    f.settings.fog = mode;
+    f.settings.fogColor = vec3(0.3f, 0.45f, 0.7f);
+    f.settings.fogStart = 2.0f;
+    f.settings.fogEnd = 14.0f;
+    f.settings.fogDensity = mode == FogMode::Exp2 ? 0.12f : 0.15f;
+    f.settings.aa = AAMode::None;
+    addMesh(f, primitives::plane(40.0f, 1), unlit(vec3(0.85f, 0.35f, 0.15f)), translation(vec3(0.0f, -1.0f, 0.0f)));
+    return f;
+}
+
+std::shared_ptr<Texture> texelGrid() {
+    auto t = std::make_shared<Texture>();
+    t->width = t->height = 4;
+    t->rgba.resize(4 * 4 * 4);
+    for (int y = 0; y < 4; ++y)
+        for (int x = 0; x < 4; ++x) {
+            uint8_t* p = &t->rgba[size_t(y * 4 + x) * 4];
+            p[0] = uint8_t(40 + 60 * x);
+            p[1] = uint8_t(40 + 60 * y);
+            p[2] = uint8_t((x + y) % 2 ? 220 : 30);
+            p[3] = 255;
+        }
+    t->filter = FilterMode::Nearest;
+    t->wrapS = t->wrapT = WrapMode::ClampToEdge;
+    return t;
+}
+
+FrameInput texturedQuadFrame(int w, int h, bool tilted) {
+    Projection p;
+    if (!tilted) {
+        p.type = ProjectionType::Orthographic;
+        p.orthoHalfHeight = 1.5f;
+    }
+    FrameInput f = makeFrame(w, h, p, vec3(0.0f, 0.0f, tilted ? 3.5f : 5.0f), vec3(0.0f));
+    f.settings.aa = AAMode::None;
+    const mat4 world = tilted ? rotationY(glm::radians(20.0f)) * rotationX(glm::radians(-50.0f)) : mat4(1.0f);
+    addMesh(f, quad(1.0f), unlit(vec3(1.0f)), world, texelGrid());
+    return f;
+}
+
+FrameInput projectedBoxFrame(int w, int h, const Projection& proj) {
+    Projection p = proj;
+    p.orthoHalfHeight = 1.5f;
+    FrameInput f = makeFrame(w, h, p, vec3(0.0f, 0.0f, 5.0f), vec3(0.0f));
+    f.settings.aa = AAMode::None;
+    const mat4 world = translation(vec3(0.2f, -0.1f, -0.3f)) * rotationY(glm::radians(30.0f)) * rotationX(glm::radians(20.0f));
+    addMesh(f, primitives::box(vec3(0.6f, 0.4f, 0.5f)), unlit(vec3(1.0f)), world);
+    return f;
+}
+
+FrameInput aaEdgeFrame(int w, int h, AAMode aa, int rate) {
+    Projection p;
+    p.type = ProjectionType::Orthographic;
+    p.orthoHalfHeight = 1.5f;
+    FrameInput f = makeFrame(w, h, p, vec3(0.0f, 0.0f, 5.0f), vec3(0.0f));
+    f.settings.aa = aa;
+    f.settings.aaRate = rate;
+    addMesh(f, quad(1.2f), unlit(vec3(1.0f)), rotationZ(glm::radians(20.0f)));
+    return f;
+}
+
 }   // namespace test_scenes

@@ -45,6 +45,31 @@ sg::FrameInput triangleAgreementFrame(const sg::Projection& proj, int w, int h);
 // A 64x64 checker of 4-texel squares (250/255 and 10/255 grey), trilinear, repeating.
 std::shared_ptr<sg::Texture> minificationChecker();
 
+// --- Reference scenes of the BackendConformance suite (tests/conformance). Every parameter a
+// check needs (material, light, camera, settings) is read back from the returned frame.
+
+// A sphere of radius 1 at the origin (uvSphere with `slices` x slices/2), camera at (0, 0, 3.2)
+// looking at the origin (perspective, 45 degrees), one light of the given kind (directional
+// from the upper left front, or a point light there without attenuation), ambient light, a
+// material with ka, kd, ks, shininess set and vertex colours never above 1.
+enum class SphereLight { Directional, Point };
+sg::FrameInput litSphereFrame(int w, int h, sg::ShadingModel shading, sg::ReflectionModel reflection, SphereLight light, int slices);
+// An unlit floor (y = -1, one quad of half size 40, colour (0.85, 0.35, 0.15)) receding from a
+// camera at (0, 0.6, 3) looking down the -z axis, fog of the given mode toward (0.3, 0.45, 0.7).
+sg::FrameInput fogPlaneFrame(int w, int h, sg::FogMode mode);
+// A 4x4 texture of 16 distinct colours, nearest filtering, clamp to edge.
+std::shared_ptr<sg::Texture> texelGrid();
+// quad(1) with texelGrid() (unlit white) seen head-on through an orthographic camera
+// (tilted == false), or tilted back 50 degrees about x and turned 20 degrees about y under a
+// perspective camera (tilted == true: perspective-correct interpolation matters).
+sg::FrameInput texturedQuadFrame(int w, int h, bool tilted);
+// An unlit white box (half extents 0.6, 0.4, 0.5) turned about y and x, at (0.2, -0.1, -0.3),
+// seen from (0, 0, 5) under `proj` (ortho half height 1.5): for the footprint checks.
+sg::FrameInput projectedBoxFrame(int w, int h, const sg::Projection& proj);
+// An unlit white quad(1.2) turned 20 degrees about z, camera at (0, 0, 5), orthographic (half
+// height 1.5) so its straight edges have known window-space lines; AA as given.
+sg::FrameInput aaEdgeFrame(int w, int h, sg::AAMode aa, int rate);
+
 // Channel c of pixel (x, y) (x right, y down from the top row).
 inline int channel(const rnd::Framebuffer& fb, int x, int y, int c) { return fb.pixel(x, y)[c]; }
 
