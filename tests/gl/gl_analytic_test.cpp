@@ -3,14 +3,14 @@
 // orientation, oblique receding angles, orthographic parallelism, anti-aliasing and the GPU
 // cache.
 #include "gl/gl_renderer.h"
-#include "gl_test_scenes.h"
 #include "renderers/shading.h"
+#include "test_scenes.h"
 #include "test_support.h"
 
 #include <cmath>
 
 using namespace sg;
-using namespace gltest;
+using namespace test_scenes;
 
 namespace {
 
@@ -36,16 +36,6 @@ rnd::Framebuffer render(const FrameInput& f, int w, int h) {
                                                  << int(rnd::toByteSRGB(linear.b)) << ") +-" << tol;
     }
     return ::testing::AssertionSuccess();
-}
-
-// A square quad in the z = 0 plane facing +z, uv (0,0) bottom-left .. (1,1) top-right.
-Mesh quad(float half) {
-    Mesh m;
-    m.positions = {{-half, -half, 0}, {half, -half, 0}, {half, half, 0}, {-half, half, 0}};
-    m.normals.assign(4, vec3(0, 0, 1));
-    m.uv0 = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
-    m.indices = {0, 1, 2, 0, 2, 3};
-    return m;
 }
 
 }   // namespace

@@ -2,7 +2,7 @@
 // caller's context (state the caller relies on is restored).
 #include "gl/gl_context.h"
 #include "gl/gl_renderer.h"
-#include "gl_test_scenes.h"
+#include "test_scenes.h"
 #include "test_support.h"
 
 #include <glad/gl.h>
@@ -36,9 +36,9 @@ private:
 };
 
 FrameInput simpleFrame() {
-    FrameInput f = gltest::makeFrame(64, 48, Projection{}, vec3(0, 0, 5), vec3(0));
-    f.lights.push_back(gltest::directional(vec3(0, 0, -1), vec3(1.0f)));
-    gltest::addMesh(f, primitives::uvSphere(1.0f, 16, 8), Material{});
+    FrameInput f = test_scenes::makeFrame(64, 48, Projection{}, vec3(0, 0, 5), vec3(0));
+    f.lights.push_back(test_scenes::directional(vec3(0, 0, -1), vec3(1.0f)));
+    test_scenes::addMesh(f, primitives::uvSphere(1.0f, 16, 8), Material{});
     return f;
 }
 

@@ -7,6 +7,7 @@
 // ReflectedTextureMatchesMirroredCamera, the ray caster against itself through a mirror.
 #include "renderers/renderer.h"
 #include "scenegraph/frame.h"
+#include "test_scenes.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>
@@ -18,47 +19,7 @@ namespace {
 
 constexpr int kW = 320, kH = 240;
 
-DrawMesh instance(std::shared_ptr<Mesh> m, const mat4& world, vec3 color) {
-    DrawMesh d;
-    d.mesh = std::move(m);
-    d.world = world;
-    d.normal = normalMatrix(world);
-    d.mirrored = glm::determinant(mat3(world)) < 0.0f;
-    d.material.baseColor = color;
-    return d;
-}
-
-FrameInput baseScene(const Projection& proj) {
-    FrameInput f;
-    f.settings.shadows = false;
-    f.settings.reflections = false;
-    f.settings.aa = AAMode::None;
-    auto sphere = std::make_shared<Mesh>(primitives::uvSphere(0.8f, 48, 24));
-    auto box = std::make_shared<Mesh>(primitives::box(vec3(0.5f)));
-    auto ground = std::make_shared<Mesh>(primitives::plane(4.0f, 8));
-    auto cyl = std::make_shared<Mesh>(primitives::cylinder(0.4f, 0.6f, 32, false));   // open: back faces visible
-    f.meshes.push_back(instance(sphere, glm::translate(mat4(1.0f), vec3(-0.9f, 0.8f, 0)), vec3(0.8f, 0.2f, 0.2f)));
-    f.meshes.push_back(instance(box, glm::rotate(glm::translate(mat4(1.0f), vec3(1.0f, 0.5f, 0.3f)), 0.6f, vec3(0, 1, 0)), vec3(0.2f, 0.6f, 0.9f)));
-    f.meshes.push_back(instance(ground, mat4(1.0f), vec3(0.7f, 0.7f, 0.6f)));
-    f.meshes.push_back(instance(cyl, glm::translate(mat4(1.0f), vec3(0.2f, 0.6f, 1.4f)), vec3(0.3f, 0.8f, 0.3f)));
-    // Mirrored instance (negative x scale): winding flips, shading must not.
-    f.meshes.push_back(
-        instance(sphere, glm::scale(glm::translate(mat4(1.0f), vec3(0.2f, 0.5f, -1.5f)), vec3(-0.5f, 0.5f, 0.5f)), vec3(0.9f, 0.8f, 0.2f)));
-    f.meshes[1].material.ks = 0.6f;
-    f.meshes[1].material.shininess = 16.0f;
-    DrawLight l1;
-    l1.position = vec3(2.5f, 4.0f, 3.0f);
-    l1.radiance = vec3(0.9f);
-    DrawLight l2;
-    l2.type = LightType::Directional;
-    l2.direction = glm::normalize(vec3(-0.3f, -1.0f, -0.5f));
-    l2.radiance = vec3(0.3f, 0.3f, 0.4f);
-    f.lights = {l1, l2};
-    f.ambientLight = vec3(0.3f);
-    mat4 cam = glm::inverse(glm::lookAt(vec3(1.5f, 3.0f, 5.5f), vec3(0, 0.4f, 0), vec3(0, 1, 0)));
-    f.camera = makeFrameCamera(cam, proj, float(kW) / kH, 6.0f);
-    return f;
-}
+FrameInput baseScene(const Projection& proj) { return test_scenes::triangleAgreementFrame(proj, kW, kH); }
 
 void expectAgree(const FrameInput& f, const std::string& name) {
     auto ray = makeRenderer("raycast");
@@ -77,13 +38,7 @@ void expectAgree(const FrameInput& f, const std::string& name) {
     testing_support::writeImage(a, "raycast_raster", name + "-raycast");
 }
 
-// A 64x64 checker of 4-texel squares, trilinear, repeating (for minification tests).
-std::shared_ptr<Texture> checkerTexture() {
-    auto tex = testing_support::checker(64, 16, vec3(250.0f / 255.0f), vec3(10.0f / 255.0f));
-    tex->filter = FilterMode::Trilinear;
-    tex->wrapS = tex->wrapT = WrapMode::Repeat;
-    return tex;
-}
+std::shared_ptr<Texture> checkerTexture() { return test_scenes::minificationChecker(); }
 
 Projection perspective() { return Projection{}; }
 Projection ortho() {
@@ -206,10 +161,11 @@ TEST(RaycastTest, ReflectedTextureMatchesMirroredCamera) {
     auto ceilingMesh = std::make_shared<Mesh>(primitives::plane(100.0f, 1));
     for (vec2& uv : ceilingMesh->uv0) uv *= 100.0f;   // 2 units per repeat, squares of 1/8
     // The ceiling at y = 2 facing down (rotated half a turn about x).
-    DrawMesh ceiling = instance(ceilingMesh, glm::rotate(glm::translate(mat4(1.0f), vec3(0, 2, 0)), glm::pi<float>(), vec3(1, 0, 0)), vec3(1.0f));
+    DrawMesh ceiling =
+        test_scenes::meshInstance(ceilingMesh, glm::rotate(glm::translate(mat4(1.0f), vec3(0, 2, 0)), glm::pi<float>(), vec3(1, 0, 0)), vec3(1.0f));
     ceiling.texture = tex;
     ceiling.material.unlit = true;
-    DrawMesh mirror = instance(std::make_shared<Mesh>(primitives::plane(100.0f, 1)), mat4(1.0f), vec3(0.2f));
+    DrawMesh mirror = test_scenes::meshInstance(std::make_shared<Mesh>(primitives::plane(100.0f, 1)), mat4(1.0f), vec3(0.2f));
     mirror.material.reflectivity = 1.0f;
 
     auto frame = [&](bool withMirror, const vec3& eye, const vec3& target, const vec3& up) {

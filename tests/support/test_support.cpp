@@ -3,6 +3,7 @@
 #include "assets/image_io.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <cstdlib>
 
 namespace fs = std::filesystem;
@@ -49,6 +50,68 @@ void writeImage(const rnd::Framebuffer& img, const std::string& suite, const std
     return ::testing::AssertionFailure() << name << ": " << d.describe() << " (allowed: mean <= " << tol.maxMeanAbs << ", within "
                                          << tol.channelTolerance << "/255 >= " << tol.minFractionWithin * 100 << "%); images written to "
                                          << outputDir(suite);
+}
+
+::testing::AssertionResult pixelsMatch(const rnd::Framebuffer& actual, const rnd::Framebuffer& expectedImage, const std::vector<PixelCheck>& checks,
+                                       const std::string& suite, const std::string& name, PixelCheckSummary* summary) {
+    PixelCheckSummary s;
+    struct Failure {
+        const PixelCheck* check;
+        int diff;
+    };
+    std::vector<Failure> failures;
+    double sum = 0;
+    for (const PixelCheck& c : checks) {
+        if (c.x < 0 || c.y < 0 || c.x >= actual.width || c.y >= actual.height) {
+            failures.push_back({&c, 256});
+            continue;
+        }
+        const uint8_t* p = actual.pixel(c.x, c.y);
+        int worst = 0;
+        for (int ch = 0; ch < 3; ++ch) {
+            int d = std::abs(int(p[ch]) - int(c.expected[ch]));
+            worst = std::max(worst, d);
+            sum += d;
+        }
+        s.maxAbs = std::max(s.maxAbs, worst);
+        if (worst > c.tolerance) failures.push_back({&c, worst});
+    }
+    s.checked = int(checks.size());
+    s.failed = int(failures.size());
+    s.meanAbs = checks.empty() ? 0.0 : sum / (3.0 * double(checks.size()));
+    if (summary) *summary = s;
+    std::printf("[pixels] %s/%s: %d checked, %d outside tolerance, max |diff| %d/255, mean %.3f/255\n", suite.c_str(), name.c_str(), s.checked,
+                s.failed, s.maxAbs, s.meanAbs);
+    if (checks.empty()) return ::testing::AssertionFailure() << name << ": no pixels were checked (the scene does not cover the test points)";
+    if (failures.empty()) return ::testing::AssertionSuccess();
+
+    std::sort(failures.begin(), failures.end(), [](const Failure& a, const Failure& b) { return a.diff > b.diff; });
+    ::testing::AssertionResult r = ::testing::AssertionFailure();
+    r << name << ": " << s.failed << " of " << s.checked << " checked pixels outside tolerance (max |diff| " << s.maxAbs << "/255); worst:";
+    for (size_t i = 0; i < failures.size() && i < 8; ++i) {
+        const PixelCheck& c = *failures[i].check;
+        r << "\n  pixel (" << c.x << "," << c.y << "): expected (" << int(c.expected[0]) << "," << int(c.expected[1]) << "," << int(c.expected[2])
+          << ") +-" << c.tolerance;
+        if (c.x >= 0 && c.y >= 0 && c.x < actual.width && c.y < actual.height) {
+            const uint8_t* p = actual.pixel(c.x, c.y);
+            r << ", actual (" << int(p[0]) << "," << int(p[1]) << "," << int(p[2]) << ")";
+        } else {
+            r << ", outside the " << actual.width << "x" << actual.height << " image";
+        }
+    }
+    // Diff of the checked pixels only: unchecked pixels take the actual value.
+    rnd::Framebuffer masked = actual;
+    int minTol = 255;
+    for (const PixelCheck& c : checks) {
+        if (c.x < 0 || c.y < 0 || c.x >= actual.width || c.y >= actual.height) continue;
+        for (int ch = 0; ch < 3; ++ch) masked.pixel(c.x, c.y)[ch] = c.expected[ch];
+        minTol = std::min(minTol, c.tolerance);
+    }
+    writeImage(actual, suite, name + "-actual");
+    writeImage(expectedImage.width > 0 ? expectedImage : masked, suite, name + "-expected");
+    if (masked.width > 0) writeImage(rnd::diffImage(actual, masked, minTol), suite, name + "-diff");
+    r << "\n  images written to " << outputDir(suite) / name << "-{actual,expected,diff}.png";
+    return r;
 }
 
 std::string base64Encode(std::string_view bytes) {

@@ -11,6 +11,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace testing_support {
 
@@ -33,6 +34,24 @@ struct ImageTolerance {
                                        const std::string& suite, const std::string& name);
 
 void writeImage(const rnd::Framebuffer& img, const std::string& suite, const std::string& name);
+
+// One pixel held to a value computed from a formula: (x, y) with y down from the top row,
+// the expected sRGB bytes and the allowed difference per channel.
+struct PixelCheck {
+    int x = 0, y = 0;
+    uint8_t expected[3] = {0, 0, 0};
+    int tolerance = 1;
+};
+struct PixelCheckSummary {
+    int checked = 0, failed = 0, maxAbs = 0;
+    double meanAbs = 0;   // over the checked pixels' channels, 0..255 units
+};
+// Checks `actual` at every PixelCheck; prints "[pixels] suite/name: ..." with the figures
+// (into *summary when given). On failure reports the worst pixels (position, expected,
+// actual) and writes <name>-actual.png, <name>-expected.png (`expectedImage`: the formula's
+// whole image) and <name>-diff.png (only the checked pixels) into outputDir(suite).
+::testing::AssertionResult pixelsMatch(const rnd::Framebuffer& actual, const rnd::Framebuffer& expectedImage, const std::vector<PixelCheck>& checks,
+                                       const std::string& suite, const std::string& name, PixelCheckSummary* summary = nullptr);
 
 // A size x size RGBA texture of checks x checks squares: colour a where the square's x + y is
 // odd, b elsewhere (0..1, rounded to 8 bits). Default sampling settings.
