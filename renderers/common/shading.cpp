@@ -32,35 +32,53 @@ LightSample sampleLight(const DrawLight& light, const vec3& p) {
     return s;
 }
 
-vec3 shadeLight(const Material& m, const SurfacePoint& s, const vec3& v, const LightSample& l, ReflectionModel model) {
-    float nl = glm::dot(s.normal, l.toLight);
-    if (nl <= 0.0f) return vec3(0.0f);
+ShadeTerms lightTerms(const Material& m, const vec3& n, const vec3& v, const LightSample& l, ReflectionModel model) {
+    ShadeTerms t;
+    float nl = glm::dot(n, l.toLight);
+    if (nl <= 0.0f) return t;
     float spec;
     if (model == ReflectionModel::Phong) {
-        vec3 r = 2.0f * nl * s.normal - l.toLight;   // mirror direction of l about n
+        vec3 r = 2.0f * nl * n - l.toLight;   // mirror direction of l about n
         spec = std::max(glm::dot(r, v), 0.0f);
     } else {
         vec3 h = l.toLight + v;
         float len = glm::length(h);
-        spec = len > 0 ? std::max(glm::dot(s.normal, h / len), 0.0f) : 0.0f;
+        spec = len > 0 ? std::max(glm::dot(n, h / len), 0.0f) : 0.0f;
     }
     spec = spec > 0.0f ? std::pow(spec, m.shininess) : 0.0f;
-    vec3 specColor = m.specularTinted ? s.albedo : m.specularColor;
-    return l.radiance * nl * (m.kd * s.albedo + m.ks * spec * specColor);
+    vec3 ln = l.radiance * nl;
+    t.mul = ln * m.kd;
+    if (m.specularTinted)
+        t.mul += ln * (m.ks * spec);   // specular colour = albedo
+    else
+        t.add = ln * (m.ks * spec) * m.specularColor;
+    return t;
+}
+
+ShadeTerms shadeTerms(const Material& m, const vec3& p, const vec3& n, const vec3& eye, const FrameInput& f, const float* visible) {
+    ShadeTerms t;
+    if (m.unlit) {
+        t.mul = vec3(1.0f);
+        t.add = m.emissive;
+        return t;
+    }
+    vec3 v = eye - p;
+    float len = glm::length(v);
+    v = len > 0 ? v / len : vec3(0, 0, 1);
+    t.mul = m.ka * f.ambientLight;
+    t.add = m.emissive;
+    for (size_t i = 0; i < f.lights.size(); ++i) {
+        if (visible && visible[i] <= 0.0f) continue;
+        ShadeTerms li = lightTerms(m, n, v, sampleLight(f.lights[i], p), f.settings.reflection);
+        float w = visible ? visible[i] : 1.0f;
+        t.mul += w * li.mul;
+        t.add += w * li.add;
+    }
+    return t;
 }
 
 vec3 shade(const Material& m, const SurfacePoint& s, const vec3& eye, const FrameInput& f, const float* visible) {
-    if (m.unlit) return s.albedo + m.emissive;
-    vec3 v = eye - s.position;
-    float len = glm::length(v);
-    v = len > 0 ? v / len : vec3(0, 0, 1);
-    vec3 c = m.ka * s.albedo * f.ambientLight + m.emissive;
-    for (size_t i = 0; i < f.lights.size(); ++i) {
-        if (visible && visible[i] <= 0.0f) continue;
-        vec3 li = shadeLight(m, s, v, sampleLight(f.lights[i], s.position), f.settings.reflection);
-        c += visible ? visible[i] * li : li;
-    }
-    return c;
+    return shadeTerms(m, s.position, s.normal, eye, f, visible).apply(s.albedo);
 }
 
 vec3 applyFog(const RenderSettings& s, const vec3& color, float d) {

@@ -123,12 +123,12 @@ std::string programKey(const FrameInput& f) {
 std::string buildProgram(const std::string& key, Program& p) {
     std::string calls;
     if (key.size() > 2 && key[2] == '*')
-        calls = "for (int i = 0; i < uNumLights; ++i) addLight(i, int(uLightPos[i].w + 0.5), uLightDir[i].w > 0.5, n, p, v, mul, add);";
+        calls = "for (int i = 0; i < uNumLights; ++i) lightTerms(i, int(uLightPos[i].w + 0.5), uLightDir[i].w > 0.5, n, p, v, mul, add);";
     for (size_t i = 2; i < key.size() && key[2] != '*'; ++i) {
         char c = char(key[i] | 0x20);
         const char* type = c == 'p' ? "LIGHT_POINT" : c == 'd' ? "LIGHT_DIRECTIONAL" : "LIGHT_SPOT";
         bool invSq = key[i] >= 'A' && key[i] <= 'Z';
-        calls += "addLight(" + std::to_string(i - 2) + ", " + type + ", " + (invSq ? "true" : "false") + ", n, p, v, mul, add); ";
+        calls += "lightTerms(" + std::to_string(i - 2) + ", " + type + ", " + (invSq ? "true" : "false") + ", n, p, v, mul, add); ";
     }
     std::string prefix = "#version 330 core\n" + glslEnumDefines() + "#define SHADING " + key[0] + "\n#define REFLECTION " + key[1] +
                          "\n#define MAX_LIGHTS " + std::to_string(kMaxLights) + "\n#define LIGHT_CALLS " + calls + "\n";

@@ -124,16 +124,6 @@ struct DrawItem {
     uint32_t vertexOf(uint32_t tri, int k) const { return perCorner ? tri * 3 + k : mesh->indices[size_t(tri) * 3 + k]; }
 };
 
-// Gouraud at one vertex: split shade() into the part proportional to the albedo (A) and the
-// rest (B: emissive, untinted specular) so the fragment can apply texture and vertex colour:
-// colour = A (x) albedo + B, which equals shade() exactly where the albedo is constant.
-void gouraudTerms(const sg::Material& m, const vec3& p, const vec3& n, const sg::FrameInput& f, vec3& a, vec3& b) {
-    SurfacePoint s{p, n, vec3(0.0f)};
-    b = shade(m, s, f.camera.eye, f);
-    s.albedo = vec3(1.0f);
-    a = shade(m, s, f.camera.eye, f) - b;
-}
-
 // ---------------------------------------------------------------------------------------
 // [vertex stage]
 // ---------------------------------------------------------------------------------------
@@ -173,8 +163,13 @@ void runVertexStage(DrawItem& d, const sg::FrameInput& f, int width, int height,
             }
             if (gouraud) {
                 const sg::Material& mat = d.perCorner ? d.materialOf(uint32_t(v / 3)) : d.material;
-                gouraudTerms(mat, d.wpos[v], d.wnrm[v], f, d.gouraudA[0][v], d.gouraudB[0][v]);
-                gouraudTerms(mat, d.wpos[v], -d.wnrm[v], f, d.gouraudA[1][v], d.gouraudB[1][v]);
+                // Gouraud: the model's two albedo-linear terms at the vertex, front and back side.
+                ShadeTerms front = shadeTerms(mat, d.wpos[v], d.wnrm[v], f.camera.eye, f);
+                ShadeTerms back = shadeTerms(mat, d.wpos[v], -d.wnrm[v], f.camera.eye, f);
+                d.gouraudA[0][v] = front.mul;
+                d.gouraudB[0][v] = front.add;
+                d.gouraudA[1][v] = back.mul;
+                d.gouraudB[1][v] = back.add;
             }
         }
     });

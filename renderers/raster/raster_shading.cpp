@@ -178,7 +178,7 @@ void shadeBatch(ShadeBatch& b, size_t n, const sg::FrameInput& f) {
         float len = glm::length(v);
         v = len > 0 ? v / len : sg::vec3(0, 0, 1);
         sg::vec3 c(b.cr[i], b.cg[i], b.cb[i]);
-        for (const auto& L : f.lights) c += shadeLight(m, s, v, sampleLight(L, s.position), f.settings.reflection);
+        for (const auto& L : f.lights) c += lightTerms(m, s.normal, v, sampleLight(L, s.position), f.settings.reflection).apply(s.albedo);
         b.cr[i] = c.x;
         b.cg[i] = c.y;
         b.cb[i] = c.z;

@@ -191,34 +191,19 @@ struct Tracer {
             const ShadingModel model = f.settings.shading;
             vec3 albedo = (w0 * albedoV[0] + w1 * albedoV[1] + w2 * albedoV[2]) * texColor;
             if (model == ShadingModel::Gouraud && !mat->unlit) {
-                // Lighting at the three vertices, interpolated with the hit's barycentrics
-                // (perspective-correct by construction). As in the rasterizer, each vertex
-                // term is split into a part proportional to the albedo (A) and the rest (B),
-                // colour = A (x) albedo + B, so texture and vertex colours apply per hit; the
-                // per-light terms are kept apart so a shadow ray can switch a light off.
+                // The model's two albedo-linear terms (shadeTerms) at the three vertices,
+                // interpolated with the hit's barycentrics (perspective-correct by
+                // construction), as the rasterizers do; texture and vertex colours apply per
+                // hit. The shadow rays of the hit point scale each light at every vertex.
                 lightVisibility(p, ng, vis);
-                vec3 v[3];
-                for (int k = 0; k < 3; ++k) {
-                    vec3 e = eye - P[k];
-                    float l = glm::length(e);
-                    v[k] = l > 0 ? e / l : vec3(0, 0, 1);
-                }
                 const float wk[3] = {w0, w1, w2};
-                vec3 A = mat->ka * f.ambientLight, B = mat->emissive;
-                for (size_t li = 0; li < f.lights.size(); ++li) {
-                    if (vis[li] <= 0.0f) continue;
-                    vec3 a(0.0f), b(0.0f);
-                    for (int k = 0; k < 3; ++k) {
-                        LightSample ls = sampleLight(f.lights[li], P[k]);
-                        vec3 b0 = shadeLight(*mat, SurfacePoint{P[k], Nv[k], vec3(0.0f)}, v[k], ls, f.settings.reflection);
-                        vec3 a1 = shadeLight(*mat, SurfacePoint{P[k], Nv[k], vec3(1.0f)}, v[k], ls, f.settings.reflection);
-                        a += wk[k] * (a1 - b0);
-                        b += wk[k] * b0;
-                    }
-                    A += vis[li] * a;
-                    B += vis[li] * b;
+                ShadeTerms t;
+                for (int k = 0; k < 3; ++k) {
+                    ShadeTerms tk = shadeTerms(*mat, P[k], Nv[k], eye, f, vis);
+                    t.mul += wk[k] * tk.mul;
+                    t.add += wk[k] * tk.add;
                 }
-                color = A * albedo + B;
+                color = t.apply(albedo);
                 n = w0 * Nv[0] + w1 * Nv[1] + w2 * Nv[2];
                 n = glm::length(n) > 0 ? glm::normalize(n) : ng;
             } else {

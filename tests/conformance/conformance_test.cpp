@@ -37,6 +37,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cmath>
 #include <functional>
 #include <map>
@@ -347,7 +349,8 @@ void checkAntiAliasing(const std::string& backend, AAMode aa, int rate, const st
         auto r = rnd::makeRenderer(backend, &err);
         ASSERT_TRUE(r) << err;
         const rnd::Capabilities caps = r->capabilities();
-        if ((aa == AAMode::MSAA && !caps.msaa) || (aa == AAMode::SSAA && !caps.ssaa))
+        const std::vector<int>& offered = aa == AAMode::MSAA ? caps.msaaSamples : caps.ssaaFactors;
+        if (aa != AAMode::None && std::find(offered.begin(), offered.end(), rate) == offered.end())
             GTEST_SKIP() << backend << " does not offer " << f.settings.aaName() << " (Capabilities)";
     }
     rnd::Framebuffer actual;

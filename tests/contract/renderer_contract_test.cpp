@@ -3,6 +3,7 @@
 #include "gl/gl_renderer.h"
 #include "renderers/render_config.h"
 #include "renderers/renderer.h"
+#include "renderers/shading.h"
 #include "scenegraph/scene.h"
 
 #include <gtest/gtest.h>
@@ -216,4 +217,52 @@ TEST(GlslEnumGuardTest, ShadersHandleEveryEnumValueByName) {
     EXPECT_NE(defines.find("#define FOG_EXP2 " + std::to_string(int(sg::FogMode::Exp2))), std::string::npos) << defines;
     EXPECT_NE(defines.find("#define SHADING_GOURAUD " + std::to_string(int(sg::ShadingModel::Gouraud))), std::string::npos) << defines;
     EXPECT_NE(defines.find("#define LIGHT_SPOT " + std::to_string(int(sg::LightType::Spot))), std::string::npos) << defines;
+}
+
+// One shading source: shade() is shadeTerms() applied to the albedo, and the terms do not
+// depend on the albedo (what lets Gouraud interpolate them and texture per pixel), for tinted
+// and untinted specular, both reflection models, every light type, with and without shadows.
+TEST(ShadeTermsTest, ShadeIsTheTermsAppliedToTheAlbedo) {
+    sg::FrameInput f;
+    f.ambientLight = sg::vec3(0.2f, 0.25f, 0.3f);
+    sg::DrawLight point, dir, spot;
+    point.type = sg::LightType::Point;
+    point.position = {2, 3, 4};
+    point.radiance = {3, 2, 1};
+    point.inverseSquare = true;
+    dir.type = sg::LightType::Directional;
+    dir.direction = glm::normalize(sg::vec3(-1, -2, -1));
+    dir.radiance = {0.5f, 0.6f, 0.7f};
+    spot.type = sg::LightType::Spot;
+    spot.position = {0, 4, 1};
+    spot.direction = glm::normalize(sg::vec3(0, -1, -0.2f));
+    spot.cosInner = 0.95f;
+    spot.cosOuter = 0.8f;
+    spot.radiance = {2, 2, 2};
+    f.lights = {point, dir, spot};
+    const float visible[3] = {1.0f, 0.0f, 0.5f};
+    for (bool tinted : {false, true})
+        for (auto model : {sg::ReflectionModel::Phong, sg::ReflectionModel::BlinnPhong})
+            for (const float* vis : {static_cast<const float*>(nullptr), visible}) {
+                f.settings.reflection = model;
+                sg::Material m;
+                m.ka = 0.3f;
+                m.kd = 0.6f;
+                m.ks = 0.5f;
+                m.shininess = 12;
+                m.specularTinted = tinted;
+                m.specularColor = {0.9f, 0.8f, 0.7f};
+                m.emissive = {0.01f, 0.02f, 0.03f};
+                const sg::vec3 p(0.1f, 0.2f, 0.3f), n = glm::normalize(sg::vec3(0.2f, 1, 0.3f)), eye(1, 2, 6);
+                ShadeTerms t = shadeTerms(m, p, n, eye, f, vis);
+                for (sg::vec3 albedo : {sg::vec3(0.0f), sg::vec3(1.0f), sg::vec3(0.8f, 0.3f, 0.1f)}) {
+                    sg::vec3 c = shade(m, SurfacePoint{p, n, albedo}, eye, f, vis);
+                    sg::vec3 want = t.mul * albedo + t.add;
+                    for (int k = 0; k < 3; ++k) EXPECT_NEAR(c[k], want[k], 1e-6f) << "tinted " << tinted << " k " << k;
+                }
+                // The terms by hand for albedo 0 and 1 (untinted specular goes to add only).
+                sg::vec3 zero = shade(m, SurfacePoint{p, n, sg::vec3(0.0f)}, eye, f, vis);
+                for (int k = 0; k < 3; ++k) EXPECT_NEAR(zero[k], t.add[k], 1e-6f);
+                if (tinted) EXPECT_EQ(t.add, m.emissive);
+            }
 }

@@ -1,7 +1,8 @@
-// lighting.glsl - the Phong model of renderers/common/shading.cpp, line by line (keep the two
-// in step). Shared by mesh.vert (Gouraud) and mesh.frag (flat, Phong).
+// lighting.glsl - the Phong model of renderers/common/shading.cpp, function for function and
+// name for name (sampleLight, lightTerms, shadeTerms; keep the two in step). Shared by
+// mesh.vert (Gouraud) and mesh.frag (flat, Phong).
 //
-// shade() is linear in the albedo rho, so it is evaluated as two terms:
+// shade() is linear in the albedo rho, so it is evaluated as two terms (ShadeTerms in C++):
 //   colour = rho * mul + add
 //   mul = ka * L_ambient + sum_i att_i L_i max(n.l_i,0) (kd + [tinted] ks spec_i)
 //   add = emissive        + sum_i att_i L_i max(n.l_i,0) [untinted] ks spec_i specularColor
@@ -9,7 +10,7 @@
 // fragment (rho = base colour * vertex colour * texel).
 //
 // The renderer compiles one program per light setup: its prefix defines MAX_LIGHTS,
-// REFLECTION (REFLECTION_PHONG or REFLECTION_BLINN) and LIGHT_CALLS: for a few lights, one addLight(i,
+// REFLECTION (REFLECTION_PHONG or REFLECTION_BLINN) and LIGHT_CALLS: for a few lights, one lightTerms(i,
 // type, inverseSquare, ...) call per light with constant arguments (the compiler drops the
 // code of the other light types; a loop over a uniform light count costs llvmpipe about 2x,
 // see bench/gl); for many lights a loop over uNumLights reading the type from the .w
@@ -62,8 +63,8 @@ void sampleLight(int i, int type, bool inverseSquare, vec3 p, out vec3 toLight, 
     }
 }
 
-// shadeLight() of light i, split into the two albedo-linear terms; v = unit vector to the eye.
-void addLight(int i, int type, bool inverseSquare, vec3 n, vec3 p, vec3 v, inout vec3 mul, inout vec3 add) {
+// lightTerms() of shading.h for light i, added to mul and add; v = unit vector to the eye.
+void lightTerms(int i, int type, bool inverseSquare, vec3 n, vec3 p, vec3 v, inout vec3 mul, inout vec3 add) {
     vec3 l, radiance;
     sampleLight(i, type, inverseSquare, p, l, radiance);
     float nl = dot(n, l);
@@ -87,7 +88,7 @@ void addLight(int i, int type, bool inverseSquare, vec3 n, vec3 p, vec3 v, inout
 
 // The two albedo-linear terms of shade() at world position p with unit normal n (already
 // facing the viewer for two-sided surfaces).
-void lightTerms(vec3 n, vec3 p, out vec3 mul, out vec3 add) {
+void shadeTerms(vec3 n, vec3 p, out vec3 mul, out vec3 add) {
     vec3 v = uEye - p;
     float len = length(v);
     v = len > 0.0 ? v / len : vec3(0.0, 0.0, 1.0);

@@ -46,7 +46,7 @@ void main() {
             // Face normal of the world-space triangle; cross(dp/dx, dp/dy) always points to
             // the side being seen, i.e. it is already flipped toward the viewer.
             vec3 n = normalize(cross(dFdx(vWorldPos), dFdy(vWorldPos)));
-            lightTerms(n, vWorldPos, mul, add);
+            shadeTerms(n, vWorldPos, mul, add);
 #elif SHADING == SHADING_GOURAUD
             mul = gl_FrontFacing ? vMulFront : vMulBack;
             add = gl_FrontFacing ? vAddFront : vAddBack;
@@ -54,7 +54,7 @@ void main() {
             float len = length(vNormal);
             vec3 n = len > 0.0 ? vNormal / len : vec3(0.0, 0.0, 1.0);
             if (!gl_FrontFacing) n = -n;                 // two-sided: seen from the back
-            lightTerms(n, vWorldPos, mul, add);
+            shadeTerms(n, vWorldPos, mul, add);
 #else
 #error "SHADING: a sg::ShadingModel value this shader does not handle"
 #endif

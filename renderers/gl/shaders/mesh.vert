@@ -36,7 +36,7 @@ void main() {
 #if SHADING == SHADING_GOURAUD
     float len = length(vNormal);
     vec3 n = len > 0.0 ? vNormal / len : vec3(0.0, 0.0, 1.0);
-    lightTerms(n, world.xyz, vMulFront, vAddFront);
-    lightTerms(-n, world.xyz, vMulBack, vAddBack);   // two-sided: seen from the back
+    shadeTerms(n, world.xyz, vMulFront, vAddFront);
+    shadeTerms(-n, world.xyz, vMulBack, vAddBack);   // two-sided: seen from the back
 #endif
 }

@@ -31,11 +31,31 @@ struct LightSample {
 };
 LightSample sampleLight(const sg::DrawLight& light, const sg::vec3& position);
 
-// Reflected radiance toward `toEye` (unit) from one light, without ambient.
-sg::vec3 shadeLight(const sg::Material& m, const SurfacePoint& s, const sg::vec3& toEye, const LightSample& l, sg::ReflectionModel model);
+// The model is linear in the albedo rho, so it is computed as two terms that do not depend on
+// it: colour = rho (x) mul + add, with
+//   mul = ka L_ambient + sum_i att_i L_i max(n.l_i,0) (kd + [tinted] ks spec_i)
+//   add = emissive     + sum_i att_i L_i max(n.l_i,0) [untinted] ks spec_i specularColor
+// Every shading model uses these: Phong and flat evaluate them per pixel; Gouraud evaluates
+// them at the vertices and interpolates mul and add, so textures and vertex colours (rho)
+// still apply per pixel. The GL shaders mirror these functions name for name
+// (renderers/gl/shaders/lighting.glsl: sampleLight, lightTerms, shadeTerms).
+struct ShadeTerms {
+    sg::vec3 mul{0.0f};
+    sg::vec3 add{0.0f};
+    sg::vec3 apply(const sg::vec3& albedo) const { return albedo * mul + add; }
+};
 
-// Full local model: ambient + emissive + all lights (no shadows). `lightVisible` (optional)
-// gives a per-light visibility factor in [0,1] (the ray caster's shadow rays).
+// One light's terms at world position p with unit normal n (facing the viewer), seen from
+// direction toEye (unit). No ambient, no emissive.
+ShadeTerms lightTerms(const sg::Material& m, const sg::vec3& n, const sg::vec3& toEye, const LightSample& l, sg::ReflectionModel model);
+
+// All of the local model's terms at p with normal n seen from `eye`: ambient + emissive + every
+// light. `lightVisible` (optional) scales light i by a visibility in [0,1] (the ray caster's
+// shadow rays). Unlit materials: mul = 1, add = emissive.
+ShadeTerms shadeTerms(const sg::Material& m, const sg::vec3& p, const sg::vec3& n, const sg::vec3& eye, const sg::FrameInput& f,
+                      const float* lightVisible = nullptr);
+
+// The full local model: shadeTerms(...).apply(s.albedo).
 sg::vec3 shade(const sg::Material& m, const SurfacePoint& s, const sg::vec3& eye, const sg::FrameInput& f, const float* lightVisible = nullptr);
 
 // Fog on eye-space distance d, then clamp.
