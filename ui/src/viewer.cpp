@@ -19,10 +19,12 @@
 #include "ui/render_slot.h"
 #include "ui/viewer_state.h"
 
+// glad must come before GLFW (it refuses a gl.h included before it).
+#include <glad/gl.h>
+
 #include <GLFW/glfw3.h>
 #include <backends/imgui_impl_glfw.h>
 #include <backends/imgui_impl_opengl3.h>
-#include <glad/gl.h>
 #include <imgui.h>
 
 #include <chrono>
