@@ -6,10 +6,12 @@
 #include "assets/image_io.h"
 #include "assets/scene_io.h"
 #include "renderers/renderer.h"
+#include "scenegraph/setting_names.h"
 #include "ui/viewer.h"
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -54,6 +56,45 @@ bool parseOnOff(const std::string& v, bool& out) {
     return false;
 }
 
+// A settings value named in its table (setting_names.h). Returns "" or an error that lists the
+// valid names, e.g. "--fog: 'fgo' is not one of off, linear, exp, exp2".
+std::string notOneOf(const char* option, const std::string& value, const std::string& names) {
+    return std::string(option) + ": '" + value + "' is not one of " + names;
+}
+template <class E>
+std::string parseNamed(const char* option, const std::string& value, E& out) {
+    return sg::parseName(value, out) ? std::string() : notOneOf(option, value, sg::nameList<E>());
+}
+
+// --projection takes a projection type or an oblique preset.
+std::string projectionNames() { return sg::nameList<sg::ProjectionType>() + ", " + sg::nameList<sg::ObliquePreset>(); }
+
+// Option help for a named setting: the names on the first line, then one line per name.
+template <class E>
+void addValueLines(std::string& out, size_t width) {
+    for (const auto& e : sg::nameTable<E>().entries)
+        out += "\n  " + std::string(e.name) + std::string(width + 2 - e.name.size(), ' ') + std::string(e.help);
+}
+template <class E>
+size_t longestName() {
+    size_t n = 0;
+    for (const auto& e : sg::nameTable<E>().entries) n = std::max(n, e.name.size());
+    return n;
+}
+template <class E>
+std::string namedHelp(const std::string& title) {
+    std::string out = title + ": " + sg::nameList<E>();
+    addValueLines<E>(out, longestName<E>());
+    return out;
+}
+std::string projectionHelp() {
+    std::string out = "Projection: " + projectionNames();
+    size_t width = std::max(longestName<sg::ProjectionType>(), longestName<sg::ObliquePreset>());
+    addValueLines<sg::ProjectionType>(out, width);
+    addValueLines<sg::ObliquePreset>(out, width);
+    return out;
+}
+
 std::optional<sg::Scene> loadSceneArg(const std::string& arg, std::string& err) {
     if (arg.empty() || arg == "demo") return assets::makeDemoScene();
     assets::LoadResult r = assets::loadScene(arg);
@@ -65,10 +106,12 @@ std::optional<sg::Scene> loadSceneArg(const std::string& arg, std::string& err) 
 // Applies command-line overrides to the scene's settings and camera. Returns "" or an error.
 std::string applyOverrides(const RenderArgs& a, sg::Scene& scene) {
     sg::RenderSettings& s = scene.settings;
-    if (a.shading && !sg::parse(*a.shading, s.shading)) return "--shading '" + *a.shading + "': expected flat, gouraud or phong";
-    if (a.reflection && !sg::parse(*a.reflection, s.reflection)) return "--reflection '" + *a.reflection + "': expected phong or blinn";
-    if (a.fog && !sg::parse(*a.fog, s.fog)) return "--fog '" + *a.fog + "': expected off, linear, exp or exp2";
-    if (a.aa && !s.setAA(*a.aa)) return "--aa '" + *a.aa + "': expected none, msaa2, msaa4, msaa8, ssaa2, ssaa3 or ssaa4";
+    auto named = [](const std::optional<std::string>& v, auto& dst, const char* option) -> std::string {
+        return v ? parseNamed(option, *v, dst) : std::string();
+    };
+    for (auto e : {named(a.shading, s.shading, "--shading"), named(a.reflection, s.reflection, "--reflection"), named(a.fog, s.fog, "--fog")})
+        if (!e.empty()) return e;
+    if (a.aa && !s.setAA(*a.aa)) return notOneOf("--aa", *a.aa, sg::nameList<sg::AAChoice>());
     auto onOff = [](const std::optional<std::string>& v, bool& dst, const char* name) -> std::string {
         if (v && !parseOnOff(*v, dst)) return std::string(name) + " '" + *v + "': expected on or off";
         return {};
@@ -100,14 +143,15 @@ std::string applyOverrides(const RenderArgs& a, sg::Scene& scene) {
         }
         auto& cam = std::get<sg::Camera>(scene.editPayload(scene.activeCamera));
         if (a.projection) {
-            std::string p = *a.projection;
-            if (p == "cavalier" || p == "cabinet") {
-                sg::Projection preset = p == "cavalier" ? sg::Projection::cavalier() : sg::Projection::cabinet();
+            const std::string& p = *a.projection;
+            sg::ObliquePreset name;
+            if (sg::parseName(p, name)) {
+                sg::Projection preset = sg::obliquePreset(name);
                 cam.projection.type = preset.type;
                 cam.projection.obliqueAngleDeg = preset.obliqueAngleDeg;
                 cam.projection.obliqueFactor = preset.obliqueFactor;
-            } else if (!sg::parse(p, cam.projection.type)) {
-                return "--projection '" + p + "': expected perspective, orthographic, oblique, cavalier or cabinet";
+            } else if (!sg::parseName(p, cam.projection.type)) {
+                return notOneOf("--projection", p, projectionNames());
             }
         }
         if (a.fovy) {
@@ -158,17 +202,17 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a, bool compare) {
     cmd.add_option("--size", a.size, "Image size WIDTHxHEIGHT")->capture_default_str();
     cmd.add_flag("--overwrite", a.overwrite, "Replace existing output files");
     cmd.add_option("--camera", a.camera, "Use the scene's N-th camera (0-based; default: the active one)");
-    cmd.add_option("--shading", a.shading, "Shading model: flat, gouraud, phong");
-    cmd.add_option("--reflection", a.reflection, "Reflection model: phong, blinn");
-    cmd.add_option("--fog", a.fog, "Fog: off, linear, exp, exp2");
+    cmd.add_option("--shading", a.shading, namedHelp<sg::ShadingModel>("Shading model"));
+    cmd.add_option("--reflection", a.reflection, namedHelp<sg::ReflectionModel>("Reflection model"));
+    cmd.add_option("--fog", a.fog, namedHelp<sg::FogMode>("Fog"));
     cmd.add_option("--fog-start", a.fogStart, "Linear fog start distance");
     cmd.add_option("--fog-end", a.fogEnd, "Linear fog end distance");
-    cmd.add_option("--fog-density", a.fogDensity, "Exp/exp2 fog density");
-    cmd.add_option("--aa", a.aa, "Anti-aliasing: none, msaa2, msaa4, msaa8, ssaa2, ssaa3, ssaa4");
-    cmd.add_option("--projection", a.projection, "Projection: perspective, orthographic, oblique, cavalier, cabinet");
+    cmd.add_option("--fog-density", a.fogDensity, "Fog density of the exponential modes");
+    cmd.add_option("--aa", a.aa, namedHelp<sg::AAChoice>("Anti-aliasing"));
+    cmd.add_option("--projection", a.projection, projectionHelp());
     cmd.add_option("--fovy", a.fovy, "Perspective vertical field of view in degrees");
     cmd.add_option("--oblique-angle", a.obliqueAngle, "Oblique receding-axis angle in degrees");
-    cmd.add_option("--oblique-factor", a.obliqueFactor, "Oblique foreshortening factor (1 cavalier, 0.5 cabinet)");
+    cmd.add_option("--oblique-factor", a.obliqueFactor, "Oblique foreshortening factor (see the presets of --projection)");
     cmd.add_option("--shadows", a.shadows, "Ray caster shadow rays: on, off");
     cmd.add_option("--reflections", a.reflections, "Ray caster mirror reflections: on, off");
     cmd.add_option("--bounces", a.bounces, "Ray caster reflection depth limit");

@@ -5,13 +5,13 @@
 //   {
 //     "format": "sceneviewer", "version": 1, "name": "...",
 //     "ambientLight": [r,g,b], "activeCamera": <node index or null>,
-//     "settings":  { "shading": "flat|gouraud|phong", "reflection": "phong|blinn",
-//                    "fog": {"mode": "off|linear|exp|exp2", "color": [..], "start", "end", "density"},
-//                    "attenuation": bool, "aa": "none|msaa2|msaa4|msaa8|ssaa2|ssaa3|ssaa4",
+//     "settings":  { "shading": <ShadingModel>, "reflection": <ReflectionModel>,
+//                    "fog": {"mode": <FogMode>, "color": [..], "start", "end", "density"},
+//                    "attenuation": bool, "aa": <AAChoice>,
 //                    "aaRate", "cullBackFaces", "wireframe", "wireframeColor", "background",
 //                    "shadows", "reflections", "maxBounces", "tessellation" },
 //     "textures":  [ {"name", "file": "relative/path.png"} | {"name", "png": "<base64 PNG>"},
-//                    + "wrapS"/"wrapT": "repeat|clamp|mirror", "filter": "nearest|bilinear|trilinear" ],
+//                    + "wrapS"/"wrapT": <WrapMode>, "filter": <FilterMode> ],
 //     "materials": [ {"name", "baseColor", "ka", "kd", "ks", "shininess", "specularTinted",
 //                     "specularColor", "diffuseTexture", "emissive", "alpha", "unlit",
 //                     "doubleSided", "reflectivity"} ],
@@ -25,6 +25,9 @@
 //                     "implicit": {...} | "csg": {"op", "material"} | "parametric": {...} |
 //                     "grid": {"dims", "values", "iso", "bounds", "material"} } ]
 //   }
+// <Enum> is a name from that enum's table in scenegraph/setting_names.h (camera "type":
+// <ProjectionType>, light "type": <LightType>); the writer writes the table's name, the reader
+// also accepts the table's aliases.
 // Nodes are a flat array with parent indices (not nested), so arbitrarily deep graphs need no
 // recursion; parents may appear in any order, cycles are rejected.
 //
@@ -33,6 +36,7 @@
 
 #include "assets/files.h"
 #include "assets/image_io.h"
+#include "scenegraph/setting_names.h"
 
 #include <nlohmann/json.hpp>
 
@@ -204,6 +208,14 @@ private:
         if (!sg::parse(s, e)) fail(path, "unknown value \"" + s + "\" (valid: " + valid + ")");
         return e;
     }
+    // A value named in its table (setting_names.h); the error lists the table's names.
+    template <class E>
+    E named(const json& v, const std::string& path) {
+        std::string s = string(v, path);
+        E e{};
+        if (!sg::parseName(s, e)) fail(path, "unknown value \"" + s + "\" (valid: " + sg::nameList<E>() + ")");
+        return e;
+    }
     // Optional field helpers: leave `dst` alone when the key is absent.
     void optFloat(const json& o, const std::string& p, const char* k, float& dst) {
         if (auto* v = optional(o, k)) dst = number(*v, p + "/" + k);
@@ -254,12 +266,12 @@ private:
 
 void Reader::readSettings(const json& j, const std::string& p, sg::RenderSettings& s) {
     if (!j.is_object()) fail(p, "expected an object");
-    if (auto* v = optional(j, "shading")) s.shading = enumValue<sg::ShadingModel>(*v, p + "/shading", "flat, gouraud, phong");
-    if (auto* v = optional(j, "reflection")) s.reflection = enumValue<sg::ReflectionModel>(*v, p + "/reflection", "phong, blinn");
+    if (auto* v = optional(j, "shading")) s.shading = named<sg::ShadingModel>(*v, p + "/shading");
+    if (auto* v = optional(j, "reflection")) s.reflection = named<sg::ReflectionModel>(*v, p + "/reflection");
     if (auto* f = optional(j, "fog")) {
         std::string fp = p + "/fog";
         if (!f->is_object()) fail(fp, "expected an object");
-        if (auto* v = optional(*f, "mode")) s.fog = enumValue<sg::FogMode>(*v, fp + "/mode", "off, linear, exp, exp2");
+        if (auto* v = optional(*f, "mode")) s.fog = named<sg::FogMode>(*v, fp + "/mode");
         optVec3(*f, fp, "color", s.fogColor);
         optFloat(*f, fp, "start", s.fogStart);
         optFloat(*f, fp, "end", s.fogEnd);
@@ -268,7 +280,7 @@ void Reader::readSettings(const json& j, const std::string& p, sg::RenderSetting
     optBool(j, p, "attenuation", s.attenuation);
     if (auto* v = optional(j, "aa")) {
         std::string a = string(*v, p + "/aa");
-        if (!s.setAA(a)) fail(p + "/aa", "unknown value \"" + a + "\" (valid: none, msaa2, msaa4, msaa8, ssaa2, ssaa3, ssaa4)");
+        if (!s.setAA(a)) fail(p + "/aa", "unknown value \"" + a + "\" (valid: " + sg::nameList<sg::AAChoice>() + ")");
     }
     if (s.aa == sg::AAMode::None) optInt(j, p, "aaRate", s.aaRate, 1, 8);
     optBool(j, p, "cullBackFaces", s.cullBackFaces);
@@ -331,32 +343,9 @@ std::shared_ptr<sg::Texture> Reader::readTexture(const json& j, const std::strin
     }
     auto t = img.texture;
     if (auto* v = optional(j, "name")) t->name = string(*v, p + "/name");
-    auto wrap = [&](const char* key, sg::WrapMode& dst) {
-        if (auto* v = optional(j, key)) {
-            std::string s = string(*v, p + "/" + key);
-            if (s == "repeat")
-                dst = sg::WrapMode::Repeat;
-            else if (s == "clamp")
-                dst = sg::WrapMode::ClampToEdge;
-            else if (s == "mirror")
-                dst = sg::WrapMode::MirroredRepeat;
-            else
-                fail(p + "/" + key, "unknown wrap mode \"" + s + "\" (valid: repeat, clamp, mirror)");
-        }
-    };
-    wrap("wrapS", t->wrapS);
-    wrap("wrapT", t->wrapT);
-    if (auto* v = optional(j, "filter")) {
-        std::string s = string(*v, p + "/filter");
-        if (s == "nearest")
-            t->filter = sg::FilterMode::Nearest;
-        else if (s == "bilinear")
-            t->filter = sg::FilterMode::Bilinear;
-        else if (s == "trilinear")
-            t->filter = sg::FilterMode::Trilinear;
-        else
-            fail(p + "/filter", "unknown filter \"" + s + "\" (valid: nearest, bilinear, trilinear)");
-    }
+    if (auto* v = optional(j, "wrapS")) t->wrapS = named<sg::WrapMode>(*v, p + "/wrapS");
+    if (auto* v = optional(j, "wrapT")) t->wrapT = named<sg::WrapMode>(*v, p + "/wrapT");
+    if (auto* v = optional(j, "filter")) t->filter = named<sg::FilterMode>(*v, p + "/filter");
     return t;
 }
 
@@ -503,7 +492,7 @@ sg::Payload Reader::readPayload(const json& j, const std::string& p, const sg::S
     if (k == "camera") {
         sg::Camera c;
         sg::Projection& pr = c.projection;
-        if (auto* t = optional(v, "type")) pr.type = enumValue<sg::ProjectionType>(*t, kp + "/type", "perspective, orthographic, oblique");
+        if (auto* t = optional(v, "type")) pr.type = named<sg::ProjectionType>(*t, kp + "/type");
         optFloat(v, kp, "fovy", pr.fovyDeg);
         optFloat(v, kp, "near", pr.zNear);
         optFloat(v, kp, "far", pr.zFar);
@@ -527,7 +516,7 @@ sg::Payload Reader::readPayload(const json& j, const std::string& p, const sg::S
     }
     if (k == "light") {
         sg::Light l;
-        if (auto* t = optional(v, "type")) l.type = enumValue<sg::LightType>(*t, kp + "/type", "point, directional, spot");
+        if (auto* t = optional(v, "type")) l.type = named<sg::LightType>(*t, kp + "/type");
         optVec3(v, kp, "color", l.color);
         optFloat(v, kp, "intensity", l.intensity);
         optBool(v, kp, "inverseSquare", l.inverseSquare);
@@ -695,10 +684,6 @@ json flat(const std::vector<T>& v) {
         }
     return a;
 }
-const char* wrapName(sg::WrapMode w) { return w == sg::WrapMode::Repeat ? "repeat" : w == sg::WrapMode::ClampToEdge ? "clamp" : "mirror"; }
-const char* filterName(sg::FilterMode f) {
-    return f == sg::FilterMode::Nearest ? "nearest" : f == sg::FilterMode::Bilinear ? "bilinear" : "trilinear";
-}
 
 json implicitJ(const sg::ImplicitShape& s) {
     json j = {{"type", sg::toString(s.type)}};
@@ -741,7 +726,7 @@ json payloadJ(const sg::Payload& p) {
                 j["mesh"] = {{"mesh", v.mesh}, {"material", v.material}};
             } else if constexpr (std::is_same_v<T, sg::Camera>) {
                 const sg::Projection& pr = v.projection;
-                j["camera"] = {{"type", sg::toString(pr.type)},
+                j["camera"] = {{"type", sg::nameOf(pr.type)},
                                {"fovy", pr.fovyDeg},
                                {"near", pr.zNear},
                                {"far", pr.zFar},
@@ -752,7 +737,7 @@ json payloadJ(const sg::Payload& p) {
                                {"obliqueFactor", pr.obliqueFactor},
                                {"focusDistance", v.focusDistance}};
             } else if constexpr (std::is_same_v<T, sg::Light>) {
-                j["light"] = {{"type", sg::toString(v.type)},     {"color", vecJ(v.color)},      {"intensity", v.intensity},
+                j["light"] = {{"type", sg::nameOf(v.type)},       {"color", vecJ(v.color)},      {"intensity", v.intensity},
                               {"inverseSquare", v.inverseSquare}, {"spotInner", v.spotInnerDeg}, {"spotOuter", v.spotOuterDeg}};
             } else if constexpr (std::is_same_v<T, sg::ImplicitPayload>) {
                 json s = implicitJ(v.shape);
@@ -853,9 +838,9 @@ std::string serializeSceneJson(const sg::Scene& s) {
     j["ambientLight"] = vecJ(s.ambientLight);
     const sg::RenderSettings& r = s.settings;
     j["settings"] = {
-        {"shading", sg::toString(r.shading)},
-        {"reflection", sg::toString(r.reflection)},
-        {"fog", {{"mode", sg::toString(r.fog)}, {"color", vecJ(r.fogColor)}, {"start", r.fogStart}, {"end", r.fogEnd}, {"density", r.fogDensity}}},
+        {"shading", sg::nameOf(r.shading)},
+        {"reflection", sg::nameOf(r.reflection)},
+        {"fog", {{"mode", sg::nameOf(r.fog)}, {"color", vecJ(r.fogColor)}, {"start", r.fogStart}, {"end", r.fogEnd}, {"density", r.fogDensity}}},
         {"attenuation", r.attenuation},
         {"aa", r.aaName()},
         {"cullBackFaces", r.cullBackFaces},
@@ -869,7 +854,7 @@ std::string serializeSceneJson(const sg::Scene& s) {
     j["settings"]["aaRate"] = r.aaRate;   // kept while AA is off, so switching it back on restores it
     j["textures"] = json::array();
     for (const auto& t : s.textures) {
-        json tj = {{"name", t->name}, {"wrapS", wrapName(t->wrapS)}, {"wrapT", wrapName(t->wrapT)}, {"filter", filterName(t->filter)}};
+        json tj = {{"name", t->name}, {"wrapS", sg::nameOf(t->wrapS)}, {"wrapT", sg::nameOf(t->wrapT)}, {"filter", sg::nameOf(t->filter)}};
         std::string png;
         encodePng(t->width, t->height, t->rgba.data(), png);
         tj["png"] = base64Encode(png);

@@ -22,22 +22,4 @@ mat4 Projection::matrix(float aspect, float focusDistance) const {
     return mat4(1.0f);
 }
 
-std::string_view toString(ProjectionType t) {
-    switch (t) {
-    case ProjectionType::Perspective: return "perspective";
-    case ProjectionType::Orthographic: return "orthographic";
-    case ProjectionType::Oblique: return "oblique";
-    }
-    return "?";
-}
-
-bool parse(std::string_view s, ProjectionType& out) {
-    for (auto t : {ProjectionType::Perspective, ProjectionType::Orthographic, ProjectionType::Oblique})
-        if (s == toString(t)) {
-            out = t;
-            return true;
-        }
-    return false;
-}
-
 }   // namespace sg

@@ -1,7 +1,8 @@
 #include "scenegraph/settings.h"
-#include "scenegraph/light.h"
+#include "scenegraph/setting_names.h"
 
-#include <charconv>
+#include <algorithm>
+#include <cmath>
 
 namespace sg {
 
@@ -18,82 +19,14 @@ std::string RenderSettings::validate() const {
     return {};
 }
 
-std::string RenderSettings::aaName() const {
-    switch (aa) {
-    case AAMode::None: return "none";
-    case AAMode::MSAA: return "msaa" + std::to_string(aaRate);
-    case AAMode::SSAA: return "ssaa" + std::to_string(aaRate);
-    }
-    return "none";
-}
+std::string RenderSettings::aaName() const { return std::string(nameOf(aaChoice(*this))); }
 
 bool RenderSettings::setAA(std::string_view name) {
-    if (name == "none" || name == "off") {
-        aa = AAMode::None;
-        return true;
-    }
-    AAMode mode;
-    if (name.substr(0, 4) == "msaa")
-        mode = AAMode::MSAA;
-    else if (name.substr(0, 4) == "ssaa")
-        mode = AAMode::SSAA;
-    else
-        return false;
-    int rate = 0;
-    auto rest = name.substr(4);
-    auto [p, ec] = std::from_chars(rest.data(), rest.data() + rest.size(), rate);
-    if (ec != std::errc() || p != rest.data() + rest.size()) return false;
-    if (mode == AAMode::MSAA && rate != 2 && rate != 4 && rate != 8) return false;
-    if (mode == AAMode::SSAA && (rate < 2 || rate > 4)) return false;
-    aa = mode;
-    aaRate = rate;
+    AAChoice c;
+    if (!parseName(name, c)) return false;
+    aa = c.mode;
+    if (c.mode != AAMode::None) aaRate = c.rate;   // none keeps the rate for switching back on
     return true;
-}
-
-std::string_view toString(ShadingModel m) {
-    switch (m) {
-    case ShadingModel::Flat: return "flat";
-    case ShadingModel::Gouraud: return "gouraud";
-    case ShadingModel::Phong: return "phong";
-    }
-    return "?";
-}
-std::string_view toString(ReflectionModel m) { return m == ReflectionModel::Phong ? "phong" : "blinn"; }
-std::string_view toString(FogMode m) {
-    switch (m) {
-    case FogMode::Off: return "off";
-    case FogMode::Linear: return "linear";
-    case FogMode::Exp: return "exp";
-    case FogMode::Exp2: return "exp2";
-    }
-    return "?";
-}
-bool parse(std::string_view s, ShadingModel& out) {
-    for (auto m : {ShadingModel::Flat, ShadingModel::Gouraud, ShadingModel::Phong})
-        if (s == toString(m)) {
-            out = m;
-            return true;
-        }
-    return false;
-}
-bool parse(std::string_view s, ReflectionModel& out) {
-    if (s == "phong") {
-        out = ReflectionModel::Phong;
-        return true;
-    }
-    if (s == "blinn" || s == "blinn-phong") {
-        out = ReflectionModel::BlinnPhong;
-        return true;
-    }
-    return false;
-}
-bool parse(std::string_view s, FogMode& out) {
-    for (auto m : {FogMode::Off, FogMode::Linear, FogMode::Exp, FogMode::Exp2})
-        if (s == toString(m)) {
-            out = m;
-            return true;
-        }
-    return false;
 }
 
 float fogVisibility(const RenderSettings& s, float d) {
@@ -107,23 +40,6 @@ float fogVisibility(const RenderSettings& s, float d) {
     }
     }
     return 1.0f;
-}
-
-std::string_view toString(LightType t) {
-    switch (t) {
-    case LightType::Point: return "point";
-    case LightType::Directional: return "directional";
-    case LightType::Spot: return "spot";
-    }
-    return "?";
-}
-bool parse(std::string_view s, LightType& out) {
-    for (auto t : {LightType::Point, LightType::Directional, LightType::Spot})
-        if (s == toString(t)) {
-            out = t;
-            return true;
-        }
-    return false;
 }
 
 }   // namespace sg

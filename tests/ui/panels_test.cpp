@@ -96,7 +96,7 @@ TEST(PanelsTest, ClickingShadingRadioChangesSettings) {
     bool wire = h.st.scene.settings.wireframe;
     h.click("render/wireframe");
     EXPECT_NE(h.st.scene.settings.wireframe, wire);
-    h.click("render/reflection/Blinn");
+    h.click("render/reflection/Blinn-Phong");
     EXPECT_EQ(h.st.scene.settings.reflection, sg::ReflectionModel::BlinnPhong);
 }
 

@@ -16,6 +16,7 @@
 
 #include "assets/scene_io.h"
 #include "renderers/renderer.h"
+#include "scenegraph/setting_names.h"
 
 #include <imgui.h>
 #include <imgui_stdlib.h>
@@ -42,23 +43,62 @@ void record(ViewerState& st, const std::string& key) {
     st.itemRects[key] = ItemRect{a.x, a.y, b.x, b.y};
 }
 
+// The last item's tooltip (a table entry's help; nothing when empty).
+void tooltip(std::string_view text) {
+    if (!text.empty() && ImGui::IsItemHovered()) ImGui::SetTooltip("%.*s", int(text.size()), text.data());
+}
+
+// A combo over a name table's entries (labels shown, help as tooltips); items recorded as label/entry label.
 template <class E>
-bool enumCombo(ViewerState& st, const char* label, E& value, std::initializer_list<std::pair<E, const char*>> items) {
-    const char* preview = "?";
-    for (auto& [v, n] : items)
-        if (v == value) preview = n;
+bool enumCombo(ViewerState& st, const char* label, E& value, std::span<const sg::NamedValue<E>> items) {
+    std::string preview = "?";
+    for (const auto& e : items)
+        if (e.value == value) preview = e.label;
     bool changed = false;
-    if (ImGui::BeginCombo(label, preview)) {
-        for (auto& [v, n] : items) {
-            if (ImGui::Selectable(n, v == value)) {
-                changed = v != value;
-                value = v;
+    if (ImGui::BeginCombo(label, preview.c_str())) {
+        for (const auto& e : items) {
+            std::string name(e.label);
+            if (ImGui::Selectable(name.c_str(), e.value == value)) {
+                changed = e.value != value;
+                value = e.value;
             }
-            record(st, std::string(label) + "/" + n);
+            tooltip(e.help);
+            record(st, std::string(label) + "/" + name);
         }
         ImGui::EndCombo();
     }
     record(st, label);
+    return changed;
+}
+// A settings enum: its table from setting_names.h.
+template <class E>
+bool enumCombo(ViewerState& st, const char* label, E& value) {
+    return enumCombo(st, label, value, sg::nameTable<E>().entries);
+}
+// Enums without a name table (shapes): labels given here.
+template <class E>
+bool enumCombo(ViewerState& st, const char* label, E& value, std::initializer_list<std::pair<E, const char*>> items) {
+    std::vector<sg::NamedValue<E>> entries;
+    for (auto& [v, n] : items) entries.push_back({v, n, n, {}});
+    return enumCombo(st, label, value, std::span<const sg::NamedValue<E>>(entries));
+}
+
+// A row of radio buttons over a name table; each recorded as key/entry label.
+template <class E>
+bool enumRadios(ViewerState& st, const std::string& key, E& value) {
+    bool changed = false;
+    ImGui::PushID(key.c_str());
+    for (const auto& e : sg::nameTable<E>().entries) {
+        if (&e != sg::nameTable<E>().entries.data()) ImGui::SameLine();
+        std::string name(e.label);
+        if (ImGui::RadioButton(name.c_str(), e.value == value)) {
+            changed = true;
+            value = e.value;
+        }
+        tooltip(e.help);
+        record(st, key + "/" + name);
+    }
+    ImGui::PopID();
     return changed;
 }
 
@@ -124,9 +164,8 @@ void addMenuItems(ViewerState& st, sg::NodeId parent) {
     if (ImGui::MenuItem("CSG intersection")) st.addCsg(sg::CsgOp::Intersection, parent);
     if (ImGui::MenuItem("CSG difference")) st.addCsg(sg::CsgOp::Difference, parent);
     ImGui::Separator();
-    if (ImGui::MenuItem("Point light")) st.addLight(sg::LightType::Point, parent);
-    if (ImGui::MenuItem("Directional light")) st.addLight(sg::LightType::Directional, parent);
-    if (ImGui::MenuItem("Spot light")) st.addLight(sg::LightType::Spot, parent);
+    for (const auto& e : sg::nameTable<sg::LightType>().entries)
+        if (ImGui::MenuItem((std::string(e.label) + " light").c_str())) st.addLight(e.value, parent);
     if (ImGui::MenuItem("Camera (at current view)")) st.addCamera();
 }
 
@@ -639,8 +678,7 @@ void drawInspector(ViewerState& st) {
         if (ImGui::CollapsingHeader("Material", ImGuiTreeNodeFlags_DefaultOpen)) ch |= materialEditor(st, cp->material);
     } else if (auto* lp = std::get_if<sg::Light>(&p)) {
         if (ImGui::CollapsingHeader("Light", ImGuiTreeNodeFlags_DefaultOpen)) {
-            ch |= enumCombo(st, "Type", lp->type,
-                            {{sg::LightType::Point, "point"}, {sg::LightType::Directional, "directional"}, {sg::LightType::Spot, "spot"}});
+            ch |= enumCombo(st, "Type", lp->type);
             ch |= ImGui::ColorEdit3("Colour", &lp->color.x, ImGuiColorEditFlags_Float);
             ch |= ImGui::DragFloat("Intensity", &lp->intensity, 0.05f, 0.0f, 1e5f);
             ch |= ImGui::Checkbox("Inverse-square falloff", &lp->inverseSquare);
@@ -748,10 +786,7 @@ void drawCameraPanel(ViewerState& st) {
 
     section("Projection");
     sg::Projection p = st.projection();
-    bool ch = enumCombo(st, "Type", p.type,
-                        {{sg::ProjectionType::Perspective, "perspective"},
-                         {sg::ProjectionType::Orthographic, "orthographic"},
-                         {sg::ProjectionType::Oblique, "oblique"}});
+    bool ch = enumCombo(st, "Type", p.type);
     switch (p.type) {
     case sg::ProjectionType::Perspective:
         ch |= ImGui::Checkbox("General frustum (l, r, b, t)", &p.useFrustum);
@@ -764,16 +799,15 @@ void drawCameraPanel(ViewerState& st) {
         break;
     case sg::ProjectionType::Orthographic: ch |= ImGui::DragFloat("Half height", &p.orthoHalfHeight, 0.01f, 0.001f, 1e5f); break;
     case sg::ProjectionType::Oblique:
-        if (ImGui::Button("Cavalier")) {
-            p.obliqueFactor = 1.0f;
-            p.obliqueAngleDeg = 45.0f;
-            ch = true;
-        }
-        ImGui::SameLine();
-        if (ImGui::Button("Cabinet")) {
-            p.obliqueFactor = 0.5f;
-            p.obliqueAngleDeg = 45.0f;
-            ch = true;
+        for (const auto& e : sg::nameTable<sg::ObliquePreset>().entries) {
+            if (&e != sg::nameTable<sg::ObliquePreset>().entries.data()) ImGui::SameLine();
+            if (ImGui::Button(std::string(e.label).c_str())) {
+                sg::Projection preset = sg::obliquePreset(e.value);
+                p.obliqueFactor = preset.obliqueFactor;
+                p.obliqueAngleDeg = preset.obliqueAngleDeg;
+                ch = true;
+            }
+            tooltip(e.help);
         }
         ch |= ImGui::SliderFloat("Angle", &p.obliqueAngleDeg, 0.0f, 90.0f, "%.1f deg");
         ch |= ImGui::SliderFloat("Factor", &p.obliqueFactor, 0.0f, 2.0f);
@@ -813,21 +847,8 @@ void drawRenderingPanel(ViewerState& st) {
     sg::RenderSettings s = st.scene.settings;
     bool ch = false;
     section("Shading");
-    int shading = int(s.shading);
-    const char* shadingNames[] = {"Flat", "Gouraud", "Phong"};
-    for (int i = 0; i < 3; ++i) {
-        if (i) ImGui::SameLine();
-        if (ImGui::RadioButton(shadingNames[i], &shading, i)) ch = true;
-        record(st, std::string("render/shading/") + shadingNames[i]);
-    }
-    s.shading = sg::ShadingModel(shading);
-    int refl = int(s.reflection);
-    if (ImGui::RadioButton("Phong (r.v)", &refl, 0)) ch = true;
-    record(st, "render/reflection/Phong");
-    ImGui::SameLine();
-    if (ImGui::RadioButton("Blinn-Phong (n.h)", &refl, 1)) ch = true;
-    record(st, "render/reflection/Blinn");
-    s.reflection = sg::ReflectionModel(refl);
+    ch |= enumRadios(st, "render/shading", s.shading);
+    ch |= enumRadios(st, "render/reflection", s.reflection);
     ch |= ImGui::Checkbox("Light attenuation (1/r^2)", &s.attenuation);
     record(st, "render/attenuation");
     sg::vec3 amb = st.scene.ambientLight;
@@ -837,8 +858,7 @@ void drawRenderingPanel(ViewerState& st) {
     }
 
     section("Fog");
-    ch |= enumCombo(st, "Fog", s.fog,
-                    {{sg::FogMode::Off, "off"}, {sg::FogMode::Linear, "linear"}, {sg::FogMode::Exp, "exp"}, {sg::FogMode::Exp2, "exp2"}});
+    ch |= enumCombo(st, "Fog", s.fog);
     if (s.fog != sg::FogMode::Off) {
         ch |= ImGui::ColorEdit3("Fog colour", &s.fogColor.x, ImGuiColorEditFlags_Float);
         if (s.fog == sg::FogMode::Linear)
@@ -848,29 +868,28 @@ void drawRenderingPanel(ViewerState& st) {
     }
 
     section("Anti-aliasing");
-    const char* aaNames[] = {"none", "msaa2", "msaa4", "msaa8", "ssaa2", "ssaa3", "ssaa4"};
-    std::string cur = s.aaName();
-    if (ImGui::BeginCombo("Scene AA", cur.c_str())) {
-        for (const char* n : aaNames)
-            if (ImGui::Selectable(n, cur == n)) ch |= s.setAA(n);
-        ImGui::EndCombo();
-    }
+    sg::AAChoice aa = sg::aaChoice(s);
+    if (enumCombo(st, "Scene AA", aa)) ch |= s.setAA(sg::nameOf(aa));   // none keeps the rate
     helpMarker("Saved with the scene. The ray caster uses SSAA-style jittered rays for either mode.");
-    // Per-backend overrides (viewer session only).
+    // Per-backend overrides (viewer session only), kept by name.
+    const sg::NameTable<sg::AAChoice>& aaNames = sg::nameTable<sg::AAChoice>();
     for (const std::string& b : rnd::rendererNames()) {
         auto it = st.aaOverride.find(b);
-        std::string ov = it == st.aaOverride.end() ? "(scene)" : it->second;
+        std::string ov = it == st.aaOverride.end() ? "" : it->second;
+        const sg::NamedValue<sg::AAChoice>* cur = aaNames.find(ov);
         std::string label = "AA " + b;
-        if (ImGui::BeginCombo(label.c_str(), ov.c_str())) {
-            if (ImGui::Selectable("(scene)", it == st.aaOverride.end())) {
+        if (ImGui::BeginCombo(label.c_str(), cur ? std::string(cur->label).c_str() : "(scene)")) {
+            if (ImGui::Selectable("(scene)", ov.empty())) {
                 st.aaOverride.erase(b);
                 st.markViewChanged();
             }
-            for (const char* n : aaNames)
-                if (ImGui::Selectable(n, ov == n)) {
-                    st.aaOverride[b] = n;
+            for (const auto& e : aaNames.entries) {
+                if (ImGui::Selectable(std::string(e.label).c_str(), &e == cur)) {
+                    st.aaOverride[b] = std::string(e.name);
                     st.markViewChanged();
                 }
+                tooltip(e.help);
+            }
             ImGui::EndCombo();
         }
     }

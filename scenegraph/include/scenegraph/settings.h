@@ -51,11 +51,13 @@ struct RenderSettings {
 
     // Returns an empty string when the settings are usable, else the reason.
     std::string validate() const;
-    // Spelling used by the command line and the JSON file: none, msaa2/4/8, ssaa2/3/4.
+    // The name of aa/aaRate used by the command line and the JSON file (the AAChoice table in
+    // setting_names.h); setAA accepts the table's names and aliases, false for anything else.
     std::string aaName() const;
     bool setAA(std::string_view name);
 };
 
+// Names from the tables in setting_names.h.
 std::string_view toString(ShadingModel m);
 std::string_view toString(ReflectionModel m);
 std::string_view toString(FogMode m);

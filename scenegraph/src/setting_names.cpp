@@ -1,0 +1,130 @@
+// setting_names.cpp - the name tables (see setting_names.h): every settings name is spelled here.
+#include "scenegraph/setting_names.h"
+
+namespace sg {
+
+namespace {
+
+constexpr NamedValue<ShadingModel> kShading[] = {
+    {ShadingModel::Flat, "flat", "Flat", "one colour per face, lit at the face normal"},
+    {ShadingModel::Gouraud, "gouraud", "Gouraud", "lit at the vertices, colours interpolated across the face"},
+    {ShadingModel::Phong, "phong", "Phong", "normals interpolated, lit at every pixel"},
+};
+
+constexpr NamedValue<ReflectionModel> kReflection[] = {
+    {ReflectionModel::Phong, "phong", "Phong", "specular from the mirrored light and the view vector: (r.v)^s"},
+    {ReflectionModel::BlinnPhong, "blinn", "Blinn-Phong", "specular from the half vector: (n.h)^s"},
+};
+constexpr NameAlias<ReflectionModel> kReflectionAliases[] = {{"blinn-phong", ReflectionModel::BlinnPhong}};
+
+constexpr NamedValue<FogMode> kFog[] = {
+    {FogMode::Off, "off", "Off", "no fog"},
+    {FogMode::Linear, "linear", "Linear", "visibility falls linearly from fog start to fog end"},
+    {FogMode::Exp, "exp", "Exponential", "visibility e^(-density d)"},
+    {FogMode::Exp2, "exp2", "Exponential squared", "visibility e^(-(density d)^2)"},
+};
+
+constexpr NamedValue<AAChoice> kAA[] = {
+    {{AAMode::None, 0}, "none", "None", "one sample per pixel"},
+    {{AAMode::MSAA, 2}, "msaa2", "MSAA 2x", "multisampling, 2 samples per pixel"},
+    {{AAMode::MSAA, 4}, "msaa4", "MSAA 4x", "multisampling, 4 samples per pixel"},
+    {{AAMode::MSAA, 8}, "msaa8", "MSAA 8x", "multisampling, 8 samples per pixel"},
+    {{AAMode::SSAA, 2}, "ssaa2", "SSAA 2x2", "supersampling, 2x2 samples per pixel"},
+    {{AAMode::SSAA, 3}, "ssaa3", "SSAA 3x3", "supersampling, 3x3 samples per pixel"},
+    {{AAMode::SSAA, 4}, "ssaa4", "SSAA 4x4", "supersampling, 4x4 samples per pixel"},
+};
+constexpr NameAlias<AAChoice> kAAAliases[] = {{"off", {AAMode::None, 0}}};
+
+constexpr NamedValue<ProjectionType> kProjection[] = {
+    {ProjectionType::Perspective, "perspective", "Perspective", "pinhole camera: vertical field of view and aspect, or a general frustum"},
+    {ProjectionType::Orthographic, "orthographic", "Orthographic", "parallel rays along the view axis"},
+    {ProjectionType::Oblique, "oblique", "Oblique", "parallel rays at an angle to the picture plane"},
+};
+
+constexpr NamedValue<ObliquePreset> kObliquePreset[] = {
+    {ObliquePreset::Cavalier, "cavalier", "Cavalier", "oblique at 45 degrees, receding axis at full length (factor 1)"},
+    {ObliquePreset::Cabinet, "cabinet", "Cabinet", "oblique at 45 degrees, receding axis at half length (factor 0.5)"},
+};
+
+constexpr NamedValue<LightType> kLight[] = {
+    {LightType::Point, "point", "Point", "shines from the node's position in every direction"},
+    {LightType::Directional, "directional", "Directional", "parallel light along the node's -z axis"},
+    {LightType::Spot, "spot", "Spot", "a cone along the node's -z axis, soft between the inner and outer angles"},
+};
+
+constexpr NamedValue<WrapMode> kWrap[] = {
+    {WrapMode::Repeat, "repeat", "Repeat", "the texture tiles"},
+    {WrapMode::ClampToEdge, "clamp", "Clamp to edge", "coordinates outside [0,1] take the edge texel"},
+    {WrapMode::MirroredRepeat, "mirror", "Mirrored repeat", "the texture tiles, every other copy mirrored"},
+};
+
+constexpr NamedValue<FilterMode> kFilter[] = {
+    {FilterMode::Nearest, "nearest", "Nearest", "the nearest texel"},
+    {FilterMode::Bilinear, "bilinear", "Bilinear", "blend of the four nearest texels"},
+    {FilterMode::Trilinear, "trilinear", "Trilinear", "bilinear on the two nearest mipmap levels, blended"},
+};
+
+}   // namespace
+
+template <>
+const NameTable<ShadingModel>& nameTable<ShadingModel>() {
+    static const NameTable<ShadingModel> t{kShading};
+    return t;
+}
+template <>
+const NameTable<ReflectionModel>& nameTable<ReflectionModel>() {
+    static const NameTable<ReflectionModel> t{kReflection, kReflectionAliases};
+    return t;
+}
+template <>
+const NameTable<FogMode>& nameTable<FogMode>() {
+    static const NameTable<FogMode> t{kFog};
+    return t;
+}
+template <>
+const NameTable<AAChoice>& nameTable<AAChoice>() {
+    static const NameTable<AAChoice> t{kAA, kAAAliases};
+    return t;
+}
+template <>
+const NameTable<ProjectionType>& nameTable<ProjectionType>() {
+    static const NameTable<ProjectionType> t{kProjection};
+    return t;
+}
+template <>
+const NameTable<ObliquePreset>& nameTable<ObliquePreset>() {
+    static const NameTable<ObliquePreset> t{kObliquePreset};
+    return t;
+}
+template <>
+const NameTable<LightType>& nameTable<LightType>() {
+    static const NameTable<LightType> t{kLight};
+    return t;
+}
+template <>
+const NameTable<WrapMode>& nameTable<WrapMode>() {
+    static const NameTable<WrapMode> t{kWrap};
+    return t;
+}
+template <>
+const NameTable<FilterMode>& nameTable<FilterMode>() {
+    static const NameTable<FilterMode> t{kFilter};
+    return t;
+}
+
+AAChoice aaChoice(const RenderSettings& s) { return s.aa == AAMode::None ? AAChoice{} : AAChoice{s.aa, s.aaRate}; }
+
+Projection obliquePreset(ObliquePreset p) { return p == ObliquePreset::Cavalier ? Projection::cavalier() : Projection::cabinet(); }
+
+std::string_view toString(ShadingModel m) { return nameOf(m); }
+std::string_view toString(ReflectionModel m) { return nameOf(m); }
+std::string_view toString(FogMode m) { return nameOf(m); }
+std::string_view toString(ProjectionType t) { return nameOf(t); }
+std::string_view toString(LightType t) { return nameOf(t); }
+bool parse(std::string_view s, ShadingModel& out) { return parseName(s, out); }
+bool parse(std::string_view s, ReflectionModel& out) { return parseName(s, out); }
+bool parse(std::string_view s, FogMode& out) { return parseName(s, out); }
+bool parse(std::string_view s, ProjectionType& out) { return parseName(s, out); }
+bool parse(std::string_view s, LightType& out) { return parseName(s, out); }
+
+}   // namespace sg
