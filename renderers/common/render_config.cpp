@@ -2,6 +2,7 @@
 #include "renderers/render_config.h"
 
 #include "renderers/renderer.h"
+#include "scenegraph/setting_names.h"
 
 #include <algorithm>
 
@@ -60,7 +61,8 @@ bool resolveRenderConfig(const sg::FrameInput& frame, const Capabilities& caps, 
             c.aa = sg::AAMode::MSAA;
             c.msaaSamples = n;
             if (n != s.aaRate)
-                c.notes.push_back(c.aaAsked + " -> msaa" + std::to_string(n) + ": takes " + joined(caps.msaaSamples) + " MSAA samples per pixel");
+                c.notes.push_back(c.aaAsked + " -> " + std::string(sg::nameOf(sg::AAChoice{sg::AAMode::MSAA, n})) + ": takes " +
+                                  joined(caps.msaaSamples) + " MSAA samples per pixel");
         } else {
             c.notes.push_back(c.aaAsked + " -> none: no MSAA in this backend");
         }
@@ -75,9 +77,7 @@ bool resolveRenderConfig(const sg::FrameInput& frame, const Capabilities& caps, 
         }
     }
     c.samplesPerPixel = c.msaaSamples * c.ssaaFactor * c.ssaaFactor;
-    c.aaUsed = c.aa == sg::AAMode::MSAA   ? "msaa" + std::to_string(c.msaaSamples)
-               : c.aa == sg::AAMode::SSAA ? "ssaa" + std::to_string(c.ssaaFactor)
-                                          : "none";
+    c.aaUsed = sg::nameOf(sg::AAChoice{c.aa, c.aa == sg::AAMode::MSAA ? c.msaaSamples : c.aa == sg::AAMode::SSAA ? c.ssaaFactor : 0});
 
     // Size: the output, and SSAA's larger image where the backend renders one.
     const int maxSize = std::max(caps.maxImageSize, 1);

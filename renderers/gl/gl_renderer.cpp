@@ -21,6 +21,7 @@
 #include "gl/gl_context.h"
 #include "renderers/draw_list.h"
 #include "renderers/tessellate.h"
+#include "scenegraph/setting_names.h"
 
 #include <glad/gl.h>
 
@@ -79,7 +80,8 @@ std::string compileShader(GLenum type, const std::string& src, GLuint& out) {
 // Every settings enum value the shaders see, as a named constant with the C++ enum's own value
 // (SHADING_PHONG, FOG_EXP2, LIGHT_SPOT, ...): the shaders compare against these names only, so
 // reordering an enum cannot silently change what GLSL does, and a test checks that the shaders
-// handle every name. Names come from sg::toString (which -Wswitch keeps complete).
+// handle every name. Names come from the settings' name tables (scenegraph/setting_names.h,
+// whose test checks that every enum value has an entry).
 std::string glslEnumDefines() {
     std::string d;
     auto upper = [](std::string_view v) {
@@ -90,10 +92,13 @@ std::string glslEnumDefines() {
     auto add = [&](const char* prefix, std::string_view name, int value) {
         d += std::string("#define ") + prefix + upper(name) + " " + std::to_string(value) + "\n";
     };
-    for (int v = 0; toString(sg::ShadingModel(v)) != "?"; ++v) add("SHADING_", toString(sg::ShadingModel(v)), v);
-    for (int v = 0; v <= int(sg::ReflectionModel::BlinnPhong); ++v) add("REFLECTION_", toString(sg::ReflectionModel(v)), v);
-    for (int v = 0; toString(sg::FogMode(v)) != "?"; ++v) add("FOG_", toString(sg::FogMode(v)), v);
-    for (int v = 0; toString(sg::LightType(v)) != "?"; ++v) add("LIGHT_", toString(sg::LightType(v)), v);
+    auto all = [&](const char* prefix, const auto& table) {
+        for (const auto& e : table.entries) add(prefix, e.name, int(e.value));
+    };
+    all("SHADING_", sg::nameTable<sg::ShadingModel>());
+    all("REFLECTION_", sg::nameTable<sg::ReflectionModel>());
+    all("FOG_", sg::nameTable<sg::FogMode>());
+    all("LIGHT_", sg::nameTable<sg::LightType>());
     return d;
 }
 
