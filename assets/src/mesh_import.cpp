@@ -263,134 +263,168 @@ struct ObjCorner {
     uint32_t v, vt, vn;   // 0-based, ~0u = absent
 };
 
-LoadResult loadObj(const fs::path& path, const std::string& text, Ctx& ctx) {
-    const std::string file = fileNameOf(path);
-    ConfinedDir dir(path.parent_path().empty() ? fs::path(".") : path.parent_path());
+struct ObjFace {
+    uint32_t first, count;   // corners[first, first + count)
+    int material;            // index into ObjData::matNames, -1: none (before any usemtl)
+};
+
+// An OBJ file as read: every corner index of a kept face/line/point is in range of the
+// arrays it refers to; faces have >= 3 corners, lines >= 2 (others were counted as dropped).
+struct ObjData {
     std::vector<sg::vec3> v, vn;
-    std::vector<sg::vec4> vc;   // vertex colours (x y z r g b)
+    std::vector<sg::vec4> vc;   // vertex colours (x y z r g b), one per v
     std::vector<sg::vec2> vt;
-    std::vector<ObjCorner> corners;
-    struct Face {
-        uint32_t first, count;
-        int material;
-    };
-    std::vector<Face> faces;
+    std::vector<ObjCorner> corners;   // of the kept faces
+    std::vector<ObjFace> faces;
     std::vector<uint32_t> linePoly;   // v indices of line segments (pairs)
     std::vector<uint32_t> pointList;
     std::vector<std::string> mtllibs;
     std::vector<std::string> matNames;   // usemtl order
-    int curMat = -1;
     size_t dropped = 0, badLines = 0;
     bool anyColor = false;
+};
+
+// OBJ index (1-based, or negative: relative to the end) -> 0-based index below n.
+bool resolveObjIndex(int64_t i, size_t n, uint32_t& out) {
+    if (i > 0 && uint64_t(i) <= n) {
+        out = uint32_t(i - 1);
+        return true;
+    }
+    if (i < 0 && uint64_t(-i) <= n) {
+        out = uint32_t(int64_t(n) + i);
+        return true;
+    }
+    return false;
+}
+
+// "v x y z [r g b]": appends one position and colour (zero / white when malformed).
+void readObjVertex(Cursor& c, ObjData& d) {
+    float x, y, z;
+    if (!toFloat(c.token(), x) || !toFloat(c.token(), y) || !toFloat(c.token(), z) || !std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) {
+        ++d.badLines;
+        d.v.push_back(sg::vec3(0.0f));
+        d.vc.push_back(sg::vec4(1.0f));
+    } else {
+        d.v.push_back({x, y, z});
+        float r, g, b;
+        std::string_view t = c.token();
+        if (!t.empty() && toFloat(t, r) && toFloat(c.token(), g) && toFloat(c.token(), b)) {
+            d.anyColor = true;
+            d.vc.push_back(sg::vec4(r, g, b, 1.0f));
+        } else {
+            d.vc.push_back(sg::vec4(1.0f));
+        }
+    }
+    if (d.v.size() > kMaxVertices) throw Fail{"more than " + std::to_string(kMaxVertices) + " vertices (budget)"};
+}
+
+// One corner token "v", "v/vt", "v//vn" or "v/vt/vn"; false when an index is malformed or out
+// of range of the elements read so far.
+bool readObjCorner(std::string_view t, const ObjData& d, ObjCorner& cr) {
+    cr = ObjCorner{~0u, ~0u, ~0u};
+    bool ok = true;
+    size_t s1 = t.find('/');
+    int64_t iv, it, in;
+    if (!toInt64(t.substr(0, s1), iv) || !resolveObjIndex(iv, d.v.size(), cr.v)) ok = false;
+    if (s1 != std::string_view::npos) {
+        std::string_view rest = t.substr(s1 + 1);
+        size_t s2 = rest.find('/');
+        std::string_view a = rest.substr(0, s2);
+        if (!a.empty() && (!toInt64(a, it) || !resolveObjIndex(it, d.vt.size(), cr.vt))) ok = false;
+        if (s2 != std::string_view::npos) {
+            std::string_view b = rest.substr(s2 + 1);
+            if (!b.empty() && (!toInt64(b, in) || !resolveObjIndex(in, d.vn.size(), cr.vn))) ok = false;
+        }
+    }
+    return ok;
+}
+
+// "f", "l" or "p" (key) with its corners: a face is kept with material curMat (counted against
+// the triangle budget), a line as segments, points as v indices; an element with a bad
+// index or too few corners is dropped whole.
+void readObjElement(Cursor& c, std::string_view key, int curMat, ObjData& d, Ctx& ctx) {
+    uint32_t first = uint32_t(d.corners.size());
+    bool ok = true;
+    size_t n = 0;
+    for (std::string_view t = c.token(); !t.empty() && t[0] != '#'; t = c.token()) {
+        ObjCorner cr;
+        if (!readObjCorner(t, d, cr)) ok = false;
+        d.corners.push_back(cr);
+        ++n;
+    }
+    if (!ok || n == 0 || (key == "f" && n < 3) || (key == "l" && n < 2)) {
+        ++d.dropped;
+        d.corners.resize(first);
+    } else if (key == "f") {
+        ctx.countTriangles(n - 2);
+        d.faces.push_back({first, uint32_t(n), curMat});
+    } else {
+        for (size_t i = 0; i < n; ++i) {
+            if (key == "p")
+                d.pointList.push_back(d.corners[first + i].v);
+            else if (i + 1 < n) {
+                d.linePoly.push_back(d.corners[first + i].v);
+                d.linePoly.push_back(d.corners[first + i + 1].v);
+            }
+        }
+        d.corners.resize(first);
+    }
+}
+
+// Reads the whole OBJ text (progress 0..0.7). Unknown statements are skipped line by line.
+ObjData parseObjText(const std::string& text, Ctx& ctx) {
+    ObjData d;
+    int curMat = -1;
     Cursor c{text.data(), text.data() + text.size()};
     size_t line = 0;
-    auto resolve = [](int64_t i, size_t n, uint32_t& out) {
-        if (i > 0 && uint64_t(i) <= n) {
-            out = uint32_t(i - 1);
-            return true;
-        }
-        if (i < 0 && uint64_t(-i) <= n) {
-            out = uint32_t(int64_t(n) + i);
-            return true;
-        }
-        return false;
-    };
     while (!c.atEnd()) {
         ctx.poll(++line, 0.0f, 0.7f, 0);
         if ((line & (kPoll - 1)) == 0) ctx.progress.set(0.7f * float(double(c.p - text.data()) / double(text.size())));
         std::string_view key = c.token();
         if (key == "v") {
-            float x, y, z;
-            if (!toFloat(c.token(), x) || !toFloat(c.token(), y) || !toFloat(c.token(), z) || !std::isfinite(x) || !std::isfinite(y) ||
-                !std::isfinite(z)) {
-                ++badLines;
-                v.push_back(sg::vec3(0.0f));
-                vc.push_back(sg::vec4(1.0f));
-            } else {
-                v.push_back({x, y, z});
-                float r, g, b;
-                std::string_view t = c.token();
-                if (!t.empty() && toFloat(t, r) && toFloat(c.token(), g) && toFloat(c.token(), b)) {
-                    anyColor = true;
-                    vc.push_back(sg::vec4(r, g, b, 1.0f));
-                } else {
-                    vc.push_back(sg::vec4(1.0f));
-                }
-            }
-            if (v.size() > kMaxVertices) throw Fail{"more than " + std::to_string(kMaxVertices) + " vertices (budget)"};
+            readObjVertex(c, d);
         } else if (key == "vt") {
             float s = 0, t = 0;
-            if (!toFloat(c.token(), s)) ++badLines;
+            if (!toFloat(c.token(), s)) ++d.badLines;
             std::string_view tt = c.token();
-            if (!tt.empty() && !toFloat(tt, t)) ++badLines;
-            vt.push_back({s, t});
+            if (!tt.empty() && !toFloat(tt, t)) ++d.badLines;
+            d.vt.push_back({s, t});
         } else if (key == "vn") {
             float x, y, z;
             if (!toFloat(c.token(), x) || !toFloat(c.token(), y) || !toFloat(c.token(), z)) {
-                ++badLines;
+                ++d.badLines;
                 x = 0;
                 y = 0;
                 z = 1;
             }
-            vn.push_back({x, y, z});
+            d.vn.push_back({x, y, z});
         } else if (key == "f" || key == "l" || key == "p") {
-            uint32_t first = uint32_t(corners.size());
-            bool ok = true;
-            size_t n = 0;
-            for (std::string_view t = c.token(); !t.empty() && t[0] != '#'; t = c.token()) {
-                ObjCorner cr{~0u, ~0u, ~0u};
-                size_t s1 = t.find('/');
-                int64_t iv, it, in;
-                if (!toInt64(t.substr(0, s1), iv) || !resolve(iv, v.size(), cr.v)) ok = false;
-                if (s1 != std::string_view::npos) {
-                    std::string_view rest = t.substr(s1 + 1);
-                    size_t s2 = rest.find('/');
-                    std::string_view a = rest.substr(0, s2);
-                    if (!a.empty() && (!toInt64(a, it) || !resolve(it, vt.size(), cr.vt))) ok = false;
-                    if (s2 != std::string_view::npos) {
-                        std::string_view b = rest.substr(s2 + 1);
-                        if (!b.empty() && (!toInt64(b, in) || !resolve(in, vn.size(), cr.vn))) ok = false;
-                    }
-                }
-                corners.push_back(cr);
-                ++n;
-            }
-            if (!ok || n == 0 || (key == "f" && n < 3) || (key == "l" && n < 2)) {
-                ++dropped;
-                corners.resize(first);
-            } else if (key == "f") {
-                ctx.countTriangles(n - 2);
-                faces.push_back({first, uint32_t(n), curMat});
-            } else {
-                for (size_t i = 0; i < n; ++i) {
-                    if (key == "p")
-                        pointList.push_back(corners[first + i].v);
-                    else if (i + 1 < n) {
-                        linePoly.push_back(corners[first + i].v);
-                        linePoly.push_back(corners[first + i + 1].v);
-                    }
-                }
-                corners.resize(first);
-            }
+            readObjElement(c, key, curMat, d, ctx);
         } else if (key == "usemtl") {
             std::string name(c.restOfLine());
-            auto it = std::find(matNames.begin(), matNames.end(), name);
-            curMat = int(it - matNames.begin());
-            if (it == matNames.end()) matNames.push_back(name);
+            auto it = std::find(d.matNames.begin(), d.matNames.end(), name);
+            curMat = int(it - d.matNames.begin());
+            if (it == d.matNames.end()) d.matNames.push_back(name);
         } else if (key == "mtllib") {
-            for (std::string_view t = c.token(); !t.empty(); t = c.token()) mtllibs.push_back(cleanRelPath(t));
+            for (std::string_view t = c.token(); !t.empty(); t = c.token()) d.mtllibs.push_back(cleanRelPath(t));
         }
         c.skipLine();
     }
-    if (v.empty()) throw Fail{"no vertices"};
-    if (dropped) ctx.warnings.push_back(file + ": " + std::to_string(dropped) + " faces/lines with missing or out-of-range indices dropped");
-    if (badLines) ctx.warnings.push_back(file + ": " + std::to_string(badLines) + " malformed vertex lines (zero used)");
+    return d;
+}
 
-    // Materials.
-    std::map<std::string, ObjMaterial> lib;
-    for (const std::string& m : mtllibs) parseMtl(dir, m, ctx, file, lib);
+// Materials of an OBJ: one per usemtl name, in order (from the MTL libraries, or defaults),
+// plus, for a file without mtllib but with UVs, one for a texture found beside the model.
+struct ObjMaterials {
     std::vector<sg::Material> materials;
-    std::vector<std::shared_ptr<sg::Texture>> textures;
+    std::vector<std::shared_ptr<sg::Texture>> textures;   // each loaded once
+    int implicitMat = -1;                                 // the material of faces without usemtl (-1: the default)
+};
+
+ObjMaterials resolveObjMaterials(const fs::path& path, const ConfinedDir& dir, const ObjData& d, Ctx& ctx, const std::string& file) {
+    ObjMaterials out;
+    std::map<std::string, ObjMaterial> lib;
+    for (const std::string& m : d.mtllibs) parseMtl(dir, m, ctx, file, lib);
     std::map<std::string, int> texIndex;
     auto textureFor = [&](const std::string& rel) -> int {
         if (rel.empty()) return -1;
@@ -398,134 +432,163 @@ LoadResult loadObj(const fs::path& path, const std::string& text, Ctx& ctx) {
         if (it != texIndex.end()) return it->second;
         int idx = -1;
         if (auto t = loadTexture(dir, rel, ctx, file)) {
-            textures.push_back(t);
-            idx = int(textures.size() - 1);
+            out.textures.push_back(t);
+            idx = int(out.textures.size() - 1);
         }
         texIndex[rel] = idx;
         return idx;
     };
-    for (const std::string& name : matNames) {
+    for (const std::string& name : d.matNames) {
         auto it = lib.find(name);
         sg::Material m;
         m.name = name;
         if (it != lib.end()) {
             m = it->second.mat;
             m.diffuseTexture = textureFor(it->second.texture);
-        } else if (!mtllibs.empty()) {
+        } else if (!d.mtllibs.empty()) {
             ctx.warnings.push_back(file + ": material '" + name + "' not found in the material libraries; default used");
         }
-        materials.push_back(m);
+        out.materials.push_back(m);
     }
     // OBJ without mtllib but with UVs: a texture named after the model next to it.
-    int implicitTexture = -1;
-    if (mtllibs.empty() && !vt.empty()) {
+    if (d.mtllibs.empty() && !d.vt.empty()) {
         std::string stem = path.stem().string();
         for (const std::string& cand : {stem + ".png", stem + ".jpg", stem + "_texture.png", stem + "_texture.jpg"}) {
             if (dir.probe(cand).empty()) {
-                implicitTexture = textureFor(cand);
-                if (implicitTexture >= 0) {
+                const int tex = textureFor(cand);
+                if (tex >= 0) {
                     sg::Material m;
                     m.name = stem;
-                    m.diffuseTexture = implicitTexture;
-                    materials.push_back(m);
+                    m.diffuseTexture = tex;
+                    out.materials.push_back(m);
+                    out.implicitMat = int(out.materials.size() - 1);
                     ctx.warnings.push_back(file + ": no mtllib; using texture '" + cand + "' found beside the model");
                 }
                 break;
             }
         }
     }
+    return out;
+}
 
-    // Build one mesh per material group, de-duplicating (v, vt, vn) corners. Faces without
-    // usemtl use the implicit texture material when there is one, else the default (-1).
-    const int implicitMat = implicitTexture >= 0 ? int(materials.size() - 1) : -1;
-    std::vector<std::vector<uint32_t>> byMaterial(materials.size() + 1);   // slot 0 = default
-    for (size_t fi = 0; fi < faces.size(); ++fi) {
-        int fm = faces[fi].material >= 0 ? faces[fi].material : implicitMat;
+// One triangle mesh from the faces faceIds, fan-triangulated, with (v, vt, vn) corners
+// de-duplicated (by v alone when the file has neither UVs nor normals). UVs / normals are
+// kept only when some / all corners have them, colours only when the file has any.
+// done: faces converted so far over all groups (progress 0.7..0.95).
+sg::Mesh buildObjGroupMesh(const ObjData& d, const std::vector<uint32_t>& faceIds, Ctx& ctx, size_t& done) {
+    sg::Mesh mesh;
+    const bool simple = d.vt.empty() && d.vn.empty();
+    std::vector<uint32_t> remap;
+    struct Key {
+        uint32_t v, t, n;
+        bool operator==(const Key&) const = default;
+    };
+    struct KeyHash {
+        size_t operator()(const Key& k) const { return (size_t(k.v) * 0x9E3779B97F4A7C15ull) ^ (size_t(k.t) * 0xC2B2AE3D27D4EB4Full) ^ k.n; }
+    };
+    std::unordered_map<Key, uint32_t, KeyHash> map;
+    if (simple) remap.assign(d.v.size(), ~0u);
+    bool hasUv = false, hasN = true;
+    auto vertexOf = [&](const ObjCorner& cr) -> uint32_t {
+        uint32_t idx;
+        if (simple) {
+            if (remap[cr.v] != ~0u) return remap[cr.v];
+            idx = remap[cr.v] = uint32_t(mesh.positions.size());
+        } else {
+            auto [it, inserted] = map.try_emplace(Key{cr.v, cr.vt, cr.vn}, uint32_t(mesh.positions.size()));
+            if (!inserted) return it->second;
+            idx = it->second;
+        }
+        mesh.positions.push_back(d.v[cr.v]);
+        mesh.colors.push_back(d.vc[cr.v]);
+        mesh.uv0.push_back(cr.vt != ~0u ? d.vt[cr.vt] : sg::vec2(0.0f));
+        mesh.normals.push_back(cr.vn != ~0u ? d.vn[cr.vn] : sg::vec3(0.0f));
+        hasUv |= cr.vt != ~0u;
+        hasN &= cr.vn != ~0u;
+        return idx;
+    };
+    std::vector<uint32_t> tri;
+    for (uint32_t fi : faceIds) {
+        ctx.poll(++done, 0.7f, 0.25f, d.faces.size());
+        const ObjFace& f = d.faces[fi];
+        tri.clear();
+        for (uint32_t k = 0; k < f.count; ++k) tri.push_back(vertexOf(d.corners[f.first + k]));
+        fan(tri.data(), tri.size(), mesh.indices);
+    }
+    if (!hasUv) mesh.uv0.clear();
+    if (!hasN) mesh.normals.clear();
+    if (!d.anyColor) mesh.colors.clear();
+    return mesh;
+}
+
+// The faces as one mesh per material group, in material order (faces without usemtl first,
+// with the implicit texture material when there is one, else the default (-1)).
+void addObjFaceMeshes(const fs::path& path, const ObjData& d, const ObjMaterials& mats, Ctx& ctx, std::vector<std::pair<sg::Mesh, int>>& parts) {
+    std::vector<std::vector<uint32_t>> byMaterial(mats.materials.size() + 1);   // slot 0 = default
+    for (size_t fi = 0; fi < d.faces.size(); ++fi) {
+        int fm = d.faces[fi].material >= 0 ? d.faces[fi].material : mats.implicitMat;
         byMaterial[size_t(fm + 1)].push_back(uint32_t(fi));
     }
-    std::vector<std::pair<sg::Mesh, int>> parts;
-    const bool simple = vt.empty() && vn.empty();
-    std::vector<uint32_t> tri;
     size_t done = 0;
     for (size_t g = 0; g < byMaterial.size(); ++g) {
         if (byMaterial[g].empty()) continue;
         const int mat = int(g) - 1;
-        sg::Mesh mesh;
-        std::vector<uint32_t> remap;
-        struct Key {
-            uint32_t v, t, n;
-            bool operator==(const Key&) const = default;
-        };
-        struct KeyHash {
-            size_t operator()(const Key& k) const { return (size_t(k.v) * 0x9E3779B97F4A7C15ull) ^ (size_t(k.t) * 0xC2B2AE3D27D4EB4Full) ^ k.n; }
-        };
-        std::unordered_map<Key, uint32_t, KeyHash> map;
-        if (simple) remap.assign(v.size(), ~0u);
-        bool hasUv = false, hasN = true;
-        auto vertexOf = [&](const ObjCorner& cr) -> uint32_t {
-            uint32_t idx;
-            if (simple) {
-                if (remap[cr.v] != ~0u) return remap[cr.v];
-                idx = remap[cr.v] = uint32_t(mesh.positions.size());
-            } else {
-                auto [it, inserted] = map.try_emplace(Key{cr.v, cr.vt, cr.vn}, uint32_t(mesh.positions.size()));
-                if (!inserted) return it->second;
-                idx = it->second;
-            }
-            mesh.positions.push_back(v[cr.v]);
-            mesh.colors.push_back(vc[cr.v]);
-            mesh.uv0.push_back(cr.vt != ~0u ? vt[cr.vt] : sg::vec2(0.0f));
-            mesh.normals.push_back(cr.vn != ~0u ? vn[cr.vn] : sg::vec3(0.0f));
-            hasUv |= cr.vt != ~0u;
-            hasN &= cr.vn != ~0u;
-            return idx;
-        };
-        for (uint32_t fi : byMaterial[g]) {
-            ctx.poll(++done, 0.7f, 0.25f, faces.size());
-            const Face& f = faces[fi];
-            tri.clear();
-            for (uint32_t k = 0; k < f.count; ++k) tri.push_back(vertexOf(corners[f.first + k]));
-            fan(tri.data(), tri.size(), mesh.indices);
-        }
-        if (!hasUv) mesh.uv0.clear();
-        if (!hasN) mesh.normals.clear();
-        if (!anyColor) mesh.colors.clear();
-        mesh.name = mat >= 0 ? materials[size_t(mat)].name : path.stem().string();
+        sg::Mesh mesh = buildObjGroupMesh(d, byMaterial[g], ctx, done);
+        mesh.name = mat >= 0 ? mats.materials[size_t(mat)].name : path.stem().string();
         parts.push_back({std::move(mesh), mat});
     }
-    if (!linePoly.empty()) {
-        sg::Mesh lines;
-        lines.mode = sg::PrimitiveMode::Lines;
-        lines.name = path.stem().string() + " lines";
-        std::vector<uint32_t> remap(v.size(), ~0u);
-        for (uint32_t i : linePoly) {
-            if (remap[i] == ~0u) {
-                remap[i] = uint32_t(lines.positions.size());
-                lines.positions.push_back(v[i]);
-                if (anyColor) lines.colors.push_back(vc[i]);
-            }
-            lines.indices.push_back(remap[i]);
+}
+
+// The `l` segments as one line mesh holding only the vertices they use.
+void addObjLineMesh(const fs::path& path, const ObjData& d, std::vector<std::pair<sg::Mesh, int>>& parts) {
+    sg::Mesh lines;
+    lines.mode = sg::PrimitiveMode::Lines;
+    lines.name = path.stem().string() + " lines";
+    std::vector<uint32_t> remap(d.v.size(), ~0u);
+    for (uint32_t i : d.linePoly) {
+        if (remap[i] == ~0u) {
+            remap[i] = uint32_t(lines.positions.size());
+            lines.positions.push_back(d.v[i]);
+            if (d.anyColor) lines.colors.push_back(d.vc[i]);
         }
-        parts.push_back({std::move(lines), -1});
+        lines.indices.push_back(remap[i]);
     }
-    if (parts.empty() || !pointList.empty()) {
-        // Vertices only (or explicit `p` elements): a point cloud.
-        sg::Mesh pts;
-        pts.mode = sg::PrimitiveMode::Points;
-        pts.name = path.stem().string() + " points";
-        pts.positions = v;
-        if (anyColor) pts.colors = vc;
-        if (!vn.empty() && vn.size() == v.size()) pts.normals = vn;
-        if (pointList.empty()) {
-            pts.indices.resize(v.size());
-            for (size_t i = 0; i < v.size(); ++i) pts.indices[i] = uint32_t(i);
-        } else {
-            pts.indices = pointList;
-        }
-        parts.push_back({std::move(pts), -1});
+    parts.push_back({std::move(lines), -1});
+}
+
+// A point cloud over all vertices: the `p` elements, or every vertex when nothing else was drawn.
+void addObjPointMesh(const fs::path& path, const ObjData& d, std::vector<std::pair<sg::Mesh, int>>& parts) {
+    sg::Mesh pts;
+    pts.mode = sg::PrimitiveMode::Points;
+    pts.name = path.stem().string() + " points";
+    pts.positions = d.v;
+    if (d.anyColor) pts.colors = d.vc;
+    if (!d.vn.empty() && d.vn.size() == d.v.size()) pts.normals = d.vn;
+    if (d.pointList.empty()) {
+        pts.indices.resize(d.v.size());
+        for (size_t i = 0; i < d.v.size(); ++i) pts.indices[i] = uint32_t(i);
+    } else {
+        pts.indices = d.pointList;
     }
+    parts.push_back({std::move(pts), -1});
+}
+
+LoadResult loadObj(const fs::path& path, const std::string& text, Ctx& ctx) {
+    const std::string file = fileNameOf(path);
+    ConfinedDir dir(path.parent_path().empty() ? fs::path(".") : path.parent_path());
+    const ObjData d = parseObjText(text, ctx);
+    if (d.v.empty()) throw Fail{"no vertices"};
+    if (d.dropped) ctx.warnings.push_back(file + ": " + std::to_string(d.dropped) + " faces/lines with missing or out-of-range indices dropped");
+    if (d.badLines) ctx.warnings.push_back(file + ": " + std::to_string(d.badLines) + " malformed vertex lines (zero used)");
+
+    ObjMaterials mats = resolveObjMaterials(path, dir, d, ctx, file);
+    std::vector<std::pair<sg::Mesh, int>> parts;
+    addObjFaceMeshes(path, d, mats, ctx, parts);
+    if (!d.linePoly.empty()) addObjLineMesh(path, d, parts);
+    // Vertices only (or explicit `p` elements): a point cloud.
+    if (parts.empty() || !d.pointList.empty()) addObjPointMesh(path, d, parts);
     LoadResult r;
-    r.scene = makeScene(path, parts, std::move(materials), std::move(textures));
+    r.scene = makeScene(path, parts, std::move(mats.materials), std::move(mats.textures));
     return r;
 }
 
