@@ -767,8 +767,11 @@ struct PlyReader {
     int format;   // 0 ascii, 1 LE, 2 BE
     Cursor text{nullptr, nullptr};
 
-    // Reads one scalar; false at end of data / malformed.
-    bool read(PlyType t, double& out) {
+    // Bytes of data left to read.
+    uint64_t left() const { return format == 0 ? uint64_t(text.end - text.p) : uint64_t(end - p); }
+
+    // Reads one scalar; false at end of data / malformed. Always inlined: it runs per value.
+    [[gnu::always_inline]] bool read(PlyType t, double& out) {
         if (format == 0) {
             std::string_view tok = text.anyToken();
             return toDouble(tok, out);
@@ -824,10 +827,18 @@ struct PlyReader {
     }
 };
 
-LoadResult loadPly(const fs::path& path, const std::string& data, Ctx& ctx) {
-    const std::string file = fileNameOf(path);
-    // Header lines end in \n, \r\n or \r alone (Box.ply).
-    size_t pos = 0;
+// A parsed PLY header: format, elements in file order, and where the body starts.
+struct PlyHeader {
+    int format = -1;   // 0 ascii, 1 LE, 2 BE
+    std::vector<PlyElement> elements;
+    size_t bodyStart = 0;
+};
+
+// Header lines end in \n, \r\n or \r alone (Box.ply). Throws Fail on a missing magic, format
+// or end_header and on malformed element/property lines.
+PlyHeader parsePlyHeader(const std::string& data) {
+    PlyHeader h;
+    size_t& pos = h.bodyStart;
     auto nextLine = [&](std::string& line) -> bool {
         if (pos >= data.size()) return false;
         size_t e = data.find_first_of("\r\n", pos);
@@ -843,8 +854,6 @@ LoadResult loadPly(const fs::path& path, const std::string& data, Ctx& ctx) {
     };
     std::string line;
     if (!nextLine(line) || line.substr(0, 3) != "ply") throw Fail{"not a PLY file (no 'ply' magic)"};
-    int format = -1;
-    std::vector<PlyElement> elements;
     bool endHeader = false;
     size_t headerLines = 0;
     while (nextLine(line)) {
@@ -853,15 +862,15 @@ LoadResult loadPly(const fs::path& path, const std::string& data, Ctx& ctx) {
         std::string_view key = c.token();
         if (key == "format") {
             std::string_view f = c.token();
-            format = f == "ascii" ? 0 : f == "binary_little_endian" ? 1 : f == "binary_big_endian" ? 2 : -1;
-            if (format < 0) throw Fail{"unknown PLY format '" + std::string(f) + "'"};
+            h.format = f == "ascii" ? 0 : f == "binary_little_endian" ? 1 : f == "binary_big_endian" ? 2 : -1;
+            if (h.format < 0) throw Fail{"unknown PLY format '" + std::string(f) + "'"};
         } else if (key == "element") {
             PlyElement e;
             e.name = std::string(c.token());
             if (!toUint64(c.token(), e.count)) throw Fail{"malformed element line '" + line + "'"};
-            elements.push_back(std::move(e));
+            h.elements.push_back(std::move(e));
         } else if (key == "property") {
-            if (elements.empty()) throw Fail{"property before any element"};
+            if (h.elements.empty()) throw Fail{"property before any element"};
             PlyProperty pr;
             std::string_view t = c.token();
             if (t == "list") {
@@ -875,7 +884,7 @@ LoadResult loadPly(const fs::path& path, const std::string& data, Ctx& ctx) {
             }
             if (pr.type == PlyType::Invalid) throw Fail{"unknown property type in '" + line + "'"};
             pr.name = std::string(c.token());
-            elements.back().props.push_back(std::move(pr));
+            h.elements.back().props.push_back(std::move(pr));
         } else if (key == "end_header") {
             endHeader = true;
             break;
@@ -883,203 +892,252 @@ LoadResult loadPly(const fs::path& path, const std::string& data, Ctx& ctx) {
         // comment, obj_info: ignored
     }
     if (!endHeader) throw Fail{"PLY header has no end_header"};
-    if (format < 0) throw Fail{"PLY header has no format line"};
-    // Size check before allocating: every element needs at least this many bytes.
-    const uint64_t bodyBytes = data.size() - pos;
+    if (h.format < 0) throw Fail{"PLY header has no format line"};
+    return h;
+}
+
+// Size check before allocating: every element needs at least this many bytes (ascii: 2 per
+// value, binary: a list's count or a scalar), so no count exceeds what the body can hold.
+void checkPlyBodySize(const PlyHeader& h, const std::string& data) {
+    const uint64_t bodyBytes = data.size() - h.bodyStart;
     uint64_t need = 0;
-    for (const PlyElement& e : elements) {
+    for (const PlyElement& e : h.elements) {
         uint64_t per = 0;
-        for (const PlyProperty& pr : e.props) per += format == 0 ? 2 : (pr.list ? plySize(pr.countType) : plySize(pr.type));
+        for (const PlyProperty& pr : e.props) per += h.format == 0 ? 2 : (pr.list ? plySize(pr.countType) : plySize(pr.type));
         uint64_t bytes;
         if (per == 0) continue;
         if (__builtin_mul_overflow(per, e.count, &bytes) || __builtin_add_overflow(need, bytes, &need) || need > bodyBytes + 1)
             throw Fail{"element '" + e.name + "' claims " + std::to_string(e.count) + " entries but the file has only " + std::to_string(bodyBytes) +
                        " bytes after the header"};
     }
+}
+
+// What an element is and which of its properties hold what we read (-1: absent). Vertex
+// elements: scalar position, normal, colour and UV properties; face / tristrips elements:
+// the index list. Other elements are read and skipped.
+struct PlyRoles {
+    bool isVertex = false, isFace = false, isStrip = false;
+    int ix = -1, iy = -1, iz = -1, inx = -1, iny = -1, inz = -1, ir = -1, ig = -1, ib = -1, ia = -1, iu = -1, iv = -1, ilist = -1;
+    bool haveNormals = false, haveColors = false, haveUv = false;   // complete attributes of a vertex element
+};
+
+PlyRoles plyRoles(const PlyElement& e) {
+    PlyRoles r;
+    r.isVertex = e.name == "vertex";
+    r.isFace = e.name == "face";
+    r.isStrip = e.name == "tristrips";
+    for (size_t k = 0; k < e.props.size(); ++k) {
+        const std::string& n = e.props[k].name;
+        int kk = int(k);
+        if (r.isVertex && !e.props[k].list) {
+            if (n == "x")
+                r.ix = kk;
+            else if (n == "y")
+                r.iy = kk;
+            else if (n == "z")
+                r.iz = kk;
+            else if (n == "nx")
+                r.inx = kk;
+            else if (n == "ny")
+                r.iny = kk;
+            else if (n == "nz")
+                r.inz = kk;
+            else if (n == "red" || n == "r" || n == "diffuse_red")
+                r.ir = kk;
+            else if (n == "green" || n == "g" || n == "diffuse_green")
+                r.ig = kk;
+            else if (n == "blue" || n == "b" || n == "diffuse_blue")
+                r.ib = kk;
+            else if (n == "alpha" || n == "a")
+                r.ia = kk;
+            else if (n == "s" || n == "u" || n == "texture_u" || n == "texture_s")
+                r.iu = kk;
+            else if (n == "t" || n == "v" || n == "texture_v" || n == "texture_t")
+                r.iv = kk;
+        }
+        if ((r.isFace || r.isStrip) && e.props[k].list && (n == "vertex_indices" || n == "vertex_index") && r.ilist < 0) r.ilist = kk;
+    }
+    r.haveNormals = r.inx >= 0 && r.iny >= 0 && r.inz >= 0;
+    r.haveColors = r.ir >= 0 && r.ig >= 0 && r.ib >= 0;
+    r.haveUv = r.iu >= 0 && r.iv >= 0;
+    return r;
+}
+
+// The mesh under construction and what the body reading keeps between elements.
+struct PlyBuild {
+    sg::Mesh mesh;
+    size_t dropped = 0;             // faces / strip triangles
+    std::vector<uint32_t> poly;     // scratch: one face's corners
+    std::vector<double> listVals;   // the kept list of the current entry
+};
+
+// A colour channel as 0..1: 8- and 16-bit integers are scaled, other types taken as they are.
+// Always inlined (per vertex and channel; GCC outlined it once split from loadPly).
+[[gnu::always_inline]] inline float plyChannel(PlyType t, double d) {
+    if (t == PlyType::U8 || t == PlyType::I8)
+        d /= 255.0;
+    else if (t == PlyType::U16 || t == PlyType::I16)
+        d /= 65535.0;
+    return float(std::clamp(d, 0.0, 1.0));
+}
+
+// Vertex i from its property values: a finite position (else Fail) and the attributes the
+// element has.
+void addPlyVertex(const PlyElement& e, const PlyRoles& k, const std::vector<double>& vals, uint64_t i, PlyBuild& b) {
+    sg::vec3 p{float(vals[size_t(k.ix)]), float(vals[size_t(k.iy)]), float(vals[size_t(k.iz)])};
+    if (!sg::isFinite(p)) throw Fail{"vertex " + std::to_string(i) + " is not finite"};
+    b.mesh.positions.push_back(p);
+    if (k.haveNormals) b.mesh.normals.push_back({float(vals[size_t(k.inx)]), float(vals[size_t(k.iny)]), float(vals[size_t(k.inz)])});
+    if (k.haveUv) b.mesh.uv0.push_back({float(vals[size_t(k.iu)]), float(vals[size_t(k.iv)])});
+    if (k.haveColors) {
+        auto ch = [&](int c) __attribute__((always_inline)) { return plyChannel(e.props[size_t(c)].type, vals[size_t(c)]); };
+        b.mesh.colors.push_back({ch(k.ir), ch(k.ig), ch(k.ib), k.ia >= 0 ? ch(k.ia) : 1.0f});
+    }
+}
+
+// A face from b.listVals: fan-triangulated when it has >= 3 corners, all indices of vertices
+// read so far; else dropped.
+void addPlyFace(PlyBuild& b, Ctx& ctx) {
+    b.poly.clear();
+    bool ok = b.listVals.size() >= 3;
+    for (double d : b.listVals) {
+        if (!(d >= 0 && d < double(b.mesh.positions.size()))) {
+            ok = false;
+            break;
+        }
+        b.poly.push_back(uint32_t(d));
+    }
+    if (!ok) {
+        ++b.dropped;
+        return;
+    }
+    ctx.countTriangles(b.listVals.size() - 2);
+    fan(b.poly.data(), b.poly.size(), b.mesh.indices);
+}
+
+// Triangle strips from b.listVals: strips separated by -1; alternate winding; degenerate
+// triangles skipped, triangles with an index beyond the vertices read so far dropped.
+void addPlyStrips(PlyBuild& b, Ctx& ctx) {
+    const std::vector<double>& lv = b.listVals;
+    const double nv = double(b.mesh.positions.size());
+    size_t start = 0;
+    for (size_t j = 0; j <= lv.size(); ++j) {
+        if (j < lv.size() && lv[j] >= 0) continue;
+        for (size_t q = start; q + 2 < j; ++q) {
+            double a = lv[q], bb = lv[q + 1], c2 = lv[q + 2];
+            if (!(a < nv && bb < nv && c2 < nv)) {
+                ++b.dropped;
+                continue;
+            }
+            uint32_t ia2 = uint32_t(a), ib2 = uint32_t(bb), ic2 = uint32_t(c2);
+            if (ia2 == ib2 || ib2 == ic2 || ia2 == ic2) continue;
+            ctx.countTriangles(1);
+            if ((q - start) % 2 == 0) {
+                b.mesh.indices.push_back(ia2);
+                b.mesh.indices.push_back(ib2);
+                b.mesh.indices.push_back(ic2);
+            } else {
+                b.mesh.indices.push_back(ib2);
+                b.mesh.indices.push_back(ia2);
+                b.mesh.indices.push_back(ic2);
+            }
+        }
+        start = j + 1;
+    }
+}
+
+// Reads list property pr of entry i of e; when keep, its values go to b.listVals. False when
+// the data ends (or the count is malformed / longer than the data left). A kept list is
+// limited to 64M entries (Fail).
+bool readPlyList(PlyReader& rd, const PlyElement& e, const PlyProperty& pr, uint64_t i, bool keep, PlyBuild& b) {
+    double cnt;
+    if (!rd.read(pr.countType, cnt) || cnt < 0 || cnt > 1e9) return false;
+    uint64_t n = uint64_t(cnt);
+    // A list cannot be longer than the remaining data.
+    if (n > rd.left()) return false;
+    if (keep && n > (64u << 20))
+        throw Fail{"element '" + e.name + "' " + std::to_string(i) + " has a list of " + std::to_string(n) + " entries (limit 64M)"};
+    if (keep) b.listVals.resize(size_t(n));
+    for (uint64_t j = 0; j < n; ++j) {
+        double d;
+        if (!rd.read(pr.type, d)) return false;
+        if (keep) b.listVals[size_t(j)] = d;
+    }
+    return true;
+}
+
+// Reads entry i of element e (values into vals) and adds what it holds to the mesh: a face or
+// strips as soon as their index list is read, a vertex once all its properties are. False
+// when the data ends within the entry.
+bool readPlyEntry(PlyReader& rd, const PlyElement& e, const PlyRoles& k, uint64_t i, std::vector<double>& vals, PlyBuild& b, Ctx& ctx) {
+    for (size_t p = 0; p < e.props.size(); ++p) {
+        const PlyProperty& pr = e.props[p];
+        if (!pr.list) {
+            if (!rd.read(pr.type, vals[p])) return false;
+            continue;
+        }
+        const bool keep = int(p) == k.ilist;
+        if (!readPlyList(rd, e, pr, i, keep, b)) return false;
+        if (!keep) continue;
+        if (k.isFace)
+            addPlyFace(b, ctx);
+        else if (k.isStrip)
+            addPlyStrips(b, ctx);
+    }
+    if (k.isVertex) addPlyVertex(e, k, vals, i, b);
+    return true;
+}
+
+// Reads element e's entries (progress 0..0.95); readOf gets the number read completely.
+// False when the file ends within the element.
+bool readPlyElement(PlyReader& rd, const PlyElement& e, const std::string& data, PlyBuild& b, Ctx& ctx, uint64_t& readOf) {
+    const PlyRoles k = plyRoles(e);
+    if (k.isVertex) {
+        if (e.count > kMaxVertices)
+            throw Fail{"element 'vertex' claims " + std::to_string(e.count) + " entries (budget " + std::to_string(kMaxVertices) + ")"};
+        if (k.ix < 0 || k.iy < 0 || k.iz < 0) throw Fail{"vertex element has no x, y, z properties"};
+        b.mesh.positions.reserve(size_t(e.count));
+    }
+    // An element without properties holds no data whatever its count (found by fuzzing:
+    // "element x 3000000000000001839" with no properties spun for hours).
+    if (e.props.empty()) return true;
+    std::vector<double> vals(e.props.size());
+    readOf = 0;
+    for (uint64_t i = 0; i < e.count; ++i) {
+        ctx.poll(size_t(i), 0.0f, 0.95f, 0);
+        if ((i & (kPoll - 1)) == 0) {
+            size_t used = rd.format == 0 ? size_t(rd.text.p - data.data()) : size_t(rd.p - reinterpret_cast<const unsigned char*>(data.data()));
+            ctx.progress.set(0.95f * float(double(used) / double(data.size())));
+        }
+        if (!readPlyEntry(rd, e, k, i, vals, b, ctx)) return false;
+        readOf = i + 1;
+    }
+    return true;
+}
+
+LoadResult loadPly(const fs::path& path, const std::string& data, Ctx& ctx) {
+    const std::string file = fileNameOf(path);
+    const PlyHeader h = parsePlyHeader(data);
+    checkPlyBodySize(h, data);   // element counts are safe to reserve by from here on
+    const size_t pos = h.bodyStart;
     PlyReader rd{reinterpret_cast<const unsigned char*>(data.data()) + pos, reinterpret_cast<const unsigned char*>(data.data()) + data.size(),
-                 format};
+                 h.format};
     rd.text = Cursor{data.data() + pos, data.data() + data.size()};
 
-    sg::Mesh mesh;
-    mesh.name = path.stem().string();
-    bool haveNormals = false, haveColors = false, haveUv = false;
-    size_t dropped = 0;
-    std::string truncatedIn;
-    uint64_t readOf = 0, claimed = 0;
-    std::vector<uint32_t> poly;
-    std::vector<double> listVals;
-    size_t faceCount = 0;
-    for (const PlyElement& e : elements) {
-        const bool isVertex = e.name == "vertex";
-        const bool isFace = e.name == "face";
-        const bool isStrip = e.name == "tristrips";
-        int ix = -1, iy = -1, iz = -1, inx = -1, iny = -1, inz = -1, ir = -1, ig = -1, ib = -1, ia = -1, iu = -1, iv = -1, ilist = -1;
-        for (size_t k = 0; k < e.props.size(); ++k) {
-            const std::string& n = e.props[k].name;
-            int kk = int(k);
-            if (isVertex && !e.props[k].list) {
-                if (n == "x")
-                    ix = kk;
-                else if (n == "y")
-                    iy = kk;
-                else if (n == "z")
-                    iz = kk;
-                else if (n == "nx")
-                    inx = kk;
-                else if (n == "ny")
-                    iny = kk;
-                else if (n == "nz")
-                    inz = kk;
-                else if (n == "red" || n == "r" || n == "diffuse_red")
-                    ir = kk;
-                else if (n == "green" || n == "g" || n == "diffuse_green")
-                    ig = kk;
-                else if (n == "blue" || n == "b" || n == "diffuse_blue")
-                    ib = kk;
-                else if (n == "alpha" || n == "a")
-                    ia = kk;
-                else if (n == "s" || n == "u" || n == "texture_u" || n == "texture_s")
-                    iu = kk;
-                else if (n == "t" || n == "v" || n == "texture_v" || n == "texture_t")
-                    iv = kk;
-            }
-            if ((isFace || isStrip) && e.props[k].list && (n == "vertex_indices" || n == "vertex_index") && ilist < 0) ilist = kk;
-        }
-        if (isVertex) {
-            if (e.count > kMaxVertices)
-                throw Fail{"element 'vertex' claims " + std::to_string(e.count) + " entries (budget " + std::to_string(kMaxVertices) + ")"};
-            if (ix < 0 || iy < 0 || iz < 0) throw Fail{"vertex element has no x, y, z properties"};
-            haveNormals = inx >= 0 && iny >= 0 && inz >= 0;
-            haveColors = ir >= 0 && ig >= 0 && ib >= 0;
-            haveUv = iu >= 0 && iv >= 0;
-            mesh.positions.reserve(size_t(e.count));
-        }
-        // An element without properties holds no data whatever its count (found by fuzzing:
-        // "element x 3000000000000001839" with no properties spun for hours).
-        if (e.props.empty()) continue;
-        std::vector<double> vals(e.props.size());
-        bool truncated = false;
-        readOf = 0;
-        for (uint64_t i = 0; i < e.count && !truncated; ++i) {
-            ctx.poll(size_t(i), 0.0f, 0.95f, 0);
-            if ((i & (kPoll - 1)) == 0) {
-                size_t used = format == 0 ? size_t(rd.text.p - data.data()) : size_t(rd.p - reinterpret_cast<const unsigned char*>(data.data()));
-                ctx.progress.set(0.95f * float(double(used) / double(data.size())));
-            }
-            for (size_t k = 0; k < e.props.size(); ++k) {
-                const PlyProperty& pr = e.props[k];
-                if (!pr.list) {
-                    if (!rd.read(pr.type, vals[k])) {
-                        truncated = true;
-                        break;
-                    }
-                    continue;
-                }
-                double cnt;
-                if (!rd.read(pr.countType, cnt) || cnt < 0 || cnt > 1e9) {
-                    truncated = true;
-                    break;
-                }
-                uint64_t n = uint64_t(cnt);
-                // A list cannot be longer than the remaining data.
-                uint64_t left = format == 0 ? uint64_t(rd.text.end - rd.text.p) : uint64_t(rd.end - rd.p);
-                if (n > left) {
-                    truncated = true;
-                    break;
-                }
-                bool keep = int(k) == ilist;
-                if (keep && n > (64u << 20))
-                    throw Fail{"element '" + e.name + "' " + std::to_string(i) + " has a list of " + std::to_string(n) + " entries (limit 64M)"};
-                if (keep) listVals.resize(size_t(n));
-                for (uint64_t j = 0; j < n; ++j) {
-                    double d;
-                    if (!rd.read(pr.type, d)) {
-                        truncated = true;
-                        break;
-                    }
-                    if (keep) listVals[size_t(j)] = d;
-                }
-                if (truncated) break;
-                if (!keep) continue;
-                if (isFace) {
-                    ++faceCount;
-                    poly.clear();
-                    bool ok = n >= 3;
-                    for (double d : listVals) {
-                        if (!(d >= 0 && d < double(mesh.positions.size()))) {
-                            ok = false;
-                            break;
-                        }
-                        poly.push_back(uint32_t(d));
-                    }
-                    if (!ok) {
-                        ++dropped;
-                        continue;
-                    }
-                    ctx.countTriangles(n - 2);
-                    fan(poly.data(), poly.size(), mesh.indices);
-                } else if (isStrip) {
-                    // Strips separated by -1; alternate winding; degenerate triangles skipped.
-                    size_t start = 0;
-                    for (size_t j = 0; j <= listVals.size(); ++j) {
-                        if (j < listVals.size() && listVals[j] >= 0) continue;
-                        for (size_t q = start; q + 2 < j; ++q) {
-                            double a = listVals[q], b = listVals[q + 1], c2 = listVals[q + 2];
-                            if (!(a < double(mesh.positions.size()) && b < double(mesh.positions.size()) && c2 < double(mesh.positions.size()))) {
-                                ++dropped;
-                                continue;
-                            }
-                            uint32_t ia2 = uint32_t(a), ib2 = uint32_t(b), ic2 = uint32_t(c2);
-                            if (ia2 == ib2 || ib2 == ic2 || ia2 == ic2) continue;
-                            ctx.countTriangles(1);
-                            if ((q - start) % 2 == 0) {
-                                mesh.indices.push_back(ia2);
-                                mesh.indices.push_back(ib2);
-                                mesh.indices.push_back(ic2);
-                            } else {
-                                mesh.indices.push_back(ib2);
-                                mesh.indices.push_back(ia2);
-                                mesh.indices.push_back(ic2);
-                            }
-                        }
-                        start = j + 1;
-                    }
-                }
-            }
-            if (truncated) break;
-            if (isVertex) {
-                sg::vec3 p{float(vals[size_t(ix)]), float(vals[size_t(iy)]), float(vals[size_t(iz)])};
-                if (!sg::isFinite(p)) throw Fail{"vertex " + std::to_string(i) + " is not finite"};
-                mesh.positions.push_back(p);
-                if (haveNormals) mesh.normals.push_back({float(vals[size_t(inx)]), float(vals[size_t(iny)]), float(vals[size_t(inz)])});
-                if (haveUv) mesh.uv0.push_back({float(vals[size_t(iu)]), float(vals[size_t(iv)])});
-                if (haveColors) {
-                    auto ch = [&](int k) {
-                        PlyType t = e.props[size_t(k)].type;
-                        double d = vals[size_t(k)];
-                        if (t == PlyType::U8 || t == PlyType::I8)
-                            d /= 255.0;
-                        else if (t == PlyType::U16 || t == PlyType::I16)
-                            d /= 65535.0;
-                        return float(std::clamp(d, 0.0, 1.0));
-                    };
-                    mesh.colors.push_back({ch(ir), ch(ig), ch(ib), ia >= 0 ? ch(ia) : 1.0f});
-                }
-            }
-            readOf = i + 1;
-        }
-        if (truncated) {
-            truncatedIn = e.name;
-            claimed = e.count;
+    PlyBuild b;
+    b.mesh.name = path.stem().string();
+    uint64_t readOf = 0;
+    for (const PlyElement& e : h.elements) {
+        if (!readPlyElement(rd, e, data, b, ctx, readOf)) {
+            ctx.warnings.push_back(file + ": file is truncated in element '" + e.name + "' (" + std::to_string(readOf) + " of " +
+                                   std::to_string(e.count) + " read)");
             break;
         }
     }
-    if (!truncatedIn.empty())
-        ctx.warnings.push_back(file + ": file is truncated in element '" + truncatedIn + "' (" + std::to_string(readOf) + " of " +
-                               std::to_string(claimed) + " read)");
-    if (dropped) ctx.warnings.push_back(file + ": " + std::to_string(dropped) + " faces with out-of-range indices or fewer than 3 corners dropped");
+    if (b.dropped)
+        ctx.warnings.push_back(file + ": " + std::to_string(b.dropped) + " faces with out-of-range indices or fewer than 3 corners dropped");
+    sg::Mesh& mesh = b.mesh;
     if (mesh.positions.empty()) throw Fail{"no vertices"};
-    (void)faceCount;
     if (mesh.indices.empty()) {
         mesh.mode = sg::PrimitiveMode::Points;
         mesh.indices.resize(mesh.positions.size());
