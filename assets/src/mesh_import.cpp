@@ -263,134 +263,168 @@ struct ObjCorner {
     uint32_t v, vt, vn;   // 0-based, ~0u = absent
 };
 
-LoadResult loadObj(const fs::path& path, const std::string& text, Ctx& ctx) {
-    const std::string file = fileNameOf(path);
-    ConfinedDir dir(path.parent_path().empty() ? fs::path(".") : path.parent_path());
+struct ObjFace {
+    uint32_t first, count;   // corners[first, first + count)
+    int material;            // index into ObjData::matNames, -1: none (before any usemtl)
+};
+
+// An OBJ file as read: every corner index of a kept face/line/point is in range of the
+// arrays it refers to; faces have >= 3 corners, lines >= 2 (others were counted as dropped).
+struct ObjData {
     std::vector<sg::vec3> v, vn;
-    std::vector<sg::vec4> vc;   // vertex colours (x y z r g b)
+    std::vector<sg::vec4> vc;   // vertex colours (x y z r g b), one per v
     std::vector<sg::vec2> vt;
-    std::vector<ObjCorner> corners;
-    struct Face {
-        uint32_t first, count;
-        int material;
-    };
-    std::vector<Face> faces;
+    std::vector<ObjCorner> corners;   // of the kept faces
+    std::vector<ObjFace> faces;
     std::vector<uint32_t> linePoly;   // v indices of line segments (pairs)
     std::vector<uint32_t> pointList;
     std::vector<std::string> mtllibs;
     std::vector<std::string> matNames;   // usemtl order
-    int curMat = -1;
     size_t dropped = 0, badLines = 0;
     bool anyColor = false;
+};
+
+// OBJ index (1-based, or negative: relative to the end) -> 0-based index below n.
+bool resolveObjIndex(int64_t i, size_t n, uint32_t& out) {
+    if (i > 0 && uint64_t(i) <= n) {
+        out = uint32_t(i - 1);
+        return true;
+    }
+    if (i < 0 && uint64_t(-i) <= n) {
+        out = uint32_t(int64_t(n) + i);
+        return true;
+    }
+    return false;
+}
+
+// "v x y z [r g b]": appends one position and colour (zero / white when malformed).
+void readObjVertex(Cursor& c, ObjData& d) {
+    float x, y, z;
+    if (!toFloat(c.token(), x) || !toFloat(c.token(), y) || !toFloat(c.token(), z) || !std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) {
+        ++d.badLines;
+        d.v.push_back(sg::vec3(0.0f));
+        d.vc.push_back(sg::vec4(1.0f));
+    } else {
+        d.v.push_back({x, y, z});
+        float r, g, b;
+        std::string_view t = c.token();
+        if (!t.empty() && toFloat(t, r) && toFloat(c.token(), g) && toFloat(c.token(), b)) {
+            d.anyColor = true;
+            d.vc.push_back(sg::vec4(r, g, b, 1.0f));
+        } else {
+            d.vc.push_back(sg::vec4(1.0f));
+        }
+    }
+    if (d.v.size() > kMaxVertices) throw Fail{"more than " + std::to_string(kMaxVertices) + " vertices (budget)"};
+}
+
+// One corner token "v", "v/vt", "v//vn" or "v/vt/vn"; false when an index is malformed or out
+// of range of the elements read so far.
+bool readObjCorner(std::string_view t, const ObjData& d, ObjCorner& cr) {
+    cr = ObjCorner{~0u, ~0u, ~0u};
+    bool ok = true;
+    size_t s1 = t.find('/');
+    int64_t iv, it, in;
+    if (!toInt64(t.substr(0, s1), iv) || !resolveObjIndex(iv, d.v.size(), cr.v)) ok = false;
+    if (s1 != std::string_view::npos) {
+        std::string_view rest = t.substr(s1 + 1);
+        size_t s2 = rest.find('/');
+        std::string_view a = rest.substr(0, s2);
+        if (!a.empty() && (!toInt64(a, it) || !resolveObjIndex(it, d.vt.size(), cr.vt))) ok = false;
+        if (s2 != std::string_view::npos) {
+            std::string_view b = rest.substr(s2 + 1);
+            if (!b.empty() && (!toInt64(b, in) || !resolveObjIndex(in, d.vn.size(), cr.vn))) ok = false;
+        }
+    }
+    return ok;
+}
+
+// "f", "l" or "p" (key) with its corners: a face is kept with material curMat (counted against
+// the triangle budget), a line as segments, points as v indices; an element with a bad
+// index or too few corners is dropped whole.
+void readObjElement(Cursor& c, std::string_view key, int curMat, ObjData& d, Ctx& ctx) {
+    uint32_t first = uint32_t(d.corners.size());
+    bool ok = true;
+    size_t n = 0;
+    for (std::string_view t = c.token(); !t.empty() && t[0] != '#'; t = c.token()) {
+        ObjCorner cr;
+        if (!readObjCorner(t, d, cr)) ok = false;
+        d.corners.push_back(cr);
+        ++n;
+    }
+    if (!ok || n == 0 || (key == "f" && n < 3) || (key == "l" && n < 2)) {
+        ++d.dropped;
+        d.corners.resize(first);
+    } else if (key == "f") {
+        ctx.countTriangles(n - 2);
+        d.faces.push_back({first, uint32_t(n), curMat});
+    } else {
+        for (size_t i = 0; i < n; ++i) {
+            if (key == "p")
+                d.pointList.push_back(d.corners[first + i].v);
+            else if (i + 1 < n) {
+                d.linePoly.push_back(d.corners[first + i].v);
+                d.linePoly.push_back(d.corners[first + i + 1].v);
+            }
+        }
+        d.corners.resize(first);
+    }
+}
+
+// Reads the whole OBJ text (progress 0..0.7). Unknown statements are skipped line by line.
+ObjData parseObjText(const std::string& text, Ctx& ctx) {
+    ObjData d;
+    int curMat = -1;
     Cursor c{text.data(), text.data() + text.size()};
     size_t line = 0;
-    auto resolve = [](int64_t i, size_t n, uint32_t& out) {
-        if (i > 0 && uint64_t(i) <= n) {
-            out = uint32_t(i - 1);
-            return true;
-        }
-        if (i < 0 && uint64_t(-i) <= n) {
-            out = uint32_t(int64_t(n) + i);
-            return true;
-        }
-        return false;
-    };
     while (!c.atEnd()) {
         ctx.poll(++line, 0.0f, 0.7f, 0);
         if ((line & (kPoll - 1)) == 0) ctx.progress.set(0.7f * float(double(c.p - text.data()) / double(text.size())));
         std::string_view key = c.token();
         if (key == "v") {
-            float x, y, z;
-            if (!toFloat(c.token(), x) || !toFloat(c.token(), y) || !toFloat(c.token(), z) || !std::isfinite(x) || !std::isfinite(y) ||
-                !std::isfinite(z)) {
-                ++badLines;
-                v.push_back(sg::vec3(0.0f));
-                vc.push_back(sg::vec4(1.0f));
-            } else {
-                v.push_back({x, y, z});
-                float r, g, b;
-                std::string_view t = c.token();
-                if (!t.empty() && toFloat(t, r) && toFloat(c.token(), g) && toFloat(c.token(), b)) {
-                    anyColor = true;
-                    vc.push_back(sg::vec4(r, g, b, 1.0f));
-                } else {
-                    vc.push_back(sg::vec4(1.0f));
-                }
-            }
-            if (v.size() > kMaxVertices) throw Fail{"more than " + std::to_string(kMaxVertices) + " vertices (budget)"};
+            readObjVertex(c, d);
         } else if (key == "vt") {
             float s = 0, t = 0;
-            if (!toFloat(c.token(), s)) ++badLines;
+            if (!toFloat(c.token(), s)) ++d.badLines;
             std::string_view tt = c.token();
-            if (!tt.empty() && !toFloat(tt, t)) ++badLines;
-            vt.push_back({s, t});
+            if (!tt.empty() && !toFloat(tt, t)) ++d.badLines;
+            d.vt.push_back({s, t});
         } else if (key == "vn") {
             float x, y, z;
             if (!toFloat(c.token(), x) || !toFloat(c.token(), y) || !toFloat(c.token(), z)) {
-                ++badLines;
+                ++d.badLines;
                 x = 0;
                 y = 0;
                 z = 1;
             }
-            vn.push_back({x, y, z});
+            d.vn.push_back({x, y, z});
         } else if (key == "f" || key == "l" || key == "p") {
-            uint32_t first = uint32_t(corners.size());
-            bool ok = true;
-            size_t n = 0;
-            for (std::string_view t = c.token(); !t.empty() && t[0] != '#'; t = c.token()) {
-                ObjCorner cr{~0u, ~0u, ~0u};
-                size_t s1 = t.find('/');
-                int64_t iv, it, in;
-                if (!toInt64(t.substr(0, s1), iv) || !resolve(iv, v.size(), cr.v)) ok = false;
-                if (s1 != std::string_view::npos) {
-                    std::string_view rest = t.substr(s1 + 1);
-                    size_t s2 = rest.find('/');
-                    std::string_view a = rest.substr(0, s2);
-                    if (!a.empty() && (!toInt64(a, it) || !resolve(it, vt.size(), cr.vt))) ok = false;
-                    if (s2 != std::string_view::npos) {
-                        std::string_view b = rest.substr(s2 + 1);
-                        if (!b.empty() && (!toInt64(b, in) || !resolve(in, vn.size(), cr.vn))) ok = false;
-                    }
-                }
-                corners.push_back(cr);
-                ++n;
-            }
-            if (!ok || n == 0 || (key == "f" && n < 3) || (key == "l" && n < 2)) {
-                ++dropped;
-                corners.resize(first);
-            } else if (key == "f") {
-                ctx.countTriangles(n - 2);
-                faces.push_back({first, uint32_t(n), curMat});
-            } else {
-                for (size_t i = 0; i < n; ++i) {
-                    if (key == "p")
-                        pointList.push_back(corners[first + i].v);
-                    else if (i + 1 < n) {
-                        linePoly.push_back(corners[first + i].v);
-                        linePoly.push_back(corners[first + i + 1].v);
-                    }
-                }
-                corners.resize(first);
-            }
+            readObjElement(c, key, curMat, d, ctx);
         } else if (key == "usemtl") {
             std::string name(c.restOfLine());
-            auto it = std::find(matNames.begin(), matNames.end(), name);
-            curMat = int(it - matNames.begin());
-            if (it == matNames.end()) matNames.push_back(name);
+            auto it = std::find(d.matNames.begin(), d.matNames.end(), name);
+            curMat = int(it - d.matNames.begin());
+            if (it == d.matNames.end()) d.matNames.push_back(name);
         } else if (key == "mtllib") {
-            for (std::string_view t = c.token(); !t.empty(); t = c.token()) mtllibs.push_back(cleanRelPath(t));
+            for (std::string_view t = c.token(); !t.empty(); t = c.token()) d.mtllibs.push_back(cleanRelPath(t));
         }
         c.skipLine();
     }
-    if (v.empty()) throw Fail{"no vertices"};
-    if (dropped) ctx.warnings.push_back(file + ": " + std::to_string(dropped) + " faces/lines with missing or out-of-range indices dropped");
-    if (badLines) ctx.warnings.push_back(file + ": " + std::to_string(badLines) + " malformed vertex lines (zero used)");
+    return d;
+}
 
-    // Materials.
-    std::map<std::string, ObjMaterial> lib;
-    for (const std::string& m : mtllibs) parseMtl(dir, m, ctx, file, lib);
+// Materials of an OBJ: one per usemtl name, in order (from the MTL libraries, or defaults),
+// plus, for a file without mtllib but with UVs, one for a texture found beside the model.
+struct ObjMaterials {
     std::vector<sg::Material> materials;
-    std::vector<std::shared_ptr<sg::Texture>> textures;
+    std::vector<std::shared_ptr<sg::Texture>> textures;   // each loaded once
+    int implicitMat = -1;                                 // the material of faces without usemtl (-1: the default)
+};
+
+ObjMaterials resolveObjMaterials(const fs::path& path, const ConfinedDir& dir, const ObjData& d, Ctx& ctx, const std::string& file) {
+    ObjMaterials out;
+    std::map<std::string, ObjMaterial> lib;
+    for (const std::string& m : d.mtllibs) parseMtl(dir, m, ctx, file, lib);
     std::map<std::string, int> texIndex;
     auto textureFor = [&](const std::string& rel) -> int {
         if (rel.empty()) return -1;
@@ -398,134 +432,163 @@ LoadResult loadObj(const fs::path& path, const std::string& text, Ctx& ctx) {
         if (it != texIndex.end()) return it->second;
         int idx = -1;
         if (auto t = loadTexture(dir, rel, ctx, file)) {
-            textures.push_back(t);
-            idx = int(textures.size() - 1);
+            out.textures.push_back(t);
+            idx = int(out.textures.size() - 1);
         }
         texIndex[rel] = idx;
         return idx;
     };
-    for (const std::string& name : matNames) {
+    for (const std::string& name : d.matNames) {
         auto it = lib.find(name);
         sg::Material m;
         m.name = name;
         if (it != lib.end()) {
             m = it->second.mat;
             m.diffuseTexture = textureFor(it->second.texture);
-        } else if (!mtllibs.empty()) {
+        } else if (!d.mtllibs.empty()) {
             ctx.warnings.push_back(file + ": material '" + name + "' not found in the material libraries; default used");
         }
-        materials.push_back(m);
+        out.materials.push_back(m);
     }
     // OBJ without mtllib but with UVs: a texture named after the model next to it.
-    int implicitTexture = -1;
-    if (mtllibs.empty() && !vt.empty()) {
+    if (d.mtllibs.empty() && !d.vt.empty()) {
         std::string stem = path.stem().string();
         for (const std::string& cand : {stem + ".png", stem + ".jpg", stem + "_texture.png", stem + "_texture.jpg"}) {
             if (dir.probe(cand).empty()) {
-                implicitTexture = textureFor(cand);
-                if (implicitTexture >= 0) {
+                const int tex = textureFor(cand);
+                if (tex >= 0) {
                     sg::Material m;
                     m.name = stem;
-                    m.diffuseTexture = implicitTexture;
-                    materials.push_back(m);
+                    m.diffuseTexture = tex;
+                    out.materials.push_back(m);
+                    out.implicitMat = int(out.materials.size() - 1);
                     ctx.warnings.push_back(file + ": no mtllib; using texture '" + cand + "' found beside the model");
                 }
                 break;
             }
         }
     }
+    return out;
+}
 
-    // Build one mesh per material group, de-duplicating (v, vt, vn) corners. Faces without
-    // usemtl use the implicit texture material when there is one, else the default (-1).
-    const int implicitMat = implicitTexture >= 0 ? int(materials.size() - 1) : -1;
-    std::vector<std::vector<uint32_t>> byMaterial(materials.size() + 1);   // slot 0 = default
-    for (size_t fi = 0; fi < faces.size(); ++fi) {
-        int fm = faces[fi].material >= 0 ? faces[fi].material : implicitMat;
+// One triangle mesh from the faces faceIds, fan-triangulated, with (v, vt, vn) corners
+// de-duplicated (by v alone when the file has neither UVs nor normals). UVs / normals are
+// kept only when some / all corners have them, colours only when the file has any.
+// done: faces converted so far over all groups (progress 0.7..0.95).
+sg::Mesh buildObjGroupMesh(const ObjData& d, const std::vector<uint32_t>& faceIds, Ctx& ctx, size_t& done) {
+    sg::Mesh mesh;
+    const bool simple = d.vt.empty() && d.vn.empty();
+    std::vector<uint32_t> remap;
+    struct Key {
+        uint32_t v, t, n;
+        bool operator==(const Key&) const = default;
+    };
+    struct KeyHash {
+        size_t operator()(const Key& k) const { return (size_t(k.v) * 0x9E3779B97F4A7C15ull) ^ (size_t(k.t) * 0xC2B2AE3D27D4EB4Full) ^ k.n; }
+    };
+    std::unordered_map<Key, uint32_t, KeyHash> map;
+    if (simple) remap.assign(d.v.size(), ~0u);
+    bool hasUv = false, hasN = true;
+    auto vertexOf = [&](const ObjCorner& cr) -> uint32_t {
+        uint32_t idx;
+        if (simple) {
+            if (remap[cr.v] != ~0u) return remap[cr.v];
+            idx = remap[cr.v] = uint32_t(mesh.positions.size());
+        } else {
+            auto [it, inserted] = map.try_emplace(Key{cr.v, cr.vt, cr.vn}, uint32_t(mesh.positions.size()));
+            if (!inserted) return it->second;
+            idx = it->second;
+        }
+        mesh.positions.push_back(d.v[cr.v]);
+        mesh.colors.push_back(d.vc[cr.v]);
+        mesh.uv0.push_back(cr.vt != ~0u ? d.vt[cr.vt] : sg::vec2(0.0f));
+        mesh.normals.push_back(cr.vn != ~0u ? d.vn[cr.vn] : sg::vec3(0.0f));
+        hasUv |= cr.vt != ~0u;
+        hasN &= cr.vn != ~0u;
+        return idx;
+    };
+    std::vector<uint32_t> tri;
+    for (uint32_t fi : faceIds) {
+        ctx.poll(++done, 0.7f, 0.25f, d.faces.size());
+        const ObjFace& f = d.faces[fi];
+        tri.clear();
+        for (uint32_t k = 0; k < f.count; ++k) tri.push_back(vertexOf(d.corners[f.first + k]));
+        fan(tri.data(), tri.size(), mesh.indices);
+    }
+    if (!hasUv) mesh.uv0.clear();
+    if (!hasN) mesh.normals.clear();
+    if (!d.anyColor) mesh.colors.clear();
+    return mesh;
+}
+
+// The faces as one mesh per material group, in material order (faces without usemtl first,
+// with the implicit texture material when there is one, else the default (-1)).
+void addObjFaceMeshes(const fs::path& path, const ObjData& d, const ObjMaterials& mats, Ctx& ctx, std::vector<std::pair<sg::Mesh, int>>& parts) {
+    std::vector<std::vector<uint32_t>> byMaterial(mats.materials.size() + 1);   // slot 0 = default
+    for (size_t fi = 0; fi < d.faces.size(); ++fi) {
+        int fm = d.faces[fi].material >= 0 ? d.faces[fi].material : mats.implicitMat;
         byMaterial[size_t(fm + 1)].push_back(uint32_t(fi));
     }
-    std::vector<std::pair<sg::Mesh, int>> parts;
-    const bool simple = vt.empty() && vn.empty();
-    std::vector<uint32_t> tri;
     size_t done = 0;
     for (size_t g = 0; g < byMaterial.size(); ++g) {
         if (byMaterial[g].empty()) continue;
         const int mat = int(g) - 1;
-        sg::Mesh mesh;
-        std::vector<uint32_t> remap;
-        struct Key {
-            uint32_t v, t, n;
-            bool operator==(const Key&) const = default;
-        };
-        struct KeyHash {
-            size_t operator()(const Key& k) const { return (size_t(k.v) * 0x9E3779B97F4A7C15ull) ^ (size_t(k.t) * 0xC2B2AE3D27D4EB4Full) ^ k.n; }
-        };
-        std::unordered_map<Key, uint32_t, KeyHash> map;
-        if (simple) remap.assign(v.size(), ~0u);
-        bool hasUv = false, hasN = true;
-        auto vertexOf = [&](const ObjCorner& cr) -> uint32_t {
-            uint32_t idx;
-            if (simple) {
-                if (remap[cr.v] != ~0u) return remap[cr.v];
-                idx = remap[cr.v] = uint32_t(mesh.positions.size());
-            } else {
-                auto [it, inserted] = map.try_emplace(Key{cr.v, cr.vt, cr.vn}, uint32_t(mesh.positions.size()));
-                if (!inserted) return it->second;
-                idx = it->second;
-            }
-            mesh.positions.push_back(v[cr.v]);
-            mesh.colors.push_back(vc[cr.v]);
-            mesh.uv0.push_back(cr.vt != ~0u ? vt[cr.vt] : sg::vec2(0.0f));
-            mesh.normals.push_back(cr.vn != ~0u ? vn[cr.vn] : sg::vec3(0.0f));
-            hasUv |= cr.vt != ~0u;
-            hasN &= cr.vn != ~0u;
-            return idx;
-        };
-        for (uint32_t fi : byMaterial[g]) {
-            ctx.poll(++done, 0.7f, 0.25f, faces.size());
-            const Face& f = faces[fi];
-            tri.clear();
-            for (uint32_t k = 0; k < f.count; ++k) tri.push_back(vertexOf(corners[f.first + k]));
-            fan(tri.data(), tri.size(), mesh.indices);
-        }
-        if (!hasUv) mesh.uv0.clear();
-        if (!hasN) mesh.normals.clear();
-        if (!anyColor) mesh.colors.clear();
-        mesh.name = mat >= 0 ? materials[size_t(mat)].name : path.stem().string();
+        sg::Mesh mesh = buildObjGroupMesh(d, byMaterial[g], ctx, done);
+        mesh.name = mat >= 0 ? mats.materials[size_t(mat)].name : path.stem().string();
         parts.push_back({std::move(mesh), mat});
     }
-    if (!linePoly.empty()) {
-        sg::Mesh lines;
-        lines.mode = sg::PrimitiveMode::Lines;
-        lines.name = path.stem().string() + " lines";
-        std::vector<uint32_t> remap(v.size(), ~0u);
-        for (uint32_t i : linePoly) {
-            if (remap[i] == ~0u) {
-                remap[i] = uint32_t(lines.positions.size());
-                lines.positions.push_back(v[i]);
-                if (anyColor) lines.colors.push_back(vc[i]);
-            }
-            lines.indices.push_back(remap[i]);
+}
+
+// The `l` segments as one line mesh holding only the vertices they use.
+void addObjLineMesh(const fs::path& path, const ObjData& d, std::vector<std::pair<sg::Mesh, int>>& parts) {
+    sg::Mesh lines;
+    lines.mode = sg::PrimitiveMode::Lines;
+    lines.name = path.stem().string() + " lines";
+    std::vector<uint32_t> remap(d.v.size(), ~0u);
+    for (uint32_t i : d.linePoly) {
+        if (remap[i] == ~0u) {
+            remap[i] = uint32_t(lines.positions.size());
+            lines.positions.push_back(d.v[i]);
+            if (d.anyColor) lines.colors.push_back(d.vc[i]);
         }
-        parts.push_back({std::move(lines), -1});
+        lines.indices.push_back(remap[i]);
     }
-    if (parts.empty() || !pointList.empty()) {
-        // Vertices only (or explicit `p` elements): a point cloud.
-        sg::Mesh pts;
-        pts.mode = sg::PrimitiveMode::Points;
-        pts.name = path.stem().string() + " points";
-        pts.positions = v;
-        if (anyColor) pts.colors = vc;
-        if (!vn.empty() && vn.size() == v.size()) pts.normals = vn;
-        if (pointList.empty()) {
-            pts.indices.resize(v.size());
-            for (size_t i = 0; i < v.size(); ++i) pts.indices[i] = uint32_t(i);
-        } else {
-            pts.indices = pointList;
-        }
-        parts.push_back({std::move(pts), -1});
+    parts.push_back({std::move(lines), -1});
+}
+
+// A point cloud over all vertices: the `p` elements, or every vertex when nothing else was drawn.
+void addObjPointMesh(const fs::path& path, const ObjData& d, std::vector<std::pair<sg::Mesh, int>>& parts) {
+    sg::Mesh pts;
+    pts.mode = sg::PrimitiveMode::Points;
+    pts.name = path.stem().string() + " points";
+    pts.positions = d.v;
+    if (d.anyColor) pts.colors = d.vc;
+    if (!d.vn.empty() && d.vn.size() == d.v.size()) pts.normals = d.vn;
+    if (d.pointList.empty()) {
+        pts.indices.resize(d.v.size());
+        for (size_t i = 0; i < d.v.size(); ++i) pts.indices[i] = uint32_t(i);
+    } else {
+        pts.indices = d.pointList;
     }
+    parts.push_back({std::move(pts), -1});
+}
+
+LoadResult loadObj(const fs::path& path, const std::string& text, Ctx& ctx) {
+    const std::string file = fileNameOf(path);
+    ConfinedDir dir(path.parent_path().empty() ? fs::path(".") : path.parent_path());
+    const ObjData d = parseObjText(text, ctx);
+    if (d.v.empty()) throw Fail{"no vertices"};
+    if (d.dropped) ctx.warnings.push_back(file + ": " + std::to_string(d.dropped) + " faces/lines with missing or out-of-range indices dropped");
+    if (d.badLines) ctx.warnings.push_back(file + ": " + std::to_string(d.badLines) + " malformed vertex lines (zero used)");
+
+    ObjMaterials mats = resolveObjMaterials(path, dir, d, ctx, file);
+    std::vector<std::pair<sg::Mesh, int>> parts;
+    addObjFaceMeshes(path, d, mats, ctx, parts);
+    if (!d.linePoly.empty()) addObjLineMesh(path, d, parts);
+    // Vertices only (or explicit `p` elements): a point cloud.
+    if (parts.empty() || !d.pointList.empty()) addObjPointMesh(path, d, parts);
     LoadResult r;
-    r.scene = makeScene(path, parts, std::move(materials), std::move(textures));
+    r.scene = makeScene(path, parts, std::move(mats.materials), std::move(mats.textures));
     return r;
 }
 
@@ -704,8 +767,11 @@ struct PlyReader {
     int format;   // 0 ascii, 1 LE, 2 BE
     Cursor text{nullptr, nullptr};
 
-    // Reads one scalar; false at end of data / malformed.
-    bool read(PlyType t, double& out) {
+    // Bytes of data left to read.
+    uint64_t left() const { return format == 0 ? uint64_t(text.end - text.p) : uint64_t(end - p); }
+
+    // Reads one scalar; false at end of data / malformed. Always inlined: it runs per value.
+    [[gnu::always_inline]] bool read(PlyType t, double& out) {
         if (format == 0) {
             std::string_view tok = text.anyToken();
             return toDouble(tok, out);
@@ -761,10 +827,18 @@ struct PlyReader {
     }
 };
 
-LoadResult loadPly(const fs::path& path, const std::string& data, Ctx& ctx) {
-    const std::string file = fileNameOf(path);
-    // Header lines end in \n, \r\n or \r alone (Box.ply).
-    size_t pos = 0;
+// A parsed PLY header: format, elements in file order, and where the body starts.
+struct PlyHeader {
+    int format = -1;   // 0 ascii, 1 LE, 2 BE
+    std::vector<PlyElement> elements;
+    size_t bodyStart = 0;
+};
+
+// Header lines end in \n, \r\n or \r alone (Box.ply). Throws Fail on a missing magic, format
+// or end_header and on malformed element/property lines.
+PlyHeader parsePlyHeader(const std::string& data) {
+    PlyHeader h;
+    size_t& pos = h.bodyStart;
     auto nextLine = [&](std::string& line) -> bool {
         if (pos >= data.size()) return false;
         size_t e = data.find_first_of("\r\n", pos);
@@ -780,8 +854,6 @@ LoadResult loadPly(const fs::path& path, const std::string& data, Ctx& ctx) {
     };
     std::string line;
     if (!nextLine(line) || line.substr(0, 3) != "ply") throw Fail{"not a PLY file (no 'ply' magic)"};
-    int format = -1;
-    std::vector<PlyElement> elements;
     bool endHeader = false;
     size_t headerLines = 0;
     while (nextLine(line)) {
@@ -790,15 +862,15 @@ LoadResult loadPly(const fs::path& path, const std::string& data, Ctx& ctx) {
         std::string_view key = c.token();
         if (key == "format") {
             std::string_view f = c.token();
-            format = f == "ascii" ? 0 : f == "binary_little_endian" ? 1 : f == "binary_big_endian" ? 2 : -1;
-            if (format < 0) throw Fail{"unknown PLY format '" + std::string(f) + "'"};
+            h.format = f == "ascii" ? 0 : f == "binary_little_endian" ? 1 : f == "binary_big_endian" ? 2 : -1;
+            if (h.format < 0) throw Fail{"unknown PLY format '" + std::string(f) + "'"};
         } else if (key == "element") {
             PlyElement e;
             e.name = std::string(c.token());
             if (!toUint64(c.token(), e.count)) throw Fail{"malformed element line '" + line + "'"};
-            elements.push_back(std::move(e));
+            h.elements.push_back(std::move(e));
         } else if (key == "property") {
-            if (elements.empty()) throw Fail{"property before any element"};
+            if (h.elements.empty()) throw Fail{"property before any element"};
             PlyProperty pr;
             std::string_view t = c.token();
             if (t == "list") {
@@ -812,7 +884,7 @@ LoadResult loadPly(const fs::path& path, const std::string& data, Ctx& ctx) {
             }
             if (pr.type == PlyType::Invalid) throw Fail{"unknown property type in '" + line + "'"};
             pr.name = std::string(c.token());
-            elements.back().props.push_back(std::move(pr));
+            h.elements.back().props.push_back(std::move(pr));
         } else if (key == "end_header") {
             endHeader = true;
             break;
@@ -820,203 +892,252 @@ LoadResult loadPly(const fs::path& path, const std::string& data, Ctx& ctx) {
         // comment, obj_info: ignored
     }
     if (!endHeader) throw Fail{"PLY header has no end_header"};
-    if (format < 0) throw Fail{"PLY header has no format line"};
-    // Size check before allocating: every element needs at least this many bytes.
-    const uint64_t bodyBytes = data.size() - pos;
+    if (h.format < 0) throw Fail{"PLY header has no format line"};
+    return h;
+}
+
+// Size check before allocating: every element needs at least this many bytes (ascii: 2 per
+// value, binary: a list's count or a scalar), so no count exceeds what the body can hold.
+void checkPlyBodySize(const PlyHeader& h, const std::string& data) {
+    const uint64_t bodyBytes = data.size() - h.bodyStart;
     uint64_t need = 0;
-    for (const PlyElement& e : elements) {
+    for (const PlyElement& e : h.elements) {
         uint64_t per = 0;
-        for (const PlyProperty& pr : e.props) per += format == 0 ? 2 : (pr.list ? plySize(pr.countType) : plySize(pr.type));
+        for (const PlyProperty& pr : e.props) per += h.format == 0 ? 2 : (pr.list ? plySize(pr.countType) : plySize(pr.type));
         uint64_t bytes;
         if (per == 0) continue;
         if (__builtin_mul_overflow(per, e.count, &bytes) || __builtin_add_overflow(need, bytes, &need) || need > bodyBytes + 1)
             throw Fail{"element '" + e.name + "' claims " + std::to_string(e.count) + " entries but the file has only " + std::to_string(bodyBytes) +
                        " bytes after the header"};
     }
+}
+
+// What an element is and which of its properties hold what we read (-1: absent). Vertex
+// elements: scalar position, normal, colour and UV properties; face / tristrips elements:
+// the index list. Other elements are read and skipped.
+struct PlyRoles {
+    bool isVertex = false, isFace = false, isStrip = false;
+    int ix = -1, iy = -1, iz = -1, inx = -1, iny = -1, inz = -1, ir = -1, ig = -1, ib = -1, ia = -1, iu = -1, iv = -1, ilist = -1;
+    bool haveNormals = false, haveColors = false, haveUv = false;   // complete attributes of a vertex element
+};
+
+PlyRoles plyRoles(const PlyElement& e) {
+    PlyRoles r;
+    r.isVertex = e.name == "vertex";
+    r.isFace = e.name == "face";
+    r.isStrip = e.name == "tristrips";
+    for (size_t k = 0; k < e.props.size(); ++k) {
+        const std::string& n = e.props[k].name;
+        int kk = int(k);
+        if (r.isVertex && !e.props[k].list) {
+            if (n == "x")
+                r.ix = kk;
+            else if (n == "y")
+                r.iy = kk;
+            else if (n == "z")
+                r.iz = kk;
+            else if (n == "nx")
+                r.inx = kk;
+            else if (n == "ny")
+                r.iny = kk;
+            else if (n == "nz")
+                r.inz = kk;
+            else if (n == "red" || n == "r" || n == "diffuse_red")
+                r.ir = kk;
+            else if (n == "green" || n == "g" || n == "diffuse_green")
+                r.ig = kk;
+            else if (n == "blue" || n == "b" || n == "diffuse_blue")
+                r.ib = kk;
+            else if (n == "alpha" || n == "a")
+                r.ia = kk;
+            else if (n == "s" || n == "u" || n == "texture_u" || n == "texture_s")
+                r.iu = kk;
+            else if (n == "t" || n == "v" || n == "texture_v" || n == "texture_t")
+                r.iv = kk;
+        }
+        if ((r.isFace || r.isStrip) && e.props[k].list && (n == "vertex_indices" || n == "vertex_index") && r.ilist < 0) r.ilist = kk;
+    }
+    r.haveNormals = r.inx >= 0 && r.iny >= 0 && r.inz >= 0;
+    r.haveColors = r.ir >= 0 && r.ig >= 0 && r.ib >= 0;
+    r.haveUv = r.iu >= 0 && r.iv >= 0;
+    return r;
+}
+
+// The mesh under construction and what the body reading keeps between elements.
+struct PlyBuild {
+    sg::Mesh mesh;
+    size_t dropped = 0;             // faces / strip triangles
+    std::vector<uint32_t> poly;     // scratch: one face's corners
+    std::vector<double> listVals;   // the kept list of the current entry
+};
+
+// A colour channel as 0..1: 8- and 16-bit integers are scaled, other types taken as they are.
+// Always inlined (per vertex and channel; GCC outlined it once split from loadPly).
+[[gnu::always_inline]] inline float plyChannel(PlyType t, double d) {
+    if (t == PlyType::U8 || t == PlyType::I8)
+        d /= 255.0;
+    else if (t == PlyType::U16 || t == PlyType::I16)
+        d /= 65535.0;
+    return float(std::clamp(d, 0.0, 1.0));
+}
+
+// Vertex i from its property values: a finite position (else Fail) and the attributes the
+// element has.
+void addPlyVertex(const PlyElement& e, const PlyRoles& k, const std::vector<double>& vals, uint64_t i, PlyBuild& b) {
+    sg::vec3 p{float(vals[size_t(k.ix)]), float(vals[size_t(k.iy)]), float(vals[size_t(k.iz)])};
+    if (!sg::isFinite(p)) throw Fail{"vertex " + std::to_string(i) + " is not finite"};
+    b.mesh.positions.push_back(p);
+    if (k.haveNormals) b.mesh.normals.push_back({float(vals[size_t(k.inx)]), float(vals[size_t(k.iny)]), float(vals[size_t(k.inz)])});
+    if (k.haveUv) b.mesh.uv0.push_back({float(vals[size_t(k.iu)]), float(vals[size_t(k.iv)])});
+    if (k.haveColors) {
+        auto ch = [&](int c) __attribute__((always_inline)) { return plyChannel(e.props[size_t(c)].type, vals[size_t(c)]); };
+        b.mesh.colors.push_back({ch(k.ir), ch(k.ig), ch(k.ib), k.ia >= 0 ? ch(k.ia) : 1.0f});
+    }
+}
+
+// A face from b.listVals: fan-triangulated when it has >= 3 corners, all indices of vertices
+// read so far; else dropped.
+void addPlyFace(PlyBuild& b, Ctx& ctx) {
+    b.poly.clear();
+    bool ok = b.listVals.size() >= 3;
+    for (double d : b.listVals) {
+        if (!(d >= 0 && d < double(b.mesh.positions.size()))) {
+            ok = false;
+            break;
+        }
+        b.poly.push_back(uint32_t(d));
+    }
+    if (!ok) {
+        ++b.dropped;
+        return;
+    }
+    ctx.countTriangles(b.listVals.size() - 2);
+    fan(b.poly.data(), b.poly.size(), b.mesh.indices);
+}
+
+// Triangle strips from b.listVals: strips separated by -1; alternate winding; degenerate
+// triangles skipped, triangles with an index beyond the vertices read so far dropped.
+void addPlyStrips(PlyBuild& b, Ctx& ctx) {
+    const std::vector<double>& lv = b.listVals;
+    const double nv = double(b.mesh.positions.size());
+    size_t start = 0;
+    for (size_t j = 0; j <= lv.size(); ++j) {
+        if (j < lv.size() && lv[j] >= 0) continue;
+        for (size_t q = start; q + 2 < j; ++q) {
+            double a = lv[q], bb = lv[q + 1], c2 = lv[q + 2];
+            if (!(a < nv && bb < nv && c2 < nv)) {
+                ++b.dropped;
+                continue;
+            }
+            uint32_t ia2 = uint32_t(a), ib2 = uint32_t(bb), ic2 = uint32_t(c2);
+            if (ia2 == ib2 || ib2 == ic2 || ia2 == ic2) continue;
+            ctx.countTriangles(1);
+            if ((q - start) % 2 == 0) {
+                b.mesh.indices.push_back(ia2);
+                b.mesh.indices.push_back(ib2);
+                b.mesh.indices.push_back(ic2);
+            } else {
+                b.mesh.indices.push_back(ib2);
+                b.mesh.indices.push_back(ia2);
+                b.mesh.indices.push_back(ic2);
+            }
+        }
+        start = j + 1;
+    }
+}
+
+// Reads list property pr of entry i of e; when keep, its values go to b.listVals. False when
+// the data ends (or the count is malformed / longer than the data left). A kept list is
+// limited to 64M entries (Fail).
+bool readPlyList(PlyReader& rd, const PlyElement& e, const PlyProperty& pr, uint64_t i, bool keep, PlyBuild& b) {
+    double cnt;
+    if (!rd.read(pr.countType, cnt) || cnt < 0 || cnt > 1e9) return false;
+    uint64_t n = uint64_t(cnt);
+    // A list cannot be longer than the remaining data.
+    if (n > rd.left()) return false;
+    if (keep && n > (64u << 20))
+        throw Fail{"element '" + e.name + "' " + std::to_string(i) + " has a list of " + std::to_string(n) + " entries (limit 64M)"};
+    if (keep) b.listVals.resize(size_t(n));
+    for (uint64_t j = 0; j < n; ++j) {
+        double d;
+        if (!rd.read(pr.type, d)) return false;
+        if (keep) b.listVals[size_t(j)] = d;
+    }
+    return true;
+}
+
+// Reads entry i of element e (values into vals) and adds what it holds to the mesh: a face or
+// strips as soon as their index list is read, a vertex once all its properties are. False
+// when the data ends within the entry.
+bool readPlyEntry(PlyReader& rd, const PlyElement& e, const PlyRoles& k, uint64_t i, std::vector<double>& vals, PlyBuild& b, Ctx& ctx) {
+    for (size_t p = 0; p < e.props.size(); ++p) {
+        const PlyProperty& pr = e.props[p];
+        if (!pr.list) {
+            if (!rd.read(pr.type, vals[p])) return false;
+            continue;
+        }
+        const bool keep = int(p) == k.ilist;
+        if (!readPlyList(rd, e, pr, i, keep, b)) return false;
+        if (!keep) continue;
+        if (k.isFace)
+            addPlyFace(b, ctx);
+        else if (k.isStrip)
+            addPlyStrips(b, ctx);
+    }
+    if (k.isVertex) addPlyVertex(e, k, vals, i, b);
+    return true;
+}
+
+// Reads element e's entries (progress 0..0.95); readOf gets the number read completely.
+// False when the file ends within the element.
+bool readPlyElement(PlyReader& rd, const PlyElement& e, const std::string& data, PlyBuild& b, Ctx& ctx, uint64_t& readOf) {
+    const PlyRoles k = plyRoles(e);
+    if (k.isVertex) {
+        if (e.count > kMaxVertices)
+            throw Fail{"element 'vertex' claims " + std::to_string(e.count) + " entries (budget " + std::to_string(kMaxVertices) + ")"};
+        if (k.ix < 0 || k.iy < 0 || k.iz < 0) throw Fail{"vertex element has no x, y, z properties"};
+        b.mesh.positions.reserve(size_t(e.count));
+    }
+    // An element without properties holds no data whatever its count (found by fuzzing:
+    // "element x 3000000000000001839" with no properties spun for hours).
+    if (e.props.empty()) return true;
+    std::vector<double> vals(e.props.size());
+    readOf = 0;
+    for (uint64_t i = 0; i < e.count; ++i) {
+        ctx.poll(size_t(i), 0.0f, 0.95f, 0);
+        if ((i & (kPoll - 1)) == 0) {
+            size_t used = rd.format == 0 ? size_t(rd.text.p - data.data()) : size_t(rd.p - reinterpret_cast<const unsigned char*>(data.data()));
+            ctx.progress.set(0.95f * float(double(used) / double(data.size())));
+        }
+        if (!readPlyEntry(rd, e, k, i, vals, b, ctx)) return false;
+        readOf = i + 1;
+    }
+    return true;
+}
+
+LoadResult loadPly(const fs::path& path, const std::string& data, Ctx& ctx) {
+    const std::string file = fileNameOf(path);
+    const PlyHeader h = parsePlyHeader(data);
+    checkPlyBodySize(h, data);   // element counts are safe to reserve by from here on
+    const size_t pos = h.bodyStart;
     PlyReader rd{reinterpret_cast<const unsigned char*>(data.data()) + pos, reinterpret_cast<const unsigned char*>(data.data()) + data.size(),
-                 format};
+                 h.format};
     rd.text = Cursor{data.data() + pos, data.data() + data.size()};
 
-    sg::Mesh mesh;
-    mesh.name = path.stem().string();
-    bool haveNormals = false, haveColors = false, haveUv = false;
-    size_t dropped = 0;
-    std::string truncatedIn;
-    uint64_t readOf = 0, claimed = 0;
-    std::vector<uint32_t> poly;
-    std::vector<double> listVals;
-    size_t faceCount = 0;
-    for (const PlyElement& e : elements) {
-        const bool isVertex = e.name == "vertex";
-        const bool isFace = e.name == "face";
-        const bool isStrip = e.name == "tristrips";
-        int ix = -1, iy = -1, iz = -1, inx = -1, iny = -1, inz = -1, ir = -1, ig = -1, ib = -1, ia = -1, iu = -1, iv = -1, ilist = -1;
-        for (size_t k = 0; k < e.props.size(); ++k) {
-            const std::string& n = e.props[k].name;
-            int kk = int(k);
-            if (isVertex && !e.props[k].list) {
-                if (n == "x")
-                    ix = kk;
-                else if (n == "y")
-                    iy = kk;
-                else if (n == "z")
-                    iz = kk;
-                else if (n == "nx")
-                    inx = kk;
-                else if (n == "ny")
-                    iny = kk;
-                else if (n == "nz")
-                    inz = kk;
-                else if (n == "red" || n == "r" || n == "diffuse_red")
-                    ir = kk;
-                else if (n == "green" || n == "g" || n == "diffuse_green")
-                    ig = kk;
-                else if (n == "blue" || n == "b" || n == "diffuse_blue")
-                    ib = kk;
-                else if (n == "alpha" || n == "a")
-                    ia = kk;
-                else if (n == "s" || n == "u" || n == "texture_u" || n == "texture_s")
-                    iu = kk;
-                else if (n == "t" || n == "v" || n == "texture_v" || n == "texture_t")
-                    iv = kk;
-            }
-            if ((isFace || isStrip) && e.props[k].list && (n == "vertex_indices" || n == "vertex_index") && ilist < 0) ilist = kk;
-        }
-        if (isVertex) {
-            if (e.count > kMaxVertices)
-                throw Fail{"element 'vertex' claims " + std::to_string(e.count) + " entries (budget " + std::to_string(kMaxVertices) + ")"};
-            if (ix < 0 || iy < 0 || iz < 0) throw Fail{"vertex element has no x, y, z properties"};
-            haveNormals = inx >= 0 && iny >= 0 && inz >= 0;
-            haveColors = ir >= 0 && ig >= 0 && ib >= 0;
-            haveUv = iu >= 0 && iv >= 0;
-            mesh.positions.reserve(size_t(e.count));
-        }
-        // An element without properties holds no data whatever its count (found by fuzzing:
-        // "element x 3000000000000001839" with no properties spun for hours).
-        if (e.props.empty()) continue;
-        std::vector<double> vals(e.props.size());
-        bool truncated = false;
-        readOf = 0;
-        for (uint64_t i = 0; i < e.count && !truncated; ++i) {
-            ctx.poll(size_t(i), 0.0f, 0.95f, 0);
-            if ((i & (kPoll - 1)) == 0) {
-                size_t used = format == 0 ? size_t(rd.text.p - data.data()) : size_t(rd.p - reinterpret_cast<const unsigned char*>(data.data()));
-                ctx.progress.set(0.95f * float(double(used) / double(data.size())));
-            }
-            for (size_t k = 0; k < e.props.size(); ++k) {
-                const PlyProperty& pr = e.props[k];
-                if (!pr.list) {
-                    if (!rd.read(pr.type, vals[k])) {
-                        truncated = true;
-                        break;
-                    }
-                    continue;
-                }
-                double cnt;
-                if (!rd.read(pr.countType, cnt) || cnt < 0 || cnt > 1e9) {
-                    truncated = true;
-                    break;
-                }
-                uint64_t n = uint64_t(cnt);
-                // A list cannot be longer than the remaining data.
-                uint64_t left = format == 0 ? uint64_t(rd.text.end - rd.text.p) : uint64_t(rd.end - rd.p);
-                if (n > left) {
-                    truncated = true;
-                    break;
-                }
-                bool keep = int(k) == ilist;
-                if (keep && n > (64u << 20))
-                    throw Fail{"element '" + e.name + "' " + std::to_string(i) + " has a list of " + std::to_string(n) + " entries (limit 64M)"};
-                if (keep) listVals.resize(size_t(n));
-                for (uint64_t j = 0; j < n; ++j) {
-                    double d;
-                    if (!rd.read(pr.type, d)) {
-                        truncated = true;
-                        break;
-                    }
-                    if (keep) listVals[size_t(j)] = d;
-                }
-                if (truncated) break;
-                if (!keep) continue;
-                if (isFace) {
-                    ++faceCount;
-                    poly.clear();
-                    bool ok = n >= 3;
-                    for (double d : listVals) {
-                        if (!(d >= 0 && d < double(mesh.positions.size()))) {
-                            ok = false;
-                            break;
-                        }
-                        poly.push_back(uint32_t(d));
-                    }
-                    if (!ok) {
-                        ++dropped;
-                        continue;
-                    }
-                    ctx.countTriangles(n - 2);
-                    fan(poly.data(), poly.size(), mesh.indices);
-                } else if (isStrip) {
-                    // Strips separated by -1; alternate winding; degenerate triangles skipped.
-                    size_t start = 0;
-                    for (size_t j = 0; j <= listVals.size(); ++j) {
-                        if (j < listVals.size() && listVals[j] >= 0) continue;
-                        for (size_t q = start; q + 2 < j; ++q) {
-                            double a = listVals[q], b = listVals[q + 1], c2 = listVals[q + 2];
-                            if (!(a < double(mesh.positions.size()) && b < double(mesh.positions.size()) && c2 < double(mesh.positions.size()))) {
-                                ++dropped;
-                                continue;
-                            }
-                            uint32_t ia2 = uint32_t(a), ib2 = uint32_t(b), ic2 = uint32_t(c2);
-                            if (ia2 == ib2 || ib2 == ic2 || ia2 == ic2) continue;
-                            ctx.countTriangles(1);
-                            if ((q - start) % 2 == 0) {
-                                mesh.indices.push_back(ia2);
-                                mesh.indices.push_back(ib2);
-                                mesh.indices.push_back(ic2);
-                            } else {
-                                mesh.indices.push_back(ib2);
-                                mesh.indices.push_back(ia2);
-                                mesh.indices.push_back(ic2);
-                            }
-                        }
-                        start = j + 1;
-                    }
-                }
-            }
-            if (truncated) break;
-            if (isVertex) {
-                sg::vec3 p{float(vals[size_t(ix)]), float(vals[size_t(iy)]), float(vals[size_t(iz)])};
-                if (!sg::isFinite(p)) throw Fail{"vertex " + std::to_string(i) + " is not finite"};
-                mesh.positions.push_back(p);
-                if (haveNormals) mesh.normals.push_back({float(vals[size_t(inx)]), float(vals[size_t(iny)]), float(vals[size_t(inz)])});
-                if (haveUv) mesh.uv0.push_back({float(vals[size_t(iu)]), float(vals[size_t(iv)])});
-                if (haveColors) {
-                    auto ch = [&](int k) {
-                        PlyType t = e.props[size_t(k)].type;
-                        double d = vals[size_t(k)];
-                        if (t == PlyType::U8 || t == PlyType::I8)
-                            d /= 255.0;
-                        else if (t == PlyType::U16 || t == PlyType::I16)
-                            d /= 65535.0;
-                        return float(std::clamp(d, 0.0, 1.0));
-                    };
-                    mesh.colors.push_back({ch(ir), ch(ig), ch(ib), ia >= 0 ? ch(ia) : 1.0f});
-                }
-            }
-            readOf = i + 1;
-        }
-        if (truncated) {
-            truncatedIn = e.name;
-            claimed = e.count;
+    PlyBuild b;
+    b.mesh.name = path.stem().string();
+    uint64_t readOf = 0;
+    for (const PlyElement& e : h.elements) {
+        if (!readPlyElement(rd, e, data, b, ctx, readOf)) {
+            ctx.warnings.push_back(file + ": file is truncated in element '" + e.name + "' (" + std::to_string(readOf) + " of " +
+                                   std::to_string(e.count) + " read)");
             break;
         }
     }
-    if (!truncatedIn.empty())
-        ctx.warnings.push_back(file + ": file is truncated in element '" + truncatedIn + "' (" + std::to_string(readOf) + " of " +
-                               std::to_string(claimed) + " read)");
-    if (dropped) ctx.warnings.push_back(file + ": " + std::to_string(dropped) + " faces with out-of-range indices or fewer than 3 corners dropped");
+    if (b.dropped)
+        ctx.warnings.push_back(file + ": " + std::to_string(b.dropped) + " faces with out-of-range indices or fewer than 3 corners dropped");
+    sg::Mesh& mesh = b.mesh;
     if (mesh.positions.empty()) throw Fail{"no vertices"};
-    (void)faceCount;
     if (mesh.indices.empty()) {
         mesh.mode = sg::PrimitiveMode::Points;
         mesh.indices.resize(mesh.positions.size());
