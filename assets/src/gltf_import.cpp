@@ -19,7 +19,8 @@
 //   (segments); POINTS -> Points. Any accessor component type (normalised or not), byteStride
 //   and sparse accessors are read. Missing normals: indexed triangles get smooth area-weighted
 //   normals (Mesh::computeNormals), non-indexed ones flat normals (vertices are unshared).
-//   COLOR_0 (vec3/vec4; float or normalised ints) -> colors (linear); TEXCOORD_0/1 -> uv0/uv1,
+//   COLOR_0 (vec3/vec4; float or normalised ints) -> colors (linear); TEXCOORD_0/1 -> uv0/uv1
+//   with v flipped (glTF: v = 0 at the image's top row; ours: v = 0 at the bottom, as GL/OBJ),
 //   except that uv0 always holds the set the diffuse texture samples: a base colour texture
 //   with texCoord 1 swaps the two sets for that primitive. Morph targets and skins are ignored
 //   (warning).
@@ -969,6 +970,11 @@ struct Converter {
             if (info.hasUvTransform)
                 for (auto& uv : mesh.uv0) uv = sg::vec2(info.uvTransform * sg::vec3(uv, 1.0f));
         }
+        // glTF puts uv (0,0) at the image's first (top-left) pixel, v down; our textures follow
+        // GL and OBJ (v = 0 at the bottom row, sg::Texture row 0 at v = 1): v -> 1 - v, after
+        // KHR_texture_transform, which is defined in glTF's uv space.
+        for (auto& uv : mesh.uv0) uv.y = 1.0f - uv.y;
+        for (auto& uv : mesh.uv1) uv.y = 1.0f - uv.y;
 
         std::vector<uint32_t> src;
         bool indexed = prim.indices >= 0;

@@ -38,7 +38,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-
 #include <cmath>
 #include <functional>
 #include <map>

@@ -199,14 +199,15 @@ TEST(GltfImportTest, TextureTransformAppliedToUvs) {
         }
         return std::make_pair(lo, hi);
     };
-    // The three share one TEXCOORD_0 accessor; offsets (0.5,0), (0,0.5), (0.5,0.5).
+    // The three share one TEXCOORD_0 accessor; offsets (0.5,0), (0,0.5), (0.5,0.5) in glTF's
+    // uv space, where v goes down the image: ours is v' = 1 - v, so a +0.5 offset in v is -0.5.
     auto [ulo, uhi] = uvBounds(*offU);
     auto [vlo, vhi] = uvBounds(*offV);
     auto [wlo, whi] = uvBounds(*offUV);
     EXPECT_NEAR(ulo.x - vlo.x, 0.5f, 1e-5);
-    EXPECT_NEAR(vlo.y - ulo.y, 0.5f, 1e-5);
+    EXPECT_NEAR(ulo.y - vlo.y, 0.5f, 1e-5);
     EXPECT_NEAR(whi.x - vhi.x, 0.5f, 1e-5);
-    EXPECT_NEAR(whi.y - uhi.y, 0.5f, 1e-5);
+    EXPECT_NEAR(uhi.y - whi.y, 0.5f, 1e-5);
     EXPECT_GE(s.textures.size(), 4u);
 }
 
