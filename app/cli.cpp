@@ -186,6 +186,13 @@ Shot renderWith(const std::string& backend, const sg::FrameInput& frame, int w, 
     shot.stats = r->render(frame, w, h, shot.image);
     if (shot.stats.milliseconds == 0)
         shot.stats.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    // Never a silent substitution: what the backend did not honour as asked, one line each.
+    if (shot.stats.ok) {
+        for (const std::string& n : shot.stats.config.notes) std::fprintf(stderr, "viewer: note: %s: %s\n", backend.c_str(), n.c_str());
+        for (const std::string& u : shot.stats.config.unsupported)
+            if (u != "shadows" && u != "reflections")   // on by default, drawn only by backends that say so
+                std::fprintf(stderr, "viewer: note: %s does not draw %s\n", backend.c_str(), u.c_str());
+    }
     return shot;
 }
 
@@ -235,10 +242,11 @@ int runRender(const RenderArgs& a) {
     if (!err.empty()) return fail(err);
     sg::FrameInput frame = sg::flatten(*scene, float(w) / float(h));
     Shot shot = renderWith(a.backend, frame, w, h);
-    if (!shot.stats.ok) return fail(a.backend + ": " + shot.stats.error);
+    if (!shot.stats.ok) return fail(shot.stats.error);   // starts with the backend's name
     err = assets::writePng(out, shot.image.width, shot.image.height, shot.image.color.data(), a.overwrite);
     if (!err.empty()) return fail(err);
-    std::printf("%s: %dx%d, %s backend, %.1f ms\n", out.string().c_str(), w, h, a.backend.c_str(), shot.stats.milliseconds);
+    std::printf("%s: %dx%d, %s backend, %s, %.1f ms\n", out.string().c_str(), w, h, a.backend.c_str(), shot.stats.config.describe().c_str(),
+                shot.stats.milliseconds);
     return 0;
 }
 
@@ -274,7 +282,13 @@ int runCompare(const RenderArgs& a) {
         fs::path p = dir / (b + ".png");
         err = assets::writePng(p, w, h, s.image.color.data(), a.overwrite);
         if (!err.empty()) return fail(err);
-        table["backends"][b] = {{"ms", s.stats.milliseconds}, {"image", p.filename().string()}};
+        table["backends"][b] = {{"ms", s.stats.milliseconds},
+                                {"image", p.filename().string()},
+                                {"aa_asked", s.stats.config.aaAsked},
+                                {"aa_used", s.stats.config.aaUsed},
+                                {"samples_per_pixel", s.stats.config.samplesPerPixel},
+                                {"notes", s.stats.config.notes},
+                                {"not_drawn", s.stats.config.unsupported}};
         md << "| " << b << " | " << s.stats.milliseconds << " | " << p.filename().string() << " |\n";
         std::printf("%s\n", p.string().c_str());
         shots.push_back(std::move(s));
