@@ -1032,6 +1032,10 @@ std::string slotStats(const SlotView& v) {
     }
     if (v.status.level > 1) extra += "  (1/" + std::to_string(v.status.level) + " res)";
     if (s.ok || !s.config.aaUsed.empty()) extra += "  " + s.config.describe();
+    if (!s.config.unsupported.empty()) {
+        extra += "  no";
+        for (const std::string& u : s.config.unsupported) extra += " " + u;
+    }
     if (v.status.rendering) extra += "  " + std::to_string(int(v.status.progress * 100)) + "%";
     std::snprintf(buf, sizeof buf, "%-8s %7.1f ms  %6.1fk tris%s", v.status.backend.c_str(), s.milliseconds, double(s.triangles) / 1000.0,
                   extra.c_str());
@@ -1046,11 +1050,11 @@ std::string renderNotes(const ViewportInput& view) {
         const rnd::RenderConfig& c = v.status.stats.config;
         std::string part;
         for (const std::string& n : c.notes) part += (part.empty() ? "" : "; ") + n;
-        if (!c.unsupported.empty()) {
-            std::string list;
-            for (const std::string& u : c.unsupported) list += (list.empty() ? "" : ", ") + u;
-            part += (part.empty() ? "" : "; ") + std::string("does not draw ") + list;
-        }
+        std::string list;   // shadows/reflections are on by default and drawn only by the ray caster:
+                            // the stats overlay lists them, the status line would always show them
+        for (const std::string& u : c.unsupported)
+            if (u != "shadows" && u != "reflections") list += (list.empty() ? "" : ", ") + u;
+        if (!list.empty()) part += (part.empty() ? "" : "; ") + std::string("does not draw ") + list;
         if (!part.empty()) line += (line.empty() ? "" : "   ") + v.status.backend + ": " + part;
     }
     return line;
