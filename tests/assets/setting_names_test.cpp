@@ -203,7 +203,8 @@ TEST(SettingsNameTableTest, JsonWriterWritesTheTableNames) {
             EXPECT_EQ(tj["wrapS"], w.name);
             EXPECT_EQ(tj["wrapT"], w.name);
             EXPECT_EQ(tj["filter"], f.name);
-            const sg::Texture& back = *reread(s).textures[0];
+            const sg::Scene again = reread(s);   // keep the scene alive while its texture is read
+            const sg::Texture& back = *again.textures[0];
             EXPECT_EQ(back.wrapS, w.value) << w.name;
             EXPECT_EQ(back.filter, f.value) << f.name;
         }
