@@ -109,7 +109,8 @@ std::string applyOverrides(const RenderArgs& a, sg::Scene& scene) {
     auto named = [](const std::optional<std::string>& v, auto& dst, const char* option) -> std::string {
         return v ? parseNamed(option, *v, dst) : std::string();
     };
-    for (auto e : {named(a.shading, s.shading, "--shading"), named(a.reflection, s.reflection, "--reflection"), named(a.fog, s.fog, "--fog")})
+    for (auto e : {named(a.shading, s.shading, "--shading"), named(a.reflection, s.reflection, "--reflection"), named(a.fog, s.fog, "--fog"),
+                   named(a.culling, s.culling, "--culling")})
         if (!e.empty()) return e;
     if (a.aa && !s.setAA(*a.aa)) return notOneOf("--aa", *a.aa, sg::nameList<sg::AAChoice>());
     auto onOff = [](const std::optional<std::string>& v, bool& dst, const char* name) -> std::string {
@@ -117,8 +118,7 @@ std::string applyOverrides(const RenderArgs& a, sg::Scene& scene) {
         return {};
     };
     for (auto e : {onOff(a.shadows, s.shadows, "--shadows"), onOff(a.reflections, s.reflections, "--reflections"),
-                   onOff(a.culling, s.cullBackFaces, "--culling"), onOff(a.wireframe, s.wireframe, "--wireframe"),
-                   onOff(a.attenuation, s.attenuation, "--attenuation")})
+                   onOff(a.wireframe, s.wireframe, "--wireframe"), onOff(a.attenuation, s.attenuation, "--attenuation")})
         if (!e.empty()) return e;
     if (a.fogStart) s.fogStart = *a.fogStart;
     if (a.fogEnd) s.fogEnd = *a.fogEnd;
@@ -223,7 +223,7 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a, bool compare) {
     cmd.add_option("--shadows", a.shadows, "Ray caster shadow rays: on, off");
     cmd.add_option("--reflections", a.reflections, "Ray caster mirror reflections: on, off");
     cmd.add_option("--bounces", a.bounces, "Ray caster reflection depth limit");
-    cmd.add_option("--culling", a.culling, "Back-face culling: on, off");
+    cmd.add_option("--culling", a.culling, namedHelp<sg::CullMode>("Back-face culling"));
     cmd.add_option("--wireframe", a.wireframe, "Wireframe overlay: on, off");
     cmd.add_option("--attenuation", a.attenuation, "Inverse-square light attenuation: on, off");
     cmd.add_option("--tessellation", a.tessellation, "Tessellation resolution for implicit shapes (4..512)");

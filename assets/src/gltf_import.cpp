@@ -39,8 +39,10 @@
 //   kd         = 1 - 0.75 * metallic (metals keep a little diffuse so they are not black
 //                without reflections); ka = 0.2 (our default).
 //   emissive   = emissiveFactor (x KHR_materials_emissive_strength).
-//   alphaMode  OPAQUE -> alpha 1; BLEND -> alpha = baseColorFactor.a; MASK -> alpha 1
-//                (cut-outs are not supported); doubleSided -> Material::doubleSided.
+//   alphaMode  -> Material::alphaMode (OPAQUE, MASK with alphaCutoff, BLEND); alpha =
+//                baseColorFactor.a, times texture and vertex colour alpha when drawn;
+//                doubleSided -> Material::doubleSided (glTF's default false: back faces are culled
+//                under RenderSettings::culling auto).
 //   KHR_materials_unlit -> Material::unlit. KHR_materials_pbrSpecularGlossiness: diffuseFactor
 //                / diffuseTexture -> baseColor / texture, ks = max(specularFactor),
 //                specularColor = specularFactor / ks, roughness = 1 - glossiness as above.
@@ -873,7 +875,11 @@ struct Converter {
                 if (const tinygltf::Value* es = extensionObject(gm.extensions, "KHR_materials_emissive_strength"))
                     mat.emissive *= float(std::clamp(numberOr(*es, "emissiveStrength", 1.0), 0.0, 1e6));
             }
-            mat.alpha = gm.alphaMode == "BLEND" ? base.a : 1.0f;
+            mat.alpha = base.a;   // baseColorFactor.a (diffuseFactor.a); texture and vertex alpha multiply it when drawn
+            mat.alphaMode = gm.alphaMode == "BLEND" ? sg::AlphaMode::Blend : gm.alphaMode == "MASK" ? sg::AlphaMode::Mask : sg::AlphaMode::Opaque;
+            if (gm.alphaMode != "OPAQUE" && gm.alphaMode != "BLEND" && gm.alphaMode != "MASK")
+                warnOnce("material " + std::to_string(i) + ": alphaMode \"" + gm.alphaMode + "\" is not one of OPAQUE, MASK, BLEND (drawn opaque)");
+            mat.alphaCutoff = std::isfinite(gm.alphaCutoff) && gm.alphaCutoff >= 0 ? float(gm.alphaCutoff) : 0.5f;
             mat.doubleSided = gm.doubleSided;
             mat.unlit = extensionObject(gm.extensions, "KHR_materials_unlit") != nullptr || gm.extensions.count("KHR_materials_unlit");
             MaterialInfo info;

@@ -8,13 +8,15 @@
 //     "settings":  { "shading": <ShadingModel>, "reflection": <ReflectionModel>,
 //                    "fog": {"mode": <FogMode>, "color": [..], "start", "end", "density"},
 //                    "attenuation": bool, "aa": <AAChoice>,
-//                    "aaRate", "cullBackFaces", "wireframe", "wireframeColor", "background",
+//                    "aaRate", "culling": <CullMode> (older files: "cullBackFaces": bool),
+//                    "wireframe", "wireframeColor", "background",
 //                    "shadows", "reflections", "maxBounces", "tessellation" },
 //     "textures":  [ {"name", "file": "relative/path.png"} | {"name", "png": "<base64 PNG>"},
 //                    + "wrapS"/"wrapT": <WrapMode>, "filter": <FilterMode> ],
 //     "materials": [ {"name", "baseColor", "ka", "kd", "ks", "shininess", "specularTinted",
-//                     "specularColor", "diffuseTexture", "emissive", "alpha", "unlit",
-//                     "doubleSided", "reflectivity"} ],
+//                     "specularColor", "diffuseTexture", "emissive", "alpha",
+//                     "alphaMode": <AlphaMode>, "alphaCutoff", "unlit", "doubleSided",
+//                     "reflectivity"} ],
 //     "meshes":    [ {"name", "file": "relative/model.obj"} |
 //                    {"name", "mode": "triangles|lines|points", "positions": [x,y,z,...],
 //                     "normals", "uv0", "uv1", "colors" (4 per vertex), "indices"} ],
@@ -283,7 +285,8 @@ void Reader::readSettings(const json& j, const std::string& p, sg::RenderSetting
         if (!s.setAA(a)) fail(p + "/aa", "unknown value \"" + a + "\" (valid: " + sg::nameList<sg::AAChoice>() + ")");
     }
     if (s.aa == sg::AAMode::None) optInt(j, p, "aaRate", s.aaRate, 1, 8);
-    optBool(j, p, "cullBackFaces", s.cullBackFaces);
+    if (auto* v = optional(j, "cullBackFaces")) s.culling = boolean(*v, p + "/cullBackFaces") ? sg::CullMode::On : sg::CullMode::Off;
+    if (auto* v = optional(j, "culling")) s.culling = named<sg::CullMode>(*v, p + "/culling");
     optBool(j, p, "wireframe", s.wireframe);
     optVec3(j, p, "wireframeColor", s.wireframeColor);
     optVec3(j, p, "background", s.background);
@@ -310,6 +313,10 @@ sg::Material Reader::readMaterial(const json& j, const std::string& p, size_t te
     optInt(j, p, "diffuseTexture", m.diffuseTexture, -1, (long long)textureCount - 1);
     optVec3(j, p, "emissive", m.emissive);
     optFloat(j, p, "alpha", m.alpha);
+    if (m.alpha < 0 || m.alpha > 1) fail(p + "/alpha", "must be in [0, 1]");
+    if (auto* v = optional(j, "alphaMode")) m.alphaMode = named<sg::AlphaMode>(*v, p + "/alphaMode");
+    optFloat(j, p, "alphaCutoff", m.alphaCutoff);
+    if (!(m.alphaCutoff >= 0)) fail(p + "/alphaCutoff", "must be >= 0");
     optBool(j, p, "unlit", m.unlit);
     optBool(j, p, "doubleSided", m.doubleSided);
     optFloat(j, p, "reflectivity", m.reflectivity);
@@ -843,7 +850,7 @@ std::string serializeSceneJson(const sg::Scene& s) {
         {"fog", {{"mode", sg::nameOf(r.fog)}, {"color", vecJ(r.fogColor)}, {"start", r.fogStart}, {"end", r.fogEnd}, {"density", r.fogDensity}}},
         {"attenuation", r.attenuation},
         {"aa", r.aaName()},
-        {"cullBackFaces", r.cullBackFaces},
+        {"culling", sg::nameOf(r.culling)},
         {"wireframe", r.wireframe},
         {"wireframeColor", vecJ(r.wireframeColor)},
         {"background", vecJ(r.background)},
@@ -873,6 +880,8 @@ std::string serializeSceneJson(const sg::Scene& s) {
                                   {"diffuseTexture", m.diffuseTexture},
                                   {"emissive", vecJ(m.emissive)},
                                   {"alpha", m.alpha},
+                                  {"alphaMode", sg::nameOf(m.alphaMode)},
+                                  {"alphaCutoff", m.alphaCutoff},
                                   {"unlit", m.unlit},
                                   {"doubleSided", m.doubleSided},
                                   {"reflectivity", m.reflectivity}});

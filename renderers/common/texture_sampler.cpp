@@ -37,78 +37,130 @@ SampledTexture::SampledTexture(const sg::Texture& t) : m_wrapS(t.wrapS), m_wrapT
     base.w = std::max(t.width, 1);
     base.h = std::max(t.height, 1);
     base.texels.assign(size_t(base.w) * base.h, vec3(1.0f));
-    if (t.width > 0 && t.height > 0 && t.rgba.size() >= size_t(t.width) * t.height * 4)
+    const bool filled = t.width > 0 && t.height > 0 && t.rgba.size() >= size_t(t.width) * t.height * 4;
+    if (filled)
         for (int r = 0; r < t.height; ++r)
             for (int c = 0; c < t.width; ++c)   // file row r is GL row h-1-r
                 base.texels[size_t(t.height - 1 - r) * base.w + c] = srgbBytesToLinear(&t.rgba[(size_t(r) * t.width + c) * 4]);
+    if (filled)
+        for (size_t i = 3; i < size_t(t.width) * t.height * 4; i += 4) m_hasAlpha = m_hasAlpha || t.rgba[i] != 255;
+    if (m_hasAlpha) {
+        base.alpha.resize(base.texels.size());
+        for (int r = 0; r < t.height; ++r)
+            for (int c = 0; c < t.width; ++c)
+                base.alpha[size_t(t.height - 1 - r) * base.w + c] = float(t.rgba[(size_t(r) * t.width + c) * 4 + 3]) / 255.0f;
+    }
     m_levels.push_back(std::move(base));
     if (m_filter != sg::FilterMode::Trilinear) return;
     // Mip chain: each level halves (floor, min 1); 2x2 box average in linear, re-quantised to
-    // 8-bit sRGB like an SRGB8 texture level.
+    // 8-bit sRGB like an SRGB8 texture level (alpha: averaged and re-quantised to 8 bits).
     while (m_levels.back().w > 1 || m_levels.back().h > 1) {
         const Level& p = m_levels.back();
         Level l;
         l.w = std::max(p.w / 2, 1);
         l.h = std::max(p.h / 2, 1);
         l.texels.resize(size_t(l.w) * l.h);
+        if (m_hasAlpha) l.alpha.resize(l.texels.size());
         for (int y = 0; y < l.h; ++y)
             for (int x = 0; x < l.w; ++x) {
                 vec3 s(0.0f);
+                float a = 0.0f;
                 for (int dy = 0; dy < 2; ++dy)
-                    for (int dx = 0; dx < 2; ++dx) s += p.texels[size_t(std::min(2 * y + dy, p.h - 1)) * p.w + std::min(2 * x + dx, p.w - 1)];
+                    for (int dx = 0; dx < 2; ++dx) {
+                        size_t src = size_t(std::min(2 * y + dy, p.h - 1)) * p.w + std::min(2 * x + dx, p.w - 1);
+                        s += p.texels[src];
+                        if (m_hasAlpha) a += p.alpha[src];
+                    }
                 s *= 0.25f;
                 uint8_t b[3] = {encodeByte(s.x), encodeByte(s.y), encodeByte(s.z)};
                 l.texels[size_t(y) * l.w + x] = srgbBytesToLinear(b);
+                if (m_hasAlpha) l.alpha[size_t(y) * l.w + x] = std::round(a * 0.25f * 255.0f) / 255.0f;
             }
         m_levels.push_back(std::move(l));
     }
 }
 
-vec3 SampledTexture::sampleLevel(vec2 uv, int level, bool bilinear) const {
-    const Level& l = m_levels[std::clamp(level, 0, int(m_levels.size()) - 1)];
-    if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) return l.texels[0];
-    float fx = uv.x * l.w, fy = uv.y * l.h;
+namespace {
+
+// Texel lookup of one level with GL's wrap modes, nearest or bilinear, for colour or alpha.
+template <class T>
+T filterLevel(const std::vector<T>& texels, int w, int h, sg::WrapMode ws, sg::WrapMode wt, vec2 uv, bool bilinear) {
+    if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) return texels[0];
+    float fx = uv.x * w, fy = uv.y * h;
     // Keep the coordinates in a range where int conversion is safe (wraps are periodic).
     auto reduce = [](float f, int n) {
         float p = 2.0f * n;
         return std::fabs(f) > 1e6f ? f - p * std::floor(f / p) : f;
     };
-    fx = reduce(fx, l.w);
-    fy = reduce(fy, l.h);
+    fx = reduce(fx, w);
+    fy = reduce(fy, h);
     if (!bilinear) {
-        int i = wrapIndex(int(std::floor(fx)), l.w, m_wrapS), j = wrapIndex(int(std::floor(fy)), l.h, m_wrapT);
-        return l.texels[size_t(j) * l.w + i];
+        int i = wrapIndex(int(std::floor(fx)), w, ws), j = wrapIndex(int(std::floor(fy)), h, wt);
+        return texels[size_t(j) * w + i];
     }
     fx -= 0.5f;
     fy -= 0.5f;
     float x0f = std::floor(fx), y0f = std::floor(fy);
     float ax = fx - x0f, ay = fy - y0f;
     int x0 = int(x0f), y0 = int(y0f);
-    int i0 = wrapIndex(x0, l.w, m_wrapS), i1 = wrapIndex(x0 + 1, l.w, m_wrapS);
-    int j0 = wrapIndex(y0, l.h, m_wrapT), j1 = wrapIndex(y0 + 1, l.h, m_wrapT);
-    const vec3& a = l.texels[size_t(j0) * l.w + i0];
-    const vec3& b = l.texels[size_t(j0) * l.w + i1];
-    const vec3& c = l.texels[size_t(j1) * l.w + i0];
-    const vec3& d = l.texels[size_t(j1) * l.w + i1];
+    int i0 = wrapIndex(x0, w, ws), i1 = wrapIndex(x0 + 1, w, ws);
+    int j0 = wrapIndex(y0, h, wt), j1 = wrapIndex(y0 + 1, h, wt);
+    const T& a = texels[size_t(j0) * w + i0];
+    const T& b = texels[size_t(j0) * w + i1];
+    const T& c = texels[size_t(j1) * w + i0];
+    const T& d = texels[size_t(j1) * w + i1];
     return (a * (1 - ax) + b * ax) * (1 - ay) + (c * (1 - ax) + d * ax) * ay;
 }
 
-vec3 SampledTexture::sample(vec2 uv, vec2 ddx, vec2 ddy) const {
-    if (m_filter == sg::FilterMode::Nearest) return sampleLevel(uv, 0, false);
-    if (m_filter == sg::FilterMode::Bilinear || m_levels.size() == 1) return sampleLevel(uv, 0, true);
+}   // namespace
+
+vec3 SampledTexture::sampleLevel(vec2 uv, int level, bool bilinear) const {
+    const Level& l = m_levels[std::clamp(level, 0, int(m_levels.size()) - 1)];
+    return filterLevel(l.texels, l.w, l.h, m_wrapS, m_wrapT, uv, bilinear);
+}
+
+float SampledTexture::sampleAlphaLevel(vec2 uv, int level, bool bilinear) const {
+    if (!m_hasAlpha) return 1.0f;
+    const Level& l = m_levels[std::clamp(level, 0, int(m_levels.size()) - 1)];
+    return filterLevel(l.alpha, l.w, l.h, m_wrapS, m_wrapT, uv, bilinear);
+}
+
+bool SampledTexture::mipLevel(vec2 ddx, vec2 ddy, int& l0, float& f) const {
+    l0 = 0;
+    f = 0.0f;
+    if (m_filter != sg::FilterMode::Trilinear || m_levels.size() == 1) return false;
     // GL: rho = max(|d(uv*size)/dx|, |d(uv*size)/dy|), lambda = log2(rho).
     const Level& b = m_levels[0];
     float ax = ddx.x * b.w, ay = ddx.y * b.h, bx = ddy.x * b.w, by = ddy.y * b.h;
     float rho2 = std::max(ax * ax + ay * ay, bx * bx + by * by);
     float lambda = rho2 > 0 ? 0.5f * std::log2(rho2) : -100.0f;
-    if (!(lambda > 0.0f)) return sampleLevel(uv, 0, true);   // magnification (or NaN)
+    if (!(lambda > 0.0f)) return false;   // magnification (or NaN)
     float maxLevel = float(m_levels.size() - 1);
     lambda = std::min(lambda, maxLevel);
-    int l0 = int(lambda);
-    float f = lambda - l0;
+    l0 = int(lambda);
+    f = l0 + 1 > int(maxLevel) ? 0.0f : lambda - float(l0);
+    return true;
+}
+
+vec3 SampledTexture::sample(vec2 uv, vec2 ddx, vec2 ddy) const {
+    if (m_filter == sg::FilterMode::Nearest) return sampleLevel(uv, 0, false);
+    int l0;
+    float f;
+    if (!mipLevel(ddx, ddy, l0, f)) return sampleLevel(uv, 0, true);
     vec3 c0 = sampleLevel(uv, l0, true);
-    if (f <= 0.0f || l0 + 1 > int(maxLevel)) return c0;
+    if (f <= 0.0f) return c0;
     return c0 * (1 - f) + sampleLevel(uv, l0 + 1, true) * f;
+}
+
+float SampledTexture::sampleAlpha(vec2 uv, vec2 ddx, vec2 ddy) const {
+    if (!m_hasAlpha) return 1.0f;
+    if (m_filter == sg::FilterMode::Nearest) return sampleAlphaLevel(uv, 0, false);
+    int l0;
+    float f;
+    if (!mipLevel(ddx, ddy, l0, f)) return sampleAlphaLevel(uv, 0, true);
+    float a0 = sampleAlphaLevel(uv, l0, true);
+    if (f <= 0.0f) return a0;
+    return a0 * (1 - f) + sampleAlphaLevel(uv, l0 + 1, true) * f;
 }
 
 const SampledTexture* SamplerCache::get(const sg::TexturePtr& t) {

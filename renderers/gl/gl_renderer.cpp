@@ -57,6 +57,7 @@ struct Program {
     GLint eye = -1, ambient = -1;
     GLint baseColor = -1, ka = -1, kd = -1, ks = -1, shininess = -1, specTinted = -1, specColor = -1, emissive = -1;
     GLint texture = -1, hasTexture = -1, unlit = -1, solid = -1, solidColor = -1;
+    GLint alpha = -1, alphaMode = -1, alphaCutoff = -1;
     GLint fogMode = -1, fogColor = -1, fogParams = -1;
 };
 
@@ -99,6 +100,7 @@ std::string glslEnumDefines() {
     all("REFLECTION_", sg::nameTable<sg::ReflectionModel>());
     all("FOG_", sg::nameTable<sg::FogMode>());
     all("LIGHT_", sg::nameTable<sg::LightType>());
+    all("ALPHA_", sg::nameTable<sg::AlphaMode>());
     return d;
 }
 
@@ -184,6 +186,9 @@ std::string buildProgram(const std::string& key, Program& p) {
     p.texture = loc("uTexture");
     p.hasTexture = loc("uHasTexture");
     p.unlit = loc("uUnlit");
+    p.alpha = loc("uAlpha");
+    p.alphaMode = loc("uAlphaMode");
+    p.alphaCutoff = loc("uAlphaCutoff");
     p.solid = loc("uSolid");
     p.solidColor = loc("uSolidColor");
     p.fogMode = loc("uFogMode");
@@ -458,6 +463,10 @@ private:
 // --- 5. GlRenderer ---------------------------------------------------------------------------
 
 // One draw: a cached GPU mesh with a transform and a material (per range for tessellations).
+// Opaque: opaque and masked surfaces, lines, points; Blended: alphaMode BLEND surfaces only;
+// Wireframe: every triangle mesh again as lines (no material changes).
+enum class DrawPass { Opaque, Blended, Wireframe };
+
 struct DrawItem {
     GpuMesh* gpu = nullptr;
     const mat4* world = nullptr;
@@ -513,7 +522,7 @@ private:
     GpuTexture* textureFor(const TexturePtr& t);
     void setFrameUniforms(const Program& p, const FrameInput& f, int ssaa);
     std::vector<DrawItem> collectDraws(const FrameInput& frame, int tessellation);   // uploads what is new
-    uint64_t drawAll(const Program& prog, const std::vector<DrawItem>& items, bool wireframe);
+    uint64_t drawAll(const Program& prog, const std::vector<DrawItem>& items, DrawPass pass, sg::CullMode culling);
     void readBack(GLuint fbo, int w, int h, Framebuffer& out);
     void setMaterial(const Program& p, const Material& m, bool hasTexture, bool unlit);
     void evict();
@@ -690,6 +699,10 @@ void GlRenderer::setMaterial(const Program& p, const Material& m, bool hasTextur
     glUniform3fv(p.emissive, 1, &m.emissive[0]);
     glUniform1i(p.hasTexture, hasTexture ? 1 : 0);
     glUniform1i(p.unlit, (unlit || m.unlit) ? 1 : 0);
+    glUniform1f(p.alpha, m.alpha);
+    // ALPHA_OPAQUE, ALPHA_MASK, ALPHA_BLEND; lines and points are always opaque (as in the CPU backends)
+    glUniform1i(p.alphaMode, int(unlit ? sg::AlphaMode::Opaque : m.alphaMode));
+    glUniform1f(p.alphaCutoff, m.alphaCutoff);
 }
 
 // Draws for the frame from the shared draw list (renderers/draw_list.h), nearest first so
@@ -721,28 +734,47 @@ std::vector<DrawItem> GlRenderer::collectDraws(const FrameInput& frame, int tess
 
 // Draws every item (wireframe: the triangle meshes again as lines, no material changes).
 // Returns the triangles submitted.
-uint64_t GlRenderer::drawAll(const Program& prog, const std::vector<DrawItem>& items, bool wireframe) {
+uint64_t GlRenderer::drawAll(const Program& prog, const std::vector<DrawItem>& items, DrawPass pass, sg::CullMode culling) {
+    const bool wireframe = pass == DrawPass::Wireframe;
     uint64_t triangles = 0;
-    for (const DrawItem& it : items) {
+    bool cullOn = false;
+    glDisable(GL_CULL_FACE);
+    auto setCull = [&](bool on) {
+        if (on == cullOn) return;
+        cullOn = on;
+        if (on)
+            glEnable(GL_CULL_FACE);
+        else
+            glDisable(GL_CULL_FACE);
+    };
+    // Blended surfaces after everything else, farthest first (items come nearest first).
+    for (size_t k = 0; k < items.size(); ++k) {
+        const DrawItem& it = items[pass == DrawPass::Blended ? items.size() - 1 - k : k];
         if (wireframe && it.gpu->primitive != GL_TRIANGLES) continue;
-        glUniformMatrix4fv(prog.model, 1, GL_FALSE, &(*it.world)[0][0]);
-        glUniformMatrix3fv(prog.normalMatrix, 1, GL_FALSE, &it.normal[0][0]);
-        glFrontFace(it.mirrored ? GL_CW : GL_CCW);
-        if (!wireframe) {
-            glBindTexture(GL_TEXTURE_2D, it.texture ? it.texture->id : 0);
-            triangles += it.gpu->triangles;
-        }
-        glBindVertexArray(it.gpu->vao);
-        bool unlit = it.gpu->primitive != GL_TRIANGLES;
+        bool bound = false;
+        const bool unlit = it.gpu->primitive != GL_TRIANGLES;
         for (const IndexRange& r : it.gpu->ranges) {
-            if (!wireframe) {
-                const Material* m = it.material;
-                if (it.rangeMaterials && r.material >= 0 && size_t(r.material) < it.rangeMaterials->size()) m = &(*it.rangeMaterials)[r.material];
-                setMaterial(prog, *m, it.texture != nullptr, unlit);
+            const Material* m = it.material;
+            if (it.rangeMaterials && r.material >= 0 && size_t(r.material) < it.rangeMaterials->size()) m = &(*it.rangeMaterials)[r.material];
+            const bool blended = m->alphaMode == sg::AlphaMode::Blend && !unlit;
+            if (!wireframe && blended != (pass == DrawPass::Blended)) continue;
+            if (!bound) {
+                glUniformMatrix4fv(prog.model, 1, GL_FALSE, &(*it.world)[0][0]);
+                glUniformMatrix3fv(prog.normalMatrix, 1, GL_FALSE, &it.normal[0][0]);
+                glFrontFace(it.mirrored ? GL_CW : GL_CCW);
+                if (!wireframe) glBindTexture(GL_TEXTURE_2D, it.texture ? it.texture->id : 0);
+                glBindVertexArray(it.gpu->vao);
+                bound = true;
             }
+            if (!wireframe) {
+                setMaterial(prog, *m, it.texture != nullptr, unlit);
+                if (!unlit) triangles += uint64_t(r.count / 3);
+            }
+            setCull(!unlit && sg::cullsBackFaces(culling, m->doubleSided));
             glDrawElements(it.gpu->primitive, r.count, GL_UNSIGNED_INT, reinterpret_cast<const void*>(size_t(r.first) * sizeof(uint32_t)));
         }
     }
+    setCull(false);
     return triangles;
 }
 
@@ -786,12 +818,8 @@ void beginFrameState(const RenderSettings& s, GLuint fbo, int w, int h, int samp
     glDepthFunc(GL_LESS);
     glEnable(GL_PROGRAM_POINT_SIZE);
     glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
-    if (s.cullBackFaces) {
-        glEnable(GL_CULL_FACE);
-        glCullFace(GL_BACK);
-    } else {
-        glDisable(GL_CULL_FACE);
-    }
+    glCullFace(GL_BACK);   // enabled per material in drawAll (RenderSettings::culling)
+    glDisable(GL_CULL_FACE);
     glActiveTexture(GL_TEXTURE0);
 }
 
@@ -847,7 +875,15 @@ RenderStats GlRenderer::doRender(const FrameInput& frame, const RenderConfig& cf
     const Program& prog = *program;
     glUseProgram(prog.id);
     setFrameUniforms(prog, frame, ssaa);
-    stats.triangles = drawAll(prog, items, false);
+    stats.triangles = drawAll(prog, items, DrawPass::Opaque, s.culling);
+    // Blended surfaces (glTF alphaMode BLEND): "over" in linear light (the sRGB framebuffer
+    // blends decoded values), sorted per draw back to front, depth tested but not written.
+    glEnable(GL_BLEND);
+    glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE);
+    glDepthMask(GL_FALSE);
+    stats.triangles += drawAll(prog, items, DrawPass::Blended, s.culling);
+    glDepthMask(GL_TRUE);
+    glDisable(GL_BLEND);
 
     // Wireframe overlay: the same triangles as lines, pulled slightly toward the viewer.
     if (s.wireframe) {
@@ -856,7 +892,7 @@ RenderStats GlRenderer::doRender(const FrameInput& frame, const RenderConfig& cf
         glEnable(GL_POLYGON_OFFSET_LINE);
         glPolygonOffset(-1.0f, -1.0f);
         glDepthFunc(GL_LEQUAL);
-        drawAll(prog, items, true);
+        drawAll(prog, items, DrawPass::Wireframe, s.culling);
         glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
         glDisable(GL_POLYGON_OFFSET_LINE);
         glUniform1i(prog.solid, 0);

@@ -116,6 +116,11 @@ struct DrawItem {
     std::vector<vec3> wpos, wnrm;
     std::vector<vec3> gouraudA[2], gouraudB[2];   // front/back: colour = A * albedo + B
 
+    // Whether back faces of triangle `tri` are culled (RenderSettings::culling, per material).
+    bool cullsBack(uint32_t tri, sg::CullMode mode) const {
+        if (mode != sg::CullMode::Auto) return mode == sg::CullMode::On;
+        return !materialOf(tri).doubleSided;
+    }
     const sg::Material& materialOf(uint32_t tri) const {
         if (triMat && materials && tri < triMat->size() && (*triMat)[tri] < materials->size()) return (*materials)[(*triMat)[tri]];
         return material;
@@ -189,6 +194,7 @@ struct Tri {
     uint32_t draw = 0, prim = 0;
     int32_t clip = -1;   // index into Chunk::clipBary (bary of setup vertices), -1 = none
     bool front = true;
+    sg::AlphaMode alpha = sg::AlphaMode::Opaque;   // of its material
 };
 
 struct Chunk {
@@ -263,7 +269,8 @@ void runTriangleStage(Chunk& ch, const FrameContext& fc) {
             float wy[3] = {d.win[v[0]].y, d.win[v[1]].y, d.win[v[2]].y};
             if (!setupTriangle(wx, wy, fc.width, fc.height, tri.s, fc.msaa)) continue;
             tri.front = tri.s.flipped == d.mirrored;   // CCW is front; mirrored instances: CW
-            if (st.cullBackFaces && !tri.front) continue;
+            if (!tri.front && d.cullsBack(t, st.culling)) continue;
+            tri.alpha = d.materialOf(t).alphaMode;
             float z[3] = {d.win[v[0]].z, d.win[v[1]].z, d.win[v[2]].z};
             float iw[3] = {d.win[v[0]].w, d.win[v[1]].w, d.win[v[2]].w};
             finishTri(tri, z, iw);
@@ -291,7 +298,8 @@ void runTriangleStage(Chunk& ch, const FrameContext& fc) {
             }
             if (!setupTriangle(wx, wy, fc.width, fc.height, tri.s, fc.msaa)) continue;
             tri.front = tri.s.flipped == d.mirrored;
-            if (st.cullBackFaces && !tri.front) continue;
+            if (!tri.front && d.cullsBack(t, st.culling)) continue;
+            tri.alpha = d.materialOf(t).alphaMode;
             finishTri(tri, z, iw);
             tri.draw = uint32_t(di);
             tri.prim = t;
@@ -323,8 +331,10 @@ void runTriangleStage(Chunk& ch, const FrameContext& fc) {
 
 // Rasterizes one triangle into the tile's visibility buffer (depth LESS). `samples` is 1 or 4
 // (MSAA: sample s of pixel p at index p*4 + s).
-__attribute__((noinline)) void rasterizeIntoTile(const Tri& t, uint32_t id, int tx0, int ty0, int tx1, int ty1, int samples, float* depth,
-                                                 uint32_t* ids) {
+// keep(i, j): whether the fragment of pixel (i, j) survives (alpha mask), asked only for
+// samples that pass the depth test.
+template <class Keep>
+inline void rasterizeTri(const Tri& t, uint32_t id, int tx0, int ty0, int tx1, int ty1, int samples, float* depth, uint32_t* ids, Keep&& keep) {
     int x0 = std::max(tx0, t.s.minX), x1 = std::min(tx1, t.s.maxX);
     int y0 = std::max(ty0, t.s.minY), y1 = std::min(ty1, t.s.maxY);
     if (x0 > x1 || y0 > y1) return;
@@ -337,7 +347,7 @@ __attribute__((noinline)) void rasterizeIntoTile(const Tri& t, uint32_t id, int 
             float z = t.zRef + t.zdx * float(i - t.s.minX) + t.zdy * float(j - t.s.minY);
             z = std::clamp(z, 0.0f, 1.0f);
             size_t p = size_t(j - ty0) * tw + (i - tx0);
-            if (z < depth[p]) {
+            if (z < depth[p] && keep(i, j)) {
                 depth[p] = z;
                 ids[p] = id;
             }
@@ -353,12 +363,17 @@ __attribute__((noinline)) void rasterizeIntoTile(const Tri& t, uint32_t id, int 
                 float z = t.zRef + t.zdx * (float(i - t.s.minX) + float(kMsaa4X[s] - kHalf) / kSub) +
                           t.zdy * (float(j - t.s.minY) + float(kMsaa4Y[s] - kHalf) / kSub);
                 z = std::clamp(z, 0.0f, 1.0f);
-                if (z < depth[p + s]) {
+                if (z < depth[p + s] && keep(i, j)) {
                     depth[p + s] = z;
                     ids[p + s] = id;
                 }
             }
         }
+}
+
+__attribute__((noinline)) void rasterizeIntoTile(const Tri& t, uint32_t id, int tx0, int ty0, int tx1, int ty1, int samples, float* depth,
+                                                 uint32_t* ids) {
+    rasterizeTri(t, id, tx0, ty0, tx1, ty1, samples, depth, ids, [](int, int) { return true; });
 }
 
 // Per-triangle data of the fragment stage, fetched once per run of fragments of the same
@@ -401,13 +416,17 @@ struct TriCache {
     }
 };
 
-// Interpolates the attributes of the cached triangle at the centre of pixel (i, j) and fills
-// slot k of the shading batch (Gouraud: the final colour, with no lights left to add). Returns
-// the eye-space distance for fog.
-__attribute__((noinline)) float prepareFragment(const TriCache& tc, const FrameContext& fc, int i, int j, ShadeBatch& sb, size_t k) {
+// Perspective-correct barycentrics at the centre of pixel (i, j): b for the setup vertices,
+// bo for the input triangle's corners; invSum = 1 / sum(lambda_k / w_k).
+struct FragBary {
+    float b[3];
+    vec3 bo;
+    float invSum;
+};
+
+inline FragBary baryAt(const TriCache& tc, int i, int j) {
     const Tri& t = *tc.t;
-    const DrawItem& d = *tc.d;
-    const sg::FrameInput& f = *fc.frame;
+    FragBary fb;
     const float di = float(i - t.s.minX), dj = float(j - t.s.minY);
     // Perspective correction: lambda/w is linear in screen space; divide by the sum (1/w).
     float u[3], sum = 0;
@@ -415,18 +434,73 @@ __attribute__((noinline)) float prepareFragment(const TriCache& tc, const FrameC
         u[q] = t.uRef[q] + t.udx[q] * di + t.udy[q] * dj;
         sum += u[q];
     }
-    float invSum = sum != 0 ? 1.0f / sum : 0.0f;
-    float b[3] = {u[0] * invSum, u[1] * invSum, u[2] * invSum};
+    fb.invSum = sum != 0 ? 1.0f / sum : 0.0f;
+    for (int q = 0; q < 3; ++q) fb.b[q] = u[q] * fb.invSum;
     // Weights of the input triangle's corners.
-    vec3 bo;
     const std::array<vec3, 3>* cb = tc.cb;
     if (cb)
-        bo = b[0] * (*cb)[0] + b[1] * (*cb)[1] + b[2] * (*cb)[2];
+        fb.bo = fb.b[0] * (*cb)[0] + fb.b[1] * (*cb)[1] + fb.b[2] * (*cb)[2];
     else {
-        bo[t.s.order[0]] = b[0];
-        bo[t.s.order[1]] = b[1];
-        bo[t.s.order[2]] = b[2];
+        fb.bo[t.s.order[0]] = fb.b[0];
+        fb.bo[t.s.order[1]] = fb.b[1];
+        fb.bo[t.s.order[2]] = fb.b[2];
     }
+    return fb;
+}
+
+// Texture coordinate at the fragment and its analytic screen derivatives (for the mip level):
+// d(uv)/dx = sum_k du_k/dx (uv_k - uv) / sum(u). Needs d.hasUV.
+inline void uvAt(const TriCache& tc, const FragBary& fb, const uint32_t mi[3], vec2& uv, vec2& ddx, vec2& ddy) {
+    const Tri& t = *tc.t;
+    const sg::Mesh& m = *tc.d->mesh;
+    const std::array<vec3, 3>* cb = tc.cb;
+    vec2 uvc[3] = {m.uv0[mi[0]], m.uv0[mi[1]], m.uv0[mi[2]]};
+    vec2 uvk[3];   // uv at the setup vertices
+    for (int q = 0; q < 3; ++q) {
+        vec3 w = cb ? (*cb)[q] : vec3(t.s.order[q] == 0, t.s.order[q] == 1, t.s.order[q] == 2);
+        uvk[q] = w[0] * uvc[0] + w[1] * uvc[1] + w[2] * uvc[2];
+    }
+    uv = fb.b[0] * uvk[0] + fb.b[1] * uvk[1] + fb.b[2] * uvk[2];
+    ddx = vec2(0.0f);
+    ddy = vec2(0.0f);
+    for (int q = 0; q < 3; ++q) {
+        ddx += t.udx[q] * (uvk[q] - uv);
+        ddy += t.udy[q] * (uvk[q] - uv);
+    }
+    ddx *= fb.invSum;
+    ddy *= fb.invSum;
+}
+
+// Alpha of the fragment at the centre of pixel (i, j): material alpha x vertex colour alpha x
+// texture alpha (filtered like the colour), as GL's fragment shader computes it.
+float fragmentAlpha(const TriCache& tc, int i, int j) {
+    const DrawItem& d = *tc.d;
+    float a = tc.mat->alpha;
+    const bool texAlpha = d.texture && d.hasUV && d.texture->hasAlpha();
+    if (!d.hasColors && !texAlpha) return a;
+    const FragBary fb = baryAt(tc, i, j);
+    const uint32_t mi[3] = {d.meshIndex(tc.v[0]), d.meshIndex(tc.v[1]), d.meshIndex(tc.v[2])};
+    if (d.hasColors) {
+        const sg::Mesh& m = *d.mesh;
+        a *= fb.bo[0] * m.colors[mi[0]].a + fb.bo[1] * m.colors[mi[1]].a + fb.bo[2] * m.colors[mi[2]].a;
+    }
+    if (texAlpha) {
+        vec2 uv, ddx, ddy;
+        uvAt(tc, fb, mi, uv, ddx, ddy);
+        a *= d.texture->sampleAlpha(uv, ddx, ddy);
+    }
+    return a;
+}
+
+// Interpolates the attributes of the cached triangle at the centre of pixel (i, j) and fills
+// slot k of the shading batch (Gouraud: the final colour, with no lights left to add). Returns
+// the eye-space distance for fog.
+__attribute__((noinline)) float prepareFragment(const TriCache& tc, const FrameContext& fc, int i, int j, ShadeBatch& sb, size_t k) {
+    const Tri& t = *tc.t;
+    const DrawItem& d = *tc.d;
+    const sg::FrameInput& f = *fc.frame;
+    const FragBary fb = baryAt(tc, i, j);
+    const vec3& bo = fb.bo;
     const uint32_t* v = tc.v;
     vec3 pos = bo[0] * tc.p[0] + bo[1] * tc.p[1] + bo[2] * tc.p[2];
     const sg::Material& mat = *tc.mat;
@@ -437,21 +511,9 @@ __attribute__((noinline)) float prepareFragment(const TriCache& tc, const FrameC
         uint32_t mi[3] = {d.meshIndex(v[0]), d.meshIndex(v[1]), d.meshIndex(v[2])};
         if (d.hasColors) albedo *= vec3(bo[0] * m.colors[mi[0]] + bo[1] * m.colors[mi[1]] + bo[2] * m.colors[mi[2]]);
         if (d.texture && d.hasUV) {
-            vec2 uvc[3] = {m.uv0[mi[0]], m.uv0[mi[1]], m.uv0[mi[2]]};
-            vec2 uvk[3];   // uv at the setup vertices
-            for (int q = 0; q < 3; ++q) {
-                vec3 w = cb ? (*cb)[q] : vec3(t.s.order[q] == 0, t.s.order[q] == 1, t.s.order[q] == 2);
-                uvk[q] = w[0] * uvc[0] + w[1] * uvc[1] + w[2] * uvc[2];
-            }
-            vec2 uv = b[0] * uvk[0] + b[1] * uvk[1] + b[2] * uvk[2];
-            // Analytic screen derivatives of the perspective-correct uv (for the mip level):
-            // d(uv)/dx = sum_k du_k/dx (uv_k - uv) / sum(u).
-            vec2 ddx(0.0f), ddy(0.0f);
-            for (int q = 0; q < 3; ++q) {
-                ddx += t.udx[q] * (uvk[q] - uv);
-                ddy += t.udy[q] * (uvk[q] - uv);
-            }
-            albedo *= d.texture->sample(uv, ddx * invSum, ddy * invSum);
+            vec2 uv, ddx, ddy;
+            uvAt(tc, fb, mi, uv, ddx, ddy);
+            albedo *= d.texture->sample(uv, ddx, ddy);
         }
     }
 
@@ -478,8 +540,20 @@ __attribute__((noinline)) float prepareFragment(const TriCache& tc, const FrameC
     return glm::length(bo[0] * tc.pe[0] + bo[1] * tc.pe[1] + bo[2] * tc.pe[2]);   // eye-space distance
 }
 
+// A fragment of a blended surface (alphaMode BLEND), kept for the per-pixel sorted composite.
+struct BlendFrag {
+    uint16_t pixel;     // in the tile
+    uint8_t coverage;   // samples of the pixel it covers in front of the opaque depth (1, or 1..4 with MSAA)
+    float z;            // window depth at the pixel centre
+    float alpha;
+    uint32_t tri;
+    uint32_t order;   // submission order (ties in depth: the later one on top, as GL)
+};
+
 struct TileBuffers {
     std::vector<float> depth;
+    std::vector<uint32_t> blendTris;   // blended triangles of this tile, in submission order
+    std::vector<BlendFrag> blendFrags;
     std::vector<uint32_t> ids;
     std::vector<uint16_t> fragPixel;   // pixel index in the tile
     std::vector<uint32_t> fragTri;
@@ -495,6 +569,11 @@ const Tri& triById(const std::vector<Chunk>& chunks, uint32_t id) { return chunk
 std::atomic<int64_t> g_rasterNs{0}, g_prepareNs{0}, g_lightNs{0}, g_outputNs{0};
 inline int64_t nowNs() { return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
 
+void shadeOpaque(const FrameContext& fc, Framebuffer& target, TileBuffers& buf, int x0, int y0, int x1, int y1, int samples);
+void renderBlended(const FrameContext& fc, Framebuffer& target, TileBuffers& buf, int x0, int y0, int x1, int y1, int samples);
+
+// Rasterizes the tile's triangles into its visibility buffer (opaque and masked ones; blended
+// ones are set aside), shades what is visible, then composites the blended surfaces.
 void renderTile(int tile, const FrameContext& fc, Framebuffer& target, TileBuffers& buf) {
     int64_t tA = fc.timing ? nowNs() : 0;
     const int tx = tile % fc.tilesX, ty = tile / fc.tilesX;
@@ -505,15 +584,45 @@ void renderTile(int tile, const FrameContext& fc, Framebuffer& target, TileBuffe
     buf.depth.assign(n, 1.0f);
     buf.ids.assign(n, kNoTri);
     const auto& chunks = *fc.chunks;
+    buf.blendTris.clear();
+    TriCache masked;
     for (size_t c = 0; c < chunks.size(); ++c) {
         const Chunk& ch = chunks[c];
         for (uint32_t k = ch.tileStart[tile]; k < ch.tileStart[tile + 1]; ++k) {
             uint32_t idx = ch.items[k];
-            rasterizeIntoTile(ch.tris[idx], uint32_t(c << kChunkBits) | idx, x0, y0, x1, y1, samples, buf.depth.data(), buf.ids.data());
+            const Tri& t = ch.tris[idx];
+            const uint32_t id = uint32_t(c << kChunkBits) | idx;
+            if (t.alpha == sg::AlphaMode::Opaque) {
+                rasterizeIntoTile(t, id, x0, y0, x1, y1, samples, buf.depth.data(), buf.ids.data());
+            } else if (t.alpha == sg::AlphaMode::Blend) {
+                buf.blendTris.push_back(id);   // after the opaque surfaces, in renderBlended
+            } else {
+                // Cut-out (MASK): a fragment below the cutoff is discarded before it writes depth,
+                // as GL's discard; alpha at the pixel centre, shared by its MSAA samples.
+                if (masked.id != id) masked.load(id, t, ch, fc);
+                int li = -1, lj = -1;
+                bool lastKeep = false;
+                const float cutoff = masked.mat->alphaCutoff;
+                rasterizeTri(t, id, x0, y0, x1, y1, samples, buf.depth.data(), buf.ids.data(), [&](int i, int j) {
+                    if (i != li || j != lj) {
+                        li = i;
+                        lj = j;
+                        lastKeep = fragmentAlpha(masked, i, j) >= cutoff;
+                    }
+                    return lastKeep;
+                });
+            }
         }
     }
+    if (fc.timing) g_rasterNs += nowNs() - tA;
+    shadeOpaque(fc, target, buf, x0, y0, x1, y1, samples);
+    if (!buf.blendTris.empty()) renderBlended(fc, target, buf, x0, y0, x1, y1, samples);
+}
+
+// Shades the visible opaque (and kept masked) fragments of the tile and writes its pixels.
+void shadeOpaque(const FrameContext& fc, Framebuffer& target, TileBuffers& buf, int x0, int y0, int x1, int y1, int samples) {
+    const auto& chunks = *fc.chunks;
     int64_t tB = fc.timing ? nowNs() : 0;
-    if (fc.timing) g_rasterNs += tB - tA;
     const auto& st = fc.frame->settings;
     const SrgbEncoder& enc = srgbEncoder();
     const vec3 bg = st.background;
@@ -615,6 +724,89 @@ void renderTile(int tile, const FrameContext& fc, Framebuffer& target, TileBuffe
             out[1] = enc(c.y);
             out[2] = enc(c.z);
         }
+}
+
+// Blended surfaces (alphaMode BLEND), order-correct per pixel: every blended fragment in front
+// of the opaque depth is kept (depth is not written), a pixel's fragments are sorted far to
+// near and composited "over" in linear light onto the pixel, each step re-encoded to 8-bit sRGB
+// as an SRGB8 framebuffer blends. With MSAA a fragment weighs by the samples it covers.
+void renderBlended(const FrameContext& fc, Framebuffer& target, TileBuffers& buf, int x0, int y0, int x1, int y1, int samples) {
+    const auto& chunks = *fc.chunks;
+    std::vector<BlendFrag>& frags = buf.blendFrags;
+    frags.clear();
+    TriCache tc;
+    const int tw = kTileSize;
+    for (uint32_t order = 0; order < buf.blendTris.size(); ++order) {
+        const uint32_t id = buf.blendTris[order];
+        const Tri& t = triById(chunks, id);
+        tc.load(id, t, chunks[id >> kChunkBits], fc);
+        const int bx0 = std::max(x0, t.s.minX), bx1 = std::min(x1, t.s.maxX);
+        const int by0 = std::max(y0, t.s.minY), by1 = std::min(y1, t.s.maxY);
+        if (bx0 > bx1 || by0 > by1) continue;
+        auto zAt = [&](float i, float j) { return std::clamp(t.zRef + t.zdx * (i - float(t.s.minX)) + t.zdy * (j - float(t.s.minY)), 0.0f, 1.0f); };
+        auto add = [&](int i, int j, int coverage) {
+            const float a = fragmentAlpha(tc, i, j);
+            if (!(a > 0.0f)) return;
+            frags.push_back(BlendFrag{uint16_t((j - y0) * tw + (i - x0)), uint8_t(coverage), zAt(float(i), float(j)), std::min(a, 1.0f), id, order});
+        };
+        if (samples == 1) {
+            forEachCoveredPixel(t.s, bx0, by0, bx1, by1, [&](int i, int j) {
+                if (zAt(float(i), float(j)) < buf.depth[size_t(j - y0) * tw + (i - x0)]) add(i, j, 1);
+            });
+            continue;
+        }
+        const Edge& e0 = t.s.e[0];
+        const Edge& e1 = t.s.e[1];
+        const Edge& e2 = t.s.e[2];
+        for (int j = by0; j <= by1; ++j)
+            for (int i = bx0; i <= bx1; ++i) {
+                int covered = 0;
+                const size_t p = (size_t(j - y0) * tw + (i - x0)) * 4;
+                for (int s = 0; s < 4; ++s) {
+                    int64_t px = int64_t(i) * kSub + kMsaa4X[s], py = int64_t(j) * kSub + kMsaa4Y[s];
+                    if (e0.at(px, py) < e0.bias || e1.at(px, py) < e1.bias || e2.at(px, py) < e2.bias) continue;
+                    const float z = zAt(float(i) + float(kMsaa4X[s] - kHalf) / kSub, float(j) + float(kMsaa4Y[s] - kHalf) / kSub);
+                    if (z < buf.depth[p + s]) ++covered;
+                }
+                if (covered) add(i, j, covered);
+            }
+    }
+    if (frags.empty()) return;
+    std::sort(frags.begin(), frags.end(), [](const BlendFrag& a, const BlendFrag& b) {
+        if (a.pixel != b.pixel) return a.pixel < b.pixel;
+        if (a.z != b.z) return a.z > b.z;   // far first
+        return a.order < b.order;
+    });
+    const size_t n = frags.size();
+    buf.batch.resize(n);
+    buf.fogDist.resize(n);
+    tc = TriCache();
+    for (size_t k = 0; k < n; ++k) {
+        const uint32_t id = frags[k].tri;
+        if (id != tc.id) tc.load(id, triById(chunks, id), chunks[id >> kChunkBits], fc);
+        const int p = frags[k].pixel;
+        buf.fogDist[k] = prepareFragment(tc, fc, x0 + p % tw, y0 + p / tw, buf.batch, k);
+    }
+    shadeBatch(buf.batch, n, *fc.frame);
+    const auto& st = fc.frame->settings;
+    const bool fog = st.fog != sg::FogMode::Off;
+    const SrgbEncoder& enc = srgbEncoder();
+    const ShadeBatch& b = buf.batch;
+    (void)x1;
+    (void)y1;
+    for (size_t k = 0; k < n; ++k) {
+        vec3 c(b.cr[k], b.cg[k], b.cb[k]);
+        if (fog) c = applyFog(st, c, buf.fogDist[k]);
+        c = glm::clamp(c, 0.0f, 1.0f);
+        const int p = frags[k].pixel;
+        uint8_t* out = target.pixel(x0 + p % tw, fc.height - 1 - (y0 + p / tw));
+        const vec3 dst = srgbBytesToLinear(out);
+        const float w = frags[k].alpha * float(frags[k].coverage) / float(samples);
+        const vec3 r = dst + w * (c - dst);
+        out[0] = enc(r.x);
+        out[1] = enc(r.y);
+        out[2] = enc(r.z);
+    }
 }
 
 // ---------------------------------------------------------------------------------------
@@ -743,7 +935,7 @@ void drawLinesAndWireframe(const std::vector<DrawItem>& lineDraws, const std::ve
             if (v[0] >= d.clip.size() || v[1] >= d.clip.size() || v[2] >= d.clip.size()) continue;
             if (d.code[v[0]] & d.code[v[1]] & d.code[v[2]]) continue;
             if ((d.code[v[0]] | d.code[v[1]] | d.code[v[2]]) & kInvalid) continue;
-            if (st.cullBackFaces && (d.code[v[0]] | d.code[v[1]] | d.code[v[2]]) == 0) {
+            if ((d.code[v[0]] | d.code[v[1]] | d.code[v[2]]) == 0 && d.cullsBack(t, st.culling)) {
                 // Culled faces draw no edges (GL culls polygons in line mode too).
                 vec2 a(d.win[v[0]]), b(d.win[v[1]]), c(d.win[v[2]]);
                 float area = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);

@@ -91,6 +91,20 @@ bool uvOnPlane(const rt::Ray& r, const vec3 P[3], const vec2 uv[3], vec2& out) {
     return std::isfinite(out.x) && std::isfinite(out.y);
 }
 
+// Whether any material of the frame is masked or blended (shadow rays then test alpha).
+bool anyTranslucent(const FrameInput& f) {
+    auto translucent = [](const Material& m) { return m.alphaMode != AlphaMode::Opaque; };
+    for (const DrawMesh& d : f.meshes)
+        if (translucent(d.material)) return true;
+    for (const DrawAnalytic& a : f.analytics) {
+        if (translucent(a.material)) return true;
+        if (a.csg)
+            for (const CsgTree::Node& n : a.csg->nodes)
+                if (translucent(n.material)) return true;
+    }
+    return false;
+}
+
 // --- Tracer --------------------------------------------------------------------------------------
 
 struct Tracer {
@@ -98,6 +112,64 @@ struct Tracer {
     const rt::SceneAccel& accel;
     const std::vector<const SampledTexture*>& textures;   // per f.meshes entry, null if none
     uint64_t rays = 0;
+    bool anyAlpha = false;   // some material is masked or blended (anyTranslucent())
+
+    // Surfaces one ray may pass through (cut-outs, blended layers) before it counts as stopped.
+    static constexpr int kMaxLayers = 64;
+
+    const Material& materialOf(const rt::SceneHit& h) const {
+        if (h.kind == rt::SceneHit::Kind::Mesh) return f.meshes[h.instance].material;
+        const DrawAnalytic& a = f.analytics[h.instance];
+        if (a.kind == DrawAnalytic::Kind::Csg && a.csg && h.csgLeaf >= 0) return a.csg->nodes[size_t(h.csgLeaf)].material;
+        return a.material;
+    }
+
+    // Alpha of the surface at a hit, as the rasterizers compute it: material alpha x vertex
+    // colour alpha x texture alpha (the texture filtered with the ray's footprint like its colour).
+    float surfaceAlpha(const rt::SceneHit& h, const rt::Ray& r, const PixelFootprint* footprint, const Material& mat) const {
+        float a = mat.alpha;
+        if (h.kind != rt::SceneHit::Kind::Mesh) return a;
+        const DrawMesh& dm = f.meshes[h.instance];
+        const Mesh& mesh = *dm.mesh;
+        const uint32_t i[3] = {mesh.indices[3 * h.prim], mesh.indices[3 * h.prim + 1], mesh.indices[3 * h.prim + 2]};
+        const float w[3] = {1.0f - h.b1 - h.b2, h.b1, h.b2};
+        if (mesh.colors.size() == mesh.positions.size()) a *= w[0] * mesh.colors[i[0]].a + w[1] * mesh.colors[i[1]].a + w[2] * mesh.colors[i[2]].a;
+        const SampledTexture* tex = textures[h.instance];
+        if (!tex || !tex->hasAlpha() || mesh.uv0.size() != mesh.positions.size()) return a;
+        const vec2 UV[3] = {mesh.uv0[i[0]], mesh.uv0[i[1]], mesh.uv0[i[2]]};
+        const vec2 uv = w[0] * UV[0] + w[1] * UV[1] + w[2] * UV[2];
+        const vec3 P[3] = {vec3(dm.world * vec4(mesh.positions[i[0]], 1.0f)), vec3(dm.world * vec4(mesh.positions[i[1]], 1.0f)),
+                           vec3(dm.world * vec4(mesh.positions[i[2]], 1.0f))};
+        vec2 uvX, uvY;
+        rt::Ray nx, ny;
+        (void)r;
+        if (footprint && footprint->neighbours(nx, ny) && uvOnPlane(nx, P, UV, uvX) && uvOnPlane(ny, P, UV, uvY))
+            return a * tex->sampleAlpha(uv, uvX - uv, uvY - uv);
+        return a * tex->sampleAlphaLevel(uv, 0, tex->filter() != FilterMode::Nearest);
+    }
+
+    // Fraction of light that passes along a shadow ray: 0 behind an opaque surface, cut-outs
+    // let it through where they are cut out, blended surfaces let (1 - alpha) through.
+    float transmittance(rt::Ray sr) {
+        if (!anyAlpha) return accel.occluded(sr) ? 0.0f : 1.0f;
+        float T = 1.0f;
+        for (int layer = 0; layer < kMaxLayers; ++layer) {
+            rt::SceneHit h;
+            if (!accel.intersect(sr, h)) return T;
+            const Material& m = materialOf(h);
+            if (m.alphaMode == AlphaMode::Opaque) return 0.0f;
+            const float a = std::clamp(surfaceAlpha(h, sr, nullptr, m), 0.0f, 1.0f);
+            if (m.alphaMode == AlphaMode::Mask) {
+                if (a >= m.alphaCutoff) return 0.0f;
+            } else {
+                T *= 1.0f - a;
+                if (!(T > 0.0f)) return 0.0f;
+            }
+            sr.tmin = h.t;
+            ++rays;
+        }
+        return 0.0f;
+    }
 
     static float offsetScale(const vec3& p) { return 1e-4f * (1.0f + std::max(std::abs(p.x), std::max(std::abs(p.y), std::abs(p.z)))); }
 
@@ -116,19 +188,41 @@ struct Tracer {
             sr.tmax = std::isfinite(ls.distance) ? ls.distance * (1.0f - 1e-4f) - eps : std::numeric_limits<float>::infinity();
             if (!(sr.tmax > 0)) continue;
             ++rays;
-            if (accel.occluded(sr)) visible[i] = 0.0f;
+            visible[i] = transmittance(sr);
         }
     }
 
     // Radiance along the ray (linear), depth of the first hit (window z via the camera) when
     // depthOut is given; eye = where the viewer is for this ray (camera eye or bounce origin).
     // footprint: the ray's differentials (texture mip selection); null: textures at level 0.
-    vec3 trace(const rt::Ray& r, const vec3& eye, int bounce, vec3* hitPos, const PixelFootprint* footprint = nullptr) {
+    // Masked surfaces cut out at the hit are passed through; a blended surface is composited
+    // over what the ray meets behind it ("over", in linear light). Primary rays (bounce 0) come
+    // back fogged by their own hit's eye distance, so layers are fogged before they blend, as
+    // the rasterizers do. hitPos: the nearest surface that is not blended (the depth the
+    // rasterizers keep, since blended surfaces do not write depth).
+    vec3 trace(const rt::Ray& ray, const vec3& eye, int bounce, vec3* hitPos, const PixelFootprint* footprint = nullptr, int layer = 0) {
         ++rays;
         rt::SceneHit h;
-        if (!accel.intersect(r, h, f.settings.cullBackFaces)) return f.settings.background;
+        rt::Ray r = ray;
+        float alpha = 1.0f;
+        for (;;) {
+            if (!accel.intersect(r, h, f.settings.culling)) return f.settings.background;
+            const Material& m = materialOf(h);
+            if (m.alphaMode == AlphaMode::Opaque) break;
+            alpha = std::clamp(surfaceAlpha(h, r, footprint, m), 0.0f, 1.0f);
+            if (m.alphaMode == AlphaMode::Blend) break;
+            if (alpha >= m.alphaCutoff || ++layer >= kMaxLayers) {
+                alpha = 1.0f;
+                break;
+            }
+            r.tmin = h.t;   // cut out here: the ray goes on behind
+            ++rays;
+        }
+        const bool blended = materialOf(h).alphaMode == AlphaMode::Blend;
+        if (blended) alpha = std::clamp(alpha, 0.0f, 1.0f);
+        vec3* const ownHit = blended ? nullptr : hitPos;
         vec3 p = r.org + h.t * r.dir;
-        if (hitPos) *hitPos = p;
+        if (ownHit) *ownHit = p;
         vec3 dirN = glm::normalize(r.dir);
         const Material* mat;
         vec3 color, n, ng;
@@ -150,7 +244,7 @@ struct Tracer {
             const vec3 P[3] = {vec3(dm.world * vec4(mesh.positions[i0], 1.0f)), vec3(dm.world * vec4(mesh.positions[i1], 1.0f)),
                                vec3(dm.world * vec4(mesh.positions[i2], 1.0f))};
             p = w0 * P[0] + w1 * P[1] + w2 * P[2];
-            if (hitPos) *hitPos = p;
+            if (ownHit) *ownHit = p;
             // Outward geometric normal: the CCW side, the CW side for mirrored instances
             // (as GL's glFrontFace(GL_CW) for them).
             vec3 gn = glm::cross(P[1] - P[0], P[2] - P[0]);
@@ -242,6 +336,13 @@ struct Tracer {
             vec3 refl = trace(rr, p, bounce + 1, nullptr, rf.carried ? &rf : nullptr);
             color = glm::mix(color, refl, std::clamp(mat->reflectivity, 0.0f, 1.0f));
         }
+        if (bounce == 0) color = applyFog(f.settings, color, glm::length(vec3(f.camera.view * vec4(p, 1.0f))));
+        if (blended && (alpha < 1.0f || hitPos) && layer + 1 < kMaxLayers) {
+            rt::Ray behind = r;
+            behind.tmin = h.t;
+            const vec3 back = trace(behind, eye, bounce, hitPos, footprint, layer + 1);
+            color = alpha * color + (1.0f - alpha) * back;
+        }
         return color;
     }
 };
@@ -300,6 +401,7 @@ protected:
         std::vector<const SampledTexture*> textures(f.meshes.size(), nullptr);
         for (size_t i = 0; i < f.meshes.size(); ++i) textures[i] = m_samplers.get(f.meshes[i].texture);
         m_samplers.endFrame();
+        const bool anyAlpha = anyTranslucent(f);
 
         // Strata per pixel (see capabilities()).
         int sx = cfg.ssaaFactor, sy = cfg.ssaaFactor;
@@ -322,7 +424,7 @@ protected:
                     cancelled = true;
                     break;
                 }
-                Tracer tr{f, m_accel, textures, 0};
+                Tracer tr{f, m_accel, textures, 0, anyAlpha};
                 const int x0 = (ti % tx) * tile, y0 = (ti / tx) * tile;   // y0: framebuffer row (top-down)
                 const int x1 = std::min(x0 + tile, w), y1 = std::min(y0 + tile, h);
                 for (int row = y0; row < y1; ++row) {
@@ -344,10 +446,7 @@ protected:
                                 hp = hpInit;
                                 const PixelFootprint fp{&cam, float(x) + ox, float(wy) + oy};
                                 vec3 c = tr.trace(r, f.camera.eye, 0, &hp, &fp);
-                                if (!std::isnan(hp.x)) {
-                                    c = applyFog(f.settings, c, glm::length(vec3(f.camera.view * vec4(hp, 1.0f))));
-                                    depth = std::min(depth, std::clamp(cam.depth(hp), 0.0f, 1.0f));
-                                }
+                                if (!std::isnan(hp.x)) depth = std::min(depth, std::clamp(cam.depth(hp), 0.0f, 1.0f));
                                 sum += c;
                             }
                         sum /= float(sx * sy);

@@ -168,7 +168,7 @@ bool SceneAccel::intersectInstance(const Instance& inst, const Ray& wr, float tm
     return true;
 }
 
-bool SceneAccel::intersect(const Ray& r, SceneHit& hit, bool cullBackFaces) const {
+bool SceneAccel::intersect(const Ray& r, SceneHit& hit, sg::CullMode culling) const {
     if (m_tlas.empty()) return false;
     float tmax = r.tmax;
     bool found = false;
@@ -176,7 +176,9 @@ bool SceneAccel::intersect(const Ray& r, SceneHit& hit, bool cullBackFaces) cons
     m_tlas.traverse(r, tmax, [&](uint32_t first, uint32_t count, float& tm) {
         for (uint32_t k = 0; k < count; ++k) {
             SceneHit h;
-            if (intersectInstance(m_instances[prims[first + k]], r, tm, h, cullBackFaces) && h.t < tm) {
+            const Instance& inst = m_instances[prims[first + k]];
+            const bool cull = inst.isMesh && sg::cullsBackFaces(culling, m_frame->meshes[inst.index].material.doubleSided);
+            if (intersectInstance(inst, r, tm, h, cull) && h.t < tm) {
                 tm = h.t;
                 hit = h;
                 found = true;

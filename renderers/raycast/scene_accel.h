@@ -37,10 +37,11 @@ public:
     // Builds/fetches BLASes for this frame and rebuilds the TLAS. Not thread-safe; call before
     // tracing. Returns the number of mesh BVHs (re)built this call.
     int update(const sg::FrameInput& frame);
-    // Closest hit in (ray.tmin, ray.tmax). Thread-safe after update(). cullBackFaces skips
-    // mesh triangles seen from their back (RenderSettings::cullBackFaces; analytic solids are
-    // closed, so culling would not change what they show).
-    bool intersect(const Ray& worldRay, SceneHit& hit, bool cullBackFaces = false) const;
+    // Closest hit in (ray.tmin, ray.tmax). Thread-safe after update(). `culling` skips mesh
+    // triangles seen from their back (RenderSettings::culling: every mesh, none, or those whose
+    // material is single-sided; analytic solids are closed, so culling would not change what
+    // they show).
+    bool intersect(const Ray& worldRay, SceneHit& hit, sg::CullMode culling = sg::CullMode::Off) const;
     // Any hit in (ray.tmin, ray.tmax).
     bool occluded(const Ray& worldRay) const;
 

@@ -52,6 +52,18 @@ constexpr NamedValue<LightType> kLight[] = {
     {LightType::Spot, "spot", "Spot", "a cone along the node's -z axis, soft between the inner and outer angles"},
 };
 
+constexpr NamedValue<CullMode> kCull[] = {
+    {CullMode::Auto, "auto", "Auto (per material)", "cull the back faces of single-sided materials, draw double-sided ones from both sides"},
+    {CullMode::On, "on", "On", "cull every back face"},
+    {CullMode::Off, "off", "Off", "draw every back face"},
+};
+
+constexpr NamedValue<AlphaMode> kAlphaMode[] = {
+    {AlphaMode::Opaque, "opaque", "Opaque", "alpha is ignored: the surface is fully opaque"},
+    {AlphaMode::Mask, "mask", "Mask", "cut-out: drawn where alpha >= the cutoff, not drawn elsewhere"},
+    {AlphaMode::Blend, "blend", "Blend", "transparent: blended over what lies behind it with its alpha"},
+};
+
 constexpr NamedValue<WrapMode> kWrap[] = {
     {WrapMode::Repeat, "repeat", "Repeat", "the texture tiles"},
     {WrapMode::ClampToEdge, "clamp", "Clamp to edge", "coordinates outside [0,1] take the edge texel"},
@@ -102,6 +114,16 @@ const NameTable<LightType>& nameTable<LightType>() {
     return t;
 }
 template <>
+const NameTable<CullMode>& nameTable<CullMode>() {
+    static const NameTable<CullMode> t{kCull};
+    return t;
+}
+template <>
+const NameTable<AlphaMode>& nameTable<AlphaMode>() {
+    static const NameTable<AlphaMode> t{kAlphaMode};
+    return t;
+}
+template <>
 const NameTable<WrapMode>& nameTable<WrapMode>() {
     static const NameTable<WrapMode> t{kWrap};
     return t;
@@ -119,6 +141,7 @@ Projection obliquePreset(ObliquePreset p) { return p == ObliquePreset::Cavalier 
 std::string_view toString(ShadingModel m) { return nameOf(m); }
 std::string_view toString(ReflectionModel m) { return nameOf(m); }
 std::string_view toString(FogMode m) { return nameOf(m); }
+std::string_view toString(CullMode m) { return nameOf(m); }
 std::string_view toString(ProjectionType t) { return nameOf(t); }
 std::string_view toString(LightType t) { return nameOf(t); }
 bool parse(std::string_view s, ShadingModel& out) { return parseName(s, out); }

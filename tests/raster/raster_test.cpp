@@ -430,16 +430,16 @@ TEST(RasterShadingTest, BackFacesAreLitWithTheFlippedNormal) {
     f.camera = cameraAt(vec3(0), vec3(0, 0, -1), p, 1.0f);
     for (ShadingModel model : {ShadingModel::Flat, ShadingModel::Gouraud, ShadingModel::Phong}) {
         f.settings.shading = model;
-        f.settings.cullBackFaces = false;
+        f.settings.culling = sg::CullMode::Off;
         Framebuffer fb = renderRaster(f, 32, 32);
         EXPECT_NEAR(px(fb, 16, 16)[0], toByteSRGB(0.8f * 0.5f), 1) << toString(model);
-        f.settings.cullBackFaces = true;
+        f.settings.culling = sg::CullMode::On;
         fb = renderRaster(f, 32, 32);
         EXPECT_EQ(px(fb, 16, 16)[0], 0) << toString(model);
     }
     // Mirrored instances: the window winding flips but the side seen does not (GL:
     // glFrontFace(GL_CW)): the mirrored back face is still culled, a mirrored front face is not.
-    f.settings.cullBackFaces = true;
+    f.settings.culling = sg::CullMode::On;
     f.meshes[0] = drawOf(q, m, scaling(vec3(-1, 1, 1)));
     Framebuffer fb = renderRaster(f, 32, 32);
     EXPECT_EQ(px(fb, 16, 16)[0], 0);

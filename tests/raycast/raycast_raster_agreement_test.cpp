@@ -143,7 +143,7 @@ TEST(RaycastRasterAgreementTest, BackFaceCulling) {
     // culling both backends show the floor through it. The mirrored sphere must not vanish.
     for (bool cull : {false, true}) {
         FrameInput f = baseScene(perspective());
-        f.settings.cullBackFaces = cull;
+        f.settings.culling = cull ? sg::CullMode::On : sg::CullMode::Off;
         f.camera = makeFrameCamera(glm::inverse(glm::lookAt(vec3(0.4f, 4.0f, 3.0f), vec3(0.2f, 0.3f, 1.2f), vec3(0, 1, 0))), perspective(),
                                    float(kW) / kH, 4.0f);
         expectAgree(f, cull ? "cull-on" : "cull-off");

@@ -72,7 +72,7 @@ void addCameraAndControl(Scene& s) {
 
 Scene makeDeepScene() {
     Scene s;
-    s.settings.cullBackFaces = false;
+    s.settings.culling = sg::CullMode::Off;
     addCameraAndControl(s);
     NodeId prev = s.root();
     for (int i = 1; i <= kDepth; ++i) {
@@ -154,7 +154,7 @@ void loadAndRender(const fs::path& path, bool hasControl) {
         s.lookAt(cam, vec3(0, 0, 5), vec3(0));
         s.activeCamera = cam;
     }
-    s.settings.cullBackFaces = false;
+    s.settings.culling = sg::CullMode::Off;
     t0 = std::chrono::steady_clock::now();
     FrameInput f = flatten(s, float(kW) / kH);
     std::printf("[ deep ] flatten %.2f s\n", secondsSince(t0));

@@ -159,7 +159,7 @@ FrameInput baselineFrame(const std::string& name, int w, int h) {
         s.wireframeColor = vec3(0.9f, 0.9f, 0.2f);
         s.aa = AAMode::MSAA;
         s.aaRate = 4;
-        s.cullBackFaces = true;
+        s.culling = sg::CullMode::On;
     }
     if (name == "ssaa2") {
         s.aa = AAMode::SSAA;
@@ -181,7 +181,7 @@ FrameInput baselineFrame(const std::string& name, int w, int h) {
         addMesh(f, points, unlit(vec3(1.0f, 1.0f, 0.3f)));
     }
     if (name == "mirrored_culled") {
-        s.cullBackFaces = true;
+        s.culling = sg::CullMode::On;
         for (auto& d : f.meshes) {   // mirror the whole scene in x: winding flips, image mirrors
             d.world = glm::scale(mat4(1.0f), vec3(-1, 1, 1)) * d.world;
             d.normal = normalMatrix(d.world);

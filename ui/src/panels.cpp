@@ -503,6 +503,12 @@ bool materialEditor(ViewerState& st, int& index) {
     ch |= ImGui::ColorEdit3("Emissive", &m.emissive.x, ImGuiColorEditFlags_Float);
     ch |= ImGui::SliderFloat("Reflectivity", &m.reflectivity, 0.0f, 1.0f);
     ch |= ImGui::Checkbox("Unlit", &m.unlit);
+    ImGui::SameLine();
+    ch |= ImGui::Checkbox("Double-sided", &m.doubleSided);
+    helpMarker("Off: the back face is not drawn when back faces are culled per material (Render > Back faces: auto)");
+    ch |= enumCombo(st, "Alpha mode", m.alphaMode);
+    if (m.alphaMode != sg::AlphaMode::Opaque) ch |= ImGui::SliderFloat("Alpha", &m.alpha, 0.0f, 1.0f);
+    if (m.alphaMode == sg::AlphaMode::Mask) ch |= ImGui::SliderFloat("Alpha cutoff", &m.alphaCutoff, 0.0f, 1.0f);
     if (ch && !(m == st.scene.materials[index])) {
         st.scene.materials[index] = m;
         st.markEdited();
@@ -906,7 +912,7 @@ void drawRenderingPanel(ViewerState& st) {
         ImGui::SameLine();
         ch |= ImGui::ColorEdit3("##wirecol", &s.wireframeColor.x, ImGuiColorEditFlags_NoInputs | ImGuiColorEditFlags_Float);
     }
-    ch |= ImGui::Checkbox("Cull back faces", &s.cullBackFaces);
+    ch |= enumCombo(st, "Back faces", s.culling);
     record(st, "render/culling");
     ch |= ImGui::SliderInt("Tessellation", &s.tessellation, 4, 256);
     helpMarker("Segments / marching-cubes resolution for implicit shapes, CSG, parametric surfaces and grids");

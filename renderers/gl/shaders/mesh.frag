@@ -15,6 +15,9 @@ in vec3 vAddBack;
 uniform sampler2D uTexture;
 uniform bool uHasTexture;
 uniform bool uUnlit;        // colour = albedo + emissive (material unlit, lines, points)
+uniform float uAlpha;       // material alpha (x texture alpha x vertex alpha)
+uniform int uAlphaMode;     // ALPHA_OPAQUE, ALPHA_MASK, ALPHA_BLEND (sg::AlphaMode values)
+uniform float uAlphaCutoff;
 uniform bool uSolid;        // wireframe overlay: uSolidColor (fogged)
 uniform vec3 uSolidColor;
 uniform int uFogMode;       // FOG_OFF, FOG_LINEAR, FOG_EXP, FOG_EXP2 (sg::FogMode values)
@@ -33,11 +36,25 @@ float fogVisibility(float d) {
 
 void main() {
     vec3 c;
+    float alpha = 1.0;
     if (uSolid) {
         c = uSolidColor;
     } else {
         vec3 albedo = uBaseColor * vColor.rgb;
-        if (uHasTexture) albedo *= texture(uTexture, vUv).rgb;   // sRGB texture: decoded to linear
+        alpha = uAlpha * vColor.a;
+        if (uHasTexture) {
+            vec4 t = texture(uTexture, vUv);   // sRGB texture: colour decoded to linear, alpha as stored
+            albedo *= t.rgb;
+            alpha *= t.a;
+        }
+        if (uAlphaMode == ALPHA_MASK) {
+            if (alpha < uAlphaCutoff) discard;   // cut-out
+            alpha = 1.0;
+        } else if (uAlphaMode == ALPHA_OPAQUE) {
+            alpha = 1.0;
+        } else if (uAlphaMode != ALPHA_BLEND) {
+            alpha = 0.0;   // unreachable: every sg::AlphaMode is handled above
+        }
         if (uUnlit) {
             c = albedo + uEmissive;
         } else {
@@ -65,5 +82,5 @@ void main() {
         float f = fogVisibility(length(vEyePos));   // eye-space distance, not just z
         c = f * c + (1.0 - f) * uFogColor;
     }
-    fragColor = vec4(clamp(c, 0.0, 1.0), 1.0);
+    fragColor = vec4(clamp(c, 0.0, 1.0), clamp(alpha, 0.0, 1.0));
 }

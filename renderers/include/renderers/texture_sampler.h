@@ -22,6 +22,11 @@ public:
     // Linear RGB at (u, v) with the screen-space derivatives of (u, v) (for the mip level).
     sg::vec3 sample(sg::vec2 uv, sg::vec2 dUVdx, sg::vec2 dUVdy) const;
     sg::vec3 sampleLevel(sg::vec2 uv, int level, bool bilinear) const;
+    // Alpha (stored linearly, as GL does for SRGB8_ALPHA8), filtered like sample(); 1 for
+    // textures whose texels are all opaque.
+    float sampleAlpha(sg::vec2 uv, sg::vec2 dUVdx, sg::vec2 dUVdy) const;
+    float sampleAlphaLevel(sg::vec2 uv, int level, bool bilinear) const;
+    bool hasAlpha() const { return m_hasAlpha; }
     int levels() const { return int(m_levels.size()); }
     sg::FilterMode filter() const { return m_filter; }
 
@@ -29,7 +34,12 @@ private:
     struct Level {
         int w = 0, h = 0;
         std::vector<sg::vec3> texels;   // linear RGB, bottom-up rows
+        std::vector<float> alpha;       // same layout; empty when the texture is opaque
     };
+    // The mip level (l0, blend weight f toward l0 + 1) GL picks for these derivatives; false
+    // for magnification or a non-trilinear filter (level 0).
+    bool mipLevel(sg::vec2 ddx, sg::vec2 ddy, int& l0, float& f) const;
+    bool m_hasAlpha = false;
     std::vector<Level> m_levels;
     sg::WrapMode m_wrapS, m_wrapT;
     sg::FilterMode m_filter;

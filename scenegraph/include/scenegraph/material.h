@@ -6,9 +6,15 @@
 
 #include "scenegraph/math.h"
 
+#include <cstdint>
 #include <string>
 
 namespace sg {
+
+// glTF alphaMode: Opaque ignores alpha; Mask keeps a fragment when its alpha >= alphaCutoff and
+// drops it otherwise (a cut-out); Blend composites the surface over what lies behind it with
+// its alpha ("over"). alpha = Material::alpha x texture alpha x vertex colour alpha.
+enum class AlphaMode : uint8_t { Opaque, Mask, Blend };
 
 struct Material {
     std::string name = "default";
@@ -21,9 +27,11 @@ struct Material {
     vec3 specularColor{1.0f};           // used when not tinted
     int diffuseTexture = -1;            // index into Scene::textures, -1 = none
     vec3 emissive{0.0f};
-    float alpha = 1.0f;
-    bool unlit = false;   // colour = base colour (times texture), no lighting
-    bool doubleSided = true;
+    float alpha = 1.0f;   // base colour alpha (glTF baseColorFactor.a)
+    AlphaMode alphaMode = AlphaMode::Opaque;
+    float alphaCutoff = 0.5f;    // Mask only
+    bool unlit = false;          // colour = base colour (times texture), no lighting
+    bool doubleSided = true;     // false: the back face is culled (RenderSettings::culling auto)
     float reflectivity = 0.0f;   // mirror reflection weight (ray caster)
 
     bool operator==(const Material&) const = default;

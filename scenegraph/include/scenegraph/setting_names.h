@@ -8,6 +8,7 @@
 #pragma once
 
 #include "scenegraph/light.h"
+#include "scenegraph/material.h"
 #include "scenegraph/mesh.h"
 #include "scenegraph/projection.h"
 #include "scenegraph/settings.h"
@@ -90,6 +91,10 @@ template <>
 const NameTable<ObliquePreset>& nameTable<ObliquePreset>();
 template <>
 const NameTable<LightType>& nameTable<LightType>();
+template <>
+const NameTable<CullMode>& nameTable<CullMode>();
+template <>
+const NameTable<AlphaMode>& nameTable<AlphaMode>();
 template <>
 const NameTable<WrapMode>& nameTable<WrapMode>();
 template <>

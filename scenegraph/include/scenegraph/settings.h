@@ -13,6 +13,13 @@ enum class ShadingModel { Flat, Gouraud, Phong };
 enum class ReflectionModel { Phong, BlinnPhong };
 enum class FogMode { Off, Linear, Exp, Exp2 };
 enum class AAMode { None, MSAA, SSAA };
+// Back-face culling: Auto culls the back faces of single-sided materials (Material::doubleSided
+// false, glTF's default) and draws double-sided ones from both sides; On culls every back face;
+// Off draws every back face.
+enum class CullMode { Auto, On, Off };
+
+// Whether a triangle of a material with this doubleSided flag loses its back face.
+inline bool cullsBackFaces(CullMode m, bool doubleSided) { return m == CullMode::On || (m == CullMode::Auto && !doubleSided); }
 
 struct RenderSettings {
     ShadingModel shading = ShadingModel::Phong;
@@ -33,7 +40,7 @@ struct RenderSettings {
     AAMode aa = AAMode::None;
     int aaRate = 4;
 
-    bool cullBackFaces = false;
+    CullMode culling = CullMode::Auto;
     bool wireframe = false;
     vec3 wireframeColor{0.05f, 0.05f, 0.05f};
     vec3 background{0.08f, 0.09f, 0.11f};
@@ -61,6 +68,7 @@ struct RenderSettings {
 std::string_view toString(ShadingModel m);
 std::string_view toString(ReflectionModel m);
 std::string_view toString(FogMode m);
+std::string_view toString(CullMode m);
 bool parse(std::string_view s, ShadingModel& out);
 bool parse(std::string_view s, ReflectionModel& out);
 bool parse(std::string_view s, FogMode& out);
