@@ -52,8 +52,12 @@ SampledTexture::SampledTexture(const sg::Texture& t) : m_wrapS(t.wrapS), m_wrapT
     }
     m_levels.push_back(std::move(base));
     if (m_filter != sg::FilterMode::Trilinear) return;
-    // Mip chain: each level halves (floor, min 1); 2x2 box average in linear, re-quantised to
-    // 8-bit sRGB like an SRGB8 texture level (alpha: averaged and re-quantised to 8 bits).
+    // Mip chain: each level halves (floor, min 1), filtered like the linear-filtered blit that
+    // glGenerateMipmap performs (Mesa's util_gen_mipmap): destination texel x takes the
+    // previous level bilinearly at its centre mapped back, (x + 0.5) * w_prev / w - 0.5,
+    // clamped to the edge, in linear light; stored re-quantised to 8-bit sRGB like an SRGB8
+    // texture level (alpha: to 8 bits). For even sizes this is the 2x2 box average; for odd
+    // (NPOT) sizes the sample points keep the image aligned instead of drifting by half a texel.
     while (m_levels.back().w > 1 || m_levels.back().h > 1) {
         const Level& p = m_levels.back();
         Level l;
@@ -61,21 +65,25 @@ SampledTexture::SampledTexture(const sg::Texture& t) : m_wrapS(t.wrapS), m_wrapT
         l.h = std::max(p.h / 2, 1);
         l.texels.resize(size_t(l.w) * l.h);
         if (m_hasAlpha) l.alpha.resize(l.texels.size());
-        for (int y = 0; y < l.h; ++y)
+        const float sx = float(p.w) / float(l.w), sy = float(p.h) / float(l.h);
+        for (int y = 0; y < l.h; ++y) {
+            const float fy = std::clamp((float(y) + 0.5f) * sy - 0.5f, 0.0f, float(p.h - 1));
+            const int y0 = std::min(int(fy), p.h - 1), y1 = std::min(y0 + 1, p.h - 1);
+            const float ay = fy - float(y0);
             for (int x = 0; x < l.w; ++x) {
-                vec3 s(0.0f);
-                float a = 0.0f;
-                for (int dy = 0; dy < 2; ++dy)
-                    for (int dx = 0; dx < 2; ++dx) {
-                        size_t src = size_t(std::min(2 * y + dy, p.h - 1)) * p.w + std::min(2 * x + dx, p.w - 1);
-                        s += p.texels[src];
-                        if (m_hasAlpha) a += p.alpha[src];
-                    }
-                s *= 0.25f;
-                uint8_t b[3] = {encodeByte(s.x), encodeByte(s.y), encodeByte(s.z)};
-                l.texels[size_t(y) * l.w + x] = srgbBytesToLinear(b);
-                if (m_hasAlpha) l.alpha[size_t(y) * l.w + x] = std::round(a * 0.25f * 255.0f) / 255.0f;
+                const float fx = std::clamp((float(x) + 0.5f) * sx - 0.5f, 0.0f, float(p.w - 1));
+                const int x0 = std::min(int(fx), p.w - 1), x1 = std::min(x0 + 1, p.w - 1);
+                const float ax = fx - float(x0);
+                const size_t a = size_t(y0) * p.w + x0, b = size_t(y0) * p.w + x1, c = size_t(y1) * p.w + x0, d = size_t(y1) * p.w + x1;
+                const vec3 s = (p.texels[a] * (1 - ax) + p.texels[b] * ax) * (1 - ay) + (p.texels[c] * (1 - ax) + p.texels[d] * ax) * ay;
+                uint8_t bytes[3] = {encodeByte(s.x), encodeByte(s.y), encodeByte(s.z)};
+                l.texels[size_t(y) * l.w + x] = srgbBytesToLinear(bytes);
+                if (m_hasAlpha) {
+                    const float al = (p.alpha[a] * (1 - ax) + p.alpha[b] * ax) * (1 - ay) + (p.alpha[c] * (1 - ax) + p.alpha[d] * ax) * ay;
+                    l.alpha[size_t(y) * l.w + x] = std::round(al * 255.0f) / 255.0f;
+                }
             }
+        }
         m_levels.push_back(std::move(l));
     }
 }

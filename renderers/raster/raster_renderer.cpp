@@ -448,9 +448,12 @@ inline FragBary baryAt(const TriCache& tc, int i, int j) {
     return fb;
 }
 
-// Texture coordinate at the fragment and its analytic screen derivatives (for the mip level):
-// d(uv)/dx = sum_k du_k/dx (uv_k - uv) / sum(u). Needs d.hasUV.
-inline void uvAt(const TriCache& tc, const FragBary& fb, const uint32_t mi[3], vec2& uv, vec2& ddx, vec2& ddy) {
+// Texture coordinate at the fragment and its screen derivatives for the mip level, taken as GL
+// implementations take them: finite differences over the fragment's 2x2 pixel quad (quads at
+// even window x and y), d/dx = uv(x0 + 1, y0) - uv(x0, y0) and d/dy = uv(x0, y0 + 1) - uv(x0, y0)
+// at pixel centres, the same for the four pixels (points outside the triangle extrapolate its
+// plane, like GL's helper invocations). Needs d.hasUV.
+inline void uvAt(const TriCache& tc, const FragBary& fb, const uint32_t mi[3], int i, int j, vec2& uv, vec2& ddx, vec2& ddy) {
     const Tri& t = *tc.t;
     const sg::Mesh& m = *tc.d->mesh;
     const std::array<vec3, 3>* cb = tc.cb;
@@ -461,14 +464,21 @@ inline void uvAt(const TriCache& tc, const FragBary& fb, const uint32_t mi[3], v
         uvk[q] = w[0] * uvc[0] + w[1] * uvc[1] + w[2] * uvc[2];
     }
     uv = fb.b[0] * uvk[0] + fb.b[1] * uvk[1] + fb.b[2] * uvk[2];
-    ddx = vec2(0.0f);
-    ddy = vec2(0.0f);
-    for (int q = 0; q < 3; ++q) {
-        ddx += t.udx[q] * (uvk[q] - uv);
-        ddy += t.udy[q] * (uvk[q] - uv);
-    }
-    ddx *= fb.invSum;
-    ddy *= fb.invSum;
+    // uv at the centre of pixel (pi, pj): perspective-correct barycentrics from the setup planes.
+    auto uvAtPixel = [&](int pi, int pj) {
+        const float di = float(pi - t.s.minX), dj = float(pj - t.s.minY);
+        float u[3], sum = 0;
+        for (int q = 0; q < 3; ++q) {
+            u[q] = t.uRef[q] + t.udx[q] * di + t.udy[q] * dj;
+            sum += u[q];
+        }
+        const float inv = sum != 0 ? 1.0f / sum : 0.0f;
+        return (u[0] * inv) * uvk[0] + (u[1] * inv) * uvk[1] + (u[2] * inv) * uvk[2];
+    };
+    const int i0 = i & ~1, j0 = j & ~1;
+    const vec2 base = (i0 == i && j0 == j) ? uv : uvAtPixel(i0, j0);
+    ddx = uvAtPixel(i0 + 1, j0) - base;
+    ddy = uvAtPixel(i0, j0 + 1) - base;
 }
 
 // Alpha of the fragment at the centre of pixel (i, j): material alpha x vertex colour alpha x
@@ -486,7 +496,7 @@ float fragmentAlpha(const TriCache& tc, int i, int j) {
     }
     if (texAlpha) {
         vec2 uv, ddx, ddy;
-        uvAt(tc, fb, mi, uv, ddx, ddy);
+        uvAt(tc, fb, mi, i, j, uv, ddx, ddy);
         a *= d.texture->sampleAlpha(uv, ddx, ddy);
     }
     return a;
@@ -512,7 +522,7 @@ __attribute__((noinline)) float prepareFragment(const TriCache& tc, const FrameC
         if (d.hasColors) albedo *= vec3(bo[0] * m.colors[mi[0]] + bo[1] * m.colors[mi[1]] + bo[2] * m.colors[mi[2]]);
         if (d.texture && d.hasUV) {
             vec2 uv, ddx, ddy;
-            uvAt(tc, fb, mi, uv, ddx, ddy);
+            uvAt(tc, fb, mi, i, j, uv, ddx, ddy);
             albedo *= d.texture->sample(uv, ddx, ddy);
         }
     }

@@ -78,8 +78,9 @@ TEST_P(MaterialConformance, CullingFollowsDoubleSidedUnderAutoAndOverridesWithOn
         bool drawn;
     };
     const Case cases[] = {
-        {false, sg::CullMode::Auto, true, false, false}, {false, sg::CullMode::Auto, false, false, true}, {true, sg::CullMode::Auto, true, false, true},
-        {false, sg::CullMode::Off, true, false, true},   {true, sg::CullMode::On, true, false, false},    {true, sg::CullMode::On, false, false, true},
+        {false, sg::CullMode::Auto, true, false, false}, {false, sg::CullMode::Auto, false, false, true},
+        {true, sg::CullMode::Auto, true, false, true},   {false, sg::CullMode::Off, true, false, true},
+        {true, sg::CullMode::On, true, false, false},    {true, sg::CullMode::On, false, false, true},
         {false, sg::CullMode::Auto, false, true, true},  {false, sg::CullMode::Auto, true, true, false},
     };
     int k = 0;
@@ -94,9 +95,9 @@ TEST_P(MaterialConformance, CullingFollowsDoubleSidedUnderAutoAndOverridesWithOn
         addMesh(f, quad(1.0f), m, world);
         const std::string name = "cull" + std::to_string(k++);
         rnd::Framebuffer fb = render(GetParam(), f, name);
-        EXPECT_TRUE(pixelIs(fb, W / 2, H / 2, c.drawn ? red : bg)) << GetParam() << " " << name << ": doubleSided " << c.doubleSided << " culling "
-                                                                   << sg::nameOf(c.mode) << (c.back ? " back" : " front")
-                                                                   << (c.mirrored ? " mirrored" : "");
+        EXPECT_TRUE(pixelIs(fb, W / 2, H / 2, c.drawn ? red : bg))
+            << GetParam() << " " << name << ": doubleSided " << c.doubleSided << " culling " << sg::nameOf(c.mode) << (c.back ? " back" : " front")
+            << (c.mirrored ? " mirrored" : "");
     }
 }
 

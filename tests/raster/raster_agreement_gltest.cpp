@@ -56,6 +56,17 @@ std::vector<Case> referenceCases(int w, int h) {
                                                                                 ProjectionType::Orthographic, ShadingModel::Flat)});
     cases.push_back({"tex_trilinear_oblique",
                      test_scenes::texturedFloorFrame(w, h, FilterMode::Trilinear, WrapMode::Repeat, ProjectionType::Oblique, ShadingModel::Phong)});
+    // A non-power-of-two texture (53x53, 7 checks: edges between texels): its mip levels must
+    // be built as GL builds them (a linear blit per level), or minified texels drift apart.
+    {
+        FrameInput f =
+            test_scenes::texturedFloorFrame(w, h, FilterMode::Trilinear, WrapMode::Repeat, ProjectionType::Perspective, ShadingModel::Phong);
+        auto t = testing_support::checker(53, 7, vec3(0.95f, 0.9f, 0.2f), vec3(0.05f, 0.1f, 0.6f));
+        t->filter = FilterMode::Trilinear;
+        for (DrawMesh& m : f.meshes)
+            if (m.texture) m.texture = t;
+        cases.push_back({"tex_trilinear_npot", std::move(f)});
+    }
     // Near-plane clipping in all three projections.
     for (ProjectionType pt : {ProjectionType::Perspective, ProjectionType::Orthographic, ProjectionType::Oblique})
         cases.push_back({"nearplane_" + std::string(toString(pt)), test_scenes::nearPlaneFrame(w, h, pt)});

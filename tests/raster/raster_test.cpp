@@ -6,6 +6,7 @@
 #include "raster/raster_shading.h"
 #include "renderers/renderer.h"
 #include "renderers/shading.h"
+#include "renderers/texture_sampler.h"
 #include "scenegraph/frame.h"
 #include "scenegraph/transforms.h"
 #include "test_support.h"
@@ -634,4 +635,32 @@ TEST(RasterRendererTest, BadGeometryIsSkippedNotCrashed) {
     // Degenerate sizes are reported, not crashed on.
     Framebuffer empty;
     EXPECT_FALSE(makeRenderer("raster")->render(f, 0, 10, empty).ok);
+}
+
+// Mip levels of a non-power-of-two texture are built like GL's linear-blit glGenerateMipmap:
+// level texel x samples the level above bilinearly at (x + 0.5) * w_prev / w - 0.5. A 3x1
+// texture red | green | blue has a 1x1 level 1 that is exactly green (the centre texel), not the
+// red-green average a 2x2 box would give; even sizes keep the box average.
+TEST(TextureSamplerTest, NpotMipLevelsAreBuiltLikeGlsBlit) {
+    sg::Texture t;
+    t.width = 3;
+    t.height = 1;
+    t.rgba = {255, 0, 0, 255, 0, 255, 0, 255, 0, 0, 255, 255};
+    t.filter = sg::FilterMode::Trilinear;
+    rnd::SampledTexture s(t);
+    ASSERT_EQ(s.levels(), 2);
+    const sg::vec3 l1 = s.sampleLevel(sg::vec2(0.5f, 0.5f), 1, false);
+    EXPECT_NEAR(l1.r, 0.0f, 1e-6f);
+    EXPECT_NEAR(l1.g, 1.0f, 1e-6f);
+    EXPECT_NEAR(l1.b, 0.0f, 1e-6f);
+    // 2x1 red | green: the box average, (0.5, 0.5, 0) in linear light (re-quantised to sRGB bytes).
+    t.width = 2;
+    t.rgba = {255, 0, 0, 255, 0, 255, 0, 255};
+    rnd::SampledTexture e(t);
+    const sg::vec3 half = e.sampleLevel(sg::vec2(0.5f, 0.5f), 1, false);
+    const uint8_t b[3] = {rnd::toByteSRGB(0.5f), rnd::toByteSRGB(0.5f), 0};
+    const sg::vec3 want = rnd::srgbBytesToLinear(b);
+    EXPECT_NEAR(half.r, want.r, 1e-6f);
+    EXPECT_NEAR(half.g, want.g, 1e-6f);
+    EXPECT_NEAR(half.b, 0.0f, 1e-6f);
 }
