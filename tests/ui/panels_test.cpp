@@ -301,3 +301,44 @@ TEST(PanelsTest, LoadShowsProgressAndCancelButtonKeepsScene) {
     EXPECT_TRUE(h.st.errorPopup.empty());
     EXPECT_NE(h.st.status.find("scene.obj cancelled"), std::string::npos) << h.st.status;
 }
+
+// The panels keep their own state (dialogs, toggles, in-place rename) in the viewer's
+// PanelState, not in globals: each viewer starts fresh, and File > Open, the screenshot dialog
+// and F2 rename go through it.
+TEST(PanelsTest, PanelStateBelongsToTheViewer) {
+    {
+        Headless h;
+        EXPECT_TRUE(h.st.panels.showOverlay);
+        h.st.panels.showOverlay = false;
+        h.st.panels.showHelp = true;   // before the modal: ImGui 1.86 asserts when a new window appears under one
+        h.frame();
+        h.st.requests.openDialog = true;
+        h.frame();
+        h.frame();
+        EXPECT_TRUE(h.st.panels.browser.open);
+        EXPECT_FALSE(h.st.panels.browser.saving);
+        EXPECT_FALSE(h.st.panels.browser.dir.empty());
+        EXPECT_NO_THROW(h.rect("browser/accept"));
+    }
+    Headless h;
+    EXPECT_TRUE(h.st.panels.showOverlay);
+    EXPECT_FALSE(h.st.panels.showHelp);
+    EXPECT_FALSE(h.st.panels.browser.open);
+    h.st.requests.screenshotDialog = true;
+    h.frame();
+    h.frame();   // an auto-resizing modal takes its size on its second frame
+    EXPECT_TRUE(h.st.panels.shotDialog.open);
+    h.click("shot/take");
+    EXPECT_TRUE(h.st.requests.screenshot);
+    EXPECT_EQ(h.st.requests.screenshotWidth, 0);   // window size by default
+}
+
+TEST(PanelsTest, F2RenamesTheSelectionInPlace) {
+    Headless h;
+    sg::NodeId crate = h.st.scene.findByName("crate");
+    h.click("tree/crate");
+    ASSERT_EQ(h.st.selected, crate);
+    h.press(keys::F2);
+    EXPECT_EQ(h.st.panels.renaming, crate);
+    EXPECT_EQ(h.st.panels.renameBuffer, "crate");
+}

@@ -34,7 +34,10 @@ namespace ui {
 
 namespace {
 
-float g_scale = 1.0f;   // content scale (HiDPI)
+// Content scale (HiDPI), set by setupStyle. It stays file-scope on purpose: it describes the
+// ImGui context's style and font atlas (ImGui's own globals), which setupStyle scales
+// together; per-viewer state lives in ViewerState (PanelState for the panels).
+float g_scale = 1.0f;
 float px(float v) { return v * g_scale; }
 
 // Records the last item's rectangle under `key` (test hook: click widgets by position).
@@ -169,29 +172,6 @@ void addMenuItems(ViewerState& st, sg::NodeId parent) {
     if (ImGui::MenuItem("Camera (at current view)")) st.addCamera();
 }
 
-// File browser state (UI-only).
-struct FileBrowser {
-    bool open = false;
-    bool saving = false;
-    bool justOpened = false;
-    fs::path dir;
-    std::string fileName;
-    std::string error;
-};
-FileBrowser g_browser;
-
-struct ScreenshotDialog {
-    bool open = false;
-    bool windowSize = true;
-    int width = 1920, height = 1080;
-};
-ScreenshotDialog g_shotDialog;
-
-bool g_showOverlay = true;
-bool g_showHelp = false;
-std::string g_renameBuffer;
-sg::NodeId g_renaming = sg::kNoNode;
-
 }   // namespace
 
 std::vector<std::string> visibleBackends(const ViewerState& st) {
@@ -276,7 +256,7 @@ void drawMainMenu(ViewerState& st) {
         if (ImGui::MenuItem("Split view (wipe)", nullptr, st.compare.mode == ViewMode::Split)) st.compare.mode = ViewMode::Split;
         if (ImGui::MenuItem("Difference view", nullptr, st.compare.mode == ViewMode::Difference)) st.compare.mode = ViewMode::Difference;
         ImGui::Separator();
-        ImGui::MenuItem("Stats overlay", nullptr, &g_showOverlay);
+        ImGui::MenuItem("Stats overlay", nullptr, &st.panels.showOverlay);
         if (ImGui::BeginMenu("Scene cameras", !st.scene.cameras().empty())) {
             for (sg::NodeId c : st.scene.cameras())
                 if (ImGui::MenuItem(st.scene.node(c).name.c_str(), nullptr, c == st.scene.activeCamera)) st.useSceneCamera(c);
@@ -296,7 +276,7 @@ void drawMainMenu(ViewerState& st) {
         ImGui::EndMenu();
     }
     if (ImGui::BeginMenu("Help")) {
-        ImGui::MenuItem("Controls", nullptr, &g_showHelp);
+        ImGui::MenuItem("Controls", nullptr, &st.panels.showHelp);
         ImGui::EndMenu();
     }
     // Right side: file name and dirty marker.
@@ -321,8 +301,8 @@ void nodeContextMenu(ViewerState& st, sg::NodeId id) {
     }
     if (st.scene.valid(id) && id != st.scene.root()) {
         if (ImGui::MenuItem("Rename", "F2")) {
-            g_renaming = id;
-            g_renameBuffer = st.scene.node(id).name;
+            st.panels.renaming = id;
+            st.panels.renameBuffer = st.scene.node(id).name;
         }
         if (ImGui::MenuItem("Duplicate", "Ctrl+D")) st.duplicateNode(id);
         bool visible = st.scene.valid(id) && st.scene.node(id).visible;
@@ -359,24 +339,24 @@ void drawNode(ViewerState& st, sg::NodeId id, int depth) {
     if (dim) ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyle().Colors[ImGuiCol_TextDisabled]);
     std::string label = std::string(payloadIcon(n.payload)) + " " + n.name + (id == st.scene.activeCamera ? "  (active)" : "");
     bool open;
-    if (g_renaming == id) {
+    if (st.panels.renaming == id) {
         open = ImGui::TreeNodeEx("##renaming", flags | ImGuiTreeNodeFlags_AllowItemOverlap, "%s", payloadIcon(n.payload));
         ImGui::SameLine();
         ImGui::SetKeyboardFocusHere();
         ImGui::SetNextItemWidth(-1);
-        if (ImGui::InputText("##rename", &g_renameBuffer, ImGuiInputTextFlags_EnterReturnsTrue | ImGuiInputTextFlags_AutoSelectAll)) {
-            st.renameNode(id, g_renameBuffer);
-            g_renaming = sg::kNoNode;
+        if (ImGui::InputText("##rename", &st.panels.renameBuffer, ImGuiInputTextFlags_EnterReturnsTrue | ImGuiInputTextFlags_AutoSelectAll)) {
+            st.renameNode(id, st.panels.renameBuffer);
+            st.panels.renaming = sg::kNoNode;
         } else if (ImGui::IsItemDeactivated() || ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Escape))) {
-            g_renaming = sg::kNoNode;
+            st.panels.renaming = sg::kNoNode;
         }
     } else {
         open = ImGui::TreeNodeEx("##node", flags, "%s", label.c_str());
         record(st, "tree/" + n.name);
         if (ImGui::IsItemClicked() && !ImGui::IsItemToggledOpen()) st.selectNode(id);
         if (ImGui::IsItemHovered() && ImGui::IsMouseDoubleClicked(0) && n.children.empty() && id != st.scene.root()) {
-            g_renaming = id;
-            g_renameBuffer = n.name;
+            st.panels.renaming = id;
+            st.panels.renameBuffer = n.name;
         }
     }
     if (dim) ImGui::PopStyleColor();
@@ -1074,7 +1054,7 @@ void cameraInput(ViewerState& st, ImVec2 a, ImVec2 b, double time, float dt) {
     bool ortho = proj.type != sg::ProjectionType::Perspective;
     bool moved = false;
     // Divider drag (split view) takes precedence over the camera when grabbed near a divider.
-    static int dragDivider = -1;
+    int& dragDivider = st.panels.dragDivider;
     if (st.compare.mode == ViewMode::Split && ImGui::IsItemClicked(ImGuiMouseButton_Left)) {
         dragDivider = -1;
         for (int i = 0; i < st.compare.count - 1; ++i) {
@@ -1212,7 +1192,7 @@ void drawViewport(ViewerState& st, const ViewportInput& view, double time, float
     }
 
     // Stats overlay (top-left).
-    if (g_showOverlay) {
+    if (st.panels.showOverlay) {
         std::vector<std::string> lines;
         for (const SlotView& v : view.slots) lines.push_back(slotStats(v));
         char buf[128];
@@ -1242,42 +1222,44 @@ void drawViewport(ViewerState& st, const ViewportInput& view, double time, float
 
 namespace {
 
-void openBrowser(bool saving, const ViewerState& st) {
-    g_browser.open = true;
-    g_browser.justOpened = true;
-    g_browser.saving = saving;
-    g_browser.error.clear();
+void openBrowser(bool saving, ViewerState& st) {
+    FileBrowserState& browser = st.panels.browser;
+    browser.open = true;
+    browser.justOpened = true;
+    browser.saving = saving;
+    browser.error.clear();
     std::error_code ec;
     fs::path start = st.scenePath.empty() ? fs::current_path(ec) : fs::absolute(st.scenePath, ec).parent_path();
-    if (g_browser.dir.empty() || !fs::is_directory(g_browser.dir, ec)) g_browser.dir = start;
-    g_browser.fileName = saving ? (st.scenePath.empty() ? st.scene.name + ".json" : st.scenePath.stem().string() + ".json") : "";
+    if (browser.dir.empty() || !fs::is_directory(browser.dir, ec)) browser.dir = start;
+    browser.fileName = saving ? (st.scenePath.empty() ? st.scene.name + ".json" : st.scenePath.stem().string() + ".json") : "";
 }
 
 void drawFileBrowser(ViewerState& st) {
-    if (!g_browser.open) return;
-    const char* title = g_browser.saving ? "Save scene as###browser" : "Open scene###browser";
-    if (g_browser.justOpened) {
+    FileBrowserState& browser = st.panels.browser;
+    if (!browser.open) return;
+    const char* title = browser.saving ? "Save scene as###browser" : "Open scene###browser";
+    if (browser.justOpened) {
         ImGui::OpenPopup(title);
-        g_browser.justOpened = false;
+        browser.justOpened = false;
     }
     ImVec2 ds = ImGui::GetIO().DisplaySize;
     ImGui::SetNextWindowSize(ImVec2(std::min(px(640), ds.x * 0.9f), std::min(px(480), ds.y * 0.9f)), ImGuiCond_Appearing);
     ImGui::SetNextWindowPos(ImVec2(ds.x * 0.5f, ds.y * 0.5f), ImGuiCond_Appearing, ImVec2(0.5f, 0.5f));
     bool keep = true;
     if (!ImGui::BeginPopupModal(title, &keep)) {
-        if (!keep) g_browser.open = false;
+        if (!keep) browser.open = false;
         return;
     }
     std::error_code ec;
-    std::string dirText = g_browser.dir.string();
-    if (ImGui::Button("Up")) g_browser.dir = g_browser.dir.parent_path();
+    std::string dirText = browser.dir.string();
+    if (ImGui::Button("Up")) browser.dir = browser.dir.parent_path();
     ImGui::SameLine();
     ImGui::SetNextItemWidth(-1);
-    if (ImGui::InputText("##dir", &dirText, ImGuiInputTextFlags_EnterReturnsTrue) && fs::is_directory(dirText, ec)) g_browser.dir = dirText;
+    if (ImGui::InputText("##dir", &dirText, ImGuiInputTextFlags_EnterReturnsTrue) && fs::is_directory(dirText, ec)) browser.dir = dirText;
 
     std::vector<std::string> exts = assets::supportedSceneExtensions();
     std::vector<fs::directory_entry> dirs, files;
-    for (fs::directory_iterator it(g_browser.dir, fs::directory_options::skip_permission_denied, ec), end; !ec && it != end; it.increment(ec)) {
+    for (fs::directory_iterator it(browser.dir, fs::directory_options::skip_permission_denied, ec), end; !ec && it != end; it.increment(ec)) {
         const fs::directory_entry& e = *it;
         std::string name = e.path().filename().string();
         if (name.empty() || name[0] == '.') continue;
@@ -1299,33 +1281,33 @@ void drawFileBrowser(ViewerState& st) {
     ImGui::BeginChild("entries", ImVec2(0, -footer), true);
     for (const auto& d : dirs) {
         std::string label = "[dir] " + d.path().filename().string();
-        if (ImGui::Selectable(label.c_str(), false, ImGuiSelectableFlags_AllowDoubleClick) && ImGui::IsMouseDoubleClicked(0))
-            g_browser.dir = d.path();
+        if (ImGui::Selectable(label.c_str(), false, ImGuiSelectableFlags_AllowDoubleClick) && ImGui::IsMouseDoubleClicked(0)) browser.dir = d.path();
     }
     for (const auto& f : files) {
         std::string name = f.path().filename().string();
-        if (ImGui::Selectable(name.c_str(), g_browser.fileName == name, ImGuiSelectableFlags_AllowDoubleClick)) {
-            g_browser.fileName = name;
+        if (ImGui::Selectable(name.c_str(), browser.fileName == name, ImGuiSelectableFlags_AllowDoubleClick)) {
+            browser.fileName = name;
             if (ImGui::IsMouseDoubleClicked(0)) chosen = f.path();
         }
     }
     ImGui::EndChild();
     ImGui::SetNextItemWidth(-px(170));
-    bool enter = ImGui::InputText("##file", &g_browser.fileName, ImGuiInputTextFlags_EnterReturnsTrue);
+    bool enter = ImGui::InputText("##file", &browser.fileName, ImGuiInputTextFlags_EnterReturnsTrue);
     ImGui::SameLine();
-    if (ImGui::Button(g_browser.saving ? "Save" : "Open", ImVec2(px(75), 0)) || enter) {
-        if (!g_browser.fileName.empty()) chosen = g_browser.dir / g_browser.fileName;
+    if (ImGui::Button(browser.saving ? "Save" : "Open", ImVec2(px(75), 0)) || enter) {
+        if (!browser.fileName.empty()) chosen = browser.dir / browser.fileName;
     }
+    record(st, "browser/accept");
     ImGui::SameLine();
     if (ImGui::Button("Cancel", ImVec2(px(75), 0))) {
-        g_browser.open = false;
+        browser.open = false;
         ImGui::CloseCurrentPopup();
     }
-    ImGui::TextDisabled(g_browser.saving ? "Native JSON scene (.json)" : "Formats: .json .gltf .glb .obj .off .ply .stl");
+    ImGui::TextDisabled(browser.saving ? "Native JSON scene (.json)" : "Formats: .json .gltf .glb .obj .off .ply .stl");
     if (!chosen.empty()) {
-        g_browser.open = false;
+        browser.open = false;
         ImGui::CloseCurrentPopup();
-        if (g_browser.saving)
+        if (browser.saving)
             st.save(chosen);
         else
             st.requestOpen(chosen);
@@ -1334,40 +1316,42 @@ void drawFileBrowser(ViewerState& st) {
 }
 
 void drawScreenshotDialog(ViewerState& st) {
+    ScreenshotDialogState& dialog = st.panels.shotDialog;
     if (st.requests.screenshotDialog) {
         st.requests.screenshotDialog = false;
-        g_shotDialog.open = true;
+        dialog.open = true;
         ImGui::OpenPopup("Screenshot");
     }
     if (!ImGui::BeginPopupModal("Screenshot", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) return;
-    ImGui::Checkbox("Window size", &g_shotDialog.windowSize);
-    ImGui::BeginDisabled(g_shotDialog.windowSize);
-    ImGui::InputInt("Width", &g_shotDialog.width);
-    ImGui::InputInt("Height", &g_shotDialog.height);
+    ImGui::Checkbox("Window size", &dialog.windowSize);
+    ImGui::BeginDisabled(dialog.windowSize);
+    ImGui::InputInt("Width", &dialog.width);
+    ImGui::InputInt("Height", &dialog.height);
     if (ImGui::SmallButton("1280x720")) {
-        g_shotDialog.width = 1280;
-        g_shotDialog.height = 720;
+        dialog.width = 1280;
+        dialog.height = 720;
     }
     ImGui::SameLine();
     if (ImGui::SmallButton("1920x1080")) {
-        g_shotDialog.width = 1920;
-        g_shotDialog.height = 1080;
+        dialog.width = 1920;
+        dialog.height = 1080;
     }
     ImGui::SameLine();
     if (ImGui::SmallButton("3840x2160")) {
-        g_shotDialog.width = 3840;
-        g_shotDialog.height = 2160;
+        dialog.width = 3840;
+        dialog.height = 2160;
     }
     ImGui::EndDisabled();
-    g_shotDialog.width = std::clamp(g_shotDialog.width, 1, 16384);
-    g_shotDialog.height = std::clamp(g_shotDialog.height, 1, 16384);
+    dialog.width = std::clamp(dialog.width, 1, 16384);
+    dialog.height = std::clamp(dialog.height, 1, 16384);
     ImGui::TextDisabled("One PNG per backend shown, rendered offscreen;\nnamed screenshot-<backend>[-N].png, never overwriting.");
     if (ImGui::Button("Take", ImVec2(px(90), 0))) {
         st.requests.screenshot = true;
-        st.requests.screenshotWidth = g_shotDialog.windowSize ? 0 : g_shotDialog.width;
-        st.requests.screenshotHeight = g_shotDialog.windowSize ? 0 : g_shotDialog.height;
+        st.requests.screenshotWidth = dialog.windowSize ? 0 : dialog.width;
+        st.requests.screenshotHeight = dialog.windowSize ? 0 : dialog.height;
         ImGui::CloseCurrentPopup();
     }
+    record(st, "shot/take");
     ImGui::SameLine();
     if (ImGui::Button("Cancel", ImVec2(px(90), 0))) ImGui::CloseCurrentPopup();
     ImGui::EndPopup();
@@ -1426,9 +1410,9 @@ void drawDialogs(ViewerState& st) {
         ImGui::EndPopup();
     }
 
-    if (g_showHelp) {
+    if (st.panels.showHelp) {
         ImGui::SetNextWindowSize(ImVec2(px(420), 0), ImGuiCond_FirstUseEver);
-        if (ImGui::Begin("Controls", &g_showHelp)) {
+        if (ImGui::Begin("Controls", &st.panels.showHelp)) {
             ImGui::TextUnformatted(
                 "Left drag          orbit around the pivot\n"
                 "Middle / Shift+left drag   pan\n"
@@ -1479,8 +1463,8 @@ void handleShortcuts(ViewerState& st) {
     if (ImGui::IsKeyPressed(keys::F12, false)) st.requests.screenshot = true;
     if (ImGui::IsKeyPressed(keys::Delete, false) && st.scene.valid(st.selected)) st.removeNode(st.selected);
     if (ImGui::IsKeyPressed(keys::F2, false) && st.scene.valid(st.selected) && st.selected != st.scene.root()) {
-        g_renaming = st.selected;
-        g_renameBuffer = st.scene.node(st.selected).name;
+        st.panels.renaming = st.selected;
+        st.panels.renameBuffer = st.scene.node(st.selected).name;
     }
 }
 

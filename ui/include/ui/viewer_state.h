@@ -14,6 +14,7 @@
 #include "scenegraph/frame.h"
 #include "scenegraph/scene.h"
 #include "ui/orbit_camera.h"
+#include "ui/panel_state.h"
 
 #include <array>
 #include <atomic>
@@ -121,6 +122,7 @@ struct ViewerState {
     bool glOnWorker = false;
 
     Requests requests;
+    PanelState panels;                           // the ImGui panels' own state (dialogs, toggles)
     std::string requestedTab;                    // select this right-panel tab next frame
     std::vector<std::string> recentFiles;        // most recent first
     std::filesystem::path configDir;             // where recent.txt lives ("" = don't persist)

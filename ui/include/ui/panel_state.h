@@ -1,0 +1,43 @@
+// panel_state.h - what the ImGui panels remember from one frame to the next that is not the
+// document or the view: the file browser, the screenshot dialog, the overlay and help toggles,
+// the scene tree's in-place rename and the split view's divider drag. Plain data (no ImGui):
+// the viewer's ViewerState holds one, so every viewer (and every test) has its own instead of
+// sharing file-scope globals.
+#pragma once
+
+#include "scenegraph/scene.h"
+
+#include <filesystem>
+#include <string>
+
+namespace ui {
+
+// File > Open / Save As: a modal listing one folder.
+struct FileBrowserState {
+    bool open = false;
+    bool saving = false;       // Save As (else Open)
+    bool justOpened = false;   // open the popup on the next frame
+    std::filesystem::path dir;
+    std::string fileName;
+    std::string error;
+};
+
+// File > Screenshot at resolution...
+struct ScreenshotDialogState {
+    bool open = false;
+    bool windowSize = true;   // render at the viewport size (else width x height)
+    int width = 1920, height = 1080;
+};
+
+struct PanelState {
+    FileBrowserState browser;
+    ScreenshotDialogState shotDialog;
+    bool showOverlay = true;   // View > Stats overlay
+    bool showHelp = false;     // Help > Controls
+    // Scene tree: the node being renamed in place (F2, double click, context menu) and its text.
+    sg::NodeId renaming = sg::kNoNode;
+    std::string renameBuffer;
+    int dragDivider = -1;   // split view: the wipe divider being dragged (-1: none)
+};
+
+}   // namespace ui
