@@ -127,6 +127,8 @@ public:
     std::vector<PendingShot> shots;
     fs::path shotDir = ".";
     std::vector<std::string> droppedFiles;
+    float newContentScale = 0.0f;   // set by the content-scale callback, applied between frames
+    std::string iniPath;            // imgui.ini; ImGui keeps the char pointer, so it lives here
     double now = 0;
 
     BackendView& viewFor(const std::string& name) {
@@ -516,8 +518,8 @@ void onClose(GLFWwindow* w) {
     if (!v->st.requestQuit()) glfwSetWindowShouldClose(w, GLFW_FALSE);   // the modal asks first
 }
 
-float g_newContentScale = 0.0f;   // set by the callback, applied between frames
-void onContentScale(GLFWwindow*, float xs, float ys) { g_newContentScale = std::max(xs, ys); }
+// Moved to a monitor of another DPI: the main loop rebuilds fonts and style between frames.
+void onContentScale(GLFWwindow* w, float xs, float ys) { static_cast<Viewer*>(glfwGetWindowUserPointer(w))->newContentScale = std::max(xs, ys); }
 
 void onGlfwError(int code, const char* msg) { std::fprintf(stderr, "viewer: GLFW error %d: %s\n", code, msg); }
 
@@ -594,13 +596,12 @@ int runViewer(const ViewerOptions& opt) {
     std::error_code ec;
     fs::create_directories(st.configDir, ec);
     st.recentFiles = loadRecentFiles(st.configDir);
-    static std::string iniPath;
-    iniPath = (st.configDir / "imgui.ini").string();
+    v.iniPath = (st.configDir / "imgui.ini").string();
 
     IMGUI_CHECKVERSION();
     ImGui::CreateContext();
     ImGuiIO& io = ImGui::GetIO();
-    io.IniFilename = ec ? nullptr : iniPath.c_str();
+    io.IniFilename = ec ? nullptr : v.iniPath.c_str();
     float xs = 1.0f, ys = 1.0f;
     glfwGetWindowContentScale(win, &xs, &ys);
     setupStyle(std::max(xs, ys), kFontPath);
@@ -653,11 +654,11 @@ int runViewer(const ViewerOptions& opt) {
             if (automation.failed) exitCode = 2;
         }
 
-        if (g_newContentScale > 0.0f) {   // HiDPI change: rebuild fonts and style at the new scale
-            setupStyle(g_newContentScale, kFontPath);
+        if (v.newContentScale > 0.0f) {   // HiDPI change: rebuild fonts and style at the new scale
+            setupStyle(v.newContentScale, kFontPath);
             ImGui_ImplOpenGL3_DestroyFontsTexture();
             ImGui_ImplOpenGL3_CreateFontsTexture();
-            g_newContentScale = 0.0f;
+            v.newContentScale = 0.0f;
         }
         ImGui_ImplOpenGL3_NewFrame();
         ImGui_ImplGlfw_NewFrame();
