@@ -85,8 +85,8 @@ ViewerState animatedState() {
     return st;
 }
 
-sg::vec3 localT(const ViewerState& st, sg::NodeId id) { return st.scene.node(id).local.translation; }
-sg::vec3 worldT(const ViewerState& st, sg::NodeId id) { return sg::vec3(st.scene.world(id)[3]); }
+sg::vec3 localT(const ViewerState& st, sg::NodeId id) { return st.doc.scene.node(id).local.translation; }
+sg::vec3 worldT(const ViewerState& st, sg::NodeId id) { return sg::vec3(st.doc.scene.world(id)[3]); }
 
 }   // namespace
 
@@ -110,15 +110,15 @@ TEST(ViewerStateAnimTest, LoadKeepsClipsAndNewSceneDropsThem) {
 
 TEST(ViewerStateAnimTest, PlayInterpolatesPauseStopsScrubSetsNeverDirty) {
     ViewerState st = animatedState();
-    sg::NodeId mover = st.scene.findByName("mover");
-    ASSERT_TRUE(st.scene.valid(mover));
-    ASSERT_FALSE(st.dirty);
+    sg::NodeId mover = st.doc.scene.findByName("mover");
+    ASSERT_TRUE(st.doc.scene.valid(mover));
+    ASSERT_FALSE(st.doc.dirty);
     sg::vec3 world0 = worldT(st, mover);
 
     // Not playing: frames change nothing.
-    uint64_t v0 = st.sceneVersion;
+    uint64_t v0 = st.doc.version;
     st.advanceAnimation(0.5);
-    EXPECT_EQ(st.sceneVersion, v0);
+    EXPECT_EQ(st.doc.version, v0);
     EXPECT_NEAR(glm::length(localT(st, mover)), 0.0f, 1e-6f);
 
     // Play: halfway between the keys (t = 1) is halfway between (0,0,0) and (4,0,0).
@@ -128,21 +128,21 @@ TEST(ViewerStateAnimTest, PlayInterpolatesPauseStopsScrubSetsNeverDirty) {
     EXPECT_NEAR(st.animationTime, 1.0, 1e-9);
     EXPECT_NEAR(glm::length(localT(st, mover) - sg::vec3(2, 0, 0)), 0.0f, 1e-5f);
     EXPECT_NEAR(glm::length(worldT(st, mover) - world0 - sg::vec3(2, 0, 0)), 0.0f, 1e-4f);
-    EXPECT_GT(st.sceneVersion, v0);   // re-render ...
-    EXPECT_FALSE(st.dirty);           // ... but not an edit
+    EXPECT_GT(st.doc.version, v0);   // re-render ...
+    EXPECT_FALSE(st.doc.dirty);      // ... but not an edit
 
     // Pause: time and pose stay.
     st.setAnimationPlaying(false);
-    uint64_t v1 = st.sceneVersion;
+    uint64_t v1 = st.doc.version;
     st.advanceAnimation(0.5);
     EXPECT_NEAR(st.animationTime, 1.0, 1e-9);
     EXPECT_NEAR(localT(st, mover).x, 2.0f, 1e-5f);
-    EXPECT_EQ(st.sceneVersion, v1);
+    EXPECT_EQ(st.doc.version, v1);
 
     // Scrub (paused): pose at the given time, clamped to the clip.
     st.setAnimationTime(0.5);
     EXPECT_NEAR(localT(st, mover).x, 1.0f, 1e-5f);
-    EXPECT_GT(st.sceneVersion, v1);
+    EXPECT_GT(st.doc.version, v1);
     st.setAnimationTime(10.0);
     EXPECT_DOUBLE_EQ(st.animationTime, 2.0);
     EXPECT_NEAR(localT(st, mover).x, 4.0f, 1e-5f);
@@ -150,17 +150,17 @@ TEST(ViewerStateAnimTest, PlayInterpolatesPauseStopsScrubSetsNeverDirty) {
     EXPECT_DOUBLE_EQ(st.animationTime, 0.0);
     EXPECT_NEAR(localT(st, mover).x, 0.0f, 1e-5f);
     EXPECT_FALSE(st.animationPlaying);
-    EXPECT_FALSE(st.dirty);
+    EXPECT_FALSE(st.doc.dirty);
 
     // An edit still marks dirty; playing afterwards does not clear or set anything else.
-    st.renameNode(st.scene.findByName("mover"), "mover 2");
-    EXPECT_TRUE(st.dirty);
+    st.renameNode(st.doc.scene.findByName("mover"), "mover 2");
+    EXPECT_TRUE(st.doc.dirty);
 }
 
 TEST(ViewerStateAnimTest, LoopWrapsAndOneShotStopsAtTheEnd) {
     ViewerState st = animatedState();
-    sg::NodeId mover = st.scene.findByName("mover");
-    ASSERT_TRUE(st.scene.valid(mover));
+    sg::NodeId mover = st.doc.scene.findByName("mover");
+    ASSERT_TRUE(st.doc.scene.valid(mover));
     ASSERT_TRUE(st.animationLoop);
     st.setAnimationPlaying(true);
     st.advanceAnimation(2.5);   // 2.5 s in a 2 s loop: t = 0.5
@@ -178,13 +178,13 @@ TEST(ViewerStateAnimTest, LoopWrapsAndOneShotStopsAtTheEnd) {
     EXPECT_DOUBLE_EQ(st.animationTime, 0.0);
     st.advanceAnimation(1.5);
     EXPECT_NEAR(localT(st, mover).x, 3.0f, 1e-5f);
-    EXPECT_FALSE(st.dirty);
+    EXPECT_FALSE(st.doc.dirty);
 }
 
 TEST(ViewerStateAnimTest, SelectingAClipRewindsAndUsesItsInterpolation) {
     ViewerState st = animatedState();
-    sg::NodeId mover = st.scene.findByName("mover");
-    ASSERT_TRUE(st.scene.valid(mover));
+    sg::NodeId mover = st.doc.scene.findByName("mover");
+    ASSERT_TRUE(st.doc.scene.valid(mover));
     st.setAnimationTime(1.0);
     EXPECT_NEAR(localT(st, mover).x, 2.0f, 1e-5f);
     st.setAnimationPlaying(true);
@@ -198,7 +198,7 @@ TEST(ViewerStateAnimTest, SelectingAClipRewindsAndUsesItsInterpolation) {
     EXPECT_NEAR(localT(st, mover).x, 4.0f, 1e-5f);
     st.selectAnimation(7);   // out of range: ignored
     EXPECT_EQ(st.animationClip, 1);
-    EXPECT_FALSE(st.dirty);
+    EXPECT_FALSE(st.doc.dirty);
 }
 
 TEST(ViewerStateAnimTest, CesiumMilkTruckWheelsTurnWithoutDirtying) {
@@ -209,13 +209,13 @@ TEST(ViewerStateAnimTest, CesiumMilkTruckWheelsTurnWithoutDirtying) {
     ASSERT_TRUE(st.errorPopup.empty()) << st.errorPopup;
     ASSERT_EQ(st.animations.size(), 1u);
     sg::NodeId wheel = st.animations[0].channels.at(0).node;
-    ASSERT_TRUE(st.scene.valid(wheel));
+    ASSERT_TRUE(st.doc.scene.valid(wheel));
     st.setAnimationTime(st.animations[0].start);
-    sg::mat4 a = st.scene.world(wheel);
+    sg::mat4 a = st.doc.scene.world(wheel);
     st.setAnimationPlaying(true);
     st.advanceAnimation(0.37 * (st.animationEnd() - st.animations[0].start));
-    EXPECT_NE(st.scene.world(wheel), a);
-    EXPECT_FALSE(st.dirty);
+    EXPECT_NE(st.doc.scene.world(wheel), a);
+    EXPECT_FALSE(st.doc.dirty);
 }
 
 // --- loading: cancel and progress --------------------------------------------------------------
@@ -277,8 +277,8 @@ TEST(ViewerStateLoadTest, CancelKeepsTheCurrentSceneAndSaysSo) {
     fs::path file = bigObj();
     ViewerState st = demoState();
     st.addShape(sg::ImplicitType::Torus);   // an unsaved edit that must survive
-    size_t nodes = st.scene.nodeCount();
-    uint64_t version = st.sceneVersion;
+    size_t nodes = st.doc.scene.nodeCount();
+    uint64_t version = st.doc.version;
     st.startLoad(file);
     ASSERT_TRUE(st.loadInProgress());
     EXPECT_FALSE(st.loadCancelRequested());
@@ -287,21 +287,21 @@ TEST(ViewerStateLoadTest, CancelKeepsTheCurrentSceneAndSaysSo) {
     EXPECT_NE(st.status.find("Cancelling"), std::string::npos) << st.status;
     ASSERT_TRUE(st.pollLoad(/*wait=*/true));
     EXPECT_FALSE(st.loadInProgress());
-    EXPECT_EQ(st.scene.nodeCount(), nodes);
-    EXPECT_EQ(st.sceneVersion, version);
-    EXPECT_TRUE(st.scene.valid(st.scene.findByName("crate")));
-    EXPECT_TRUE(st.scenePath.empty());
-    EXPECT_TRUE(st.dirty);
+    EXPECT_EQ(st.doc.scene.nodeCount(), nodes);
+    EXPECT_EQ(st.doc.version, version);
+    EXPECT_TRUE(st.doc.scene.valid(st.doc.scene.findByName("crate")));
+    EXPECT_TRUE(st.doc.path.empty());
+    EXPECT_TRUE(st.doc.dirty);
     EXPECT_TRUE(st.errorPopup.empty()) << st.errorPopup;   // a cancel is not an error
     EXPECT_NE(st.status.find("big-grid.obj cancelled"), std::string::npos) << st.status;
 
     // The next load is not affected by the old cancel.
-    st.dirty = false;
+    st.doc.dirty = false;
     st.startLoad(file);
     EXPECT_FALSE(st.loadCancelRequested());
     ASSERT_TRUE(st.pollLoad(true));
     EXPECT_TRUE(st.errorPopup.empty()) << st.errorPopup;
-    EXPECT_EQ(st.scenePath, file);
+    EXPECT_EQ(st.doc.path, file);
 }
 
 TEST(ViewerStateLoadTest, ProgressIsReported) {
@@ -317,7 +317,7 @@ TEST(ViewerStateLoadTest, ProgressIsReported) {
     EXPECT_GT(maxSeen, 0.0f);
     EXPECT_FLOAT_EQ(st.loadProgress(), 1.0f);   // the importer ends at 1
     size_t triangles = 0;
-    for (const auto& m : st.scene.meshes)
+    for (const auto& m : st.doc.scene.meshes)
         if (m) triangles += m->indices.size() / 3;
     EXPECT_EQ(triangles, 2u * 700u * 700u);
 }

@@ -86,68 +86,68 @@ TEST(PanelsTest, LayoutHasTreeTabsAndViewport) {
 TEST(PanelsTest, ClickingShadingRadioChangesSettings) {
     Headless h;
     h.click("tab/Rendering");
-    ASSERT_EQ(h.st.scene.settings.shading, sg::ShadingModel::Phong);
-    h.st.dirty = false;
+    ASSERT_EQ(h.st.doc.scene.settings.shading, sg::ShadingModel::Phong);
+    h.st.doc.dirty = false;
     h.click("render/shading/Flat");
-    EXPECT_EQ(h.st.scene.settings.shading, sg::ShadingModel::Flat);
-    EXPECT_TRUE(h.st.dirty);
+    EXPECT_EQ(h.st.doc.scene.settings.shading, sg::ShadingModel::Flat);
+    EXPECT_TRUE(h.st.doc.dirty);
     h.click("render/shading/Gouraud");
-    EXPECT_EQ(h.st.scene.settings.shading, sg::ShadingModel::Gouraud);
-    bool wire = h.st.scene.settings.wireframe;
+    EXPECT_EQ(h.st.doc.scene.settings.shading, sg::ShadingModel::Gouraud);
+    bool wire = h.st.doc.scene.settings.wireframe;
     h.click("render/wireframe");
-    EXPECT_NE(h.st.scene.settings.wireframe, wire);
+    EXPECT_NE(h.st.doc.scene.settings.wireframe, wire);
     h.click("render/reflection/Blinn-Phong");
-    EXPECT_EQ(h.st.scene.settings.reflection, sg::ReflectionModel::BlinnPhong);
+    EXPECT_EQ(h.st.doc.scene.settings.reflection, sg::ReflectionModel::BlinnPhong);
 }
 
 TEST(PanelsTest, AddSphereFromMenuAddsImplicitNode) {
     Headless h;
     h.st.selectNode(sg::kNoNode);
-    size_t before = h.st.scene.nodeCount();
+    size_t before = h.st.doc.scene.nodeCount();
     h.click("tree/addButton");
     h.click("add/Sphere");
-    ASSERT_EQ(h.st.scene.nodeCount(), before + 1);
-    ASSERT_TRUE(h.st.scene.valid(h.st.selected));
-    EXPECT_TRUE(std::holds_alternative<sg::ImplicitPayload>(h.st.scene.node(h.st.selected).payload));
-    EXPECT_EQ(h.st.scene.node(h.st.selected).parent, h.st.scene.root());
+    ASSERT_EQ(h.st.doc.scene.nodeCount(), before + 1);
+    ASSERT_TRUE(h.st.doc.scene.valid(h.st.doc.selected));
+    EXPECT_TRUE(std::holds_alternative<sg::ImplicitPayload>(h.st.doc.scene.node(h.st.doc.selected).payload));
+    EXPECT_EQ(h.st.doc.scene.node(h.st.doc.selected).parent, h.st.doc.scene.root());
 }
 
 TEST(PanelsTest, TreeSelectsAndHides) {
     Headless h;
-    sg::NodeId crate = h.st.scene.findByName("crate");
+    sg::NodeId crate = h.st.doc.scene.findByName("crate");
     h.click("tree/crate");
-    EXPECT_EQ(h.st.selected, crate);
+    EXPECT_EQ(h.st.doc.selected, crate);
     h.click("tree/vis/crate");
-    EXPECT_FALSE(h.st.scene.node(crate).visible);
-    EXPECT_TRUE(h.st.dirty);
+    EXPECT_FALSE(h.st.doc.scene.node(crate).visible);
+    EXPECT_TRUE(h.st.doc.dirty);
     // The inspector shows it: the visible checkbox there toggles it back.
     h.click("tab/Inspector");
     h.click("inspector/visible");
-    EXPECT_TRUE(h.st.scene.node(crate).visible);
+    EXPECT_TRUE(h.st.doc.scene.node(crate).visible);
 }
 
 TEST(PanelsTest, MatrixEditSwitchesToMatrixModeAndBack) {
     Headless h;
-    sg::NodeId crate = h.st.scene.findByName("crate");
+    sg::NodeId crate = h.st.doc.scene.findByName("crate");
     h.st.selectNode(crate);
     h.click("tab/Inspector");
     h.frame();
-    ASSERT_EQ(h.st.scene.node(crate).local.mode, sg::LocalTransform::Mode::TRS);
+    ASSERT_EQ(h.st.doc.scene.node(crate).local.mode, sg::LocalTransform::Mode::TRS);
     // Matrix edits (here: the mirror button under the 4x4) switch to Matrix mode.
-    sg::vec3 worldX(h.st.scene.world(crate)[0]);
+    sg::vec3 worldX(h.st.doc.scene.world(crate)[0]);
     h.click("inspector/mirrorX");
-    EXPECT_EQ(h.st.scene.node(crate).local.mode, sg::LocalTransform::Mode::Matrix);
+    EXPECT_EQ(h.st.doc.scene.node(crate).local.mode, sg::LocalTransform::Mode::Matrix);
     h.frame();
-    EXPECT_NEAR(glm::dot(sg::vec3(h.st.scene.world(crate)[0]), worldX), -glm::dot(worldX, worldX), 1e-4f);
+    EXPECT_NEAR(glm::dot(sg::vec3(h.st.doc.scene.world(crate)[0]), worldX), -glm::dot(worldX, worldX), 1e-4f);
     // A mirror is still translate * rotate * (negative) scale: convertible back to TRS.
     h.click("inspector/toTRS");
-    EXPECT_EQ(h.st.scene.node(crate).local.mode, sg::LocalTransform::Mode::TRS);
-    EXPECT_NEAR(glm::dot(sg::vec3(h.st.scene.world(crate)[0]), worldX), -glm::dot(worldX, worldX), 1e-4f);
+    EXPECT_EQ(h.st.doc.scene.node(crate).local.mode, sg::LocalTransform::Mode::TRS);
+    EXPECT_NEAR(glm::dot(sg::vec3(h.st.doc.scene.world(crate)[0]), worldX), -glm::dot(worldX, worldX), 1e-4f);
     // Shear cannot be converted: the button refuses with a message and keeps the matrix.
     h.click("inspector/shear");
-    ASSERT_EQ(h.st.scene.node(crate).local.mode, sg::LocalTransform::Mode::Matrix);
+    ASSERT_EQ(h.st.doc.scene.node(crate).local.mode, sg::LocalTransform::Mode::Matrix);
     h.click("inspector/toTRS");
-    EXPECT_EQ(h.st.scene.node(crate).local.mode, sg::LocalTransform::Mode::Matrix);
+    EXPECT_EQ(h.st.doc.scene.node(crate).local.mode, sg::LocalTransform::Mode::Matrix);
     EXPECT_FALSE(h.st.errorPopup.empty());
 }
 
@@ -201,7 +201,7 @@ TEST(PanelsTest, QuitWithUnsavedChangesShowsModal) {
     ASSERT_NO_THROW(h.rect("confirm/cancel"));
     h.click("confirm/cancel");
     EXPECT_FALSE(h.st.requests.quit);
-    EXPECT_TRUE(h.st.dirty);
+    EXPECT_TRUE(h.st.doc.dirty);
     EXPECT_FALSE(h.st.requestQuit());
     h.frame();
     h.frame();
@@ -251,7 +251,7 @@ assets::AnimationClip crateClip(const sg::Scene& s) {
 TEST(PanelsTest, AnimationBarOnlyWithClipsPlayButtonAndSpaceToggle) {
     Headless h;
     EXPECT_EQ(h.st.itemRects.count("anim/play"), 0u);   // the demo has no clips: no bar
-    h.st.animations.push_back(crateClip(h.st.scene));
+    h.st.animations.push_back(crateClip(h.st.doc.scene));
     h.frame();
     ASSERT_NO_THROW(h.rect("anim/play"));
     EXPECT_NO_THROW(h.rect("anim/time"));
@@ -261,8 +261,8 @@ TEST(PanelsTest, AnimationBarOnlyWithClipsPlayButtonAndSpaceToggle) {
     h.click("anim/play");
     EXPECT_TRUE(h.st.animationPlaying);
     h.st.advanceAnimation(1.0);   // the window's main loop does this every frame
-    sg::NodeId crate = h.st.scene.findByName("crate");
-    EXPECT_NEAR(h.st.scene.node(crate).local.translation.x, 2.0f, 1e-5f);
+    sg::NodeId crate = h.st.doc.scene.findByName("crate");
+    EXPECT_NEAR(h.st.doc.scene.node(crate).local.translation.x, 2.0f, 1e-5f);
     h.click("anim/play");   // now "Pause"
     EXPECT_FALSE(h.st.animationPlaying);
     bool loop = h.st.animationLoop;
@@ -282,13 +282,13 @@ TEST(PanelsTest, AnimationBarOnlyWithClipsPlayButtonAndSpaceToggle) {
     ImGui::GetIO().MouseDown[0] = false;
     h.frame();
     EXPECT_NEAR(h.st.animationTime, 0.0, 0.05);
-    EXPECT_NEAR(h.st.scene.node(crate).local.translation.x, 2.0f * float(h.st.animationTime), 1e-4f);
-    EXPECT_FALSE(h.st.dirty);
+    EXPECT_NEAR(h.st.doc.scene.node(crate).local.translation.x, 2.0f * float(h.st.animationTime), 1e-4f);
+    EXPECT_FALSE(h.st.doc.dirty);
 }
 
 TEST(PanelsTest, LoadShowsProgressAndCancelButtonKeepsScene) {
     Headless h;
-    size_t nodes = h.st.scene.nodeCount();
+    size_t nodes = h.st.doc.scene.nodeCount();
     EXPECT_EQ(h.st.itemRects.count("status/cancelLoad"), 0u);
     // The panels never finish loads (the main loop's pollLoad does), so the bar stays up.
     h.st.startLoad("/nonexistent/dir/scene.obj");
@@ -297,7 +297,7 @@ TEST(PanelsTest, LoadShowsProgressAndCancelButtonKeepsScene) {
     h.click("status/cancelLoad");
     EXPECT_TRUE(h.st.loadCancelRequested());
     ASSERT_TRUE(h.st.pollLoad(true));
-    EXPECT_EQ(h.st.scene.nodeCount(), nodes);
+    EXPECT_EQ(h.st.doc.scene.nodeCount(), nodes);
     EXPECT_TRUE(h.st.errorPopup.empty());
     EXPECT_NE(h.st.status.find("scene.obj cancelled"), std::string::npos) << h.st.status;
 }
@@ -335,9 +335,9 @@ TEST(PanelsTest, PanelStateBelongsToTheViewer) {
 
 TEST(PanelsTest, F2RenamesTheSelectionInPlace) {
     Headless h;
-    sg::NodeId crate = h.st.scene.findByName("crate");
+    sg::NodeId crate = h.st.doc.scene.findByName("crate");
     h.click("tree/crate");
-    ASSERT_EQ(h.st.selected, crate);
+    ASSERT_EQ(h.st.doc.selected, crate);
     h.press(keys::F2);
     EXPECT_EQ(h.st.panels.renaming, crate);
     EXPECT_EQ(h.st.panels.renameBuffer, "crate");

@@ -27,69 +27,69 @@ ViewerState demoState() {
 
 TEST(ViewerStateTest, SetSceneStartsCleanAndLooksThroughActiveCamera) {
     ViewerState st = demoState();
-    EXPECT_FALSE(st.dirty);
-    ASSERT_TRUE(st.scene.valid(st.scene.activeCamera));
-    sg::vec3 camEye(st.scene.world(st.scene.activeCamera)[3]);
+    EXPECT_FALSE(st.doc.dirty);
+    ASSERT_TRUE(st.doc.scene.valid(st.doc.scene.activeCamera));
+    sg::vec3 camEye(st.doc.scene.world(st.doc.scene.activeCamera)[3]);
     sg::vec3 e = st.camera.eye();
     EXPECT_NEAR(glm::length(e - camEye), 0.0f, 1e-3f);
 }
 
 TEST(ViewerStateTest, AddShapeAddsImplicitNode) {
     ViewerState st = demoState();
-    size_t before = st.scene.nodeCount();
+    size_t before = st.doc.scene.nodeCount();
     sg::NodeId id = st.addShape(sg::ImplicitType::Sphere);
-    ASSERT_TRUE(st.scene.valid(id));
-    EXPECT_EQ(st.scene.nodeCount(), before + 1);
-    auto* p = std::get_if<sg::ImplicitPayload>(&st.scene.node(id).payload);
+    ASSERT_TRUE(st.doc.scene.valid(id));
+    EXPECT_EQ(st.doc.scene.nodeCount(), before + 1);
+    auto* p = std::get_if<sg::ImplicitPayload>(&st.doc.scene.node(id).payload);
     ASSERT_NE(p, nullptr);
     EXPECT_EQ(p->shape.type, sg::ImplicitType::Sphere);
-    EXPECT_EQ(st.selected, id);
-    EXPECT_TRUE(st.dirty);
+    EXPECT_EQ(st.doc.selected, id);
+    EXPECT_TRUE(st.doc.dirty);
     // A second one gets a distinct name.
-    sg::NodeId id2 = st.addShape(sg::ImplicitType::Sphere, st.scene.root());
-    EXPECT_NE(st.scene.node(id).name, st.scene.node(id2).name);
+    sg::NodeId id2 = st.addShape(sg::ImplicitType::Sphere, st.doc.scene.root());
+    EXPECT_NE(st.doc.scene.node(id).name, st.doc.scene.node(id2).name);
 }
 
 TEST(ViewerStateTest, AddCsgAddsTwoOperands) {
     ViewerState st = demoState();
-    sg::NodeId id = st.addCsg(sg::CsgOp::Difference, st.scene.root());
-    ASSERT_TRUE(std::holds_alternative<sg::CsgPayload>(st.scene.node(id).payload));
-    EXPECT_EQ(st.scene.node(id).children.size(), 2u);
+    sg::NodeId id = st.addCsg(sg::CsgOp::Difference, st.doc.scene.root());
+    ASSERT_TRUE(std::holds_alternative<sg::CsgPayload>(st.doc.scene.node(id).payload));
+    EXPECT_EQ(st.doc.scene.node(id).children.size(), 2u);
 }
 
 TEST(ViewerStateTest, RenameDuplicateRemove) {
     ViewerState st = demoState();
-    sg::NodeId crate = st.scene.findByName("crate");
+    sg::NodeId crate = st.doc.scene.findByName("crate");
     ASSERT_NE(crate, sg::kNoNode);
     EXPECT_TRUE(st.renameNode(crate, "box of things"));
-    EXPECT_EQ(st.scene.node(crate).name, "box of things");
+    EXPECT_EQ(st.doc.scene.node(crate).name, "box of things");
     EXPECT_FALSE(st.renameNode(crate, ""));   // empty names refused
     sg::NodeId copy = st.duplicateNode(crate);
-    ASSERT_TRUE(st.scene.valid(copy));
-    EXPECT_NE(st.scene.node(copy).name, "box of things");
+    ASSERT_TRUE(st.doc.scene.valid(copy));
+    EXPECT_NE(st.doc.scene.node(copy).name, "box of things");
     EXPECT_TRUE(st.removeNode(copy));
-    EXPECT_FALSE(st.scene.valid(copy));
-    EXPECT_FALSE(st.removeNode(st.scene.root()));
+    EXPECT_FALSE(st.doc.scene.valid(copy));
+    EXPECT_FALSE(st.removeNode(st.doc.scene.root()));
 }
 
 TEST(ViewerStateTest, ReparentKeepsWorldAndRefusesCycles) {
     ViewerState st = demoState();
-    sg::NodeId turntable = st.scene.findByName("turntable");
-    sg::NodeId torus = st.scene.findByName("torus");
-    sg::NodeId crate = st.scene.findByName("crate");
-    sg::mat4 before = st.scene.world(crate);
+    sg::NodeId turntable = st.doc.scene.findByName("turntable");
+    sg::NodeId torus = st.doc.scene.findByName("torus");
+    sg::NodeId crate = st.doc.scene.findByName("crate");
+    sg::mat4 before = st.doc.scene.world(crate);
     EXPECT_TRUE(st.reparent(crate, torus));
-    sg::mat4 after = st.scene.world(crate);
+    sg::mat4 after = st.doc.scene.world(crate);
     for (int c = 0; c < 4; ++c)
         for (int r = 0; r < 4; ++r) EXPECT_NEAR(after[c][r], before[c][r], 1e-4f);
-    st.dirty = false;
+    st.doc.dirty = false;
     // turntable -> its own descendant: refused, with a reason, nothing changes.
     std::string err;
     EXPECT_FALSE(st.reparent(turntable, torus, &err));
     EXPECT_FALSE(err.empty());
     EXPECT_NE(st.status.find("refused"), std::string::npos);
-    EXPECT_FALSE(st.dirty);
-    EXPECT_FALSE(st.reparent(st.scene.root(), crate, &err));
+    EXPECT_FALSE(st.doc.dirty);
+    EXPECT_FALSE(st.reparent(st.doc.scene.root(), crate, &err));
 }
 
 TEST(ViewerStateTest, BackendKeysAndEditsBumpVersions) {
@@ -100,10 +100,10 @@ TEST(ViewerStateTest, BackendKeysAndEditsBumpVersions) {
     EXPECT_EQ(st.backend, "raycast");
     st.setBackendIndex(7);   // ignored
     EXPECT_EQ(st.backend, "raycast");
-    uint64_t v = st.sceneVersion, vv = st.viewVersion;
+    uint64_t v = st.doc.version, vv = st.viewVersion;
     st.editProjection().fovyDeg = 60.0f;
-    EXPECT_GT(st.sceneVersion, v);   // the scene camera's projection is scene data
-    EXPECT_TRUE(st.dirty);
+    EXPECT_GT(st.doc.version, v);   // the scene camera's projection is scene data
+    EXPECT_TRUE(st.doc.dirty);
     EXPECT_EQ(st.projection().fovyDeg, 60.0f);
     st.fitView(false);
     EXPECT_GT(st.viewVersion, vv);
@@ -122,7 +122,7 @@ TEST(ViewerStateTest, BuildFrameUsesOrbitCameraAndSceneProjection) {
     // Per-backend AA override changes only that backend's settings.
     st.aaOverride["raster"] = "ssaa2";
     EXPECT_EQ(st.settingsFor("raster").aa, sg::AAMode::SSAA);
-    EXPECT_EQ(st.settingsFor("gl").aa, st.scene.settings.aa);
+    EXPECT_EQ(st.settingsFor("gl").aa, st.doc.scene.settings.aa);
 }
 
 TEST(ViewerStateTest, SceneWithoutCameraGetsFramingView) {
@@ -146,24 +146,24 @@ TEST(ViewerStateTest, UnsavedChangesAreNeverLostWithoutAsking) {
     st.requests.quit = false;
 
     st.addShape(sg::ImplicitType::Box);
-    ASSERT_TRUE(st.dirty);
+    ASSERT_TRUE(st.doc.dirty);
     EXPECT_FALSE(st.requestQuit());
     EXPECT_FALSE(st.requests.quit);
     EXPECT_TRUE(st.confirmOpen);
     st.confirm(ConfirmChoice::Cancel);
     EXPECT_FALSE(st.requests.quit);
-    EXPECT_TRUE(st.dirty);
+    EXPECT_TRUE(st.doc.dirty);
 
     // Open while dirty: asks; cancel keeps the scene; discard loads.
-    size_t nodes = st.scene.nodeCount();
+    size_t nodes = st.doc.scene.nodeCount();
     EXPECT_FALSE(st.requestOpen("/nonexistent/file.obj"));
     EXPECT_FALSE(st.loadInProgress());
     st.confirm(ConfirmChoice::Cancel);
-    EXPECT_EQ(st.scene.nodeCount(), nodes);
+    EXPECT_EQ(st.doc.scene.nodeCount(), nodes);
     EXPECT_FALSE(st.requestNew());
     st.confirm(ConfirmChoice::Discard);
-    EXPECT_EQ(st.scene.nodeCount(), 1u);   // new, empty scene
-    EXPECT_FALSE(st.dirty);
+    EXPECT_EQ(st.doc.scene.nodeCount(), 1u);   // new, empty scene
+    EXPECT_FALSE(st.doc.dirty);
 
     // Save with no file name: asks for one instead of quitting.
     st.addGroup();
@@ -171,7 +171,7 @@ TEST(ViewerStateTest, UnsavedChangesAreNeverLostWithoutAsking) {
     st.confirm(ConfirmChoice::Save);
     EXPECT_FALSE(st.requests.quit);
     EXPECT_TRUE(st.requests.saveAsDialog);
-    EXPECT_TRUE(st.dirty);
+    EXPECT_TRUE(st.doc.dirty);
 
     // Discard on quit quits.
     EXPECT_FALSE(st.requestQuit());
@@ -184,18 +184,18 @@ TEST(ViewerStateTest, UnsavedChangesAreNeverLostWithoutAsking) {
 TEST(ViewerStateTest, DiscardThenFailedOrCancelledLoadKeepsEditsAndDirtyFlag) {
     ViewerState st = demoState();
     sg::NodeId added = st.addShape(sg::ImplicitType::Sphere);
-    ASSERT_TRUE(st.dirty);
-    size_t nodes = st.scene.nodeCount();
+    ASSERT_TRUE(st.doc.dirty);
+    size_t nodes = st.doc.scene.nodeCount();
 
     EXPECT_FALSE(st.requestOpen("/nonexistent/dir/broken.gltf"));
     st.confirm(ConfirmChoice::Discard);
-    EXPECT_TRUE(st.dirty) << "Discard alone must not clear the flag: nothing has replaced the scene yet";
+    EXPECT_TRUE(st.doc.dirty) << "Discard alone must not clear the flag: nothing has replaced the scene yet";
     ASSERT_TRUE(st.loadInProgress());
     EXPECT_TRUE(st.pollLoad(/*wait=*/true));
     EXPECT_FALSE(st.errorPopup.empty());
-    EXPECT_TRUE(st.dirty);
-    EXPECT_EQ(st.scene.nodeCount(), nodes);
-    EXPECT_TRUE(st.scene.valid(added));
+    EXPECT_TRUE(st.doc.dirty);
+    EXPECT_EQ(st.doc.scene.nodeCount(), nodes);
+    EXPECT_TRUE(st.doc.scene.valid(added));
     st.errorPopup.clear();
 
     // Quit still asks.
@@ -214,21 +214,21 @@ TEST(ViewerStateTest, DiscardThenFailedOrCancelledLoadKeepsEditsAndDirtyFlag) {
     st.confirm(ConfirmChoice::Discard);
     st.cancelLoad();
     EXPECT_TRUE(st.pollLoad(/*wait=*/true));
-    EXPECT_TRUE(st.dirty);
-    EXPECT_EQ(st.scene.nodeCount(), nodes);
+    EXPECT_TRUE(st.doc.dirty);
+    EXPECT_EQ(st.doc.scene.nodeCount(), nodes);
 
     // A load that succeeds after Discard replaces the scene and starts clean.
     EXPECT_FALSE(st.requestOpen(good));
     st.confirm(ConfirmChoice::Discard);
     EXPECT_TRUE(st.pollLoad(/*wait=*/true));
     EXPECT_TRUE(st.errorPopup.empty()) << st.errorPopup;
-    EXPECT_FALSE(st.dirty);
-    EXPECT_EQ(st.scenePath, good);
+    EXPECT_FALSE(st.doc.dirty);
+    EXPECT_EQ(st.doc.path, good);
 }
 
 TEST(ViewerStateTest, FailedLoadKeepsCurrentSceneAndShowsError) {
     ViewerState st = demoState();
-    size_t nodes = st.scene.nodeCount();
+    size_t nodes = st.doc.scene.nodeCount();
     fs::path bad = testing_support::outputDir("ui") / "broken.obj";
     {
         std::ofstream out(bad);
@@ -239,8 +239,8 @@ TEST(ViewerStateTest, FailedLoadKeepsCurrentSceneAndShowsError) {
     EXPECT_TRUE(st.pollLoad(/*wait=*/true));
     EXPECT_FALSE(st.errorPopup.empty());
     EXPECT_NE(st.errorPopup.find("scene.gltf"), std::string::npos);
-    EXPECT_EQ(st.scene.nodeCount(), nodes);
-    EXPECT_TRUE(st.scenePath.empty());
+    EXPECT_EQ(st.doc.scene.nodeCount(), nodes);
+    EXPECT_TRUE(st.doc.path.empty());
 }
 
 TEST(ViewerStateTest, ScreenshotNamesNeverOverwrite) {
@@ -322,8 +322,8 @@ TEST(RenderSlotTest, RapidRequestsCancelAndDestroyCleanly) {
 TEST(ViewerStateTest, SaveAndReopenKeepsEditsAndView) {
     ViewerState st = demoState();
     st.configDir.clear();
-    st.scene.settings.shading = sg::ShadingModel::Gouraud;
-    st.scene.settings.fog = sg::FogMode::Exp;
+    st.doc.scene.settings.shading = sg::ShadingModel::Gouraud;
+    st.doc.scene.settings.fog = sg::FogMode::Exp;
     st.markEdited();
     st.editProjection().fovyDeg = 52.0f;
     st.camera.orbit(80.0f, 20.0f);
@@ -333,8 +333,8 @@ TEST(ViewerStateTest, SaveAndReopenKeepsEditsAndView) {
     std::string err = st.save(file);
     if (err.find("not") != std::string::npos && err.find("implemented") != std::string::npos) GTEST_SKIP() << err;
     ASSERT_EQ(err, "");
-    EXPECT_FALSE(st.dirty);
-    EXPECT_EQ(st.scenePath, file);
+    EXPECT_FALSE(st.doc.dirty);
+    EXPECT_EQ(st.doc.path, file);
 
     ViewerState other;
     other.viewportWidth = 800;
@@ -342,8 +342,8 @@ TEST(ViewerStateTest, SaveAndReopenKeepsEditsAndView) {
     other.startLoad(file);
     ASSERT_TRUE(other.pollLoad(true));
     ASSERT_TRUE(other.errorPopup.empty()) << other.errorPopup;
-    EXPECT_EQ(other.scene.settings.shading, sg::ShadingModel::Gouraud);
-    EXPECT_EQ(other.scene.settings.fog, sg::FogMode::Exp);
+    EXPECT_EQ(other.doc.scene.settings.shading, sg::ShadingModel::Gouraud);
+    EXPECT_EQ(other.doc.scene.settings.fog, sg::FogMode::Exp);
     EXPECT_FLOAT_EQ(other.projection().fovyDeg, 52.0f);
     EXPECT_NEAR(glm::length(other.camera.eye() - eye), 0.0f, 1e-3f);
 }

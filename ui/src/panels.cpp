@@ -249,7 +249,7 @@ void drawMainMenu(ViewerState& st) {
         ImGui::EndMenu();
     }
     if (ImGui::BeginMenu("View")) {
-        if (ImGui::MenuItem("Fit to scene / selection", "F")) st.fitView(st.scene.valid(st.selected));
+        if (ImGui::MenuItem("Fit to scene / selection", "F")) st.fitView(st.doc.scene.valid(st.doc.selected));
         if (ImGui::MenuItem("Reset to scene camera", "Home")) st.resetView();
         ImGui::Separator();
         if (ImGui::MenuItem("Single backend", nullptr, st.compare.mode == ViewMode::Single)) st.compare.mode = ViewMode::Single;
@@ -257,9 +257,9 @@ void drawMainMenu(ViewerState& st) {
         if (ImGui::MenuItem("Difference view", nullptr, st.compare.mode == ViewMode::Difference)) st.compare.mode = ViewMode::Difference;
         ImGui::Separator();
         ImGui::MenuItem("Stats overlay", nullptr, &st.panels.showOverlay);
-        if (ImGui::BeginMenu("Scene cameras", !st.scene.cameras().empty())) {
-            for (sg::NodeId c : st.scene.cameras())
-                if (ImGui::MenuItem(st.scene.node(c).name.c_str(), nullptr, c == st.scene.activeCamera)) st.useSceneCamera(c);
+        if (ImGui::BeginMenu("Scene cameras", !st.doc.scene.cameras().empty())) {
+            for (sg::NodeId c : st.doc.scene.cameras())
+                if (ImGui::MenuItem(st.doc.scene.node(c).name.c_str(), nullptr, c == st.doc.scene.activeCamera)) st.useSceneCamera(c);
             ImGui::EndMenu();
         }
         ImGui::EndMenu();
@@ -280,7 +280,7 @@ void drawMainMenu(ViewerState& st) {
         ImGui::EndMenu();
     }
     // Right side: file name and dirty marker.
-    std::string title = (st.scenePath.empty() ? st.scene.name : st.scenePath.filename().string()) + (st.dirty ? " *" : "");
+    std::string title = (st.doc.path.empty() ? st.doc.scene.name : st.doc.path.filename().string()) + (st.doc.dirty ? " *" : "");
     float w = ImGui::CalcTextSize(title.c_str()).x;
     ImGui::SameLine(ImGui::GetWindowWidth() - w - px(12));
     ImGui::TextDisabled("%s", title.c_str());
@@ -299,31 +299,31 @@ void nodeContextMenu(ViewerState& st, sg::NodeId id) {
         addMenuItems(st, id);
         ImGui::EndMenu();
     }
-    if (st.scene.valid(id) && id != st.scene.root()) {
+    if (st.doc.scene.valid(id) && id != st.doc.scene.root()) {
         if (ImGui::MenuItem("Rename", "F2")) {
             st.panels.renaming = id;
-            st.panels.renameBuffer = st.scene.node(id).name;
+            st.panels.renameBuffer = st.doc.scene.node(id).name;
         }
         if (ImGui::MenuItem("Duplicate", "Ctrl+D")) st.duplicateNode(id);
-        bool visible = st.scene.valid(id) && st.scene.node(id).visible;
+        bool visible = st.doc.scene.valid(id) && st.doc.scene.node(id).visible;
         if (ImGui::MenuItem(visible ? "Hide" : "Show")) st.setVisible(id, !visible);
         if (ImGui::MenuItem("Delete", "Del")) st.removeNode(id);
     }
-    if (st.scene.valid(id)) {
+    if (st.doc.scene.valid(id)) {
         if (ImGui::MenuItem("Frame in view", "F")) st.fitView(true);
-        if (std::holds_alternative<sg::Camera>(st.scene.node(id).payload) && ImGui::MenuItem("Look through")) st.useSceneCamera(id);
+        if (std::holds_alternative<sg::Camera>(st.doc.scene.node(id).payload) && ImGui::MenuItem("Look through")) st.useSceneCamera(id);
     }
     ImGui::EndPopup();
 }
 
 // Iterative-safe enough: depth is capped, deeper levels are listed flat under a marker.
 void drawNode(ViewerState& st, sg::NodeId id, int depth) {
-    const sg::Node& n = st.scene.node(id);
+    const sg::Node& n = st.doc.scene.node(id);
     ImGui::PushID(int(id));
     // Visibility toggle.
     bool vis = n.visible;
     ImGui::PushStyleVar(ImGuiStyleVar_FramePadding, ImVec2(1, 1));
-    if (id != st.scene.root()) {
+    if (id != st.doc.scene.root()) {
         if (ImGui::Checkbox("##vis", &vis)) st.setVisible(id, vis);
         record(st, "tree/vis/" + n.name);
         if (ImGui::IsItemHovered()) ImGui::SetTooltip("Show / hide");
@@ -334,10 +334,10 @@ void drawNode(ViewerState& st, sg::NodeId id, int depth) {
     ImGuiTreeNodeFlags flags = ImGuiTreeNodeFlags_OpenOnArrow | ImGuiTreeNodeFlags_OpenOnDoubleClick | ImGuiTreeNodeFlags_SpanAvailWidth;
     if (n.children.empty()) flags |= ImGuiTreeNodeFlags_Leaf;
     if (depth < 2) flags |= ImGuiTreeNodeFlags_DefaultOpen;
-    if (id == st.selected) flags |= ImGuiTreeNodeFlags_Selected;
-    bool dim = !st.scene.effectiveVisible(id);
+    if (id == st.doc.selected) flags |= ImGuiTreeNodeFlags_Selected;
+    bool dim = !st.doc.scene.effectiveVisible(id);
     if (dim) ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyle().Colors[ImGuiCol_TextDisabled]);
-    std::string label = std::string(payloadIcon(n.payload)) + " " + n.name + (id == st.scene.activeCamera ? "  (active)" : "");
+    std::string label = std::string(payloadIcon(n.payload)) + " " + n.name + (id == st.doc.scene.activeCamera ? "  (active)" : "");
     bool open;
     if (st.panels.renaming == id) {
         open = ImGui::TreeNodeEx("##renaming", flags | ImGuiTreeNodeFlags_AllowItemOverlap, "%s", payloadIcon(n.payload));
@@ -354,7 +354,7 @@ void drawNode(ViewerState& st, sg::NodeId id, int depth) {
         open = ImGui::TreeNodeEx("##node", flags, "%s", label.c_str());
         record(st, "tree/" + n.name);
         if (ImGui::IsItemClicked() && !ImGui::IsItemToggledOpen()) st.selectNode(id);
-        if (ImGui::IsItemHovered() && ImGui::IsMouseDoubleClicked(0) && n.children.empty() && id != st.scene.root()) {
+        if (ImGui::IsItemHovered() && ImGui::IsMouseDoubleClicked(0) && n.children.empty() && id != st.doc.scene.root()) {
             st.panels.renaming = id;
             st.panels.renameBuffer = n.name;
         }
@@ -362,18 +362,18 @@ void drawNode(ViewerState& st, sg::NodeId id, int depth) {
     if (dim) ImGui::PopStyleColor();
 
     // Drag source / drop target: re-parent keeping the world transform.
-    if (id != st.scene.root() && ImGui::BeginDragDropSource()) {
+    if (id != st.doc.scene.root() && ImGui::BeginDragDropSource()) {
         sg::NodeId payload = id;
         ImGui::SetDragDropPayload("SG_NODE", &payload, sizeof(payload));
-        ImGui::Text("Move %s", st.scene.node(id).name.c_str());
+        ImGui::Text("Move %s", st.doc.scene.node(id).name.c_str());
         ImGui::EndDragDropSource();
     }
     if (ImGui::BeginDragDropTarget()) {
         if (const ImGuiPayload* p = ImGui::AcceptDragDropPayload("SG_NODE")) {
             sg::NodeId moved = *static_cast<const sg::NodeId*>(p->Data);
             std::string err;
-            if (st.scene.valid(moved) && !st.reparent(moved, id, &err) && !err.empty())
-                st.errorPopup = "Cannot move '" + st.scene.node(moved).name + "' under '" + st.scene.node(id).name + "':\n" + err;
+            if (st.doc.scene.valid(moved) && !st.reparent(moved, id, &err) && !err.empty())
+                st.errorPopup = "Cannot move '" + st.doc.scene.node(moved).name + "' under '" + st.doc.scene.node(id).name + "':\n" + err;
         }
         ImGui::EndDragDropTarget();
     }
@@ -381,9 +381,9 @@ void drawNode(ViewerState& st, sg::NodeId id, int depth) {
 
     if (open) {
         // Copy: edits in the loop (context menu) may change the children vector.
-        std::vector<sg::NodeId> kids = st.scene.valid(id) ? st.scene.node(id).children : std::vector<sg::NodeId>{};
+        std::vector<sg::NodeId> kids = st.doc.scene.valid(id) ? st.doc.scene.node(id).children : std::vector<sg::NodeId>{};
         for (sg::NodeId c : kids) {
-            if (!st.scene.valid(c)) continue;
+            if (!st.doc.scene.valid(c)) continue;
             if (depth > 200) {
                 ImGui::TextDisabled("... (deeper levels not shown)");
                 break;
@@ -406,22 +406,23 @@ void drawSceneTree(ViewerState& st) {
         ImGui::EndPopup();
     }
     ImGui::SameLine();
-    bool canEdit = st.scene.valid(st.selected) && st.selected != st.scene.root();
+    bool canEdit = st.doc.scene.valid(st.doc.selected) && st.doc.selected != st.doc.scene.root();
     ImGui::BeginDisabled(!canEdit);
-    if (ImGui::Button("Duplicate")) st.duplicateNode(st.selected);
+    if (ImGui::Button("Duplicate")) st.duplicateNode(st.doc.selected);
     ImGui::SameLine();
-    if (ImGui::Button("Delete")) st.removeNode(st.selected);
+    if (ImGui::Button("Delete")) st.removeNode(st.doc.selected);
     ImGui::EndDisabled();
     ImGui::Separator();
 
     ImGui::BeginChild("tree", ImVec2(0, 0), false);
-    drawNode(st, st.scene.root(), 0);
+    drawNode(st, st.doc.scene.root(), 0);
     // Empty space below the tree: drop here to move under the root; click to deselect.
     ImVec2 avail = ImGui::GetContentRegionAvail();
     ImGui::InvisibleButton("##treeEmpty", ImVec2(std::max(avail.x, 1.0f), std::max(avail.y, px(20))));
     if (ImGui::IsItemClicked()) st.selectNode(sg::kNoNode);
     if (ImGui::BeginDragDropTarget()) {
-        if (const ImGuiPayload* p = ImGui::AcceptDragDropPayload("SG_NODE")) st.reparent(*static_cast<const sg::NodeId*>(p->Data), st.scene.root());
+        if (const ImGuiPayload* p = ImGui::AcceptDragDropPayload("SG_NODE"))
+            st.reparent(*static_cast<const sg::NodeId*>(p->Data), st.doc.scene.root());
         ImGui::EndDragDropTarget();
     }
     ImGui::EndChild();
@@ -434,15 +435,16 @@ namespace {
 // Material editor for a payload's material index. Returns true when the index changed.
 bool materialEditor(ViewerState& st, int& index) {
     bool indexChanged = false;
-    std::string preview = index < 0 || size_t(index) >= st.scene.materials.size() ? std::string("(default)")
-                                                                                  : std::to_string(index) + ": " + st.scene.materials[index].name;
+    std::string preview = index < 0 || size_t(index) >= st.doc.scene.materials.size()
+                              ? std::string("(default)")
+                              : std::to_string(index) + ": " + st.doc.scene.materials[index].name;
     if (ImGui::BeginCombo("Material", preview.c_str())) {
         if (ImGui::Selectable("(default)", index < 0)) {
             index = -1;
             indexChanged = true;
         }
-        for (size_t i = 0; i < st.scene.materials.size(); ++i) {
-            std::string n = std::to_string(i) + ": " + st.scene.materials[i].name;
+        for (size_t i = 0; i < st.doc.scene.materials.size(); ++i) {
+            std::string n = std::to_string(i) + ": " + st.doc.scene.materials[i].name;
             if (ImGui::Selectable(n.c_str(), int(i) == index)) {
                 index = int(i);
                 indexChanged = true;
@@ -452,17 +454,17 @@ bool materialEditor(ViewerState& st, int& index) {
     }
     ImGui::SameLine();
     if (ImGui::SmallButton("New")) {
-        sg::Material m = st.scene.material(index);
-        m.name = "material " + std::to_string(st.scene.materials.size());
-        st.scene.materials.push_back(m);
-        index = int(st.scene.materials.size()) - 1;
+        sg::Material m = st.doc.scene.material(index);
+        m.name = "material " + std::to_string(st.doc.scene.materials.size());
+        st.doc.scene.materials.push_back(m);
+        index = int(st.doc.scene.materials.size()) - 1;
         indexChanged = true;
     }
-    if (index < 0 || size_t(index) >= st.scene.materials.size()) {
+    if (index < 0 || size_t(index) >= st.doc.scene.materials.size()) {
         ImGui::TextDisabled("Default material (press New to edit a copy)");
         return indexChanged;
     }
-    sg::Material m = st.scene.materials[index];
+    sg::Material m = st.doc.scene.materials[index];
     bool ch = false;
     ch |= ImGui::InputText("Name##mat", &m.name, ImGuiInputTextFlags_EnterReturnsTrue);
     ch |= ImGui::ColorEdit3("Base colour", &m.baseColor.x, ImGuiColorEditFlags_Float);
@@ -476,7 +478,7 @@ bool materialEditor(ViewerState& st, int& index) {
     ImGui::EndDisabled();
     int tex = m.diffuseTexture;
     if (ImGui::InputInt("Texture index", &tex)) {
-        m.diffuseTexture = std::clamp(tex, -1, int(st.scene.textures.size()) - 1);
+        m.diffuseTexture = std::clamp(tex, -1, int(st.doc.scene.textures.size()) - 1);
         ch = true;
     }
     helpMarker("-1 = none; index into the scene's textures");
@@ -489,8 +491,8 @@ bool materialEditor(ViewerState& st, int& index) {
     ch |= enumCombo(st, "Alpha mode", m.alphaMode);
     if (m.alphaMode != sg::AlphaMode::Opaque) ch |= ImGui::SliderFloat("Alpha", &m.alpha, 0.0f, 1.0f);
     if (m.alphaMode == sg::AlphaMode::Mask) ch |= ImGui::SliderFloat("Alpha cutoff", &m.alphaCutoff, 0.0f, 1.0f);
-    if (ch && !(m == st.scene.materials[index])) {
-        st.scene.materials[index] = m;
+    if (ch && !(m == st.doc.scene.materials[index])) {
+        st.doc.scene.materials[index] = m;
         st.markEdited();
     }
     return indexChanged;
@@ -537,7 +539,7 @@ bool implicitEditor(ViewerState& st, sg::ImplicitShape& s) {
 }
 
 void transformEditor(ViewerState& st, sg::NodeId id) {
-    const sg::Node& n = st.scene.node(id);
+    const sg::Node& n = st.doc.scene.node(id);
     sg::LocalTransform t = n.local;
     bool trs = t.mode == sg::LocalTransform::Mode::TRS;
     ImGui::Text("Mode: %s", trs ? "TRS (translate, rotate, scale)" : "Matrix (general affine)");
@@ -600,7 +602,7 @@ void transformEditor(ViewerState& st, sg::NodeId id) {
             st.status = "Matrix edit refused: singular or not finite";
     }
     if (ImGui::TreeNode("World matrix (read-only)")) {
-        matrixTable("world", st.scene.world(id));
+        matrixTable("world", st.doc.scene.world(id));
         ImGui::TreePop();
     }
 }
@@ -608,38 +610,38 @@ void transformEditor(ViewerState& st, sg::NodeId id) {
 }   // namespace
 
 void drawInspector(ViewerState& st) {
-    sg::NodeId id = st.selected;
-    if (!st.scene.valid(id)) {
+    sg::NodeId id = st.doc.selected;
+    if (!st.doc.scene.valid(id)) {
         ImGui::TextDisabled("Select a node in the scene tree.");
         ImGui::Spacing();
-        ImGui::Text("Scene: %s", st.scene.name.c_str());
-        ImGui::Text("Nodes: %zu   meshes: %zu   materials: %zu   textures: %zu", st.scene.nodeCount(), st.scene.meshes.size(),
-                    st.scene.materials.size(), st.scene.textures.size());
-        if (ImGui::ColorEdit3("Ambient light", &st.scene.ambientLight.x, ImGuiColorEditFlags_Float)) st.markEdited();
+        ImGui::Text("Scene: %s", st.doc.scene.name.c_str());
+        ImGui::Text("Nodes: %zu   meshes: %zu   materials: %zu   textures: %zu", st.doc.scene.nodeCount(), st.doc.scene.meshes.size(),
+                    st.doc.scene.materials.size(), st.doc.scene.textures.size());
+        if (ImGui::ColorEdit3("Ambient light", &st.doc.scene.ambientLight.x, ImGuiColorEditFlags_Float)) st.markEdited();
         return;
     }
-    const sg::Node& n = st.scene.node(id);
+    const sg::Node& n = st.doc.scene.node(id);
     std::string name = n.name;
     ImGui::SetNextItemWidth(-px(70));
     if (ImGui::InputText("Name", &name, ImGuiInputTextFlags_EnterReturnsTrue)) st.renameNode(id, name);
     record(st, "inspector/name");
     ImGui::TextDisabled("%s  (id %u)", std::string(sg::payloadKind(n.payload)).c_str(), id);
-    if (id != st.scene.root()) {
+    if (id != st.doc.scene.root()) {
         ImGui::SameLine();
         bool vis = n.visible;
         if (ImGui::Checkbox("Visible", &vis)) st.setVisible(id, vis);
         record(st, "inspector/visible");
     }
 
-    if (id != st.scene.root() && ImGui::CollapsingHeader("Transform", ImGuiTreeNodeFlags_DefaultOpen)) transformEditor(st, id);
+    if (id != st.doc.scene.root() && ImGui::CollapsingHeader("Transform", ImGuiTreeNodeFlags_DefaultOpen)) transformEditor(st, id);
 
     // Payload.
-    sg::Payload p = st.scene.node(id).payload;
+    sg::Payload p = st.doc.scene.node(id).payload;
     bool ch = false;
     if (auto* mi = std::get_if<sg::MeshInstance>(&p)) {
         if (ImGui::CollapsingHeader("Mesh", ImGuiTreeNodeFlags_DefaultOpen)) {
-            if (mi->mesh >= 0 && size_t(mi->mesh) < st.scene.meshes.size() && st.scene.meshes[mi->mesh]) {
-                const sg::Mesh& mesh = *st.scene.meshes[mi->mesh];
+            if (mi->mesh >= 0 && size_t(mi->mesh) < st.doc.scene.meshes.size() && st.doc.scene.meshes[mi->mesh]) {
+                const sg::Mesh& mesh = *st.doc.scene.meshes[mi->mesh];
                 ImGui::Text("Mesh %d: %zu vertices, %zu triangles", mi->mesh, mesh.positions.size(), mesh.indices.size() / 3);
             } else {
                 ImGui::TextColored(ImVec4(1, 0.5f, 0.4f, 1), "Mesh index %d is missing", mi->mesh);
@@ -712,8 +714,8 @@ void drawInspector(ViewerState& st) {
         }
         if (ImGui::CollapsingHeader("Material", ImGuiTreeNodeFlags_DefaultOpen)) ch |= materialEditor(st, gp->material);
     }
-    if (ch && st.scene.valid(id) && !(p == st.scene.node(id).payload)) {
-        st.scene.setPayload(id, p);
+    if (ch && st.doc.scene.valid(id) && !(p == st.doc.scene.node(id).payload)) {
+        st.doc.scene.setPayload(id, p);
         st.markEdited();
     }
 }
@@ -752,19 +754,19 @@ void drawAnimationPanel(ViewerState& st) {
 // --- 6. camera panel ---------------------------------------------------------------------------
 
 void drawCameraPanel(ViewerState& st) {
-    std::vector<sg::NodeId> cams = st.scene.cameras();
-    std::string preview = st.scene.valid(st.scene.activeCamera) ? st.scene.node(st.scene.activeCamera).name : "(viewer camera)";
+    std::vector<sg::NodeId> cams = st.doc.scene.cameras();
+    std::string preview = st.doc.scene.valid(st.doc.scene.activeCamera) ? st.doc.scene.node(st.doc.scene.activeCamera).name : "(viewer camera)";
     if (ImGui::BeginCombo("Scene camera", preview.c_str())) {
         for (sg::NodeId c : cams)
-            if (ImGui::Selectable(st.scene.node(c).name.c_str(), c == st.scene.activeCamera)) st.useSceneCamera(c);
+            if (ImGui::Selectable(st.doc.scene.node(c).name.c_str(), c == st.doc.scene.activeCamera)) st.useSceneCamera(c);
         ImGui::EndCombo();
     }
-    if (ImGui::Button("Fit (F)")) st.fitView(st.scene.valid(st.selected));
+    if (ImGui::Button("Fit (F)")) st.fitView(st.doc.scene.valid(st.doc.selected));
     ImGui::SameLine();
     if (ImGui::Button("Reset (Home)")) st.resetView();
     ImGui::SameLine();
     if (ImGui::Button("New camera here")) st.addCamera();
-    if (st.scene.valid(st.scene.activeCamera)) {
+    if (st.doc.scene.valid(st.doc.scene.activeCamera)) {
         if (ImGui::Button("Store view in active camera")) st.storeViewInCamera();
         helpMarker("Also done on save, so the scene reopens with this view.");
     }
@@ -811,9 +813,9 @@ void drawCameraPanel(ViewerState& st) {
     section("Live matrices");
     float aspect = float(std::max(st.viewportWidth, 1)) / float(std::max(st.viewportHeight, 1));
     sg::FrameCamera fc = sg::makeFrameCamera(st.camera.world(), st.viewProjection(), aspect, st.camera.distance);
-    if (st.scene.valid(st.selected)) {
-        ImGui::Text("Model (world of '%s')", st.scene.node(st.selected).name.c_str());
-        matrixTable("model", st.scene.world(st.selected));
+    if (st.doc.scene.valid(st.doc.selected)) {
+        ImGui::Text("Model (world of '%s')", st.doc.scene.node(st.doc.selected).name.c_str());
+        matrixTable("model", st.doc.scene.world(st.doc.selected));
     } else {
         ImGui::TextDisabled("Model: select a node");
     }
@@ -830,16 +832,16 @@ void drawCameraPanel(ViewerState& st) {
 // --- 7. rendering panel ------------------------------------------------------------------------
 
 void drawRenderingPanel(ViewerState& st) {
-    sg::RenderSettings s = st.scene.settings;
+    sg::RenderSettings s = st.doc.scene.settings;
     bool ch = false;
     section("Shading");
     ch |= enumRadios(st, "render/shading", s.shading);
     ch |= enumRadios(st, "render/reflection", s.reflection);
     ch |= ImGui::Checkbox("Light attenuation (1/r^2)", &s.attenuation);
     record(st, "render/attenuation");
-    sg::vec3 amb = st.scene.ambientLight;
+    sg::vec3 amb = st.doc.scene.ambientLight;
     if (ImGui::ColorEdit3("Ambient light", &amb.x, ImGuiColorEditFlags_Float)) {
-        st.scene.ambientLight = amb;
+        st.doc.scene.ambientLight = amb;
         st.markEdited();
     }
 
@@ -908,10 +910,10 @@ void drawRenderingPanel(ViewerState& st) {
     section("Background");
     ch |= ImGui::ColorEdit3("Background", &s.background.x, ImGuiColorEditFlags_Float);
 
-    if (ch && !(s == st.scene.settings)) {
+    if (ch && !(s == st.doc.scene.settings)) {
         std::string err = s.validate();
         if (err.empty()) {
-            st.scene.settings = s;
+            st.doc.scene.settings = s;
             st.markEdited();
         } else {
             st.status = "Setting refused: " + err;
@@ -1229,9 +1231,9 @@ void openBrowser(bool saving, ViewerState& st) {
     browser.saving = saving;
     browser.error.clear();
     std::error_code ec;
-    fs::path start = st.scenePath.empty() ? fs::current_path(ec) : fs::absolute(st.scenePath, ec).parent_path();
+    fs::path start = st.doc.path.empty() ? fs::current_path(ec) : fs::absolute(st.doc.path, ec).parent_path();
     if (browser.dir.empty() || !fs::is_directory(browser.dir, ec)) browser.dir = start;
-    browser.fileName = saving ? (st.scenePath.empty() ? st.scene.name + ".json" : st.scenePath.stem().string() + ".json") : "";
+    browser.fileName = saving ? (st.doc.path.empty() ? st.doc.scene.name + ".json" : st.doc.path.stem().string() + ".json") : "";
 }
 
 void drawFileBrowser(ViewerState& st) {
@@ -1450,7 +1452,7 @@ void handleShortcuts(ViewerState& st) {
         }
         if (ImGui::IsKeyPressed(keys::N, false)) st.requestNew();
         if (ImGui::IsKeyPressed(keys::Q, false)) st.requestQuit();
-        if (ImGui::IsKeyPressed(keys::D, false)) st.duplicateNode(st.selected);
+        if (ImGui::IsKeyPressed(keys::D, false)) st.duplicateNode(st.doc.selected);
         return;
     }
     for (int i = 0; i < 3; ++i)
@@ -1458,13 +1460,13 @@ void handleShortcuts(ViewerState& st) {
             st.setBackendIndex(i);
             st.compare.mode = ViewMode::Single;
         }
-    if (ImGui::IsKeyPressed(keys::F, false)) st.fitView(st.scene.valid(st.selected));
+    if (ImGui::IsKeyPressed(keys::F, false)) st.fitView(st.doc.scene.valid(st.doc.selected));
     if (ImGui::IsKeyPressed(keys::Home, false)) st.resetView();
     if (ImGui::IsKeyPressed(keys::F12, false)) st.requests.screenshot = true;
-    if (ImGui::IsKeyPressed(keys::Delete, false) && st.scene.valid(st.selected)) st.removeNode(st.selected);
-    if (ImGui::IsKeyPressed(keys::F2, false) && st.scene.valid(st.selected) && st.selected != st.scene.root()) {
-        st.panels.renaming = st.selected;
-        st.panels.renameBuffer = st.scene.node(st.selected).name;
+    if (ImGui::IsKeyPressed(keys::Delete, false) && st.doc.scene.valid(st.doc.selected)) st.removeNode(st.doc.selected);
+    if (ImGui::IsKeyPressed(keys::F2, false) && st.doc.scene.valid(st.doc.selected) && st.doc.selected != st.doc.scene.root()) {
+        st.panels.renaming = st.doc.selected;
+        st.panels.renameBuffer = st.doc.scene.node(st.doc.selected).name;
     }
 }
 

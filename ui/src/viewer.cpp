@@ -161,7 +161,7 @@ public:
                            ImGui::GetIO().MouseDown[2] || st.animationPlaying;
         std::vector<std::string> names = visibleBackends(st);
         std::shared_ptr<sg::FrameInput> base;
-        uint64_t key = (st.sceneVersion * 1000003u) ^ (st.viewVersion * 7919u) ^ (uint64_t(w) << 40) ^ (uint64_t(h) << 20);
+        uint64_t key = (st.doc.version * 1000003u) ^ (st.viewVersion * 7919u) ^ (uint64_t(w) << 40) ^ (uint64_t(h) << 20);
         for (const std::string& n : names) {
             BackendView& v = viewFor(n);
             sg::RenderSettings settings = st.settingsFor(n);
@@ -461,7 +461,7 @@ public:
             if (cmd == "select") {
                 std::string name;
                 std::getline(in >> std::ws, name);
-                v.st.selectNode(v.st.scene.findByName(name));
+                v.st.selectNode(v.st.doc.scene.findByName(name));
                 continue;
             }
             if (cmd == "screenshot") {
@@ -613,7 +613,7 @@ int runViewer(const ViewerOptions& opt) {
         st.setScene(assets::makeDemoScene(), {});
         st.status = "Demo scene. Drop a file on the window or use File > Open.";
     } else {
-        st.scene = sg::Scene{};
+        st.doc.scene = sg::Scene{};
         st.startLoad(opt.scene);
     }
     if (!opt.backend.empty()) st.setBackend(opt.backend);
@@ -697,7 +697,8 @@ int runViewer(const ViewerOptions& opt) {
         glfwSwapBuffers(win);
         if (st.requests.quit) running = false;
         // Window title: file name and the unsaved-changes marker.
-        std::string title = (st.scenePath.empty() ? st.scene.name : st.scenePath.filename().string()) + (st.dirty ? " *" : "") + " - Scene viewer";
+        std::string title =
+            (st.doc.path.empty() ? st.doc.scene.name : st.doc.path.filename().string()) + (st.doc.dirty ? " *" : "") + " - Scene viewer";
         if (title != windowTitle) {
             windowTitle = title;
             glfwSetWindowTitle(win, title.c_str());

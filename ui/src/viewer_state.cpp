@@ -20,49 +20,49 @@ namespace ui {
 // --- scene + edits --------------------------------------------------------------------------
 
 void ViewerState::setScene(sg::Scene s, fs::path path) {
-    scene = std::move(s);
-    scenePath = std::move(path);
-    dirty = false;
-    selected = sg::kNoNode;
+    doc.scene = std::move(s);
+    doc.path = std::move(path);
+    doc.dirty = false;
+    doc.selected = sg::kNoNode;
     animations.clear();   // a load puts its clips back after this
     animationClip = 0;
     animationTime = 0.0;
     animationPlaying = false;
-    ++sceneVersion;
+    ++doc.version;
     resetView();
 }
 
 void ViewerState::markEdited() {
-    dirty = true;
-    ++sceneVersion;
+    doc.dirty = true;
+    ++doc.version;
 }
 
 void ViewerState::markViewChanged() { ++viewVersion; }
 
-void ViewerState::selectNode(sg::NodeId id) { selected = scene.valid(id) ? id : sg::kNoNode; }
+void ViewerState::selectNode(sg::NodeId id) { doc.selected = doc.scene.valid(id) ? id : sg::kNoNode; }
 
 bool ViewerState::renameNode(sg::NodeId id, const std::string& name) {
-    if (!scene.valid(id) || name.empty() || scene.node(id).name == name) return false;
-    scene.setName(id, name);
+    if (!doc.scene.valid(id) || name.empty() || doc.scene.node(id).name == name) return false;
+    doc.scene.setName(id, name);
     markEdited();
     return true;
 }
 
 void ViewerState::setVisible(sg::NodeId id, bool v) {
-    if (!scene.valid(id) || scene.node(id).visible == v) return;
-    scene.setVisible(id, v);
+    if (!doc.scene.valid(id) || doc.scene.node(id).visible == v) return;
+    doc.scene.setVisible(id, v);
     markEdited();
 }
 
 namespace {
 // Default parent for new nodes: the selection when it can hold children, else the root.
 sg::NodeId parentFor(const ViewerState& st, sg::NodeId parent) {
-    if (st.scene.valid(parent)) return parent;
-    sg::NodeId s = st.selected;
-    if (!st.scene.valid(s)) return st.scene.root();
-    const sg::Payload& p = st.scene.node(s).payload;
+    if (st.doc.scene.valid(parent)) return parent;
+    sg::NodeId s = st.doc.selected;
+    if (!st.doc.scene.valid(s)) return st.doc.scene.root();
+    const sg::Payload& p = st.doc.scene.node(s).payload;
     if (std::holds_alternative<std::monostate>(p) || std::holds_alternative<sg::CsgPayload>(p)) return s;
-    return st.scene.valid(st.scene.node(s).parent) ? st.scene.node(s).parent : st.scene.root();
+    return st.doc.scene.valid(st.doc.scene.node(s).parent) ? st.doc.scene.node(s).parent : st.doc.scene.root();
 }
 std::string uniqueName(const sg::Scene& s, const std::string& base) {
     if (s.findByName(base) == sg::kNoNode) return base;
@@ -74,8 +74,8 @@ std::string uniqueName(const sg::Scene& s, const std::string& base) {
 }   // namespace
 
 sg::NodeId ViewerState::addGroup(sg::NodeId parent) {
-    sg::NodeId id = scene.addNode(uniqueName(scene, "group"), parentFor(*this, parent));
-    selected = id;
+    sg::NodeId id = doc.scene.addNode(uniqueName(doc.scene, "group"), parentFor(*this, parent));
+    doc.selected = id;
     markEdited();
     return id;
 }
@@ -87,15 +87,15 @@ sg::NodeId ViewerState::addShape(sg::ImplicitType type, sg::NodeId parent) {
         // A one-sheet hyperboloid x^2 + z^2 - y^2 = 0.25, clipped to the unit box.
         p.shape.quadric = sg::mat4(1, 0, 0, 0, 0, -1, 0, 0, 0, 0, 1, 0, 0, 0, 0, -0.25f);
     }
-    sg::NodeId id = scene.addNode(uniqueName(scene, std::string(sg::toString(type))), parentFor(*this, parent), p);
-    selected = id;
+    sg::NodeId id = doc.scene.addNode(uniqueName(doc.scene, std::string(sg::toString(type))), parentFor(*this, parent), p);
+    doc.selected = id;
     markEdited();
     return id;
 }
 
 sg::NodeId ViewerState::addCsg(sg::CsgOp op, sg::NodeId parent) {
-    sg::NodeId id =
-        scene.addNode(uniqueName(scene, "csg " + std::string(sg::toString(op))), parentFor(*this, parent), sg::CsgPayload{sg::CsgNode{op}, -1});
+    sg::NodeId id = doc.scene.addNode(uniqueName(doc.scene, "csg " + std::string(sg::toString(op))), parentFor(*this, parent),
+                                      sg::CsgPayload{sg::CsgNode{op}, -1});
     // Two operands so the node shows something right away.
     sg::ImplicitShape a;
     a.type = sg::ImplicitType::Box;
@@ -103,9 +103,9 @@ sg::NodeId ViewerState::addCsg(sg::CsgOp op, sg::NodeId parent) {
     sg::ImplicitShape b;
     b.type = sg::ImplicitType::Sphere;
     b.radius = 0.75f;
-    scene.addNode("box", id, sg::ImplicitPayload{a, -1});
-    scene.addNode("sphere", id, sg::ImplicitPayload{b, -1});
-    selected = id;
+    doc.scene.addNode("box", id, sg::ImplicitPayload{a, -1});
+    doc.scene.addNode("sphere", id, sg::ImplicitPayload{b, -1});
+    doc.selected = id;
     markEdited();
     return id;
 }
@@ -115,11 +115,11 @@ sg::NodeId ViewerState::addLight(sg::LightType type, sg::NodeId parent) {
     l.type = type;
     l.intensity = type == sg::LightType::Directional ? 1.0f : 10.0f;
     l.inverseSquare = type != sg::LightType::Directional;
-    sg::NodeId id = scene.addNode(uniqueName(scene, std::string(sg::toString(type)) + " light"), parentFor(*this, parent), l);
+    sg::NodeId id = doc.scene.addNode(uniqueName(doc.scene, std::string(sg::toString(type)) + " light"), parentFor(*this, parent), l);
     sg::LocalTransform t = sg::LocalTransform::fromTRS(camera.pivot + sg::vec3(0, 3, 0));
     t.setEulerDegrees(sg::vec3(-90, 0, 0));   // point down
-    scene.setLocal(id, t);
-    selected = id;
+    doc.scene.setLocal(id, t);
+    doc.selected = id;
     markEdited();
     return id;
 }
@@ -128,32 +128,32 @@ sg::NodeId ViewerState::addCamera() {
     sg::Camera c;
     c.projection = projection();
     c.focusDistance = camera.distance;
-    sg::NodeId id = scene.addNode(uniqueName(scene, "camera"), scene.root(), c);
-    scene.setLocalMatrix(id, camera.world());
-    sg::LocalTransform t = scene.node(id).local;
-    if (t.tryMakeTRS()) scene.setLocal(id, t);
-    if (!scene.valid(scene.activeCamera)) scene.activeCamera = id;
-    selected = id;
+    sg::NodeId id = doc.scene.addNode(uniqueName(doc.scene, "camera"), doc.scene.root(), c);
+    doc.scene.setLocalMatrix(id, camera.world());
+    sg::LocalTransform t = doc.scene.node(id).local;
+    if (t.tryMakeTRS()) doc.scene.setLocal(id, t);
+    if (!doc.scene.valid(doc.scene.activeCamera)) doc.scene.activeCamera = id;
+    doc.selected = id;
     markEdited();
     return id;
 }
 
 bool ViewerState::removeNode(sg::NodeId id) {
-    if (!scene.valid(id) || id == scene.root()) return false;
-    bool hadActive = scene.valid(scene.activeCamera) && scene.isAncestor(id, scene.activeCamera);
-    if (!scene.removeNode(id)) return false;
-    if (hadActive) scene.activeCamera = sg::kNoNode;
-    if (!scene.valid(selected)) selected = sg::kNoNode;
+    if (!doc.scene.valid(id) || id == doc.scene.root()) return false;
+    bool hadActive = doc.scene.valid(doc.scene.activeCamera) && doc.scene.isAncestor(id, doc.scene.activeCamera);
+    if (!doc.scene.removeNode(id)) return false;
+    if (hadActive) doc.scene.activeCamera = sg::kNoNode;
+    if (!doc.scene.valid(doc.selected)) doc.selected = sg::kNoNode;
     markEdited();
     return true;
 }
 
 sg::NodeId ViewerState::duplicateNode(sg::NodeId id) {
-    if (!scene.valid(id) || id == scene.root()) return sg::kNoNode;
-    sg::NodeId c = scene.duplicate(id);
-    if (scene.valid(c)) {
-        scene.setName(c, uniqueName(scene, scene.node(id).name + " copy"));
-        selected = c;
+    if (!doc.scene.valid(id) || id == doc.scene.root()) return sg::kNoNode;
+    sg::NodeId c = doc.scene.duplicate(id);
+    if (doc.scene.valid(c)) {
+        doc.scene.setName(c, uniqueName(doc.scene, doc.scene.node(id).name + " copy"));
+        doc.selected = c;
         markEdited();
     }
     return c;
@@ -161,8 +161,8 @@ sg::NodeId ViewerState::duplicateNode(sg::NodeId id) {
 
 bool ViewerState::reparent(sg::NodeId id, sg::NodeId newParent, std::string* error) {
     std::string err;
-    if (scene.valid(id) && scene.valid(newParent) && scene.node(id).parent == newParent) return false;   // no-op
-    if (!scene.reparent(id, newParent, /*keepWorld=*/true, &err)) {
+    if (doc.scene.valid(id) && doc.scene.valid(newParent) && doc.scene.node(id).parent == newParent) return false;   // no-op
+    if (!doc.scene.reparent(id, newParent, /*keepWorld=*/true, &err)) {
         if (err.empty()) err = "cannot move this node there";
         status = "Move refused: " + err;
         if (error) *error = err;
@@ -173,8 +173,8 @@ bool ViewerState::reparent(sg::NodeId id, sg::NodeId newParent, std::string* err
 }
 
 void ViewerState::setLocal(sg::NodeId id, const sg::LocalTransform& t) {
-    if (!scene.valid(id) || scene.node(id).local == t) return;
-    scene.setLocal(id, t);
+    if (!doc.scene.valid(id) || doc.scene.node(id).local == t) return;
+    doc.scene.setLocal(id, t);
     markEdited();
 }
 
@@ -202,21 +202,21 @@ const sg::Camera* activeCam(const sg::Scene& s) {
 }   // namespace
 
 const sg::Projection& ViewerState::projection() const {
-    const sg::Camera* c = activeCam(scene);
+    const sg::Camera* c = activeCam(doc.scene);
     return c ? c->projection : fallbackProjection;
 }
 
 sg::Projection& ViewerState::editProjection() {
-    if (scene.valid(scene.activeCamera) && std::holds_alternative<sg::Camera>(scene.node(scene.activeCamera).payload)) {
+    if (doc.scene.valid(doc.scene.activeCamera) && std::holds_alternative<sg::Camera>(doc.scene.node(doc.scene.activeCamera).payload)) {
         markEdited();
-        return std::get<sg::Camera>(scene.editPayload(scene.activeCamera)).projection;
+        return std::get<sg::Camera>(doc.scene.editPayload(doc.scene.activeCamera)).projection;
     }
     ++viewVersion;
     return fallbackProjection;
 }
 
 float ViewerState::focusDistance() const {
-    const sg::Camera* c = activeCam(scene);
+    const sg::Camera* c = activeCam(doc.scene);
     return c ? c->focusDistance : fallbackFocus;
 }
 
@@ -234,36 +234,36 @@ sg::Projection ViewerState::viewProjection() const {
 
 void ViewerState::fitView(bool selectionOnly) {
     sg::Aabb b;
-    if (selectionOnly && scene.valid(selected)) {
+    if (selectionOnly && doc.scene.valid(doc.selected)) {
         // Bounds of the selected subtree.
-        for (sg::NodeId id : scene.depthFirstOrder())
-            if (scene.isAncestor(selected, id)) b.extend(scene.localBounds(id).transformed(scene.world(id)));
-        if (b.empty()) b = sg::Aabb{sg::vec3(scene.world(selected)[3]) - 0.5f, sg::vec3(scene.world(selected)[3]) + 0.5f};
+        for (sg::NodeId id : doc.scene.depthFirstOrder())
+            if (doc.scene.isAncestor(doc.selected, id)) b.extend(doc.scene.localBounds(id).transformed(doc.scene.world(id)));
+        if (b.empty()) b = sg::Aabb{sg::vec3(doc.scene.world(doc.selected)[3]) - 0.5f, sg::vec3(doc.scene.world(doc.selected)[3]) + 0.5f};
     }
-    if (b.empty()) b = scene.worldBounds();
+    if (b.empty()) b = doc.scene.worldBounds();
     float aspect = float(std::max(viewportWidth, 1)) / float(std::max(viewportHeight, 1));
     camera.fit(b, projection().fovyDeg, aspect, projection().orthoHalfHeight);
     markViewChanged();
 }
 
 void ViewerState::resetView() {
-    const sg::Camera* c = activeCam(scene);
+    const sg::Camera* c = activeCam(doc.scene);
     if (c) {
-        camera.setFromWorld(scene.world(scene.activeCamera), c->focusDistance);
+        camera.setFromWorld(doc.scene.world(doc.scene.activeCamera), c->focusDistance);
     } else {
-        if (scene.cameras().empty()) {
+        if (doc.scene.cameras().empty()) {
             camera = OrbitCamera{};
             camera.yaw = std::atan2(0.5f, 1.0f);
             camera.pitch = 0.35f;
             float aspect = float(std::max(viewportWidth, 1)) / float(std::max(viewportHeight, 1));
-            camera.fit(scene.worldBounds(), fallbackProjection.fovyDeg, aspect, fallbackProjection.orthoHalfHeight);
-            sg::Aabb b = scene.worldBounds();
+            camera.fit(doc.scene.worldBounds(), fallbackProjection.fovyDeg, aspect, fallbackProjection.orthoHalfHeight);
+            sg::Aabb b = doc.scene.worldBounds();
             float r = b.empty() ? 2.0f : 0.5f * glm::length(b.extent());
             fallbackProjection.zNear = std::max(camera.distance - 3.0f * r, camera.distance * 0.01f);
             fallbackProjection.zFar = camera.distance + 3.0f * r;
             fallbackFocus = camera.distance;
         } else {
-            useSceneCamera(scene.cameras().front());
+            useSceneCamera(doc.scene.cameras().front());
             return;
         }
     }
@@ -271,43 +271,43 @@ void ViewerState::resetView() {
 }
 
 void ViewerState::useSceneCamera(sg::NodeId id) {
-    if (!scene.valid(id) || !std::holds_alternative<sg::Camera>(scene.node(id).payload)) return;
-    if (scene.activeCamera != id) {
-        scene.activeCamera = id;
+    if (!doc.scene.valid(id) || !std::holds_alternative<sg::Camera>(doc.scene.node(id).payload)) return;
+    if (doc.scene.activeCamera != id) {
+        doc.scene.activeCamera = id;
         markEdited();
     }
-    camera.setFromWorld(scene.world(id), std::get<sg::Camera>(scene.node(id).payload).focusDistance);
+    camera.setFromWorld(doc.scene.world(id), std::get<sg::Camera>(doc.scene.node(id).payload).focusDistance);
     markViewChanged();
 }
 
 void ViewerState::storeViewInCamera() {
-    sg::NodeId id = scene.activeCamera;
-    if (!scene.valid(id) || !std::holds_alternative<sg::Camera>(scene.node(id).payload)) return;
-    sg::NodeId parent = scene.node(id).parent;
-    sg::mat4 parentWorld = scene.valid(parent) ? scene.world(parent) : sg::mat4(1.0f);
+    sg::NodeId id = doc.scene.activeCamera;
+    if (!doc.scene.valid(id) || !std::holds_alternative<sg::Camera>(doc.scene.node(id).payload)) return;
+    sg::NodeId parent = doc.scene.node(id).parent;
+    sg::mat4 parentWorld = doc.scene.valid(parent) ? doc.scene.world(parent) : sg::mat4(1.0f);
     sg::LocalTransform t = sg::LocalTransform::fromMatrix(glm::inverse(parentWorld) * camera.world());
     t.tryMakeTRS();
-    sg::Camera c = std::get<sg::Camera>(scene.node(id).payload);
+    sg::Camera c = std::get<sg::Camera>(doc.scene.node(id).payload);
     float focus = camera.distance;
     float ortho = c.projection.orthoHalfHeight * camera.orthoScale;
-    bool changed = !(scene.node(id).local == t) || c.focusDistance != focus || c.projection.orthoHalfHeight != ortho;
+    bool changed = !(doc.scene.node(id).local == t) || c.focusDistance != focus || c.projection.orthoHalfHeight != ortho;
     if (!changed) return;
-    scene.setLocal(id, t);
+    doc.scene.setLocal(id, t);
     c.focusDistance = focus;
     c.projection.orthoHalfHeight = ortho;
-    scene.setPayload(id, c);
+    doc.scene.setPayload(id, c);
     camera.orthoScale = 1.0f;
     markEdited();
 }
 
 sg::FrameInput ViewerState::buildFrame(float aspect) const {
-    sg::FrameInput f = sg::flatten(scene, aspect, scene.activeCamera);
+    sg::FrameInput f = sg::flatten(doc.scene, aspect, doc.scene.activeCamera);
     f.camera = sg::makeFrameCamera(camera.world(), viewProjection(), aspect, camera.distance);
     return f;
 }
 
 sg::RenderSettings ViewerState::settingsFor(const std::string& b) const {
-    sg::RenderSettings s = scene.settings;
+    sg::RenderSettings s = doc.scene.settings;
     auto it = aaOverride.find(b);
     if (it != aaOverride.end()) s.setAA(it->second);
     return s;
@@ -316,7 +316,7 @@ sg::RenderSettings ViewerState::settingsFor(const std::string& b) const {
 // --- files -----------------------------------------------------------------------------------
 
 bool ViewerState::requestOpen(const fs::path& path) {
-    if (dirty) {
+    if (doc.dirty) {
         pending = PendingAction::Open;
         pendingPath = path;
         confirmOpen = true;
@@ -327,7 +327,7 @@ bool ViewerState::requestOpen(const fs::path& path) {
 }
 
 bool ViewerState::requestNew() {
-    if (dirty) {
+    if (doc.dirty) {
         pending = PendingAction::New;
         confirmOpen = true;
         return false;
@@ -342,7 +342,7 @@ void ViewerState::newScene() {
 }
 
 bool ViewerState::requestQuit() {
-    if (dirty) {
+    if (doc.dirty) {
         pending = PendingAction::Quit;
         confirmOpen = true;
         return false;
@@ -360,7 +360,7 @@ void ViewerState::confirm(ConfirmChoice choice) {
         return;
     }
     if (choice == ConfirmChoice::Save) {
-        if (scenePath.empty() || scenePath.extension() != ".json") {
+        if (doc.path.empty() || doc.path.extension() != ".json") {
             // Needs a file name first: ask for one, then the user repeats the action.
             requests.saveAsDialog = true;
             status = "Choose where to save, then repeat the action";
@@ -409,7 +409,7 @@ bool ViewerState::pollLoad(bool wait) {
         status = "Loading " + loadingPath.filename().string() + " cancelled; the current scene is unchanged";
         return true;
     }
-    loadWarnings = r.warnings;
+    doc.loadWarnings = r.warnings;
     if (!r.scene) {
         errorPopup = "Could not open " + loadingPath.string() + ":\n" + (r.error.empty() ? "unknown error" : r.error);
         status = "Open failed; the current scene is unchanged";
@@ -431,7 +431,7 @@ void ViewerState::cancelLoad() {
 }
 
 std::string ViewerState::save(const fs::path& path) {
-    fs::path target = path.empty() ? scenePath : path;
+    fs::path target = path.empty() ? doc.path : path;
     if (target.empty()) {
         requests.saveAsDialog = true;
         return "no file name";
@@ -440,15 +440,15 @@ std::string ViewerState::save(const fs::path& path) {
     storeViewInCamera();
     std::string err;
     try {
-        err = assets::saveSceneJson(scene, target, /*overwrite=*/true);
+        err = assets::saveSceneJson(doc.scene, target, /*overwrite=*/true);
     } catch (const std::exception& e) { err = target.string() + ": " + e.what(); }
     if (!err.empty()) {
         errorPopup = "Could not save:\n" + err;
         status = "Save failed";
         return err;
     }
-    scenePath = target;
-    dirty = false;
+    doc.path = target;
+    doc.dirty = false;
     addRecent(fs::absolute(target).lexically_normal().string());
     status = "Saved " + target.string();
     return {};
@@ -466,8 +466,8 @@ void ViewerState::addRecent(const std::string& path) {
 namespace {
 // Writes the clip's pose at t into the scene: a re-render, not an edit (dirty untouched).
 void applyPose(ViewerState& st, const assets::AnimationClip& clip, double t) {
-    assets::applyAnimation(st.scene, clip, float(t));
-    ++st.sceneVersion;
+    assets::applyAnimation(st.doc.scene, clip, float(t));
+    ++st.doc.version;
 }
 }   // namespace
 

@@ -70,17 +70,22 @@ struct LoadControl {
     std::atomic<float> progress{0.0f};
 };
 
-struct ViewerState {
-    // --- scene and file ----------------------------------------------------------------
+// The document: the scene being edited, where it lives on disk and whether it has unsaved
+// edits. Replaced as a whole by setScene (a load, a new scene, the demo).
+struct Document {
     sg::Scene scene;
-    std::filesystem::path scenePath;   // empty for the demo / a new scene
-    bool dirty = false;                // unsaved edits
-    uint64_t sceneVersion = 1;         // bumped on every scene edit (re-render)
-    uint64_t viewVersion = 1;          // bumped on camera moves (re-render)
-    std::vector<std::string> loadWarnings;
-
-    // --- selection and view ------------------------------------------------------------
+    std::filesystem::path path;   // empty for the demo / a new scene
+    bool dirty = false;           // unsaved edits
+    uint64_t version = 1;         // bumped on every scene change, edits and animation poses (re-render)
     sg::NodeId selected = sg::kNoNode;
+    std::vector<std::string> loadWarnings;   // of the load that brought this scene
+};
+
+struct ViewerState {
+    Document doc;
+    uint64_t viewVersion = 1;   // bumped on camera moves (re-render)
+
+    // --- view ----------------------------------------------------------------------------
     std::string backend = "gl";   // the single view's backend
     CompareConfig compare;
     OrbitCamera camera;
@@ -105,7 +110,7 @@ struct ViewerState {
     std::shared_ptr<LoadControl> loadControl;   // of the current / last load
 
     // --- animation (glTF node TRS clips of the loaded file) --------------------------------
-    // Playing changes node locals and re-renders (sceneVersion) but is not an edit: the dirty
+    // Playing changes node locals and re-renders (doc.version) but is not an edit: the dirty
     // flag is untouched. Clips come with a load and are dropped by setScene (new scene, demo).
     std::vector<assets::AnimationClip> animations;
     int animationClip = 0;        // index into animations
@@ -195,7 +200,7 @@ struct ViewerState {
     float loadProgress() const { return loadControl ? loadControl->progress.load() : 0.0f; }
     // Finishes a completed load (non-blocking); returns true when a load finished.
     bool pollLoad(bool wait = false);
-    // Saves to scenePath (or `path`), writing the view into the active camera first.
+    // Saves to doc.path (or `path`), writing the view into the active camera first.
     // Returns "" or an error (also put in errorPopup).
     std::string save(const std::filesystem::path& path = {});
 
