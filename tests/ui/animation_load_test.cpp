@@ -26,8 +26,8 @@ namespace {
 
 ViewerState demoState() {
     ViewerState st;
-    st.viewportWidth = 800;
-    st.viewportHeight = 600;
+    st.view.viewportWidth = 800;
+    st.view.viewportHeight = 600;
     st.configDir.clear();   // never touch the user's recent files
     st.setScene(assets::makeDemoScene(), {});
     return st;

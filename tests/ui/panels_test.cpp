@@ -24,8 +24,8 @@ public:
         unsigned char* pixels = nullptr;
         int w = 0, h = 0;
         io.Fonts->GetTexDataAsRGBA32(&pixels, &w, &h);
-        st.viewportWidth = 800;
-        st.viewportHeight = 600;
+        st.view.viewportWidth = 800;
+        st.view.viewportHeight = 600;
         st.setScene(assets::makeDemoScene(), {});
         view.slots.resize(1);
         view.slots[0].status.backend = "gl";
@@ -80,7 +80,7 @@ TEST(PanelsTest, LayoutHasTreeTabsAndViewport) {
     const ItemRect& vp = h.rect("viewport");
     EXPECT_GT(vp.x1 - vp.x0, 500.0f);   // the centre keeps most of the width
     EXPECT_GT(vp.y1 - vp.y0, 600.0f);
-    EXPECT_GT(h.st.viewportWidth, 500);
+    EXPECT_GT(h.st.view.viewportWidth, 500);
 }
 
 TEST(PanelsTest, ClickingShadingRadioChangesSettings) {
@@ -155,11 +155,11 @@ TEST(PanelsTest, NumberKeysSwitchBackends) {
     Headless h;
     h.moveTo(800, 450);
     h.press(keys::Num2);
-    EXPECT_EQ(h.st.backend, "raster");
+    EXPECT_EQ(h.st.view.backend, "raster");
     h.press(keys::Num3);
-    EXPECT_EQ(h.st.backend, "raycast");
+    EXPECT_EQ(h.st.view.backend, "raycast");
     h.press(keys::Num1);
-    EXPECT_EQ(h.st.backend, "gl");
+    EXPECT_EQ(h.st.view.backend, "gl");
     h.st.requests.screenshot = false;
     h.press(keys::F12);
     EXPECT_TRUE(h.st.requests.screenshot);
@@ -168,28 +168,28 @@ TEST(PanelsTest, NumberKeysSwitchBackends) {
 TEST(PanelsTest, ViewportDragOrbitsWheelZooms) {
     Headless h;
     const ItemRect vp = h.rect("viewport");
-    float yaw = h.st.camera.yaw, dist = h.st.camera.distance;
-    sg::vec3 pivot = h.st.camera.pivot;
+    float yaw = h.st.view.camera.yaw, dist = h.st.view.camera.distance;
+    sg::vec3 pivot = h.st.view.camera.pivot;
     h.moveTo(vp.cx(), vp.cy());
     ImGui::GetIO().MouseDown[0] = true;
     h.frame();
     for (int i = 1; i <= 5; ++i) h.moveTo(vp.cx() + 10.0f * i, vp.cy());
     ImGui::GetIO().MouseDown[0] = false;
     h.frame();
-    EXPECT_NE(h.st.camera.yaw, yaw);
-    EXPECT_NEAR(h.st.camera.distance, dist, 1e-4f);
-    EXPECT_NEAR(glm::length(h.st.camera.pivot - pivot), 0.0f, 1e-5f);
+    EXPECT_NE(h.st.view.camera.yaw, yaw);
+    EXPECT_NEAR(h.st.view.camera.distance, dist, 1e-4f);
+    EXPECT_NEAR(glm::length(h.st.view.camera.pivot - pivot), 0.0f, 1e-5f);
     ImGui::GetIO().MouseWheel = 2.0f;
     h.frame();
     ImGui::GetIO().MouseWheel = 0.0f;
-    EXPECT_LT(h.st.camera.distance, dist);
+    EXPECT_LT(h.st.view.camera.distance, dist);
     // Middle drag pans: the pivot moves.
     ImGui::GetIO().MouseDown[2] = true;
     h.frame();
     for (int i = 1; i <= 5; ++i) h.moveTo(vp.cx() - 10.0f * i, vp.cy() + 4.0f * i);
     ImGui::GetIO().MouseDown[2] = false;
     h.frame();
-    EXPECT_GT(glm::length(h.st.camera.pivot - pivot), 1e-3f);
+    EXPECT_GT(glm::length(h.st.view.camera.pivot - pivot), 1e-3f);
 }
 
 TEST(PanelsTest, QuitWithUnsavedChangesShowsModal) {
@@ -213,21 +213,21 @@ TEST(PanelsTest, SplitViewDividerDrags) {
     Headless h;
     h.click("tab/Compare");
     h.click("compare/split");
-    EXPECT_EQ(h.st.compare.mode, ViewMode::Split);
+    EXPECT_EQ(h.st.view.compare.mode, ViewMode::Split);
     h.view.slots.resize(2);
     h.view.slots[1].status.backend = "raster";
     h.frame();
     const ItemRect vp = h.rect("viewport");
     float x = vp.x0 + 0.5f * (vp.x1 - vp.x0);
-    float yaw = h.st.camera.yaw;
+    float yaw = h.st.view.camera.yaw;
     h.moveTo(x, vp.cy());
     ImGui::GetIO().MouseDown[0] = true;
     h.frame();
     for (int i = 1; i <= 5; ++i) h.moveTo(x + 20.0f * i, vp.cy());
     ImGui::GetIO().MouseDown[0] = false;
     h.frame();
-    EXPECT_GT(h.st.compare.dividers[0], 0.55f);
-    EXPECT_EQ(h.st.camera.yaw, yaw);   // the divider took the drag, not the camera
+    EXPECT_GT(h.st.view.compare.dividers[0], 0.55f);
+    EXPECT_EQ(h.st.view.camera.yaw, yaw);   // the divider took the drag, not the camera
     EXPECT_EQ(visibleBackends(h.st).size(), 2u);
 }
 

@@ -18,8 +18,8 @@ namespace fs = std::filesystem;
 namespace {
 ViewerState demoState() {
     ViewerState st;
-    st.viewportWidth = 800;
-    st.viewportHeight = 600;
+    st.view.viewportWidth = 800;
+    st.view.viewportHeight = 600;
     st.setScene(assets::makeDemoScene(), {});
     return st;
 }
@@ -30,7 +30,7 @@ TEST(ViewerStateTest, SetSceneStartsCleanAndLooksThroughActiveCamera) {
     EXPECT_FALSE(st.doc.dirty);
     ASSERT_TRUE(st.doc.scene.valid(st.doc.scene.activeCamera));
     sg::vec3 camEye(st.doc.scene.world(st.doc.scene.activeCamera)[3]);
-    sg::vec3 e = st.camera.eye();
+    sg::vec3 e = st.view.camera.eye();
     EXPECT_NEAR(glm::length(e - camEye), 0.0f, 1e-3f);
 }
 
@@ -95,45 +95,45 @@ TEST(ViewerStateTest, ReparentKeepsWorldAndRefusesCycles) {
 TEST(ViewerStateTest, BackendKeysAndEditsBumpVersions) {
     ViewerState st = demoState();
     st.setBackendIndex(1);
-    EXPECT_EQ(st.backend, "raster");
+    EXPECT_EQ(st.view.backend, "raster");
     st.setBackendIndex(2);
-    EXPECT_EQ(st.backend, "raycast");
+    EXPECT_EQ(st.view.backend, "raycast");
     st.setBackendIndex(7);   // ignored
-    EXPECT_EQ(st.backend, "raycast");
-    uint64_t v = st.doc.version, vv = st.viewVersion;
+    EXPECT_EQ(st.view.backend, "raycast");
+    uint64_t v = st.doc.version, vv = st.view.version;
     st.editProjection().fovyDeg = 60.0f;
     EXPECT_GT(st.doc.version, v);   // the scene camera's projection is scene data
     EXPECT_TRUE(st.doc.dirty);
     EXPECT_EQ(st.projection().fovyDeg, 60.0f);
     st.fitView(false);
-    EXPECT_GT(st.viewVersion, vv);
+    EXPECT_GT(st.view.version, vv);
 }
 
 TEST(ViewerStateTest, BuildFrameUsesOrbitCameraAndSceneProjection) {
     ViewerState st = demoState();
-    st.camera.orbit(120.0f, 30.0f);
+    st.view.camera.orbit(120.0f, 30.0f);
     sg::FrameInput f = st.buildFrame(2.0f);
-    sg::mat4 w = st.camera.world();
+    sg::mat4 w = st.view.camera.world();
     for (int c = 0; c < 4; ++c)
         for (int r = 0; r < 4; ++r) EXPECT_NEAR(f.camera.viewInverse[c][r], w[c][r], 1e-5f);
     EXPECT_EQ(f.camera.projection.fovyDeg, st.projection().fovyDeg);
     EXPECT_FLOAT_EQ(f.camera.aspect, 2.0f);
     EXPECT_FALSE(f.meshes.empty());
     // Per-backend AA override changes only that backend's settings.
-    st.aaOverride["raster"] = "ssaa2";
+    st.view.aaOverride["raster"] = "ssaa2";
     EXPECT_EQ(st.settingsFor("raster").aa, sg::AAMode::SSAA);
     EXPECT_EQ(st.settingsFor("gl").aa, st.doc.scene.settings.aa);
 }
 
 TEST(ViewerStateTest, SceneWithoutCameraGetsFramingView) {
     ViewerState st;
-    st.viewportWidth = 400;
-    st.viewportHeight = 300;
+    st.view.viewportWidth = 400;
+    st.view.viewportHeight = 300;
     sg::Scene s;
     s.addNode("ball", 0, sg::ImplicitPayload{});
     st.setScene(std::move(s), {});
-    EXPECT_NEAR(glm::length(st.camera.pivot), 0.0f, 1e-4f);
-    EXPECT_GT(st.camera.distance, 1.0f);
+    EXPECT_NEAR(glm::length(st.view.camera.pivot), 0.0f, 1e-4f);
+    EXPECT_GT(st.view.camera.distance, 1.0f);
     sg::FrameInput f = st.buildFrame(4.0f / 3.0f);
     EXPECT_EQ(f.analytics.size(), 1u);
 }
@@ -310,7 +310,7 @@ TEST(RenderSlotTest, RapidRequestsCancelAndDestroyCleanly) {
     ViewerState st = demoState();
     auto slot = std::make_unique<RenderSlot>("raycast");
     for (int i = 0; i < 20; ++i) {
-        st.camera.orbit(5.0f, 0.0f);
+        st.view.camera.orbit(5.0f, 0.0f);
         slot->request(std::make_shared<sg::FrameInput>(st.buildFrame(1.0f)), 96, 96, uint64_t(i + 10), false);
     }
     slot.reset();   // cancels and joins while busy
@@ -326,8 +326,8 @@ TEST(ViewerStateTest, SaveAndReopenKeepsEditsAndView) {
     st.doc.scene.settings.fog = sg::FogMode::Exp;
     st.markEdited();
     st.editProjection().fovyDeg = 52.0f;
-    st.camera.orbit(80.0f, 20.0f);
-    sg::vec3 eye = st.camera.eye();
+    st.view.camera.orbit(80.0f, 20.0f);
+    sg::vec3 eye = st.view.camera.eye();
     fs::path file = testing_support::outputDir("ui") / "saved-scene.json";
     fs::remove(file);
     std::string err = st.save(file);
@@ -337,13 +337,13 @@ TEST(ViewerStateTest, SaveAndReopenKeepsEditsAndView) {
     EXPECT_EQ(st.doc.path, file);
 
     ViewerState other;
-    other.viewportWidth = 800;
-    other.viewportHeight = 600;
+    other.view.viewportWidth = 800;
+    other.view.viewportHeight = 600;
     other.startLoad(file);
     ASSERT_TRUE(other.pollLoad(true));
     ASSERT_TRUE(other.errorPopup.empty()) << other.errorPopup;
     EXPECT_EQ(other.doc.scene.settings.shading, sg::ShadingModel::Gouraud);
     EXPECT_EQ(other.doc.scene.settings.fog, sg::FogMode::Exp);
     EXPECT_FLOAT_EQ(other.projection().fovyDeg, 52.0f);
-    EXPECT_NEAR(glm::length(other.camera.eye() - eye), 0.0f, 1e-3f);
+    EXPECT_NEAR(glm::length(other.view.camera.eye() - eye), 0.0f, 1e-3f);
 }

@@ -175,16 +175,16 @@ void addMenuItems(ViewerState& st, sg::NodeId parent) {
 }   // namespace
 
 std::vector<std::string> visibleBackends(const ViewerState& st) {
-    switch (st.compare.mode) {
-    case ViewMode::Single: return {st.backend};
+    switch (st.view.compare.mode) {
+    case ViewMode::Single: return {st.view.backend};
     case ViewMode::Split: {
-        std::vector<std::string> v(st.compare.backends.begin(), st.compare.backends.begin() + std::clamp(st.compare.count, 2, 3));
+        std::vector<std::string> v(st.view.compare.backends.begin(), st.view.compare.backends.begin() + std::clamp(st.view.compare.count, 2, 3));
         return v;
     }
     case ViewMode::Difference:
-        return {st.compare.backends[std::clamp(st.compare.diffA, 0, 2)], st.compare.backends[std::clamp(st.compare.diffB, 0, 2)]};
+        return {st.view.compare.backends[std::clamp(st.view.compare.diffA, 0, 2)], st.view.compare.backends[std::clamp(st.view.compare.diffB, 0, 2)]};
     }
-    return {st.backend};
+    return {st.view.backend};
 }
 
 // --- 2. style ----------------------------------------------------------------------------------
@@ -252,9 +252,9 @@ void drawMainMenu(ViewerState& st) {
         if (ImGui::MenuItem("Fit to scene / selection", "F")) st.fitView(st.doc.scene.valid(st.doc.selected));
         if (ImGui::MenuItem("Reset to scene camera", "Home")) st.resetView();
         ImGui::Separator();
-        if (ImGui::MenuItem("Single backend", nullptr, st.compare.mode == ViewMode::Single)) st.compare.mode = ViewMode::Single;
-        if (ImGui::MenuItem("Split view (wipe)", nullptr, st.compare.mode == ViewMode::Split)) st.compare.mode = ViewMode::Split;
-        if (ImGui::MenuItem("Difference view", nullptr, st.compare.mode == ViewMode::Difference)) st.compare.mode = ViewMode::Difference;
+        if (ImGui::MenuItem("Single backend", nullptr, st.view.compare.mode == ViewMode::Single)) st.view.compare.mode = ViewMode::Single;
+        if (ImGui::MenuItem("Split view (wipe)", nullptr, st.view.compare.mode == ViewMode::Split)) st.view.compare.mode = ViewMode::Split;
+        if (ImGui::MenuItem("Difference view", nullptr, st.view.compare.mode == ViewMode::Difference)) st.view.compare.mode = ViewMode::Difference;
         ImGui::Separator();
         ImGui::MenuItem("Stats overlay", nullptr, &st.panels.showOverlay);
         if (ImGui::BeginMenu("Scene cameras", !st.doc.scene.cameras().empty())) {
@@ -268,9 +268,9 @@ void drawMainMenu(ViewerState& st) {
         std::vector<std::string> names = rnd::rendererNames();
         for (size_t i = 0; i < names.size(); ++i) {
             std::string key = std::to_string(i + 1);
-            if (ImGui::MenuItem(names[i].c_str(), key.c_str(), st.backend == names[i])) {
+            if (ImGui::MenuItem(names[i].c_str(), key.c_str(), st.view.backend == names[i])) {
                 st.setBackend(names[i]);
-                st.compare.mode = ViewMode::Single;
+                st.view.compare.mode = ViewMode::Single;
             }
         }
         ImGui::EndMenu();
@@ -808,11 +808,11 @@ void drawCameraPanel(ViewerState& st) {
         p.zFar = std::max(p.zFar, p.zNear * 1.001f);
         st.editProjection() = p;
     }
-    ImGui::TextDisabled("Zoom factor %.3f  (orthographic / oblique)", st.camera.orthoScale);
+    ImGui::TextDisabled("Zoom factor %.3f  (orthographic / oblique)", st.view.camera.orthoScale);
 
     section("Live matrices");
-    float aspect = float(std::max(st.viewportWidth, 1)) / float(std::max(st.viewportHeight, 1));
-    sg::FrameCamera fc = sg::makeFrameCamera(st.camera.world(), st.viewProjection(), aspect, st.camera.distance);
+    float aspect = float(std::max(st.view.viewportWidth, 1)) / float(std::max(st.view.viewportHeight, 1));
+    sg::FrameCamera fc = sg::makeFrameCamera(st.view.camera.world(), st.viewProjection(), aspect, st.view.camera.distance);
     if (st.doc.scene.valid(st.doc.selected)) {
         ImGui::Text("Model (world of '%s')", st.doc.scene.node(st.doc.selected).name.c_str());
         matrixTable("model", st.doc.scene.world(st.doc.selected));
@@ -824,8 +824,8 @@ void drawCameraPanel(ViewerState& st) {
     ImGui::Text("Projection (aspect %.3f)", aspect);
     matrixTable("proj", fc.proj);
     ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyle().Colors[ImGuiCol_TextDisabled]);
-    ImGui::TextWrapped("Eye (%.2f, %.2f, %.2f)  pivot (%.2f, %.2f, %.2f)  distance %.3f", fc.eye.x, fc.eye.y, fc.eye.z, st.camera.pivot.x,
-                       st.camera.pivot.y, st.camera.pivot.z, st.camera.distance);
+    ImGui::TextWrapped("Eye (%.2f, %.2f, %.2f)  pivot (%.2f, %.2f, %.2f)  distance %.3f", fc.eye.x, fc.eye.y, fc.eye.z, st.view.camera.pivot.x,
+                       st.view.camera.pivot.y, st.view.camera.pivot.z, st.view.camera.distance);
     ImGui::PopStyleColor();
 }
 
@@ -862,18 +862,18 @@ void drawRenderingPanel(ViewerState& st) {
     // Per-backend overrides (viewer session only), kept by name.
     const sg::NameTable<sg::AAChoice>& aaNames = sg::nameTable<sg::AAChoice>();
     for (const std::string& b : rnd::rendererNames()) {
-        auto it = st.aaOverride.find(b);
-        std::string ov = it == st.aaOverride.end() ? "" : it->second;
+        auto it = st.view.aaOverride.find(b);
+        std::string ov = it == st.view.aaOverride.end() ? "" : it->second;
         const sg::NamedValue<sg::AAChoice>* cur = aaNames.find(ov);
         std::string label = "AA " + b;
         if (ImGui::BeginCombo(label.c_str(), cur ? std::string(cur->label).c_str() : "(scene)")) {
             if (ImGui::Selectable("(scene)", ov.empty())) {
-                st.aaOverride.erase(b);
+                st.view.aaOverride.erase(b);
                 st.markViewChanged();
             }
             for (const auto& e : aaNames.entries) {
                 if (ImGui::Selectable(std::string(e.label).c_str(), &e == cur)) {
-                    st.aaOverride[b] = std::string(e.name);
+                    st.view.aaOverride[b] = std::string(e.name);
                     st.markViewChanged();
                 }
                 tooltip(e.help);
@@ -882,7 +882,7 @@ void drawRenderingPanel(ViewerState& st) {
         }
     }
 
-    if (ImGui::Checkbox("GL on a worker thread", &st.glOnWorker)) st.markViewChanged();
+    if (ImGui::Checkbox("GL on a worker thread", &st.view.glOnWorker)) st.markViewChanged();
     helpMarker(
         "The gl backend renders on its own thread with a headless context: the UI never waits, even with software GL.\nOff: it renders on the UI "
         "thread with the window's context.");
@@ -924,7 +924,7 @@ void drawRenderingPanel(ViewerState& st) {
 // --- 8. compare panel --------------------------------------------------------------------------
 
 void drawComparePanel(ViewerState& st) {
-    CompareConfig& c = st.compare;
+    CompareConfig& c = st.view.compare;
     int mode = int(c.mode);
     ImGui::RadioButton("Single", &mode, 0);
     record(st, "compare/single");
@@ -945,9 +945,9 @@ void drawComparePanel(ViewerState& st) {
     };
     section("Backends (one shared camera)");
     if (c.mode == ViewMode::Single) {
-        std::string b = st.backend;
+        std::string b = st.view.backend;
         backendCombo("Backend", b);
-        if (b != st.backend) st.setBackend(b);
+        if (b != st.view.backend) st.setBackend(b);
         ImGui::TextDisabled("Keys 1 / 2 / 3 switch backends.");
     } else if (c.mode == ViewMode::Split) {
         ImGui::SliderInt("Count", &c.count, 2, 3);
@@ -969,11 +969,12 @@ void drawComparePanel(ViewerState& st) {
         ImGui::Text("|%s - %s| per pixel", c.backends[c.diffA].c_str(), c.backends[c.diffB].c_str());
         ImGui::SliderInt("Threshold", &c.threshold, 0, 255);
         record(st, "compare/threshold");
-        if (st.haveDiff) {
-            ImGui::Text("Mean |a-b|  %.3f", st.diffMean);
-            ImGui::Text("Max  |a-b|  %d", st.diffMax);
-            ImGui::Text("PSNR        %s", std::isfinite(st.diffPsnr) ? (std::to_string(st.diffPsnr).substr(0, 6) + " dB").c_str() : "identical");
-            ImGui::Text("Within threshold  %.2f %%", 100.0 * st.diffWithin);
+        if (st.view.diff.valid) {
+            ImGui::Text("Mean |a-b|  %.3f", st.view.diff.mean);
+            ImGui::Text("Max  |a-b|  %d", st.view.diff.max);
+            ImGui::Text("PSNR        %s",
+                        std::isfinite(st.view.diff.psnr) ? (std::to_string(st.view.diff.psnr).substr(0, 6) + " dB").c_str() : "identical");
+            ImGui::Text("Within threshold  %.2f %%", 100.0 * st.view.diff.within);
         } else {
             ImGui::TextDisabled("Waiting for both full-resolution images...");
         }
@@ -1057,44 +1058,44 @@ void cameraInput(ViewerState& st, ImVec2 a, ImVec2 b, double time, float dt) {
     bool moved = false;
     // Divider drag (split view) takes precedence over the camera when grabbed near a divider.
     int& dragDivider = st.panels.dragDivider;
-    if (st.compare.mode == ViewMode::Split && ImGui::IsItemClicked(ImGuiMouseButton_Left)) {
+    if (st.view.compare.mode == ViewMode::Split && ImGui::IsItemClicked(ImGuiMouseButton_Left)) {
         dragDivider = -1;
-        for (int i = 0; i < st.compare.count - 1; ++i) {
-            float x = a.x + st.compare.dividers[i] * (b.x - a.x);
+        for (int i = 0; i < st.view.compare.count - 1; ++i) {
+            float x = a.x + st.view.compare.dividers[i] * (b.x - a.x);
             if (std::abs(io.MousePos.x - x) < px(6)) dragDivider = i;
         }
     }
     if (!io.MouseDown[0]) dragDivider = -1;
     if (dragDivider >= 0 && active) {
         float f = std::clamp((io.MousePos.x - a.x) / std::max(b.x - a.x, 1.0f), 0.0f, 1.0f);
-        st.compare.dividers[dragDivider] = f;
+        st.view.compare.dividers[dragDivider] = f;
         if (dragDivider == 0)
-            st.compare.dividers[1] = std::max(st.compare.dividers[1], f);
+            st.view.compare.dividers[1] = std::max(st.view.compare.dividers[1], f);
         else
-            st.compare.dividers[0] = std::min(st.compare.dividers[0], f);
+            st.view.compare.dividers[0] = std::min(st.view.compare.dividers[0], f);
         return;
     }
     if (active && (io.MouseDelta.x != 0 || io.MouseDelta.y != 0)) {
         bool panning = io.MouseDown[2] || (io.MouseDown[0] && io.KeyShift);
         if (io.MouseDown[1]) {
-            st.camera.look(io.MouseDelta.x, io.MouseDelta.y);
+            st.view.camera.look(io.MouseDelta.x, io.MouseDelta.y);
             moved = true;
         } else if (panning) {
-            st.camera.pan(io.MouseDelta.x, io.MouseDelta.y, st.camera.panScale(proj.fovyDeg, b.y - a.y, ortho, proj.orthoHalfHeight));
+            st.view.camera.pan(io.MouseDelta.x, io.MouseDelta.y, st.view.camera.panScale(proj.fovyDeg, b.y - a.y, ortho, proj.orthoHalfHeight));
             moved = true;
         } else if (io.MouseDown[0]) {
-            st.camera.orbit(io.MouseDelta.x, io.MouseDelta.y);
+            st.view.camera.orbit(io.MouseDelta.x, io.MouseDelta.y);
             moved = true;
         }
     }
     if (hovered && io.MouseWheel != 0.0f) {
-        st.camera.zoom(io.MouseWheel);
+        st.view.camera.zoom(io.MouseWheel);
         moved = true;
     }
     // Fly mode: right mouse held + WASD (QE down/up), Shift = faster.
-    st.flyMode = active && io.MouseDown[1];
-    if (st.flyMode) {
-        float speed = std::max(st.camera.distance, 0.5f) * 0.8f * dt * (io.KeyShift ? 4.0f : 1.0f);
+    st.view.flyMode = active && io.MouseDown[1];
+    if (st.view.flyMode) {
+        float speed = std::max(st.view.camera.distance, 0.5f) * 0.8f * dt * (io.KeyShift ? 4.0f : 1.0f);
         sg::vec3 o(0.0f);
         if (ImGui::IsKeyDown(keys::W)) o.z += speed;
         if (ImGui::IsKeyDown(keys::S)) o.z -= speed;
@@ -1103,12 +1104,12 @@ void cameraInput(ViewerState& st, ImVec2 a, ImVec2 b, double time, float dt) {
         if (ImGui::IsKeyDown(keys::E)) o.y += speed;
         if (ImGui::IsKeyDown(keys::Q)) o.y -= speed;
         if (o != sg::vec3(0.0f)) {
-            st.camera.fly(o);
+            st.view.camera.fly(o);
             moved = true;
         }
     }
     if (moved) {
-        st.lastInteraction = time;
+        st.view.lastInteraction = time;
         st.markViewChanged();
     }
 }
@@ -1123,8 +1124,8 @@ void drawViewport(ViewerState& st, const ViewportInput& view, double time, float
     ImVec2 b(a.x + avail.x, a.y + avail.y);
     // Render at framebuffer pixels (HiDPI: DisplayFramebufferScale).
     ImVec2 fbs = ImGui::GetIO().DisplayFramebufferScale;
-    st.viewportWidth = std::max(1, int(avail.x * fbs.x));
-    st.viewportHeight = std::max(1, int(avail.y * fbs.y));
+    st.view.viewportWidth = std::max(1, int(avail.x * fbs.x));
+    st.view.viewportHeight = std::max(1, int(avail.y * fbs.y));
 
     ImGui::InvisibleButton("##viewport", avail,
                            ImGuiButtonFlags_MouseButtonLeft | ImGuiButtonFlags_MouseButtonRight | ImGuiButtonFlags_MouseButtonMiddle);
@@ -1136,13 +1137,13 @@ void drawViewport(ViewerState& st, const ViewportInput& view, double time, float
 
     ImDrawList* dl = ImGui::GetWindowDrawList();
     dl->PushClipRect(a, b, true);
-    switch (st.compare.mode) {
+    switch (st.view.compare.mode) {
     case ViewMode::Single:
         if (!view.slots.empty()) drawSlotImage(dl, view.slots[0], a, b, 0, 1, a, b);
         break;
     case ViewMode::Split: {
-        int n = std::min<int>(int(view.slots.size()), std::clamp(st.compare.count, 2, 3));
-        float edges[4] = {0.0f, st.compare.dividers[0], n == 3 ? st.compare.dividers[1] : 1.0f, 1.0f};
+        int n = std::min<int>(int(view.slots.size()), std::clamp(st.view.compare.count, 2, 3));
+        float edges[4] = {0.0f, st.view.compare.dividers[0], n == 3 ? st.view.compare.dividers[1] : 1.0f, 1.0f};
         if (n == 2) edges[2] = 1.0f;
         for (int i = 0; i < n; ++i) {
             float u0 = edges[i], u1 = edges[i + 1];
@@ -1157,7 +1158,7 @@ void drawViewport(ViewerState& st, const ViewportInput& view, double time, float
             dl->AddText(lp, IM_COL32(255, 255, 255, 255), name.c_str());
         }
         for (int i = 0; i + 1 < n; ++i) {
-            float x = a.x + st.compare.dividers[i] * avail.x;
+            float x = a.x + st.view.compare.dividers[i] * avail.x;
             dl->AddLine(ImVec2(x, a.y), ImVec2(x, b.y), IM_COL32(255, 255, 255, 200), px(2));
             dl->AddCircleFilled(ImVec2(x, (a.y + b.y) * 0.5f), px(7), IM_COL32(255, 255, 255, 230));
             dl->AddCircle(ImVec2(x, (a.y + b.y) * 0.5f), px(7), IM_COL32(40, 40, 40, 255), 0, px(1.5f));
@@ -1178,10 +1179,10 @@ void drawViewport(ViewerState& st, const ViewportInput& view, double time, float
         }
         if (view.slots.size() >= 2) {
             char buf[256];
-            if (st.haveDiff)
+            if (st.view.diff.valid)
                 std::snprintf(buf, sizeof buf, "|%s - %s|   mean %.2f   max %d   PSNR %.1f dB   within %d: %.1f%%",
-                              view.slots[0].status.backend.c_str(), view.slots[1].status.backend.c_str(), st.diffMean, st.diffMax, st.diffPsnr,
-                              st.compare.threshold, 100.0 * st.diffWithin);
+                              view.slots[0].status.backend.c_str(), view.slots[1].status.backend.c_str(), st.view.diff.mean, st.view.diff.max,
+                              st.view.diff.psnr, st.view.compare.threshold, 100.0 * st.view.diff.within);
             else
                 std::snprintf(buf, sizeof buf, "|%s - %s|", view.slots[0].status.backend.c_str(), view.slots[1].status.backend.c_str());
             ImVec2 ts = ImGui::CalcTextSize(buf);
@@ -1198,12 +1199,12 @@ void drawViewport(ViewerState& st, const ViewportInput& view, double time, float
         std::vector<std::string> lines;
         for (const SlotView& v : view.slots) lines.push_back(slotStats(v));
         char buf[128];
-        std::snprintf(buf, sizeof buf, "%d x %d   %s", st.viewportWidth, st.viewportHeight, st.flyMode ? "FLY (WASD QE)" : "");
+        std::snprintf(buf, sizeof buf, "%d x %d   %s", st.view.viewportWidth, st.view.viewportHeight, st.view.flyMode ? "FLY (WASD QE)" : "");
         lines.emplace_back(buf);
         float h = ImGui::GetTextLineHeightWithSpacing();
         float w = 0;
         for (auto& l : lines) w = std::max(w, ImGui::CalcTextSize(l.c_str()).x);
-        ImVec2 o(a.x + px(10), a.y + (st.compare.mode == ViewMode::Split ? px(36) : px(10)));
+        ImVec2 o(a.x + px(10), a.y + (st.view.compare.mode == ViewMode::Split ? px(36) : px(10)));
         dl->AddRectFilled(o, ImVec2(o.x + w + px(16), o.y + h * lines.size() + px(10)), IM_COL32(0, 0, 0, 150), px(4));
         for (size_t i = 0; i < lines.size(); ++i) {
             bool rendering = i < view.slots.size() && view.slots[i].status.rendering;
@@ -1439,7 +1440,7 @@ void drawDialogs(ViewerState& st) {
 
 void handleShortcuts(ViewerState& st) {
     ImGuiIO& io = ImGui::GetIO();
-    if (io.WantTextInput || st.flyMode) return;
+    if (io.WantTextInput || st.view.flyMode) return;
     if (ImGui::IsPopupOpen(nullptr, ImGuiPopupFlags_AnyPopupId)) return;
     bool ctrl = io.KeyCtrl;
     if (ctrl) {
@@ -1458,7 +1459,7 @@ void handleShortcuts(ViewerState& st) {
     for (int i = 0; i < 3; ++i)
         if (ImGui::IsKeyPressed(keys::Num1 + i, false)) {
             st.setBackendIndex(i);
-            st.compare.mode = ViewMode::Single;
+            st.view.compare.mode = ViewMode::Single;
         }
     if (ImGui::IsKeyPressed(keys::F, false)) st.fitView(st.doc.scene.valid(st.doc.selected));
     if (ImGui::IsKeyPressed(keys::Home, false)) st.resetView();
@@ -1572,7 +1573,9 @@ void drawUi(ViewerState& st, const ViewportInput& view, double time, float dt) {
             record(st, "status/renderNotes");
         }
         char right[160];
-        std::string mode = st.compare.mode == ViewMode::Single ? st.backend : st.compare.mode == ViewMode::Split ? "split view" : "difference view";
+        std::string mode = st.view.compare.mode == ViewMode::Single  ? st.view.backend
+                           : st.view.compare.mode == ViewMode::Split ? "split view"
+                                                                     : "difference view";
         std::snprintf(right, sizeof right, "%s   %s   %.0f fps", mode.c_str(), st.loadInProgress() ? "loading..." : "", io.Framerate);
         float w = ImGui::CalcTextSize(right).x;
         ImGui::SameLine(io.DisplaySize.x - w - px(12));

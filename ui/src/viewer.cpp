@@ -140,28 +140,28 @@ public:
     // Backends bound to the caller's GL context render on the UI thread with the window's
     // context, or on a worker with their own when glOnWorker (software GL); others always on a
     // worker (Auto).
-    RenderSlot::Threading slotThreading() const { return st.glOnWorker ? RenderSlot::Threading::Worker : RenderSlot::Threading::Auto; }
+    RenderSlot::Threading slotThreading() const { return st.view.glOnWorker ? RenderSlot::Threading::Worker : RenderSlot::Threading::Auto; }
     static bool contextBound(const RenderSlot& slot) { return slot.capabilities().affinity == rnd::ContextAffinity::CurrentGLContext; }
 
     // Requests renders for the visible backends and uploads finished images.
     void updateRenders() {
-        if (st.glOnWorker != m_glOnWorker) {   // where context-bound backends run changed: new slots
-            m_glOnWorker = st.glOnWorker;
+        if (st.view.glOnWorker != m_glOnWorker) {   // where context-bound backends run changed: new slots
+            m_glOnWorker = st.view.glOnWorker;
             for (auto& [name, v] : views) {
                 if (!v.slot || !contextBound(*v.slot)) continue;
                 v.slot.reset();   // joins its worker first
                 v.slot = std::make_unique<RenderSlot>(name, slotThreading());
             }
         }
-        int w = st.viewportWidth, h = st.viewportHeight;
+        int w = st.view.viewportWidth, h = st.view.viewportHeight;
         float aspect = float(w) / float(std::max(h, 1));
         // A playing animation changes the scene every frame: previews only, like a camera drag
         // (full resolution follows when it pauses).
-        bool interacting = (now - st.lastInteraction) < 0.25 || ImGui::GetIO().MouseDown[0] || ImGui::GetIO().MouseDown[1] ||
+        bool interacting = (now - st.view.lastInteraction) < 0.25 || ImGui::GetIO().MouseDown[0] || ImGui::GetIO().MouseDown[1] ||
                            ImGui::GetIO().MouseDown[2] || st.animationPlaying;
         std::vector<std::string> names = visibleBackends(st);
         std::shared_ptr<sg::FrameInput> base;
-        uint64_t key = (st.doc.version * 1000003u) ^ (st.viewVersion * 7919u) ^ (uint64_t(w) << 40) ^ (uint64_t(h) << 20);
+        uint64_t key = (st.doc.version * 1000003u) ^ (st.view.version * 7919u) ^ (uint64_t(w) << 40) ^ (uint64_t(h) << 20);
         for (const std::string& n : names) {
             BackendView& v = viewFor(n);
             sg::RenderSettings settings = st.settingsFor(n);
@@ -178,8 +178,8 @@ public:
     }
 
     void updateDiff() {
-        st.haveDiff = false;
-        if (st.compare.mode != ViewMode::Difference) return;
+        st.view.diff.valid = false;
+        if (st.view.compare.mode != ViewMode::Difference) return;
         std::vector<std::string> names = visibleBackends(st);
         const RenderSlot& a = *viewFor(names[0]).slot;
         const RenderSlot& b = *viewFor(names[1]).slot;
@@ -191,19 +191,19 @@ public:
             return;
         }
         // Recompute when either image, the pair or the threshold changed.
-        uint64_t k = (a.imageSerial() * 1000003u) ^ (b.imageSerial() * 7919u) ^ (uint64_t(st.compare.threshold) << 56) ^
+        uint64_t k = (a.imageSerial() * 1000003u) ^ (b.imageSerial() * 7919u) ^ (uint64_t(st.view.compare.threshold) << 56) ^
                      std::hash<std::string>{}(names[0] + "|" + names[1]);
         if (k != diffKey) {
             diffKey = k;
-            diffTexture.upload(rnd::diffImage(fa, fb, st.compare.threshold));
-            rnd::ImageDiff d = rnd::compareImages(fa, fb, st.compare.threshold);
+            diffTexture.upload(rnd::diffImage(fa, fb, st.view.compare.threshold));
+            rnd::ImageDiff d = rnd::compareImages(fa, fb, st.view.compare.threshold);
             m_lastDiff = d;
         }
-        st.haveDiff = true;
-        st.diffMean = m_lastDiff.meanAbs;
-        st.diffMax = m_lastDiff.maxAbs;
-        st.diffPsnr = m_lastDiff.psnr;
-        st.diffWithin = m_lastDiff.fractionWithin;
+        st.view.diff.valid = true;
+        st.view.diff.mean = m_lastDiff.meanAbs;
+        st.view.diff.max = m_lastDiff.maxAbs;
+        st.view.diff.psnr = m_lastDiff.psnr;
+        st.view.diff.within = m_lastDiff.fractionWithin;
     }
 
     ViewportInput viewportInput() {
@@ -217,7 +217,7 @@ public:
             s.status = v.slot->status();
             in.slots.push_back(s);
         }
-        if (st.compare.mode == ViewMode::Difference && st.haveDiff) {
+        if (st.view.compare.mode == ViewMode::Difference && st.view.diff.valid) {
             in.diff.texture = diffTexture.imguiId();
             in.diff.width = diffTexture.width;
             in.diff.height = diffTexture.height;
@@ -228,8 +228,8 @@ public:
     // Starts offscreen screenshots of every visible backend at w x h (0 = viewport size).
     void startScreenshots(int w, int h, const fs::path& dir) {
         if (w < 1 || h < 1) {
-            w = st.viewportWidth;
-            h = st.viewportHeight;
+            w = st.view.viewportWidth;
+            h = st.view.viewportHeight;
         }
         float aspect = float(w) / float(h);
         auto base = std::make_shared<sg::FrameInput>(st.buildFrame(aspect));
@@ -399,7 +399,7 @@ public:
                 std::string b;
                 in >> b;
                 v.st.setBackend(b);
-                v.st.compare.mode = ViewMode::Single;
+                v.st.view.compare.mode = ViewMode::Single;
                 continue;
             }
             if (cmd == "view") {
@@ -411,14 +411,14 @@ public:
             if (cmd == "orbit") {
                 float dx = 0, dy = 0;
                 in >> dx >> dy;
-                v.st.camera.orbit(dx, dy);
+                v.st.view.camera.orbit(dx, dy);
                 v.st.markViewChanged();
                 continue;
             }
             if (cmd == "zoom") {
                 float s = 0;
                 in >> s;
-                v.st.camera.zoom(s);
+                v.st.view.camera.zoom(s);
                 v.st.markViewChanged();
                 continue;
             }
@@ -429,7 +429,7 @@ public:
             if (cmd == "gl-worker") {
                 std::string on;
                 in >> on;
-                v.st.glOnWorker = on == "on";
+                v.st.view.glOnWorker = on == "on";
                 continue;
             }
             if (cmd == "tab") {
@@ -451,8 +451,8 @@ public:
             if (cmd == "stats") {   // one line per shown backend: time, triangles, rays, error
                 for (const std::string& n : visibleBackends(v.st)) {
                     SlotStatus s = v.viewFor(n).slot->status();
-                    std::printf("viewer: stats %s %dx%d level %d: %.1f ms, %llu triangles, %llu rays%s%s\n", n.c_str(), v.st.viewportWidth,
-                                v.st.viewportHeight, s.level, s.stats.milliseconds, (unsigned long long)s.stats.triangles,
+                    std::printf("viewer: stats %s %dx%d level %d: %.1f ms, %llu triangles, %llu rays%s%s\n", n.c_str(), v.st.view.viewportWidth,
+                                v.st.view.viewportHeight, s.level, s.stats.milliseconds, (unsigned long long)s.stats.triangles,
                                 (unsigned long long)s.stats.rays, s.error.empty() ? "" : ", error: ", s.error.c_str());
                 }
                 std::fflush(stdout);
@@ -484,21 +484,21 @@ public:
 
     static void applyView(ViewerState& st, const std::string& m) {
         if (m == "single")
-            st.compare.mode = ViewMode::Single;
+            st.view.compare.mode = ViewMode::Single;
         else if (m == "split") {
-            st.compare.mode = ViewMode::Split;
-            st.compare.count = 2;
-            st.compare.backends = {"gl", "raster", "raycast"};
+            st.view.compare.mode = ViewMode::Split;
+            st.view.compare.count = 2;
+            st.view.compare.backends = {"gl", "raster", "raycast"};
         } else if (m == "split3") {
-            st.compare.mode = ViewMode::Split;
-            st.compare.count = 3;
-            st.compare.dividers = {0.33f, 0.66f};
-            st.compare.backends = {"gl", "raster", "raycast"};
+            st.view.compare.mode = ViewMode::Split;
+            st.view.compare.count = 3;
+            st.view.compare.dividers = {0.33f, 0.66f};
+            st.view.compare.backends = {"gl", "raster", "raycast"};
         } else if (m == "difference") {
-            st.compare.mode = ViewMode::Difference;
-            st.compare.backends = {"raster", "raycast", "gl"};
-            st.compare.diffA = 0;
-            st.compare.diffB = 1;
+            st.view.compare.mode = ViewMode::Difference;
+            st.view.compare.backends = {"raster", "raycast", "gl"};
+            st.view.compare.diffA = 0;
+            st.view.compare.diffB = 1;
         }
     }
 };
@@ -588,7 +588,7 @@ int runViewer(const ViewerOptions& opt) {
     // On a hardware GL the window's context on the UI thread is the fast path.
     if (const char* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER))) {
         std::string r = renderer;
-        st.glOnWorker = r.find("llvmpipe") != std::string::npos || r.find("softpipe") != std::string::npos;
+        st.view.glOnWorker = r.find("llvmpipe") != std::string::npos || r.find("softpipe") != std::string::npos;
     }
 
     // Config: imgui.ini (layout) and recent files in the per-user config folder.
@@ -627,7 +627,7 @@ int runViewer(const ViewerOptions& opt) {
     while (running) {
         bool busy = !v.shots.empty() || st.loadInProgress() || st.animationPlaying || automated;
         for (auto& [n, bv] : v.views) busy |= bv.slot->status().rendering;
-        if (busy || (v.now - st.lastInteraction) < 0.5)
+        if (busy || (v.now - st.view.lastInteraction) < 0.5)
             glfwPollEvents();
         else
             glfwWaitEventsTimeout(0.1);

@@ -37,7 +37,7 @@ void ViewerState::markEdited() {
     ++doc.version;
 }
 
-void ViewerState::markViewChanged() { ++viewVersion; }
+void ViewerState::markViewChanged() { ++view.version; }
 
 void ViewerState::selectNode(sg::NodeId id) { doc.selected = doc.scene.valid(id) ? id : sg::kNoNode; }
 
@@ -116,7 +116,7 @@ sg::NodeId ViewerState::addLight(sg::LightType type, sg::NodeId parent) {
     l.intensity = type == sg::LightType::Directional ? 1.0f : 10.0f;
     l.inverseSquare = type != sg::LightType::Directional;
     sg::NodeId id = doc.scene.addNode(uniqueName(doc.scene, std::string(sg::toString(type)) + " light"), parentFor(*this, parent), l);
-    sg::LocalTransform t = sg::LocalTransform::fromTRS(camera.pivot + sg::vec3(0, 3, 0));
+    sg::LocalTransform t = sg::LocalTransform::fromTRS(view.camera.pivot + sg::vec3(0, 3, 0));
     t.setEulerDegrees(sg::vec3(-90, 0, 0));   // point down
     doc.scene.setLocal(id, t);
     doc.selected = id;
@@ -127,9 +127,9 @@ sg::NodeId ViewerState::addLight(sg::LightType type, sg::NodeId parent) {
 sg::NodeId ViewerState::addCamera() {
     sg::Camera c;
     c.projection = projection();
-    c.focusDistance = camera.distance;
+    c.focusDistance = view.camera.distance;
     sg::NodeId id = doc.scene.addNode(uniqueName(doc.scene, "camera"), doc.scene.root(), c);
-    doc.scene.setLocalMatrix(id, camera.world());
+    doc.scene.setLocalMatrix(id, view.camera.world());
     sg::LocalTransform t = doc.scene.node(id).local;
     if (t.tryMakeTRS()) doc.scene.setLocal(id, t);
     if (!doc.scene.valid(doc.scene.activeCamera)) doc.scene.activeCamera = id;
@@ -181,9 +181,9 @@ void ViewerState::setLocal(sg::NodeId id, const sg::LocalTransform& t) {
 // --- backend ---------------------------------------------------------------------------------
 
 void ViewerState::setBackend(const std::string& name) {
-    if (backend == name) return;
-    backend = name;
-    compare.backends[0] = name;
+    if (view.backend == name) return;
+    view.backend = name;
+    view.compare.backends[0] = name;
     status = "Backend: " + name;
 }
 
@@ -203,7 +203,7 @@ const sg::Camera* activeCam(const sg::Scene& s) {
 
 const sg::Projection& ViewerState::projection() const {
     const sg::Camera* c = activeCam(doc.scene);
-    return c ? c->projection : fallbackProjection;
+    return c ? c->projection : view.fallbackProjection;
 }
 
 sg::Projection& ViewerState::editProjection() {
@@ -211,21 +211,21 @@ sg::Projection& ViewerState::editProjection() {
         markEdited();
         return std::get<sg::Camera>(doc.scene.editPayload(doc.scene.activeCamera)).projection;
     }
-    ++viewVersion;
-    return fallbackProjection;
+    ++view.version;
+    return view.fallbackProjection;
 }
 
 float ViewerState::focusDistance() const {
     const sg::Camera* c = activeCam(doc.scene);
-    return c ? c->focusDistance : fallbackFocus;
+    return c ? c->focusDistance : view.fallbackFocus;
 }
 
 sg::Projection ViewerState::viewProjection() const {
     sg::Projection p = projection();
-    p.orthoHalfHeight *= camera.orthoScale;
+    p.orthoHalfHeight *= view.camera.orthoScale;
     // Keep the clip range around the pivot when the user zooms far out or in.
     if (p.type == sg::ProjectionType::Perspective && !p.useFrustum) {
-        float ratio = camera.distance / std::max(focusDistance(), 1e-6f);
+        float ratio = view.camera.distance / std::max(focusDistance(), 1e-6f);
         if (ratio > 1.0f) p.zFar *= ratio;
         if (ratio < 1.0f) p.zNear = std::max(p.zNear * ratio, 1e-4f);
     }
@@ -241,27 +241,27 @@ void ViewerState::fitView(bool selectionOnly) {
         if (b.empty()) b = sg::Aabb{sg::vec3(doc.scene.world(doc.selected)[3]) - 0.5f, sg::vec3(doc.scene.world(doc.selected)[3]) + 0.5f};
     }
     if (b.empty()) b = doc.scene.worldBounds();
-    float aspect = float(std::max(viewportWidth, 1)) / float(std::max(viewportHeight, 1));
-    camera.fit(b, projection().fovyDeg, aspect, projection().orthoHalfHeight);
+    float aspect = float(std::max(view.viewportWidth, 1)) / float(std::max(view.viewportHeight, 1));
+    view.camera.fit(b, projection().fovyDeg, aspect, projection().orthoHalfHeight);
     markViewChanged();
 }
 
 void ViewerState::resetView() {
     const sg::Camera* c = activeCam(doc.scene);
     if (c) {
-        camera.setFromWorld(doc.scene.world(doc.scene.activeCamera), c->focusDistance);
+        view.camera.setFromWorld(doc.scene.world(doc.scene.activeCamera), c->focusDistance);
     } else {
         if (doc.scene.cameras().empty()) {
-            camera = OrbitCamera{};
-            camera.yaw = std::atan2(0.5f, 1.0f);
-            camera.pitch = 0.35f;
-            float aspect = float(std::max(viewportWidth, 1)) / float(std::max(viewportHeight, 1));
-            camera.fit(doc.scene.worldBounds(), fallbackProjection.fovyDeg, aspect, fallbackProjection.orthoHalfHeight);
+            view.camera = OrbitCamera{};
+            view.camera.yaw = std::atan2(0.5f, 1.0f);
+            view.camera.pitch = 0.35f;
+            float aspect = float(std::max(view.viewportWidth, 1)) / float(std::max(view.viewportHeight, 1));
+            view.camera.fit(doc.scene.worldBounds(), view.fallbackProjection.fovyDeg, aspect, view.fallbackProjection.orthoHalfHeight);
             sg::Aabb b = doc.scene.worldBounds();
             float r = b.empty() ? 2.0f : 0.5f * glm::length(b.extent());
-            fallbackProjection.zNear = std::max(camera.distance - 3.0f * r, camera.distance * 0.01f);
-            fallbackProjection.zFar = camera.distance + 3.0f * r;
-            fallbackFocus = camera.distance;
+            view.fallbackProjection.zNear = std::max(view.camera.distance - 3.0f * r, view.camera.distance * 0.01f);
+            view.fallbackProjection.zFar = view.camera.distance + 3.0f * r;
+            view.fallbackFocus = view.camera.distance;
         } else {
             useSceneCamera(doc.scene.cameras().front());
             return;
@@ -276,7 +276,7 @@ void ViewerState::useSceneCamera(sg::NodeId id) {
         doc.scene.activeCamera = id;
         markEdited();
     }
-    camera.setFromWorld(doc.scene.world(id), std::get<sg::Camera>(doc.scene.node(id).payload).focusDistance);
+    view.camera.setFromWorld(doc.scene.world(id), std::get<sg::Camera>(doc.scene.node(id).payload).focusDistance);
     markViewChanged();
 }
 
@@ -285,31 +285,31 @@ void ViewerState::storeViewInCamera() {
     if (!doc.scene.valid(id) || !std::holds_alternative<sg::Camera>(doc.scene.node(id).payload)) return;
     sg::NodeId parent = doc.scene.node(id).parent;
     sg::mat4 parentWorld = doc.scene.valid(parent) ? doc.scene.world(parent) : sg::mat4(1.0f);
-    sg::LocalTransform t = sg::LocalTransform::fromMatrix(glm::inverse(parentWorld) * camera.world());
+    sg::LocalTransform t = sg::LocalTransform::fromMatrix(glm::inverse(parentWorld) * view.camera.world());
     t.tryMakeTRS();
     sg::Camera c = std::get<sg::Camera>(doc.scene.node(id).payload);
-    float focus = camera.distance;
-    float ortho = c.projection.orthoHalfHeight * camera.orthoScale;
+    float focus = view.camera.distance;
+    float ortho = c.projection.orthoHalfHeight * view.camera.orthoScale;
     bool changed = !(doc.scene.node(id).local == t) || c.focusDistance != focus || c.projection.orthoHalfHeight != ortho;
     if (!changed) return;
     doc.scene.setLocal(id, t);
     c.focusDistance = focus;
     c.projection.orthoHalfHeight = ortho;
     doc.scene.setPayload(id, c);
-    camera.orthoScale = 1.0f;
+    view.camera.orthoScale = 1.0f;
     markEdited();
 }
 
 sg::FrameInput ViewerState::buildFrame(float aspect) const {
     sg::FrameInput f = sg::flatten(doc.scene, aspect, doc.scene.activeCamera);
-    f.camera = sg::makeFrameCamera(camera.world(), viewProjection(), aspect, camera.distance);
+    f.camera = sg::makeFrameCamera(view.camera.world(), viewProjection(), aspect, view.camera.distance);
     return f;
 }
 
 sg::RenderSettings ViewerState::settingsFor(const std::string& b) const {
     sg::RenderSettings s = doc.scene.settings;
-    auto it = aaOverride.find(b);
-    if (it != aaOverride.end()) s.setAA(it->second);
+    auto it = view.aaOverride.find(b);
+    if (it != view.aaOverride.end()) s.setAA(it->second);
     return s;
 }
 

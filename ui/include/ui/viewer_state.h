@@ -81,19 +81,40 @@ struct Document {
     std::vector<std::string> loadWarnings;   // of the load that brought this scene
 };
 
-struct ViewerState {
-    Document doc;
-    uint64_t viewVersion = 1;   // bumped on camera moves (re-render)
+// Figures of the difference view (filled by the window from the two shown images).
+struct DiffFigures {
+    bool valid = false;   // both full-resolution images are there
+    double mean = 0, psnr = 0;
+    int max = 0;
+    double within = 1;   // fraction of pixels within the threshold
+};
 
-    // --- view ----------------------------------------------------------------------------
-    std::string backend = "gl";   // the single view's backend
-    CompareConfig compare;
+// How the scene is looked at: the orbit camera, the viewport, which backends show it and how
+// they render. Not saved with the scene (except the camera, stored into the active scene
+// camera on save); camera moves bump `version` (re-render, not an edit).
+struct View {
     OrbitCamera camera;
     sg::Projection fallbackProjection;   // used when the scene has no camera
     float fallbackFocus = 5.0f;
+    uint64_t version = 1;                        // bumped on camera moves (re-render)
     int viewportWidth = 1, viewportHeight = 1;   // pixels, set by the viewport panel
     double lastInteraction = -1e9;               // time (s) of the last camera drag/zoom/fly
     bool flyMode = false;
+
+    std::string backend = "gl";   // the single view's backend
+    CompareConfig compare;
+    DiffFigures diff;
+    // Per-backend anti-aliasing overrides for this session (backend -> "msaa4", ...); the
+    // scene's own setting (saved) applies to backends without one.
+    std::map<std::string, std::string> aaOverride;
+    // Run the GL backend on a worker thread with its own headless context (never blocks the
+    // UI with software GL); off = on the UI thread with the window's context.
+    bool glOnWorker = false;
+};
+
+struct ViewerState {
+    Document doc;
+    View view;
 
     // --- messages ----------------------------------------------------------------------
     std::string status;       // one line shown in the status bar
@@ -118,26 +139,12 @@ struct ViewerState {
     bool animationPlaying = false;
     bool animationLoop = true;   // wrap at the end (else stop there)
 
-    // Per-backend anti-aliasing overrides for this session (backend -> "msaa4", ...); the
-    // scene's own setting (saved) applies to backends without one.
-    std::map<std::string, std::string> aaOverride;
-
-    // Run the GL backend on a worker thread with its own headless context (never blocks the
-    // UI with software GL); off = on the UI thread with the window's context.
-    bool glOnWorker = false;
-
     Requests requests;
     PanelState panels;                           // the ImGui panels' own state (dialogs, toggles)
     std::string requestedTab;                    // select this right-panel tab next frame
     std::vector<std::string> recentFiles;        // most recent first
     std::filesystem::path configDir;             // where recent.txt lives ("" = don't persist)
     std::map<std::string, ItemRect> itemRects;   // test hook, filled by panels
-
-    // Comparison figures of the difference view (filled by the window).
-    bool haveDiff = false;
-    double diffMean = 0, diffPsnr = 0;
-    int diffMax = 0;
-    double diffWithin = 1;
 
     // --- actions -----------------------------------------------------------------------
     // Replaces the scene (after a load): resets selection, dirty flag and camera.
@@ -172,7 +179,7 @@ struct ViewerState {
     void resetView();                             // Home: back to the active scene camera
     void useSceneCamera(sg::NodeId cameraNode);   // make active and look through it
     void storeViewInCamera();                     // writes the orbit view into the active camera
-    sg::mat4 cameraWorld() const { return camera.world(); }
+    sg::mat4 cameraWorld() const { return view.camera.world(); }
     // The effective projection of the view (ortho zoom applied).
     sg::Projection viewProjection() const;
     // Flattened frame for the current view: sg::flatten, then the orbit camera.
