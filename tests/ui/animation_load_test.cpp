@@ -310,7 +310,7 @@ TEST(ViewerStateLoadTest, ProgressIsReported) {
     EXPECT_EQ(st.loadProgress(), 0.0f);
     st.startLoad(file);
     float maxSeen = 0.0f;
-    while (st.loading.wait_for(std::chrono::milliseconds(2)) != std::future_status::ready) maxSeen = std::max(maxSeen, st.loadProgress());
+    while (st.load.task.wait_for(std::chrono::milliseconds(2)) != std::future_status::ready) maxSeen = std::max(maxSeen, st.loadProgress());
     maxSeen = std::max(maxSeen, st.loadProgress());
     ASSERT_TRUE(st.pollLoad(true));
     ASSERT_TRUE(st.errorPopup.empty()) << st.errorPopup;

@@ -380,14 +380,14 @@ void ViewerState::confirm(ConfirmChoice choice) {
 }
 
 void ViewerState::startLoad(const fs::path& path) {
-    if (loading.valid()) {
-        status = "Still loading " + loadingPath.filename().string();
+    if (load.task.valid()) {
+        status = "Still loading " + load.path.filename().string();
         return;
     }
-    loadingPath = path;
+    load.path = path;
     status = "Loading " + path.string() + " ...";
-    loadControl = std::make_shared<LoadControl>();
-    loading = std::async(std::launch::async, [path, control = loadControl] {
+    load.control = std::make_shared<LoadControl>();
+    load.task = std::async(std::launch::async, [path, control = load.control] {
         try {
             assets::LoadOptions options;
             options.cancel = &control->cancel;
@@ -402,32 +402,32 @@ void ViewerState::startLoad(const fs::path& path) {
 }
 
 bool ViewerState::pollLoad(bool wait) {
-    if (!loading.valid()) return false;
-    if (!wait && loading.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return false;
-    assets::LoadResult r = loading.get();
+    if (!load.task.valid()) return false;
+    if (!wait && load.task.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return false;
+    assets::LoadResult r = load.task.get();
     if (loadCancelRequested()) {   // whatever the importer returned: the user said no
-        status = "Loading " + loadingPath.filename().string() + " cancelled; the current scene is unchanged";
+        status = "Loading " + load.path.filename().string() + " cancelled; the current scene is unchanged";
         return true;
     }
     doc.loadWarnings = r.warnings;
     if (!r.scene) {
-        errorPopup = "Could not open " + loadingPath.string() + ":\n" + (r.error.empty() ? "unknown error" : r.error);
+        errorPopup = "Could not open " + load.path.string() + ":\n" + (r.error.empty() ? "unknown error" : r.error);
         status = "Open failed; the current scene is unchanged";
         return true;
     }
-    setScene(std::move(*r.scene), loadingPath);
+    setScene(std::move(*r.scene), load.path);
     animations = std::move(r.animations);
     if (!animations.empty()) animationTime = animations.front().start;
-    addRecent(fs::absolute(loadingPath).lexically_normal().string());
-    status = "Opened " + loadingPath.string() + (r.warnings.empty() ? "" : " (" + std::to_string(r.warnings.size()) + " warnings)") +
+    addRecent(fs::absolute(load.path).lexically_normal().string());
+    status = "Opened " + load.path.string() + (r.warnings.empty() ? "" : " (" + std::to_string(r.warnings.size()) + " warnings)") +
              (animations.empty() ? "" : ", " + std::to_string(animations.size()) + " animation(s): Space plays");
     return true;
 }
 
 void ViewerState::cancelLoad() {
-    if (!loading.valid() || !loadControl || loadControl->cancel.load()) return;
-    loadControl->cancel = true;
-    status = "Cancelling loading " + loadingPath.filename().string() + " ...";
+    if (!load.task.valid() || !load.control || load.control->cancel.load()) return;
+    load.control->cancel = true;
+    status = "Cancelling loading " + load.path.filename().string() + " ...";
 }
 
 std::string ViewerState::save(const fs::path& path) {

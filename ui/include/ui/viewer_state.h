@@ -112,9 +112,18 @@ struct View {
     bool glOnWorker = false;
 };
 
+// A scene load running off the UI thread: startLoad starts it, pollLoad finishes it (the
+// document changes only then, and only when it succeeded).
+struct AsyncLoad {
+    std::future<assets::LoadResult> task;
+    std::filesystem::path path;
+    std::shared_ptr<LoadControl> control;   // of the current / last load
+};
+
 struct ViewerState {
     Document doc;
     View view;
+    AsyncLoad load;
 
     // --- messages ----------------------------------------------------------------------
     std::string status;       // one line shown in the status bar
@@ -124,11 +133,6 @@ struct ViewerState {
     PendingAction pending = PendingAction::None;
     std::filesystem::path pendingPath;
     bool confirmOpen = false;   // the modal should be shown
-
-    // --- async load --------------------------------------------------------------------
-    std::future<assets::LoadResult> loading;
-    std::filesystem::path loadingPath;
-    std::shared_ptr<LoadControl> loadControl;   // of the current / last load
 
     // --- animation (glTF node TRS clips of the loaded file) --------------------------------
     // Playing changes node locals and re-renders (doc.version) but is not an edit: the dirty
@@ -199,12 +203,12 @@ struct ViewerState {
     void newScene();   // replaces the scene by an empty one without asking
     // std::async with a fresh LoadControl (progress + cancel).
     void startLoad(const std::filesystem::path& path);
-    bool loadInProgress() const { return loading.valid(); }
+    bool loadInProgress() const { return load.task.valid(); }
     // Asks the running load to stop; pollLoad then keeps the current scene and reports
     // "Loading X cancelled" (also when the importer finished before it saw the request).
     void cancelLoad();
-    bool loadCancelRequested() const { return loadControl && loadControl->cancel.load(); }
-    float loadProgress() const { return loadControl ? loadControl->progress.load() : 0.0f; }
+    bool loadCancelRequested() const { return load.control && load.control->cancel.load(); }
+    float loadProgress() const { return load.control ? load.control->progress.load() : 0.0f; }
     // Finishes a completed load (non-blocking); returns true when a load finished.
     bool pollLoad(bool wait = false);
     // Saves to doc.path (or `path`), writing the view into the active camera first.
