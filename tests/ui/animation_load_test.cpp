@@ -92,19 +92,19 @@ sg::vec3 worldT(const ViewerState& st, sg::NodeId id) { return sg::vec3(st.doc.s
 
 TEST(ViewerStateAnimTest, LoadKeepsClipsAndNewSceneDropsThem) {
     ViewerState st = animatedState();
-    ASSERT_EQ(st.animations.size(), 2u);
-    EXPECT_EQ(st.animations[0].name, "slide");
-    EXPECT_EQ(st.animationClip, 0);
-    EXPECT_FALSE(st.animationPlaying);
-    EXPECT_FLOAT_EQ(st.animations[0].start, 0.0f);
+    ASSERT_EQ(st.anim.clips.size(), 2u);
+    EXPECT_EQ(st.anim.clips[0].name, "slide");
+    EXPECT_EQ(st.anim.clip, 0);
+    EXPECT_FALSE(st.anim.playing);
+    EXPECT_FLOAT_EQ(st.anim.clips[0].start, 0.0f);
     EXPECT_DOUBLE_EQ(st.animationEnd(), 2.0);
     EXPECT_NE(st.status.find("animation"), std::string::npos) << st.status;
     // The demo / a new scene has no clips.
     st.setScene(assets::makeDemoScene(), {});
-    EXPECT_TRUE(st.animations.empty());
+    EXPECT_TRUE(st.anim.clips.empty());
     EXPECT_EQ(st.currentAnimation(), nullptr);
     st.setAnimationPlaying(true);   // nothing to play: stays stopped
-    EXPECT_FALSE(st.animationPlaying);
+    EXPECT_FALSE(st.anim.playing);
     st.advanceAnimation(0.5);   // and does nothing
 }
 
@@ -125,7 +125,7 @@ TEST(ViewerStateAnimTest, PlayInterpolatesPauseStopsScrubSetsNeverDirty) {
     st.setAnimationPlaying(true);
     st.advanceAnimation(0.5);
     st.advanceAnimation(0.5);
-    EXPECT_NEAR(st.animationTime, 1.0, 1e-9);
+    EXPECT_NEAR(st.anim.time, 1.0, 1e-9);
     EXPECT_NEAR(glm::length(localT(st, mover) - sg::vec3(2, 0, 0)), 0.0f, 1e-5f);
     EXPECT_NEAR(glm::length(worldT(st, mover) - world0 - sg::vec3(2, 0, 0)), 0.0f, 1e-4f);
     EXPECT_GT(st.doc.version, v0);   // re-render ...
@@ -135,7 +135,7 @@ TEST(ViewerStateAnimTest, PlayInterpolatesPauseStopsScrubSetsNeverDirty) {
     st.setAnimationPlaying(false);
     uint64_t v1 = st.doc.version;
     st.advanceAnimation(0.5);
-    EXPECT_NEAR(st.animationTime, 1.0, 1e-9);
+    EXPECT_NEAR(st.anim.time, 1.0, 1e-9);
     EXPECT_NEAR(localT(st, mover).x, 2.0f, 1e-5f);
     EXPECT_EQ(st.doc.version, v1);
 
@@ -144,12 +144,12 @@ TEST(ViewerStateAnimTest, PlayInterpolatesPauseStopsScrubSetsNeverDirty) {
     EXPECT_NEAR(localT(st, mover).x, 1.0f, 1e-5f);
     EXPECT_GT(st.doc.version, v1);
     st.setAnimationTime(10.0);
-    EXPECT_DOUBLE_EQ(st.animationTime, 2.0);
+    EXPECT_DOUBLE_EQ(st.anim.time, 2.0);
     EXPECT_NEAR(localT(st, mover).x, 4.0f, 1e-5f);
     st.setAnimationTime(-1.0);
-    EXPECT_DOUBLE_EQ(st.animationTime, 0.0);
+    EXPECT_DOUBLE_EQ(st.anim.time, 0.0);
     EXPECT_NEAR(localT(st, mover).x, 0.0f, 1e-5f);
-    EXPECT_FALSE(st.animationPlaying);
+    EXPECT_FALSE(st.anim.playing);
     EXPECT_FALSE(st.doc.dirty);
 
     // An edit still marks dirty; playing afterwards does not clear or set anything else.
@@ -161,21 +161,21 @@ TEST(ViewerStateAnimTest, LoopWrapsAndOneShotStopsAtTheEnd) {
     ViewerState st = animatedState();
     sg::NodeId mover = st.doc.scene.findByName("mover");
     ASSERT_TRUE(st.doc.scene.valid(mover));
-    ASSERT_TRUE(st.animationLoop);
+    ASSERT_TRUE(st.anim.loop);
     st.setAnimationPlaying(true);
     st.advanceAnimation(2.5);   // 2.5 s in a 2 s loop: t = 0.5
-    EXPECT_TRUE(st.animationPlaying);
-    EXPECT_NEAR(st.animationTime, 0.5, 1e-9);
+    EXPECT_TRUE(st.anim.playing);
+    EXPECT_NEAR(st.anim.time, 0.5, 1e-9);
     EXPECT_NEAR(localT(st, mover).x, 1.0f, 1e-5f);
 
-    st.animationLoop = false;
+    st.anim.loop = false;
     st.advanceAnimation(3.0);   // past the end: clamps and stops
-    EXPECT_FALSE(st.animationPlaying);
-    EXPECT_DOUBLE_EQ(st.animationTime, 2.0);
+    EXPECT_FALSE(st.anim.playing);
+    EXPECT_DOUBLE_EQ(st.anim.time, 2.0);
     EXPECT_NEAR(localT(st, mover).x, 4.0f, 1e-5f);
     st.toggleAnimation();   // play again from the end: restarts at the clip start
-    EXPECT_TRUE(st.animationPlaying);
-    EXPECT_DOUBLE_EQ(st.animationTime, 0.0);
+    EXPECT_TRUE(st.anim.playing);
+    EXPECT_DOUBLE_EQ(st.anim.time, 0.0);
     st.advanceAnimation(1.5);
     EXPECT_NEAR(localT(st, mover).x, 3.0f, 1e-5f);
     EXPECT_FALSE(st.doc.dirty);
@@ -189,15 +189,15 @@ TEST(ViewerStateAnimTest, SelectingAClipRewindsAndUsesItsInterpolation) {
     EXPECT_NEAR(localT(st, mover).x, 2.0f, 1e-5f);
     st.setAnimationPlaying(true);
     st.selectAnimation(1);   // "step": stops and rewinds
-    EXPECT_EQ(st.animationClip, 1);
-    EXPECT_FALSE(st.animationPlaying);
-    EXPECT_DOUBLE_EQ(st.animationTime, 0.0);
+    EXPECT_EQ(st.anim.clip, 1);
+    EXPECT_FALSE(st.anim.playing);
+    EXPECT_DOUBLE_EQ(st.anim.time, 0.0);
     st.setAnimationTime(1.5);
     EXPECT_NEAR(localT(st, mover).x, 0.0f, 1e-5f);   // STEP holds the first key until t = 2
     st.setAnimationTime(2.0);
     EXPECT_NEAR(localT(st, mover).x, 4.0f, 1e-5f);
     st.selectAnimation(7);   // out of range: ignored
-    EXPECT_EQ(st.animationClip, 1);
+    EXPECT_EQ(st.anim.clip, 1);
     EXPECT_FALSE(st.doc.dirty);
 }
 
@@ -207,13 +207,13 @@ TEST(ViewerStateAnimTest, CesiumMilkTruckWheelsTurnWithoutDirtying) {
     st.startLoad(testing_support::testdataDir() / "gltf/CesiumMilkTruck/glTF/CesiumMilkTruck.gltf");
     ASSERT_TRUE(st.pollLoad(true));
     ASSERT_TRUE(st.errorPopup.empty()) << st.errorPopup;
-    ASSERT_EQ(st.animations.size(), 1u);
-    sg::NodeId wheel = st.animations[0].channels.at(0).node;
+    ASSERT_EQ(st.anim.clips.size(), 1u);
+    sg::NodeId wheel = st.anim.clips[0].channels.at(0).node;
     ASSERT_TRUE(st.doc.scene.valid(wheel));
-    st.setAnimationTime(st.animations[0].start);
+    st.setAnimationTime(st.anim.clips[0].start);
     sg::mat4 a = st.doc.scene.world(wheel);
     st.setAnimationPlaying(true);
-    st.advanceAnimation(0.37 * (st.animationEnd() - st.animations[0].start));
+    st.advanceAnimation(0.37 * (st.animationEnd() - st.anim.clips[0].start));
     EXPECT_NE(st.doc.scene.world(wheel), a);
     EXPECT_FALSE(st.doc.dirty);
 }

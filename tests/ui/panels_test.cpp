@@ -251,29 +251,29 @@ assets::AnimationClip crateClip(const sg::Scene& s) {
 TEST(PanelsTest, AnimationBarOnlyWithClipsPlayButtonAndSpaceToggle) {
     Headless h;
     EXPECT_EQ(h.st.itemRects.count("anim/play"), 0u);   // the demo has no clips: no bar
-    h.st.animations.push_back(crateClip(h.st.doc.scene));
+    h.st.anim.clips.push_back(crateClip(h.st.doc.scene));
     h.frame();
     ASSERT_NO_THROW(h.rect("anim/play"));
     EXPECT_NO_THROW(h.rect("anim/time"));
     EXPECT_NO_THROW(h.rect("anim/loop"));
     EXPECT_NO_THROW(h.rect("anim/clip"));
-    ASSERT_FALSE(h.st.animationPlaying);
+    ASSERT_FALSE(h.st.anim.playing);
     h.click("anim/play");
-    EXPECT_TRUE(h.st.animationPlaying);
+    EXPECT_TRUE(h.st.anim.playing);
     h.st.advanceAnimation(1.0);   // the window's main loop does this every frame
     sg::NodeId crate = h.st.doc.scene.findByName("crate");
     EXPECT_NEAR(h.st.doc.scene.node(crate).local.translation.x, 2.0f, 1e-5f);
     h.click("anim/play");   // now "Pause"
-    EXPECT_FALSE(h.st.animationPlaying);
-    bool loop = h.st.animationLoop;
+    EXPECT_FALSE(h.st.anim.playing);
+    bool loop = h.st.anim.loop;
     h.click("anim/loop");
-    EXPECT_NE(h.st.animationLoop, loop);
+    EXPECT_NE(h.st.anim.loop, loop);
     // Space toggles while the viewport has focus (a click in it gives it focus).
     h.click("viewport");
     h.press(keys::Space);
-    EXPECT_TRUE(h.st.animationPlaying);
+    EXPECT_TRUE(h.st.anim.playing);
     h.press(keys::Space);
-    EXPECT_FALSE(h.st.animationPlaying);
+    EXPECT_FALSE(h.st.anim.playing);
     // Scrub: a click at the slider's left end goes to the clip start.
     const ItemRect r = h.rect("anim/time");
     h.moveTo(r.x0 + 2.0f, r.cy());
@@ -281,8 +281,8 @@ TEST(PanelsTest, AnimationBarOnlyWithClipsPlayButtonAndSpaceToggle) {
     h.frame();
     ImGui::GetIO().MouseDown[0] = false;
     h.frame();
-    EXPECT_NEAR(h.st.animationTime, 0.0, 0.05);
-    EXPECT_NEAR(h.st.doc.scene.node(crate).local.translation.x, 2.0f * float(h.st.animationTime), 1e-4f);
+    EXPECT_NEAR(h.st.anim.time, 0.0, 0.05);
+    EXPECT_NEAR(h.st.doc.scene.node(crate).local.translation.x, 2.0f * float(h.st.anim.time), 1e-4f);
     EXPECT_FALSE(h.st.doc.dirty);
 }
 

@@ -721,31 +721,31 @@ void drawInspector(ViewerState& st) {
 }
 
 void drawAnimationPanel(ViewerState& st) {
-    if (st.animations.empty()) return;
+    if (st.anim.clips.empty()) return;
     section("Animation");
     const assets::AnimationClip* cur = st.currentAnimation();
     auto clipName = [&](int i) {
-        const std::string& n = st.animations[size_t(i)].name;
+        const std::string& n = st.anim.clips[size_t(i)].name;
         return n.empty() ? "clip " + std::to_string(i) : n;
     };
-    if (ImGui::BeginCombo("Clip", cur ? clipName(st.animationClip).c_str() : "-")) {
-        for (int i = 0; i < int(st.animations.size()); ++i) {
+    if (ImGui::BeginCombo("Clip", cur ? clipName(st.anim.clip).c_str() : "-")) {
+        for (int i = 0; i < int(st.anim.clips.size()); ++i) {
             ImGui::PushID(i);
-            if (ImGui::Selectable(clipName(i).c_str(), i == st.animationClip) && i != st.animationClip) st.selectAnimation(i);
+            if (ImGui::Selectable(clipName(i).c_str(), i == st.anim.clip) && i != st.anim.clip) st.selectAnimation(i);
             ImGui::PopID();
         }
         ImGui::EndCombo();
     }
     record(st, "anim/clip");
     if (!cur) return;
-    if (ImGui::Button(st.animationPlaying ? "Pause###animPlay" : "Play###animPlay", ImVec2(px(64), 0))) st.toggleAnimation();
+    if (ImGui::Button(st.anim.playing ? "Pause###animPlay" : "Play###animPlay", ImVec2(px(64), 0))) st.toggleAnimation();
     record(st, "anim/play");
     ImGui::SameLine();
-    ImGui::Checkbox("Loop", &st.animationLoop);
+    ImGui::Checkbox("Loop", &st.anim.loop);
     record(st, "anim/loop");
     ImGui::SameLine();
     ImGui::TextDisabled("(Space in the viewport)");
-    float t = float(st.animationTime);
+    float t = float(st.anim.time);
     float t0 = cur->start, t1 = float(st.animationEnd());
     if (ImGui::SliderFloat("Time", &t, t0, std::max(t1, t0 + 1e-3f), "%.2f s")) st.setAnimationTime(t);
     record(st, "anim/time");
@@ -1132,7 +1132,7 @@ void drawViewport(ViewerState& st, const ViewportInput& view, double time, float
     record(st, "viewport");
     cameraInput(st, a, b, time, dt);
     // Space: play / pause the animation while the viewport has focus (not while typing).
-    if (!st.animations.empty() && ImGui::IsWindowFocused() && !ImGui::GetIO().WantTextInput && ImGui::IsKeyPressed(keys::Space, false))
+    if (!st.anim.clips.empty() && ImGui::IsWindowFocused() && !ImGui::GetIO().WantTextInput && ImGui::IsKeyPressed(keys::Space, false))
         st.toggleAnimation();
 
     ImDrawList* dl = ImGui::GetWindowDrawList();

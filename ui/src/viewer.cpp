@@ -158,7 +158,7 @@ public:
         // A playing animation changes the scene every frame: previews only, like a camera drag
         // (full resolution follows when it pauses).
         bool interacting = (now - st.view.lastInteraction) < 0.25 || ImGui::GetIO().MouseDown[0] || ImGui::GetIO().MouseDown[1] ||
-                           ImGui::GetIO().MouseDown[2] || st.animationPlaying;
+                           ImGui::GetIO().MouseDown[2] || st.anim.playing;
         std::vector<std::string> names = visibleBackends(st);
         std::shared_ptr<sg::FrameInput> base;
         uint64_t key = (st.doc.version * 1000003u) ^ (st.view.version * 7919u) ^ (uint64_t(w) << 40) ^ (uint64_t(h) << 20);
@@ -625,7 +625,7 @@ int runViewer(const ViewerOptions& opt) {
     bool running = true;
     std::string windowTitle;
     while (running) {
-        bool busy = !v.shots.empty() || st.loadInProgress() || st.animationPlaying || automated;
+        bool busy = !v.shots.empty() || st.loadInProgress() || st.anim.playing || automated;
         for (auto& [n, bv] : v.views) busy |= bv.slot->status().rendering;
         if (busy || (v.now - st.view.lastInteraction) < 0.5)
             glfwPollEvents();

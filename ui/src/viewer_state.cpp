@@ -24,10 +24,10 @@ void ViewerState::setScene(sg::Scene s, fs::path path) {
     doc.path = std::move(path);
     doc.dirty = false;
     doc.selected = sg::kNoNode;
-    animations.clear();   // a load puts its clips back after this
-    animationClip = 0;
-    animationTime = 0.0;
-    animationPlaying = false;
+    anim.clips.clear();   // a load puts its clips back after this
+    anim.clip = 0;
+    anim.time = 0.0;
+    anim.playing = false;
     ++doc.version;
     resetView();
 }
@@ -416,11 +416,11 @@ bool ViewerState::pollLoad(bool wait) {
         return true;
     }
     setScene(std::move(*r.scene), load.path);
-    animations = std::move(r.animations);
-    if (!animations.empty()) animationTime = animations.front().start;
+    anim.clips = std::move(r.animations);
+    if (!anim.clips.empty()) anim.time = anim.clips.front().start;
     addRecent(fs::absolute(load.path).lexically_normal().string());
     status = "Opened " + load.path.string() + (r.warnings.empty() ? "" : " (" + std::to_string(r.warnings.size()) + " warnings)") +
-             (animations.empty() ? "" : ", " + std::to_string(animations.size()) + " animation(s): Space plays");
+             (anim.clips.empty() ? "" : ", " + std::to_string(anim.clips.size()) + " animation(s): Space plays");
     return true;
 }
 
@@ -472,8 +472,8 @@ void applyPose(ViewerState& st, const assets::AnimationClip& clip, double t) {
 }   // namespace
 
 const assets::AnimationClip* ViewerState::currentAnimation() const {
-    if (animationClip < 0 || size_t(animationClip) >= animations.size()) return nullptr;
-    return &animations[size_t(animationClip)];
+    if (anim.clip < 0 || size_t(anim.clip) >= anim.clips.size()) return nullptr;
+    return &anim.clips[size_t(anim.clip)];
 }
 
 double ViewerState::animationEnd() const {
@@ -482,47 +482,47 @@ double ViewerState::animationEnd() const {
 }
 
 void ViewerState::selectAnimation(int index) {
-    if (index < 0 || size_t(index) >= animations.size()) return;
-    animationClip = index;
-    animationPlaying = false;
-    animationTime = animations[size_t(index)].start;
-    applyPose(*this, animations[size_t(index)], animationTime);
-    status = "Animation: " + (animations[size_t(index)].name.empty() ? "clip " + std::to_string(index) : animations[size_t(index)].name);
+    if (index < 0 || size_t(index) >= anim.clips.size()) return;
+    anim.clip = index;
+    anim.playing = false;
+    anim.time = anim.clips[size_t(index)].start;
+    applyPose(*this, anim.clips[size_t(index)], anim.time);
+    status = "Animation: " + (anim.clips[size_t(index)].name.empty() ? "clip " + std::to_string(index) : anim.clips[size_t(index)].name);
 }
 
 void ViewerState::setAnimationPlaying(bool play) {
     const assets::AnimationClip* c = currentAnimation();
     if (!c) {
-        animationPlaying = false;
+        anim.playing = false;
         return;
     }
-    if (play && !animationLoop && animationTime >= animationEnd()) animationTime = c->start;   // replay
-    animationPlaying = play;
-    applyPose(*this, *c, animationTime);
+    if (play && !anim.loop && anim.time >= animationEnd()) anim.time = c->start;   // replay
+    anim.playing = play;
+    applyPose(*this, *c, anim.time);
 }
 
 void ViewerState::setAnimationTime(double t) {
     const assets::AnimationClip* c = currentAnimation();
     if (!c || !std::isfinite(t)) return;
-    animationTime = std::clamp(t, double(c->start), animationEnd());
-    applyPose(*this, *c, animationTime);
+    anim.time = std::clamp(t, double(c->start), animationEnd());
+    applyPose(*this, *c, anim.time);
 }
 
 void ViewerState::advanceAnimation(double dt) {
     const assets::AnimationClip* c = currentAnimation();
-    if (!c || !animationPlaying) return;
+    if (!c || !anim.playing) return;
     double start = c->start, end = animationEnd(), length = end - start;
-    double t = animationTime + (std::isfinite(dt) ? std::max(dt, 0.0) : 0.0);
+    double t = anim.time + (std::isfinite(dt) ? std::max(dt, 0.0) : 0.0);
     if (t > end) {
-        if (animationLoop && length > 0.0) {
+        if (anim.loop && length > 0.0) {
             t = start + std::fmod(t - start, length);
         } else {   // not looping (or a single-key clip): stop at the end
             t = end;
-            animationPlaying = false;
+            anim.playing = false;
         }
     }
-    animationTime = std::clamp(t, start, end);
-    applyPose(*this, *c, animationTime);
+    anim.time = std::clamp(t, start, end);
+    applyPose(*this, *c, anim.time);
 }
 
 // --- config helpers --------------------------------------------------------------------------

@@ -120,10 +120,22 @@ struct AsyncLoad {
     std::shared_ptr<LoadControl> control;   // of the current / last load
 };
 
+// Animation playback (glTF node TRS clips of the loaded file). Playing changes node locals
+// and re-renders (doc.version) but is not an edit: the dirty flag is untouched. Clips come
+// with a load and are dropped by setScene (new scene, demo).
+struct Playback {
+    std::vector<assets::AnimationClip> clips;
+    int clip = 0;        // index into clips
+    double time = 0.0;   // seconds, within [clip.start, clip end]
+    bool playing = false;
+    bool loop = true;   // wrap at the end (else stop there)
+};
+
 struct ViewerState {
     Document doc;
     View view;
     AsyncLoad load;
+    Playback anim;
 
     // --- messages ----------------------------------------------------------------------
     std::string status;       // one line shown in the status bar
@@ -133,15 +145,6 @@ struct ViewerState {
     PendingAction pending = PendingAction::None;
     std::filesystem::path pendingPath;
     bool confirmOpen = false;   // the modal should be shown
-
-    // --- animation (glTF node TRS clips of the loaded file) --------------------------------
-    // Playing changes node locals and re-renders (doc.version) but is not an edit: the dirty
-    // flag is untouched. Clips come with a load and are dropped by setScene (new scene, demo).
-    std::vector<assets::AnimationClip> animations;
-    int animationClip = 0;        // index into animations
-    double animationTime = 0.0;   // seconds, within [clip.start, clip end]
-    bool animationPlaying = false;
-    bool animationLoop = true;   // wrap at the end (else stop there)
 
     Requests requests;
     PanelState panels;                           // the ImGui panels' own state (dialogs, toggles)
@@ -222,7 +225,7 @@ struct ViewerState {
     double animationEnd() const;           // latest key time of the current clip
     void selectAnimation(int index);       // stops, rewinds to the clip start, applies
     void setAnimationPlaying(bool play);   // play at the end of a non-looping clip rewinds
-    void toggleAnimation() { setAnimationPlaying(!animationPlaying); }
+    void toggleAnimation() { setAnimationPlaying(!anim.playing); }
     void setAnimationTime(double t);   // scrub: clamps to the clip range and applies
     // Called every frame: when playing, advances by dt (wrapping when looping, else stopping at
     // the end) and applies the clip.
