@@ -81,7 +81,7 @@ ViewerState animatedState() {
     ViewerState st = demoState();
     st.startLoad(writeAnimatedGltf());
     EXPECT_TRUE(st.pollLoad(/*wait=*/true));
-    EXPECT_TRUE(st.errorPopup.empty()) << st.errorPopup;
+    EXPECT_TRUE(st.ui.errorPopup.empty()) << st.ui.errorPopup;
     return st;
 }
 
@@ -98,7 +98,7 @@ TEST(ViewerStateAnimTest, LoadKeepsClipsAndNewSceneDropsThem) {
     EXPECT_FALSE(st.anim.playing);
     EXPECT_FLOAT_EQ(st.anim.clips[0].start, 0.0f);
     EXPECT_DOUBLE_EQ(st.animationEnd(), 2.0);
-    EXPECT_NE(st.status.find("animation"), std::string::npos) << st.status;
+    EXPECT_NE(st.ui.status.find("animation"), std::string::npos) << st.ui.status;
     // The demo / a new scene has no clips.
     st.setScene(assets::makeDemoScene(), {});
     EXPECT_TRUE(st.anim.clips.empty());
@@ -206,7 +206,7 @@ TEST(ViewerStateAnimTest, CesiumMilkTruckWheelsTurnWithoutDirtying) {
     ViewerState st = demoState();
     st.startLoad(testing_support::testdataDir() / "gltf/CesiumMilkTruck/glTF/CesiumMilkTruck.gltf");
     ASSERT_TRUE(st.pollLoad(true));
-    ASSERT_TRUE(st.errorPopup.empty()) << st.errorPopup;
+    ASSERT_TRUE(st.ui.errorPopup.empty()) << st.ui.errorPopup;
     ASSERT_EQ(st.anim.clips.size(), 1u);
     sg::NodeId wheel = st.anim.clips[0].channels.at(0).node;
     ASSERT_TRUE(st.doc.scene.valid(wheel));
@@ -284,7 +284,7 @@ TEST(ViewerStateLoadTest, CancelKeepsTheCurrentSceneAndSaysSo) {
     EXPECT_FALSE(st.loadCancelRequested());
     st.cancelLoad();
     EXPECT_TRUE(st.loadCancelRequested());
-    EXPECT_NE(st.status.find("Cancelling"), std::string::npos) << st.status;
+    EXPECT_NE(st.ui.status.find("Cancelling"), std::string::npos) << st.ui.status;
     ASSERT_TRUE(st.pollLoad(/*wait=*/true));
     EXPECT_FALSE(st.loadInProgress());
     EXPECT_EQ(st.doc.scene.nodeCount(), nodes);
@@ -292,15 +292,15 @@ TEST(ViewerStateLoadTest, CancelKeepsTheCurrentSceneAndSaysSo) {
     EXPECT_TRUE(st.doc.scene.valid(st.doc.scene.findByName("crate")));
     EXPECT_TRUE(st.doc.path.empty());
     EXPECT_TRUE(st.doc.dirty);
-    EXPECT_TRUE(st.errorPopup.empty()) << st.errorPopup;   // a cancel is not an error
-    EXPECT_NE(st.status.find("big-grid.obj cancelled"), std::string::npos) << st.status;
+    EXPECT_TRUE(st.ui.errorPopup.empty()) << st.ui.errorPopup;   // a cancel is not an error
+    EXPECT_NE(st.ui.status.find("big-grid.obj cancelled"), std::string::npos) << st.ui.status;
 
     // The next load is not affected by the old cancel.
     st.doc.dirty = false;
     st.startLoad(file);
     EXPECT_FALSE(st.loadCancelRequested());
     ASSERT_TRUE(st.pollLoad(true));
-    EXPECT_TRUE(st.errorPopup.empty()) << st.errorPopup;
+    EXPECT_TRUE(st.ui.errorPopup.empty()) << st.ui.errorPopup;
     EXPECT_EQ(st.doc.path, file);
 }
 
@@ -313,7 +313,7 @@ TEST(ViewerStateLoadTest, ProgressIsReported) {
     while (st.load.task.wait_for(std::chrono::milliseconds(2)) != std::future_status::ready) maxSeen = std::max(maxSeen, st.loadProgress());
     maxSeen = std::max(maxSeen, st.loadProgress());
     ASSERT_TRUE(st.pollLoad(true));
-    ASSERT_TRUE(st.errorPopup.empty()) << st.errorPopup;
+    ASSERT_TRUE(st.ui.errorPopup.empty()) << st.ui.errorPopup;
     EXPECT_GT(maxSeen, 0.0f);
     EXPECT_FLOAT_EQ(st.loadProgress(), 1.0f);   // the importer ends at 1
     size_t triangles = 0;

@@ -148,7 +148,7 @@ TEST(PanelsTest, MatrixEditSwitchesToMatrixModeAndBack) {
     ASSERT_EQ(h.st.doc.scene.node(crate).local.mode, sg::LocalTransform::Mode::Matrix);
     h.click("inspector/toTRS");
     EXPECT_EQ(h.st.doc.scene.node(crate).local.mode, sg::LocalTransform::Mode::Matrix);
-    EXPECT_FALSE(h.st.errorPopup.empty());
+    EXPECT_FALSE(h.st.ui.errorPopup.empty());
 }
 
 TEST(PanelsTest, NumberKeysSwitchBackends) {
@@ -160,9 +160,9 @@ TEST(PanelsTest, NumberKeysSwitchBackends) {
     EXPECT_EQ(h.st.view.backend, "raycast");
     h.press(keys::Num1);
     EXPECT_EQ(h.st.view.backend, "gl");
-    h.st.requests.screenshot = false;
+    h.st.ui.requests.screenshot = false;
     h.press(keys::F12);
-    EXPECT_TRUE(h.st.requests.screenshot);
+    EXPECT_TRUE(h.st.ui.requests.screenshot);
 }
 
 TEST(PanelsTest, ViewportDragOrbitsWheelZooms) {
@@ -200,13 +200,13 @@ TEST(PanelsTest, QuitWithUnsavedChangesShowsModal) {
     h.frame();
     ASSERT_NO_THROW(h.rect("confirm/cancel"));
     h.click("confirm/cancel");
-    EXPECT_FALSE(h.st.requests.quit);
+    EXPECT_FALSE(h.st.ui.requests.quit);
     EXPECT_TRUE(h.st.doc.dirty);
     EXPECT_FALSE(h.st.requestQuit());
     h.frame();
     h.frame();
     h.click("confirm/discard");
-    EXPECT_TRUE(h.st.requests.quit);
+    EXPECT_TRUE(h.st.ui.requests.quit);
 }
 
 TEST(PanelsTest, SplitViewDividerDrags) {
@@ -298,8 +298,8 @@ TEST(PanelsTest, LoadShowsProgressAndCancelButtonKeepsScene) {
     EXPECT_TRUE(h.st.loadCancelRequested());
     ASSERT_TRUE(h.st.pollLoad(true));
     EXPECT_EQ(h.st.doc.scene.nodeCount(), nodes);
-    EXPECT_TRUE(h.st.errorPopup.empty());
-    EXPECT_NE(h.st.status.find("scene.obj cancelled"), std::string::npos) << h.st.status;
+    EXPECT_TRUE(h.st.ui.errorPopup.empty());
+    EXPECT_NE(h.st.ui.status.find("scene.obj cancelled"), std::string::npos) << h.st.ui.status;
 }
 
 // The panels keep their own state (dialogs, toggles, in-place rename) in the viewer's
@@ -308,29 +308,29 @@ TEST(PanelsTest, LoadShowsProgressAndCancelButtonKeepsScene) {
 TEST(PanelsTest, PanelStateBelongsToTheViewer) {
     {
         Headless h;
-        EXPECT_TRUE(h.st.panels.showOverlay);
-        h.st.panels.showOverlay = false;
-        h.st.panels.showHelp = true;   // before the modal: ImGui 1.86 asserts when a new window appears under one
+        EXPECT_TRUE(h.st.ui.panels.showOverlay);
+        h.st.ui.panels.showOverlay = false;
+        h.st.ui.panels.showHelp = true;   // before the modal: ImGui 1.86 asserts when a new window appears under one
         h.frame();
-        h.st.requests.openDialog = true;
+        h.st.ui.requests.openDialog = true;
         h.frame();
         h.frame();
-        EXPECT_TRUE(h.st.panels.browser.open);
-        EXPECT_FALSE(h.st.panels.browser.saving);
-        EXPECT_FALSE(h.st.panels.browser.dir.empty());
+        EXPECT_TRUE(h.st.ui.panels.browser.open);
+        EXPECT_FALSE(h.st.ui.panels.browser.saving);
+        EXPECT_FALSE(h.st.ui.panels.browser.dir.empty());
         EXPECT_NO_THROW(h.rect("browser/accept"));
     }
     Headless h;
-    EXPECT_TRUE(h.st.panels.showOverlay);
-    EXPECT_FALSE(h.st.panels.showHelp);
-    EXPECT_FALSE(h.st.panels.browser.open);
-    h.st.requests.screenshotDialog = true;
+    EXPECT_TRUE(h.st.ui.panels.showOverlay);
+    EXPECT_FALSE(h.st.ui.panels.showHelp);
+    EXPECT_FALSE(h.st.ui.panels.browser.open);
+    h.st.ui.requests.screenshotDialog = true;
     h.frame();
     h.frame();   // an auto-resizing modal takes its size on its second frame
-    EXPECT_TRUE(h.st.panels.shotDialog.open);
+    EXPECT_TRUE(h.st.ui.panels.shotDialog.open);
     h.click("shot/take");
-    EXPECT_TRUE(h.st.requests.screenshot);
-    EXPECT_EQ(h.st.requests.screenshotWidth, 0);   // window size by default
+    EXPECT_TRUE(h.st.ui.requests.screenshot);
+    EXPECT_EQ(h.st.ui.requests.screenshotWidth, 0);   // window size by default
 }
 
 TEST(PanelsTest, F2RenamesTheSelectionInPlace) {
@@ -339,6 +339,6 @@ TEST(PanelsTest, F2RenamesTheSelectionInPlace) {
     h.click("tree/crate");
     ASSERT_EQ(h.st.doc.selected, crate);
     h.press(keys::F2);
-    EXPECT_EQ(h.st.panels.renaming, crate);
-    EXPECT_EQ(h.st.panels.renameBuffer, "crate");
+    EXPECT_EQ(h.st.ui.panels.renaming, crate);
+    EXPECT_EQ(h.st.ui.panels.renameBuffer, "crate");
 }

@@ -87,7 +87,7 @@ TEST(ViewerStateTest, ReparentKeepsWorldAndRefusesCycles) {
     std::string err;
     EXPECT_FALSE(st.reparent(turntable, torus, &err));
     EXPECT_FALSE(err.empty());
-    EXPECT_NE(st.status.find("refused"), std::string::npos);
+    EXPECT_NE(st.ui.status.find("refused"), std::string::npos);
     EXPECT_FALSE(st.doc.dirty);
     EXPECT_FALSE(st.reparent(st.doc.scene.root(), crate, &err));
 }
@@ -142,16 +142,16 @@ TEST(ViewerStateTest, UnsavedChangesAreNeverLostWithoutAsking) {
     ViewerState st = demoState();
     // Clean: quit goes through at once.
     EXPECT_TRUE(st.requestQuit());
-    EXPECT_TRUE(st.requests.quit);
-    st.requests.quit = false;
+    EXPECT_TRUE(st.ui.requests.quit);
+    st.ui.requests.quit = false;
 
     st.addShape(sg::ImplicitType::Box);
     ASSERT_TRUE(st.doc.dirty);
     EXPECT_FALSE(st.requestQuit());
-    EXPECT_FALSE(st.requests.quit);
-    EXPECT_TRUE(st.confirmOpen);
+    EXPECT_FALSE(st.ui.requests.quit);
+    EXPECT_TRUE(st.ui.confirmOpen);
     st.confirm(ConfirmChoice::Cancel);
-    EXPECT_FALSE(st.requests.quit);
+    EXPECT_FALSE(st.ui.requests.quit);
     EXPECT_TRUE(st.doc.dirty);
 
     // Open while dirty: asks; cancel keeps the scene; discard loads.
@@ -169,14 +169,14 @@ TEST(ViewerStateTest, UnsavedChangesAreNeverLostWithoutAsking) {
     st.addGroup();
     EXPECT_FALSE(st.requestQuit());
     st.confirm(ConfirmChoice::Save);
-    EXPECT_FALSE(st.requests.quit);
-    EXPECT_TRUE(st.requests.saveAsDialog);
+    EXPECT_FALSE(st.ui.requests.quit);
+    EXPECT_TRUE(st.ui.requests.saveAsDialog);
     EXPECT_TRUE(st.doc.dirty);
 
     // Discard on quit quits.
     EXPECT_FALSE(st.requestQuit());
     st.confirm(ConfirmChoice::Discard);
-    EXPECT_TRUE(st.requests.quit);
+    EXPECT_TRUE(st.ui.requests.quit);
 }
 
 // Regression (first-hour issue, item 1): edit, Open a file that fails, answer Discard. The load
@@ -192,17 +192,17 @@ TEST(ViewerStateTest, DiscardThenFailedOrCancelledLoadKeepsEditsAndDirtyFlag) {
     EXPECT_TRUE(st.doc.dirty) << "Discard alone must not clear the flag: nothing has replaced the scene yet";
     ASSERT_TRUE(st.loadInProgress());
     EXPECT_TRUE(st.pollLoad(/*wait=*/true));
-    EXPECT_FALSE(st.errorPopup.empty());
+    EXPECT_FALSE(st.ui.errorPopup.empty());
     EXPECT_TRUE(st.doc.dirty);
     EXPECT_EQ(st.doc.scene.nodeCount(), nodes);
     EXPECT_TRUE(st.doc.scene.valid(added));
-    st.errorPopup.clear();
+    st.ui.errorPopup.clear();
 
     // Quit still asks.
     EXPECT_FALSE(st.requestQuit());
-    EXPECT_TRUE(st.confirmOpen);
+    EXPECT_TRUE(st.ui.confirmOpen);
     st.confirm(ConfirmChoice::Cancel);
-    EXPECT_FALSE(st.requests.quit);
+    EXPECT_FALSE(st.ui.requests.quit);
 
     // Same after a cancelled load (cancel before the importer even starts reading).
     fs::path good = testing_support::outputDir("ui") / "discard-cancel.obj";
@@ -221,7 +221,7 @@ TEST(ViewerStateTest, DiscardThenFailedOrCancelledLoadKeepsEditsAndDirtyFlag) {
     EXPECT_FALSE(st.requestOpen(good));
     st.confirm(ConfirmChoice::Discard);
     EXPECT_TRUE(st.pollLoad(/*wait=*/true));
-    EXPECT_TRUE(st.errorPopup.empty()) << st.errorPopup;
+    EXPECT_TRUE(st.ui.errorPopup.empty()) << st.ui.errorPopup;
     EXPECT_FALSE(st.doc.dirty);
     EXPECT_EQ(st.doc.path, good);
 }
@@ -237,8 +237,8 @@ TEST(ViewerStateTest, FailedLoadKeepsCurrentSceneAndShowsError) {
     st.startLoad("/nonexistent/dir/scene.gltf");
     ASSERT_TRUE(st.loadInProgress());
     EXPECT_TRUE(st.pollLoad(/*wait=*/true));
-    EXPECT_FALSE(st.errorPopup.empty());
-    EXPECT_NE(st.errorPopup.find("scene.gltf"), std::string::npos);
+    EXPECT_FALSE(st.ui.errorPopup.empty());
+    EXPECT_NE(st.ui.errorPopup.find("scene.gltf"), std::string::npos);
     EXPECT_EQ(st.doc.scene.nodeCount(), nodes);
     EXPECT_TRUE(st.doc.path.empty());
 }
@@ -341,7 +341,7 @@ TEST(ViewerStateTest, SaveAndReopenKeepsEditsAndView) {
     other.view.viewportHeight = 600;
     other.startLoad(file);
     ASSERT_TRUE(other.pollLoad(true));
-    ASSERT_TRUE(other.errorPopup.empty()) << other.errorPopup;
+    ASSERT_TRUE(other.ui.errorPopup.empty()) << other.ui.errorPopup;
     EXPECT_EQ(other.doc.scene.settings.shading, sg::ShadingModel::Gouraud);
     EXPECT_EQ(other.doc.scene.settings.fog, sg::FogMode::Exp);
     EXPECT_FLOAT_EQ(other.projection().fovyDeg, 52.0f);

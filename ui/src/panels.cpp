@@ -232,7 +232,7 @@ void drawMainMenu(ViewerState& st) {
     if (!ImGui::BeginMainMenuBar()) return;
     if (ImGui::BeginMenu("File")) {
         if (ImGui::MenuItem("New", "Ctrl+N")) st.requestNew();
-        if (ImGui::MenuItem("Open...", "Ctrl+O")) st.requests.openDialog = true;
+        if (ImGui::MenuItem("Open...", "Ctrl+O")) st.ui.requests.openDialog = true;
         if (ImGui::BeginMenu("Open Recent", !st.recentFiles.empty())) {
             for (const std::string& f : st.recentFiles)
                 if (ImGui::MenuItem(f.c_str())) st.requestOpen(f);
@@ -240,10 +240,10 @@ void drawMainMenu(ViewerState& st) {
         }
         ImGui::Separator();
         if (ImGui::MenuItem("Save", "Ctrl+S")) st.save();
-        if (ImGui::MenuItem("Save As...", "Ctrl+Shift+S")) st.requests.saveAsDialog = true;
+        if (ImGui::MenuItem("Save As...", "Ctrl+Shift+S")) st.ui.requests.saveAsDialog = true;
         ImGui::Separator();
-        if (ImGui::MenuItem("Screenshot", "F12")) st.requests.screenshot = true;
-        if (ImGui::MenuItem("Screenshot at resolution...")) st.requests.screenshotDialog = true;
+        if (ImGui::MenuItem("Screenshot", "F12")) st.ui.requests.screenshot = true;
+        if (ImGui::MenuItem("Screenshot at resolution...")) st.ui.requests.screenshotDialog = true;
         ImGui::Separator();
         if (ImGui::MenuItem("Quit", "Ctrl+Q")) st.requestQuit();
         ImGui::EndMenu();
@@ -256,7 +256,7 @@ void drawMainMenu(ViewerState& st) {
         if (ImGui::MenuItem("Split view (wipe)", nullptr, st.view.compare.mode == ViewMode::Split)) st.view.compare.mode = ViewMode::Split;
         if (ImGui::MenuItem("Difference view", nullptr, st.view.compare.mode == ViewMode::Difference)) st.view.compare.mode = ViewMode::Difference;
         ImGui::Separator();
-        ImGui::MenuItem("Stats overlay", nullptr, &st.panels.showOverlay);
+        ImGui::MenuItem("Stats overlay", nullptr, &st.ui.panels.showOverlay);
         if (ImGui::BeginMenu("Scene cameras", !st.doc.scene.cameras().empty())) {
             for (sg::NodeId c : st.doc.scene.cameras())
                 if (ImGui::MenuItem(st.doc.scene.node(c).name.c_str(), nullptr, c == st.doc.scene.activeCamera)) st.useSceneCamera(c);
@@ -276,7 +276,7 @@ void drawMainMenu(ViewerState& st) {
         ImGui::EndMenu();
     }
     if (ImGui::BeginMenu("Help")) {
-        ImGui::MenuItem("Controls", nullptr, &st.panels.showHelp);
+        ImGui::MenuItem("Controls", nullptr, &st.ui.panels.showHelp);
         ImGui::EndMenu();
     }
     // Right side: file name and dirty marker.
@@ -301,8 +301,8 @@ void nodeContextMenu(ViewerState& st, sg::NodeId id) {
     }
     if (st.doc.scene.valid(id) && id != st.doc.scene.root()) {
         if (ImGui::MenuItem("Rename", "F2")) {
-            st.panels.renaming = id;
-            st.panels.renameBuffer = st.doc.scene.node(id).name;
+            st.ui.panels.renaming = id;
+            st.ui.panels.renameBuffer = st.doc.scene.node(id).name;
         }
         if (ImGui::MenuItem("Duplicate", "Ctrl+D")) st.duplicateNode(id);
         bool visible = st.doc.scene.valid(id) && st.doc.scene.node(id).visible;
@@ -339,24 +339,24 @@ void drawNode(ViewerState& st, sg::NodeId id, int depth) {
     if (dim) ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyle().Colors[ImGuiCol_TextDisabled]);
     std::string label = std::string(payloadIcon(n.payload)) + " " + n.name + (id == st.doc.scene.activeCamera ? "  (active)" : "");
     bool open;
-    if (st.panels.renaming == id) {
+    if (st.ui.panels.renaming == id) {
         open = ImGui::TreeNodeEx("##renaming", flags | ImGuiTreeNodeFlags_AllowItemOverlap, "%s", payloadIcon(n.payload));
         ImGui::SameLine();
         ImGui::SetKeyboardFocusHere();
         ImGui::SetNextItemWidth(-1);
-        if (ImGui::InputText("##rename", &st.panels.renameBuffer, ImGuiInputTextFlags_EnterReturnsTrue | ImGuiInputTextFlags_AutoSelectAll)) {
-            st.renameNode(id, st.panels.renameBuffer);
-            st.panels.renaming = sg::kNoNode;
+        if (ImGui::InputText("##rename", &st.ui.panels.renameBuffer, ImGuiInputTextFlags_EnterReturnsTrue | ImGuiInputTextFlags_AutoSelectAll)) {
+            st.renameNode(id, st.ui.panels.renameBuffer);
+            st.ui.panels.renaming = sg::kNoNode;
         } else if (ImGui::IsItemDeactivated() || ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Escape))) {
-            st.panels.renaming = sg::kNoNode;
+            st.ui.panels.renaming = sg::kNoNode;
         }
     } else {
         open = ImGui::TreeNodeEx("##node", flags, "%s", label.c_str());
         record(st, "tree/" + n.name);
         if (ImGui::IsItemClicked() && !ImGui::IsItemToggledOpen()) st.selectNode(id);
         if (ImGui::IsItemHovered() && ImGui::IsMouseDoubleClicked(0) && n.children.empty() && id != st.doc.scene.root()) {
-            st.panels.renaming = id;
-            st.panels.renameBuffer = n.name;
+            st.ui.panels.renaming = id;
+            st.ui.panels.renameBuffer = n.name;
         }
     }
     if (dim) ImGui::PopStyleColor();
@@ -373,7 +373,7 @@ void drawNode(ViewerState& st, sg::NodeId id, int depth) {
             sg::NodeId moved = *static_cast<const sg::NodeId*>(p->Data);
             std::string err;
             if (st.doc.scene.valid(moved) && !st.reparent(moved, id, &err) && !err.empty())
-                st.errorPopup = "Cannot move '" + st.doc.scene.node(moved).name + "' under '" + st.doc.scene.node(id).name + "':\n" + err;
+                st.ui.errorPopup = "Cannot move '" + st.doc.scene.node(moved).name + "' under '" + st.doc.scene.node(id).name + "':\n" + err;
         }
         ImGui::EndDragDropTarget();
     }
@@ -561,7 +561,7 @@ void transformEditor(ViewerState& st, sg::NodeId id) {
             if (c.tryMakeTRS())
                 st.setLocal(id, c);
             else
-                st.errorPopup = "This matrix has shear (or is not affine): it cannot be written as translate * rotate * scale.";
+                st.ui.errorPopup = "This matrix has shear (or is not affine): it cannot be written as translate * rotate * scale.";
         }
         record(st, "inspector/toTRS");
     }
@@ -599,7 +599,7 @@ void transformEditor(ViewerState& st, sg::NodeId id) {
         if (sg::isFinite(m) && sg::isInvertible(m))
             st.setLocal(id, sg::LocalTransform::fromMatrix(m));
         else
-            st.status = "Matrix edit refused: singular or not finite";
+            st.ui.status = "Matrix edit refused: singular or not finite";
     }
     if (ImGui::TreeNode("World matrix (read-only)")) {
         matrixTable("world", st.doc.scene.world(id));
@@ -916,7 +916,7 @@ void drawRenderingPanel(ViewerState& st) {
             st.doc.scene.settings = s;
             st.markEdited();
         } else {
-            st.status = "Setting refused: " + err;
+            st.ui.status = "Setting refused: " + err;
         }
     }
 }
@@ -1057,7 +1057,7 @@ void cameraInput(ViewerState& st, ImVec2 a, ImVec2 b, double time, float dt) {
     bool ortho = proj.type != sg::ProjectionType::Perspective;
     bool moved = false;
     // Divider drag (split view) takes precedence over the camera when grabbed near a divider.
-    int& dragDivider = st.panels.dragDivider;
+    int& dragDivider = st.ui.panels.dragDivider;
     if (st.view.compare.mode == ViewMode::Split && ImGui::IsItemClicked(ImGuiMouseButton_Left)) {
         dragDivider = -1;
         for (int i = 0; i < st.view.compare.count - 1; ++i) {
@@ -1195,7 +1195,7 @@ void drawViewport(ViewerState& st, const ViewportInput& view, double time, float
     }
 
     // Stats overlay (top-left).
-    if (st.panels.showOverlay) {
+    if (st.ui.panels.showOverlay) {
         std::vector<std::string> lines;
         for (const SlotView& v : view.slots) lines.push_back(slotStats(v));
         char buf[128];
@@ -1226,7 +1226,7 @@ void drawViewport(ViewerState& st, const ViewportInput& view, double time, float
 namespace {
 
 void openBrowser(bool saving, ViewerState& st) {
-    FileBrowserState& browser = st.panels.browser;
+    FileBrowserState& browser = st.ui.panels.browser;
     browser.open = true;
     browser.justOpened = true;
     browser.saving = saving;
@@ -1238,7 +1238,7 @@ void openBrowser(bool saving, ViewerState& st) {
 }
 
 void drawFileBrowser(ViewerState& st) {
-    FileBrowserState& browser = st.panels.browser;
+    FileBrowserState& browser = st.ui.panels.browser;
     if (!browser.open) return;
     const char* title = browser.saving ? "Save scene as###browser" : "Open scene###browser";
     if (browser.justOpened) {
@@ -1319,9 +1319,9 @@ void drawFileBrowser(ViewerState& st) {
 }
 
 void drawScreenshotDialog(ViewerState& st) {
-    ScreenshotDialogState& dialog = st.panels.shotDialog;
-    if (st.requests.screenshotDialog) {
-        st.requests.screenshotDialog = false;
+    ScreenshotDialogState& dialog = st.ui.panels.shotDialog;
+    if (st.ui.requests.screenshotDialog) {
+        st.ui.requests.screenshotDialog = false;
         dialog.open = true;
         ImGui::OpenPopup("Screenshot");
     }
@@ -1349,9 +1349,9 @@ void drawScreenshotDialog(ViewerState& st) {
     dialog.height = std::clamp(dialog.height, 1, 16384);
     ImGui::TextDisabled("One PNG per backend shown, rendered offscreen;\nnamed screenshot-<backend>[-N].png, never overwriting.");
     if (ImGui::Button("Take", ImVec2(px(90), 0))) {
-        st.requests.screenshot = true;
-        st.requests.screenshotWidth = dialog.windowSize ? 0 : dialog.width;
-        st.requests.screenshotHeight = dialog.windowSize ? 0 : dialog.height;
+        st.ui.requests.screenshot = true;
+        st.ui.requests.screenshotWidth = dialog.windowSize ? 0 : dialog.width;
+        st.ui.requests.screenshotHeight = dialog.windowSize ? 0 : dialog.height;
         ImGui::CloseCurrentPopup();
     }
     record(st, "shot/take");
@@ -1363,22 +1363,22 @@ void drawScreenshotDialog(ViewerState& st) {
 }   // namespace
 
 void drawDialogs(ViewerState& st) {
-    if (st.requests.openDialog) {
-        st.requests.openDialog = false;
+    if (st.ui.requests.openDialog) {
+        st.ui.requests.openDialog = false;
         openBrowser(false, st);
     }
-    if (st.requests.saveAsDialog) {
-        st.requests.saveAsDialog = false;
+    if (st.ui.requests.saveAsDialog) {
+        st.ui.requests.saveAsDialog = false;
         openBrowser(true, st);
     }
     drawFileBrowser(st);
     drawScreenshotDialog(st);
 
-    if (st.confirmOpen && !ImGui::IsPopupOpen("Unsaved changes")) ImGui::OpenPopup("Unsaved changes");
+    if (st.ui.confirmOpen && !ImGui::IsPopupOpen("Unsaved changes")) ImGui::OpenPopup("Unsaved changes");
     if (ImGui::BeginPopupModal("Unsaved changes", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
-        const char* what = st.pending == PendingAction::Quit  ? "quitting"
-                           : st.pending == PendingAction::New ? "starting a new scene"
-                                                              : "opening another file";
+        const char* what = st.ui.pending == PendingAction::Quit  ? "quitting"
+                           : st.ui.pending == PendingAction::New ? "starting a new scene"
+                                                                 : "opening another file";
         ImGui::Text("The scene has unsaved changes.\nSave them before %s?", what);
         ImGui::Spacing();
         if (ImGui::Button("Save", ImVec2(px(90), 0))) {
@@ -1401,21 +1401,21 @@ void drawDialogs(ViewerState& st) {
         ImGui::EndPopup();
     }
 
-    if (!st.errorPopup.empty() && !ImGui::IsPopupOpen("Error")) ImGui::OpenPopup("Error");
+    if (!st.ui.errorPopup.empty() && !ImGui::IsPopupOpen("Error")) ImGui::OpenPopup("Error");
     if (ImGui::BeginPopupModal("Error", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
         ImGui::PushTextWrapPos(px(520));
-        ImGui::TextColored(ImVec4(1.0f, 0.6f, 0.5f, 1.0f), "%s", st.errorPopup.c_str());
+        ImGui::TextColored(ImVec4(1.0f, 0.6f, 0.5f, 1.0f), "%s", st.ui.errorPopup.c_str());
         ImGui::PopTextWrapPos();
         if (ImGui::Button("OK", ImVec2(px(90), 0)) || ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Enter))) {
-            st.errorPopup.clear();
+            st.ui.errorPopup.clear();
             ImGui::CloseCurrentPopup();
         }
         ImGui::EndPopup();
     }
 
-    if (st.panels.showHelp) {
+    if (st.ui.panels.showHelp) {
         ImGui::SetNextWindowSize(ImVec2(px(420), 0), ImGuiCond_FirstUseEver);
-        if (ImGui::Begin("Controls", &st.panels.showHelp)) {
+        if (ImGui::Begin("Controls", &st.ui.panels.showHelp)) {
             ImGui::TextUnformatted(
                 "Left drag          orbit around the pivot\n"
                 "Middle / Shift+left drag   pan\n"
@@ -1444,10 +1444,10 @@ void handleShortcuts(ViewerState& st) {
     if (ImGui::IsPopupOpen(nullptr, ImGuiPopupFlags_AnyPopupId)) return;
     bool ctrl = io.KeyCtrl;
     if (ctrl) {
-        if (ImGui::IsKeyPressed(keys::O, false)) st.requests.openDialog = true;
+        if (ImGui::IsKeyPressed(keys::O, false)) st.ui.requests.openDialog = true;
         if (ImGui::IsKeyPressed(keys::S, false)) {
             if (io.KeyShift)
-                st.requests.saveAsDialog = true;
+                st.ui.requests.saveAsDialog = true;
             else
                 st.save();
         }
@@ -1463,11 +1463,11 @@ void handleShortcuts(ViewerState& st) {
         }
     if (ImGui::IsKeyPressed(keys::F, false)) st.fitView(st.doc.scene.valid(st.doc.selected));
     if (ImGui::IsKeyPressed(keys::Home, false)) st.resetView();
-    if (ImGui::IsKeyPressed(keys::F12, false)) st.requests.screenshot = true;
+    if (ImGui::IsKeyPressed(keys::F12, false)) st.ui.requests.screenshot = true;
     if (ImGui::IsKeyPressed(keys::Delete, false) && st.doc.scene.valid(st.doc.selected)) st.removeNode(st.doc.selected);
     if (ImGui::IsKeyPressed(keys::F2, false) && st.doc.scene.valid(st.doc.selected) && st.doc.selected != st.doc.scene.root()) {
-        st.panels.renaming = st.doc.selected;
-        st.panels.renameBuffer = st.doc.scene.node(st.doc.selected).name;
+        st.ui.panels.renaming = st.doc.selected;
+        st.ui.panels.renameBuffer = st.doc.scene.node(st.doc.selected).name;
     }
 }
 
@@ -1548,8 +1548,8 @@ void drawUi(ViewerState& st, const ViewportInput& view, double time, float dt) {
     if (ImGui::Begin(
             "##status", nullptr,
             ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoBringToFrontOnFocus)) {
-        bool bad =
-            st.status.rfind("Move refused", 0) == 0 || st.status.find("fail") != std::string::npos || st.status.find("refused") != std::string::npos;
+        bool bad = st.ui.status.rfind("Move refused", 0) == 0 || st.ui.status.find("fail") != std::string::npos ||
+                   st.ui.status.find("refused") != std::string::npos;
         if (st.loadInProgress()) {   // progress of the load (off the UI thread) and its Cancel
             float f = st.loadProgress();
             char label[32];
@@ -1564,9 +1564,9 @@ void drawUi(ViewerState& st, const ViewportInput& view, double time, float dt) {
             ImGui::SameLine();
         }
         if (bad)
-            ImGui::TextColored(ImVec4(1.0f, 0.6f, 0.45f, 1.0f), "%s", st.status.c_str());
+            ImGui::TextColored(ImVec4(1.0f, 0.6f, 0.45f, 1.0f), "%s", st.ui.status.c_str());
         else
-            ImGui::TextUnformatted(st.status.empty() ? "Ready" : st.status.c_str());
+            ImGui::TextUnformatted(st.ui.status.empty() ? "Ready" : st.ui.status.c_str());
         if (std::string notes = renderNotes(view); !notes.empty()) {   // never a silent substitution
             ImGui::SameLine(0, px(24));
             ImGui::TextColored(ImVec4(0.95f, 0.8f, 0.4f, 1.0f), "%s", notes.c_str());

@@ -267,7 +267,8 @@ public:
             }
             shots.push_back(std::move(p));
         }
-        st.status = "Screenshot: rendering " + std::to_string(names.size()) + " image(s) at " + std::to_string(w) + "x" + std::to_string(h) + "...";
+        st.ui.status =
+            "Screenshot: rendering " + std::to_string(names.size()) + " image(s) at " + std::to_string(w) + "x" + std::to_string(h) + "...";
     }
 
     void pollScreenshots(bool wait) {
@@ -278,9 +279,9 @@ public:
             }
             std::string err = shots[i].result.get();
             if (err.empty())
-                st.status = "Saved " + shots[i].path.string();
+                st.ui.status = "Saved " + shots[i].path.string();
             else {
-                st.status = "Screenshot failed: " + err;
+                st.ui.status = "Screenshot failed: " + err;
                 std::fprintf(stderr, "viewer: screenshot: %s\n", err.c_str());
             }
             lastShotErrors.push_back(err);
@@ -611,7 +612,7 @@ int runViewer(const ViewerOptions& opt) {
     // Initial scene: the demo, or the file (loaded off the UI thread).
     if (opt.scene.empty() || opt.scene == "demo") {
         st.setScene(assets::makeDemoScene(), {});
-        st.status = "Demo scene. Drop a file on the window or use File > Open.";
+        st.ui.status = "Demo scene. Drop a file on the window or use File > Open.";
     } else {
         st.doc.scene = sg::Scene{};
         st.startLoad(opt.scene);
@@ -669,10 +670,10 @@ int runViewer(const ViewerOptions& opt) {
         // Renders after the UI decided viewport size, camera and settings for this frame.
         v.updateRenders();
         v.updateDiff();
-        if (st.requests.screenshot) {
-            st.requests.screenshot = false;
-            v.startScreenshots(st.requests.screenshotWidth, st.requests.screenshotHeight, v.shotDir);
-            st.requests.screenshotWidth = st.requests.screenshotHeight = 0;
+        if (st.ui.requests.screenshot) {
+            st.ui.requests.screenshot = false;
+            v.startScreenshots(st.ui.requests.screenshotWidth, st.ui.requests.screenshotHeight, v.shotDir);
+            st.ui.requests.screenshotWidth = st.ui.requests.screenshotHeight = 0;
         }
 
         int fbw = 0, fbh = 0;
@@ -695,7 +696,7 @@ int runViewer(const ViewerOptions& opt) {
             automation.windowShot.clear();
         }
         glfwSwapBuffers(win);
-        if (st.requests.quit) running = false;
+        if (st.ui.requests.quit) running = false;
         // Window title: file name and the unsaved-changes marker.
         std::string title =
             (st.doc.path.empty() ? st.doc.scene.name : st.doc.path.filename().string()) + (st.doc.dirty ? " *" : "") + " - Scene viewer";

@@ -164,7 +164,7 @@ bool ViewerState::reparent(sg::NodeId id, sg::NodeId newParent, std::string* err
     if (doc.scene.valid(id) && doc.scene.valid(newParent) && doc.scene.node(id).parent == newParent) return false;   // no-op
     if (!doc.scene.reparent(id, newParent, /*keepWorld=*/true, &err)) {
         if (err.empty()) err = "cannot move this node there";
-        status = "Move refused: " + err;
+        ui.status = "Move refused: " + err;
         if (error) *error = err;
         return false;
     }
@@ -184,7 +184,7 @@ void ViewerState::setBackend(const std::string& name) {
     if (view.backend == name) return;
     view.backend = name;
     view.compare.backends[0] = name;
-    status = "Backend: " + name;
+    ui.status = "Backend: " + name;
 }
 
 void ViewerState::setBackendIndex(int index) {
@@ -317,9 +317,9 @@ sg::RenderSettings ViewerState::settingsFor(const std::string& b) const {
 
 bool ViewerState::requestOpen(const fs::path& path) {
     if (doc.dirty) {
-        pending = PendingAction::Open;
-        pendingPath = path;
-        confirmOpen = true;
+        ui.pending = PendingAction::Open;
+        ui.pendingPath = path;
+        ui.confirmOpen = true;
         return false;
     }
     startLoad(path);
@@ -328,8 +328,8 @@ bool ViewerState::requestOpen(const fs::path& path) {
 
 bool ViewerState::requestNew() {
     if (doc.dirty) {
-        pending = PendingAction::New;
-        confirmOpen = true;
+        ui.pending = PendingAction::New;
+        ui.confirmOpen = true;
         return false;
     }
     newScene();
@@ -338,32 +338,32 @@ bool ViewerState::requestNew() {
 
 void ViewerState::newScene() {
     setScene(sg::Scene{}, {});
-    status = "New scene";
+    ui.status = "New scene";
 }
 
 bool ViewerState::requestQuit() {
     if (doc.dirty) {
-        pending = PendingAction::Quit;
-        confirmOpen = true;
+        ui.pending = PendingAction::Quit;
+        ui.confirmOpen = true;
         return false;
     }
-    requests.quit = true;
+    ui.requests.quit = true;
     return true;
 }
 
 void ViewerState::confirm(ConfirmChoice choice) {
-    PendingAction action = pending;
-    pending = PendingAction::None;
-    confirmOpen = false;
+    PendingAction action = ui.pending;
+    ui.pending = PendingAction::None;
+    ui.confirmOpen = false;
     if (choice == ConfirmChoice::Cancel || action == PendingAction::None) {
-        status = "Cancelled";
+        ui.status = "Cancelled";
         return;
     }
     if (choice == ConfirmChoice::Save) {
         if (doc.path.empty() || doc.path.extension() != ".json") {
             // Needs a file name first: ask for one, then the user repeats the action.
-            requests.saveAsDialog = true;
-            status = "Choose where to save, then repeat the action";
+            ui.requests.saveAsDialog = true;
+            ui.status = "Choose where to save, then repeat the action";
             return;
         }
         if (!save().empty()) return;   // failed: keep everything, the error is shown
@@ -372,20 +372,20 @@ void ViewerState::confirm(ConfirmChoice choice) {
     // after a successful load, a new scene) clears it. A failed or cancelled load after
     // "Discard" leaves the document exactly as it was, unsaved edits and '*' included.
     switch (action) {
-    case PendingAction::Open: startLoad(pendingPath); break;
+    case PendingAction::Open: startLoad(ui.pendingPath); break;
     case PendingAction::New: newScene(); break;
-    case PendingAction::Quit: requests.quit = true; break;
+    case PendingAction::Quit: ui.requests.quit = true; break;
     case PendingAction::None: break;
     }
 }
 
 void ViewerState::startLoad(const fs::path& path) {
     if (load.task.valid()) {
-        status = "Still loading " + load.path.filename().string();
+        ui.status = "Still loading " + load.path.filename().string();
         return;
     }
     load.path = path;
-    status = "Loading " + path.string() + " ...";
+    ui.status = "Loading " + path.string() + " ...";
     load.control = std::make_shared<LoadControl>();
     load.task = std::async(std::launch::async, [path, control = load.control] {
         try {
@@ -406,34 +406,34 @@ bool ViewerState::pollLoad(bool wait) {
     if (!wait && load.task.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return false;
     assets::LoadResult r = load.task.get();
     if (loadCancelRequested()) {   // whatever the importer returned: the user said no
-        status = "Loading " + load.path.filename().string() + " cancelled; the current scene is unchanged";
+        ui.status = "Loading " + load.path.filename().string() + " cancelled; the current scene is unchanged";
         return true;
     }
     doc.loadWarnings = r.warnings;
     if (!r.scene) {
-        errorPopup = "Could not open " + load.path.string() + ":\n" + (r.error.empty() ? "unknown error" : r.error);
-        status = "Open failed; the current scene is unchanged";
+        ui.errorPopup = "Could not open " + load.path.string() + ":\n" + (r.error.empty() ? "unknown error" : r.error);
+        ui.status = "Open failed; the current scene is unchanged";
         return true;
     }
     setScene(std::move(*r.scene), load.path);
     anim.clips = std::move(r.animations);
     if (!anim.clips.empty()) anim.time = anim.clips.front().start;
     addRecent(fs::absolute(load.path).lexically_normal().string());
-    status = "Opened " + load.path.string() + (r.warnings.empty() ? "" : " (" + std::to_string(r.warnings.size()) + " warnings)") +
-             (anim.clips.empty() ? "" : ", " + std::to_string(anim.clips.size()) + " animation(s): Space plays");
+    ui.status = "Opened " + load.path.string() + (r.warnings.empty() ? "" : " (" + std::to_string(r.warnings.size()) + " warnings)") +
+                (anim.clips.empty() ? "" : ", " + std::to_string(anim.clips.size()) + " animation(s): Space plays");
     return true;
 }
 
 void ViewerState::cancelLoad() {
     if (!load.task.valid() || !load.control || load.control->cancel.load()) return;
     load.control->cancel = true;
-    status = "Cancelling loading " + load.path.filename().string() + " ...";
+    ui.status = "Cancelling loading " + load.path.filename().string() + " ...";
 }
 
 std::string ViewerState::save(const fs::path& path) {
     fs::path target = path.empty() ? doc.path : path;
     if (target.empty()) {
-        requests.saveAsDialog = true;
+        ui.requests.saveAsDialog = true;
         return "no file name";
     }
     if (target.extension() != ".json") target += ".json";   // imports are never overwritten
@@ -443,14 +443,14 @@ std::string ViewerState::save(const fs::path& path) {
         err = assets::saveSceneJson(doc.scene, target, /*overwrite=*/true);
     } catch (const std::exception& e) { err = target.string() + ": " + e.what(); }
     if (!err.empty()) {
-        errorPopup = "Could not save:\n" + err;
-        status = "Save failed";
+        ui.errorPopup = "Could not save:\n" + err;
+        ui.status = "Save failed";
         return err;
     }
     doc.path = target;
     doc.dirty = false;
     addRecent(fs::absolute(target).lexically_normal().string());
-    status = "Saved " + target.string();
+    ui.status = "Saved " + target.string();
     return {};
 }
 
@@ -487,7 +487,7 @@ void ViewerState::selectAnimation(int index) {
     anim.playing = false;
     anim.time = anim.clips[size_t(index)].start;
     applyPose(*this, anim.clips[size_t(index)], anim.time);
-    status = "Animation: " + (anim.clips[size_t(index)].name.empty() ? "clip " + std::to_string(index) : anim.clips[size_t(index)].name);
+    ui.status = "Animation: " + (anim.clips[size_t(index)].name.empty() ? "clip " + std::to_string(index) : anim.clips[size_t(index)].name);
 }
 
 void ViewerState::setAnimationPlaying(bool play) {

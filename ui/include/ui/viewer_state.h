@@ -131,23 +131,26 @@ struct Playback {
     bool loop = true;   // wrap at the end (else stop there)
 };
 
+// Transient UI state: messages, the unsaved-changes question, work requested of the window
+// and the panels' own state (dialogs, toggles). None of it is saved.
+struct UiState {
+    std::string status;       // one line shown in the status bar
+    std::string errorPopup;   // shown in a modal until dismissed (e.g. load failure)
+    // Unsaved-changes guard: the action waiting for the answer.
+    PendingAction pending = PendingAction::None;
+    std::filesystem::path pendingPath;
+    bool confirmOpen = false;   // the modal should be shown
+    Requests requests;
+    PanelState panels;
+};
+
 struct ViewerState {
     Document doc;
     View view;
     AsyncLoad load;
     Playback anim;
+    UiState ui;
 
-    // --- messages ----------------------------------------------------------------------
-    std::string status;       // one line shown in the status bar
-    std::string errorPopup;   // shown in a modal until dismissed (e.g. load failure)
-
-    // --- unsaved-changes guard -------------------------------------------------------------
-    PendingAction pending = PendingAction::None;
-    std::filesystem::path pendingPath;
-    bool confirmOpen = false;   // the modal should be shown
-
-    Requests requests;
-    PanelState panels;                           // the ImGui panels' own state (dialogs, toggles)
     std::string requestedTab;                    // select this right-panel tab next frame
     std::vector<std::string> recentFiles;        // most recent first
     std::filesystem::path configDir;             // where recent.txt lives ("" = don't persist)
