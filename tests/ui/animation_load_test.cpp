@@ -28,7 +28,7 @@ ViewerState demoState() {
     ViewerState st;
     st.view.viewportWidth = 800;
     st.view.viewportHeight = 600;
-    st.configDir.clear();   // never touch the user's recent files
+    st.config.dir.clear();   // never touch the user's recent files
     st.setScene(assets::makeDemoScene(), {});
     return st;
 }

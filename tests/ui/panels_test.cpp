@@ -42,8 +42,8 @@ public:
         t += 1.0 / 60.0;
     }
     const ItemRect& rect(const std::string& key) {
-        auto it = st.itemRects.find(key);
-        if (it == st.itemRects.end()) throw std::runtime_error("no item '" + key + "'");
+        auto it = st.hooks.itemRects.find(key);
+        if (it == st.hooks.itemRects.end()) throw std::runtime_error("no item '" + key + "'");
         return it->second;
     }
     void moveTo(float x, float y) {
@@ -250,7 +250,7 @@ assets::AnimationClip crateClip(const sg::Scene& s) {
 
 TEST(PanelsTest, AnimationBarOnlyWithClipsPlayButtonAndSpaceToggle) {
     Headless h;
-    EXPECT_EQ(h.st.itemRects.count("anim/play"), 0u);   // the demo has no clips: no bar
+    EXPECT_EQ(h.st.hooks.itemRects.count("anim/play"), 0u);   // the demo has no clips: no bar
     h.st.anim.clips.push_back(crateClip(h.st.doc.scene));
     h.frame();
     ASSERT_NO_THROW(h.rect("anim/play"));
@@ -289,7 +289,7 @@ TEST(PanelsTest, AnimationBarOnlyWithClipsPlayButtonAndSpaceToggle) {
 TEST(PanelsTest, LoadShowsProgressAndCancelButtonKeepsScene) {
     Headless h;
     size_t nodes = h.st.doc.scene.nodeCount();
-    EXPECT_EQ(h.st.itemRects.count("status/cancelLoad"), 0u);
+    EXPECT_EQ(h.st.hooks.itemRects.count("status/cancelLoad"), 0u);
     // The panels never finish loads (the main loop's pollLoad does), so the bar stays up.
     h.st.startLoad("/nonexistent/dir/scene.obj");
     h.frame();

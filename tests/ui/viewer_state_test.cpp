@@ -261,7 +261,7 @@ TEST(ViewerStateTest, RecentFilesPersist) {
     fs::path dir = testing_support::outputDir("ui") / "config";
     fs::remove_all(dir);
     ViewerState st;
-    st.configDir = dir;
+    st.config.dir = dir;
     for (int i = 0; i < 12; ++i) st.addRecent("/tmp/scene" + std::to_string(i) + ".json");
     st.addRecent("/tmp/scene3.json");   // moves to the front, no duplicate
     std::vector<std::string> r = loadRecentFiles(dir);
@@ -321,7 +321,7 @@ TEST(RenderSlotTest, RapidRequestsCancelAndDestroyCleanly) {
 // including the view (stored into the active camera on save).
 TEST(ViewerStateTest, SaveAndReopenKeepsEditsAndView) {
     ViewerState st = demoState();
-    st.configDir.clear();
+    st.config.dir.clear();
     st.doc.scene.settings.shading = sg::ShadingModel::Gouraud;
     st.doc.scene.settings.fog = sg::FogMode::Exp;
     st.markEdited();

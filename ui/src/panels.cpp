@@ -43,7 +43,7 @@ float px(float v) { return v * g_scale; }
 // Records the last item's rectangle under `key` (test hook: click widgets by position).
 void record(ViewerState& st, const std::string& key) {
     ImVec2 a = ImGui::GetItemRectMin(), b = ImGui::GetItemRectMax();
-    st.itemRects[key] = ItemRect{a.x, a.y, b.x, b.y};
+    st.hooks.itemRects[key] = ItemRect{a.x, a.y, b.x, b.y};
 }
 
 // The last item's tooltip (a table entry's help; nothing when empty).
@@ -233,8 +233,8 @@ void drawMainMenu(ViewerState& st) {
     if (ImGui::BeginMenu("File")) {
         if (ImGui::MenuItem("New", "Ctrl+N")) st.requestNew();
         if (ImGui::MenuItem("Open...", "Ctrl+O")) st.ui.requests.openDialog = true;
-        if (ImGui::BeginMenu("Open Recent", !st.recentFiles.empty())) {
-            for (const std::string& f : st.recentFiles)
+        if (ImGui::BeginMenu("Open Recent", !st.config.recentFiles.empty())) {
+            for (const std::string& f : st.config.recentFiles)
                 if (ImGui::MenuItem(f.c_str())) st.requestOpen(f);
             ImGui::EndMenu();
         }
@@ -1497,25 +1497,25 @@ void drawUi(ViewerState& st, const ViewportInput& view, double time, float dt) {
         ImGui::PushItemWidth(-px(150));   // room for the labels on the right
         drawAnimationPanel(st);           // only when the scene has clips
         if (ImGui::BeginTabBar("tabs")) {
-            bool openInspector = ImGui::BeginTabItem("Inspector", nullptr, st.requestedTab == "Inspector" ? ImGuiTabItemFlags_SetSelected : 0);
+            bool openInspector = ImGui::BeginTabItem("Inspector", nullptr, st.hooks.requestedTab == "Inspector" ? ImGuiTabItemFlags_SetSelected : 0);
             record(st, "tab/Inspector");   // the tab itself (before its contents)
             if (openInspector) {
                 drawInspector(st);
                 ImGui::EndTabItem();
             }
-            bool openCamera = ImGui::BeginTabItem("Camera", nullptr, st.requestedTab == "Camera" ? ImGuiTabItemFlags_SetSelected : 0);
+            bool openCamera = ImGui::BeginTabItem("Camera", nullptr, st.hooks.requestedTab == "Camera" ? ImGuiTabItemFlags_SetSelected : 0);
             record(st, "tab/Camera");   // the tab itself (before its contents)
             if (openCamera) {
                 drawCameraPanel(st);
                 ImGui::EndTabItem();
             }
-            bool openRendering = ImGui::BeginTabItem("Rendering", nullptr, st.requestedTab == "Rendering" ? ImGuiTabItemFlags_SetSelected : 0);
+            bool openRendering = ImGui::BeginTabItem("Rendering", nullptr, st.hooks.requestedTab == "Rendering" ? ImGuiTabItemFlags_SetSelected : 0);
             record(st, "tab/Rendering");   // the tab itself (before its contents)
             if (openRendering) {
                 drawRenderingPanel(st);
                 ImGui::EndTabItem();
             }
-            bool openCompare = ImGui::BeginTabItem("Compare", nullptr, st.requestedTab == "Compare" ? ImGuiTabItemFlags_SetSelected : 0);
+            bool openCompare = ImGui::BeginTabItem("Compare", nullptr, st.hooks.requestedTab == "Compare" ? ImGuiTabItemFlags_SetSelected : 0);
             record(st, "tab/Compare");   // the tab itself (before its contents)
             if (openCompare) {
                 drawComparePanel(st);
@@ -1523,7 +1523,7 @@ void drawUi(ViewerState& st, const ViewportInput& view, double time, float dt) {
             }
             ImGui::EndTabBar();
         }
-        st.requestedTab.clear();
+        st.hooks.requestedTab.clear();
         ImGui::PopItemWidth();
     }
     rightW = ImGui::GetWindowWidth();

@@ -138,7 +138,7 @@ public:
     }
 
     // Backends bound to the caller's GL context render on the UI thread with the window's
-    // context, or on a worker with their own when glOnWorker (software GL); others always on a
+    // context, or on a worker with their own when view.glOnWorker (software GL); others always on a
     // worker (Auto).
     RenderSlot::Threading slotThreading() const { return st.view.glOnWorker ? RenderSlot::Threading::Worker : RenderSlot::Threading::Auto; }
     static bool contextBound(const RenderSlot& slot) { return slot.capabilities().affinity == rnd::ContextAffinity::CurrentGLContext; }
@@ -434,7 +434,7 @@ public:
                 continue;
             }
             if (cmd == "tab") {
-                in >> v.st.requestedTab;
+                in >> v.st.hooks.requestedTab;
                 continue;
             }
             if (cmd == "anim") {
@@ -593,11 +593,11 @@ int runViewer(const ViewerOptions& opt) {
     }
 
     // Config: imgui.ini (layout) and recent files in the per-user config folder.
-    st.configDir = defaultConfigDir();
+    st.config.dir = defaultConfigDir();
     std::error_code ec;
-    fs::create_directories(st.configDir, ec);
-    st.recentFiles = loadRecentFiles(st.configDir);
-    v.iniPath = (st.configDir / "imgui.ini").string();
+    fs::create_directories(st.config.dir, ec);
+    st.config.recentFiles = loadRecentFiles(st.config.dir);
+    v.iniPath = (st.config.dir / "imgui.ini").string();
 
     IMGUI_CHECKVERSION();
     ImGui::CreateContext();

@@ -455,10 +455,10 @@ std::string ViewerState::save(const fs::path& path) {
 }
 
 void ViewerState::addRecent(const std::string& path) {
-    std::erase(recentFiles, path);
-    recentFiles.insert(recentFiles.begin(), path);
-    if (recentFiles.size() > 10) recentFiles.resize(10);
-    if (!configDir.empty()) saveRecentFiles(configDir, recentFiles);
+    std::erase(config.recentFiles, path);
+    config.recentFiles.insert(config.recentFiles.begin(), path);
+    if (config.recentFiles.size() > 10) config.recentFiles.resize(10);
+    if (!config.dir.empty()) saveRecentFiles(config.dir, config.recentFiles);
 }
 
 // --- animation playback ----------------------------------------------------------------------

@@ -2,9 +2,18 @@
 //
 // Sections: CompareConfig (split / wipe / difference views), Requests (things the window
 // must do: screenshots, quit, file dialogs), LoadControl (cancel flag + progress shared with
-// the loader thread), ViewerState (scene, selection, camera, settings, dirty flag, load/save
-// with progress and cancel, unsaved-changes guard, node TRS animation playback), config
+// the loader thread), the parts of a ViewerState, ViewerState itself (actions: edits, camera,
+// unsaved-changes guard, load/save with progress and cancel, animation playback), config
 // helpers (per-user config folder, recent files, screenshot names).
+//
+// ViewerState's parts, by lifetime:
+//   doc    Document    the scene being edited, its file, dirty flag, selection (setScene replaces it)
+//   view   View        orbit camera, viewport, shown backends, compare config, AA overrides
+//   load   AsyncLoad   the load running off the UI thread (becomes the document in pollLoad)
+//   anim   Playback    animation clips of the loaded file and their playback (never an edit)
+//   ui     UiState     status line, error popup, unsaved-changes question, requests, panel state
+//   config UserConfig  per-user config folder and recent files
+//   hooks  TestHooks   recorded widget rectangles and the automation's tab request
 // The ImGui panels (panels.h) edit a ViewerState; the GLFW window (viewer.cpp) owns one, runs
 // the renderers for it and shows their images. Tests drive the state directly, or through
 // the panels in headless ImGui frames.
@@ -71,7 +80,8 @@ struct LoadControl {
 };
 
 // The document: the scene being edited, where it lives on disk and whether it has unsaved
-// edits. Replaced as a whole by setScene (a load, a new scene, the demo).
+// edits. setScene (a load, a new scene, the demo) replaces scene and path, clears the dirty
+// flag and the selection.
 struct Document {
     sg::Scene scene;
     std::filesystem::path path;   // empty for the demo / a new scene
@@ -144,17 +154,27 @@ struct UiState {
     PanelState panels;
 };
 
+// Per-user files: the config folder and the recent-files list kept there.
+struct UserConfig {
+    std::filesystem::path dir;              // where recent.txt lives ("" = don't persist)
+    std::vector<std::string> recentFiles;   // most recent first
+};
+
+// Test and automation hooks: the widget rectangles the panels record (tests click real
+// widgets by position) and the tab an automation script wants shown.
+struct TestHooks {
+    std::map<std::string, ItemRect> itemRects;
+    std::string requestedTab;   // select this right-panel tab next frame
+};
+
 struct ViewerState {
     Document doc;
     View view;
     AsyncLoad load;
     Playback anim;
     UiState ui;
-
-    std::string requestedTab;                    // select this right-panel tab next frame
-    std::vector<std::string> recentFiles;        // most recent first
-    std::filesystem::path configDir;             // where recent.txt lives ("" = don't persist)
-    std::map<std::string, ItemRect> itemRects;   // test hook, filled by panels
+    UserConfig config;
+    TestHooks hooks;
 
     // --- actions -----------------------------------------------------------------------
     // Replaces the scene (after a load): resets selection, dirty flag and camera.
