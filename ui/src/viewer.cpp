@@ -5,7 +5,8 @@
 //   2. Viewer: slots per backend, per-frame render requests, difference image, screenshots
 //   3. automation (hidden command-line scripting for tests and docs)
 //   4. GLFW callbacks (file drop, close with unsaved changes)
-//   5. main loop
+//   5. start-up and shutdown (automation script, window + GL context, ImGui, initial scene)
+//   6. main loop (one frame: events, UI, renders, present)
 //
 // Threads: the UI thread owns GLFW, GL, ImGui and the ViewerState. CPU backends render on
 // their RenderSlot worker threads; the GL backend renders on the UI thread with the window's
@@ -372,109 +373,11 @@ public:
             std::string cmd;
             in >> cmd;
             if (cmd.empty() || cmd[0] == '#') continue;
-            if (cmd == "frames") {
-                in >> waitFrames;
-                return true;
-            }
-            if (cmd == "wait") {
-                waiting = true;
-                return true;
-            }
-            if (cmd == "quit") return false;
-            if (cmd == "key") {
-                std::string k;
-                in >> k;
-                int code = k == "Home"                                   ? GLFW_KEY_HOME
-                           : k == "F12"                                  ? GLFW_KEY_F12
-                           : k == "F"                                    ? GLFW_KEY_F
-                           : k.size() == 1 && k[0] >= '1' && k[0] <= '9' ? GLFW_KEY_1 + (k[0] - '1')
-                                                                         : std::atoi(k.c_str());
-                if (code > 0 && code < 512) {
-                    ImGui::GetIO().KeysDown[code] = true;
-                    releaseKey = code;
-                }
-                waitFrames = 1;
-                return true;
-            }
-            if (cmd == "backend") {
-                std::string b;
-                in >> b;
-                v.st.setBackend(b);
-                v.st.view.compare.mode = ViewMode::Single;
-                continue;
-            }
-            if (cmd == "view") {
-                std::string m;
-                in >> m;
-                applyView(v.st, m);
-                continue;
-            }
-            if (cmd == "orbit") {
-                float dx = 0, dy = 0;
-                in >> dx >> dy;
-                v.st.view.camera.orbit(dx, dy);
-                v.st.markViewChanged();
-                continue;
-            }
-            if (cmd == "zoom") {
-                float s = 0;
-                in >> s;
-                v.st.view.camera.zoom(s);
-                v.st.markViewChanged();
-                continue;
-            }
-            if (cmd == "fit") {
-                v.st.fitView(false);
-                continue;
-            }
-            if (cmd == "gl-worker") {
-                std::string on;
-                in >> on;
-                v.st.view.glOnWorker = on == "on";
-                continue;
-            }
-            if (cmd == "tab") {
-                in >> v.st.hooks.requestedTab;
-                continue;
-            }
-            if (cmd == "anim") {
-                std::string what;
-                in >> what;
-                if (what == "play" || what == "pause")
-                    v.st.setAnimationPlaying(what == "play");
-                else if (what == "time") {
-                    double t = 0;
-                    in >> t;
-                    v.st.setAnimationTime(t);
-                }
-                continue;
-            }
-            if (cmd == "stats") {   // one line per shown backend: time, triangles, rays, error
-                for (const std::string& n : visibleBackends(v.st)) {
-                    SlotStatus s = v.viewFor(n).slot->status();
-                    std::printf("viewer: stats %s %dx%d level %d: %.1f ms, %llu triangles, %llu rays%s%s\n", n.c_str(), v.st.view.viewportWidth,
-                                v.st.view.viewportHeight, s.level, s.stats.milliseconds, (unsigned long long)s.stats.triangles,
-                                (unsigned long long)s.stats.rays, s.error.empty() ? "" : ", error: ", s.error.c_str());
-                }
-                std::fflush(stdout);
-                continue;
-            }
-            if (cmd == "select") {
-                std::string name;
-                std::getline(in >> std::ws, name);
-                v.st.selectNode(v.st.doc.scene.findByName(name));
-                continue;
-            }
-            if (cmd == "screenshot") {
-                std::string dir;
-                in >> dir;
-                v.startScreenshots(0, 0, dir.empty() ? "." : dir);
-                waiting = true;
-                return true;
-            }
-            if (cmd == "window-shot") {
-                in >> windowShot;
-                return true;
+            switch (runCommand(cmd, in, v)) {
+            case Next::Continue: continue;
+            case Next::Yield: return true;
+            case Next::Quit: return false;
+            case Next::Unknown: break;
             }
             std::fprintf(stderr, "viewer: automation: unknown command '%s' (line %zu)\n", cmd.c_str(), pc);
             failed = true;
@@ -483,6 +386,120 @@ public:
         return false;   // script finished
     }
 
+private:
+    enum class Next { Continue, Yield, Quit, Unknown };   // after a command: next line, let frames pass, stop
+
+    // One command. Those that need frames to pass (frames, wait, key, screenshot, window-shot)
+    // are here; the ones that only change the state are in applyStateCommand.
+    Next runCommand(const std::string& cmd, std::istringstream& in, Viewer& v) {
+        if (cmd == "frames") {
+            in >> waitFrames;
+            return Next::Yield;
+        }
+        if (cmd == "wait") {
+            waiting = true;
+            return Next::Yield;
+        }
+        if (cmd == "quit") return Next::Quit;
+        if (cmd == "key") {
+            std::string k;
+            in >> k;
+            int code = keyCode(k);
+            if (code > 0 && code < 512) {
+                ImGui::GetIO().KeysDown[code] = true;
+                releaseKey = code;
+            }
+            waitFrames = 1;
+            return Next::Yield;
+        }
+        if (cmd == "screenshot") {
+            std::string dir;
+            in >> dir;
+            v.startScreenshots(0, 0, dir.empty() ? "." : dir);
+            waiting = true;
+            return Next::Yield;
+        }
+        if (cmd == "window-shot") {
+            in >> windowShot;
+            return Next::Yield;
+        }
+        if (cmd == "stats") {
+            printStats(v);
+            return Next::Continue;
+        }
+        return applyStateCommand(cmd, in, v.st) ? Next::Continue : Next::Unknown;
+    }
+
+    // 1 2 3 F Home F12, or a GLFW key code.
+    static int keyCode(const std::string& k) {
+        return k == "Home"                                   ? GLFW_KEY_HOME
+               : k == "F12"                                  ? GLFW_KEY_F12
+               : k == "F"                                    ? GLFW_KEY_F
+               : k.size() == 1 && k[0] >= '1' && k[0] <= '9' ? GLFW_KEY_1 + (k[0] - '1')
+                                                             : std::atoi(k.c_str());
+    }
+
+    // Commands that change the viewer state and go on with the next line. False: unknown.
+    static bool applyStateCommand(const std::string& cmd, std::istringstream& in, ViewerState& st) {
+        if (cmd == "backend") {
+            std::string b;
+            in >> b;
+            st.setBackend(b);
+            st.view.compare.mode = ViewMode::Single;
+        } else if (cmd == "view") {
+            std::string m;
+            in >> m;
+            applyView(st, m);
+        } else if (cmd == "orbit") {
+            float dx = 0, dy = 0;
+            in >> dx >> dy;
+            st.view.camera.orbit(dx, dy);
+            st.markViewChanged();
+        } else if (cmd == "zoom") {
+            float s = 0;
+            in >> s;
+            st.view.camera.zoom(s);
+            st.markViewChanged();
+        } else if (cmd == "fit") {
+            st.fitView(false);
+        } else if (cmd == "gl-worker") {
+            std::string on;
+            in >> on;
+            st.view.glOnWorker = on == "on";
+        } else if (cmd == "tab") {
+            in >> st.hooks.requestedTab;
+        } else if (cmd == "anim") {
+            std::string what;
+            in >> what;
+            if (what == "play" || what == "pause")
+                st.setAnimationPlaying(what == "play");
+            else if (what == "time") {
+                double t = 0;
+                in >> t;
+                st.setAnimationTime(t);
+            }
+        } else if (cmd == "select") {
+            std::string name;
+            std::getline(in >> std::ws, name);
+            st.selectNode(st.doc.scene.findByName(name));
+        } else {
+            return false;
+        }
+        return true;
+    }
+
+    // One line per shown backend: time, triangles, rays, error.
+    static void printStats(Viewer& v) {
+        for (const std::string& n : visibleBackends(v.st)) {
+            SlotStatus s = v.viewFor(n).slot->status();
+            std::printf("viewer: stats %s %dx%d level %d: %.1f ms, %llu triangles, %llu rays%s%s\n", n.c_str(), v.st.view.viewportWidth,
+                        v.st.view.viewportHeight, s.level, s.stats.milliseconds, (unsigned long long)s.stats.triangles,
+                        (unsigned long long)s.stats.rays, s.error.empty() ? "" : ", error: ", s.error.c_str());
+        }
+        std::fflush(stdout);
+    }
+
+public:
     static void applyView(ViewerState& st, const std::string& m) {
         if (m == "single")
             st.view.compare.mode = ViewMode::Single;
@@ -526,21 +543,19 @@ void onGlfwError(int code, const char* msg) { std::fprintf(stderr, "viewer: GLFW
 
 }   // namespace
 
-// --- 5. main loop ------------------------------------------------------------------------------
+// --- 5. start-up and shutdown -----------------------------------------------------------------
 
-int runViewer(const std::string& scenePath) {
-    ViewerOptions o;
-    o.scene = scenePath;
-    return runViewer(o);
-}
+namespace {
 
-int runViewer(const ViewerOptions& opt) {
-    Automation automation;
+// The automation script: the --automate file, or the shorthand --frames N [--screenshot P] =
+// "frames N / wait / window-shot P / frames 1 / quit". False (message printed) when the file
+// cannot be read.
+bool loadAutomation(const ViewerOptions& opt, Automation& automation) {
     if (!opt.script.empty()) {
         std::ifstream in(opt.script);
         if (!in) {
             std::fprintf(stderr, "viewer: error: cannot read automation script '%s'\n", opt.script.c_str());
-            return 1;
+            return false;
         }
         for (std::string line; std::getline(in, line);) automation.lines.push_back(line);
     } else if (opt.frames > 0 || !opt.screenshot.empty()) {
@@ -549,12 +564,16 @@ int runViewer(const ViewerOptions& opt) {
         automation.lines.push_back("frames 1");
         automation.lines.push_back("quit");
     }
-    bool automated = !automation.lines.empty();
+    return true;
+}
 
+// GLFW, a window with a current GL 3.3 core context, the GL functions. Null (message printed,
+// GLFW terminated) on failure. Scripted runs do not wait for vsync.
+GLFWwindow* createWindow(const ViewerOptions& opt, bool automated) {
     glfwSetErrorCallback(onGlfwError);
     if (!glfwInit()) {
         std::fprintf(stderr, "viewer: error: cannot open a window (no X display? try xvfb-run, or use 'viewer render' headless)\n");
-        return 1;
+        return nullptr;
     }
     glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
     glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
@@ -565,7 +584,7 @@ int runViewer(const ViewerOptions& opt) {
     if (!win) {
         std::fprintf(stderr, "viewer: error: cannot create a GL 3.3 core window\n");
         glfwTerminate();
-        return 1;
+        return nullptr;
     }
     glfwMakeContextCurrent(win);
     glfwSwapInterval(automated ? 0 : 1);
@@ -573,11 +592,14 @@ int runViewer(const ViewerOptions& opt) {
         std::fprintf(stderr, "viewer: error: cannot load OpenGL functions\n");
         glfwDestroyWindow(win);
         glfwTerminate();
-        return 1;
+        return nullptr;
     }
+    return win;
+}
 
-    auto viewer = std::make_unique<Viewer>();
-    Viewer& v = *viewer;
+// Connects the window to the viewer (callbacks), picks where the GL backend renders, reads the
+// per-user config and sets up ImGui (context, layout file, style at the window's scale).
+void setUpViewer(Viewer& v, GLFWwindow* win) {
     ViewerState& st = v.st;
     glfwSetWindowUserPointer(win, &v);
     glfwSetDropCallback(win, onDrop);
@@ -608,8 +630,10 @@ int runViewer(const ViewerOptions& opt) {
     setupStyle(std::max(xs, ys), kFontPath);
     ImGui_ImplGlfw_InitForOpenGL(win, true);
     ImGui_ImplOpenGL3_Init("#version 330");
+}
 
-    // Initial scene: the demo, or the file (loaded off the UI thread).
+// The demo, or the file (loaded off the UI thread); then the initial backend and view.
+void openInitialScene(ViewerState& st, const ViewerOptions& opt) {
     if (opt.scene.empty() || opt.scene == "demo") {
         st.setScene(assets::makeDemoScene(), {});
         st.ui.status = "Demo scene. Drop a file on the window or use File > Open.";
@@ -619,94 +643,13 @@ int runViewer(const ViewerOptions& opt) {
     }
     if (!opt.backend.empty()) st.setBackend(opt.backend);
     if (!opt.view.empty()) Automation::applyView(st, opt.view);
+}
 
-    auto start = std::chrono::steady_clock::now();
-    double last = 0;
-    int exitCode = 0;
-    bool running = true;
-    std::string windowTitle;
-    while (running) {
-        bool busy = !v.shots.empty() || st.loadInProgress() || st.anim.playing || automated;
-        for (auto& [n, bv] : v.views) busy |= bv.slot->status().rendering;
-        if (busy || (v.now - st.view.lastInteraction) < 0.5)
-            glfwPollEvents();
-        else
-            glfwWaitEventsTimeout(0.1);
-
-        v.now = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        float dt = float(std::clamp(v.now - last, 1e-4, 0.25));
-        last = v.now;
-        if (automated && v.now > opt.timeoutSeconds) {
-            std::fprintf(stderr, "viewer: automation: timed out after %.0f s\n", opt.timeoutSeconds);
-            exitCode = 3;
-            break;
-        }
-
-        // Events that arrived through callbacks.
-        if (!v.droppedFiles.empty()) {
-            st.requestOpen(v.droppedFiles.front());
-            v.droppedFiles.clear();
-        }
-        st.pollLoad();
-        st.advanceAnimation(dt);
-        v.pollScreenshots(false);
-        if (automated && !automation.step(v, win)) {
-            running = false;
-            if (automation.failed) exitCode = 2;
-        }
-
-        if (v.newContentScale > 0.0f) {   // HiDPI change: rebuild fonts and style at the new scale
-            setupStyle(v.newContentScale, kFontPath);
-            ImGui_ImplOpenGL3_DestroyFontsTexture();
-            ImGui_ImplOpenGL3_CreateFontsTexture();
-            v.newContentScale = 0.0f;
-        }
-        ImGui_ImplOpenGL3_NewFrame();
-        ImGui_ImplGlfw_NewFrame();
-        ImGui::NewFrame();
-        drawUi(st, v.viewportInput(), v.now, dt);
-        ImGui::Render();
-
-        // Renders after the UI decided viewport size, camera and settings for this frame.
-        v.updateRenders();
-        v.updateDiff();
-        if (st.ui.requests.screenshot) {
-            st.ui.requests.screenshot = false;
-            v.startScreenshots(st.ui.requests.screenshotWidth, st.ui.requests.screenshotHeight, v.shotDir);
-            st.ui.requests.screenshotWidth = st.ui.requests.screenshotHeight = 0;
-        }
-
-        int fbw = 0, fbh = 0;
-        glfwGetFramebufferSize(win, &fbw, &fbh);
-        glBindFramebuffer(GL_FRAMEBUFFER, 0);
-        glViewport(0, 0, fbw, fbh);
-        glDisable(GL_FRAMEBUFFER_SRGB);   // the UI colours and the images are already sRGB
-        glDisable(GL_DEPTH_TEST);
-        glClearColor(0.08f, 0.09f, 0.10f, 1.0f);
-        glClear(GL_COLOR_BUFFER_BIT);
-        ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
-        if (!automation.windowShot.empty()) {
-            std::string err = saveWindowPng(win, automation.windowShot);
-            if (!err.empty()) {
-                std::fprintf(stderr, "viewer: window-shot: %s\n", err.c_str());
-                exitCode = 2;
-            } else {
-                std::printf("viewer: wrote %s\n", automation.windowShot.c_str());
-            }
-            automation.windowShot.clear();
-        }
-        glfwSwapBuffers(win);
-        if (st.ui.requests.quit) running = false;
-        // Window title: file name and the unsaved-changes marker.
-        std::string title =
-            (st.doc.path.empty() ? st.doc.scene.name : st.doc.path.filename().string()) + (st.doc.dirty ? " *" : "") + " - Scene viewer";
-        if (title != windowTitle) {
-            windowTitle = title;
-            glfwSetWindowTitle(win, title.c_str());
-        }
-    }
+// Finishes the screenshots in flight, stops a running load, frees the GL objects while the
+// context is current, then ImGui, the window and GLFW.
+void shutDown(Viewer& v, GLFWwindow* win) {
     v.pollScreenshots(true);
-    st.cancelLoad();   // a load still running stops soon instead of finishing for nobody
+    v.st.cancelLoad();   // a load still running stops soon instead of finishing for nobody
 
     v.releaseGL();
     ImGui_ImplOpenGL3_Shutdown();
@@ -714,6 +657,169 @@ int runViewer(const ViewerOptions& opt) {
     ImGui::DestroyContext();
     glfwDestroyWindow(win);
     glfwTerminate();
+}
+
+}   // namespace
+
+// --- 6. main loop ------------------------------------------------------------------------------
+
+namespace {
+
+// One frame: wait for events, advance the clock, take in what arrived (files, a finished load,
+// animation time, screenshots), run the script, draw the UI, start renders for what it
+// decided, present.
+class MainLoop {
+public:
+    MainLoop(Viewer& v, GLFWwindow* win, Automation& automation, const ViewerOptions& opt)
+        : m_v(v), m_st(v.st), m_win(win), m_automation(automation), m_opt(opt), m_automated(!automation.lines.empty()) {}
+
+    // Runs frames until the viewer quits (window, Ctrl+Q, end of the script); the exit code.
+    int run() {
+        m_start = std::chrono::steady_clock::now();
+        bool running = true;
+        while (running) {
+            waitForEvents();
+            float dt = tick();
+            if (m_automated && m_v.now > m_opt.timeoutSeconds) {
+                std::fprintf(stderr, "viewer: automation: timed out after %.0f s\n", m_opt.timeoutSeconds);
+                m_exitCode = 3;
+                break;
+            }
+            handleEvents(dt);
+            if (m_automated && !m_automation.step(m_v, m_win)) {
+                running = false;
+                if (m_automation.failed) m_exitCode = 2;
+            }
+            drawUiFrame(dt);
+            updateRenders();   // after the UI decided viewport size, camera and settings for this frame
+            present();
+            if (m_st.ui.requests.quit) running = false;
+            updateTitle();
+        }
+        return m_exitCode;
+    }
+
+private:
+    // Polls while work is in flight or the user just moved the camera; otherwise sleeps until
+    // an event arrives (at most 0.1 s).
+    void waitForEvents() {
+        bool busy = !m_v.shots.empty() || m_st.loadInProgress() || m_st.anim.playing || m_automated;
+        for (auto& [n, bv] : m_v.views) busy |= bv.slot->status().rendering;
+        if (busy || (m_v.now - m_st.view.lastInteraction) < 0.5)
+            glfwPollEvents();
+        else
+            glfwWaitEventsTimeout(0.1);
+    }
+
+    // Sets v.now (seconds since the start); returns the frame time, clamped to [0.1 ms, 0.25 s].
+    float tick() {
+        m_v.now = std::chrono::duration<double>(std::chrono::steady_clock::now() - m_start).count();
+        float dt = float(std::clamp(m_v.now - m_last, 1e-4, 0.25));
+        m_last = m_v.now;
+        return dt;
+    }
+
+    // Events that arrived through callbacks, a finished load, animation time, screenshots.
+    void handleEvents(float dt) {
+        if (!m_v.droppedFiles.empty()) {
+            m_st.requestOpen(m_v.droppedFiles.front());
+            m_v.droppedFiles.clear();
+        }
+        m_st.pollLoad();
+        m_st.advanceAnimation(dt);
+        m_v.pollScreenshots(false);
+    }
+
+    void drawUiFrame(float dt) {
+        if (m_v.newContentScale > 0.0f) {   // HiDPI change: rebuild fonts and style at the new scale
+            setupStyle(m_v.newContentScale, kFontPath);
+            ImGui_ImplOpenGL3_DestroyFontsTexture();
+            ImGui_ImplOpenGL3_CreateFontsTexture();
+            m_v.newContentScale = 0.0f;
+        }
+        ImGui_ImplOpenGL3_NewFrame();
+        ImGui_ImplGlfw_NewFrame();
+        ImGui::NewFrame();
+        drawUi(m_st, m_v.viewportInput(), m_v.now, dt);
+        ImGui::Render();
+    }
+
+    // Renders for the shown backends, the difference image, a requested screenshot.
+    void updateRenders() {
+        m_v.updateRenders();
+        m_v.updateDiff();
+        Requests& r = m_st.ui.requests;
+        if (r.screenshot) {
+            r.screenshot = false;
+            m_v.startScreenshots(r.screenshotWidth, r.screenshotHeight, m_v.shotDir);
+            r.screenshotWidth = r.screenshotHeight = 0;
+        }
+    }
+
+    // Draws the UI into the window, takes the script's window shot, swaps.
+    void present() {
+        int fbw = 0, fbh = 0;
+        glfwGetFramebufferSize(m_win, &fbw, &fbh);
+        glBindFramebuffer(GL_FRAMEBUFFER, 0);
+        glViewport(0, 0, fbw, fbh);
+        glDisable(GL_FRAMEBUFFER_SRGB);   // the UI colours and the images are already sRGB
+        glDisable(GL_DEPTH_TEST);
+        glClearColor(0.08f, 0.09f, 0.10f, 1.0f);
+        glClear(GL_COLOR_BUFFER_BIT);
+        ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+        if (!m_automation.windowShot.empty()) {
+            std::string err = saveWindowPng(m_win, m_automation.windowShot);
+            if (!err.empty()) {
+                std::fprintf(stderr, "viewer: window-shot: %s\n", err.c_str());
+                m_exitCode = 2;
+            } else {
+                std::printf("viewer: wrote %s\n", m_automation.windowShot.c_str());
+            }
+            m_automation.windowShot.clear();
+        }
+        glfwSwapBuffers(m_win);
+    }
+
+    // Window title: file name and the unsaved-changes marker.
+    void updateTitle() {
+        const Document& doc = m_st.doc;
+        std::string title = (doc.path.empty() ? doc.scene.name : doc.path.filename().string()) + (doc.dirty ? " *" : "") + " - Scene viewer";
+        if (title != m_windowTitle) {
+            m_windowTitle = title;
+            glfwSetWindowTitle(m_win, title.c_str());
+        }
+    }
+
+    Viewer& m_v;
+    ViewerState& m_st;
+    GLFWwindow* m_win;
+    Automation& m_automation;
+    const ViewerOptions& m_opt;
+    const bool m_automated;
+    std::chrono::steady_clock::time_point m_start;
+    double m_last = 0;
+    int m_exitCode = 0;
+    std::string m_windowTitle;
+};
+
+}   // namespace
+
+int runViewer(const std::string& scenePath) {
+    ViewerOptions o;
+    o.scene = scenePath;
+    return runViewer(o);
+}
+
+int runViewer(const ViewerOptions& opt) {
+    Automation automation;
+    if (!loadAutomation(opt, automation)) return 1;
+    GLFWwindow* win = createWindow(opt, /*automated=*/!automation.lines.empty());
+    if (!win) return 1;
+    auto viewer = std::make_unique<Viewer>();   // outlives the ImGui context (it holds the ini path)
+    setUpViewer(*viewer, win);
+    openInitialScene(viewer->st, opt);
+    int exitCode = MainLoop(*viewer, win, automation, opt).run();
+    shutDown(*viewer, win);
     return exitCode;
 }
 
