@@ -607,19 +607,19 @@ void transformEditor(ViewerState& st, sg::NodeId id) {
     }
 }
 
-}   // namespace
+// Inspector with nothing selected: what the scene holds, and its ambient light.
+void sceneSummary(ViewerState& st) {
+    sg::Scene& scene = st.doc.scene;
+    ImGui::TextDisabled("Select a node in the scene tree.");
+    ImGui::Spacing();
+    ImGui::Text("Scene: %s", scene.name.c_str());
+    ImGui::Text("Nodes: %zu   meshes: %zu   materials: %zu   textures: %zu", scene.nodeCount(), scene.meshes.size(), scene.materials.size(),
+                scene.textures.size());
+    if (ImGui::ColorEdit3("Ambient light", &scene.ambientLight.x, ImGuiColorEditFlags_Float)) st.markEdited();
+}
 
-void drawInspector(ViewerState& st) {
-    sg::NodeId id = st.doc.selected;
-    if (!st.doc.scene.valid(id)) {
-        ImGui::TextDisabled("Select a node in the scene tree.");
-        ImGui::Spacing();
-        ImGui::Text("Scene: %s", st.doc.scene.name.c_str());
-        ImGui::Text("Nodes: %zu   meshes: %zu   materials: %zu   textures: %zu", st.doc.scene.nodeCount(), st.doc.scene.meshes.size(),
-                    st.doc.scene.materials.size(), st.doc.scene.textures.size());
-        if (ImGui::ColorEdit3("Ambient light", &st.doc.scene.ambientLight.x, ImGuiColorEditFlags_Float)) st.markEdited();
-        return;
-    }
+// Name, kind and id, visibility.
+void nodeHeader(ViewerState& st, sg::NodeId id) {
     const sg::Node& n = st.doc.scene.node(id);
     std::string name = n.name;
     ImGui::SetNextItemWidth(-px(70));
@@ -632,89 +632,131 @@ void drawInspector(ViewerState& st) {
         if (ImGui::Checkbox("Visible", &vis)) st.setVisible(id, vis);
         record(st, "inspector/visible");
     }
+}
 
-    if (id != st.doc.scene.root() && ImGui::CollapsingHeader("Transform", ImGuiTreeNodeFlags_DefaultOpen)) transformEditor(st, id);
+// The payload sections below edit a copy of the payload and return true when it changed;
+// drawInspector writes it back.
 
-    // Payload.
-    sg::Payload p = st.doc.scene.node(id).payload;
+bool materialSection(ViewerState& st, int& index) {
+    return ImGui::CollapsingHeader("Material", ImGuiTreeNodeFlags_DefaultOpen) && materialEditor(st, index);
+}
+
+void meshSection(const ViewerState& st, const sg::MeshInstance& mi) {
+    if (!ImGui::CollapsingHeader("Mesh", ImGuiTreeNodeFlags_DefaultOpen)) return;
+    const sg::Scene& scene = st.doc.scene;
+    if (mi.mesh >= 0 && size_t(mi.mesh) < scene.meshes.size() && scene.meshes[mi.mesh]) {
+        const sg::Mesh& mesh = *scene.meshes[mi.mesh];
+        ImGui::Text("Mesh %d: %zu vertices, %zu triangles", mi.mesh, mesh.positions.size(), mesh.indices.size() / 3);
+    } else {
+        ImGui::TextColored(ImVec4(1, 0.5f, 0.4f, 1), "Mesh index %d is missing", mi.mesh);
+    }
+}
+
+// Operation, and a menu adding implicit operands under the node `id`.
+bool csgSection(ViewerState& st, sg::NodeId id, sg::CsgPayload& cp) {
+    if (!ImGui::CollapsingHeader("CSG", ImGuiTreeNodeFlags_DefaultOpen)) return false;
+    bool ch = enumCombo(st, "Operation", cp.csg.op,
+                        {{sg::CsgOp::Union, "union"}, {sg::CsgOp::Intersection, "intersection"}, {sg::CsgOp::Difference, "difference"}});
+    ImGui::TextDisabled("Children combine left to right (first child minus the others for difference).");
+    if (ImGui::Button("Add operand")) ImGui::OpenPopup("csg_add");
+    if (ImGui::BeginPopup("csg_add")) {
+        for (auto& [t, nm] : kShapes)
+            if (ImGui::MenuItem(nm)) st.addShape(t, id);
+        ImGui::EndPopup();
+    }
+    return ch;
+}
+
+bool lightSection(ViewerState& st, sg::Light& l) {
+    if (!ImGui::CollapsingHeader("Light", ImGuiTreeNodeFlags_DefaultOpen)) return false;
+    bool ch = enumCombo(st, "Type", l.type);
+    ch |= ImGui::ColorEdit3("Colour", &l.color.x, ImGuiColorEditFlags_Float);
+    ch |= ImGui::DragFloat("Intensity", &l.intensity, 0.05f, 0.0f, 1e5f);
+    ch |= ImGui::Checkbox("Inverse-square falloff", &l.inverseSquare);
+    if (l.type == sg::LightType::Spot) {
+        ch |= ImGui::SliderFloat("Inner angle", &l.spotInnerDeg, 0.0f, 90.0f);
+        ch |= ImGui::SliderFloat("Outer angle", &l.spotOuterDeg, 0.0f, 90.0f);
+        l.spotInnerDeg = std::min(l.spotInnerDeg, l.spotOuterDeg);
+    }
+    ImGui::TextDisabled("Lights point down their local -z axis.");
+    return ch;
+}
+
+bool cameraSection(ViewerState& st, sg::NodeId id, sg::Camera& cam) {
+    if (!ImGui::CollapsingHeader("Camera", ImGuiTreeNodeFlags_DefaultOpen)) return false;
+    if (ImGui::Button("Look through this camera")) st.useSceneCamera(id);
+    ImGui::SameLine();
+    ImGui::TextDisabled("(projection: Camera tab)");
+    return ImGui::DragFloat("Focus distance", &cam.focusDistance, 0.05f, 0.001f, 1e5f);
+}
+
+bool parametricSection(ViewerState& st, sg::ParametricPayload& pp) {
+    if (!ImGui::CollapsingHeader("Parametric surface", ImGuiTreeNodeFlags_DefaultOpen)) return false;
+    bool ch = enumCombo(st, "Surface", pp.surface.type, {{sg::ParametricType::Torus, "torus"}, {sg::ParametricType::BezierPatch, "bezier patch"}});
+    if (pp.surface.type == sg::ParametricType::Torus) {
+        ch |= ImGui::DragFloat("Major radius", &pp.surface.majorRadius, 0.01f, 0.001f, 1e4f);
+        ch |= ImGui::DragFloat("Minor radius", &pp.surface.minorRadius, 0.01f, 0.001f, 1e4f);
+    } else if (ImGui::TreeNode("Control points")) {
+        for (int i = 0; i < 16; ++i) {
+            ImGui::PushID(i);
+            ch |= ImGui::DragFloat3("##cp", &pp.surface.control[i].x, 0.01f);
+            ImGui::PopID();
+        }
+        ImGui::TreePop();
+    }
+    return ch;
+}
+
+bool gridSection(sg::GridPayload& gp) {
+    if (!ImGui::CollapsingHeader("Density grid", ImGuiTreeNodeFlags_DefaultOpen) || !gp.grid) return false;
+    ImGui::Text("%d x %d x %d samples", gp.grid->dims.x, gp.grid->dims.y, gp.grid->dims.z);
+    float iso = gp.grid->isoValue;
+    if (!ImGui::SliderFloat("Iso value", &iso, 0.0f, 2.0f)) return false;
+    auto copy = std::make_shared<sg::DensityGrid>(*gp.grid);   // payloads share grids: copy on write
+    copy->isoValue = iso;
+    gp.grid = copy;
+    return true;
+}
+
+// The sections of the node's payload kind (its material last, for kinds that have one).
+bool payloadEditor(ViewerState& st, sg::NodeId id, sg::Payload& p) {
     bool ch = false;
     if (auto* mi = std::get_if<sg::MeshInstance>(&p)) {
-        if (ImGui::CollapsingHeader("Mesh", ImGuiTreeNodeFlags_DefaultOpen)) {
-            if (mi->mesh >= 0 && size_t(mi->mesh) < st.doc.scene.meshes.size() && st.doc.scene.meshes[mi->mesh]) {
-                const sg::Mesh& mesh = *st.doc.scene.meshes[mi->mesh];
-                ImGui::Text("Mesh %d: %zu vertices, %zu triangles", mi->mesh, mesh.positions.size(), mesh.indices.size() / 3);
-            } else {
-                ImGui::TextColored(ImVec4(1, 0.5f, 0.4f, 1), "Mesh index %d is missing", mi->mesh);
-            }
-        }
-        if (ImGui::CollapsingHeader("Material", ImGuiTreeNodeFlags_DefaultOpen)) ch |= materialEditor(st, mi->material);
+        meshSection(st, *mi);
+        ch |= materialSection(st, mi->material);
     } else if (auto* ip = std::get_if<sg::ImplicitPayload>(&p)) {
         if (ImGui::CollapsingHeader("Implicit shape", ImGuiTreeNodeFlags_DefaultOpen)) ch |= implicitEditor(st, ip->shape);
-        if (ImGui::CollapsingHeader("Material", ImGuiTreeNodeFlags_DefaultOpen)) ch |= materialEditor(st, ip->material);
+        ch |= materialSection(st, ip->material);
     } else if (auto* cp = std::get_if<sg::CsgPayload>(&p)) {
-        if (ImGui::CollapsingHeader("CSG", ImGuiTreeNodeFlags_DefaultOpen)) {
-            ch |= enumCombo(st, "Operation", cp->csg.op,
-                            {{sg::CsgOp::Union, "union"}, {sg::CsgOp::Intersection, "intersection"}, {sg::CsgOp::Difference, "difference"}});
-            ImGui::TextDisabled("Children combine left to right (first child minus the others for difference).");
-            if (ImGui::Button("Add operand")) ImGui::OpenPopup("csg_add");
-            if (ImGui::BeginPopup("csg_add")) {
-                for (auto& [t, nm] : kShapes)
-                    if (ImGui::MenuItem(nm)) st.addShape(t, id);
-                ImGui::EndPopup();
-            }
-        }
-        if (ImGui::CollapsingHeader("Material", ImGuiTreeNodeFlags_DefaultOpen)) ch |= materialEditor(st, cp->material);
+        ch |= csgSection(st, id, *cp);
+        ch |= materialSection(st, cp->material);
     } else if (auto* lp = std::get_if<sg::Light>(&p)) {
-        if (ImGui::CollapsingHeader("Light", ImGuiTreeNodeFlags_DefaultOpen)) {
-            ch |= enumCombo(st, "Type", lp->type);
-            ch |= ImGui::ColorEdit3("Colour", &lp->color.x, ImGuiColorEditFlags_Float);
-            ch |= ImGui::DragFloat("Intensity", &lp->intensity, 0.05f, 0.0f, 1e5f);
-            ch |= ImGui::Checkbox("Inverse-square falloff", &lp->inverseSquare);
-            if (lp->type == sg::LightType::Spot) {
-                ch |= ImGui::SliderFloat("Inner angle", &lp->spotInnerDeg, 0.0f, 90.0f);
-                ch |= ImGui::SliderFloat("Outer angle", &lp->spotOuterDeg, 0.0f, 90.0f);
-                lp->spotInnerDeg = std::min(lp->spotInnerDeg, lp->spotOuterDeg);
-            }
-            ImGui::TextDisabled("Lights point down their local -z axis.");
-        }
+        ch |= lightSection(st, *lp);
     } else if (auto* cam = std::get_if<sg::Camera>(&p)) {
-        if (ImGui::CollapsingHeader("Camera", ImGuiTreeNodeFlags_DefaultOpen)) {
-            if (ImGui::Button("Look through this camera")) st.useSceneCamera(id);
-            ImGui::SameLine();
-            ImGui::TextDisabled("(projection: Camera tab)");
-            ch |= ImGui::DragFloat("Focus distance", &cam->focusDistance, 0.05f, 0.001f, 1e5f);
-        }
+        ch |= cameraSection(st, id, *cam);
     } else if (auto* pp = std::get_if<sg::ParametricPayload>(&p)) {
-        if (ImGui::CollapsingHeader("Parametric surface", ImGuiTreeNodeFlags_DefaultOpen)) {
-            ch |=
-                enumCombo(st, "Surface", pp->surface.type, {{sg::ParametricType::Torus, "torus"}, {sg::ParametricType::BezierPatch, "bezier patch"}});
-            if (pp->surface.type == sg::ParametricType::Torus) {
-                ch |= ImGui::DragFloat("Major radius", &pp->surface.majorRadius, 0.01f, 0.001f, 1e4f);
-                ch |= ImGui::DragFloat("Minor radius", &pp->surface.minorRadius, 0.01f, 0.001f, 1e4f);
-            } else if (ImGui::TreeNode("Control points")) {
-                for (int i = 0; i < 16; ++i) {
-                    ImGui::PushID(i);
-                    ch |= ImGui::DragFloat3("##cp", &pp->surface.control[i].x, 0.01f);
-                    ImGui::PopID();
-                }
-                ImGui::TreePop();
-            }
-        }
-        if (ImGui::CollapsingHeader("Material", ImGuiTreeNodeFlags_DefaultOpen)) ch |= materialEditor(st, pp->material);
+        ch |= parametricSection(st, *pp);
+        ch |= materialSection(st, pp->material);
     } else if (auto* gp = std::get_if<sg::GridPayload>(&p)) {
-        if (ImGui::CollapsingHeader("Density grid", ImGuiTreeNodeFlags_DefaultOpen) && gp->grid) {
-            ImGui::Text("%d x %d x %d samples", gp->grid->dims.x, gp->grid->dims.y, gp->grid->dims.z);
-            float iso = gp->grid->isoValue;
-            if (ImGui::SliderFloat("Iso value", &iso, 0.0f, 2.0f)) {
-                auto copy = std::make_shared<sg::DensityGrid>(*gp->grid);   // payloads share grids: copy on write
-                copy->isoValue = iso;
-                gp->grid = copy;
-                ch = true;
-            }
-        }
-        if (ImGui::CollapsingHeader("Material", ImGuiTreeNodeFlags_DefaultOpen)) ch |= materialEditor(st, gp->material);
+        ch |= gridSection(*gp);
+        ch |= materialSection(st, gp->material);
     }
-    if (ch && st.doc.scene.valid(id) && !(p == st.doc.scene.node(id).payload)) {
+    return ch;
+}
+
+}   // namespace
+
+void drawInspector(ViewerState& st) {
+    sg::NodeId id = st.doc.selected;
+    if (!st.doc.scene.valid(id)) {
+        sceneSummary(st);
+        return;
+    }
+    nodeHeader(st, id);
+    if (id != st.doc.scene.root() && ImGui::CollapsingHeader("Transform", ImGuiTreeNodeFlags_DefaultOpen)) transformEditor(st, id);
+
+    sg::Payload p = st.doc.scene.node(id).payload;
+    if (payloadEditor(st, id, p) && st.doc.scene.valid(id) && !(p == st.doc.scene.node(id).payload)) {
         st.doc.scene.setPayload(id, p);
         st.markEdited();
     }
@@ -831,6 +873,36 @@ void drawCameraPanel(ViewerState& st) {
 
 // --- 7. rendering panel ------------------------------------------------------------------------
 
+namespace {
+
+// One combo per backend: its anti-aliasing override for this session, or "(scene)" for the
+// scene's own setting. Overrides are kept by name and re-render without an edit.
+void aaOverrideCombos(ViewerState& st) {
+    const sg::NameTable<sg::AAChoice>& aaNames = sg::nameTable<sg::AAChoice>();
+    for (const std::string& b : rnd::rendererNames()) {
+        auto it = st.view.aaOverride.find(b);
+        std::string ov = it == st.view.aaOverride.end() ? "" : it->second;
+        const sg::NamedValue<sg::AAChoice>* cur = aaNames.find(ov);
+        std::string label = "AA " + b;
+        if (ImGui::BeginCombo(label.c_str(), cur ? std::string(cur->label).c_str() : "(scene)")) {
+            if (ImGui::Selectable("(scene)", ov.empty())) {
+                st.view.aaOverride.erase(b);
+                st.markViewChanged();
+            }
+            for (const auto& e : aaNames.entries) {
+                if (ImGui::Selectable(std::string(e.label).c_str(), &e == cur)) {
+                    st.view.aaOverride[b] = std::string(e.name);
+                    st.markViewChanged();
+                }
+                tooltip(e.help);
+            }
+            ImGui::EndCombo();
+        }
+    }
+}
+
+}   // namespace
+
 void drawRenderingPanel(ViewerState& st) {
     sg::RenderSettings s = st.doc.scene.settings;
     bool ch = false;
@@ -859,28 +931,7 @@ void drawRenderingPanel(ViewerState& st) {
     sg::AAChoice aa = sg::aaChoice(s);
     if (enumCombo(st, "Scene AA", aa)) ch |= s.setAA(sg::nameOf(aa));   // none keeps the rate
     helpMarker("Saved with the scene. The ray caster uses SSAA-style jittered rays for either mode.");
-    // Per-backend overrides (viewer session only), kept by name.
-    const sg::NameTable<sg::AAChoice>& aaNames = sg::nameTable<sg::AAChoice>();
-    for (const std::string& b : rnd::rendererNames()) {
-        auto it = st.view.aaOverride.find(b);
-        std::string ov = it == st.view.aaOverride.end() ? "" : it->second;
-        const sg::NamedValue<sg::AAChoice>* cur = aaNames.find(ov);
-        std::string label = "AA " + b;
-        if (ImGui::BeginCombo(label.c_str(), cur ? std::string(cur->label).c_str() : "(scene)")) {
-            if (ImGui::Selectable("(scene)", ov.empty())) {
-                st.view.aaOverride.erase(b);
-                st.markViewChanged();
-            }
-            for (const auto& e : aaNames.entries) {
-                if (ImGui::Selectable(std::string(e.label).c_str(), &e == cur)) {
-                    st.view.aaOverride[b] = std::string(e.name);
-                    st.markViewChanged();
-                }
-                tooltip(e.help);
-            }
-            ImGui::EndCombo();
-        }
-    }
+    aaOverrideCombos(st);
 
     if (ImGui::Checkbox("GL on a worker thread", &st.view.glOnWorker)) st.markViewChanged();
     helpMarker(
@@ -1114,6 +1165,90 @@ void cameraInput(ViewerState& st, ImVec2 a, ImVec2 b, double time, float dt) {
     }
 }
 
+// The viewport's parts, each drawn over [a, a + avail].
+
+// Split view: each backend's image over its part of the width, its name on top, the dividers.
+void drawSplitView(ImDrawList* dl, const ViewerState& st, const ViewportInput& view, ImVec2 a, ImVec2 avail) {
+    ImVec2 b(a.x + avail.x, a.y + avail.y);
+    int n = std::min<int>(int(view.slots.size()), std::clamp(st.view.compare.count, 2, 3));
+    float edges[4] = {0.0f, st.view.compare.dividers[0], n == 3 ? st.view.compare.dividers[1] : 1.0f, 1.0f};
+    if (n == 2) edges[2] = 1.0f;
+    for (int i = 0; i < n; ++i) {
+        float u0 = edges[i], u1 = edges[i + 1];
+        if (u1 <= u0) continue;
+        ImVec2 p0(a.x + u0 * avail.x, a.y), p1(a.x + u1 * avail.x, b.y);
+        drawSlotImage(dl, view.slots[i], p0, p1, u0, u1, a, b);
+        // Backend label at the top of its region.
+        const std::string& name = view.slots[i].status.backend;
+        ImVec2 ts = ImGui::CalcTextSize(name.c_str());
+        ImVec2 lp(p0.x + (p1.x - p0.x - ts.x) * 0.5f, a.y + px(8));
+        dl->AddRectFilled(ImVec2(lp.x - px(6), lp.y - px(3)), ImVec2(lp.x + ts.x + px(6), lp.y + ts.y + px(3)), IM_COL32(0, 0, 0, 160), px(3));
+        dl->AddText(lp, IM_COL32(255, 255, 255, 255), name.c_str());
+    }
+    for (int i = 0; i + 1 < n; ++i) {
+        float x = a.x + st.view.compare.dividers[i] * avail.x;
+        dl->AddLine(ImVec2(x, a.y), ImVec2(x, b.y), IM_COL32(255, 255, 255, 200), px(2));
+        dl->AddCircleFilled(ImVec2(x, (a.y + b.y) * 0.5f), px(7), IM_COL32(255, 255, 255, 230));
+        dl->AddCircle(ImVec2(x, (a.y + b.y) * 0.5f), px(7), IM_COL32(40, 40, 40, 255), 0, px(1.5f));
+    }
+}
+
+// Difference view: the heat map (or why there is none yet) and the figures at the bottom.
+void drawDifferenceView(ImDrawList* dl, const ViewerState& st, const ViewportInput& view, ImVec2 a, ImVec2 avail) {
+    ImVec2 b(a.x + avail.x, a.y + avail.y);
+    SlotView d = view.diff;
+    if (!d.texture) {
+        // No diff yet: say why (an error of either side, or still rendering).
+        std::string msg = "Waiting for both images...";
+        for (const SlotView& s : view.slots)
+            if (!s.status.error.empty()) msg = s.status.backend + ": " + s.status.error;
+        dl->AddRectFilled(a, b, IM_COL32(24, 25, 29, 255));
+        centeredText(dl, a, b, msg, IM_COL32(255, 170, 140, 255));
+    } else {
+        dl->AddImage(d.texture, a, b);
+    }
+    if (view.slots.size() >= 2) {
+        char buf[256];
+        if (st.view.diff.valid)
+            std::snprintf(buf, sizeof buf, "|%s - %s|   mean %.2f   max %d   PSNR %.1f dB   within %d: %.1f%%", view.slots[0].status.backend.c_str(),
+                          view.slots[1].status.backend.c_str(), st.view.diff.mean, st.view.diff.max, st.view.diff.psnr, st.view.compare.threshold,
+                          100.0 * st.view.diff.within);
+        else
+            std::snprintf(buf, sizeof buf, "|%s - %s|", view.slots[0].status.backend.c_str(), view.slots[1].status.backend.c_str());
+        ImVec2 ts = ImGui::CalcTextSize(buf);
+        ImVec2 lp(a.x + (avail.x - ts.x) * 0.5f, b.y - ts.y - px(12));
+        dl->AddRectFilled(ImVec2(lp.x - px(8), lp.y - px(4)), ImVec2(lp.x + ts.x + px(8), lp.y + ts.y + px(4)), IM_COL32(0, 0, 0, 180), px(3));
+        dl->AddText(lp, IM_COL32(255, 230, 160, 255), buf);
+    }
+}
+
+// Stats overlay (top-left): one line per shown backend and the viewport size; progress bars
+// at the bottom for renders in flight.
+void drawStatsOverlay(ImDrawList* dl, const ViewerState& st, const ViewportInput& view, ImVec2 a, ImVec2 avail) {
+    ImVec2 b(a.x + avail.x, a.y + avail.y);
+    std::vector<std::string> lines;
+    for (const SlotView& v : view.slots) lines.push_back(slotStats(v));
+    char buf[128];
+    std::snprintf(buf, sizeof buf, "%d x %d   %s", st.view.viewportWidth, st.view.viewportHeight, st.view.flyMode ? "FLY (WASD QE)" : "");
+    lines.emplace_back(buf);
+    float h = ImGui::GetTextLineHeightWithSpacing();
+    float w = 0;
+    for (auto& l : lines) w = std::max(w, ImGui::CalcTextSize(l.c_str()).x);
+    ImVec2 o(a.x + px(10), a.y + (st.view.compare.mode == ViewMode::Split ? px(36) : px(10)));
+    dl->AddRectFilled(o, ImVec2(o.x + w + px(16), o.y + h * lines.size() + px(10)), IM_COL32(0, 0, 0, 150), px(4));
+    for (size_t i = 0; i < lines.size(); ++i) {
+        bool rendering = i < view.slots.size() && view.slots[i].status.rendering;
+        dl->AddText(ImVec2(o.x + px(8), o.y + px(5) + h * i), rendering ? IM_COL32(255, 220, 120, 255) : IM_COL32(220, 230, 240, 255),
+                    lines[i].c_str());
+    }
+    // Progress bars for renders in flight.
+    for (size_t i = 0; i < view.slots.size(); ++i) {
+        if (!view.slots[i].status.rendering) continue;
+        float y = b.y - px(4) - px(5) * i;
+        dl->AddRectFilled(ImVec2(a.x, y - px(3)), ImVec2(a.x + avail.x * view.slots[i].status.progress, y), IM_COL32(90, 170, 255, 220));
+    }
+}
+
 }   // namespace
 
 void drawViewport(ViewerState& st, const ViewportInput& view, double time, float dt) {
@@ -1141,83 +1276,10 @@ void drawViewport(ViewerState& st, const ViewportInput& view, double time, float
     case ViewMode::Single:
         if (!view.slots.empty()) drawSlotImage(dl, view.slots[0], a, b, 0, 1, a, b);
         break;
-    case ViewMode::Split: {
-        int n = std::min<int>(int(view.slots.size()), std::clamp(st.view.compare.count, 2, 3));
-        float edges[4] = {0.0f, st.view.compare.dividers[0], n == 3 ? st.view.compare.dividers[1] : 1.0f, 1.0f};
-        if (n == 2) edges[2] = 1.0f;
-        for (int i = 0; i < n; ++i) {
-            float u0 = edges[i], u1 = edges[i + 1];
-            if (u1 <= u0) continue;
-            ImVec2 p0(a.x + u0 * avail.x, a.y), p1(a.x + u1 * avail.x, b.y);
-            drawSlotImage(dl, view.slots[i], p0, p1, u0, u1, a, b);
-            // Backend label at the top of its region.
-            const std::string& name = view.slots[i].status.backend;
-            ImVec2 ts = ImGui::CalcTextSize(name.c_str());
-            ImVec2 lp(p0.x + (p1.x - p0.x - ts.x) * 0.5f, a.y + px(8));
-            dl->AddRectFilled(ImVec2(lp.x - px(6), lp.y - px(3)), ImVec2(lp.x + ts.x + px(6), lp.y + ts.y + px(3)), IM_COL32(0, 0, 0, 160), px(3));
-            dl->AddText(lp, IM_COL32(255, 255, 255, 255), name.c_str());
-        }
-        for (int i = 0; i + 1 < n; ++i) {
-            float x = a.x + st.view.compare.dividers[i] * avail.x;
-            dl->AddLine(ImVec2(x, a.y), ImVec2(x, b.y), IM_COL32(255, 255, 255, 200), px(2));
-            dl->AddCircleFilled(ImVec2(x, (a.y + b.y) * 0.5f), px(7), IM_COL32(255, 255, 255, 230));
-            dl->AddCircle(ImVec2(x, (a.y + b.y) * 0.5f), px(7), IM_COL32(40, 40, 40, 255), 0, px(1.5f));
-        }
-        break;
+    case ViewMode::Split: drawSplitView(dl, st, view, a, avail); break;
+    case ViewMode::Difference: drawDifferenceView(dl, st, view, a, avail); break;
     }
-    case ViewMode::Difference: {
-        SlotView d = view.diff;
-        if (!d.texture) {
-            // No diff yet: say why (an error of either side, or still rendering).
-            std::string msg = "Waiting for both images...";
-            for (const SlotView& s : view.slots)
-                if (!s.status.error.empty()) msg = s.status.backend + ": " + s.status.error;
-            dl->AddRectFilled(a, b, IM_COL32(24, 25, 29, 255));
-            centeredText(dl, a, b, msg, IM_COL32(255, 170, 140, 255));
-        } else {
-            dl->AddImage(d.texture, a, b);
-        }
-        if (view.slots.size() >= 2) {
-            char buf[256];
-            if (st.view.diff.valid)
-                std::snprintf(buf, sizeof buf, "|%s - %s|   mean %.2f   max %d   PSNR %.1f dB   within %d: %.1f%%",
-                              view.slots[0].status.backend.c_str(), view.slots[1].status.backend.c_str(), st.view.diff.mean, st.view.diff.max,
-                              st.view.diff.psnr, st.view.compare.threshold, 100.0 * st.view.diff.within);
-            else
-                std::snprintf(buf, sizeof buf, "|%s - %s|", view.slots[0].status.backend.c_str(), view.slots[1].status.backend.c_str());
-            ImVec2 ts = ImGui::CalcTextSize(buf);
-            ImVec2 lp(a.x + (avail.x - ts.x) * 0.5f, b.y - ts.y - px(12));
-            dl->AddRectFilled(ImVec2(lp.x - px(8), lp.y - px(4)), ImVec2(lp.x + ts.x + px(8), lp.y + ts.y + px(4)), IM_COL32(0, 0, 0, 180), px(3));
-            dl->AddText(lp, IM_COL32(255, 230, 160, 255), buf);
-        }
-        break;
-    }
-    }
-
-    // Stats overlay (top-left).
-    if (st.ui.panels.showOverlay) {
-        std::vector<std::string> lines;
-        for (const SlotView& v : view.slots) lines.push_back(slotStats(v));
-        char buf[128];
-        std::snprintf(buf, sizeof buf, "%d x %d   %s", st.view.viewportWidth, st.view.viewportHeight, st.view.flyMode ? "FLY (WASD QE)" : "");
-        lines.emplace_back(buf);
-        float h = ImGui::GetTextLineHeightWithSpacing();
-        float w = 0;
-        for (auto& l : lines) w = std::max(w, ImGui::CalcTextSize(l.c_str()).x);
-        ImVec2 o(a.x + px(10), a.y + (st.view.compare.mode == ViewMode::Split ? px(36) : px(10)));
-        dl->AddRectFilled(o, ImVec2(o.x + w + px(16), o.y + h * lines.size() + px(10)), IM_COL32(0, 0, 0, 150), px(4));
-        for (size_t i = 0; i < lines.size(); ++i) {
-            bool rendering = i < view.slots.size() && view.slots[i].status.rendering;
-            dl->AddText(ImVec2(o.x + px(8), o.y + px(5) + h * i), rendering ? IM_COL32(255, 220, 120, 255) : IM_COL32(220, 230, 240, 255),
-                        lines[i].c_str());
-        }
-        // Progress bars for renders in flight.
-        for (size_t i = 0; i < view.slots.size(); ++i) {
-            if (!view.slots[i].status.rendering) continue;
-            float y = b.y - px(4) - px(5) * i;
-            dl->AddRectFilled(ImVec2(a.x, y - px(3)), ImVec2(a.x + avail.x * view.slots[i].status.progress, y), IM_COL32(90, 170, 255, 220));
-        }
-    }
+    if (st.ui.panels.showOverlay) drawStatsOverlay(dl, st, view, a, avail);
     dl->PopClipRect();
 }
 
@@ -1471,67 +1533,61 @@ void handleShortcuts(ViewerState& st) {
     }
 }
 
-void drawUi(ViewerState& st, const ViewportInput& view, double time, float dt) {
-    ImGuiIO& io = ImGui::GetIO();
-    drawMainMenu(st);
-    float menuH = ImGui::GetFrameHeight();
-    float statusH = ImGui::GetFrameHeight() + px(4);
-    float bodyH = std::max(io.DisplaySize.y - menuH - statusH, 50.0f);
-    const ImGuiWindowFlags panelFlags = ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoBringToFrontOnFocus;
+namespace {
 
-    // Left: scene tree (width resizable and persisted in imgui.ini).
-    ImGui::SetNextWindowPos(ImVec2(0, menuH), ImGuiCond_Always);
+constexpr ImGuiWindowFlags kPanelFlags = ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoBringToFrontOnFocus;
+
+// Left: the scene tree (width resizable and persisted in imgui.ini). Returns its width.
+float drawScenePanel(ViewerState& st, float top, float bodyH) {
+    ImGuiIO& io = ImGui::GetIO();
+    ImGui::SetNextWindowPos(ImVec2(0, top), ImGuiCond_Always);
     ImGui::SetNextWindowSize(ImVec2(px(260), bodyH), ImGuiCond_FirstUseEver);
     ImGui::SetNextWindowSizeConstraints(ImVec2(px(160), bodyH), ImVec2(std::max(px(160), io.DisplaySize.x * 0.45f), bodyH));
-    float leftW = 0;
-    if (ImGui::Begin("Scene", nullptr, panelFlags)) drawSceneTree(st);
-    leftW = ImGui::GetWindowWidth();
+    if (ImGui::Begin("Scene", nullptr, kPanelFlags)) drawSceneTree(st);
+    float w = ImGui::GetWindowWidth();
     ImGui::End();
+    return w;
+}
 
-    // Right: tabs.
-    ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x, menuH), ImGuiCond_Always, ImVec2(1.0f, 0.0f));
+// One tab of the right panel; selected when the automation asks for it. Its rectangle is
+// recorded for the tab itself (before its contents).
+void drawTab(ViewerState& st, const char* name, void (*draw)(ViewerState&)) {
+    bool open = ImGui::BeginTabItem(name, nullptr, st.hooks.requestedTab == name ? ImGuiTabItemFlags_SetSelected : 0);
+    record(st, std::string("tab/") + name);
+    if (open) {
+        draw(st);
+        ImGui::EndTabItem();
+    }
+}
+
+// Right: the animation bar (scenes with clips) above the tabs. Returns its width.
+float drawPropertiesPanel(ViewerState& st, float top, float bodyH) {
+    ImGuiIO& io = ImGui::GetIO();
+    ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x, top), ImGuiCond_Always, ImVec2(1.0f, 0.0f));
     ImGui::SetNextWindowSize(ImVec2(px(380), bodyH), ImGuiCond_FirstUseEver);
     ImGui::SetNextWindowSizeConstraints(ImVec2(px(220), bodyH), ImVec2(std::max(px(220), io.DisplaySize.x * 0.45f), bodyH));
-    float rightW = 0;
-    if (ImGui::Begin("Properties", nullptr, panelFlags)) {
+    if (ImGui::Begin("Properties", nullptr, kPanelFlags)) {
         ImGui::PushItemWidth(-px(150));   // room for the labels on the right
         drawAnimationPanel(st);           // only when the scene has clips
         if (ImGui::BeginTabBar("tabs")) {
-            bool openInspector = ImGui::BeginTabItem("Inspector", nullptr, st.hooks.requestedTab == "Inspector" ? ImGuiTabItemFlags_SetSelected : 0);
-            record(st, "tab/Inspector");   // the tab itself (before its contents)
-            if (openInspector) {
-                drawInspector(st);
-                ImGui::EndTabItem();
-            }
-            bool openCamera = ImGui::BeginTabItem("Camera", nullptr, st.hooks.requestedTab == "Camera" ? ImGuiTabItemFlags_SetSelected : 0);
-            record(st, "tab/Camera");   // the tab itself (before its contents)
-            if (openCamera) {
-                drawCameraPanel(st);
-                ImGui::EndTabItem();
-            }
-            bool openRendering = ImGui::BeginTabItem("Rendering", nullptr, st.hooks.requestedTab == "Rendering" ? ImGuiTabItemFlags_SetSelected : 0);
-            record(st, "tab/Rendering");   // the tab itself (before its contents)
-            if (openRendering) {
-                drawRenderingPanel(st);
-                ImGui::EndTabItem();
-            }
-            bool openCompare = ImGui::BeginTabItem("Compare", nullptr, st.hooks.requestedTab == "Compare" ? ImGuiTabItemFlags_SetSelected : 0);
-            record(st, "tab/Compare");   // the tab itself (before its contents)
-            if (openCompare) {
-                drawComparePanel(st);
-                ImGui::EndTabItem();
-            }
+            drawTab(st, "Inspector", drawInspector);
+            drawTab(st, "Camera", drawCameraPanel);
+            drawTab(st, "Rendering", drawRenderingPanel);
+            drawTab(st, "Compare", drawComparePanel);
             ImGui::EndTabBar();
         }
         st.hooks.requestedTab.clear();
         ImGui::PopItemWidth();
     }
-    rightW = ImGui::GetWindowWidth();
+    float w = ImGui::GetWindowWidth();
     ImGui::End();
+    return w;
+}
 
-    // Centre: viewport.
-    ImGui::SetNextWindowPos(ImVec2(leftW, menuH), ImGuiCond_Always);
-    ImGui::SetNextWindowSize(ImVec2(std::max(io.DisplaySize.x - leftW - rightW, 1.0f), bodyH), ImGuiCond_Always);
+// Centre: the viewport between the two panels.
+void drawViewportWindow(ViewerState& st, const ViewportInput& view, double time, float dt, ImVec2 pos, ImVec2 size) {
+    ImGui::SetNextWindowPos(pos, ImGuiCond_Always);
+    ImGui::SetNextWindowSize(size, ImGuiCond_Always);
     ImGui::PushStyleVar(ImGuiStyleVar_WindowPadding, ImVec2(0, 0));
     ImGui::PushStyleVar(ImGuiStyleVar_WindowBorderSize, 0.0f);
     if (ImGui::Begin("Viewport", nullptr,
@@ -1540,16 +1596,20 @@ void drawUi(ViewerState& st, const ViewportInput& view, double time, float dt) {
         drawViewport(st, view, time, dt);
     ImGui::End();
     ImGui::PopStyleVar(2);
+}
 
-    // Bottom: status bar.
-    ImGui::SetNextWindowPos(ImVec2(0, io.DisplaySize.y - statusH), ImGuiCond_Always);
-    ImGui::SetNextWindowSize(ImVec2(io.DisplaySize.x, statusH), ImGuiCond_Always);
+// Bottom: load progress and Cancel, the status line, what the backends do not honour, and
+// on the right the view mode and frame rate.
+void drawStatusBar(ViewerState& st, const ViewportInput& view, float height) {
+    ImGuiIO& io = ImGui::GetIO();
+    ImGui::SetNextWindowPos(ImVec2(0, io.DisplaySize.y - height), ImGuiCond_Always);
+    ImGui::SetNextWindowSize(ImVec2(io.DisplaySize.x, height), ImGuiCond_Always);
     ImGui::PushStyleVar(ImGuiStyleVar_WindowPadding, ImVec2(px(8), px(2)));
     if (ImGui::Begin(
             "##status", nullptr,
             ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoBringToFrontOnFocus)) {
-        bool bad = st.ui.status.rfind("Move refused", 0) == 0 || st.ui.status.find("fail") != std::string::npos ||
-                   st.ui.status.find("refused") != std::string::npos;
+        const std::string& status = st.ui.status;
+        bool bad = status.rfind("Move refused", 0) == 0 || status.find("fail") != std::string::npos || status.find("refused") != std::string::npos;
         if (st.loadInProgress()) {   // progress of the load (off the UI thread) and its Cancel
             float f = st.loadProgress();
             char label[32];
@@ -1564,18 +1624,17 @@ void drawUi(ViewerState& st, const ViewportInput& view, double time, float dt) {
             ImGui::SameLine();
         }
         if (bad)
-            ImGui::TextColored(ImVec4(1.0f, 0.6f, 0.45f, 1.0f), "%s", st.ui.status.c_str());
+            ImGui::TextColored(ImVec4(1.0f, 0.6f, 0.45f, 1.0f), "%s", status.c_str());
         else
-            ImGui::TextUnformatted(st.ui.status.empty() ? "Ready" : st.ui.status.c_str());
+            ImGui::TextUnformatted(status.empty() ? "Ready" : status.c_str());
         if (std::string notes = renderNotes(view); !notes.empty()) {   // never a silent substitution
             ImGui::SameLine(0, px(24));
             ImGui::TextColored(ImVec4(0.95f, 0.8f, 0.4f, 1.0f), "%s", notes.c_str());
             record(st, "status/renderNotes");
         }
+        const CompareConfig& c = st.view.compare;
         char right[160];
-        std::string mode = st.view.compare.mode == ViewMode::Single  ? st.view.backend
-                           : st.view.compare.mode == ViewMode::Split ? "split view"
-                                                                     : "difference view";
+        std::string mode = c.mode == ViewMode::Single ? st.view.backend : c.mode == ViewMode::Split ? "split view" : "difference view";
         std::snprintf(right, sizeof right, "%s   %s   %.0f fps", mode.c_str(), st.loadInProgress() ? "loading..." : "", io.Framerate);
         float w = ImGui::CalcTextSize(right).x;
         ImGui::SameLine(io.DisplaySize.x - w - px(12));
@@ -1583,7 +1642,20 @@ void drawUi(ViewerState& st, const ViewportInput& view, double time, float dt) {
     }
     ImGui::End();
     ImGui::PopStyleVar();
+}
 
+}   // namespace
+
+void drawUi(ViewerState& st, const ViewportInput& view, double time, float dt) {
+    ImGuiIO& io = ImGui::GetIO();
+    drawMainMenu(st);
+    float menuH = ImGui::GetFrameHeight();
+    float statusH = ImGui::GetFrameHeight() + px(4);
+    float bodyH = std::max(io.DisplaySize.y - menuH - statusH, 50.0f);
+    float leftW = drawScenePanel(st, menuH, bodyH);
+    float rightW = drawPropertiesPanel(st, menuH, bodyH);
+    drawViewportWindow(st, view, time, dt, ImVec2(leftW, menuH), ImVec2(std::max(io.DisplaySize.x - leftW - rightW, 1.0f), bodyH));
+    drawStatusBar(st, view, statusH);
     drawDialogs(st);
     handleShortcuts(st);
 }
