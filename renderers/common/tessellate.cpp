@@ -432,162 +432,211 @@ struct MarchResult {
     std::vector<std::array<uint32_t, 3>> triangles;
 };
 
-MarchResult march(const Field& field, sg::Aabb bounds, int res) {
-    MarchResult out;
-    if (bounds.empty() || !sg::isFinite(bounds.min) || !sg::isFinite(bounds.max)) return out;
+// The sampling grid: field values at nx * ny * nz vertices spaced h apart from origin.
+struct MarchGrid {
+    vec3 origin{0.0f};
+    float h = 1.0f;
+    size_t nx = 0, ny = 0, nz = 0;
+    std::vector<float> val;
+    size_t index(size_t x, size_t y, size_t z) const { return (z * ny + y) * nx + x; }
+    vec3 pos(size_t x, size_t y, size_t z) const { return origin + vec3(float(x), float(y), float(z)) * h; }
+    vec3 pos(size_t i) const { return pos(i % nx, (i / nx) % ny, i / (nx * ny)); }
+};
+
+// The surface inside one tetrahedron: a triangle or a quad of crossing-edge vertices.
+struct MarchPoly {
+    uint32_t v[4];
+    int n;
+};
+
+// Cube corner offsets by corner bits (x=1, y=2, z=4).
+const vec3 kCornerOffset[8] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {0, 0, 1}, {1, 0, 1}, {0, 1, 1}, {1, 1, 1}};
+
+// Samples the field over `bounds` at `res` cells along the longest side, plus one cell of
+// margin on each side whose outermost layer is forced outside, so the surface closes inside
+// the grid.
+MarchGrid sampleGrid(const Field& field, const sg::Aabb& bounds, int res) {
+    MarchGrid g;
     res = std::clamp(res, 2, 256);
     vec3 ext = glm::max(bounds.extent(), vec3(1e-6f));
-    float h = std::max(ext.x, std::max(ext.y, ext.z)) / float(res);
-    // One cell of margin on each side so the surface closes inside the grid.
-    ivec3 cells = glm::max(ivec3(glm::ceil(ext / h)), ivec3(1)) + 2;
-    vec3 origin = bounds.center() - 0.5f * vec3(cells) * h;
+    g.h = std::max(ext.x, std::max(ext.y, ext.z)) / float(res);
+    ivec3 cells = glm::max(ivec3(glm::ceil(ext / g.h)), ivec3(1)) + 2;
+    g.origin = bounds.center() - 0.5f * vec3(cells) * g.h;
     ivec3 dims = cells + 1;
-    const size_t nx = size_t(dims.x), ny = size_t(dims.y), nz = size_t(dims.z);
-    auto gridPos = [&](size_t x, size_t y, size_t z) { return origin + vec3(float(x), float(y), float(z)) * h; };
-    auto lin = [&](size_t x, size_t y, size_t z) { return (z * ny + y) * nx + x; };
-
-    // Field values at the grid vertices; the outermost layer is forced outside.
-    std::vector<float> val(nx * ny * nz);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, nz), [&](const tbb::blocked_range<size_t>& r) {
+    g.nx = size_t(dims.x);
+    g.ny = size_t(dims.y);
+    g.nz = size_t(dims.z);
+    g.val.resize(g.nx * g.ny * g.nz);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, g.nz), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t z = r.begin(); z < r.end(); ++z)
-            for (size_t y = 0; y < ny; ++y)
-                for (size_t x = 0; x < nx; ++x) {
-                    float v = field.value(gridPos(x, y, z));
+            for (size_t y = 0; y < g.ny; ++y)
+                for (size_t x = 0; x < g.nx; ++x) {
+                    float v = field.value(g.pos(x, y, z));
                     if (!std::isfinite(v)) v = 1.0f;
-                    bool border = x == 0 || y == 0 || z == 0 || x == nx - 1 || y == ny - 1 || z == nz - 1;
+                    bool border = x == 0 || y == 0 || z == 0 || x == g.nx - 1 || y == g.ny - 1 || z == g.nz - 1;
                     if (border && v < 0) v = 1e-6f;
-                    val[lin(x, y, z)] = v;
+                    g.val[g.index(x, y, z)] = v;
                 }
     });
+    return g;
+}
 
-    // Vertices live on crossing edges: key = lower corner index * 8 + offset bits.
+// The polygon where the surface crosses tetrahedron `tet` (corner bits) of a cube whose
+// inside corners are the bits of `inside`; false when it does not cross. edge(ca, cb) gives
+// the vertex on the edge between two corners. The polygon normal points from the inside
+// corners to the outside ones.
+template <class EdgeVertex>
+bool tetPolygon(const int (&tet)[4], int inside, EdgeVertex&& edge, MarchPoly& p) {
+    int in[4], outv[4], ni = 0, no = 0;
+    for (int k = 0; k < 4; ++k) ((inside >> tet[k]) & 1 ? in[ni++] : outv[no++]) = tet[k];
+    if (ni == 0 || no == 0) return false;
+    auto mid = [&](int ca, int cb) { return 0.5f * (kCornerOffset[ca] + kCornerOffset[cb]); };
+    vec3 inC(0.0f), outC(0.0f);
+    for (int k = 0; k < ni; ++k) inC += kCornerOffset[in[k]] / float(ni);
+    for (int k = 0; k < no; ++k) outC += kCornerOffset[outv[k]] / float(no);
+    vec3 dir = outC - inC;
+    p = MarchPoly{};
+    vec3 m[4];
+    if (ni == 1 || no == 1) {
+        int apex = ni == 1 ? in[0] : outv[0];
+        const int* others = ni == 1 ? outv : in;
+        for (int k = 0; k < 3; ++k) {
+            p.v[k] = edge(apex, others[k]);
+            m[k] = mid(apex, others[k]);
+        }
+        p.n = 3;
+    } else {
+        // Cycle around the quad: (i0,o0) (i0,o1) (i1,o1) (i1,o0).
+        const int pairs[4][2] = {{in[0], outv[0]}, {in[0], outv[1]}, {in[1], outv[1]}, {in[1], outv[0]}};
+        for (int k = 0; k < 4; ++k) {
+            p.v[k] = edge(pairs[k][0], pairs[k][1]);
+            m[k] = mid(pairs[k][0], pairs[k][1]);
+        }
+        p.n = 4;
+    }
+    // Orientation from the edge midpoints (planar and separating): the polygon
+    // normal must point from the inside corners to the outside ones.
+    vec3 nrm = glm::cross(m[1] - m[0], m[2] - m[0]);
+    if (glm::dot(nrm, dir) < 0) std::reverse(p.v, p.v + p.n);
+    return true;
+}
+
+// Marching tetrahedra over every cell of the grid. Vertices live on crossing edges and are
+// shared between the polygons using them: edgeEnds[i] = (inside corner, outside corner) of
+// vertex i, as grid indices.
+std::vector<MarchPoly> polygonize(const MarchGrid& g, std::vector<std::pair<size_t, size_t>>& edgeEnds) {
+    const size_t nx = g.nx, ny = g.ny, nz = g.nz;
+    // Key = lower corner index * 8 + offset bits.
     std::unordered_map<uint64_t, uint32_t> edgeVertex;
-    std::vector<std::pair<size_t, size_t>> edgeEnds;   // (inside corner, outside corner)
     edgeVertex.reserve(size_t(16) * nx * ny);
     auto vertexOn = [&](size_t a, size_t b, size_t lower, int bits) {
         uint64_t key = uint64_t(lower) * 8 + uint64_t(bits);
         auto [it, fresh] = edgeVertex.try_emplace(key, uint32_t(edgeEnds.size()));
-        if (fresh) edgeEnds.push_back(val[a] < 0 ? std::make_pair(a, b) : std::make_pair(b, a));
+        if (fresh) edgeEnds.push_back(g.val[a] < 0 ? std::make_pair(a, b) : std::make_pair(b, a));
         return it->second;
     };
-    struct Poly {
-        uint32_t v[4];
-        int n;
-    };
-    std::vector<Poly> polys;
+    std::vector<MarchPoly> polys;
     const size_t offs[8] = {0, 1, nx, nx + 1, nx * ny, nx * ny + 1, nx * ny + nx, nx * ny + nx + 1};
-    const vec3 cornerOff[8] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {0, 0, 1}, {1, 0, 1}, {0, 1, 1}, {1, 1, 1}};
     for (size_t z = 0; z + 1 < nz; ++z)
         for (size_t y = 0; y + 1 < ny; ++y)
             for (size_t x = 0; x + 1 < nx; ++x) {
-                size_t c0 = lin(x, y, z);
+                size_t c0 = g.index(x, y, z);
                 int inside = 0;
-                for (int k = 0; k < 8; ++k) inside |= (val[c0 + offs[k]] < 0 ? 1 : 0) << k;
+                for (int k = 0; k < 8; ++k) inside |= (g.val[c0 + offs[k]] < 0 ? 1 : 0) << k;
                 if (inside == 0 || inside == 255) continue;
-                for (const auto& tet : kTets) {
-                    int in[4], outv[4], ni = 0, no = 0;
-                    for (int k = 0; k < 4; ++k) ((inside >> tet[k]) & 1 ? in[ni++] : outv[no++]) = tet[k];
-                    if (ni == 0 || no == 0) continue;
-                    // Edge between two cube corners (bits): the smaller one is the lower end.
-                    auto edge = [&](int ca, int cb) {
-                        int lo = std::min(ca, cb), hi = std::max(ca, cb);   // chains: lo's bits are a subset of hi's
-                        return vertexOn(c0 + offs[ca], c0 + offs[cb], c0 + offs[lo], hi & ~lo);
-                    };
-                    auto mid = [&](int ca, int cb) { return 0.5f * (cornerOff[ca] + cornerOff[cb]); };
-                    vec3 inC(0.0f), outC(0.0f);
-                    for (int k = 0; k < ni; ++k) inC += cornerOff[in[k]] / float(ni);
-                    for (int k = 0; k < no; ++k) outC += cornerOff[outv[k]] / float(no);
-                    vec3 dir = outC - inC;
-                    Poly p{};
-                    vec3 m[4];
-                    if (ni == 1 || no == 1) {
-                        int apex = ni == 1 ? in[0] : outv[0];
-                        const int* others = ni == 1 ? outv : in;
-                        for (int k = 0; k < 3; ++k) {
-                            p.v[k] = edge(apex, others[k]);
-                            m[k] = mid(apex, others[k]);
-                        }
-                        p.n = 3;
-                    } else {
-                        // Cycle around the quad: (i0,o0) (i0,o1) (i1,o1) (i1,o0).
-                        const int pairs[4][2] = {{in[0], outv[0]}, {in[0], outv[1]}, {in[1], outv[1]}, {in[1], outv[0]}};
-                        for (int k = 0; k < 4; ++k) {
-                            p.v[k] = edge(pairs[k][0], pairs[k][1]);
-                            m[k] = mid(pairs[k][0], pairs[k][1]);
-                        }
-                        p.n = 4;
-                    }
-                    // Orientation from the edge midpoints (planar and separating): the polygon
-                    // normal must point from the inside corners to the outside ones.
-                    vec3 nrm = glm::cross(m[1] - m[0], m[2] - m[0]);
-                    if (glm::dot(nrm, dir) < 0) std::reverse(p.v, p.v + p.n);
-                    polys.push_back(p);
-                }
+                // Edge between two cube corners (bits): the smaller one is the lower end.
+                auto edge = [&](int ca, int cb) {
+                    int lo = std::min(ca, cb), hi = std::max(ca, cb);   // chains: lo's bits are a subset of hi's
+                    return vertexOn(c0 + offs[ca], c0 + offs[cb], c0 + offs[lo], hi & ~lo);
+                };
+                MarchPoly p;
+                for (const auto& tet : kTets)
+                    if (tetPolygon(tet, inside, edge, p)) polys.push_back(p);
             }
+    return polys;
+}
 
-    // Refine vertices onto the exact surface (Illinois regula falsi, bracket kept).
-    out.positions.resize(edgeEnds.size());
-    auto posOf = [&](size_t i) {
-        size_t x = i % nx, y = (i / nx) % ny, z = i / (nx * ny);
-        return gridPos(x, y, z);
-    };
+// Where the surface crosses the segment a-b (field values fa < 0 <= fb at the grid), as a
+// fraction of the way from a: the linear guess, refined on the exact function by the Illinois
+// variant of regula falsi (bracket kept). Kept strictly inside the edge so no two vertices
+// coincide.
+float surfaceCrossing(const Field& field, vec3 a, vec3 b, float fa, float fb) {
+    float t = fa / (fa - fb);
+    float ea = field.value(a), eb = field.value(b);
+    if (ea < 0 && eb >= 0) {
+        // Bracket [ta, tb] with f(ta) < 0 <= f(tb).
+        float ta = 0, tb = 1;
+        float ga = ea, gb = eb;
+        int side = 0;
+        for (int it = 0; it < 16 && tb - ta > 2e-5f; ++it) {
+            float tm = (ga * tb - gb * ta) / (ga - gb);
+            if (!(tm > ta && tm < tb)) tm = 0.5f * (ta + tb);
+            float gm = field.value(glm::mix(a, b, tm));
+            if (gm == 0) {
+                ta = tb = tm;
+                break;
+            }
+            if (gm < 0) {
+                ta = tm;
+                ga = gm;
+                if (side == -1) gb *= 0.5f;
+                side = -1;
+            } else {
+                tb = tm;
+                gb = gm;
+                if (side == 1) ga *= 0.5f;
+                side = 1;
+            }
+        }
+        t = ga == gb ? 0.5f * (ta + tb) : (ga * tb - gb * ta) / (ga - gb);
+        if (!(t >= ta && t <= tb)) t = 0.5f * (ta + tb);
+    }
+    return std::clamp(t, 1e-3f, 1.0f - 1e-3f);
+}
+
+// The vertex positions: each crossing edge's point on the exact surface.
+std::vector<vec3> refineVertices(const Field& field, const MarchGrid& g, const std::vector<std::pair<size_t, size_t>>& edgeEnds) {
+    std::vector<vec3> positions(edgeEnds.size());
     tbb::parallel_for(tbb::blocked_range<size_t>(0, edgeEnds.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t e = r.begin(); e < r.end(); ++e) {
             auto [ia, ib] = edgeEnds[e];
-            vec3 a = posOf(ia), b = posOf(ib);
-            float fa = val[ia], fb = val[ib];   // fa < 0 <= fb
-            float t = fa / (fa - fb);
-            float ea = field.value(a), eb = field.value(b);
-            if (ea < 0 && eb >= 0) {
-                // Bracket [ta, tb] with f(ta) < 0 <= f(tb).
-                float ta = 0, tb = 1;
-                float ga = ea, gb = eb;
-                int side = 0;
-                for (int it = 0; it < 16 && tb - ta > 2e-5f; ++it) {
-                    float tm = (ga * tb - gb * ta) / (ga - gb);
-                    if (!(tm > ta && tm < tb)) tm = 0.5f * (ta + tb);
-                    float gm = field.value(glm::mix(a, b, tm));
-                    if (gm == 0) {
-                        ta = tb = tm;
-                        break;
-                    }
-                    if (gm < 0) {
-                        ta = tm;
-                        ga = gm;
-                        if (side == -1) gb *= 0.5f;
-                        side = -1;
-                    } else {
-                        tb = tm;
-                        gb = gm;
-                        if (side == 1) ga *= 0.5f;
-                        side = 1;
-                    }
-                }
-                t = ga == gb ? 0.5f * (ta + tb) : (ga * tb - gb * ta) / (ga - gb);
-                if (!(t >= ta && t <= tb)) t = 0.5f * (ta + tb);
-            }
-            // Keep vertices strictly inside their edge so no two vertices coincide.
-            t = std::clamp(t, 1e-3f, 1.0f - 1e-3f);
-            out.positions[e] = glm::mix(a, b, t);
+            vec3 a = g.pos(ia), b = g.pos(ib);
+            positions[e] = glm::mix(a, b, surfaceCrossing(field, a, b, g.val[ia], g.val[ib]));
         }
     });
+    return positions;
+}
 
-    // Triangles; quads split along their shorter diagonal.
-    out.triangles.reserve(polys.size() * 2);
-    for (const Poly& p : polys) {
+// Triangles; quads split along their shorter diagonal.
+std::vector<std::array<uint32_t, 3>> triangulate(const std::vector<MarchPoly>& polys, const std::vector<vec3>& positions) {
+    std::vector<std::array<uint32_t, 3>> triangles;
+    triangles.reserve(polys.size() * 2);
+    const vec3* P = positions.data();
+    for (const MarchPoly& p : polys) {
         if (p.n == 3) {
-            out.triangles.push_back({p.v[0], p.v[1], p.v[2]});
+            triangles.push_back({p.v[0], p.v[1], p.v[2]});
             continue;
         }
-        const vec3* P = out.positions.data();
         if (glm::distance(P[p.v[0]], P[p.v[2]]) <= glm::distance(P[p.v[1]], P[p.v[3]])) {
-            out.triangles.push_back({p.v[0], p.v[1], p.v[2]});
-            out.triangles.push_back({p.v[0], p.v[2], p.v[3]});
+            triangles.push_back({p.v[0], p.v[1], p.v[2]});
+            triangles.push_back({p.v[0], p.v[2], p.v[3]});
         } else {
-            out.triangles.push_back({p.v[0], p.v[1], p.v[3]});
-            out.triangles.push_back({p.v[1], p.v[2], p.v[3]});
+            triangles.push_back({p.v[0], p.v[1], p.v[3]});
+            triangles.push_back({p.v[1], p.v[2], p.v[3]});
         }
     }
+    return triangles;
+}
+
+// Sample, polygonize, refine the vertices onto the surface, triangulate.
+MarchResult march(const Field& field, sg::Aabb bounds, int res) {
+    MarchResult out;
+    if (bounds.empty() || !sg::isFinite(bounds.min) || !sg::isFinite(bounds.max)) return out;
+    MarchGrid grid = sampleGrid(field, bounds, res);
+    std::vector<std::pair<size_t, size_t>> edgeEnds;   // per vertex: (inside corner, outside corner)
+    std::vector<MarchPoly> polys = polygonize(grid, edgeEnds);
+    out.positions = refineVertices(field, grid, edgeEnds);
+    out.triangles = triangulate(polys, out.positions);
     return out;
 }
 
