@@ -17,9 +17,10 @@
 //   * Huge header counts throw std::bad_alloc, truncated files report success, faces with bad
 //     indices vanish silently, OBJ mtllib paths are followed anywhere.
 // A viewer needs triangle soups, not a manifold half-edge structure, so the importer keeps
-// every face (polygons fan-triangulated), checks header counts against the file size before
-// allocating, reports truncation and dropped faces as warnings, polls cancel/progress, and
-// reads MTL files and textures only through ConfinedDir (model folder only).
+// every face (polygons triangulated by assets/polygon.h: convex ones as a fan, concave ones by
+// ear clipping), checks header counts against the file size before allocating, reports
+// truncation and dropped faces as warnings, polls cancel/progress, and reads MTL files and
+// textures only through ConfinedDir (model folder only).
 // Mapping: one node per material group (OBJ usemtl) or one node; normals from the file when
 // complete, else smooth area-weighted (Mesh::computeNormals; STL vertices are welded by exact
 // position first). Colours are taken as linear. MTL: Kd -> baseColor, Ks -> ks (max channel)
@@ -32,6 +33,7 @@
 
 #include "assets/files.h"
 #include "assets/image_io.h"
+#include "assets/polygon.h"
 
 #include <algorithm>
 #include <charconv>
@@ -128,6 +130,7 @@ struct Ctx {
     const Progress& progress;
     std::vector<std::string> warnings;
     uint64_t triangles = 0;
+    PolygonTriangulator triangulator{};
     void poll(size_t i, float base, float span, size_t total) const {
         if ((i & (kPoll - 1)) != 0) return;
         if (progress.cancelled()) throw Fail{"cancelled"};
@@ -139,13 +142,10 @@ struct Ctx {
     }
 };
 
-// Fan-triangulates a polygon given by corner indices into `out`.
-void fan(const uint32_t* c, size_t n, std::vector<uint32_t>& out) {
-    for (size_t i = 1; i + 1 < n; ++i) {
-        out.push_back(c[0]);
-        out.push_back(c[i]);
-        out.push_back(c[i + 1]);
-    }
+// Triangulates a polygon given by corner indices into mesh.positions (assets/polygon.h:
+// convex faces as the fan, concave ones by ear clipping) onto mesh.indices.
+void addPolygon(Ctx& ctx, sg::Mesh& mesh, const std::vector<uint32_t>& corners) {
+    ctx.triangulator.triangulate(mesh.positions, corners, mesh.indices);
 }
 
 // Scene with one node per (mesh, material) and defaults.
@@ -471,7 +471,7 @@ ObjMaterials resolveObjMaterials(const fs::path& path, const ConfinedDir& dir, c
     return out;
 }
 
-// One triangle mesh from the faces faceIds, fan-triangulated, with (v, vt, vn) corners
+// One triangle mesh from the faces faceIds, triangulated, with (v, vt, vn) corners
 // de-duplicated (by v alone when the file has neither UVs nor normals). UVs / normals are
 // kept only when some / all corners have them, colours only when the file has any.
 // done: faces converted so far over all groups (progress 0.7..0.95).
@@ -513,7 +513,7 @@ sg::Mesh buildObjGroupMesh(const ObjData& d, const std::vector<uint32_t>& faceId
         const ObjFace& f = d.faces[fi];
         tri.clear();
         for (uint32_t k = 0; k < f.count; ++k) tri.push_back(vertexOf(d.corners[f.first + k]));
-        fan(tri.data(), tri.size(), mesh.indices);
+        addPolygon(ctx, mesh, tri);
     }
     if (!hasUv) mesh.uv0.clear();
     if (!hasN) mesh.normals.clear();
@@ -700,7 +700,7 @@ LoadResult loadOff(const fs::path& path, const std::string& text, Ctx& ctx) {
                 continue;
             }
             ctx.countTriangles(k - 2);
-            fan(poly.data(), poly.size(), mesh.indices);
+            addPolygon(ctx, mesh, poly);
         }
     }
     if (truncated)
@@ -995,7 +995,7 @@ void addPlyVertex(const PlyElement& e, const PlyRoles& k, const std::vector<doub
     }
 }
 
-// A face from b.listVals: fan-triangulated when it has >= 3 corners, all indices of vertices
+// A face from b.listVals: triangulated when it has >= 3 corners, all indices of vertices
 // read so far; else dropped.
 void addPlyFace(PlyBuild& b, Ctx& ctx) {
     b.poly.clear();
@@ -1012,7 +1012,7 @@ void addPlyFace(PlyBuild& b, Ctx& ctx) {
         return;
     }
     ctx.countTriangles(b.listVals.size() - 2);
-    fan(b.poly.data(), b.poly.size(), b.mesh.indices);
+    addPolygon(ctx, b.mesh, b.poly);
 }
 
 // Triangle strips from b.listVals: strips separated by -1; alternate winding; degenerate
