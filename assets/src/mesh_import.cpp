@@ -172,6 +172,22 @@ sg::Scene makeScene(const fs::path& path, std::vector<std::pair<sg::Mesh, int>>&
     return s;
 }
 
+// A scene of one mesh (OFF, PLY): its faces, or a point cloud of all its vertices when it has
+// none. Fails when there are no vertices.
+LoadResult singleMeshScene(const fs::path& path, sg::Mesh mesh) {
+    if (mesh.positions.empty()) throw Fail{"no vertices"};
+    if (mesh.indices.empty()) {
+        mesh.mode = sg::PrimitiveMode::Points;
+        mesh.indices.resize(mesh.positions.size());
+        for (size_t i = 0; i < mesh.indices.size(); ++i) mesh.indices[i] = uint32_t(i);
+    }
+    std::vector<std::pair<sg::Mesh, int>> parts;
+    parts.push_back({std::move(mesh), -1});
+    LoadResult r;
+    r.scene = makeScene(path, parts, {}, {});
+    return r;
+}
+
 // ---- 4. OBJ + MTL --------------------------------------------------------------------------
 struct ObjMaterial {
     sg::Material mat;
@@ -593,134 +609,133 @@ LoadResult loadObj(const fs::path& path, const std::string& text, Ctx& ctx) {
 }
 
 // ---- 5. OFF -------------------------------------------------------------------------------
-LoadResult loadOff(const fs::path& path, const std::string& text, Ctx& ctx) {
-    const std::string file = fileNameOf(path);
-    Cursor c{text.data(), text.data() + text.size()};
-    auto nextToken = [&]() {
-        // Skips comments (# to end of line).
-        for (;;) {
-            c.skipWs();
-            if (c.p < c.end && *c.p == '#') {
-                c.skipLine();
-                continue;
-            }
-            return c.anyToken();
+// The next token, skipping comments (# to end of line).
+std::string_view offToken(Cursor& c) {
+    for (;;) {
+        c.skipWs();
+        if (c.p < c.end && *c.p == '#') {
+            c.skipLine();
+            continue;
         }
-    };
-    std::string_view head = nextToken();
-    // Header keyword: [ST][C][N][4][n]OFF, optionally glued to the counts line.
-    if (head.size() < 3 || head.substr(head.size() - 3) != "OFF") throw Fail{"not an OFF file (no OFF header)"};
-    std::string_view prefix = head.substr(0, head.size() - 3);
+        return c.anyToken();
+    }
+}
+
+struct OffHeader {
     bool hasTex = false, hasColor = false, hasNormal = false;
+    uint64_t nv = 0, nf = 0;
+};
+
+// The keyword ([ST][C][N][4][n]OFF, optionally glued to the counts line) and the counts, which
+// are checked against the bytes left (each vertex needs at least "0 0 0\n", each face
+// "3 0 1 2\n") so that they are safe to reserve.
+OffHeader parseOffHeader(Cursor& c) {
+    OffHeader h;
+    const std::string_view head = offToken(c);
+    if (head.size() < 3 || head.substr(head.size() - 3) != "OFF") throw Fail{"not an OFF file (no OFF header)"};
+    const std::string_view prefix = head.substr(0, head.size() - 3);
     for (size_t i = 0; i < prefix.size(); ++i) {
         if (prefix.substr(i, 2) == "ST") {
-            hasTex = true;
+            h.hasTex = true;
             ++i;
         } else if (prefix[i] == 'C')
-            hasColor = true;
+            h.hasColor = true;
         else if (prefix[i] == 'N')
-            hasNormal = true;
+            h.hasNormal = true;
         else
             throw Fail{"unsupported OFF variant '" + std::string(head) + "' (4D, nD and binary OFF are not supported)"};
     }
-    uint64_t nv, nf, ne;
-    std::string_view t1 = nextToken();
+    uint64_t ne;
+    const std::string_view t1 = offToken(c);
     if (t1 == "BINARY") throw Fail{"binary OFF is not supported"};
-    if (!toUint64(t1, nv) || !toUint64(nextToken(), nf) || !toUint64(nextToken(), ne))
+    if (!toUint64(t1, h.nv) || !toUint64(offToken(c), h.nf) || !toUint64(offToken(c), ne))
         throw Fail{"malformed OFF header (expected vertex, face and edge counts)"};
-    // Each vertex needs at least 3 numbers ("0 0 0\n" = 6 bytes), each face "3 0 1 2\n" (8).
-    uint64_t remaining = uint64_t(c.end - c.p), need = 0;
-    if (nv > kMaxVertices) throw Fail{"header claims " + std::to_string(nv) + " vertices (budget " + std::to_string(kMaxVertices) + ")"};
-    if (__builtin_mul_overflow(nv, uint64_t(6), &need) || need > remaining + 1)
-        throw Fail{"header claims " + std::to_string(nv) + " vertices but the file has only " + std::to_string(remaining) + " bytes left"};
-    uint64_t needF = 0;
-    if (__builtin_mul_overflow(nf, uint64_t(8), &needF) || need + needF > remaining + 1 + 8)
-        throw Fail{"header claims " + std::to_string(nf) + " faces but the file has only " + std::to_string(remaining) + " bytes left"};
-    sg::Mesh mesh;
-    mesh.name = path.stem().string();
-    mesh.positions.reserve(size_t(nv));
-    bool truncated = false;
-    size_t perVertexExtra = (hasNormal ? 3 : 0) + (hasTex ? 2 : 0);
-    for (uint64_t i = 0; i < nv; ++i) {
-        ctx.poll(size_t(i), 0.0f, 0.5f, size_t(nv));
+    const uint64_t remaining = uint64_t(c.end - c.p);
+    uint64_t need = 0, needF = 0;
+    if (h.nv > kMaxVertices) throw Fail{"header claims " + std::to_string(h.nv) + " vertices (budget " + std::to_string(kMaxVertices) + ")"};
+    if (__builtin_mul_overflow(h.nv, uint64_t(6), &need) || need > remaining + 1)
+        throw Fail{"header claims " + std::to_string(h.nv) + " vertices but the file has only " + std::to_string(remaining) + " bytes left"};
+    if (__builtin_mul_overflow(h.nf, uint64_t(8), &needF) || need + needF > remaining + 1 + 8)
+        throw Fail{"header claims " + std::to_string(h.nf) + " faces but the file has only " + std::to_string(remaining) + " bytes left"};
+    return h;
+}
+
+// A vertex colour: r g b [a] up to the end of the line, 0..1 floats or 0..255 integers.
+sg::vec4 readOffColor(Cursor& c) {
+    float col[4] = {1, 1, 1, 1};
+    int n = 0;
+    while (n < 4 && !c.atLineEnd()) {
+        if (!toFloat(c.token(), col[n])) break;
+        ++n;
+    }
+    const bool ints = n >= 3 && (col[0] > 1 || col[1] > 1 || col[2] > 1);
+    sg::vec4 cv(col[0], col[1], col[2], n == 4 ? col[3] : (ints ? 255.0f : 1.0f));
+    return ints ? cv / 255.0f : cv;
+}
+
+// The vertices with the attributes the header names (progress 0..0.5). False when the file
+// ends (or a coordinate is malformed) first.
+bool readOffVertices(Cursor& c, const OffHeader& h, sg::Mesh& mesh, Ctx& ctx) {
+    mesh.positions.reserve(size_t(h.nv));
+    const size_t perVertexExtra = (h.hasNormal ? 3 : 0) + (h.hasTex ? 2 : 0);
+    for (uint64_t i = 0; i < h.nv; ++i) {
+        ctx.poll(size_t(i), 0.0f, 0.5f, size_t(h.nv));
         float x, y, z;
-        if (!toFloat(nextToken(), x) || !toFloat(nextToken(), y) || !toFloat(nextToken(), z)) {
-            truncated = true;
-            break;
-        }
+        if (!toFloat(offToken(c), x) || !toFloat(offToken(c), y) || !toFloat(offToken(c), z)) return false;
         if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) throw Fail{"vertex " + std::to_string(i) + " is not finite"};
         mesh.positions.push_back({x, y, z});
         float extra[5];
-        for (size_t k = 0; k < perVertexExtra; ++k) toFloat(nextToken(), extra[k]);
-        if (hasNormal) mesh.normals.push_back({extra[0], extra[1], extra[2]});
-        if (hasTex) mesh.uv0.push_back({extra[hasNormal ? 3 : 0], extra[hasNormal ? 4 : 1]});
-        if (hasColor) {
-            // r g b [a], 0..1 floats or 0..255 ints; rest of the line.
-            float col[4] = {1, 1, 1, 1};
-            int n = 0;
-            while (n < 4 && !c.atLineEnd()) {
-                if (!toFloat(c.token(), col[n])) break;
-                ++n;
-            }
-            bool ints = n >= 3 && (col[0] > 1 || col[1] > 1 || col[2] > 1);
-            sg::vec4 cv(col[0], col[1], col[2], n == 4 ? col[3] : (ints ? 255.0f : 1.0f));
-            if (ints) cv /= 255.0f;
-            mesh.colors.push_back(cv);
-        }
+        for (size_t k = 0; k < perVertexExtra; ++k) toFloat(offToken(c), extra[k]);
+        if (h.hasNormal) mesh.normals.push_back({extra[0], extra[1], extra[2]});
+        if (h.hasTex) mesh.uv0.push_back({extra[h.hasNormal ? 3 : 0], extra[h.hasNormal ? 4 : 1]});
+        if (h.hasColor) mesh.colors.push_back(readOffColor(c));
     }
-    size_t dropped = 0, facesRead = 0;
+    return true;
+}
+
+// The faces (progress 0.5..0.95), triangulated; a face with an index out of range or fewer
+// than 3 corners is counted in `dropped`. False when the file ends first.
+bool readOffFaces(Cursor& c, const OffHeader& h, sg::Mesh& mesh, Ctx& ctx, size_t& facesRead, size_t& dropped) {
     std::vector<uint32_t> poly;
-    if (!truncated) {
-        for (uint64_t f = 0; f < nf; ++f) {
-            ctx.poll(size_t(f), 0.5f, 0.45f, size_t(nf));
-            uint64_t k;
-            if (!toUint64(nextToken(), k)) {
-                truncated = true;
-                break;
-            }
-            if (k > 1'000'000) throw Fail{"face " + std::to_string(f) + " claims " + std::to_string(k) + " corners"};
-            poly.clear();
-            bool ok = true;
-            for (uint64_t j = 0; j < k; ++j) {
-                int64_t idx;
-                if (!toInt64(nextToken(), idx)) {
-                    truncated = true;
-                    break;
-                }
-                if (idx < 0 || uint64_t(idx) >= mesh.positions.size())
-                    ok = false;
-                else
-                    poly.push_back(uint32_t(idx));
-            }
-            if (truncated) break;
-            while (!c.atLineEnd()) c.token();   // per-face colour
-            ++facesRead;
-            if (!ok || k < 3) {
-                ++dropped;
-                continue;
-            }
-            ctx.countTriangles(k - 2);
-            addPolygon(ctx, mesh, poly);
+    for (uint64_t f = 0; f < h.nf; ++f) {
+        ctx.poll(size_t(f), 0.5f, 0.45f, size_t(h.nf));
+        uint64_t k;
+        if (!toUint64(offToken(c), k)) return false;
+        if (k > 1'000'000) throw Fail{"face " + std::to_string(f) + " claims " + std::to_string(k) + " corners"};
+        poly.clear();
+        bool ok = true;
+        for (uint64_t j = 0; j < k; ++j) {
+            int64_t idx;
+            if (!toInt64(offToken(c), idx)) return false;
+            if (idx < 0 || uint64_t(idx) >= mesh.positions.size())
+                ok = false;
+            else
+                poly.push_back(uint32_t(idx));
         }
+        while (!c.atLineEnd()) c.token();   // per-face colour
+        ++facesRead;
+        if (!ok || k < 3) {
+            ++dropped;
+            continue;
+        }
+        ctx.countTriangles(k - 2);
+        addPolygon(ctx, mesh, poly);
     }
-    if (truncated)
-        ctx.warnings.push_back(file + ": file is truncated: read " + std::to_string(mesh.positions.size()) + " of " + std::to_string(nv) +
-                               " vertices and " + std::to_string(facesRead) + " of " + std::to_string(nf) + " faces");
+    return true;
+}
+
+LoadResult loadOff(const fs::path& path, const std::string& text, Ctx& ctx) {
+    const std::string file = fileNameOf(path);
+    Cursor c{text.data(), text.data() + text.size()};
+    const OffHeader h = parseOffHeader(c);
+    sg::Mesh mesh;
+    mesh.name = path.stem().string();
+    size_t facesRead = 0, dropped = 0;
+    if (!readOffVertices(c, h, mesh, ctx) || !readOffFaces(c, h, mesh, ctx, facesRead, dropped))
+        ctx.warnings.push_back(file + ": file is truncated: read " + std::to_string(mesh.positions.size()) + " of " + std::to_string(h.nv) +
+                               " vertices and " + std::to_string(facesRead) + " of " + std::to_string(h.nf) + " faces");
     if (dropped) ctx.warnings.push_back(file + ": " + std::to_string(dropped) + " faces with out-of-range indices or fewer than 3 corners dropped");
-    if (mesh.positions.empty()) throw Fail{"no vertices"};
-    if (mesh.normals.size() != mesh.positions.size()) mesh.normals.clear();
-    if (mesh.uv0.size() != mesh.positions.size()) mesh.uv0.clear();
-    if (mesh.colors.size() != mesh.positions.size()) mesh.colors.clear();
-    if (mesh.indices.empty()) {
-        mesh.mode = sg::PrimitiveMode::Points;
-        mesh.indices.resize(mesh.positions.size());
-        for (size_t i = 0; i < mesh.indices.size(); ++i) mesh.indices[i] = uint32_t(i);
-    }
-    std::vector<std::pair<sg::Mesh, int>> parts;
-    parts.push_back({std::move(mesh), -1});
-    LoadResult r;
-    r.scene = makeScene(path, parts, {}, {});
-    return r;
+    return singleMeshScene(path, std::move(mesh));
 }
 
 // ---- 6. PLY -------------------------------------------------------------------------------
@@ -1136,18 +1151,7 @@ LoadResult loadPly(const fs::path& path, const std::string& data, Ctx& ctx) {
     }
     if (b.dropped)
         ctx.warnings.push_back(file + ": " + std::to_string(b.dropped) + " faces with out-of-range indices or fewer than 3 corners dropped");
-    sg::Mesh& mesh = b.mesh;
-    if (mesh.positions.empty()) throw Fail{"no vertices"};
-    if (mesh.indices.empty()) {
-        mesh.mode = sg::PrimitiveMode::Points;
-        mesh.indices.resize(mesh.positions.size());
-        for (size_t i = 0; i < mesh.indices.size(); ++i) mesh.indices[i] = uint32_t(i);
-    }
-    std::vector<std::pair<sg::Mesh, int>> parts;
-    parts.push_back({std::move(mesh), -1});
-    LoadResult r;
-    r.scene = makeScene(path, parts, {}, {});
-    return r;
+    return singleMeshScene(path, std::move(b.mesh));
 }
 
 // ---- 7. STL -------------------------------------------------------------------------------
