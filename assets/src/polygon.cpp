@@ -36,7 +36,7 @@ double turn(const P& a, const P& b, const P& c) {
 }
 template <class P>
 double dist(const P& a, const P& b) {
-    return std::hypot(b.x - a.x, b.y - a.y);
+    return std::sqrt((b.x - a.x) * (b.x - a.x) + (b.y - a.y) * (b.y - a.y));   // no overflow: coordinates are <= 1e30-ish
 }
 
 // -1 reflex, 0 flat (within tol of straight: collinear, repeated, doubling back), +1 convex.
@@ -133,6 +133,45 @@ bool PolygonTriangulator::earClip(size_t n) {
     return std::fabs(clipped2 - area2) <= 1e-6 * std::fabs(area2) + 4 * m_tol * perimeter;
 }
 
+// Quads, the most common polygon, decided in 3D without projecting: each corner's turn
+// against the Newell normal (the projected 2D cross product, times the normal's length). Only
+// clear cases: all four corners clearly convex (the fan) or one clearly reflex (the diagonal
+// through it); anything else (repeated or straight corners, zero area, non-finite) is left to
+// the general path, whose thresholds are never larger, so both always agree.
+bool quadFastPath(std::span<const sg::vec3> positions, std::span<const uint32_t> c, std::vector<uint32_t>& out, PolygonKind& kind) {
+    const glm::dvec3 o(positions[c[0]]);
+    const glm::dvec3 p[4] = {glm::dvec3(0.0), glm::dvec3(positions[c[1]]) - o, glm::dvec3(positions[c[2]]) - o, glm::dvec3(positions[c[3]]) - o};
+    const glm::dvec3 normal = glm::cross(p[2], p[3] - p[1]);
+    double ext = 0.0, mag = 0.0;
+    for (int i = 0; i < 4; ++i) {
+        const glm::dvec3 q(positions[c[i]]);
+        ext = std::max({ext, std::fabs(p[i].x), std::fabs(p[i].y), std::fabs(p[i].z)});
+        mag = std::max({mag, std::fabs(q.x), std::fabs(q.y), std::fabs(q.z)});
+    }
+    const double len2 = glm::dot(normal, normal);
+    if (!std::isfinite(len2) || !(len2 > 1e-20 * ext * ext * ext * ext)) return false;
+    const double tol = 1e-6 * mag + 1e-12 * ext;
+    int reflex = -1;
+    for (int i = 0; i < 4; ++i) {
+        const glm::dvec3 e = p[i] - p[(i + 3) % 4], f = p[(i + 1) % 4] - p[i];
+        const double t = glm::dot(glm::cross(e, f), normal);
+        // |t| / |normal| against tol * (|e| + |f|), squared: (|e| + |f|)^2 <= 2 (|e|^2 + |f|^2).
+        if (t * t <= 2.0 * tol * tol * (glm::dot(e, e) + glm::dot(f, f)) * len2) return false;   // straight or repeated
+        if (t < 0) {
+            if (reflex >= 0) return false;
+            reflex = i;
+        }
+    }
+    if (reflex == 1 || reflex == 3) {
+        const uint32_t r0 = c[size_t(reflex)], r1 = c[size_t(reflex + 1) % 4], r2 = c[size_t(reflex + 2) % 4], r3 = c[size_t(reflex + 3) % 4];
+        out.insert(out.end(), {r0, r1, r2, r0, r2, r3});
+    } else {
+        out.insert(out.end(), {c[0], c[1], c[2], c[0], c[2], c[3]});
+    }
+    kind = reflex < 0 ? PolygonKind::Convex : PolygonKind::Concave;
+    return true;
+}
+
 PolygonKind PolygonTriangulator::triangulate(std::span<const sg::vec3> positions, std::span<const uint32_t> corners, std::vector<uint32_t>& out) {
     const size_t n = corners.size();
     if (n < 3) return PolygonKind::TooFew;
@@ -140,6 +179,8 @@ PolygonKind PolygonTriangulator::triangulate(std::span<const sg::vec3> positions
         out.insert(out.end(), corners.begin(), corners.end());
         return PolygonKind::Triangle;
     }
+    PolygonKind quad;
+    if (n == 4 && quadFastPath(positions, corners, out, quad)) return quad;
     // Newell normal (twice the vector area), relative to the first corner for precision.
     const glm::dvec3 o(positions[corners[0]]);
     glm::dvec3 normal(0.0);

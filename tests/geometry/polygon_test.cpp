@@ -387,6 +387,30 @@ TEST(PolygonTriangulatorTest, ConcaveQuadUsesTheReflexDiagonal) {
             }
 }
 
+// Random simple quads (convex and concave, both windings, in space): the quad fast path
+// covers each exactly, and the fan when convex.
+TEST(PolygonTriangulatorTest, RandomQuadsCoverExactly) {
+    PolygonTriangulator t;
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> U(0.0, 40.0);
+    auto crosses = [](V2 a, V2 b, V2 c, V2 d) {   // segments ab and cd cross properly
+        auto side = [](V2 p, V2 q, V2 r) { return (q.x - p.x) * (r.y - p.y) - (q.y - p.y) * (r.x - p.x); };
+        return side(a, b, c) * side(a, b, d) < 0 && side(c, d, a) * side(c, d, b) < 0;
+    };
+    int concave = 0, convex = 0;
+    for (int iter = 0; iter < 2000 && !HasFailure(); ++iter) {
+        Poly q = {{U(rng), U(rng)}, {U(rng), U(rng)}, {U(rng), U(rng)}, {U(rng), U(rng)}};
+        if (crosses(q[0], q[1], q[2], q[3]) || crosses(q[1], q[2], q[3], q[0]) || std::fabs(shoelace(q)) < 20.0) continue;
+        Result r = triangulate(q, placements()[size_t(iter) % 4], t);
+        ASSERT_TRUE(r.kind == PolygonKind::Convex || r.kind == PolygonKind::Concave) << iter;
+        (r.kind == PolygonKind::Convex ? convex : concave)++;
+        if (r.kind == PolygonKind::Convex) { EXPECT_EQ(r.tris, fanOf(4)); }
+        expectExactCover(q, r.tris, "random quad " + std::to_string(iter));
+    }
+    EXPECT_GT(concave, 100);
+    EXPECT_GT(convex, 100);
+}
+
 // Collinear runs, repeated corners, a spike doubling back: still an exact cover.
 TEST(PolygonTriangulatorTest, CollinearAndRepeatedCorners) {
     PolygonTriangulator t;
