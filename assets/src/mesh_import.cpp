@@ -17,9 +17,12 @@
 //   * Huge header counts throw std::bad_alloc, truncated files report success, faces with bad
 //     indices vanish silently, OBJ mtllib paths are followed anywhere.
 // A viewer needs triangle soups, not a manifold half-edge structure, so the importer keeps
-// every face (polygons fan-triangulated), checks header counts against the file size before
-// allocating, reports truncation and dropped faces as warnings, polls cancel/progress, and
-// reads MTL files and textures only through ConfinedDir (model folder only).
+// every face (polygons triangulated by assets/polygon.h: convex ones as a fan, concave ones by
+// ear clipping), checks header counts against the file size before allocating, reports
+// truncation and dropped faces as warnings, drops vertices that are not finite or lie beyond
+// kMaxCoordinate together with the faces using them (one warning with the counts; a point
+// cloud keeps its other points), polls cancel/progress, and reads MTL files and textures only
+// through ConfinedDir (model folder only).
 // Mapping: one node per material group (OBJ usemtl) or one node; normals from the file when
 // complete, else smooth area-weighted (Mesh::computeNormals; STL vertices are welded by exact
 // position first). Colours are taken as linear. MTL: Kd -> baseColor, Ks -> ks (max channel)
@@ -32,13 +35,16 @@
 
 #include "assets/files.h"
 #include "assets/image_io.h"
+#include "assets/polygon.h"
 
 #include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <map>
 #include <unordered_map>
+#include <utility>
 
 namespace fs = std::filesystem;
 
@@ -109,11 +115,53 @@ bool parseNumber(std::string_view t, T& out) {
     return r.ec == std::errc() && r.ptr == t.data() + t.size();
 }
 bool toFloat(std::string_view t, float& out) { return parseNumber(t, out); }
-bool toDouble(std::string_view t, double& out) { return parseNumber(t, out); }
+// A number beyond double's range reads as +-infinity (or zero when it is tiny) rather than as
+// malformed, so that "1e400" in a coordinate counts as a bad vertex, not as a broken file.
+bool toDouble(std::string_view t, double& out) {
+    if (t.empty()) return false;
+    const char* b = t.data() + (t[0] == '+');
+    const char* e = t.data() + t.size();
+    const auto r = std::from_chars(b, e, out);
+    if (r.ptr != e) return false;
+    if (r.ec == std::errc()) return true;
+    if (r.ec != std::errc::result_out_of_range) return false;
+    const size_t x = t.find_first_of("eE");
+    const bool tiny = x != std::string_view::npos ? x + 1 < t.size() && t[x + 1] == '-'
+                                                  : t.substr(0, t.find('.')).find_first_of("123456789") == std::string_view::npos;
+    out = tiny ? 0.0 : std::numeric_limits<double>::infinity();
+    if (t[0] == '-') out = -out;
+    return true;
+}
 bool toInt64(std::string_view t, int64_t& out) { return parseNumber(t, out); }
 bool toUint64(std::string_view t, uint64_t& out) {
     auto r = std::from_chars(t.data(), t.data() + t.size(), out);
     return !t.empty() && r.ec == std::errc() && r.ptr == t.data() + t.size();
+}
+
+// Vertex positions must be finite and within +-kMaxCoordinate (the glTF importer's bound for
+// numbers too): beyond it, bounds, normals and camera framing overflow or lose all precision.
+// Other vertices are dropped with the faces that use them (BadVertices, section 3).
+constexpr double kMaxCoordinate = 1e30;
+
+bool goodCoordinate(double d) { return std::fabs(d) <= kMaxCoordinate; }   // false for NaN
+bool goodPosition(const sg::vec3& p) { return goodCoordinate(p.x) && goodCoordinate(p.y) && goodCoordinate(p.z); }
+
+// A coordinate token of a text format: Ok (out set), Bad (a number, but not finite or beyond
+// kMaxCoordinate) or Malformed (not a number).
+enum class Coord { Ok, Bad, Malformed };
+Coord parseCoordinate(std::string_view t, float& out) {
+    double d;
+    if (!toDouble(t, d)) return Coord::Malformed;
+    if (!goodCoordinate(d)) return Coord::Bad;
+    out = float(d);
+    return Coord::Ok;
+}
+// Three coordinates: the worst of the three (Malformed over Bad over Ok).
+Coord parsePosition(std::string_view x, std::string_view y, std::string_view z, sg::vec3& out) {
+    const Coord c[3] = {parseCoordinate(x, out.x), parseCoordinate(y, out.y), parseCoordinate(z, out.z)};
+    for (Coord want : {Coord::Malformed, Coord::Bad})
+        if (c[0] == want || c[1] == want || c[2] == want) return want;
+    return Coord::Ok;
 }
 
 std::string lower(std::string_view s) {
@@ -128,6 +176,7 @@ struct Ctx {
     const Progress& progress;
     std::vector<std::string> warnings;
     uint64_t triangles = 0;
+    PolygonTriangulator triangulator{};
     void poll(size_t i, float base, float span, size_t total) const {
         if ((i & (kPoll - 1)) != 0) return;
         if (progress.cancelled()) throw Fail{"cancelled"};
@@ -139,13 +188,63 @@ struct Ctx {
     }
 };
 
-// Fan-triangulates a polygon given by corner indices into `out`.
-void fan(const uint32_t* c, size_t n, std::vector<uint32_t>& out) {
-    for (size_t i = 1; i + 1 < n; ++i) {
-        out.push_back(c[0]);
-        out.push_back(c[i]);
-        out.push_back(c[i + 1]);
+// Vertices with a bad position (see kMaxCoordinate) and what goes with them: the faces (and
+// OBJ lines) that use any of them. Reported in one warning; a point cloud just loses the
+// points. A file of nothing but bad vertices is refused.
+struct BadVertices {
+    std::vector<uint8_t> flag;   // flag[i] != 0: vertex i is bad (empty until the first one)
+    size_t count = 0, faces = 0, lines = 0;
+    void mark(size_t i) {
+        if (flag.size() <= i) flag.resize(i + 1, 0);
+        flag[i] = 1;
+        ++count;
     }
+    bool operator[](size_t i) const { return i < flag.size() && flag[i] != 0; }
+    bool anyOf(const std::vector<uint32_t>& corners) const {
+        return count && std::any_of(corners.begin(), corners.end(), [&](uint32_t i) { return (*this)[i]; });
+    }
+};
+
+// "<file>: dropped 3 of 16 vertices (non-finite or |coordinate| > 1e30) and 2 faces that use
+// them", or nothing when none was bad.
+void warnBadVertices(Ctx& ctx, const std::string& file, size_t bad, size_t total, size_t faces, size_t lines = 0) {
+    if (!bad) return;
+    auto counted = [](size_t n, const char* what) { return std::to_string(n) + " " + what + (n == 1 ? "" : "s"); };
+    std::string w = file + ": dropped " + std::to_string(bad) + " of " + std::to_string(total) + " vertices (non-finite or |coordinate| > 1e30)";
+    if (faces) w += " and " + counted(faces, "face");
+    if (lines) w += " and " + counted(lines, "line");
+    if (faces || lines) w += bad == 1 ? " that use it" : " that use them";
+    ctx.warnings.push_back(std::move(w));
+}
+
+// Removes the bad vertices (with their attributes) from `mesh` and renumbers its indices, which
+// must not refer to them. Fails when no vertex is left.
+void dropBadVertices(sg::Mesh& mesh, const BadVertices& bad) {
+    if (!bad.count) return;
+    const size_t n = mesh.positions.size();
+    if (bad.count >= n) throw Fail{"all " + std::to_string(n) + " vertices are non-finite or have a |coordinate| > 1e30"};
+    std::vector<uint32_t> remap(n);
+    uint32_t kept = 0;
+    for (size_t i = 0; i < n; ++i) remap[i] = bad[i] ? ~0u : kept++;
+    auto compact = [&](auto& attr) {
+        if (attr.size() != n) return;   // incomplete: makeScene drops it anyway
+        size_t o = 0;
+        for (size_t i = 0; i < n; ++i)
+            if (!bad[i]) attr[o++] = attr[i];
+        attr.resize(o);
+    };
+    compact(mesh.positions);
+    compact(mesh.normals);
+    compact(mesh.uv0);
+    compact(mesh.uv1);
+    compact(mesh.colors);
+    for (uint32_t& i : mesh.indices) i = remap[i];
+}
+
+// Triangulates a polygon given by corner indices into mesh.positions (assets/polygon.h:
+// convex faces as the fan, concave ones by ear clipping) onto mesh.indices.
+void addPolygon(Ctx& ctx, sg::Mesh& mesh, const std::vector<uint32_t>& corners) {
+    ctx.triangulator.triangulate(mesh.positions, corners, mesh.indices);
 }
 
 // Scene with one node per (mesh, material) and defaults.
@@ -170,6 +269,22 @@ sg::Scene makeScene(const fs::path& path, std::vector<std::pair<sg::Mesh, int>>&
     }
     addDefaultCameraAndLight(s);
     return s;
+}
+
+// A scene of one mesh (OFF, PLY): its faces, or a point cloud of all its vertices when it has
+// none. Fails when there are no vertices.
+LoadResult singleMeshScene(const fs::path& path, sg::Mesh mesh) {
+    if (mesh.positions.empty()) throw Fail{"no vertices"};
+    if (mesh.indices.empty()) {
+        mesh.mode = sg::PrimitiveMode::Points;
+        mesh.indices.resize(mesh.positions.size());
+        for (size_t i = 0; i < mesh.indices.size(); ++i) mesh.indices[i] = uint32_t(i);
+    }
+    std::vector<std::pair<sg::Mesh, int>> parts;
+    parts.push_back({std::move(mesh), -1});
+    LoadResult r;
+    r.scene = makeScene(path, parts, {}, {});
+    return r;
 }
 
 // ---- 4. OBJ + MTL --------------------------------------------------------------------------
@@ -269,7 +384,8 @@ struct ObjFace {
 };
 
 // An OBJ file as read: every corner index of a kept face/line/point is in range of the
-// arrays it refers to; faces have >= 3 corners, lines >= 2 (others were counted as dropped).
+// arrays it refers to and names no bad vertex; faces have >= 3 corners, lines >= 2 (others
+// were counted as dropped, or in `bad`).
 struct ObjData {
     std::vector<sg::vec3> v, vn;
     std::vector<sg::vec4> vc;   // vertex colours (x y z r g b), one per v
@@ -280,7 +396,8 @@ struct ObjData {
     std::vector<uint32_t> pointList;
     std::vector<std::string> mtllibs;
     std::vector<std::string> matNames;   // usemtl order
-    size_t dropped = 0, badLines = 0;
+    size_t dropped = 0, malformedLines = 0;
+    BadVertices bad;   // non-finite / absurd positions, with the faces and lines using them
     bool anyColor = false;
 };
 
@@ -297,15 +414,19 @@ bool resolveObjIndex(int64_t i, size_t n, uint32_t& out) {
     return false;
 }
 
-// "v x y z [r g b]": appends one position and colour (zero / white when malformed).
+// "v x y z [r g b]": appends one position and colour (zero / white when malformed; a
+// non-finite or absurd position marks the vertex bad).
 void readObjVertex(Cursor& c, ObjData& d) {
-    float x, y, z;
-    if (!toFloat(c.token(), x) || !toFloat(c.token(), y) || !toFloat(c.token(), z) || !std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) {
-        ++d.badLines;
+    sg::vec3 p;
+    const std::string_view x = c.token(), y = c.token(), z = c.token();
+    const Coord k = parsePosition(x, y, z, p);
+    if (k != Coord::Ok) {
+        if (k == Coord::Malformed) ++d.malformedLines;
+        if (k == Coord::Bad) d.bad.mark(d.v.size());
         d.v.push_back(sg::vec3(0.0f));
         d.vc.push_back(sg::vec4(1.0f));
     } else {
-        d.v.push_back({x, y, z});
+        d.v.push_back(p);
         float r, g, b;
         std::string_view t = c.token();
         if (!t.empty() && toFloat(t, r) && toFloat(c.token(), g) && toFloat(c.token(), b)) {
@@ -341,7 +462,8 @@ bool readObjCorner(std::string_view t, const ObjData& d, ObjCorner& cr) {
 
 // "f", "l" or "p" (key) with its corners: a face is kept with material curMat (counted against
 // the triangle budget), a line as segments, points as v indices; an element with a bad
-// index or too few corners is dropped whole.
+// index or too few corners is dropped whole, so is a face or line using a bad vertex (counted
+// in d.bad); of points only the bad ones are dropped.
 void readObjElement(Cursor& c, std::string_view key, int curMat, ObjData& d, Ctx& ctx) {
     uint32_t first = uint32_t(d.corners.size());
     bool ok = true;
@@ -352,17 +474,21 @@ void readObjElement(Cursor& c, std::string_view key, int curMat, ObjData& d, Ctx
         d.corners.push_back(cr);
         ++n;
     }
+    const bool usesBad = d.bad.count && std::any_of(d.corners.begin() + first, d.corners.end(), [&](const ObjCorner& k) { return d.bad[k.v]; });
     if (!ok || n == 0 || (key == "f" && n < 3) || (key == "l" && n < 2)) {
         ++d.dropped;
+        d.corners.resize(first);
+    } else if (usesBad && key != "p") {
+        ++(key == "f" ? d.bad.faces : d.bad.lines);
         d.corners.resize(first);
     } else if (key == "f") {
         ctx.countTriangles(n - 2);
         d.faces.push_back({first, uint32_t(n), curMat});
     } else {
         for (size_t i = 0; i < n; ++i) {
-            if (key == "p")
-                d.pointList.push_back(d.corners[first + i].v);
-            else if (i + 1 < n) {
+            if (key == "p") {
+                if (!d.bad[d.corners[first + i].v]) d.pointList.push_back(d.corners[first + i].v);
+            } else if (i + 1 < n) {
                 d.linePoly.push_back(d.corners[first + i].v);
                 d.linePoly.push_back(d.corners[first + i + 1].v);
             }
@@ -385,14 +511,14 @@ ObjData parseObjText(const std::string& text, Ctx& ctx) {
             readObjVertex(c, d);
         } else if (key == "vt") {
             float s = 0, t = 0;
-            if (!toFloat(c.token(), s)) ++d.badLines;
+            if (!toFloat(c.token(), s)) ++d.malformedLines;
             std::string_view tt = c.token();
-            if (!tt.empty() && !toFloat(tt, t)) ++d.badLines;
+            if (!tt.empty() && !toFloat(tt, t)) ++d.malformedLines;
             d.vt.push_back({s, t});
         } else if (key == "vn") {
             float x, y, z;
             if (!toFloat(c.token(), x) || !toFloat(c.token(), y) || !toFloat(c.token(), z)) {
-                ++d.badLines;
+                ++d.malformedLines;
                 x = 0;
                 y = 0;
                 z = 1;
@@ -471,7 +597,7 @@ ObjMaterials resolveObjMaterials(const fs::path& path, const ConfinedDir& dir, c
     return out;
 }
 
-// One triangle mesh from the faces faceIds, fan-triangulated, with (v, vt, vn) corners
+// One triangle mesh from the faces faceIds, triangulated, with (v, vt, vn) corners
 // de-duplicated (by v alone when the file has neither UVs nor normals). UVs / normals are
 // kept only when some / all corners have them, colours only when the file has any.
 // done: faces converted so far over all groups (progress 0.7..0.95).
@@ -513,7 +639,7 @@ sg::Mesh buildObjGroupMesh(const ObjData& d, const std::vector<uint32_t>& faceId
         const ObjFace& f = d.faces[fi];
         tri.clear();
         for (uint32_t k = 0; k < f.count; ++k) tri.push_back(vertexOf(d.corners[f.first + k]));
-        fan(tri.data(), tri.size(), mesh.indices);
+        addPolygon(ctx, mesh, tri);
     }
     if (!hasUv) mesh.uv0.clear();
     if (!hasN) mesh.normals.clear();
@@ -556,7 +682,8 @@ void addObjLineMesh(const fs::path& path, const ObjData& d, std::vector<std::pai
     parts.push_back({std::move(lines), -1});
 }
 
-// A point cloud over all vertices: the `p` elements, or every vertex when nothing else was drawn.
+// A point cloud over all (good) vertices: the `p` elements, or every vertex when nothing else
+// was drawn.
 void addObjPointMesh(const fs::path& path, const ObjData& d, std::vector<std::pair<sg::Mesh, int>>& parts) {
     sg::Mesh pts;
     pts.mode = sg::PrimitiveMode::Points;
@@ -565,11 +692,12 @@ void addObjPointMesh(const fs::path& path, const ObjData& d, std::vector<std::pa
     if (d.anyColor) pts.colors = d.vc;
     if (!d.vn.empty() && d.vn.size() == d.v.size()) pts.normals = d.vn;
     if (d.pointList.empty()) {
-        pts.indices.resize(d.v.size());
-        for (size_t i = 0; i < d.v.size(); ++i) pts.indices[i] = uint32_t(i);
+        for (size_t i = 0; i < d.v.size(); ++i)
+            if (!d.bad[i]) pts.indices.push_back(uint32_t(i));
     } else {
         pts.indices = d.pointList;
     }
+    dropBadVertices(pts, d.bad);
     parts.push_back({std::move(pts), -1});
 }
 
@@ -579,7 +707,8 @@ LoadResult loadObj(const fs::path& path, const std::string& text, Ctx& ctx) {
     const ObjData d = parseObjText(text, ctx);
     if (d.v.empty()) throw Fail{"no vertices"};
     if (d.dropped) ctx.warnings.push_back(file + ": " + std::to_string(d.dropped) + " faces/lines with missing or out-of-range indices dropped");
-    if (d.badLines) ctx.warnings.push_back(file + ": " + std::to_string(d.badLines) + " malformed vertex lines (zero used)");
+    if (d.malformedLines) ctx.warnings.push_back(file + ": " + std::to_string(d.malformedLines) + " malformed vertex lines (zero used)");
+    warnBadVertices(ctx, file, d.bad.count, d.v.size(), d.bad.faces, d.bad.lines);
 
     ObjMaterials mats = resolveObjMaterials(path, dir, d, ctx, file);
     std::vector<std::pair<sg::Mesh, int>> parts;
@@ -593,134 +722,143 @@ LoadResult loadObj(const fs::path& path, const std::string& text, Ctx& ctx) {
 }
 
 // ---- 5. OFF -------------------------------------------------------------------------------
-LoadResult loadOff(const fs::path& path, const std::string& text, Ctx& ctx) {
-    const std::string file = fileNameOf(path);
-    Cursor c{text.data(), text.data() + text.size()};
-    auto nextToken = [&]() {
-        // Skips comments (# to end of line).
-        for (;;) {
-            c.skipWs();
-            if (c.p < c.end && *c.p == '#') {
-                c.skipLine();
-                continue;
-            }
-            return c.anyToken();
+// The next token, skipping comments (# to end of line).
+std::string_view offToken(Cursor& c) {
+    for (;;) {
+        c.skipWs();
+        if (c.p < c.end && *c.p == '#') {
+            c.skipLine();
+            continue;
         }
-    };
-    std::string_view head = nextToken();
-    // Header keyword: [ST][C][N][4][n]OFF, optionally glued to the counts line.
-    if (head.size() < 3 || head.substr(head.size() - 3) != "OFF") throw Fail{"not an OFF file (no OFF header)"};
-    std::string_view prefix = head.substr(0, head.size() - 3);
+        return c.anyToken();
+    }
+}
+
+struct OffHeader {
     bool hasTex = false, hasColor = false, hasNormal = false;
+    uint64_t nv = 0, nf = 0;
+};
+
+// The keyword ([ST][C][N][4][n]OFF, optionally glued to the counts line) and the counts, which
+// are checked against the bytes left (each vertex needs at least "0 0 0\n", each face
+// "3 0 1 2\n") so that they are safe to reserve.
+OffHeader parseOffHeader(Cursor& c) {
+    OffHeader h;
+    const std::string_view head = offToken(c);
+    if (head.size() < 3 || head.substr(head.size() - 3) != "OFF") throw Fail{"not an OFF file (no OFF header)"};
+    const std::string_view prefix = head.substr(0, head.size() - 3);
     for (size_t i = 0; i < prefix.size(); ++i) {
         if (prefix.substr(i, 2) == "ST") {
-            hasTex = true;
+            h.hasTex = true;
             ++i;
         } else if (prefix[i] == 'C')
-            hasColor = true;
+            h.hasColor = true;
         else if (prefix[i] == 'N')
-            hasNormal = true;
+            h.hasNormal = true;
         else
             throw Fail{"unsupported OFF variant '" + std::string(head) + "' (4D, nD and binary OFF are not supported)"};
     }
-    uint64_t nv, nf, ne;
-    std::string_view t1 = nextToken();
+    uint64_t ne;
+    const std::string_view t1 = offToken(c);
     if (t1 == "BINARY") throw Fail{"binary OFF is not supported"};
-    if (!toUint64(t1, nv) || !toUint64(nextToken(), nf) || !toUint64(nextToken(), ne))
+    if (!toUint64(t1, h.nv) || !toUint64(offToken(c), h.nf) || !toUint64(offToken(c), ne))
         throw Fail{"malformed OFF header (expected vertex, face and edge counts)"};
-    // Each vertex needs at least 3 numbers ("0 0 0\n" = 6 bytes), each face "3 0 1 2\n" (8).
-    uint64_t remaining = uint64_t(c.end - c.p), need = 0;
-    if (nv > kMaxVertices) throw Fail{"header claims " + std::to_string(nv) + " vertices (budget " + std::to_string(kMaxVertices) + ")"};
-    if (__builtin_mul_overflow(nv, uint64_t(6), &need) || need > remaining + 1)
-        throw Fail{"header claims " + std::to_string(nv) + " vertices but the file has only " + std::to_string(remaining) + " bytes left"};
-    uint64_t needF = 0;
-    if (__builtin_mul_overflow(nf, uint64_t(8), &needF) || need + needF > remaining + 1 + 8)
-        throw Fail{"header claims " + std::to_string(nf) + " faces but the file has only " + std::to_string(remaining) + " bytes left"};
+    const uint64_t remaining = uint64_t(c.end - c.p);
+    uint64_t need = 0, needF = 0;
+    if (h.nv > kMaxVertices) throw Fail{"header claims " + std::to_string(h.nv) + " vertices (budget " + std::to_string(kMaxVertices) + ")"};
+    if (__builtin_mul_overflow(h.nv, uint64_t(6), &need) || need > remaining + 1)
+        throw Fail{"header claims " + std::to_string(h.nv) + " vertices but the file has only " + std::to_string(remaining) + " bytes left"};
+    if (__builtin_mul_overflow(h.nf, uint64_t(8), &needF) || need + needF > remaining + 1 + 8)
+        throw Fail{"header claims " + std::to_string(h.nf) + " faces but the file has only " + std::to_string(remaining) + " bytes left"};
+    return h;
+}
+
+// A vertex colour: r g b [a] up to the end of the line, 0..1 floats or 0..255 integers.
+sg::vec4 readOffColor(Cursor& c) {
+    float col[4] = {1, 1, 1, 1};
+    int n = 0;
+    while (n < 4 && !c.atLineEnd()) {
+        if (!toFloat(c.token(), col[n])) break;
+        ++n;
+    }
+    const bool ints = n >= 3 && (col[0] > 1 || col[1] > 1 || col[2] > 1);
+    sg::vec4 cv(col[0], col[1], col[2], n == 4 ? col[3] : (ints ? 255.0f : 1.0f));
+    return ints ? cv / 255.0f : cv;
+}
+
+// The vertices with the attributes the header names (progress 0..0.5); non-finite or absurd
+// positions are marked in `bad`. False when the file ends (or a coordinate is malformed) first.
+bool readOffVertices(Cursor& c, const OffHeader& h, sg::Mesh& mesh, BadVertices& bad, Ctx& ctx) {
+    mesh.positions.reserve(size_t(h.nv));
+    const size_t perVertexExtra = (h.hasNormal ? 3 : 0) + (h.hasTex ? 2 : 0);
+    for (uint64_t i = 0; i < h.nv; ++i) {
+        ctx.poll(size_t(i), 0.0f, 0.5f, size_t(h.nv));
+        sg::vec3 p;
+        const std::string_view x = offToken(c), y = offToken(c), z = offToken(c);
+        const Coord k = parsePosition(x, y, z, p);
+        if (k == Coord::Malformed) return false;
+        if (k == Coord::Bad) bad.mark(mesh.positions.size());
+        mesh.positions.push_back(p);
+        float extra[5];
+        for (size_t k = 0; k < perVertexExtra; ++k) toFloat(offToken(c), extra[k]);
+        if (h.hasNormal) mesh.normals.push_back({extra[0], extra[1], extra[2]});
+        if (h.hasTex) mesh.uv0.push_back({extra[h.hasNormal ? 3 : 0], extra[h.hasNormal ? 4 : 1]});
+        if (h.hasColor) mesh.colors.push_back(readOffColor(c));
+    }
+    return true;
+}
+
+// The faces (progress 0.5..0.95), triangulated; a face with an index out of range or fewer
+// than 3 corners is counted in `dropped`, one using a bad vertex in bad.faces. False when the
+// file ends first.
+bool readOffFaces(Cursor& c, const OffHeader& h, sg::Mesh& mesh, BadVertices& bad, Ctx& ctx, size_t& facesRead, size_t& dropped) {
+    std::vector<uint32_t> poly;
+    for (uint64_t f = 0; f < h.nf; ++f) {
+        ctx.poll(size_t(f), 0.5f, 0.45f, size_t(h.nf));
+        uint64_t k;
+        if (!toUint64(offToken(c), k)) return false;
+        if (k > 1'000'000) throw Fail{"face " + std::to_string(f) + " claims " + std::to_string(k) + " corners"};
+        poly.clear();
+        bool ok = true;
+        for (uint64_t j = 0; j < k; ++j) {
+            int64_t idx;
+            if (!toInt64(offToken(c), idx)) return false;
+            if (idx < 0 || uint64_t(idx) >= mesh.positions.size())
+                ok = false;
+            else
+                poly.push_back(uint32_t(idx));
+        }
+        while (!c.atLineEnd()) c.token();   // per-face colour
+        ++facesRead;
+        if (!ok || k < 3) {
+            ++dropped;
+            continue;
+        }
+        if (bad.anyOf(poly)) {
+            ++bad.faces;
+            continue;
+        }
+        ctx.countTriangles(k - 2);
+        addPolygon(ctx, mesh, poly);
+    }
+    return true;
+}
+
+LoadResult loadOff(const fs::path& path, const std::string& text, Ctx& ctx) {
+    const std::string file = fileNameOf(path);
+    Cursor c{text.data(), text.data() + text.size()};
+    const OffHeader h = parseOffHeader(c);
     sg::Mesh mesh;
     mesh.name = path.stem().string();
-    mesh.positions.reserve(size_t(nv));
-    bool truncated = false;
-    size_t perVertexExtra = (hasNormal ? 3 : 0) + (hasTex ? 2 : 0);
-    for (uint64_t i = 0; i < nv; ++i) {
-        ctx.poll(size_t(i), 0.0f, 0.5f, size_t(nv));
-        float x, y, z;
-        if (!toFloat(nextToken(), x) || !toFloat(nextToken(), y) || !toFloat(nextToken(), z)) {
-            truncated = true;
-            break;
-        }
-        if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) throw Fail{"vertex " + std::to_string(i) + " is not finite"};
-        mesh.positions.push_back({x, y, z});
-        float extra[5];
-        for (size_t k = 0; k < perVertexExtra; ++k) toFloat(nextToken(), extra[k]);
-        if (hasNormal) mesh.normals.push_back({extra[0], extra[1], extra[2]});
-        if (hasTex) mesh.uv0.push_back({extra[hasNormal ? 3 : 0], extra[hasNormal ? 4 : 1]});
-        if (hasColor) {
-            // r g b [a], 0..1 floats or 0..255 ints; rest of the line.
-            float col[4] = {1, 1, 1, 1};
-            int n = 0;
-            while (n < 4 && !c.atLineEnd()) {
-                if (!toFloat(c.token(), col[n])) break;
-                ++n;
-            }
-            bool ints = n >= 3 && (col[0] > 1 || col[1] > 1 || col[2] > 1);
-            sg::vec4 cv(col[0], col[1], col[2], n == 4 ? col[3] : (ints ? 255.0f : 1.0f));
-            if (ints) cv /= 255.0f;
-            mesh.colors.push_back(cv);
-        }
-    }
-    size_t dropped = 0, facesRead = 0;
-    std::vector<uint32_t> poly;
-    if (!truncated) {
-        for (uint64_t f = 0; f < nf; ++f) {
-            ctx.poll(size_t(f), 0.5f, 0.45f, size_t(nf));
-            uint64_t k;
-            if (!toUint64(nextToken(), k)) {
-                truncated = true;
-                break;
-            }
-            if (k > 1'000'000) throw Fail{"face " + std::to_string(f) + " claims " + std::to_string(k) + " corners"};
-            poly.clear();
-            bool ok = true;
-            for (uint64_t j = 0; j < k; ++j) {
-                int64_t idx;
-                if (!toInt64(nextToken(), idx)) {
-                    truncated = true;
-                    break;
-                }
-                if (idx < 0 || uint64_t(idx) >= mesh.positions.size())
-                    ok = false;
-                else
-                    poly.push_back(uint32_t(idx));
-            }
-            if (truncated) break;
-            while (!c.atLineEnd()) c.token();   // per-face colour
-            ++facesRead;
-            if (!ok || k < 3) {
-                ++dropped;
-                continue;
-            }
-            ctx.countTriangles(k - 2);
-            fan(poly.data(), poly.size(), mesh.indices);
-        }
-    }
-    if (truncated)
-        ctx.warnings.push_back(file + ": file is truncated: read " + std::to_string(mesh.positions.size()) + " of " + std::to_string(nv) +
-                               " vertices and " + std::to_string(facesRead) + " of " + std::to_string(nf) + " faces");
+    size_t facesRead = 0, dropped = 0;
+    BadVertices bad;
+    if (!readOffVertices(c, h, mesh, bad, ctx) || !readOffFaces(c, h, mesh, bad, ctx, facesRead, dropped))
+        ctx.warnings.push_back(file + ": file is truncated: read " + std::to_string(mesh.positions.size()) + " of " + std::to_string(h.nv) +
+                               " vertices and " + std::to_string(facesRead) + " of " + std::to_string(h.nf) + " faces");
     if (dropped) ctx.warnings.push_back(file + ": " + std::to_string(dropped) + " faces with out-of-range indices or fewer than 3 corners dropped");
-    if (mesh.positions.empty()) throw Fail{"no vertices"};
-    if (mesh.normals.size() != mesh.positions.size()) mesh.normals.clear();
-    if (mesh.uv0.size() != mesh.positions.size()) mesh.uv0.clear();
-    if (mesh.colors.size() != mesh.positions.size()) mesh.colors.clear();
-    if (mesh.indices.empty()) {
-        mesh.mode = sg::PrimitiveMode::Points;
-        mesh.indices.resize(mesh.positions.size());
-        for (size_t i = 0; i < mesh.indices.size(); ++i) mesh.indices[i] = uint32_t(i);
-    }
-    std::vector<std::pair<sg::Mesh, int>> parts;
-    parts.push_back({std::move(mesh), -1});
-    LoadResult r;
-    r.scene = makeScene(path, parts, {}, {});
-    return r;
+    warnBadVertices(ctx, file, bad.count, mesh.positions.size(), bad.faces);
+    dropBadVertices(mesh, bad);
+    return singleMeshScene(path, std::move(mesh));
 }
 
 // ---- 6. PLY -------------------------------------------------------------------------------
@@ -966,6 +1104,7 @@ PlyRoles plyRoles(const PlyElement& e) {
 // The mesh under construction and what the body reading keeps between elements.
 struct PlyBuild {
     sg::Mesh mesh;
+    BadVertices bad;                // non-finite / absurd positions (faces using them: bad.faces)
     size_t dropped = 0;             // faces / strip triangles
     std::vector<uint32_t> poly;     // scratch: one face's corners
     std::vector<double> listVals;   // the kept list of the current entry
@@ -981,12 +1120,13 @@ struct PlyBuild {
     return float(std::clamp(d, 0.0, 1.0));
 }
 
-// Vertex i from its property values: a finite position (else Fail) and the attributes the
-// element has.
-void addPlyVertex(const PlyElement& e, const PlyRoles& k, const std::vector<double>& vals, uint64_t i, PlyBuild& b) {
-    sg::vec3 p{float(vals[size_t(k.ix)]), float(vals[size_t(k.iy)]), float(vals[size_t(k.iz)])};
-    if (!sg::isFinite(p)) throw Fail{"vertex " + std::to_string(i) + " is not finite"};
-    b.mesh.positions.push_back(p);
+// A vertex from its property values: its position (a non-finite or absurd one is marked in
+// b.bad) and the attributes the element has.
+void addPlyVertex(const PlyElement& e, const PlyRoles& k, const std::vector<double>& vals, PlyBuild& b) {
+    const double x = vals[size_t(k.ix)], y = vals[size_t(k.iy)], z = vals[size_t(k.iz)];
+    const bool good = goodCoordinate(x) && goodCoordinate(y) && goodCoordinate(z);
+    if (!good) b.bad.mark(b.mesh.positions.size());
+    b.mesh.positions.push_back(good ? sg::vec3(float(x), float(y), float(z)) : sg::vec3(0.0f));
     if (k.haveNormals) b.mesh.normals.push_back({float(vals[size_t(k.inx)]), float(vals[size_t(k.iny)]), float(vals[size_t(k.inz)])});
     if (k.haveUv) b.mesh.uv0.push_back({float(vals[size_t(k.iu)]), float(vals[size_t(k.iv)])});
     if (k.haveColors) {
@@ -995,8 +1135,8 @@ void addPlyVertex(const PlyElement& e, const PlyRoles& k, const std::vector<doub
     }
 }
 
-// A face from b.listVals: fan-triangulated when it has >= 3 corners, all indices of vertices
-// read so far; else dropped.
+// A face from b.listVals: triangulated when it has >= 3 corners, all indices of vertices
+// read so far; else dropped. A face using a bad vertex is dropped into b.bad.faces.
 void addPlyFace(PlyBuild& b, Ctx& ctx) {
     b.poly.clear();
     bool ok = b.listVals.size() >= 3;
@@ -1011,12 +1151,17 @@ void addPlyFace(PlyBuild& b, Ctx& ctx) {
         ++b.dropped;
         return;
     }
+    if (b.bad.anyOf(b.poly)) {
+        ++b.bad.faces;
+        return;
+    }
     ctx.countTriangles(b.listVals.size() - 2);
-    fan(b.poly.data(), b.poly.size(), b.mesh.indices);
+    addPolygon(ctx, b.mesh, b.poly);
 }
 
 // Triangle strips from b.listVals: strips separated by -1; alternate winding; degenerate
-// triangles skipped, triangles with an index beyond the vertices read so far dropped.
+// triangles skipped, triangles with an index beyond the vertices read so far dropped, those
+// using a bad vertex dropped into b.bad.faces.
 void addPlyStrips(PlyBuild& b, Ctx& ctx) {
     const std::vector<double>& lv = b.listVals;
     const double nv = double(b.mesh.positions.size());
@@ -1031,6 +1176,10 @@ void addPlyStrips(PlyBuild& b, Ctx& ctx) {
             }
             uint32_t ia2 = uint32_t(a), ib2 = uint32_t(bb), ic2 = uint32_t(c2);
             if (ia2 == ib2 || ib2 == ic2 || ia2 == ic2) continue;
+            if (b.bad[ia2] || b.bad[ib2] || b.bad[ic2]) {
+                ++b.bad.faces;
+                continue;
+            }
             ctx.countTriangles(1);
             if ((q - start) % 2 == 0) {
                 b.mesh.indices.push_back(ia2);
@@ -1084,7 +1233,7 @@ bool readPlyEntry(PlyReader& rd, const PlyElement& e, const PlyRoles& k, uint64_
         else if (k.isStrip)
             addPlyStrips(b, ctx);
     }
-    if (k.isVertex) addPlyVertex(e, k, vals, i, b);
+    if (k.isVertex) addPlyVertex(e, k, vals, b);
     return true;
 }
 
@@ -1136,18 +1285,9 @@ LoadResult loadPly(const fs::path& path, const std::string& data, Ctx& ctx) {
     }
     if (b.dropped)
         ctx.warnings.push_back(file + ": " + std::to_string(b.dropped) + " faces with out-of-range indices or fewer than 3 corners dropped");
-    sg::Mesh& mesh = b.mesh;
-    if (mesh.positions.empty()) throw Fail{"no vertices"};
-    if (mesh.indices.empty()) {
-        mesh.mode = sg::PrimitiveMode::Points;
-        mesh.indices.resize(mesh.positions.size());
-        for (size_t i = 0; i < mesh.indices.size(); ++i) mesh.indices[i] = uint32_t(i);
-    }
-    std::vector<std::pair<sg::Mesh, int>> parts;
-    parts.push_back({std::move(mesh), -1});
-    LoadResult r;
-    r.scene = makeScene(path, parts, {}, {});
-    return r;
+    warnBadVertices(ctx, file, b.bad.count, b.mesh.positions.size(), b.bad.faces);
+    dropBadVertices(b.mesh, b.bad);
+    return singleMeshScene(path, std::move(b.mesh));
 }
 
 // ---- 7. STL -------------------------------------------------------------------------------
@@ -1174,6 +1314,7 @@ LoadResult loadStl(const fs::path& path, const std::string& data, Ctx& ctx) {
     std::unordered_map<uint64_t, std::vector<uint32_t>> buckets;
     bool binary = false;
     uint32_t n = 0;
+    size_t badFacets = 0;   // facets with a non-finite or absurd corner
     if (data.size() >= 84) {
         std::memcpy(&n, data.data() + 80, 4);
         binary = 84 + 50ull * n == data.size();
@@ -1197,51 +1338,54 @@ LoadResult loadStl(const fs::path& path, const std::string& data, Ctx& ctx) {
         mesh.positions.reserve(n);   // at most 3n after welding, typically n/2
         mesh.indices.reserve(size_t(n) * 3);
         buckets.reserve(size_t(n));
-        size_t bad = 0;
+        size_t badCorners = 0;
         for (uint32_t i = 0; i < n; ++i) {
             ctx.poll(i, 0.0f, 0.95f, n);
             const char* f = data.data() + 84 + size_t(i) * 50;
             float fl[9];
             std::memcpy(fl, f + 12, 36);
             sg::vec3 v[3] = {{fl[0], fl[1], fl[2]}, {fl[3], fl[4], fl[5]}, {fl[6], fl[7], fl[8]}};
-            if (!sg::isFinite(v[0]) || !sg::isFinite(v[1]) || !sg::isFinite(v[2])) {
-                ++bad;
+            const size_t bad = size_t(!goodPosition(v[0])) + !goodPosition(v[1]) + !goodPosition(v[2]);
+            if (bad) {
+                badCorners += bad;
+                ++badFacets;
                 continue;
             }
             for (auto& p : v) weldAndAdd(mesh, buckets, p + sg::vec3(0.0f));   // +0 turns -0 into +0
         }
-        if (bad) ctx.warnings.push_back(file + ": " + std::to_string(bad) + " triangles with non-finite coordinates dropped");
+        warnBadVertices(ctx, file, badCorners, 3 * size_t(n), badFacets);
     } else {
         if (data.size() < 5) throw Fail{"file too short to be STL"};
         Cursor c{data.data(), data.data() + data.size()};
         std::string_view first = c.anyToken();
         if (first != "solid") throw Fail{"not an STL file (neither binary nor starting with 'solid')"};
         sg::vec3 tri[3];
+        Coord worst = Coord::Ok;   // of the facet's corners so far
         int k = 0;
-        size_t bad = 0, count = 0;
+        size_t malformed = 0, badCorners = 0, count = 0;
         while (!c.atEnd()) {
             std::string_view t = c.anyToken();
             if (t != "vertex") continue;
             ctx.poll(++count, 0.0f, 0.0f, 0);
             if ((count & (kPoll - 1)) == 0) ctx.progress.set(0.95f * float(double(c.p - data.data()) / double(data.size())));
-            float x, y, z;
-            if (!toFloat(c.anyToken(), x) || !toFloat(c.anyToken(), y) || !toFloat(c.anyToken(), z) || !std::isfinite(x) || !std::isfinite(y) ||
-                !std::isfinite(z)) {
-                ++bad;
-                x = y = z = std::numeric_limits<float>::quiet_NaN();
-            }
-            tri[k++] = sg::vec3(x, y, z);
-            if (k == 3) {
-                k = 0;
-                if (!sg::isFinite(tri[0]) || !sg::isFinite(tri[1]) || !sg::isFinite(tri[2])) continue;
-                ctx.countTriangles(1);
-                for (auto& p : tri) weldAndAdd(mesh, buckets, p + sg::vec3(0.0f));
-            }
+            const std::string_view x = c.anyToken(), y = c.anyToken(), z = c.anyToken();
+            const Coord q = parsePosition(x, y, z, tri[k++]);
+            malformed += q == Coord::Malformed;
+            badCorners += q == Coord::Bad;
+            if (q == Coord::Malformed || (q == Coord::Bad && worst == Coord::Ok)) worst = q;
+            if (k < 3) continue;
+            k = 0;
+            badFacets += worst == Coord::Bad;
+            if (std::exchange(worst, Coord::Ok) != Coord::Ok) continue;
+            ctx.countTriangles(1);
+            for (auto& p : tri) weldAndAdd(mesh, buckets, p + sg::vec3(0.0f));
         }
         if (k != 0) ctx.warnings.push_back(file + ": file ends inside a facet (truncated?)");
-        if (bad) ctx.warnings.push_back(file + ": " + std::to_string(bad) + " malformed vertex lines; their facets dropped");
+        if (malformed) ctx.warnings.push_back(file + ": " + std::to_string(malformed) + " malformed vertex lines; their facets dropped");
+        warnBadVertices(ctx, file, badCorners, count, badFacets);
     }
-    if (mesh.indices.empty()) throw Fail{"no triangles"};
+    if (mesh.indices.empty())
+        throw Fail{badFacets ? "no triangles: every facet has a non-finite corner or one with a |coordinate| > 1e30" : "no triangles"};
     std::vector<std::pair<sg::Mesh, int>> parts;
     parts.push_back({std::move(mesh), -1});
     LoadResult r;
