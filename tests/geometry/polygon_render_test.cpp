@@ -56,7 +56,7 @@ TEST(PolygonRenderTest, UFaceHasItsNotchEmpty) {
                 proj.type = sg::ProjectionType::Orthographic;
                 proj.orthoHalfHeight = 1.6f;
                 sg::FrameInput f = test_scenes::makeFrame(W, H, proj, sg::vec3(1.5f, 1.5f, 5.0f), sg::vec3(1.5f, 1.5f, 0.0f));
-                f.settings.cullBackFaces = cull;
+                f.settings.culling = cull ? sg::CullMode::On : sg::CullMode::Off;
                 test_scenes::addMesh(f, mesh, test_scenes::unlit(sg::vec3(1.0f)));
                 auto r = rnd::makeRenderer(backend);
                 ASSERT_TRUE(r);
