@@ -192,6 +192,143 @@ struct Tracer {
         }
     }
 
+    // A hit after shading: the point, its shading normal n and geometric normal ng (both on the
+    // side the ray came from), the material and the lit colour (linear, before reflection and fog).
+    struct ShadedHit {
+        vec3 p, n, ng, color;
+        const Material* mat = nullptr;
+    };
+
+    // The surface the ray stops at: the first opaque or blended one, passing masked surfaces
+    // where they are cut out (r.tmin moves behind them, layer counts them, at most kMaxLayers).
+    // False when the ray leaves the scene. alpha: the blended surface's coverage (else 1).
+    bool firstSurface(rt::Ray& r, rt::SceneHit& h, float& alpha, int& layer, const PixelFootprint* footprint) {
+        for (;;) {
+            if (!accel.intersect(r, h, f.settings.culling)) return false;
+            const Material& m = materialOf(h);
+            if (m.alphaMode == AlphaMode::Opaque) return true;
+            alpha = std::clamp(surfaceAlpha(h, r, footprint, m), 0.0f, 1.0f);
+            if (m.alphaMode == AlphaMode::Blend) return true;
+            if (alpha >= m.alphaCutoff || ++layer >= kMaxLayers) {
+                alpha = 1.0f;
+                return true;
+            }
+            r.tmin = h.t;   // cut out here: the ray goes on behind
+            ++rays;
+        }
+    }
+
+    // Shades a triangle hit: interpolated position (s.p), normals, vertex colours, texture
+    // (filtered with the footprint), then the shading model with shadow rays into vis.
+    void shadeMeshHit(const rt::SceneHit& h, const rt::Ray& r, const vec3& eye, const PixelFootprint* footprint, float* vis, ShadedHit& s) {
+        vec3 &p = s.p, &n = s.n, &ng = s.ng, &color = s.color;
+        const Material*& mat = s.mat;
+        const DrawMesh& dm = f.meshes[h.instance];
+        const Mesh& mesh = *dm.mesh;
+        mat = &dm.material;
+        const uint32_t i0 = mesh.indices[3 * h.prim], i1 = mesh.indices[3 * h.prim + 1], i2 = mesh.indices[3 * h.prim + 2];
+        const float w0 = 1.0f - h.b1 - h.b2, w1 = h.b1, w2 = h.b2;
+        const vec3 P[3] = {vec3(dm.world * vec4(mesh.positions[i0], 1.0f)), vec3(dm.world * vec4(mesh.positions[i1], 1.0f)),
+                           vec3(dm.world * vec4(mesh.positions[i2], 1.0f))};
+        p = w0 * P[0] + w1 * P[1] + w2 * P[2];
+        // Outward geometric normal: the CCW side, the CW side for mirrored instances
+        // (as GL's glFrontFace(GL_CW) for them).
+        vec3 gn = glm::cross(P[1] - P[0], P[2] - P[0]);
+        float gl = glm::length(gn);
+        gn = gl > 0 ? gn / gl : vec3(0, 1, 0);
+        if (dm.mirrored) gn = -gn;
+        const bool back = glm::dot(gn, r.dir) > 0;   // seen from its back: flip (two-sided)
+        ng = back ? -gn : gn;
+        const bool hasN = mesh.normals.size() == mesh.positions.size();
+        const bool hasC = mesh.colors.size() == mesh.positions.size();
+        const bool hasUV = mesh.uv0.size() == mesh.positions.size();
+        vec3 albedoV[3];
+        for (int k = 0; k < 3; ++k) albedoV[k] = mat->baseColor;
+        if (hasC) {
+            albedoV[0] *= vec3(mesh.colors[i0]);
+            albedoV[1] *= vec3(mesh.colors[i1]);
+            albedoV[2] *= vec3(mesh.colors[i2]);
+        }
+        vec3 texColor(1.0f);
+        if (const SampledTexture* tex = textures[h.instance]; tex && hasUV) {
+            const vec2 UV[3] = {mesh.uv0[i0], mesh.uv0[i1], mesh.uv0[i2]};
+            const vec2 uv = w0 * UV[0] + w1 * UV[1] + w2 * UV[2];
+            vec2 uvX, uvY;
+            rt::Ray nx, ny;
+            if (footprint && footprint->neighbours(nx, ny) && uvOnPlane(nx, P, UV, uvX) && uvOnPlane(ny, P, UV, uvY))
+                texColor = tex->sample(uv, uvX - uv, uvY - uv);
+            else
+                texColor = tex->sampleLevel(uv, 0, tex->filter() != FilterMode::Nearest);
+        }
+        vec3 Nv[3];
+        for (int k = 0; k < 3; ++k) {
+            uint32_t idx = k == 0 ? i0 : k == 1 ? i1 : i2;
+            vec3 nn = hasN ? dm.normal * mesh.normals[idx] : gn;
+            float l = glm::length(nn);
+            Nv[k] = l > 1e-20f ? nn / l : gn;
+            if (back) Nv[k] = -Nv[k];
+        }
+        const ShadingModel model = f.settings.shading;
+        vec3 albedo = (w0 * albedoV[0] + w1 * albedoV[1] + w2 * albedoV[2]) * texColor;
+        if (model == ShadingModel::Gouraud && !mat->unlit) {
+            // The model's two albedo-linear terms (shadeTerms) at the three vertices,
+            // interpolated with the hit's barycentrics (perspective-correct by
+            // construction), as the rasterizers do; texture and vertex colours apply per
+            // hit. The shadow rays of the hit point scale each light at every vertex.
+            lightVisibility(p, ng, vis);
+            const float wk[3] = {w0, w1, w2};
+            ShadeTerms t;
+            for (int k = 0; k < 3; ++k) {
+                ShadeTerms tk = shadeTerms(*mat, P[k], Nv[k], eye, f, vis);
+                t.mul += wk[k] * tk.mul;
+                t.add += wk[k] * tk.add;
+            }
+            color = t.apply(albedo);
+            n = w0 * Nv[0] + w1 * Nv[1] + w2 * Nv[2];
+            n = glm::length(n) > 0 ? glm::normalize(n) : ng;
+        } else {
+            if (model == ShadingModel::Flat || !hasN)
+                n = ng;
+            else {
+                n = w0 * Nv[0] + w1 * Nv[1] + w2 * Nv[2];
+                float l = glm::length(n);
+                n = l > 1e-20f ? n / l : ng;
+            }
+            if (!mat->unlit) lightVisibility(p, ng, vis);
+            color = shade(*mat, SurfacePoint{p, n, albedo}, eye, f, mat->unlit ? nullptr : vis);
+        }
+    }
+
+    // Shades an analytic hit (implicit shape, CSG leaf, parametric surface, grid) at s.p.
+    void shadeAnalyticHit(const rt::SceneHit& h, const rt::Ray& r, const vec3& eye, float* vis, ShadedHit& s) {
+        vec3 &p = s.p, &n = s.n, &ng = s.ng, &color = s.color;
+        const Material*& mat = s.mat;
+        const DrawAnalytic& a = f.analytics[h.instance];
+        mat = &a.material;
+        if (a.kind == DrawAnalytic::Kind::Csg && a.csg && h.csgLeaf >= 0) mat = &a.csg->nodes[size_t(h.csgLeaf)].material;
+        n = h.normal;
+        if (glm::dot(n, r.dir) > 0) n = -n;   // analytic surfaces: face the ray
+        ng = n;
+        if (!mat->unlit) lightVisibility(p, ng, vis);
+        color = shade(*mat, SurfacePoint{p, n, mat->baseColor}, eye, f, mat->unlit ? nullptr : vis);
+    }
+
+    // The colour seen in the mirror direction at s (dirN: the incoming ray, normalized), the
+    // pixel footprint carried along when both neighbour rays reflect too.
+    vec3 reflection(const ShadedHit& s, const vec3& dirN, int bounce, const PixelFootprint* footprint) {
+        const vec3 &p = s.p, &n = s.n, &ng = s.ng;
+        rt::Ray rr;
+        vec3 rd = dirN - 2.0f * glm::dot(dirN, n) * n;
+        rr.org = p + offsetScale(p) * ng;
+        rr.dir = rd;
+        rr.tmin = 0.0f;
+        rr.tmax = std::numeric_limits<float>::infinity();
+        PixelFootprint rf;
+        rt::Ray nx, ny;
+        rf.carried = footprint && footprint->neighbours(nx, ny) && reflectNeighbour(nx, p, ng, n, rf.rx) && reflectNeighbour(ny, p, ng, n, rf.ry);
+        return trace(rr, p, bounce + 1, nullptr, rf.carried ? &rf : nullptr);
+    }
+
     // Radiance along the ray (linear), depth of the first hit (window z via the camera) when
     // depthOut is given; eye = where the viewer is for this ray (camera eye or bounce origin).
     // footprint: the ray's differentials (texture mip selection); null: textures at level 0.
@@ -205,29 +342,12 @@ struct Tracer {
         rt::SceneHit h;
         rt::Ray r = ray;
         float alpha = 1.0f;
-        for (;;) {
-            if (!accel.intersect(r, h, f.settings.culling)) return f.settings.background;
-            const Material& m = materialOf(h);
-            if (m.alphaMode == AlphaMode::Opaque) break;
-            alpha = std::clamp(surfaceAlpha(h, r, footprint, m), 0.0f, 1.0f);
-            if (m.alphaMode == AlphaMode::Blend) break;
-            if (alpha >= m.alphaCutoff || ++layer >= kMaxLayers) {
-                alpha = 1.0f;
-                break;
-            }
-            r.tmin = h.t;   // cut out here: the ray goes on behind
-            ++rays;
-        }
+        if (!firstSurface(r, h, alpha, layer, footprint)) return f.settings.background;
         const bool blended = materialOf(h).alphaMode == AlphaMode::Blend;
         if (blended) alpha = std::clamp(alpha, 0.0f, 1.0f);
         vec3* const ownHit = blended ? nullptr : hitPos;
-        vec3 p = r.org + h.t * r.dir;
-        if (ownHit) *ownHit = p;
         vec3 dirN = glm::normalize(r.dir);
-        const Material* mat;
-        vec3 color, n, ng;
         float visible[64];
-        const size_t nl = std::min<size_t>(f.lights.size(), 64);
         std::vector<float> visHeap;
         float* vis = visible;
         if (f.lights.size() > 64) {
@@ -235,108 +355,18 @@ struct Tracer {
             vis = visHeap.data();
         }
 
-        if (h.kind == rt::SceneHit::Kind::Mesh) {
-            const DrawMesh& dm = f.meshes[h.instance];
-            const Mesh& mesh = *dm.mesh;
-            mat = &dm.material;
-            const uint32_t i0 = mesh.indices[3 * h.prim], i1 = mesh.indices[3 * h.prim + 1], i2 = mesh.indices[3 * h.prim + 2];
-            const float w0 = 1.0f - h.b1 - h.b2, w1 = h.b1, w2 = h.b2;
-            const vec3 P[3] = {vec3(dm.world * vec4(mesh.positions[i0], 1.0f)), vec3(dm.world * vec4(mesh.positions[i1], 1.0f)),
-                               vec3(dm.world * vec4(mesh.positions[i2], 1.0f))};
-            p = w0 * P[0] + w1 * P[1] + w2 * P[2];
-            if (ownHit) *ownHit = p;
-            // Outward geometric normal: the CCW side, the CW side for mirrored instances
-            // (as GL's glFrontFace(GL_CW) for them).
-            vec3 gn = glm::cross(P[1] - P[0], P[2] - P[0]);
-            float gl = glm::length(gn);
-            gn = gl > 0 ? gn / gl : vec3(0, 1, 0);
-            if (dm.mirrored) gn = -gn;
-            const bool back = glm::dot(gn, r.dir) > 0;   // seen from its back: flip (two-sided)
-            ng = back ? -gn : gn;
-            const bool hasN = mesh.normals.size() == mesh.positions.size();
-            const bool hasC = mesh.colors.size() == mesh.positions.size();
-            const bool hasUV = mesh.uv0.size() == mesh.positions.size();
-            vec3 albedoV[3];
-            for (int k = 0; k < 3; ++k) albedoV[k] = mat->baseColor;
-            if (hasC) {
-                albedoV[0] *= vec3(mesh.colors[i0]);
-                albedoV[1] *= vec3(mesh.colors[i1]);
-                albedoV[2] *= vec3(mesh.colors[i2]);
-            }
-            vec3 texColor(1.0f);
-            if (const SampledTexture* tex = textures[h.instance]; tex && hasUV) {
-                const vec2 UV[3] = {mesh.uv0[i0], mesh.uv0[i1], mesh.uv0[i2]};
-                const vec2 uv = w0 * UV[0] + w1 * UV[1] + w2 * UV[2];
-                vec2 uvX, uvY;
-                rt::Ray nx, ny;
-                if (footprint && footprint->neighbours(nx, ny) && uvOnPlane(nx, P, UV, uvX) && uvOnPlane(ny, P, UV, uvY))
-                    texColor = tex->sample(uv, uvX - uv, uvY - uv);
-                else
-                    texColor = tex->sampleLevel(uv, 0, tex->filter() != FilterMode::Nearest);
-            }
-            vec3 Nv[3];
-            for (int k = 0; k < 3; ++k) {
-                uint32_t idx = k == 0 ? i0 : k == 1 ? i1 : i2;
-                vec3 nn = hasN ? dm.normal * mesh.normals[idx] : gn;
-                float l = glm::length(nn);
-                Nv[k] = l > 1e-20f ? nn / l : gn;
-                if (back) Nv[k] = -Nv[k];
-            }
-            const ShadingModel model = f.settings.shading;
-            vec3 albedo = (w0 * albedoV[0] + w1 * albedoV[1] + w2 * albedoV[2]) * texColor;
-            if (model == ShadingModel::Gouraud && !mat->unlit) {
-                // The model's two albedo-linear terms (shadeTerms) at the three vertices,
-                // interpolated with the hit's barycentrics (perspective-correct by
-                // construction), as the rasterizers do; texture and vertex colours apply per
-                // hit. The shadow rays of the hit point scale each light at every vertex.
-                lightVisibility(p, ng, vis);
-                const float wk[3] = {w0, w1, w2};
-                ShadeTerms t;
-                for (int k = 0; k < 3; ++k) {
-                    ShadeTerms tk = shadeTerms(*mat, P[k], Nv[k], eye, f, vis);
-                    t.mul += wk[k] * tk.mul;
-                    t.add += wk[k] * tk.add;
-                }
-                color = t.apply(albedo);
-                n = w0 * Nv[0] + w1 * Nv[1] + w2 * Nv[2];
-                n = glm::length(n) > 0 ? glm::normalize(n) : ng;
-            } else {
-                if (model == ShadingModel::Flat || !hasN)
-                    n = ng;
-                else {
-                    n = w0 * Nv[0] + w1 * Nv[1] + w2 * Nv[2];
-                    float l = glm::length(n);
-                    n = l > 1e-20f ? n / l : ng;
-                }
-                if (!mat->unlit) lightVisibility(p, ng, vis);
-                color = shade(*mat, SurfacePoint{p, n, albedo}, eye, f, mat->unlit ? nullptr : vis);
-            }
-        } else {
-            const DrawAnalytic& a = f.analytics[h.instance];
-            mat = &a.material;
-            if (a.kind == DrawAnalytic::Kind::Csg && a.csg && h.csgLeaf >= 0) mat = &a.csg->nodes[size_t(h.csgLeaf)].material;
-            n = h.normal;
-            if (glm::dot(n, r.dir) > 0) n = -n;   // analytic surfaces: face the ray
-            ng = n;
-            if (!mat->unlit) lightVisibility(p, ng, vis);
-            color = shade(*mat, SurfacePoint{p, n, mat->baseColor}, eye, f, mat->unlit ? nullptr : vis);
-        }
-        (void)nl;
+        ShadedHit s;
+        s.p = r.org + h.t * r.dir;
+        if (h.kind == rt::SceneHit::Kind::Mesh)
+            shadeMeshHit(h, r, eye, footprint, vis, s);
+        else
+            shadeAnalyticHit(h, r, eye, vis, s);
+        if (ownHit) *ownHit = s.p;
+        vec3 color = s.color;
 
-        if (f.settings.reflections && mat->reflectivity > 0.0f && bounce < f.settings.maxBounces) {
-            rt::Ray rr;
-            vec3 rd = dirN - 2.0f * glm::dot(dirN, n) * n;
-            rr.org = p + offsetScale(p) * ng;
-            rr.dir = rd;
-            rr.tmin = 0.0f;
-            rr.tmax = std::numeric_limits<float>::infinity();
-            PixelFootprint rf;
-            rt::Ray nx, ny;
-            rf.carried = footprint && footprint->neighbours(nx, ny) && reflectNeighbour(nx, p, ng, n, rf.rx) && reflectNeighbour(ny, p, ng, n, rf.ry);
-            vec3 refl = trace(rr, p, bounce + 1, nullptr, rf.carried ? &rf : nullptr);
-            color = glm::mix(color, refl, std::clamp(mat->reflectivity, 0.0f, 1.0f));
-        }
-        if (bounce == 0) color = applyFog(f.settings, color, glm::length(vec3(f.camera.view * vec4(p, 1.0f))));
+        if (f.settings.reflections && s.mat->reflectivity > 0.0f && bounce < f.settings.maxBounces)
+            color = glm::mix(color, reflection(s, dirN, bounce, footprint), std::clamp(s.mat->reflectivity, 0.0f, 1.0f));
+        if (bounce == 0) color = applyFog(f.settings, color, glm::length(vec3(f.camera.view * vec4(s.p, 1.0f))));
         if (blended && (alpha < 1.0f || hitPos) && layer + 1 < kMaxLayers) {
             rt::Ray behind = r;
             behind.tmin = h.t;
