@@ -802,8 +802,6 @@ void renderBlended(const FrameContext& fc, Framebuffer& target, TileBuffers& buf
     const bool fog = st.fog != sg::FogMode::Off;
     const SrgbEncoder& enc = srgbEncoder();
     const ShadeBatch& b = buf.batch;
-    (void)x1;
-    (void)y1;
     for (size_t k = 0; k < n; ++k) {
         vec3 c(b.cr[k], b.cg[k], b.cb[k]);
         if (fog) c = applyFog(st, c, buf.fogDist[k]);

@@ -105,6 +105,19 @@ bool anyTranslucent(const FrameInput& f) {
     return false;
 }
 
+// uv at a hit (barycentric weights w of triangle P with uvs UV) and, when the ray carries a
+// footprint, its screen derivatives from the neighbouring rays met on the triangle's plane.
+// False when there is no footprint: sample level 0 then.
+bool uvWithFootprint(const PixelFootprint* footprint, const vec3 P[3], const vec2 UV[3], const float w[3], vec2& uv, vec2& ddx, vec2& ddy) {
+    uv = w[0] * UV[0] + w[1] * UV[1] + w[2] * UV[2];
+    vec2 uvX, uvY;
+    rt::Ray nx, ny;
+    if (!(footprint && footprint->neighbours(nx, ny) && uvOnPlane(nx, P, UV, uvX) && uvOnPlane(ny, P, UV, uvY))) return false;
+    ddx = uvX - uv;
+    ddy = uvY - uv;
+    return true;
+}
+
 // --- Tracer --------------------------------------------------------------------------------------
 
 struct Tracer {
@@ -126,7 +139,7 @@ struct Tracer {
 
     // Alpha of the surface at a hit, as the rasterizers compute it: material alpha x vertex
     // colour alpha x texture alpha (the texture filtered with the ray's footprint like its colour).
-    float surfaceAlpha(const rt::SceneHit& h, const rt::Ray& r, const PixelFootprint* footprint, const Material& mat) const {
+    float surfaceAlpha(const rt::SceneHit& h, const PixelFootprint* footprint, const Material& mat) const {
         float a = mat.alpha;
         if (h.kind != rt::SceneHit::Kind::Mesh) return a;
         const DrawMesh& dm = f.meshes[h.instance];
@@ -137,14 +150,10 @@ struct Tracer {
         const SampledTexture* tex = textures[h.instance];
         if (!tex || !tex->hasAlpha() || mesh.uv0.size() != mesh.positions.size()) return a;
         const vec2 UV[3] = {mesh.uv0[i[0]], mesh.uv0[i[1]], mesh.uv0[i[2]]};
-        const vec2 uv = w[0] * UV[0] + w[1] * UV[1] + w[2] * UV[2];
         const vec3 P[3] = {vec3(dm.world * vec4(mesh.positions[i[0]], 1.0f)), vec3(dm.world * vec4(mesh.positions[i[1]], 1.0f)),
                            vec3(dm.world * vec4(mesh.positions[i[2]], 1.0f))};
-        vec2 uvX, uvY;
-        rt::Ray nx, ny;
-        (void)r;
-        if (footprint && footprint->neighbours(nx, ny) && uvOnPlane(nx, P, UV, uvX) && uvOnPlane(ny, P, UV, uvY))
-            return a * tex->sampleAlpha(uv, uvX - uv, uvY - uv);
+        vec2 uv, ddx, ddy;
+        if (uvWithFootprint(footprint, P, UV, w, uv, ddx, ddy)) return a * tex->sampleAlpha(uv, ddx, ddy);
         return a * tex->sampleAlphaLevel(uv, 0, tex->filter() != FilterMode::Nearest);
     }
 
@@ -158,7 +167,7 @@ struct Tracer {
             if (!accel.intersect(sr, h)) return T;
             const Material& m = materialOf(h);
             if (m.alphaMode == AlphaMode::Opaque) return 0.0f;
-            const float a = std::clamp(surfaceAlpha(h, sr, nullptr, m), 0.0f, 1.0f);
+            const float a = std::clamp(surfaceAlpha(h, nullptr, m), 0.0f, 1.0f);
             if (m.alphaMode == AlphaMode::Mask) {
                 if (a >= m.alphaCutoff) return 0.0f;
             } else {
@@ -207,7 +216,7 @@ struct Tracer {
             if (!accel.intersect(r, h, f.settings.culling)) return false;
             const Material& m = materialOf(h);
             if (m.alphaMode == AlphaMode::Opaque) return true;
-            alpha = std::clamp(surfaceAlpha(h, r, footprint, m), 0.0f, 1.0f);
+            alpha = std::clamp(surfaceAlpha(h, footprint, m), 0.0f, 1.0f);
             if (m.alphaMode == AlphaMode::Blend) return true;
             if (alpha >= m.alphaCutoff || ++layer >= kMaxLayers) {
                 alpha = 1.0f;
@@ -252,11 +261,10 @@ struct Tracer {
         vec3 texColor(1.0f);
         if (const SampledTexture* tex = textures[h.instance]; tex && hasUV) {
             const vec2 UV[3] = {mesh.uv0[i0], mesh.uv0[i1], mesh.uv0[i2]};
-            const vec2 uv = w0 * UV[0] + w1 * UV[1] + w2 * UV[2];
-            vec2 uvX, uvY;
-            rt::Ray nx, ny;
-            if (footprint && footprint->neighbours(nx, ny) && uvOnPlane(nx, P, UV, uvX) && uvOnPlane(ny, P, UV, uvY))
-                texColor = tex->sample(uv, uvX - uv, uvY - uv);
+            const float w[3] = {w0, w1, w2};
+            vec2 uv, ddx, ddy;
+            if (uvWithFootprint(footprint, P, UV, w, uv, ddx, ddy))
+                texColor = tex->sample(uv, ddx, ddy);
             else
                 texColor = tex->sampleLevel(uv, 0, tex->filter() != FilterMode::Nearest);
         }
