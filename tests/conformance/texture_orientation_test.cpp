@@ -111,7 +111,10 @@ void checkQuadrants(const std::string& backend, const fs::path& file) {
 class TextureOrientation : public ::testing::TestWithParam<std::string> {
 protected:
     fs::path dir() {
-        fs::path d = testing_support::outputDir("conformance") / ("orientation-" + GetParam());
+        // One folder per test: ctest runs the glTF and OBJ cases of a backend in parallel, and
+        // each rewrites quadrants.png.
+        const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+        fs::path d = testing_support::outputDir("conformance") / ("orientation-" + GetParam() + "-" + test.substr(0, test.find('/')));
         fs::create_directories(d);
         writeQuadrantsPng(d / "quadrants.png");
         return d;
