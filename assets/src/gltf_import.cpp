@@ -113,6 +113,7 @@ struct Ctx {
     std::vector<std::string> refused;                       // why a file was not read
     std::map<int, std::vector<unsigned char>> imageBytes;   // image index -> raw file bytes
     std::vector<std::string> imageWarnings;
+    std::string parserWarning;   // tinygltf's warnings, on one line
     tinygltf::Model* model = nullptr;
 };
 
@@ -916,60 +917,49 @@ struct Converter {
     }
 
     // ---- 7. Meshes -----------------------------------------------------------------------
-    // Builds the sg::Mesh of one primitive; returns "" or an error; *skipped when the
-    // primitive has nothing to draw.
-    std::string buildPrimitive(size_t mi, size_t pi, sg::Mesh& mesh, bool& skipped) {
-        const tinygltf::Primitive& prim = m.meshes[mi].primitives[pi];
-        std::string id = "mesh " + std::to_string(mi) + " primitive " + std::to_string(pi) + ": ";
-        skipped = false;
-        auto attr = [&](const char* name) -> int {
-            auto it = prim.attributes.find(name);
-            return it == prim.attributes.end() ? -1 : it->second;
-        };
-        int pos = attr("POSITION");
-        if (pos < 0) {
-            skipped = true;
-            return {};
-        }
-        const size_t nv = m.accessors[size_t(pos)].count;
+    static int attribute(const tinygltf::Primitive& prim, const char* name) {
+        auto it = prim.attributes.find(name);
+        return it == prim.attributes.end() ? -1 : it->second;
+    }
+    static std::string prefixed(const std::string& id, const std::string& e) { return e.empty() || e == "cancelled" ? e : id + e; }
+
+    // Counts what the primitive will add against the vertex and triangle budgets before anything
+    // large is read; "" or the reason.
+    std::string checkBudgets(const tinygltf::Primitive& prim, const std::string& id, size_t nv, size_t nIdx) {
         if (vertices + nv > kMaxVertices)
             return id + "vertex budget exceeded (" + std::to_string(vertices + nv) + " > " + std::to_string(kMaxVertices) + ")";
-        int mode = prim.mode;
-        // Output primitive count before reading anything large.
-        size_t nIdx = prim.indices >= 0 ? m.accessors[size_t(prim.indices)].count : nv;
         uint64_t tris = 0;
-        if (mode == TINYGLTF_MODE_TRIANGLES)
+        if (prim.mode == TINYGLTF_MODE_TRIANGLES)
             tris = nIdx / 3;
-        else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP || mode == TINYGLTF_MODE_TRIANGLE_FAN)
+        else if (prim.mode == TINYGLTF_MODE_TRIANGLE_STRIP || prim.mode == TINYGLTF_MODE_TRIANGLE_FAN)
             tris = nIdx >= 3 ? nIdx - 2 : 0;
         if (triangles + tris > kMaxTriangles)
             return id + "triangle budget exceeded (" + std::to_string(triangles + tris) + " > " + std::to_string(kMaxTriangles) + ")";
         if (nIdx > 3 * kMaxTriangles) return id + "index count " + std::to_string(nIdx) + " exceeds the budget";
         vertices += nv;
+        return {};
+    }
 
-        std::string e = readVectors(m, size_t(pos), 3, progress, mesh.positions);
-        if (!e.empty()) return e == "cancelled" ? e : id + e;
-        for (size_t i = 0; i < nv; ++i)
-            if (!sg::isFinite(mesh.positions[i])) return id + "POSITION " + std::to_string(i) + " is not finite";
-        if (int a = attr("NORMAL"); a >= 0) {
-            e = readVectors(m, size_t(a), 3, progress, mesh.normals);
-            if (!e.empty()) return e == "cancelled" ? e : id + e;
-            for (auto& n : mesh.normals) {
+    // POSITION, NORMAL, TEXCOORD_0/1 and COLOR_0 into `mesh`; the diffuse texture's UV set goes
+    // to uv0 with its KHR_texture_transform applied, and v is flipped into our convention.
+    std::string readAttributes(const tinygltf::Primitive& prim, const std::string& id, sg::Mesh& mesh) {
+        std::string e = readVectors(m, size_t(attribute(prim, "POSITION")), 3, progress, mesh.positions);
+        if (!e.empty()) return prefixed(id, e);
+        if (int a = attribute(prim, "NORMAL"); a >= 0) {
+            if (!(e = readVectors(m, size_t(a), 3, progress, mesh.normals)).empty()) return prefixed(id, e);
+            for (auto& n : mesh.normals)
                 if (!sg::isFinite(n)) n = sg::vec3(0, 0, 1);
-            }
         }
-        int uvA = attr("TEXCOORD_0"), uvB = attr("TEXCOORD_1");
-        if (uvA >= 0 && !(e = readVectors(m, size_t(uvA), 2, progress, mesh.uv0)).empty()) return e == "cancelled" ? e : id + e;
-        if (uvB >= 0 && !(e = readVectors(m, size_t(uvB), 2, progress, mesh.uv1)).empty()) return e == "cancelled" ? e : id + e;
-        if (int a = attr("COLOR_0"); a >= 0) {
-            e = readVectors(m, size_t(a), 4, progress, mesh.colors, 1.0f);
-            if (!e.empty()) return e == "cancelled" ? e : id + e;
+        int uvA = attribute(prim, "TEXCOORD_0"), uvB = attribute(prim, "TEXCOORD_1");
+        if (uvA >= 0 && !(e = readVectors(m, size_t(uvA), 2, progress, mesh.uv0)).empty()) return prefixed(id, e);
+        if (uvB >= 0 && !(e = readVectors(m, size_t(uvB), 2, progress, mesh.uv1)).empty()) return prefixed(id, e);
+        if (int a = attribute(prim, "COLOR_0"); a >= 0) {
+            if (!(e = readVectors(m, size_t(a), 4, progress, mesh.colors, 1.0f)).empty()) return prefixed(id, e);
             if (m.accessors[size_t(a)].type == TINYGLTF_TYPE_VEC3)
                 for (auto& c : mesh.colors) c.a = 1.0f;
         }
         if (!prim.targets.empty()) warnOnce("morph targets are not supported (base shape shown)");
         if (prim.attributes.count("JOINTS_0")) warnOnce("skinning is not supported (bind pose shown)");
-        // The UV set the diffuse texture samples goes to uv0; texture transform applied.
         if (prim.material >= 0) {
             const MaterialInfo& info = materials[size_t(prim.material)];
             if (info.texCoord == 1 && !mesh.uv1.empty()) std::swap(mesh.uv0, mesh.uv1);
@@ -981,78 +971,104 @@ struct Converter {
         // KHR_texture_transform, which is defined in glTF's uv space.
         for (auto& uv : mesh.uv0) uv.y = 1.0f - uv.y;
         for (auto& uv : mesh.uv1) uv.y = 1.0f - uv.y;
+        return {};
+    }
 
+    // The primitive's topology as our index list (points, line segments or triangles): strips,
+    // loops and fans unrolled, degenerate strip/fan triangles skipped.
+    void assembleIndices(int mode, const std::string& id, size_t nIdx, const std::vector<uint32_t>* src, sg::Mesh& mesh) {
+        auto at = [&](size_t i) -> uint32_t { return src ? (*src)[i] : uint32_t(i); };
+        auto& out = mesh.indices;
+        if (mode == TINYGLTF_MODE_POINTS) {
+            mesh.mode = sg::PrimitiveMode::Points;
+            out.resize(nIdx);
+            for (size_t i = 0; i < nIdx; ++i) out[i] = at(i);
+        } else if (mode == TINYGLTF_MODE_LINE) {
+            mesh.mode = sg::PrimitiveMode::Lines;
+            if (nIdx % 2) warnOnce(id + "odd LINES index count; last index ignored");
+            out.resize(nIdx / 2 * 2);
+            for (size_t i = 0; i < out.size(); ++i) out[i] = at(i);
+        } else if (mode == TINYGLTF_MODE_LINE_STRIP || mode == TINYGLTF_MODE_LINE_LOOP) {
+            mesh.mode = sg::PrimitiveMode::Lines;
+            for (size_t i = 0; i + 1 < nIdx; ++i) out.insert(out.end(), {at(i), at(i + 1)});
+            if (mode == TINYGLTF_MODE_LINE_LOOP && nIdx >= 2) out.insert(out.end(), {at(nIdx - 1), at(0)});
+        } else if (mode == TINYGLTF_MODE_TRIANGLES) {
+            if (nIdx % 3) warnOnce(id + "index count is not a multiple of 3; last " + std::to_string(nIdx % 3) + " ignored");
+            out.resize(nIdx / 3 * 3);
+            for (size_t i = 0; i < out.size(); ++i) out[i] = at(i);
+        } else {   // TRIANGLE_STRIP, TRIANGLE_FAN
+            out.reserve(nIdx >= 3 ? (nIdx - 2) * 3 : 0);
+            for (size_t i = 0; i + 2 < nIdx; ++i) {
+                const bool strip = mode == TINYGLTF_MODE_TRIANGLE_STRIP;
+                uint32_t a = strip ? at(i) : at(i + 1), b = strip ? at(i + 1 + (i % 2)) : at(i + 2), c = strip ? at(i + 2 - (i % 2)) : at(0);
+                if (a != b && b != c && a != c) out.insert(out.end(), {a, b, c});
+            }
+        }
+    }
+
+    // Vertices whose position is not finite or beyond +-1e30 are dropped together with the
+    // points, lines and triangles that use them (as the OBJ/OFF/PLY importers do); the unused
+    // slots get a harmless copy of a good position so bounds stay finite. "" or the reason
+    // when no vertex is usable.
+    std::string dropBadVertices(const std::string& id, sg::Mesh& mesh) {
+        std::vector<uint8_t> bad(mesh.positions.size(), 0);
+        size_t nBad = 0, good = SIZE_MAX;
+        for (size_t i = 0; i < mesh.positions.size(); ++i) {
+            const sg::vec3& p = mesh.positions[i];
+            bad[i] = !(sg::isFinite(p) && std::fabs(p.x) <= 1e30f && std::fabs(p.y) <= 1e30f && std::fabs(p.z) <= 1e30f);
+            nBad += bad[i];
+            if (!bad[i] && good == SIZE_MAX) good = i;
+        }
+        if (nBad == 0) return {};
+        if (good == SIZE_MAX) return id + "all " + std::to_string(bad.size()) + " POSITION values are non-finite or beyond 1e30";
+        const size_t k = mesh.mode == sg::PrimitiveMode::Triangles ? 3 : mesh.mode == sg::PrimitiveMode::Lines ? 2 : 1;
+        std::vector<uint32_t> kept;
+        kept.reserve(mesh.indices.size());
+        for (size_t i = 0; i + k <= mesh.indices.size(); i += k) {
+            bool ok = true;
+            for (size_t j = 0; j < k; ++j) ok = ok && !bad[mesh.indices[i + j]];
+            if (ok) kept.insert(kept.end(), mesh.indices.begin() + std::ptrdiff_t(i), mesh.indices.begin() + std::ptrdiff_t(i + k));
+        }
+        for (size_t i = 0; i < bad.size(); ++i)
+            if (bad[i]) mesh.positions[i] = mesh.positions[good];
+        warnOnce(id + "dropped " + std::to_string(nBad) + " of " + std::to_string(bad.size()) + " vertices (non-finite or |coordinate| > 1e30) and " +
+                 std::to_string((mesh.indices.size() - kept.size()) / k) +
+                 (k == 3   ? " triangles"
+                  : k == 2 ? " lines"
+                           : " points") +
+                 " that use them");
+        mesh.indices = std::move(kept);
+        return {};
+    }
+
+    // Builds the sg::Mesh of one primitive; returns "" or an error; *skipped when the
+    // primitive has nothing to draw.
+    std::string buildPrimitive(size_t mi, size_t pi, sg::Mesh& mesh, bool& skipped) {
+        const tinygltf::Primitive& prim = m.meshes[mi].primitives[pi];
+        const std::string id = "mesh " + std::to_string(mi) + " primitive " + std::to_string(pi) + ": ";
+        const int pos = attribute(prim, "POSITION");
+        skipped = pos < 0;
+        if (skipped) return {};
+        const size_t nv = m.accessors[size_t(pos)].count;
+        const bool indexed = prim.indices >= 0;
+        const size_t nIdx = indexed ? m.accessors[size_t(prim.indices)].count : nv;
+        std::string e = checkBudgets(prim, id, nv, nIdx);
+        if (e.empty()) e = readAttributes(prim, id, mesh);
+        if (!e.empty()) return e;
         std::vector<uint32_t> src;
-        bool indexed = prim.indices >= 0;
         if (indexed) {
-            e = readIndices(m, size_t(prim.indices), progress, src);
-            if (!e.empty()) return e == "cancelled" ? e : id + e;
+            if (!(e = readIndices(m, size_t(prim.indices), progress, src)).empty()) return prefixed(id, e);
             for (size_t i = 0; i < src.size(); ++i)
                 if (src[i] >= nv)
                     return id + "index " + std::to_string(i) + " is " + std::to_string(src[i]) + ", but there are only " + std::to_string(nv) +
                            " vertices";
         }
-        auto at = [&](size_t i) -> uint32_t { return indexed ? src[i] : uint32_t(i); };
-        auto& out = mesh.indices;
-        switch (mode) {
-        case TINYGLTF_MODE_POINTS:
-            mesh.mode = sg::PrimitiveMode::Points;
-            out.resize(nIdx);
-            for (size_t i = 0; i < nIdx; ++i) out[i] = at(i);
-            break;
-        case TINYGLTF_MODE_LINE:
-        case TINYGLTF_MODE_LINE_STRIP:
-        case TINYGLTF_MODE_LINE_LOOP:
-            mesh.mode = sg::PrimitiveMode::Lines;
-            if (mode == TINYGLTF_MODE_LINE) {
-                if (nIdx % 2) warnOnce(id + "odd LINES index count; last index ignored");
-                out.resize(nIdx / 2 * 2);
-                for (size_t i = 0; i < out.size(); ++i) out[i] = at(i);
-            } else if (nIdx >= 2) {
-                out.reserve(2 * nIdx);
-                for (size_t i = 0; i + 1 < nIdx; ++i) {
-                    out.push_back(at(i));
-                    out.push_back(at(i + 1));
-                }
-                if (mode == TINYGLTF_MODE_LINE_LOOP) {
-                    out.push_back(at(nIdx - 1));
-                    out.push_back(at(0));
-                }
-            }
-            break;
-        case TINYGLTF_MODE_TRIANGLES:
-            if (nIdx % 3) warnOnce(id + "index count is not a multiple of 3; last " + std::to_string(nIdx % 3) + " ignored");
-            out.resize(nIdx / 3 * 3);
-            if (indexed)
-                std::copy(src.begin(), src.begin() + std::ptrdiff_t(out.size()), out.begin());
-            else
-                for (size_t i = 0; i < out.size(); ++i) out[i] = uint32_t(i);
-            break;
-        case TINYGLTF_MODE_TRIANGLE_STRIP:
-        case TINYGLTF_MODE_TRIANGLE_FAN:
-            out.reserve(size_t(tris) * 3);
-            for (size_t i = 0; i + 2 < nIdx; ++i) {
-                uint32_t a, b, c;
-                if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
-                    a = at(i);
-                    b = at(i + 1 + (i % 2));
-                    c = at(i + 2 - (i % 2));
-                } else {
-                    a = at(i + 1);
-                    b = at(i + 2);
-                    c = at(0);
-                }
-                if (a == b || b == c || a == c) continue;
-                out.push_back(a);
-                out.push_back(b);
-                out.push_back(c);
-            }
-            break;
-        }
+        assembleIndices(prim.mode, id, nIdx, indexed ? &src : nullptr, mesh);
+        if (!(e = dropBadVertices(id, mesh)).empty()) return e;
         if (mesh.mode == sg::PrimitiveMode::Triangles) {
-            triangles += out.size() / 3;
+            triangles += mesh.indices.size() / 3;
             if (mesh.normals.empty()) {
-                if (!indexed && mode != TINYGLTF_MODE_TRIANGLES) unweld(mesh);   // flat normals for non-indexed strips/fans
+                if (!indexed && prim.mode != TINYGLTF_MODE_TRIANGLES) unweld(mesh);   // flat normals for non-indexed strips/fans
                 mesh.computeNormals();
             }
         }
@@ -1293,52 +1309,37 @@ struct Converter {
 }   // namespace
 
 // ---- 10. loadGltf ----------------------------------------------------------------------------
-LoadResult loadGltf(const fs::path& path, const LoadOptions& options) {
-    LoadResult result;
-    const std::string file = fileNameOf(path);
-    Progress progress{options};
-    auto fail = [&](const std::string& why) {
-        result.scene.reset();
-        result.error = file + ": " + why;
-        return std::move(result);
-    };
-    std::string bytes;
-    std::string err = readFileLimited(path, kMaxFileBytes, bytes);
-    if (!err.empty()) {
-        result.error = err;
-        return result;
-    }
-    if (bytes.empty()) return fail("empty file");
-    progress.set(0.02f);
+namespace {
 
-    const bool binary = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
-    const char* json = bytes.data();
-    size_t jsonSize = bytes.size();
+// Checks the size limits and, for GLB, the header; sets `json` to the JSON text. "" or the reason.
+std::string locateJson(const std::string& bytes, const fs::path& path, bool& binary, std::string_view& json) {
+    binary = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
+    json = bytes;
     if (binary) {
-        if (bytes.size() < 20) return fail("GLB file is truncated (" + std::to_string(bytes.size()) + " bytes)");
+        if (bytes.size() < 20) return "GLB file is truncated (" + std::to_string(bytes.size()) + " bytes)";
         uint32_t chunkLen = 0, chunkType = 0, total = 0;
         std::memcpy(&total, bytes.data() + 8, 4);
         std::memcpy(&chunkLen, bytes.data() + 12, 4);
         std::memcpy(&chunkType, bytes.data() + 16, 4);
-        if (chunkType != 0x4E4F534Au) return fail("GLB: first chunk is not JSON");
+        if (chunkType != 0x4E4F534Au) return "GLB: first chunk is not JSON";
         if (uint64_t(chunkLen) + 20 > bytes.size())
-            return fail("GLB: JSON chunk length " + std::to_string(chunkLen) + " exceeds the file size " + std::to_string(bytes.size()));
+            return "GLB: JSON chunk length " + std::to_string(chunkLen) + " exceeds the file size " + std::to_string(bytes.size());
         if (total > bytes.size())
-            return fail("GLB: header length " + std::to_string(total) + " exceeds the file size " + std::to_string(bytes.size()) +
-                        " (truncated file?)");
-        json = bytes.data() + 20;
-        jsonSize = chunkLen;
+            return "GLB: header length " + std::to_string(total) + " exceeds the file size " + std::to_string(bytes.size()) + " (truncated file?)";
+        json = std::string_view(bytes.data() + 20, chunkLen);
     } else if (path.extension() == ".glb" || path.extension() == ".GLB") {
-        return fail("not a GLB file (no 'glTF' magic)");
+        return "not a GLB file (no 'glTF' magic)";
     }
-    if (jsonSize > kMaxJsonBytes) return fail("JSON is " + std::to_string(jsonSize) + " bytes, limit " + std::to_string(kMaxJsonBytes));
-    if (size_t d = jsonDepth(json, jsonSize, kMaxJsonDepth); d > kMaxJsonDepth)
-        return fail("JSON nesting deeper than " + std::to_string(kMaxJsonDepth) + " levels");
-    if (bytes.size() > UINT32_MAX) return fail("file larger than 4 GB");
+    if (json.size() > kMaxJsonBytes) return "JSON is " + std::to_string(json.size()) + " bytes, limit " + std::to_string(kMaxJsonBytes);
+    if (jsonDepth(json.data(), json.size(), kMaxJsonDepth) > kMaxJsonDepth)
+        return "JSON nesting deeper than " + std::to_string(kMaxJsonDepth) + " levels";
+    if (bytes.size() > UINT32_MAX) return "file larger than 4 GB";
+    return {};
+}
 
-    Ctx ctx(path.parent_path().empty() ? fs::path(".") : path.parent_path());
-    if (!ctx.dir.ok()) return fail(ctx.dir.error());
-    tinygltf::Model model;
+// tinygltf parses `bytes` with our file-system and image callbacks (which confine reads to the
+// file's folder and keep images undecoded). "" or the reason.
+std::string parseModel(const std::string& bytes, bool binary, Ctx& ctx, tinygltf::Model& model) {
     ctx.model = &model;
     tinygltf::TinyGLTF loader;
     tinygltf::FsCallbacks cb{};
@@ -1358,25 +1359,19 @@ LoadResult loadGltf(const fs::path& path, const LoadOptions& options) {
                                              base, 0);
         else
             ok = loader.LoadASCIIFromString(&model, &terr, &twarn, bytes.data(), unsigned(bytes.size()), base, 0);
-    } catch (const std::bad_alloc&) { return fail("out of memory while parsing"); } catch (const std::exception& e) {
-        return fail(std::string("parse error: ") + e.what());
+    } catch (const std::bad_alloc&) { return "out of memory while parsing"; } catch (const std::exception& e) {
+        return std::string("parse error: ") + e.what();
     }
-    std::string().swap(bytes);
-    if (!ok) {
-        std::string why = oneLine(terr.empty() ? "tinygltf could not parse the file" : terr);
-        if (!ctx.refused.empty() && why.find("File not found") != std::string::npos)
-            why = ctx.refused.front() + " (" + why + ")";
-        else if (!ctx.refused.empty() && why.find("read error") != std::string::npos)
-            why = ctx.refused.front();
-        return fail(why);
-    }
-    progress.set(0.3f);
-    // Files we refused or could not read (images: the load goes on without them).
-    for (const std::string& why : ctx.refused) result.warnings.push_back(file + ": file not read: " + why);
-    if (!twarn.empty() && ctx.refused.empty()) result.warnings.push_back(file + ": " + oneLine(twarn));
-    for (const auto& w : ctx.imageWarnings) result.warnings.push_back(file + ": " + w);
+    ctx.parserWarning = oneLine(twarn);
+    if (ok) return {};
+    std::string why = oneLine(terr.empty() ? "tinygltf could not parse the file" : terr);
+    if (!ctx.refused.empty() && why.find("File not found") != std::string::npos) return ctx.refused.front() + " (" + why + ")";
+    if (!ctx.refused.empty() && why.find("read error") != std::string::npos) return ctx.refused.front();
+    return why;
+}
 
-    // Required extensions we cannot honour make the file unloadable (the spec says so).
+// Required extensions we cannot honour make the file unloadable (the spec says so). "" or why.
+std::string checkRequiredExtensions(const tinygltf::Model& model) {
     static const char* kSupported[] = {"KHR_materials_unlit",
                                        "KHR_texture_transform",
                                        "KHR_lights_punctual",
@@ -1385,15 +1380,41 @@ LoadResult loadGltf(const fs::path& path, const LoadOptions& options) {
                                        "KHR_mesh_quantization"};   // quantized attributes: any component type is read
     for (const std::string& ext : model.extensionsRequired)
         if (std::none_of(std::begin(kSupported), std::end(kSupported), [&](const char* s) { return ext == s; }))
-            return fail("requires the unsupported extension " + ext);
-    if (model.asset.version.rfind("2.", 0) != 0) return fail("glTF version '" + model.asset.version + "' is not 2.x");
+            return "requires the unsupported extension " + ext;
+    if (model.asset.version.rfind("2.", 0) != 0) return "glTF version '" + model.asset.version + "' is not 2.x";
+    return {};
+}
 
-    std::vector<std::string> vwarn;
-    std::string verr = validate(model, vwarn);
-    if (!verr.empty()) return fail(verr);
-    for (auto& w : vwarn) result.warnings.push_back(file + ": " + w);
-    if (progress.cancelled()) return fail("cancelled");
+// The root nodes to load: the default scene's (or the first), else every node without a parent.
+// Fills result.sceneNames / loadedScene and says which scenes were left out.
+std::vector<int> chooseRoots(const tinygltf::Model& model, const std::string& file, LoadResult& result) {
+    for (size_t i = 0; i < model.scenes.size(); ++i)
+        result.sceneNames.push_back(model.scenes[i].name.empty() ? "scene " + std::to_string(i) : model.scenes[i].name);
+    std::vector<int> roots;
+    if (!model.scenes.empty()) {
+        result.loadedScene = model.defaultScene >= 0 ? model.defaultScene : 0;
+        roots = model.scenes[size_t(result.loadedScene)].nodes;
+        if (model.scenes.size() > 1) {
+            std::string others;
+            for (size_t i = 0; i < model.scenes.size(); ++i)
+                if (int(i) != result.loadedScene) others += (others.empty() ? "'" : ", '") + result.sceneNames[i] + "'";
+            result.warnings.push_back(file + ": loaded scene '" + result.sceneNames[size_t(result.loadedScene)] + "'; other scenes: " + others);
+        }
+        return roots;
+    }
+    std::vector<uint8_t> isChild(model.nodes.size(), 0);
+    for (const auto& n : model.nodes)
+        for (int c : n.children) isChild[size_t(c)] = 1;
+    for (size_t i = 0; i < model.nodes.size(); ++i)
+        if (!isChild[i]) roots.push_back(int(i));
+    result.warnings.push_back(
+        file + (roots.empty() ? ": the file contains no nodes" : ": no scenes; loading all " + std::to_string(roots.size()) + " root nodes"));
+    return roots;
+}
 
+// The validated model -> result.scene (+ animations, warnings). "" or the reason.
+std::string convertModel(const tinygltf::Model& model, Ctx& ctx, const Progress& progress, const fs::path& path, LoadResult& result) {
+    const std::string file = fileNameOf(path);
     Converter conv(model, ctx, progress);
     conv.file = file;
     conv.scene.name = path.stem().string();
@@ -1405,38 +1426,57 @@ LoadResult loadGltf(const fs::path& path, const LoadOptions& options) {
     try {
         conv.convertMaterials();
         progress.set(0.4f);
-        for (size_t i = 0; i < model.scenes.size(); ++i)
-            result.sceneNames.push_back(model.scenes[i].name.empty() ? "scene " + std::to_string(i) : model.scenes[i].name);
-        std::vector<int> roots;
-        if (!model.scenes.empty()) {
-            result.loadedScene = model.defaultScene >= 0 ? model.defaultScene : 0;
-            roots = model.scenes[size_t(result.loadedScene)].nodes;
-            if (model.scenes.size() > 1) {
-                std::string others;
-                for (size_t i = 0; i < model.scenes.size(); ++i)
-                    if (int(i) != result.loadedScene) others += (others.empty() ? "'" : ", '") + result.sceneNames[i] + "'";
-                result.warnings.push_back(file + ": loaded scene '" + result.sceneNames[size_t(result.loadedScene)] + "'; other scenes: " + others);
-            }
-        } else {
-            std::vector<uint8_t> isChild(model.nodes.size(), 0);
-            for (const auto& n : model.nodes)
-                for (int c : n.children) isChild[size_t(c)] = 1;
-            for (size_t i = 0; i < model.nodes.size(); ++i)
-                if (!isChild[i]) roots.push_back(int(i));
-            if (!roots.empty())
-                result.warnings.push_back(file + ": no scenes; loading all " + std::to_string(roots.size()) + " root nodes");
-            else
-                result.warnings.push_back(file + ": the file contains no nodes");
-        }
-        std::string e = conv.buildNodes(roots);
-        if (!e.empty()) return e == "cancelled" ? fail("cancelled") : fail(e);
+        std::string e = conv.buildNodes(chooseRoots(model, file, result));
+        if (!e.empty()) return e;
         result.animations = conv.animations();
         if (!model.skins.empty()) conv.warnOnce("skinning is not supported (bind pose shown)");
-    } catch (const std::bad_alloc&) { return fail("out of memory while building the scene"); }
+    } catch (const std::bad_alloc&) { return "out of memory while building the scene"; }
     progress.set(0.95f);
     addDefaultCameraAndLight(conv.scene);
     for (auto& w : conv.warnings) result.warnings.push_back(file + ": " + w);
     result.scene = std::move(conv.scene);
+    return {};
+}
+
+}   // namespace
+
+LoadResult loadGltf(const fs::path& path, const LoadOptions& options) {
+    LoadResult result;
+    const std::string file = fileNameOf(path);
+    Progress progress{options};
+    auto fail = [&](const std::string& why) {
+        result.scene.reset();
+        result.error = file + ": " + why;
+        return std::move(result);
+    };
+    std::string bytes;
+    if (std::string err = readFileLimited(path, kMaxFileBytes, bytes); !err.empty()) {
+        result.error = err;
+        return result;
+    }
+    if (bytes.empty()) return fail("empty file");
+    progress.set(0.02f);
+    bool binary = false;
+    std::string_view json;
+    if (std::string e = locateJson(bytes, path, binary, json); !e.empty()) return fail(e);
+
+    Ctx ctx(path.parent_path().empty() ? fs::path(".") : path.parent_path());
+    if (!ctx.dir.ok()) return fail(ctx.dir.error());
+    tinygltf::Model model;
+    std::string e = parseModel(bytes, binary, ctx, model);
+    std::string().swap(bytes);
+    if (!e.empty()) return fail(e);
+    progress.set(0.3f);
+    // Files we refused or could not read (images: the load goes on without them).
+    for (const std::string& why : ctx.refused) result.warnings.push_back(file + ": file not read: " + why);
+    if (!ctx.parserWarning.empty() && ctx.refused.empty()) result.warnings.push_back(file + ": " + ctx.parserWarning);
+    for (const auto& w : ctx.imageWarnings) result.warnings.push_back(file + ": " + w);
+    if (!(e = checkRequiredExtensions(model)).empty()) return fail(e);
+
+    std::vector<std::string> vwarn;
+    if (!(e = validate(model, vwarn)).empty()) return fail(e);
+    for (auto& w : vwarn) result.warnings.push_back(file + ": " + w);
+    if (progress.cancelled() || !(e = convertModel(model, ctx, progress, path, result)).empty()) return fail(e.empty() ? "cancelled" : e);
     progress.set(1.0f);
     return result;
 }

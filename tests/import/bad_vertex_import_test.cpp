@@ -223,3 +223,41 @@ TEST(BadVertexImportTest, AllBadIsRefusedAndTruncationStillReported) {
     EXPECT_FALSE(r.scene);
     EXPECT_NE(r.error.find("400 vertices"), std::string::npos) << r.error;
 }
+
+// glTF: the same grid as float32 POSITION (NaN, +Inf, -1e31) with 18 indexed triangles, and as
+// a POINTS primitive: the bad vertices go with the triangles (points) that use them, one
+// warning, the rest loads (the glTF importer used to refuse the whole file). Each quad is split
+// (a,b,c) (a,c,d): quads 1 and 6 keep the triangle without a bad corner, so 12 of 18 go.
+TEST(BadVertexImportTest, GltfPrimitivesDropBadVertices) {
+    std::vector<float> pos;
+    for (int i = 0; i < 16; ++i) {
+        float x = float(i % 4), y = float(i / 4), z = 0.0f;
+        if (i == 5) x = std::numeric_limits<float>::quiet_NaN();
+        if (i == 9) y = std::numeric_limits<float>::infinity();
+        if (i == 15) z = -1e31f;
+        pos.insert(pos.end(), {x, y, z});
+    }
+    std::vector<uint32_t> idx;
+    for (const auto& q : gridQuads())
+        idx.insert(idx.end(), {uint32_t(q[0]), uint32_t(q[1]), uint32_t(q[2]), uint32_t(q[0]), uint32_t(q[2]), uint32_t(q[3])});
+    std::string bytes(reinterpret_cast<const char*>(pos.data()), pos.size() * 4);
+    bytes.append(reinterpret_cast<const char*>(idx.data()), idx.size() * 4);
+    auto gltf = [&](int mode, bool indexed) {
+        return std::string(R"({"asset":{"version":"2.0"},"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],)") +
+               R"("meshes":[{"primitives":[{"attributes":{"POSITION":0})" + (indexed ? std::string(R"(,"indices":1)") : "") +
+               ",\"mode\":" + std::to_string(mode) + "}]}]," + R"("buffers":[{"byteLength":)" + std::to_string(bytes.size()) +
+               R"(,"uri":"data:application/octet-stream;base64,)" + testing_support::base64Encode(bytes) + R"("}],)" +
+               R"("bufferViews":[{"buffer":0,"byteLength":192},{"buffer":0,"byteOffset":192,"byteLength":216}],)" +
+               R"("accessors":[{"bufferView":0,"componentType":5126,"count":16,"type":"VEC3"},)" +
+               R"({"bufferView":1,"componentType":5125,"count":54,"type":"SCALAR"}]})";
+    };
+    assets::LoadResult r = loadText("grid.gltf", gltf(4, true));
+    expectLoadedWithOneWarning(r, "grid.gltf", "dropped 3 of 16 vertices (non-finite or |coordinate| > 1e30) and 12 triangles that use them");
+    ASSERT_TRUE(r.scene);
+    EXPECT_EQ(only(r, sg::PrimitiveMode::Triangles).indices.size(), 6u * 3u);
+
+    r = loadText("points.gltf", gltf(0, false));
+    expectLoadedWithOneWarning(r, "points.gltf", "dropped 3 of 16 vertices (non-finite or |coordinate| > 1e30) and 3 points that use them");
+    ASSERT_TRUE(r.scene);
+    EXPECT_EQ(only(r, sg::PrimitiveMode::Points).indices.size(), 13u);
+}
