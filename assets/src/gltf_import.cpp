@@ -21,23 +21,26 @@
 //   normals (Mesh::computeNormals), non-indexed ones flat normals (vertices are unshared).
 //   COLOR_0 (vec3/vec4; float or normalised ints) -> colors (linear); TEXCOORD_0/1 -> uv0/uv1
 //   with v flipped (glTF: v = 0 at the image's top row; ours: v = 0 at the bottom, as GL/OBJ),
-//   except that uv0 always holds the set the diffuse texture samples: a base colour texture
-//   with texCoord 1 swaps the two sets for that primitive. Morph targets and skins are ignored
-//   (warning).
+//   except that uv0 always holds the set the material's textures sample: a texCoord of 1
+//   swaps the two sets for that primitive. Non-finite or |x| > 1e30 positions are dropped with
+//   the triangles/lines/points that use them (one warning). Morph targets and skins are
+//   ignored (warning).
 // Materials (glTF metallic-roughness -> our Phong material):
 //   baseColor  = baseColorFactor.rgb (linear), diffuseTexture = baseColorTexture (sRGB data,
 //                as our textures are), sampler wrapS/wrapT -> WrapMode; filters:
 //                min NEAREST or NEAREST_MIPMAP_NEAREST+mag NEAREST -> Nearest, min LINEAR ->
 //                Bilinear, mipmapped or unspecified -> Trilinear (unspecified + mag NEAREST ->
 //                Nearest).
-//   alpha_r    = roughness^2;  shininess = clamp(2 / alpha_r^2 - 2, 1, 2048)  (Blinn-Phong
-//                exponent matching a Beckmann/GGX lobe of that width)
-//   F0         = 0.04 for dielectrics, baseColor for metals; ks = clamp(mix(0.04, 1, metallic)
-//                + 0.25 * (1 - roughness) * (1 - metallic), 0, 1) (the second term keeps
-//                glossy dielectrics visibly shiny in a Phong model without environment light);
-//                specularTinted = metallic >= 0.5 (metal highlights take the base colour).
-//   kd         = 1 - 0.75 * metallic (metals keep a little diffuse so they are not black
-//                without reflections); ka = 0.2 (our default).
+//   kd, ks, shininess, specularTinted = sg::phongFromMetallicRoughness(metallicFactor,
+//                roughnessFactor) (scenegraph/material.h, docs/math.md: a Blinn-Phong exponent
+//                matching a GGX lobe of width roughness^2, F0 0.04 for dielectrics, metal
+//                highlights tinted, metals keep a little diffuse); ka = 0.2 (our default). The
+//                factors are kept too (Material::metallic / roughness) for the texture below.
+//   metallicRoughnessTexture (linear data: B metallic, G roughness) -> Material::
+//                metallicRoughnessTexture: the mapping above per texel (flat and Phong shading).
+//   occlusionTexture (linear, R) + strength -> on the ambient term; emissiveTexture (sRGB) x
+//                emissive. A glTF texture used both as colour and as data becomes two textures.
+//                normalTexture: not applied yet (warning).
 //   emissive   = emissiveFactor (x KHR_materials_emissive_strength).
 //   alphaMode  -> Material::alphaMode (OPAQUE, MASK with alphaCutoff, BLEND); alpha =
 //                baseColorFactor.a, times texture and vertex colour alpha when drawn;
@@ -46,11 +49,12 @@
 //   KHR_materials_unlit -> Material::unlit. KHR_materials_pbrSpecularGlossiness: diffuseFactor
 //                / diffuseTexture -> baseColor / texture, ks = max(specularFactor),
 //                specularColor = specularFactor / ks, roughness = 1 - glossiness as above.
-//   KHR_texture_transform on the base colour texture (offset, rotation, scale, texCoord) is
-//                applied to the UVs of each primitive using the material at import time
-//                (uv' = T * R * S * uv as in the extension), since our textures have no
-//                transform. Metallic-roughness, normal, occlusion and emissive textures are
-//                not used.
+//   KHR_texture_transform (offset, rotation, scale, texCoord) is applied to the UVs of each
+//                primitive using the material at import time (uv' = T * R * S * uv as in the
+//                extension): our meshes carry one UV set for all of a material's textures, the
+//                base colour texture's (else the first other one's); a texture asking for
+//                another set or transform samples that one (one warning).
+//                KHR_materials_pbrSpecularGlossiness: specularGlossinessTexture not applied (warning).
 // Cameras: perspective -> Projection Perspective (fovy = yfov, zNear, zFar; infinite zfar ->
 //   max(1000 * znear, 100)); orthographic -> Orthographic (orthoHalfHeight = ymag). The glTF
 //   aspectRatio is ignored (the viewport decides). The first camera met is made active.
@@ -84,6 +88,7 @@
 #include <tiny_gltf.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <map>
@@ -736,8 +741,8 @@ struct Converter {
     std::string file;
     sg::Scene scene;
     std::vector<std::string> warnings;
-    std::vector<int> textureOf;                 // glTF texture -> scene texture (-2 = not yet)
-    std::vector<sg::TexturePtr> decodedImage;   // glTF image -> decoded (null: failed/unused)
+    std::vector<std::array<int, 2>> textureOf;   // glTF texture -> scene texture as [sRGB colour, linear data] (-2 = not yet)
+    std::vector<sg::TexturePtr> decodedImage;    // glTF image -> decoded (null: failed/unused)
     std::vector<int8_t> imageTried;
     uint64_t textureBytes = 0;
     std::vector<MaterialInfo> materials;                       // glTF material -> ours
@@ -781,10 +786,12 @@ struct Converter {
         return r.texture;
     }
 
-    int texture(int ti) {
-        if (ti < 0) return -1;
-        if (textureOf[size_t(ti)] != -2) return textureOf[size_t(ti)];
-        textureOf[size_t(ti)] = -1;
+    // Scene texture for glTF texture ti, holding colour (sRGB) or data (linear); -1 if unusable.
+    int texture(int ti, bool srgb = true) {
+        if (ti < 0 || size_t(ti) >= m.textures.size()) return -1;
+        int& slot = textureOf[size_t(ti)][srgb ? 0 : 1];
+        if (slot != -2) return slot;
+        slot = -1;
         const tinygltf::Texture& t = m.textures[size_t(ti)];
         if (t.source < 0) {
             warnOnce("texture " + std::to_string(ti) + " has no PNG/JPEG source (other image formats are not supported)");
@@ -794,6 +801,7 @@ struct Converter {
         if (!src) return -1;
         auto tex = std::make_shared<sg::Texture>(*src);
         tex->id = sg::newResourceId();
+        tex->srgb = srgb;
         if (!t.name.empty()) tex->name = t.name;
         if (t.sampler >= 0) {
             const tinygltf::Sampler& s = m.samplers[size_t(t.sampler)];
@@ -815,105 +823,143 @@ struct Converter {
                 tex->filter = sg::FilterMode::Trilinear;
         }
         scene.textures.push_back(std::move(tex));
-        textureOf[size_t(ti)] = int(scene.textures.size() - 1);
-        return textureOf[size_t(ti)];
+        slot = int(scene.textures.size() - 1);
+        return slot;
     }
 
-    static float shininessFromRoughness(float roughness) {
-        float a = std::clamp(roughness, 0.0f, 1.0f);
-        a = a * a;
-        if (a < 1e-3f) return 2048.0f;
-        return std::clamp(2.0f / (a * a) - 2.0f, 1.0f, 2048.0f);
+    // One texture reference of a material: which glTF texture, which UV set, its
+    // KHR_texture_transform (null: none).
+    struct TexRef {
+        int index = -1;
+        int texCoord = 0;
+        const tinygltf::Value* transform = nullptr;
+    };
+    static TexRef texRef(const tinygltf::TextureInfo& t) { return {t.index, t.texCoord, extensionObject(t.extensions, "KHR_texture_transform")}; }
+    static TexRef texRef(int index, int texCoord, const tinygltf::ExtensionMap& ext) {
+        return {index, texCoord, extensionObject(ext, "KHR_texture_transform")};
+    }
+    static TexRef texRef(const tinygltf::Value& v) {   // a textureInfo inside an extension object
+        TexRef r{int(numberOr(v, "index", -1)), int(numberOr(v, "texCoord", 0)), nullptr};
+        if (v.Has("extensions") && v.Get("extensions").IsObject() && v.Get("extensions").Has("KHR_texture_transform"))
+            r.transform = &v.Get("extensions").Get("KHR_texture_transform");
+        return r;
+    }
+
+    // KHR_texture_transform as a matrix in glTF's uv space: T * R * S (column-major), with
+    // R = [cos sin; -sin cos] as in the extension. Its texCoord override goes to texCoord.
+    static sg::mat3 uvTransformOf(const tinygltf::Value& tt, int& texCoord) {
+        double off[2] = {0, 0}, sc[2] = {1, 1};
+        numberArray(tt, "offset", 2, off);
+        numberArray(tt, "scale", 2, sc);
+        float rot = float(numberOr(tt, "rotation", 0.0));
+        if (tt.Has("texCoord")) texCoord = int(numberOr(tt, "texCoord", 0));
+        sg::mat3 T(1.0f), R(1.0f), S(1.0f);
+        T[2] = sg::vec3(float(off[0]), float(off[1]), 1.0f);
+        float c = std::cos(rot), s = std::sin(rot);
+        R[0] = sg::vec3(c, -s, 0.0f);
+        R[1] = sg::vec3(s, c, 0.0f);
+        S[0][0] = float(sc[0]);
+        S[1][1] = float(sc[1]);
+        return T * R * S;
+    }
+
+    // Our meshes carry one UV set for all of a material's textures: the base colour texture's
+    // (else the first other texture's), with its transform baked in (buildPrimitive). A texture
+    // that asks for another set or transform samples that one; one warning says so.
+    void chooseUvSet(size_t i, const std::vector<TexRef>& refs, MaterialInfo& info) {
+        const TexRef* first = nullptr;
+        for (const TexRef& r : refs) {
+            if (r.index < 0) continue;
+            int tc = r.texCoord;
+            sg::mat3 t = r.transform ? uvTransformOf(*r.transform, tc) : sg::mat3(1.0f);
+            if (!first) {
+                first = &r;
+                info.texCoord = tc == 1 ? 1 : 0;
+                if (tc > 1) warnOnce("material " + std::to_string(i) + ": texCoord " + std::to_string(tc) + " is not supported (using TEXCOORD_0)");
+                info.hasUvTransform = r.transform != nullptr;
+                info.uvTransform = t;
+            } else if ((tc == 1 ? 1 : 0) != info.texCoord || t != info.uvTransform) {
+                warnOnce("material " + std::to_string(i) +
+                         ": its textures use different UV sets or texture transforms; all sample the base colour texture's");
+            }
+        }
+    }
+
+    // metallic-roughness (or specular-glossiness) parameters -> Phong factors and textures.
+    void convertPbr(size_t i, const tinygltf::Material& gm, sg::Material& mat, sg::vec4& base, std::vector<TexRef>& refs) {
+        const auto& pbr = gm.pbrMetallicRoughness;
+        base = glm::clamp(
+            sg::vec4(float(pbr.baseColorFactor[0]), float(pbr.baseColorFactor[1]), float(pbr.baseColorFactor[2]), float(pbr.baseColorFactor[3])),
+            sg::vec4(0.0f), sg::vec4(1.0f));
+        mat.metallic = std::clamp(float(pbr.metallicFactor), 0.0f, 1.0f);
+        mat.roughness = std::clamp(float(pbr.roughnessFactor), 0.0f, 1.0f);
+        const sg::PhongFromPbr ph = sg::phongFromMetallicRoughness(mat.metallic, mat.roughness);
+        mat.kd = ph.kd;
+        mat.ks = ph.ks;
+        mat.shininess = ph.shininess;
+        mat.specularTinted = ph.tinted;
+        mat.specularColor = sg::vec3(1.0f);
+        mat.ka = 0.2f;
+        refs[0] = texRef(pbr.baseColorTexture);
+        refs[1] = texRef(pbr.metallicRoughnessTexture);
+        const tinygltf::Value* sgx = extensionObject(gm.extensions, "KHR_materials_pbrSpecularGlossiness");
+        if (!sgx) return;
+        double d[4] = {1, 1, 1, 1}, s[3] = {1, 1, 1};
+        numberArray(*sgx, "diffuseFactor", 4, d);
+        numberArray(*sgx, "specularFactor", 3, s);
+        float gloss = std::clamp(float(numberOr(*sgx, "glossinessFactor", 1.0)), 0.0f, 1.0f);
+        base = glm::clamp(sg::vec4(float(d[0]), float(d[1]), float(d[2]), float(d[3])), sg::vec4(0.0f), sg::vec4(1.0f));
+        sg::vec3 spec = glm::clamp(sg::vec3(float(s[0]), float(s[1]), float(s[2])), sg::vec3(0.0f), sg::vec3(1.0f));
+        float ks = std::max({spec.x, spec.y, spec.z});
+        mat.kd = 1.0f;
+        mat.ks = ks;
+        mat.specularColor = ks > 0 ? spec / ks : sg::vec3(1.0f);
+        mat.specularTinted = false;
+        mat.shininess = sg::phongFromMetallicRoughness(0.0f, 1.0f - gloss).shininess;
+        refs[0] = sgx->Has("diffuseTexture") && sgx->Get("diffuseTexture").IsObject() ? texRef(sgx->Get("diffuseTexture")) : TexRef{};
+        refs[1] = TexRef{};
+        if (sgx->Has("specularGlossinessTexture"))
+            warnOnce("material " + std::to_string(i) + ": specularGlossinessTexture is not applied (the specular and glossiness factors are)");
+    }
+
+    void convertMaterial(size_t i) {
+        const tinygltf::Material& gm = m.materials[i];
+        sg::Material mat;
+        mat.name = gm.name.empty() ? "material " + std::to_string(i) : gm.name;
+        sg::vec4 base(1.0f);
+        std::vector<TexRef> refs(4);   // base colour, metallic-roughness, occlusion, emissive
+        convertPbr(i, gm, mat, base, refs);
+        refs[2] = texRef(gm.occlusionTexture.index, gm.occlusionTexture.texCoord, gm.occlusionTexture.extensions);
+        refs[3] = texRef(gm.emissiveTexture);
+        mat.baseColor = sg::vec3(base);
+        if (!gm.emissiveFactor.empty()) {
+            mat.emissive = sg::vec3(float(gm.emissiveFactor[0]), float(gm.emissiveFactor[1]), float(gm.emissiveFactor[2]));
+            if (const tinygltf::Value* es = extensionObject(gm.extensions, "KHR_materials_emissive_strength"))
+                mat.emissive *= float(std::clamp(numberOr(*es, "emissiveStrength", 1.0), 0.0, 1e6));
+        }
+        mat.alpha = base.a;   // baseColorFactor.a (diffuseFactor.a); texture and vertex alpha multiply it when drawn
+        mat.alphaMode = gm.alphaMode == "BLEND" ? sg::AlphaMode::Blend : gm.alphaMode == "MASK" ? sg::AlphaMode::Mask : sg::AlphaMode::Opaque;
+        if (gm.alphaMode != "OPAQUE" && gm.alphaMode != "BLEND" && gm.alphaMode != "MASK")
+            warnOnce("material " + std::to_string(i) + ": alphaMode \"" + gm.alphaMode + "\" is not one of OPAQUE, MASK, BLEND (drawn opaque)");
+        mat.alphaCutoff = std::isfinite(gm.alphaCutoff) && gm.alphaCutoff >= 0 ? float(gm.alphaCutoff) : 0.5f;
+        mat.doubleSided = gm.doubleSided;
+        mat.unlit = extensionObject(gm.extensions, "KHR_materials_unlit") != nullptr || gm.extensions.count("KHR_materials_unlit");
+        mat.diffuseTexture = texture(refs[0].index, true);
+        mat.metallicRoughnessTexture = texture(refs[1].index, false);
+        mat.occlusionTexture = texture(refs[2].index, false);
+        mat.occlusionStrength = std::isfinite(gm.occlusionTexture.strength) ? std::clamp(float(gm.occlusionTexture.strength), 0.0f, 1.0f) : 1.0f;
+        mat.emissiveTexture = texture(refs[3].index, true);
+        if (gm.normalTexture.index >= 0) warnOnce("material " + std::to_string(i) + ": normalTexture is not applied yet (the mesh normals are used)");
+        MaterialInfo info;
+        chooseUvSet(i, refs, info);
+        scene.materials.push_back(std::move(mat));
+        info.sgIndex = int(scene.materials.size() - 1);
+        materials[i] = info;
     }
 
     void convertMaterials() {
         materials.resize(m.materials.size());
-        for (size_t i = 0; i < m.materials.size(); ++i) {
-            const tinygltf::Material& gm = m.materials[i];
-            sg::Material mat;
-            mat.name = gm.name.empty() ? "material " + std::to_string(i) : gm.name;
-            const auto& pbr = gm.pbrMetallicRoughness;
-            sg::vec4 base(float(pbr.baseColorFactor[0]), float(pbr.baseColorFactor[1]), float(pbr.baseColorFactor[2]), float(pbr.baseColorFactor[3]));
-            base = glm::clamp(base, sg::vec4(0.0f), sg::vec4(1.0f));
-            float metallic = std::clamp(float(pbr.metallicFactor), 0.0f, 1.0f);
-            float roughness = std::clamp(float(pbr.roughnessFactor), 0.0f, 1.0f);
-            int texIndex = pbr.baseColorTexture.index;
-            int texCoord = pbr.baseColorTexture.texCoord;
-            const tinygltf::ExtensionMap* texExt = &pbr.baseColorTexture.extensions;
-            mat.baseColor = sg::vec3(base);
-            mat.kd = 1.0f - 0.75f * metallic;
-            mat.ka = 0.2f;
-            mat.ks = std::clamp(glm::mix(0.04f, 1.0f, metallic) + 0.25f * (1.0f - roughness) * (1.0f - metallic), 0.0f, 1.0f);
-            mat.shininess = shininessFromRoughness(roughness);
-            mat.specularTinted = metallic >= 0.5f;
-            mat.specularColor = sg::vec3(1.0f);
-            if (const tinygltf::Value* sgx = extensionObject(gm.extensions, "KHR_materials_pbrSpecularGlossiness")) {
-                double d[4] = {1, 1, 1, 1}, s[3] = {1, 1, 1};
-                numberArray(*sgx, "diffuseFactor", 4, d);
-                numberArray(*sgx, "specularFactor", 3, s);
-                float gloss = std::clamp(float(numberOr(*sgx, "glossinessFactor", 1.0)), 0.0f, 1.0f);
-                base = glm::clamp(sg::vec4(float(d[0]), float(d[1]), float(d[2]), float(d[3])), sg::vec4(0.0f), sg::vec4(1.0f));
-                mat.baseColor = sg::vec3(base);
-                sg::vec3 spec = glm::clamp(sg::vec3(float(s[0]), float(s[1]), float(s[2])), sg::vec3(0.0f), sg::vec3(1.0f));
-                float ks = std::max({spec.x, spec.y, spec.z});
-                mat.kd = 1.0f;
-                mat.ks = ks;
-                mat.specularColor = ks > 0 ? spec / ks : sg::vec3(1.0f);
-                mat.specularTinted = false;
-                mat.shininess = shininessFromRoughness(1.0f - gloss);
-                texIndex = -1;
-                if (sgx->Has("diffuseTexture") && sgx->Get("diffuseTexture").IsObject()) {
-                    const tinygltf::Value& dt = sgx->Get("diffuseTexture");
-                    texIndex = int(numberOr(dt, "index", -1));
-                    texCoord = int(numberOr(dt, "texCoord", 0));
-                    texExt = nullptr;
-                    if (dt.Has("extensions") && dt.Get("extensions").IsObject() && dt.Get("extensions").Has("KHR_texture_transform"))
-                        warnOnce("material " + std::to_string(i) + ": KHR_texture_transform on a specular-glossiness texture is ignored");
-                }
-            }
-            if (!gm.emissiveFactor.empty()) {
-                mat.emissive = sg::vec3(float(gm.emissiveFactor[0]), float(gm.emissiveFactor[1]), float(gm.emissiveFactor[2]));
-                if (const tinygltf::Value* es = extensionObject(gm.extensions, "KHR_materials_emissive_strength"))
-                    mat.emissive *= float(std::clamp(numberOr(*es, "emissiveStrength", 1.0), 0.0, 1e6));
-            }
-            mat.alpha = base.a;   // baseColorFactor.a (diffuseFactor.a); texture and vertex alpha multiply it when drawn
-            mat.alphaMode = gm.alphaMode == "BLEND" ? sg::AlphaMode::Blend : gm.alphaMode == "MASK" ? sg::AlphaMode::Mask : sg::AlphaMode::Opaque;
-            if (gm.alphaMode != "OPAQUE" && gm.alphaMode != "BLEND" && gm.alphaMode != "MASK")
-                warnOnce("material " + std::to_string(i) + ": alphaMode \"" + gm.alphaMode + "\" is not one of OPAQUE, MASK, BLEND (drawn opaque)");
-            mat.alphaCutoff = std::isfinite(gm.alphaCutoff) && gm.alphaCutoff >= 0 ? float(gm.alphaCutoff) : 0.5f;
-            mat.doubleSided = gm.doubleSided;
-            mat.unlit = extensionObject(gm.extensions, "KHR_materials_unlit") != nullptr || gm.extensions.count("KHR_materials_unlit");
-            MaterialInfo info;
-            info.texCoord = texCoord == 1 ? 1 : 0;
-            if (texCoord > 1)
-                warnOnce("material " + std::to_string(i) + ": texCoord " + std::to_string(texCoord) + " is not supported (using TEXCOORD_0)");
-            if (texIndex >= 0 && size_t(texIndex) < m.textures.size()) mat.diffuseTexture = texture(texIndex);
-            if (texExt) {
-                if (const tinygltf::Value* tt = extensionObject(*texExt, "KHR_texture_transform")) {
-                    double off[2] = {0, 0}, sc[2] = {1, 1};
-                    numberArray(*tt, "offset", 2, off);
-                    numberArray(*tt, "scale", 2, sc);
-                    float rot = float(numberOr(*tt, "rotation", 0.0));
-                    if (tt->Has("texCoord")) {
-                        int tc = int(numberOr(*tt, "texCoord", 0));
-                        info.texCoord = tc == 1 ? 1 : 0;
-                    }
-                    // Column-major: T * R * S with R = [cos sin; -sin cos] as in the extension.
-                    sg::mat3 T(1.0f), R(1.0f), S(1.0f);
-                    T[2] = sg::vec3(float(off[0]), float(off[1]), 1.0f);
-                    float c = std::cos(rot), s = std::sin(rot);
-                    R[0] = sg::vec3(c, -s, 0.0f);
-                    R[1] = sg::vec3(s, c, 0.0f);
-                    S[0][0] = float(sc[0]);
-                    S[1][1] = float(sc[1]);
-                    info.uvTransform = T * R * S;
-                    info.hasUvTransform = true;
-                }
-            }
-            scene.materials.push_back(std::move(mat));
-            info.sgIndex = int(scene.materials.size() - 1);
-            materials[i] = info;
-        }
+        for (size_t i = 0; i < m.materials.size(); ++i) convertMaterial(i);
     }
 
     // ---- 7. Meshes -----------------------------------------------------------------------
@@ -1418,7 +1464,7 @@ std::string convertModel(const tinygltf::Model& model, Ctx& ctx, const Progress&
     Converter conv(model, ctx, progress);
     conv.file = file;
     conv.scene.name = path.stem().string();
-    conv.textureOf.assign(model.textures.size(), -2);
+    conv.textureOf.assign(model.textures.size(), {-2, -2});
     conv.decodedImage.assign(model.images.size(), nullptr);
     conv.imageTried.assign(model.images.size(), 0);
     conv.meshPrims.resize(model.meshes.size());

@@ -12,9 +12,12 @@
 //                    "wireframe", "wireframeColor", "background",
 //                    "shadows", "reflections", "maxBounces", "tessellation" },
 //     "textures":  [ {"name", "file": "relative/path.png"} | {"name", "png": "<base64 PNG>"},
-//                    + "wrapS"/"wrapT": <WrapMode>, "filter": <FilterMode> ],
+//                    + "wrapS"/"wrapT": <WrapMode>, "filter": <FilterMode>,
+//                    "srgb": false for data textures (metallic-roughness, occlusion) ],
 //     "materials": [ {"name", "baseColor", "ka", "kd", "ks", "shininess", "specularTinted",
-//                     "specularColor", "diffuseTexture", "emissive", "alpha",
+//                     "specularColor", "diffuseTexture", "emissive", "emissiveTexture",
+//                     "occlusionTexture", "occlusionStrength", "metallicRoughnessTexture",
+//                     "metallic", "roughness", "alpha",
 //                     "alphaMode": <AlphaMode>, "alphaCutoff", "unlit", "doubleSided",
 //                     "reflectivity"} ],
 //     "meshes":    [ {"name", "file": "relative/model.obj"} |
@@ -312,6 +315,15 @@ sg::Material Reader::readMaterial(const json& j, const std::string& p, size_t te
     optVec3(j, p, "specularColor", m.specularColor);
     optInt(j, p, "diffuseTexture", m.diffuseTexture, -1, (long long)textureCount - 1);
     optVec3(j, p, "emissive", m.emissive);
+    optInt(j, p, "emissiveTexture", m.emissiveTexture, -1, (long long)textureCount - 1);
+    optInt(j, p, "occlusionTexture", m.occlusionTexture, -1, (long long)textureCount - 1);
+    optFloat(j, p, "occlusionStrength", m.occlusionStrength);
+    if (!(m.occlusionStrength >= 0 && m.occlusionStrength <= 1)) fail(p + "/occlusionStrength", "must be in [0, 1]");
+    optInt(j, p, "metallicRoughnessTexture", m.metallicRoughnessTexture, -1, (long long)textureCount - 1);
+    optFloat(j, p, "metallic", m.metallic);
+    optFloat(j, p, "roughness", m.roughness);
+    if (!(m.metallic >= 0 && m.metallic <= 1)) fail(p + "/metallic", "must be in [0, 1]");
+    if (!(m.roughness >= 0 && m.roughness <= 1)) fail(p + "/roughness", "must be in [0, 1]");
     optFloat(j, p, "alpha", m.alpha);
     if (m.alpha < 0 || m.alpha > 1) fail(p + "/alpha", "must be in [0, 1]");
     if (auto* v = optional(j, "alphaMode")) m.alphaMode = named<sg::AlphaMode>(*v, p + "/alphaMode");
@@ -353,6 +365,7 @@ std::shared_ptr<sg::Texture> Reader::readTexture(const json& j, const std::strin
     if (auto* v = optional(j, "wrapS")) t->wrapS = named<sg::WrapMode>(*v, p + "/wrapS");
     if (auto* v = optional(j, "wrapT")) t->wrapT = named<sg::WrapMode>(*v, p + "/wrapT");
     if (auto* v = optional(j, "filter")) t->filter = named<sg::FilterMode>(*v, p + "/filter");
+    optBool(j, p, "srgb", t->srgb);
     return t;
 }
 
@@ -862,6 +875,7 @@ std::string serializeSceneJson(const sg::Scene& s) {
     j["textures"] = json::array();
     for (const auto& t : s.textures) {
         json tj = {{"name", t->name}, {"wrapS", sg::nameOf(t->wrapS)}, {"wrapT", sg::nameOf(t->wrapT)}, {"filter", sg::nameOf(t->filter)}};
+        if (!t->srgb) tj["srgb"] = false;
         std::string png;
         encodePng(t->width, t->height, t->rgba.data(), png);
         tj["png"] = base64Encode(png);
@@ -879,6 +893,12 @@ std::string serializeSceneJson(const sg::Scene& s) {
                                   {"specularColor", vecJ(m.specularColor)},
                                   {"diffuseTexture", m.diffuseTexture},
                                   {"emissive", vecJ(m.emissive)},
+                                  {"emissiveTexture", m.emissiveTexture},
+                                  {"occlusionTexture", m.occlusionTexture},
+                                  {"occlusionStrength", m.occlusionStrength},
+                                  {"metallicRoughnessTexture", m.metallicRoughnessTexture},
+                                  {"metallic", m.metallic},
+                                  {"roughness", m.roughness},
                                   {"alpha", m.alpha},
                                   {"alphaMode", sg::nameOf(m.alphaMode)},
                                   {"alphaCutoff", m.alphaCutoff},

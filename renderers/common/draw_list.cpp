@@ -16,6 +16,7 @@ std::vector<PreparedDraw> prepareDraws(const sg::FrameInput& frame, int tessella
         p.mirrored = d.mirrored;
         p.material = &d.material;
         p.texture = d.texture;
+        p.maps = d.maps;
         p.node = d.node;
         draws.push_back(std::move(p));
     }

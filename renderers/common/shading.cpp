@@ -1,5 +1,7 @@
 #include "renderers/shading.h"
 
+#include "renderers/texture_sampler.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -32,7 +34,56 @@ LightSample sampleLight(const DrawLight& light, const vec3& p) {
     return s;
 }
 
-ShadeTerms lightTerms(const Material& m, const vec3& n, const vec3& v, const LightSample& l, ReflectionModel model) {
+PhongCoefficients coefficientsOf(const Material& m) {
+    PhongCoefficients c;
+    c.ka = m.ka;
+    c.kd = m.kd;
+    c.ks = m.ks;
+    c.shininess = m.shininess;
+    c.specularTinted = m.specularTinted;
+    c.unlit = m.unlit;
+    c.specularColor = m.specularColor;
+    c.emissive = m.emissive;
+    return c;
+}
+
+MapSample sampleMaps(const SampledTexture* em, const SampledTexture* occ, const SampledTexture* mr, vec2 uv, vec2 ddx, vec2 ddy) {
+    MapSample s;
+    if (em) s.emissive = em->sample(uv, ddx, ddy);
+    if (occ) s.occlusion = occ->sample(uv, ddx, ddy).x;
+    if (mr) {
+        const vec3 t = mr->sample(uv, ddx, ddy);
+        s.hasMetallicRoughness = true;
+        s.roughness = t.y;
+        s.metallic = t.z;
+    }
+    return s;
+}
+
+PhongCoefficients coefficientsAt(const Material& m, const MapSample& s) {
+    PhongCoefficients c = coefficientsOf(m);
+    c.ka *= 1.0f + m.occlusionStrength * (s.occlusion - 1.0f);
+    c.emissive *= s.emissive;
+    if (s.hasMetallicRoughness) {
+        const PhongFromPbr p = phongFromMetallicRoughness(m.metallic * s.metallic, m.roughness * s.roughness);
+        c.kd = p.kd;
+        c.ks = p.ks;
+        c.shininess = p.shininess;
+        c.specularTinted = p.tinted;
+    }
+    return c;
+}
+
+void applyMapsToTerms(ShadeTerms& t, const Material& m, const MapSample& s, const vec3& ambient) {
+    if (m.unlit) {
+        t.add += m.emissive * (s.emissive - 1.0f);
+        return;
+    }
+    t.mul -= m.ka * m.occlusionStrength * (1.0f - s.occlusion) * ambient;
+    t.add += m.emissive * (s.emissive - 1.0f);
+}
+
+ShadeTerms lightTerms(const PhongCoefficients& m, const vec3& n, const vec3& v, const LightSample& l, ReflectionModel model) {
     ShadeTerms t;
     float nl = glm::dot(n, l.toLight);
     if (nl <= 0.0f) return t;
@@ -55,7 +106,7 @@ ShadeTerms lightTerms(const Material& m, const vec3& n, const vec3& v, const Lig
     return t;
 }
 
-ShadeTerms shadeTerms(const Material& m, const vec3& p, const vec3& n, const vec3& eye, const FrameInput& f, const float* visible) {
+ShadeTerms shadeTerms(const PhongCoefficients& m, const vec3& p, const vec3& n, const vec3& eye, const FrameInput& f, const float* visible) {
     ShadeTerms t;
     if (m.unlit) {
         t.mul = vec3(1.0f);
@@ -77,7 +128,7 @@ ShadeTerms shadeTerms(const Material& m, const vec3& p, const vec3& n, const vec
     return t;
 }
 
-vec3 shade(const Material& m, const SurfacePoint& s, const vec3& eye, const FrameInput& f, const float* visible) {
+vec3 shade(const PhongCoefficients& m, const SurfacePoint& s, const vec3& eye, const FrameInput& f, const float* visible) {
     return shadeTerms(m, s.position, s.normal, eye, f, visible).apply(s.albedo);
 }
 

@@ -28,11 +28,18 @@ int wrapIndex(int i, int n, sg::WrapMode m) {
     return 0;
 }
 
-uint8_t encodeByte(float linear) { return toByteSRGB(linear); }
+// A texel's colour bytes -> linear values: sRGB-decoded for colour textures, /255 for data.
+vec3 texelValue(const uint8_t* rgb, bool srgb) { return srgb ? srgbBytesToLinear(rgb) : vec3(rgb[0], rgb[1], rgb[2]) * (1.0f / 255.0f); }
+// Re-quantised to the texture's 8-bit storage (mip levels).
+vec3 quantised(const vec3& v, bool srgb) {
+    if (!srgb) return glm::round(glm::clamp(v, 0.0f, 1.0f) * 255.0f) / 255.0f;
+    const uint8_t bytes[3] = {toByteSRGB(v.x), toByteSRGB(v.y), toByteSRGB(v.z)};
+    return srgbBytesToLinear(bytes);
+}
 
 }   // namespace
 
-SampledTexture::SampledTexture(const sg::Texture& t) : m_wrapS(t.wrapS), m_wrapT(t.wrapT), m_filter(t.filter) {
+SampledTexture::SampledTexture(const sg::Texture& t) : m_wrapS(t.wrapS), m_wrapT(t.wrapT), m_filter(t.filter), m_srgb(t.srgb) {
     Level base;
     base.w = std::max(t.width, 1);
     base.h = std::max(t.height, 1);
@@ -41,7 +48,7 @@ SampledTexture::SampledTexture(const sg::Texture& t) : m_wrapS(t.wrapS), m_wrapT
     if (filled)
         for (int r = 0; r < t.height; ++r)
             for (int c = 0; c < t.width; ++c)   // file row r is GL row h-1-r
-                base.texels[size_t(t.height - 1 - r) * base.w + c] = srgbBytesToLinear(&t.rgba[(size_t(r) * t.width + c) * 4]);
+                base.texels[size_t(t.height - 1 - r) * base.w + c] = texelValue(&t.rgba[(size_t(r) * t.width + c) * 4], t.srgb);
     if (filled)
         for (size_t i = 3; i < size_t(t.width) * t.height * 4; i += 4) m_hasAlpha = m_hasAlpha || t.rgba[i] != 255;
     if (m_hasAlpha) {
@@ -55,8 +62,8 @@ SampledTexture::SampledTexture(const sg::Texture& t) : m_wrapS(t.wrapS), m_wrapT
     // Mip chain: each level halves (floor, min 1), filtered like the linear-filtered blit that
     // glGenerateMipmap performs (Mesa's util_gen_mipmap): destination texel x takes the
     // previous level bilinearly at its centre mapped back, (x + 0.5) * w_prev / w - 0.5,
-    // clamped to the edge, in linear light; stored re-quantised to 8-bit sRGB like an SRGB8
-    // texture level (alpha: to 8 bits). For even sizes this is the 2x2 box average; for odd
+    // clamped to the edge, in linear light; stored re-quantised to 8 bits (sRGB like an SRGB8
+    // texture level, linear like RGBA8 for data textures; alpha: to 8 bits). For even sizes this is the 2x2 box average; for odd
     // (NPOT) sizes the sample points keep the image aligned instead of drifting by half a texel.
     while (m_levels.back().w > 1 || m_levels.back().h > 1) {
         const Level& p = m_levels.back();
@@ -76,8 +83,7 @@ SampledTexture::SampledTexture(const sg::Texture& t) : m_wrapS(t.wrapS), m_wrapT
                 const float ax = fx - float(x0);
                 const size_t a = size_t(y0) * p.w + x0, b = size_t(y0) * p.w + x1, c = size_t(y1) * p.w + x0, d = size_t(y1) * p.w + x1;
                 const vec3 s = (p.texels[a] * (1 - ax) + p.texels[b] * ax) * (1 - ay) + (p.texels[c] * (1 - ax) + p.texels[d] * ax) * ay;
-                uint8_t bytes[3] = {encodeByte(s.x), encodeByte(s.y), encodeByte(s.z)};
-                l.texels[size_t(y) * l.w + x] = srgbBytesToLinear(bytes);
+                l.texels[size_t(y) * l.w + x] = quantised(s, t.srgb);
                 if (m_hasAlpha) {
                     const float al = (p.alpha[a] * (1 - ax) + p.alpha[b] * ax) * (1 - ay) + (p.alpha[c] * (1 - ax) + p.alpha[d] * ax) * ay;
                     l.alpha[size_t(y) * l.w + x] = std::round(al * 255.0f) / 255.0f;
@@ -174,7 +180,7 @@ float SampledTexture::sampleAlpha(vec2 uv, vec2 ddx, vec2 ddy) const {
 const SampledTexture* SamplerCache::get(const sg::TexturePtr& t) {
     if (!t || t->width <= 0 || t->height <= 0 || t->rgba.size() < size_t(t->width) * size_t(t->height) * 4) return nullptr;
     Entry& e = m_entries[t->id];
-    if (!e.tex || e.version != t->version || e.filter != t->filter || e.wrapS != t->wrapS || e.wrapT != t->wrapT) {
+    if (!e.tex || e.version != t->version || e.filter != t->filter || e.wrapS != t->wrapS || e.wrapT != t->wrapT || e.tex->srgb() != t->srgb) {
         e.tex = std::make_unique<SampledTexture>(*t);
         e.version = t->version;
         e.filter = t->filter;

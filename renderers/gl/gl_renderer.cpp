@@ -57,6 +57,8 @@ struct Program {
     GLint eye = -1, ambient = -1;
     GLint baseColor = -1, ka = -1, kd = -1, ks = -1, shininess = -1, specTinted = -1, specColor = -1, emissive = -1;
     GLint texture = -1, hasTexture = -1, unlit = -1, solid = -1, solidColor = -1;
+    // Material maps (texture units 1..3, kMapUnits order) and their factors.
+    GLint maps[3] = {-1, -1, -1}, hasMap[3] = {-1, -1, -1}, occlusionStrength = -1, metallic = -1, roughness = -1;
     GLint alpha = -1, alphaMode = -1, alphaCutoff = -1;
     GLint fogMode = -1, fogColor = -1, fogParams = -1;
 };
@@ -185,6 +187,15 @@ std::string buildProgram(const std::string& key, Program& p) {
     p.emissive = loc("uEmissive");
     p.texture = loc("uTexture");
     p.hasTexture = loc("uHasTexture");
+    const char* mapNames[3][2] = {
+        {"uEmissiveMap", "uHasEmissiveMap"}, {"uOcclusionMap", "uHasOcclusionMap"}, {"uMetalRoughMap", "uHasMetalRoughMap"}};
+    for (int k = 0; k < 3; ++k) {
+        p.maps[k] = loc(mapNames[k][0]);
+        p.hasMap[k] = loc(mapNames[k][1]);
+    }
+    p.occlusionStrength = loc("uOcclusionStrength");
+    p.metallic = loc("uMetallic");
+    p.roughness = loc("uRoughness");
     p.unlit = loc("uUnlit");
     p.alpha = loc("uAlpha");
     p.alphaMode = loc("uAlphaMode");
@@ -218,6 +229,7 @@ struct GpuMesh {
 
 struct GpuTexture {
     uint64_t version = 0;
+    bool srgb = true;
     GLuint id = 0;
     uint64_t lastUsed = 0;
 };
@@ -333,6 +345,7 @@ bool uploadTexture(GpuTexture& g, const Texture& t) {
     if (g.id) glDeleteTextures(1, &g.id);
     g.id = 0;
     g.version = t.version;
+    g.srgb = t.srgb;
     if (t.width <= 0 || t.height <= 0 || t.rgba.size() < size_t(t.width) * t.height * 4) return false;
     std::vector<uint8_t> flipped(size_t(t.width) * t.height * 4);
     size_t row = size_t(t.width) * 4;
@@ -340,7 +353,8 @@ bool uploadTexture(GpuTexture& g, const Texture& t) {
     glGenTextures(1, &g.id);
     glBindTexture(GL_TEXTURE_2D, g.id);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    glTexImage2D(GL_TEXTURE_2D, 0, GL_SRGB8_ALPHA8, t.width, t.height, 0, GL_RGBA, GL_UNSIGNED_BYTE, flipped.data());
+    // Colour textures decode sRGB when sampled; data textures (metallic-roughness, occlusion) are linear.
+    glTexImage2D(GL_TEXTURE_2D, 0, t.srgb ? GL_SRGB8_ALPHA8 : GL_RGBA8, t.width, t.height, 0, GL_RGBA, GL_UNSIGNED_BYTE, flipped.data());
     glGenerateMipmap(GL_TEXTURE_2D);
     GLint minF = t.filter == FilterMode::Nearest ? GL_NEAREST : t.filter == FilterMode::Bilinear ? GL_LINEAR : GL_LINEAR_MIPMAP_LINEAR;
     GLint magF = t.filter == FilterMode::Nearest ? GL_NEAREST : GL_LINEAR;
@@ -475,6 +489,7 @@ struct DrawItem {
     const Material* material = nullptr;
     const std::vector<Material>* rangeMaterials = nullptr;   // tessellation's per-range materials
     GpuTexture* texture = nullptr;
+    GpuTexture* maps[3] = {nullptr, nullptr, nullptr};   // emissive, occlusion, metallic-roughness (units 1..3)
 };
 
 class GlRenderer final : public Renderer {
@@ -524,7 +539,7 @@ private:
     std::vector<DrawItem> collectDraws(const FrameInput& frame, int tessellation);   // uploads what is new
     uint64_t drawAll(const Program& prog, const std::vector<DrawItem>& items, DrawPass pass, sg::CullMode culling);
     void readBack(GLuint fbo, int w, int h, Framebuffer& out);
-    void setMaterial(const Program& p, const Material& m, bool hasTexture, bool unlit);
+    void setMaterial(const Program& p, const Material& m, const DrawItem& it, bool unlit);
     void evict();
 
     std::unique_ptr<gl::GlContext> m_own;     // our headless context, made on first need
@@ -627,7 +642,7 @@ GpuMesh* GlRenderer::meshFor(const Mesh& mesh, const std::vector<uint16_t>* tria
 GpuTexture* GlRenderer::textureFor(const TexturePtr& t) {
     if (!t) return nullptr;
     GpuTexture& g = m_textures[t->id];
-    if (g.version != t->version) {
+    if (g.version != t->version || g.srgb != t->srgb) {
         uploadTexture(g, *t);
         ++m_textureUploads;
     }
@@ -663,6 +678,7 @@ void GlRenderer::setFrameUniforms(const Program& p, const FrameInput& f, int ssa
     glUniform3fv(p.ambient, 1, &f.ambientLight[0]);
     glUniform1f(p.pointSize, 2.0f * float(ssaa));
     glUniform1i(p.texture, 0);
+    for (int k = 0; k < 3; ++k) glUniform1i(p.maps[k], 1 + k);
     glUniform1i(p.fogMode, int(s.fog));
     glUniform3fv(p.fogColor, 1, &s.fogColor[0]);
     glUniform3f(p.fogParams, s.fogStart, s.fogEnd, s.fogDensity);
@@ -688,7 +704,22 @@ void GlRenderer::setFrameUniforms(const Program& p, const FrameInput& f, int ssa
     }
 }
 
-void GlRenderer::setMaterial(const Program& p, const Material& m, bool hasTexture, bool unlit) {
+// The draw's textures: the base colour on unit 0, its maps on units 1..3 (unit 0 left active).
+void bindTextures(const DrawItem& it) {
+    for (int k = 0; k < 3; ++k) {
+        glActiveTexture(GLenum(GL_TEXTURE1 + k));
+        glBindTexture(GL_TEXTURE_2D, it.maps[k] ? it.maps[k]->id : 0);
+    }
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, it.texture ? it.texture->id : 0);
+}
+
+void GlRenderer::setMaterial(const Program& p, const Material& m, const DrawItem& it, bool unlit) {
+    const bool hasTexture = it.texture != nullptr;
+    for (int k = 0; k < 3; ++k) glUniform1i(p.hasMap[k], it.maps[k] && !unlit ? 1 : 0);
+    glUniform1f(p.occlusionStrength, m.occlusionStrength);
+    glUniform1f(p.metallic, m.metallic);
+    glUniform1f(p.roughness, m.roughness);
     glUniform3fv(p.baseColor, 1, &m.baseColor[0]);
     glUniform1f(p.ka, m.ka);
     glUniform1f(p.kd, m.kd);
@@ -720,6 +751,9 @@ std::vector<DrawItem> GlRenderer::collectDraws(const FrameInput& frame, int tess
         it.material = p.material;
         it.rangeMaterials = p.materials;
         it.texture = textureFor(p.texture);
+        it.maps[0] = textureFor(p.maps.emissive);
+        it.maps[1] = textureFor(p.maps.occlusion);
+        it.maps[2] = textureFor(p.maps.metallicRoughness);
         items.push_back(it);
     }
     std::vector<float> distance(items.size());
@@ -762,12 +796,12 @@ uint64_t GlRenderer::drawAll(const Program& prog, const std::vector<DrawItem>& i
                 glUniformMatrix4fv(prog.model, 1, GL_FALSE, &(*it.world)[0][0]);
                 glUniformMatrix3fv(prog.normalMatrix, 1, GL_FALSE, &it.normal[0][0]);
                 glFrontFace(it.mirrored ? GL_CW : GL_CCW);
-                if (!wireframe) glBindTexture(GL_TEXTURE_2D, it.texture ? it.texture->id : 0);
+                if (!wireframe) bindTextures(it);
                 glBindVertexArray(it.gpu->vao);
                 bound = true;
             }
             if (!wireframe) {
-                setMaterial(prog, *m, it.texture != nullptr, unlit);
+                setMaterial(prog, *m, it, unlit);
                 if (!unlit) triangles += uint64_t(r.count / 3);
             }
             setCull(!unlit && sg::cullsBackFaces(culling, m->doubleSided));

@@ -101,6 +101,8 @@ struct DrawItem {
     std::shared_ptr<const std::vector<uint16_t>> triMat;   // per-triangle material (CSG)
     std::shared_ptr<const std::vector<sg::Material>> materials;
     const SampledTexture* texture = nullptr;
+    const SampledTexture *emissiveMap = nullptr, *occlusionMap = nullptr, *metallicRoughnessMap = nullptr;
+    bool hasMaps() const { return emissiveMap || occlusionMap || metallicRoughnessMap; }
     bool mirrored = false;
     bool perCorner = false;   // Gouraud with per-triangle materials: one vertex per corner
     bool hasNormals = false;
@@ -516,22 +518,27 @@ __attribute__((noinline)) float prepareFragment(const TriCache& tc, const FrameC
     const sg::Material& mat = *tc.mat;
 
     vec3 albedo = mat.baseColor;
-    if (d.hasColors || (d.texture && d.hasUV)) {
+    const bool maps = d.hasUV && d.hasMaps();
+    MapSample ms;
+    if (d.hasColors || (d.texture && d.hasUV) || maps) {
         const sg::Mesh& m = *d.mesh;
         uint32_t mi[3] = {d.meshIndex(v[0]), d.meshIndex(v[1]), d.meshIndex(v[2])};
         if (d.hasColors) albedo *= vec3(bo[0] * m.colors[mi[0]] + bo[1] * m.colors[mi[1]] + bo[2] * m.colors[mi[2]]);
-        if (d.texture && d.hasUV) {
+        if ((d.texture && d.hasUV) || maps) {
             vec2 uv, ddx, ddy;
             uvAt(tc, fb, mi, i, j, uv, ddx, ddy);
-            albedo *= d.texture->sample(uv, ddx, ddy);
+            if (d.texture) albedo *= d.texture->sample(uv, ddx, ddy);
+            if (maps) ms = sampleMaps(d.emissiveMap, d.occlusionMap, d.metallicRoughnessMap, uv, ddx, ddy);
         }
     }
 
     if (tc.gouraud) {
         int side = t.front ? 0 : 1;
-        vec3 A = bo[0] * d.gouraudA[side][v[0]] + bo[1] * d.gouraudA[side][v[1]] + bo[2] * d.gouraudA[side][v[2]];
-        vec3 B = bo[0] * d.gouraudB[side][v[0]] + bo[1] * d.gouraudB[side][v[1]] + bo[2] * d.gouraudB[side][v[2]];
-        sb.setColor(k, A * albedo + B);
+        ShadeTerms terms;
+        terms.mul = bo[0] * d.gouraudA[side][v[0]] + bo[1] * d.gouraudA[side][v[1]] + bo[2] * d.gouraudA[side][v[2]];
+        terms.add = bo[0] * d.gouraudB[side][v[0]] + bo[1] * d.gouraudB[side][v[1]] + bo[2] * d.gouraudB[side][v[2]];
+        if (maps) applyMapsToTerms(terms, mat, ms, f.ambientLight);
+        sb.setColor(k, terms.apply(albedo));
     } else {
         vec3 n;
         if (tc.faceNormal) {
@@ -541,10 +548,11 @@ __attribute__((noinline)) float prepareFragment(const TriCache& tc, const FrameC
             float len = glm::length(n);
             n = len > 0 ? n / len : vec3(0, 0, 1);
         }
+        const PhongCoefficients coeff = maps ? coefficientsAt(mat, ms) : coefficientsOf(mat);
         if (fc.referenceShading)
-            sb.setColor(k, shade(mat, SurfacePoint{pos, n, albedo}, f.camera.eye, f));   // rnd::shade itself
+            sb.setColor(k, shade(coeff, SurfacePoint{pos, n, albedo}, f.camera.eye, f));   // rnd::shade itself
         else
-            sb.set(k, mat, pos, n, albedo, f.ambientLight);
+            sb.set(k, coeff, pos, n, albedo, f.ambientLight);
     }
     if (f.settings.fog == sg::FogMode::Off) return 0.0f;
     return glm::length(bo[0] * tc.pe[0] + bo[1] * tc.pe[1] + bo[2] * tc.pe[2]);   // eye-space distance
@@ -1012,6 +1020,9 @@ private:
             d.material = *p.material;
             d.mirrored = p.mirrored;
             d.texture = m_samplers.get(p.texture);
+            d.emissiveMap = m_samplers.get(p.maps.emissive);
+            d.occlusionMap = m_samplers.get(p.maps.occlusion);
+            d.metallicRoughnessMap = m_samplers.get(p.maps.metallicRoughness);
             d.hasNormals = p.mesh->normals.size() == p.mesh->positions.size();
             d.hasUV = p.mesh->uv0.size() == p.mesh->positions.size();
             d.hasColors = p.mesh->colors.size() == p.mesh->positions.size();

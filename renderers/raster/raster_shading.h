@@ -25,8 +25,10 @@ struct ShadeBatch {
     size_t size = 0;
 
     void resize(size_t n);
-    // Fills fragment i from a material, position, normal, albedo (as rnd::shade sees them).
-    void set(size_t i, const sg::Material& m, const sg::vec3& p, const sg::vec3& n, const sg::vec3& albedo, const sg::vec3& ambient) {
+    // Fills fragment i from a material's coefficients (rnd::PhongCoefficients, or an
+    // sg::Material: the same field names), position, normal, albedo (as rnd::shade sees them).
+    template <class Coefficients>
+    void set(size_t i, const Coefficients& m, const sg::vec3& p, const sg::vec3& n, const sg::vec3& albedo, const sg::vec3& ambient) {
         px[i] = p.x;
         py[i] = p.y;
         pz[i] = p.z;

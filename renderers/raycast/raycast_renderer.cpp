@@ -120,10 +120,17 @@ bool uvWithFootprint(const PixelFootprint* footprint, const vec3 P[3], const vec
 
 // --- Tracer --------------------------------------------------------------------------------------
 
+// A mesh's other material textures (null when absent).
+struct MeshMaps {
+    const SampledTexture *emissive = nullptr, *occlusion = nullptr, *metallicRoughness = nullptr;
+    bool any() const { return emissive || occlusion || metallicRoughness; }
+};
+
 struct Tracer {
     const FrameInput& f;
     const rt::SceneAccel& accel;
     const std::vector<const SampledTexture*>& textures;   // per f.meshes entry, null if none
+    const std::vector<MeshMaps>& maps;                    // per f.meshes entry: emissive, occlusion, metallic-roughness
     uint64_t rays = 0;
     bool anyAlpha = false;   // some material is masked or blended (anyTranslucent())
 
@@ -259,14 +266,16 @@ struct Tracer {
             albedoV[2] *= vec3(mesh.colors[i2]);
         }
         vec3 texColor(1.0f);
-        if (const SampledTexture* tex = textures[h.instance]; tex && hasUV) {
+        const MeshMaps& mm = maps[h.instance];
+        const bool hasMaps = hasUV && mm.any();
+        MapSample ms;
+        if (const SampledTexture* tex = textures[h.instance]; (tex || hasMaps) && hasUV) {
             const vec2 UV[3] = {mesh.uv0[i0], mesh.uv0[i1], mesh.uv0[i2]};
             const float w[3] = {w0, w1, w2};
-            vec2 uv, ddx, ddy;
-            if (uvWithFootprint(footprint, P, UV, w, uv, ddx, ddy))
-                texColor = tex->sample(uv, ddx, ddy);
-            else
-                texColor = tex->sampleLevel(uv, 0, tex->filter() != FilterMode::Nearest);
+            vec2 uv, ddx(0.0f), ddy(0.0f);
+            const bool footprinted = uvWithFootprint(footprint, P, UV, w, uv, ddx, ddy);
+            if (tex) texColor = footprinted ? tex->sample(uv, ddx, ddy) : tex->sampleLevel(uv, 0, tex->filter() != FilterMode::Nearest);
+            if (hasMaps) ms = sampleMaps(mm.emissive, mm.occlusion, mm.metallicRoughness, uv, ddx, ddy);   // no footprint: derivatives 0, level 0
         }
         vec3 Nv[3];
         for (int k = 0; k < 3; ++k) {
@@ -291,6 +300,7 @@ struct Tracer {
                 t.mul += wk[k] * tk.mul;
                 t.add += wk[k] * tk.add;
             }
+            if (hasMaps) applyMapsToTerms(t, *mat, ms, f.ambientLight);
             color = t.apply(albedo);
             n = w0 * Nv[0] + w1 * Nv[1] + w2 * Nv[2];
             n = glm::length(n) > 0 ? glm::normalize(n) : ng;
@@ -303,7 +313,8 @@ struct Tracer {
                 n = l > 1e-20f ? n / l : ng;
             }
             if (!mat->unlit) lightVisibility(p, ng, vis);
-            color = shade(*mat, SurfacePoint{p, n, albedo}, eye, f, mat->unlit ? nullptr : vis);
+            const PhongCoefficients coeff = hasMaps ? coefficientsAt(*mat, ms) : coefficientsOf(*mat);
+            color = shade(coeff, SurfacePoint{p, n, albedo}, eye, f, mat->unlit ? nullptr : vis);
         }
     }
 
@@ -437,7 +448,12 @@ protected:
         // Samplers (mip chains) per texture, cached by id + version; one pointer per mesh.
         m_samplers.beginFrame();
         std::vector<const SampledTexture*> textures(f.meshes.size(), nullptr);
-        for (size_t i = 0; i < f.meshes.size(); ++i) textures[i] = m_samplers.get(f.meshes[i].texture);
+        std::vector<MeshMaps> maps(f.meshes.size());
+        for (size_t i = 0; i < f.meshes.size(); ++i) {
+            textures[i] = m_samplers.get(f.meshes[i].texture);
+            const sg::MaterialMaps& fm = f.meshes[i].maps;
+            maps[i] = {m_samplers.get(fm.emissive), m_samplers.get(fm.occlusion), m_samplers.get(fm.metallicRoughness)};
+        }
         m_samplers.endFrame();
         const bool anyAlpha = anyTranslucent(f);
 
@@ -462,7 +478,7 @@ protected:
                     cancelled = true;
                     break;
                 }
-                Tracer tr{f, m_accel, textures, 0, anyAlpha};
+                Tracer tr{f, m_accel, textures, maps, 0, anyAlpha};
                 const int x0 = (ti % tx) * tile, y0 = (ti / tx) * tile;   // y0: framebuffer row (top-down)
                 const int x1 = std::min(x0 + tile, w), y1 = std::min(y0 + tile, h);
                 for (int row = y0; row < y1; ++row) {

@@ -28,9 +28,10 @@ FrameCamera makeFrameCamera(const mat4& cameraWorld, const Projection& p, float 
 
 namespace {
 
-TexturePtr textureOf(const Scene& s, const Material& m) {
-    if (m.diffuseTexture < 0 || size_t(m.diffuseTexture) >= s.textures.size()) return nullptr;
-    return s.textures[m.diffuseTexture];
+TexturePtr textureAt(const Scene& s, int i) { return i < 0 || size_t(i) >= s.textures.size() ? nullptr : s.textures[size_t(i)]; }
+TexturePtr textureOf(const Scene& s, const Material& m) { return textureAt(s, m.diffuseTexture); }
+MaterialMaps mapsOf(const Scene& s, const Material& m) {
+    return {textureAt(s, m.emissiveTexture), textureAt(s, m.occlusionTexture), textureAt(s, m.metallicRoughnessTexture)};
 }
 
 // Builds the CSG tree below `csgNode`; leaves are implicit shapes in world space.
@@ -124,6 +125,7 @@ FrameInput flatten(const Scene& scene, float aspect, NodeId cameraNode) {
             d.mesh = scene.meshes[mi->mesh];
             d.material = scene.material(mi->material);
             d.texture = textureOf(scene, d.material);
+            d.maps = mapsOf(scene, d.material);
             d.world = w;
             d.normal = normalMatrix(w);
             d.mirrored = glm::determinant(mat3(w)) < 0.0f;

@@ -186,7 +186,7 @@ TEST_P(BackendContractTest, StatsSayWhatWasAskedAndUsed) {
         bool listed = s.aa == sg::AAMode::None || std::find(list.begin(), list.end(), s.aaRate) != list.end();
         EXPECT_EQ(st.config.aaUsed == st.config.aaAsked, listed) << GetParam() << " " << aa << " used " << st.config.aaUsed;
         EXPECT_EQ(st.config.notes.empty(), listed) << GetParam() << " " << aa;
-        if (!listed) EXPECT_NE(st.config.notes[0].find(std::string(aa) + " -> "), std::string::npos) << st.config.notes[0];
+        if (!listed) { EXPECT_NE(st.config.notes[0].find(std::string(aa) + " -> "), std::string::npos) << st.config.notes[0]; }
     }
     // Shadows: asked by default; listed as not drawn exactly by the backends without them.
     Framebuffer fb;
@@ -263,6 +263,6 @@ TEST(ShadeTermsTest, ShadeIsTheTermsAppliedToTheAlbedo) {
                 // The terms by hand for albedo 0 and 1 (untinted specular goes to add only).
                 sg::vec3 zero = shade(m, SurfacePoint{p, n, sg::vec3(0.0f)}, eye, f, vis);
                 for (int k = 0; k < 3; ++k) EXPECT_NEAR(zero[k], t.add[k], 1e-6f);
-                if (tinted) EXPECT_EQ(t.add, m.emissive);
+                if (tinted) { EXPECT_EQ(t.add, m.emissive); }
             }
 }

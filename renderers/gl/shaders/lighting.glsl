@@ -34,6 +34,20 @@ uniform bool uSpecTinted;
 uniform vec3 uSpecColor;
 uniform vec3 uEmissive;
 
+// The coefficients the model uses at this vertex or fragment (rnd::PhongCoefficients): the
+// material's uniforms, which mesh.frag changes per texel by the material's maps.
+float gKa, gKd, gKs, gShininess;
+bool gSpecTinted;
+vec3 gEmissive;
+void coefficientsOfMaterial() {
+    gKa = uKa;
+    gKd = uKd;
+    gKs = uKs;
+    gShininess = uShininess;
+    gSpecTinted = uSpecTinted;
+    gEmissive = uEmissive;
+}
+
 // LIGHT_POINT, LIGHT_DIRECTIONAL, LIGHT_SPOT, SHADING_*, REFLECTION_* and FOG_* are defined by the
 // renderer's prefix with the values of the C++ enums (glslEnumDefines() in gl_renderer.cpp).
 
@@ -79,11 +93,11 @@ void lightTerms(int i, int type, bool inverseSquare, vec3 n, vec3 p, vec3 v, ino
 #else
 #error "REFLECTION: a sg::ReflectionModel value this shader does not handle"
 #endif
-    spec = spec > 0.0 ? pow(spec, uShininess) : 0.0;
+    spec = spec > 0.0 ? pow(spec, gShininess) : 0.0;
     vec3 ln = radiance * nl;
-    mul += ln * uKd;
-    if (uSpecTinted) mul += ln * (uKs * spec);
-    else add += ln * (uKs * spec) * uSpecColor;
+    mul += ln * gKd;
+    if (gSpecTinted) mul += ln * (gKs * spec);
+    else add += ln * (gKs * spec) * uSpecColor;
 }
 
 // The two albedo-linear terms of shade() at world position p with unit normal n (already
@@ -92,7 +106,7 @@ void shadeTerms(vec3 n, vec3 p, out vec3 mul, out vec3 add) {
     vec3 v = uEye - p;
     float len = length(v);
     v = len > 0.0 ? v / len : vec3(0.0, 0.0, 1.0);
-    mul = uKa * uAmbient;
-    add = uEmissive;
+    mul = gKa * uAmbient;
+    add = gEmissive;
     LIGHT_CALLS
 }

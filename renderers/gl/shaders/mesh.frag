@@ -14,6 +14,16 @@ in vec3 vAddBack;
 
 uniform sampler2D uTexture;
 uniform bool uHasTexture;
+// Material maps (rnd::sampleMaps / coefficientsAt in renderers/common/shading.cpp).
+uniform sampler2D uEmissiveMap;     // sRGB colour, x uEmissive
+uniform sampler2D uOcclusionMap;    // R: ambient occlusion
+uniform sampler2D uMetalRoughMap;   // G: roughness, B: metallic (linear)
+uniform bool uHasEmissiveMap;
+uniform bool uHasOcclusionMap;
+uniform bool uHasMetalRoughMap;
+uniform float uOcclusionStrength;
+uniform float uMetallic;
+uniform float uRoughness;
 uniform bool uUnlit;        // colour = albedo + emissive (material unlit, lines, points)
 uniform float uAlpha;       // material alpha (x texture alpha x vertex alpha)
 uniform int uAlphaMode;     // ALPHA_OPAQUE, ALPHA_MASK, ALPHA_BLEND (sg::AlphaMode values)
@@ -25,6 +35,16 @@ uniform vec3 uFogColor;
 uniform vec3 uFogParams;    // start, end, density
 
 out vec4 fragColor;
+
+// sg::phongFromMetallicRoughness() (scenegraph/src/material.cpp).
+void phongFromMetallicRoughness(float metallic, float roughness) {
+    float m = clamp(metallic, 0.0, 1.0), r = clamp(roughness, 0.0, 1.0);
+    float a = r * r;
+    gKd = 1.0 - 0.75 * m;
+    gKs = clamp(0.04 + 0.96 * m + 0.25 * (1.0 - r) * (1.0 - m), 0.0, 1.0);
+    gShininess = a < 1e-3 ? 2048.0 : clamp(2.0 / (a * a) - 2.0, 1.0, 2048.0);
+    gSpecTinted = m >= 0.5;
+}
 
 // sg::fogVisibility(): f(d) in [0,1], 1 = no fog.
 float fogVisibility(float d) {
@@ -47,6 +67,16 @@ void main() {
             albedo *= t.rgb;
             alpha *= t.a;
         }
+        // The maps, sampled before any discard (implicit derivatives): coefficientsAt().
+        float ao = uHasOcclusionMap ? texture(uOcclusionMap, vUv).r : 1.0;
+        vec3 em = uHasEmissiveMap ? texture(uEmissiveMap, vUv).rgb : vec3(1.0);
+        coefficientsOfMaterial();
+        gKa *= 1.0 + uOcclusionStrength * (ao - 1.0);
+        gEmissive *= em;
+        if (uHasMetalRoughMap) {
+            vec3 mr = texture(uMetalRoughMap, vUv).rgb;
+            phongFromMetallicRoughness(uMetallic * mr.b, uRoughness * mr.g);
+        }
         if (uAlphaMode == ALPHA_MASK) {
             if (alpha < uAlphaCutoff) discard;   // cut-out
             alpha = 1.0;
@@ -56,7 +86,7 @@ void main() {
             alpha = 0.0;   // unreachable: every sg::AlphaMode is handled above
         }
         if (uUnlit) {
-            c = albedo + uEmissive;
+            c = albedo + gEmissive;
         } else {
             vec3 mul, add;
 #if SHADING == SHADING_FLAT
@@ -65,8 +95,10 @@ void main() {
             vec3 n = normalize(cross(dFdx(vWorldPos), dFdy(vWorldPos)));
             shadeTerms(n, vWorldPos, mul, add);
 #elif SHADING == SHADING_GOURAUD
-            mul = gl_FrontFacing ? vMulFront : vMulBack;
-            add = gl_FrontFacing ? vAddFront : vAddBack;
+            // Lit at the vertices with the material's coefficients; occlusion and emissive maps
+            // still apply exactly here (applyMapsToTerms): both terms are additive.
+            mul = (gl_FrontFacing ? vMulFront : vMulBack) - uKa * uOcclusionStrength * (1.0 - ao) * uAmbient;
+            add = (gl_FrontFacing ? vAddFront : vAddBack) + uEmissive * (em - 1.0);
 #elif SHADING == SHADING_PHONG
             float len = length(vNormal);
             vec3 n = len > 0.0 ? vNormal / len : vec3(0.0, 0.0, 1.0);

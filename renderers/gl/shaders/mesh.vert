@@ -34,6 +34,7 @@ void main() {
     gl_Position = uViewProj * world;
     gl_PointSize = uPointSize;
 #if SHADING == SHADING_GOURAUD
+    coefficientsOfMaterial();   // the maps apply per fragment (mesh.frag)
     float len = length(vNormal);
     vec3 n = len > 0.0 ? vNormal / len : vec3(0.0, 0.0, 1.0);
     shadeTerms(n, world.xyz, vMulFront, vAddFront);

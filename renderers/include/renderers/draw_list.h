@@ -23,6 +23,7 @@ struct PreparedDraw {
     bool mirrored = false;                  // det(world) < 0: front faces wind clockwise
     const sg::Material* material = nullptr;
     sg::TexturePtr texture;   // null when none, and for per-triangle materials
+    sg::MaterialMaps maps;    // the material's other textures (meshes only)
     // Per-triangle material indices into *materials (CSG faces take their leaf's material),
     // both null when the whole mesh uses *material.
     const std::vector<uint16_t>* triangleMaterial = nullptr;

@@ -45,18 +45,60 @@ struct ShadeTerms {
     sg::vec3 apply(const sg::vec3& albedo) const { return albedo * mul + add; }
 };
 
+// The coefficients the local model uses at one surface point: the material's, changed per
+// texel by its occlusion, emissive and metallic-roughness textures (docs/math.md, "Material
+// textures"). Field names as in sg::Material.
+struct PhongCoefficients {
+    float ka = 0.2f, kd = 0.8f, ks = 0.3f, shininess = 32.0f;
+    bool specularTinted = false;
+    bool unlit = false;
+    sg::vec3 specularColor{1.0f};
+    sg::vec3 emissive{0.0f};
+};
+PhongCoefficients coefficientsOf(const sg::Material& m);
+
+// What a material's maps hold at one point, linear: occlusion (R), emissive colour (RGB),
+// roughness (G) and metallic (B); a missing map leaves its neutral value.
+struct MapSample {
+    float occlusion = 1.0f;
+    sg::vec3 emissive{1.0f};
+    bool hasMetallicRoughness = false;
+    float roughness = 1.0f, metallic = 1.0f;
+};
+// Samples the maps (null = absent) at uv with the screen-space derivatives of uv.
+class SampledTexture;
+MapSample sampleMaps(const SampledTexture* emissive, const SampledTexture* occlusion, const SampledTexture* metallicRoughness, sg::vec2 uv,
+                     sg::vec2 ddx, sg::vec2 ddy);
+// The coefficients at a point with these map samples:
+//   ka_eff = ka (1 + strength (occlusion - 1)),  emissive_eff = emissive (x) emissive texel,
+//   metallic-roughness texture: (kd, ks, n, tint) = phongFromMetallicRoughness(metallic x B, roughness x G).
+PhongCoefficients coefficientsAt(const sg::Material& m, const MapSample& s);
+// Gouraud shading lights the vertices with the material's own coefficients; the occlusion and
+// emissive maps still apply per pixel, exactly, because both terms are additive:
+//   mul -= ka (1 - ao_eff) L_ambient,  add += emissive (x) (emissive texel - 1).
+// (The metallic-roughness map needs per-pixel lighting: flat and Phong shading.)
+void applyMapsToTerms(ShadeTerms& t, const sg::Material& m, const MapSample& s, const sg::vec3& ambient);
+
 // One light's terms at world position p with unit normal n (facing the viewer), seen from
 // direction toEye (unit). No ambient, no emissive.
-ShadeTerms lightTerms(const sg::Material& m, const sg::vec3& n, const sg::vec3& toEye, const LightSample& l, sg::ReflectionModel model);
+ShadeTerms lightTerms(const PhongCoefficients& m, const sg::vec3& n, const sg::vec3& toEye, const LightSample& l, sg::ReflectionModel model);
 
 // All of the local model's terms at p with normal n seen from `eye`: ambient + emissive + every
 // light. `lightVisible` (optional) scales light i by a visibility in [0,1] (the ray caster's
 // shadow rays). Unlit materials: mul = 1, add = emissive.
-ShadeTerms shadeTerms(const sg::Material& m, const sg::vec3& p, const sg::vec3& n, const sg::vec3& eye, const sg::FrameInput& f,
+ShadeTerms shadeTerms(const PhongCoefficients& m, const sg::vec3& p, const sg::vec3& n, const sg::vec3& eye, const sg::FrameInput& f,
                       const float* lightVisible = nullptr);
+inline ShadeTerms shadeTerms(const sg::Material& m, const sg::vec3& p, const sg::vec3& n, const sg::vec3& eye, const sg::FrameInput& f,
+                             const float* lightVisible = nullptr) {
+    return shadeTerms(coefficientsOf(m), p, n, eye, f, lightVisible);
+}
 
 // The full local model: shadeTerms(...).apply(s.albedo).
-sg::vec3 shade(const sg::Material& m, const SurfacePoint& s, const sg::vec3& eye, const sg::FrameInput& f, const float* lightVisible = nullptr);
+sg::vec3 shade(const PhongCoefficients& m, const SurfacePoint& s, const sg::vec3& eye, const sg::FrameInput& f, const float* lightVisible = nullptr);
+inline sg::vec3 shade(const sg::Material& m, const SurfacePoint& s, const sg::vec3& eye, const sg::FrameInput& f,
+                      const float* lightVisible = nullptr) {
+    return shade(coefficientsOf(m), s, eye, f, lightVisible);
+}
 
 // Fog on eye-space distance d, then clamp.
 sg::vec3 applyFog(const sg::RenderSettings& s, const sg::vec3& color, float eyeDistance);

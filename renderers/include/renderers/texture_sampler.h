@@ -29,6 +29,7 @@ public:
     bool hasAlpha() const { return m_hasAlpha; }
     int levels() const { return int(m_levels.size()); }
     sg::FilterMode filter() const { return m_filter; }
+    bool srgb() const { return m_srgb; }   // colour texture (decoded to linear); false: data, values / 255
 
 private:
     struct Level {
@@ -43,6 +44,7 @@ private:
     std::vector<Level> m_levels;
     sg::WrapMode m_wrapS, m_wrapT;
     sg::FilterMode m_filter;
+    bool m_srgb = true;
 };
 
 // Samplers (mip chains) per texture, rebuilt when a texture's version or its filter/wrap modes

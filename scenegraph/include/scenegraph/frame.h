@@ -10,12 +10,20 @@
 
 namespace sg {
 
+// A material's textures other than the base colour (null when absent), resolved from the
+// Material's indices; they sample the same UVs as the diffuse texture.
+struct MaterialMaps {
+    TexturePtr emissive, occlusion, metallicRoughness;
+    bool any() const { return emissive || occlusion || metallicRoughness; }
+};
+
 struct DrawMesh {
     NodeId node = kNoNode;
     uint64_t nodeUid = 0;
     MeshPtr mesh;
     Material material;
     TexturePtr texture;   // diffuse texture or null
+    MaterialMaps maps;
     mat4 world{1.0f};
     mat3 normal{1.0f};       // inverse transpose of world's 3x3
     bool mirrored = false;   // det(world) < 0: winding flips

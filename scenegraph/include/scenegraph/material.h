@@ -25,8 +25,16 @@ struct Material {
     float shininess = 32.0f;            // Phong exponent n
     bool specularTinted = false;        // false: white highlights; true: tinted by base colour
     vec3 specularColor{1.0f};           // used when not tinted
-    int diffuseTexture = -1;            // index into Scene::textures, -1 = none
-    vec3 emissive{0.0f};
+    int diffuseTexture = -1;            // index into Scene::textures, -1 = none (base colour, sRGB)
+    vec3 emissive{0.0f};                // emission factor, linear RGB (x emissiveTexture)
+    // glTF's other textures (indices into Scene::textures, -1 = none). They sample the same UV
+    // set as the diffuse texture. docs/math.md, "Material textures", has the formulas.
+    int emissiveTexture = -1;    // sRGB colour, multiplies `emissive`
+    int occlusionTexture = -1;   // R: ambient occlusion; ka_eff = ka (1 + strength (R - 1))
+    float occlusionStrength = 1.0f;
+    int metallicRoughnessTexture = -1;   // B: metallic, G: roughness (x the factors below), mapped
+    float metallic = 0.0f;               // per texel to kd, ks, shininess, tint by phongFromMetallicRoughness()
+    float roughness = 1.0f;
     float alpha = 1.0f;   // base colour alpha (glTF baseColorFactor.a)
     AlphaMode alphaMode = AlphaMode::Opaque;
     float alphaCutoff = 0.5f;    // Mask only
@@ -36,5 +44,17 @@ struct Material {
 
     bool operator==(const Material&) const = default;
 };
+
+// The documented mapping of glTF's metallic-roughness parameters to Phong coefficients (the
+// importer uses it for the factors, the renderers per texel of a metallicRoughnessTexture):
+//   kd = 1 - 0.75 m
+//   ks = clamp(mix(0.04, 1, m) + 0.25 (1 - r)(1 - m), 0, 1)
+//   n  = clamp(2 / a^2 - 2, 1, 2048) with a = r^2 (Blinn-Phong exponent of GGX width a; 2048 when a < 1e-3)
+//   specular tinted by the base colour when m >= 0.5 (a metal), white otherwise
+struct PhongFromPbr {
+    float kd, ks, shininess;
+    bool tinted;
+};
+PhongFromPbr phongFromMetallicRoughness(float metallic, float roughness);
 
 }   // namespace sg

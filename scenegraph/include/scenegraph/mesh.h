@@ -48,7 +48,10 @@ struct Texture {
     std::string name;
     std::string sourcePath;   // where it was loaded from (for saving), may be empty
     int width = 0, height = 0;
-    std::vector<uint8_t> rgba;   // width*height*4, sRGB-encoded colour as stored in the file
+    std::vector<uint8_t> rgba;   // width*height*4, as stored in the file
+    // Colour textures (base colour, emissive) hold sRGB-encoded colour, decoded to linear when
+    // sampled; data textures (metallic-roughness, occlusion, normal) hold linear values.
+    bool srgb = true;
     WrapMode wrapS = WrapMode::Repeat, wrapT = WrapMode::Repeat;
     FilterMode filter = FilterMode::Trilinear;
 };

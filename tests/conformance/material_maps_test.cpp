@@ -1,0 +1,241 @@
+// glTF material maps in every backend, held to the formulas of docs/math.md ("Material
+// textures"; rnd::coefficientsAt / applyMapsToTerms in renderers/common/shading.cpp):
+//  - emissiveTexture: emissive_eff = emissiveFactor (x) texel (sRGB colour);
+//  - occlusionTexture: ka_eff = ka (1 + strength (R - 1)) on the ambient term only (linear data);
+//  - metallicRoughnessTexture: per texel (kd, ks, n, tint) = phongFromMetallicRoughness(
+//    metallic x B, roughness x G) under flat and Phong shading, the material's own coefficients
+//    under Gouraud (lighting at the vertices), where occlusion and emissive still apply exactly.
+// Each case is a 2x1 texture (nearest filter) on an orthographic head-on quad, the left and
+// right halves of the image sampling one texel each, so every expected colour is exact.
+#include "assets/image_io.h"
+#include "assets/scene_io.h"
+#include "renderers/renderer.h"
+#include "renderers/shading.h"
+#include "scenegraph/setting_names.h"
+#include "test_scenes.h"
+#include "test_support.h"
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <filesystem>
+#include <fstream>
+#include <map>
+
+namespace {
+
+using namespace test_scenes;
+using sg::vec3;
+
+constexpr int W = 32, H = 32;
+constexpr int kLeft = W / 2 - 5, kRight = W / 2 + 5;
+
+// A 2x1 texture of two RGB texels, nearest, clamped; srgb false for data textures.
+sg::TexturePtr twoTexels(std::array<uint8_t, 3> left, std::array<uint8_t, 3> right, bool srgb) {
+    auto t = std::make_shared<sg::Texture>();
+    t->width = 2;
+    t->height = 1;
+    t->rgba = {left[0], left[1], left[2], 255, right[0], right[1], right[2], 255};
+    t->filter = sg::FilterMode::Nearest;
+    t->wrapS = t->wrapT = sg::WrapMode::ClampToEdge;
+    t->srgb = srgb;
+    return t;
+}
+
+// Head-on orthographic quad, a directional light straight along the view (n.l = 1 and r.v = 1
+// everywhere: the specular factor is 1 whatever the exponent), ambient L_a.
+sg::FrameInput mapsFrame(const sg::Material& m, const sg::MaterialMaps& maps, sg::ShadingModel model, const vec3& ambient, const vec3& light) {
+    sg::Projection p;
+    p.type = sg::ProjectionType::Orthographic;
+    p.orthoHalfHeight = 1.5f;
+    sg::FrameInput f = makeFrame(W, H, p, vec3(0, 0, 3), vec3(0.0f));
+    f.settings.shadows = false;
+    f.settings.shading = model;
+    f.ambientLight = ambient;
+    if (light != vec3(0.0f)) f.lights.push_back(directional(vec3(0, 0, -1), light));
+    addMesh(f, quad(1.0f), m);
+    f.meshes.back().maps = maps;
+    return f;
+}
+
+rnd::Framebuffer render(const std::string& backend, const sg::FrameInput& f, const std::string& name) {
+    std::string err;
+    auto r = rnd::makeRenderer(backend, &err);
+    EXPECT_TRUE(r) << err;
+    rnd::Framebuffer fb;
+    if (!r) return fb;
+    rnd::RenderStats st = r->render(f, W, H, fb);
+    EXPECT_TRUE(st.ok) << backend << " " << name << ": " << st.error;
+    testing_support::writeImage(fb, "conformance", "maps-" + backend + "-" + name);
+    return fb;
+}
+
+::testing::AssertionResult pixelIs(const rnd::Framebuffer& fb, int x, const vec3& linear, int tol = 2) {
+    const uint8_t* p = fb.pixel(x, H / 2);
+    const int want[3] = {rnd::toByteSRGB(linear.x), rnd::toByteSRGB(linear.y), rnd::toByteSRGB(linear.z)};
+    for (int c = 0; c < 3; ++c)
+        if (std::abs(int(p[c]) - want[c]) > tol)
+            return ::testing::AssertionFailure() << "pixel x=" << x << " is " << int(p[0]) << "," << int(p[1]) << "," << int(p[2]) << ", expected "
+                                                 << want[0] << "," << want[1] << "," << want[2];
+    return ::testing::AssertionSuccess();
+}
+
+class MaterialMaps : public ::testing::TestWithParam<std::string> {};
+
+const sg::ShadingModel kModels[] = {sg::ShadingModel::Flat, sg::ShadingModel::Gouraud, sg::ShadingModel::Phong};
+
+// Emission only (ka = kd = ks = 0): the factor times the sRGB-decoded texel, lit or unlit.
+TEST_P(MaterialMaps, EmissiveTextureMultipliesTheFactor) {
+    for (bool unlitMat : {false, true})
+        for (sg::ShadingModel model : kModels) {
+            sg::Material m;
+            m.baseColor = vec3(0.0f);
+            m.ka = m.kd = m.ks = 0.0f;
+            m.unlit = unlitMat;
+            m.emissive = vec3(1.0f, 0.5f, 0.8f);
+            sg::MaterialMaps maps;
+            maps.emissive = twoTexels({255, 0, 0}, {0, 188, 255}, true);
+            const std::string name = std::string("emissive-") + (unlitMat ? "unlit-" : "") + std::string(sg::nameOf(model));
+            rnd::Framebuffer fb = render(GetParam(), mapsFrame(m, maps, model, vec3(0.3f), vec3(1.0f)), name);
+            EXPECT_TRUE(pixelIs(fb, kLeft, vec3(1.0f, 0.0f, 0.0f))) << GetParam() << " " << name;
+            EXPECT_TRUE(pixelIs(fb, kRight, vec3(0.0f, 0.5f * rnd::decodeSRGB(188.0f / 255.0f), 0.8f))) << GetParam() << " " << name;
+        }
+}
+
+// Ambient only (kd = ks = 0, no light): ka (1 + strength (R - 1)) L_a rho, R read linearly
+// (128 -> 0.50196, not sRGB-decoded), at strength 0.5 and 1.
+TEST_P(MaterialMaps, OcclusionTextureScalesTheAmbientTermOnly) {
+    for (float strength : {1.0f, 0.5f})
+        for (sg::ShadingModel model : kModels) {
+            sg::Material m;
+            m.baseColor = vec3(0.8f, 0.6f, 0.4f);
+            m.ka = 1.0f;
+            m.kd = m.ks = 0.0f;
+            m.occlusionStrength = strength;
+            sg::MaterialMaps maps;
+            maps.occlusion = twoTexels({128, 0, 0}, {255, 255, 255}, false);
+            const vec3 La(0.5f);
+            const std::string name = "occlusion-" + std::to_string(int(strength * 10)) + "-" + std::string(sg::nameOf(model));
+            rnd::Framebuffer fb = render(GetParam(), mapsFrame(m, maps, model, La, vec3(0.0f)), name);
+            const float ao = 1.0f + strength * (128.0f / 255.0f - 1.0f);
+            EXPECT_TRUE(pixelIs(fb, kLeft, ao * La * m.baseColor)) << GetParam() << " " << name;
+            EXPECT_TRUE(pixelIs(fb, kRight, La * m.baseColor)) << GetParam() << " " << name;
+        }
+    // A light adds its diffuse term unoccluded: occlusion darkens the ambient term alone.
+    sg::Material m;
+    m.baseColor = vec3(0.5f);
+    m.ka = 1.0f;
+    m.kd = 1.0f;
+    m.ks = 0.0f;
+    sg::MaterialMaps maps;
+    maps.occlusion = twoTexels({0, 0, 0}, {255, 255, 255}, false);
+    rnd::Framebuffer fb = render(GetParam(), mapsFrame(m, maps, sg::ShadingModel::Phong, vec3(0.4f), vec3(0.6f)), "occlusion-lit");
+    EXPECT_TRUE(pixelIs(fb, kLeft, vec3(0.6f * 0.5f))) << GetParam();
+    EXPECT_TRUE(pixelIs(fb, kRight, vec3((0.4f + 0.6f) * 0.5f))) << GetParam();
+}
+
+// Left texel: dielectric (B = 0), rough (G = 255); right: metal (B = 255), rough. With the
+// factors metallic 1, roughness 1: colour = L (kd rho + ks spec), spec = 1, untinted (white)
+// for the dielectric, tinted (rho) for the metal. Gouraud keeps the material's coefficients.
+TEST_P(MaterialMaps, MetallicRoughnessTextureGivesPhongCoefficientsPerTexel) {
+    for (sg::ShadingModel model : kModels) {
+        sg::Material m;
+        m.baseColor = vec3(0.4f, 0.2f, 0.1f);
+        m.ka = 0.0f;
+        m.kd = 0.5f;
+        m.ks = 0.0f;
+        m.metallic = 1.0f;
+        m.roughness = 1.0f;
+        sg::MaterialMaps maps;
+        maps.metallicRoughness = twoTexels({0, 255, 0}, {0, 255, 255}, false);
+        const vec3 L(0.5f);
+        const std::string name = "mr-" + std::string(sg::nameOf(model));
+        rnd::Framebuffer fb = render(GetParam(), mapsFrame(m, maps, model, vec3(0.0f), L), name);
+        if (model == sg::ShadingModel::Gouraud) {
+            EXPECT_TRUE(pixelIs(fb, kLeft, L * 0.5f * m.baseColor)) << GetParam() << " " << name;
+            EXPECT_TRUE(pixelIs(fb, kRight, L * 0.5f * m.baseColor)) << GetParam() << " " << name;
+            continue;
+        }
+        const sg::PhongFromPbr d = sg::phongFromMetallicRoughness(0.0f, 1.0f), metal = sg::phongFromMetallicRoughness(1.0f, 1.0f);
+        ASSERT_FALSE(d.tinted);
+        ASSERT_TRUE(metal.tinted);
+        EXPECT_TRUE(pixelIs(fb, kLeft, L * (d.kd * m.baseColor + vec3(d.ks)))) << GetParam() << " " << name;
+        EXPECT_TRUE(pixelIs(fb, kRight, L * (metal.kd + metal.ks) * m.baseColor)) << GetParam() << " " << name;
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(EveryBackend, MaterialMaps, ::testing::ValuesIn(rnd::rendererNames()), [](const auto& info) { return info.param; });
+
+// The mapping itself at known points (docs/math.md).
+TEST(PhongFromMetallicRoughness, KnownValues) {
+    const sg::PhongFromPbr a = sg::phongFromMetallicRoughness(0.0f, 1.0f);
+    EXPECT_FLOAT_EQ(a.kd, 1.0f);
+    EXPECT_FLOAT_EQ(a.ks, 0.04f);
+    EXPECT_FLOAT_EQ(a.shininess, 1.0f);   // 2/1 - 2 = 0, clamped to 1
+    const sg::PhongFromPbr b = sg::phongFromMetallicRoughness(1.0f, 0.5f);
+    EXPECT_FLOAT_EQ(b.kd, 0.25f);
+    EXPECT_FLOAT_EQ(b.ks, 1.0f);
+    EXPECT_FLOAT_EQ(b.shininess, 2.0f / (0.25f * 0.25f) - 2.0f);   // a = r^2 = 0.25
+    EXPECT_TRUE(b.tinted);
+    EXPECT_FLOAT_EQ(sg::phongFromMetallicRoughness(0.0f, 0.0f).shininess, 2048.0f);
+    EXPECT_NEAR(sg::phongFromMetallicRoughness(0.0f, 0.0f).ks, 0.29f, 1e-6f);
+}
+
+// glTF import: the maps, their factors and colour spaces reach the material (one glTF texture
+// used as colour and as data becomes two textures), and the scene file keeps them.
+TEST(MaterialMapsImport, GltfTexturesFactorsAndColourSpaces) {
+    namespace fs = std::filesystem;
+    fs::path dir = testing_support::outputDir("conformance") / "maps-import";
+    fs::create_directories(dir);
+    const uint8_t rgba[8] = {255, 0, 0, 255, 0, 255, 0, 255};
+    std::string png;
+    ASSERT_EQ(assets::encodePng(2, 1, rgba, png), "");
+    const float pos[12] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0}, uv[8] = {0, 1, 1, 1, 1, 0, 0, 0};
+    std::string buf(reinterpret_cast<const char*>(pos), sizeof pos);
+    buf.append(reinterpret_cast<const char*>(uv), sizeof uv);
+    const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
+    buf.append(reinterpret_cast<const char*>(idx), sizeof idx);
+    fs::path file = dir / "maps.gltf";
+    std::ofstream(file) << R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],
+"meshes":[{"primitives":[{"attributes":{"POSITION":0,"TEXCOORD_0":1},"indices":2,"material":0}]}],
+"materials":[{"name":"bottle","pbrMetallicRoughness":{"baseColorTexture":{"index":0},"metallicFactor":0.7,"roughnessFactor":0.4,
+  "metallicRoughnessTexture":{"index":0}},"occlusionTexture":{"index":1,"strength":0.3},"emissiveTexture":{"index":1},
+  "emissiveFactor":[1,0.5,0.25]}],
+"textures":[{"source":0},{"source":0}],
+"images":[{"uri":"data:image/png;base64,)"
+                        << testing_support::base64Encode(png) << R"("}],
+"buffers":[{"byteLength":92,"uri":"data:application/octet-stream;base64,)"
+                        << testing_support::base64Encode(buf) << R"("}],
+"bufferViews":[{"buffer":0,"byteLength":48},{"buffer":0,"byteOffset":48,"byteLength":32},{"buffer":0,"byteOffset":80,"byteLength":12}],
+"accessors":[{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3","min":[0,0,0],"max":[1,1,0]},
+ {"bufferView":1,"componentType":5126,"count":4,"type":"VEC2"},{"bufferView":2,"componentType":5123,"count":6,"type":"SCALAR"}]})";
+    assets::LoadResult r = assets::loadScene(file);
+    ASSERT_TRUE(r.scene) << r.error;
+    for (const std::string& w : r.warnings) ADD_FAILURE() << "unexpected warning: " << w;
+    ASSERT_EQ(r.scene->materials.size(), 1u);
+    const sg::Material& m = r.scene->materials[0];
+    const auto& tex = r.scene->textures;
+    auto srgbOf = [&](int i) { return i >= 0 && size_t(i) < tex.size() ? int(tex[size_t(i)]->srgb) : -1; };
+    EXPECT_EQ(srgbOf(m.diffuseTexture), 1);
+    EXPECT_EQ(srgbOf(m.metallicRoughnessTexture), 0);   // glTF texture 0 as data: a second texture
+    EXPECT_NE(m.diffuseTexture, m.metallicRoughnessTexture);
+    EXPECT_EQ(srgbOf(m.occlusionTexture), 0);
+    EXPECT_EQ(srgbOf(m.emissiveTexture), 1);
+    EXPECT_NEAR(m.metallic, 0.7f, 1e-6f);
+    EXPECT_NEAR(m.roughness, 0.4f, 1e-6f);
+    EXPECT_NEAR(m.occlusionStrength, 0.3f, 1e-6f);
+    EXPECT_EQ(m.emissive, vec3(1.0f, 0.5f, 0.25f));
+    const sg::PhongFromPbr ph = sg::phongFromMetallicRoughness(0.7f, 0.4f);
+    EXPECT_FLOAT_EQ(m.kd, ph.kd);
+    EXPECT_FLOAT_EQ(m.ks, ph.ks);
+    EXPECT_FLOAT_EQ(m.shininess, ph.shininess);
+    fs::path json = dir / "maps.scene.json";
+    ASSERT_EQ(assets::saveSceneJson(*r.scene, json, true), "");
+    assets::LoadResult again = assets::loadScene(json);
+    ASSERT_TRUE(again.scene) << again.error;
+    EXPECT_EQ(again.scene->materials, r.scene->materials);
+    ASSERT_EQ(again.scene->textures.size(), tex.size());
+    for (size_t i = 0; i < tex.size(); ++i) EXPECT_EQ(again.scene->textures[i]->srgb, tex[i]->srgb) << i;
+}
+
+}   // namespace
