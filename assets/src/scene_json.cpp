@@ -16,13 +16,15 @@
 //                    "srgb": false for data textures (metallic-roughness, occlusion) ],
 //     "materials": [ {"name", "baseColor", "ka", "kd", "ks", "shininess", "specularTinted",
 //                     "specularColor", "diffuseTexture", "emissive", "emissiveTexture",
-//                     "occlusionTexture", "occlusionStrength", "metallicRoughnessTexture",
+//                     "occlusionTexture", "occlusionStrength", "normalTexture", "normalScale",
+//                     "metallicRoughnessTexture",
 //                     "metallic", "roughness", "alpha",
 //                     "alphaMode": <AlphaMode>, "alphaCutoff", "unlit", "doubleSided",
 //                     "reflectivity"} ],
 //     "meshes":    [ {"name", "file": "relative/model.obj"} |
 //                    {"name", "mode": "triangles|lines|points", "positions": [x,y,z,...],
-//                     "normals", "uv0", "uv1", "colors" (4 per vertex), "indices"} ],
+//                     "normals", "uv0", "uv1", "colors" (4 per vertex), "tangents" (4 per
+//                     vertex: xyz, handedness), "indices"} ],
 //     "nodes":     [ {"name", "parent": <index, absent for node 0 = root>, "visible",
 //                     "transform": {"translation", "rotation", "scale"} | {"matrix": [16]},
 //                     one optional payload:
@@ -319,6 +321,9 @@ sg::Material Reader::readMaterial(const json& j, const std::string& p, size_t te
     optInt(j, p, "occlusionTexture", m.occlusionTexture, -1, (long long)textureCount - 1);
     optFloat(j, p, "occlusionStrength", m.occlusionStrength);
     if (!(m.occlusionStrength >= 0 && m.occlusionStrength <= 1)) fail(p + "/occlusionStrength", "must be in [0, 1]");
+    optInt(j, p, "normalTexture", m.normalTexture, -1, (long long)textureCount - 1);
+    optFloat(j, p, "normalScale", m.normalScale);
+    if (!std::isfinite(m.normalScale)) fail(p + "/normalScale", "must be finite");
     optInt(j, p, "metallicRoughnessTexture", m.metallicRoughnessTexture, -1, (long long)textureCount - 1);
     optFloat(j, p, "metallic", m.metallic);
     optFloat(j, p, "roughness", m.roughness);
@@ -418,6 +423,7 @@ std::shared_ptr<sg::Mesh> Reader::readMesh(const json& j, const std::string& p) 
         floatArray<sg::vec2, 2>(j, p, "uv0", m->uv0, kMaxVertices);
         floatArray<sg::vec2, 2>(j, p, "uv1", m->uv1, kMaxVertices);
         floatArray<sg::vec4, 4>(j, p, "colors", m->colors, kMaxVertices);
+        floatArray<sg::vec4, 4>(j, p, "tangents", m->tangents, kMaxVertices);
         if (auto* v = optional(j, "indices")) {
             if (!v->is_array()) fail(p + "/indices", "expected an array of integers");
             if (v->size() > kMaxIndices) fail(p + "/indices", "too many indices");
@@ -896,6 +902,8 @@ std::string serializeSceneJson(const sg::Scene& s) {
                                   {"emissiveTexture", m.emissiveTexture},
                                   {"occlusionTexture", m.occlusionTexture},
                                   {"occlusionStrength", m.occlusionStrength},
+                                  {"normalTexture", m.normalTexture},
+                                  {"normalScale", m.normalScale},
                                   {"metallicRoughnessTexture", m.metallicRoughnessTexture},
                                   {"metallic", m.metallic},
                                   {"roughness", m.roughness},
@@ -913,6 +921,7 @@ std::string serializeSceneJson(const sg::Scene& s) {
         if (!m->uv0.empty()) mj["uv0"] = flat<sg::vec2, 2>(m->uv0);
         if (!m->uv1.empty()) mj["uv1"] = flat<sg::vec2, 2>(m->uv1);
         if (!m->colors.empty()) mj["colors"] = flat<sg::vec4, 4>(m->colors);
+        if (!m->tangents.empty()) mj["tangents"] = flat<sg::vec4, 4>(m->tangents);
         j["meshes"].push_back(std::move(mj));
     }
     const auto& order = s.depthFirstOrder();

@@ -101,8 +101,9 @@ struct DrawItem {
     std::shared_ptr<const std::vector<uint16_t>> triMat;   // per-triangle material (CSG)
     std::shared_ptr<const std::vector<sg::Material>> materials;
     const SampledTexture* texture = nullptr;
-    const SampledTexture *emissiveMap = nullptr, *occlusionMap = nullptr, *metallicRoughnessMap = nullptr;
-    bool hasMaps() const { return emissiveMap || occlusionMap || metallicRoughnessMap; }
+    const SampledTexture *emissiveMap = nullptr, *occlusionMap = nullptr, *metallicRoughnessMap = nullptr, *normalMap = nullptr;
+    bool hasMaps() const { return emissiveMap || occlusionMap || metallicRoughnessMap || normalMap; }
+    bool hasTangents = false;   // normal map with mesh tangents: wtan filled
     bool mirrored = false;
     bool perCorner = false;   // Gouraud with per-triangle materials: one vertex per corner
     bool hasNormals = false;
@@ -116,6 +117,7 @@ struct DrawItem {
     std::vector<uint8_t> code;
     std::vector<vec4> win;   // window x, y, z, 1/w (valid when code == 0)
     std::vector<vec3> wpos, wnrm;
+    std::vector<vec4> wtan;                       // world tangent (xyz, handedness; mirrored draws flip it), when hasTangents
     std::vector<vec3> gouraudA[2], gouraudB[2];   // front/back: colour = A * albedo + B
 
     // Whether back faces of triangle `tri` are culled (RenderSettings::culling, per material).
@@ -143,6 +145,8 @@ void runVertexStage(DrawItem& d, const sg::FrameInput& f, int width, int height,
     d.win.resize(n);
     d.wpos.resize(n);
     d.wnrm.assign(n, vec3(0.0f));
+    d.wtan.resize(d.hasTangents ? n : 0);
+    const float handedness = d.mirrored ? -1.0f : 1.0f;   // a mirroring transform flips cross(n, t)
     if (gouraud)
         for (int s = 0; s < 2; ++s) {
             d.gouraudA[s].resize(n);
@@ -168,6 +172,7 @@ void runVertexStage(DrawItem& d, const sg::FrameInput& f, int width, int height,
                 float len = glm::length(nn);
                 d.wnrm[v] = len > 0 ? nn / len : vec3(0, 0, 1);
             }
+            if (d.hasTangents) d.wtan[v] = vec4(mat3(d.world) * vec3(m.tangents[mi]), m.tangents[mi].w * handedness);
             if (gouraud) {
                 const sg::Material& mat = d.perCorner ? d.materialOf(uint32_t(v / 3)) : d.material;
                 // Gouraud: the model's two albedo-linear terms at the vertex, front and back side.
@@ -528,7 +533,7 @@ __attribute__((noinline)) float prepareFragment(const TriCache& tc, const FrameC
             vec2 uv, ddx, ddy;
             uvAt(tc, fb, mi, i, j, uv, ddx, ddy);
             if (d.texture) albedo *= d.texture->sample(uv, ddx, ddy);
-            if (maps) ms = sampleMaps(d.emissiveMap, d.occlusionMap, d.metallicRoughnessMap, uv, ddx, ddy);
+            if (maps) ms = sampleMaps(d.emissiveMap, d.occlusionMap, d.metallicRoughnessMap, d.normalMap, uv, ddx, ddy);
         }
     }
 
@@ -547,6 +552,11 @@ __attribute__((noinline)) float prepareFragment(const TriCache& tc, const FrameC
             n = bo[0] * tc.n[0] + bo[1] * tc.n[1] + bo[2] * tc.n[2];
             float len = glm::length(n);
             n = len > 0 ? n / len : vec3(0, 0, 1);
+            if (ms.hasNormal && d.hasTangents) {   // the map's normal, on the outward side, then flipped back
+                const vec4 tan = bo[0] * d.wtan[v[0]] + bo[1] * d.wtan[v[1]] + bo[2] * d.wtan[v[2]];
+                const vec4 tw(vec3(tan), d.wtan[v[0]].w);
+                n = t.front ? perturbNormal(n, tw, ms.normalTexel, mat.normalScale) : -perturbNormal(-n, tw, ms.normalTexel, mat.normalScale);
+            }
         }
         const PhongCoefficients coeff = maps ? coefficientsAt(mat, ms) : coefficientsOf(mat);
         if (fc.referenceShading)
@@ -1023,6 +1033,8 @@ private:
             d.emissiveMap = m_samplers.get(p.maps.emissive);
             d.occlusionMap = m_samplers.get(p.maps.occlusion);
             d.metallicRoughnessMap = m_samplers.get(p.maps.metallicRoughness);
+            d.normalMap = m_samplers.get(p.maps.normal);
+            d.hasTangents = d.normalMap && p.mesh->tangents.size() == p.mesh->positions.size();
             d.hasNormals = p.mesh->normals.size() == p.mesh->positions.size();
             d.hasUV = p.mesh->uv0.size() == p.mesh->positions.size();
             d.hasColors = p.mesh->colors.size() == p.mesh->positions.size();
