@@ -22,7 +22,8 @@ if(rev STREQUAL "")
                       OUTPUT_VARIABLE hash OUTPUT_STRIP_TRAILING_WHITESPACE ERROR_QUIET RESULT_VARIABLE rc)
       if(rc EQUAL 0 AND NOT hash STREQUAL "")
         set(rev "${hash}")
-        execute_process(COMMAND "${GIT_EXECUTABLE}" -C "${SOURCE_DIR}" diff-index --quiet HEAD --
+        # `git diff`, not diff-index: it compares contents where only the time stamps changed.
+        execute_process(COMMAND "${GIT_EXECUTABLE}" -C "${SOURCE_DIR}" diff --no-ext-diff --quiet HEAD --
                         RESULT_VARIABLE dirty OUTPUT_QUIET ERROR_QUIET)
         if(dirty EQUAL 1)
           string(APPEND rev "-dirty")
