@@ -42,7 +42,7 @@ build_package() {
   if ! (cd "$build" && "$CPACK_COMMAND" -G DEB -B "$out" --config "$build/CPackConfig.cmake") >"$out/cpack.log" 2>&1; then
     fail "cpack -G DEB failed: $(grep -m1 -i 'error' "$out/cpack.log" || tail -n1 "$out/cpack.log") (log: $out/cpack.log)"
   fi
-  [ -f "$deb" ] || fail "cpack made no $(basename "$deb"): $(ls "$out"/*.deb 2>/dev/null | xargs -r -n1 basename | tr '\n' ' ')"
+  [ -f "$deb" ] || fail "cpack made no $(basename "$deb"): $(find "$out" -maxdepth 1 -name '*.deb' -printf '%f ')"
   dpkg-deb -x "$deb" "$root" || fail "dpkg-deb -x $deb failed"
   echo "package test: $deb"
   dpkg-deb --field "$deb" Depends
@@ -94,9 +94,9 @@ check_contents() {
   msg="$(LC_ALL=C.UTF-8 groff -man -Tutf8 -ww -z <<<"$page" 2>&1)"
   [ -z "$msg" ] || fail "viewer.1: groff: $(firstline "$msg")"
   help="$("$viewer" --help-all 2>&1)" || fail "viewer --help-all failed: $(firstline "$help")"
-  for word in $(grep -oE -- '--[a-z][a-z-]*' <<<"$help" | sort -u); do
+  while read -r word; do
     grep -qF -- "${word//-/\\-}" <<<"$page" || fail "viewer.1 does not mention $word (viewer --help-all lists it)"
-  done
+  done < <(grep -oE -- '--[a-z][a-z-]*' <<<"$help" | sort -u)
   for word in render compare demo-shots convert; do
     grep -qF -- "${word//-/\\-}" <<<"$page" || fail "viewer.1 does not mention the command $word"
   done
@@ -104,7 +104,8 @@ check_contents() {
   # Nothing installed may point back into the source or build folder. The executable may name
   # source files (sanitizer builds keep them for their reports) but no other path there;
   # debug info is left out of the look.
-  [ -z "$(grep -rlF -- "$src/" "$root/usr/share")" ] || fail "$(grep -rlF -- "$src/" "$root/usr/share" | head -n1) mentions $src/"
+  msg="$(grep -rlF -- "$src/" "$root/usr/share" || true)"
+  [ -z "$msg" ] || fail "$(firstline "$msg") mentions $src/"
   need objcopy binutils
   need strings binutils
   local stripped="$out/viewer.nodebug" paths
