@@ -14,8 +14,10 @@
 // are untextured.
 #include "raycast/raycast_renderer.h"
 
+#include "common/line_overlay.h"
 #include "raycast/camera_rays.h"
 #include "raycast/scene_accel.h"
+#include "renderers/draw_list.h"
 #include "renderers/shading.h"
 #include "renderers/texture_sampler.h"
 
@@ -435,6 +437,8 @@ public:
         c.exactImplicits = true;
         c.shadows = true;
         c.reflections = true;
+        c.wireframe = true;        // the CPU backends' overlay (common/line_overlay.h), after the rays
+        c.pointsAndLines = true;   // the same pixel footprint as the rasterizers
         // MSAA n and SSAA f are both taken as stratified jittered rays per pixel: n rays
         // (2 -> 2x1, 4 -> 2x2, 8 -> 4x2 strata) and f x f rays; each ray is shaded.
         c.msaaSamples = {2, 4, 8};
@@ -541,14 +545,32 @@ protected:
 
         stats.rays = rays.load();
         stats.cancelled = cancelled.load();
+        if (!stats.cancelled) drawOverlay(f, cfg, target);
         stats.ok = !stats.cancelled;
         if (stats.cancelled) stats.error = "cancelled";
         return stats;
     }
 
 private:
+    // Points, lines and the wireframe, rasterized over the ray-cast image against its depth
+    // exactly as the CPU rasterizer draws them (rays cannot hit zero-width primitives). The
+    // wireframe of analytic shapes is their tessellation's, as in the rasterizers. Drawn at the
+    // output size: with SSAA the rasterizers' 1-pixel lines come out fainter after downsampling.
+    void drawOverlay(const FrameInput& f, const RenderConfig& cfg, Framebuffer& target) {
+        std::vector<PreparedDraw> draws;
+        if (f.settings.wireframe) {
+            draws = prepareDraws(f, cfg.tessellation, m_tess);
+            m_tess.nextFrame();
+        } else {
+            for (const PreparedDraw& d : prepareMeshDraws(f))
+                if (d.mesh->mode != sg::PrimitiveMode::Triangles) draws.push_back(d);
+        }
+        if (!draws.empty()) drawPointsLinesWireframe(draws, f, target, 2.0f);
+    }
+
     rt::SceneAccel m_accel;
     SamplerCache m_samplers;
+    TessellationCache m_tess;   // wireframe of analytic shapes only
 };
 
 }   // namespace

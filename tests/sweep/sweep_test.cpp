@@ -27,13 +27,7 @@ namespace {
 constexpr int W = 320, H = 180;
 
 // Models whose backends differ for a documented reason (README, known limitations).
-const std::string kNoPoints = "the ray caster draws no points or lines yet (issue 17, item 3)";
-const std::map<std::string, std::string> kKnown = {
-    {"gltf/AssetGenerator-Mesh_PrimitiveMode/Mesh_PrimitiveMode/Mesh_PrimitiveMode_00.gltf", kNoPoints},
-    {"gltf/AssetGenerator-Mesh_PrimitiveMode/Mesh_PrimitiveMode/Mesh_PrimitiveMode_07.gltf", kNoPoints},
-    {"meshes/assimp/PLY/pond.0.ply", kNoPoints},
-    {"meshes/draco-testdata/test_lines.obj", kNoPoints},
-};
+const std::map<std::string, std::string> kKnown = {};
 // Files every loader must refuse, with (part of) the one-line reason.
 const std::map<std::string, std::string> kRefused = {
     {"meshes/assimp/OBJ/box_UTF16BE.obj", "box_UTF16BE.obj: UTF-16 text is not supported"},
@@ -97,8 +91,8 @@ TEST_P(Sweep, BackendsAgree) {
     const rnd::ImageDiff c = rnd::compareImages(img["raster"], img["raycast"], 4);
     const bool agree = a.meanAbs <= 1.0 && a.fractionWithin >= 0.995 && c.fractionWithin >= 0.99;
     char line[512];
-    std::snprintf(line, sizeof line, "| %s | %.3f | %.2f%% | %.2f%% | %s |", rel.c_str(), a.meanAbs, 100.0 * a.fractionWithin, 100.0 * c.fractionWithin,
-                  agree ? "ok" : "differs");
+    std::snprintf(line, sizeof line, "| %s | %.3f | %.2f%% | %.2f%% | %s |", rel.c_str(), a.meanAbs, 100.0 * a.fractionWithin,
+                  100.0 * c.fractionWithin, agree ? "ok" : "differs");
     std::printf("sweep: %s\n", line);
     std::ofstream(testing_support::outputDir("sweep") / (stem + ".md")) << line << "\n";
     auto known = kKnown.find(rel);
