@@ -1,11 +1,13 @@
 // cli.cpp - render / compare / demo-shots: everything the UI can make, made headless.
 #include "cli.h"
 
+#include "assets/aov_io.h"
 #include "assets/demo.h"
 #include "assets/files.h"
 #include "assets/image_io.h"
 #include "assets/scene_io.h"
 #include "renderers/renderer.h"
+#include "scenegraph/camera_model.h"
 #include "scenegraph/setting_names.h"
 #include "ui/viewer.h"
 
@@ -205,6 +207,9 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a, bool compare) {
     } else {
         cmd.add_option("--out", a.out, "Output PNG file")->required();
         cmd.add_option("--backend", a.backend, "Backend: gl, raster or raycast")->capture_default_str();
+        cmd.add_option("--aov", a.aov,
+                       "Also write, next to OUT.png: depth (OUT.depth.pfm, float32 depth along the optical axis, 0 = nothing) and the "
+                       "camera sidecar OUT.json (K, world_to_camera, projection, near, far)");
     }
     cmd.add_option("--size", a.size, "Image size WIDTHxHEIGHT")->capture_default_str();
     cmd.add_flag("--overwrite", a.overwrite, "Replace existing output files");
@@ -229,6 +234,48 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a, bool compare) {
     cmd.add_option("--tessellation", a.tessellation, "Tessellation resolution for implicit shapes (4..512)");
 }
 
+// --aov: the extra files next to `out` (P.png -> P.depth.pfm, P.json). Checked before
+// rendering: known kinds only, and no existing file replaced without --overwrite.
+std::string checkAovs(const RenderArgs& a, const fs::path& out) {
+    std::stringstream list(a.aov);
+    fs::path base = out;
+    base.replace_extension();
+    std::vector<fs::path> files;
+    for (std::string k; std::getline(list, k, ',');) {
+        if (k.empty()) continue;
+        if (k != "depth") return "--aov: '" + k + "' is not supported yet (supported: depth)";
+        files.push_back(base.string() + ".depth.pfm");
+    }
+    if (!files.empty()) files.push_back(base.string() + ".json");
+    std::error_code ec;
+    for (const fs::path& f : files)
+        if (!a.overwrite && fs::exists(fs::symlink_status(f, ec))) return f.string() + ": file exists (use --overwrite to replace it)";
+    return {};
+}
+
+std::string writeAovs(const RenderArgs& a, const fs::path& out, const sg::FrameInput& frame, const rnd::Framebuffer& img) {
+    std::vector<std::string> kinds;
+    std::stringstream list(a.aov);
+    for (std::string k; std::getline(list, k, ',');)
+        if (!k.empty()) kinds.push_back(k);
+    if (kinds.empty()) return {};
+    fs::path base = out;
+    base.replace_extension();
+    assets::AovSidecar side;
+    side.width = img.width;
+    side.height = img.height;
+    side.backend = a.backend;
+    side.projection = std::string(sg::nameOf(frame.camera.projection.type));
+    side.camera = sg::cameraModelOf(frame.camera, img.width, img.height);
+    for (const std::string& k : kinds) {
+        fs::path p = base.string() + "." + k + ".pfm";   // k is "depth" (checkAovs)
+        std::string e = assets::writePfm(p, img.width, img.height, sg::opticalDepthMap(frame.camera, img.width, img.height, img.depth), a.overwrite);
+        if (!e.empty()) return e;
+        side.files.push_back(p.filename().string());
+    }
+    return assets::writeAovSidecar(base.string() + ".json", side, a.overwrite);
+}
+
 int runRender(const RenderArgs& a) {
     int w = 0, h = 0;
     std::string err;
@@ -236,6 +283,7 @@ int runRender(const RenderArgs& a) {
     fs::path out = a.out;
     std::error_code ec;
     if (!a.overwrite && fs::exists(fs::symlink_status(out, ec))) return fail(out.string() + ": file exists (use --overwrite to replace it)");
+    if (!(err = checkAovs(a, out)).empty()) return fail(err);
     auto scene = loadSceneArg(a.scene, err);
     if (!scene) return fail(err);
     err = applyOverrides(a, *scene);
@@ -245,6 +293,7 @@ int runRender(const RenderArgs& a) {
     if (!shot.stats.ok) return fail(shot.stats.error);   // starts with the backend's name
     err = assets::writePng(out, shot.image.width, shot.image.height, shot.image.color.data(), a.overwrite);
     if (!err.empty()) return fail(err);
+    if (!(err = writeAovs(a, out, frame, shot.image)).empty()) return fail(err);
     std::printf("%s: %dx%d, %s backend, %s, %.1f ms\n", out.string().c_str(), w, h, a.backend.c_str(), shot.stats.config.describe().c_str(),
                 shot.stats.milliseconds);
     return 0;

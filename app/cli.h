@@ -19,6 +19,7 @@ struct RenderArgs {
     std::optional<std::string> shading, reflection, fog, aa, projection, shadows, reflections, culling, wireframe, attenuation;
     std::optional<float> fogStart, fogEnd, fogDensity, fovy, obliqueAngle, obliqueFactor;
     std::optional<int> tessellation, bounces;
+    std::string aov;   // comma-separated list of extra outputs (render only): depth
 };
 
 void addRenderOptions(CLI::App& cmd, RenderArgs& args, bool compare);

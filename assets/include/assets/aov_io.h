@@ -1,0 +1,30 @@
+// aov_io.h - files of the synthetic-data export (`viewer render --aov`): a depth map as a
+// grey float32 PFM and the JSON sidecar with the camera (K, world_to_camera in computer-vision
+// axes, projection, near, far). Written atomically; an existing file is replaced only with
+// overwrite. Each returns "" or a one-line error naming the file.
+#pragma once
+
+#include "scenegraph/camera_model.h"
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace assets {
+
+// Grey PFM ("Pf"), little-endian (scale -1), rows bottom to top as the format stores them;
+// `topDown` holds width x height values, row 0 the image's top row.
+std::string writePfm(const std::filesystem::path& path, int width, int height, const std::vector<float>& topDown, bool overwrite);
+// Reads a grey PFM written by writePfm (either endianness) back into top-down rows.
+std::string readPfm(const std::filesystem::path& path, int& width, int& height, std::vector<float>& topDown);
+
+struct AovSidecar {
+    int width = 0, height = 0;
+    std::string backend;
+    std::string projection;   // "perspective", "orthographic" or "oblique"
+    sg::CameraModel camera;
+    std::vector<std::string> files;   // the exported images, names relative to the sidecar
+};
+std::string writeAovSidecar(const std::filesystem::path& path, const AovSidecar& s, bool overwrite);
+
+}   // namespace assets
