@@ -228,6 +228,35 @@ void setupStyle(float scale, const char* fontPath) {
 
 // --- 3. main menu ------------------------------------------------------------------------------
 
+namespace {
+
+// Edit: Undo / Redo naming the step they apply (greyed when there is none), then the
+// selection's rename / duplicate / delete.
+void drawEditMenu(ViewerState& st) {
+    bool open = ImGui::BeginMenu("Edit");
+    record(st, "menu/edit");
+    if (!open) return;
+    const UndoStack& h = st.doc.history;
+    std::string undo = h.canUndo() ? "Undo " + h.undoLabel() : std::string("Undo");
+    std::string redo = h.canRedo() ? "Redo " + h.redoLabel() : std::string("Redo");
+    if (ImGui::MenuItem((undo + "###undo").c_str(), "Ctrl+Z", false, h.canUndo())) st.undo();
+    record(st, "edit/undo");
+    if (ImGui::MenuItem((redo + "###redo").c_str(), "Ctrl+Shift+Z", false, h.canRedo())) st.redo();
+    record(st, "edit/redo");
+    ImGui::Separator();
+    sg::NodeId sel = st.doc.selected;
+    bool canEdit = st.doc.scene.valid(sel) && sel != st.doc.scene.root();
+    if (ImGui::MenuItem("Rename", "F2", false, canEdit)) {
+        st.ui.panels.renaming = sel;
+        st.ui.panels.renameBuffer = st.doc.scene.node(sel).name;
+    }
+    if (ImGui::MenuItem("Duplicate", "Ctrl+D", false, canEdit)) st.duplicateNode(sel);
+    if (ImGui::MenuItem("Delete", "Del", false, canEdit)) st.removeNode(sel);
+    ImGui::EndMenu();
+}
+
+}   // namespace
+
 void drawMainMenu(ViewerState& st) {
     if (!ImGui::BeginMainMenuBar()) return;
     if (ImGui::BeginMenu("File")) {
@@ -248,6 +277,7 @@ void drawMainMenu(ViewerState& st) {
         if (ImGui::MenuItem("Quit", "Ctrl+Q")) st.requestQuit();
         ImGui::EndMenu();
     }
+    drawEditMenu(st);
     if (ImGui::BeginMenu("View")) {
         if (ImGui::MenuItem("Fit to scene / selection", "F")) st.fitView(st.doc.scene.valid(st.doc.selected));
         if (ImGui::MenuItem("Reset to scene camera", "Home")) st.resetView();
@@ -432,8 +462,9 @@ void drawSceneTree(ViewerState& st) {
 
 namespace {
 
-// Material editor for a payload's material index. Returns true when the index changed.
-bool materialEditor(ViewerState& st, int& index) {
+// Material editor for the material index of node `id`'s payload. Returns true when the index
+// changed. Edits of one material while a widget is held merge into one undo step.
+bool materialEditor(ViewerState& st, sg::NodeId id, int& index) {
     bool indexChanged = false;
     std::string preview = index < 0 || size_t(index) >= st.doc.scene.materials.size()
                               ? std::string("(default)")
@@ -453,13 +484,13 @@ bool materialEditor(ViewerState& st, int& index) {
         ImGui::EndCombo();
     }
     ImGui::SameLine();
-    if (ImGui::SmallButton("New")) {
+    if (ImGui::SmallButton("New")) {   // one undo step: the material and the node's index
         sg::Material m = st.doc.scene.material(index);
         m.name = "material " + std::to_string(st.doc.scene.materials.size());
-        st.doc.scene.materials.push_back(m);
-        index = int(st.doc.scene.materials.size()) - 1;
-        indexChanged = true;
+        int added = st.addMaterialFor(id, m);
+        if (added >= 0) index = added;   // the node already has it: no second step
     }
+    record(st, "material/new");
     if (index < 0 || size_t(index) >= st.doc.scene.materials.size()) {
         ImGui::TextDisabled("Default material (press New to edit a copy)");
         return indexChanged;
@@ -469,7 +500,9 @@ bool materialEditor(ViewerState& st, int& index) {
     ch |= ImGui::InputText("Name##mat", &m.name, ImGuiInputTextFlags_EnterReturnsTrue);
     ch |= ImGui::ColorEdit3("Base colour", &m.baseColor.x, ImGuiColorEditFlags_Float);
     ch |= ImGui::SliderFloat("ka (ambient)", &m.ka, 0.0f, 1.0f);
+    record(st, "material/ka");
     ch |= ImGui::SliderFloat("kd (diffuse)", &m.kd, 0.0f, 1.0f);
+    record(st, "material/kd");
     ch |= ImGui::SliderFloat("ks (specular)", &m.ks, 0.0f, 1.0f);
     ch |= ImGui::SliderFloat("Shininess n", &m.shininess, 1.0f, 512.0f, "%.1f", ImGuiSliderFlags_Logarithmic);
     ch |= ImGui::Checkbox("Specular tinted by base colour", &m.specularTinted);
@@ -491,10 +524,7 @@ bool materialEditor(ViewerState& st, int& index) {
     ch |= enumCombo(st, "Alpha mode", m.alphaMode);
     if (m.alphaMode != sg::AlphaMode::Opaque) ch |= ImGui::SliderFloat("Alpha", &m.alpha, 0.0f, 1.0f);
     if (m.alphaMode == sg::AlphaMode::Mask) ch |= ImGui::SliderFloat("Alpha cutoff", &m.alphaCutoff, 0.0f, 1.0f);
-    if (ch && !(m == st.doc.scene.materials[index])) {
-        st.doc.scene.materials[index] = m;
-        st.markEdited();
-    }
+    if (ch) st.setMaterial(index, m, "material " + std::to_string(index));
     return indexChanged;
 }
 
@@ -554,7 +584,7 @@ void transformEditor(ViewerState& st, sg::NodeId id) {
         }
         helpMarker("Euler angles applied X, then Y, then Z (R = Rz Ry Rx)");
         ch |= ImGui::DragFloat3("Scale", &t.scale.x, 0.01f);
-        if (ch) st.setLocal(id, t);
+        if (ch) st.setLocal(id, t, "local " + std::to_string(id));
     } else {
         if (ImGui::Button("Convert back to TRS")) {
             sg::LocalTransform c = t;
@@ -597,7 +627,7 @@ void transformEditor(ViewerState& st, sg::NodeId id) {
     if (ImGui::SmallButton("Identity")) { st.setLocal(id, sg::LocalTransform{}); }
     if (mch) {
         if (sg::isFinite(m) && sg::isInvertible(m))
-            st.setLocal(id, sg::LocalTransform::fromMatrix(m));
+            st.setLocal(id, sg::LocalTransform::fromMatrix(m), "local " + std::to_string(id));
         else
             st.ui.status = "Matrix edit refused: singular or not finite";
     }
@@ -615,7 +645,8 @@ void sceneSummary(ViewerState& st) {
     ImGui::Text("Scene: %s", scene.name.c_str());
     ImGui::Text("Nodes: %zu   meshes: %zu   materials: %zu   textures: %zu", scene.nodeCount(), scene.meshes.size(), scene.materials.size(),
                 scene.textures.size());
-    if (ImGui::ColorEdit3("Ambient light", &scene.ambientLight.x, ImGuiColorEditFlags_Float)) st.markEdited();
+    sg::vec3 ambient = scene.ambientLight;
+    if (ImGui::ColorEdit3("Ambient light", &ambient.x, ImGuiColorEditFlags_Float)) st.setAmbientLight(ambient, "ambient");
 }
 
 // Name, kind and id, visibility.
@@ -637,8 +668,8 @@ void nodeHeader(ViewerState& st, sg::NodeId id) {
 // The payload sections below edit a copy of the payload and return true when it changed;
 // drawInspector writes it back.
 
-bool materialSection(ViewerState& st, int& index) {
-    return ImGui::CollapsingHeader("Material", ImGuiTreeNodeFlags_DefaultOpen) && materialEditor(st, index);
+bool materialSection(ViewerState& st, sg::NodeId id, int& index) {
+    return ImGui::CollapsingHeader("Material", ImGuiTreeNodeFlags_DefaultOpen) && materialEditor(st, id, index);
 }
 
 void meshSection(const ViewerState& st, const sg::MeshInstance& mi) {
@@ -723,23 +754,23 @@ bool payloadEditor(ViewerState& st, sg::NodeId id, sg::Payload& p) {
     bool ch = false;
     if (auto* mi = std::get_if<sg::MeshInstance>(&p)) {
         meshSection(st, *mi);
-        ch |= materialSection(st, mi->material);
+        ch |= materialSection(st, id, mi->material);
     } else if (auto* ip = std::get_if<sg::ImplicitPayload>(&p)) {
         if (ImGui::CollapsingHeader("Implicit shape", ImGuiTreeNodeFlags_DefaultOpen)) ch |= implicitEditor(st, ip->shape);
-        ch |= materialSection(st, ip->material);
+        ch |= materialSection(st, id, ip->material);
     } else if (auto* cp = std::get_if<sg::CsgPayload>(&p)) {
         ch |= csgSection(st, id, *cp);
-        ch |= materialSection(st, cp->material);
+        ch |= materialSection(st, id, cp->material);
     } else if (auto* lp = std::get_if<sg::Light>(&p)) {
         ch |= lightSection(st, *lp);
     } else if (auto* cam = std::get_if<sg::Camera>(&p)) {
         ch |= cameraSection(st, id, *cam);
     } else if (auto* pp = std::get_if<sg::ParametricPayload>(&p)) {
         ch |= parametricSection(st, *pp);
-        ch |= materialSection(st, pp->material);
+        ch |= materialSection(st, id, pp->material);
     } else if (auto* gp = std::get_if<sg::GridPayload>(&p)) {
         ch |= gridSection(*gp);
-        ch |= materialSection(st, gp->material);
+        ch |= materialSection(st, id, gp->material);
     }
     return ch;
 }
@@ -756,10 +787,7 @@ void drawInspector(ViewerState& st) {
     if (id != st.doc.scene.root() && ImGui::CollapsingHeader("Transform", ImGuiTreeNodeFlags_DefaultOpen)) transformEditor(st, id);
 
     sg::Payload p = st.doc.scene.node(id).payload;
-    if (payloadEditor(st, id, p) && st.doc.scene.valid(id) && !(p == st.doc.scene.node(id).payload)) {
-        st.doc.scene.setPayload(id, p);
-        st.markEdited();
-    }
+    if (payloadEditor(st, id, p) && st.doc.scene.valid(id)) st.setPayload(id, p, "payload " + std::to_string(id));
 }
 
 void drawAnimationPanel(ViewerState& st) {
@@ -848,7 +876,7 @@ void drawCameraPanel(ViewerState& st) {
     if (ch) {
         p.zNear = std::max(p.zNear, 1e-4f);
         p.zFar = std::max(p.zFar, p.zNear * 1.001f);
-        st.editProjection() = p;
+        st.setProjection(p, "projection");
     }
     ImGui::TextDisabled("Zoom factor %.3f  (orthographic / oblique)", st.view.camera.orthoScale);
 
@@ -912,10 +940,7 @@ void drawRenderingPanel(ViewerState& st) {
     ch |= ImGui::Checkbox("Light attenuation (1/r^2)", &s.attenuation);
     record(st, "render/attenuation");
     sg::vec3 amb = st.doc.scene.ambientLight;
-    if (ImGui::ColorEdit3("Ambient light", &amb.x, ImGuiColorEditFlags_Float)) {
-        st.doc.scene.ambientLight = amb;
-        st.markEdited();
-    }
+    if (ImGui::ColorEdit3("Ambient light", &amb.x, ImGuiColorEditFlags_Float)) st.setAmbientLight(amb, "ambient");
 
     section("Fog");
     ch |= enumCombo(st, "Fog", s.fog);
@@ -961,15 +986,7 @@ void drawRenderingPanel(ViewerState& st) {
     section("Background");
     ch |= ImGui::ColorEdit3("Background", &s.background.x, ImGuiColorEditFlags_Float);
 
-    if (ch && !(s == st.doc.scene.settings)) {
-        std::string err = s.validate();
-        if (err.empty()) {
-            st.doc.scene.settings = s;
-            st.markEdited();
-        } else {
-            st.ui.status = "Setting refused: " + err;
-        }
-    }
+    if (ch) st.setSettings(s, "settings");   // refused values: the reason goes to the status line
 }
 
 // --- 8. compare panel --------------------------------------------------------------------------
@@ -1438,6 +1455,7 @@ void drawDialogs(ViewerState& st) {
 
     if (st.ui.confirmOpen && !ImGui::IsPopupOpen("Unsaved changes")) ImGui::OpenPopup("Unsaved changes");
     if (ImGui::BeginPopupModal("Unsaved changes", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
+        if (!st.ui.confirmOpen) ImGui::CloseCurrentPopup();   // answered elsewhere (automation's `answer`)
         const char* what = st.ui.pending == PendingAction::Quit  ? "quitting"
                            : st.ui.pending == PendingAction::New ? "starting a new scene"
                                                                  : "opening another file";
@@ -1490,6 +1508,8 @@ void drawDialogs(ViewerState& st) {
                 "Space              play / pause the animation (viewport)\n"
                 "F2                 rename selection\n"
                 "Del, Ctrl+D        delete / duplicate selection\n"
+                "Ctrl+Z             undo (Edit menu names the step)\n"
+                "Ctrl+Shift+Z, Ctrl+Y  redo\n"
                 "Ctrl+N/O/S/Q       new / open / save / quit\n"
                 "Drag tree nodes onto others to re-parent.\n"
                 "Drop files onto the window to open them.");
@@ -1516,6 +1536,13 @@ void handleShortcuts(ViewerState& st) {
         if (ImGui::IsKeyPressed(keys::N, false)) st.requestNew();
         if (ImGui::IsKeyPressed(keys::Q, false)) st.requestQuit();
         if (ImGui::IsKeyPressed(keys::D, false)) st.duplicateNode(st.doc.selected);
+        if (ImGui::IsKeyPressed(keys::Z, false)) {
+            if (io.KeyShift)
+                st.redo();
+            else
+                st.undo();
+        }
+        if (ImGui::IsKeyPressed(keys::Y, false)) st.redo();
         return;
     }
     for (int i = 0; i < 3; ++i)
@@ -1658,6 +1685,9 @@ void drawUi(ViewerState& st, const ViewportInput& view, double time, float dt) {
     drawStatusBar(st, view, statusH);
     drawDialogs(st);
     handleShortcuts(st);
+    // The mouse was released (or never pressed): the next edit starts a new undo step instead
+    // of merging into the last drag's.
+    if (!ImGui::IsAnyItemActive()) st.doc.history.closeMerge();
 }
 
 }   // namespace ui

@@ -24,6 +24,8 @@ void ViewerState::setScene(sg::Scene s, fs::path path) {
     doc.path = std::move(path);
     doc.dirty = false;
     doc.selected = sg::kNoNode;
+    doc.history.clear();
+    ui.panels.renaming = sg::kNoNode;
     anim.clips.clear();   // a load puts its clips back after this
     anim.clip = 0;
     anim.time = 0.0;
@@ -33,25 +35,79 @@ void ViewerState::setScene(sg::Scene s, fs::path path) {
 }
 
 void ViewerState::markEdited() {
+    doc.history.forgetSaved();
     doc.dirty = true;
     ++doc.version;
 }
 
 void ViewerState::markViewChanged() { ++view.version; }
 
+UndoStep ViewerState::newStep(std::string label) const {
+    UndoStep step;
+    step.label = std::move(label);
+    step.selectedBefore = doc.selected;
+    return step;
+}
+
+void ViewerState::commit(UndoStep step, std::string_view mergeKey) {
+    if (step.changes.empty()) return;
+    step.selectedAfter = doc.selected;
+    doc.history.push(std::move(step), mergeKey);
+    doc.dirty = !doc.history.atSavedState();
+    ++doc.version;
+}
+
+namespace {
+// After undo / redo: the step's selection when its node is there, else none; an in-place
+// rename of a node that is gone ends.
+void afterHistoryMove(ViewerState& st, sg::NodeId selection, const std::string& what) {
+    st.doc.selected = st.doc.scene.valid(selection) ? selection : sg::kNoNode;
+    if (!st.doc.scene.valid(st.ui.panels.renaming)) st.ui.panels.renaming = sg::kNoNode;
+    st.doc.dirty = !st.doc.history.atSavedState();
+    ++st.doc.version;
+    st.ui.status = what;
+}
+}   // namespace
+
+bool ViewerState::undo() {
+    std::string err;
+    const UndoStep* step = doc.history.undo(doc.scene, &err);
+    if (!step) {
+        if (!err.empty()) afterHistoryMove(*this, doc.selected, err);
+        return false;
+    }
+    afterHistoryMove(*this, step->selectedBefore, "Undone: " + step->label);
+    return true;
+}
+
+bool ViewerState::redo() {
+    std::string err;
+    const UndoStep* step = doc.history.redo(doc.scene, &err);
+    if (!step) {
+        if (!err.empty()) afterHistoryMove(*this, doc.selected, err);
+        return false;
+    }
+    afterHistoryMove(*this, step->selectedAfter, "Redone: " + step->label);
+    return true;
+}
+
 void ViewerState::selectNode(sg::NodeId id) { doc.selected = doc.scene.valid(id) ? id : sg::kNoNode; }
 
 bool ViewerState::renameNode(sg::NodeId id, const std::string& name) {
     if (!doc.scene.valid(id) || name.empty() || doc.scene.node(id).name == name) return false;
+    UndoStep step = newStep("Rename " + doc.scene.node(id).name);
+    step.changes.push_back(NodeNameChange{id, doc.scene.node(id).name, name});
     doc.scene.setName(id, name);
-    markEdited();
+    commit(std::move(step));
     return true;
 }
 
 void ViewerState::setVisible(sg::NodeId id, bool v) {
     if (!doc.scene.valid(id) || doc.scene.node(id).visible == v) return;
+    UndoStep step = newStep((v ? "Show " : "Hide ") + doc.scene.node(id).name);
+    step.changes.push_back(NodeVisibleChange{id, !v, v});
     doc.scene.setVisible(id, v);
-    markEdited();
+    commit(std::move(step));
 }
 
 namespace {
@@ -71,16 +127,24 @@ std::string uniqueName(const sg::Scene& s, const std::string& base) {
         if (s.findByName(n) == sg::kNoNode) return n;
     }
 }
+// The step of a node just added (with its subtree): selects it and records it.
+sg::NodeId commitAdded(ViewerState& st, UndoStep step, sg::NodeId id) {
+    step.label += " " + st.doc.scene.node(id).name;
+    step.changes.insert(step.changes.begin(), SubtreeChange{id, /*added=*/true, {}});
+    st.doc.selected = id;
+    st.commit(std::move(step));
+    return id;
+}
 }   // namespace
 
 sg::NodeId ViewerState::addGroup(sg::NodeId parent) {
+    UndoStep step = newStep("Add");
     sg::NodeId id = doc.scene.addNode(uniqueName(doc.scene, "group"), parentFor(*this, parent));
-    doc.selected = id;
-    markEdited();
-    return id;
+    return commitAdded(*this, std::move(step), id);
 }
 
 sg::NodeId ViewerState::addShape(sg::ImplicitType type, sg::NodeId parent) {
+    UndoStep step = newStep("Add");
     sg::ImplicitPayload p;
     p.shape.type = type;
     if (type == sg::ImplicitType::Quadric) {
@@ -88,12 +152,11 @@ sg::NodeId ViewerState::addShape(sg::ImplicitType type, sg::NodeId parent) {
         p.shape.quadric = sg::mat4(1, 0, 0, 0, 0, -1, 0, 0, 0, 0, 1, 0, 0, 0, 0, -0.25f);
     }
     sg::NodeId id = doc.scene.addNode(uniqueName(doc.scene, std::string(sg::toString(type))), parentFor(*this, parent), p);
-    doc.selected = id;
-    markEdited();
-    return id;
+    return commitAdded(*this, std::move(step), id);
 }
 
 sg::NodeId ViewerState::addCsg(sg::CsgOp op, sg::NodeId parent) {
+    UndoStep step = newStep("Add");
     sg::NodeId id = doc.scene.addNode(uniqueName(doc.scene, "csg " + std::string(sg::toString(op))), parentFor(*this, parent),
                                       sg::CsgPayload{sg::CsgNode{op}, -1});
     // Two operands so the node shows something right away.
@@ -105,12 +168,11 @@ sg::NodeId ViewerState::addCsg(sg::CsgOp op, sg::NodeId parent) {
     b.radius = 0.75f;
     doc.scene.addNode("box", id, sg::ImplicitPayload{a, -1});
     doc.scene.addNode("sphere", id, sg::ImplicitPayload{b, -1});
-    doc.selected = id;
-    markEdited();
-    return id;
+    return commitAdded(*this, std::move(step), id);
 }
 
 sg::NodeId ViewerState::addLight(sg::LightType type, sg::NodeId parent) {
+    UndoStep step = newStep("Add");
     sg::Light l;
     l.type = type;
     l.intensity = type == sg::LightType::Directional ? 1.0f : 10.0f;
@@ -119,12 +181,11 @@ sg::NodeId ViewerState::addLight(sg::LightType type, sg::NodeId parent) {
     sg::LocalTransform t = sg::LocalTransform::fromTRS(view.camera.pivot + sg::vec3(0, 3, 0));
     t.setEulerDegrees(sg::vec3(-90, 0, 0));   // point down
     doc.scene.setLocal(id, t);
-    doc.selected = id;
-    markEdited();
-    return id;
+    return commitAdded(*this, std::move(step), id);
 }
 
 sg::NodeId ViewerState::addCamera() {
+    UndoStep step = newStep("Add");
     sg::Camera c;
     c.projection = projection();
     c.focusDistance = view.camera.distance;
@@ -132,50 +193,127 @@ sg::NodeId ViewerState::addCamera() {
     doc.scene.setLocalMatrix(id, view.camera.world());
     sg::LocalTransform t = doc.scene.node(id).local;
     if (t.tryMakeTRS()) doc.scene.setLocal(id, t);
-    if (!doc.scene.valid(doc.scene.activeCamera)) doc.scene.activeCamera = id;
-    doc.selected = id;
-    markEdited();
-    return id;
+    if (!doc.scene.valid(doc.scene.activeCamera)) {
+        step.changes.push_back(ActiveCameraChange{doc.scene.activeCamera, id});
+        doc.scene.activeCamera = id;
+    }
+    return commitAdded(*this, std::move(step), id);
 }
 
 bool ViewerState::removeNode(sg::NodeId id) {
     if (!doc.scene.valid(id) || id == doc.scene.root()) return false;
-    bool hadActive = doc.scene.valid(doc.scene.activeCamera) && doc.scene.isAncestor(id, doc.scene.activeCamera);
-    if (!doc.scene.removeNode(id)) return false;
-    if (hadActive) doc.scene.activeCamera = sg::kNoNode;
+    UndoStep step = newStep("Delete " + doc.scene.node(id).name);
+    sg::DetachedSubtree d = doc.scene.detach(id);   // also clears the active camera when it was inside
+    if (d.id != id) return false;
+    step.changes.push_back(SubtreeChange{id, /*added=*/false, std::move(d)});
     if (!doc.scene.valid(doc.selected)) doc.selected = sg::kNoNode;
-    markEdited();
+    commit(std::move(step));
     return true;
 }
 
 sg::NodeId ViewerState::duplicateNode(sg::NodeId id) {
     if (!doc.scene.valid(id) || id == doc.scene.root()) return sg::kNoNode;
+    UndoStep step = newStep("Duplicate " + doc.scene.node(id).name);
     sg::NodeId c = doc.scene.duplicate(id);
-    if (doc.scene.valid(c)) {
-        doc.scene.setName(c, uniqueName(doc.scene, doc.scene.node(id).name + " copy"));
-        doc.selected = c;
-        markEdited();
-    }
+    if (!doc.scene.valid(c)) return c;
+    doc.scene.setName(c, uniqueName(doc.scene, doc.scene.node(id).name + " copy"));
+    step.changes.push_back(SubtreeChange{c, /*added=*/true, {}});
+    doc.selected = c;
+    commit(std::move(step));
     return c;
 }
 
 bool ViewerState::reparent(sg::NodeId id, sg::NodeId newParent, std::string* error) {
     std::string err;
     if (doc.scene.valid(id) && doc.scene.valid(newParent) && doc.scene.node(id).parent == newParent) return false;   // no-op
+    NodePlace before;
+    if (doc.scene.valid(id)) before = NodePlace{doc.scene.node(id).parent, doc.scene.childIndex(id), doc.scene.node(id).local};
     if (!doc.scene.reparent(id, newParent, /*keepWorld=*/true, &err)) {
         if (err.empty()) err = "cannot move this node there";
         ui.status = "Move refused: " + err;
         if (error) *error = err;
         return false;
     }
-    markEdited();
+    UndoStep step = newStep("Move " + doc.scene.node(id).name + " under " + doc.scene.node(newParent).name);
+    step.changes.push_back(MoveChange{id, before, NodePlace{newParent, doc.scene.childIndex(id), doc.scene.node(id).local}});
+    commit(std::move(step));
     return true;
 }
 
-void ViewerState::setLocal(sg::NodeId id, const sg::LocalTransform& t) {
+void ViewerState::setLocal(sg::NodeId id, const sg::LocalTransform& t, std::string_view mergeKey) {
     if (!doc.scene.valid(id) || doc.scene.node(id).local == t) return;
+    UndoStep step = newStep("Transform " + doc.scene.node(id).name);
+    step.changes.push_back(NodeLocalChange{id, doc.scene.node(id).local, t});
     doc.scene.setLocal(id, t);
-    markEdited();
+    commit(std::move(step), mergeKey);
+}
+
+void ViewerState::setPayload(sg::NodeId id, const sg::Payload& p, std::string_view mergeKey) {
+    if (!doc.scene.valid(id) || doc.scene.node(id).payload == p) return;
+    UndoStep step = newStep("Edit " + doc.scene.node(id).name);
+    step.changes.push_back(NodePayloadChange{id, doc.scene.node(id).payload, p});
+    doc.scene.setPayload(id, p);
+    commit(std::move(step), mergeKey);
+}
+
+void ViewerState::setMaterial(int index, const sg::Material& m, std::string_view mergeKey) {
+    if (index < 0 || size_t(index) >= doc.scene.materials.size() || doc.scene.materials[size_t(index)] == m) return;
+    UndoStep step = newStep("Edit material " + doc.scene.materials[size_t(index)].name);
+    step.changes.push_back(MaterialChange{index, doc.scene.materials[size_t(index)], m});
+    doc.scene.materials[size_t(index)] = m;
+    commit(std::move(step), mergeKey);
+}
+
+namespace {
+// The material index of a payload kind that has one (null for groups, cameras, lights).
+int* materialIndexOf(sg::Payload& p) {
+    return std::visit(
+        [](auto& x) -> int* {
+            if constexpr (requires { x.material; })
+                return &x.material;
+            else
+                return nullptr;
+        },
+        p);
+}
+}   // namespace
+
+int ViewerState::addMaterialFor(sg::NodeId id, const sg::Material& m) {
+    if (!doc.scene.valid(id)) return -1;
+    sg::Payload p = doc.scene.node(id).payload;
+    int* slot = materialIndexOf(p);
+    if (!slot) return -1;
+    UndoStep step = newStep("New material for " + doc.scene.node(id).name);
+    int index = int(doc.scene.materials.size());
+    step.changes.push_back(MaterialChange{index, std::nullopt, m});
+    doc.scene.materials.push_back(m);
+    *slot = index;
+    step.changes.push_back(NodePayloadChange{id, doc.scene.node(id).payload, p});
+    doc.scene.setPayload(id, p);
+    commit(std::move(step));
+    return index;
+}
+
+std::string ViewerState::setSettings(const sg::RenderSettings& s, std::string_view mergeKey) {
+    if (s == doc.scene.settings) return {};
+    std::string err = s.validate();
+    if (!err.empty()) {
+        ui.status = "Setting refused: " + err;
+        return err;
+    }
+    UndoStep step = newStep("Change rendering settings");
+    step.changes.push_back(SettingsChange{doc.scene.settings, s});
+    doc.scene.settings = s;
+    commit(std::move(step), mergeKey);
+    return {};
+}
+
+void ViewerState::setAmbientLight(const sg::vec3& color, std::string_view mergeKey) {
+    if (color == doc.scene.ambientLight) return;
+    UndoStep step = newStep("Change ambient light");
+    step.changes.push_back(AmbientChange{doc.scene.ambientLight, color});
+    doc.scene.ambientLight = color;
+    commit(std::move(step), mergeKey);
 }
 
 // --- backend ---------------------------------------------------------------------------------
@@ -206,13 +344,16 @@ const sg::Projection& ViewerState::projection() const {
     return c ? c->projection : view.fallbackProjection;
 }
 
-sg::Projection& ViewerState::editProjection() {
-    if (doc.scene.valid(doc.scene.activeCamera) && std::holds_alternative<sg::Camera>(doc.scene.node(doc.scene.activeCamera).payload)) {
-        markEdited();
-        return std::get<sg::Camera>(doc.scene.editPayload(doc.scene.activeCamera)).projection;
+void ViewerState::setProjection(const sg::Projection& p, std::string_view mergeKey) {
+    sg::NodeId cam = doc.scene.activeCamera;
+    if (doc.scene.valid(cam) && std::holds_alternative<sg::Camera>(doc.scene.node(cam).payload)) {
+        sg::Payload payload = doc.scene.node(cam).payload;
+        std::get<sg::Camera>(payload).projection = p;
+        setPayload(cam, payload, mergeKey);
+        return;
     }
+    view.fallbackProjection = p;
     ++view.version;
-    return view.fallbackProjection;
 }
 
 float ViewerState::focusDistance() const {
@@ -273,8 +414,10 @@ void ViewerState::resetView() {
 void ViewerState::useSceneCamera(sg::NodeId id) {
     if (!doc.scene.valid(id) || !std::holds_alternative<sg::Camera>(doc.scene.node(id).payload)) return;
     if (doc.scene.activeCamera != id) {
+        UndoStep step = newStep("Look through " + doc.scene.node(id).name);
+        step.changes.push_back(ActiveCameraChange{doc.scene.activeCamera, id});
         doc.scene.activeCamera = id;
-        markEdited();
+        commit(std::move(step));
     }
     view.camera.setFromWorld(doc.scene.world(id), std::get<sg::Camera>(doc.scene.node(id).payload).focusDistance);
     markViewChanged();
@@ -292,12 +435,16 @@ void ViewerState::storeViewInCamera() {
     float ortho = c.projection.orthoHalfHeight * view.camera.orthoScale;
     bool changed = !(doc.scene.node(id).local == t) || c.focusDistance != focus || c.projection.orthoHalfHeight != ortho;
     if (!changed) return;
+    UndoStep step = newStep("Store view in " + doc.scene.node(id).name);
+    step.changes.push_back(NodeLocalChange{id, doc.scene.node(id).local, t});
     doc.scene.setLocal(id, t);
+    sg::Payload before = doc.scene.node(id).payload;
     c.focusDistance = focus;
     c.projection.orthoHalfHeight = ortho;
+    step.changes.push_back(NodePayloadChange{id, std::move(before), c});
     doc.scene.setPayload(id, c);
     view.camera.orthoScale = 1.0f;
-    markEdited();
+    commit(std::move(step));
 }
 
 sg::FrameInput ViewerState::buildFrame(float aspect) const {
@@ -448,6 +595,7 @@ std::string ViewerState::save(const fs::path& path) {
         return err;
     }
     doc.path = target;
+    doc.history.markSaved();
     doc.dirty = false;
     addRecent(fs::absolute(target).lexically_normal().string());
     ui.status = "Saved " + target.string();

@@ -24,6 +24,7 @@
 #include "scenegraph/scene.h"
 #include "ui/orbit_camera.h"
 #include "ui/panel_state.h"
+#include "ui/undo.h"
 
 #include <array>
 #include <atomic>
@@ -79,13 +80,14 @@ struct LoadControl {
     std::atomic<float> progress{0.0f};
 };
 
-// The document: the scene being edited, where it lives on disk and whether it has unsaved
-// edits. setScene (a load, a new scene, the demo) replaces scene and path, clears the dirty
-// flag and the selection.
+// The document: the scene being edited, where it lives on disk, whether it has unsaved
+// edits and its undo history. setScene (a load, a new scene, the demo) replaces scene and
+// path, clears the dirty flag, the selection and the history.
 struct Document {
     sg::Scene scene;
     std::filesystem::path path;   // empty for the demo / a new scene
-    bool dirty = false;           // unsaved edits
+    bool dirty = false;           // unsaved edits (= !history.atSavedState() after every edit, undo, redo, save)
+    UndoStack history;            // every scene edit, for Edit > Undo / Redo
     uint64_t version = 1;         // bumped on every scene change, edits and animation poses (re-render)
     sg::NodeId selected = sg::kNoNode;
     std::vector<std::string> loadWarnings;   // of the load that brought this scene
@@ -177,10 +179,21 @@ struct ViewerState {
     TestHooks hooks;
 
     // --- actions -----------------------------------------------------------------------
-    // Replaces the scene (after a load): resets selection, dirty flag and camera.
+    // Replaces the scene (after a load): resets selection, dirty flag, history and camera.
     void setScene(sg::Scene s, std::filesystem::path path);
-    void markEdited();        // scene or settings changed: dirty + re-render
     void markViewChanged();   // camera moved: re-render only
+
+    // Every scene edit below is recorded as one undo step (ui/undo.h). An empty mergeKey makes
+    // its own step; the panels pass one per edited target ("local 5", "material 2", ...) so the
+    // frames of one drag merge into one step (they close it when no widget is active).
+    UndoStep newStep(std::string label) const;   // with the selection before the edit
+    // Records an edit already made to doc.scene: pushes it, updates the dirty flag, re-renders.
+    void commit(UndoStep step, std::string_view mergeKey = {});
+    bool undo();   // Edit > Undo (Ctrl+Z): false when there is nothing to undo
+    bool redo();   // Edit > Redo (Ctrl+Shift+Z, Ctrl+Y)
+    // An edit made to doc.scene outside the history (tests): dirty, and undo can no longer
+    // bring back the saved state.
+    void markEdited();
 
     void selectNode(sg::NodeId id);
     bool renameNode(sg::NodeId id, const std::string& name);
@@ -195,7 +208,15 @@ struct ViewerState {
     sg::NodeId duplicateNode(sg::NodeId id);
     // Re-parents keeping the world transform; on refusal returns false and sets status/error.
     bool reparent(sg::NodeId id, sg::NodeId newParent, std::string* error = nullptr);
-    void setLocal(sg::NodeId id, const sg::LocalTransform& t);
+    void setLocal(sg::NodeId id, const sg::LocalTransform& t, std::string_view mergeKey = {});
+    void setPayload(sg::NodeId id, const sg::Payload& p, std::string_view mergeKey = {});
+    void setMaterial(int index, const sg::Material& m, std::string_view mergeKey = {});
+    // A new material (a copy of m) assigned to the node's payload, as one step. Its index, or
+    // -1 when the node's payload has no material.
+    int addMaterialFor(sg::NodeId id, const sg::Material& m);
+    // Refused (the reason returned, also in the status line) when s.validate() fails.
+    std::string setSettings(const sg::RenderSettings& s, std::string_view mergeKey = {});
+    void setAmbientLight(const sg::vec3& color, std::string_view mergeKey = {});
 
     void setBackend(const std::string& name);
     // 0-based backend index (keys 1/2/3); ignores indices beyond the built backends.
@@ -203,7 +224,8 @@ struct ViewerState {
 
     // Camera.
     const sg::Projection& projection() const;   // the active scene camera's, or the fallback
-    sg::Projection& editProjection();           // marks edited when it is the scene's
+    // The active scene camera's projection (an edit), or the viewer's fallback (a view change).
+    void setProjection(const sg::Projection& p, std::string_view mergeKey = {});
     float focusDistance() const;
     void fitView(bool selectionOnly);             // F
     void resetView();                             // Home: back to the active scene camera
