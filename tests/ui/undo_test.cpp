@@ -354,6 +354,60 @@ TEST(ViewerUndoTest, LoadingClearsTheHistoryAFailedLoadKeepsIt) {
     EXPECT_FALSE(st.doc.history.canUndo());
 }
 
+// `set KEY VALUE` (automation): names and values as in the scene file, checked by its reader,
+// one undo step each, refusals with the reader's reason.
+TEST(ViewerUndoTest, SetByNameTakesSceneFileNamesAndIsUndoable) {
+    ViewerState st = demoState();
+    EXPECT_EQ(st.setByName("shading", "flat"), "");
+    EXPECT_EQ(st.doc.scene.settings.shading, sg::ShadingModel::Flat);
+    EXPECT_EQ(st.doc.history.undoLabel(), "Change shading");
+    EXPECT_EQ(st.setByName("fog.mode", "linear"), "");
+    EXPECT_EQ(st.setByName("fog.end", "40"), "");
+    EXPECT_EQ(st.doc.scene.settings.fogEnd, 40.0f);
+    std::string err = st.setByName("fog.end", "1");
+    EXPECT_NE(err.find("end > start"), std::string::npos) << err;
+    EXPECT_NE(st.ui.status.find("refused"), std::string::npos) << st.ui.status;
+    EXPECT_EQ(st.doc.scene.settings.fogEnd, 40.0f);
+    EXPECT_NE(st.setByName("shading", "plastic").find("plastic"), std::string::npos);
+    EXPECT_NE(st.setByName("no.such", "1").find("unknown setting"), std::string::npos);
+    EXPECT_EQ(st.setByName("ambientLight", "[0.1, 0.2, 0.3]"), "");
+    EXPECT_EQ(st.doc.scene.ambientLight, sg::vec3(0.1f, 0.2f, 0.3f));
+
+    // material.FIELD: the selection's material.
+    EXPECT_NE(st.setByName("material.kd", "0.5").find("no material"), std::string::npos) << "nothing selected";
+    sg::NodeId crate = st.doc.scene.findByName("crate");
+    st.selectNode(crate);
+    int mat = std::get<sg::MeshInstance>(st.doc.scene.node(crate).payload).material;
+    int texture = st.doc.scene.materials[size_t(mat)].diffuseTexture;
+    ASSERT_GE(texture, 0);
+    EXPECT_EQ(st.setByName("material.kd", "0.25"), "");
+    EXPECT_EQ(st.setByName("material.baseColor", "[1, 0, 0]"), "");
+    EXPECT_EQ(st.setByName("material.alphaMode", "mask"), "");
+    const sg::Material& m = st.doc.scene.materials[size_t(mat)];
+    EXPECT_EQ(m.kd, 0.25f);
+    EXPECT_EQ(m.baseColor, sg::vec3(1, 0, 0));
+    EXPECT_EQ(m.alphaMode, sg::AlphaMode::Mask);
+    EXPECT_EQ(m.diffuseTexture, texture) << "untouched fields stay, the texture included";
+    EXPECT_NE(st.setByName("material.diffuseTexture", "99"), "");
+    EXPECT_EQ(st.setByName("material.diffuseTexture", "-1"), "");
+    EXPECT_EQ(st.doc.scene.materials[size_t(mat)].diffuseTexture, -1);
+
+    while (st.undo()) {}
+    EXPECT_EQ(sg::sceneDifference(assets::makeDemoScene(), st.doc.scene), "");
+}
+
+TEST(ViewerUndoTest, SettingNamesAreTheSceneFileNames) {
+    sg::RenderSettings a, b = a;
+    EXPECT_EQ(settingNames(a, b), "");
+    b.fog = sg::FogMode::Exp;
+    b.fogDensity = 0.2f;
+    b.shadows = !a.shadows;
+    std::string names = settingNames(a, b);
+    EXPECT_NE(names.find("fog.mode"), std::string::npos) << names;
+    EXPECT_NE(names.find("fog.density"), std::string::npos) << names;
+    EXPECT_NE(names.find("shadows"), std::string::npos) << names;
+}
+
 // --- through the panels ------------------------------------------------------------------------
 
 TEST(UndoPanelsTest, ADragIsOneStepAndCtrlZUndoesIt) {

@@ -278,13 +278,22 @@ void drawMainMenu(ViewerState& st) {
         ImGui::EndMenu();
     }
     drawEditMenu(st);
-    if (ImGui::BeginMenu("View")) {
+    bool viewOpen = ImGui::BeginMenu("View");
+    record(st, "menu/view");
+    if (viewOpen) {
         if (ImGui::MenuItem("Fit to scene / selection", "F")) st.fitView(st.doc.scene.valid(st.doc.selected));
         if (ImGui::MenuItem("Reset to scene camera", "Home")) st.resetView();
         ImGui::Separator();
-        if (ImGui::MenuItem("Single backend", nullptr, st.view.compare.mode == ViewMode::Single)) st.view.compare.mode = ViewMode::Single;
-        if (ImGui::MenuItem("Split view (wipe)", nullptr, st.view.compare.mode == ViewMode::Split)) st.view.compare.mode = ViewMode::Split;
-        if (ImGui::MenuItem("Difference view", nullptr, st.view.compare.mode == ViewMode::Difference)) st.view.compare.mode = ViewMode::Difference;
+        // The same modes as the Compare tab, --view and the automation's `view` (showView).
+        std::string mode = st.viewName();
+        if (ImGui::MenuItem("Single backend", nullptr, mode == "single")) st.showView(ViewMode::Single);
+        record(st, "view/single");
+        if (ImGui::MenuItem("Split view, 2 backends (wipe)", nullptr, mode == "split")) st.showView(ViewMode::Split, 2);
+        record(st, "view/split");
+        if (ImGui::MenuItem("Split view, 3 backends", nullptr, mode == "split3")) st.showView(ViewMode::Split, 3);
+        record(st, "view/split3");
+        if (ImGui::MenuItem("Difference view", nullptr, mode == "difference")) st.showView(ViewMode::Difference);
+        record(st, "view/difference");
         ImGui::Separator();
         ImGui::MenuItem("Stats overlay", nullptr, &st.ui.panels.showOverlay);
         if (ImGui::BeginMenu("Scene cameras", !st.doc.scene.cameras().empty())) {
@@ -300,7 +309,7 @@ void drawMainMenu(ViewerState& st) {
             std::string key = std::to_string(i + 1);
             if (ImGui::MenuItem(names[i].c_str(), key.c_str(), st.view.backend == names[i])) {
                 st.setBackend(names[i]);
-                st.view.compare.mode = ViewMode::Single;
+                st.showView(ViewMode::Single);
             }
         }
         ImGui::EndMenu();
@@ -1002,7 +1011,7 @@ void drawComparePanel(ViewerState& st) {
     ImGui::SameLine();
     ImGui::RadioButton("Difference", &mode, 2);
     record(st, "compare/difference");
-    c.mode = ViewMode(mode);
+    if (ViewMode(mode) != c.mode) st.showView(ViewMode(mode));
     std::vector<std::string> names = rnd::rendererNames();
     auto backendCombo = [&](const char* label, std::string& value) {
         if (ImGui::BeginCombo(label, value.c_str())) {
@@ -1018,7 +1027,8 @@ void drawComparePanel(ViewerState& st) {
         if (b != st.view.backend) st.setBackend(b);
         ImGui::TextDisabled("Keys 1 / 2 / 3 switch backends.");
     } else if (c.mode == ViewMode::Split) {
-        ImGui::SliderInt("Count", &c.count, 2, 3);
+        int count = c.count;
+        if (ImGui::SliderInt("Count", &count, 2, 3)) st.showView(ViewMode::Split, count);
         const char* labels[] = {"Left", c.count == 3 ? "Middle" : "Right", "Right"};
         for (int i = 0; i < c.count; ++i) backendCombo(labels[i], c.backends[i]);
         ImGui::SliderFloat("Divider 1", &c.dividers[0], 0.0f, 1.0f);
@@ -1548,7 +1558,7 @@ void handleShortcuts(ViewerState& st) {
     for (int i = 0; i < 3; ++i)
         if (ImGui::IsKeyPressed(keys::Num1 + i, false)) {
             st.setBackendIndex(i);
-            st.view.compare.mode = ViewMode::Single;
+            st.showView(ViewMode::Single);
         }
     if (ImGui::IsKeyPressed(keys::F, false)) st.fitView(st.doc.scene.valid(st.doc.selected));
     if (ImGui::IsKeyPressed(keys::Home, false)) st.resetView();

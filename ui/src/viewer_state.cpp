@@ -301,7 +301,8 @@ std::string ViewerState::setSettings(const sg::RenderSettings& s, std::string_vi
         ui.status = "Setting refused: " + err;
         return err;
     }
-    UndoStep step = newStep("Change rendering settings");
+    std::string names = settingNames(doc.scene.settings, s);
+    UndoStep step = newStep("Change " + (names.empty() ? std::string("rendering settings") : names));
     step.changes.push_back(SettingsChange{doc.scene.settings, s});
     doc.scene.settings = s;
     commit(std::move(step), mergeKey);
@@ -328,6 +329,40 @@ void ViewerState::setBackend(const std::string& name) {
 void ViewerState::setBackendIndex(int index) {
     std::vector<std::string> names = rnd::rendererNames();
     if (index >= 0 && size_t(index) < names.size()) setBackend(names[index]);
+}
+
+// --- view modes ------------------------------------------------------------------------------
+
+void ViewerState::showView(ViewMode mode, int splitCount) {
+    CompareConfig& c = view.compare;
+    c.mode = mode;
+    if (mode == ViewMode::Split && (splitCount == 2 || splitCount == 3) && splitCount != c.count) {
+        c.count = splitCount;
+        c.dividers = splitCount == 2 ? std::array<float, 2>{0.5f, 0.75f} : std::array<float, 2>{1.0f / 3.0f, 2.0f / 3.0f};
+    }
+}
+
+bool ViewerState::showView(std::string_view name) {
+    if (name == "single")
+        showView(ViewMode::Single);
+    else if (name == "split")
+        showView(ViewMode::Split, 2);
+    else if (name == "split3")
+        showView(ViewMode::Split, 3);
+    else if (name == "difference")
+        showView(ViewMode::Difference);
+    else
+        return false;
+    return true;
+}
+
+std::string ViewerState::viewName() const {
+    switch (view.compare.mode) {
+    case ViewMode::Single: return "single";
+    case ViewMode::Split: return view.compare.count == 3 ? "split3" : "split";
+    case ViewMode::Difference: return "difference";
+    }
+    return "single";
 }
 
 // --- camera ----------------------------------------------------------------------------------

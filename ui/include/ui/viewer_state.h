@@ -218,6 +218,19 @@ struct ViewerState {
     std::string setSettings(const sg::RenderSettings& s, std::string_view mergeKey = {});
     void setAmbientLight(const sg::vec3& color, std::string_view mergeKey = {});
 
+    // A render setting, `ambientLight` or `material.FIELD` of the selection's material, named
+    // and written as in the scene JSON (fog.mode, shading, aa, material.kd, material.baseColor
+    // [1,0,0]; see assets/src/scene_json.cpp): read and checked by the scene file's own writer
+    // and reader, then applied as one undoable edit. "" or the reason it was refused.
+    std::string setByName(const std::string& key, const std::string& value);
+
+    // The view modes, one way for the View menu, the Compare tab, --view and the automation:
+    // Single, Split (splitCount 2 or 3; 0 keeps the current count) or Difference.
+    void showView(ViewMode mode, int splitCount = 0);
+    // By name: single, split, split3, difference. False for other names.
+    bool showView(std::string_view name);
+    std::string viewName() const;   // the current one, as showView(name) takes it
+
     void setBackend(const std::string& name);
     // 0-based backend index (keys 1/2/3); ignores indices beyond the built backends.
     void setBackendIndex(int index);
@@ -276,6 +289,10 @@ struct ViewerState {
     // the end) and applies the clip.
     void advanceAnimation(double dt);
 };
+
+// The scene-JSON names of the settings that differ between a and b ("fog.mode, fog.end"; ""
+// when equal), for undo labels.
+std::string settingNames(const sg::RenderSettings& a, const sg::RenderSettings& b);
 
 // Per-user config folder: $XDG_CONFIG_HOME/sceneviewer, else $HOME/.config/sceneviewer.
 std::filesystem::path defaultConfigDir();
