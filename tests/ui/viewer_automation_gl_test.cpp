@@ -217,3 +217,39 @@ TEST(ViewerAutomationGLTest, BadCommandsFailTheScript) {
         EXPECT_TRUE(r.out.empty()) << "stopped at the bad line\n" << dump(r);
     }
 }
+
+// Issue 19, item 5: started from raster the difference view compares raster with another
+// backend; split3 started from raycast shows three different ones; each view keeps its own
+// choice; the figures are written one way (and only say 100% when every pixel is within).
+TEST(ViewerAutomationGLTest, ComparisonDefaultsCompareDifferentBackendsAndEachViewKeepsItsOwn) {
+    if (!viewer_test::haveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+    fs::path dir = sceneFolder("automation_compare");
+    ScriptRun r = runScript(dir,
+                            "wait\n"
+                            "backend raster\n"
+                            "view difference\n"
+                            "print compare\n"   // 0
+                            "wait\n"
+                            "print diff\n"   // 1
+                            "window-shot difference.png\n"
+                            "backend raycast\n"
+                            "view split3\n"
+                            "print compare\n"   // 3
+                            "view difference\n"
+                            "print compare\n"   // 4
+                            "view split\n"
+                            "print compare\n"   // 5
+                            "quit\n");
+    ASSERT_EQ(r.rc, 0) << dump(r);
+    ASSERT_EQ(r.out.size(), 6u) << dump(r);
+    EXPECT_EQ(r.out[0], "compare difference raster gl");
+    EXPECT_EQ(r.out[1].rfind("diff |raster - gl|   mean ", 0), 0u) << r.out[1];
+    EXPECT_EQ(r.out[1].find("identical"), std::string::npos) << r.out[1];
+    size_t pct = r.out[1].find("within 8: ");
+    ASSERT_NE(pct, std::string::npos) << r.out[1];
+    std::string within = r.out[1].substr(pct + 10);
+    EXPECT_TRUE(within == "100%" || (within.size() >= 5 && within[within.size() - 4] == '.' && within.back() == '%')) << within;
+    EXPECT_EQ(r.out[3], "compare split3 raycast gl raster");
+    EXPECT_EQ(r.out[4], "compare difference raster gl") << "the difference view kept its own pair";
+    EXPECT_EQ(r.out[5], "compare split raycast gl") << "the split view kept its own";
+}

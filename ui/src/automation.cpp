@@ -39,6 +39,9 @@
 //                         ("root") unindented
 //   print compare         viewer: compare MODE BACKEND... (MODE single|split|split3|difference,
 //                         then the backends shown, left to right / A B)
+//   print diff            viewer: diff |A - B|   mean M   max X   PSNR P   within T: W% (the
+//                         difference view's figures, as its overlay and the Compare tab write
+//                         them; only |A - B| until both full-resolution images are there)
 //   print selection       viewer: selection NAME (or -)
 //   print status          viewer: status TEXT (the status bar's line)
 //   print undo            viewer: undo LABEL | redo LABEL (what Edit > Undo / Redo would do, "-")
@@ -263,6 +266,10 @@ Automation::Next Automation::printCommand(const std::string& what, AutomationHos
         std::string line = "viewer: compare " + st.viewName();
         for (const std::string& b : visibleBackends(st)) line += " " + b;
         std::printf("%s\n", line.c_str());
+    } else if (what == "diff") {
+        std::vector<std::string> b = visibleBackends(st);
+        if (st.view.compare.mode != ViewMode::Difference || b.size() < 2) return fail("print diff: not in the difference view");
+        std::printf("viewer: diff %s\n", st.view.diff.summary(b[0], b[1], st.view.compare.threshold).c_str());
     } else if (what == "selection") {
         std::printf("viewer: selection %s\n", st.doc.scene.valid(st.doc.selected) ? st.doc.scene.node(st.doc.selected).name.c_str() : "-");
     } else if (what == "status") {
@@ -271,7 +278,7 @@ Automation::Next Automation::printCommand(const std::string& what, AutomationHos
         const UndoStack& h = st.doc.history;
         std::printf("viewer: undo %s | redo %s\n", h.canUndo() ? h.undoLabel().c_str() : "-", h.canRedo() ? h.redoLabel().c_str() : "-");
     } else {
-        return fail("print " + what + ": expected dirty, tree, compare, selection, status or undo");
+        return fail("print " + what + ": expected dirty, tree, compare, diff, selection, status or undo");
     }
     return Next::Continue;
 }

@@ -15,6 +15,7 @@
 #include "ui/panels.h"
 
 #include "assets/scene_io.h"
+#include "renderers/framebuffer.h"
 #include "renderers/renderer.h"
 #include "scenegraph/setting_names.h"
 
@@ -22,6 +23,7 @@
 #include <imgui_stdlib.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -175,14 +177,19 @@ void addMenuItems(ViewerState& st, sg::NodeId parent) {
 }   // namespace
 
 std::vector<std::string> visibleBackends(const ViewerState& st) {
-    switch (st.view.compare.mode) {
-    case ViewMode::Single: return {st.view.backend};
-    case ViewMode::Split: {
-        std::vector<std::string> v(st.view.compare.backends.begin(), st.view.compare.backends.begin() + std::clamp(st.view.compare.count, 2, 3));
+    const CompareConfig& c = st.view.compare;
+    // A view whose backends were never chosen (mode set without showView) shows its defaults.
+    auto chosen = [&](auto& slots, size_t n) {
+        std::vector<std::string> v = comparisonBackends(st.view.backend, slots.size());
+        for (size_t i = 0; i < slots.size(); ++i)
+            if (!slots[i].empty()) v[i] = slots[i];
+        v.resize(n);
         return v;
-    }
-    case ViewMode::Difference:
-        return {st.view.compare.backends[std::clamp(st.view.compare.diffA, 0, 2)], st.view.compare.backends[std::clamp(st.view.compare.diffB, 0, 2)]};
+    };
+    switch (c.mode) {
+    case ViewMode::Single: return {st.view.backend};
+    case ViewMode::Split: return chosen(c.split, size_t(std::clamp(c.count, 2, 3)));
+    case ViewMode::Difference: return chosen(c.diff, 2);
     }
     return {st.view.backend};
 }
@@ -1030,29 +1037,27 @@ void drawComparePanel(ViewerState& st) {
         int count = c.count;
         if (ImGui::SliderInt("Count", &count, 2, 3)) st.showView(ViewMode::Split, count);
         const char* labels[] = {"Left", c.count == 3 ? "Middle" : "Right", "Right"};
-        for (int i = 0; i < c.count; ++i) backendCombo(labels[i], c.backends[i]);
+        for (int i = 0; i < c.count; ++i) backendCombo(labels[i], c.split[size_t(i)]);
         ImGui::SliderFloat("Divider 1", &c.dividers[0], 0.0f, 1.0f);
         if (c.count == 3) ImGui::SliderFloat("Divider 2", &c.dividers[1], 0.0f, 1.0f);
         c.dividers[1] = std::max(c.dividers[1], c.dividers[0]);
         ImGui::TextDisabled("Drag the dividers in the viewport.");
     } else {
-        c.diffA = std::clamp(c.diffA, 0, 2);
-        c.diffB = std::clamp(c.diffB, 0, 2);
-        if (c.diffA == c.diffB) c.diffB = (c.diffA + 1) % 3;
-        backendCombo("A", c.backends[c.diffA]);
-        backendCombo("B", c.backends[c.diffB]);
+        backendCombo("A", c.diff[0]);
+        backendCombo("B", c.diff[1]);
+        if (c.diff[0] == c.diff[1]) ImGui::TextColored(ImVec4(1.0f, 0.75f, 0.4f, 1.0f), "A and B are the same backend: nothing to compare.");
     }
     if (c.mode == ViewMode::Difference) {
         section("Difference");
-        ImGui::Text("|%s - %s| per pixel", c.backends[c.diffA].c_str(), c.backends[c.diffB].c_str());
+        ImGui::Text("|%s - %s| per pixel", c.diff[0].c_str(), c.diff[1].c_str());
         ImGui::SliderInt("Threshold", &c.threshold, 0, 255);
         record(st, "compare/threshold");
-        if (st.view.diff.valid) {
-            ImGui::Text("Mean |a-b|  %.3f", st.view.diff.mean);
-            ImGui::Text("Max  |a-b|  %d", st.view.diff.max);
-            ImGui::Text("PSNR        %s",
-                        std::isfinite(st.view.diff.psnr) ? (std::to_string(st.view.diff.psnr).substr(0, 6) + " dB").c_str() : "identical");
-            ImGui::Text("Within threshold  %.2f %%", 100.0 * st.view.diff.within);
+        const DiffFigures& d = st.view.diff;   // the overlay writes the same texts
+        if (d.valid) {
+            ImGui::Text("Mean |a-b|  %s", d.meanText().c_str());
+            ImGui::Text("Max  |a-b|  %d", d.max);
+            ImGui::Text("PSNR        %s", d.psnrText().c_str());
+            ImGui::Text("Within %d   %s of the pixels", c.threshold, d.withinText().c_str());
         } else {
             ImGui::TextDisabled("Waiting for both full-resolution images...");
         }
@@ -1220,8 +1225,65 @@ void drawSplitView(ImDrawList* dl, const ViewerState& st, const ViewportInput& v
     }
 }
 
-// Difference view: the heat map (or why there is none yet) and the figures at the bottom.
-void drawDifferenceView(ImDrawList* dl, const ViewerState& st, const ViewportInput& view, ImVec2 a, ImVec2 avail) {
+// The heat map's colours for a largest-channel difference of 0..64 (64 and above look the
+// same), and of a pixel within the threshold (a dimmed grey copy of image A, here of mid grey):
+// taken from rnd::diffImage itself on a ramp, so the legend cannot drift from the image.
+struct HeatColours {
+    std::array<ImU32, 65> ramp;
+    ImU32 within;
+};
+HeatColours heatColours() {
+    rnd::Framebuffer x, y;
+    x.resize(66, 1);
+    y.resize(66, 1);
+    std::fill(x.color.begin(), x.color.end(), uint8_t(0));
+    std::fill(y.color.begin(), y.color.end(), uint8_t(0));
+    for (int i = 0; i < 66; ++i) x.color[size_t(i) * 4 + 3] = y.color[size_t(i) * 4 + 3] = 255;
+    for (int v = 0; v <= 64; ++v) y.color[size_t(v) * 4] = uint8_t(v);   // pixel v differs by v
+    for (int c = 0; c < 3; ++c) x.color[65 * 4 + size_t(c)] = y.color[65 * 4 + size_t(c)] = 128;
+    rnd::Framebuffer d = rnd::diffImage(x, y, 0);
+    auto colour = [&](int i) { return IM_COL32(d.color[size_t(i) * 4], d.color[size_t(i) * 4 + 1], d.color[size_t(i) * 4 + 2], 255); };
+    HeatColours h{};
+    for (int v = 0; v <= 64; ++v) h.ramp[size_t(v)] = colour(v);
+    h.within = colour(65);
+    return h;
+}
+
+// Legend (top right of the heat map): what grey and the red-to-white ramp mean.
+void drawDiffLegend(ImDrawList* dl, ViewerState& st, ImVec2 a, ImVec2 avail) {
+    const HeatColours heat = heatColours();
+    int t = std::clamp(st.view.compare.threshold, 0, 255);
+    const std::string title = "|A - B|, largest channel (0-255)", within = "0-" + std::to_string(t) + ": within threshold (A, dimmed)";
+    float lh = ImGui::GetTextLineHeight(), barH = px(12), pad = px(8);
+    float w = std::max(ImGui::CalcTextSize(title.c_str()).x, px(26) + ImGui::CalcTextSize(within.c_str()).x) + 2 * pad;
+    ImVec2 o(a.x + std::max(avail.x - w - px(10), 0.0f), a.y + px(10));
+    ImVec2 end(o.x + w, o.y + pad * 2 + lh * 3 + barH + px(8));
+    dl->AddRectFilled(o, end, IM_COL32(0, 0, 0, 190), px(4));
+    ImU32 text = IM_COL32(230, 230, 235, 255);
+    float x0 = o.x + pad, x1 = end.x - pad, y = o.y + pad;
+    dl->AddText(ImVec2(x0, y), text, title.c_str());
+    y += lh + px(2);
+    dl->AddRectFilled(ImVec2(x0, y + px(2)), ImVec2(x0 + px(18), y + lh - px(2)), heat.within);
+    dl->AddRect(ImVec2(x0, y + px(2)), ImVec2(x0 + px(18), y + lh - px(2)), IM_COL32(120, 120, 120, 255));
+    dl->AddText(ImVec2(x0 + px(26), y), text, within.c_str());
+    y += lh + px(4);
+    int from = std::min(t + 1, 64);   // the ramp from the first highlighted difference
+    int steps = std::max(64 - from, 1);
+    for (int i = 0; i < steps; ++i) {
+        float u0 = x0 + (x1 - x0) * float(i) / float(steps), u1 = x0 + (x1 - x0) * float(i + 1) / float(steps);
+        ImU32 c0 = heat.ramp[size_t(std::min(from + i, 64))], c1 = heat.ramp[size_t(std::min(from + i + 1, 64))];
+        dl->AddRectFilledMultiColor(ImVec2(u0, y), ImVec2(u1, y + barH), c0, c1, c1, c0);
+    }
+    y += barH + px(2);
+    std::string left = std::to_string(t + 1), right = t + 1 >= 64 ? "" : "64+";
+    dl->AddText(ImVec2(x0, y), text, left.c_str());
+    dl->AddText(ImVec2(x1 - ImGui::CalcTextSize(right.c_str()).x, y), text, right.c_str());
+    st.hooks.itemRects["diff/legend"] = ItemRect{o.x, o.y, end.x, end.y};
+}
+
+// Difference view: the heat map (or why there is none yet), its legend and the figures at the
+// bottom (DiffFigures::summary, as the Compare tab writes them).
+void drawDifferenceView(ImDrawList* dl, ViewerState& st, const ViewportInput& view, ImVec2 a, ImVec2 avail) {
     ImVec2 b(a.x + avail.x, a.y + avail.y);
     SlotView d = view.diff;
     if (!d.texture) {
@@ -1233,19 +1295,14 @@ void drawDifferenceView(ImDrawList* dl, const ViewerState& st, const ViewportInp
         centeredText(dl, a, b, msg, IM_COL32(255, 170, 140, 255));
     } else {
         dl->AddImage(d.texture, a, b);
+        drawDiffLegend(dl, st, a, avail);
     }
     if (view.slots.size() >= 2) {
-        char buf[256];
-        if (st.view.diff.valid)
-            std::snprintf(buf, sizeof buf, "|%s - %s|   mean %.2f   max %d   PSNR %.1f dB   within %d: %.1f%%", view.slots[0].status.backend.c_str(),
-                          view.slots[1].status.backend.c_str(), st.view.diff.mean, st.view.diff.max, st.view.diff.psnr, st.view.compare.threshold,
-                          100.0 * st.view.diff.within);
-        else
-            std::snprintf(buf, sizeof buf, "|%s - %s|", view.slots[0].status.backend.c_str(), view.slots[1].status.backend.c_str());
-        ImVec2 ts = ImGui::CalcTextSize(buf);
+        std::string line = st.view.diff.summary(view.slots[0].status.backend, view.slots[1].status.backend, st.view.compare.threshold);
+        ImVec2 ts = ImGui::CalcTextSize(line.c_str());
         ImVec2 lp(a.x + (avail.x - ts.x) * 0.5f, b.y - ts.y - px(12));
         dl->AddRectFilled(ImVec2(lp.x - px(8), lp.y - px(4)), ImVec2(lp.x + ts.x + px(8), lp.y + ts.y + px(4)), IM_COL32(0, 0, 0, 180), px(3));
-        dl->AddText(lp, IM_COL32(255, 230, 160, 255), buf);
+        dl->AddText(lp, IM_COL32(255, 230, 160, 255), line.c_str());
     }
 }
 

@@ -7,8 +7,10 @@
 #include "assets/files.h"
 #include "renderers/renderer.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -321,9 +323,22 @@ void ViewerState::setAmbientLight(const sg::vec3& color, std::string_view mergeK
 
 void ViewerState::setBackend(const std::string& name) {
     if (view.backend == name) return;
-    view.backend = name;
-    view.compare.backends[0] = name;
+    view.backend = name;   // the split and difference views keep their own backends
     ui.status = "Backend: " + name;
+}
+
+std::string defaultBackend() {
+    std::vector<std::string> names = rnd::rendererNames();
+    return names.empty() ? std::string() : names.front();
+}
+
+std::vector<std::string> comparisonBackends(const std::string& first, size_t n) {
+    std::vector<std::string> out{first};
+    for (const std::string& b : rnd::rendererNames())
+        if (out.size() < n && b != first) out.push_back(b);
+    while (out.size() < n) out.push_back(out.back());
+    out.resize(n);
+    return out;
 }
 
 void ViewerState::setBackendIndex(int index) {
@@ -336,6 +351,15 @@ void ViewerState::setBackendIndex(int index) {
 void ViewerState::showView(ViewMode mode, int splitCount) {
     CompareConfig& c = view.compare;
     c.mode = mode;
+    // First shown: start from the single view's backend and compare it with the others.
+    if (mode == ViewMode::Split && std::any_of(c.split.begin(), c.split.end(), [](const std::string& b) { return b.empty(); })) {
+        std::vector<std::string> d = comparisonBackends(view.backend, 3);
+        std::copy(d.begin(), d.end(), c.split.begin());
+    }
+    if (mode == ViewMode::Difference && (c.diff[0].empty() || c.diff[1].empty())) {
+        std::vector<std::string> d = comparisonBackends(view.backend, 2);
+        std::copy(d.begin(), d.end(), c.diff.begin());
+    }
     if (mode == ViewMode::Split && (splitCount == 2 || splitCount == 3) && splitCount != c.count) {
         c.count = splitCount;
         c.dividers = splitCount == 2 ? std::array<float, 2>{0.5f, 0.75f} : std::array<float, 2>{1.0f / 3.0f, 2.0f / 3.0f};
@@ -363,6 +387,36 @@ std::string ViewerState::viewName() const {
     case ViewMode::Difference: return "difference";
     }
     return "single";
+}
+
+// --- difference figures ----------------------------------------------------------------------
+
+std::string DiffFigures::meanText() const {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.2f", mean);
+    return buf;
+}
+
+std::string DiffFigures::psnrText() const {
+    if (!std::isfinite(psnr)) return "identical";
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.1f dB", psnr);
+    return buf;
+}
+
+std::string DiffFigures::withinText() const {
+    if (within >= 1.0) return "100%";
+    char buf[32];   // cut to 0.01%: 99.997% is "99.99%", never a rounded-up 100%
+    std::snprintf(buf, sizeof buf, "%.2f%%", std::floor(std::max(within, 0.0) * 10000.0 + 1e-6) / 100.0);
+    return buf;
+}
+
+std::string DiffFigures::summary(const std::string& a, const std::string& b, int threshold) const {
+    std::string s = "|" + a + " - " + b + "|";
+    if (valid)
+        s += "   mean " + meanText() + "   max " + std::to_string(max) + "   PSNR " + psnrText() + "   within " + std::to_string(threshold) + ": " +
+             withinText();
+    return s;
 }
 
 // --- camera ----------------------------------------------------------------------------------

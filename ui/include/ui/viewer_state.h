@@ -41,14 +41,25 @@ namespace ui {
 // How the viewport shows backends.
 enum class ViewMode { Single, Split, Difference };
 
+std::string defaultBackend();   // the first registered backend
+
+// The split and difference views. Each keeps its own backends: chosen when the view is first
+// shown (ViewerState::showView: the single view's backend, then the other registered backends
+// in registry order, so the defaults always compare different backends) and kept after that,
+// whatever the other view or the single view shows.
 struct CompareConfig {
     ViewMode mode = ViewMode::Single;
-    int count = 2;   // backends in the split view (2 or 3)
-    std::array<std::string, 3> backends{"gl", "raster", "raycast"};
+    int count = 2;                                // backends in the split view (2 or 3)
+    std::array<std::string, 3> split;             // split view, left to right ("" until first shown)
+    std::array<std::string, 2> diff;              // difference view: A, B ("" until first shown)
     std::array<float, 2> dividers{0.5f, 0.75f};   // wipe positions, fractions of the width
-    int diffA = 0, diffB = 1;                     // slots compared in the difference view
     int threshold = 8;                            // diffImage highlight threshold (0..255)
 };
+
+// The backends a comparison starting from `first` shows: `first`, then the other registered
+// backends in registry order (rnd::rendererNames; `first` once only), `n` of them; fewer
+// registered backends than n repeat the last.
+std::vector<std::string> comparisonBackends(const std::string& first, size_t n);
 
 // Work for the window: set by panels and shortcuts, consumed by viewer.cpp.
 struct Requests {
@@ -93,12 +104,20 @@ struct Document {
     std::vector<std::string> loadWarnings;   // of the load that brought this scene
 };
 
-// Figures of the difference view (filled by the window from the two shown images).
+// Figures of the difference view (filled by the window from the two shown images). The
+// Compare tab, the viewport overlay and the automation's `print diff` all write them with the
+// functions below, so they never disagree.
 struct DiffFigures {
     bool valid = false;   // both full-resolution images are there
     double mean = 0, psnr = 0;
     int max = 0;
     double within = 1;   // fraction of pixels within the threshold
+
+    std::string meanText() const;     // "0.42"
+    std::string psnrText() const;     // "41.3 dB", "identical" (infinite)
+    std::string withinText() const;   // "99.97%": cut, not rounded, so 100% means every pixel
+    // "|A - B|  mean 0.42  max 37  PSNR 41.3 dB  within 8: 99.97%"
+    std::string summary(const std::string& a, const std::string& b, int threshold) const;
 };
 
 // How the scene is looked at: the orbit camera, the viewport, which backends show it and how
@@ -113,7 +132,7 @@ struct View {
     double lastInteraction = -1e9;               // time (s) of the last camera drag/zoom/fly
     bool flyMode = false;
 
-    std::string backend = "gl";   // the single view's backend
+    std::string backend = defaultBackend();   // the single view's backend
     CompareConfig compare;
     DiffFigures diff;
     // Per-backend anti-aliasing overrides for this session (backend -> "msaa4", ...); the
