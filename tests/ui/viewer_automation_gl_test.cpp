@@ -253,3 +253,35 @@ TEST(ViewerAutomationGLTest, ComparisonDefaultsCompareDifferentBackendsAndEachVi
     EXPECT_EQ(r.out[4], "compare difference raster gl") << "the difference view kept its own pair";
     EXPECT_EQ(r.out[5], "compare split raycast gl") << "the split view kept its own";
 }
+
+// Issue 19, items 11 and 8: File > New (Ctrl+N) then Add > Sphere gives a lit sphere in view
+// (the new scene has a light and a camera); a refused value's message leaves the status bar
+// once the value is valid.
+TEST(ViewerAutomationGLTest, NewSceneThenAddSphereAndRefusalsThatClear) {
+    if (!viewer_test::haveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+    fs::path dir = sceneFolder("automation_new_scene");
+    ScriptRun r = runScript(dir,
+                            "wait\n"
+                            "key ctrl+n\n"
+                            "print tree\n"   // 0
+                            "click tree/addButton\n"
+                            "click add/Sphere\n"
+                            "print tree\n"    // 1
+                            "print dirty\n"   // 2
+                            "wait\n"
+                            "window-shot new-sphere.png\n"   // 3
+                            "set fog.mode linear\n"
+                            "set fog.end 1\n"   // 4: refused
+                            "print status\n"    // 5
+                            "set fog.end 50\n"
+                            "print status\n"   // 6
+                            "quit\n");
+    ASSERT_EQ(r.rc, 0) << dump(r);
+    ASSERT_EQ(r.out.size(), 7u) << dump(r);
+    EXPECT_EQ(r.out[0], "tree\nroot\n  light\n  default camera");
+    EXPECT_EQ(r.out[1], "tree\nroot\n  light\n  default camera\n  sphere");
+    EXPECT_EQ(r.out[2], "dirty yes");
+    EXPECT_EQ(r.out[4].rfind("set fog.end: refused", 0), 0u) << r.out[4];
+    EXPECT_NE(r.out[5].find("Setting refused"), std::string::npos) << r.out[5];
+    EXPECT_EQ(r.out[6].find("refused"), std::string::npos) << r.out[6];
+}

@@ -164,7 +164,7 @@ TEST(ViewerStateTest, UnsavedChangesAreNeverLostWithoutAsking) {
     EXPECT_EQ(st.doc.scene.nodeCount(), nodes);
     EXPECT_FALSE(st.requestNew());
     st.confirm(ConfirmChoice::Discard);
-    EXPECT_EQ(st.doc.scene.nodeCount(), 1u);   // new, empty scene
+    EXPECT_EQ(st.doc.scene.nodeCount(), 3u);   // new scene: root, a light and a camera
     EXPECT_FALSE(st.doc.dirty);
 
     // Save with no file name: asks for one instead of quitting.

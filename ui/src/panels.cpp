@@ -1176,9 +1176,11 @@ void cameraInput(ViewerState& st, ImVec2 a, ImVec2 b, double time, float dt) {
         moved = true;
     }
     // Fly mode: right mouse held + WASD (QE down/up), Shift = faster.
+    bool wasFlying = st.view.flyMode;
     st.view.flyMode = active && io.MouseDown[1];
+    if (st.view.flyMode && !wasFlying) st.view.flySpeed = flySpeedFor(st.doc.scene);   // the scene's size, once per flight
     if (st.view.flyMode) {
-        float speed = std::max(st.view.camera.distance, 0.5f) * 0.8f * dt * (io.KeyShift ? 4.0f : 1.0f);
+        float speed = st.view.flySpeed * dt * (io.KeyShift ? 4.0f : 1.0f);
         sg::vec3 o(0.0f);
         if (ImGui::IsKeyDown(keys::W)) o.z += speed;
         if (ImGui::IsKeyDown(keys::S)) o.z -= speed;

@@ -88,8 +88,9 @@ std::string ViewerState::setByName(const std::string& key, const std::string& va
     } else if (key == "ambientLight") {
         setAmbientLight(r.scene->ambientLight);
     } else {
-        return setSettings(r.scene->settings);
+        return setSettings(r.scene->settings);   // also clears an earlier refusal
     }
+    if (ui.status.rfind("Setting refused", 0) == 0) ui.status.clear();
     return {};
 }
 

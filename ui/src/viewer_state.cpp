@@ -267,6 +267,10 @@ void ViewerState::setMaterial(int index, const sg::Material& m, std::string_view
 }
 
 namespace {
+// A "Setting refused: ..." status line goes once a valid value is set.
+void clearRefusal(ViewerState& st) {
+    if (st.ui.status.rfind("Setting refused", 0) == 0) st.ui.status.clear();
+}
 // The material index of a payload kind that has one (null for groups, cameras, lights).
 int* materialIndexOf(sg::Payload& p) {
     return std::visit(
@@ -297,12 +301,13 @@ int ViewerState::addMaterialFor(sg::NodeId id, const sg::Material& m) {
 }
 
 std::string ViewerState::setSettings(const sg::RenderSettings& s, std::string_view mergeKey) {
-    if (s == doc.scene.settings) return {};
     std::string err = s.validate();
     if (!err.empty()) {
         ui.status = "Setting refused: " + err;
         return err;
     }
+    clearRefusal(*this);   // valid again (also when dragged back to the value it had)
+    if (s == doc.scene.settings) return {};
     std::string names = settingNames(doc.scene.settings, s);
     UndoStep step = newStep("Change " + (names.empty() ? std::string("rendering settings") : names));
     step.changes.push_back(SettingsChange{doc.scene.settings, s});
@@ -573,7 +578,18 @@ bool ViewerState::requestNew() {
 }
 
 void ViewerState::newScene() {
-    setScene(sg::Scene{}, {});
+    sg::Scene s;
+    s.name = "untitled";
+    sg::Light sun;
+    sun.type = sg::LightType::Directional;
+    sun.intensity = 1.0f;
+    sun.inverseSquare = false;
+    sg::NodeId light = s.addNode("light", s.root(), sun);
+    sg::LocalTransform t;
+    t.setEulerDegrees(sg::vec3(-50, 30, 0));   // from above, over the camera's shoulder
+    s.setLocal(light, t);
+    s.addDefaultCamera();   // frames the unit box around the origin, where new shapes go
+    setScene(std::move(s), {});
     ui.status = "New scene";
 }
 
@@ -651,7 +667,14 @@ bool ViewerState::pollLoad(bool wait) {
         ui.status = "Open failed; the current scene is unchanged";
         return true;
     }
-    setScene(std::move(*r.scene), load.path);
+    sg::Scene& loaded = *r.scene;
+    if (loaded.settings.fog == sg::FogMode::Off) {   // fog unused: defaults for when it is turned on
+        sg::RenderSettings defaults;
+        if (loaded.settings.fogStart == defaults.fogStart && loaded.settings.fogEnd == defaults.fogEnd &&
+            loaded.settings.fogDensity == defaults.fogDensity)
+            fitFogToScene(loaded.settings, sceneRadius(loaded));
+    }
+    setScene(std::move(loaded), load.path);
     anim.clips = std::move(r.animations);
     if (!anim.clips.empty()) anim.time = anim.clips.front().start;
     addRecent(fs::absolute(load.path).lexically_normal().string());
@@ -761,6 +784,23 @@ void ViewerState::advanceAnimation(double dt) {
     anim.time = std::clamp(t, start, end);
     applyPose(*this, *c, anim.time);
 }
+
+// --- defaults from the scene's size ----------------------------------------------------------
+
+float sceneRadius(const sg::Scene& scene) {
+    sg::Aabb b = scene.worldBounds();
+    if (b.empty()) return 1.0f;
+    float r = 0.5f * glm::length(b.extent());
+    return std::isfinite(r) && r > 1e-6f ? r : 1.0f;
+}
+
+void fitFogToScene(sg::RenderSettings& s, float r) {
+    s.fogStart = r;
+    s.fogEnd = 6.0f * r;
+    s.fogDensity = std::log(2.0f) / (3.0f * r);
+}
+
+float flySpeedFor(const sg::Scene& scene) { return sceneRadius(scene); }
 
 // --- config helpers --------------------------------------------------------------------------
 

@@ -131,6 +131,7 @@ struct View {
     int viewportWidth = 1, viewportHeight = 1;   // pixels, set by the viewport panel
     double lastInteraction = -1e9;               // time (s) of the last camera drag/zoom/fly
     bool flyMode = false;
+    float flySpeed = 1.0f;   // world units per second while flying: sceneSizeSpeed() when fly mode starts
 
     std::string backend = defaultBackend();   // the single view's backend
     CompareConfig compare;
@@ -280,7 +281,9 @@ struct ViewerState {
     // Open keeps it until the loaded scene replaces this one, so a failed or cancelled load
     // leaves the document (edits and dirty flag) exactly as it was.
     void confirm(ConfirmChoice choice);
-    void newScene();   // replaces the scene by an empty one without asking
+    // Replaces the scene by a new one without asking: a directional light and a camera, so the
+    // first shape added is lit and in view.
+    void newScene();
     // std::async with a fresh LoadControl (progress + cancel).
     void startLoad(const std::filesystem::path& path);
     bool loadInProgress() const { return load.task.valid(); }
@@ -312,6 +315,14 @@ struct ViewerState {
 // The scene-JSON names of the settings that differ between a and b ("fog.mode, fog.end"; ""
 // when equal), for undo labels.
 std::string settingNames(const sg::RenderSettings& a, const sg::RenderSettings& b);
+
+// Defaults that follow the scene's size (half the diagonal of its visible bounds, r; 1 when it
+// has no geometry): fog from r to 6 r (linear) or halving at 3 r (exp: density ln 2 / 3 r),
+// set when a loaded scene's fog is off and still at RenderSettings' defaults; fly speed r per
+// second (Shift: 4 r).
+float sceneRadius(const sg::Scene& scene);
+void fitFogToScene(sg::RenderSettings& settings, float radius);
+float flySpeedFor(const sg::Scene& scene);
 
 // Per-user config folder: $XDG_CONFIG_HOME/sceneviewer, else $HOME/.config/sceneviewer.
 std::filesystem::path defaultConfigDir();
