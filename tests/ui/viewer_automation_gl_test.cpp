@@ -135,16 +135,19 @@ TEST(ViewerAutomationGLTest, ClicksReachTheTreeAndTheEditMenu) {
                             "print tree\n"   // 1
                             "click menu/edit\n"
                             "click edit/undo\n"
-                            "print tree\n"    // 2
-                            "print dirty\n"   // 3
+                            "print tree\n"             // 2
+                            "print dirty\n"            // 3
+                            "click viewport 40 40\n"   // a click in the 3D viewport: no edit, no selection change
+                            "print selection\n"        // 4
                             "window-shot undone.png\n"
                             "quit\n");
     ASSERT_EQ(r.rc, 0) << dump(r);
-    ASSERT_EQ(r.out.size(), 5u) << dump(r);   // + "wrote undone.png"
+    ASSERT_EQ(r.out.size(), 6u) << dump(r);   // + "wrote undone.png"
     EXPECT_EQ(r.out[0], "selection crate");
     EXPECT_FALSE(treeHas(r.out[1], "crate"));
     EXPECT_TRUE(treeHas(r.out[2], "crate")) << r.out[2];
     EXPECT_EQ(r.out[3], "dirty no");
+    EXPECT_EQ(r.out[4], "selection crate");
 }
 
 TEST(ViewerAutomationGLTest, OpenAsksAboutUnsavedChangesAndAnswersWork) {
@@ -209,7 +212,8 @@ TEST(ViewerAutomationGLTest, BadCommandsFailTheScript) {
                                                                                         {"set no.such.setting 1", "unknown setting"},
                                                                                         {"key ctrl+nokey", "unknown key"},
                                                                                         {"select nobody", "no node of that name"},
-                                                                                        {"print everything", "expected dirty"}}) {
+                                                                                        {"print everything", "expected dirty"},
+                                                                                        {"click nowhere/at all", "no widget of that name"}}) {
         SCOPED_TRACE(line);
         ScriptRun r = runScript(dir, "frames 1\n" + line + "\nprint dirty\nquit\n");
         EXPECT_EQ(r.rc, 2) << dump(r);

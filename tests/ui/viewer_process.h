@@ -17,13 +17,17 @@ namespace viewer_test {
 
 inline bool haveXvfb() { return std::system("command -v xvfb-run >/dev/null 2>&1") == 0; }
 
+// -noreset: without it Xvfb resets when the viewer disconnects and signals xvfb-run (SIGUSR1)
+// again; landing during xvfb-run's clean-up, that made it fail with exit code 5 ("problem
+// while cleaning up temporary directory"), mostly after short runs.
+//
 // Writes `script` to DIR/script.txt and runs `viewer ARGS --automate script.txt` in DIR with
 // DIR/config as the per-user config folder. Returns the exit code (-1: killed).
 inline int runViewer(const std::filesystem::path& dir, const std::string& script, const std::string& args = "", bool separateStdout = false) {
     std::filesystem::path scriptPath = dir / "script.txt";
     std::ofstream(scriptPath) << script;
     std::string cmd = "cd '" + dir.string() + "' && XDG_CONFIG_HOME='" + (dir / "config").string() +
-                      "' timeout -k 5 240 xvfb-run -a -s '-screen 0 1280x720x24' '" VIEWER_EXE "' " + args +
+                      "' timeout -k 5 240 xvfb-run -a -s '-screen 0 1280x720x24 -noreset' '" VIEWER_EXE "' " + args +
                       " --window-size 1280x720 --timeout 200 --automate '" + scriptPath.string() + "'" +
                       (separateStdout ? " > '" + (dir / "out.txt").string() + "' 2> '" + (dir / "log.txt").string() + "'"
                                       : " > '" + (dir / "log.txt").string() + "' 2>&1");

@@ -12,9 +12,10 @@
 //                         F1..F12, Home, End, Delete, Escape, Enter, Space, Tab, Backspace,
 //                         Insert, Left, Right, Up, Down, PageUp, PageDown or a GLFW key code
 //                         (key ctrl+z, key ctrl+shift+z, key Delete, key 2)
-//   click X Y | click ITEM   left click at window pixel (X, Y) (ImGui coordinates, the menu bar
-//                         at the top) or at the centre of a widget the panels record
-//                         (menu/edit, edit/undo, tree/crate, confirm/discard, ...)
+//   click X Y | click viewport X Y | click ITEM   left click at window pixel (X, Y) (ImGui
+//                         coordinates, the menu bar at the top), at pixel (X, Y) of the 3D
+//                         viewport (from its top-left corner), or at the centre of a widget the
+//                         panels record (menu/edit, edit/undo, tree/crate, confirm/discard, ...)
 // The document (as the File and Edit menus do)
 //   open PATH             File > Open, asking first when there are unsaved changes
 //   answer save|discard|cancel   answers the unsaved-changes question
@@ -245,7 +246,13 @@ Automation::Next Automation::clickCommand(std::istringstream& in, const ViewerSt
     std::string first = restOfLine(in);
     float x = 0, y = 0;
     std::istringstream xy(first);
-    if (!(xy >> x >> y)) {
+    if (first.rfind("viewport ", 0) == 0) {   // relative to the 3D viewport's top-left corner
+        auto vp = st.hooks.itemRects.find("viewport");
+        std::istringstream rel(first.substr(9));
+        if (vp == st.hooks.itemRects.end() || !(rel >> x >> y)) return fail("click " + first + ": expected viewport X Y, after a frame was drawn");
+        x += vp->second.x0;
+        y += vp->second.y0;
+    } else if (!(xy >> x >> y)) {
         auto it = st.hooks.itemRects.find(first);
         if (it == st.hooks.itemRects.end()) return fail("click " + first + ": not X Y, and no widget of that name was drawn");
         x = it->second.cx();
