@@ -177,6 +177,53 @@ bool Scene::removeNode(NodeId id) {
     return true;
 }
 
+DetachedSubtree Scene::detach(NodeId id) {
+    DetachedSubtree d;
+    if (!valid(id) || id == root()) return d;
+    d.id = id;
+    d.parent = m_nodes[id].parent;
+    d.index = childIndex(id);
+    auto& siblings = m_nodes[d.parent].children;
+    siblings.erase(siblings.begin() + std::ptrdiff_t(d.index));
+    // Parents first: a breadth-first walk over the subtree.
+    d.nodes.emplace_back(id, Node{});
+    for (size_t i = 0; i < d.nodes.size(); ++i) {
+        NodeId n = d.nodes[i].first;
+        for (NodeId c : m_nodes[n].children) d.nodes.emplace_back(c, Node{});
+        if (activeCamera == n) {
+            d.activeCamera = n;
+            activeCamera = kNoNode;
+        }
+        d.nodes[i].second = std::move(m_nodes[n]);
+        m_nodes[n] = Node{};   // alive = false
+        --m_aliveCount;
+    }
+    markStructureDirty();
+    return d;
+}
+
+bool Scene::reattach(DetachedSubtree d) {
+    if (d.id == kNoNode || d.nodes.empty() || d.nodes.front().first != d.id || !valid(d.parent)) return false;
+    for (const auto& [n, node] : d.nodes)
+        if (n >= m_nodes.size() || m_nodes[n].alive || !node.alive) return false;
+    auto& siblings = m_nodes[d.parent].children;
+    siblings.insert(siblings.begin() + std::ptrdiff_t(std::min(d.index, siblings.size())), d.id);
+    for (auto& [n, node] : d.nodes) {
+        m_nodes[n] = std::move(node);
+        ++m_aliveCount;
+    }
+    m_nodes[d.id].parent = d.parent;
+    if (d.activeCamera != kNoNode && valid(d.activeCamera)) activeCamera = d.activeCamera;
+    markStructureDirty();
+    return true;
+}
+
+size_t Scene::childIndex(NodeId id) const {
+    if (!valid(id) || id == root()) return 0;
+    const auto& siblings = m_nodes[m_nodes[id].parent].children;
+    return size_t(std::find(siblings.begin(), siblings.end(), id) - siblings.begin());
+}
+
 NodeId Scene::duplicate(NodeId id) {
     if (!valid(id) || id == root()) return kNoNode;
     // Copy breadth-first, mapping old ids to new ids; parents are created before children.

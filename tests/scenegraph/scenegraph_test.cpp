@@ -270,6 +270,63 @@ TEST(SceneTest, RemoveAndDuplicateSubtrees) {
     EXPECT_EQ(s.activeCamera, kNoNode);
 }
 
+// detach / reattach (undo of a removal or an addition): the same ids, place, transforms,
+// world matrices and active camera come back; refused when the parent is gone or ids are taken.
+TEST(SceneTest, DetachAndReattachRestoreTheSubtreeExactly) {
+    SmallTree t;
+    Scene& s = t.s;
+    NodeId cam = s.addNode("cam", t.b, Camera{});
+    s.activeCamera = cam;
+    NodeId sibling = s.addNode("sibling", s.root());
+    std::vector<NodeId> order = s.depthFirstOrder();
+    mat4 worldC = s.world(t.c);
+    size_t n0 = s.nodeCount();
+    ASSERT_EQ(s.childIndex(t.a), 0u);
+
+    DetachedSubtree d = s.detach(t.a);
+    ASSERT_EQ(d.id, t.a);
+    EXPECT_EQ(d.parent, s.root());
+    EXPECT_EQ(d.index, 0u);
+    EXPECT_EQ(d.activeCamera, cam);
+    EXPECT_EQ(d.nodes.front().first, t.a);
+    EXPECT_EQ(s.nodeCount(), n0 - d.nodes.size());
+    EXPECT_FALSE(s.valid(t.a));
+    EXPECT_FALSE(s.valid(cam));
+    EXPECT_EQ(s.activeCamera, kNoNode);
+    EXPECT_TRUE(s.valid(sibling));
+    EXPECT_EQ(s.depthFirstOrder().size(), s.nodeCount());
+
+    NodeId later = s.addNode("later", s.root());   // new ids never collide with detached ones
+    EXPECT_EQ(std::find_if(d.nodes.begin(), d.nodes.end(), [&](const auto& p) { return p.first == later; }), d.nodes.end());
+    s.removeNode(later);
+
+    ASSERT_TRUE(s.reattach(d));
+    EXPECT_EQ(s.nodeCount(), n0);
+    EXPECT_EQ(s.depthFirstOrder(), order);
+    EXPECT_EQ(s.childIndex(t.a), 0u);
+    EXPECT_EQ(s.activeCamera, cam);
+    EXPECT_TRUE(matNear(s.world(t.c), worldC));
+    EXPECT_FALSE(s.reattach(d)) << "ids already alive";
+
+    // Reattached elsewhere (a move): under e, same ids.
+    DetachedSubtree moved = s.detach(t.b);
+    moved.parent = t.e;
+    moved.index = 99;   // clamped to the end
+    ASSERT_TRUE(s.reattach(std::move(moved)));
+    EXPECT_EQ(s.node(t.b).parent, t.e);
+    EXPECT_TRUE(s.isAncestor(t.e, t.c));
+    EXPECT_EQ(s.depthFirstOrder().size(), s.nodeCount());
+
+    // Refusals: nothing detached for the root or bad ids; the parent must be alive.
+    EXPECT_EQ(s.detach(s.root()).id, kNoNode);
+    EXPECT_EQ(s.detach(123456).id, kNoNode);
+    DetachedSubtree gone = s.detach(t.c);
+    s.removeNode(t.e);   // c's old parent b is below e: gone too
+    EXPECT_FALSE(s.reattach(gone));
+    EXPECT_FALSE(s.valid(t.c));
+    EXPECT_EQ(s.depthFirstOrder().size(), s.nodeCount());
+}
+
 TEST(SceneTest, DepthFirstOrderPutsParentsFirst) {
     SmallTree t;
     const auto& order = t.s.depthFirstOrder();

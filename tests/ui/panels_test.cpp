@@ -1,77 +1,12 @@
 // The ImGui panels in headless frames (no window, no renderer backend): real clicks at the
 // positions of recorded widgets change the scene and settings; keys switch backends; drags
 // in the viewport move the camera; the unsaved-changes modal appears and works.
-#include "ui/panels.h"
-
-#include "assets/demo.h"
+#include "headless_ui.h"
 
 #include <gtest/gtest.h>
 #include <imgui.h>
 
 using namespace ui;
-
-namespace {
-
-class Headless {
-public:
-    Headless() {
-        ImGui::CreateContext();
-        ImGuiIO& io = ImGui::GetIO();
-        io.IniFilename = nullptr;
-        io.DisplaySize = ImVec2(1600, 900);
-        io.DeltaTime = 1.0f / 60.0f;
-        setupStyle(1.0f, nullptr);
-        unsigned char* pixels = nullptr;
-        int w = 0, h = 0;
-        io.Fonts->GetTexDataAsRGBA32(&pixels, &w, &h);
-        st.view.viewportWidth = 800;
-        st.view.viewportHeight = 600;
-        st.setScene(assets::makeDemoScene(), {});
-        view.slots.resize(1);
-        view.slots[0].status.backend = "gl";
-        view.slots[0].status.error = "not built";
-        frame();
-        frame();
-    }
-    ~Headless() { ImGui::DestroyContext(); }
-
-    void frame() {
-        ImGui::NewFrame();
-        drawUi(st, view, t, 1.0f / 60.0f);
-        ImGui::Render();
-        t += 1.0 / 60.0;
-    }
-    const ItemRect& rect(const std::string& key) {
-        auto it = st.hooks.itemRects.find(key);
-        if (it == st.hooks.itemRects.end()) throw std::runtime_error("no item '" + key + "'");
-        return it->second;
-    }
-    void moveTo(float x, float y) {
-        ImGui::GetIO().MousePos = ImVec2(x, y);
-        frame();
-    }
-    void click(const std::string& key) {
-        const ItemRect r = rect(key);
-        moveTo(r.cx(), r.cy());
-        ImGui::GetIO().MouseDown[0] = true;
-        frame();
-        ImGui::GetIO().MouseDown[0] = false;
-        frame();
-        frame();
-    }
-    void press(int key) {
-        ImGui::GetIO().KeysDown[key] = true;
-        frame();
-        ImGui::GetIO().KeysDown[key] = false;
-        frame();
-    }
-
-    ViewerState st;
-    ViewportInput view;
-    double t = 0;
-};
-
-}   // namespace
 
 TEST(PanelsTest, LayoutHasTreeTabsAndViewport) {
     Headless h;

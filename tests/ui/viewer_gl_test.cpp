@@ -4,18 +4,19 @@
 // Never hangs: the viewer has its own --timeout and the command runs under `timeout`.
 #include "assets/image_io.h"
 #include "test_support.h"
+#include "viewer_process.h"
 
 #include <gtest/gtest.h>
 
-#include <cstdlib>
 #include <cstring>
-#include <fstream>
 
 namespace fs = std::filesystem;
 
-namespace {
+using viewer_test::haveXvfb;
+using viewer_test::readLog;
+using viewer_test::runViewer;
 
-bool haveXvfb() { return std::system("command -v xvfb-run >/dev/null 2>&1") == 0; }
+namespace {
 
 // Non-empty and not one flat colour.
 ::testing::AssertionResult pngHasContent(const fs::path& p) {
@@ -31,21 +32,6 @@ bool haveXvfb() { return std::system("command -v xvfb-run >/dev/null 2>&1") == 0
         if (std::memcmp(&t.rgba[i * 4], &t.rgba[0], 3) != 0) ++differing;
     if (differing < n / 100) return ::testing::AssertionFailure() << p << " is (nearly) uniform";
     return ::testing::AssertionSuccess();
-}
-
-int runViewer(const fs::path& dir, const std::string& script, const std::string& args = "") {
-    fs::path scriptPath = dir / "script.txt";
-    std::ofstream(scriptPath) << script;
-    std::string cmd = "cd '" + dir.string() + "' && XDG_CONFIG_HOME='" + (dir / "config").string() +
-                      "' timeout -k 5 240 xvfb-run -a -s '-screen 0 1280x720x24' '" VIEWER_EXE "' " + args +
-                      " --window-size 1280x720 --timeout 200 --automate '" + scriptPath.string() + "' > '" + (dir / "log.txt").string() + "' 2>&1";
-    int rc = std::system(cmd.c_str());
-    return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
-}
-
-std::string readLog(const fs::path& dir) {
-    std::ifstream in(dir / "log.txt");
-    return std::string(std::istreambuf_iterator<char>(in), {});
 }
 
 }   // namespace

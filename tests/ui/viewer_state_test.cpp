@@ -101,7 +101,9 @@ TEST(ViewerStateTest, BackendKeysAndEditsBumpVersions) {
     st.setBackendIndex(7);   // ignored
     EXPECT_EQ(st.view.backend, "raycast");
     uint64_t v = st.doc.version, vv = st.view.version;
-    st.editProjection().fovyDeg = 60.0f;
+    sg::Projection p = st.projection();
+    p.fovyDeg = 60.0f;
+    st.setProjection(p);
     EXPECT_GT(st.doc.version, v);   // the scene camera's projection is scene data
     EXPECT_TRUE(st.doc.dirty);
     EXPECT_EQ(st.projection().fovyDeg, 60.0f);
@@ -162,7 +164,7 @@ TEST(ViewerStateTest, UnsavedChangesAreNeverLostWithoutAsking) {
     EXPECT_EQ(st.doc.scene.nodeCount(), nodes);
     EXPECT_FALSE(st.requestNew());
     st.confirm(ConfirmChoice::Discard);
-    EXPECT_EQ(st.doc.scene.nodeCount(), 1u);   // new, empty scene
+    EXPECT_EQ(st.doc.scene.nodeCount(), 3u);   // new scene: root, a light and a camera
     EXPECT_FALSE(st.doc.dirty);
 
     // Save with no file name: asks for one instead of quitting.
@@ -325,7 +327,9 @@ TEST(ViewerStateTest, SaveAndReopenKeepsEditsAndView) {
     st.doc.scene.settings.shading = sg::ShadingModel::Gouraud;
     st.doc.scene.settings.fog = sg::FogMode::Exp;
     st.markEdited();
-    st.editProjection().fovyDeg = 52.0f;
+    sg::Projection p = st.projection();
+    p.fovyDeg = 52.0f;
+    st.setProjection(p);
     st.view.camera.orbit(80.0f, 20.0f);
     sg::vec3 eye = st.view.camera.eye();
     fs::path file = testing_support::outputDir("ui") / "saved-scene.json";

@@ -15,6 +15,7 @@
 #include "ui/panels.h"
 
 #include "assets/scene_io.h"
+#include "renderers/framebuffer.h"
 #include "renderers/renderer.h"
 #include "scenegraph/setting_names.h"
 
@@ -22,6 +23,7 @@
 #include <imgui_stdlib.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -175,14 +177,19 @@ void addMenuItems(ViewerState& st, sg::NodeId parent) {
 }   // namespace
 
 std::vector<std::string> visibleBackends(const ViewerState& st) {
-    switch (st.view.compare.mode) {
-    case ViewMode::Single: return {st.view.backend};
-    case ViewMode::Split: {
-        std::vector<std::string> v(st.view.compare.backends.begin(), st.view.compare.backends.begin() + std::clamp(st.view.compare.count, 2, 3));
+    const CompareConfig& c = st.view.compare;
+    // A view whose backends were never chosen (mode set without showView) shows its defaults.
+    auto chosen = [&](auto& slots, size_t n) {
+        std::vector<std::string> v = comparisonBackends(st.view.backend, slots.size());
+        for (size_t i = 0; i < slots.size(); ++i)
+            if (!slots[i].empty()) v[i] = slots[i];
+        v.resize(n);
         return v;
-    }
-    case ViewMode::Difference:
-        return {st.view.compare.backends[std::clamp(st.view.compare.diffA, 0, 2)], st.view.compare.backends[std::clamp(st.view.compare.diffB, 0, 2)]};
+    };
+    switch (c.mode) {
+    case ViewMode::Single: return {st.view.backend};
+    case ViewMode::Split: return chosen(c.split, size_t(std::clamp(c.count, 2, 3)));
+    case ViewMode::Difference: return chosen(c.diff, 2);
     }
     return {st.view.backend};
 }
@@ -228,6 +235,35 @@ void setupStyle(float scale, const char* fontPath) {
 
 // --- 3. main menu ------------------------------------------------------------------------------
 
+namespace {
+
+// Edit: Undo / Redo naming the step they apply (greyed when there is none), then the
+// selection's rename / duplicate / delete.
+void drawEditMenu(ViewerState& st) {
+    bool open = ImGui::BeginMenu("Edit");
+    record(st, "menu/edit");
+    if (!open) return;
+    const UndoStack& h = st.doc.history;
+    std::string undo = h.canUndo() ? "Undo " + h.undoLabel() : std::string("Undo");
+    std::string redo = h.canRedo() ? "Redo " + h.redoLabel() : std::string("Redo");
+    if (ImGui::MenuItem((undo + "###undo").c_str(), "Ctrl+Z", false, h.canUndo())) st.undo();
+    record(st, "edit/undo");
+    if (ImGui::MenuItem((redo + "###redo").c_str(), "Ctrl+Shift+Z", false, h.canRedo())) st.redo();
+    record(st, "edit/redo");
+    ImGui::Separator();
+    sg::NodeId sel = st.doc.selected;
+    bool canEdit = st.doc.scene.valid(sel) && sel != st.doc.scene.root();
+    if (ImGui::MenuItem("Rename", "F2", false, canEdit)) {
+        st.ui.panels.renaming = sel;
+        st.ui.panels.renameBuffer = st.doc.scene.node(sel).name;
+    }
+    if (ImGui::MenuItem("Duplicate", "Ctrl+D", false, canEdit)) st.duplicateNode(sel);
+    if (ImGui::MenuItem("Delete", "Del", false, canEdit)) st.removeNode(sel);
+    ImGui::EndMenu();
+}
+
+}   // namespace
+
 void drawMainMenu(ViewerState& st) {
     if (!ImGui::BeginMainMenuBar()) return;
     if (ImGui::BeginMenu("File")) {
@@ -248,13 +284,23 @@ void drawMainMenu(ViewerState& st) {
         if (ImGui::MenuItem("Quit", "Ctrl+Q")) st.requestQuit();
         ImGui::EndMenu();
     }
-    if (ImGui::BeginMenu("View")) {
+    drawEditMenu(st);
+    bool viewOpen = ImGui::BeginMenu("View");
+    record(st, "menu/view");
+    if (viewOpen) {
         if (ImGui::MenuItem("Fit to scene / selection", "F")) st.fitView(st.doc.scene.valid(st.doc.selected));
         if (ImGui::MenuItem("Reset to scene camera", "Home")) st.resetView();
         ImGui::Separator();
-        if (ImGui::MenuItem("Single backend", nullptr, st.view.compare.mode == ViewMode::Single)) st.view.compare.mode = ViewMode::Single;
-        if (ImGui::MenuItem("Split view (wipe)", nullptr, st.view.compare.mode == ViewMode::Split)) st.view.compare.mode = ViewMode::Split;
-        if (ImGui::MenuItem("Difference view", nullptr, st.view.compare.mode == ViewMode::Difference)) st.view.compare.mode = ViewMode::Difference;
+        // The same modes as the Compare tab, --view and the automation's `view` (showView).
+        std::string mode = st.viewName();
+        if (ImGui::MenuItem("Single backend", nullptr, mode == "single")) st.showView(ViewMode::Single);
+        record(st, "view/single");
+        if (ImGui::MenuItem("Split view, 2 backends (wipe)", nullptr, mode == "split")) st.showView(ViewMode::Split, 2);
+        record(st, "view/split");
+        if (ImGui::MenuItem("Split view, 3 backends", nullptr, mode == "split3")) st.showView(ViewMode::Split, 3);
+        record(st, "view/split3");
+        if (ImGui::MenuItem("Difference view", nullptr, mode == "difference")) st.showView(ViewMode::Difference);
+        record(st, "view/difference");
         ImGui::Separator();
         ImGui::MenuItem("Stats overlay", nullptr, &st.ui.panels.showOverlay);
         if (ImGui::BeginMenu("Scene cameras", !st.doc.scene.cameras().empty())) {
@@ -270,7 +316,7 @@ void drawMainMenu(ViewerState& st) {
             std::string key = std::to_string(i + 1);
             if (ImGui::MenuItem(names[i].c_str(), key.c_str(), st.view.backend == names[i])) {
                 st.setBackend(names[i]);
-                st.view.compare.mode = ViewMode::Single;
+                st.showView(ViewMode::Single);
             }
         }
         ImGui::EndMenu();
@@ -432,8 +478,9 @@ void drawSceneTree(ViewerState& st) {
 
 namespace {
 
-// Material editor for a payload's material index. Returns true when the index changed.
-bool materialEditor(ViewerState& st, int& index) {
+// Material editor for the material index of node `id`'s payload. Returns true when the index
+// changed. Edits of one material while a widget is held merge into one undo step.
+bool materialEditor(ViewerState& st, sg::NodeId id, int& index) {
     bool indexChanged = false;
     std::string preview = index < 0 || size_t(index) >= st.doc.scene.materials.size()
                               ? std::string("(default)")
@@ -453,13 +500,13 @@ bool materialEditor(ViewerState& st, int& index) {
         ImGui::EndCombo();
     }
     ImGui::SameLine();
-    if (ImGui::SmallButton("New")) {
+    if (ImGui::SmallButton("New")) {   // one undo step: the material and the node's index
         sg::Material m = st.doc.scene.material(index);
         m.name = "material " + std::to_string(st.doc.scene.materials.size());
-        st.doc.scene.materials.push_back(m);
-        index = int(st.doc.scene.materials.size()) - 1;
-        indexChanged = true;
+        int added = st.addMaterialFor(id, m);
+        if (added >= 0) index = added;   // the node already has it: no second step
     }
+    record(st, "material/new");
     if (index < 0 || size_t(index) >= st.doc.scene.materials.size()) {
         ImGui::TextDisabled("Default material (press New to edit a copy)");
         return indexChanged;
@@ -469,7 +516,9 @@ bool materialEditor(ViewerState& st, int& index) {
     ch |= ImGui::InputText("Name##mat", &m.name, ImGuiInputTextFlags_EnterReturnsTrue);
     ch |= ImGui::ColorEdit3("Base colour", &m.baseColor.x, ImGuiColorEditFlags_Float);
     ch |= ImGui::SliderFloat("ka (ambient)", &m.ka, 0.0f, 1.0f);
+    record(st, "material/ka");
     ch |= ImGui::SliderFloat("kd (diffuse)", &m.kd, 0.0f, 1.0f);
+    record(st, "material/kd");
     ch |= ImGui::SliderFloat("ks (specular)", &m.ks, 0.0f, 1.0f);
     ch |= ImGui::SliderFloat("Shininess n", &m.shininess, 1.0f, 512.0f, "%.1f", ImGuiSliderFlags_Logarithmic);
     ch |= ImGui::Checkbox("Specular tinted by base colour", &m.specularTinted);
@@ -491,10 +540,7 @@ bool materialEditor(ViewerState& st, int& index) {
     ch |= enumCombo(st, "Alpha mode", m.alphaMode);
     if (m.alphaMode != sg::AlphaMode::Opaque) ch |= ImGui::SliderFloat("Alpha", &m.alpha, 0.0f, 1.0f);
     if (m.alphaMode == sg::AlphaMode::Mask) ch |= ImGui::SliderFloat("Alpha cutoff", &m.alphaCutoff, 0.0f, 1.0f);
-    if (ch && !(m == st.doc.scene.materials[index])) {
-        st.doc.scene.materials[index] = m;
-        st.markEdited();
-    }
+    if (ch) st.setMaterial(index, m, "material " + std::to_string(index));
     return indexChanged;
 }
 
@@ -554,7 +600,7 @@ void transformEditor(ViewerState& st, sg::NodeId id) {
         }
         helpMarker("Euler angles applied X, then Y, then Z (R = Rz Ry Rx)");
         ch |= ImGui::DragFloat3("Scale", &t.scale.x, 0.01f);
-        if (ch) st.setLocal(id, t);
+        if (ch) st.setLocal(id, t, "local " + std::to_string(id));
     } else {
         if (ImGui::Button("Convert back to TRS")) {
             sg::LocalTransform c = t;
@@ -597,7 +643,7 @@ void transformEditor(ViewerState& st, sg::NodeId id) {
     if (ImGui::SmallButton("Identity")) { st.setLocal(id, sg::LocalTransform{}); }
     if (mch) {
         if (sg::isFinite(m) && sg::isInvertible(m))
-            st.setLocal(id, sg::LocalTransform::fromMatrix(m));
+            st.setLocal(id, sg::LocalTransform::fromMatrix(m), "local " + std::to_string(id));
         else
             st.ui.status = "Matrix edit refused: singular or not finite";
     }
@@ -615,7 +661,8 @@ void sceneSummary(ViewerState& st) {
     ImGui::Text("Scene: %s", scene.name.c_str());
     ImGui::Text("Nodes: %zu   meshes: %zu   materials: %zu   textures: %zu", scene.nodeCount(), scene.meshes.size(), scene.materials.size(),
                 scene.textures.size());
-    if (ImGui::ColorEdit3("Ambient light", &scene.ambientLight.x, ImGuiColorEditFlags_Float)) st.markEdited();
+    sg::vec3 ambient = scene.ambientLight;
+    if (ImGui::ColorEdit3("Ambient light", &ambient.x, ImGuiColorEditFlags_Float)) st.setAmbientLight(ambient, "ambient");
 }
 
 // Name, kind and id, visibility.
@@ -637,8 +684,8 @@ void nodeHeader(ViewerState& st, sg::NodeId id) {
 // The payload sections below edit a copy of the payload and return true when it changed;
 // drawInspector writes it back.
 
-bool materialSection(ViewerState& st, int& index) {
-    return ImGui::CollapsingHeader("Material", ImGuiTreeNodeFlags_DefaultOpen) && materialEditor(st, index);
+bool materialSection(ViewerState& st, sg::NodeId id, int& index) {
+    return ImGui::CollapsingHeader("Material", ImGuiTreeNodeFlags_DefaultOpen) && materialEditor(st, id, index);
 }
 
 void meshSection(const ViewerState& st, const sg::MeshInstance& mi) {
@@ -723,23 +770,23 @@ bool payloadEditor(ViewerState& st, sg::NodeId id, sg::Payload& p) {
     bool ch = false;
     if (auto* mi = std::get_if<sg::MeshInstance>(&p)) {
         meshSection(st, *mi);
-        ch |= materialSection(st, mi->material);
+        ch |= materialSection(st, id, mi->material);
     } else if (auto* ip = std::get_if<sg::ImplicitPayload>(&p)) {
         if (ImGui::CollapsingHeader("Implicit shape", ImGuiTreeNodeFlags_DefaultOpen)) ch |= implicitEditor(st, ip->shape);
-        ch |= materialSection(st, ip->material);
+        ch |= materialSection(st, id, ip->material);
     } else if (auto* cp = std::get_if<sg::CsgPayload>(&p)) {
         ch |= csgSection(st, id, *cp);
-        ch |= materialSection(st, cp->material);
+        ch |= materialSection(st, id, cp->material);
     } else if (auto* lp = std::get_if<sg::Light>(&p)) {
         ch |= lightSection(st, *lp);
     } else if (auto* cam = std::get_if<sg::Camera>(&p)) {
         ch |= cameraSection(st, id, *cam);
     } else if (auto* pp = std::get_if<sg::ParametricPayload>(&p)) {
         ch |= parametricSection(st, *pp);
-        ch |= materialSection(st, pp->material);
+        ch |= materialSection(st, id, pp->material);
     } else if (auto* gp = std::get_if<sg::GridPayload>(&p)) {
         ch |= gridSection(*gp);
-        ch |= materialSection(st, gp->material);
+        ch |= materialSection(st, id, gp->material);
     }
     return ch;
 }
@@ -756,10 +803,7 @@ void drawInspector(ViewerState& st) {
     if (id != st.doc.scene.root() && ImGui::CollapsingHeader("Transform", ImGuiTreeNodeFlags_DefaultOpen)) transformEditor(st, id);
 
     sg::Payload p = st.doc.scene.node(id).payload;
-    if (payloadEditor(st, id, p) && st.doc.scene.valid(id) && !(p == st.doc.scene.node(id).payload)) {
-        st.doc.scene.setPayload(id, p);
-        st.markEdited();
-    }
+    if (payloadEditor(st, id, p) && st.doc.scene.valid(id)) st.setPayload(id, p, "payload " + std::to_string(id));
 }
 
 void drawAnimationPanel(ViewerState& st) {
@@ -848,7 +892,7 @@ void drawCameraPanel(ViewerState& st) {
     if (ch) {
         p.zNear = std::max(p.zNear, 1e-4f);
         p.zFar = std::max(p.zFar, p.zNear * 1.001f);
-        st.editProjection() = p;
+        st.setProjection(p, "projection");
     }
     ImGui::TextDisabled("Zoom factor %.3f  (orthographic / oblique)", st.view.camera.orthoScale);
 
@@ -912,10 +956,7 @@ void drawRenderingPanel(ViewerState& st) {
     ch |= ImGui::Checkbox("Light attenuation (1/r^2)", &s.attenuation);
     record(st, "render/attenuation");
     sg::vec3 amb = st.doc.scene.ambientLight;
-    if (ImGui::ColorEdit3("Ambient light", &amb.x, ImGuiColorEditFlags_Float)) {
-        st.doc.scene.ambientLight = amb;
-        st.markEdited();
-    }
+    if (ImGui::ColorEdit3("Ambient light", &amb.x, ImGuiColorEditFlags_Float)) st.setAmbientLight(amb, "ambient");
 
     section("Fog");
     ch |= enumCombo(st, "Fog", s.fog);
@@ -961,15 +1002,7 @@ void drawRenderingPanel(ViewerState& st) {
     section("Background");
     ch |= ImGui::ColorEdit3("Background", &s.background.x, ImGuiColorEditFlags_Float);
 
-    if (ch && !(s == st.doc.scene.settings)) {
-        std::string err = s.validate();
-        if (err.empty()) {
-            st.doc.scene.settings = s;
-            st.markEdited();
-        } else {
-            st.ui.status = "Setting refused: " + err;
-        }
-    }
+    if (ch) st.setSettings(s, "settings");   // refused values: the reason goes to the status line
 }
 
 // --- 8. compare panel --------------------------------------------------------------------------
@@ -985,7 +1018,7 @@ void drawComparePanel(ViewerState& st) {
     ImGui::SameLine();
     ImGui::RadioButton("Difference", &mode, 2);
     record(st, "compare/difference");
-    c.mode = ViewMode(mode);
+    if (ViewMode(mode) != c.mode) st.showView(ViewMode(mode));
     std::vector<std::string> names = rnd::rendererNames();
     auto backendCombo = [&](const char* label, std::string& value) {
         if (ImGui::BeginCombo(label, value.c_str())) {
@@ -1001,31 +1034,30 @@ void drawComparePanel(ViewerState& st) {
         if (b != st.view.backend) st.setBackend(b);
         ImGui::TextDisabled("Keys 1 / 2 / 3 switch backends.");
     } else if (c.mode == ViewMode::Split) {
-        ImGui::SliderInt("Count", &c.count, 2, 3);
+        int count = c.count;
+        if (ImGui::SliderInt("Count", &count, 2, 3)) st.showView(ViewMode::Split, count);
         const char* labels[] = {"Left", c.count == 3 ? "Middle" : "Right", "Right"};
-        for (int i = 0; i < c.count; ++i) backendCombo(labels[i], c.backends[i]);
+        for (int i = 0; i < c.count; ++i) backendCombo(labels[i], c.split[size_t(i)]);
         ImGui::SliderFloat("Divider 1", &c.dividers[0], 0.0f, 1.0f);
         if (c.count == 3) ImGui::SliderFloat("Divider 2", &c.dividers[1], 0.0f, 1.0f);
         c.dividers[1] = std::max(c.dividers[1], c.dividers[0]);
         ImGui::TextDisabled("Drag the dividers in the viewport.");
     } else {
-        c.diffA = std::clamp(c.diffA, 0, 2);
-        c.diffB = std::clamp(c.diffB, 0, 2);
-        if (c.diffA == c.diffB) c.diffB = (c.diffA + 1) % 3;
-        backendCombo("A", c.backends[c.diffA]);
-        backendCombo("B", c.backends[c.diffB]);
+        backendCombo("A", c.diff[0]);
+        backendCombo("B", c.diff[1]);
+        if (c.diff[0] == c.diff[1]) ImGui::TextColored(ImVec4(1.0f, 0.75f, 0.4f, 1.0f), "A and B are the same backend: nothing to compare.");
     }
     if (c.mode == ViewMode::Difference) {
         section("Difference");
-        ImGui::Text("|%s - %s| per pixel", c.backends[c.diffA].c_str(), c.backends[c.diffB].c_str());
+        ImGui::Text("|%s - %s| per pixel", c.diff[0].c_str(), c.diff[1].c_str());
         ImGui::SliderInt("Threshold", &c.threshold, 0, 255);
         record(st, "compare/threshold");
-        if (st.view.diff.valid) {
-            ImGui::Text("Mean |a-b|  %.3f", st.view.diff.mean);
-            ImGui::Text("Max  |a-b|  %d", st.view.diff.max);
-            ImGui::Text("PSNR        %s",
-                        std::isfinite(st.view.diff.psnr) ? (std::to_string(st.view.diff.psnr).substr(0, 6) + " dB").c_str() : "identical");
-            ImGui::Text("Within threshold  %.2f %%", 100.0 * st.view.diff.within);
+        const DiffFigures& d = st.view.diff;   // the overlay writes the same texts
+        if (d.valid) {
+            ImGui::Text("Mean |a-b|  %s", d.meanText().c_str());
+            ImGui::Text("Max  |a-b|  %d", d.max);
+            ImGui::Text("PSNR        %s", d.psnrText().c_str());
+            ImGui::Text("Within %d   %s of the pixels", c.threshold, d.withinText().c_str());
         } else {
             ImGui::TextDisabled("Waiting for both full-resolution images...");
         }
@@ -1144,9 +1176,11 @@ void cameraInput(ViewerState& st, ImVec2 a, ImVec2 b, double time, float dt) {
         moved = true;
     }
     // Fly mode: right mouse held + WASD (QE down/up), Shift = faster.
+    bool wasFlying = st.view.flyMode;
     st.view.flyMode = active && io.MouseDown[1];
+    if (st.view.flyMode && !wasFlying) st.view.flySpeed = flySpeedFor(st.doc.scene);   // the scene's size, once per flight
     if (st.view.flyMode) {
-        float speed = std::max(st.view.camera.distance, 0.5f) * 0.8f * dt * (io.KeyShift ? 4.0f : 1.0f);
+        float speed = st.view.flySpeed * dt * (io.KeyShift ? 4.0f : 1.0f);
         sg::vec3 o(0.0f);
         if (ImGui::IsKeyDown(keys::W)) o.z += speed;
         if (ImGui::IsKeyDown(keys::S)) o.z -= speed;
@@ -1193,8 +1227,65 @@ void drawSplitView(ImDrawList* dl, const ViewerState& st, const ViewportInput& v
     }
 }
 
-// Difference view: the heat map (or why there is none yet) and the figures at the bottom.
-void drawDifferenceView(ImDrawList* dl, const ViewerState& st, const ViewportInput& view, ImVec2 a, ImVec2 avail) {
+// The heat map's colours for a largest-channel difference of 0..64 (64 and above look the
+// same), and of a pixel within the threshold (a dimmed grey copy of image A, here of mid grey):
+// taken from rnd::diffImage itself on a ramp, so the legend cannot drift from the image.
+struct HeatColours {
+    std::array<ImU32, 65> ramp;
+    ImU32 within;
+};
+HeatColours heatColours() {
+    rnd::Framebuffer x, y;
+    x.resize(66, 1);
+    y.resize(66, 1);
+    std::fill(x.color.begin(), x.color.end(), uint8_t(0));
+    std::fill(y.color.begin(), y.color.end(), uint8_t(0));
+    for (int i = 0; i < 66; ++i) x.color[size_t(i) * 4 + 3] = y.color[size_t(i) * 4 + 3] = 255;
+    for (int v = 0; v <= 64; ++v) y.color[size_t(v) * 4] = uint8_t(v);   // pixel v differs by v
+    for (int c = 0; c < 3; ++c) x.color[65 * 4 + size_t(c)] = y.color[65 * 4 + size_t(c)] = 128;
+    rnd::Framebuffer d = rnd::diffImage(x, y, 0);
+    auto colour = [&](int i) { return IM_COL32(d.color[size_t(i) * 4], d.color[size_t(i) * 4 + 1], d.color[size_t(i) * 4 + 2], 255); };
+    HeatColours h{};
+    for (int v = 0; v <= 64; ++v) h.ramp[size_t(v)] = colour(v);
+    h.within = colour(65);
+    return h;
+}
+
+// Legend (top right of the heat map): what grey and the red-to-white ramp mean.
+void drawDiffLegend(ImDrawList* dl, ViewerState& st, ImVec2 a, ImVec2 avail) {
+    const HeatColours heat = heatColours();
+    int t = std::clamp(st.view.compare.threshold, 0, 255);
+    const std::string title = "|A - B|, largest channel (0-255)", within = "0-" + std::to_string(t) + ": within threshold (A, dimmed)";
+    float lh = ImGui::GetTextLineHeight(), barH = px(12), pad = px(8);
+    float w = std::max(ImGui::CalcTextSize(title.c_str()).x, px(26) + ImGui::CalcTextSize(within.c_str()).x) + 2 * pad;
+    ImVec2 o(a.x + std::max(avail.x - w - px(10), 0.0f), a.y + px(10));
+    ImVec2 end(o.x + w, o.y + pad * 2 + lh * 3 + barH + px(8));
+    dl->AddRectFilled(o, end, IM_COL32(0, 0, 0, 190), px(4));
+    ImU32 text = IM_COL32(230, 230, 235, 255);
+    float x0 = o.x + pad, x1 = end.x - pad, y = o.y + pad;
+    dl->AddText(ImVec2(x0, y), text, title.c_str());
+    y += lh + px(2);
+    dl->AddRectFilled(ImVec2(x0, y + px(2)), ImVec2(x0 + px(18), y + lh - px(2)), heat.within);
+    dl->AddRect(ImVec2(x0, y + px(2)), ImVec2(x0 + px(18), y + lh - px(2)), IM_COL32(120, 120, 120, 255));
+    dl->AddText(ImVec2(x0 + px(26), y), text, within.c_str());
+    y += lh + px(4);
+    int from = std::min(t + 1, 64);   // the ramp from the first highlighted difference
+    int steps = std::max(64 - from, 1);
+    for (int i = 0; i < steps; ++i) {
+        float u0 = x0 + (x1 - x0) * float(i) / float(steps), u1 = x0 + (x1 - x0) * float(i + 1) / float(steps);
+        ImU32 c0 = heat.ramp[size_t(std::min(from + i, 64))], c1 = heat.ramp[size_t(std::min(from + i + 1, 64))];
+        dl->AddRectFilledMultiColor(ImVec2(u0, y), ImVec2(u1, y + barH), c0, c1, c1, c0);
+    }
+    y += barH + px(2);
+    std::string left = std::to_string(t + 1), right = t + 1 >= 64 ? "" : "64+";
+    dl->AddText(ImVec2(x0, y), text, left.c_str());
+    dl->AddText(ImVec2(x1 - ImGui::CalcTextSize(right.c_str()).x, y), text, right.c_str());
+    st.hooks.itemRects["diff/legend"] = ItemRect{o.x, o.y, end.x, end.y};
+}
+
+// Difference view: the heat map (or why there is none yet), its legend and the figures at the
+// bottom (DiffFigures::summary, as the Compare tab writes them).
+void drawDifferenceView(ImDrawList* dl, ViewerState& st, const ViewportInput& view, ImVec2 a, ImVec2 avail) {
     ImVec2 b(a.x + avail.x, a.y + avail.y);
     SlotView d = view.diff;
     if (!d.texture) {
@@ -1206,19 +1297,14 @@ void drawDifferenceView(ImDrawList* dl, const ViewerState& st, const ViewportInp
         centeredText(dl, a, b, msg, IM_COL32(255, 170, 140, 255));
     } else {
         dl->AddImage(d.texture, a, b);
+        drawDiffLegend(dl, st, a, avail);
     }
     if (view.slots.size() >= 2) {
-        char buf[256];
-        if (st.view.diff.valid)
-            std::snprintf(buf, sizeof buf, "|%s - %s|   mean %.2f   max %d   PSNR %.1f dB   within %d: %.1f%%", view.slots[0].status.backend.c_str(),
-                          view.slots[1].status.backend.c_str(), st.view.diff.mean, st.view.diff.max, st.view.diff.psnr, st.view.compare.threshold,
-                          100.0 * st.view.diff.within);
-        else
-            std::snprintf(buf, sizeof buf, "|%s - %s|", view.slots[0].status.backend.c_str(), view.slots[1].status.backend.c_str());
-        ImVec2 ts = ImGui::CalcTextSize(buf);
+        std::string line = st.view.diff.summary(view.slots[0].status.backend, view.slots[1].status.backend, st.view.compare.threshold);
+        ImVec2 ts = ImGui::CalcTextSize(line.c_str());
         ImVec2 lp(a.x + (avail.x - ts.x) * 0.5f, b.y - ts.y - px(12));
         dl->AddRectFilled(ImVec2(lp.x - px(8), lp.y - px(4)), ImVec2(lp.x + ts.x + px(8), lp.y + ts.y + px(4)), IM_COL32(0, 0, 0, 180), px(3));
-        dl->AddText(lp, IM_COL32(255, 230, 160, 255), buf);
+        dl->AddText(lp, IM_COL32(255, 230, 160, 255), line.c_str());
     }
 }
 
@@ -1438,6 +1524,7 @@ void drawDialogs(ViewerState& st) {
 
     if (st.ui.confirmOpen && !ImGui::IsPopupOpen("Unsaved changes")) ImGui::OpenPopup("Unsaved changes");
     if (ImGui::BeginPopupModal("Unsaved changes", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
+        if (!st.ui.confirmOpen) ImGui::CloseCurrentPopup();   // answered elsewhere (automation's `answer`)
         const char* what = st.ui.pending == PendingAction::Quit  ? "quitting"
                            : st.ui.pending == PendingAction::New ? "starting a new scene"
                                                                  : "opening another file";
@@ -1490,6 +1577,8 @@ void drawDialogs(ViewerState& st) {
                 "Space              play / pause the animation (viewport)\n"
                 "F2                 rename selection\n"
                 "Del, Ctrl+D        delete / duplicate selection\n"
+                "Ctrl+Z             undo (Edit menu names the step)\n"
+                "Ctrl+Shift+Z, Ctrl+Y  redo\n"
                 "Ctrl+N/O/S/Q       new / open / save / quit\n"
                 "Drag tree nodes onto others to re-parent.\n"
                 "Drop files onto the window to open them.");
@@ -1516,12 +1605,19 @@ void handleShortcuts(ViewerState& st) {
         if (ImGui::IsKeyPressed(keys::N, false)) st.requestNew();
         if (ImGui::IsKeyPressed(keys::Q, false)) st.requestQuit();
         if (ImGui::IsKeyPressed(keys::D, false)) st.duplicateNode(st.doc.selected);
+        if (ImGui::IsKeyPressed(keys::Z, false)) {
+            if (io.KeyShift)
+                st.redo();
+            else
+                st.undo();
+        }
+        if (ImGui::IsKeyPressed(keys::Y, false)) st.redo();
         return;
     }
     for (int i = 0; i < 3; ++i)
         if (ImGui::IsKeyPressed(keys::Num1 + i, false)) {
             st.setBackendIndex(i);
-            st.view.compare.mode = ViewMode::Single;
+            st.showView(ViewMode::Single);
         }
     if (ImGui::IsKeyPressed(keys::F, false)) st.fitView(st.doc.scene.valid(st.doc.selected));
     if (ImGui::IsKeyPressed(keys::Home, false)) st.resetView();
@@ -1658,6 +1754,9 @@ void drawUi(ViewerState& st, const ViewportInput& view, double time, float dt) {
     drawStatusBar(st, view, statusH);
     drawDialogs(st);
     handleShortcuts(st);
+    // The mouse was released (or never pressed): the next edit starts a new undo step instead
+    // of merging into the last drag's.
+    if (!ImGui::IsAnyItemActive()) st.doc.history.closeMerge();
 }
 
 }   // namespace ui

@@ -14,6 +14,8 @@
 // progress and cancel in the status bar. Animations advance once per frame on the UI thread.
 #include "ui/viewer.h"
 
+#include "automation.h"
+
 #include "assets/demo.h"
 #include "assets/image_io.h"
 #include "ui/panels.h"
@@ -42,7 +44,7 @@ namespace fs = std::filesystem;
 
 static_assert(ui::keys::F == GLFW_KEY_F && ui::keys::Num1 == GLFW_KEY_1 && ui::keys::Home == GLFW_KEY_HOME && ui::keys::F12 == GLFW_KEY_F12 &&
                   ui::keys::Delete == GLFW_KEY_DELETE && ui::keys::W == GLFW_KEY_W && ui::keys::F2 == GLFW_KEY_F2 && ui::keys::Q == GLFW_KEY_Q &&
-                  ui::keys::Space == GLFW_KEY_SPACE,
+                  ui::keys::Space == GLFW_KEY_SPACE && ui::keys::Y == GLFW_KEY_Y && ui::keys::Z == GLFW_KEY_Z,
               "panel key codes must match GLFW's");
 
 namespace ui {
@@ -119,9 +121,10 @@ struct PendingShot {
     std::future<std::string> result;   // "" or error
 };
 
-class Viewer {
+class Viewer final : public AutomationHost {
 public:
     ViewerState st;
+    GLFWwindow* window = nullptr;
     std::map<std::string, BackendView> views;
     Texture diffTexture;
     uint64_t diffKey = ~uint64_t(0);
@@ -311,6 +314,26 @@ public:
 
     std::vector<std::string> lastShotErrors;
 
+    // --- AutomationHost ---
+    ViewerState& state() override { return st; }
+    bool idle() override { return allIdle(); }
+    void pollScreenshots() override { pollScreenshots(false); }
+    void startScreenshots(const fs::path& dir) override { startScreenshots(0, 0, dir); }
+    void printStats() override {
+        for (const std::string& n : visibleBackends(st)) {
+            SlotStatus s = viewFor(n).slot->status();
+            std::printf("viewer: stats %s %dx%d level %d: %.1f ms, %llu triangles, %llu rays%s%s\n", n.c_str(), st.view.viewportWidth,
+                        st.view.viewportHeight, s.level, s.stats.milliseconds, (unsigned long long)s.stats.triangles,
+                        (unsigned long long)s.stats.rays, s.error.empty() ? "" : ", error: ", s.error.c_str());
+        }
+        std::fflush(stdout);
+    }
+    // As GLFW would deliver it: the ImGui GLFW backend's callback sets KeysDown and the
+    // modifier flags the panels read.
+    void keyEvent(int key, bool press, int mods) override {
+        ImGui_ImplGlfw_KeyCallback(window, key, glfwGetKeyScancode(key), press ? GLFW_PRESS : GLFW_RELEASE, mods);
+    }
+
 private:
     rnd::ImageDiff m_lastDiff;
     bool m_glOnWorker = false;
@@ -320,208 +343,11 @@ private:
 
 // --- 3. automation -----------------------------------------------------------------------------
 //
-// Script commands (one per line, '#' comments):
-//   frames N              run N frames
-//   wait                  until the visible backends have full-resolution images (or errors)
-//   key K                 press a key for one frame: 1 2 3 F Home F12 or a GLFW key code
-//   backend NAME          single view with that backend
-//   view single|split|split3|difference
-//   orbit DX DY | zoom STEPS | fit
-//   select NODE-NAME
-//   tab Inspector|Camera|Rendering|Compare
-//   gl-worker on|off      run the GL backend on a worker thread (own headless context)
-//   anim play|pause|time T   animation of the loaded file: play, pause, or pose at T seconds
-//   stats                 print time / triangles / rays of the shown backends
-//   screenshot DIR        offscreen PNG per visible backend into DIR (as F12)
-//   window-shot PATH      PNG of the whole window (UI included)
-//   quit
-
-namespace {
-
-class Automation {
-public:
-    std::vector<std::string> lines;
-    size_t pc = 0;
-    int waitFrames = 0;
-    bool waiting = false;
-    int pressKey = -1, releaseKey = -1;
-    bool failed = false;
-    std::string windowShot;   // set for one frame: taken after rendering
-
-    bool active() const { return pc < lines.size() || waitFrames > 0 || waiting; }
-
-    // Runs commands until one needs frames to pass. Returns false to quit.
-    bool step(Viewer& v, GLFWwindow* win) {
-        (void)win;
-        if (releaseKey >= 0) {
-            ImGui::GetIO().KeysDown[releaseKey] = false;
-            releaseKey = -1;
-        }
-        if (waitFrames > 0) {
-            --waitFrames;
-            return true;
-        }
-        if (waiting) {
-            v.pollScreenshots(false);
-            if (!v.allIdle()) return true;
-            waiting = false;
-            waitFrames = 2;   // let the UI show the final images
-            return true;
-        }
-        while (pc < lines.size()) {
-            std::istringstream in(lines[pc++]);
-            std::string cmd;
-            in >> cmd;
-            if (cmd.empty() || cmd[0] == '#') continue;
-            switch (runCommand(cmd, in, v)) {
-            case Next::Continue: continue;
-            case Next::Yield: return true;
-            case Next::Quit: return false;
-            case Next::Unknown: break;
-            }
-            std::fprintf(stderr, "viewer: automation: unknown command '%s' (line %zu)\n", cmd.c_str(), pc);
-            failed = true;
-            return false;
-        }
-        return false;   // script finished
-    }
-
-private:
-    enum class Next { Continue, Yield, Quit, Unknown };   // after a command: next line, let frames pass, stop
-
-    // One command. Those that need frames to pass (frames, wait, key, screenshot, window-shot)
-    // are here; the ones that only change the state are in applyStateCommand.
-    Next runCommand(const std::string& cmd, std::istringstream& in, Viewer& v) {
-        if (cmd == "frames") {
-            in >> waitFrames;
-            return Next::Yield;
-        }
-        if (cmd == "wait") {
-            waiting = true;
-            return Next::Yield;
-        }
-        if (cmd == "quit") return Next::Quit;
-        if (cmd == "key") {
-            std::string k;
-            in >> k;
-            int code = keyCode(k);
-            if (code > 0 && code < 512) {
-                ImGui::GetIO().KeysDown[code] = true;
-                releaseKey = code;
-            }
-            waitFrames = 1;
-            return Next::Yield;
-        }
-        if (cmd == "screenshot") {
-            std::string dir;
-            in >> dir;
-            v.startScreenshots(0, 0, dir.empty() ? "." : dir);
-            waiting = true;
-            return Next::Yield;
-        }
-        if (cmd == "window-shot") {
-            in >> windowShot;
-            return Next::Yield;
-        }
-        if (cmd == "stats") {
-            printStats(v);
-            return Next::Continue;
-        }
-        return applyStateCommand(cmd, in, v.st) ? Next::Continue : Next::Unknown;
-    }
-
-    // 1 2 3 F Home F12, or a GLFW key code.
-    static int keyCode(const std::string& k) {
-        return k == "Home"                                   ? GLFW_KEY_HOME
-               : k == "F12"                                  ? GLFW_KEY_F12
-               : k == "F"                                    ? GLFW_KEY_F
-               : k.size() == 1 && k[0] >= '1' && k[0] <= '9' ? GLFW_KEY_1 + (k[0] - '1')
-                                                             : std::atoi(k.c_str());
-    }
-
-    // Commands that change the viewer state and go on with the next line. False: unknown.
-    static bool applyStateCommand(const std::string& cmd, std::istringstream& in, ViewerState& st) {
-        if (cmd == "backend") {
-            std::string b;
-            in >> b;
-            st.setBackend(b);
-            st.view.compare.mode = ViewMode::Single;
-        } else if (cmd == "view") {
-            std::string m;
-            in >> m;
-            applyView(st, m);
-        } else if (cmd == "orbit") {
-            float dx = 0, dy = 0;
-            in >> dx >> dy;
-            st.view.camera.orbit(dx, dy);
-            st.markViewChanged();
-        } else if (cmd == "zoom") {
-            float s = 0;
-            in >> s;
-            st.view.camera.zoom(s);
-            st.markViewChanged();
-        } else if (cmd == "fit") {
-            st.fitView(false);
-        } else if (cmd == "gl-worker") {
-            std::string on;
-            in >> on;
-            st.view.glOnWorker = on == "on";
-        } else if (cmd == "tab") {
-            in >> st.hooks.requestedTab;
-        } else if (cmd == "anim") {
-            std::string what;
-            in >> what;
-            if (what == "play" || what == "pause")
-                st.setAnimationPlaying(what == "play");
-            else if (what == "time") {
-                double t = 0;
-                in >> t;
-                st.setAnimationTime(t);
-            }
-        } else if (cmd == "select") {
-            std::string name;
-            std::getline(in >> std::ws, name);
-            st.selectNode(st.doc.scene.findByName(name));
-        } else {
-            return false;
-        }
-        return true;
-    }
-
-    // One line per shown backend: time, triangles, rays, error.
-    static void printStats(Viewer& v) {
-        for (const std::string& n : visibleBackends(v.st)) {
-            SlotStatus s = v.viewFor(n).slot->status();
-            std::printf("viewer: stats %s %dx%d level %d: %.1f ms, %llu triangles, %llu rays%s%s\n", n.c_str(), v.st.view.viewportWidth,
-                        v.st.view.viewportHeight, s.level, s.stats.milliseconds, (unsigned long long)s.stats.triangles,
-                        (unsigned long long)s.stats.rays, s.error.empty() ? "" : ", error: ", s.error.c_str());
-        }
-        std::fflush(stdout);
-    }
-
-public:
-    static void applyView(ViewerState& st, const std::string& m) {
-        if (m == "single")
-            st.view.compare.mode = ViewMode::Single;
-        else if (m == "split") {
-            st.view.compare.mode = ViewMode::Split;
-            st.view.compare.count = 2;
-            st.view.compare.backends = {"gl", "raster", "raycast"};
-        } else if (m == "split3") {
-            st.view.compare.mode = ViewMode::Split;
-            st.view.compare.count = 3;
-            st.view.compare.dividers = {0.33f, 0.66f};
-            st.view.compare.backends = {"gl", "raster", "raycast"};
-        } else if (m == "difference") {
-            st.view.compare.mode = ViewMode::Difference;
-            st.view.compare.backends = {"raster", "raycast", "gl"};
-            st.view.compare.diffA = 0;
-            st.view.compare.diffB = 1;
-        }
-    }
-};
+// The script commands are in automation.cpp; Viewer is their AutomationHost (section 2).
 
 // --- 4. GLFW callbacks -------------------------------------------------------------------------
+
+namespace {
 
 // DejaVu Sans (Debian fonts-dejavu-core) when present; ImGui's built-in font otherwise.
 constexpr const char* kFontPath = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
@@ -601,6 +427,7 @@ GLFWwindow* createWindow(const ViewerOptions& opt, bool automated) {
 // per-user config and sets up ImGui (context, layout file, style at the window's scale).
 void setUpViewer(Viewer& v, GLFWwindow* win) {
     ViewerState& st = v.st;
+    v.window = win;
     glfwSetWindowUserPointer(win, &v);
     glfwSetDropCallback(win, onDrop);
     glfwSetWindowCloseCallback(win, onClose);
@@ -642,7 +469,8 @@ void openInitialScene(ViewerState& st, const ViewerOptions& opt) {
         st.startLoad(opt.scene);
     }
     if (!opt.backend.empty()) st.setBackend(opt.backend);
-    if (!opt.view.empty()) Automation::applyView(st, opt.view);
+    if (!opt.view.empty() && !st.showView(opt.view))
+        std::fprintf(stderr, "viewer: warning: --view '%s': expected single, split, split3 or difference\n", opt.view.c_str());
 }
 
 // Finishes the screenshots in flight, stops a running load, frees the GL objects while the
@@ -686,7 +514,7 @@ public:
                 break;
             }
             handleEvents(dt);
-            if (m_automated && !m_automation.step(m_v, m_win)) {
+            if (m_automated && !m_automation.step(m_v)) {
                 running = false;
                 if (m_automation.failed) m_exitCode = 2;
             }
@@ -739,6 +567,7 @@ private:
         }
         ImGui_ImplOpenGL3_NewFrame();
         ImGui_ImplGlfw_NewFrame();
+        if (m_automated) m_automation.overrideMouse();   // a scripted click, as the mouse of this frame
         ImGui::NewFrame();
         drawUi(m_st, m_v.viewportInput(), m_v.now, dt);
         ImGui::Render();

@@ -7,8 +7,10 @@
 #include "assets/files.h"
 #include "renderers/renderer.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -24,6 +26,8 @@ void ViewerState::setScene(sg::Scene s, fs::path path) {
     doc.path = std::move(path);
     doc.dirty = false;
     doc.selected = sg::kNoNode;
+    doc.history.clear();
+    ui.panels.renaming = sg::kNoNode;
     anim.clips.clear();   // a load puts its clips back after this
     anim.clip = 0;
     anim.time = 0.0;
@@ -33,25 +37,79 @@ void ViewerState::setScene(sg::Scene s, fs::path path) {
 }
 
 void ViewerState::markEdited() {
+    doc.history.forgetSaved();
     doc.dirty = true;
     ++doc.version;
 }
 
 void ViewerState::markViewChanged() { ++view.version; }
 
+UndoStep ViewerState::newStep(std::string label) const {
+    UndoStep step;
+    step.label = std::move(label);
+    step.selectedBefore = doc.selected;
+    return step;
+}
+
+void ViewerState::commit(UndoStep step, std::string_view mergeKey) {
+    if (step.changes.empty()) return;
+    step.selectedAfter = doc.selected;
+    doc.history.push(std::move(step), mergeKey);
+    doc.dirty = !doc.history.atSavedState();
+    ++doc.version;
+}
+
+namespace {
+// After undo / redo: the step's selection when its node is there, else none; an in-place
+// rename of a node that is gone ends.
+void afterHistoryMove(ViewerState& st, sg::NodeId selection, const std::string& what) {
+    st.doc.selected = st.doc.scene.valid(selection) ? selection : sg::kNoNode;
+    if (!st.doc.scene.valid(st.ui.panels.renaming)) st.ui.panels.renaming = sg::kNoNode;
+    st.doc.dirty = !st.doc.history.atSavedState();
+    ++st.doc.version;
+    st.ui.status = what;
+}
+}   // namespace
+
+bool ViewerState::undo() {
+    std::string err;
+    const UndoStep* step = doc.history.undo(doc.scene, &err);
+    if (!step) {
+        if (!err.empty()) afterHistoryMove(*this, doc.selected, err);
+        return false;
+    }
+    afterHistoryMove(*this, step->selectedBefore, "Undone: " + step->label);
+    return true;
+}
+
+bool ViewerState::redo() {
+    std::string err;
+    const UndoStep* step = doc.history.redo(doc.scene, &err);
+    if (!step) {
+        if (!err.empty()) afterHistoryMove(*this, doc.selected, err);
+        return false;
+    }
+    afterHistoryMove(*this, step->selectedAfter, "Redone: " + step->label);
+    return true;
+}
+
 void ViewerState::selectNode(sg::NodeId id) { doc.selected = doc.scene.valid(id) ? id : sg::kNoNode; }
 
 bool ViewerState::renameNode(sg::NodeId id, const std::string& name) {
     if (!doc.scene.valid(id) || name.empty() || doc.scene.node(id).name == name) return false;
+    UndoStep step = newStep("Rename " + doc.scene.node(id).name);
+    step.changes.push_back(NodeNameChange{id, doc.scene.node(id).name, name});
     doc.scene.setName(id, name);
-    markEdited();
+    commit(std::move(step));
     return true;
 }
 
 void ViewerState::setVisible(sg::NodeId id, bool v) {
     if (!doc.scene.valid(id) || doc.scene.node(id).visible == v) return;
+    UndoStep step = newStep((v ? "Show " : "Hide ") + doc.scene.node(id).name);
+    step.changes.push_back(NodeVisibleChange{id, !v, v});
     doc.scene.setVisible(id, v);
-    markEdited();
+    commit(std::move(step));
 }
 
 namespace {
@@ -71,16 +129,24 @@ std::string uniqueName(const sg::Scene& s, const std::string& base) {
         if (s.findByName(n) == sg::kNoNode) return n;
     }
 }
+// The step of a node just added (with its subtree): selects it and records it.
+sg::NodeId commitAdded(ViewerState& st, UndoStep step, sg::NodeId id) {
+    step.label += " " + st.doc.scene.node(id).name;
+    step.changes.insert(step.changes.begin(), SubtreeChange{id, /*added=*/true, {}});
+    st.doc.selected = id;
+    st.commit(std::move(step));
+    return id;
+}
 }   // namespace
 
 sg::NodeId ViewerState::addGroup(sg::NodeId parent) {
+    UndoStep step = newStep("Add");
     sg::NodeId id = doc.scene.addNode(uniqueName(doc.scene, "group"), parentFor(*this, parent));
-    doc.selected = id;
-    markEdited();
-    return id;
+    return commitAdded(*this, std::move(step), id);
 }
 
 sg::NodeId ViewerState::addShape(sg::ImplicitType type, sg::NodeId parent) {
+    UndoStep step = newStep("Add");
     sg::ImplicitPayload p;
     p.shape.type = type;
     if (type == sg::ImplicitType::Quadric) {
@@ -88,12 +154,11 @@ sg::NodeId ViewerState::addShape(sg::ImplicitType type, sg::NodeId parent) {
         p.shape.quadric = sg::mat4(1, 0, 0, 0, 0, -1, 0, 0, 0, 0, 1, 0, 0, 0, 0, -0.25f);
     }
     sg::NodeId id = doc.scene.addNode(uniqueName(doc.scene, std::string(sg::toString(type))), parentFor(*this, parent), p);
-    doc.selected = id;
-    markEdited();
-    return id;
+    return commitAdded(*this, std::move(step), id);
 }
 
 sg::NodeId ViewerState::addCsg(sg::CsgOp op, sg::NodeId parent) {
+    UndoStep step = newStep("Add");
     sg::NodeId id = doc.scene.addNode(uniqueName(doc.scene, "csg " + std::string(sg::toString(op))), parentFor(*this, parent),
                                       sg::CsgPayload{sg::CsgNode{op}, -1});
     // Two operands so the node shows something right away.
@@ -105,12 +170,11 @@ sg::NodeId ViewerState::addCsg(sg::CsgOp op, sg::NodeId parent) {
     b.radius = 0.75f;
     doc.scene.addNode("box", id, sg::ImplicitPayload{a, -1});
     doc.scene.addNode("sphere", id, sg::ImplicitPayload{b, -1});
-    doc.selected = id;
-    markEdited();
-    return id;
+    return commitAdded(*this, std::move(step), id);
 }
 
 sg::NodeId ViewerState::addLight(sg::LightType type, sg::NodeId parent) {
+    UndoStep step = newStep("Add");
     sg::Light l;
     l.type = type;
     l.intensity = type == sg::LightType::Directional ? 1.0f : 10.0f;
@@ -119,12 +183,11 @@ sg::NodeId ViewerState::addLight(sg::LightType type, sg::NodeId parent) {
     sg::LocalTransform t = sg::LocalTransform::fromTRS(view.camera.pivot + sg::vec3(0, 3, 0));
     t.setEulerDegrees(sg::vec3(-90, 0, 0));   // point down
     doc.scene.setLocal(id, t);
-    doc.selected = id;
-    markEdited();
-    return id;
+    return commitAdded(*this, std::move(step), id);
 }
 
 sg::NodeId ViewerState::addCamera() {
+    UndoStep step = newStep("Add");
     sg::Camera c;
     c.projection = projection();
     c.focusDistance = view.camera.distance;
@@ -132,64 +195,233 @@ sg::NodeId ViewerState::addCamera() {
     doc.scene.setLocalMatrix(id, view.camera.world());
     sg::LocalTransform t = doc.scene.node(id).local;
     if (t.tryMakeTRS()) doc.scene.setLocal(id, t);
-    if (!doc.scene.valid(doc.scene.activeCamera)) doc.scene.activeCamera = id;
-    doc.selected = id;
-    markEdited();
-    return id;
+    if (!doc.scene.valid(doc.scene.activeCamera)) {
+        step.changes.push_back(ActiveCameraChange{doc.scene.activeCamera, id});
+        doc.scene.activeCamera = id;
+    }
+    return commitAdded(*this, std::move(step), id);
 }
 
 bool ViewerState::removeNode(sg::NodeId id) {
     if (!doc.scene.valid(id) || id == doc.scene.root()) return false;
-    bool hadActive = doc.scene.valid(doc.scene.activeCamera) && doc.scene.isAncestor(id, doc.scene.activeCamera);
-    if (!doc.scene.removeNode(id)) return false;
-    if (hadActive) doc.scene.activeCamera = sg::kNoNode;
+    UndoStep step = newStep("Delete " + doc.scene.node(id).name);
+    sg::DetachedSubtree d = doc.scene.detach(id);   // also clears the active camera when it was inside
+    if (d.id != id) return false;
+    step.changes.push_back(SubtreeChange{id, /*added=*/false, std::move(d)});
     if (!doc.scene.valid(doc.selected)) doc.selected = sg::kNoNode;
-    markEdited();
+    commit(std::move(step));
     return true;
 }
 
 sg::NodeId ViewerState::duplicateNode(sg::NodeId id) {
     if (!doc.scene.valid(id) || id == doc.scene.root()) return sg::kNoNode;
+    UndoStep step = newStep("Duplicate " + doc.scene.node(id).name);
     sg::NodeId c = doc.scene.duplicate(id);
-    if (doc.scene.valid(c)) {
-        doc.scene.setName(c, uniqueName(doc.scene, doc.scene.node(id).name + " copy"));
-        doc.selected = c;
-        markEdited();
-    }
+    if (!doc.scene.valid(c)) return c;
+    doc.scene.setName(c, uniqueName(doc.scene, doc.scene.node(id).name + " copy"));
+    step.changes.push_back(SubtreeChange{c, /*added=*/true, {}});
+    doc.selected = c;
+    commit(std::move(step));
     return c;
 }
 
 bool ViewerState::reparent(sg::NodeId id, sg::NodeId newParent, std::string* error) {
     std::string err;
     if (doc.scene.valid(id) && doc.scene.valid(newParent) && doc.scene.node(id).parent == newParent) return false;   // no-op
+    NodePlace before;
+    if (doc.scene.valid(id)) before = NodePlace{doc.scene.node(id).parent, doc.scene.childIndex(id), doc.scene.node(id).local};
     if (!doc.scene.reparent(id, newParent, /*keepWorld=*/true, &err)) {
         if (err.empty()) err = "cannot move this node there";
         ui.status = "Move refused: " + err;
         if (error) *error = err;
         return false;
     }
-    markEdited();
+    UndoStep step = newStep("Move " + doc.scene.node(id).name + " under " + doc.scene.node(newParent).name);
+    step.changes.push_back(MoveChange{id, before, NodePlace{newParent, doc.scene.childIndex(id), doc.scene.node(id).local}});
+    commit(std::move(step));
     return true;
 }
 
-void ViewerState::setLocal(sg::NodeId id, const sg::LocalTransform& t) {
+void ViewerState::setLocal(sg::NodeId id, const sg::LocalTransform& t, std::string_view mergeKey) {
     if (!doc.scene.valid(id) || doc.scene.node(id).local == t) return;
+    UndoStep step = newStep("Transform " + doc.scene.node(id).name);
+    step.changes.push_back(NodeLocalChange{id, doc.scene.node(id).local, t});
     doc.scene.setLocal(id, t);
-    markEdited();
+    commit(std::move(step), mergeKey);
+}
+
+void ViewerState::setPayload(sg::NodeId id, const sg::Payload& p, std::string_view mergeKey) {
+    if (!doc.scene.valid(id) || doc.scene.node(id).payload == p) return;
+    UndoStep step = newStep("Edit " + doc.scene.node(id).name);
+    step.changes.push_back(NodePayloadChange{id, doc.scene.node(id).payload, p});
+    doc.scene.setPayload(id, p);
+    commit(std::move(step), mergeKey);
+}
+
+void ViewerState::setMaterial(int index, const sg::Material& m, std::string_view mergeKey) {
+    if (index < 0 || size_t(index) >= doc.scene.materials.size() || doc.scene.materials[size_t(index)] == m) return;
+    UndoStep step = newStep("Edit material " + doc.scene.materials[size_t(index)].name);
+    step.changes.push_back(MaterialChange{index, doc.scene.materials[size_t(index)], m});
+    doc.scene.materials[size_t(index)] = m;
+    commit(std::move(step), mergeKey);
+}
+
+namespace {
+// A "Setting refused: ..." status line goes once a valid value is set.
+void clearRefusal(ViewerState& st) {
+    if (st.ui.status.rfind("Setting refused", 0) == 0) st.ui.status.clear();
+}
+// The material index of a payload kind that has one (null for groups, cameras, lights).
+int* materialIndexOf(sg::Payload& p) {
+    return std::visit(
+        [](auto& x) -> int* {
+            if constexpr (requires { x.material; })
+                return &x.material;
+            else
+                return nullptr;
+        },
+        p);
+}
+}   // namespace
+
+int ViewerState::addMaterialFor(sg::NodeId id, const sg::Material& m) {
+    if (!doc.scene.valid(id)) return -1;
+    sg::Payload p = doc.scene.node(id).payload;
+    int* slot = materialIndexOf(p);
+    if (!slot) return -1;
+    UndoStep step = newStep("New material for " + doc.scene.node(id).name);
+    int index = int(doc.scene.materials.size());
+    step.changes.push_back(MaterialChange{index, std::nullopt, m});
+    doc.scene.materials.push_back(m);
+    *slot = index;
+    step.changes.push_back(NodePayloadChange{id, doc.scene.node(id).payload, p});
+    doc.scene.setPayload(id, p);
+    commit(std::move(step));
+    return index;
+}
+
+std::string ViewerState::setSettings(const sg::RenderSettings& s, std::string_view mergeKey) {
+    std::string err = s.validate();
+    if (!err.empty()) {
+        ui.status = "Setting refused: " + err;
+        return err;
+    }
+    clearRefusal(*this);   // valid again (also when dragged back to the value it had)
+    if (s == doc.scene.settings) return {};
+    std::string names = settingNames(doc.scene.settings, s);
+    UndoStep step = newStep("Change " + (names.empty() ? std::string("rendering settings") : names));
+    step.changes.push_back(SettingsChange{doc.scene.settings, s});
+    doc.scene.settings = s;
+    commit(std::move(step), mergeKey);
+    return {};
+}
+
+void ViewerState::setAmbientLight(const sg::vec3& color, std::string_view mergeKey) {
+    if (color == doc.scene.ambientLight) return;
+    UndoStep step = newStep("Change ambient light");
+    step.changes.push_back(AmbientChange{doc.scene.ambientLight, color});
+    doc.scene.ambientLight = color;
+    commit(std::move(step), mergeKey);
 }
 
 // --- backend ---------------------------------------------------------------------------------
 
 void ViewerState::setBackend(const std::string& name) {
     if (view.backend == name) return;
-    view.backend = name;
-    view.compare.backends[0] = name;
+    view.backend = name;   // the split and difference views keep their own backends
     ui.status = "Backend: " + name;
+}
+
+std::string defaultBackend() {
+    std::vector<std::string> names = rnd::rendererNames();
+    return names.empty() ? std::string() : names.front();
+}
+
+std::vector<std::string> comparisonBackends(const std::string& first, size_t n) {
+    std::vector<std::string> out{first};
+    for (const std::string& b : rnd::rendererNames())
+        if (out.size() < n && b != first) out.push_back(b);
+    while (out.size() < n) out.push_back(out.back());
+    out.resize(n);
+    return out;
 }
 
 void ViewerState::setBackendIndex(int index) {
     std::vector<std::string> names = rnd::rendererNames();
     if (index >= 0 && size_t(index) < names.size()) setBackend(names[index]);
+}
+
+// --- view modes ------------------------------------------------------------------------------
+
+void ViewerState::showView(ViewMode mode, int splitCount) {
+    CompareConfig& c = view.compare;
+    c.mode = mode;
+    // First shown: start from the single view's backend and compare it with the others.
+    if (mode == ViewMode::Split && std::any_of(c.split.begin(), c.split.end(), [](const std::string& b) { return b.empty(); })) {
+        std::vector<std::string> d = comparisonBackends(view.backend, 3);
+        std::copy(d.begin(), d.end(), c.split.begin());
+    }
+    if (mode == ViewMode::Difference && (c.diff[0].empty() || c.diff[1].empty())) {
+        std::vector<std::string> d = comparisonBackends(view.backend, 2);
+        std::copy(d.begin(), d.end(), c.diff.begin());
+    }
+    if (mode == ViewMode::Split && (splitCount == 2 || splitCount == 3) && splitCount != c.count) {
+        c.count = splitCount;
+        c.dividers = splitCount == 2 ? std::array<float, 2>{0.5f, 0.75f} : std::array<float, 2>{1.0f / 3.0f, 2.0f / 3.0f};
+    }
+}
+
+bool ViewerState::showView(std::string_view name) {
+    if (name == "single")
+        showView(ViewMode::Single);
+    else if (name == "split")
+        showView(ViewMode::Split, 2);
+    else if (name == "split3")
+        showView(ViewMode::Split, 3);
+    else if (name == "difference")
+        showView(ViewMode::Difference);
+    else
+        return false;
+    return true;
+}
+
+std::string ViewerState::viewName() const {
+    switch (view.compare.mode) {
+    case ViewMode::Single: return "single";
+    case ViewMode::Split: return view.compare.count == 3 ? "split3" : "split";
+    case ViewMode::Difference: return "difference";
+    }
+    return "single";
+}
+
+// --- difference figures ----------------------------------------------------------------------
+
+std::string DiffFigures::meanText() const {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.2f", mean);
+    return buf;
+}
+
+std::string DiffFigures::psnrText() const {
+    if (!std::isfinite(psnr)) return "identical";
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.1f dB", psnr);
+    return buf;
+}
+
+std::string DiffFigures::withinText() const {
+    if (within >= 1.0) return "100%";
+    char buf[32];   // cut to 0.01%: 99.997% is "99.99%", never a rounded-up 100%
+    std::snprintf(buf, sizeof buf, "%.2f%%", std::floor(std::max(within, 0.0) * 10000.0 + 1e-6) / 100.0);
+    return buf;
+}
+
+std::string DiffFigures::summary(const std::string& a, const std::string& b, int threshold) const {
+    std::string s = "|" + a + " - " + b + "|";
+    if (valid)
+        s += "   mean " + meanText() + "   max " + std::to_string(max) + "   PSNR " + psnrText() + "   within " + std::to_string(threshold) + ": " +
+             withinText();
+    return s;
 }
 
 // --- camera ----------------------------------------------------------------------------------
@@ -206,13 +438,16 @@ const sg::Projection& ViewerState::projection() const {
     return c ? c->projection : view.fallbackProjection;
 }
 
-sg::Projection& ViewerState::editProjection() {
-    if (doc.scene.valid(doc.scene.activeCamera) && std::holds_alternative<sg::Camera>(doc.scene.node(doc.scene.activeCamera).payload)) {
-        markEdited();
-        return std::get<sg::Camera>(doc.scene.editPayload(doc.scene.activeCamera)).projection;
+void ViewerState::setProjection(const sg::Projection& p, std::string_view mergeKey) {
+    sg::NodeId cam = doc.scene.activeCamera;
+    if (doc.scene.valid(cam) && std::holds_alternative<sg::Camera>(doc.scene.node(cam).payload)) {
+        sg::Payload payload = doc.scene.node(cam).payload;
+        std::get<sg::Camera>(payload).projection = p;
+        setPayload(cam, payload, mergeKey);
+        return;
     }
+    view.fallbackProjection = p;
     ++view.version;
-    return view.fallbackProjection;
 }
 
 float ViewerState::focusDistance() const {
@@ -273,8 +508,10 @@ void ViewerState::resetView() {
 void ViewerState::useSceneCamera(sg::NodeId id) {
     if (!doc.scene.valid(id) || !std::holds_alternative<sg::Camera>(doc.scene.node(id).payload)) return;
     if (doc.scene.activeCamera != id) {
+        UndoStep step = newStep("Look through " + doc.scene.node(id).name);
+        step.changes.push_back(ActiveCameraChange{doc.scene.activeCamera, id});
         doc.scene.activeCamera = id;
-        markEdited();
+        commit(std::move(step));
     }
     view.camera.setFromWorld(doc.scene.world(id), std::get<sg::Camera>(doc.scene.node(id).payload).focusDistance);
     markViewChanged();
@@ -292,12 +529,16 @@ void ViewerState::storeViewInCamera() {
     float ortho = c.projection.orthoHalfHeight * view.camera.orthoScale;
     bool changed = !(doc.scene.node(id).local == t) || c.focusDistance != focus || c.projection.orthoHalfHeight != ortho;
     if (!changed) return;
+    UndoStep step = newStep("Store view in " + doc.scene.node(id).name);
+    step.changes.push_back(NodeLocalChange{id, doc.scene.node(id).local, t});
     doc.scene.setLocal(id, t);
+    sg::Payload before = doc.scene.node(id).payload;
     c.focusDistance = focus;
     c.projection.orthoHalfHeight = ortho;
+    step.changes.push_back(NodePayloadChange{id, std::move(before), c});
     doc.scene.setPayload(id, c);
     view.camera.orthoScale = 1.0f;
-    markEdited();
+    commit(std::move(step));
 }
 
 sg::FrameInput ViewerState::buildFrame(float aspect) const {
@@ -337,7 +578,18 @@ bool ViewerState::requestNew() {
 }
 
 void ViewerState::newScene() {
-    setScene(sg::Scene{}, {});
+    sg::Scene s;
+    s.name = "untitled";
+    sg::Light sun;
+    sun.type = sg::LightType::Directional;
+    sun.intensity = 1.0f;
+    sun.inverseSquare = false;
+    sg::NodeId light = s.addNode("light", s.root(), sun);
+    sg::LocalTransform t;
+    t.setEulerDegrees(sg::vec3(-50, 30, 0));   // from above, over the camera's shoulder
+    s.setLocal(light, t);
+    s.addDefaultCamera();   // frames the unit box around the origin, where new shapes go
+    setScene(std::move(s), {});
     ui.status = "New scene";
 }
 
@@ -415,7 +667,14 @@ bool ViewerState::pollLoad(bool wait) {
         ui.status = "Open failed; the current scene is unchanged";
         return true;
     }
-    setScene(std::move(*r.scene), load.path);
+    sg::Scene& loaded = *r.scene;
+    if (loaded.settings.fog == sg::FogMode::Off) {   // fog unused: defaults for when it is turned on
+        sg::RenderSettings defaults;
+        if (loaded.settings.fogStart == defaults.fogStart && loaded.settings.fogEnd == defaults.fogEnd &&
+            loaded.settings.fogDensity == defaults.fogDensity)
+            fitFogToScene(loaded.settings, sceneRadius(loaded));
+    }
+    setScene(std::move(loaded), load.path);
     anim.clips = std::move(r.animations);
     if (!anim.clips.empty()) anim.time = anim.clips.front().start;
     addRecent(fs::absolute(load.path).lexically_normal().string());
@@ -448,6 +707,7 @@ std::string ViewerState::save(const fs::path& path) {
         return err;
     }
     doc.path = target;
+    doc.history.markSaved();
     doc.dirty = false;
     addRecent(fs::absolute(target).lexically_normal().string());
     ui.status = "Saved " + target.string();
@@ -524,6 +784,23 @@ void ViewerState::advanceAnimation(double dt) {
     anim.time = std::clamp(t, start, end);
     applyPose(*this, *c, anim.time);
 }
+
+// --- defaults from the scene's size ----------------------------------------------------------
+
+float sceneRadius(const sg::Scene& scene) {
+    sg::Aabb b = scene.worldBounds();
+    if (b.empty()) return 1.0f;
+    float r = 0.5f * glm::length(b.extent());
+    return std::isfinite(r) && r > 1e-6f ? r : 1.0f;
+}
+
+void fitFogToScene(sg::RenderSettings& s, float r) {
+    s.fogStart = r;
+    s.fogEnd = 6.0f * r;
+    s.fogDensity = std::log(2.0f) / (3.0f * r);
+}
+
+float flySpeedFor(const sg::Scene& scene) { return sceneRadius(scene); }
 
 // --- config helpers --------------------------------------------------------------------------
 

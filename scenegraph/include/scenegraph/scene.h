@@ -103,6 +103,17 @@ struct Node {
     bool alive = false;
 };
 
+// A subtree taken out of a scene by Scene::detach, kept whole with its node ids so that
+// Scene::reattach puts it back exactly (undo of a removal, redo of an addition). Ids are never
+// reused within a scene, so the ids of a detached subtree stay free until it is reattached.
+struct DetachedSubtree {
+    NodeId id = kNoNode;                          // the subtree's top node (kNoNode: nothing detached)
+    NodeId parent = kNoNode;                      // where it hung ...
+    size_t index = 0;                             // ... and its place among the parent's children
+    NodeId activeCamera = kNoNode;                // the scene's active camera when it was inside
+    std::vector<std::pair<NodeId, Node>> nodes;   // every node of the subtree, parents first
+};
+
 class Scene {
 public:
     Scene();
@@ -124,6 +135,13 @@ public:
     NodeId addNode(std::string name, NodeId parent = 0, Payload payload = {});
     // Removes the node and its subtree (not the root). Returns false for invalid ids.
     bool removeNode(NodeId id);
+    // removeNode that keeps what it removed; an empty result (id kNoNode) for invalid ids / the root.
+    DetachedSubtree detach(NodeId id);
+    // Puts a detached subtree back under d.parent at d.index (clamped; the parent may differ from
+    // the one it was detached from) with the same ids, restoring the active camera when it was
+    // inside. Refuses (returns false, nothing changes) when the parent is gone or an id is taken.
+    bool reattach(DetachedSubtree d);
+    size_t childIndex(NodeId id) const;   // place among its parent's children (0 for the root)
     // Deep copy of the subtree under the same parent; returns the copy's id.
     NodeId duplicate(NodeId id);
     // Moves `id` under `newParent` (appended last). keepWorld: adjust the local transform so

@@ -20,7 +20,7 @@ namespace ui {
 // equal GLFW's, which viewer.cpp static_asserts).
 namespace keys {
 constexpr int Space = 32, Num1 = 49, Num2 = 50, Num3 = 51;
-constexpr int A = 65, D = 68, E = 69, F = 70, N = 78, O = 79, Q = 81, S = 83, W = 87;
+constexpr int A = 65, D = 68, E = 69, F = 70, N = 78, O = 79, Q = 81, S = 83, W = 87, Y = 89, Z = 90;
 constexpr int Delete = 261, Home = 268, F2 = 291, F12 = 301;
 }   // namespace keys
 

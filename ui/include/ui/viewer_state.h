@@ -24,6 +24,7 @@
 #include "scenegraph/scene.h"
 #include "ui/orbit_camera.h"
 #include "ui/panel_state.h"
+#include "ui/undo.h"
 
 #include <array>
 #include <atomic>
@@ -40,14 +41,25 @@ namespace ui {
 // How the viewport shows backends.
 enum class ViewMode { Single, Split, Difference };
 
+std::string defaultBackend();   // the first registered backend
+
+// The split and difference views. Each keeps its own backends: chosen when the view is first
+// shown (ViewerState::showView: the single view's backend, then the other registered backends
+// in registry order, so the defaults always compare different backends) and kept after that,
+// whatever the other view or the single view shows.
 struct CompareConfig {
     ViewMode mode = ViewMode::Single;
-    int count = 2;   // backends in the split view (2 or 3)
-    std::array<std::string, 3> backends{"gl", "raster", "raycast"};
+    int count = 2;                                // backends in the split view (2 or 3)
+    std::array<std::string, 3> split;             // split view, left to right ("" until first shown)
+    std::array<std::string, 2> diff;              // difference view: A, B ("" until first shown)
     std::array<float, 2> dividers{0.5f, 0.75f};   // wipe positions, fractions of the width
-    int diffA = 0, diffB = 1;                     // slots compared in the difference view
     int threshold = 8;                            // diffImage highlight threshold (0..255)
 };
+
+// The backends a comparison starting from `first` shows: `first`, then the other registered
+// backends in registry order (rnd::rendererNames; `first` once only), `n` of them; fewer
+// registered backends than n repeat the last.
+std::vector<std::string> comparisonBackends(const std::string& first, size_t n);
 
 // Work for the window: set by panels and shortcuts, consumed by viewer.cpp.
 struct Requests {
@@ -79,24 +91,33 @@ struct LoadControl {
     std::atomic<float> progress{0.0f};
 };
 
-// The document: the scene being edited, where it lives on disk and whether it has unsaved
-// edits. setScene (a load, a new scene, the demo) replaces scene and path, clears the dirty
-// flag and the selection.
+// The document: the scene being edited, where it lives on disk, whether it has unsaved
+// edits and its undo history. setScene (a load, a new scene, the demo) replaces scene and
+// path, clears the dirty flag, the selection and the history.
 struct Document {
     sg::Scene scene;
     std::filesystem::path path;   // empty for the demo / a new scene
-    bool dirty = false;           // unsaved edits
+    bool dirty = false;           // unsaved edits (= !history.atSavedState() after every edit, undo, redo, save)
+    UndoStack history;            // every scene edit, for Edit > Undo / Redo
     uint64_t version = 1;         // bumped on every scene change, edits and animation poses (re-render)
     sg::NodeId selected = sg::kNoNode;
     std::vector<std::string> loadWarnings;   // of the load that brought this scene
 };
 
-// Figures of the difference view (filled by the window from the two shown images).
+// Figures of the difference view (filled by the window from the two shown images). The
+// Compare tab, the viewport overlay and the automation's `print diff` all write them with the
+// functions below, so they never disagree.
 struct DiffFigures {
     bool valid = false;   // both full-resolution images are there
     double mean = 0, psnr = 0;
     int max = 0;
     double within = 1;   // fraction of pixels within the threshold
+
+    std::string meanText() const;     // "0.42"
+    std::string psnrText() const;     // "41.3 dB", "identical" (infinite)
+    std::string withinText() const;   // "99.97%": cut, not rounded, so 100% means every pixel
+    // "|A - B|  mean 0.42  max 37  PSNR 41.3 dB  within 8: 99.97%"
+    std::string summary(const std::string& a, const std::string& b, int threshold) const;
 };
 
 // How the scene is looked at: the orbit camera, the viewport, which backends show it and how
@@ -110,8 +131,9 @@ struct View {
     int viewportWidth = 1, viewportHeight = 1;   // pixels, set by the viewport panel
     double lastInteraction = -1e9;               // time (s) of the last camera drag/zoom/fly
     bool flyMode = false;
+    float flySpeed = 1.0f;   // world units per second while flying: sceneSizeSpeed() when fly mode starts
 
-    std::string backend = "gl";   // the single view's backend
+    std::string backend = defaultBackend();   // the single view's backend
     CompareConfig compare;
     DiffFigures diff;
     // Per-backend anti-aliasing overrides for this session (backend -> "msaa4", ...); the
@@ -177,10 +199,21 @@ struct ViewerState {
     TestHooks hooks;
 
     // --- actions -----------------------------------------------------------------------
-    // Replaces the scene (after a load): resets selection, dirty flag and camera.
+    // Replaces the scene (after a load): resets selection, dirty flag, history and camera.
     void setScene(sg::Scene s, std::filesystem::path path);
-    void markEdited();        // scene or settings changed: dirty + re-render
     void markViewChanged();   // camera moved: re-render only
+
+    // Every scene edit below is recorded as one undo step (ui/undo.h). An empty mergeKey makes
+    // its own step; the panels pass one per edited target ("local 5", "material 2", ...) so the
+    // frames of one drag merge into one step (they close it when no widget is active).
+    UndoStep newStep(std::string label) const;   // with the selection before the edit
+    // Records an edit already made to doc.scene: pushes it, updates the dirty flag, re-renders.
+    void commit(UndoStep step, std::string_view mergeKey = {});
+    bool undo();   // Edit > Undo (Ctrl+Z): false when there is nothing to undo
+    bool redo();   // Edit > Redo (Ctrl+Shift+Z, Ctrl+Y)
+    // An edit made to doc.scene outside the history (tests): dirty, and undo can no longer
+    // bring back the saved state.
+    void markEdited();
 
     void selectNode(sg::NodeId id);
     bool renameNode(sg::NodeId id, const std::string& name);
@@ -195,7 +228,28 @@ struct ViewerState {
     sg::NodeId duplicateNode(sg::NodeId id);
     // Re-parents keeping the world transform; on refusal returns false and sets status/error.
     bool reparent(sg::NodeId id, sg::NodeId newParent, std::string* error = nullptr);
-    void setLocal(sg::NodeId id, const sg::LocalTransform& t);
+    void setLocal(sg::NodeId id, const sg::LocalTransform& t, std::string_view mergeKey = {});
+    void setPayload(sg::NodeId id, const sg::Payload& p, std::string_view mergeKey = {});
+    void setMaterial(int index, const sg::Material& m, std::string_view mergeKey = {});
+    // A new material (a copy of m) assigned to the node's payload, as one step. Its index, or
+    // -1 when the node's payload has no material.
+    int addMaterialFor(sg::NodeId id, const sg::Material& m);
+    // Refused (the reason returned, also in the status line) when s.validate() fails.
+    std::string setSettings(const sg::RenderSettings& s, std::string_view mergeKey = {});
+    void setAmbientLight(const sg::vec3& color, std::string_view mergeKey = {});
+
+    // A render setting, `ambientLight` or `material.FIELD` of the selection's material, named
+    // and written as in the scene JSON (fog.mode, shading, aa, material.kd, material.baseColor
+    // [1,0,0]; see assets/src/scene_json.cpp): read and checked by the scene file's own writer
+    // and reader, then applied as one undoable edit. "" or the reason it was refused.
+    std::string setByName(const std::string& key, const std::string& value);
+
+    // The view modes, one way for the View menu, the Compare tab, --view and the automation:
+    // Single, Split (splitCount 2 or 3; 0 keeps the current count) or Difference.
+    void showView(ViewMode mode, int splitCount = 0);
+    // By name: single, split, split3, difference. False for other names.
+    bool showView(std::string_view name);
+    std::string viewName() const;   // the current one, as showView(name) takes it
 
     void setBackend(const std::string& name);
     // 0-based backend index (keys 1/2/3); ignores indices beyond the built backends.
@@ -203,7 +257,8 @@ struct ViewerState {
 
     // Camera.
     const sg::Projection& projection() const;   // the active scene camera's, or the fallback
-    sg::Projection& editProjection();           // marks edited when it is the scene's
+    // The active scene camera's projection (an edit), or the viewer's fallback (a view change).
+    void setProjection(const sg::Projection& p, std::string_view mergeKey = {});
     float focusDistance() const;
     void fitView(bool selectionOnly);             // F
     void resetView();                             // Home: back to the active scene camera
@@ -226,7 +281,9 @@ struct ViewerState {
     // Open keeps it until the loaded scene replaces this one, so a failed or cancelled load
     // leaves the document (edits and dirty flag) exactly as it was.
     void confirm(ConfirmChoice choice);
-    void newScene();   // replaces the scene by an empty one without asking
+    // Replaces the scene by a new one without asking: a directional light and a camera, so the
+    // first shape added is lit and in view.
+    void newScene();
     // std::async with a fresh LoadControl (progress + cancel).
     void startLoad(const std::filesystem::path& path);
     bool loadInProgress() const { return load.task.valid(); }
@@ -254,6 +311,18 @@ struct ViewerState {
     // the end) and applies the clip.
     void advanceAnimation(double dt);
 };
+
+// The scene-JSON names of the settings that differ between a and b ("fog.mode, fog.end"; ""
+// when equal), for undo labels.
+std::string settingNames(const sg::RenderSettings& a, const sg::RenderSettings& b);
+
+// Defaults that follow the scene's size (half the diagonal of its visible bounds, r; 1 when it
+// has no geometry): fog from r to 6 r (linear) or halving at 3 r (exp: density ln 2 / 3 r),
+// set when a loaded scene's fog is off and still at RenderSettings' defaults; fly speed r per
+// second (Shift: 4 r).
+float sceneRadius(const sg::Scene& scene);
+void fitFogToScene(sg::RenderSettings& settings, float radius);
+float flySpeedFor(const sg::Scene& scene);
 
 // Per-user config folder: $XDG_CONFIG_HOME/sceneviewer, else $HOME/.config/sceneviewer.
 std::filesystem::path defaultConfigDir();
