@@ -19,6 +19,9 @@ struct RenderArgs {
     std::optional<std::string> shading, reflection, fog, aa, projection, shadows, reflections, culling, wireframe, attenuation;
     std::optional<float> fogStart, fogEnd, fogDensity, fovy, obliqueAngle, obliqueFactor;
     std::optional<int> tessellation, bounces;
+    // Pose: clip `animation` (default 0) of the file at `time` seconds (default: the clip's start).
+    std::optional<std::string> time;
+    std::optional<int> animation;
 };
 
 void addRenderOptions(CLI::App& cmd, RenderArgs& args, bool compare);
