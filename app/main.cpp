@@ -4,7 +4,9 @@
 //   viewer compare SCENE --out DIR       render every backend, write images, diffs, a table
 //   viewer demo-shots --out DIR          the demo scene with every backend (./run headless)
 //   viewer convert SCENE --out x.json    save any scene in the native JSON format
+//   viewer --version                     "viewer 0.1.0 (git a33dede)"
 // SCENE is a file (.json .gltf .glb .obj .off .ply .stl) or the word "demo".
+#include "build_info.h"
 #include "cli.h"
 #include "ui/viewer.h"
 
@@ -17,6 +19,8 @@ int main(int argc, char** argv) {
         "Scene-graph viewer: GL rasterization, CPU rasterizer and CPU ray caster side by side.\n"
         "Without a subcommand, opens the viewer window on SCENE (default: the bundled demo)."};
     app.set_help_all_flag("--help-all", "Print help for all subcommands");
+    app.set_version_flag("--version", std::string("viewer ") + buildinfo::kVersion + " (git " + buildinfo::kGitRevision + ")",
+                         "Print the version and the git revision it was built from, then exit");
     app.require_subcommand(0, 1);
 
     std::string windowScene;

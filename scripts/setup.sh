@@ -11,6 +11,9 @@ packages=(
   libglfw3-dev libimgui-dev libglm-dev libtinygltf-dev libopenmesh-dev libstb-dev
   libtbb-dev libcli11-dev nlohmann-json3-dev libgtest-dev libgmock-dev libbenchmark-dev libembree-dev
   libgl1-mesa-dri libegl-mesa0 libegl-dev libgl-dev libosmesa6-dev xvfb xauth fonts-dejavu-core clang-format
+  # The Debian package: CPack computes Depends with dpkg-shlibdeps (dpkg-dev) and file; the
+  # package test checks the desktop entry (desktop-file-validate) and the man page (groff).
+  dpkg-dev file desktop-file-utils groff-base
 )
 
 # The fuzz preset also needs clang and its libFuzzer runtime.

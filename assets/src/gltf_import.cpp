@@ -46,7 +46,8 @@
 //                metallicRoughnessTexture: the mapping above per texel (flat and Phong shading).
 //   occlusionTexture (linear, R) + strength -> on the ambient term; emissiveTexture (sRGB) x
 //                emissive. A glTF texture used both as colour and as data becomes two textures.
-//                normalTexture: not applied yet (warning).
+//                normalTexture (linear) + scale -> Material::normalTexture / normalScale, with
+//                TANGENT (xyz, w) or tangents generated from the UVs (Mesh::computeTangents).
 //   emissive   = emissiveFactor (x KHR_materials_emissive_strength).
 //   alphaMode  -> Material::alphaMode (OPAQUE, MASK with alphaCutoff, BLEND); alpha =
 //                baseColorFactor.a, times texture and vertex colour alpha when drawn;
@@ -1007,10 +1008,11 @@ struct Converter {
         sg::Material mat;
         mat.name = gm.name.empty() ? "material " + std::to_string(i) : gm.name;
         sg::vec4 base(1.0f);
-        std::vector<TexRef> refs(4);   // base colour, metallic-roughness, occlusion, emissive
+        std::vector<TexRef> refs(5);   // base colour, metallic-roughness, occlusion, emissive, normal
         convertPbr(i, gm, mat, base, refs);
         refs[2] = texRef(gm.occlusionTexture.index, gm.occlusionTexture.texCoord, gm.occlusionTexture.extensions);
         refs[3] = texRef(gm.emissiveTexture);
+        refs[4] = texRef(gm.normalTexture.index, gm.normalTexture.texCoord, gm.normalTexture.extensions);
         mat.baseColor = sg::vec3(base);
         if (!gm.emissiveFactor.empty()) {
             mat.emissive = sg::vec3(float(gm.emissiveFactor[0]), float(gm.emissiveFactor[1]), float(gm.emissiveFactor[2]));
@@ -1029,7 +1031,8 @@ struct Converter {
         mat.occlusionTexture = texture(refs[2].index, false);
         mat.occlusionStrength = std::isfinite(gm.occlusionTexture.strength) ? std::clamp(float(gm.occlusionTexture.strength), 0.0f, 1.0f) : 1.0f;
         mat.emissiveTexture = texture(refs[3].index, true);
-        if (gm.normalTexture.index >= 0) warnOnce("material " + std::to_string(i) + ": normalTexture is not applied yet (the mesh normals are used)");
+        mat.normalTexture = texture(gm.normalTexture.index, false);
+        mat.normalScale = std::isfinite(gm.normalTexture.scale) ? float(gm.normalTexture.scale) : 1.0f;
         MaterialInfo info;
         chooseUvSet(i, refs, info);
         scene.materials.push_back(std::move(mat));
@@ -1083,6 +1086,12 @@ struct Converter {
             if (!(e = readVectors(m, size_t(a), 4, progress, mesh.colors, 1.0f)).empty()) return prefixed(id, e);
             if (m.accessors[size_t(a)].type == TINYGLTF_TYPE_VEC3)
                 for (auto& c : mesh.colors) c.a = 1.0f;
+        }
+        if (int a = attribute(prim, "TANGENT"); a >= 0 && !mesh.normals.empty()) {
+            if (!(e = readVectors(m, size_t(a), 4, progress, mesh.tangents, 1.0f)).empty()) return prefixed(id, e);
+            for (auto& t : mesh.tangents)
+                if (!sg::isFinite(sg::vec3(t)) || !std::isfinite(t.w) || glm::length(sg::vec3(t)) < 1e-12f) t = sg::vec4(1, 0, 0, 1);
+            for (auto& t : mesh.tangents) t.w = t.w < 0.0f ? -1.0f : 1.0f;
         }
         if (prim.material >= 0) {
             const MaterialInfo& info = materials[size_t(prim.material)];
@@ -1236,7 +1245,13 @@ struct Converter {
             if (mesh.normals.empty()) {
                 if (!indexed && prim.mode != TINYGLTF_MODE_TRIANGLES) unweld(mesh);   // flat normals for non-indexed strips/fans
                 mesh.computeNormals();
+                mesh.tangents.clear();   // glTF: tangents without normals are ignored
             }
+            // A normal map needs tangents: generated from the UVs when the file has none.
+            const bool normalMapped = prim.material >= 0 && m.materials[size_t(prim.material)].normalTexture.index >= 0;
+            if (normalMapped && mesh.tangents.empty()) mesh.computeTangents();
+        } else {
+            mesh.tangents.clear();
         }
         return {};
     }
@@ -1263,7 +1278,8 @@ struct Converter {
         for (size_t i = 0; i < mesh.indices.size(); ++i) mesh.indices[i] = uint32_t(i);
     }
     // unweld() for the per-vertex skin and morph data (`copy` gathers by the old indices).
-    // Base tangents are not read by this importer yet (whoever reads TANGENT unwelds them).
+    // (Base tangents need none: unweld runs only for a primitive without normals, whose
+    // tangents are then dropped.)
     template <class Copy>
     static void unweldDeformation(sg::Mesh& mesh, Copy& copy) {
         sg::Mesh o;

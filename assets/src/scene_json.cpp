@@ -16,14 +16,15 @@
 //                    "srgb": false for data textures (metallic-roughness, occlusion) ],
 //     "materials": [ {"name", "baseColor", "ka", "kd", "ks", "shininess", "specularTinted",
 //                     "specularColor", "diffuseTexture", "emissive", "emissiveTexture",
-//                     "occlusionTexture", "occlusionStrength", "metallicRoughnessTexture",
+//                     "occlusionTexture", "occlusionStrength", "normalTexture", "normalScale",
+//                     "metallicRoughnessTexture",
 //                     "metallic", "roughness", "alpha",
 //                     "alphaMode": <AlphaMode>, "alphaCutoff", "unlit", "doubleSided",
 //                     "reflectivity"} ],
 //     "meshes":    [ {"name", "file": "relative/model.obj"} |
 //                    {"name", "mode": "triangles|lines|points", "positions": [x,y,z,...],
 //                     "normals", "uv0", "uv1", "colors" (4 per vertex), "tangents" (4 per
-//                     vertex), "indices",
+//                     vertex: xyz, handedness), "indices",
 //                     skin: "joints0", "weights0", "joints1", "weights1" (4 per vertex),
 //                     morph: "morphTargets": [ {"positions", "normals", "tangents"} (3 per
 //                     vertex each) ], "morphWeights": [one per target]} ],
@@ -332,6 +333,9 @@ sg::Material Reader::readMaterial(const json& j, const std::string& p, size_t te
     optInt(j, p, "occlusionTexture", m.occlusionTexture, -1, (long long)textureCount - 1);
     optFloat(j, p, "occlusionStrength", m.occlusionStrength);
     if (!(m.occlusionStrength >= 0 && m.occlusionStrength <= 1)) fail(p + "/occlusionStrength", "must be in [0, 1]");
+    optInt(j, p, "normalTexture", m.normalTexture, -1, (long long)textureCount - 1);
+    optFloat(j, p, "normalScale", m.normalScale);
+    if (!std::isfinite(m.normalScale)) fail(p + "/normalScale", "must be finite");
     optInt(j, p, "metallicRoughnessTexture", m.metallicRoughnessTexture, -1, (long long)textureCount - 1);
     optFloat(j, p, "metallic", m.metallic);
     optFloat(j, p, "roughness", m.roughness);
@@ -431,6 +435,7 @@ std::shared_ptr<sg::Mesh> Reader::readMesh(const json& j, const std::string& p) 
         floatArray<sg::vec2, 2>(j, p, "uv0", m->uv0, kMaxVertices);
         floatArray<sg::vec2, 2>(j, p, "uv1", m->uv1, kMaxVertices);
         floatArray<sg::vec4, 4>(j, p, "colors", m->colors, kMaxVertices);
+        floatArray<sg::vec4, 4>(j, p, "tangents", m->tangents, kMaxVertices);
         readDeformation(j, p, *m);
         if (auto* v = optional(j, "indices")) {
             if (!v->is_array()) fail(p + "/indices", "expected an array of integers");
@@ -450,9 +455,8 @@ std::shared_ptr<sg::Mesh> Reader::readMesh(const json& j, const std::string& p) 
     return m;
 }
 
-// Tangents, skin influences and morph targets of an inline mesh (checked by Mesh::validate).
+// Skin influences and morph targets of an inline mesh (checked by Mesh::validate).
 void Reader::readDeformation(const json& j, const std::string& p, sg::Mesh& m) {
-    floatArray<sg::vec4, 4>(j, p, "tangents", m.tangents, kMaxVertices);
     readJoints(j, p, "joints0", m.joints0);
     readJoints(j, p, "joints1", m.joints1);
     floatArray<sg::vec4, 4>(j, p, "weights0", m.weights0, kMaxVertices);
@@ -785,9 +789,8 @@ json flat(const std::vector<T>& v) {
     return a;
 }
 
-// Tangents, skin influences and morph targets of a mesh (only what it has).
+// Skin influences and morph targets of a mesh (only what it has).
 void deformationJ(const sg::Mesh& m, json& mj) {
-    if (!m.tangents.empty()) mj["tangents"] = flat<sg::vec4, 4>(m.tangents);
     if (!m.joints0.empty()) mj["joints0"] = flat<sg::u16vec4, 4>(m.joints0);
     if (!m.weights0.empty()) mj["weights0"] = flat<sg::vec4, 4>(m.weights0);
     if (!m.joints1.empty()) mj["joints1"] = flat<sg::u16vec4, 4>(m.joints1);
@@ -999,6 +1002,8 @@ std::string serializeSceneJson(const sg::Scene& s) {
                                   {"emissiveTexture", m.emissiveTexture},
                                   {"occlusionTexture", m.occlusionTexture},
                                   {"occlusionStrength", m.occlusionStrength},
+                                  {"normalTexture", m.normalTexture},
+                                  {"normalScale", m.normalScale},
                                   {"metallicRoughnessTexture", m.metallicRoughnessTexture},
                                   {"metallic", m.metallic},
                                   {"roughness", m.roughness},
@@ -1016,6 +1021,7 @@ std::string serializeSceneJson(const sg::Scene& s) {
         if (!m->uv0.empty()) mj["uv0"] = flat<sg::vec2, 2>(m->uv0);
         if (!m->uv1.empty()) mj["uv1"] = flat<sg::vec2, 2>(m->uv1);
         if (!m->colors.empty()) mj["colors"] = flat<sg::vec4, 4>(m->colors);
+        if (!m->tangents.empty()) mj["tangents"] = flat<sg::vec4, 4>(m->tangents);
         deformationJ(*m, mj);
         j["meshes"].push_back(std::move(mj));
     }

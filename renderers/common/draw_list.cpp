@@ -3,10 +3,9 @@
 
 namespace rnd {
 
-std::vector<PreparedDraw> prepareDraws(const sg::FrameInput& frame, int tessellation, TessellationCache& cache) {
-    static const sg::mat4 kIdentity(1.0f);
+std::vector<PreparedDraw> prepareMeshDraws(const sg::FrameInput& frame) {
     std::vector<PreparedDraw> draws;
-    draws.reserve(frame.meshes.size() + frame.analytics.size());
+    draws.reserve(frame.meshes.size());
     for (const sg::DrawMesh& d : frame.meshes) {
         if (!d.mesh || d.mesh->positions.empty()) continue;
         PreparedDraw p;
@@ -20,6 +19,13 @@ std::vector<PreparedDraw> prepareDraws(const sg::FrameInput& frame, int tessella
         p.node = d.node;
         draws.push_back(std::move(p));
     }
+    return draws;
+}
+
+std::vector<PreparedDraw> prepareDraws(const sg::FrameInput& frame, int tessellation, TessellationCache& cache) {
+    static const sg::mat4 kIdentity(1.0f);
+    std::vector<PreparedDraw> draws = prepareMeshDraws(frame);
+    draws.reserve(frame.meshes.size() + frame.analytics.size());
     for (const sg::DrawAnalytic& a : frame.analytics) {
         const Tessellation& t = cache.get(a, tessellation);
         if (!t.mesh || t.mesh->positions.empty()) continue;

@@ -47,8 +47,13 @@ PhongCoefficients coefficientsOf(const Material& m) {
     return c;
 }
 
-MapSample sampleMaps(const SampledTexture* em, const SampledTexture* occ, const SampledTexture* mr, vec2 uv, vec2 ddx, vec2 ddy) {
+MapSample sampleMaps(const SampledTexture* em, const SampledTexture* occ, const SampledTexture* mr, const SampledTexture* nm, vec2 uv, vec2 ddx,
+                     vec2 ddy) {
     MapSample s;
+    if (nm) {
+        s.hasNormal = true;
+        s.normalTexel = nm->sample(uv, ddx, ddy);
+    }
     if (em) s.emissive = em->sample(uv, ddx, ddy);
     if (occ) s.occlusion = occ->sample(uv, ddx, ddy).x;
     if (mr) {
@@ -58,6 +63,20 @@ MapSample sampleMaps(const SampledTexture* em, const SampledTexture* occ, const 
         s.metallic = t.z;
     }
     return s;
+}
+
+vec3 perturbNormal(const vec3& n, const vec4& t, const vec3& texel, float scale) {
+    vec3 m = 2.0f * texel - 1.0f;
+    m.x *= scale;
+    m.y *= scale;
+    vec3 T = vec3(t) - n * glm::dot(n, vec3(t));
+    const float lt = glm::length(T);
+    if (!(lt > 1e-12f)) return n;
+    T /= lt;
+    const vec3 B = (t.w < 0.0f ? -1.0f : 1.0f) * glm::cross(n, T);
+    const vec3 p = m.x * T + m.y * B + m.z * n;
+    const float lp = glm::length(p);
+    return lp > 1e-12f ? p / lp : n;
 }
 
 PhongCoefficients coefficientsAt(const Material& m, const MapSample& s) {

@@ -30,9 +30,10 @@ int wrapIndex(int i, int n, sg::WrapMode m) {
 
 // A texel's colour bytes -> linear values: sRGB-decoded for colour textures, /255 for data.
 vec3 texelValue(const uint8_t* rgb, bool srgb) { return srgb ? srgbBytesToLinear(rgb) : vec3(rgb[0], rgb[1], rgb[2]) * (1.0f / 255.0f); }
-// Re-quantised to the texture's 8-bit storage (mip levels).
+// Re-quantised to the texture's storage (mip levels): 8-bit sRGB for colour; data textures are
+// RGBA16 in GL (renderers/gl), whose 16 bits we treat as exact.
 vec3 quantised(const vec3& v, bool srgb) {
-    if (!srgb) return glm::round(glm::clamp(v, 0.0f, 1.0f) * 255.0f) / 255.0f;
+    if (!srgb) return glm::clamp(v, 0.0f, 1.0f);
     const uint8_t bytes[3] = {toByteSRGB(v.x), toByteSRGB(v.y), toByteSRGB(v.z)};
     return srgbBytesToLinear(bytes);
 }
@@ -63,7 +64,7 @@ SampledTexture::SampledTexture(const sg::Texture& t) : m_wrapS(t.wrapS), m_wrapT
     // glGenerateMipmap performs (Mesa's util_gen_mipmap): destination texel x takes the
     // previous level bilinearly at its centre mapped back, (x + 0.5) * w_prev / w - 0.5,
     // clamped to the edge, in linear light; stored re-quantised to 8 bits (sRGB like an SRGB8
-    // texture level, linear like RGBA8 for data textures; alpha: to 8 bits). For even sizes this is the 2x2 box average; for odd
+    // texture level; data textures unrounded, like GL's RGBA16 levels; alpha: to 8 bits). For even sizes this is the 2x2 box average; for odd
     // (NPOT) sizes the sample points keep the image aligned instead of drifting by half a texel.
     while (m_levels.back().w > 1 || m_levels.back().h > 1) {
         const Level& p = m_levels.back();

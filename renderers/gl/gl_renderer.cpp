@@ -57,8 +57,8 @@ struct Program {
     GLint eye = -1, ambient = -1;
     GLint baseColor = -1, ka = -1, kd = -1, ks = -1, shininess = -1, specTinted = -1, specColor = -1, emissive = -1;
     GLint texture = -1, hasTexture = -1, unlit = -1, solid = -1, solidColor = -1;
-    // Material maps (texture units 1..3, kMapUnits order) and their factors.
-    GLint maps[3] = {-1, -1, -1}, hasMap[3] = {-1, -1, -1}, occlusionStrength = -1, metallic = -1, roughness = -1;
+    // Material maps (texture units 1..4: emissive, occlusion, metallic-roughness, normal) and their factors.
+    GLint maps[4] = {-1, -1, -1, -1}, hasMap[4] = {-1, -1, -1, -1}, occlusionStrength = -1, metallic = -1, roughness = -1, normalScale = -1;
     GLint alpha = -1, alphaMode = -1, alphaCutoff = -1;
     GLint fogMode = -1, fogColor = -1, fogParams = -1;
 };
@@ -187,15 +187,18 @@ std::string buildProgram(const std::string& key, Program& p) {
     p.emissive = loc("uEmissive");
     p.texture = loc("uTexture");
     p.hasTexture = loc("uHasTexture");
-    const char* mapNames[3][2] = {
-        {"uEmissiveMap", "uHasEmissiveMap"}, {"uOcclusionMap", "uHasOcclusionMap"}, {"uMetalRoughMap", "uHasMetalRoughMap"}};
-    for (int k = 0; k < 3; ++k) {
+    const char* mapNames[4][2] = {{"uEmissiveMap", "uHasEmissiveMap"},
+                                  {"uOcclusionMap", "uHasOcclusionMap"},
+                                  {"uMetalRoughMap", "uHasMetalRoughMap"},
+                                  {"uNormalMap", "uHasNormalMap"}};
+    for (int k = 0; k < 4; ++k) {
         p.maps[k] = loc(mapNames[k][0]);
         p.hasMap[k] = loc(mapNames[k][1]);
     }
     p.occlusionStrength = loc("uOcclusionStrength");
     p.metallic = loc("uMetallic");
     p.roughness = loc("uRoughness");
+    p.normalScale = loc("uNormalScale");
     p.unlit = loc("uUnlit");
     p.alpha = loc("uAlpha");
     p.alphaMode = loc("uAlphaMode");
@@ -219,6 +222,7 @@ struct IndexRange {
 struct GpuMesh {
     uint64_t version = 0;
     GLuint vao = 0, vbo = 0, ebo = 0;
+    GLuint tbo = 0;   // tangents (attribute 4), only for meshes that have them
     GLenum primitive = GL_TRIANGLES;
     std::vector<IndexRange> ranges;
     size_t triangles = 0;
@@ -243,7 +247,8 @@ void releaseMesh(GpuMesh& m) {
     if (m.vao) glDeleteVertexArrays(1, &m.vao);
     if (m.vbo) glDeleteBuffers(1, &m.vbo);
     if (m.ebo) glDeleteBuffers(1, &m.ebo);
-    m.vao = m.vbo = m.ebo = 0;
+    if (m.tbo) glDeleteBuffers(1, &m.tbo);
+    m.vao = m.vbo = m.ebo = m.tbo = 0;
 }
 
 // Builds (or rebuilds) the buffers of `mesh`; triangleMaterial (optional) groups the
@@ -327,6 +332,13 @@ void uploadMesh(GpuMesh& g, const Mesh& mesh, const std::vector<uint16_t>* trian
     attrib(1, 3, offsetof(Vertex, n));
     attrib(2, 2, offsetof(Vertex, uv));
     attrib(3, 4, offsetof(Vertex, c));
+    if (per == 3 && mesh.tangents.size() == mesh.positions.size()) {   // normal maps: own buffer, other meshes pay nothing
+        glGenBuffers(1, &g.tbo);
+        glBindBuffer(GL_ARRAY_BUFFER, g.tbo);
+        glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(mesh.tangents.size() * sizeof(vec4)), mesh.tangents.data(), GL_STATIC_DRAW);
+        glEnableVertexAttribArray(4);
+        glVertexAttribPointer(4, 4, GL_FLOAT, GL_FALSE, sizeof(vec4), nullptr);
+    }
     glBindVertexArray(0);
 }
 
@@ -353,8 +365,11 @@ bool uploadTexture(GpuTexture& g, const Texture& t) {
     glGenTextures(1, &g.id);
     glBindTexture(GL_TEXTURE_2D, g.id);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    // Colour textures decode sRGB when sampled; data textures (metallic-roughness, occlusion) are linear.
-    glTexImage2D(GL_TEXTURE_2D, 0, t.srgb ? GL_SRGB8_ALPHA8 : GL_RGBA8, t.width, t.height, 0, GL_RGBA, GL_UNSIGNED_BYTE, flipped.data());
+    // Colour textures decode sRGB when sampled; data textures (normal, metallic-roughness,
+    // occlusion) are linear, stored as RGBA16 (the 8-bit values exactly): llvmpipe filters RGBA8
+    // with 8-bit weights, which sharp highlights on normal maps turn into visible differences
+    // (SheenCloth: 99.3% of pixels within 3/255 of the CPU backends with RGBA8, 99.99% with RGBA16).
+    glTexImage2D(GL_TEXTURE_2D, 0, t.srgb ? GL_SRGB8_ALPHA8 : GL_RGBA16, t.width, t.height, 0, GL_RGBA, GL_UNSIGNED_BYTE, flipped.data());
     glGenerateMipmap(GL_TEXTURE_2D);
     GLint minF = t.filter == FilterMode::Nearest ? GL_NEAREST : t.filter == FilterMode::Bilinear ? GL_LINEAR : GL_LINEAR_MIPMAP_LINEAR;
     GLint magF = t.filter == FilterMode::Nearest ? GL_NEAREST : GL_LINEAR;
@@ -489,7 +504,7 @@ struct DrawItem {
     const Material* material = nullptr;
     const std::vector<Material>* rangeMaterials = nullptr;   // tessellation's per-range materials
     GpuTexture* texture = nullptr;
-    GpuTexture* maps[3] = {nullptr, nullptr, nullptr};   // emissive, occlusion, metallic-roughness (units 1..3)
+    GpuTexture* maps[4] = {nullptr, nullptr, nullptr, nullptr};   // emissive, occlusion, metallic-roughness, normal (units 1..4)
 };
 
 class GlRenderer final : public Renderer {
@@ -678,7 +693,7 @@ void GlRenderer::setFrameUniforms(const Program& p, const FrameInput& f, int ssa
     glUniform3fv(p.ambient, 1, &f.ambientLight[0]);
     glUniform1f(p.pointSize, 2.0f * float(ssaa));
     glUniform1i(p.texture, 0);
-    for (int k = 0; k < 3; ++k) glUniform1i(p.maps[k], 1 + k);
+    for (int k = 0; k < 4; ++k) glUniform1i(p.maps[k], 1 + k);
     glUniform1i(p.fogMode, int(s.fog));
     glUniform3fv(p.fogColor, 1, &s.fogColor[0]);
     glUniform3f(p.fogParams, s.fogStart, s.fogEnd, s.fogDensity);
@@ -704,9 +719,9 @@ void GlRenderer::setFrameUniforms(const Program& p, const FrameInput& f, int ssa
     }
 }
 
-// The draw's textures: the base colour on unit 0, its maps on units 1..3 (unit 0 left active).
+// The draw's textures: the base colour on unit 0, its maps on units 1..4 (unit 0 left active).
 void bindTextures(const DrawItem& it) {
-    for (int k = 0; k < 3; ++k) {
+    for (int k = 0; k < 4; ++k) {
         glActiveTexture(GLenum(GL_TEXTURE1 + k));
         glBindTexture(GL_TEXTURE_2D, it.maps[k] ? it.maps[k]->id : 0);
     }
@@ -716,7 +731,8 @@ void bindTextures(const DrawItem& it) {
 
 void GlRenderer::setMaterial(const Program& p, const Material& m, const DrawItem& it, bool unlit) {
     const bool hasTexture = it.texture != nullptr;
-    for (int k = 0; k < 3; ++k) glUniform1i(p.hasMap[k], it.maps[k] && !unlit ? 1 : 0);
+    for (int k = 0; k < 4; ++k) glUniform1i(p.hasMap[k], it.maps[k] && !unlit ? 1 : 0);
+    glUniform1f(p.normalScale, m.normalScale);
     glUniform1f(p.occlusionStrength, m.occlusionStrength);
     glUniform1f(p.metallic, m.metallic);
     glUniform1f(p.roughness, m.roughness);
@@ -754,6 +770,7 @@ std::vector<DrawItem> GlRenderer::collectDraws(const FrameInput& frame, int tess
         it.maps[0] = textureFor(p.maps.emissive);
         it.maps[1] = textureFor(p.maps.occlusion);
         it.maps[2] = textureFor(p.maps.metallicRoughness);
+        it.maps[3] = it.gpu->tbo ? textureFor(p.maps.normal) : nullptr;   // a normal map needs the mesh's tangents
         items.push_back(it);
     }
     std::vector<float> distance(items.size());

@@ -10,6 +10,7 @@
 // Sections: 1. fixed-point triangle setup   2. coverage iteration   3. clipping   4. lines
 #pragma once
 
+#include "common/window_lines.h"
 #include "scenegraph/math.h"
 
 #include <algorithm>
@@ -19,11 +20,18 @@
 
 namespace rnd::raster {
 
-constexpr int kSubBits = 8;               // sub-pixel precision
-constexpr int kSub = 1 << kSubBits;       // fixed-point units per pixel
-constexpr int kHalf = kSub / 2;           // pixel centre offset
-constexpr int kTileSize = 64;             // screen tiles rasterized in parallel
-constexpr float kGuardPixels = 8192.0f;   // guard band beyond the viewport (x, y)
+using rnd::lines::drawLineDDA;
+using rnd::lines::GuardBand;
+using rnd::lines::guardBand;
+using rnd::lines::kGuardPixels;
+using rnd::lines::outcode;
+using rnd::lines::toWindow;
+using namespace rnd::lines::clipbits;
+
+constexpr int kSubBits = 8;           // sub-pixel precision
+constexpr int kSub = 1 << kSubBits;   // fixed-point units per pixel
+constexpr int kHalf = kSub / 2;       // pixel centre offset
+constexpr int kTileSize = 64;         // screen tiles rasterized in parallel
 
 // GL standard 4x MSAA sample positions in fixed-point units from the pixel's lower-left corner
 // (y up). Same pattern as D3D's standard 4x, mirrored for the y-up window convention.
@@ -186,30 +194,7 @@ inline void forEachCoveredPixelSimple(const TriSetup& t, int x0, int y0, int x1,
 // 3. Clipping in homogeneous clip space
 // ---------------------------------------------------------------------------------------
 
-// Outcode bits: near (z < -w), far (z > w), and the four guard-band planes |x|,|y| <= g*w.
-// Triangles whose vertices have no bits set need no clipping; near and far are clipped
-// exactly, x and y only outside the guard band (the viewport scissor does the rest).
-enum : uint8_t { kClipNear = 1, kClipFar = 2, kClipLeft = 4, kClipRight = 8, kClipBottom = 16, kClipTop = 32, kInvalid = 64 };
-
-struct GuardBand {
-    float gx = 1, gy = 1;
-};
-inline GuardBand guardBand(int width, int height) {
-    return {1.0f + 2.0f * kGuardPixels / std::max(width, 1), 1.0f + 2.0f * kGuardPixels / std::max(height, 1)};
-}
-
-// kInvalid marks a non-finite position: triangles using it are dropped, not clipped.
-inline uint8_t outcode(const sg::vec4& c, const GuardBand& g) {
-    if (!(std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z) && std::isfinite(c.w))) return kInvalid | kClipNear;
-    uint8_t o = 0;
-    if (!(c.z >= -c.w)) o |= kClipNear;   // also catches NaN
-    if (!(c.z <= c.w)) o |= kClipFar;
-    if (c.x < -g.gx * c.w) o |= kClipLeft;
-    if (c.x > g.gx * c.w) o |= kClipRight;
-    if (c.y < -g.gy * c.w) o |= kClipBottom;
-    if (c.y > g.gy * c.w) o |= kClipTop;
-    return o;
-}
+// Outcode bits, GuardBand, guardBand(), outcode() and toWindow(): common/window_lines.h.
 
 // A clipped polygon vertex: clip position and barycentric weights w.r.t. the input triangle.
 struct ClipVertex {
@@ -258,44 +243,10 @@ inline int clipTriangle(const sg::vec4 c[3], uint8_t planes, const GuardBand& g,
     return n < 3 ? 0 : n;
 }
 
-// Window coordinates (x, y, z, 1/w) of a clip-space position for a width x height viewport.
-inline sg::vec4 toWindow(const sg::vec4& c, int width, int height) {
-    float iw = 1.0f / c.w;
-    return {(c.x * iw * 0.5f + 0.5f) * width, (c.y * iw * 0.5f + 0.5f) * height, c.z * iw * 0.5f + 0.5f, iw};
-}
-
 // ---------------------------------------------------------------------------------------
 // 4. Lines: DDA ("Digital Differential Analyzer") over window coordinates
 // ---------------------------------------------------------------------------------------
 
-// Calls fn(i, j, t) for the pixels of the segment a -> b (window coordinates): one pixel per
-// column (x-major) or row (y-major) whose centre lies in [start, end) along the major axis,
-// the minor coordinate stepped incrementally by the slope and sampled at that centre (GL's
-// diamond-exit rule for thin lines, approximately); t in [0,1] is the screen-space position
-// of the sample along the segment. Half-open, so joined segments do not repeat a pixel.
-template <class Fn>
-inline void drawLineDDA(float ax, float ay, float bx, float by, int width, int height, Fn&& fn) {
-    float dx = bx - ax, dy = by - ay;
-    if (!(std::fabs(dx) < 1e6f && std::fabs(dy) < 1e6f)) return;   // non-finite or absurd
-    const bool xMajor = std::fabs(dx) >= std::fabs(dy);
-    const float a0 = xMajor ? ax : ay, len = xMajor ? dx : dy;
-    const float b0 = xMajor ? ay : ax, d = xMajor ? dy : dx;
-    if (len == 0) return;
-    const float slope = d / len;
-    const int majorSize = xMajor ? width : height, minorSize = xMajor ? height : width;
-    int lo = int(std::ceil(std::min(a0, a0 + len) - 0.5f)), hi = int(std::ceil(std::max(a0, a0 + len) - 0.5f)) - 1;
-    lo = std::max(lo, 0);
-    hi = std::min(hi, majorSize - 1);
-    for (int k = lo; k <= hi; ++k) {
-        float c = k + 0.5f;
-        float t = (c - a0) / len;
-        int m = int(std::floor(b0 + (c - a0) * slope));
-        if (m < 0 || m >= minorSize) continue;
-        if (xMajor)
-            fn(k, m, t);
-        else
-            fn(m, k, t);
-    }
-}
+// drawLineDDA(): common/window_lines.h.
 
 }   // namespace rnd::raster

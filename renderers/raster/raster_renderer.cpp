@@ -20,6 +20,7 @@
 //           [renderer]
 #include "raster/raster_renderer.h"
 
+#include "common/line_overlay.h"
 #include "raster/raster_core.h"
 #include "raster/raster_shading.h"
 #include "renderers/draw_list.h"
@@ -101,8 +102,9 @@ struct DrawItem {
     std::shared_ptr<const std::vector<uint16_t>> triMat;   // per-triangle material (CSG)
     std::shared_ptr<const std::vector<sg::Material>> materials;
     const SampledTexture* texture = nullptr;
-    const SampledTexture *emissiveMap = nullptr, *occlusionMap = nullptr, *metallicRoughnessMap = nullptr;
-    bool hasMaps() const { return emissiveMap || occlusionMap || metallicRoughnessMap; }
+    const SampledTexture *emissiveMap = nullptr, *occlusionMap = nullptr, *metallicRoughnessMap = nullptr, *normalMap = nullptr;
+    bool hasMaps() const { return emissiveMap || occlusionMap || metallicRoughnessMap || normalMap; }
+    bool hasTangents = false;   // normal map with mesh tangents: wtan filled
     bool mirrored = false;
     bool perCorner = false;   // Gouraud with per-triangle materials: one vertex per corner
     bool hasNormals = false;
@@ -116,6 +118,7 @@ struct DrawItem {
     std::vector<uint8_t> code;
     std::vector<vec4> win;   // window x, y, z, 1/w (valid when code == 0)
     std::vector<vec3> wpos, wnrm;
+    std::vector<vec4> wtan;                       // world tangent (xyz, handedness; mirrored draws flip it), when hasTangents
     std::vector<vec3> gouraudA[2], gouraudB[2];   // front/back: colour = A * albedo + B
 
     // Whether back faces of triangle `tri` are culled (RenderSettings::culling, per material).
@@ -143,6 +146,8 @@ void runVertexStage(DrawItem& d, const sg::FrameInput& f, int width, int height,
     d.win.resize(n);
     d.wpos.resize(n);
     d.wnrm.assign(n, vec3(0.0f));
+    d.wtan.resize(d.hasTangents ? n : 0);
+    const float handedness = d.mirrored ? -1.0f : 1.0f;   // a mirroring transform flips cross(n, t)
     if (gouraud)
         for (int s = 0; s < 2; ++s) {
             d.gouraudA[s].resize(n);
@@ -168,6 +173,7 @@ void runVertexStage(DrawItem& d, const sg::FrameInput& f, int width, int height,
                 float len = glm::length(nn);
                 d.wnrm[v] = len > 0 ? nn / len : vec3(0, 0, 1);
             }
+            if (d.hasTangents) d.wtan[v] = vec4(mat3(d.world) * vec3(m.tangents[mi]), m.tangents[mi].w * handedness);
             if (gouraud) {
                 const sg::Material& mat = d.perCorner ? d.materialOf(uint32_t(v / 3)) : d.material;
                 // Gouraud: the model's two albedo-linear terms at the vertex, front and back side.
@@ -528,7 +534,7 @@ __attribute__((noinline)) float prepareFragment(const TriCache& tc, const FrameC
             vec2 uv, ddx, ddy;
             uvAt(tc, fb, mi, i, j, uv, ddx, ddy);
             if (d.texture) albedo *= d.texture->sample(uv, ddx, ddy);
-            if (maps) ms = sampleMaps(d.emissiveMap, d.occlusionMap, d.metallicRoughnessMap, uv, ddx, ddy);
+            if (maps) ms = sampleMaps(d.emissiveMap, d.occlusionMap, d.metallicRoughnessMap, d.normalMap, uv, ddx, ddy);
         }
     }
 
@@ -547,6 +553,11 @@ __attribute__((noinline)) float prepareFragment(const TriCache& tc, const FrameC
             n = bo[0] * tc.n[0] + bo[1] * tc.n[1] + bo[2] * tc.n[2];
             float len = glm::length(n);
             n = len > 0 ? n / len : vec3(0, 0, 1);
+            if (ms.hasNormal && d.hasTangents) {   // the map's normal, on the outward side, then flipped back
+                const vec4 tan = bo[0] * d.wtan[v[0]] + bo[1] * d.wtan[v[1]] + bo[2] * d.wtan[v[2]];
+                const vec4 tw(vec3(tan), d.wtan[v[0]].w);
+                n = t.front ? perturbNormal(n, tw, ms.normalTexel, mat.normalScale) : -perturbNormal(-n, tw, ms.normalTexel, mat.normalScale);
+            }
         }
         const PhongCoefficients coeff = maps ? coefficientsAt(mat, ms) : coefficientsOf(mat);
         if (fc.referenceShading)
@@ -826,146 +837,6 @@ void renderBlended(const FrameContext& fc, Framebuffer& target, TileBuffers& buf
 }
 
 // ---------------------------------------------------------------------------------------
-// [lines]
-// ---------------------------------------------------------------------------------------
-
-// Clips segment a-b (clip space) to near/far and the guard band; false when nothing is left.
-bool clipSegment(vec4& a, vec4& b, const GuardBand& g) {
-    float t0 = 0, t1 = 1;
-    auto clipPlane = [&](float da, float db) {
-        if (da < 0 && db < 0) return false;
-        if (da < 0)
-            t0 = std::max(t0, da / (da - db));
-        else if (db < 0)
-            t1 = std::min(t1, da / (da - db));
-        return t0 <= t1;
-    };
-    if (!clipPlane(a.z + a.w, b.z + b.w) || !clipPlane(a.w - a.z, b.w - b.z) || !clipPlane(a.x + g.gx * a.w, b.x + g.gx * b.w) ||
-        !clipPlane(g.gx * a.w - a.x, g.gx * b.w - b.x) || !clipPlane(a.y + g.gy * a.w, b.y + g.gy * b.w) ||
-        !clipPlane(g.gy * a.w - a.y, g.gy * b.w - b.y))
-        return false;
-    vec4 na = a + t0 * (b - a), nb = a + t1 * (b - a);
-    a = na;
-    b = nb;
-    return true;
-}
-
-void writeLinePixel(Framebuffer& fb, int i, int j, float z, const vec3& linear, float bias) {
-    int row = fb.height - 1 - j;
-    float& dst = fb.depth[size_t(row) * fb.width + i];
-    if (!(z < dst + bias)) return;   // LESS (wireframe: LEQUAL with a small offset)
-    dst = std::min(dst, z);
-    const SrgbEncoder& enc = srgbEncoder();
-    uint8_t* p = fb.pixel(i, row);
-    p[0] = enc(linear.x);
-    p[1] = enc(linear.y);
-    p[2] = enc(linear.z);
-    p[3] = 255;
-}
-
-// End point of a line: clip position, unfogged linear colour, eye distance (for fog).
-struct LineEnd {
-    vec4 clip;
-    vec3 color;
-    float eyeDist;
-};
-
-// Draws segment a-b: clipped in clip space, DDA in window space; depth, colour and fog
-// distance interpolated perspective-correctly per pixel, fog applied per pixel (as GL does).
-void drawSegment(Framebuffer& fb, LineEnd a, LineEnd b, const GuardBand& g, const sg::RenderSettings& st, float bias) {
-    vec4 ca = a.clip, cb = b.clip;
-    float t0 = 0, t1 = 1;
-    {
-        vec4 ta = ca, tb = cb;
-        if (!clipSegment(ta, tb, g)) return;
-        // Recover the clip parameters to interpolate the attributes.
-        vec4 dd = cb - ca;
-        int axis = 0;
-        for (int k = 1; k < 4; ++k)
-            if (std::fabs(dd[k]) > std::fabs(dd[axis])) axis = k;
-        if (dd[axis] != 0) {
-            t0 = (ta[axis] - ca[axis]) / dd[axis];
-            t1 = (tb[axis] - ca[axis]) / dd[axis];
-        }
-        ca = ta;
-        cb = tb;
-    }
-    auto lerp = [](const LineEnd& x, const LineEnd& y, float t) {
-        return LineEnd{x.clip + t * (y.clip - x.clip), x.color + t * (y.color - x.color), x.eyeDist + t * (y.eyeDist - x.eyeDist)};
-    };
-    LineEnd ea = lerp(a, b, t0), eb = lerp(a, b, t1);
-    vec4 wa = toWindow(ca, fb.width, fb.height), wb = toWindow(cb, fb.width, fb.height);
-    const bool fog = st.fog != sg::FogMode::Off;
-    drawLineDDA(wa.x, wa.y, wb.x, wb.y, fb.width, fb.height, [&](int i, int j, float t) {
-        float z = std::clamp(wa.z + t * (wb.z - wa.z), 0.0f, 1.0f);   // window z: screen-linear
-        float tp = t * wb.w / ((1 - t) * wa.w + t * wb.w);            // perspective-correct
-        vec3 c = ea.color + tp * (eb.color - ea.color);
-        if (fog) c = applyFog(st, c, ea.eyeDist + tp * (eb.eyeDist - ea.eyeDist));
-        writeLinePixel(fb, i, j, z, c, bias);
-    });
-}
-
-void drawLinesAndWireframe(const std::vector<DrawItem>& lineDraws, const std::vector<DrawItem>& triDraws, const sg::FrameInput& f, Framebuffer& fb,
-                           float pointSize) {
-    const GuardBand g = guardBand(fb.width, fb.height);
-    const auto& st = f.settings;
-    auto eyeDist = [&](const vec3& wpos) { return glm::length(vec3(f.camera.view * vec4(wpos, 1.0f))); };
-    for (const DrawItem& d : lineDraws) {
-        const sg::Mesh& m = *d.mesh;
-        // Unlit, as GL draws lines and points: base colour (x) vertex colour + emissive.
-        auto end = [&](uint32_t v) {
-            vec3 c = d.material.baseColor * (d.hasColors ? vec3(m.colors[v]) : vec3(1.0f)) + d.material.emissive;
-            return LineEnd{d.clip[v], c, eyeDist(d.wpos[v])};
-        };
-        size_t n = m.indices.empty() ? m.positions.size() : m.indices.size();
-        auto idx = [&](size_t k) { return m.indices.empty() ? uint32_t(k) : m.indices[k]; };
-        if (m.mode == sg::PrimitiveMode::Lines) {
-            for (size_t k = 0; k + 1 < n; k += 2) {
-                uint32_t ia = idx(k), ib = idx(k + 1);
-                if (ia >= d.clip.size() || ib >= d.clip.size() || ((d.code[ia] | d.code[ib]) & kInvalid)) continue;
-                drawSegment(fb, end(ia), end(ib), g, st, 0.0f);
-            }
-        } else {
-            // Points: squares of pointSize pixels centred on the vertex (GL point rules).
-            for (size_t k = 0; k < n; ++k) {
-                uint32_t ia = idx(k);
-                if (ia >= d.clip.size() || d.code[ia] != 0) continue;
-                vec4 w = toWindow(d.clip[ia], fb.width, fb.height);
-                LineEnd e = end(ia);
-                vec3 c = st.fog != sg::FogMode::Off ? applyFog(st, e.color, e.eyeDist) : e.color;
-                float h = 0.5f * pointSize;
-                int i0 = int(std::ceil(w.x - h - 0.5f)), i1 = int(std::ceil(w.x + h - 0.5f)) - 1;
-                int j0 = int(std::ceil(w.y - h - 0.5f)), j1 = int(std::ceil(w.y + h - 0.5f)) - 1;
-                for (int j = std::max(j0, 0); j <= std::min(j1, fb.height - 1); ++j)
-                    for (int i = std::max(i0, 0); i <= std::min(i1, fb.width - 1); ++i)
-                        writeLinePixel(fb, i, j, std::clamp(w.z, 0.0f, 1.0f), c, 0.0f);
-            }
-        }
-    }
-    if (!st.wireframe) return;
-    // Wireframe overlay: every triangle edge, depth LEQUAL with a small offset toward the
-    // viewer (GL: glPolygonOffset(-1, -1)), wireframe colour fogged like GL's overlay.
-    for (const DrawItem& d : triDraws)
-        for (uint32_t t = 0; t < d.triCount; ++t) {
-            uint32_t v[3] = {d.vertexOf(t, 0), d.vertexOf(t, 1), d.vertexOf(t, 2)};
-            if (v[0] >= d.clip.size() || v[1] >= d.clip.size() || v[2] >= d.clip.size()) continue;
-            if (d.code[v[0]] & d.code[v[1]] & d.code[v[2]]) continue;
-            if ((d.code[v[0]] | d.code[v[1]] | d.code[v[2]]) & kInvalid) continue;
-            if ((d.code[v[0]] | d.code[v[1]] | d.code[v[2]]) == 0 && d.cullsBack(t, st.culling)) {
-                // Culled faces draw no edges (GL culls polygons in line mode too).
-                vec2 a(d.win[v[0]]), b(d.win[v[1]]), c(d.win[v[2]]);
-                float area = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
-                if ((area > 0) == d.mirrored) continue;
-            }
-            for (int k = 0; k < 3; ++k) {
-                LineEnd a{d.clip[v[k]], st.wireframeColor, eyeDist(d.wpos[v[k]])};
-                LineEnd b{d.clip[v[(k + 1) % 3]], st.wireframeColor, eyeDist(d.wpos[v[(k + 1) % 3]])};
-                drawSegment(fb, a, b, g, st, 2e-4f);
-            }
-        }
-}
-
-// ---------------------------------------------------------------------------------------
 // [renderer]
 // ---------------------------------------------------------------------------------------
 
@@ -1011,8 +882,9 @@ private:
         const bool gouraud = st.shading == sg::ShadingModel::Gouraud;
 
         // 1. gather (the draw list shared with the GL backend)
-        std::vector<DrawItem> draws, lineDraws;
-        for (const PreparedDraw& p : prepareDraws(frame, tessRes, m_tess)) {
+        std::vector<DrawItem> draws;
+        const std::vector<PreparedDraw> prepared = prepareDraws(frame, tessRes, m_tess);
+        for (const PreparedDraw& p : prepared) {
             DrawItem d;
             d.mesh = p.mesh;
             d.world = *p.world;
@@ -1023,6 +895,8 @@ private:
             d.emissiveMap = m_samplers.get(p.maps.emissive);
             d.occlusionMap = m_samplers.get(p.maps.occlusion);
             d.metallicRoughnessMap = m_samplers.get(p.maps.metallicRoughness);
+            d.normalMap = m_samplers.get(p.maps.normal);
+            d.hasTangents = d.normalMap && p.mesh->tangents.size() == p.mesh->positions.size();
             d.hasNormals = p.mesh->normals.size() == p.mesh->positions.size();
             d.hasUV = p.mesh->uv0.size() == p.mesh->positions.size();
             d.hasColors = p.mesh->colors.size() == p.mesh->positions.size();
@@ -1035,9 +909,7 @@ private:
                 if (d.triCount == 0) continue;
                 d.perCorner = gouraud && d.triMat;
                 draws.push_back(std::move(d));
-            } else {
-                lineDraws.push_back(std::move(d));
-            }
+            }   // points and lines: the overlay (step 5)
         }
         m_samplers.endFrame();
 
@@ -1051,7 +923,6 @@ private:
         }
         stats.triangles = total;
         tbb::parallel_for(size_t(0), draws.size(), [&](size_t i) { runVertexStage(draws[i], frame, width, height, gouraud); });
-        tbb::parallel_for(size_t(0), lineDraws.size(), [&](size_t i) { runVertexStage(lineDraws[i], frame, width, height, false); });
 
         auto tVert = std::chrono::steady_clock::now();
         // 3. triangles
@@ -1111,7 +982,7 @@ private:
 
         auto tTiles = std::chrono::steady_clock::now();
         // 5. lines, points, wireframe
-        drawLinesAndWireframe(lineDraws, draws, frame, target, 2.0f * float(pointScale));
+        drawPointsLinesWireframe(prepared, frame, target, 2.0f * float(pointScale));
         if (m_timing) {
             size_t ntri = 0;
             for (const auto& c : chunks) ntri += c.tris.size();

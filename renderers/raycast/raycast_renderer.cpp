@@ -14,8 +14,10 @@
 // are untextured.
 #include "raycast/raycast_renderer.h"
 
+#include "common/line_overlay.h"
 #include "raycast/camera_rays.h"
 #include "raycast/scene_accel.h"
+#include "renderers/draw_list.h"
 #include "renderers/shading.h"
 #include "renderers/texture_sampler.h"
 
@@ -122,8 +124,8 @@ bool uvWithFootprint(const PixelFootprint* footprint, const vec3 P[3], const vec
 
 // A mesh's other material textures (null when absent).
 struct MeshMaps {
-    const SampledTexture *emissive = nullptr, *occlusion = nullptr, *metallicRoughness = nullptr;
-    bool any() const { return emissive || occlusion || metallicRoughness; }
+    const SampledTexture *emissive = nullptr, *occlusion = nullptr, *metallicRoughness = nullptr, *normal = nullptr;
+    bool any() const { return emissive || occlusion || metallicRoughness || normal; }
 };
 
 struct Tracer {
@@ -234,6 +236,19 @@ struct Tracer {
         }
     }
 
+    // The normal map's normal (perturbNormal) with the world tangent interpolated like the
+    // normal; n is the interpolated normal facing the viewer, flipped back for the map when the
+    // hit is on the back. Mirrored instances flip the handedness (cross(n, t) flips with them).
+    vec3 mappedNormal(const DrawMesh& dm, uint32_t i0, uint32_t i1, uint32_t i2, float w0, float w1, float w2, const vec3& n, bool back,
+                      const MapSample& ms) const {
+        const Mesh& mesh = *dm.mesh;
+        const sg::mat3 m3(dm.world);
+        const vec3 t = m3 * (w0 * vec3(mesh.tangents[i0]) + w1 * vec3(mesh.tangents[i1]) + w2 * vec3(mesh.tangents[i2]));
+        const vec4 tw(t, mesh.tangents[i0].w * (dm.mirrored ? -1.0f : 1.0f));
+        const float scale = dm.material.normalScale;
+        return back ? -perturbNormal(-n, tw, ms.normalTexel, scale) : perturbNormal(n, tw, ms.normalTexel, scale);
+    }
+
     // Shades a triangle hit: interpolated position (s.p), normals, vertex colours, texture
     // (filtered with the footprint), then the shading model with shadow rays into vis.
     void shadeMeshHit(const rt::SceneHit& h, const rt::Ray& r, const vec3& eye, const PixelFootprint* footprint, float* vis, ShadedHit& s) {
@@ -275,7 +290,8 @@ struct Tracer {
             vec2 uv, ddx(0.0f), ddy(0.0f);
             const bool footprinted = uvWithFootprint(footprint, P, UV, w, uv, ddx, ddy);
             if (tex) texColor = footprinted ? tex->sample(uv, ddx, ddy) : tex->sampleLevel(uv, 0, tex->filter() != FilterMode::Nearest);
-            if (hasMaps) ms = sampleMaps(mm.emissive, mm.occlusion, mm.metallicRoughness, uv, ddx, ddy);   // no footprint: derivatives 0, level 0
+            if (hasMaps)
+                ms = sampleMaps(mm.emissive, mm.occlusion, mm.metallicRoughness, mm.normal, uv, ddx, ddy);   // no footprint: derivatives 0, level 0
         }
         vec3 Nv[3];
         for (int k = 0; k < 3; ++k) {
@@ -311,6 +327,7 @@ struct Tracer {
                 n = w0 * Nv[0] + w1 * Nv[1] + w2 * Nv[2];
                 float l = glm::length(n);
                 n = l > 1e-20f ? n / l : ng;
+                if (ms.hasNormal && mesh.tangents.size() == mesh.positions.size()) n = mappedNormal(dm, i0, i1, i2, w0, w1, w2, n, back, ms);
             }
             if (!mat->unlit) lightVisibility(p, ng, vis);
             const PhongCoefficients coeff = hasMaps ? coefficientsAt(*mat, ms) : coefficientsOf(*mat);
@@ -420,6 +437,8 @@ public:
         c.exactImplicits = true;
         c.shadows = true;
         c.reflections = true;
+        c.wireframe = true;        // the CPU backends' overlay (common/line_overlay.h), after the rays
+        c.pointsAndLines = true;   // the same pixel footprint as the rasterizers
         // MSAA n and SSAA f are both taken as stratified jittered rays per pixel: n rays
         // (2 -> 2x1, 4 -> 2x2, 8 -> 4x2 strata) and f x f rays; each ray is shaded.
         c.msaaSamples = {2, 4, 8};
@@ -452,7 +471,7 @@ protected:
         for (size_t i = 0; i < f.meshes.size(); ++i) {
             textures[i] = m_samplers.get(f.meshes[i].texture);
             const sg::MaterialMaps& fm = f.meshes[i].maps;
-            maps[i] = {m_samplers.get(fm.emissive), m_samplers.get(fm.occlusion), m_samplers.get(fm.metallicRoughness)};
+            maps[i] = {m_samplers.get(fm.emissive), m_samplers.get(fm.occlusion), m_samplers.get(fm.metallicRoughness), m_samplers.get(fm.normal)};
         }
         m_samplers.endFrame();
         const bool anyAlpha = anyTranslucent(f);
@@ -526,14 +545,32 @@ protected:
 
         stats.rays = rays.load();
         stats.cancelled = cancelled.load();
+        if (!stats.cancelled) drawOverlay(f, cfg, target);
         stats.ok = !stats.cancelled;
         if (stats.cancelled) stats.error = "cancelled";
         return stats;
     }
 
 private:
+    // Points, lines and the wireframe, rasterized over the ray-cast image against its depth
+    // exactly as the CPU rasterizer draws them (rays cannot hit zero-width primitives). The
+    // wireframe of analytic shapes is their tessellation's, as in the rasterizers. Drawn at the
+    // output size: with SSAA the rasterizers' 1-pixel lines come out fainter after downsampling.
+    void drawOverlay(const FrameInput& f, const RenderConfig& cfg, Framebuffer& target) {
+        std::vector<PreparedDraw> draws;
+        if (f.settings.wireframe) {
+            draws = prepareDraws(f, cfg.tessellation, m_tess);
+            m_tess.nextFrame();
+        } else {
+            for (const PreparedDraw& d : prepareMeshDraws(f))
+                if (d.mesh->mode != sg::PrimitiveMode::Triangles) draws.push_back(d);
+        }
+        if (!draws.empty()) drawPointsLinesWireframe(draws, f, target, 2.0f);
+    }
+
     rt::SceneAccel m_accel;
     SamplerCache m_samplers;
+    TessellationCache m_tess;   // wireframe of analytic shapes only
 };
 
 }   // namespace

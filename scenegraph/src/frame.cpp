@@ -31,7 +31,8 @@ namespace {
 TexturePtr textureAt(const Scene& s, int i) { return i < 0 || size_t(i) >= s.textures.size() ? nullptr : s.textures[size_t(i)]; }
 TexturePtr textureOf(const Scene& s, const Material& m) { return textureAt(s, m.diffuseTexture); }
 MaterialMaps mapsOf(const Scene& s, const Material& m) {
-    return {textureAt(s, m.emissiveTexture), textureAt(s, m.occlusionTexture), textureAt(s, m.metallicRoughnessTexture)};
+    return {textureAt(s, m.emissiveTexture), textureAt(s, m.occlusionTexture), textureAt(s, m.metallicRoughnessTexture),
+            textureAt(s, m.normalTexture)};
 }
 
 // Builds the CSG tree below `csgNode`; leaves are implicit shapes in world space.

@@ -1,6 +1,7 @@
 #include "scenegraph/mesh.h"
 
 #include <atomic>
+#include <cmath>
 
 namespace sg {
 
@@ -31,6 +32,39 @@ void Mesh::computeNormals() {
     for (vec3& n : normals) {
         float len = glm::length(n);
         n = len > 0.0f ? n / len : vec3(0, 1, 0);
+    }
+}
+
+void Mesh::computeTangents() {
+    tangents.clear();
+    const size_t n = positions.size();
+    if (mode != PrimitiveMode::Triangles || normals.size() != n || uv0.size() != n) return;
+    std::vector<vec3> du(n, vec3(0.0f)), dv(n, vec3(0.0f));
+    for (size_t i = 0; i + 2 < indices.size(); i += 3) {
+        const uint32_t a = indices[i], b = indices[i + 1], c = indices[i + 2];
+        if (a >= n || b >= n || c >= n) continue;
+        const vec3 e1 = positions[b] - positions[a], e2 = positions[c] - positions[a];
+        const vec2 t1 = uv0[b] - uv0[a], t2 = uv0[c] - uv0[a];
+        const float det = t1.x * t2.y - t2.x * t1.y;
+        if (!(std::fabs(det) > 1e-20f)) continue;   // no uv area (or NaN): no direction
+        const vec3 su = (e1 * t2.y - e2 * t1.y) / det, sv = (e2 * t1.x - e1 * t2.x) / det;
+        if (!isFinite(su) || !isFinite(sv)) continue;
+        for (uint32_t v : {a, b, c}) {
+            du[v] += su;
+            dv[v] += sv;
+        }
+    }
+    tangents.resize(n);
+    for (size_t v = 0; v < n; ++v) {
+        const vec3& nn = normals[v];
+        vec3 t = du[v] - nn * glm::dot(nn, du[v]);
+        float len = glm::length(t);
+        if (!(len > 1e-20f)) {   // any direction perpendicular to the normal
+            t = std::fabs(nn.x) < 0.9f ? glm::cross(nn, vec3(1, 0, 0)) : glm::cross(nn, vec3(0, 1, 0));
+            len = glm::length(t);
+        }
+        t = len > 0 ? t / len : vec3(1, 0, 0);
+        tangents[v] = vec4(t, glm::dot(glm::cross(nn, t), dv[v]) < 0.0f ? -1.0f : 1.0f);
     }
 }
 

@@ -5,6 +5,7 @@ in vec3 vEyePos;
 in vec3 vNormal;
 in vec2 vUv;
 in vec4 vColor;
+in vec4 vTangent;
 #if SHADING == SHADING_GOURAUD
 in vec3 vMulFront;
 in vec3 vAddFront;
@@ -21,6 +22,9 @@ uniform sampler2D uMetalRoughMap;   // G: roughness, B: metallic (linear)
 uniform bool uHasEmissiveMap;
 uniform bool uHasOcclusionMap;
 uniform bool uHasMetalRoughMap;
+uniform sampler2D uNormalMap;       // tangent-space normal, linear RGB = 0.5 n + 0.5
+uniform bool uHasNormalMap;         // set only for meshes with tangents
+uniform float uNormalScale;
 uniform float uOcclusionStrength;
 uniform float uMetallic;
 uniform float uRoughness;
@@ -35,6 +39,20 @@ uniform vec3 uFogColor;
 uniform vec3 uFogParams;    // start, end, density
 
 out vec4 fragColor;
+
+// rnd::perturbNormal() (renderers/common/shading.cpp): the normal map's normal at n (outward).
+vec3 perturbNormal(vec3 n, vec4 t, vec3 texel, float scale) {
+    vec3 m = 2.0 * texel - 1.0;
+    m.xy *= scale;
+    vec3 T = t.xyz - n * dot(n, t.xyz);
+    float lt = length(T);
+    if (!(lt > 1e-12)) return n;
+    T /= lt;
+    vec3 B = (t.w < 0.0 ? -1.0 : 1.0) * cross(n, T);
+    vec3 p = m.x * T + m.y * B + m.z * n;
+    float lp = length(p);
+    return lp > 1e-12 ? p / lp : n;
+}
 
 // sg::phongFromMetallicRoughness() (scenegraph/src/material.cpp).
 void phongFromMetallicRoughness(float metallic, float roughness) {
@@ -70,6 +88,7 @@ void main() {
         // The maps, sampled before any discard (implicit derivatives): coefficientsAt().
         float ao = uHasOcclusionMap ? texture(uOcclusionMap, vUv).r : 1.0;
         vec3 em = uHasEmissiveMap ? texture(uEmissiveMap, vUv).rgb : vec3(1.0);
+        vec3 nt = uHasNormalMap ? texture(uNormalMap, vUv).rgb : vec3(0.5, 0.5, 1.0);
         coefficientsOfMaterial();
         gKa *= 1.0 + uOcclusionStrength * (ao - 1.0);
         gEmissive *= em;
@@ -102,6 +121,7 @@ void main() {
 #elif SHADING == SHADING_PHONG
             float len = length(vNormal);
             vec3 n = len > 0.0 ? vNormal / len : vec3(0.0, 0.0, 1.0);
+            if (uHasNormalMap) n = perturbNormal(n, vTangent, nt, uNormalScale);   // on the outward side
             if (!gl_FrontFacing) n = -n;                 // two-sided: seen from the back
             shadeTerms(n, vWorldPos, mul, add);
 #else

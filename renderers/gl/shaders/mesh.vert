@@ -5,6 +5,7 @@ layout(location = 0) in vec3 aPosition;
 layout(location = 1) in vec3 aNormal;
 layout(location = 2) in vec2 aUv;
 layout(location = 3) in vec4 aColor;
+layout(location = 4) in vec4 aTangent;   // xyz, handedness (normal-mapped meshes only)
 
 uniform mat4 uModel;
 uniform mat3 uNormalMatrix;
@@ -17,6 +18,7 @@ out vec3 vEyePos;
 out vec3 vNormal;
 out vec2 vUv;
 out vec4 vColor;
+out vec4 vTangent;   // world xyz; w: handedness, flipped by a mirroring model matrix
 #if SHADING == SHADING_GOURAUD
 out vec3 vMulFront;
 out vec3 vAddFront;
@@ -31,6 +33,7 @@ void main() {
     vNormal = uNormalMatrix * aNormal;
     vUv = aUv;
     vColor = aColor;
+    vTangent = vec4(mat3(uModel) * aTangent.xyz, determinant(mat3(uModel)) < 0.0 ? -aTangent.w : aTangent.w);
     gl_Position = uViewProj * world;
     gl_PointSize = uPointSize;
 #if SHADING == SHADING_GOURAUD

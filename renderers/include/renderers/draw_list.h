@@ -35,5 +35,7 @@ struct PreparedDraw {
 // Meshes first (in frame.meshes order), then analytic shapes (in frame.analytics order).
 // Pointers refer into `frame` and `cache`: valid until either changes (cache.nextFrame()).
 std::vector<PreparedDraw> prepareDraws(const sg::FrameInput& frame, int tessellation, TessellationCache& cache);
+// The meshes only (no tessellation); pointers refer into `frame`.
+std::vector<PreparedDraw> prepareMeshDraws(const sg::FrameInput& frame);
 
 }   // namespace rnd

@@ -64,11 +64,19 @@ struct MapSample {
     sg::vec3 emissive{1.0f};
     bool hasMetallicRoughness = false;
     float roughness = 1.0f, metallic = 1.0f;
+    bool hasNormal = false;
+    sg::vec3 normalTexel{0.5f, 0.5f, 1.0f};   // RGB as stored (0.5 n + 0.5)
 };
 // Samples the maps (null = absent) at uv with the screen-space derivatives of uv.
 class SampledTexture;
-MapSample sampleMaps(const SampledTexture* emissive, const SampledTexture* occlusion, const SampledTexture* metallicRoughness, sg::vec2 uv,
-                     sg::vec2 ddx, sg::vec2 ddy);
+MapSample sampleMaps(const SampledTexture* emissive, const SampledTexture* occlusion, const SampledTexture* metallicRoughness,
+                     const SampledTexture* normal, sg::vec2 uv, sg::vec2 ddx, sg::vec2 ddy);
+// The normal map's normal at a point (glTF 3.9.3): with the unit interpolated normal n (world,
+// the surface's outward side), tangent t (world xyz, w = handedness) and the texel c,
+//   m = 2c - 1, m.xy *= scale;  T = normalize(t - n (n.t));  B = w cross(n, T)
+//   n' = normalize(m.x T + m.y B + m.z n)
+// (n when the frame degenerates). Used by Phong shading; flat and Gouraud keep their normals.
+sg::vec3 perturbNormal(const sg::vec3& n, const sg::vec4& t, const sg::vec3& texel, float scale);
 // The coefficients at a point with these map samples:
 //   ka_eff = ka (1 + strength (occlusion - 1)),  emissive_eff = emissive (x) emissive texel,
 //   metallic-roughness texture: (kd, ks, n, tint) = phongFromMetallicRoughness(metallic x B, roughness x G).

@@ -13,8 +13,8 @@ namespace sg {
 // A material's textures other than the base colour (null when absent), resolved from the
 // Material's indices; they sample the same UVs as the diffuse texture.
 struct MaterialMaps {
-    TexturePtr emissive, occlusion, metallicRoughness;
-    bool any() const { return emissive || occlusion || metallicRoughness; }
+    TexturePtr emissive, occlusion, metallicRoughness, normal;
+    bool any() const { return emissive || occlusion || metallicRoughness || normal; }
 };
 
 struct DrawMesh {

@@ -32,6 +32,8 @@ struct Material {
     int emissiveTexture = -1;    // sRGB colour, multiplies `emissive`
     int occlusionTexture = -1;   // R: ambient occlusion; ka_eff = ka (1 + strength (R - 1))
     float occlusionStrength = 1.0f;
+    int normalTexture = -1;              // tangent-space normal (linear, RGB = 0.5 n + 0.5), needs tangents
+    float normalScale = 1.0f;            // scales the map's x and y
     int metallicRoughnessTexture = -1;   // B: metallic, G: roughness (x the factors below), mapped
     float metallic = 0.0f;               // per texel to kd, ks, shininess, tint by phongFromMetallicRoughness()
     float roughness = 1.0f;

@@ -32,8 +32,10 @@ struct Mesh {
     std::vector<vec3> normals;   // empty or one per position
     std::vector<vec2> uv0;       // empty or one per position
     std::vector<vec2> uv1;
-    std::vector<vec4> colors;        // empty or one per position (linear RGBA)
-    std::vector<vec4> tangents;      // empty or one per position: xyz unit tangent, w = +-1 (glTF TANGENT)
+    std::vector<vec4> colors;   // empty or one per position (linear RGBA)
+    // Empty or one per position: xyz the unit tangent (direction of increasing u), w = +-1 the
+    // handedness, bitangent = w cross(normal, tangent) (glTF's TANGENT; direction of increasing v).
+    std::vector<vec4> tangents;
     std::vector<uint32_t> indices;   // 3 per triangle (2 per line, 1 per point)
     // Skinning (glTF JOINTS_0/1, WEIGHTS_0/1): up to 8 influences per vertex, four per set.
     // Joint numbers index the Skin of the instance (MeshInstance::skin); each array is empty or
@@ -51,6 +53,10 @@ struct Mesh {
     Aabb bounds() const;
     // Area-weighted smooth normals from the triangles (replaces `normals`).
     void computeNormals();
+    // Per-vertex tangents from the positions, normals and uv0 (Lengyel's method: each
+    // triangle's dP/du and dP/dv summed at its corners, Gram-Schmidt against the normal,
+    // handedness from dP/dv). Needs normals and uv0; leaves `tangents` empty otherwise.
+    void computeTangents();
     // Checks index ranges and attribute counts; returns an empty string when valid.
     std::string validate() const;
     std::string validateDeformation() const;   // the skin and morph part of validate()

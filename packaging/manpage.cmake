@@ -1,0 +1,14 @@
+# Script mode (cmake -P): OUT = IN with the version in the .TH footer ("sceneviewer" becomes
+# "sceneviewer VERSION"), gzipped with -9n (no name or time stamp inside, so the result only
+# changes when the page does).   -DIN=docs/viewer.1 -DOUT=viewer.1.gz -DVERSION=... -DGZIP=gzip
+file(READ "${IN}" page)
+string(REGEX REPLACE "(\n\\.TH [^\n]*)\"sceneviewer\"" "\\1\"sceneviewer ${VERSION}\"" page "${page}")
+get_filename_component(dir "${OUT}" DIRECTORY)
+set(tmp "${dir}/viewer.1")
+file(WRITE "${tmp}" "${page}")
+execute_process(COMMAND "${GZIP}" -9 -n -c "${tmp}" OUTPUT_FILE "${OUT}.tmp" RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "manpage.cmake: gzip failed (${rc})")
+endif()
+file(RENAME "${OUT}.tmp" "${OUT}")
+file(REMOVE "${tmp}")

@@ -1,0 +1,21 @@
+// line_overlay.h - points, lines and the wireframe overlay as both CPU backends draw them, so
+// they cover the same pixels: after the surfaces (the rasterizer's triangles, the ray
+// caster's rays), depth-tested against the image's window-z depth, unlit (base colour x
+// vertex colour + emissive, as GL draws lines and points) and fogged per pixel.
+//   Lines: clipped in clip space, one pixel per column/row (DDA, half-open), depth LESS.
+//   Points: squares of `pointSize` pixels centred on the vertex (GL's point rules).
+//   Wireframe (settings.wireframe): every triangle edge in the wireframe colour, depth LEQUAL
+//   with a small offset toward the viewer (GL: glPolygonOffset(-1, -1)); culled faces draw
+//   no edges.
+#pragma once
+
+#include "renderers/draw_list.h"
+#include "renderers/framebuffer.h"
+
+#include <vector>
+
+namespace rnd {
+
+void drawPointsLinesWireframe(const std::vector<PreparedDraw>& draws, const sg::FrameInput& f, Framebuffer& fb, float pointSize);
+
+}   // namespace rnd
