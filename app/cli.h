@@ -20,6 +20,9 @@ struct RenderArgs {
     std::optional<float> fogStart, fogEnd, fogDensity, fovy, obliqueAngle, obliqueFactor;
     std::optional<int> tessellation, bounces;
     std::string aov;   // comma-separated list of extra outputs (render only): depth
+    // Pose: clip `animation` (default 0) of the file at `time` seconds (default: the clip's start).
+    std::optional<std::string> time;
+    std::optional<int> animation;
 };
 
 void addRenderOptions(CLI::App& cmd, RenderArgs& args, bool compare);

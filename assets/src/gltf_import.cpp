@@ -23,8 +23,14 @@
 //   with v flipped (glTF: v = 0 at the image's top row; ours: v = 0 at the bottom, as GL/OBJ),
 //   except that uv0 always holds the set the material's textures sample: a texCoord of 1
 //   swaps the two sets for that primitive. Non-finite or |x| > 1e30 positions are dropped with
-//   the triangles/lines/points that use them (one warning). Morph targets and skins are
-//   ignored (warning).
+//   the triangles/lines/points that use them (one warning).
+// Skins and morph targets (posed on the CPU by sg::Scene::posedMesh, scenegraph/deform.h):
+//   JOINTS_0/1 + WEIGHTS_0/1 -> Mesh::joints0/1 + weights0/1 (up to 8 influences; JOINTS_2+
+//   ignored with a warning); skins -> Scene::skins (joints as node ids, inverseBindMatrices,
+//   identity when absent); node.skin -> MeshInstance::skin of each of the node's primitives.
+//   Morph targets' POSITION/NORMAL/TANGENT -> Mesh::morphTargets (other target attributes
+//   ignored with a warning), mesh.weights -> Mesh::morphWeights, node.weights ->
+//   MeshInstance::weights (they override the mesh's).
 // Materials (glTF metallic-roughness -> our Phong material):
 //   baseColor  = baseColorFactor.rgb (linear), diffuseTexture = baseColorTexture (sRGB data,
 //                as our textures are), sampler wrapS/wrapT -> WrapMode; filters:
@@ -64,9 +70,9 @@
 //   with inverseSquare = true, so E = I / r^2 at distance r (again lux). Spot cone angles
 //   (radians from the axis) -> spotInnerDeg / spotOuterDeg. `range` is ignored.
 //   Scenes with neither cameras nor lights get Scene::addDefaultCamera and a directional key.
-// Animations: node translation/rotation/scale channels (LINEAR, STEP, CUBICSPLINE) become
-//   assets::AnimationClip (animation.h) in LoadResult::animations; "weights" channels
-//   (morphs) are skipped with a warning.
+// Animations: node translation/rotation/scale and morph "weights" channels (LINEAR, STEP,
+//   CUBICSPLINE) become assets::AnimationClip (animation.h) in LoadResult::animations; a
+//   weights channel becomes one channel per MeshInstance of its node (one per primitive).
 //
 // Extensions honoured: KHR_materials_unlit, KHR_texture_transform, KHR_lights_punctual,
 // KHR_materials_pbrSpecularGlossiness, KHR_materials_emissive_strength, KHR_mesh_quantization
@@ -109,6 +115,7 @@ constexpr uint64_t kMaxResourceBytes = 2ull << 30;   // one external buffer or i
 constexpr uint64_t kMaxTriangles = 50'000'000;
 constexpr uint64_t kMaxVertices = 100'000'000;   // sum over primitives (incl. lines/points)
 constexpr uint64_t kMaxNodes = 10'000'000;
+constexpr uint64_t kMaxMorphVectors = 50'000'000;   // morph displacements (vec3) over all primitives
 constexpr uint64_t kMaxTextureBytes = 2ull << 30;   // decoded RGBA8
 constexpr size_t kPollEvery = 1u << 16;
 
@@ -508,6 +515,74 @@ std::string checkPrimitive(const tinygltf::Model& m, size_t i, size_t p, std::ve
     return {};
 }
 
+// Primitive p of mesh i, skin and morph part: JOINTS_0/1 unsigned byte/short VEC4, WEIGHTS_0/1
+// float or normalised unsigned byte/short VEC4, each set complete; morph targets with existing
+// VEC3 POSITION/NORMAL/TANGENT accessors of the primitive's vertex count, within the budget
+// of displacement vectors (`morphVectors` adds up over the file). Warns about what is ignored.
+std::string checkSkinAndMorph(const tinygltf::Model& m, size_t i, size_t p, uint64_t& morphVectors, std::vector<std::string>& warnings) {
+    const auto& prim = m.meshes[i].primitives[p];
+    std::string id = "mesh " + std::to_string(i) + " primitive " + std::to_string(p) + ": ";
+    auto accessorOf = [&](const std::map<std::string, int>& attrs, const char* name) -> const tinygltf::Accessor* {
+        auto it = attrs.find(name);
+        return it == attrs.end() ? nullptr : &m.accessors[size_t(it->second)];   // index checked by checkPrimitive
+    };
+    for (int set = 0; set < 2; ++set) {
+        std::string jn = "JOINTS_" + std::to_string(set), wn = "WEIGHTS_" + std::to_string(set);
+        const tinygltf::Accessor *j = accessorOf(prim.attributes, jn.c_str()), *w = accessorOf(prim.attributes, wn.c_str());
+        if (!j && !w) continue;
+        if (!j || !w) return id + jn + " and " + wn + " must come together";
+        if (j->type != TINYGLTF_TYPE_VEC4 ||
+            (j->componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && j->componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT))
+            return id + jn + " must be unsigned byte or short VEC4";
+        bool normInt = w->normalized &&
+                       (w->componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE || w->componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT);
+        if (w->type != TINYGLTF_TYPE_VEC4 || (w->componentType != TINYGLTF_COMPONENT_TYPE_FLOAT && !normInt))
+            return id + wn + " must be float or normalized unsigned byte/short VEC4";
+    }
+    if (prim.attributes.count("JOINTS_1") && !prim.attributes.count("JOINTS_0")) return id + "JOINTS_1 without JOINTS_0";
+    if (prim.attributes.count("JOINTS_2")) warnings.push_back(id + "more than 8 joint influences per vertex (JOINTS_2...) are ignored");
+    const tinygltf::Accessor* pos = accessorOf(prim.attributes, "POSITION");
+    for (size_t k = 0; k < prim.targets.size(); ++k) {
+        for (const auto& [name, ai] : prim.targets[k]) {
+            std::string tid = id + "morph target " + std::to_string(k) + " " + name + ": ";
+            if (name != "POSITION" && name != "NORMAL" && name != "TANGENT") {
+                warnings.push_back(id + "morph target attribute " + name + " is ignored");
+                continue;
+            }
+            if (ai < 0 || size_t(ai) >= m.accessors.size()) return tid + "accessor " + std::to_string(ai) + " does not exist";
+            const auto& a = m.accessors[size_t(ai)];
+            if (a.type != TINYGLTF_TYPE_VEC3) return tid + "must be VEC3";
+            if (pos && a.count != pos->count)
+                return tid + "has " + std::to_string(a.count) + " elements but POSITION has " + std::to_string(pos->count);
+            morphVectors += a.count;
+            if (morphVectors > kMaxMorphVectors)
+                return tid + "morph target budget exceeded (" + std::to_string(morphVectors) + " > " + std::to_string(kMaxMorphVectors) + " vectors)";
+        }
+    }
+    return {};
+}
+
+// Skin i: existing joints and skeleton; inverse bind matrices (if given) float MAT4, one per joint.
+std::string checkSkin(const tinygltf::Model& m, size_t i) {
+    const auto& sk = m.skins[i];
+    for (int j : sk.joints)
+        if (j < 0 || size_t(j) >= m.nodes.size()) return itemId("skin", i) + "joint " + std::to_string(j) + " does not exist";
+    if (sk.skeleton < -1 || (sk.skeleton >= 0 && size_t(sk.skeleton) >= m.nodes.size()))
+        return itemId("skin", i) + "skeleton " + std::to_string(sk.skeleton) + " does not exist";
+    if (sk.inverseBindMatrices >= 0) {
+        if (size_t(sk.inverseBindMatrices) >= m.accessors.size())
+            return itemId("skin", i) + "inverseBindMatrices accessor " + std::to_string(sk.inverseBindMatrices) + " does not exist";
+        const auto& a = m.accessors[size_t(sk.inverseBindMatrices)];
+        if (a.type != TINYGLTF_TYPE_MAT4 || a.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT)
+            return itemId("skin", i) + "inverseBindMatrices must be float MAT4";
+        if (a.count < sk.joints.size())
+            return itemId("skin", i) + std::to_string(a.count) + " inverse bind matrices for " + std::to_string(sk.joints.size()) + " joints";
+    } else if (sk.inverseBindMatrices < -1) {
+        return itemId("skin", i) + "invalid inverseBindMatrices accessor";
+    }
+    return {};
+}
+
 // Node i: existing mesh / camera / skin / light, finite transforms with an affine matrix, and
 // existing children that have no other parent (recorded in parent[child] = i).
 std::string checkNode(const tinygltf::Model& m, size_t i, std::vector<int32_t>& parent) {
@@ -585,7 +660,8 @@ std::string checkScenes(const tinygltf::Model& m, const std::vector<int32_t>& pa
 // Everything the conversion relies on. Returns "" or the first problem. The order of the
 // phases is part of the behaviour (it decides which problem a broken file reports, and
 // which primitive warnings are added before it): buffers, accessors, samplers/textures,
-// materials, cameras, lights, meshes, nodes, hierarchy, scenes, skins.
+// materials, cameras, lights, meshes, their skin/morph attributes, nodes, hierarchy, scenes,
+// skins.
 std::string validate(const tinygltf::Model& m, std::vector<std::string>& warnings) {
     if (m.nodes.size() > kMaxNodes) return std::to_string(m.nodes.size()) + " nodes exceed the budget of " + std::to_string(kMaxNodes);
     if (std::string e = checkBufferViews(m); !e.empty()) return e;
@@ -601,6 +677,10 @@ std::string validate(const tinygltf::Model& m, std::vector<std::string>& warning
     for (size_t i = 0; i < m.meshes.size(); ++i)
         for (size_t p = 0; p < m.meshes[i].primitives.size(); ++p)
             if (std::string e = checkPrimitive(m, i, p, warnings); !e.empty()) return e;
+    uint64_t morphVectors = 0;
+    for (size_t i = 0; i < m.meshes.size(); ++i)
+        for (size_t p = 0; p < m.meshes[i].primitives.size(); ++p)
+            if (std::string e = checkSkinAndMorph(m, i, p, morphVectors, warnings); !e.empty()) return e;
     // Nodes: indices, finite transforms, tree structure.
     std::vector<int32_t> parent(m.nodes.size(), -1);
     for (size_t i = 0; i < m.nodes.size(); ++i)
@@ -608,8 +688,7 @@ std::string validate(const tinygltf::Model& m, std::vector<std::string>& warning
     if (std::string e = checkNodeCycles(parent); !e.empty()) return e;
     if (std::string e = checkScenes(m, parent); !e.empty()) return e;
     for (size_t i = 0; i < m.skins.size(); ++i)
-        for (int j : m.skins[i].joints)
-            if (j < 0 || size_t(j) >= m.nodes.size()) return itemId("skin", i) + "joint " + std::to_string(j) + " does not exist";
+        if (std::string e = checkSkin(m, i); !e.empty()) return e;
     return {};
 }
 
@@ -750,7 +829,8 @@ struct Converter {
     std::vector<std::vector<std::pair<int, int>>> meshPrims;   // glTF mesh -> (sg mesh, material) per primitive
     std::vector<int8_t> meshDone;
     uint64_t triangles = 0, vertices = 0;
-    std::vector<sg::NodeId> sgOf;   // glTF node -> sg node
+    std::vector<sg::NodeId> sgOf;                       // glTF node -> sg node
+    std::vector<std::vector<sg::NodeId>> instancesOf;   // glTF node -> the sg nodes carrying its MeshInstances
 
     std::string warnOnce(const std::string& w) {
         if (std::find(warnings.begin(), warnings.end(), w) == warnings.end()) warnings.push_back(w);
@@ -1013,8 +1093,6 @@ struct Converter {
                 if (!sg::isFinite(sg::vec3(t)) || !std::isfinite(t.w) || glm::length(sg::vec3(t)) < 1e-12f) t = sg::vec4(1, 0, 0, 1);
             for (auto& t : mesh.tangents) t.w = t.w < 0.0f ? -1.0f : 1.0f;
         }
-        if (!prim.targets.empty()) warnOnce("morph targets are not supported (base shape shown)");
-        if (prim.attributes.count("JOINTS_0")) warnOnce("skinning is not supported (bind pose shown)");
         if (prim.material >= 0) {
             const MaterialInfo& info = materials[size_t(prim.material)];
             if (info.texCoord == 1 && !mesh.uv1.empty()) std::swap(mesh.uv0, mesh.uv1);
@@ -1026,6 +1104,47 @@ struct Converter {
         // KHR_texture_transform, which is defined in glTF's uv space.
         for (auto& uv : mesh.uv0) uv.y = 1.0f - uv.y;
         for (auto& uv : mesh.uv1) uv.y = 1.0f - uv.y;
+        return {};
+    }
+
+    // JOINTS_0/1 + WEIGHTS_0/1, the morph targets' POSITION/NORMAL/TANGENT displacements and
+    // the mesh's default weights (`meshWeights`, glTF mesh.weights) into `mesh`.
+    std::string readSkinAndMorph(const tinygltf::Primitive& prim, const std::string& id, const std::vector<double>& meshWeights, sg::Mesh& mesh) {
+        std::string e;
+        for (int set = 0; set < 2; ++set) {
+            int ja = attribute(prim, set ? "JOINTS_1" : "JOINTS_0"), wa = attribute(prim, set ? "WEIGHTS_1" : "WEIGHTS_0");
+            if (ja < 0 || wa < 0) continue;   // validate() made sure they come together
+            std::vector<sg::vec4> j;
+            if (!(e = readVectors(m, size_t(ja), 4, progress, j)).empty()) return prefixed(id, e);
+            auto& joints = set ? mesh.joints1 : mesh.joints0;
+            joints.resize(j.size());
+            for (size_t v = 0; v < j.size(); ++v) joints[v] = sg::u16vec4(glm::clamp(j[v], sg::vec4(0.0f), sg::vec4(65535.0f)));
+            auto& weights = set ? mesh.weights1 : mesh.weights0;
+            if (!(e = readVectors(m, size_t(wa), 4, progress, weights)).empty()) return prefixed(id, e);
+            for (auto& w : weights)
+                if (!(std::isfinite(w.x + w.y + w.z + w.w)))
+                    w = sg::vec4(0.0f);   // that set then has no influence
+                else
+                    w = glm::max(w, sg::vec4(0.0f));
+        }
+        if (mesh.joints0.empty()) mesh.joints1.clear(), mesh.weights1.clear();
+        mesh.morphTargets.resize(prim.targets.size());
+        for (size_t k = 0; k < prim.targets.size(); ++k) {
+            sg::MorphTarget& t = mesh.morphTargets[k];
+            for (auto [name, dst] :
+                 {std::pair<const char*, std::vector<sg::vec3>*>{"POSITION", &t.positions}, {"NORMAL", &t.normals}, {"TANGENT", &t.tangents}}) {
+                auto it = prim.targets[k].find(name);
+                if (it == prim.targets[k].end()) continue;
+                if (!(e = readVectors(m, size_t(it->second), 3, progress, *dst)).empty()) return prefixed(id, e);
+                for (auto& d : *dst)
+                    if (!sg::isFinite(d)) d = sg::vec3(0.0f);
+            }
+        }
+        if (!meshWeights.empty() && meshWeights.size() != prim.targets.size())
+            warnOnce(id + std::to_string(meshWeights.size()) + " mesh weights for " + std::to_string(prim.targets.size()) +
+                     " morph targets; weights ignored");
+        else
+            for (double w : meshWeights) mesh.morphWeights.push_back(std::isfinite(w) ? float(w) : 0.0f);
         return {};
     }
 
@@ -1109,6 +1228,7 @@ struct Converter {
         const size_t nIdx = indexed ? m.accessors[size_t(prim.indices)].count : nv;
         std::string e = checkBudgets(prim, id, nv, nIdx);
         if (e.empty()) e = readAttributes(prim, id, mesh);
+        if (e.empty()) e = readSkinAndMorph(prim, id, m.meshes[mi].weights, mesh);
         if (!e.empty()) return e;
         std::vector<uint32_t> src;
         if (indexed) {
@@ -1154,7 +1274,30 @@ struct Converter {
         mesh.uv0 = std::move(o.uv0);
         mesh.uv1 = std::move(o.uv1);
         mesh.colors = std::move(o.colors);
+        unweldDeformation(mesh, copy);
         for (size_t i = 0; i < mesh.indices.size(); ++i) mesh.indices[i] = uint32_t(i);
+    }
+    // unweld() for the per-vertex skin and morph data (`copy` gathers by the old indices).
+    // (Base tangents need none: unweld runs only for a primitive without normals, whose
+    // tangents are then dropped.)
+    template <class Copy>
+    static void unweldDeformation(sg::Mesh& mesh, Copy& copy) {
+        sg::Mesh o;
+        copy(o.joints0, mesh.joints0);
+        copy(o.joints1, mesh.joints1);
+        copy(o.weights0, mesh.weights0);
+        copy(o.weights1, mesh.weights1);
+        o.morphTargets.resize(mesh.morphTargets.size());
+        for (size_t k = 0; k < mesh.morphTargets.size(); ++k) {
+            copy(o.morphTargets[k].positions, mesh.morphTargets[k].positions);
+            copy(o.morphTargets[k].normals, mesh.morphTargets[k].normals);
+            copy(o.morphTargets[k].tangents, mesh.morphTargets[k].tangents);
+        }
+        mesh.joints0 = std::move(o.joints0);
+        mesh.joints1 = std::move(o.joints1);
+        mesh.weights0 = std::move(o.weights0);
+        mesh.weights1 = std::move(o.weights1);
+        mesh.morphTargets = std::move(o.morphTargets);
     }
 
     std::string meshPrimitives(size_t mi, const std::vector<std::pair<int, int>>*& out) {
@@ -1232,8 +1375,57 @@ struct Converter {
         return sg::LocalTransform::fromTRS(t, q, s);
     }
 
+    // A node's skin (the index is the same in our Scene::skins) and its own morph weights.
+    void setSkinAndWeights(const tinygltf::Node& n, sg::MeshInstance& inst) {
+        const sg::Mesh& mesh = *scene.meshes[size_t(inst.mesh)];
+        if (n.skin >= 0 && mesh.skinned()) {
+            inst.skin = n.skin;
+            const size_t joints = m.skins[size_t(n.skin)].joints.size();
+            uint16_t most = 0;
+            for (const auto* set : {&mesh.joints0, &mesh.joints1})
+                for (const sg::u16vec4& j : *set) most = std::max({most, j.x, j.y, j.z, j.w});
+            if (most >= joints)
+                warnOnce("mesh '" + mesh.name + "' names joint " + std::to_string(most) + " of skin " + std::to_string(n.skin) + ", which has " +
+                         std::to_string(joints) + " joints; those influences are ignored");
+        }
+        for (double w : n.weights) inst.weights.push_back(std::isfinite(w) ? float(w) : 0.0f);
+    }
+
+    // Scene::skins from the file's skins (after buildNodes: joints not in the loaded scene
+    // become kNoNode, which poses as the identity). Non-finite matrices become the identity.
+    std::string convertSkins() {
+        for (size_t i = 0; i < m.skins.size(); ++i) {
+            const tinygltf::Skin& gs = m.skins[i];
+            sg::Skin skin;
+            skin.name = gs.name.empty() ? "skin " + std::to_string(i) : gs.name;
+            for (int j : gs.joints) skin.joints.push_back(sgOf[size_t(j)]);
+            skin.skeleton = gs.skeleton >= 0 ? sgOf[size_t(gs.skeleton)] : sg::kNoNode;
+            skin.inverseBind.assign(gs.joints.size(), sg::mat4(1.0f));
+            if (gs.inverseBindMatrices >= 0) {
+                std::vector<sg::mat4>& ibm = skin.inverseBind;
+                bool bad = false;
+                std::string e = forEachElement(m, size_t(gs.inverseBindMatrices), progress, [&](size_t k, const unsigned char* p) {
+                    if (k >= ibm.size()) return;
+                    sg::mat4 mm;
+                    for (int c = 0; c < 16; ++c) mm[c / 4][c % 4] = readComponent(p + 4 * c, TINYGLTF_COMPONENT_TYPE_FLOAT, false);
+                    if (sg::isFinite(mm))
+                        ibm[k] = mm;
+                    else
+                        bad = true;
+                });
+                if (!e.empty()) return prefixed("skin " + std::to_string(i) + ": ", e);
+                if (bad) warnOnce("skin " + std::to_string(i) + ": non-finite inverse bind matrices replaced by the identity");
+            }
+            if (std::any_of(skin.joints.begin(), skin.joints.end(), [](sg::NodeId j) { return j == sg::kNoNode; }))
+                warnOnce("skin " + std::to_string(i) + ": joints outside the loaded scene stay in their bind pose");
+            scene.skins.push_back(std::move(skin));
+        }
+        return {};
+    }
+
     std::string buildNodes(const std::vector<int>& roots) {
         sgOf.assign(m.nodes.size(), sg::kNoNode);
+        instancesOf.assign(m.nodes.size(), {});
         std::vector<std::pair<int, sg::NodeId>> stack;
         for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.push_back({*it, scene.root()});
         size_t done = 0, created = 0;
@@ -1261,10 +1453,12 @@ struct Converter {
             if (prims) {
                 for (size_t k = 0; k < prims->size(); ++k) {
                     sg::MeshInstance inst{(*prims)[k].first, (*prims)[k].second};
+                    setSkinAndWeights(n, inst);
                     if (onNode)
                         scene.setPayload(id, inst);
                     else
                         scene.addNode(name + "#" + std::to_string(k), id, inst), ++created;
+                    instancesOf[size_t(gi)].push_back(onNode ? id : scene.node(id).children.back());
                 }
             }
             if (n.camera >= 0) {
@@ -1282,6 +1476,74 @@ struct Converter {
     }
 
     // ---- 9. Animations ---------------------------------------------------------------------
+    // The morph target count of a node's mesh (its first primitive; glTF requires all
+    // primitives of a mesh to have the same number), 0 without a mesh.
+    size_t targetCount(int node) const {
+        int mi = m.nodes[size_t(node)].mesh;
+        if (mi < 0 || m.meshes[size_t(mi)].primitives.empty()) return 0;
+        return m.meshes[size_t(mi)].primitives[0].targets.size();
+    }
+
+    // Path, target node and interpolation of channel `ci` into `out`; "" or why it is skipped.
+    std::string channelTarget(const tinygltf::Animation& ga, size_t ci, AnimationChannel& out) const {
+        const auto& ch = ga.channels[ci];
+        if (ch.target_path == "translation")
+            out.path = AnimationPath::Translation;
+        else if (ch.target_path == "rotation")
+            out.path = AnimationPath::Rotation;
+        else if (ch.target_path == "scale")
+            out.path = AnimationPath::Scale;
+        else if (ch.target_path == "weights")
+            out.path = AnimationPath::Weights;
+        else
+            return "'" + ch.target_path + "' animation is not supported";
+        if (ch.sampler < 0 || size_t(ch.sampler) >= ga.samplers.size()) return "sampler does not exist";
+        if (ch.target_node < 0 || size_t(ch.target_node) >= m.nodes.size()) return "target node does not exist";
+        const auto& s = ga.samplers[size_t(ch.sampler)];
+        if (s.interpolation == "STEP")
+            out.interpolation = AnimationInterpolation::Step;
+        else if (s.interpolation == "CUBICSPLINE")
+            out.interpolation = AnimationInterpolation::CubicSpline;
+        else if (s.interpolation == "LINEAR" || s.interpolation.empty())
+            out.interpolation = AnimationInterpolation::Linear;
+        else
+            return "unknown interpolation '" + s.interpolation + "'";
+        if (out.path == AnimationPath::Weights && (out.width = targetCount(ch.target_node)) == 0) return "weights of a node without morph targets";
+        return {};
+    }
+
+    // Key times and values of the channel's sampler (types and counts checked, times finite and
+    // increasing, values finite); "" or why the channel is skipped.
+    std::string readKeys(const tinygltf::AnimationSampler& s, AnimationChannel& out) {
+        if (s.input < 0 || size_t(s.input) >= m.accessors.size() || s.output < 0 || size_t(s.output) >= m.accessors.size())
+            return "sampler accessors do not exist";
+        const auto& in = m.accessors[size_t(s.input)];
+        const auto& op = m.accessors[size_t(s.output)];
+        const bool weights = out.path == AnimationPath::Weights;
+        int want = weights ? TINYGLTF_TYPE_SCALAR : out.path == AnimationPath::Rotation ? TINYGLTF_TYPE_VEC4 : TINYGLTF_TYPE_VEC3;
+        uint64_t perKey = (out.interpolation == AnimationInterpolation::CubicSpline ? 3 : 1) * (weights ? out.width : 1);
+        if (in.type != TINYGLTF_TYPE_SCALAR || in.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT || op.type != want || in.count == 0 ||
+            op.count != in.count * perKey)
+            return "sampler input/output accessors have the wrong type or count";
+        std::vector<sg::vec4> t4, v4;
+        if (!readVectors(m, size_t(s.input), 1, progress, t4).empty() || !readVectors(m, size_t(s.output), weights ? 1 : 4, progress, v4).empty())
+            return "cannot read keyframes";
+        out.times.resize(t4.size());
+        bool ok = true;
+        for (size_t k = 0; k < t4.size(); ++k) {
+            out.times[k] = t4[k].x;
+            if (!std::isfinite(out.times[k]) || (k > 0 && out.times[k] <= out.times[k - 1])) ok = false;
+        }
+        for (const auto& v : v4)
+            if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z) || !std::isfinite(v.w)) ok = false;
+        if (!ok) return "key times must be finite and increasing, values finite";
+        if (weights)
+            for (const auto& v : v4) out.weights.push_back(v.x);
+        else
+            out.values = std::move(v4);
+        return {};
+    }
+
     std::vector<AnimationClip> animations() {
         std::vector<AnimationClip> clips;
         for (size_t ai = 0; ai < m.animations.size(); ++ai) {
@@ -1290,73 +1552,29 @@ struct Converter {
             clip.name = ga.name.empty() ? "animation " + std::to_string(ai) : ga.name;
             float tmin = std::numeric_limits<float>::infinity(), tmax = 0.0f;
             for (size_t ci = 0; ci < ga.channels.size(); ++ci) {
-                const auto& ch = ga.channels[ci];
                 std::string id = "animation " + std::to_string(ai) + " channel " + std::to_string(ci) + ": ";
                 AnimationChannel out;
-                if (ch.target_path == "translation")
-                    out.path = AnimationPath::Translation;
-                else if (ch.target_path == "rotation")
-                    out.path = AnimationPath::Rotation;
-                else if (ch.target_path == "scale")
-                    out.path = AnimationPath::Scale;
-                else {
-                    warnOnce(id + "'" + ch.target_path + "' animation is not supported; channel skipped");
-                    continue;
+                std::string why = channelTarget(ga, ci, out);
+                if (why.empty()) {
+                    out.node = sgOf[size_t(ga.channels[ci].target_node)];
+                    if (out.node == sg::kNoNode) continue;   // node not in the loaded scene
+                    why = readKeys(ga.samplers[size_t(ga.channels[ci].sampler)], out);
                 }
-                if (ch.sampler < 0 || size_t(ch.sampler) >= ga.samplers.size()) {
-                    warnOnce(id + "sampler does not exist; channel skipped");
-                    continue;
-                }
-                if (ch.target_node < 0 || size_t(ch.target_node) >= m.nodes.size()) {
-                    warnOnce(id + "target node does not exist; channel skipped");
-                    continue;
-                }
-                out.node = sgOf[size_t(ch.target_node)];
-                if (out.node == sg::kNoNode) continue;   // node not in the loaded scene
-                const auto& s = ga.samplers[size_t(ch.sampler)];
-                if (s.interpolation == "STEP")
-                    out.interpolation = AnimationInterpolation::Step;
-                else if (s.interpolation == "CUBICSPLINE")
-                    out.interpolation = AnimationInterpolation::CubicSpline;
-                else if (s.interpolation == "LINEAR" || s.interpolation.empty())
-                    out.interpolation = AnimationInterpolation::Linear;
-                else {
-                    warnOnce(id + "unknown interpolation '" + s.interpolation + "'; channel skipped");
-                    continue;
-                }
-                if (s.input < 0 || size_t(s.input) >= m.accessors.size() || s.output < 0 || size_t(s.output) >= m.accessors.size()) {
-                    warnOnce(id + "sampler accessors do not exist; channel skipped");
-                    continue;
-                }
-                const auto& in = m.accessors[size_t(s.input)];
-                const auto& op = m.accessors[size_t(s.output)];
-                int want = out.path == AnimationPath::Rotation ? TINYGLTF_TYPE_VEC4 : TINYGLTF_TYPE_VEC3;
-                size_t perKey = out.interpolation == AnimationInterpolation::CubicSpline ? 3 : 1;
-                if (in.type != TINYGLTF_TYPE_SCALAR || in.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT || op.type != want || in.count == 0 ||
-                    op.count != in.count * perKey) {
-                    warnOnce(id + "sampler input/output accessors have the wrong type or count; channel skipped");
-                    continue;
-                }
-                std::vector<sg::vec4> t4;
-                if (!readVectors(m, size_t(s.input), 1, progress, t4).empty() || !readVectors(m, size_t(s.output), 4, progress, out.values).empty()) {
-                    warnOnce(id + "cannot read keyframes; channel skipped");
-                    continue;
-                }
-                out.times.resize(t4.size());
-                bool ok = true;
-                for (size_t k = 0; k < t4.size(); ++k) {
-                    out.times[k] = t4[k].x;
-                    if (!std::isfinite(out.times[k]) || (k > 0 && out.times[k] <= out.times[k - 1])) ok = false;
-                }
-                for (const auto& v : out.values)
-                    if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z) || !std::isfinite(v.w)) ok = false;
-                if (!ok) {
-                    warnOnce(id + "key times must be finite and increasing, values finite; channel skipped");
+                if (!why.empty()) {
+                    warnOnce(id + why + "; channel skipped");
                     continue;
                 }
                 tmin = std::min(tmin, out.times.front());
                 tmax = std::max(tmax, out.times.back());
-                clip.channels.push_back(std::move(out));
+                if (out.path != AnimationPath::Weights) {
+                    clip.channels.push_back(std::move(out));
+                    continue;
+                }
+                // Morph weights go to every MeshInstance of the node (one per primitive).
+                for (sg::NodeId inst : instancesOf[size_t(ga.channels[ci].target_node)]) {
+                    clip.channels.push_back(out);
+                    clip.channels.back().node = inst;
+                }
             }
             if (clip.channels.empty()) continue;
             clip.start = std::isfinite(tmin) ? tmin : 0.0f;
@@ -1489,8 +1707,8 @@ std::string convertModel(const tinygltf::Model& model, Ctx& ctx, const Progress&
         progress.set(0.4f);
         std::string e = conv.buildNodes(chooseRoots(model, file, result));
         if (!e.empty()) return e;
+        if (!(e = conv.convertSkins()).empty()) return e;
         result.animations = conv.animations();
-        if (!model.skins.empty()) conv.warnOnce("skinning is not supported (bind pose shown)");
     } catch (const std::bad_alloc&) { return "out of memory while building the scene"; }
     progress.set(0.95f);
     addDefaultCameraAndLight(conv.scene);

@@ -24,14 +24,22 @@
 //     "meshes":    [ {"name", "file": "relative/model.obj"} |
 //                    {"name", "mode": "triangles|lines|points", "positions": [x,y,z,...],
 //                     "normals", "uv0", "uv1", "colors" (4 per vertex), "tangents" (4 per
-//                     vertex: xyz, handedness), "indices"} ],
+//                     vertex: xyz, handedness), "indices",
+//                     skin: "joints0", "weights0", "joints1", "weights1" (4 per vertex),
+//                     morph: "morphTargets": [ {"positions", "normals", "tangents"} (3 per
+//                     vertex each) ], "morphWeights": [one per target]} ],
 //     "nodes":     [ {"name", "parent": <index, absent for node 0 = root>, "visible",
 //                     "transform": {"translation", "rotation", "scale"} | {"matrix": [16]},
 //                     one optional payload:
-//                     "mesh": {"mesh", "material"} | "camera": {...} | "light": {...} |
-//                     "implicit": {...} | "csg": {"op", "material"} | "parametric": {...} |
-//                     "grid": {"dims", "values", "iso", "bounds", "material"} } ]
+//                     "mesh": {"mesh", "material", "skin", "weights"} | "camera": {...} |
+//                     "light": {...} | "implicit": {...} | "csg": {"op", "material"} |
+//                     "parametric": {...} | "grid": {"dims", "values", "iso", "bounds", "material"} } ],
+//     "skins":     [ {"name", "joints": [node index, or null for a joint no longer in the
+//                     scene], "inverseBindMatrices": [16 per joint, column-major],
+//                     "skeleton": <node index or null>} ]
 //   }
+// Animation clips are not part of the format (convert says so); a skinned or morphed scene is
+// saved in the pose it has (node transforms and MeshInstance weights as they are).
 // <Enum> is a name from that enum's table in scenegraph/setting_names.h (camera "type":
 // <ProjectionType>, light "type": <LightType>); the writer writes the table's name, the reader
 // also accepts the table's aliases.
@@ -67,6 +75,7 @@ constexpr size_t kMaxNodes = 20'000'000;
 constexpr size_t kMaxVertices = 100'000'000;
 constexpr size_t kMaxIndices = 300'000'000;
 constexpr size_t kMaxGridValues = 512ull * 512 * 512;
+constexpr size_t kMaxMorphTargets = 4096;
 
 struct ParseError {
     std::string path;   // JSON pointer, e.g. /nodes/3/transform
@@ -262,6 +271,9 @@ private:
     sg::Material readMaterial(const json& j, const std::string& p, size_t textureCount);
     std::shared_ptr<sg::Texture> readTexture(const json& j, const std::string& p);
     std::shared_ptr<sg::Mesh> readMesh(const json& j, const std::string& p);
+    void readDeformation(const json& j, const std::string& p, sg::Mesh& m);
+    void readJoints(const json& o, const std::string& p, const char* k, std::vector<sg::u16vec4>& dst);
+    sg::Skin readSkin(const json& j, const std::string& p, const std::vector<sg::NodeId>& idOf);
     sg::Payload readPayload(const json& j, const std::string& p, const sg::Scene& s);
     sg::LocalTransform readTransform(const json& j, const std::string& p);
     sg::ImplicitShape readImplicit(const json& j, const std::string& p);
@@ -424,6 +436,7 @@ std::shared_ptr<sg::Mesh> Reader::readMesh(const json& j, const std::string& p) 
         floatArray<sg::vec2, 2>(j, p, "uv1", m->uv1, kMaxVertices);
         floatArray<sg::vec4, 4>(j, p, "colors", m->colors, kMaxVertices);
         floatArray<sg::vec4, 4>(j, p, "tangents", m->tangents, kMaxVertices);
+        readDeformation(j, p, *m);
         if (auto* v = optional(j, "indices")) {
             if (!v->is_array()) fail(p + "/indices", "expected an array of integers");
             if (v->size() > kMaxIndices) fail(p + "/indices", "too many indices");
@@ -440,6 +453,65 @@ std::shared_ptr<sg::Mesh> Reader::readMesh(const json& j, const std::string& p) 
     }
     if (auto* v = optional(j, "name")) m->name = string(*v, p + "/name");
     return m;
+}
+
+// Skin influences and morph targets of an inline mesh (checked by Mesh::validate).
+void Reader::readDeformation(const json& j, const std::string& p, sg::Mesh& m) {
+    readJoints(j, p, "joints0", m.joints0);
+    readJoints(j, p, "joints1", m.joints1);
+    floatArray<sg::vec4, 4>(j, p, "weights0", m.weights0, kMaxVertices);
+    floatArray<sg::vec4, 4>(j, p, "weights1", m.weights1, kMaxVertices);
+    if (auto* t = optional(j, "morphTargets")) {
+        std::string tp = p + "/morphTargets";
+        if (!t->is_array()) fail(tp, "expected an array");
+        if (t->size() > kMaxMorphTargets) fail(tp, "too many morph targets (" + std::to_string(t->size()) + ")");
+        m.morphTargets.resize(t->size());
+        for (size_t k = 0; k < t->size(); ++k) {
+            std::string kp = tp + "/" + std::to_string(k);
+            if (!(*t)[k].is_object()) fail(kp, "expected an object");
+            floatArray<sg::vec3, 3>((*t)[k], kp, "positions", m.morphTargets[k].positions, kMaxVertices);
+            floatArray<sg::vec3, 3>((*t)[k], kp, "normals", m.morphTargets[k].normals, kMaxVertices);
+            floatArray<sg::vec3, 3>((*t)[k], kp, "tangents", m.morphTargets[k].tangents, kMaxVertices);
+        }
+    }
+    floatArray<float, 1>(j, p, "morphWeights", m.morphWeights, kMaxMorphTargets);
+}
+
+void Reader::readJoints(const json& o, const std::string& p, const char* k, std::vector<sg::u16vec4>& dst) {
+    const json* v = optional(o, k);
+    if (!v) return;
+    std::string path = p + "/" + k;
+    if (!v->is_array() || v->size() % 4 != 0) fail(path, "expected a flat array of 4 joint numbers per vertex");
+    if (v->size() / 4 > kMaxVertices) fail(path, "too many elements (" + std::to_string(v->size() / 4) + ")");
+    dst.resize(v->size() / 4);
+    for (size_t i = 0; i < v->size(); ++i) {
+        const json& x = (*v)[i];
+        if (!x.is_number_unsigned() || x.get<uint64_t>() > 65535) fail(path + "/" + std::to_string(i), "expected an integer in [0, 65535]");
+        dst[i / 4][int(i % 4)] = uint16_t(x.get<uint64_t>());
+    }
+}
+
+sg::Skin Reader::readSkin(const json& j, const std::string& p, const std::vector<sg::NodeId>& idOf) {
+    if (!j.is_object()) fail(p, "expected an object");
+    sg::Skin skin;
+    if (auto* v = optional(j, "name")) skin.name = string(*v, p + "/name");
+    if (auto* v = optional(j, "joints")) {
+        if (!v->is_array()) fail(p + "/joints", "expected an array of node indices");
+        for (size_t i = 0; i < v->size(); ++i) {
+            const json& x = (*v)[i];   // null: a joint that is not in the scene (poses as the identity)
+            skin.joints.push_back(x.is_null() ? sg::kNoNode
+                                              : idOf[size_t(integer(x, p + "/joints/" + std::to_string(i), 0, (long long)idOf.size() - 1))]);
+        }
+    }
+    std::vector<float> ibm;
+    floatArray<float, 1>(j, p, "inverseBindMatrices", ibm, 16 * kMaxVertices);
+    if (ibm.size() != 16 * skin.joints.size())
+        fail(p + "/inverseBindMatrices",
+             "expected 16 numbers per joint (" + std::to_string(16 * skin.joints.size()) + "), found " + std::to_string(ibm.size()));
+    skin.inverseBind.resize(skin.joints.size());
+    for (size_t i = 0; i < ibm.size(); ++i) skin.inverseBind[i / 16][int(i % 16 / 4)][int(i % 4)] = ibm[i];
+    if (auto* v = optional(j, "skeleton")) skin.skeleton = idOf[size_t(integer(*v, p + "/skeleton", 0, (long long)idOf.size() - 1))];
+    return skin;
 }
 
 sg::LocalTransform Reader::readTransform(const json& j, const std::string& p) {
@@ -513,6 +585,8 @@ sg::Payload Reader::readPayload(const json& j, const std::string& p, const sg::S
         sg::MeshInstance mi;
         mi.mesh = integer(member(v, kp, "mesh"), kp + "/mesh", 0, (long long)s.meshes.size() - 1);
         optInt(v, kp, "material", mi.material, -1, maxMat);
+        optInt(v, kp, "skin", mi.skin, -1, (long long)s.skins.size() - 1);
+        floatArray<float, 1>(v, kp, "weights", mi.weights, kMaxMorphTargets);
         return mi;
     }
     if (k == "camera") {
@@ -629,7 +703,10 @@ sg::Scene Reader::read() {
     if (auto* a = array("meshes"))
         for (size_t i = 0; i < a->size(); ++i) s.meshes.push_back(readMesh((*a)[i], "/meshes/" + std::to_string(i)));
 
+    const json* skins = array("skins");
+    s.skins.resize(skins ? skins->size() : 0);   // filled once the nodes (their joints) exist
     const json* nodes = array("nodes");
+    if ((!nodes || nodes->empty()) && skins && !skins->empty()) fail("/skins", "skins need nodes");
     if (!nodes || nodes->empty()) return s;   // an empty scene is valid
     size_t n = nodes->size();
     if (n > kMaxNodes) fail("/nodes", "too many nodes (" + std::to_string(n) + ")");
@@ -682,6 +759,7 @@ sg::Scene Reader::read() {
         if (auto* v = optional(nj, "transform")) s.setLocal(id, readTransform(*v, p + "/transform"));
         s.setPayload(id, readPayload(nj, p, s));
     }
+    for (size_t i = 0; skins && i < skins->size(); ++i) s.skins[i] = readSkin((*skins)[i], "/skins/" + std::to_string(i), idOf);
     if (auto* v = optional(j, "activeCamera")) {
         int c = integer(*v, "/activeCamera", 0, (long long)n - 1);
         if (!std::holds_alternative<sg::Camera>(s.node(idOf[c]).payload)) fail("/activeCamera", "node " + std::to_string(c) + " is not a camera");
@@ -709,6 +787,26 @@ json flat(const std::vector<T>& v) {
                 a.push_back(x[c]);
         }
     return a;
+}
+
+// Skin influences and morph targets of a mesh (only what it has).
+void deformationJ(const sg::Mesh& m, json& mj) {
+    if (!m.joints0.empty()) mj["joints0"] = flat<sg::u16vec4, 4>(m.joints0);
+    if (!m.weights0.empty()) mj["weights0"] = flat<sg::vec4, 4>(m.weights0);
+    if (!m.joints1.empty()) mj["joints1"] = flat<sg::u16vec4, 4>(m.joints1);
+    if (!m.weights1.empty()) mj["weights1"] = flat<sg::vec4, 4>(m.weights1);
+    if (!m.morphTargets.empty()) {
+        json targets = json::array();
+        for (const sg::MorphTarget& t : m.morphTargets) {
+            json tj = json::object();
+            if (!t.positions.empty()) tj["positions"] = flat<sg::vec3, 3>(t.positions);
+            if (!t.normals.empty()) tj["normals"] = flat<sg::vec3, 3>(t.normals);
+            if (!t.tangents.empty()) tj["tangents"] = flat<sg::vec3, 3>(t.tangents);
+            targets.push_back(std::move(tj));
+        }
+        mj["morphTargets"] = std::move(targets);
+    }
+    if (!m.morphWeights.empty()) mj["morphWeights"] = m.morphWeights;
 }
 
 json implicitJ(const sg::ImplicitShape& s) {
@@ -750,6 +848,8 @@ json payloadJ(const sg::Payload& p) {
             using T = std::decay_t<decltype(v)>;
             if constexpr (std::is_same_v<T, sg::MeshInstance>) {
                 j["mesh"] = {{"mesh", v.mesh}, {"material", v.material}};
+                if (v.skin >= 0) j["mesh"]["skin"] = v.skin;
+                if (!v.weights.empty()) j["mesh"]["weights"] = v.weights;
             } else if constexpr (std::is_same_v<T, sg::Camera>) {
                 const sg::Projection& pr = v.projection;
                 j["camera"] = {{"type", sg::nameOf(pr.type)},
@@ -922,6 +1022,7 @@ std::string serializeSceneJson(const sg::Scene& s) {
         if (!m->uv1.empty()) mj["uv1"] = flat<sg::vec2, 2>(m->uv1);
         if (!m->colors.empty()) mj["colors"] = flat<sg::vec4, 4>(m->colors);
         if (!m->tangents.empty()) mj["tangents"] = flat<sg::vec4, 4>(m->tangents);
+        deformationJ(*m, mj);
         j["meshes"].push_back(std::move(mj));
     }
     const auto& order = s.depthFirstOrder();
@@ -941,6 +1042,19 @@ std::string serializeSceneJson(const sg::Scene& s) {
             nj["transform"] = {{"translation", vecJ(n.local.translation)}, {"rotation", {q.x, q.y, q.z, q.w}}, {"scale", vecJ(n.local.scale)}};
         }
         j["nodes"].push_back(std::move(nj));
+    }
+    if (!s.skins.empty()) {
+        j["skins"] = json::array();
+        auto index = [&](sg::NodeId n) { return s.valid(n) && indexOf[n] >= 0 ? json(indexOf[n]) : json(nullptr); };
+        for (const sg::Skin& sk : s.skins) {
+            json joints = json::array(), ibm = json::array();
+            for (size_t i = 0; i < sk.joints.size(); ++i) {
+                joints.push_back(index(sk.joints[i]));   // null: a joint no longer in the scene
+                const sg::mat4 m = i < sk.inverseBind.size() ? sk.inverseBind[i] : sg::mat4(1.0f);
+                for (int c = 0; c < 16; ++c) ibm.push_back(m[c / 4][c % 4]);
+            }
+            j["skins"].push_back({{"name", sk.name}, {"joints", joints}, {"inverseBindMatrices", ibm}, {"skeleton", index(sk.skeleton)}});
+        }
     }
     j["activeCamera"] = s.valid(s.activeCamera) ? json(indexOf[s.activeCamera]) : json(nullptr);
     std::string out;

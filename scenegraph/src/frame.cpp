@@ -95,6 +95,25 @@ Aabb csgBounds(const CsgTree& t, int i) {
     return b;
 }
 
+// The draw of a MeshInstance: its posed mesh (skinned ones are already in world space, so
+// they are drawn with the identity; morphed ones with the node's world matrix). False when
+// the instance has no mesh.
+bool drawMeshOf(const Scene& scene, NodeId id, const MeshInstance& mi, const mat4& w, DrawMesh& d) {
+    bool worldSpace = false;
+    d.mesh = scene.posedMesh(id, &worldSpace);
+    if (!d.mesh) return false;
+    const mat4 world = worldSpace ? mat4(1.0f) : w;
+    d.node = id;
+    d.nodeUid = scene.node(id).uid;
+    d.material = scene.material(mi.material);
+    d.texture = textureOf(scene, d.material);
+    d.maps = mapsOf(scene, d.material);
+    d.world = world;
+    d.normal = normalMatrix(world);
+    d.mirrored = glm::determinant(mat3(world)) < 0.0f;
+    return true;
+}
+
 }   // namespace
 
 FrameInput flatten(const Scene& scene, float aspect, NodeId cameraNode) {
@@ -103,6 +122,7 @@ FrameInput flatten(const Scene& scene, float aspect, NodeId cameraNode) {
     f.ambientLight = scene.ambientLight;
     const auto& order = scene.depthFirstOrder();
     scene.updateWorld();
+    scene.trimPoseCache();
 
     // One pass over the pre-order (parents come first): per-id flags
     // bit 0 = hidden (self or an ancestor), bit 1 = a CSG node or inside one.
@@ -119,18 +139,8 @@ FrameInput flatten(const Scene& scene, float aspect, NodeId cameraNode) {
         if (std::holds_alternative<std::monostate>(n.payload) || std::holds_alternative<Camera>(n.payload)) continue;
         const mat4& w = scene.world(id);
         if (auto* mi = std::get_if<MeshInstance>(&n.payload)) {
-            if (mi->mesh < 0 || size_t(mi->mesh) >= scene.meshes.size() || !scene.meshes[mi->mesh]) continue;
             DrawMesh d;
-            d.node = id;
-            d.nodeUid = n.uid;
-            d.mesh = scene.meshes[mi->mesh];
-            d.material = scene.material(mi->material);
-            d.texture = textureOf(scene, d.material);
-            d.maps = mapsOf(scene, d.material);
-            d.world = w;
-            d.normal = normalMatrix(w);
-            d.mirrored = glm::determinant(mat3(w)) < 0.0f;
-            f.meshes.push_back(std::move(d));
+            if (drawMeshOf(scene, id, *mi, w, d)) f.meshes.push_back(std::move(d));
         } else if (auto* lp = std::get_if<Light>(&n.payload)) {
             DrawLight l;
             l.type = lp->type;

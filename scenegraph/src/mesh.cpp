@@ -75,12 +75,38 @@ std::string Mesh::validate() const {
     if (!uv1.empty() && uv1.size() != n) return "uv1 count differs from position count";
     if (!colors.empty() && colors.size() != n) return "color count differs from position count";
     if (!tangents.empty() && tangents.size() != n) return "tangent count differs from position count";
+    if (std::string e = validateDeformation(); !e.empty()) return e;
     size_t per = mode == PrimitiveMode::Triangles ? 3 : mode == PrimitiveMode::Lines ? 2 : 1;
     if (indices.size() % per != 0) return "index count is not a multiple of " + std::to_string(per);
     for (uint32_t i : indices)
         if (i >= n) return "index " + std::to_string(i) + " out of range (" + std::to_string(n) + " vertices)";
     for (const vec3& p : positions)
         if (!isFinite(p)) return "non-finite vertex position";
+    return {};
+}
+
+std::string Mesh::validateDeformation() const {
+    size_t n = positions.size();
+    auto sized = [n](size_t k) { return k == 0 || k == n; };
+    if (!sized(joints0.size()) || !sized(weights0.size()) || !sized(joints1.size()) || !sized(weights1.size()))
+        return "joint/weight count differs from position count";
+    if (joints0.empty() != weights0.empty() || joints1.empty() != weights1.empty()) return "joints and weights must come together";
+    if (!joints1.empty() && joints0.empty()) return "joints1/weights1 without joints0/weights0";
+    for (const auto* w : {&weights0, &weights1})
+        for (const vec4& v : *w)
+            if (!(v.x >= 0 && v.y >= 0 && v.z >= 0 && v.w >= 0 && std::isfinite(v.x + v.y + v.z + v.w)))
+                return "skin weights must be finite and >= 0";
+    for (size_t k = 0; k < morphTargets.size(); ++k) {
+        const MorphTarget& t = morphTargets[k];
+        if (!sized(t.positions.size()) || !sized(t.normals.size()) || !sized(t.tangents.size()))
+            return "morph target " + std::to_string(k) + ": count differs from position count";
+        for (const auto* a : {&t.positions, &t.normals, &t.tangents})
+            for (const vec3& d : *a)
+                if (!isFinite(d)) return "morph target " + std::to_string(k) + ": non-finite displacement";
+    }
+    if (!morphWeights.empty() && morphWeights.size() != morphTargets.size()) return "morph weight count differs from morph target count";
+    for (float w : morphWeights)
+        if (!std::isfinite(w)) return "non-finite morph weight";
     return {};
 }
 

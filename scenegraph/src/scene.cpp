@@ -4,6 +4,7 @@
 //           sceneDifference
 #include "scenegraph/scene.h"
 
+#include "scenegraph/deform.h"
 #include "scenegraph/transforms.h"
 
 #include <glm/gtx/matrix_decompose.hpp>
@@ -104,7 +105,7 @@ std::string_view payloadKind(const Payload& p) {
 
 // --- structure edits ---------------------------------------------------------------------
 
-Scene::Scene() {
+Scene::Scene() : m_deform(std::make_shared<DeformCache>()) {
     Node root;
     root.name = "root";
     root.uid = newResourceId();
@@ -120,6 +121,7 @@ Scene& Scene::operator=(const Scene& o) {
     name = o.name;
     materials = o.materials;
     textures = o.textures;
+    skins = o.skins;
     ambientLight = o.ambientLight;
     settings = o.settings;
     activeCamera = o.activeCamera;
@@ -132,6 +134,7 @@ Scene& Scene::operator=(const Scene& o) {
         if (auto* g = std::get_if<GridPayload>(&n.payload); g && g->grid) g->grid = std::make_shared<DensityGrid>(*g->grid);
     }
     m_aliveCount = o.m_aliveCount;
+    m_deform = std::make_shared<DeformCache>();   // posed meshes are keyed by node uid: none carry over
     m_structureVersion = o.m_structureVersion + 1;
     m_orderValid = false;
     m_allDirty = true;
@@ -543,11 +546,46 @@ Aabb Scene::worldBounds() const {
             const auto& shape = std::get<ImplicitPayload>(n.payload).shape;
             if (shape.type == ImplicitType::Plane) continue;   // infinite: don't let it dominate framing
         }
-        Aabb lb = localBounds(id);
-        if (!lb.empty()) b.extend(lb.transformed(world(id)));
+        b.extend(nodeWorldBounds(id));
     }
     return b;
 }
+
+Aabb Scene::nodeWorldBounds(NodeId id) const {
+    if (!valid(id)) return {};
+    if (std::holds_alternative<MeshInstance>(m_nodes[id].payload)) {
+        bool worldSpace = false;
+        MeshPtr m = posedMesh(id, &worldSpace);
+        if (!m) return {};
+        return worldSpace ? m->bounds() : m->bounds().transformed(world(id));
+    }
+    Aabb lb = localBounds(id);
+    return lb.empty() ? lb : lb.transformed(world(id));
+}
+
+MeshPtr Scene::posedMesh(NodeId id, bool* worldSpace) const {
+    if (worldSpace) *worldSpace = false;
+    if (!valid(id)) return nullptr;
+    const auto* mi = std::get_if<MeshInstance>(&m_nodes[id].payload);
+    if (!mi || mi->mesh < 0 || size_t(mi->mesh) >= meshes.size() || !meshes[size_t(mi->mesh)]) return nullptr;
+    if (!isDeformed(*this, *mi)) return meshes[size_t(mi->mesh)];
+    bool ws = false;
+    MeshPtr m;
+    if (m_deform) {
+        m = m_deform->posed(*this, id, *mi, ws);
+    } else {   // a moved-from scene: no cache
+        DeformCache once;
+        m = once.posed(*this, id, *mi, ws);
+    }
+    if (worldSpace) *worldSpace = ws;
+    return m;
+}
+
+void Scene::trimPoseCache() const {
+    if (m_deform) m_deform->trim();
+}
+
+uint64_t Scene::poseEvaluations() const { return m_deform ? m_deform->evaluations() : 0; }
 
 std::vector<NodeId> Scene::cameras() const {
     std::vector<NodeId> out;
@@ -598,6 +636,24 @@ bool near(const mat4& a, const mat4& b, float eps = 1e-5f) {
             if (std::abs(a[c][r] - b[c][r]) > eps * (1 + std::abs(a[c][r]))) return false;
     return true;
 }
+
+// Skins: names, inverse bind matrices and joints (node ids mapped from a to b).
+std::string skinDifference(const Scene& a, const Scene& b, const std::vector<NodeId>& mapAB) {
+    if (a.skins.size() != b.skins.size()) return "skin count differs";
+    auto mapped = [&](NodeId n) { return a.valid(n) ? mapAB[n] : kNoNode; };
+    for (size_t i = 0; i < a.skins.size(); ++i) {
+        const Skin &x = a.skins[i], &y = b.skins[i];
+        std::string where = "skin " + std::to_string(i) + " (" + x.name + "): ";
+        if (x.name != y.name) return where + "name differs";
+        if (x.joints.size() != y.joints.size() || x.inverseBind.size() != y.inverseBind.size()) return where + "joint count differs";
+        for (size_t j = 0; j < x.joints.size(); ++j)
+            if (mapped(x.joints[j]) != (b.valid(y.joints[j]) ? y.joints[j] : kNoNode)) return where + "joint " + std::to_string(j) + " differs";
+        for (size_t j = 0; j < x.inverseBind.size(); ++j)
+            if (!near(x.inverseBind[j], y.inverseBind[j])) return where + "inverse bind matrix " + std::to_string(j) + " differs";
+        if (mapped(x.skeleton) != (b.valid(y.skeleton) ? y.skeleton : kNoNode)) return where + "skeleton differs";
+    }
+    return {};
+}
 }   // namespace
 
 std::string sceneDifference(const Scene& a, const Scene& b) {
@@ -612,6 +668,9 @@ std::string sceneDifference(const Scene& a, const Scene& b) {
         if (x.name != y.name || x.mode != y.mode || x.positions != y.positions || x.normals != y.normals || x.uv0 != y.uv0 || x.uv1 != y.uv1 ||
             x.colors != y.colors || x.indices != y.indices)
             return "mesh " + std::to_string(i) + " (" + x.name + ") differs";
+        if (x.tangents != y.tangents || x.joints0 != y.joints0 || x.joints1 != y.joints1 || x.weights0 != y.weights0 || x.weights1 != y.weights1 ||
+            x.morphTargets != y.morphTargets || x.morphWeights != y.morphWeights)
+            return "mesh " + std::to_string(i) + " (" + x.name + "): tangents, skin or morph data differ";
     }
     if (a.textures.size() != b.textures.size()) return "texture count differs";
     for (size_t i = 0; i < a.textures.size(); ++i) {
@@ -633,6 +692,7 @@ std::string sceneDifference(const Scene& a, const Scene& b) {
         if (!near(x.local.toMatrix(), y.local.toMatrix())) return where + "local transform differs";
         if (!(x.payload == y.payload)) return where + std::string(payloadKind(x.payload)) + " payload differs";
     }
+    if (std::string e = skinDifference(a, b, mapAB); !e.empty()) return e;
     bool camA = a.activeCamera != kNoNode, camB = b.activeCamera != kNoNode;
     if (camA != camB || (camA && mapAB[a.activeCamera] != b.activeCamera)) return "active camera differs";
     return {};

@@ -32,6 +32,57 @@ TEST(SceneJsonTest, DemoRoundTripInMemory) {
     EXPECT_EQ(assets::serializeSceneJson(*r.scene), text);
 }
 
+TEST(SceneJsonTest, SkinsAndMorphTargetsRoundTrip) {
+    // A skinned mesh (two influence sets, tangents) with a two-joint skin, and a morphed mesh
+    // instanced with its own weights: save, load, compare, and the posed meshes agree.
+    sg::Scene s;
+    auto skinned = std::make_shared<sg::Mesh>(sg::primitives::box(sg::vec3(0.5f)));
+    const size_t n = skinned->positions.size();
+    skinned->tangents.assign(n, sg::vec4(1, 0, 0, -1));
+    skinned->joints0.assign(n, sg::u16vec4(0, 1, 0, 0));
+    skinned->weights0.assign(n, sg::vec4(0.25f, 0.25f, 0, 0));
+    skinned->joints1.assign(n, sg::u16vec4(1, 0, 0, 0));
+    skinned->weights1.assign(n, sg::vec4(0.5f, 0, 0, 0));
+    auto morphed = std::make_shared<sg::Mesh>(sg::primitives::box(sg::vec3(0.5f)));
+    morphed->morphTargets.resize(2);
+    morphed->morphTargets[0].positions.assign(n, sg::vec3(0, 0.5f, 0));
+    morphed->morphTargets[1].normals.assign(n, sg::vec3(0.1f, 0, 0));
+    morphed->morphTargets[1].tangents.assign(n, sg::vec3(0, 0.2f, 0));
+    morphed->morphWeights = {0.5f, 0.25f};
+    s.meshes = {skinned, morphed};
+    sg::NodeId j0 = s.addNode("j0");
+    sg::NodeId j1 = s.addNode("j1", j0);
+    s.setLocal(j1, sg::LocalTransform::fromTRS(sg::vec3(1, 0, 0), glm::angleAxis(0.7f, sg::vec3(0, 0, 1))));
+    s.skins.push_back({"bones", {j0, j1}, {sg::mat4(1.0f), glm::translate(sg::mat4(1.0f), sg::vec3(-1, 0, 0))}, j0});
+    sg::MeshInstance a{0, -1};
+    a.skin = 0;
+    sg::NodeId an = s.addNode("skinned", s.root(), a);
+    sg::MeshInstance b{1, -1};
+    b.weights = {0.75f, 0.0f};
+    sg::NodeId bn = s.addNode("morphed", s.root(), b);
+    std::string text = assets::serializeSceneJson(s);
+    assets::LoadResult r = assets::parseSceneJson(text, "skin.json");
+    ASSERT_TRUE(r.scene) << r.error;
+    EXPECT_EQ(sg::sceneDifference(s, *r.scene), "");
+    EXPECT_EQ(assets::serializeSceneJson(*r.scene), text);
+    const sg::Scene& t = *r.scene;
+    EXPECT_EQ(t.posedMesh(t.findByName("skinned"))->positions, s.posedMesh(an)->positions);
+    EXPECT_EQ(t.posedMesh(t.findByName("morphed"))->positions, s.posedMesh(bn)->positions);
+    // sceneDifference notices skin and morph changes.
+    sg::Scene c = *r.scene;
+    c.skins[0].inverseBind[1][3][0] = -2.0f;
+    EXPECT_NE(sg::sceneDifference(s, c), "");
+    c = *r.scene;
+    c.meshes[1]->morphTargets[0].positions[0].y = 9.0f;
+    EXPECT_NE(sg::sceneDifference(s, c), "");
+    // A joint that left the scene is saved as null and stays out.
+    s.removeNode(j1);
+    r = assets::parseSceneJson(assets::serializeSceneJson(s), "skin.json");
+    ASSERT_TRUE(r.scene) << r.error;
+    EXPECT_EQ(r.scene->skins[0].joints[1], sg::kNoNode);
+    EXPECT_EQ(sg::sceneDifference(s, *r.scene), "");
+}
+
 TEST(SceneJsonTest, EditedSettingsAndTransformsRoundTripThroughAFile) {
     sg::Scene s = assets::makeDemoScene();
     s.settings.shading = sg::ShadingModel::Gouraud;
@@ -144,6 +195,20 @@ INSTANTIATE_TEST_SUITE_P(
                 "at most one payload"},
         BadCase{"absolute_mesh_file", R"({"meshes": [{"file": "/etc/passwd"}]})", "/meshes/0/file", "absolute"},
         BadCase{"escaping_mesh_file", R"({"meshes": [{"file": "../../secret.obj"}]})", "/meshes/0/file", "inside the scene's folder"},
+        BadCase{
+            "missing_skin",
+            R"({"meshes": [{"positions": [0,0,0], "mode": "points", "indices": [0]}], "nodes": [{}, {"parent": 0, "mesh": {"mesh": 0, "skin": 0}}]})",
+            "/nodes/1/mesh/skin", "out of range"},
+        BadCase{"skin_joint_range", R"({"nodes": [{}], "skins": [{"joints": [4], "inverseBindMatrices": [1,0,0,0,0,1,0,0,0,0,1,0,0,0,0,1]}]})",
+                "/skins/0/joints/0", "out of range"},
+        BadCase{"skin_matrix_count", R"({"nodes": [{}], "skins": [{"joints": [0], "inverseBindMatrices": [1, 0]}]})", "/skins/0/inverseBindMatrices",
+                "16 numbers per joint"},
+        BadCase{"joint_number", R"({"meshes": [{"positions": [0,0,0], "joints0": [0, 0, 70000, 0], "weights0": [1,0,0,0]}]})", "/meshes/0/joints0/2",
+                "[0, 65535]"},
+        BadCase{"negative_weight", R"({"meshes": [{"positions": [0,0,0], "joints0": [0, 0, 0, 0], "weights0": [-1,0,0,0]}]})", "/meshes/0",
+                "weights must be finite and >= 0"},
+        BadCase{"morph_count", R"({"meshes": [{"positions": [0,0,0], "morphTargets": [{"positions": [1,0,0, 2,0,0]}]}]})", "/meshes/0",
+                "morph target 0: count differs"},
         BadCase{"newer_version", R"({"version": 7})", "/version", "newer"}, BadCase{"deep_nesting", deepNesting(100000), "", "nested deeper"}),
     [](const ::testing::TestParamInfo<BadCase>& i) { return std::string(i.param.name); });
 

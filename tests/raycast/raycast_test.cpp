@@ -736,3 +736,55 @@ TEST(RaycastTest, BadMeshIsSkippedNotCrashed) {
     RenderStats s = r->render(f, 32, 32, fb);
     EXPECT_TRUE(s.ok) << s.error;
 }
+
+// --- skinned / morphed meshes ----------------------------------------------------------------
+
+TEST(RaycastTest, PosedMeshesRebuildOnlyWhatMoved) {
+    // A static box, a box skinned to one joint and a morphed box: the first update builds three
+    // BVHs; a new pose rebuilds only the posed mesh that changed; a still pose builds none; and
+    // rays hit the posed surface, not the bind pose.
+    Scene s;
+    s.meshes.push_back(std::make_shared<Mesh>(primitives::box(vec3(0.5f))));
+    auto skinned = std::make_shared<Mesh>(primitives::box(vec3(0.5f)));
+    skinned->joints0.assign(skinned->positions.size(), u16vec4(0));
+    skinned->weights0.assign(skinned->positions.size(), vec4(1, 0, 0, 0));
+    s.meshes.push_back(skinned);
+    auto morphed = std::make_shared<Mesh>(primitives::box(vec3(0.5f)));
+    morphed->morphTargets.resize(1);
+    morphed->morphTargets[0].positions.assign(morphed->positions.size(), vec3(0, 3, 0));
+    s.meshes.push_back(morphed);
+    NodeId joint = s.addNode("joint");
+    s.skins.push_back(Skin{"skin", {joint}, {mat4(1.0f)}, kNoNode});
+    s.addNode("static", s.root(), MeshInstance{0, -1});
+    MeshInstance si{1, -1};
+    si.skin = 0;
+    NodeId parked = s.addNode("parked far away");   // the skinned node's own transform is ignored
+    s.setLocal(parked, LocalTransform::fromTRS(vec3(100, 0, 0)));
+    s.addNode("skinned", parked, si);
+    MeshInstance mi{2, -1};
+    mi.weights = {0.0f};
+    NodeId morphNode = s.addNode("morphed", s.root(), mi);
+    s.setLocal(morphNode, LocalTransform::fromTRS(vec3(0, 0, -10)));
+
+    SceneAccel acc;
+    s.setLocal(joint, LocalTransform::fromTRS(vec3(5, 0, 0)));
+    std::get<MeshInstance>(s.editPayload(morphNode)).weights = {1.0f};
+    FrameInput f1 = flatten(s, 1.0f);
+    EXPECT_EQ(acc.update(f1), 3);
+    SceneHit h;
+    ASSERT_TRUE(acc.intersect(mkRay({5, 10, 0}, {0, -1, 0}), h));   // skinned box moved to x = 5
+    EXPECT_NEAR(h.t, 9.5f, 1e-4f);
+    EXPECT_FALSE(acc.intersect(mkRay({100, 10, 0}, {0, -1, 0}), h));
+    ASSERT_TRUE(acc.intersect(mkRay({0, 10, -10}, {0, -1, 0}), h));   // morphed box lifted by 3
+    EXPECT_NEAR(h.t, 6.5f, 1e-4f);
+
+    FrameInput f2 = flatten(s, 1.0f);   // still pose
+    EXPECT_EQ(acc.update(f2), 0);
+    s.setLocal(joint, LocalTransform::fromTRS(vec3(-5, 0, 0)));   // only the skin moves
+    FrameInput f3 = flatten(s, 1.0f);
+    EXPECT_EQ(acc.update(f3), 1);
+    ASSERT_TRUE(acc.intersect(mkRay({-5, 10, 0}, {0, -1, 0}), h));
+    EXPECT_NEAR(h.t, 9.5f, 1e-4f);
+    s.setLocal(morphNode, LocalTransform::fromTRS(vec3(0, 0, -20)));   // a morphed node moving is a transform
+    EXPECT_EQ(acc.update(flatten(s, 1.0f)), 0);
+}

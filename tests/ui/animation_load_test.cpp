@@ -8,6 +8,8 @@
 #include "ui/viewer_state.h"
 
 #include "assets/demo.h"
+#include "assets/scene_io.h"
+#include "scenegraph/frame.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>
@@ -215,6 +217,34 @@ TEST(ViewerStateAnimTest, CesiumMilkTruckWheelsTurnWithoutDirtying) {
     st.setAnimationPlaying(true);
     st.advanceAnimation(0.37 * (st.animationEnd() - st.anim.clips[0].start));
     EXPECT_NE(st.doc.scene.world(wheel), a);
+    EXPECT_FALSE(st.doc.dirty);
+}
+
+// The animation bar poses skins and morphs through the same code as `viewer render --time`:
+// assets::applyAnimation on the document, deformation in flatten.
+TEST(ViewerStateAnimTest, AnimationBarPosesSkinsLikeTheCommandLine) {
+    ASSERT_TRUE(testing_support::requireTestdata());
+    const fs::path file = testing_support::testdataDir() / "gltf/CesiumMan/glTF/CesiumMan.gltf";
+    ViewerState st = demoState();
+    st.startLoad(file);
+    ASSERT_TRUE(st.pollLoad(true));
+    ASSERT_TRUE(st.ui.errorPopup.empty()) << st.ui.errorPopup;
+    ASSERT_EQ(st.anim.clips.size(), 1u);
+    st.setAnimationTime(1.0);
+    sg::FrameInput ui = st.buildFrame(1.0f);
+    assets::LoadResult r = assets::loadScene(file);
+    ASSERT_TRUE(r.scene);
+    assets::applyAnimation(*r.scene, r.animations[0], 1.0f);
+    sg::FrameInput cli = sg::flatten(*r.scene, 1.0f);
+    ASSERT_EQ(ui.meshes.size(), 1u);
+    ASSERT_EQ(cli.meshes.size(), 1u);
+    EXPECT_EQ(ui.meshes[0].mesh->positions, cli.meshes[0].mesh->positions);
+    EXPECT_EQ(ui.meshes[0].world, sg::mat4(1.0f));   // skinned: drawn in world space
+    // Scrubbing moves the figure; a still time reuses the posed mesh.
+    st.setAnimationTime(1.5);
+    sg::FrameInput later = st.buildFrame(1.0f);
+    EXPECT_NE(later.meshes[0].mesh->positions, ui.meshes[0].mesh->positions);
+    EXPECT_EQ(st.buildFrame(1.0f).meshes[0].mesh, later.meshes[0].mesh);
     EXPECT_FALSE(st.doc.dirty);
 }
 

@@ -17,6 +17,7 @@
 #include "assets/scene_io.h"
 #include "renderers/framebuffer.h"
 #include "renderers/renderer.h"
+#include "scenegraph/deform.h"
 #include "scenegraph/setting_names.h"
 
 #include <imgui.h>
@@ -688,15 +689,27 @@ bool materialSection(ViewerState& st, sg::NodeId id, int& index) {
     return ImGui::CollapsingHeader("Material", ImGuiTreeNodeFlags_DefaultOpen) && materialEditor(st, id, index);
 }
 
-void meshSection(const ViewerState& st, const sg::MeshInstance& mi) {
-    if (!ImGui::CollapsingHeader("Mesh", ImGuiTreeNodeFlags_DefaultOpen)) return;
+// Mesh facts, the skin, and the instance's morph weights (editable; an animation playing sets them too).
+bool meshSection(const ViewerState& st, sg::MeshInstance& mi) {
+    if (!ImGui::CollapsingHeader("Mesh", ImGuiTreeNodeFlags_DefaultOpen)) return false;
     const sg::Scene& scene = st.doc.scene;
-    if (mi.mesh >= 0 && size_t(mi.mesh) < scene.meshes.size() && scene.meshes[mi.mesh]) {
-        const sg::Mesh& mesh = *scene.meshes[mi.mesh];
-        ImGui::Text("Mesh %d: %zu vertices, %zu triangles", mi.mesh, mesh.positions.size(), mesh.indices.size() / 3);
-    } else {
+    if (mi.mesh < 0 || size_t(mi.mesh) >= scene.meshes.size() || !scene.meshes[mi.mesh]) {
         ImGui::TextColored(ImVec4(1, 0.5f, 0.4f, 1), "Mesh index %d is missing", mi.mesh);
+        return false;
     }
+    const sg::Mesh& mesh = *scene.meshes[mi.mesh];
+    ImGui::Text("Mesh %d: %zu vertices, %zu triangles", mi.mesh, mesh.positions.size(), mesh.indices.size() / 3);
+    if (sg::isSkinned(scene, mi)) {
+        const sg::Skin& skin = scene.skins[size_t(mi.skin)];
+        ImGui::Text("Skin '%s': %zu joints (drawn where the joints put it)", skin.name.c_str(), skin.joints.size());
+    }
+    if (mesh.morphTargets.empty()) return false;
+    std::vector<float> w = sg::instanceMorphWeights(mesh, mi);
+    bool ch = false;
+    for (size_t k = 0; k < w.size() && k < 16; ++k) ch |= ImGui::SliderFloat(("Morph weight " + std::to_string(k)).c_str(), &w[k], 0.0f, 1.0f);
+    if (w.size() > 16) ImGui::TextDisabled("(%zu more morph targets)", w.size() - 16);
+    if (ch) mi.weights = std::move(w);
+    return ch;
 }
 
 // Operation, and a menu adding implicit operands under the node `id`.
@@ -769,7 +782,7 @@ bool gridSection(sg::GridPayload& gp) {
 bool payloadEditor(ViewerState& st, sg::NodeId id, sg::Payload& p) {
     bool ch = false;
     if (auto* mi = std::get_if<sg::MeshInstance>(&p)) {
-        meshSection(st, *mi);
+        ch |= meshSection(st, *mi);
         ch |= materialSection(st, id, mi->material);
     } else if (auto* ip = std::get_if<sg::ImplicitPayload>(&p)) {
         if (ImGui::CollapsingHeader("Implicit shape", ImGuiTreeNodeFlags_DefaultOpen)) ch |= implicitEditor(st, ip->shape);

@@ -472,7 +472,7 @@ void ViewerState::fitView(bool selectionOnly) {
     if (selectionOnly && doc.scene.valid(doc.selected)) {
         // Bounds of the selected subtree.
         for (sg::NodeId id : doc.scene.depthFirstOrder())
-            if (doc.scene.isAncestor(doc.selected, id)) b.extend(doc.scene.localBounds(id).transformed(doc.scene.world(id)));
+            if (doc.scene.isAncestor(doc.selected, id)) b.extend(doc.scene.nodeWorldBounds(id));   // skinned meshes as posed
         if (b.empty()) b = sg::Aabb{sg::vec3(doc.scene.world(doc.selected)[3]) - 0.5f, sg::vec3(doc.scene.world(doc.selected)[3]) + 0.5f};
     }
     if (b.empty()) b = doc.scene.worldBounds();

@@ -2,6 +2,7 @@
 // camera looking down -z; conventions in docs/math.md) plus a few small helpers.
 #pragma once
 
+#include <glm/ext/vector_uint4_sized.hpp>
 #include <glm/glm.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
@@ -17,6 +18,7 @@ using glm::ivec3;
 using glm::mat3;
 using glm::mat4;
 using glm::quat;
+using glm::u16vec4;
 using glm::vec2;
 using glm::vec3;
 using glm::vec4;

@@ -16,6 +16,13 @@ uint64_t newResourceId();
 
 enum class PrimitiveMode : uint8_t { Triangles, Lines, Points };
 
+// One morph target (glTF mesh.primitives[].targets[k]): per-vertex displacements, each array
+// empty or one per position. Tangent deltas move xyz of Mesh::tangents (w is kept).
+struct MorphTarget {
+    std::vector<vec3> positions, normals, tangents;
+    bool operator==(const MorphTarget&) const = default;
+};
+
 struct Mesh {
     uint64_t id = newResourceId();
     uint64_t version = 1;
@@ -30,8 +37,19 @@ struct Mesh {
     // handedness, bitangent = w cross(normal, tangent) (glTF's TANGENT; direction of increasing v).
     std::vector<vec4> tangents;
     std::vector<uint32_t> indices;   // 3 per triangle (2 per line, 1 per point)
+    // Skinning (glTF JOINTS_0/1, WEIGHTS_0/1): up to 8 influences per vertex, four per set.
+    // Joint numbers index the Skin of the instance (MeshInstance::skin); each array is empty or
+    // one per position, set 1 only with set 0. Weights >= 0; they are normalised to sum 1 when
+    // the mesh is deformed (sg::deformMesh, scenegraph/deform.h).
+    std::vector<u16vec4> joints0, joints1;
+    std::vector<vec4> weights0, weights1;
+    // Morph targets and their default weights (glTF mesh.weights: empty = all 0, else one per
+    // target); an instance's own weights (MeshInstance::weights) take precedence.
+    std::vector<MorphTarget> morphTargets;
+    std::vector<float> morphWeights;
 
     size_t triangleCount() const { return mode == PrimitiveMode::Triangles ? indices.size() / 3 : 0; }
+    bool skinned() const { return !joints0.empty() && !weights0.empty(); }
     Aabb bounds() const;
     // Area-weighted smooth normals from the triangles (replaces `normals`).
     void computeNormals();
@@ -41,6 +59,7 @@ struct Mesh {
     void computeTangents();
     // Checks index ranges and attribute counts; returns an empty string when valid.
     std::string validate() const;
+    std::string validateDeformation() const;   // the skin and morph part of validate()
     void touch() { ++version; }
 };
 using MeshPtr = std::shared_ptr<const Mesh>;

@@ -55,8 +55,27 @@ struct LocalTransform {
 struct MeshInstance {
     int mesh = -1;       // index into Scene::meshes
     int material = -1;   // index into Scene::materials, -1 = default material
+    int skin = -1;       // index into Scene::skins, -1 = not skinned (used when the mesh has joints)
+    // Morph weights of this instance (glTF node.weights, animated by "weights" channels):
+    // empty = the mesh's own Mesh::morphWeights; missing entries count as 0.
+    std::vector<float> weights;
     bool operator==(const MeshInstance&) const = default;
 };
+
+// A skin (glTF skins[i]): joints by node id and their inverse bind matrices. A skinned
+// instance's vertices go straight to world space through sum_i w_i J_i with
+// J_i = world(joint_i) * inverseBind_i (docs/math.md, scenegraph/deform.h): the instance
+// node's own transform does not move them. A joint that is not (or no longer) in the scene
+// contributes J_i = identity.
+struct Skin {
+    std::string name;
+    std::vector<NodeId> joints;
+    std::vector<mat4> inverseBind;   // one per joint
+    NodeId skeleton = kNoNode;       // the file's skeleton root, if it named one (informational)
+    bool operator==(const Skin&) const = default;
+};
+
+class DeformCache;   // scenegraph/deform.h
 
 // Camera payload. The view matrix is the inverse of the node's world matrix: the camera looks
 // down its local -z with +y up.
@@ -126,6 +145,7 @@ public:
     std::vector<std::shared_ptr<Mesh>> meshes;
     std::vector<Material> materials;
     std::vector<std::shared_ptr<Texture>> textures;
+    std::vector<Skin> skins;
     vec3 ambientLight{1.0f};   // L_ambient of docs/math.md (scaled per material by ka)
     RenderSettings settings;
     NodeId activeCamera = kNoNode;
@@ -179,7 +199,23 @@ public:
 
     // --- queries -------------------------------------------------------------------------
     Aabb localBounds(NodeId id) const;   // payload bounds in the node's frame (empty if none)
-    Aabb worldBounds() const;            // all visible geometry
+    Aabb worldBounds() const;            // all visible geometry (skinned and morphed meshes as posed)
+    // World bounds of the node's own payload as drawn (posed meshes included; empty if none).
+    Aabb nodeWorldBounds(NodeId id) const;
+
+    // --- skins and morph targets ---------------------------------------------------------
+    // The mesh a MeshInstance node draws at the current pose: for a skinned or morphed
+    // instance a deformed copy (computed on the CPU once per pose and cached: the same pointer
+    // while nothing it depends on changes; a new pose gives a new object with the same
+    // Mesh::id and a higher version, so backend caches replace their entry), else the scene's
+    // mesh; null for other payloads. *worldSpace: the result is already in world space (skinned:
+    // draw it with the identity). Safe to call from several threads.
+    MeshPtr posedMesh(NodeId id, bool* worldSpace = nullptr) const;
+    // Drops cached posed meshes that were not used since the call before last (flatten calls
+    // it once per frame).
+    void trimPoseCache() const;
+    // Posed meshes computed so far (tests: a still pose computes none).
+    uint64_t poseEvaluations() const;
     std::vector<NodeId> cameras() const;
     const Material& material(int index) const;   // default material for -1 or out of range
 
@@ -195,6 +231,7 @@ private:
 
     std::vector<Node> m_nodes;
     size_t m_aliveCount = 0;
+    std::shared_ptr<DeformCache> m_deform;   // never shared between scenes (a copy starts empty)
     uint64_t m_structureVersion = 1;
 
     // Hot arrays in depth-first pre-order ("slots"); mutable: rebuilt/updated lazily.
