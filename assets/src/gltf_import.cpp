@@ -61,7 +61,8 @@
 //                extension): our meshes carry one UV set for all of a material's textures, the
 //                base colour texture's (else the first other one's); a texture asking for
 //                another set or transform samples that one (one warning).
-//                KHR_materials_pbrSpecularGlossiness: specularGlossinessTexture not applied (warning).
+//                KHR_materials_pbrSpecularGlossiness: specularGlossinessTexture (sRGB specular, linear
+//                glossiness in A) -> metallicRoughnessTexture with Material::specularGlossiness.
 // Cameras: perspective -> Projection Perspective (fovy = yfov, zNear, zFar; infinite zfar ->
 //   max(1000 * znear, 100)); orthographic -> Orthographic (orthoHalfHeight = ymag). The glTF
 //   aspectRatio is ignored (the viewport decides). The first camera met is made active.
@@ -967,7 +968,7 @@ struct Converter {
     }
 
     // metallic-roughness (or specular-glossiness) parameters -> Phong factors and textures.
-    void convertPbr(size_t i, const tinygltf::Material& gm, sg::Material& mat, sg::vec4& base, std::vector<TexRef>& refs) {
+    void convertPbr(const tinygltf::Material& gm, sg::Material& mat, sg::vec4& base, std::vector<TexRef>& refs) {
         const auto& pbr = gm.pbrMetallicRoughness;
         base = glm::clamp(
             sg::vec4(float(pbr.baseColorFactor[0]), float(pbr.baseColorFactor[1]), float(pbr.baseColorFactor[2]), float(pbr.baseColorFactor[3])),
@@ -998,9 +999,11 @@ struct Converter {
         mat.specularTinted = false;
         mat.shininess = sg::phongFromMetallicRoughness(0.0f, 1.0f - gloss).shininess;
         refs[0] = sgx->Has("diffuseTexture") && sgx->Get("diffuseTexture").IsObject() ? texRef(sgx->Get("diffuseTexture")) : TexRef{};
-        refs[1] = TexRef{};
-        if (sgx->Has("specularGlossinessTexture"))
-            warnOnce("material " + std::to_string(i) + ": specularGlossinessTexture is not applied (the specular and glossiness factors are)");
+        mat.specularGlossiness = true;
+        mat.glossiness = gloss;
+        refs[1] = sgx->Has("specularGlossinessTexture") && sgx->Get("specularGlossinessTexture").IsObject()
+                      ? texRef(sgx->Get("specularGlossinessTexture"))
+                      : TexRef{};
     }
 
     void convertMaterial(size_t i) {
@@ -1009,7 +1012,7 @@ struct Converter {
         mat.name = gm.name.empty() ? "material " + std::to_string(i) : gm.name;
         sg::vec4 base(1.0f);
         std::vector<TexRef> refs(5);   // base colour, metallic-roughness, occlusion, emissive, normal
-        convertPbr(i, gm, mat, base, refs);
+        convertPbr(gm, mat, base, refs);
         refs[2] = texRef(gm.occlusionTexture.index, gm.occlusionTexture.texCoord, gm.occlusionTexture.extensions);
         refs[3] = texRef(gm.emissiveTexture);
         refs[4] = texRef(gm.normalTexture.index, gm.normalTexture.texCoord, gm.normalTexture.extensions);
@@ -1027,7 +1030,7 @@ struct Converter {
         mat.doubleSided = gm.doubleSided;
         mat.unlit = extensionObject(gm.extensions, "KHR_materials_unlit") != nullptr || gm.extensions.count("KHR_materials_unlit");
         mat.diffuseTexture = texture(refs[0].index, true);
-        mat.metallicRoughnessTexture = texture(refs[1].index, false);
+        mat.metallicRoughnessTexture = texture(refs[1].index, mat.specularGlossiness);   // specular-glossiness: sRGB colour
         mat.occlusionTexture = texture(refs[2].index, false);
         mat.occlusionStrength = std::isfinite(gm.occlusionTexture.strength) ? std::clamp(float(gm.occlusionTexture.strength), 0.0f, 1.0f) : 1.0f;
         mat.emissiveTexture = texture(refs[3].index, true);

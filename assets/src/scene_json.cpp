@@ -18,7 +18,7 @@
 //                     "specularColor", "diffuseTexture", "emissive", "emissiveTexture",
 //                     "occlusionTexture", "occlusionStrength", "normalTexture", "normalScale",
 //                     "metallicRoughnessTexture",
-//                     "metallic", "roughness", "alpha",
+//                     "metallic", "roughness", "specularGlossiness", "glossiness", "alpha",
 //                     "alphaMode": <AlphaMode>, "alphaCutoff", "unlit", "doubleSided",
 //                     "reflectivity"} ],
 //     "meshes":    [ {"name", "file": "relative/model.obj"} |
@@ -339,6 +339,9 @@ sg::Material Reader::readMaterial(const json& j, const std::string& p, size_t te
     optInt(j, p, "metallicRoughnessTexture", m.metallicRoughnessTexture, -1, (long long)textureCount - 1);
     optFloat(j, p, "metallic", m.metallic);
     optFloat(j, p, "roughness", m.roughness);
+    optBool(j, p, "specularGlossiness", m.specularGlossiness);
+    optFloat(j, p, "glossiness", m.glossiness);
+    if (!(m.glossiness >= 0 && m.glossiness <= 1)) fail(p + "/glossiness", "must be in [0, 1]");
     if (!(m.metallic >= 0 && m.metallic <= 1)) fail(p + "/metallic", "must be in [0, 1]");
     if (!(m.roughness >= 0 && m.roughness <= 1)) fail(p + "/roughness", "must be in [0, 1]");
     optFloat(j, p, "alpha", m.alpha);
@@ -1007,6 +1010,8 @@ std::string serializeSceneJson(const sg::Scene& s) {
                                   {"metallicRoughnessTexture", m.metallicRoughnessTexture},
                                   {"metallic", m.metallic},
                                   {"roughness", m.roughness},
+                                  {"specularGlossiness", m.specularGlossiness},
+                                  {"glossiness", m.glossiness},
                                   {"alpha", m.alpha},
                                   {"alphaMode", sg::nameOf(m.alphaMode)},
                                   {"alphaCutoff", m.alphaCutoff},

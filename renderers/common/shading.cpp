@@ -61,6 +61,7 @@ MapSample sampleMaps(const SampledTexture* em, const SampledTexture* occ, const 
         s.hasMetallicRoughness = true;
         s.roughness = t.y;
         s.metallic = t.z;
+        s.pbrTexel = vec4(t, mr->sampleAlpha(uv, ddx, ddy));
     }
     return s;
 }
@@ -83,7 +84,15 @@ PhongCoefficients coefficientsAt(const Material& m, const MapSample& s) {
     PhongCoefficients c = coefficientsOf(m);
     c.ka *= 1.0f + m.occlusionStrength * (s.occlusion - 1.0f);
     c.emissive *= s.emissive;
-    if (s.hasMetallicRoughness) {
+    if (s.hasMetallicRoughness && m.specularGlossiness) {
+        const vec3 spec = m.ks * m.specularColor * vec3(s.pbrTexel);
+        const float ks = std::max({spec.x, spec.y, spec.z});
+        c.kd = 1.0f;
+        c.ks = ks;
+        c.specularColor = ks > 0.0f ? spec / ks : vec3(1.0f);
+        c.specularTinted = false;
+        c.shininess = phongFromMetallicRoughness(0.0f, 1.0f - m.glossiness * s.pbrTexel.w).shininess;
+    } else if (s.hasMetallicRoughness) {
         const PhongFromPbr p = phongFromMetallicRoughness(m.metallic * s.metallic, m.roughness * s.roughness);
         c.kd = p.kd;
         c.ks = p.ks;

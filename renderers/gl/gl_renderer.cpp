@@ -59,6 +59,7 @@ struct Program {
     GLint texture = -1, hasTexture = -1, unlit = -1, solid = -1, solidColor = -1;
     // Material maps (texture units 1..4: emissive, occlusion, metallic-roughness, normal) and their factors.
     GLint maps[4] = {-1, -1, -1, -1}, hasMap[4] = {-1, -1, -1, -1}, occlusionStrength = -1, metallic = -1, roughness = -1, normalScale = -1;
+    GLint specGloss = -1, glossiness = -1;
     GLint alpha = -1, alphaMode = -1, alphaCutoff = -1;
     GLint fogMode = -1, fogColor = -1, fogParams = -1;
 };
@@ -198,6 +199,8 @@ std::string buildProgram(const std::string& key, Program& p) {
     p.occlusionStrength = loc("uOcclusionStrength");
     p.metallic = loc("uMetallic");
     p.roughness = loc("uRoughness");
+    p.specGloss = loc("uSpecGloss");
+    p.glossiness = loc("uGlossiness");
     p.normalScale = loc("uNormalScale");
     p.unlit = loc("uUnlit");
     p.alpha = loc("uAlpha");
@@ -736,6 +739,8 @@ void GlRenderer::setMaterial(const Program& p, const Material& m, const DrawItem
     glUniform1f(p.occlusionStrength, m.occlusionStrength);
     glUniform1f(p.metallic, m.metallic);
     glUniform1f(p.roughness, m.roughness);
+    glUniform1i(p.specGloss, m.specularGlossiness ? 1 : 0);
+    glUniform1f(p.glossiness, m.glossiness);
     glUniform3fv(p.baseColor, 1, &m.baseColor[0]);
     glUniform1f(p.ka, m.ka);
     glUniform1f(p.kd, m.kd);

@@ -231,6 +231,42 @@ TEST(MeshTangents, GeneratedFromUvsWithHandedness) {
     }
 }
 
+// KHR_materials_pbrSpecularGlossiness texture: specular = ks specularColor (x) RGB (sRGB),
+// untinted, exponent n from glossiness x A. With a black base colour the pixel is
+// L (x) specular (r.v)^n, r = l = +z, v toward the eye point (0, 0, 3) from the pixel's point
+// on the quad. Gouraud keeps the material's own coefficients.
+TEST_P(MaterialMaps, SpecularGlossinessTextureGivesTheSpecularColourPerTexel) {
+    auto specAt = [](int x, float gloss) {   // (r.v)^n at the centre of pixel (x, H/2)
+        const float px = (float(x) + 0.5f) / W * 3.0f - 1.5f, py = 1.5f - (float(H / 2) + 0.5f) / H * 3.0f;
+        const vec3 v = glm::normalize(vec3(0, 0, 3) - vec3(px, py, 0));
+        return std::pow(v.z, sg::phongFromMetallicRoughness(0.0f, 1.0f - gloss).shininess);
+    };
+    for (sg::ShadingModel model : kModels) {
+        sg::Material m;
+        m.baseColor = vec3(0.0f);
+        m.ka = 0.0f;
+        m.ks = 1.0f;
+        m.specularColor = vec3(1.0f, 1.0f, 0.5f);
+        m.specularGlossiness = true;
+        m.glossiness = 0.5f;
+        sg::MaterialMaps maps;
+        auto t = std::make_shared<sg::Texture>(*twoTexels({255, 0, 0}, {0, 188, 255}, true));
+        t->rgba[3] = 255;   // glossiness 0.5 x 1 and 0.5 x 128/255 (alpha is linear)
+        t->rgba[7] = 128;
+        maps.metallicRoughness = t;
+        const vec3 L(0.8f);
+        const std::string name = "specgloss-" + std::string(sg::nameOf(model));
+        rnd::Framebuffer fb = render(GetParam(), mapsFrame(m, maps, model, vec3(0.0f), L), name);
+        if (model == sg::ShadingModel::Gouraud) {   // lit at the corners with n = m.shininess: not checked per pixel
+            EXPECT_GT(fb.pixel(kLeft, H / 2)[1], 0) << GetParam() << " " << name << ": the texture's red must not reach Gouraud";
+            continue;
+        }
+        EXPECT_TRUE(pixelIs(fb, kLeft, L * vec3(1.0f, 0.0f, 0.0f) * specAt(kLeft, 0.5f))) << GetParam() << " " << name;
+        EXPECT_TRUE(pixelIs(fb, kRight, L * vec3(0.0f, rnd::decodeSRGB(188.0f / 255.0f), 0.5f) * specAt(kRight, 0.5f * 128.0f / 255.0f)))
+            << GetParam() << " " << name;
+    }
+}
+
 INSTANTIATE_TEST_SUITE_P(EveryBackend, MaterialMaps, ::testing::ValuesIn(rnd::rendererNames()), [](const auto& info) { return info.param; });
 
 // The mapping itself at known points (docs/math.md).

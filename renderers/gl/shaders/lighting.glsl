@@ -38,6 +38,7 @@ uniform vec3 uEmissive;
 // material's uniforms, which mesh.frag changes per texel by the material's maps.
 float gKa, gKd, gKs, gShininess;
 bool gSpecTinted;
+vec3 gSpecColor;
 vec3 gEmissive;
 void coefficientsOfMaterial() {
     gKa = uKa;
@@ -45,6 +46,7 @@ void coefficientsOfMaterial() {
     gKs = uKs;
     gShininess = uShininess;
     gSpecTinted = uSpecTinted;
+    gSpecColor = uSpecColor;
     gEmissive = uEmissive;
 }
 
@@ -97,7 +99,7 @@ void lightTerms(int i, int type, bool inverseSquare, vec3 n, vec3 p, vec3 v, ino
     vec3 ln = radiance * nl;
     mul += ln * gKd;
     if (gSpecTinted) mul += ln * (gKs * spec);
-    else add += ln * (gKs * spec) * uSpecColor;
+    else add += ln * (gKs * spec) * gSpecColor;
 }
 
 // The two albedo-linear terms of shade() at world position p with unit normal n (already

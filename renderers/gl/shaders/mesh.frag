@@ -28,6 +28,8 @@ uniform float uNormalScale;
 uniform float uOcclusionStrength;
 uniform float uMetallic;
 uniform float uRoughness;
+uniform bool uSpecGloss;            // uMetalRoughMap holds a specular-glossiness texture (sRGB RGB, A glossiness)
+uniform float uGlossiness;
 uniform bool uUnlit;        // colour = albedo + emissive (material unlit, lines, points)
 uniform float uAlpha;       // material alpha (x texture alpha x vertex alpha)
 uniform int uAlphaMode;     // ALPHA_OPAQUE, ALPHA_MASK, ALPHA_BLEND (sg::AlphaMode values)
@@ -93,8 +95,18 @@ void main() {
         gKa *= 1.0 + uOcclusionStrength * (ao - 1.0);
         gEmissive *= em;
         if (uHasMetalRoughMap) {
-            vec3 mr = texture(uMetalRoughMap, vUv).rgb;
-            phongFromMetallicRoughness(uMetallic * mr.b, uRoughness * mr.g);
+            vec4 mr = texture(uMetalRoughMap, vUv);
+            if (uSpecGloss) {   // rnd::coefficientsAt, specular-glossiness
+                vec3 spec = uKs * uSpecColor * mr.rgb;
+                float ks = max(spec.r, max(spec.g, spec.b));
+                phongFromMetallicRoughness(0.0, 1.0 - uGlossiness * mr.a);   // for the exponent
+                gKd = 1.0;
+                gKs = ks;
+                gSpecColor = ks > 0.0 ? spec / ks : vec3(1.0);
+                gSpecTinted = false;
+            } else {
+                phongFromMetallicRoughness(uMetallic * mr.b, uRoughness * mr.g);
+            }
         }
         if (uAlphaMode == ALPHA_MASK) {
             if (alpha < uAlphaCutoff) discard;   // cut-out

@@ -64,6 +64,7 @@ struct MapSample {
     sg::vec3 emissive{1.0f};
     bool hasMetallicRoughness = false;
     float roughness = 1.0f, metallic = 1.0f;
+    sg::vec4 pbrTexel{1.0f};   // the parameter texture's RGBA (specular-glossiness: RGB linear-decoded, A glossiness)
     bool hasNormal = false;
     sg::vec3 normalTexel{0.5f, 0.5f, 1.0f};   // RGB as stored (0.5 n + 0.5)
 };
@@ -79,7 +80,9 @@ MapSample sampleMaps(const SampledTexture* emissive, const SampledTexture* occlu
 sg::vec3 perturbNormal(const sg::vec3& n, const sg::vec4& t, const sg::vec3& texel, float scale);
 // The coefficients at a point with these map samples:
 //   ka_eff = ka (1 + strength (occlusion - 1)),  emissive_eff = emissive (x) emissive texel,
-//   metallic-roughness texture: (kd, ks, n, tint) = phongFromMetallicRoughness(metallic x B, roughness x G).
+//   metallic-roughness texture: (kd, ks, n, tint) = phongFromMetallicRoughness(metallic x B, roughness x G);
+//   specular-glossiness texture: spec = ks specularColor (x) RGB, gloss = glossiness x A:
+//   kd = 1, ks = max(spec), specularColor = spec / ks, n = phongFromMetallicRoughness(0, 1 - gloss).n.
 PhongCoefficients coefficientsAt(const sg::Material& m, const MapSample& s);
 // Gouraud shading lights the vertices with the material's own coefficients; the occlusion and
 // emissive maps still apply per pixel, exactly, because both terms are additive:

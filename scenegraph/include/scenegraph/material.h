@@ -37,6 +37,10 @@ struct Material {
     int metallicRoughnessTexture = -1;   // B: metallic, G: roughness (x the factors below), mapped
     float metallic = 0.0f;               // per texel to kd, ks, shininess, tint by phongFromMetallicRoughness()
     float roughness = 1.0f;
+    // KHR_materials_pbrSpecularGlossiness: metallicRoughnessTexture then holds the
+    // specular-glossiness texture (sRGB specular RGB x ks specularColor, linear A x glossiness).
+    bool specularGlossiness = false;
+    float glossiness = 1.0f;
     float alpha = 1.0f;   // base colour alpha (glTF baseColorFactor.a)
     AlphaMode alphaMode = AlphaMode::Opaque;
     float alphaCutoff = 0.5f;    // Mask only
