@@ -45,25 +45,7 @@ TEST_P(SampleBaselineGLTest, MatchesBaseline) {
     rnd::RenderStats st = gl->render(frame, kWidth, kHeight, actual);
     ASSERT_TRUE(st.ok) << st.error;
 
-    fs::path path = fs::path(VIEWER_SOURCE_DIR) / "tests" / "baselines" / "gl" / (std::string("sample_") + c.name + ".png");
-    const char* accept = std::getenv("VIEWER_ACCEPT_BASELINES");
-    if (accept && std::string(accept) == "1") {
-        std::string err = assets::writePng(path, actual.width, actual.height, actual.color.data(), true);
-        ASSERT_TRUE(err.empty()) << err;
-        std::printf("[baseline] wrote %s\n", path.c_str());
-        return;
-    }
-    assets::ImageLoad load = assets::loadImage(path);
-    ASSERT_TRUE(load.texture) << "baseline " << path << " missing or unreadable (" << load.error
-                              << "): run scripts/accept-baselines.sh after looking at the render";
-    rnd::Framebuffer expected;
-    expected.resize(load.texture->width, load.texture->height);
-    expected.color = load.texture->rgba;
-    testing_support::ImageTolerance tol;
-    tol.maxMeanAbs = 1.0;
-    tol.minFractionWithin = 0.98;
-    tol.channelTolerance = 8;
-    EXPECT_TRUE(testing_support::imagesClose(actual, expected, tol, "gl-baselines", std::string("sample_") + c.name));
+    EXPECT_TRUE(testing_support::matchesGlBaseline(actual, std::string("sample_") + c.name));
 }
 
 INSTANTIATE_TEST_SUITE_P(Samples, SampleBaselineGLTest,

@@ -144,4 +144,27 @@ std::shared_ptr<sg::Texture> checker(int size, int checks, const sg::vec3& a, co
     return t;
 }
 
+::testing::AssertionResult matchesGlBaseline(const rnd::Framebuffer& actual, const std::string& name) {
+    const std::filesystem::path path = std::filesystem::path(VIEWER_SOURCE_DIR) / "tests" / "baselines" / "gl" / (name + ".png");
+    const char* accept = std::getenv("VIEWER_ACCEPT_BASELINES");
+    if (accept && std::string(accept) == "1") {
+        std::string err = assets::writePng(path, actual.width, actual.height, actual.color.data(), true);
+        if (!err.empty()) return ::testing::AssertionFailure() << err;
+        std::printf("[baseline] wrote %s\n", path.c_str());
+        return ::testing::AssertionSuccess();
+    }
+    assets::ImageLoad load = assets::loadImage(path);
+    if (!load.texture)
+        return ::testing::AssertionFailure() << "baseline " << path << " missing or unreadable (" << load.error
+                                             << "): run scripts/accept-baselines.sh after looking at the render";
+    rnd::Framebuffer expected;
+    expected.resize(load.texture->width, load.texture->height);
+    expected.color = load.texture->rgba;
+    ImageTolerance tol;
+    tol.maxMeanAbs = 1.0;
+    tol.minFractionWithin = 0.98;
+    tol.channelTolerance = 8;
+    return imagesClose(actual, expected, tol, "gl-baselines", name);
+}
+
 }   // namespace testing_support

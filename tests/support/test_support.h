@@ -33,6 +33,11 @@ struct ImageTolerance {
 ::testing::AssertionResult imagesClose(const rnd::Framebuffer& actual, const rnd::Framebuffer& expected, const ImageTolerance& tol,
                                        const std::string& suite, const std::string& name);
 
+// A GL baseline image: tests/baselines/gl/<name>.png. Compares `actual` with it (mean <= 1,
+// >= 98% of pixels within 8/255; failures write actual/expected/diff to test-output/gl-baselines),
+// or writes it when VIEWER_ACCEPT_BASELINES=1 (scripts/accept-baselines.sh; look first).
+::testing::AssertionResult matchesGlBaseline(const rnd::Framebuffer& actual, const std::string& name);
+
 void writeImage(const rnd::Framebuffer& img, const std::string& suite, const std::string& name);
 
 // One pixel held to a value computed from a formula: (x, y) with y down from the top row,
