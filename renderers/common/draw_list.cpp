@@ -6,9 +6,11 @@ namespace rnd {
 std::vector<PreparedDraw> prepareMeshDraws(const sg::FrameInput& frame) {
     std::vector<PreparedDraw> draws;
     draws.reserve(frame.meshes.size());
-    for (const sg::DrawMesh& d : frame.meshes) {
+    for (size_t i = 0; i < frame.meshes.size(); ++i) {
+        const sg::DrawMesh& d = frame.meshes[i];
         if (!d.mesh || d.mesh->positions.empty()) continue;
         PreparedDraw p;
+        p.drawable = uint32_t(i + 1);
         p.mesh = d.mesh;
         p.world = &d.world;
         p.normal = d.normal;
@@ -26,7 +28,8 @@ std::vector<PreparedDraw> prepareDraws(const sg::FrameInput& frame, int tessella
     static const sg::mat4 kIdentity(1.0f);
     std::vector<PreparedDraw> draws = prepareMeshDraws(frame);
     draws.reserve(frame.meshes.size() + frame.analytics.size());
-    for (const sg::DrawAnalytic& a : frame.analytics) {
+    for (size_t j = 0; j < frame.analytics.size(); ++j) {
+        const sg::DrawAnalytic& a = frame.analytics[j];
         const Tessellation& t = cache.get(a, tessellation);
         if (!t.mesh || t.mesh->positions.empty()) continue;
         const bool perTriangle = !t.triangleMaterial.empty() && !t.materials.empty();
@@ -41,6 +44,7 @@ std::vector<PreparedDraw> prepareDraws(const sg::FrameInput& frame, int tessella
         p.materials = perTriangle ? &t.materials : nullptr;
         p.node = a.node;
         p.analytic = true;
+        p.drawable = uint32_t(frame.meshes.size() + j + 1);
         draws.push_back(std::move(p));
     }
     return draws;

@@ -15,6 +15,13 @@ void Framebuffer::resize(int w, int h) {
     height = std::max(h, 0);
     color.assign(size_t(width) * height * 4, 0);
     depth.assign(size_t(width) * height, 1.0f);
+    drawable.clear();
+    primitive.clear();
+}
+
+void Framebuffer::resizeVisibility() {
+    drawable.assign(size_t(width) * height, 0u);
+    primitive.assign(size_t(width) * height, kNoPrimitive);
 }
 
 void Framebuffer::clear(const uint8_t rgba[4], float d) {

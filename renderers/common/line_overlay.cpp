@@ -15,11 +15,22 @@ using sg::vec4;
 
 namespace {
 
-void writeLinePixel(Framebuffer& fb, int i, int j, float z, const vec3& linear, float bias) {
+// Which drawable and primitive a point or line pixel belongs to (wireframe: none, the
+// surface under the edge keeps the pixel's visibility).
+struct Provenance {
+    uint32_t drawable = 0, primitive = kNoPrimitive;
+};
+
+void writeLinePixel(Framebuffer& fb, int i, int j, float z, const vec3& linear, float bias, const Provenance& from = {}) {
     int row = fb.height - 1 - j;
-    float& dst = fb.depth[size_t(row) * fb.width + i];
+    const size_t at = size_t(row) * fb.width + i;
+    float& dst = fb.depth[at];
     if (!(z < dst + bias)) return;   // LESS (wireframe: LEQUAL with a small offset)
     dst = std::min(dst, z);
+    if (from.drawable && fb.hasVisibility()) {
+        fb.drawable[at] = from.drawable;
+        fb.primitive[at] = from.primitive;
+    }
     uint8_t* p = fb.pixel(i, row);
     p[0] = toByteSRGB(linear.x);
     p[1] = toByteSRGB(linear.y);
@@ -36,7 +47,7 @@ struct LineEnd {
 
 // Draws segment a-b: clipped in clip space, DDA in window space; depth, colour and fog
 // distance interpolated perspective-correctly per pixel, fog applied per pixel (as GL does).
-void drawSegment(Framebuffer& fb, LineEnd a, LineEnd b, const GuardBand& g, const sg::RenderSettings& st, float bias) {
+void drawSegment(Framebuffer& fb, LineEnd a, LineEnd b, const GuardBand& g, const sg::RenderSettings& st, float bias, const Provenance& from = {}) {
     vec4 ca = a.clip, cb = b.clip;
     float t0 = 0, t1 = 1;
     {
@@ -65,7 +76,7 @@ void drawSegment(Framebuffer& fb, LineEnd a, LineEnd b, const GuardBand& g, cons
         float tp = t * wb.w / ((1 - t) * wa.w + t * wb.w);            // perspective-correct
         vec3 c = ea.color + tp * (eb.color - ea.color);
         if (fog) c = applyFog(st, c, ea.eyeDist + tp * (eb.eyeDist - ea.eyeDist));
-        writeLinePixel(fb, i, j, z, c, bias);
+        writeLinePixel(fb, i, j, z, c, bias, from);
     });
 }
 
@@ -106,7 +117,7 @@ void drawPointsAndLines(const PreparedDraw& d, const Vertices& v, const sg::Fram
         for (size_t k = 0; k + 1 < n; k += 2) {
             uint32_t ia = idx(k), ib = idx(k + 1);
             if (ia >= v.clip.size() || ib >= v.clip.size() || ((v.code[ia] | v.code[ib]) & kInvalid)) continue;
-            drawSegment(fb, end(ia), end(ib), g, st, 0.0f);
+            drawSegment(fb, end(ia), end(ib), g, st, 0.0f, Provenance{d.drawable, uint32_t(k / 2)});
         }
         return;
     }
@@ -120,7 +131,8 @@ void drawPointsAndLines(const PreparedDraw& d, const Vertices& v, const sg::Fram
         int i0 = int(std::ceil(w.x - h - 0.5f)), i1 = int(std::ceil(w.x + h - 0.5f)) - 1;
         int j0 = int(std::ceil(w.y - h - 0.5f)), j1 = int(std::ceil(w.y + h - 0.5f)) - 1;
         for (int j = std::max(j0, 0); j <= std::min(j1, fb.height - 1); ++j)
-            for (int i = std::max(i0, 0); i <= std::min(i1, fb.width - 1); ++i) writeLinePixel(fb, i, j, std::clamp(w.z, 0.0f, 1.0f), c, 0.0f);
+            for (int i = std::max(i0, 0); i <= std::min(i1, fb.width - 1); ++i)
+                writeLinePixel(fb, i, j, std::clamp(w.z, 0.0f, 1.0f), c, 0.0f, Provenance{d.drawable, uint32_t(k)});
     }
 }
 

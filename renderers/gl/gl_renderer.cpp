@@ -62,6 +62,7 @@ struct Program {
     GLint specGloss = -1, glossiness = -1;
     GLint alpha = -1, alphaMode = -1, alphaCutoff = -1;
     GLint fogMode = -1, fogColor = -1, fogParams = -1;
+    GLint drawable = -1, primitiveBase = -1;   // visibility output (location 1)
 };
 
 std::string compileShader(GLenum type, const std::string& src, GLuint& out) {
@@ -167,6 +168,8 @@ std::string buildProgram(const std::string& key, Program& p) {
     if (!err.empty()) return err;
     auto loc = [&](const char* n) { return glGetUniformLocation(p.id, n); };
     p.model = loc("uModel");
+    p.drawable = loc("uDrawable");
+    p.primitiveBase = loc("uPrimitiveBase");
     p.normalMatrix = loc("uNormalMatrix");
     p.viewProj = loc("uViewProj");
     p.view = loc("uView");
@@ -388,21 +391,29 @@ bool uploadTexture(GpuTexture& g, const Texture& t) {
 struct RenderTarget {
     int width = 0, height = 0, samples = 0;
     GLuint fbo = 0, color = 0, depth = 0;
+    GLuint ids = 0;   // RG32UI visibility (drawable, primitive) at attachment 1, when asked
 
     void release() {
         if (fbo) glDeleteFramebuffers(1, &fbo);
         if (color) glDeleteRenderbuffers(1, &color);
         if (depth) glDeleteRenderbuffers(1, &depth);
-        fbo = color = depth = 0;
+        if (ids) glDeleteRenderbuffers(1, &ids);
+        fbo = color = depth = ids = 0;
         width = height = samples = 0;
     }
-    // (Re)creates the FBO when the size or sample count changed. Returns "" or the reason.
-    std::string ensure(int w, int h, int s) {
-        if (fbo && w == width && h == height && s == samples) return {};
+    // (Re)creates the FBO when the size, sample count or visibility changed. Returns "" or the
+    // reason. Only attachment 0 is a draw buffer; the frame enables 1 when it wants ids.
+    std::string ensure(int w, int h, int s, bool withIds = false) {
+        if (fbo && w == width && h == height && s == samples && withIds == (ids != 0)) return {};
         release();
         width = w;
         height = h;
         samples = s;
+        if (withIds) {   // single-sampled only (RenderConfig::visibility)
+            glGenRenderbuffers(1, &ids);
+            glBindRenderbuffer(GL_RENDERBUFFER, ids);
+            glRenderbufferStorage(GL_RENDERBUFFER, GL_RG32UI, w, h);
+        }
         glGenRenderbuffers(1, &color);
         glBindRenderbuffer(GL_RENDERBUFFER, color);
         if (s > 1)
@@ -420,6 +431,9 @@ struct RenderTarget {
         glBindFramebuffer(GL_FRAMEBUFFER, fbo);
         glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, color);
         glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth);
+        if (ids) glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_RENDERBUFFER, ids);
+        glDrawBuffer(GL_COLOR_ATTACHMENT0);
+        glReadBuffer(GL_COLOR_ATTACHMENT0);
         GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
         if (status != GL_FRAMEBUFFER_COMPLETE) {
             char buf[160];
@@ -508,6 +522,8 @@ struct DrawItem {
     const std::vector<Material>* rangeMaterials = nullptr;   // tessellation's per-range materials
     GpuTexture* texture = nullptr;
     GpuTexture* maps[4] = {nullptr, nullptr, nullptr, nullptr};   // emissive, occlusion, metallic-roughness, normal (units 1..4)
+    uint32_t drawable = 0;                                        // Framebuffer::drawable (PreparedDraw::drawable)
+    bool analytic = false;                                        // tessellated: no primitive index in the visibility
 };
 
 class GlRenderer final : public Renderer {
@@ -521,6 +537,7 @@ public:
         c.affinity = ContextAffinity::CurrentGLContext;
         c.wireframe = true;
         c.pointsAndLines = true;
+        c.visibility = true;   // a second colour attachment, RG32UI (mesh.frag's fragId)
         // MSAA sample counts: those of 2/4/8 the driver allows once a context was made (before
         // that, all three; doRender reports a late reduction).
         for (int n : {2, 4, 8})
@@ -769,6 +786,8 @@ std::vector<DrawItem> GlRenderer::collectDraws(const FrameInput& frame, int tess
         it.world = p.world;
         it.normal = p.normal;
         it.mirrored = p.mirrored;
+        it.drawable = p.drawable;
+        it.analytic = p.analytic;
         it.material = p.material;
         it.rangeMaterials = p.materials;
         it.texture = textureFor(p.texture);
@@ -818,6 +837,7 @@ uint64_t GlRenderer::drawAll(const Program& prog, const std::vector<DrawItem>& i
                 glUniformMatrix4fv(prog.model, 1, GL_FALSE, &(*it.world)[0][0]);
                 glUniformMatrix3fv(prog.normalMatrix, 1, GL_FALSE, &it.normal[0][0]);
                 glFrontFace(it.mirrored ? GL_CW : GL_CCW);
+                glUniform1ui(prog.drawable, it.drawable);
                 if (!wireframe) bindTextures(it);
                 glBindVertexArray(it.gpu->vao);
                 bound = true;
@@ -827,6 +847,9 @@ uint64_t GlRenderer::drawAll(const Program& prog, const std::vector<DrawItem>& i
                 if (!unlit) triangles += uint64_t(r.count / 3);
             }
             setCull(!unlit && sg::cullsBackFaces(culling, m->doubleSided));
+            // gl_PrimitiveID counts from 0 in every draw call: the range's first primitive.
+            const GLuint perPrim = it.gpu->primitive == GL_TRIANGLES ? 3 : it.gpu->primitive == GL_LINES ? 2 : 1;
+            glUniform1ui(prog.primitiveBase, it.analytic ? kNoPrimitive : GLuint(r.first) / perPrim);
             glDrawElements(it.gpu->primitive, r.count, GL_UNSIGNED_INT, reinterpret_cast<const void*>(size_t(r.first) * sizeof(uint32_t)));
         }
     }
@@ -850,6 +873,32 @@ void GlRenderer::readBack(GLuint fbo, int w, int h, Framebuffer& out) {
         std::memcpy(&out.depth[size_t(y) * w], &depth[size_t(src) * w], size_t(w) * sizeof(float));
     }
     for (size_t i = 3; i < out.color.size(); i += 4) out.color[i] = 255;
+}
+
+// Reads the visibility attachment (drawable, primitive) of `fbo` into `out` (already sized).
+void readVisibility(GLuint fbo, int w, int h, Framebuffer& out) {
+    out.resizeVisibility();
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
+    glReadBuffer(GL_COLOR_ATTACHMENT1);
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    std::vector<uint32_t> rg(size_t(w) * h * 2);
+    glReadPixels(0, 0, w, h, GL_RG_INTEGER, GL_UNSIGNED_INT, rg.data());
+    glReadBuffer(GL_COLOR_ATTACHMENT0);
+    for (int y = 0; y < h; ++y) {
+        const uint32_t* src = &rg[size_t(h - 1 - y) * w * 2];
+        for (int x = 0; x < w; ++x) {
+            out.drawable[size_t(y) * w + x] = src[2 * x];
+            out.primitive[size_t(y) * w + x] = src[2 * x + 1];
+        }
+    }
+}
+
+// Makes attachment 1 (visibility) a draw buffer and clears it to "nothing".
+void beginVisibility() {
+    const GLenum bufs[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    glDrawBuffers(2, bufs);
+    const GLuint none[4] = {0u, kNoPrimitive, 0u, 0u};
+    glClearBufferuiv(GL_COLOR, 1, none);
 }
 
 // Sets the fixed-function state of a frame and clears the target (background is linear; the
@@ -919,7 +968,8 @@ RenderStats GlRenderer::doRender(const FrameInput& frame, const RenderConfig& cf
         stats.error = "render size " + std::to_string(rw) + "x" + std::to_string(rh) + " exceeds the driver's limit of " + std::to_string(m_maxSize);
         return stats;
     }
-    err = m_target.ensure(rw, rh, samples > 1 ? samples : 0);
+    const bool visibility = cfg.visibility && samples <= 1 && ssaa == 1;   // render() asks only for one-sample frames
+    err = m_target.ensure(rw, rh, samples > 1 ? samples : 0, visibility);
     if (err.empty() && samples > 1) err = m_resolve.ensure(rw, rh, 0);
     if (!err.empty()) {
         stats.error = err;
@@ -927,13 +977,16 @@ RenderStats GlRenderer::doRender(const FrameInput& frame, const RenderConfig& cf
     }
 
     beginFrameState(s, m_target.fbo, rw, rh, samples);
+    if (visibility) beginVisibility();
     const std::vector<DrawItem> items = collectDraws(frame, cfg.tessellation);
     const Program& prog = *program;
     glUseProgram(prog.id);
     setFrameUniforms(prog, frame, ssaa);
     stats.triangles = drawAll(prog, items, DrawPass::Opaque, s.culling);
     // Blended surfaces (glTF alphaMode BLEND): "over" in linear light (the sRGB framebuffer
-    // blends decoded values), sorted per draw back to front, depth tested but not written.
+    // blends decoded values), sorted per draw back to front, depth tested but not written
+    // (nor is the visibility, which belongs to the surface that wrote depth).
+    glColorMaski(1, GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
     glEnable(GL_BLEND);
     glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE);
     glDepthMask(GL_FALSE);
@@ -954,6 +1007,7 @@ RenderStats GlRenderer::doRender(const FrameInput& frame, const RenderConfig& cf
         glUniform1i(prog.solid, 0);
     }
     glBindVertexArray(0);
+    glColorMaski(1, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
 
     // Resolve MSAA (reading a multisampled buffer directly would give an aliased image).
     GLuint readFbo = m_target.fbo;
@@ -970,7 +1024,9 @@ RenderStats GlRenderer::doRender(const FrameInput& frame, const RenderConfig& cf
         target = downsample(full, ssaa);
     } else {
         readBack(readFbo, rw, rh, target);
+        if (visibility) readVisibility(readFbo, rw, rh, target);
     }
+    if (visibility) glDrawBuffer(GL_COLOR_ATTACHMENT0);
 
     GLenum glErr = glGetError();
     evict();

@@ -111,6 +111,8 @@ struct DrawItem {
     bool hasUV = false;
     bool hasColors = false;
     uint64_t firstTri = 0;   // global index of its first triangle
+    uint32_t drawable = 0;   // Framebuffer::drawable (PreparedDraw::drawable)
+    bool analytic = false;   // tessellated analytic shape: no primitive in the visibility
     uint32_t triCount = 0;
 
     // Vertex stage outputs (one per vertex, or per corner when perCorner).
@@ -219,7 +221,8 @@ struct FrameContext {
     int tilesX = 0, tilesY = 0;
     bool msaa = false;
     bool referenceShading = false;
-    bool timing = false;   // VIEWER_RASTER_TIMING=1: print stage times to stderr   // call rnd::shade per fragment instead of the batch
+    bool timing = false;       // VIEWER_RASTER_TIMING=1: print stage times to stderr
+    bool visibility = false;   // fill target.drawable/primitive (one sample per pixel)
     std::vector<DrawItem>* draws = nullptr;
     std::vector<Chunk>* chunks = nullptr;
 };
@@ -599,6 +602,13 @@ std::atomic<int64_t> g_rasterNs{0}, g_prepareNs{0}, g_lightNs{0}, g_outputNs{0};
 inline int64_t nowNs() { return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
 
 void shadeOpaque(const FrameContext& fc, Framebuffer& target, TileBuffers& buf, int x0, int y0, int x1, int y1, int samples);
+
+// The pixel's visibility: the drawable and mesh triangle of its front-most kept surface.
+inline void writeVisibility(const FrameContext& fc, Framebuffer& target, size_t pixel, const Tri& t) {
+    const DrawItem& d = (*fc.draws)[t.draw];
+    target.drawable[pixel] = d.drawable;
+    target.primitive[pixel] = d.analytic ? kNoPrimitive : t.prim;
+}
 void renderBlended(const FrameContext& fc, Framebuffer& target, TileBuffers& buf, int x0, int y0, int x1, int y1, int samples);
 
 // Rasterizes the tile's triangles into its visibility buffer (opaque and masked ones; blended
@@ -679,6 +689,7 @@ void shadeOpaque(const FrameContext& fc, Framebuffer& target, TileBuffers& buf, 
             if (samples == 1) {
                 *dOut = buf.depth[p];
                 if (buf.ids[p] == kNoTri) continue;
+                if (fc.visibility) writeVisibility(fc, target, size_t(row) * fc.width + x0 + ii, triById(chunks, buf.ids[p]));
                 buf.fragPixel[nf] = uint16_t(p);
                 buf.fragTri[nf] = buf.ids[p];
                 buf.fragCount[nf++] = 1;
@@ -848,6 +859,7 @@ public:
         c.progressive = true;
         c.wireframe = true;
         c.pointsAndLines = true;
+        c.visibility = true;   // the visibility buffer the tiles shade from
         c.msaaSamples = {4};   // one fixed 4-sample pattern (raster_core.h)
         c.ssaaFactors = {2, 3, 4};
         c.ssaaRendersLarger = true;
@@ -864,20 +876,22 @@ protected:
             stats = renderSingle(frame, cfg.width * r, cfg.height * r, cfg.tessellation, hi, false, control, r);
             if (stats.ok) target = downsample(hi, r);
         } else {
-            stats = renderSingle(frame, cfg.width, cfg.height, cfg.tessellation, target, cfg.msaaSamples > 1, control);
+            stats = renderSingle(frame, cfg.width, cfg.height, cfg.tessellation, target, cfg.msaaSamples > 1, control, 1, cfg.visibility);
         }
         return stats;
     }
 
 private:
     // pointScale: the SSAA factor (points are 2 pixels wide at the output resolution, like GL).
+    // visibility: fill target.drawable/primitive (one sample per pixel only).
     RenderStats renderSingle(const sg::FrameInput& frame, int width, int height, int tessRes, Framebuffer& target, bool msaa, RenderControl* control,
-                             int pointScale = 1) {
+                             int pointScale = 1, bool visibility = false) {
         RenderStats stats;
         auto t0frame = std::chrono::steady_clock::now();
         m_samplers.beginFrame();
         m_tess.nextFrame();
         target.resize(width, height);
+        if (visibility) target.resizeVisibility();
         const auto& st = frame.settings;
         const bool gouraud = st.shading == sg::ShadingModel::Gouraud;
 
@@ -891,6 +905,8 @@ private:
             d.normal = p.normal;
             d.material = *p.material;
             d.mirrored = p.mirrored;
+            d.drawable = p.drawable;
+            d.analytic = p.analytic;
             d.texture = m_samplers.get(p.texture);
             d.emissiveMap = m_samplers.get(p.maps.emissive);
             d.occlusionMap = m_samplers.get(p.maps.occlusion);
@@ -935,6 +951,7 @@ private:
         fc.msaa = msaa;
         fc.referenceShading = m_referenceShading;
         fc.timing = m_timing;
+        fc.visibility = visibility && !msaa;
         fc.draws = &draws;
         uint64_t chunkSize = std::max<uint64_t>(4096, (total + 4000) / 4000);
         if (chunkSize * 7 >= (1u << kChunkBits)) {

@@ -123,6 +123,13 @@ bool uvWithFootprint(const PixelFootprint* footprint, const vec3 P[3], const vec
 // --- Tracer --------------------------------------------------------------------------------------
 
 // A mesh's other material textures (null when absent).
+// The surface a primary ray keeps (see Tracer::trace): where, and what (Framebuffer's
+// visibility). p is NaN while the ray has met nothing that writes depth.
+struct SurfaceRecord {
+    vec3 p{std::numeric_limits<float>::quiet_NaN()};
+    uint32_t drawable = 0, primitive = kNoPrimitive;
+};
+
 struct MeshMaps {
     const SampledTexture *emissive = nullptr, *occlusion = nullptr, *metallicRoughness = nullptr, *normal = nullptr;
     bool any() const { return emissive || occlusion || metallicRoughness || normal; }
@@ -372,8 +379,8 @@ struct Tracer {
     // over what the ray meets behind it ("over", in linear light). Primary rays (bounce 0) come
     // back fogged by their own hit's eye distance, so layers are fogged before they blend, as
     // the rasterizers do. hitPos: the nearest surface that is not blended (the depth the
-    // rasterizers keep, since blended surfaces do not write depth).
-    vec3 trace(const rt::Ray& ray, const vec3& eye, int bounce, vec3* hitPos, const PixelFootprint* footprint = nullptr, int layer = 0) {
+    // rasterizers keep, since blended surfaces do not write depth) and what it is.
+    vec3 trace(const rt::Ray& ray, const vec3& eye, int bounce, SurfaceRecord* hitPos, const PixelFootprint* footprint = nullptr, int layer = 0) {
         ++rays;
         rt::SceneHit h;
         rt::Ray r = ray;
@@ -381,7 +388,7 @@ struct Tracer {
         if (!firstSurface(r, h, alpha, layer, footprint)) return f.settings.background;
         const bool blended = materialOf(h).alphaMode == AlphaMode::Blend;
         if (blended) alpha = std::clamp(alpha, 0.0f, 1.0f);
-        vec3* const ownHit = blended ? nullptr : hitPos;
+        SurfaceRecord* const ownHit = blended ? nullptr : hitPos;
         vec3 dirN = glm::normalize(r.dir);
         float visible[64];
         std::vector<float> visHeap;
@@ -397,7 +404,12 @@ struct Tracer {
             shadeMeshHit(h, r, eye, footprint, vis, s);
         else
             shadeAnalyticHit(h, r, eye, vis, s);
-        if (ownHit) *ownHit = s.p;
+        if (ownHit) {
+            const bool mesh = h.kind == rt::SceneHit::Kind::Mesh;
+            ownHit->p = s.p;
+            ownHit->drawable = uint32_t(mesh ? h.instance + 1 : f.meshes.size() + h.instance + 1);
+            ownHit->primitive = mesh ? h.prim : kNoPrimitive;
+        }
         vec3 color = s.color;
 
         if (f.settings.reflections && s.mat->reflectivity > 0.0f && bounce < f.settings.maxBounces)
@@ -439,6 +451,7 @@ public:
         c.reflections = true;
         c.wireframe = true;        // the CPU backends' overlay (common/line_overlay.h), after the rays
         c.pointsAndLines = true;   // the same pixel footprint as the rasterizers
+        c.visibility = true;       // what each primary ray keeps
         // MSAA n and SSAA f are both taken as stratified jittered rays per pixel: n rays
         // (2 -> 2x1, 4 -> 2x2, 8 -> 4x2 strata) and f x f rays; each ray is shaded.
         c.msaaSamples = {2, 4, 8};
@@ -454,6 +467,7 @@ protected:
         target.resize(w, h);
         const uint8_t bg[4] = {toByteSRGB(f.settings.background.x), toByteSRGB(f.settings.background.y), toByteSRGB(f.settings.background.z), 255};
         target.clear(bg, 1.0f);
+        if (cfg.visibility) target.resizeVisibility();
         rt::CameraRays cam(f.camera, w, h);
         if (!cam.valid() || !isFinite(f.camera.eye)) {
             stats.error = "camera matrices are not invertible";
@@ -514,12 +528,14 @@ protected:
                                     oy = (float(j) + rand01(seed)) / float(sy);
                                 }
                                 rt::Ray r = cam.ray(float(x) + ox, float(wy) + oy);
-                                vec3 hp;
-                                vec3 hpInit(std::numeric_limits<float>::quiet_NaN());
-                                hp = hpInit;
+                                SurfaceRecord hp;
                                 const PixelFootprint fp{&cam, float(x) + ox, float(wy) + oy};
                                 vec3 c = tr.trace(r, f.camera.eye, 0, &hp, &fp);
-                                if (!std::isnan(hp.x)) depth = std::min(depth, std::clamp(cam.depth(hp), 0.0f, 1.0f));
+                                if (!std::isnan(hp.p.x)) depth = std::min(depth, std::clamp(cam.depth(hp.p), 0.0f, 1.0f));
+                                if (cfg.visibility) {   // one centre ray per pixel (RenderConfig::visibility)
+                                    target.drawable[size_t(row) * w + x] = hp.drawable;
+                                    target.primitive[size_t(row) * w + x] = hp.primitive;
+                                }
                                 sum += c;
                             }
                         sum /= float(sx * sy);

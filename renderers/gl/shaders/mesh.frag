@@ -40,7 +40,13 @@ uniform int uFogMode;       // FOG_OFF, FOG_LINEAR, FOG_EXP, FOG_EXP2 (sg::FogMo
 uniform vec3 uFogColor;
 uniform vec3 uFogParams;    // start, end, density
 
-out vec4 fragColor;
+uniform uint uDrawable;        // Framebuffer::drawable of this draw
+uniform uint uPrimitiveBase;   // the draw call's first primitive in its mesh (0xffffffff: analytic)
+
+layout(location = 0) out vec4 fragColor;
+// Visibility (written only when the target has the attachment, rnd::RenderConfig::visibility):
+// drawable, and the primitive index within its mesh.
+layout(location = 1) out uvec2 fragId;
 
 // rnd::perturbNormal() (renderers/common/shading.cpp): the normal map's normal at n (outward).
 vec3 perturbNormal(vec3 n, vec4 t, vec3 texel, float scale) {
@@ -75,6 +81,7 @@ float fogVisibility(float d) {
 }
 
 void main() {
+    fragId = uvec2(uDrawable, uPrimitiveBase == 0xffffffffu ? uPrimitiveBase : uPrimitiveBase + uint(gl_PrimitiveID));
     vec3 c;
     float alpha = 1.0;
     if (uSolid) {

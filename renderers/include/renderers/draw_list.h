@@ -30,6 +30,7 @@ struct PreparedDraw {
     const std::vector<sg::Material>* materials = nullptr;
     sg::NodeId node = sg::kNoNode;
     bool analytic = false;   // from frame.analytics (tessellated)
+    uint32_t drawable = 0;   // Framebuffer::drawable of its pixels: meshes[k-1], or analytics[k-1-M]
 };
 
 // Meshes first (in frame.meshes order), then analytic shapes (in frame.analytics order).

@@ -1,4 +1,5 @@
-// framebuffer.h - what every backend renders into: RGBA8 colour + float depth, any size.
+// framebuffer.h - what every backend renders into: RGBA8 colour + float depth, any size, and on
+// request the visibility of each pixel (which drawable and which of its primitives it shows).
 // Rows are stored top to bottom (row 0 is the top of the image, as in PNG files).
 #pragma once
 
@@ -8,12 +9,23 @@
 
 namespace rnd {
 
+inline constexpr uint32_t kNoPrimitive = 0xffffffffu;
+
 struct Framebuffer {
     int width = 0, height = 0;
     std::vector<uint8_t> color;   // width*height*4, sRGB-encoded RGBA8 (display-ready)
     std::vector<float> depth;     // width*height, window-space depth in [0,1] (1 = far / empty)
+    // Visibility (empty unless render() was asked for it): the surface seen through each
+    // pixel's centre, the one that wrote depth (opaque, masked and kept, a point or a line;
+    // never a blended layer), sampled once per pixel whatever the anti-aliasing.
+    //   drawable:  0 = nothing; k <= M: frame.meshes[k-1]; k > M: frame.analytics[k-1-M]
+    //   primitive: triangle (points: point, lines: segment) index within that mesh;
+    //              kNoPrimitive for analytic shapes and empty pixels
+    std::vector<uint32_t> drawable, primitive;
 
-    void resize(int w, int h);
+    void resize(int w, int h);   // colour and depth; drops the visibility
+    void resizeVisibility();     // visibility at the current size, all empty
+    bool hasVisibility() const { return drawable.size() == size_t(width) * height && primitive.size() == drawable.size() && !drawable.empty(); }
     void clear(const uint8_t rgba[4], float depthValue = 1.0f);
     uint8_t* pixel(int x, int y) { return &color[(size_t(y) * width + x) * 4]; }
     const uint8_t* pixel(int x, int y) const { return &color[(size_t(y) * width + x) * 4]; }

@@ -26,8 +26,13 @@ struct RenderConfig {
     int ssaaFactor = 1;                 // SSAA: factor x factor samples per pixel (1 = off)
     int samplesPerPixel = 1;            // samples (or rays) per pixel actually taken
     int tessellation = 64;              // grid resolution / segments of analytic shapes
-    std::string aaAsked = "none";       // RenderSettings::aaName() as asked
-    std::string aaUsed = "none";        // the same spelling for what is used
+    // Fill the target's visibility (Framebuffer::drawable/primitive). render() asks for it
+    // only with one sample per pixel at the pixel centre (it renders the visibility in a
+    // second pass when the image is anti-aliased), so backends write the one surface they
+    // see through each pixel centre.
+    bool visibility = false;
+    std::string aaAsked = "none";   // RenderSettings::aaName() as asked
+    std::string aaUsed = "none";    // the same spelling for what is used
     // Settings the backend does not honour as asked, one line each ("msaa8 -> msaa4: raster
     // takes 4 samples per pixel"); empty when everything is honoured exactly.
     std::vector<std::string> notes;

@@ -4,8 +4,10 @@
 // Renderer::render() is the one entry point and is not virtual: it validates the settings,
 // checks the size against the backend's Capabilities, resolves one RenderConfig (AA mode and
 // the sample count actually used, SSAA factor, tessellation; see render_config.h), checks
-// for cancellation, calls the backend's doRender(), times the call and fills RenderStats with
-// what was asked and what was used. Backends implement name(), capabilities() and doRender().
+// for cancellation, calls the backend's doRender() (twice when visibility is asked for an
+// anti-aliased image: the second pass at one sample per pixel), times the call and fills
+// RenderStats with what was asked and what was used. Backends implement name(),
+// capabilities() and doRender().
 //
 // Slow backends render progressively: they write finished tiles straight into the target,
 // report progress and check for cancellation between tiles, so callers may run render() on a
@@ -44,6 +46,7 @@ struct Capabilities {
     bool wireframe = false;           // draws RenderSettings::wireframe
     bool pointsAndLines = false;      // draws meshes of PrimitiveMode::Points / Lines
     bool depth = true;                // fills Framebuffer::depth (window depth in [0,1])
+    bool visibility = false;          // fills Framebuffer::drawable/primitive when asked (RenderRequest)
     std::vector<int> msaaSamples;     // MSAA sample counts taken as asked, ascending ({} = no MSAA)
     std::vector<int> ssaaFactors;     // SSAA factors taken as asked, ascending ({} = no SSAA)
     bool ssaaRendersLarger = false;   // SSAA renders a factor x larger image (counts against maxImageSize)
@@ -55,6 +58,15 @@ struct RenderControl {
     std::atomic<bool> cancel{false};
     std::atomic<float> progress{0.0f};   // 0..1
     std::function<void()> onTileDone;    // optional, called from worker threads
+};
+
+// What the caller wants besides the colour image and depth.
+struct RenderRequest {
+    // Framebuffer::drawable/primitive: what each pixel centre shows (picking, the pixel
+    // inspector, id/normal export). With anti-aliasing, render() renders them in a second,
+    // one-sample pass, so they never mix surfaces; a backend without Capabilities::visibility
+    // fails the render with an error saying so.
+    bool visibility = false;
 };
 
 struct RenderStats {
@@ -76,7 +88,8 @@ public:
     // Renders the frame into `target` (resized to width x height on success). Thread-compatible:
     // one render at a time per renderer instance (see Capabilities::affinity for which thread).
     // On failure returns ok = false with a one-line error and leaves `target` unspecified.
-    RenderStats render(const sg::FrameInput& frame, int width, int height, Framebuffer& target, RenderControl* control = nullptr);
+    RenderStats render(const sg::FrameInput& frame, int width, int height, Framebuffer& target, RenderControl* control = nullptr,
+                       const RenderRequest& request = {});
 
 protected:
     // The backend's part: render `frame` with `config` (size, AA, tessellation already resolved
