@@ -1,19 +1,23 @@
 // cli.cpp - render / compare / demo-shots: everything the UI can make, made headless.
 #include "cli.h"
+#include "provenance_json.h"
 
 #include "assets/aov_io.h"
 #include "assets/demo.h"
 #include "assets/files.h"
 #include "assets/image_io.h"
 #include "assets/scene_io.h"
+#include "renderers/inspect.h"
 #include "renderers/renderer.h"
 #include "scenegraph/camera_model.h"
+#include "scenegraph/instances.h"
 #include "scenegraph/setting_names.h"
 #include "ui/viewer.h"
 
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -202,9 +206,10 @@ struct Shot {
     std::string backend;
     rnd::Framebuffer image;
     rnd::RenderStats stats;
+    std::unique_ptr<rnd::Renderer> renderer;   // kept for questions about the frame (lightVisibility)
 };
 
-Shot renderWith(const std::string& backend, const sg::FrameInput& frame, int w, int h) {
+Shot renderWith(const std::string& backend, const sg::FrameInput& frame, int w, int h, bool visibility = false) {
     Shot shot;
     shot.backend = backend;
     std::string err;
@@ -214,7 +219,10 @@ Shot renderWith(const std::string& backend, const sg::FrameInput& frame, int w, 
         return shot;
     }
     auto t0 = std::chrono::steady_clock::now();
-    shot.stats = r->render(frame, w, h, shot.image);
+    rnd::RenderRequest request;
+    request.visibility = visibility;
+    shot.stats = r->render(frame, w, h, shot.image, nullptr, request);
+    shot.renderer = std::move(r);
     if (shot.stats.milliseconds == 0)
         shot.stats.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     // Never a silent substitution: what the backend did not honour as asked, one line each.
@@ -229,16 +237,20 @@ Shot renderWith(const std::string& backend, const sg::FrameInput& frame, int w, 
 
 }   // namespace
 
-void addRenderOptions(CLI::App& cmd, RenderArgs& a, bool compare) {
+void addRenderOptions(CLI::App& cmd, RenderArgs& a, Command command) {
     cmd.add_option("scene", a.scene, "Scene file (.json .gltf .glb .obj .off .ply .stl) or 'demo'")->required();
-    if (compare) {
+    if (command == Command::Compare) {
         cmd.add_option("--out", a.out, "Output folder (created if missing)")->required();
+    } else if (command == Command::Inspect) {
+        cmd.add_option("--at", a.at, "Pixel X,Y (from the top-left corner of the image)")->required();
+        cmd.add_option("--backend", a.backend, "Backend: gl, raster, raycast or all")->capture_default_str();
     } else {
         cmd.add_option("--out", a.out, "Output PNG file")->required();
         cmd.add_option("--backend", a.backend, "Backend: gl, raster or raycast")->capture_default_str();
         cmd.add_option("--aov", a.aov,
-                       "Also write, next to OUT.png: depth (OUT.depth.pfm, float32 depth along the optical axis, 0 = nothing) and the "
-                       "camera sidecar OUT.json (K, world_to_camera, projection, near, far)");
+                       "Also write, next to OUT.png, any of: depth (OUT.depth.pfm, float32 depth along the optical axis, 0 = nothing), "
+                       "normal (OUT.normal.png, world normal as 0.5 n + 0.5, black = nothing), id (OUT.id.png, 16-bit instance id, 0 = "
+                       "nothing); always with the sidecar OUT.json (K, world_to_camera, projection, near, far, ids)");
     }
     cmd.add_option("--size", a.size, "Image size WIDTHxHEIGHT")->capture_default_str();
     cmd.add_flag("--overwrite", a.overwrite, "Replace existing output files");
@@ -265,17 +277,37 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a, bool compare) {
     cmd.add_option("--animation", a.animation, "Which animation clip --time poses (0-based; default 0)");
 }
 
-// --aov: the extra files next to `out` (P.png -> P.depth.pfm, P.json). Checked before
-// rendering: known kinds only, and no existing file replaced without --overwrite.
-std::string checkAovs(const RenderArgs& a, const fs::path& out) {
+// --aov kinds and the file each writes next to OUT.png.
+const char* aovSuffix(const std::string& kind) {
+    if (kind == "depth") return ".depth.pfm";
+    if (kind == "normal") return ".normal.png";
+    if (kind == "id") return ".id.png";
+    return nullptr;
+}
+
+std::vector<std::string> aovKinds(const RenderArgs& a) {
+    std::vector<std::string> kinds;
     std::stringstream list(a.aov);
+    for (std::string k; std::getline(list, k, ',');)
+        if (!k.empty() && std::find(kinds.begin(), kinds.end(), k) == kinds.end()) kinds.push_back(k);
+    return kinds;
+}
+
+bool needsVisibility(const RenderArgs& a) {
+    for (const std::string& k : aovKinds(a))
+        if (k != "depth") return true;
+    return false;
+}
+
+// --aov: the extra files next to `out` (P.png -> P.depth.pfm, P.normal.png, P.id.png, P.json).
+// Checked before rendering: known kinds only, and no existing file replaced without --overwrite.
+std::string checkAovs(const RenderArgs& a, const fs::path& out) {
     fs::path base = out;
     base.replace_extension();
     std::vector<fs::path> files;
-    for (std::string k; std::getline(list, k, ',');) {
-        if (k.empty()) continue;
-        if (k != "depth") return "--aov: '" + k + "' is not supported yet (supported: depth)";
-        files.push_back(base.string() + ".depth.pfm");
+    for (const std::string& k : aovKinds(a)) {
+        if (!aovSuffix(k)) return "--aov: unknown kind '" + k + "' (known: depth, normal, id)";
+        files.push_back(base.string() + aovSuffix(k));
     }
     if (!files.empty()) files.push_back(base.string() + ".json");
     std::error_code ec;
@@ -284,12 +316,31 @@ std::string checkAovs(const RenderArgs& a, const fs::path& out) {
     return {};
 }
 
-std::string writeAovs(const RenderArgs& a, const fs::path& out, const sg::FrameInput& frame, const rnd::Framebuffer& img) {
-    std::vector<std::string> kinds;
-    std::stringstream list(a.aov);
-    for (std::string k; std::getline(list, k, ',');)
-        if (!k.empty()) kinds.push_back(k);
+// OUT.normal.png: 0.5 n + 0.5 as 8-bit RGB (opaque), black where nothing was drawn.
+std::string writeNormalAov(const fs::path& p, const sg::FrameInput& frame, const sg::InstanceTable& ids, const rnd::Framebuffer& img,
+                           bool overwrite) {
+    const std::vector<sg::vec3> n = rnd::normalImage(frame, ids, img);
+    std::vector<uint8_t> rgba(n.size() * 4, 0);
+    for (size_t k = 0; k < n.size(); ++k) {
+        rgba[4 * k + 3] = 255;
+        if (img.drawable[k] == 0 || glm::dot(n[k], n[k]) == 0.0f) continue;
+        for (int c = 0; c < 3; ++c) rgba[4 * k + size_t(c)] = uint8_t(std::lround(std::clamp(0.5f * n[k][c] + 0.5f, 0.0f, 1.0f) * 255.0f));
+    }
+    return assets::writePng(p, img.width, img.height, rgba.data(), overwrite);
+}
+
+// OUT.id.png: the instance id of each pixel (sg::instanceTable), 0 = nothing.
+std::string writeIdAov(const fs::path& p, const sg::InstanceTable& ids, const rnd::Framebuffer& img, bool overwrite) {
+    if (ids.node.size() > 65536) return p.string() + ": " + std::to_string(ids.node.size() - 1) + " instances do not fit a 16-bit id image";
+    std::vector<uint16_t> v(img.drawable.size());
+    for (size_t k = 0; k < v.size(); ++k) v[k] = uint16_t(ids.instanceOf(img.drawable[k]));
+    return assets::writePngGray16(p, img.width, img.height, v, overwrite);
+}
+
+std::string writeAovs(const RenderArgs& a, const fs::path& out, const sg::Scene& scene, const sg::FrameInput& frame, const rnd::Framebuffer& img) {
+    const std::vector<std::string> kinds = aovKinds(a);
     if (kinds.empty()) return {};
+    const sg::InstanceTable ids = sg::instanceTable(frame);
     fs::path base = out;
     base.replace_extension();
     assets::AovSidecar side;
@@ -299,10 +350,21 @@ std::string writeAovs(const RenderArgs& a, const fs::path& out, const sg::FrameI
     side.projection = std::string(sg::nameOf(frame.camera.projection.type));
     side.camera = sg::cameraModelOf(frame.camera, img.width, img.height);
     for (const std::string& k : kinds) {
-        fs::path p = base.string() + "." + k + ".pfm";   // k is "depth" (checkAovs)
-        std::string e = assets::writePfm(p, img.width, img.height, sg::opticalDepthMap(frame.camera, img.width, img.height, img.depth), a.overwrite);
+        const fs::path p = base.string() + aovSuffix(k);   // a known kind (checkAovs)
+        std::string e;
+        if (k == "depth")
+            e = assets::writePfm(p, img.width, img.height, sg::opticalDepthMap(frame.camera, img.width, img.height, img.depth), a.overwrite);
+        else if (k == "normal")
+            e = writeNormalAov(p, frame, ids, img, a.overwrite);
+        else
+            e = writeIdAov(p, ids, img, a.overwrite);
         if (!e.empty()) return e;
         side.files.push_back(p.filename().string());
+        side.hasIds = side.hasIds || k == "id";
+    }
+    for (uint32_t i = 1; side.hasIds && i < ids.node.size(); ++i) {
+        const sg::NodeId n = ids.node[i];
+        side.ids.push_back({i, scene.valid(n) ? scene.node(n).name : std::string(), sg::nodePath(scene, n)});
     }
     return assets::writeAovSidecar(base.string() + ".json", side, a.overwrite);
 }
@@ -322,11 +384,11 @@ int runRender(const RenderArgs& a) {
     if (err.empty()) err = applyOverrides(a, *scene);
     if (!err.empty()) return fail(err);
     sg::FrameInput frame = sg::flatten(*scene, float(w) / float(h));
-    Shot shot = renderWith(a.backend, frame, w, h);
+    Shot shot = renderWith(a.backend, frame, w, h, needsVisibility(a));
     if (!shot.stats.ok) return fail(shot.stats.error);   // starts with the backend's name
     err = assets::writePng(out, shot.image.width, shot.image.height, shot.image.color.data(), a.overwrite);
     if (!err.empty()) return fail(err);
-    if (!(err = writeAovs(a, out, frame, shot.image)).empty()) return fail(err);
+    if (!(err = writeAovs(a, out, *scene, frame, shot.image)).empty()) return fail(err);
     std::printf("%s: %dx%d, %s backend, %s, %.1f ms\n", out.string().c_str(), w, h, a.backend.c_str(), shot.stats.config.describe().c_str(),
                 shot.stats.milliseconds);
     return 0;
@@ -448,5 +510,57 @@ int runConvert(const std::string& sceneArg, const std::string& out, bool overwri
 }
 
 int runWindow(const std::string& scene) { return ui::runViewer(scene); }
+
+int runInspect(const RenderArgs& a) {
+    int w = 0, h = 0, x = -1, y = -1;
+    std::string err;
+    if (!parseSize(a.size, w, h, err)) return fail(err);
+    char tail = 0;
+    if (std::sscanf(a.at.c_str(), "%d,%d%c", &x, &y, &tail) != 2) return fail("--at '" + a.at + "': expected X,Y");
+    if (x < 0 || y < 0 || x >= w || y >= h)
+        return fail("--at " + a.at + ": outside the " + std::to_string(w) + "x" + std::to_string(h) + " image (0.." + std::to_string(w - 1) +
+                    ", 0.." + std::to_string(h - 1) + ")");
+    std::vector<std::string> backends = rnd::rendererNames();
+    if (a.backend != "all") {
+        if (std::find(backends.begin(), backends.end(), a.backend) == backends.end())
+            return fail("--backend '" + a.backend + "': expected all or one of " + [&] {
+                std::string l;
+                for (const std::string& b : backends) l += (l.empty() ? "" : ", ") + b;
+                return l;
+            }());
+        backends = {a.backend};
+    }
+    std::vector<assets::AnimationClip> clips;
+    auto scene = loadSceneArg(a.scene, err, &clips);
+    if (!scene) return fail(err);
+    err = applyPose(a, clips, *scene);
+    if (err.empty()) err = applyOverrides(a, *scene);
+    if (!err.empty()) return fail(err);
+    const sg::FrameInput frame = sg::flatten(*scene, float(w) / float(h));
+    const sg::InstanceTable ids = sg::instanceTable(frame);
+    nlohmann::json out = {{"x", x}, {"y", y}, {"width", w}, {"height", h}};
+    std::vector<std::pair<std::string, std::array<int, 3>>> rgb;
+    int failures = 0;
+    for (const std::string& b : backends) {
+        Shot s = renderWith(b, frame, w, h, /*visibility=*/true);
+        if (!s.stats.ok) {
+            out["backends"][b] = {{"error", s.stats.error}};
+            ++failures;
+            continue;
+        }
+        const rnd::SurfaceAt surface = rnd::surfaceAt(frame, ids, s.image, x, y);
+        const std::vector<float> shadows =
+            surface.hit ? s.renderer->lightVisibility(frame, surface.position, surface.geometricNormal) : std::vector<float>{};
+        out["backends"][b] = provenanceJson(*scene, frame, ids, s.image, x, y, shadows);
+        const uint8_t* p = s.image.pixel(x, y);
+        rgb.push_back({b, {p[0], p[1], p[2]}});
+    }
+    for (size_t i = 0; i < rgb.size(); ++i)   // pairwise colour differences (b - a, sRGB bytes)
+        for (size_t j = i + 1; j < rgb.size(); ++j)
+            out["differences"][rgb[i].first + "-" + rgb[j].first] = {rgb[j].second[0] - rgb[i].second[0], rgb[j].second[1] - rgb[i].second[1],
+                                                                     rgb[j].second[2] - rgb[i].second[2]};
+    std::printf("%s\n", out.dump(2).c_str());
+    return failures == 0 ? 0 : 1;
+}
 
 }   // namespace cli

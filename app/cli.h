@@ -19,14 +19,19 @@ struct RenderArgs {
     std::optional<std::string> shading, reflection, fog, aa, projection, shadows, reflections, culling, wireframe, attenuation;
     std::optional<float> fogStart, fogEnd, fogDensity, fovy, obliqueAngle, obliqueFactor;
     std::optional<int> tessellation, bounces;
-    std::string aov;   // comma-separated list of extra outputs (render only): depth
+    std::string aov;   // comma-separated list of extra outputs (render only): depth, normal, id
+    std::string at;    // inspect: pixel "X,Y" from the top-left corner
     // Pose: clip `animation` (default 0) of the file at `time` seconds (default: the clip's start).
     std::optional<std::string> time;
     std::optional<int> animation;
 };
 
-void addRenderOptions(CLI::App& cmd, RenderArgs& args, bool compare);
+enum class Command { Render, Compare, Inspect };
+void addRenderOptions(CLI::App& cmd, RenderArgs& args, Command command);
 int runRender(const RenderArgs& args);
+// `viewer inspect SCENE --at X,Y [--backend NAME|all]`: one JSON object on stdout with the
+// pixel's provenance in each backend (app/provenance_json.h) and their differences.
+int runInspect(const RenderArgs& args);
 int runCompare(const RenderArgs& args);
 int runDemoShots(const std::string& outDir, const std::string& size);
 int runConvert(const std::string& scene, const std::string& out, bool overwrite);

@@ -2,6 +2,7 @@
 //   viewer [SCENE]                       open the viewer (demo scene when SCENE is omitted)
 //   viewer render SCENE --out shot.png   render one image offscreen with any backend/settings
 //   viewer compare SCENE --out DIR       render every backend, write images, diffs, a table
+//   viewer inspect SCENE --at X,Y        where a pixel comes from in each backend (JSON)
 //   viewer demo-shots --out DIR          the demo scene with every backend (./run headless)
 //   viewer convert SCENE --out x.json    save any scene in the native JSON format
 //   viewer --version                     "viewer 0.1.0 (git a33dede)"
@@ -40,12 +41,17 @@ int main(int argc, char** argv) {
 
     cli::RenderArgs renderArgs;
     CLI::App* render = app.add_subcommand("render", "Render SCENE offscreen to a PNG (no window needed)");
-    cli::addRenderOptions(*render, renderArgs, /*compare=*/false);
+    cli::addRenderOptions(*render, renderArgs, cli::Command::Render);
 
     cli::RenderArgs compareArgs;
     compareArgs.size = "960x540";
     CLI::App* compare = app.add_subcommand("compare", "Render SCENE with every backend; write images, pairwise diffs and a timing/difference table");
-    cli::addRenderOptions(*compare, compareArgs, /*compare=*/true);
+    cli::addRenderOptions(*compare, compareArgs, cli::Command::Compare);
+
+    cli::RenderArgs inspectArgs;
+    inspectArgs.backend = "all";
+    CLI::App* inspect = app.add_subcommand("inspect", "Print where pixel X,Y of SCENE comes from in each backend, as JSON");
+    cli::addRenderOptions(*inspect, inspectArgs, cli::Command::Inspect);
 
     std::string convertIn, convertOut;
     bool convertOverwrite = false;
@@ -66,6 +72,7 @@ int main(int argc, char** argv) {
 
     if (*render) return cli::runRender(renderArgs);
     if (*compare) return cli::runCompare(compareArgs);
+    if (*inspect) return cli::runInspect(inspectArgs);
     if (*demo) return cli::runDemoShots(demoOut, demoSize);
     if (*convert) return cli::runConvert(convertIn, convertOut, convertOverwrite);
     windowOpts.scene = windowScene;

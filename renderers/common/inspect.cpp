@@ -52,7 +52,7 @@ bool rayPlaneBary(const PixelRay& r, const glm::dvec3& a, const glm::dvec3& b, c
 }
 
 // A normal from the depths around (x, y) (same drawable only): analytic shapes other than
-// implicit primitives.
+// implicit primitives. 0 when no horizontal or no vertical neighbour is on the same surface.
 vec3 normalFromDepth(const sg::FrameInput& f, const Framebuffer& fb, int x, int y) {
     auto at = [&](int i, int j, vec3& out) {
         if (i < 0 || j < 0 || i >= fb.width || j >= fb.height) return false;
@@ -77,6 +77,14 @@ vec3 normalFromDepth(const sg::FrameInput& f, const Framebuffer& fb, int x, int 
     return len > 0 ? n / len : vec3(0.0f);
 }
 
+// uv where the ray through pixel (x, y) meets the plane of P (extrapolated past the triangle).
+bool uvOnPlane(const sg::FrameCamera& cam, int w, int h, int x, int y, const glm::dvec3 P[3], const vec2 UV[3], vec2& uv) {
+    glm::dvec3 b, p;
+    if (!rayPlaneBary(pixelRay(cam, w, h, x, y), P[0], P[1], P[2], b, p)) return false;
+    uv = float(b.x) * UV[0] + float(b.y) * UV[1] + float(b.z) * UV[2];
+    return true;
+}
+
 void meshSurface(const sg::FrameInput& f, const sg::DrawMesh& dm, const PixelRay& ray, const Framebuffer& fb, int x, int y, SurfaceAt& s) {
     const sg::Mesh& m = *dm.mesh;
     const size_t k = size_t(y) * fb.width + x;
@@ -94,7 +102,11 @@ void meshSurface(const sg::FrameInput& f, const sg::DrawMesh& dm, const PixelRay
     const vec3 w = s.barycentric;
     if (m.uv0.size() == m.positions.size()) {
         s.hasUv = true;
-        s.uv = w.x * m.uv0[i[0]] + w.y * m.uv0[i[1]] + w.z * m.uv0[i[2]];
+        const vec2 UV[3] = {m.uv0[i[0]], m.uv0[i[1]], m.uv0[i[2]]};
+        s.uv = w.x * UV[0] + w.y * UV[1] + w.z * UV[2];
+        vec2 ux, uy;
+        if (uvOnPlane(f.camera, fb.width, fb.height, x + 1, y, P, UV, ux)) s.uvDx = ux - s.uv;
+        if (uvOnPlane(f.camera, fb.width, fb.height, x, y + 1, P, UV, uy)) s.uvDy = uy - s.uv;
     }
     const vec3 ng = glm::normalize(dm.normal * glm::cross(m.positions[i[1]] - m.positions[i[0]], m.positions[i[2]] - m.positions[i[0]]));
     vec3 n = ng;
@@ -102,7 +114,9 @@ void meshSurface(const sg::FrameInput& f, const sg::DrawMesh& dm, const PixelRay
         const vec3 ni = dm.normal * (w.x * m.normals[i[0]] + w.y * m.normals[i[1]] + w.z * m.normals[i[2]]);
         if (glm::length(ni) > 0) n = glm::normalize(ni);
     }
-    if (glm::dot(glm::dvec3(ng), ray.dir) > 0) n = -n;   // seen from the back: the side facing the viewer
+    const bool back = glm::dot(glm::dvec3(ng), ray.dir) > 0;   // seen from the back: the side facing the viewer
+    if (back) n = -n;
+    s.geometricNormal = back ? -ng : ng;
     if (!(glm::dot(n, n) > 0)) n = vec3(0.0f);
     s.normal = n;
 }
@@ -118,8 +132,9 @@ void analyticSurface(const sg::FrameInput& f, const sg::DrawAnalytic& a, const P
         n = len > 0 ? n / len : vec3(0.0f);
     }
     if (!(glm::dot(n, n) > 0)) n = normalFromDepth(f, fb, x, y);
+    if (!(glm::dot(n, n) > 0)) n = vec3(glm::normalize(-ray.dir));   // a lone pixel: facing the viewer
     if (glm::dot(glm::dvec3(n), ray.dir) > 0) n = -n;
-    s.normal = n;
+    s.normal = s.geometricNormal = n;
 }
 
 }   // namespace
@@ -148,7 +163,7 @@ SurfaceAt surfaceAt(const sg::FrameInput& f, const sg::InstanceTable& ids, const
     return s;
 }
 
-PixelTerms pixelTerms(const sg::FrameInput& f, const SurfaceAt& s) {
+PixelTerms pixelTerms(const sg::FrameInput& f, const SurfaceAt& s, const std::vector<float>& lightVisibility) {
     PixelTerms t;
     if (!s.hit) return t;
     const size_t M = f.meshes.size();
@@ -171,7 +186,7 @@ PixelTerms pixelTerms(const sg::FrameInput& f, const SurfaceAt& s) {
         const vec3& w = s.barycentric;
         rho *= w.x * vec3(mesh->colors[i[0]]) + w.y * vec3(mesh->colors[i[1]]) + w.z * vec3(mesh->colors[i[2]]);
     }
-    if (tex && s.hasUv) rho *= SampledTexture(*tex).sampleLevel(s.uv, 0, tex->filter != sg::FilterMode::Nearest);
+    if (tex && s.hasUv) rho *= SampledTexture(*tex).sample(s.uv, s.uvDx, s.uvDy);
     t.albedo = rho;
     const PhongCoefficients c = coefficientsOf(*mat);
     t.emissive = c.emissive;
@@ -183,14 +198,15 @@ PixelTerms pixelTerms(const sg::FrameInput& f, const SurfaceAt& s) {
         vec3 v = f.camera.eye - s.position;
         v = glm::length(v) > 0 ? glm::normalize(v) : vec3(0, 0, 1);
         t.beforeFog = t.ambient + t.emissive;
-        for (const sg::DrawLight& light : f.lights) {
-            const LightSample ls = sampleLight(light, s.position);
+        for (size_t i = 0; i < f.lights.size(); ++i) {
+            const LightSample ls = sampleLight(f.lights[i], s.position);
             LightPart part;
             part.radiance = ls.radiance;
+            part.visibility = i < lightVisibility.size() ? lightVisibility[i] : 1.0f;
             part.nDotL = std::max(glm::dot(s.normal, ls.toLight), 0.0f);
             const ShadeTerms lt = lightTerms(c, s.normal, v, ls, f.settings.reflection);
-            part.diffuse = ls.radiance * part.nDotL * c.kd * rho;
-            part.specular = lt.apply(rho) - part.diffuse;
+            part.diffuse = part.visibility * ls.radiance * part.nDotL * c.kd * rho;
+            part.specular = part.visibility * lt.apply(rho) - part.diffuse;
             t.beforeFog += part.diffuse + part.specular;
             t.lights.push_back(part);
         }

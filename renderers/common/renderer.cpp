@@ -83,4 +83,6 @@ RenderStats Renderer::render(const sg::FrameInput& frame, int width, int height,
     return finish(stats);
 }
 
+std::vector<float> Renderer::lightVisibility(const sg::FrameInput&, const sg::vec3&, const sg::vec3&) { return {}; }
+
 }   // namespace rnd

@@ -480,8 +480,10 @@ protected:
         stats.triangles = f.triangleCount();
         // Samplers (mip chains) per texture, cached by id + version; one pointer per mesh.
         m_samplers.beginFrame();
-        std::vector<const SampledTexture*> textures(f.meshes.size(), nullptr);
-        std::vector<MeshMaps> maps(f.meshes.size());
+        std::vector<const SampledTexture*>& textures = m_textures;
+        std::vector<MeshMaps>& maps = m_maps;
+        textures.assign(f.meshes.size(), nullptr);
+        maps.assign(f.meshes.size(), {});
         for (size_t i = 0; i < f.meshes.size(); ++i) {
             textures[i] = m_samplers.get(f.meshes[i].texture);
             const sg::MaterialMaps& fm = f.meshes[i].maps;
@@ -567,6 +569,15 @@ protected:
         return stats;
     }
 
+public:
+    std::vector<float> lightVisibility(const FrameInput& f, const vec3& p, const vec3& ng) override {
+        if (!f.settings.shadows || m_textures.size() != f.meshes.size()) return {};
+        Tracer tr{f, m_accel, m_textures, m_maps, 0, anyTranslucent(f)};
+        std::vector<float> v(f.lights.size(), 1.0f);
+        if (!v.empty()) tr.lightVisibility(p, ng, v.data());
+        return v;
+    }
+
 private:
     // Points, lines and the wireframe, rasterized over the ray-cast image against its depth
     // exactly as the CPU rasterizer draws them (rays cannot hit zero-width primitives). The
@@ -586,6 +597,9 @@ private:
 
     rt::SceneAccel m_accel;
     SamplerCache m_samplers;
+    // The last frame's samplers per mesh (kept for lightVisibility).
+    std::vector<const SampledTexture*> m_textures;
+    std::vector<MeshMaps> m_maps;
     TessellationCache m_tess;   // wireframe of analytic shapes only
 };
 

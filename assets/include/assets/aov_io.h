@@ -1,5 +1,5 @@
 // aov_io.h - files of the synthetic-data export (`viewer render --aov`): a depth map as a
-// grey float32 PFM and the JSON sidecar with the camera (K, world_to_camera in computer-vision
+// grey float32 PFM, the instance ids as a 16-bit grey PNG, and the JSON sidecar with the camera (K, world_to_camera in computer-vision
 // axes, projection, near, far). Written atomically; an existing file is replaced only with
 // overwrite. Each returns "" or a one-line error naming the file.
 #pragma once
@@ -18,12 +18,25 @@ std::string writePfm(const std::filesystem::path& path, int width, int height, c
 // Reads a grey PFM written by writePfm (either endianness) back into top-down rows.
 std::string readPfm(const std::filesystem::path& path, int& width, int& height, std::vector<float>& topDown);
 
+// 16-bit grey PNG (the id export: 0 background, k = instance id), rows top-down.
+std::string writePngGray16(const std::filesystem::path& path, int width, int height, const std::vector<uint16_t>& topDown, bool overwrite);
+// Reads a PNG written by writePngGray16 back (16-bit grey only); "" or the reason.
+std::string readPngGray16(const std::filesystem::path& path, int& width, int& height, std::vector<uint16_t>& topDown);
+
+// One instance of the id export: its id (the value in OUT.id.png), node name and path.
+struct AovInstance {
+    uint32_t id = 0;
+    std::string node, path;
+};
+
 struct AovSidecar {
     int width = 0, height = 0;
     std::string backend;
     std::string projection;   // "perspective", "orthographic" or "oblique"
     sg::CameraModel camera;
     std::vector<std::string> files;   // the exported images, names relative to the sidecar
+    std::vector<AovInstance> ids;     // written as "ids" when the id image was exported
+    bool hasIds = false;
 };
 std::string writeAovSidecar(const std::filesystem::path& path, const AovSidecar& s, bool overwrite);
 

@@ -91,6 +91,12 @@ public:
     RenderStats render(const sg::FrameInput& frame, int width, int height, Framebuffer& target, RenderControl* control = nullptr,
                        const RenderRequest& request = {});
 
+    // For the pixel inspector: the fraction of each of frame.lights that reaches world point p
+    // (geometric normal ng, facing the viewer) in this backend, i.e. its shadows; `frame` must
+    // be the one of the last successful render(). Empty when the backend draws no shadows for
+    // it (every light reaches every point).
+    virtual std::vector<float> lightVisibility(const sg::FrameInput& frame, const sg::vec3& p, const sg::vec3& ng);
+
 protected:
     // The backend's part: render `frame` with `config` (size, AA, tessellation already resolved
     // and valid for this backend) into `target`. Errors need not name the backend; render()
