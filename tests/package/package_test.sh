@@ -97,7 +97,7 @@ check_contents() {
   while read -r word; do
     grep -qF -- "${word//-/\\-}" <<<"$page" || fail "viewer.1 does not mention $word (viewer --help-all lists it)"
   done < <(grep -oE -- '--[a-z][a-z-]*' <<<"$help" | sort -u)
-  for word in render compare demo-shots convert; do
+  for word in render compare inspect demo-shots convert; do
     grep -qF -- "${word//-/\\-}" <<<"$page" || fail "viewer.1 does not mention the command $word"
   done
 
