@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace rnd {
 
@@ -121,6 +122,28 @@ void meshSurface(const sg::FrameInput& f, const sg::DrawMesh& dm, const PixelRay
     s.normal = n;
 }
 
+// The CSG leaf whose surface passes nearest world point p: the smallest |f| / |grad f| (a
+// first-order distance), the gradient by central differences.
+int nearestCsgLeaf(const sg::CsgTree& tree, const vec3& p) {
+    int best = -1;
+    float bestDist = std::numeric_limits<float>::infinity();
+    for (size_t i = 0; i < tree.nodes.size(); ++i) {
+        const sg::CsgTree::Node& leaf = tree.nodes[i];
+        if (leaf.op != -1) continue;
+        const vec3 q = vec3(leaf.invWorld * vec4(p, 1.0f));
+        const float h = 1e-3f * (1.0f + glm::length(q));
+        const vec3 g((leaf.shape.value(q + vec3(h, 0, 0)) - leaf.shape.value(q - vec3(h, 0, 0))) / (2 * h),
+                     (leaf.shape.value(q + vec3(0, h, 0)) - leaf.shape.value(q - vec3(0, h, 0))) / (2 * h),
+                     (leaf.shape.value(q + vec3(0, 0, h)) - leaf.shape.value(q - vec3(0, 0, h))) / (2 * h));
+        const float d = std::fabs(leaf.shape.value(q)) / std::max(glm::length(g), 1e-12f);
+        if (d < bestDist) {
+            bestDist = d;
+            best = int(i);
+        }
+    }
+    return best;
+}
+
 void analyticSurface(const sg::FrameInput& f, const sg::DrawAnalytic& a, const PixelRay& ray, const Framebuffer& fb, int x, int y, SurfaceAt& s) {
     const size_t k = size_t(y) * fb.width + x;
     s.position = unprojectDepth(f.camera, fb.width, fb.height, x, y, fb.depth[k]);
@@ -128,9 +151,15 @@ void analyticSurface(const sg::FrameInput& f, const sg::DrawAnalytic& a, const P
     if (a.kind == sg::DrawAnalytic::Kind::Implicit) {
         const vec3 local = vec3(a.invWorld * vec4(s.position, 1.0f));
         n = a.normal * a.implicit.normal(local);
-        const float len = glm::length(n);
-        n = len > 0 ? n / len : vec3(0.0f);
+    } else if (a.kind == sg::DrawAnalytic::Kind::Csg && a.csg) {
+        s.csgLeaf = nearestCsgLeaf(*a.csg, s.position);
+        if (s.csgLeaf >= 0) {
+            const sg::CsgTree::Node& leaf = a.csg->nodes[size_t(s.csgLeaf)];
+            n = leaf.normal * leaf.shape.normal(vec3(leaf.invWorld * vec4(s.position, 1.0f)));
+        }
     }
+    const float len = glm::length(n);
+    n = len > 0 ? n / len : vec3(0.0f);
     if (!(glm::dot(n, n) > 0)) n = normalFromDepth(f, fb, x, y);
     if (!(glm::dot(n, n) > 0)) n = vec3(glm::normalize(-ray.dir));   // a lone pixel: facing the viewer
     if (glm::dot(glm::dvec3(n), ray.dir) > 0) n = -n;
@@ -179,6 +208,10 @@ PixelTerms pixelTerms(const sg::FrameInput& f, const SurfaceAt& s, const std::ve
         const sg::DrawAnalytic& a = f.analytics[s.drawable - 1 - M];
         mat = &a.material;
         tex = a.texture;
+        if (a.csg && s.csgLeaf >= 0 && size_t(s.csgLeaf) < a.csg->nodes.size()) {
+            mat = &a.csg->nodes[size_t(s.csgLeaf)].material;
+            tex = a.csg->nodes[size_t(s.csgLeaf)].texture;
+        }
     }
     vec3 rho = mat->baseColor;
     if (s.triangle && mesh && mesh->colors.size() == mesh->positions.size()) {

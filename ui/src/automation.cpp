@@ -44,6 +44,8 @@
 //                         difference view's figures, as its overlay and the Compare tab write
 //                         them; only |A - B| until both full-resolution images are there)
 //   print selection       viewer: selection NAME (or -)
+//   print pixel           viewer: pixel BACKEND X Y rgb R G B node PATH triangle N depth D predicted R G B
+//                         (one line per shown backend: the pixel inspector's probe)
 //   print status          viewer: status TEXT (the status bar's line)
 //   print undo            viewer: undo LABEL | redo LABEL (what Edit > Undo / Redo would do, "-")
 //   stats                 time / triangles / rays of the shown backends
@@ -279,13 +281,18 @@ Automation::Next Automation::printCommand(const std::string& what, AutomationHos
         std::printf("viewer: diff %s\n", st.view.diff.summary(b[0], b[1], st.view.compare.threshold).c_str());
     } else if (what == "selection") {
         std::printf("viewer: selection %s\n", st.doc.scene.valid(st.doc.selected) ? st.doc.scene.node(st.doc.selected).name.c_str() : "-");
+    } else if (what == "pixel") {
+        const PixelProbeState& p = st.ui.panels.probe;
+        if (p.results.empty()) return fail("print pixel: nothing probed (hover or click the viewport first)");
+        std::istringstream lines(probeSummary(p));
+        for (std::string line; std::getline(lines, line);) std::printf("viewer: pixel %s\n", line.c_str());
     } else if (what == "status") {
         std::printf("viewer: status %s\n", st.ui.status.c_str());
     } else if (what == "undo") {
         const UndoStack& h = st.doc.history;
         std::printf("viewer: undo %s | redo %s\n", h.canUndo() ? h.undoLabel().c_str() : "-", h.canRedo() ? h.redoLabel().c_str() : "-");
     } else {
-        return fail("print " + what + ": expected dirty, tree, compare, diff, selection, status or undo");
+        return fail("print " + what + ": expected dirty, tree, compare, diff, selection, pixel, status or undo");
     }
     return Next::Continue;
 }

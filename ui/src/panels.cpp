@@ -1350,6 +1350,52 @@ void drawStatsOverlay(ImDrawList* dl, const ViewerState& st, const ViewportInput
 
 }   // namespace
 
+namespace {
+
+// The shown image under viewport fraction u (single: the one image; split: the part under the
+// cursor; difference: A).
+const SlotView* slotUnder(const ViewerState& st, const ViewportInput& view, float u) {
+    if (view.slots.empty()) return nullptr;
+    if (st.view.compare.mode != ViewMode::Split) return &view.slots[0];
+    const int n = std::min<int>(int(view.slots.size()), std::clamp(st.view.compare.count, 2, 3));
+    if (u < st.view.compare.dividers[0]) return &view.slots[0];
+    if (n == 3 && u >= st.view.compare.dividers[1]) return &view.slots[2];
+    return &view.slots[1];
+}
+
+// A left click (no drag, no modifier that pans) in the viewport: pick the node under it
+// (nothing there clears the selection; as soon as the image under it has its visibility) and
+// pin the pixel inspector there.
+void pickAndProbe(ViewerState& st, const ViewportInput& view, ImVec2 a, ImVec2 avail) {
+    ImGuiIO& io = ImGui::GetIO();
+    const float u = (io.MousePos.x - a.x) / avail.x, v = (io.MousePos.y - a.y) / avail.y;
+    const bool inside = u >= 0 && v >= 0 && u < 1 && v < 1;
+    PixelProbeState& probe = st.ui.panels.probe;
+    if (inside && ImGui::IsItemDeactivated() && ImGui::IsMouseReleased(ImGuiMouseButton_Left) && io.MouseDragMaxDistanceSqr[0] < px(3) * px(3) &&
+        !io.KeyShift) {
+        probe.pinned = true;
+        probe.u = u;
+        probe.v = v;
+        probe.pickPending = true;
+        probe.pickViewVersion = st.view.version;
+        probe.pickDocVersion = st.doc.version;
+    } else if (!probe.pinned) {
+        probe.u = inside && ImGui::IsItemHovered() ? u : -1.0f;
+        probe.v = inside && ImGui::IsItemHovered() ? v : -1.0f;
+    }
+    if (probe.pickPending && (probe.pickViewVersion != st.view.version || probe.pickDocVersion != st.doc.version)) probe.pickPending = false;
+    if (probe.pickPending)
+        if (const SlotView* s = slotUnder(st, view, probe.u); s && s->probe.image && s->probe.image->hasVisibility()) {
+            st.selectNode(pickAt(s->probe, probe.u, probe.v));
+            probe.pickPending = false;
+        }
+    probe.results.clear();
+    if (probe.u < 0) return;
+    for (const SlotView& s : view.slots) probe.results.push_back(probeAt(st, s.probe, probe.u, probe.v));
+}
+
+}   // namespace
+
 void drawViewport(ViewerState& st, const ViewportInput& view, double time, float dt) {
     ImVec2 a = ImGui::GetCursorScreenPos();
     ImVec2 avail = ImGui::GetContentRegionAvail();
@@ -1365,6 +1411,7 @@ void drawViewport(ViewerState& st, const ViewportInput& view, double time, float
                            ImGuiButtonFlags_MouseButtonLeft | ImGuiButtonFlags_MouseButtonRight | ImGuiButtonFlags_MouseButtonMiddle);
     record(st, "viewport");
     cameraInput(st, a, b, time, dt);
+    pickAndProbe(st, view, a, avail);
     // Space: play / pause the animation while the viewport has focus (not while typing).
     if (!st.anim.clips.empty() && ImGui::IsWindowFocused() && !ImGui::GetIO().WantTextInput && ImGui::IsKeyPressed(keys::Space, false))
         st.toggleAnimation();
@@ -1683,6 +1730,7 @@ float drawPropertiesPanel(ViewerState& st, float top, float bodyH) {
             drawTab(st, "Camera", drawCameraPanel);
             drawTab(st, "Rendering", drawRenderingPanel);
             drawTab(st, "Compare", drawComparePanel);
+            drawTab(st, "Pixel", drawPixelPanel);
             ImGui::EndTabBar();
         }
         st.hooks.requestedTab.clear();

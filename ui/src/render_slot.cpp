@@ -36,19 +36,20 @@ void RenderSlot::request(std::shared_ptr<const sg::FrameInput> frame, int width,
     if (!needs(key, interacting)) return;   // nothing new to draw
     m_lastKey = key;
     m_lastPreviewOnly = interacting;
-    Job job{std::move(frame), width, height, key, interacting};
+    Job job{std::move(frame), width, height, key, interacting, interacting};
     std::lock_guard<std::mutex> lock(m_mutex);
     m_pending = std::move(job);
     if (m_control) m_control->cancel = true;   // restart with the new frame
     m_cv.notify_all();
 }
 
-void RenderSlot::publish(rnd::Framebuffer&& fb, const rnd::RenderStats& st, int level) {
+void RenderSlot::publish(rnd::Framebuffer&& fb, const rnd::RenderStats& st, int level, std::shared_ptr<const sg::FrameInput> frame) {
     std::lock_guard<std::mutex> lock(m_mutex);
     m_status.stats = st;
     m_status.error = st.ok ? std::string() : (st.error.empty() ? "render failed" : st.error);
     if (st.ok) {
         m_finished = std::move(fb);
+        m_finishedFrame = std::move(frame);
         m_status.level = level;
         m_haveNew = true;
     }
@@ -75,8 +76,14 @@ void RenderSlot::runJob(const Job& job) {
         }
         rnd::Framebuffer fb;
         rnd::RenderStats st;
+        rnd::RenderRequest request;
+        // Visibility at full resolution; while the camera moves only when it is free (one pass,
+        // no anti-aliasing), so a click right after an edit still picks.
+        request.visibility = m_caps.visibility && d == 1 && (!job.interacting || job.frame->settings.aa == sg::AAMode::None);
         try {
-            st = m_renderer->render(*job.frame, w, h, fb, &control);
+            std::lock_guard<std::mutex> rendering(m_renderMutex);
+            m_renderedFrame = job.frame.get();
+            st = m_renderer->render(*job.frame, w, h, fb, &control, request);
         } catch (const std::exception& e) {
             st.ok = false;
             st.error = std::string("exception: ") + e.what();
@@ -91,7 +98,7 @@ void RenderSlot::runJob(const Job& job) {
             st.ok = false;
             st.error = "backend returned a " + std::to_string(fb.width) + "x" + std::to_string(fb.height) + " image";
         }
-        publish(std::move(fb), st, d);
+        publish(std::move(fb), st, d, job.frame);
         if (!st.ok) return;
     }
 }
@@ -137,8 +144,18 @@ bool RenderSlot::poll() {
     if (!m_haveNew) return false;
     m_haveNew = false;
     std::swap(m_shown, m_finished);
+    std::swap(m_shownFrame, m_finishedFrame);
     ++m_serial;
     return true;
+}
+
+std::vector<float> RenderSlot::lightVisibility(const sg::vec3& p, const sg::vec3& ng) {
+    if (!m_renderer || !m_shownFrame) return {};
+    std::unique_lock<std::mutex> rendering(m_renderMutex, std::try_to_lock);
+    if (!rendering.owns_lock()) return {};
+    // The renderer answers for the frame it rendered last: only while that is the one shown.
+    if (m_renderedFrame != m_shownFrame.get()) return {};
+    return m_renderer->lightVisibility(*m_shownFrame, p, ng);
 }
 
 SlotStatus RenderSlot::status() const {

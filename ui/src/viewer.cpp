@@ -112,6 +112,8 @@ namespace {
 struct BackendView {
     std::unique_ptr<RenderSlot> slot;
     Texture texture;
+    sg::NodeId outlined = sg::kNoNode;   // the selection outlined in the texture
+    uint64_t outlinedVersion = 0;        // doc.version when it was outlined
 };
 
 // A screenshot in progress (CPU backends render it on a thread; GL right away).
@@ -177,8 +179,25 @@ public:
             frame->settings = settings;
             v.slot->request(std::move(frame), w, h, k, preview);
         }
-        for (auto& [name, v] : views)
-            if (v.slot->poll()) v.texture.upload(v.slot->image());
+        for (auto& [name, v] : views) refreshTexture(v);
+    }
+
+    // Uploads a new image, and again when the selection changes: the selection is outlined in
+    // every backend's image alike, from its visibility (ui/pixel_probe.h).
+    void refreshTexture(BackendView& v) {
+        const bool fresh = v.slot->poll();
+        const sg::NodeId sel = st.doc.selected;
+        if (!fresh && sel == v.outlined && (sel == sg::kNoNode || v.outlinedVersion == st.doc.version)) return;
+        v.outlined = sel;
+        v.outlinedVersion = st.doc.version;
+        const rnd::Framebuffer& img = v.slot->image();
+        if (sel == sg::kNoNode || !img.hasVisibility() || !v.slot->imageFrame()) {
+            v.texture.upload(img);
+            return;
+        }
+        rnd::Framebuffer outlined = img;
+        outlineNode(outlined, *v.slot->imageFrame(), st.doc.scene, sel);
+        v.texture.upload(outlined);
     }
 
     void updateDiff() {
@@ -219,6 +238,7 @@ public:
             s.width = v.texture.width;
             s.height = v.texture.height;
             s.status = v.slot->status();
+            s.probe = ProbeImage{n, &v.slot->image(), v.slot->imageFrame(), v.slot.get()};
             in.slots.push_back(s);
         }
         if (st.view.compare.mode == ViewMode::Difference && st.view.diff.valid) {

@@ -31,6 +31,7 @@ struct SurfaceAt {
     sg::vec2 uvDx{0.0f}, uvDy{0.0f};   // uv's change to the next pixel right / down (texture footprint)
     sg::vec3 normal{0.0f};             // world, unit, facing the viewer; 0 for points and lines
     sg::vec3 geometricNormal{0.0f};    // the facet's (analytic shapes: = normal), facing the viewer
+    int csgLeaf = -1;                  // CSG: the leaf whose surface the point is on (its material)
     float opticalDepth = 0.0f;         // along the camera's optical axis (sg::opticalDepth), 0 = nothing
     float eyeDistance = 0.0f;          // |eye-space position| (what fog uses)
 };

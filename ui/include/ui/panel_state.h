@@ -6,6 +6,7 @@
 #pragma once
 
 #include "scenegraph/scene.h"
+#include "ui/pixel_probe.h"
 
 #include <filesystem>
 #include <string>
@@ -37,7 +38,8 @@ struct PanelState {
     // Scene tree: the node being renamed in place (F2, double click, context menu) and its text.
     sg::NodeId renaming = sg::kNoNode;
     std::string renameBuffer;
-    int dragDivider = -1;   // split view: the wipe divider being dragged (-1: none)
+    int dragDivider = -1;    // split view: the wipe divider being dragged (-1: none)
+    PixelProbeState probe;   // the pixel inspector: hovered or pinned point, per-backend answers
 };
 
 }   // namespace ui

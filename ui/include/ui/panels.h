@@ -8,6 +8,7 @@
 // modal dialogs.
 #pragma once
 
+#include "ui/pixel_probe.h"
 #include "ui/render_slot.h"
 #include "ui/viewer_state.h"
 
@@ -29,6 +30,7 @@ struct SlotView {
     void* texture = nullptr;     // ImTextureID (GL texture name), null when no image yet
     int width = 0, height = 0;   // of the texture
     SlotStatus status;
+    ProbeImage probe;   // the image itself, its frame and slot: picking and the pixel inspector
 };
 struct ViewportInput {
     std::vector<SlotView> slots;   // single view: slot 0; split: count slots; difference: A, B
@@ -50,6 +52,8 @@ void drawAnimationPanel(ViewerState& st);
 void drawCameraPanel(ViewerState& st);
 void drawRenderingPanel(ViewerState& st);
 void drawComparePanel(ViewerState& st);
+// The pixel inspector (right panel tab "Pixel"): what the probed pixel shows in each backend.
+void drawPixelPanel(ViewerState& st);
 void drawViewport(ViewerState& st, const ViewportInput& view, double time, float dt);
 void drawDialogs(ViewerState& st);
 void handleShortcuts(ViewerState& st);

@@ -51,8 +51,15 @@ public:
     bool needs(uint64_t key, bool interacting) const;
     // Runs synchronous work and collects finished images; returns true when image() changed.
     bool poll();
-    // Last finished image (UI thread only; valid until the next poll()).
+    // Last finished image (UI thread only; valid until the next poll()). Full-resolution
+    // images carry the visibility (picking, the pixel inspector) when the backend has it,
+    // except anti-aliased ones rendered while interacting (that would be a second pass);
+    // imageFrame() is the frame they show.
     const rnd::Framebuffer& image() const { return m_shown; }
+    const std::shared_ptr<const sg::FrameInput>& imageFrame() const { return m_shownFrame; }
+    // The backend's shadows at a point of imageFrame() (rnd::Renderer::lightVisibility); empty
+    // when it has none, or while a render is in flight (asked again on a later frame).
+    std::vector<float> lightVisibility(const sg::vec3& p, const sg::vec3& ng);
     uint64_t imageSerial() const { return m_serial; }   // bumped whenever image() changes
     SlotStatus status() const;
     // Blocks until nothing is pending (tests, screenshots at exit).
@@ -66,11 +73,12 @@ private:
         int width = 0, height = 0;
         uint64_t key = 0;
         bool previewOnly = false;
+        bool interacting = false;   // no visibility while the camera moves
     };
     void workerLoop();
     // Renders one job level by level; publishes each finished level. Returns false when cancelled.
     void runJob(const Job& job);
-    void publish(rnd::Framebuffer&& fb, const rnd::RenderStats& st, int level);
+    void publish(rnd::Framebuffer&& fb, const rnd::RenderStats& st, int level, std::shared_ptr<const sg::FrameInput> frame);
 
     std::string m_backend;
     bool m_threaded;
@@ -89,10 +97,14 @@ private:
     rnd::RenderControl* m_control = nullptr;   // of the render in flight (guarded by m_mutex)
     bool m_haveNew = false;
     rnd::Framebuffer m_finished;   // published by the worker
+    std::shared_ptr<const sg::FrameInput> m_finishedFrame;
+    std::mutex m_renderMutex;                          // held while m_renderer renders (lightVisibility asks between renders)
+    const sg::FrameInput* m_renderedFrame = nullptr;   // the frame m_renderer rendered last (guarded by m_renderMutex)
     SlotStatus m_status;
     std::thread m_thread;
 
     rnd::Framebuffer m_shown;   // UI thread
+    std::shared_ptr<const sg::FrameInput> m_shownFrame;
     uint64_t m_serial = 0;
 };
 

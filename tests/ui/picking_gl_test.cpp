@@ -1,0 +1,83 @@
+// picking_gl_test.cpp - picking and the pixel inspector in the real window (Xvfb), through the
+// automation: a click in the viewport selects the node the pixel inspector names there, in the
+// split view both backends name the same node and triangle and their terms add up to their
+// pixels, and a click on empty space clears the selection.
+#include "assets/demo.h"
+#include "assets/scene_io.h"
+#include "test_support.h"
+#include "viewer_process.h"
+
+#include <gtest/gtest.h>
+
+#include <sstream>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::vector<std::string> printed(const std::string& text) {
+    std::vector<std::string> out;
+    std::istringstream in(text);
+    for (std::string line; std::getline(in, line);)
+        if (line.rfind("viewer: ", 0) == 0) out.push_back(line.substr(8));
+    return out;
+}
+
+// "pixel gl 300 420 rgb 115 60 16 node /crate triangle 8 depth 12.2 predicted 115 60 17" -> fields.
+struct PixelLine {
+    std::string backend, node;
+    int rgb[3] = {0, 0, 0}, predicted[3] = {0, 0, 0};
+    int triangle = -2;
+    bool background = false;
+};
+PixelLine parsePixel(const std::string& line) {
+    PixelLine p;
+    std::istringstream in(line);
+    std::string word, x, y;
+    in >> word >> p.backend >> x >> y;
+    while (in >> word) {
+        if (word == "rgb") in >> p.rgb[0] >> p.rgb[1] >> p.rgb[2];
+        if (word == "predicted") in >> p.predicted[0] >> p.predicted[1] >> p.predicted[2];
+        if (word == "node") in >> p.node;
+        if (word == "triangle") in >> p.triangle;
+        if (word == "background") p.background = true;
+    }
+    return p;
+}
+
+}   // namespace
+
+TEST(PickingGLTest, ClickSelectsWhatTheInspectorNamesInEveryBackend) {
+    if (!viewer_test::haveXvfb()) GTEST_FAIL() << "xvfb-run is missing (apt-get install xvfb): window tests cannot run";
+    fs::path dir = testing_support::outputDir("ui") / "picking";
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    ASSERT_EQ(assets::saveSceneJson(assets::makeDemoScene(), dir / "demo.json", true), "");
+    const std::string script =
+        "wait\nframes 10\nwait\nclick viewport 300 330\nframes 5\nwait\nprint selection\nprint pixel\n"
+        "view split\nwait\nframes 10\nwait\nclick viewport 300 330\nframes 5\nwait\nprint pixel\n"
+        "click viewport 12 12\nframes 3\nprint selection\nprint pixel\nquit\n";
+    const int rc = viewer_test::runViewer(dir, script, "demo.json", /*separateStdout=*/true);
+    const std::vector<std::string> out = printed(viewer_test::readLog(dir, "out.txt"));
+    const std::string log = viewer_test::readLog(dir);
+    ASSERT_EQ(rc, 0) << log;
+    ASSERT_EQ(out.size(), 7u) << log;
+    // Single view (gl): the selection is the node the inspector names.
+    ASSERT_EQ(out[0].rfind("selection ", 0), 0u);
+    const std::string selected = out[0].substr(10);
+    ASSERT_NE(selected, "-") << "the click at (300, 330) should hit the demo's geometry";
+    const PixelLine single = parsePixel(out[1]);
+    EXPECT_EQ(single.node.substr(single.node.rfind('/') + 1), selected) << out[1];
+    // Split view (gl | raster): the same node and triangle, and each pixel is what its terms add up to.
+    const PixelLine a = parsePixel(out[2]), b = parsePixel(out[3]);
+    EXPECT_NE(a.backend, b.backend);
+    EXPECT_EQ(a.node, single.node);
+    EXPECT_EQ(b.node, single.node);
+    EXPECT_EQ(a.triangle, b.triangle);
+    for (const PixelLine* p : {&single, &a, &b})
+        for (int c = 0; c < 3; ++c) EXPECT_NEAR(p->rgb[c], p->predicted[c], 3) << p->backend << " channel " << c;
+    // Empty space clears the selection.
+    EXPECT_EQ(out[4], "selection -");
+    EXPECT_TRUE(parsePixel(out[5]).background) << out[5];
+    EXPECT_TRUE(parsePixel(out[6]).background) << out[6];
+}
