@@ -7,6 +7,7 @@
 #include "assets/files.h"
 #include "assets/image_io.h"
 #include "assets/scene_io.h"
+#include "renderers/diagnostic.h"
 #include "renderers/inspect.h"
 #include "renderers/renderer.h"
 #include "scenegraph/camera_model.h"
@@ -251,6 +252,10 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a, Command command) {
                        "Also write, next to OUT.png, any of: depth (OUT.depth.pfm, float32 depth along the optical axis, 0 = nothing), "
                        "normal (OUT.normal.png, world normal as 0.5 n + 0.5, black = nothing), id (OUT.id.png, 16-bit instance id, 0 = "
                        "nothing); always with the sidecar OUT.json (K, world_to_camera, projection, near, far, ids)");
+        cmd.add_option("--view", a.view,
+                       "What OUT.png shows: shaded (default), depth, normal, id, uv or triangles (density); the diagnostic views are "
+                       "made from the backend's own visibility, and the legend is printed")
+            ->capture_default_str();
     }
     cmd.add_option("--size", a.size, "Image size WIDTHxHEIGHT")->capture_default_str();
     cmd.add_flag("--overwrite", a.overwrite, "Replace existing output files");
@@ -377,6 +382,12 @@ int runRender(const RenderArgs& a) {
     std::error_code ec;
     if (!a.overwrite && fs::exists(fs::symlink_status(out, ec))) return fail(out.string() + ": file exists (use --overwrite to replace it)");
     if (!(err = checkAovs(a, out)).empty()) return fail(err);
+    rnd::DiagnosticView view = rnd::DiagnosticView::Shaded;
+    if (!rnd::parseDiagnosticView(a.view, view)) {
+        std::string names;
+        for (std::string_view n : rnd::diagnosticViewNames()) names += (names.empty() ? "" : ", ") + std::string(n);
+        return fail("--view '" + a.view + "': expected one of " + names);
+    }
     std::vector<assets::AnimationClip> clips;
     auto scene = loadSceneArg(a.scene, err, &clips);
     if (!scene) return fail(err);
@@ -384,13 +395,15 @@ int runRender(const RenderArgs& a) {
     if (err.empty()) err = applyOverrides(a, *scene);
     if (!err.empty()) return fail(err);
     sg::FrameInput frame = sg::flatten(*scene, float(w) / float(h));
-    Shot shot = renderWith(a.backend, frame, w, h, needsVisibility(a));
+    Shot shot = renderWith(a.backend, frame, w, h, needsVisibility(a) || view != rnd::DiagnosticView::Shaded);
     if (!shot.stats.ok) return fail(shot.stats.error);   // starts with the backend's name
-    err = assets::writePng(out, shot.image.width, shot.image.height, shot.image.color.data(), a.overwrite);
+    const rnd::DiagnosticImage shown = rnd::diagnosticImage(view, frame, shot.image);
+    err = assets::writePng(out, shown.image.width, shown.image.height, shown.image.color.data(), a.overwrite);
     if (!err.empty()) return fail(err);
     if (!(err = writeAovs(a, out, *scene, frame, shot.image)).empty()) return fail(err);
     std::printf("%s: %dx%d, %s backend, %s, %.1f ms\n", out.string().c_str(), w, h, a.backend.c_str(), shot.stats.config.describe().c_str(),
                 shot.stats.milliseconds);
+    if (!shown.legend.empty()) std::printf("%s view: %s\n", a.view.c_str(), shown.legend.c_str());
     return 0;
 }
 

@@ -19,8 +19,9 @@ struct RenderArgs {
     std::optional<std::string> shading, reflection, fog, aa, projection, shadows, reflections, culling, wireframe, attenuation;
     std::optional<float> fogStart, fogEnd, fogDensity, fovy, obliqueAngle, obliqueFactor;
     std::optional<int> tessellation, bounces;
-    std::string aov;   // comma-separated list of extra outputs (render only): depth, normal, id
-    std::string at;    // inspect: pixel "X,Y" from the top-left corner
+    std::string aov;               // comma-separated list of extra outputs (render only): depth, normal, id
+    std::string at;                // inspect: pixel "X,Y" from the top-left corner
+    std::string view = "shaded";   // render: the diagnostic view written (rnd::DiagnosticView names)
     // Pose: clip `animation` (default 0) of the file at `time` seconds (default: the clip's start).
     std::optional<std::string> time;
     std::optional<int> animation;

@@ -139,7 +139,8 @@ TEST(CliInspect, BadRequestsGetOneLineErrors) {
     fs::create_directories(dir);
     for (const Case& c : {Case{"inspect demo --size 160x90 --at 160,10", "outside the 160x90 image"}, Case{"inspect demo --at ten,3", "expected X,Y"},
                           Case{"inspect demo --at 1,1 --backend vulkan", "expected all or one of"},
-                          Case{"render demo --aov depth,albedo --out " + quoted(dir / "bad.png"), "unknown kind 'albedo'"}}) {
+                          Case{"render demo --aov depth,albedo --out " + quoted(dir / "bad.png"), "unknown kind 'albedo'"},
+                          Case{"render demo --view heat --out " + quoted(dir / "bad.png"), "--view 'heat': expected one of shaded, depth"}}) {
         ViewerRun r = runViewer(c.args);
         EXPECT_NE(r.status, 0) << c.args;
         EXPECT_NE(r.output.find(c.message), std::string::npos) << c.args << " -> " << r.output;
@@ -159,4 +160,19 @@ TEST(AovFiles, Gray16PngRoundTrips) {
     EXPECT_EQ(h, 2);
     EXPECT_EQ(back, v);
     EXPECT_NE(assets::writePngGray16(dir / "g16.png", 3, 2, v, false), "");   // never replaced without overwrite
+}
+
+TEST(CliView, DiagnosticViewsAreWrittenWithTheirLegend) {
+    const fs::path dir = testing_support::outputDir("cli-aov");
+    fs::create_directories(dir);
+    for (const char* view : {"depth", "normal", "id", "uv", "triangles"}) {
+        SCOPED_TRACE(view);
+        const fs::path out = dir / (std::string("view-") + view + ".png");
+        ViewerRun r = runViewer("render demo --backend raycast --size 96x54 --overwrite --view " + std::string(view) + " --out " + quoted(out));
+        ASSERT_EQ(r.status, 0) << r.output;
+        EXPECT_NE(r.output.find(std::string(view) + " view: "), std::string::npos) << r.output;
+        assets::ImageLoad img = assets::loadImage(out);
+        ASSERT_TRUE(img.texture) << img.error;
+        EXPECT_EQ(img.texture->width, 96);
+    }
 }

@@ -4,12 +4,16 @@
 // anti-aliased images getting the one-sample visibility, blended layers never taking a pixel,
 // and the inspector's terms adding up to the pixel's colour.
 #include "assets/demo.h"
+#include "renderers/diagnostic.h"
 #include "renderers/inspect.h"
 #include "renderers/renderer.h"
 #include "renderers/shading.h"
 #include "test_scenes.h"
 
 #include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
 
 namespace {
 
@@ -219,4 +223,67 @@ TEST(VisibilityDemo, TermsAddUpToThePixelsOfTheDemo) {
         ASSERT_GT(hit, 500) << b;
         EXPECT_GE(double(close) / hit, 0.97) << b << ": " << close << " of " << hit << " pixels within 3/255 of their terms";
     }
+}
+
+// Diagnostic views hold the numbers they show: the uv view's red/green is frac(u)/frac(v) at
+// a known point, the id view gives one colour per instance (two drawables of one node share
+// it), the depth view is brighter where the surface is nearer, the triangle-density view at a
+// floor pixel is the colour of 1 / (the floor triangle's projected area), computed by hand.
+TEST(DiagnosticViews, KnownAnswersInEveryBackend) {
+    const sg::FrameInput f = scene();
+    for (const std::string& b : rnd::rendererNames()) {
+        SCOPED_TRACE(b);
+        const rnd::Framebuffer fb = renderVisible(b, f);
+        auto at = [&](const rnd::DiagnosticImage& d, const vec3& p) {
+            auto [x, y] = pixelOf(f, p);
+            const uint8_t* c = d.image.pixel(x, y);
+            return std::array<int, 3>{c[0], c[1], c[2]};
+        };
+        const rnd::DiagnosticImage uv = rnd::diagnosticImage(rnd::DiagnosticView::Uv, f, fb);
+        const auto c = at(uv, vec3(1.5f, -1.5f, 0.0f));
+        EXPECT_NEAR(c[0], 0.875 * 255, 4);
+        EXPECT_NEAR(c[1], 0.125 * 255, 4);
+        EXPECT_EQ(at(uv, vec3(-1.0f, -0.5f, 1.4f)), (std::array<int, 3>{153, 0, 153}));   // the sphere has no uv
+        const rnd::DiagnosticImage id = rnd::diagnosticImage(rnd::DiagnosticView::Id, f, fb);
+        EXPECT_EQ(at(id, vec3(0.9f, 0.2f, 1.0f)), at(id, vec3(0.7f, -0.8f, 1.0f)));   // one node, two drawables
+        EXPECT_NE(at(id, vec3(0.9f, 0.2f, 1.0f)), at(id, vec3(1.5f, -1.5f, 0.0f)));
+        EXPECT_EQ(at(id, vec3(3.0f, 2.5f, 0.0f)), (std::array<int, 3>{0, 0, 0}));   // background
+        const rnd::DiagnosticImage depth = rnd::diagnosticImage(rnd::DiagnosticView::Depth, f, fb);
+        EXPECT_GT(at(depth, vec3(0.9f, 0.2f, 1.0f))[0], at(depth, vec3(1.5f, -1.5f, 0.0f))[0]);   // the card is nearer than the floor
+        EXPECT_NE(depth.legend.find("scene units"), std::string::npos);
+        const rnd::DiagnosticImage normal = rnd::diagnosticImage(rnd::DiagnosticView::Normal, f, fb);
+        EXPECT_EQ(at(normal, vec3(1.5f, -1.5f, 0.0f)), (std::array<int, 3>{128, 128, 255}));   // +z
+    }
+}
+
+TEST(DiagnosticViews, TriangleDensityIsOneOverTheProjectedArea) {
+    const sg::FrameInput f = scene();
+    const rnd::Framebuffer fb = renderVisible("raster", f);
+    // The card's triangle 0: (0.3,-0.2,1), (1.3,-0.2,1), (1.3,0.8,1) projected by hand.
+    float area = 0;
+    {
+        vec3 w[3];
+        const vec3 P[3] = {{0.3f, -0.2f, 1}, {1.3f, -0.2f, 1}, {1.3f, 0.8f, 1}};
+        for (int k = 0; k < 3; ++k) {
+            vec4 c = f.camera.proj * f.camera.view * vec4(P[k], 1.0f);
+            w[k] = vec3((c.x / c.w * 0.5f + 0.5f) * W, (c.y / c.w * 0.5f + 0.5f) * H, 0);
+        }
+        area = 0.5f * std::fabs((w[1].x - w[0].x) * (w[2].y - w[0].y) - (w[1].y - w[0].y) * (w[2].x - w[0].x));
+    }
+    ASSERT_GT(area, 170.0f);
+    ASSERT_LT(area, 1000.0f);
+    // The same density through the view's own colour scale: render a one-triangle-per-`area` legend point.
+    const rnd::DiagnosticImage tri = rnd::diagnosticImage(rnd::DiagnosticView::Triangles, f, fb);
+    auto [x, y] = pixelOf(f, vec3(0.9f, 0.2f, 1.0f));
+    const uint8_t* c = tri.image.pixel(x, y);
+    // density = 1/area is between 1e-3 and 6e-3 here (blue .. cyan): blue dominant, no red.
+    const double t = (std::log10(1.0 / area) + 3.0) / 3.0;
+    ASSERT_GT(t, 0.0);
+    ASSERT_LT(t, 0.25);
+    EXPECT_GT(c[2], 200);
+    EXPECT_LT(c[0], 40);
+    EXPECT_NEAR(c[1], (0.2 + (0.8 - 0.2) * (t * 4.0)) * 255, 3);   // green runs 0.2 -> 0.8 from blue to cyan
+    // Analytic shapes have no triangles of their own: grey.
+    auto [sx, sy] = pixelOf(f, vec3(-1.0f, -0.5f, 1.4f));
+    EXPECT_EQ(tri.image.pixel(sx, sy)[0], 89);
 }

@@ -56,12 +56,15 @@ TEST(PickingGLTest, ClickSelectsWhatTheInspectorNamesInEveryBackend) {
     const std::string script =
         "wait\nframes 10\nwait\nclick viewport 300 330\nframes 5\nwait\nprint selection\nprint pixel\n"
         "view split\nwait\nframes 10\nwait\nclick viewport 300 330\nframes 5\nwait\nprint pixel\n"
-        "click viewport 12 12\nframes 3\nprint selection\nprint pixel\nquit\n";
+        "click viewport 12 12\nframes 3\nprint selection\nprint pixel\n"
+        "diagnostic id\nframes 3\nwait\nprint view\nwindow-shot ids.png\ndiagnostic bogus\nquit\n";
     const int rc = viewer_test::runViewer(dir, script, "demo.json", /*separateStdout=*/true);
     const std::vector<std::string> out = printed(viewer_test::readLog(dir, "out.txt"));
     const std::string log = viewer_test::readLog(dir);
-    ASSERT_EQ(rc, 0) << log;
-    ASSERT_EQ(out.size(), 7u) << log;
+    EXPECT_NE(rc, 0) << "diagnostic bogus must fail the script";
+    EXPECT_NE(log.find("diagnostic bogus: expected shaded, depth"), std::string::npos) << log;
+    ASSERT_EQ(out.size(), 9u) << log;
+    EXPECT_EQ(out[7], "view split id");
     // Single view (gl): the selection is the node the inspector names.
     ASSERT_EQ(out[0].rfind("selection ", 0), 0u);
     const std::string selected = out[0].substr(10);

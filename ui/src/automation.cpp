@@ -29,6 +29,7 @@
 // The view
 //   backend NAME          single view with that backend
 //   view single|split|split3|difference   as the View menu
+//   diagnostic NAME       View > Diagnostic view: shaded, depth, normal, id, uv, triangles
 //   orbit DX DY | zoom STEPS | fit
 //   tab Inspector|Camera|Rendering|Compare
 //   gl-worker on|off      run the GL backend on a worker thread (own headless context)
@@ -44,6 +45,7 @@
 //                         difference view's figures, as its overlay and the Compare tab write
 //                         them; only |A - B| until both full-resolution images are there)
 //   print selection       viewer: selection NAME (or -)
+//   print view            viewer: view MODE DIAGNOSTIC (e.g. single depth)
 //   print pixel           viewer: pixel BACKEND X Y rgb R G B node PATH triangle N depth D predicted R G B
 //                         (one line per shown backend: the pixel inspector's probe)
 //   print status          viewer: status TEXT (the status bar's line)
@@ -281,6 +283,8 @@ Automation::Next Automation::printCommand(const std::string& what, AutomationHos
         std::printf("viewer: diff %s\n", st.view.diff.summary(b[0], b[1], st.view.compare.threshold).c_str());
     } else if (what == "selection") {
         std::printf("viewer: selection %s\n", st.doc.scene.valid(st.doc.selected) ? st.doc.scene.node(st.doc.selected).name.c_str() : "-");
+    } else if (what == "view") {
+        std::printf("viewer: view %s %s\n", st.viewName().c_str(), std::string(rnd::nameOf(st.view.diagnostic)).c_str());
     } else if (what == "pixel") {
         const PixelProbeState& p = st.ui.panels.probe;
         if (p.results.empty()) return fail("print pixel: nothing probed (hover or click the viewport first)");
@@ -292,7 +296,7 @@ Automation::Next Automation::printCommand(const std::string& what, AutomationHos
         const UndoStack& h = st.doc.history;
         std::printf("viewer: undo %s | redo %s\n", h.canUndo() ? h.undoLabel().c_str() : "-", h.canRedo() ? h.redoLabel().c_str() : "-");
     } else {
-        return fail("print " + what + ": expected dirty, tree, compare, diff, selection, pixel, status or undo");
+        return fail("print " + what + ": expected dirty, tree, compare, diff, selection, pixel, view, status or undo");
     }
     return Next::Continue;
 }
@@ -336,6 +340,9 @@ Automation::Next Automation::viewCommand(const std::string& cmd, std::istringstr
         st.showView(ViewMode::Single);
     } else if (cmd == "view") {
         if (!st.showView(arg)) return fail("view " + arg + ": expected single, split, split3 or difference");
+    } else if (cmd == "diagnostic") {
+        if (!rnd::parseDiagnosticView(arg, st.view.diagnostic))
+            return fail("diagnostic " + arg + ": expected shaded, depth, normal, id, uv or triangles");
     } else if (cmd == "orbit") {
         float dx = 0, dy = 0;
         args >> dx >> dy;

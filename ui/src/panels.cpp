@@ -303,6 +303,17 @@ void drawMainMenu(ViewerState& st) {
         if (ImGui::MenuItem("Difference view", nullptr, mode == "difference")) st.showView(ViewMode::Difference);
         record(st, "view/difference");
         ImGui::Separator();
+        bool diagOpen = ImGui::BeginMenu("Diagnostic view");
+        record(st, "view/diagnostic");
+        if (diagOpen) {
+            for (std::string_view name : rnd::diagnosticViewNames()) {
+                rnd::DiagnosticView v{};
+                rnd::parseDiagnosticView(name, v);
+                if (ImGui::MenuItem(std::string(name).c_str(), nullptr, st.view.diagnostic == v)) st.view.diagnostic = v;
+                record(st, "diagnostic/" + std::string(name));
+            }
+            ImGui::EndMenu();
+        }
         ImGui::MenuItem("Stats overlay", nullptr, &st.ui.panels.showOverlay);
         if (ImGui::BeginMenu("Scene cameras", !st.doc.scene.cameras().empty())) {
             for (sg::NodeId c : st.doc.scene.cameras())
@@ -1330,6 +1341,7 @@ void drawStatsOverlay(ImDrawList* dl, const ViewerState& st, const ViewportInput
     char buf[128];
     std::snprintf(buf, sizeof buf, "%d x %d   %s", st.view.viewportWidth, st.view.viewportHeight, st.view.flyMode ? "FLY (WASD QE)" : "");
     lines.emplace_back(buf);
+    if (!view.slots.empty() && !view.slots[0].legend.empty()) lines.push_back(view.slots[0].legend);   // the diagnostic view's
     float h = ImGui::GetTextLineHeightWithSpacing();
     float w = 0;
     for (auto& l : lines) w = std::max(w, ImGui::CalcTextSize(l.c_str()).x);

@@ -112,8 +112,10 @@ namespace {
 struct BackendView {
     std::unique_ptr<RenderSlot> slot;
     Texture texture;
-    sg::NodeId outlined = sg::kNoNode;   // the selection outlined in the texture
-    uint64_t outlinedVersion = 0;        // doc.version when it was outlined
+    sg::NodeId outlined = sg::kNoNode;                              // the selection outlined in the texture
+    uint64_t outlinedVersion = 0;                                   // doc.version when it was outlined
+    rnd::DiagnosticView diagnostic = rnd::DiagnosticView::Shaded;   // what the texture shows
+    std::string legend;                                             // of that diagnostic view
 };
 
 // A screenshot in progress (CPU backends render it on a thread; GL right away).
@@ -182,22 +184,29 @@ public:
         for (auto& [name, v] : views) refreshTexture(v);
     }
 
-    // Uploads a new image, and again when the selection changes: the selection is outlined in
-    // every backend's image alike, from its visibility (ui/pixel_probe.h).
+    // Uploads a new image, and again when the selection or the diagnostic view changes: the
+    // image is drawn as the chosen diagnostic view and the selection is outlined in it, in
+    // every backend's image alike, from its visibility (ui/pixel_probe.h, renderers/diagnostic.h).
     void refreshTexture(BackendView& v) {
         const bool fresh = v.slot->poll();
         const sg::NodeId sel = st.doc.selected;
-        if (!fresh && sel == v.outlined && (sel == sg::kNoNode || v.outlinedVersion == st.doc.version)) return;
+        if (!fresh && sel == v.outlined && st.view.diagnostic == v.diagnostic && (sel == sg::kNoNode || v.outlinedVersion == st.doc.version)) return;
         v.outlined = sel;
         v.outlinedVersion = st.doc.version;
+        v.diagnostic = st.view.diagnostic;
         const rnd::Framebuffer& img = v.slot->image();
-        if (sel == sg::kNoNode || !img.hasVisibility() || !v.slot->imageFrame()) {
+        const bool visible = img.hasVisibility() && v.slot->imageFrame();
+        if ((sel == sg::kNoNode && v.diagnostic == rnd::DiagnosticView::Shaded) || !visible) {
             v.texture.upload(img);
+            v.legend = v.diagnostic == rnd::DiagnosticView::Shaded ? "" : std::string(rnd::nameOf(v.diagnostic)) + ": waiting for the full image";
             return;
         }
-        rnd::Framebuffer outlined = img;
-        outlineNode(outlined, *v.slot->imageFrame(), st.doc.scene, sel);
-        v.texture.upload(outlined);
+        rnd::DiagnosticImage shown = rnd::diagnosticImage(v.diagnostic, *v.slot->imageFrame(), img);
+        v.legend = shown.legend;
+        shown.image.drawable = img.drawable;   // outlineNode reads the visibility
+        shown.image.primitive = img.primitive;
+        if (sel != sg::kNoNode) outlineNode(shown.image, *v.slot->imageFrame(), st.doc.scene, sel);
+        v.texture.upload(shown.image);
     }
 
     void updateDiff() {
@@ -239,6 +248,7 @@ public:
             s.height = v.texture.height;
             s.status = v.slot->status();
             s.probe = ProbeImage{n, &v.slot->image(), v.slot->imageFrame(), v.slot.get()};
+            s.legend = v.legend;
             in.slots.push_back(s);
         }
         if (st.view.compare.mode == ViewMode::Difference && st.view.diff.valid) {

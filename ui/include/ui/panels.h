@@ -30,7 +30,8 @@ struct SlotView {
     void* texture = nullptr;     // ImTextureID (GL texture name), null when no image yet
     int width = 0, height = 0;   // of the texture
     SlotStatus status;
-    ProbeImage probe;   // the image itself, its frame and slot: picking and the pixel inspector
+    ProbeImage probe;     // the image itself, its frame and slot: picking and the pixel inspector
+    std::string legend;   // the diagnostic view's legend ("" for the shaded image)
 };
 struct ViewportInput {
     std::vector<SlotView> slots;   // single view: slot 0; split: count slots; difference: A, B

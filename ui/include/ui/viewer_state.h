@@ -20,6 +20,7 @@
 #pragma once
 
 #include "assets/scene_io.h"
+#include "renderers/diagnostic.h"
 #include "scenegraph/frame.h"
 #include "scenegraph/scene.h"
 #include "ui/orbit_camera.h"
@@ -134,6 +135,9 @@ struct View {
     float flySpeed = 1.0f;   // world units per second while flying: sceneSizeSpeed() when fly mode starts
 
     std::string backend = defaultBackend();   // the single view's backend
+    // What each shown image is drawn as: the shaded image, or a diagnostic view made from its
+    // visibility (renderers/diagnostic.h), the same for every backend.
+    rnd::DiagnosticView diagnostic = rnd::DiagnosticView::Shaded;
     CompareConfig compare;
     DiffFigures diff;
     // Per-backend anti-aliasing overrides for this session (backend -> "msaa4", ...); the
