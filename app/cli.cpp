@@ -1,5 +1,6 @@
 // cli.cpp - render / compare / demo-shots: everything the UI can make, made headless.
 #include "cli.h"
+#include "camera_jobs.h"
 #include "provenance_json.h"
 
 #include "assets/aov_io.h"
@@ -252,12 +253,20 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a, Command command) {
                        "Also write, next to OUT.png, any of: depth (OUT.depth.pfm, float32 depth along the optical axis, 0 = nothing), "
                        "normal (OUT.normal.png, world normal as 0.5 n + 0.5, black = nothing), id (OUT.id.png, 16-bit instance id, 0 = "
                        "nothing); always with the sidecar OUT.json (K, world_to_camera, projection, near, far, ids)");
+        cmd.add_option("--cameras", a.cameras, "Render one frame per line of this JSON-lines file of cameras: OUT_0000.png, OUT_0001.png, ...");
+        cmd.add_option("--turntable", a.turntable, "Render N frames around the camera's pivot: OUT_0000.png, ...");
+        cmd.add_option("--shard", a.shard, "Render only frames k with k mod N == I (I/N), for a scheduler's array jobs");
         cmd.add_option("--view", a.view,
                        "What OUT.png shows: shaded (default), depth, normal, id, uv or triangles (density); the diagnostic views are "
                        "made from the backend's own visibility, and the legend is printed")
             ->capture_default_str();
     }
-    cmd.add_option("--size", a.size, "Image size WIDTHxHEIGHT")->capture_default_str();
+    cmd.add_option("--size", a.size,
+                   command == Command::Compare  ? "Image size WIDTHxHEIGHT (default 960x540)"
+                   : command == Command::Render ? "Image size WIDTHxHEIGHT (default 1280x720, or the size --camera-json / --cameras name)"
+                                                : "Image size WIDTHxHEIGHT (default 1280x720)");
+    cmd.add_option("--intrinsics", a.intrinsics, "Perspective camera from K for the image size: fx,fy,cx,cy in pixels (top-left origin)");
+    cmd.add_option("--camera-json", a.cameraJson, "Render from exactly this camera: a sidecar P.json (or its camera object)");
     cmd.add_flag("--overwrite", a.overwrite, "Replace existing output files");
     cmd.add_option("--camera", a.camera, "Use the scene's N-th camera (0-based; default: the active one)");
     cmd.add_option("--shading", a.shading, namedHelp<sg::ShadingModel>("Shading model"));
@@ -374,14 +383,34 @@ std::string writeAovs(const RenderArgs& a, const fs::path& out, const sg::Scene&
     return assets::writeAovSidecar(base.string() + ".json", side, a.overwrite);
 }
 
+// One image of `viewer render`: render, write the PNG (or its diagnostic view) and the AOVs.
+std::string renderJob(const RenderArgs& a, const CameraJob& job, const sg::Scene& scene, rnd::DiagnosticView view) {
+    const int w = job.width, h = job.height;
+    sg::FrameInput frame = sg::flatten(scene, float(w) / float(h));
+    std::string err = applyCameraJob(a, job, frame);
+    if (!err.empty()) return (job.index >= 0 ? job.out.string() + ": " : std::string()) + err;
+    Shot shot = renderWith(a.backend, frame, w, h, needsVisibility(a) || view != rnd::DiagnosticView::Shaded);
+    if (!shot.stats.ok) return shot.stats.error;   // starts with the backend's name
+    const rnd::DiagnosticImage shown = rnd::diagnosticImage(view, frame, shot.image);
+    err = assets::writePng(job.out, shown.image.width, shown.image.height, shown.image.color.data(), a.overwrite);
+    if (!err.empty()) return err;
+    if (!(err = writeAovs(a, job.out, scene, frame, shot.image)).empty()) return err;
+    std::printf("%s: %dx%d, %s backend, %s, %.1f ms\n", job.out.string().c_str(), w, h, a.backend.c_str(), shot.stats.config.describe().c_str(),
+                shot.stats.milliseconds);
+    if (!shown.legend.empty() && job.index <= 0) std::printf("%s view: %s\n", a.view.c_str(), shown.legend.c_str());
+    return {};
+}
+
 int runRender(const RenderArgs& a) {
-    int w = 0, h = 0;
     std::string err;
-    if (!parseSize(a.size, w, h, err)) return fail(err);
-    fs::path out = a.out;
-    std::error_code ec;
-    if (!a.overwrite && fs::exists(fs::symlink_status(out, ec))) return fail(out.string() + ": file exists (use --overwrite to replace it)");
-    if (!(err = checkAovs(a, out)).empty()) return fail(err);
+    std::vector<CameraJob> jobs;
+    if (!(err = planCameraJobs(a, jobs)).empty()) return fail(err);
+    for (const CameraJob& job : jobs) {
+        std::error_code ec;
+        if (!a.overwrite && fs::exists(fs::symlink_status(job.out, ec)))
+            return fail(job.out.string() + ": file exists (use --overwrite to replace it)");
+        if (!(err = checkAovs(a, job.out)).empty()) return fail(err);
+    }
     rnd::DiagnosticView view = rnd::DiagnosticView::Shaded;
     if (!rnd::parseDiagnosticView(a.view, view)) {
         std::string names;
@@ -394,23 +423,19 @@ int runRender(const RenderArgs& a) {
     err = applyPose(a, clips, *scene);
     if (err.empty()) err = applyOverrides(a, *scene);
     if (!err.empty()) return fail(err);
-    sg::FrameInput frame = sg::flatten(*scene, float(w) / float(h));
-    Shot shot = renderWith(a.backend, frame, w, h, needsVisibility(a) || view != rnd::DiagnosticView::Shaded);
-    if (!shot.stats.ok) return fail(shot.stats.error);   // starts with the backend's name
-    const rnd::DiagnosticImage shown = rnd::diagnosticImage(view, frame, shot.image);
-    err = assets::writePng(out, shown.image.width, shown.image.height, shown.image.color.data(), a.overwrite);
-    if (!err.empty()) return fail(err);
-    if (!(err = writeAovs(a, out, *scene, frame, shot.image)).empty()) return fail(err);
-    std::printf("%s: %dx%d, %s backend, %s, %.1f ms\n", out.string().c_str(), w, h, a.backend.c_str(), shot.stats.config.describe().c_str(),
-                shot.stats.milliseconds);
-    if (!shown.legend.empty()) std::printf("%s view: %s\n", a.view.c_str(), shown.legend.c_str());
+    if (!jobs.empty() && jobs.front().index >= 0) {
+        std::error_code ec;
+        if (jobs.front().out.has_parent_path()) fs::create_directories(jobs.front().out.parent_path(), ec);
+    }
+    for (const CameraJob& job : jobs)
+        if (!(err = renderJob(a, job, *scene, view)).empty()) return fail(err);
     return 0;
 }
 
 int runCompare(const RenderArgs& a) {
     int w = 0, h = 0;
     std::string err;
-    if (!parseSize(a.size, w, h, err)) return fail(err);
+    if (!parseSize(a.size.empty() ? "960x540" : a.size, w, h, err)) return fail(err);
     std::vector<assets::AnimationClip> clips;
     auto scene = loadSceneArg(a.scene, err, &clips);
     if (!scene) return fail(err);
@@ -527,7 +552,7 @@ int runWindow(const std::string& scene) { return ui::runViewer(scene); }
 int runInspect(const RenderArgs& a) {
     int w = 0, h = 0, x = -1, y = -1;
     std::string err;
-    if (!parseSize(a.size, w, h, err)) return fail(err);
+    if (!parseSize(a.size.empty() ? "1280x720" : a.size, w, h, err)) return fail(err);
     char tail = 0;
     if (std::sscanf(a.at.c_str(), "%d,%d%c", &x, &y, &tail) != 2) return fail("--at '" + a.at + "': expected X,Y");
     if (x < 0 || y < 0 || x >= w || y >= h)

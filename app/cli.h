@@ -12,7 +12,7 @@ struct RenderArgs {
     std::string scene;
     std::string out;
     std::string backend = "gl";
-    std::string size = "1280x720";
+    std::string size;   // "" = 1280x720 (render: or the --camera-json camera's own size)
     bool overwrite = false;
     int camera = -1;   // index into the scene's cameras, -1 = active
     // Settings overrides (unset = the scene's own setting).
@@ -22,6 +22,9 @@ struct RenderArgs {
     std::string aov;               // comma-separated list of extra outputs (render only): depth, normal, id
     std::string at;                // inspect: pixel "X,Y" from the top-left corner
     std::string view = "shaded";   // render: the diagnostic view written (rnd::DiagnosticView names)
+    // Cameras (app/camera_jobs.h): --intrinsics, --camera-json, --cameras, --turntable, --shard.
+    std::string intrinsics, cameraJson, cameras, shard;
+    int turntable = 0;
     // Pose: clip `animation` (default 0) of the file at `time` seconds (default: the clip's start).
     std::optional<std::string> time;
     std::optional<int> animation;

@@ -7,6 +7,7 @@
 #include <stb_image_write.h>
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <sstream>
@@ -64,6 +65,7 @@ std::string writeAovSidecar(const fs::path& path, const AovSidecar& s, bool over
         return r;
     };
     json cam = {{"world_to_camera", rows4(s.camera.worldToCamera)},
+                {"camera_to_world", rows4(s.camera.cameraToWorld)},
                 {"projection", s.projection},
                 {"projection_matrix", rows4(s.camera.projection)},
                 {"near", s.camera.zNear},
@@ -150,6 +152,80 @@ std::string readPngGray16(const fs::path& path, int& width, int& height, std::ve
     topDown.assign(px, px + size_t(w) * size_t(h));
     stbi_image_free(px);
     return {};
+}
+
+namespace {
+
+bool readMatrix4(const nlohmann::json& j, sg::mat4& m) {
+    if (!j.is_array() || j.size() != 4) return false;
+    for (int row = 0; row < 4; ++row) {
+        if (!j[size_t(row)].is_array() || j[size_t(row)].size() != 4) return false;
+        for (int col = 0; col < 4; ++col) {
+            const nlohmann::json& v = j[size_t(row)][size_t(col)];
+            if (!v.is_number() || !std::isfinite(v.get<double>())) return false;
+            m[col][row] = v.get<float>();   // row-major in the file, glm is column-major
+        }
+    }
+    return true;
+}
+
+}   // namespace
+
+std::string parseAovCamera(const std::string& text, const std::string& where, AovCamera& out) {
+    using nlohmann::json;
+    json j = json::parse(text, nullptr, false);
+    if (j.is_discarded() || !j.is_object()) return where + ": not a JSON object";
+    AovCamera c;
+    if (j.contains("width") && j["width"].is_number_integer()) c.width = j["width"].get<int>();
+    if (j.contains("height") && j["height"].is_number_integer()) c.height = j["height"].get<int>();
+    const json& cam = j.contains("camera") && j["camera"].is_object() ? j["camera"] : j;
+    if (!cam.contains("world_to_camera") || !readMatrix4(cam["world_to_camera"], c.model.worldToCamera))
+        return where + ": \"world_to_camera\" must be a 4x4 array of finite numbers";
+    c.model.cameraToWorld = glm::inverse(c.model.worldToCamera);
+    if (cam.contains("camera_to_world") && !readMatrix4(cam["camera_to_world"], c.model.cameraToWorld))
+        return where + ": \"camera_to_world\" must be a 4x4 array of finite numbers";
+    if (cam.contains("near") && cam["near"].is_number()) c.model.zNear = cam["near"].get<float>();
+    if (cam.contains("far") && cam["far"].is_number()) c.model.zFar = cam["far"].get<float>();
+    if (!(c.model.zNear > 0) || !(c.model.zFar > c.model.zNear) || !std::isfinite(c.model.zFar)) return where + ": needs 0 < near < far";
+    if (cam.contains("projection") && cam["projection"].is_string()) c.projection = cam["projection"].get<std::string>();
+    if (c.projection != "perspective" && c.projection != "orthographic" && c.projection != "oblique")
+        return where + ": \"projection\" must be perspective, orthographic or oblique";
+    if (cam.contains("K") && cam["K"].is_array()) {
+        const json& K = cam["K"];
+        if (K.size() != 3) return where + ": \"K\" must be 3x3";
+        for (int r = 0; r < 3; ++r) {
+            if (!K[size_t(r)].is_array() || K[size_t(r)].size() != 3) return where + ": \"K\" must be 3x3";
+            for (int col = 0; col < 3; ++col) {
+                if (!K[size_t(r)][size_t(col)].is_number()) return where + ": \"K\" must hold numbers";
+                c.model.K[r][col] = K[size_t(r)][size_t(col)].get<double>();
+            }
+        }
+        c.model.pinhole = true;
+    }
+    if (cam.contains("projection_matrix")) {
+        if (!readMatrix4(cam["projection_matrix"], c.model.projection))
+            return where + ": \"projection_matrix\" must be a 4x4 array of finite numbers";
+    } else if (c.model.pinhole) {
+        if (c.width < 1 || c.height < 1) return where + ": K without a projection matrix needs \"width\" and \"height\"";
+        if (c.model.K[0][1] != 0.0) return where + ": K with skew needs a projection matrix";
+        sg::Projection p;
+        std::string err;
+        if (!sg::projectionFromIntrinsics(c.model.K[0][0], c.model.K[1][1], c.model.K[0][2], c.model.K[1][2], c.width, c.height, c.model.zNear,
+                                          c.model.zFar, p, &err))
+            return where + ": " + err;
+        c.model.projection = p.matrix(float(c.width) / float(c.height), 1.0f);
+    } else {
+        return where + ": needs \"projection_matrix\" or \"K\"";
+    }
+    out = c;
+    return {};
+}
+
+std::string readAovCamera(const fs::path& path, AovCamera& out) {
+    std::string text;
+    std::string err = readFileLimited(path, 16u << 20, text);
+    if (!err.empty()) return err;
+    return parseAovCamera(text, path.string(), out);
 }
 
 }   // namespace assets

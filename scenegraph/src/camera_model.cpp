@@ -22,6 +22,7 @@ CameraModel cameraModelOf(const FrameCamera& cam, int width, int height) {
     m.zFar = cam.projection.zFar;
     const mat4 flip = glm::scale(mat4(1.0f), vec3(1.0f, -1.0f, -1.0f));   // eye (y up, z back) -> camera (y down, z forward)
     m.worldToCamera = flip * cam.view;
+    m.cameraToWorld = cam.viewInverse * flip;
     m.pinhole = P[0][3] == 0.0f && P[1][3] == 0.0f && P[2][3] == -1.0f && P[3][3] == 0.0f && P[3][0] == 0.0f && P[3][1] == 0.0f && P[0][1] == 0.0f;
     if (!m.pinhole) return m;
     const double hw = 0.5 * width, hh = 0.5 * height;
@@ -57,6 +58,47 @@ std::vector<float> opticalDepthMap(const FrameCamera& cam, int width, int height
             if (k < zWindow.size()) out[k] = depthAt(inv, width, height, i, j, zWindow[k]);
         }
     return out;
+}
+
+bool projectionFromIntrinsics(double fx, double fy, double cx, double cy, int width, int height, float zNear, float zFar, Projection& out,
+                              std::string* error) {
+    auto fail = [&](const std::string& msg) {
+        if (error) *error = msg;
+        return false;
+    };
+    if (!(fx > 0) || !(fy > 0) || !std::isfinite(fx) || !std::isfinite(fy) || !std::isfinite(cx) || !std::isfinite(cy))
+        return fail("focal lengths must be positive and finite, the principal point finite");
+    if (width < 1 || height < 1) return fail("image size must be positive");
+    if (!(zNear > 0) || !(zFar > zNear) || !std::isfinite(zFar)) return fail("needs 0 < near < far");
+    Projection p;
+    p.type = ProjectionType::Perspective;
+    p.useFrustum = true;
+    p.zNear = zNear;
+    p.zFar = zFar;
+    const double n = zNear;
+    p.left = float(-n * cx / fx);
+    p.right = float(n * (width - cx) / fx);
+    p.top = float(n * cy / fy);
+    p.bottom = float(n * (cy - height) / fy);
+    p.fovyDeg = float(glm::degrees(2.0 * std::atan(0.5 * height / fy)));   // for the UI; the frustum is what renders
+    out = p;
+    return true;
+}
+
+FrameCamera frameCameraFromModel(const CameraModel& m, ProjectionType type, float aspect, float focusDistance) {
+    const mat4 flip = glm::scale(mat4(1.0f), vec3(1.0f, -1.0f, -1.0f));   // its own inverse
+    FrameCamera c;
+    c.projection.type = type;
+    c.projection.zNear = m.zNear;
+    c.projection.zFar = m.zFar;
+    c.aspect = aspect;
+    c.focusDistance = focusDistance;
+    c.view = flip * m.worldToCamera;
+    c.viewInverse = m.cameraToWorld * flip;   // exact, so the same eye and rays as the original
+    c.proj = m.projection;
+    c.viewProj = c.proj * c.view;
+    c.eye = vec3(c.viewInverse[3]);
+    return c;
 }
 
 }   // namespace sg

@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cstring>
 #include <fstream>
 
@@ -167,3 +168,27 @@ TEST(AovFiles, PfmRoundTripsAndTheSidecarHoldsTheCamera) {
 }
 
 }   // namespace
+
+// K -> projection -> K: projectionFromIntrinsics is the inverse of cameraModelOf, off-centre
+// principal points included, and rejects what has no frustum.
+TEST(CameraModel, ProjectionFromIntrinsicsGivesBackItsK) {
+    const sg::FrameInput f = planeFrame();
+    for (auto [fx, fy, cx, cy] : {std::array<double, 4>{200, 200, 80, 60}, {150.5, 171.25, 20.0, 100.0}, {400, 380, 159.0, 1.0}}) {
+        sg::Projection p;
+        std::string err;
+        ASSERT_TRUE(sg::projectionFromIntrinsics(fx, fy, cx, cy, W, H, 0.5f, 20.0f, p, &err)) << err;
+        const sg::FrameCamera cam = sg::makeFrameCamera(f.camera.viewInverse, p, float(W) / H, 5.0f);
+        const sg::CameraModel m = sg::cameraModelOf(cam, W, H);
+        ASSERT_TRUE(m.pinhole);
+        EXPECT_NEAR(m.K[0][0], fx, 1e-3 * fx);
+        EXPECT_NEAR(m.K[1][1], fy, 1e-3 * fy);
+        EXPECT_NEAR(m.K[0][2], cx, 1e-3);
+        EXPECT_NEAR(m.K[1][2], cy, 1e-3);
+        EXPECT_EQ(m.K[0][1], 0.0);
+    }
+    sg::Projection p;
+    std::string err;
+    EXPECT_FALSE(sg::projectionFromIntrinsics(0, 100, 10, 10, W, H, 0.5f, 20.0f, p, &err));
+    EXPECT_FALSE(sg::projectionFromIntrinsics(100, 100, 10, 10, W, H, 2.0f, 1.0f, p, &err));
+    EXPECT_FALSE(err.empty());
+}

@@ -40,4 +40,19 @@ struct AovSidecar {
 };
 std::string writeAovSidecar(const std::filesystem::path& path, const AovSidecar& s, bool overwrite);
 
+// A camera read back from a sidecar (its "camera" object) or from one line of a camera list:
+// {"K": [[fx,s,cx],[0,fy,cy],[0,0,1]] | null, "world_to_camera": 4x4 row-major (required),
+//  "camera_to_world" (its inverse; computed when absent),
+//  "projection": "perspective|orthographic|oblique", "projection_matrix": 4x4 row-major,
+//  "near", "far"} and optionally "width", "height" (the image it was made for; a whole sidecar
+// has them next to "camera"). Without a projection matrix, K (with near and far) makes one.
+struct AovCamera {
+    sg::CameraModel model;   // worldToCamera, projection (matrix), K / pinhole, near, far
+    std::string projection = "perspective";
+    int width = 0, height = 0;   // 0 = not given
+};
+// `text` is one JSON object; `where` names it in errors ("cams.jsonl:3"). "" or the reason.
+std::string parseAovCamera(const std::string& text, const std::string& where, AovCamera& out);
+std::string readAovCamera(const std::filesystem::path& path, AovCamera& out);
+
 }   // namespace assets
