@@ -57,26 +57,44 @@ std::string readPfm(const fs::path& path, int& width, int& height, std::vector<f
     return {};
 }
 
-std::string writeAovSidecar(const fs::path& path, const AovSidecar& s, bool overwrite) {
+namespace {
+
+nlohmann::json rows4(const sg::mat4& m) {
+    nlohmann::json r = nlohmann::json::array();
+    for (int row = 0; row < 4; ++row) r.push_back({m[0][row], m[1][row], m[2][row], m[3][row]});   // row-major
+    return r;
+}
+
+nlohmann::json cameraObject(const sg::CameraModel& c, const std::string& projection) {
     using nlohmann::json;
-    auto rows4 = [](const sg::mat4& m) {
-        json r = json::array();
-        for (int row = 0; row < 4; ++row) r.push_back({m[0][row], m[1][row], m[2][row], m[3][row]});   // row-major
-        return r;
-    };
-    json cam = {{"world_to_camera", rows4(s.camera.worldToCamera)},
-                {"camera_to_world", rows4(s.camera.cameraToWorld)},
-                {"projection", s.projection},
-                {"projection_matrix", rows4(s.camera.projection)},
-                {"near", s.camera.zNear},
-                {"far", s.camera.zFar}};
-    if (s.camera.pinhole) {
+    json cam = {{"world_to_camera", rows4(c.worldToCamera)},
+                {"camera_to_world", rows4(c.cameraToWorld)},
+                {"projection", projection},
+                {"projection_matrix", rows4(c.projection)},
+                {"near", c.zNear},
+                {"far", c.zFar}};
+    if (c.pinhole) {
         json K = json::array();
-        for (const auto& row : s.camera.K) K.push_back({row[0], row[1], row[2]});
+        for (const auto& row : c.K) K.push_back({row[0], row[1], row[2]});
         cam["K"] = K;
     } else {
         cam["K"] = nullptr;   // orthographic / oblique: no pinhole; projection_matrix maps eye to clip
     }
+    return cam;
+}
+
+}   // namespace
+
+std::string aovCameraJson(const sg::CameraModel& camera, const std::string& projection, int width, int height) {
+    nlohmann::json cam = cameraObject(camera, projection);
+    cam["width"] = width;
+    cam["height"] = height;
+    return cam.dump();
+}
+
+std::string writeAovSidecar(const fs::path& path, const AovSidecar& s, bool overwrite) {
+    using nlohmann::json;
+    json cam = cameraObject(s.camera, s.projection);
     json j = {{"width", s.width}, {"height", s.height}, {"backend", s.backend}, {"camera", cam}, {"files", s.files}};
     if (s.hasIds) {
         json ids = json::array();

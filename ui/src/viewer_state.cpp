@@ -481,6 +481,36 @@ void ViewerState::fitView(bool selectionOnly) {
     markViewChanged();
 }
 
+std::string ViewerState::setViewFromCameraModel(const sg::CameraModel& m, const std::string& projection, int width, int height) {
+    const int vw = std::max(view.viewportWidth, 1), vh = std::max(view.viewportHeight, 1);
+    if (width < 1 || height < 1) {
+        width = vw;
+        height = vh;
+    }
+    sg::Projection p = this->projection();
+    p.zNear = m.zNear;
+    p.zFar = m.zFar;
+    std::string err;
+    if (projection == "perspective") {
+        if (!m.pinhole) return "a perspective camera needs K";
+        const double sx = double(vw) / width, sy = double(vh) / height;
+        if (!sg::projectionFromIntrinsics(m.K[0][0] * sx, m.K[1][1] * sy, m.K[0][2] * sx, m.K[1][2] * sy, vw, vh, m.zNear, m.zFar, p, &err))
+            return err;
+    } else {
+        if (!(std::fabs(m.projection[1][1]) > 0)) return "the projection matrix has no vertical scale";
+        p.type = projection == "oblique" ? sg::ProjectionType::Oblique : sg::ProjectionType::Orthographic;
+        p.orthoHalfHeight = 1.0f / std::fabs(m.projection[1][1]);
+    }
+    const sg::mat4 flip = glm::scale(sg::mat4(1.0f), sg::vec3(1.0f, -1.0f, -1.0f));
+    const sg::mat4 cameraWorld = m.cameraToWorld * flip;   // computer-vision axes -> the camera's own (looks down -z)
+    if (!sg::isFinite(cameraWorld)) return "the pose is not finite";
+    view.camera.setFromWorld(cameraWorld, view.camera.distance);
+    view.camera.orthoScale = 1.0f;
+    setProjection(p, "");
+    markViewChanged();
+    return {};
+}
+
 void ViewerState::resetView() {
     const sg::Camera* c = activeCam(doc.scene);
     if (c) {

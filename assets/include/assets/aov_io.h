@@ -39,6 +39,9 @@ struct AovSidecar {
     bool hasIds = false;
 };
 std::string writeAovSidecar(const std::filesystem::path& path, const AovSidecar& s, bool overwrite);
+// The camera object of a sidecar, with "width" and "height" (one line of a camera list; what
+// Camera > Copy camera as JSON puts on the clipboard).
+std::string aovCameraJson(const sg::CameraModel& camera, const std::string& projection, int width, int height);
 
 // A camera read back from a sidecar (its "camera" object) or from one line of a camera list:
 // {"K": [[fx,s,cx],[0,fy,cy],[0,0,1]] | null, "world_to_camera": 4x4 row-major (required),

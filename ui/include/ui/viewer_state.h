@@ -21,6 +21,7 @@
 
 #include "assets/scene_io.h"
 #include "renderers/diagnostic.h"
+#include "scenegraph/camera_model.h"
 #include "scenegraph/frame.h"
 #include "scenegraph/scene.h"
 #include "ui/orbit_camera.h"
@@ -268,6 +269,10 @@ struct ViewerState {
     void resetView();                             // Home: back to the active scene camera
     void useSceneCamera(sg::NodeId cameraNode);   // make active and look through it
     void storeViewInCamera();                     // writes the orbit view into the active camera
+    // Camera > Paste camera: the view (pose and projection) from a computer-vision camera model
+    // (a sidecar's, assets/aov_io.h) made for a width x height image (0: the viewport's). K is
+    // scaled to the viewport. "" or the reason it cannot be used.
+    std::string setViewFromCameraModel(const sg::CameraModel& m, const std::string& projection, int width, int height);
     sg::mat4 cameraWorld() const { return view.camera.world(); }
     // The effective projection of the view (ortho zoom applied).
     sg::Projection viewProjection() const;
