@@ -265,7 +265,8 @@ TEST(PanelsTest, PanelStateBelongsToTheViewer) {
     EXPECT_TRUE(h.st.ui.panels.shotDialog.open);
     h.click("shot/take");
     EXPECT_TRUE(h.st.ui.requests.screenshot);
-    EXPECT_EQ(h.st.ui.requests.screenshotWidth, 0);   // window size by default
+    EXPECT_EQ(h.st.ui.requests.screenshotWidth, h.st.view.viewportWidth);   // the viewport's size by default, as the option's label says
+    EXPECT_EQ(h.st.ui.requests.screenshotHeight, h.st.view.viewportHeight);
 }
 
 TEST(PanelsTest, F2RenamesTheSelectionInPlace) {

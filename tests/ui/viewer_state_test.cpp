@@ -259,6 +259,46 @@ TEST(ViewerStateTest, ScreenshotNamesNeverOverwrite) {
     EXPECT_EQ(b.extension(), ".png");
 }
 
+// Issue 19 item 9: the dialog's size option says the size it writes; the status line names
+// every file written (the folder once, absolute) and every failure; a folder that cannot be
+// made is an error, not a silent "."
+TEST(ViewerStateTest, ScreenshotSizeIsTheOneTheLabelNames) {
+    View view;
+    view.viewportWidth = 1031;
+    view.viewportHeight = 644;
+    ScreenshotDialogState dialog;   // ticked, with 1920x1080 in the (disabled) fields
+    EXPECT_EQ(screenshotSize(dialog, view), std::make_pair(1031, 644));
+    EXPECT_EQ(screenshotSizeLabel(dialog, view).rfind("Viewport size (1031x644)", 0), 0u) << screenshotSizeLabel(dialog, view);
+    dialog.windowSize = false;
+    EXPECT_EQ(screenshotSize(dialog, view), std::make_pair(1920, 1080));
+    EXPECT_EQ(screenshotSizeLabel(dialog, view).rfind("Viewport size (1031x644)", 0), 0u) << "the option names the viewport either way";
+}
+
+TEST(ViewerStateTest, ScreenshotSummaryNamesEveryFileAndFailure) {
+    const fs::path dir = "/home/me/shots";
+    EXPECT_EQ(screenshotSummary({{"gl", dir / "screenshot-gl.png", ""}, {"raster", dir / "screenshot-raster.png", ""}}),
+              "Saved 2 screenshots in /home/me/shots: screenshot-gl.png, screenshot-raster.png");
+    EXPECT_EQ(screenshotSummary({{"gl", dir / "screenshot-gl.png", "OpenGL error 0x502"}, {"raster", dir / "screenshot-raster.png", ""}}),
+              "Saved screenshot-raster.png in /home/me/shots; gl failed: OpenGL error 0x502");
+    EXPECT_EQ(screenshotSummary({{"gl", dir / "screenshot-gl.png", "no context"}}), "Screenshot failed: gl failed: no context");
+}
+
+TEST(ViewerStateTest, ScreenshotFolderIsAbsoluteAndABadOneIsAnError) {
+    fs::path base = testing_support::outputDir("ui") / "shot_folder";
+    fs::remove_all(base);
+    std::string err;
+    fs::path made = prepareScreenshotFolder(base / "new" / "", &err);
+    EXPECT_EQ(err, "");
+    EXPECT_TRUE(made.is_absolute());
+    EXPECT_EQ(made.filename(), "new") << "no trailing separator: " << made;
+    EXPECT_TRUE(fs::is_directory(made));
+    EXPECT_TRUE(prepareScreenshotFolder("", &err).is_absolute()) << "empty = the current folder";
+    ASSERT_EQ(assets::writeFileAtomic(base / "file", "x", false), "");
+    EXPECT_TRUE(prepareScreenshotFolder(base / "file", &err).empty());
+    EXPECT_NE(err.find("cannot use folder"), std::string::npos) << err;
+    EXPECT_TRUE(prepareScreenshotFolder(base / "file" / "sub", &err).empty());
+}
+
 TEST(ViewerStateTest, RecentFilesPersist) {
     fs::path dir = testing_support::outputDir("ui") / "config";
     fs::remove_all(dir);

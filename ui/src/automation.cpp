@@ -16,6 +16,8 @@
 //                         coordinates, the menu bar at the top), at pixel (X, Y) of the 3D
 //                         viewport (from its top-left corner), or at the centre of a widget the
 //                         panels record (menu/edit, edit/undo, tree/crate, confirm/discard, ...)
+//   drag X0 Y0 X1 Y1      left drag in the 3D viewport (pixels from its top-left corner): press
+//                         at (X0, Y0), move to (X1, Y1) over 8 frames, release (an orbit)
 // The document (as the File and Edit menus do)
 //   open PATH             File > Open, asking first when there are unsaved changes
 //   answer save|discard|cancel   answers the unsaved-changes question
@@ -189,6 +191,7 @@ Automation::Next Automation::runCommand(const std::string& cmd, std::istringstre
     if (cmd == "quit") return Next::Quit;
     if (cmd == "key") return keyCommand(restOfLine(in), host);
     if (cmd == "click") return clickCommand(in, host.state());
+    if (cmd == "drag") return dragCommand(restOfLine(in), host.state());
     if (cmd == "print") return printCommand(restOfLine(in), host);
     if (cmd == "stats") {
         host.printStats();
@@ -260,6 +263,25 @@ Automation::Next Automation::clickCommand(std::istringstream& in, const ViewerSt
     }
     m_mouse = {{x, y, false}, {x, y, true}, {x, y, false}};
     m_waitFrames = 1;
+    return Next::Yield;
+}
+
+// Hover, press, 8 moving frames held down, release: what a user's orbit drag gives ImGui.
+Automation::Next Automation::dragCommand(const std::string& args, const ViewerState& st) {
+    auto vp = st.hooks.itemRects.find("viewport");
+    float x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+    std::istringstream in(args);
+    if (vp == st.hooks.itemRects.end() || !(in >> x0 >> y0 >> x1 >> y1))
+        return fail("drag " + args + ": expected X0 Y0 X1 Y1 in the viewport, after a frame was drawn");
+    const float ox = vp->second.x0, oy = vp->second.y0;
+    constexpr int kSteps = 8;
+    m_mouse = {{ox + x0, oy + y0, false}, {ox + x0, oy + y0, true}};
+    for (int i = 1; i <= kSteps; ++i) {
+        float t = float(i) / kSteps;
+        m_mouse.push_back({ox + x0 + t * (x1 - x0), oy + y0 + t * (y1 - y0), true});
+    }
+    m_mouse.push_back({ox + x1, oy + y1, false});
+    m_waitFrames = 0;
     return Next::Yield;
 }
 

@@ -267,7 +267,9 @@ void drawEditMenu(ViewerState& st) {
 
 void drawMainMenu(ViewerState& st) {
     if (!ImGui::BeginMainMenuBar()) return;
-    if (ImGui::BeginMenu("File")) {
+    bool fileOpen = ImGui::BeginMenu("File");
+    record(st, "menu/file");
+    if (fileOpen) {
         if (ImGui::MenuItem("New", "Ctrl+N")) st.requestNew();
         if (ImGui::MenuItem("Open...", "Ctrl+O")) st.ui.requests.openDialog = true;
         if (ImGui::BeginMenu("Open Recent", !st.config.recentFiles.empty())) {
@@ -281,6 +283,7 @@ void drawMainMenu(ViewerState& st) {
         ImGui::Separator();
         if (ImGui::MenuItem("Screenshot", "F12")) st.ui.requests.screenshot = true;
         if (ImGui::MenuItem("Screenshot at resolution...")) st.ui.requests.screenshotDialog = true;
+        record(st, "file/screenshotDialog");
         ImGui::Separator();
         if (ImGui::MenuItem("Quit", "Ctrl+Q")) st.requestQuit();
         ImGui::EndMenu();
@@ -1479,45 +1482,60 @@ void drawFileBrowser(ViewerState& st) {
     ImGui::EndPopup();
 }
 
+// Width and height fields: the viewport's size, read-only, while "Viewport size" is ticked
+// (so they show what will be written), else the custom size with presets.
+void screenshotSizeFields(ScreenshotDialogState& dialog, const View& view) {
+    bool viewport = dialog.windowSize;
+    int w = viewport ? view.viewportWidth : dialog.width, h = viewport ? view.viewportHeight : dialog.height;
+    ImGui::BeginDisabled(viewport);
+    ImGui::InputInt("Width", &w);
+    ImGui::InputInt("Height", &h);
+    for (auto [pw, ph] : {std::pair{1280, 720}, std::pair{1920, 1080}, std::pair{3840, 2160}}) {
+        if (pw != 1280) ImGui::SameLine();
+        if (ImGui::SmallButton((std::to_string(pw) + "x" + std::to_string(ph)).c_str())) w = pw, h = ph;
+    }
+    ImGui::EndDisabled();
+    if (viewport) return;
+    dialog.width = std::clamp(w, 1, 16384);
+    dialog.height = std::clamp(h, 1, 16384);
+}
+
+// Take: the folder typed is checked (made when missing) before anything renders; a folder
+// that cannot be used keeps the dialog open with the reason.
+bool takeScreenshot(ViewerState& st, ScreenshotDialogState& dialog, std::string& error) {
+    fs::path dir = prepareScreenshotFolder(dialog.dirText, &error);
+    if (dir.empty()) return false;
+    dialog.dir = dir;
+    auto [w, h] = screenshotSize(dialog, st.view);
+    st.ui.requests.screenshot = true;
+    st.ui.requests.screenshotWidth = w;
+    st.ui.requests.screenshotHeight = h;
+    return true;
+}
+
 void drawScreenshotDialog(ViewerState& st) {
     ScreenshotDialogState& dialog = st.ui.panels.shotDialog;
     if (st.ui.requests.screenshotDialog) {
         st.ui.requests.screenshotDialog = false;
         dialog.open = true;
+        dialog.error.clear();
+        dialog.dirText = absoluteFolder(dialog.dir).string();
         ImGui::OpenPopup("Screenshot");
     }
     if (!ImGui::BeginPopupModal("Screenshot", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) return;
-    ImGui::Checkbox("Window size", &dialog.windowSize);
-    ImGui::BeginDisabled(dialog.windowSize);
-    ImGui::InputInt("Width", &dialog.width);
-    ImGui::InputInt("Height", &dialog.height);
-    if (ImGui::SmallButton("1280x720")) {
-        dialog.width = 1280;
-        dialog.height = 720;
-    }
-    ImGui::SameLine();
-    if (ImGui::SmallButton("1920x1080")) {
-        dialog.width = 1920;
-        dialog.height = 1080;
-    }
-    ImGui::SameLine();
-    if (ImGui::SmallButton("3840x2160")) {
-        dialog.width = 3840;
-        dialog.height = 2160;
-    }
-    ImGui::EndDisabled();
-    dialog.width = std::clamp(dialog.width, 1, 16384);
-    dialog.height = std::clamp(dialog.height, 1, 16384);
-    ImGui::TextDisabled("One PNG per backend shown, rendered offscreen;\nnamed screenshot-<backend>[-N].png, never overwriting.");
-    if (ImGui::Button("Take", ImVec2(px(90), 0))) {
-        st.ui.requests.screenshot = true;
-        st.ui.requests.screenshotWidth = dialog.windowSize ? 0 : dialog.width;
-        st.ui.requests.screenshotHeight = dialog.windowSize ? 0 : dialog.height;
-        ImGui::CloseCurrentPopup();
-    }
+    ImGui::Checkbox(screenshotSizeLabel(dialog, st.view).c_str(), &dialog.windowSize);
+    record(st, "shot/viewportSize");
+    screenshotSizeFields(dialog, st.view);
+    ImGui::SetNextItemWidth(px(360));
+    ImGui::InputText("Folder", &dialog.dirText);
+    record(st, "shot/folder");
+    if (!dialog.error.empty()) ImGui::TextColored(ImVec4(1.0f, 0.6f, 0.45f, 1.0f), "%s", dialog.error.c_str());
+    ImGui::TextDisabled(
+        "One PNG per backend shown, rendered offscreen;\nnamed screenshot-<backend>[-N].png, never overwriting.\nF12 saves into the same folder.");
+    if (ImGui::Button("Take", ImVec2(px(90), 0)) && takeScreenshot(st, dialog, dialog.error)) ImGui::CloseCurrentPopup();
     record(st, "shot/take");
     ImGui::SameLine();
-    if (ImGui::Button("Cancel", ImVec2(px(90), 0))) ImGui::CloseCurrentPopup();
+    if (ImGui::Button("Cancel", ImVec2(px(90), 0)) || ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Escape))) ImGui::CloseCurrentPopup();
     ImGui::EndPopup();
 }
 

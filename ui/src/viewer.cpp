@@ -85,6 +85,16 @@ struct Texture {
     void* imguiId() const { return id ? reinterpret_cast<void*>(uintptr_t(id)) : nullptr; }
 };
 
+// Clears the window context's latched GL errors, reporting each on stderr with `where` (what
+// ran since the last check). GL keeps an error until someone calls glGetError: without this, a
+// later GL render in the same context (a GL screenshot on the UI thread) reports it as its own
+// failure. Returns how many there were.
+int drainGlErrors(const char* where) {
+    int n = 0;
+    for (GLenum e; (e = glGetError()) != GL_NO_ERROR && n < 16; ++n) std::fprintf(stderr, "viewer: OpenGL error 0x%x in %s\n", e, where);
+    return n;
+}
+
 // Reads the default framebuffer (the whole window) into a PNG.
 std::string saveWindowPng(GLFWwindow* win, const fs::path& path) {
     int w = 0, h = 0;
@@ -129,7 +139,6 @@ public:
     Texture diffTexture;
     uint64_t diffKey = ~uint64_t(0);
     std::vector<PendingShot> shots;
-    fs::path shotDir = ".";
     std::vector<std::string> droppedFiles;
     float newContentScale = 0.0f;   // set by the content-scale callback, applied between frames
     std::string iniPath;            // imgui.ini; ImGui keeps the char pointer, so it lives here
@@ -190,8 +199,10 @@ public:
         const rnd::Framebuffer& fa = a.image();
         const rnd::Framebuffer& fb = b.image();
         if (fa.width == 0 || fa.width != fb.width || fa.height != fb.height || a.status().level != 1 || b.status().level != 1) {
+            // Not shown (viewportInput checks diff.valid) but not deleted either: this frame's
+            // ImGui draw data, recorded before this call, may still name the texture, and
+            // drawing a deleted texture is GL_INVALID_OPERATION (issue 19 item 3).
             diffKey = ~uint64_t(0);
-            diffTexture.release();
             return;
         }
         // Recompute when either image, the pair or the threshold changed.
@@ -229,16 +240,22 @@ public:
         return in;
     }
 
-    // Starts offscreen screenshots of every visible backend at w x h (0 = viewport size).
-    void startScreenshots(int w, int h, const fs::path& dir) {
+    // Starts offscreen screenshots of every visible backend at w x h (0 = viewport size) into
+    // `dir` (made absolute, created when missing; a folder that cannot be made is a one-line
+    // error in the status bar).
+    void startScreenshots(int w, int h, const fs::path& folder) {
         if (w < 1 || h < 1) {
             w = st.view.viewportWidth;
             h = st.view.viewportHeight;
         }
+        std::string folderError;
+        fs::path dir = prepareScreenshotFolder(folder, &folderError);
+        if (dir.empty()) {
+            st.ui.status = "Screenshot failed: " + folderError;
+            return;
+        }
         float aspect = float(w) / float(h);
         auto base = std::make_shared<sg::FrameInput>(st.buildFrame(aspect));
-        std::error_code ec;
-        fs::create_directories(dir, ec);
         std::vector<std::string> names = visibleBackends(st);
         std::sort(names.begin(), names.end());
         names.erase(std::unique(names.begin(), names.end()), names.end());
@@ -263,6 +280,7 @@ public:
                 return assets::writePng(path, fb.width, fb.height, fb.color.data(), /*overwrite=*/false);
             };
             if (r->capabilities().affinity == rnd::ContextAffinity::CurrentGLContext) {   // the window's context: here, now
+                drainGlErrors("the window's context before a GL screenshot");             // not this render's errors
                 std::promise<std::string> pr;
                 pr.set_value(job());
                 p.result = pr.get_future();
@@ -271,8 +289,8 @@ public:
             }
             shots.push_back(std::move(p));
         }
-        st.ui.status =
-            "Screenshot: rendering " + std::to_string(names.size()) + " image(s) at " + std::to_string(w) + "x" + std::to_string(h) + "...";
+        st.ui.status = "Screenshot: rendering " + std::to_string(names.size()) + " image(s) at " + std::to_string(w) + "x" + std::to_string(h) +
+                       " into " + dir.string() + "...";
     }
 
     void pollScreenshots(bool wait) {
@@ -282,14 +300,13 @@ public:
                 continue;
             }
             std::string err = shots[i].result.get();
-            if (err.empty())
-                st.ui.status = "Saved " + shots[i].path.string();
-            else {
-                st.ui.status = "Screenshot failed: " + err;
-                std::fprintf(stderr, "viewer: screenshot: %s\n", err.c_str());
-            }
-            lastShotErrors.push_back(err);
+            if (!err.empty()) std::fprintf(stderr, "viewer: screenshot: %s: %s\n", shots[i].backend.c_str(), err.c_str());
+            shotResults.push_back({shots[i].backend, shots[i].path, err});
             shots.erase(shots.begin() + i);
+        }
+        if (shots.empty() && !shotResults.empty()) {   // the whole batch is done: one line naming every file
+            st.ui.status = screenshotSummary(shotResults);
+            shotResults.clear();
         }
     }
 
@@ -312,7 +329,7 @@ public:
         diffTexture.release();
     }
 
-    std::vector<std::string> lastShotErrors;
+    std::vector<ScreenshotResult> shotResults;   // of the batch in flight, finished so far
 
     // --- AutomationHost ---
     ViewerState& state() override { return st; }
@@ -580,7 +597,7 @@ private:
         Requests& r = m_st.ui.requests;
         if (r.screenshot) {
             r.screenshot = false;
-            m_v.startScreenshots(r.screenshotWidth, r.screenshotHeight, m_v.shotDir);
+            m_v.startScreenshots(r.screenshotWidth, r.screenshotHeight, m_st.ui.panels.shotDialog.dir);
             r.screenshotWidth = r.screenshotHeight = 0;
         }
     }
@@ -596,6 +613,7 @@ private:
         glClearColor(0.08f, 0.09f, 0.10f, 1.0f);
         glClear(GL_COLOR_BUFFER_BIT);
         ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+        drainGlErrors("the UI drawing");
         if (!m_automation.windowShot.empty()) {
             std::string err = saveWindowPng(m_win, m_automation.windowShot);
             if (!err.empty()) {

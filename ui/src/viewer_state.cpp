@@ -833,4 +833,54 @@ fs::path screenshotPath(const fs::path& dir, const std::string& backend, const s
     return assets::uniquePath(dir / (stem + "-" + backend + ".png"));
 }
 
+std::string screenshotSummary(const std::vector<ScreenshotResult>& results) {
+    std::string saved, failed;
+    int count = 0;
+    fs::path dir;
+    for (const ScreenshotResult& r : results) {
+        if (!r.error.empty()) {
+            failed += "; " + r.backend + " failed: " + r.error;
+            continue;
+        }
+        saved += (count++ ? ", " : "") + r.path.filename().string();
+        dir = r.path.parent_path();
+    }
+    std::string line = count == 0   ? "Screenshot failed"
+                       : count == 1 ? "Saved " + saved + " in " + dir.string()
+                                    : "Saved " + std::to_string(count) + " screenshots in " + dir.string() + ": " + saved;
+    return count == 0 && !failed.empty() ? line + ": " + failed.substr(2) : line + failed;
+}
+
+std::pair<int, int> screenshotSize(const ScreenshotDialogState& dialog, const View& view) {
+    if (dialog.windowSize) return {std::max(view.viewportWidth, 1), std::max(view.viewportHeight, 1)};
+    return {std::clamp(dialog.width, 1, 16384), std::clamp(dialog.height, 1, 16384)};
+}
+
+std::string screenshotSizeLabel(const ScreenshotDialogState& dialog, const View& view) {
+    ScreenshotDialogState viewport = dialog;
+    viewport.windowSize = true;
+    auto [w, h] = screenshotSize(viewport, view);
+    return "Viewport size (" + std::to_string(w) + "x" + std::to_string(h) + ")###viewportSize";
+}
+
+fs::path absoluteFolder(const fs::path& folder) {
+    std::error_code ec;
+    fs::path dir = fs::absolute(folder.empty() ? fs::path(".") : folder, ec).lexically_normal();
+    if (ec) return folder;
+    if (!dir.has_filename() && dir != dir.root_path()) dir = dir.parent_path();   // "/a/b/" -> "/a/b"
+    return dir;
+}
+
+fs::path prepareScreenshotFolder(const fs::path& folder, std::string* error) {
+    std::error_code ec;
+    fs::path dir = absoluteFolder(folder);
+    fs::create_directories(dir, ec);
+    if (!ec && !fs::is_directory(dir, ec)) ec = std::make_error_code(std::errc::not_a_directory);
+    if (ec) {
+        if (error) *error = "cannot use folder '" + folder.string() + "': " + ec.message();
+        return {};
+    }
+    return dir;
+}
+
 }   // namespace ui

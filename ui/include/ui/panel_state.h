@@ -27,6 +27,9 @@ struct ScreenshotDialogState {
     bool open = false;
     bool windowSize = true;   // render at the viewport size (else width x height)
     int width = 1920, height = 1080;
+    std::filesystem::path dir;   // where screenshots go, F12's too ("" = the folder the viewer started in)
+    std::string dirText;         // the folder field being edited (filled when the dialog opens)
+    std::string error;           // why Take was refused (a folder that cannot be made)
 };
 
 struct PanelState {

@@ -331,4 +331,24 @@ std::string saveRecentFiles(const std::filesystem::path& configDir, const std::v
 // dir/"<stem>-<backend>.png" or, when taken, the first free "-N" variant (assets::uniquePath).
 std::filesystem::path screenshotPath(const std::filesystem::path& dir, const std::string& backend, const std::string& stem = "screenshot");
 
+// One backend's screenshot, finished: the file written, or why not.
+struct ScreenshotResult {
+    std::string backend;
+    std::filesystem::path path;   // absolute
+    std::string error;            // "" when written
+};
+// The status line for a finished batch: every file written, the folder once (absolute), then
+// each failure ("Saved 2 screenshots in /home/me/shots: screenshot-gl.png, screenshot-raster.png",
+// "Saved screenshot-raster.png in /home/me/shots; gl failed: OpenGL error 0x502 ...").
+std::string screenshotSummary(const std::vector<ScreenshotResult>& results);
+// `folder` absolute and normalised, without a trailing separator ("" = the current folder).
+std::filesystem::path absoluteFolder(const std::filesystem::path& folder);
+// `folder` made absolute (empty = the current folder) and created when missing; empty with
+// *error set when it cannot be.
+std::filesystem::path prepareScreenshotFolder(const std::filesystem::path& folder, std::string* error);
+// The size a screenshot from the dialog is written at: the viewport's while "Viewport size" is
+// ticked, else the dialog's width x height; and the checkbox's label, which names it.
+std::pair<int, int> screenshotSize(const ScreenshotDialogState& dialog, const View& view);
+std::string screenshotSizeLabel(const ScreenshotDialogState& dialog, const View& view);
+
 }   // namespace ui
