@@ -316,3 +316,32 @@ TEST(ViewerAutomationGLTest, ScreenshotAfterAnOrbitSavesEveryShownBackend) {
         EXPECT_EQ(r.log.find("OpenGL error"), std::string::npos) << dump(r);
     }
 }
+
+// Issue 19, item 12: right after a load the viewport shows nothing of the previous scene: no
+// image (it says "rendering...") and no figures, in the single and the split view; once
+// rendered, the new scene's.
+TEST(ViewerAutomationGLTest, AfterALoadNothingOfThePreviousSceneIsShown) {
+    if (!viewer_test::haveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+    fs::path dir = sceneFolder("automation_load_clears");
+    ScriptRun r = runScript(dir,
+                            "wait\n"
+                            "view split\n"
+                            "wait\n"
+                            "stats\n"   // 0, 1: the demo
+                            "open small.json\n"
+                            "wait load\n"
+                            "stats\n"   // 2, 3: right after the load
+                            "window-shot loaded.png\n"
+                            "wait\n"
+                            "stats\n"   // 5, 6: the small scene (no geometry)
+                            "quit\n");
+    ASSERT_EQ(r.rc, 0) << dump(r);
+    ASSERT_EQ(r.out.size(), 7u) << dump(r);
+    for (int i : {0, 1}) EXPECT_EQ(r.out[size_t(i)].find(", 0 triangles"), std::string::npos) << "the demo has triangles: " << r.out[size_t(i)];
+    for (int i : {2, 3}) {
+        EXPECT_EQ(r.out[size_t(i)].rfind("stats ", 0), 0u) << r.out[size_t(i)];
+        EXPECT_NE(r.out[size_t(i)].find(": no image yet"), std::string::npos) << r.out[size_t(i)];
+    }
+    for (int i : {5, 6}) EXPECT_NE(r.out[size_t(i)].find("level 1: "), std::string::npos) << r.out[size_t(i)];
+    for (int i : {5, 6}) EXPECT_NE(r.out[size_t(i)].find(", 0 triangles"), std::string::npos) << r.out[size_t(i)];
+}

@@ -340,6 +340,35 @@ TEST(RenderSlotTest, RendersCoarseToFineOrReportsError) {
     EXPECT_EQ(slot.status().level, 1);
 }
 
+// Issue 19 item 12: after a load the slot forgets the old scene's picture and figures, and a
+// render requested before forget() never shows up afterwards, however far it got.
+TEST(RenderSlotTest, ForgetDropsTheImageAndRendersInFlight) {
+    ViewerState st = demoState();
+    auto frame = std::make_shared<sg::FrameInput>(st.buildFrame(64.0f / 48.0f));
+    RenderSlot slot("raster");
+    slot.request(frame, 64, 48, 1, /*interacting=*/false);
+    slot.waitIdle();
+    slot.poll();
+    if (!slot.status().error.empty()) GTEST_SKIP() << "raster backend not available: " << slot.status().error;
+    ASSERT_TRUE(slot.hasImage());
+    ASSERT_GT(slot.status().stats.triangles, 0u);
+    uint64_t serial = slot.imageSerial();
+    slot.forget();
+    EXPECT_FALSE(slot.hasImage());
+    EXPECT_EQ(slot.status().stats.triangles, 0u);
+    EXPECT_NE(slot.imageSerial(), serial);
+    EXPECT_TRUE(slot.needs(1, false)) << "the same key renders again after forget()";
+    slot.request(frame, 64, 48, 2, /*interacting=*/false);
+    slot.forget();   // pending or in flight: either way it is dropped
+    slot.waitIdle();
+    slot.poll();
+    EXPECT_FALSE(slot.hasImage());
+    slot.request(frame, 64, 48, 3, /*interacting=*/false);
+    slot.waitIdle();
+    slot.poll();
+    EXPECT_EQ(slot.image().width, 64);
+}
+
 TEST(RenderSlotTest, UnknownBackendIsAnError) {
     RenderSlot slot("nope");
     EXPECT_FALSE(slot.status().error.empty());

@@ -6,6 +6,8 @@
 //   frames N              run N frames
 //   wait                  until no load / screenshot is in flight and the shown backends have
 //                         their full-resolution images (or errors)
+//   wait load             until no load is in flight (renders of the new scene may not have
+//                         started: what the user sees right after a load)
 //   quit
 // Input, through the paths the user's input takes
 //   key [MOD+]...KEY      press for one frame: MOD ctrl|shift|alt|super, KEY a letter, a digit,
@@ -145,7 +147,10 @@ bool Automation::step(AutomationHost& host) {
         --m_waitFrames;
         return true;
     }
-    if (m_waiting) {
+    if (m_waitingLoad) {
+        if (host.state().loadInProgress()) return true;
+        m_waitingLoad = false;
+    } else if (m_waiting) {
         host.pollScreenshots();
         if (!host.idle()) return true;
         m_waiting = false;
@@ -185,7 +190,9 @@ Automation::Next Automation::runCommand(const std::string& cmd, std::istringstre
         return Next::Yield;
     }
     if (cmd == "wait") {
-        m_waiting = true;
+        std::string what = restOfLine(in);
+        if (!what.empty() && what != "load") return fail("wait " + what + ": expected wait or wait load");
+        (what.empty() ? m_waiting : m_waitingLoad) = true;
         return Next::Yield;
     }
     if (cmd == "quit") return Next::Quit;

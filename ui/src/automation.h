@@ -64,6 +64,7 @@ private:
     size_t m_pc = 0;   // next line
     int m_waitFrames = 0;
     bool m_waiting = false;                    // `wait`: until host.idle()
+    bool m_waitingLoad = false;                // `wait load`: until no load is in flight
     std::vector<std::pair<int, int>> m_held;   // keys pressed last frame (key, mods), released next step
     std::deque<MouseFrame> m_mouse;            // one per frame, consumed by overrideMouse
 };

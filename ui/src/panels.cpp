@@ -1110,6 +1110,7 @@ void drawSlotImage(ImDrawList* dl, const SlotView& v, ImVec2 a, ImVec2 b, float 
 }
 
 std::string slotStats(const SlotView& v) {
+    if (!v.texture && v.status.error.empty()) return v.status.backend + "  rendering...";   // no figures of a picture not shown
     char buf[256];
     const rnd::RenderStats& s = v.status.stats;
     std::string extra;

@@ -156,8 +156,20 @@ public:
     RenderSlot::Threading slotThreading() const { return st.view.glOnWorker ? RenderSlot::Threading::Worker : RenderSlot::Threading::Auto; }
     static bool contextBound(const RenderSlot& slot) { return slot.capabilities().affinity == rnd::ContextAffinity::CurrentGLContext; }
 
+    // After setScene (a load, File > New): every slot drops the previous scene's image, stats and
+    // renders in flight, so the viewport says "rendering..." until the new scene's first
+    // (coarse) image instead of showing the old one (issue 19 item 12). The textures stay (this
+    // frame's UI may draw them) but are not shown while their slot has no image.
+    void forgetOldScene() {
+        if (st.doc.sceneSerial == m_shownScene) return;
+        m_shownScene = st.doc.sceneSerial;
+        for (auto& [name, v] : views) v.slot->forget();
+        diffKey = ~uint64_t(0);
+    }
+
     // Requests renders for the visible backends and uploads finished images.
     void updateRenders() {
+        forgetOldScene();
         if (st.view.glOnWorker != m_glOnWorker) {   // where context-bound backends run changed: new slots
             m_glOnWorker = st.view.glOnWorker;
             for (auto& [name, v] : views) {
@@ -226,7 +238,7 @@ public:
         for (const std::string& n : visibleBackends(st)) {
             BackendView& v = viewFor(n);
             SlotView s;
-            s.texture = v.texture.imguiId();
+            s.texture = v.slot->hasImage() ? v.texture.imguiId() : nullptr;
             s.width = v.texture.width;
             s.height = v.texture.height;
             s.status = v.slot->status();
@@ -338,7 +350,12 @@ public:
     void startScreenshots(const fs::path& dir) override { startScreenshots(0, 0, dir); }
     void printStats() override {
         for (const std::string& n : visibleBackends(st)) {
-            SlotStatus s = viewFor(n).slot->status();
+            const RenderSlot& slot = *viewFor(n).slot;
+            SlotStatus s = slot.status();
+            if (!slot.hasImage() && s.error.empty()) {
+                std::printf("viewer: stats %s %dx%d: no image yet\n", n.c_str(), st.view.viewportWidth, st.view.viewportHeight);
+                continue;
+            }
             std::printf("viewer: stats %s %dx%d level %d: %.1f ms, %llu triangles, %llu rays%s%s\n", n.c_str(), st.view.viewportWidth,
                         st.view.viewportHeight, s.level, s.stats.milliseconds, (unsigned long long)s.stats.triangles,
                         (unsigned long long)s.stats.rays, s.error.empty() ? "" : ", error: ", s.error.c_str());
@@ -354,6 +371,7 @@ public:
 private:
     rnd::ImageDiff m_lastDiff;
     bool m_glOnWorker = false;
+    uint64_t m_shownScene = 0;   // doc.sceneSerial the slots' images belong to
 };
 
 }   // namespace
@@ -570,7 +588,7 @@ private:
             m_st.requestOpen(m_v.droppedFiles.front());
             m_v.droppedFiles.clear();
         }
-        m_st.pollLoad();
+        if (m_st.pollLoad()) m_v.forgetOldScene();   // before the script or the UI look at the images
         m_st.advanceAnimation(dt);
         m_v.pollScreenshots(false);
     }

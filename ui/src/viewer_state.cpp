@@ -33,6 +33,7 @@ void ViewerState::setScene(sg::Scene s, fs::path path) {
     anim.time = 0.0;
     anim.playing = false;
     ++doc.version;
+    ++doc.sceneSerial;
     resetView();
 }
 

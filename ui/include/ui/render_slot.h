@@ -57,6 +57,11 @@ public:
     SlotStatus status() const;
     // Blocks until nothing is pending (tests, screenshots at exit).
     void waitIdle();
+    // Drops the shown image, its stats and every render pending or in flight (a different scene
+    // was loaded: the old one's picture and figures must not stay on screen). A render that
+    // finishes afterwards is thrown away; the next request() starts afresh.
+    void forget();
+    bool hasImage() const { return m_shown.width > 0; }
 
     int previewDivisor = 4;
 
@@ -66,11 +71,12 @@ private:
         int width = 0, height = 0;
         uint64_t key = 0;
         bool previewOnly = false;
+        uint64_t generation = 0;   // m_generation when requested: forget() outdates it
     };
     void workerLoop();
     // Renders one job level by level; publishes each finished level. Returns false when cancelled.
     void runJob(const Job& job);
-    void publish(rnd::Framebuffer&& fb, const rnd::RenderStats& st, int level);
+    void publish(rnd::Framebuffer&& fb, const rnd::RenderStats& st, int level, uint64_t generation);
 
     std::string m_backend;
     bool m_threaded;
@@ -88,6 +94,7 @@ private:
     bool m_quit = false;
     rnd::RenderControl* m_control = nullptr;   // of the render in flight (guarded by m_mutex)
     bool m_haveNew = false;
+    uint64_t m_generation = 0;     // bumped by forget() (guarded by m_mutex)
     rnd::Framebuffer m_finished;   // published by the worker
     SlotStatus m_status;
     std::thread m_thread;

@@ -100,6 +100,7 @@ struct Document {
     bool dirty = false;           // unsaved edits (= !history.atSavedState() after every edit, undo, redo, save)
     UndoStack history;            // every scene edit, for Edit > Undo / Redo
     uint64_t version = 1;         // bumped on every scene change, edits and animation poses (re-render)
+    uint64_t sceneSerial = 1;     // bumped by setScene only: a different scene (drop the old one's images)
     sg::NodeId selected = sg::kNoNode;
     std::vector<std::string> loadWarnings;   // of the load that brought this scene
 };
