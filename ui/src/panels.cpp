@@ -14,6 +14,8 @@
 //  11. shortcuts and layout
 #include "ui/panels.h"
 
+#include "ui/colour.h"
+
 #include "assets/scene_io.h"
 #include "renderers/framebuffer.h"
 #include "renderers/renderer.h"
@@ -47,6 +49,17 @@ float px(float v) { return v * g_scale; }
 void record(ViewerState& st, const std::string& key) {
     ImVec2 a = ImGui::GetItemRectMin(), b = ImGui::GetItemRectMax();
     st.hooks.itemRects[key] = ItemRect{a.x, a.y, b.x, b.y};
+}
+
+// A colour editor for a colour the scene stores linear: it shows and takes sRGB-encoded 0..255
+// values (what the viewport and a colour picker show); only an edit writes back, so an
+// untouched value never drifts. Values above 1 (HDR light colours) switch to floats.
+bool srgbColorEdit(const char* label, sg::vec3& linear, ImGuiColorEditFlags flags = 0) {
+    sg::vec3 shown = srgbFromLinear(linear);
+    if (std::max({shown.x, shown.y, shown.z}) > 1.0f) flags |= ImGuiColorEditFlags_Float | ImGuiColorEditFlags_HDR;
+    if (!ImGui::ColorEdit3(label, &shown.x, flags)) return false;
+    linear = linearFromSrgb(shown);
+    return true;
 }
 
 // The last item's tooltip (a table entry's help; nothing when empty).
@@ -518,7 +531,7 @@ bool materialEditor(ViewerState& st, sg::NodeId id, int& index) {
     sg::Material m = st.doc.scene.materials[index];
     bool ch = false;
     ch |= ImGui::InputText("Name##mat", &m.name, ImGuiInputTextFlags_EnterReturnsTrue);
-    ch |= ImGui::ColorEdit3("Base colour", &m.baseColor.x, ImGuiColorEditFlags_Float);
+    ch |= srgbColorEdit("Base colour", m.baseColor);
     ch |= ImGui::SliderFloat("ka (ambient)", &m.ka, 0.0f, 1.0f);
     record(st, "material/ka");
     ch |= ImGui::SliderFloat("kd (diffuse)", &m.kd, 0.0f, 1.0f);
@@ -527,7 +540,7 @@ bool materialEditor(ViewerState& st, sg::NodeId id, int& index) {
     ch |= ImGui::SliderFloat("Shininess n", &m.shininess, 1.0f, 512.0f, "%.1f", ImGuiSliderFlags_Logarithmic);
     ch |= ImGui::Checkbox("Specular tinted by base colour", &m.specularTinted);
     ImGui::BeginDisabled(m.specularTinted);
-    ch |= ImGui::ColorEdit3("Specular colour", &m.specularColor.x, ImGuiColorEditFlags_Float);
+    ch |= srgbColorEdit("Specular colour", m.specularColor);
     ImGui::EndDisabled();
     int tex = m.diffuseTexture;
     if (ImGui::InputInt("Texture index", &tex)) {
@@ -535,7 +548,7 @@ bool materialEditor(ViewerState& st, sg::NodeId id, int& index) {
         ch = true;
     }
     helpMarker("-1 = none; index into the scene's textures");
-    ch |= ImGui::ColorEdit3("Emissive", &m.emissive.x, ImGuiColorEditFlags_Float);
+    ch |= srgbColorEdit("Emissive", m.emissive);
     ch |= ImGui::SliderFloat("Reflectivity", &m.reflectivity, 0.0f, 1.0f);
     ch |= ImGui::Checkbox("Unlit", &m.unlit);
     ImGui::SameLine();
@@ -666,7 +679,7 @@ void sceneSummary(ViewerState& st) {
     ImGui::Text("Nodes: %zu   meshes: %zu   materials: %zu   textures: %zu", scene.nodeCount(), scene.meshes.size(), scene.materials.size(),
                 scene.textures.size());
     sg::vec3 ambient = scene.ambientLight;
-    if (ImGui::ColorEdit3("Ambient light", &ambient.x, ImGuiColorEditFlags_Float)) st.setAmbientLight(ambient, "ambient");
+    if (srgbColorEdit("Ambient light", ambient)) st.setAmbientLight(ambient, "ambient");
 }
 
 // Name, kind and id, visibility.
@@ -733,7 +746,7 @@ bool csgSection(ViewerState& st, sg::NodeId id, sg::CsgPayload& cp) {
 bool lightSection(ViewerState& st, sg::Light& l) {
     if (!ImGui::CollapsingHeader("Light", ImGuiTreeNodeFlags_DefaultOpen)) return false;
     bool ch = enumCombo(st, "Type", l.type);
-    ch |= ImGui::ColorEdit3("Colour", &l.color.x, ImGuiColorEditFlags_Float);
+    ch |= srgbColorEdit("Colour", l.color);
     ch |= ImGui::DragFloat("Intensity", &l.intensity, 0.05f, 0.0f, 1e5f);
     ch |= ImGui::Checkbox("Inverse-square falloff", &l.inverseSquare);
     if (l.type == sg::LightType::Spot) {
@@ -972,12 +985,12 @@ void drawRenderingPanel(ViewerState& st) {
     ch |= ImGui::Checkbox("Light attenuation (1/r^2)", &s.attenuation);
     record(st, "render/attenuation");
     sg::vec3 amb = st.doc.scene.ambientLight;
-    if (ImGui::ColorEdit3("Ambient light", &amb.x, ImGuiColorEditFlags_Float)) st.setAmbientLight(amb, "ambient");
+    if (srgbColorEdit("Ambient light", amb)) st.setAmbientLight(amb, "ambient");
 
     section("Fog");
     ch |= enumCombo(st, "Fog", s.fog);
     if (s.fog != sg::FogMode::Off) {
-        ch |= ImGui::ColorEdit3("Fog colour", &s.fogColor.x, ImGuiColorEditFlags_Float);
+        ch |= srgbColorEdit("Fog colour", s.fogColor);
         if (s.fog == sg::FogMode::Linear)
             ch |= ImGui::DragFloatRange2("Start / end", &s.fogStart, &s.fogEnd, 0.05f, 0.0f, 1e5f);
         else
@@ -1000,7 +1013,7 @@ void drawRenderingPanel(ViewerState& st) {
     record(st, "render/wireframe");
     if (s.wireframe) {
         ImGui::SameLine();
-        ch |= ImGui::ColorEdit3("##wirecol", &s.wireframeColor.x, ImGuiColorEditFlags_NoInputs | ImGuiColorEditFlags_Float);
+        ch |= srgbColorEdit("##wirecol", s.wireframeColor, ImGuiColorEditFlags_NoInputs);
     }
     ch |= enumCombo(st, "Back faces", s.culling);
     record(st, "render/culling");
@@ -1016,7 +1029,7 @@ void drawRenderingPanel(ViewerState& st) {
     ch |= ImGui::SliderInt("Max bounces", &s.maxBounces, 0, 16);
 
     section("Background");
-    ch |= ImGui::ColorEdit3("Background", &s.background.x, ImGuiColorEditFlags_Float);
+    ch |= srgbColorEdit("Background", s.background);
 
     if (ch) st.setSettings(s, "settings");   // refused values: the reason goes to the status line
 }
