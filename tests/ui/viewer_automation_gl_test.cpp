@@ -11,6 +11,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdio>
+#include <fstream>
 #include <sstream>
 
 namespace fs = std::filesystem;
@@ -52,9 +54,9 @@ fs::path sceneFolder(const std::string& name) {
     return dir;
 }
 
-ScriptRun runScript(const fs::path& dir, const std::string& script, const std::string& args = "demo.json") {
+ScriptRun runScript(const fs::path& dir, const std::string& script, const std::string& args = "demo.json", const std::string& screen = "") {
     ScriptRun r;
-    r.rc = viewer_test::runViewer(dir, script, args, /*separateStdout=*/true);
+    r.rc = viewer_test::runViewer(dir, script, args, /*separateStdout=*/true, screen);
     r.out = parseOutput(viewer_test::readLog(dir, "out.txt"));
     r.log = viewer_test::readLog(dir);
     return r;
@@ -344,4 +346,38 @@ TEST(ViewerAutomationGLTest, AfterALoadNothingOfThePreviousSceneIsShown) {
     }
     for (int i : {5, 6}) EXPECT_NE(r.out[size_t(i)].find("level 1: "), std::string::npos) << r.out[size_t(i)];
     for (int i : {5, 6}) EXPECT_NE(r.out[size_t(i)].find(", 0 triangles"), std::string::npos) << r.out[size_t(i)];
+}
+
+// Issue 19, item 4: on a 1366x768 screen the window opens inside the work area, sized from it;
+// it reopens at the size it had (remembered in the config folder); a remembered rectangle too
+// big or off the screen, or a window.txt that does not parse, still gives a window that fits.
+TEST(ViewerAutomationGLTest, WindowFitsASmallScreenAndRemembersItsSize) {
+    if (!viewer_test::haveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+    fs::path dir = sceneFolder("automation_window");
+    auto fits = [](const std::string& line) {
+        int x, y, w, h, ax, ay, aw, ah;
+        if (std::sscanf(line.c_str(), "window %d %d %d %d in work area %d %d %d %d", &x, &y, &w, &h, &ax, &ay, &aw, &ah) != 8) return false;
+        return x >= ax && y >= ay && x + w <= ax + aw && y + h <= ay + ah && w >= aw / 2 && h >= ah / 2;
+    };
+    const std::string screen = "1366x768x24";
+    ScriptRun first = runScript(dir, "frames 2\nprint window\nresize 900 600\nprint window\nquit\n", "demo.json", screen);
+    ASSERT_EQ(first.rc, 0) << dump(first);
+    ASSERT_EQ(first.out.size(), 2u) << dump(first);
+    EXPECT_TRUE(fits(first.out[0])) << first.out[0];
+    EXPECT_NE(first.out[0].find(" in work area 0 0 1366 768"), std::string::npos) << first.out[0];
+    EXPECT_NE(first.out[1].find(" 900 600 in"), std::string::npos) << first.out[1];
+
+    ScriptRun second = runScript(dir, "frames 2\nprint window\nquit\n", "demo.json", screen);
+    ASSERT_EQ(second.rc, 0) << dump(second);
+    ASSERT_EQ(second.out.size(), 1u) << dump(second);
+    EXPECT_EQ(second.out[0], first.out[1]) << "reopened where and as big as it was";
+
+    for (const char* remembered : {"-500 -300 3000 2000\n", "not a rectangle\n"}) {
+        SCOPED_TRACE(remembered);
+        std::ofstream(dir / "config" / "sceneviewer" / "window.txt") << remembered;
+        ScriptRun r = runScript(dir, "frames 2\nprint window\nquit\n", "demo.json", screen);
+        ASSERT_EQ(r.rc, 0) << dump(r);
+        ASSERT_EQ(r.out.size(), 1u) << dump(r);
+        EXPECT_TRUE(fits(r.out[0])) << r.out[0];
+    }
 }

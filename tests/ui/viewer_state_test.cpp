@@ -299,6 +299,32 @@ TEST(ViewerStateTest, ScreenshotFolderIsAbsoluteAndABadOneIsAnError) {
     EXPECT_TRUE(prepareScreenshotFolder(base / "file" / "sub", &err).empty());
 }
 
+// Issue 19 item 4: the window's rectangle comes from the work area, --window-size or the last
+// run, and always fits inside the work area.
+TEST(ViewerStateTest, WindowPlacementFitsTheWorkArea) {
+    const WindowRect small{0, 0, 1366, 768};
+    WindowRect r = placeWindow(small, std::nullopt);
+    EXPECT_EQ(r, (WindowRect{102, 58, 1161, 652})) << "85% of the work area, centred";
+    EXPECT_EQ(placeWindow(small, std::nullopt, 1600, 900), (WindowRect{0, 0, 1366, 768})) << "a requested size is clamped";
+    EXPECT_EQ(placeWindow(small, WindowRect{40, 30, 900, 600}), (WindowRect{40, 30, 900, 600})) << "remembered";
+    EXPECT_EQ(placeWindow(small, WindowRect{1000, 500, 900, 600}), (WindowRect{466, 168, 900, 600})) << "moved back on screen";
+    EXPECT_EQ(placeWindow(WindowRect{1920, 24, 1280, 776}, WindowRect{-9000, 0, 4000, 3000}), (WindowRect{1920, 24, 1280, 776}))
+        << "a second monitor's work area, below a panel";
+    EXPECT_EQ(placeWindow(WindowRect{0, 0, 300, 200}, std::nullopt, 1280, 720), (WindowRect{0, 0, 300, 200})) << "smaller than the minimum";
+}
+
+TEST(ViewerStateTest, WindowRectPersistsAndBadFilesAreIgnored) {
+    fs::path dir = testing_support::outputDir("ui") / "window_rect";
+    fs::remove_all(dir);
+    EXPECT_FALSE(loadWindowRect(dir).has_value());
+    ASSERT_EQ(saveWindowRect(dir, WindowRect{-10, 20, 900, 600}), "");
+    EXPECT_EQ(loadWindowRect(dir), (WindowRect{-10, 20, 900, 600}));
+    for (const char* bad : {"", "1 2 3", "0 0 0 600", "0 0 -5 600", "x y w h"}) {
+        std::ofstream(dir / "window.txt") << bad;
+        EXPECT_FALSE(loadWindowRect(dir).has_value()) << "'" << bad << "'";
+    }
+}
+
 TEST(ViewerStateTest, RecentFilesPersist) {
     fs::path dir = testing_support::outputDir("ui") / "config";
     fs::remove_all(dir);

@@ -50,6 +50,8 @@
 //   print selection       viewer: selection NAME (or -)
 //   print status          viewer: status TEXT (the status bar's line)
 //   print undo            viewer: undo LABEL | redo LABEL (what Edit > Undo / Redo would do, "-")
+//   print window          viewer: window X Y W H in work area X Y W H (screen coordinates)
+//   resize W H            sets the window's size, as the user dragging its border
 //   stats                 time / triangles / rays of the shown backends
 //   screenshot DIR        offscreen PNG per shown backend into DIR (as F12)
 //   window-shot PATH      PNG of the whole window (UI included)
@@ -200,6 +202,13 @@ Automation::Next Automation::runCommand(const std::string& cmd, std::istringstre
     if (cmd == "click") return clickCommand(in, host.state());
     if (cmd == "drag") return dragCommand(restOfLine(in), host.state());
     if (cmd == "print") return printCommand(restOfLine(in), host);
+    if (cmd == "resize") {
+        int w = 0, h = 0;
+        if (!(in >> w >> h) || w < 1 || h < 1) return fail("resize: expected WIDTH HEIGHT");
+        host.resizeWindow(w, h);
+        m_waitFrames = 2;   // the new size reaches ImGui on the next frame
+        return Next::Yield;
+    }
     if (cmd == "stats") {
         host.printStats();
         return Next::Continue;
@@ -294,7 +303,10 @@ Automation::Next Automation::dragCommand(const std::string& args, const ViewerSt
 
 Automation::Next Automation::printCommand(const std::string& what, AutomationHost& host) {
     const ViewerState& st = host.state();
-    if (what == "dirty") {
+    if (what == "window") {
+        WindowRect w = host.windowRect(), a = host.workArea();
+        std::printf("viewer: window %d %d %d %d in work area %d %d %d %d\n", w.x, w.y, w.width, w.height, a.x, a.y, a.width, a.height);
+    } else if (what == "dirty") {
         std::printf("viewer: dirty %s\n", st.doc.dirty ? "yes" : "no");
     } else if (what == "tree") {
         printTree(st.doc.scene);
@@ -314,7 +326,7 @@ Automation::Next Automation::printCommand(const std::string& what, AutomationHos
         const UndoStack& h = st.doc.history;
         std::printf("viewer: undo %s | redo %s\n", h.canUndo() ? h.undoLabel().c_str() : "-", h.canRedo() ? h.redoLabel().c_str() : "-");
     } else {
-        return fail("print " + what + ": expected dirty, tree, compare, diff, selection, status or undo");
+        return fail("print " + what + ": expected dirty, tree, compare, diff, selection, status, undo or window");
     }
     return Next::Continue;
 }

@@ -27,6 +27,9 @@ public:
     virtual void printStats() = 0;   // one line per shown backend: time, triangles, rays
     // A key event as GLFW delivers it (through the platform backend's key callback).
     virtual void keyEvent(int glfwKey, bool press, int glfwMods) = 0;
+    virtual WindowRect windowRect() = 0;   // the window's position and size (screen coordinates)
+    virtual WindowRect workArea() = 0;     // of the monitor it is on, less the window's frame
+    virtual void resizeWindow(int width, int height) = 0;
 
 protected:
     ~AutomationHost() = default;

@@ -95,6 +95,8 @@ int drainGlErrors(const char* where) {
     return n;
 }
 
+WindowRect workAreaFor(GLFWwindow* win, const std::optional<WindowRect>& r);   // section 5
+
 // Reads the default framebuffer (the whole window) into a PNG.
 std::string saveWindowPng(GLFWwindow* win, const fs::path& path) {
     int w = 0, h = 0;
@@ -367,6 +369,14 @@ public:
     void keyEvent(int key, bool press, int mods) override {
         ImGui_ImplGlfw_KeyCallback(window, key, glfwGetKeyScancode(key), press ? GLFW_PRESS : GLFW_RELEASE, mods);
     }
+    WindowRect windowRect() override {
+        WindowRect r;
+        glfwGetWindowPos(window, &r.x, &r.y);
+        glfwGetWindowSize(window, &r.width, &r.height);
+        return r;
+    }
+    WindowRect workArea() override { return workAreaFor(window, windowRect()); }
+    void resizeWindow(int width, int height) override { glfwSetWindowSize(window, width, height); }
 
 private:
     rnd::ImageDiff m_lastDiff;
@@ -441,6 +451,7 @@ GLFWwindow* createWindow(const ViewerOptions& opt, bool automated) {
     glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
     glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
     glfwWindowHint(GLFW_SCALE_TO_MONITOR, GLFW_TRUE);
+    glfwWindowHint(GLFW_VISIBLE, GLFW_FALSE);   // shown by placeWindowOnScreen, at its place and size
     GLFWwindow* win = glfwCreateWindow(std::max(opt.width, 320), std::max(opt.height, 240), "Scene viewer", nullptr, nullptr);
     if (!win) {
         std::fprintf(stderr, "viewer: error: cannot create a GL 3.3 core window\n");
@@ -456,6 +467,48 @@ GLFWwindow* createWindow(const ViewerOptions& opt, bool automated) {
         return nullptr;
     }
     return win;
+}
+
+// The work area of the monitor holding the centre of `r` (the primary monitor when none does,
+// or without `r`), less the window's frame (title bar, borders) where the window manager says.
+WindowRect workAreaFor(GLFWwindow* win, const std::optional<WindowRect>& r) {
+    int count = 0;
+    GLFWmonitor** monitors = glfwGetMonitors(&count);
+    GLFWmonitor* chosen = glfwGetPrimaryMonitor();
+    WindowRect area;
+    for (int i = 0; r && i < count; ++i) {
+        WindowRect a;
+        glfwGetMonitorWorkarea(monitors[i], &a.x, &a.y, &a.width, &a.height);
+        int cx = r->x + r->width / 2, cy = r->y + r->height / 2;
+        if (cx >= a.x && cx < a.x + a.width && cy >= a.y && cy < a.y + a.height) chosen = monitors[i];
+    }
+    if (chosen) glfwGetMonitorWorkarea(chosen, &area.x, &area.y, &area.width, &area.height);
+    if (area.width < 1 || area.height < 1) area = {0, 0, 1600, 900};   // no monitor information: the old fixed size
+    int left = 0, top = 0, right = 0, bottom = 0;
+    glfwGetWindowFrameSize(win, &left, &top, &right, &bottom);
+    return {area.x + left, area.y + top, std::max(area.width - left - right, 1), std::max(area.height - top - bottom, 1)};
+}
+
+// Sizes and places the (hidden) window from the monitor's work area, the rectangle remembered
+// from the last run or --window-size, always inside the work area, then shows it (issue 19
+// item 4). Screen coordinates throughout, so the content scale (HiDPI) stays the fonts' business.
+void placeWindowOnScreen(GLFWwindow* win, const ViewerOptions& opt, const fs::path& configDir) {
+    std::optional<WindowRect> remembered = loadWindowRect(configDir);
+    WindowRect r = placeWindow(workAreaFor(win, remembered), remembered, opt.width, opt.height);
+    glfwSetWindowSize(win, r.width, r.height);
+    glfwSetWindowPos(win, r.x, r.y);
+    glfwShowWindow(win);
+}
+
+// Remembers the window's rectangle for the next run (not when maximized or minimized: the next
+// run would open that way without being so).
+void rememberWindow(GLFWwindow* win, const fs::path& configDir) {
+    if (configDir.empty() || glfwGetWindowAttrib(win, GLFW_MAXIMIZED) || glfwGetWindowAttrib(win, GLFW_ICONIFIED)) return;
+    WindowRect r;
+    glfwGetWindowPos(win, &r.x, &r.y);
+    glfwGetWindowSize(win, &r.width, &r.height);
+    if (std::string err = saveWindowRect(configDir, r); !err.empty())
+        std::fprintf(stderr, "viewer: warning: cannot remember the window size: %s\n", err.c_str());
 }
 
 // Connects the window to the viewer (callbacks), picks where the GL backend renders, reads the
@@ -514,6 +567,7 @@ void shutDown(Viewer& v, GLFWwindow* win) {
     v.pollScreenshots(true);
     v.st.cancelLoad();   // a load still running stops soon instead of finishing for nobody
 
+    rememberWindow(win, v.st.config.dir);
     v.releaseGL();
     ImGui_ImplOpenGL3_Shutdown();
     ImGui_ImplGlfw_Shutdown();
@@ -682,6 +736,7 @@ int runViewer(const ViewerOptions& opt) {
     if (!win) return 1;
     auto viewer = std::make_unique<Viewer>();   // outlives the ImGui context (it holds the ini path)
     setUpViewer(*viewer, win);
+    placeWindowOnScreen(win, opt, viewer->st.config.dir);
     openInitialScene(viewer->st, opt);
     int exitCode = MainLoop(*viewer, win, automation, opt).run();
     shutDown(*viewer, win);

@@ -830,6 +830,43 @@ std::string saveRecentFiles(const fs::path& dir, const std::vector<std::string>&
     return assets::writeFileAtomic(dir / "recent.txt", text, /*overwrite=*/true);
 }
 
+namespace {
+WindowRect centred(int width, int height, const WindowRect& area) {
+    return {area.x + (area.width - width) / 2, area.y + (area.height - height) / 2, width, height};
+}
+}   // namespace
+
+WindowRect placeWindow(const WindowRect& workArea, const std::optional<WindowRect>& remembered, int requestedWidth, int requestedHeight) {
+    WindowRect r;
+    if (requestedWidth > 0 && requestedHeight > 0)
+        r = centred(requestedWidth, requestedHeight, workArea);
+    else if (remembered && remembered->width > 0 && remembered->height > 0)
+        r = *remembered;
+    else
+        r = centred(workArea.width * 85 / 100, workArea.height * 85 / 100, workArea);
+    r.width = std::clamp(r.width, std::min(320, workArea.width), std::max(workArea.width, 1));
+    r.height = std::clamp(r.height, std::min(240, workArea.height), std::max(workArea.height, 1));
+    r.x = std::clamp(r.x, workArea.x, workArea.x + std::max(workArea.width - r.width, 0));
+    r.y = std::clamp(r.y, workArea.y, workArea.y + std::max(workArea.height - r.height, 0));
+    return r;
+}
+
+std::optional<WindowRect> loadWindowRect(const fs::path& dir) {
+    std::string text;
+    if (dir.empty() || !assets::readFileLimited(dir / "window.txt", 4096, text).empty()) return std::nullopt;
+    std::istringstream in(text);
+    WindowRect r;
+    if (!(in >> r.x >> r.y >> r.width >> r.height) || r.width < 1 || r.height < 1 || r.width > 100000 || r.height > 100000) return std::nullopt;
+    return r;
+}
+
+std::string saveWindowRect(const fs::path& dir, const WindowRect& r) {
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    std::string text = std::to_string(r.x) + " " + std::to_string(r.y) + " " + std::to_string(r.width) + " " + std::to_string(r.height) + "\n";
+    return assets::writeFileAtomic(dir / "window.txt", text, /*overwrite=*/true);
+}
+
 fs::path screenshotPath(const fs::path& dir, const std::string& backend, const std::string& stem) {
     return assets::uniquePath(dir / (stem + "-" + backend + ".png"));
 }

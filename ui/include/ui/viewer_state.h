@@ -329,6 +329,22 @@ float flySpeedFor(const sg::Scene& scene);
 std::filesystem::path defaultConfigDir();
 std::vector<std::string> loadRecentFiles(const std::filesystem::path& configDir);
 std::string saveRecentFiles(const std::filesystem::path& configDir, const std::vector<std::string>& files);
+// A window's place on the desktop in screen coordinates (GLFW's: pixels on X11 and Windows,
+// points on macOS; monitor work areas use the same units, so HiDPI needs no factor here).
+struct WindowRect {
+    int x = 0, y = 0, width = 0, height = 0;
+    bool operator==(const WindowRect&) const = default;
+};
+// Where the viewer window opens on a monitor whose work area (the desktop less panels and
+// docks) is `workArea`: the requested size when given (--window-size), else the remembered
+// rectangle, else 85% of the work area; centred unless remembered; always clamped so the whole
+// window lies inside the work area (a 1600x900 default never spills off a 1366x768 screen).
+WindowRect placeWindow(const WindowRect& workArea, const std::optional<WindowRect>& remembered, int requestedWidth = 0, int requestedHeight = 0);
+// The last window rectangle, kept in configDir/window.txt ("x y width height"); nullopt when
+// there is none or it does not parse (then the default applies, nothing fails).
+std::optional<WindowRect> loadWindowRect(const std::filesystem::path& configDir);
+std::string saveWindowRect(const std::filesystem::path& configDir, const WindowRect& r);
+
 // dir/"<stem>-<backend>.png" or, when taken, the first free "-N" variant (assets::uniquePath).
 std::filesystem::path screenshotPath(const std::filesystem::path& dir, const std::string& backend, const std::string& stem = "screenshot");
 
