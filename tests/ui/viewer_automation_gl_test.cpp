@@ -381,3 +381,42 @@ TEST(ViewerAutomationGLTest, WindowFitsASmallScreenAndRemembersItsSize) {
         EXPECT_TRUE(fits(r.out[0])) << r.out[0];
     }
 }
+
+// Issue 19: Escape closes menus and dialogs: the File menu, a submenu level at a time, the
+// screenshot dialog (as Cancel: nothing is taken), the unsaved-changes question (as Cancel:
+// the edits stay).
+TEST(ViewerAutomationGLTest, EscapeClosesMenusAndDialogs) {
+    if (!viewer_test::haveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+    fs::path dir = sceneFolder("automation_escape");
+    ScriptRun r = runScript(dir,
+                            "frames 2\n"
+                            "click menu/file\n"
+                            "print popup\n"   // 0
+                            "key Escape\n"
+                            "print popup\n"   // 1
+                            "click menu/file\n"
+                            "click file/screenshotDialog\n"
+                            "frames 2\n"
+                            "print popup\n"   // 2
+                            "key Escape\n"
+                            "print popup\n"    // 3
+                            "print status\n"   // 4: no screenshot taken
+                            "set shading flat\n"
+                            "key ctrl+n\n"
+                            "print popup\n"   // 5: the unsaved-changes question
+                            "key Escape\n"
+                            "print popup\n"   // 6
+                            "print dirty\n"   // 7
+                            "quit\n");
+    ASSERT_EQ(r.rc, 0) << dump(r);
+    ASSERT_EQ(r.out.size(), 8u) << dump(r);
+    EXPECT_EQ(r.out[0], "popup yes");
+    EXPECT_EQ(r.out[1], "popup no");
+    EXPECT_EQ(r.out[2], "popup yes");
+    EXPECT_EQ(r.out[3], "popup no");
+    EXPECT_EQ(r.out[4].find("Screenshot"), std::string::npos) << r.out[4];
+    EXPECT_EQ(r.out[5], "popup yes");
+    EXPECT_EQ(r.out[6], "popup no");
+    EXPECT_EQ(r.out[7], "dirty yes");
+    EXPECT_FALSE(fs::exists(dir / "screenshot-gl.png"));
+}

@@ -51,6 +51,7 @@
 //   print status          viewer: status TEXT (the status bar's line)
 //   print undo            viewer: undo LABEL | redo LABEL (what Edit > Undo / Redo would do, "-")
 //   print window          viewer: window X Y W H in work area X Y W H (screen coordinates)
+//   print popup           viewer: popup yes|no (a menu, combo or dialog is open)
 //   resize W H            sets the window's size, as the user dragging its border
 //   stats                 time / triangles / rays of the shown backends
 //   screenshot DIR        offscreen PNG per shown backend into DIR (as F12)
@@ -306,6 +307,8 @@ Automation::Next Automation::printCommand(const std::string& what, AutomationHos
     if (what == "window") {
         WindowRect w = host.windowRect(), a = host.workArea();
         std::printf("viewer: window %d %d %d %d in work area %d %d %d %d\n", w.x, w.y, w.width, w.height, a.x, a.y, a.width, a.height);
+    } else if (what == "popup") {
+        std::printf("viewer: popup %s\n", ImGui::IsPopupOpen(nullptr, ImGuiPopupFlags_AnyPopupId) ? "yes" : "no");
     } else if (what == "dirty") {
         std::printf("viewer: dirty %s\n", st.doc.dirty ? "yes" : "no");
     } else if (what == "tree") {
@@ -326,7 +329,7 @@ Automation::Next Automation::printCommand(const std::string& what, AutomationHos
         const UndoStack& h = st.doc.history;
         std::printf("viewer: undo %s | redo %s\n", h.canUndo() ? h.undoLabel().c_str() : "-", h.canRedo() ? h.redoLabel().c_str() : "-");
     } else {
-        return fail("print " + what + ": expected dirty, tree, compare, diff, selection, status, undo or window");
+        return fail("print " + what + ": expected dirty, tree, compare, diff, selection, status, undo, window or popup");
     }
     return Next::Continue;
 }

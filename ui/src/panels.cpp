@@ -23,6 +23,7 @@
 #include "scenegraph/setting_names.h"
 
 #include <imgui.h>
+#include <imgui_internal.h>   // the open-popup stack: Escape closes the innermost menu or combo
 #include <imgui_stdlib.h>
 
 #include <algorithm>
@@ -61,6 +62,11 @@ bool srgbColorEdit(const char* label, sg::vec3& linear, ImGuiColorEditFlags flag
     linear = linearFromSrgb(shown);
     return true;
 }
+
+bool escapePressed() { return ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Escape), false); }
+
+// Escape in a modal dialog: Cancel (or OK), unless the same press closed a menu or combo in it.
+bool escapeCancels(const ViewerState& st) { return escapePressed() && !st.ui.panels.escapeClosedPopup; }
 
 // The last item's tooltip (a table entry's help; nothing when empty).
 void tooltip(std::string_view text) {
@@ -338,8 +344,11 @@ void drawMainMenu(ViewerState& st) {
         }
         ImGui::EndMenu();
     }
-    if (ImGui::BeginMenu("Help")) {
+    bool helpOpen = ImGui::BeginMenu("Help");
+    record(st, "menu/help");
+    if (helpOpen) {
         ImGui::MenuItem("Controls", nullptr, &st.ui.panels.showHelp);
+        record(st, "help/controls");
         ImGui::EndMenu();
     }
     // Right side: file name and dirty marker.
@@ -1480,7 +1489,7 @@ void drawFileBrowser(ViewerState& st) {
     }
     record(st, "browser/accept");
     ImGui::SameLine();
-    if (ImGui::Button("Cancel", ImVec2(px(75), 0))) {
+    if (ImGui::Button("Cancel", ImVec2(px(75), 0)) || escapeCancels(st)) {
         browser.open = false;
         ImGui::CloseCurrentPopup();
     }
@@ -1549,8 +1558,45 @@ void drawScreenshotDialog(ViewerState& st) {
     if (ImGui::Button("Take", ImVec2(px(90), 0)) && takeScreenshot(st, dialog, dialog.error)) ImGui::CloseCurrentPopup();
     record(st, "shot/take");
     ImGui::SameLine();
-    if (ImGui::Button("Cancel", ImVec2(px(90), 0)) || ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Escape))) ImGui::CloseCurrentPopup();
+    if (ImGui::Button("Cancel", ImVec2(px(90), 0)) || escapeCancels(st)) ImGui::CloseCurrentPopup();
     ImGui::EndPopup();
+}
+
+// Help > Controls: input and action in two table columns (the font is proportional, so
+// space-padded text never lined up).
+void drawControlsHelp(ViewerState& st) {
+    static constexpr std::pair<const char*, const char*> kControls[] = {
+        {"Left drag", "orbit around the pivot"},
+        {"Middle / Shift+left drag", "pan"},
+        {"Wheel", "zoom"},
+        {"Right drag + WASD", "fly (Q/E down/up, Shift faster)"},
+        {"F", "fit scene / selection"},
+        {"Home", "reset to the scene camera"},
+        {"1 / 2 / 3", "backend gl / raster / raycast"},
+        {"F12", "screenshot"},
+        {"Space", "play / pause the animation (viewport)"},
+        {"F2", "rename selection"},
+        {"Del, Ctrl+D", "delete / duplicate selection"},
+        {"Ctrl+Z", "undo (Edit menu names the step)"},
+        {"Ctrl+Shift+Z, Ctrl+Y", "redo"},
+        {"Ctrl+N/O/S/Q", "new / open / save / quit"},
+        {"Escape", "close a menu, list or dialog"},
+    };
+    ImGui::SetNextWindowSize(ImVec2(px(460), 0), ImGuiCond_FirstUseEver);
+    if (ImGui::Begin("Controls", &st.ui.panels.showHelp)) {
+        if (ImGui::BeginTable("controls", 2, ImGuiTableFlags_RowBg | ImGuiTableFlags_SizingFixedFit)) {
+            for (const auto& [input, action] : kControls) {
+                ImGui::TableNextRow();
+                ImGui::TableNextColumn();
+                ImGui::TextUnformatted(input);
+                ImGui::TableNextColumn();
+                ImGui::TextUnformatted(action);
+            }
+            ImGui::EndTable();
+        }
+        ImGui::TextUnformatted("Drag tree nodes onto others to re-parent.\nDrop files onto the window to open them.");
+    }
+    ImGui::End();
 }
 
 }   // namespace
@@ -1587,7 +1633,7 @@ void drawDialogs(ViewerState& st) {
         }
         record(st, "confirm/discard");
         ImGui::SameLine();
-        if (ImGui::Button("Cancel", ImVec2(px(90), 0)) || ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Escape))) {
+        if (ImGui::Button("Cancel", ImVec2(px(90), 0)) || escapeCancels(st)) {
             st.confirm(ConfirmChoice::Cancel);
             ImGui::CloseCurrentPopup();
         }
@@ -1600,36 +1646,14 @@ void drawDialogs(ViewerState& st) {
         ImGui::PushTextWrapPos(px(520));
         ImGui::TextColored(ImVec4(1.0f, 0.6f, 0.5f, 1.0f), "%s", st.ui.errorPopup.c_str());
         ImGui::PopTextWrapPos();
-        if (ImGui::Button("OK", ImVec2(px(90), 0)) || ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Enter))) {
+        if (ImGui::Button("OK", ImVec2(px(90), 0)) || ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Enter)) || escapeCancels(st)) {
             st.ui.errorPopup.clear();
             ImGui::CloseCurrentPopup();
         }
         ImGui::EndPopup();
     }
 
-    if (st.ui.panels.showHelp) {
-        ImGui::SetNextWindowSize(ImVec2(px(420), 0), ImGuiCond_FirstUseEver);
-        if (ImGui::Begin("Controls", &st.ui.panels.showHelp)) {
-            ImGui::TextUnformatted(
-                "Left drag          orbit around the pivot\n"
-                "Middle / Shift+left drag   pan\n"
-                "Wheel              zoom\n"
-                "Right drag + WASD  fly (Q/E down/up, Shift faster)\n"
-                "F                  fit scene / selection\n"
-                "Home               reset to the scene camera\n"
-                "1 / 2 / 3          backend gl / raster / raycast\n"
-                "F12                screenshot\n"
-                "Space              play / pause the animation (viewport)\n"
-                "F2                 rename selection\n"
-                "Del, Ctrl+D        delete / duplicate selection\n"
-                "Ctrl+Z             undo (Edit menu names the step)\n"
-                "Ctrl+Shift+Z, Ctrl+Y  redo\n"
-                "Ctrl+N/O/S/Q       new / open / save / quit\n"
-                "Drag tree nodes onto others to re-parent.\n"
-                "Drop files onto the window to open them.");
-        }
-        ImGui::End();
-    }
+    if (st.ui.panels.showHelp) drawControlsHelp(st);
 }
 
 // --- 11. shortcuts and layout ------------------------------------------------------------------
@@ -1787,8 +1811,25 @@ void drawStatusBar(ViewerState& st, const ViewportInput& view, float height) {
 
 }   // namespace
 
+namespace {
+
+// Escape closes the innermost open menu, submenu, combo or context menu, one per press. A modal
+// dialog on top is left to its own Cancel (escapeCancels), so its answer is never skipped.
+void closePopupOnEscape(ViewerState& st) {
+    st.ui.panels.escapeClosedPopup = false;
+    ImGuiContext& g = *ImGui::GetCurrentContext();
+    if (!escapePressed() || g.OpenPopupStack.empty()) return;
+    const ImGuiWindow* top = g.OpenPopupStack.back().Window;
+    if (top && (top->Flags & ImGuiWindowFlags_Modal)) return;
+    ImGui::ClosePopupToLevel(g.OpenPopupStack.Size - 1, /*restore_focus_to_window_under_popup=*/true);
+    st.ui.panels.escapeClosedPopup = true;
+}
+
+}   // namespace
+
 void drawUi(ViewerState& st, const ViewportInput& view, double time, float dt) {
     ImGuiIO& io = ImGui::GetIO();
+    closePopupOnEscape(st);
     drawMainMenu(st);
     float menuH = ImGui::GetFrameHeight();
     float statusH = ImGui::GetFrameHeight() + px(4);

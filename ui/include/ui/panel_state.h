@@ -40,7 +40,8 @@ struct PanelState {
     // Scene tree: the node being renamed in place (F2, double click, context menu) and its text.
     sg::NodeId renaming = sg::kNoNode;
     std::string renameBuffer;
-    int dragDivider = -1;   // split view: the wipe divider being dragged (-1: none)
+    int dragDivider = -1;             // split view: the wipe divider being dragged (-1: none)
+    bool escapeClosedPopup = false;   // this frame's Escape closed a menu / combo: a dialog under it stays
 };
 
 }   // namespace ui
