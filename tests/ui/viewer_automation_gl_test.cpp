@@ -295,15 +295,19 @@ TEST(ViewerAutomationGLTest, NewSceneThenAddSphereAndRefusalsThatClear) {
 
 // Issue 19, item 3: F12 right after an orbit (a real drag) in the split and difference views
 // saves every shown backend; the status line names each file, with the absolute folder once.
-// (The difference view used to lose GL: the difference texture was deleted while the frame's
-// UI still drew it, and the GL error it left in the window's context failed the GL screenshot.)
+// (GL used to be lost: after an orbit in the difference view its texture was deleted while the
+// frame's UI still drew it; the GL error that left in the window's context stayed there, in
+// whatever view came next, until a GL screenshot read it as its own failure.)
 TEST(ViewerAutomationGLTest, ScreenshotAfterAnOrbitSavesEveryShownBackend) {
     if (!viewer_test::haveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
-    for (const char* view : {"split", "difference"}) {
-        SCOPED_TRACE(view);
-        fs::path dir = sceneFolder(std::string("automation_shot_") + view);
+    const std::pair<std::string, std::string> cases[] = {
+        {"split", "view split\n"}, {"difference", "view difference\n"}, {"difference_then_split", "view difference\n"}};
+    for (const auto& [name, view] : cases) {
+        SCOPED_TRACE(name);
+        fs::path dir = sceneFolder("automation_shot_" + name);
+        std::string thenSplit = name == "difference_then_split" ? "view split\n" : "";
         ScriptRun r =
-            runScript(dir, std::string("wait\nview ") + view + "\nprint compare\nwait\ndrag 100 100 260 140\nkey F12\nwait\nprint status\nquit\n");
+            runScript(dir, "wait\n" + view + "wait\ndrag 100 100 260 140\n" + thenSplit + "print compare\nkey F12\nwait\nprint status\nquit\n");
         ASSERT_EQ(r.rc, 0) << dump(r);
         ASSERT_EQ(r.out.size(), 2u) << dump(r);
         std::istringstream compare(r.out[0]);

@@ -281,6 +281,8 @@ TEST(ViewerStateTest, ScreenshotSummaryNamesEveryFileAndFailure) {
     EXPECT_EQ(screenshotSummary({{"gl", dir / "screenshot-gl.png", "OpenGL error 0x502"}, {"raster", dir / "screenshot-raster.png", ""}}),
               "Saved screenshot-raster.png in /home/me/shots; gl failed: OpenGL error 0x502");
     EXPECT_EQ(screenshotSummary({{"gl", dir / "screenshot-gl.png", "no context"}}), "Screenshot failed: gl failed: no context");
+    EXPECT_EQ(screenshotSummary({{"gl", dir / "screenshot-gl.png", "gl: no context"}}), "Screenshot failed: gl failed: no context")
+        << "the backend named once";
 }
 
 TEST(ViewerStateTest, ScreenshotFolderIsAbsoluteAndABadOneIsAnError) {

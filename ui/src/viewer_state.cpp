@@ -877,7 +877,9 @@ std::string screenshotSummary(const std::vector<ScreenshotResult>& results) {
     fs::path dir;
     for (const ScreenshotResult& r : results) {
         if (!r.error.empty()) {
-            failed += "; " + r.backend + " failed: " + r.error;
+            std::string_view why = r.error;
+            if (why.rfind(r.backend + ": ", 0) == 0) why.remove_prefix(r.backend.size() + 2);   // "gl: ..." from the renderer
+            failed += "; " + r.backend + " failed: " + std::string(why);
             continue;
         }
         saved += (count++ ? ", " : "") + r.path.filename().string();
