@@ -354,7 +354,8 @@ TEST(ViewerAutomationGLTest, AfterALoadNothingOfThePreviousSceneIsShown) {
 
 // Issue 19, item 4: on a 1366x768 screen the window opens inside the work area, sized from it;
 // it reopens at the size it had (remembered in the config folder); a remembered rectangle too
-// big or off the screen, or a window.txt that does not parse, still gives a window that fits.
+// big or off the screen, or a window.txt that does not parse, still gives a window that fits;
+// a run sized by --window-size is not remembered.
 TEST(ViewerAutomationGLTest, WindowFitsASmallScreenAndRemembersItsSize) {
     if (!viewer_test::haveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
     fs::path dir = sceneFolder("automation_window");
@@ -375,6 +376,12 @@ TEST(ViewerAutomationGLTest, WindowFitsASmallScreenAndRemembersItsSize) {
     ASSERT_EQ(second.rc, 0) << dump(second);
     ASSERT_EQ(second.out.size(), 1u) << dump(second);
     EXPECT_EQ(second.out[0], first.out[1]) << "reopened where and as big as it was";
+
+    ScriptRun sized = runScript(dir, "frames 2\nresize 700 500\nquit\n", "demo.json --window-size 800x600", screen);
+    ASSERT_EQ(sized.rc, 0) << dump(sized);
+    ScriptRun third = runScript(dir, "frames 2\nprint window\nquit\n", "demo.json", screen);
+    ASSERT_EQ(third.out.size(), 1u) << dump(third);
+    EXPECT_EQ(third.out[0], first.out[1]) << "a run sized by --window-size is not remembered";
 
     for (const char* remembered : {"-500 -300 3000 2000\n", "not a rectangle\n"}) {
         SCOPED_TRACE(remembered);

@@ -500,10 +500,12 @@ void placeWindowOnScreen(GLFWwindow* win, const ViewerOptions& opt, const fs::pa
     glfwShowWindow(win);
 }
 
-// Remembers the window's rectangle for the next run (not when maximized or minimized: the next
-// run would open that way without being so).
-void rememberWindow(GLFWwindow* win, const fs::path& configDir) {
-    if (configDir.empty() || glfwGetWindowAttrib(win, GLFW_MAXIMIZED) || glfwGetWindowAttrib(win, GLFW_ICONIFIED)) return;
+// Remembers the window's rectangle for the next run. Not when maximized or minimized (the next
+// run would open that way without being so), nor after a run sized by --window-size (tests,
+// documentation shots: a one-off that must not change the user's next window).
+void rememberWindow(GLFWwindow* win, const fs::path& configDir, const ViewerOptions& opt) {
+    if (configDir.empty() || (opt.width > 0 && opt.height > 0)) return;
+    if (glfwGetWindowAttrib(win, GLFW_MAXIMIZED) || glfwGetWindowAttrib(win, GLFW_ICONIFIED)) return;
     WindowRect r;
     glfwGetWindowPos(win, &r.x, &r.y);
     glfwGetWindowSize(win, &r.width, &r.height);
@@ -563,11 +565,11 @@ void openInitialScene(ViewerState& st, const ViewerOptions& opt) {
 
 // Finishes the screenshots in flight, stops a running load, frees the GL objects while the
 // context is current, then ImGui, the window and GLFW.
-void shutDown(Viewer& v, GLFWwindow* win) {
+void shutDown(Viewer& v, GLFWwindow* win, const ViewerOptions& opt) {
     v.pollScreenshots(true);
     v.st.cancelLoad();   // a load still running stops soon instead of finishing for nobody
 
-    rememberWindow(win, v.st.config.dir);
+    rememberWindow(win, v.st.config.dir, opt);
     v.releaseGL();
     ImGui_ImplOpenGL3_Shutdown();
     ImGui_ImplGlfw_Shutdown();
@@ -739,7 +741,7 @@ int runViewer(const ViewerOptions& opt) {
     placeWindowOnScreen(win, opt, viewer->st.config.dir);
     openInitialScene(viewer->st, opt);
     int exitCode = MainLoop(*viewer, win, automation, opt).run();
-    shutDown(*viewer, win);
+    shutDown(*viewer, win, opt);
     return exitCode;
 }
 
