@@ -301,6 +301,13 @@ TEST(PanelsTest, ScreenshotDialogFolderIsShownAndChecked) {
     EXPECT_FALSE(h.st.ui.requests.screenshot);
     EXPECT_NE(h.st.ui.panels.shotDialog.error.find("cannot use folder"), std::string::npos) << h.st.ui.panels.shotDialog.error;
     EXPECT_TRUE(ImGui::IsPopupOpen(nullptr, ImGuiPopupFlags_AnyPopupId)) << "the dialog stays open";
+    fs::create_directories(base / "picked");
+    h.st.ui.panels.shotDialog.dirText = base.string();
+    h.frame();
+    h.click("shot/dir/picked");   // chosen by clicking, not typing
+    EXPECT_EQ(h.st.ui.panels.shotDialog.dirText, (fs::absolute(base).lexically_normal() / "picked").string());
+    h.click("shot/up");
+    EXPECT_EQ(h.st.ui.panels.shotDialog.dirText, fs::absolute(base).lexically_normal().string());
     h.st.ui.panels.shotDialog.dirText = (base / "shots").string();
     h.click("shot/take");
     EXPECT_TRUE(h.st.ui.requests.screenshot);

@@ -1523,6 +1523,39 @@ void screenshotSizeFields(ScreenshotDialogState& dialog, const View& view) {
     dialog.height = std::clamp(h, 1, 16384);
 }
 
+// The subfolders of `dir` by name (hidden ones left out; at most `limit`); none when it is not a
+// readable folder.
+std::vector<std::string> subfolders(const fs::path& dir, size_t limit) {
+    std::vector<std::string> names;
+    std::error_code ec;
+    for (fs::directory_iterator it(dir, fs::directory_options::skip_permission_denied, ec), end; !ec && it != end && names.size() < limit;
+         it.increment(ec)) {
+        std::string name = it->path().filename().string();
+        if (!name.empty() && name[0] != '.' && it->is_directory(ec)) names.push_back(name);
+    }
+    std::sort(names.begin(), names.end());
+    return names;
+}
+
+// The folder: typed, or chosen with Up and a click on one of its subfolders.
+void screenshotFolderPicker(ViewerState& st, ScreenshotDialogState& dialog) {
+    if (ImGui::Button("Up##shotFolder")) dialog.dirText = absoluteFolder(dialog.dirText).parent_path().string();
+    record(st, "shot/up");
+    ImGui::SameLine();
+    ImGui::SetNextItemWidth(px(360));
+    ImGui::InputText("Folder", &dialog.dirText);
+    record(st, "shot/folder");
+    ImGui::BeginChild("shotFolders", ImVec2(px(420), px(110)), true);
+    std::vector<std::string> names = subfolders(dialog.dirText, 500);
+    std::error_code ec;
+    if (names.empty()) ImGui::TextDisabled(fs::is_directory(dialog.dirText, ec) ? "(no subfolders)" : "(not a folder yet: Take makes it)");
+    for (const std::string& name : names) {
+        if (ImGui::Selectable(("[dir] " + name).c_str())) dialog.dirText = (absoluteFolder(dialog.dirText) / name).string();
+        record(st, "shot/dir/" + name);
+    }
+    ImGui::EndChild();
+}
+
 // Take: the folder typed is checked (made when missing) before anything renders; a folder
 // that cannot be used keeps the dialog open with the reason.
 bool takeScreenshot(ViewerState& st, ScreenshotDialogState& dialog, std::string& error) {
@@ -1549,9 +1582,7 @@ void drawScreenshotDialog(ViewerState& st) {
     ImGui::Checkbox(screenshotSizeLabel(dialog, st.view).c_str(), &dialog.windowSize);
     record(st, "shot/viewportSize");
     screenshotSizeFields(dialog, st.view);
-    ImGui::SetNextItemWidth(px(360));
-    ImGui::InputText("Folder", &dialog.dirText);
-    record(st, "shot/folder");
+    screenshotFolderPicker(st, dialog);
     if (!dialog.error.empty()) ImGui::TextColored(ImVec4(1.0f, 0.6f, 0.45f, 1.0f), "%s", dialog.error.c_str());
     ImGui::TextDisabled(
         "One PNG per backend shown, rendered offscreen;\nnamed screenshot-<backend>[-N].png, never overwriting.\nF12 saves into the same folder.");
