@@ -318,12 +318,17 @@ TEST(ViewerStateTest, WindowPlacementFitsTheWorkArea) {
 TEST(ViewerStateTest, WindowRectPersistsAndBadFilesAreIgnored) {
     fs::path dir = testing_support::outputDir("ui") / "window_rect";
     fs::remove_all(dir);
-    EXPECT_FALSE(loadWindowRect(dir).has_value());
+    std::string error;
+    EXPECT_FALSE(loadWindowRect(dir, &error).has_value());
+    EXPECT_EQ(error, "") << "no file yet is no error";
     ASSERT_EQ(saveWindowRect(dir, WindowRect{-10, 20, 900, 600}), "");
-    EXPECT_EQ(loadWindowRect(dir), (WindowRect{-10, 20, 900, 600}));
+    EXPECT_EQ(loadWindowRect(dir, &error), (WindowRect{-10, 20, 900, 600}));
     for (const char* bad : {"", "1 2 3", "0 0 0 600", "0 0 -5 600", "x y w h"}) {
         std::ofstream(dir / "window.txt") << bad;
-        EXPECT_FALSE(loadWindowRect(dir).has_value()) << "'" << bad << "'";
+        error.clear();
+        EXPECT_FALSE(loadWindowRect(dir, &error).has_value()) << "'" << bad << "'";
+        EXPECT_NE(error.find("expected 'x y width height'; ignored"), std::string::npos) << error;
+        EXPECT_EQ(error.find('\n'), std::string::npos) << "one line";
     }
 }
 

@@ -493,7 +493,9 @@ WindowRect workAreaFor(GLFWwindow* win, const std::optional<WindowRect>& r) {
 // from the last run or --window-size, always inside the work area, then shows it (issue 19
 // item 4). Screen coordinates throughout, so the content scale (HiDPI) stays the fonts' business.
 void placeWindowOnScreen(GLFWwindow* win, const ViewerOptions& opt, const fs::path& configDir) {
-    std::optional<WindowRect> remembered = loadWindowRect(configDir);
+    std::string error;
+    std::optional<WindowRect> remembered = loadWindowRect(configDir, &error);
+    if (!error.empty()) std::fprintf(stderr, "viewer: warning: %s\n", error.c_str());
     WindowRect r = placeWindow(workAreaFor(win, remembered), remembered, opt.width, opt.height);
     glfwSetWindowSize(win, r.width, r.height);
     glfwSetWindowPos(win, r.x, r.y);

@@ -851,13 +851,17 @@ WindowRect placeWindow(const WindowRect& workArea, const std::optional<WindowRec
     return r;
 }
 
-std::optional<WindowRect> loadWindowRect(const fs::path& dir) {
+std::optional<WindowRect> loadWindowRect(const fs::path& dir, std::string* error) {
     std::string text;
-    if (dir.empty() || !assets::readFileLimited(dir / "window.txt", 4096, text).empty()) return std::nullopt;
+    std::error_code ec;
+    if (dir.empty() || !fs::exists(dir / "window.txt", ec)) return std::nullopt;
+    std::string readError = assets::readFileLimited(dir / "window.txt", 4096, text);
     std::istringstream in(text);
     WindowRect r;
-    if (!(in >> r.x >> r.y >> r.width >> r.height) || r.width < 1 || r.height < 1 || r.width > 100000 || r.height > 100000) return std::nullopt;
-    return r;
+    if (readError.empty() && (in >> r.x >> r.y >> r.width >> r.height) && r.width >= 1 && r.height >= 1 && r.width <= 100000 && r.height <= 100000)
+        return r;
+    if (error) *error = (dir / "window.txt").string() + ": " + (readError.empty() ? "expected 'x y width height'" : readError) + "; ignored";
+    return std::nullopt;
 }
 
 std::string saveWindowRect(const fs::path& dir, const WindowRect& r) {

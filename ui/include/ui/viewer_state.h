@@ -341,8 +341,9 @@ struct WindowRect {
 // window lies inside the work area (a 1600x900 default never spills off a 1366x768 screen).
 WindowRect placeWindow(const WindowRect& workArea, const std::optional<WindowRect>& remembered, int requestedWidth = 0, int requestedHeight = 0);
 // The last window rectangle, kept in configDir/window.txt ("x y width height"); nullopt when
-// there is none or it does not parse (then the default applies, nothing fails).
-std::optional<WindowRect> loadWindowRect(const std::filesystem::path& configDir);
+// there is none or it does not parse (then the default applies, nothing fails; *error says
+// why a file that is there was not used).
+std::optional<WindowRect> loadWindowRect(const std::filesystem::path& configDir, std::string* error = nullptr);
 std::string saveWindowRect(const std::filesystem::path& configDir, const WindowRect& r);
 
 // dir/"<stem>-<backend>.png" or, when taken, the first free "-N" variant (assets::uniquePath).
