@@ -2,11 +2,16 @@
 // positions of recorded widgets change the scene and settings; keys switch backends; drags
 // in the viewport move the camera; the unsaved-changes modal appears and works.
 #include "headless_ui.h"
+#include "test_support.h"
 
 #include <gtest/gtest.h>
 #include <imgui.h>
 
+#include <filesystem>
+#include <fstream>
+
 using namespace ui;
+namespace fs = std::filesystem;
 
 TEST(PanelsTest, LayoutHasTreeTabsAndViewport) {
     Headless h;
@@ -265,7 +270,8 @@ TEST(PanelsTest, PanelStateBelongsToTheViewer) {
     EXPECT_TRUE(h.st.ui.panels.shotDialog.open);
     h.click("shot/take");
     EXPECT_TRUE(h.st.ui.requests.screenshot);
-    EXPECT_EQ(h.st.ui.requests.screenshotWidth, 0);   // window size by default
+    EXPECT_EQ(h.st.ui.requests.screenshotWidth, h.st.view.viewportWidth);   // the viewport's size by default, as the option's label says
+    EXPECT_EQ(h.st.ui.requests.screenshotHeight, h.st.view.viewportHeight);
 }
 
 TEST(PanelsTest, F2RenamesTheSelectionInPlace) {
@@ -276,4 +282,35 @@ TEST(PanelsTest, F2RenamesTheSelectionInPlace) {
     h.press(keys::F2);
     EXPECT_EQ(h.st.ui.panels.renaming, crate);
     EXPECT_EQ(h.st.ui.panels.renameBuffer, "crate");
+}
+
+// The screenshot dialog shows the folder (absolute) and takes another one; a
+// folder that cannot be made keeps the dialog open with the reason and takes nothing.
+TEST(PanelsTest, ScreenshotDialogFolderIsShownAndChecked) {
+    fs::path base = testing_support::outputDir("ui") / "shot_dialog";
+    fs::remove_all(base);
+    fs::create_directories(base);
+    std::ofstream(base / "file") << "x";
+    Headless h;
+    h.st.ui.requests.screenshotDialog = true;
+    h.frame();
+    h.frame();
+    EXPECT_TRUE(fs::path(h.st.ui.panels.shotDialog.dirText).is_absolute()) << h.st.ui.panels.shotDialog.dirText;
+    h.st.ui.panels.shotDialog.dirText = (base / "file" / "sub").string();
+    h.click("shot/take");
+    EXPECT_FALSE(h.st.ui.requests.screenshot);
+    EXPECT_NE(h.st.ui.panels.shotDialog.error.find("cannot use folder"), std::string::npos) << h.st.ui.panels.shotDialog.error;
+    EXPECT_TRUE(ImGui::IsPopupOpen(nullptr, ImGuiPopupFlags_AnyPopupId)) << "the dialog stays open";
+    fs::create_directories(base / "picked");
+    h.st.ui.panels.shotDialog.dirText = base.string();
+    h.frame();
+    h.click("shot/dir/picked");   // chosen by clicking, not typing
+    EXPECT_EQ(h.st.ui.panels.shotDialog.dirText, (fs::absolute(base).lexically_normal() / "picked").string());
+    h.click("shot/up");
+    EXPECT_EQ(h.st.ui.panels.shotDialog.dirText, fs::absolute(base).lexically_normal().string());
+    h.st.ui.panels.shotDialog.dirText = (base / "shots").string();
+    h.click("shot/take");
+    EXPECT_TRUE(h.st.ui.requests.screenshot);
+    EXPECT_EQ(h.st.ui.panels.shotDialog.dir, fs::absolute(base / "shots").lexically_normal());
+    EXPECT_TRUE(fs::is_directory(base / "shots"));
 }

@@ -22,13 +22,17 @@ inline bool haveXvfb() { return std::system("command -v xvfb-run >/dev/null 2>&1
 // while cleaning up temporary directory"), mostly after short runs.
 //
 // Writes `script` to DIR/script.txt and runs `viewer ARGS --automate script.txt` in DIR with
-// DIR/config as the per-user config folder. Returns the exit code (-1: killed).
-inline int runViewer(const std::filesystem::path& dir, const std::string& script, const std::string& args = "", bool separateStdout = false) {
+// DIR/config as the per-user config folder, on a 1280x720 screen with a 1280x720 window, or
+// on `screen` ("1366x768x24") with the window sized as the viewer decides when `screen` is
+// given. Returns the exit code (-1: killed).
+inline int runViewer(const std::filesystem::path& dir, const std::string& script, const std::string& args = "", bool separateStdout = false,
+                     const std::string& screen = "") {
     std::filesystem::path scriptPath = dir / "script.txt";
     std::ofstream(scriptPath) << script;
-    std::string cmd = "cd '" + dir.string() + "' && XDG_CONFIG_HOME='" + (dir / "config").string() +
-                      "' timeout -k 5 240 xvfb-run -a -s '-screen 0 1280x720x24 -noreset' '" VIEWER_EXE "' " + args +
-                      " --window-size 1280x720 --timeout 200 --automate '" + scriptPath.string() + "'" +
+    std::string size = screen.empty() ? " --window-size 1280x720" : "";
+    std::string cmd = "cd '" + dir.string() + "' && XDG_CONFIG_HOME='" + (dir / "config").string() + "' timeout -k 5 240 xvfb-run -a -s '-screen 0 " +
+                      (screen.empty() ? "1280x720x24" : screen) + " -noreset' '" VIEWER_EXE "' " + args + size + " --timeout 200 --automate '" +
+                      scriptPath.string() + "'" +
                       (separateStdout ? " > '" + (dir / "out.txt").string() + "' 2> '" + (dir / "log.txt").string() + "'"
                                       : " > '" + (dir / "log.txt").string() + "' 2>&1");
     int rc = std::system(cmd.c_str());

@@ -181,7 +181,7 @@ TEST(ViewerStateTest, UnsavedChangesAreNeverLostWithoutAsking) {
     EXPECT_TRUE(st.ui.requests.quit);
 }
 
-// Regression (first-hour issue, item 1): edit, Open a file that fails, answer Discard. The load
+// Regression: edit, Open a file that fails, answer Discard. The load
 // fails, so the document must stay exactly as it was: edits, dirty flag, and Quit still asks.
 TEST(ViewerStateTest, DiscardThenFailedOrCancelledLoadKeepsEditsAndDirtyFlag) {
     ViewerState st = demoState();
@@ -259,6 +259,79 @@ TEST(ViewerStateTest, ScreenshotNamesNeverOverwrite) {
     EXPECT_EQ(b.extension(), ".png");
 }
 
+// The screenshot dialog's size option says the size it writes; the status line names
+// every file written (the folder once, absolute) and every failure; a folder that cannot be
+// made is an error, not a silent "."
+TEST(ViewerStateTest, ScreenshotSizeIsTheOneTheLabelNames) {
+    View view;
+    view.viewportWidth = 1031;
+    view.viewportHeight = 644;
+    ScreenshotDialogState dialog;   // ticked, with 1920x1080 in the (disabled) fields
+    EXPECT_EQ(screenshotSize(dialog, view), std::make_pair(1031, 644));
+    EXPECT_EQ(screenshotSizeLabel(dialog, view).rfind("Viewport size (1031x644)", 0), 0u) << screenshotSizeLabel(dialog, view);
+    dialog.windowSize = false;
+    EXPECT_EQ(screenshotSize(dialog, view), std::make_pair(1920, 1080));
+    EXPECT_EQ(screenshotSizeLabel(dialog, view).rfind("Viewport size (1031x644)", 0), 0u) << "the option names the viewport either way";
+}
+
+TEST(ViewerStateTest, ScreenshotSummaryNamesEveryFileAndFailure) {
+    const fs::path dir = "/home/me/shots";
+    EXPECT_EQ(screenshotSummary({{"gl", dir / "screenshot-gl.png", ""}, {"raster", dir / "screenshot-raster.png", ""}}),
+              "Saved 2 screenshots in /home/me/shots: screenshot-gl.png, screenshot-raster.png");
+    EXPECT_EQ(screenshotSummary({{"gl", dir / "screenshot-gl.png", "OpenGL error 0x502"}, {"raster", dir / "screenshot-raster.png", ""}}),
+              "Saved screenshot-raster.png in /home/me/shots; gl failed: OpenGL error 0x502");
+    EXPECT_EQ(screenshotSummary({{"gl", dir / "screenshot-gl.png", "no context"}}), "Screenshot failed: gl failed: no context");
+    EXPECT_EQ(screenshotSummary({{"gl", dir / "screenshot-gl.png", "gl: no context"}}), "Screenshot failed: gl failed: no context")
+        << "the backend named once";
+}
+
+TEST(ViewerStateTest, ScreenshotFolderIsAbsoluteAndABadOneIsAnError) {
+    fs::path base = testing_support::outputDir("ui") / "shot_folder";
+    fs::remove_all(base);
+    std::string err;
+    fs::path made = prepareScreenshotFolder(base / "new" / "", &err);
+    EXPECT_EQ(err, "");
+    EXPECT_TRUE(made.is_absolute());
+    EXPECT_EQ(made.filename(), "new") << "no trailing separator: " << made;
+    EXPECT_TRUE(fs::is_directory(made));
+    EXPECT_TRUE(prepareScreenshotFolder("", &err).is_absolute()) << "empty = the current folder";
+    ASSERT_EQ(assets::writeFileAtomic(base / "file", "x", false), "");
+    EXPECT_TRUE(prepareScreenshotFolder(base / "file", &err).empty());
+    EXPECT_NE(err.find("cannot use folder"), std::string::npos) << err;
+    EXPECT_TRUE(prepareScreenshotFolder(base / "file" / "sub", &err).empty());
+}
+
+// The window's rectangle comes from the work area, --window-size or the last
+// run, and always fits inside the work area.
+TEST(ViewerStateTest, WindowPlacementFitsTheWorkArea) {
+    const WindowRect small{0, 0, 1366, 768};
+    WindowRect r = placeWindow(small, std::nullopt);
+    EXPECT_EQ(r, (WindowRect{102, 58, 1161, 652})) << "85% of the work area, centred";
+    EXPECT_EQ(placeWindow(small, std::nullopt, 1600, 900), (WindowRect{0, 0, 1366, 768})) << "a requested size is clamped";
+    EXPECT_EQ(placeWindow(small, WindowRect{40, 30, 900, 600}), (WindowRect{40, 30, 900, 600})) << "remembered";
+    EXPECT_EQ(placeWindow(small, WindowRect{1000, 500, 900, 600}), (WindowRect{466, 168, 900, 600})) << "moved back on screen";
+    EXPECT_EQ(placeWindow(WindowRect{1920, 24, 1280, 776}, WindowRect{-9000, 0, 4000, 3000}), (WindowRect{1920, 24, 1280, 776}))
+        << "a second monitor's work area, below a panel";
+    EXPECT_EQ(placeWindow(WindowRect{0, 0, 300, 200}, std::nullopt, 1280, 720), (WindowRect{0, 0, 300, 200})) << "smaller than the minimum";
+}
+
+TEST(ViewerStateTest, WindowRectPersistsAndBadFilesAreIgnored) {
+    fs::path dir = testing_support::outputDir("ui") / "window_rect";
+    fs::remove_all(dir);
+    std::string error;
+    EXPECT_FALSE(loadWindowRect(dir, &error).has_value());
+    EXPECT_EQ(error, "") << "no file yet is no error";
+    ASSERT_EQ(saveWindowRect(dir, WindowRect{-10, 20, 900, 600}), "");
+    EXPECT_EQ(loadWindowRect(dir, &error), (WindowRect{-10, 20, 900, 600}));
+    for (const char* bad : {"", "1 2 3", "0 0 0 600", "0 0 -5 600", "x y w h"}) {
+        std::ofstream(dir / "window.txt") << bad;
+        error.clear();
+        EXPECT_FALSE(loadWindowRect(dir, &error).has_value()) << "'" << bad << "'";
+        EXPECT_NE(error.find("expected 'x y width height'; ignored"), std::string::npos) << error;
+        EXPECT_EQ(error.find('\n'), std::string::npos) << "one line";
+    }
+}
+
 TEST(ViewerStateTest, RecentFilesPersist) {
     fs::path dir = testing_support::outputDir("ui") / "config";
     fs::remove_all(dir);
@@ -298,6 +371,35 @@ TEST(RenderSlotTest, RendersCoarseToFineOrReportsError) {
     slot.poll();
     EXPECT_EQ(slot.image().width, 64);
     EXPECT_EQ(slot.status().level, 1);
+}
+
+// After a load the slot forgets the old scene's picture and figures, and a
+// render requested before forget() never shows up afterwards, however far it got.
+TEST(RenderSlotTest, ForgetDropsTheImageAndRendersInFlight) {
+    ViewerState st = demoState();
+    auto frame = std::make_shared<sg::FrameInput>(st.buildFrame(64.0f / 48.0f));
+    RenderSlot slot("raster");
+    slot.request(frame, 64, 48, 1, /*interacting=*/false);
+    slot.waitIdle();
+    slot.poll();
+    if (!slot.status().error.empty()) GTEST_SKIP() << "raster backend not available: " << slot.status().error;
+    ASSERT_TRUE(slot.hasImage());
+    ASSERT_GT(slot.status().stats.triangles, 0u);
+    uint64_t serial = slot.imageSerial();
+    slot.forget();
+    EXPECT_FALSE(slot.hasImage());
+    EXPECT_EQ(slot.status().stats.triangles, 0u);
+    EXPECT_NE(slot.imageSerial(), serial);
+    EXPECT_TRUE(slot.needs(1, false)) << "the same key renders again after forget()";
+    slot.request(frame, 64, 48, 2, /*interacting=*/false);
+    slot.forget();   // pending or in flight: either way it is dropped
+    slot.waitIdle();
+    slot.poll();
+    EXPECT_FALSE(slot.hasImage());
+    slot.request(frame, 64, 48, 3, /*interacting=*/false);
+    slot.waitIdle();
+    slot.poll();
+    EXPECT_EQ(slot.image().width, 64);
 }
 
 TEST(RenderSlotTest, UnknownBackendIsAnError) {

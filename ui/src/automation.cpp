@@ -6,6 +6,8 @@
 //   frames N              run N frames
 //   wait                  until no load / screenshot is in flight and the shown backends have
 //                         their full-resolution images (or errors)
+//   wait load             until no load is in flight (renders of the new scene may not have
+//                         started: what the user sees right after a load)
 //   quit
 // Input, through the paths the user's input takes
 //   key [MOD+]...KEY      press for one frame: MOD ctrl|shift|alt|super, KEY a letter, a digit,
@@ -16,6 +18,8 @@
 //                         coordinates, the menu bar at the top), at pixel (X, Y) of the 3D
 //                         viewport (from its top-left corner), or at the centre of a widget the
 //                         panels record (menu/edit, edit/undo, tree/crate, confirm/discard, ...)
+//   drag X0 Y0 X1 Y1      left drag in the 3D viewport (pixels from its top-left corner): press
+//                         at (X0, Y0), move to (X1, Y1) over 8 frames, release (an orbit)
 // The document (as the File and Edit menus do)
 //   open PATH             File > Open, asking first when there are unsaved changes
 //   answer save|discard|cancel   answers the unsaved-changes question
@@ -50,6 +54,9 @@
 //                         (one line per shown backend: the pixel inspector's probe)
 //   print status          viewer: status TEXT (the status bar's line)
 //   print undo            viewer: undo LABEL | redo LABEL (what Edit > Undo / Redo would do, "-")
+//   print window          viewer: window X Y W H in work area X Y W H (screen coordinates)
+//   print popup           viewer: popup yes|no (a menu, combo or dialog is open)
+//   resize W H            sets the window's size, as the user dragging its border
 //   stats                 time / triangles / rays of the shown backends
 //   screenshot DIR        offscreen PNG per shown backend into DIR (as F12)
 //   window-shot PATH      PNG of the whole window (UI included)
@@ -147,7 +154,10 @@ bool Automation::step(AutomationHost& host) {
         --m_waitFrames;
         return true;
     }
-    if (m_waiting) {
+    if (m_waitingLoad) {
+        if (host.state().loadInProgress()) return true;
+        m_waitingLoad = false;
+    } else if (m_waiting) {
         host.pollScreenshots();
         if (!host.idle()) return true;
         m_waiting = false;
@@ -187,13 +197,23 @@ Automation::Next Automation::runCommand(const std::string& cmd, std::istringstre
         return Next::Yield;
     }
     if (cmd == "wait") {
-        m_waiting = true;
+        std::string what = restOfLine(in);
+        if (!what.empty() && what != "load") return fail("wait " + what + ": expected wait or wait load");
+        (what.empty() ? m_waiting : m_waitingLoad) = true;
         return Next::Yield;
     }
     if (cmd == "quit") return Next::Quit;
     if (cmd == "key") return keyCommand(restOfLine(in), host);
     if (cmd == "click") return clickCommand(in, host.state());
+    if (cmd == "drag") return dragCommand(restOfLine(in), host.state());
     if (cmd == "print") return printCommand(restOfLine(in), host);
+    if (cmd == "resize") {
+        int w = 0, h = 0;
+        if (!(in >> w >> h) || w < 1 || h < 1) return fail("resize: expected WIDTH HEIGHT");
+        host.resizeWindow(w, h);
+        m_waitFrames = 2;   // the new size reaches ImGui on the next frame
+        return Next::Yield;
+    }
     if (cmd == "stats") {
         host.printStats();
         return Next::Continue;
@@ -267,9 +287,33 @@ Automation::Next Automation::clickCommand(std::istringstream& in, const ViewerSt
     return Next::Yield;
 }
 
+// Hover, press, 8 moving frames held down, release: what a user's orbit drag gives ImGui.
+Automation::Next Automation::dragCommand(const std::string& args, const ViewerState& st) {
+    auto vp = st.hooks.itemRects.find("viewport");
+    float x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+    std::istringstream in(args);
+    if (vp == st.hooks.itemRects.end() || !(in >> x0 >> y0 >> x1 >> y1))
+        return fail("drag " + args + ": expected X0 Y0 X1 Y1 in the viewport, after a frame was drawn");
+    const float ox = vp->second.x0, oy = vp->second.y0;
+    constexpr int kSteps = 8;
+    m_mouse = {{ox + x0, oy + y0, false}, {ox + x0, oy + y0, true}};
+    for (int i = 1; i <= kSteps; ++i) {
+        float t = float(i) / kSteps;
+        m_mouse.push_back({ox + x0 + t * (x1 - x0), oy + y0 + t * (y1 - y0), true});
+    }
+    m_mouse.push_back({ox + x1, oy + y1, false});
+    m_waitFrames = 0;
+    return Next::Yield;
+}
+
 Automation::Next Automation::printCommand(const std::string& what, AutomationHost& host) {
     const ViewerState& st = host.state();
-    if (what == "dirty") {
+    if (what == "window") {
+        WindowRect w = host.windowRect(), a = host.workArea();
+        std::printf("viewer: window %d %d %d %d in work area %d %d %d %d\n", w.x, w.y, w.width, w.height, a.x, a.y, a.width, a.height);
+    } else if (what == "popup") {
+        std::printf("viewer: popup %s\n", ImGui::IsPopupOpen(nullptr, ImGuiPopupFlags_AnyPopupId) ? "yes" : "no");
+    } else if (what == "dirty") {
         std::printf("viewer: dirty %s\n", st.doc.dirty ? "yes" : "no");
     } else if (what == "tree") {
         printTree(st.doc.scene);
@@ -296,7 +340,7 @@ Automation::Next Automation::printCommand(const std::string& what, AutomationHos
         const UndoStack& h = st.doc.history;
         std::printf("viewer: undo %s | redo %s\n", h.canUndo() ? h.undoLabel().c_str() : "-", h.canRedo() ? h.redoLabel().c_str() : "-");
     } else {
-        return fail("print " + what + ": expected dirty, tree, compare, diff, selection, pixel, view, status or undo");
+        return fail("print " + what + ": expected dirty, tree, compare, diff, selection, pixel, view, status, undo, window or popup");
     }
     return Next::Continue;
 }

@@ -27,6 +27,9 @@ public:
     virtual void printStats() = 0;   // one line per shown backend: time, triangles, rays
     // A key event as GLFW delivers it (through the platform backend's key callback).
     virtual void keyEvent(int glfwKey, bool press, int glfwMods) = 0;
+    virtual WindowRect windowRect() = 0;   // the window's position and size (screen coordinates)
+    virtual WindowRect workArea() = 0;     // of the monitor it is on, less the window's frame
+    virtual void resizeWindow(int width, int height) = 0;
 
 protected:
     ~AutomationHost() = default;
@@ -55,6 +58,7 @@ private:
     Next runCommand(const std::string& cmd, std::istringstream& in, AutomationHost& host);
     Next keyCommand(const std::string& spec, AutomationHost& host);
     Next clickCommand(std::istringstream& in, const ViewerState& st);
+    Next dragCommand(const std::string& args, const ViewerState& st);
     Next printCommand(const std::string& what, AutomationHost& host);
     Next documentCommand(const std::string& cmd, std::istringstream& in, ViewerState& st);
     Next viewCommand(const std::string& cmd, std::istringstream& in, ViewerState& st);
@@ -63,6 +67,7 @@ private:
     size_t m_pc = 0;   // next line
     int m_waitFrames = 0;
     bool m_waiting = false;                    // `wait`: until host.idle()
+    bool m_waitingLoad = false;                // `wait load`: until no load is in flight
     std::vector<std::pair<int, int>> m_held;   // keys pressed last frame (key, mods), released next step
     std::deque<MouseFrame> m_mouse;            // one per frame, consumed by overrideMouse
 };

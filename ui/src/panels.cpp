@@ -15,6 +15,8 @@
 #include "ui/panels.h"
 
 #include "assets/aov_io.h"
+#include "ui/colour.h"
+
 #include "assets/scene_io.h"
 #include "renderers/framebuffer.h"
 #include "renderers/renderer.h"
@@ -24,6 +26,7 @@
 #include "scenegraph/transforms.h"
 
 #include <imgui.h>
+#include <imgui_internal.h>   // the open-popup stack: Escape closes the innermost menu or combo
 #include <imgui_stdlib.h>
 
 #include <algorithm>
@@ -51,6 +54,22 @@ void record(ViewerState& st, const std::string& key) {
     ImVec2 a = ImGui::GetItemRectMin(), b = ImGui::GetItemRectMax();
     st.hooks.itemRects[key] = ItemRect{a.x, a.y, b.x, b.y};
 }
+
+// A colour editor for a colour the scene stores linear: it shows and takes sRGB-encoded 0..255
+// values (what the viewport and a colour picker show); only an edit writes back, so an
+// untouched value never drifts. Values above 1 (HDR light colours) switch to floats.
+bool srgbColorEdit(const char* label, sg::vec3& linear, ImGuiColorEditFlags flags = 0) {
+    sg::vec3 shown = srgbFromLinear(linear);
+    if (std::max({shown.x, shown.y, shown.z}) > 1.0f) flags |= ImGuiColorEditFlags_Float | ImGuiColorEditFlags_HDR;
+    if (!ImGui::ColorEdit3(label, &shown.x, flags)) return false;
+    linear = linearFromSrgb(shown);
+    return true;
+}
+
+bool escapePressed() { return ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Escape), false); }
+
+// Escape in a modal dialog: Cancel (or OK), unless the same press closed a menu or combo in it.
+bool escapeCancels(const ViewerState& st) { return escapePressed() && !st.ui.panels.escapeClosedPopup; }
 
 // The last item's tooltip (a table entry's help; nothing when empty).
 void tooltip(std::string_view text) {
@@ -270,7 +289,9 @@ void drawEditMenu(ViewerState& st) {
 
 void drawMainMenu(ViewerState& st) {
     if (!ImGui::BeginMainMenuBar()) return;
-    if (ImGui::BeginMenu("File")) {
+    bool fileOpen = ImGui::BeginMenu("File");
+    record(st, "menu/file");
+    if (fileOpen) {
         if (ImGui::MenuItem("New", "Ctrl+N")) st.requestNew();
         if (ImGui::MenuItem("Open...", "Ctrl+O")) st.ui.requests.openDialog = true;
         if (ImGui::BeginMenu("Open Recent", !st.config.recentFiles.empty())) {
@@ -284,6 +305,7 @@ void drawMainMenu(ViewerState& st) {
         ImGui::Separator();
         if (ImGui::MenuItem("Screenshot", "F12")) st.ui.requests.screenshot = true;
         if (ImGui::MenuItem("Screenshot at resolution...")) st.ui.requests.screenshotDialog = true;
+        record(st, "file/screenshotDialog");
         ImGui::Separator();
         if (ImGui::MenuItem("Quit", "Ctrl+Q")) st.requestQuit();
         ImGui::EndMenu();
@@ -336,8 +358,11 @@ void drawMainMenu(ViewerState& st) {
         }
         ImGui::EndMenu();
     }
-    if (ImGui::BeginMenu("Help")) {
+    bool helpOpen = ImGui::BeginMenu("Help");
+    record(st, "menu/help");
+    if (helpOpen) {
         ImGui::MenuItem("Controls", nullptr, &st.ui.panels.showHelp);
+        record(st, "help/controls");
         ImGui::EndMenu();
     }
     // Right side: file name and dirty marker.
@@ -529,7 +554,7 @@ bool materialEditor(ViewerState& st, sg::NodeId id, int& index) {
     sg::Material m = st.doc.scene.materials[index];
     bool ch = false;
     ch |= ImGui::InputText("Name##mat", &m.name, ImGuiInputTextFlags_EnterReturnsTrue);
-    ch |= ImGui::ColorEdit3("Base colour", &m.baseColor.x, ImGuiColorEditFlags_Float);
+    ch |= srgbColorEdit("Base colour", m.baseColor);
     ch |= ImGui::SliderFloat("ka (ambient)", &m.ka, 0.0f, 1.0f);
     record(st, "material/ka");
     ch |= ImGui::SliderFloat("kd (diffuse)", &m.kd, 0.0f, 1.0f);
@@ -538,7 +563,7 @@ bool materialEditor(ViewerState& st, sg::NodeId id, int& index) {
     ch |= ImGui::SliderFloat("Shininess n", &m.shininess, 1.0f, 512.0f, "%.1f", ImGuiSliderFlags_Logarithmic);
     ch |= ImGui::Checkbox("Specular tinted by base colour", &m.specularTinted);
     ImGui::BeginDisabled(m.specularTinted);
-    ch |= ImGui::ColorEdit3("Specular colour", &m.specularColor.x, ImGuiColorEditFlags_Float);
+    ch |= srgbColorEdit("Specular colour", m.specularColor);
     ImGui::EndDisabled();
     int tex = m.diffuseTexture;
     if (ImGui::InputInt("Texture index", &tex)) {
@@ -546,7 +571,7 @@ bool materialEditor(ViewerState& st, sg::NodeId id, int& index) {
         ch = true;
     }
     helpMarker("-1 = none; index into the scene's textures");
-    ch |= ImGui::ColorEdit3("Emissive", &m.emissive.x, ImGuiColorEditFlags_Float);
+    ch |= srgbColorEdit("Emissive", m.emissive);
     ch |= ImGui::SliderFloat("Reflectivity", &m.reflectivity, 0.0f, 1.0f);
     ch |= ImGui::Checkbox("Unlit", &m.unlit);
     ImGui::SameLine();
@@ -677,7 +702,7 @@ void sceneSummary(ViewerState& st) {
     ImGui::Text("Nodes: %zu   meshes: %zu   materials: %zu   textures: %zu", scene.nodeCount(), scene.meshes.size(), scene.materials.size(),
                 scene.textures.size());
     sg::vec3 ambient = scene.ambientLight;
-    if (ImGui::ColorEdit3("Ambient light", &ambient.x, ImGuiColorEditFlags_Float)) st.setAmbientLight(ambient, "ambient");
+    if (srgbColorEdit("Ambient light", ambient)) st.setAmbientLight(ambient, "ambient");
 }
 
 // Name, kind and id, visibility.
@@ -744,7 +769,7 @@ bool csgSection(ViewerState& st, sg::NodeId id, sg::CsgPayload& cp) {
 bool lightSection(ViewerState& st, sg::Light& l) {
     if (!ImGui::CollapsingHeader("Light", ImGuiTreeNodeFlags_DefaultOpen)) return false;
     bool ch = enumCombo(st, "Type", l.type);
-    ch |= ImGui::ColorEdit3("Colour", &l.color.x, ImGuiColorEditFlags_Float);
+    ch |= srgbColorEdit("Colour", l.color);
     ch |= ImGui::DragFloat("Intensity", &l.intensity, 0.05f, 0.0f, 1e5f);
     ch |= ImGui::Checkbox("Inverse-square falloff", &l.inverseSquare);
     if (l.type == sg::LightType::Spot) {
@@ -1078,12 +1103,12 @@ void drawRenderingPanel(ViewerState& st) {
     ch |= ImGui::Checkbox("Light attenuation (1/r^2)", &s.attenuation);
     record(st, "render/attenuation");
     sg::vec3 amb = st.doc.scene.ambientLight;
-    if (ImGui::ColorEdit3("Ambient light", &amb.x, ImGuiColorEditFlags_Float)) st.setAmbientLight(amb, "ambient");
+    if (srgbColorEdit("Ambient light", amb)) st.setAmbientLight(amb, "ambient");
 
     section("Fog");
     ch |= enumCombo(st, "Fog", s.fog);
     if (s.fog != sg::FogMode::Off) {
-        ch |= ImGui::ColorEdit3("Fog colour", &s.fogColor.x, ImGuiColorEditFlags_Float);
+        ch |= srgbColorEdit("Fog colour", s.fogColor);
         if (s.fog == sg::FogMode::Linear)
             ch |= ImGui::DragFloatRange2("Start / end", &s.fogStart, &s.fogEnd, 0.05f, 0.0f, 1e5f);
         else
@@ -1106,7 +1131,7 @@ void drawRenderingPanel(ViewerState& st) {
     record(st, "render/wireframe");
     if (s.wireframe) {
         ImGui::SameLine();
-        ch |= ImGui::ColorEdit3("##wirecol", &s.wireframeColor.x, ImGuiColorEditFlags_NoInputs | ImGuiColorEditFlags_Float);
+        ch |= srgbColorEdit("##wirecol", s.wireframeColor, ImGuiColorEditFlags_NoInputs);
     }
     ch |= enumCombo(st, "Back faces", s.culling);
     record(st, "render/culling");
@@ -1122,7 +1147,7 @@ void drawRenderingPanel(ViewerState& st) {
     ch |= ImGui::SliderInt("Max bounces", &s.maxBounces, 0, 16);
 
     section("Background");
-    ch |= ImGui::ColorEdit3("Background", &s.background.x, ImGuiColorEditFlags_Float);
+    ch |= srgbColorEdit("Background", s.background);
 
     if (ch) st.setSettings(s, "settings");   // refused values: the reason goes to the status line
 }
@@ -1216,6 +1241,7 @@ void drawSlotImage(ImDrawList* dl, const SlotView& v, ImVec2 a, ImVec2 b, float 
 }
 
 std::string slotStats(const SlotView& v) {
+    if (!v.texture && v.status.error.empty()) return v.status.backend + "  rendering...";   // no figures of a picture not shown
     char buf[256];
     const rnd::RenderStats& s = v.status.stats;
     std::string extra;
@@ -1620,7 +1646,7 @@ void drawFileBrowser(ViewerState& st) {
     }
     record(st, "browser/accept");
     ImGui::SameLine();
-    if (ImGui::Button("Cancel", ImVec2(px(75), 0))) {
+    if (ImGui::Button("Cancel", ImVec2(px(75), 0)) || escapeCancels(st)) {
         browser.open = false;
         ImGui::CloseCurrentPopup();
     }
@@ -1636,46 +1662,129 @@ void drawFileBrowser(ViewerState& st) {
     ImGui::EndPopup();
 }
 
+// Width and height fields: the viewport's size, read-only, while "Viewport size" is ticked
+// (so they show what will be written), else the custom size with presets.
+void screenshotSizeFields(ScreenshotDialogState& dialog, const View& view) {
+    bool viewport = dialog.windowSize;
+    int w = viewport ? view.viewportWidth : dialog.width, h = viewport ? view.viewportHeight : dialog.height;
+    ImGui::BeginDisabled(viewport);
+    ImGui::InputInt("Width", &w);
+    ImGui::InputInt("Height", &h);
+    for (auto [pw, ph] : {std::pair{1280, 720}, std::pair{1920, 1080}, std::pair{3840, 2160}}) {
+        if (pw != 1280) ImGui::SameLine();
+        if (ImGui::SmallButton((std::to_string(pw) + "x" + std::to_string(ph)).c_str())) w = pw, h = ph;
+    }
+    ImGui::EndDisabled();
+    if (viewport) return;
+    dialog.width = std::clamp(w, 1, 16384);
+    dialog.height = std::clamp(h, 1, 16384);
+}
+
+// The subfolders of `dir` by name (hidden ones left out; at most `limit`); none when it is not a
+// readable folder.
+std::vector<std::string> subfolders(const fs::path& dir, size_t limit) {
+    std::vector<std::string> names;
+    std::error_code ec;
+    for (fs::directory_iterator it(dir, fs::directory_options::skip_permission_denied, ec), end; !ec && it != end && names.size() < limit;
+         it.increment(ec)) {
+        std::string name = it->path().filename().string();
+        if (!name.empty() && name[0] != '.' && it->is_directory(ec)) names.push_back(name);
+    }
+    std::sort(names.begin(), names.end());
+    return names;
+}
+
+// The folder: typed, or chosen with Up and a click on one of its subfolders.
+void screenshotFolderPicker(ViewerState& st, ScreenshotDialogState& dialog) {
+    if (ImGui::Button("Up##shotFolder")) dialog.dirText = absoluteFolder(dialog.dirText).parent_path().string();
+    record(st, "shot/up");
+    ImGui::SameLine();
+    ImGui::SetNextItemWidth(px(360));
+    ImGui::InputText("Folder", &dialog.dirText);
+    record(st, "shot/folder");
+    ImGui::BeginChild("shotFolders", ImVec2(px(420), px(110)), true);
+    std::vector<std::string> names = subfolders(dialog.dirText, 500);
+    std::error_code ec;
+    if (names.empty()) ImGui::TextDisabled(fs::is_directory(dialog.dirText, ec) ? "(no subfolders)" : "(not a folder yet: Take makes it)");
+    for (const std::string& name : names) {
+        if (ImGui::Selectable(("[dir] " + name).c_str())) dialog.dirText = (absoluteFolder(dialog.dirText) / name).string();
+        record(st, "shot/dir/" + name);
+    }
+    ImGui::EndChild();
+}
+
+// Take: the folder typed is checked (made when missing) before anything renders; a folder
+// that cannot be used keeps the dialog open with the reason.
+bool takeScreenshot(ViewerState& st, ScreenshotDialogState& dialog, std::string& error) {
+    fs::path dir = prepareScreenshotFolder(dialog.dirText, &error);
+    if (dir.empty()) return false;
+    dialog.dir = dir;
+    auto [w, h] = screenshotSize(dialog, st.view);
+    st.ui.requests.screenshot = true;
+    st.ui.requests.screenshotWidth = w;
+    st.ui.requests.screenshotHeight = h;
+    return true;
+}
+
 void drawScreenshotDialog(ViewerState& st) {
     ScreenshotDialogState& dialog = st.ui.panels.shotDialog;
     if (st.ui.requests.screenshotDialog) {
         st.ui.requests.screenshotDialog = false;
         dialog.open = true;
+        dialog.error.clear();
+        dialog.dirText = absoluteFolder(dialog.dir).string();
         ImGui::OpenPopup("Screenshot");
     }
     if (!ImGui::BeginPopupModal("Screenshot", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) return;
-    ImGui::Checkbox("Window size", &dialog.windowSize);
-    ImGui::BeginDisabled(dialog.windowSize);
-    ImGui::InputInt("Width", &dialog.width);
-    ImGui::InputInt("Height", &dialog.height);
-    if (ImGui::SmallButton("1280x720")) {
-        dialog.width = 1280;
-        dialog.height = 720;
-    }
-    ImGui::SameLine();
-    if (ImGui::SmallButton("1920x1080")) {
-        dialog.width = 1920;
-        dialog.height = 1080;
-    }
-    ImGui::SameLine();
-    if (ImGui::SmallButton("3840x2160")) {
-        dialog.width = 3840;
-        dialog.height = 2160;
-    }
-    ImGui::EndDisabled();
-    dialog.width = std::clamp(dialog.width, 1, 16384);
-    dialog.height = std::clamp(dialog.height, 1, 16384);
-    ImGui::TextDisabled("One PNG per backend shown, rendered offscreen;\nnamed screenshot-<backend>[-N].png, never overwriting.");
-    if (ImGui::Button("Take", ImVec2(px(90), 0))) {
-        st.ui.requests.screenshot = true;
-        st.ui.requests.screenshotWidth = dialog.windowSize ? 0 : dialog.width;
-        st.ui.requests.screenshotHeight = dialog.windowSize ? 0 : dialog.height;
-        ImGui::CloseCurrentPopup();
-    }
+    ImGui::Checkbox(screenshotSizeLabel(dialog, st.view).c_str(), &dialog.windowSize);
+    record(st, "shot/viewportSize");
+    screenshotSizeFields(dialog, st.view);
+    screenshotFolderPicker(st, dialog);
+    if (!dialog.error.empty()) ImGui::TextColored(ImVec4(1.0f, 0.6f, 0.45f, 1.0f), "%s", dialog.error.c_str());
+    ImGui::TextDisabled(
+        "One PNG per backend shown, rendered offscreen;\nnamed screenshot-<backend>[-N].png, never overwriting.\nF12 saves into the same folder.");
+    if (ImGui::Button("Take", ImVec2(px(90), 0)) && takeScreenshot(st, dialog, dialog.error)) ImGui::CloseCurrentPopup();
     record(st, "shot/take");
     ImGui::SameLine();
-    if (ImGui::Button("Cancel", ImVec2(px(90), 0))) ImGui::CloseCurrentPopup();
+    if (ImGui::Button("Cancel", ImVec2(px(90), 0)) || escapeCancels(st)) ImGui::CloseCurrentPopup();
     ImGui::EndPopup();
+}
+
+// Help > Controls: input and action in two table columns (the font is proportional, so
+// space-padded text never lined up).
+void drawControlsHelp(ViewerState& st) {
+    static constexpr std::pair<const char*, const char*> kControls[] = {
+        {"Left drag", "orbit around the pivot"},
+        {"Middle / Shift+left drag", "pan"},
+        {"Wheel", "zoom"},
+        {"Right drag + WASD", "fly (Q/E down/up, Shift faster)"},
+        {"F", "fit scene / selection"},
+        {"Home", "reset to the scene camera"},
+        {"1 / 2 / 3", "backend gl / raster / raycast"},
+        {"F12", "screenshot"},
+        {"Space", "play / pause the animation (viewport)"},
+        {"F2", "rename selection"},
+        {"Del, Ctrl+D", "delete / duplicate selection"},
+        {"Ctrl+Z", "undo (Edit menu names the step)"},
+        {"Ctrl+Shift+Z, Ctrl+Y", "redo"},
+        {"Ctrl+N/O/S/Q", "new / open / save / quit"},
+        {"Escape", "close a menu, list or dialog"},
+    };
+    ImGui::SetNextWindowSize(ImVec2(px(460), 0), ImGuiCond_FirstUseEver);
+    if (ImGui::Begin("Controls", &st.ui.panels.showHelp)) {
+        if (ImGui::BeginTable("controls", 2, ImGuiTableFlags_RowBg | ImGuiTableFlags_SizingFixedFit)) {
+            for (const auto& [input, action] : kControls) {
+                ImGui::TableNextRow();
+                ImGui::TableNextColumn();
+                ImGui::TextUnformatted(input);
+                ImGui::TableNextColumn();
+                ImGui::TextUnformatted(action);
+            }
+            ImGui::EndTable();
+        }
+        ImGui::TextUnformatted("Drag tree nodes onto others to re-parent.\nDrop files onto the window to open them.");
+    }
+    ImGui::End();
 }
 
 }   // namespace
@@ -1712,7 +1821,7 @@ void drawDialogs(ViewerState& st) {
         }
         record(st, "confirm/discard");
         ImGui::SameLine();
-        if (ImGui::Button("Cancel", ImVec2(px(90), 0)) || ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Escape))) {
+        if (ImGui::Button("Cancel", ImVec2(px(90), 0)) || escapeCancels(st)) {
             st.confirm(ConfirmChoice::Cancel);
             ImGui::CloseCurrentPopup();
         }
@@ -1725,36 +1834,14 @@ void drawDialogs(ViewerState& st) {
         ImGui::PushTextWrapPos(px(520));
         ImGui::TextColored(ImVec4(1.0f, 0.6f, 0.5f, 1.0f), "%s", st.ui.errorPopup.c_str());
         ImGui::PopTextWrapPos();
-        if (ImGui::Button("OK", ImVec2(px(90), 0)) || ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Enter))) {
+        if (ImGui::Button("OK", ImVec2(px(90), 0)) || ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Enter)) || escapeCancels(st)) {
             st.ui.errorPopup.clear();
             ImGui::CloseCurrentPopup();
         }
         ImGui::EndPopup();
     }
 
-    if (st.ui.panels.showHelp) {
-        ImGui::SetNextWindowSize(ImVec2(px(420), 0), ImGuiCond_FirstUseEver);
-        if (ImGui::Begin("Controls", &st.ui.panels.showHelp)) {
-            ImGui::TextUnformatted(
-                "Left drag          orbit around the pivot\n"
-                "Middle / Shift+left drag   pan\n"
-                "Wheel              zoom\n"
-                "Right drag + WASD  fly (Q/E down/up, Shift faster)\n"
-                "F                  fit scene / selection\n"
-                "Home               reset to the scene camera\n"
-                "1 / 2 / 3          backend gl / raster / raycast\n"
-                "F12                screenshot\n"
-                "Space              play / pause the animation (viewport)\n"
-                "F2                 rename selection\n"
-                "Del, Ctrl+D        delete / duplicate selection\n"
-                "Ctrl+Z             undo (Edit menu names the step)\n"
-                "Ctrl+Shift+Z, Ctrl+Y  redo\n"
-                "Ctrl+N/O/S/Q       new / open / save / quit\n"
-                "Drag tree nodes onto others to re-parent.\n"
-                "Drop files onto the window to open them.");
-        }
-        ImGui::End();
-    }
+    if (st.ui.panels.showHelp) drawControlsHelp(st);
 }
 
 // --- 11. shortcuts and layout ------------------------------------------------------------------
@@ -1913,8 +2000,25 @@ void drawStatusBar(ViewerState& st, const ViewportInput& view, float height) {
 
 }   // namespace
 
+namespace {
+
+// Escape closes the innermost open menu, submenu, combo or context menu, one per press. A modal
+// dialog on top is left to its own Cancel (escapeCancels), so its answer is never skipped.
+void closePopupOnEscape(ViewerState& st) {
+    st.ui.panels.escapeClosedPopup = false;
+    ImGuiContext& g = *ImGui::GetCurrentContext();
+    if (!escapePressed() || g.OpenPopupStack.empty()) return;
+    const ImGuiWindow* top = g.OpenPopupStack.back().Window;
+    if (top && (top->Flags & ImGuiWindowFlags_Modal)) return;
+    ImGui::ClosePopupToLevel(g.OpenPopupStack.Size - 1, /*restore_focus_to_window_under_popup=*/true);
+    st.ui.panels.escapeClosedPopup = true;
+}
+
+}   // namespace
+
 void drawUi(ViewerState& st, const ViewportInput& view, double time, float dt) {
     ImGuiIO& io = ImGui::GetIO();
+    closePopupOnEscape(st);
     drawMainMenu(st);
     float menuH = ImGui::GetFrameHeight();
     float statusH = ImGui::GetFrameHeight() + px(4);

@@ -36,15 +36,16 @@ void RenderSlot::request(std::shared_ptr<const sg::FrameInput> frame, int width,
     if (!needs(key, interacting)) return;   // nothing new to draw
     m_lastKey = key;
     m_lastPreviewOnly = interacting;
-    Job job{std::move(frame), width, height, key, interacting, interacting};
     std::lock_guard<std::mutex> lock(m_mutex);
-    m_pending = std::move(job);
+    m_pending = Job{std::move(frame), width, height, key, interacting, interacting, m_generation};
     if (m_control) m_control->cancel = true;   // restart with the new frame
     m_cv.notify_all();
 }
 
-void RenderSlot::publish(rnd::Framebuffer&& fb, const rnd::RenderStats& st, int level, std::shared_ptr<const sg::FrameInput> frame) {
+void RenderSlot::publish(rnd::Framebuffer&& fb, const rnd::RenderStats& st, int level, uint64_t generation,
+                         std::shared_ptr<const sg::FrameInput> frame) {
     std::lock_guard<std::mutex> lock(m_mutex);
+    if (generation != m_generation) return;   // rendered for a scene forget() dropped
     m_status.stats = st;
     m_status.error = st.ok ? std::string() : (st.error.empty() ? "render failed" : st.error);
     if (st.ok) {
@@ -98,7 +99,7 @@ void RenderSlot::runJob(const Job& job) {
             st.ok = false;
             st.error = "backend returned a " + std::to_string(fb.width) + "x" + std::to_string(fb.height) + " image";
         }
-        publish(std::move(fb), st, d, job.frame);
+        publish(std::move(fb), st, d, job.generation, job.frame);
         if (!st.ok) return;
     }
 }
@@ -156,6 +157,24 @@ std::vector<float> RenderSlot::lightVisibility(const sg::vec3& p, const sg::vec3
     // The renderer answers for the frame it rendered last: only while that is the one shown.
     if (m_renderedFrame != m_shownFrame.get()) return {};
     return m_renderer->lightVisibility(*m_shownFrame, p, ng);
+}
+
+void RenderSlot::forget() {
+    std::lock_guard<std::mutex> lock(m_mutex);
+    ++m_generation;
+    m_pending.reset();
+    if (m_control) m_control->cancel = true;
+    m_haveNew = false;
+    m_finished = {};
+    m_shown = {};
+    m_finishedFrame.reset();
+    m_shownFrame.reset();
+    ++m_serial;
+    m_status.stats = {};
+    m_status.error.clear();
+    m_status.level = 1;
+    m_lastKey = ~uint64_t(0);
+    if (!m_renderer) m_status.error = m_makeError.empty() ? "unknown backend " + m_backend : m_makeError;
 }
 
 SlotStatus RenderSlot::status() const {

@@ -85,6 +85,18 @@ struct Texture {
     void* imguiId() const { return id ? reinterpret_cast<void*>(uintptr_t(id)) : nullptr; }
 };
 
+// Clears the window context's latched GL errors, reporting each on stderr with `where` (what
+// ran since the last check). GL keeps an error until someone calls glGetError: without this, a
+// later GL render in the same context (a GL screenshot on the UI thread) reports it as its own
+// failure. Returns how many there were.
+int drainGlErrors(const char* where) {
+    int n = 0;
+    for (GLenum e; (e = glGetError()) != GL_NO_ERROR && n < 16; ++n) std::fprintf(stderr, "viewer: OpenGL error 0x%x in %s\n", e, where);
+    return n;
+}
+
+WindowRect workAreaFor(GLFWwindow* win, const std::optional<WindowRect>& r);   // section 5
+
 // Reads the default framebuffer (the whole window) into a PNG.
 std::string saveWindowPng(GLFWwindow* win, const fs::path& path) {
     int w = 0, h = 0;
@@ -133,7 +145,6 @@ public:
     Texture diffTexture;
     uint64_t diffKey = ~uint64_t(0);
     std::vector<PendingShot> shots;
-    fs::path shotDir = ".";
     std::vector<std::string> droppedFiles;
     float newContentScale = 0.0f;   // set by the content-scale callback, applied between frames
     std::string iniPath;            // imgui.ini; ImGui keeps the char pointer, so it lives here
@@ -151,8 +162,20 @@ public:
     RenderSlot::Threading slotThreading() const { return st.view.glOnWorker ? RenderSlot::Threading::Worker : RenderSlot::Threading::Auto; }
     static bool contextBound(const RenderSlot& slot) { return slot.capabilities().affinity == rnd::ContextAffinity::CurrentGLContext; }
 
+    // After setScene (a load, File > New): every slot drops the previous scene's image, stats and
+    // renders in flight, so the viewport says "rendering..." until the new scene's first
+    // (coarse) image instead of showing the old one. The textures stay (this
+    // frame's UI may draw them) but are not shown while their slot has no image.
+    void forgetOldScene() {
+        if (st.doc.sceneSerial == m_shownScene) return;
+        m_shownScene = st.doc.sceneSerial;
+        for (auto& [name, v] : views) v.slot->forget();
+        diffKey = ~uint64_t(0);
+    }
+
     // Requests renders for the visible backends and uploads finished images.
     void updateRenders() {
+        forgetOldScene();
         if (st.view.glOnWorker != m_glOnWorker) {   // where context-bound backends run changed: new slots
             m_glOnWorker = st.view.glOnWorker;
             for (auto& [name, v] : views) {
@@ -218,8 +241,10 @@ public:
         const rnd::Framebuffer& fa = a.image();
         const rnd::Framebuffer& fb = b.image();
         if (fa.width == 0 || fa.width != fb.width || fa.height != fb.height || a.status().level != 1 || b.status().level != 1) {
+            // Not shown (viewportInput checks diff.valid) but not deleted either: this frame's
+            // ImGui draw data, recorded before this call, may still name the texture, and
+            // drawing a deleted texture is GL_INVALID_OPERATION.
             diffKey = ~uint64_t(0);
-            diffTexture.release();
             return;
         }
         // Recompute when either image, the pair or the threshold changed.
@@ -243,7 +268,7 @@ public:
         for (const std::string& n : visibleBackends(st)) {
             BackendView& v = viewFor(n);
             SlotView s;
-            s.texture = v.texture.imguiId();
+            s.texture = v.slot->hasImage() ? v.texture.imguiId() : nullptr;
             s.width = v.texture.width;
             s.height = v.texture.height;
             s.status = v.slot->status();
@@ -259,16 +284,22 @@ public:
         return in;
     }
 
-    // Starts offscreen screenshots of every visible backend at w x h (0 = viewport size).
-    void startScreenshots(int w, int h, const fs::path& dir) {
+    // Starts offscreen screenshots of every visible backend at w x h (0 = viewport size) into
+    // `dir` (made absolute, created when missing; a folder that cannot be made is a one-line
+    // error in the status bar).
+    void startScreenshots(int w, int h, const fs::path& folder) {
         if (w < 1 || h < 1) {
             w = st.view.viewportWidth;
             h = st.view.viewportHeight;
         }
+        std::string folderError;
+        fs::path dir = prepareScreenshotFolder(folder, &folderError);
+        if (dir.empty()) {
+            st.ui.status = "Screenshot failed: " + folderError;
+            return;
+        }
         float aspect = float(w) / float(h);
         auto base = std::make_shared<sg::FrameInput>(st.buildFrame(aspect));
-        std::error_code ec;
-        fs::create_directories(dir, ec);
         std::vector<std::string> names = visibleBackends(st);
         std::sort(names.begin(), names.end());
         names.erase(std::unique(names.begin(), names.end()), names.end());
@@ -293,6 +324,7 @@ public:
                 return assets::writePng(path, fb.width, fb.height, fb.color.data(), /*overwrite=*/false);
             };
             if (r->capabilities().affinity == rnd::ContextAffinity::CurrentGLContext) {   // the window's context: here, now
+                drainGlErrors("the window's context before a GL screenshot");             // not this render's errors
                 std::promise<std::string> pr;
                 pr.set_value(job());
                 p.result = pr.get_future();
@@ -301,8 +333,8 @@ public:
             }
             shots.push_back(std::move(p));
         }
-        st.ui.status =
-            "Screenshot: rendering " + std::to_string(names.size()) + " image(s) at " + std::to_string(w) + "x" + std::to_string(h) + "...";
+        st.ui.status = "Screenshot: rendering " + std::to_string(names.size()) + " image(s) at " + std::to_string(w) + "x" + std::to_string(h) +
+                       " into " + dir.string() + "...";
     }
 
     void pollScreenshots(bool wait) {
@@ -312,14 +344,13 @@ public:
                 continue;
             }
             std::string err = shots[i].result.get();
-            if (err.empty())
-                st.ui.status = "Saved " + shots[i].path.string();
-            else {
-                st.ui.status = "Screenshot failed: " + err;
-                std::fprintf(stderr, "viewer: screenshot: %s\n", err.c_str());
-            }
-            lastShotErrors.push_back(err);
+            if (!err.empty()) std::fprintf(stderr, "viewer: screenshot: %s: %s\n", shots[i].backend.c_str(), err.c_str());
+            shotResults.push_back({shots[i].backend, shots[i].path, err});
             shots.erase(shots.begin() + i);
+        }
+        if (shots.empty() && !shotResults.empty()) {   // the whole batch is done: one line naming every file
+            st.ui.status = screenshotSummary(shotResults);
+            shotResults.clear();
         }
     }
 
@@ -342,7 +373,7 @@ public:
         diffTexture.release();
     }
 
-    std::vector<std::string> lastShotErrors;
+    std::vector<ScreenshotResult> shotResults;   // of the batch in flight, finished so far
 
     // --- AutomationHost ---
     ViewerState& state() override { return st; }
@@ -351,7 +382,12 @@ public:
     void startScreenshots(const fs::path& dir) override { startScreenshots(0, 0, dir); }
     void printStats() override {
         for (const std::string& n : visibleBackends(st)) {
-            SlotStatus s = viewFor(n).slot->status();
+            const RenderSlot& slot = *viewFor(n).slot;
+            SlotStatus s = slot.status();
+            if (!slot.hasImage() && s.error.empty()) {
+                std::printf("viewer: stats %s %dx%d: no image yet\n", n.c_str(), st.view.viewportWidth, st.view.viewportHeight);
+                continue;
+            }
             std::printf("viewer: stats %s %dx%d level %d: %.1f ms, %llu triangles, %llu rays%s%s\n", n.c_str(), st.view.viewportWidth,
                         st.view.viewportHeight, s.level, s.stats.milliseconds, (unsigned long long)s.stats.triangles,
                         (unsigned long long)s.stats.rays, s.error.empty() ? "" : ", error: ", s.error.c_str());
@@ -363,10 +399,19 @@ public:
     void keyEvent(int key, bool press, int mods) override {
         ImGui_ImplGlfw_KeyCallback(window, key, glfwGetKeyScancode(key), press ? GLFW_PRESS : GLFW_RELEASE, mods);
     }
+    WindowRect windowRect() override {
+        WindowRect r;
+        glfwGetWindowPos(window, &r.x, &r.y);
+        glfwGetWindowSize(window, &r.width, &r.height);
+        return r;
+    }
+    WindowRect workArea() override { return workAreaFor(window, windowRect()); }
+    void resizeWindow(int width, int height) override { glfwSetWindowSize(window, width, height); }
 
 private:
     rnd::ImageDiff m_lastDiff;
     bool m_glOnWorker = false;
+    uint64_t m_shownScene = 0;   // doc.sceneSerial the slots' images belong to
 };
 
 }   // namespace
@@ -436,6 +481,7 @@ GLFWwindow* createWindow(const ViewerOptions& opt, bool automated) {
     glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
     glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
     glfwWindowHint(GLFW_SCALE_TO_MONITOR, GLFW_TRUE);
+    glfwWindowHint(GLFW_VISIBLE, GLFW_FALSE);   // shown by placeWindowOnScreen, at its place and size
     GLFWwindow* win = glfwCreateWindow(std::max(opt.width, 320), std::max(opt.height, 240), "Scene viewer", nullptr, nullptr);
     if (!win) {
         std::fprintf(stderr, "viewer: error: cannot create a GL 3.3 core window\n");
@@ -451,6 +497,52 @@ GLFWwindow* createWindow(const ViewerOptions& opt, bool automated) {
         return nullptr;
     }
     return win;
+}
+
+// The work area of the monitor holding the centre of `r` (the primary monitor when none does,
+// or without `r`), less the window's frame (title bar, borders) where the window manager says.
+WindowRect workAreaFor(GLFWwindow* win, const std::optional<WindowRect>& r) {
+    int count = 0;
+    GLFWmonitor** monitors = glfwGetMonitors(&count);
+    GLFWmonitor* chosen = glfwGetPrimaryMonitor();
+    WindowRect area;
+    for (int i = 0; r && i < count; ++i) {
+        WindowRect a;
+        glfwGetMonitorWorkarea(monitors[i], &a.x, &a.y, &a.width, &a.height);
+        int cx = r->x + r->width / 2, cy = r->y + r->height / 2;
+        if (cx >= a.x && cx < a.x + a.width && cy >= a.y && cy < a.y + a.height) chosen = monitors[i];
+    }
+    if (chosen) glfwGetMonitorWorkarea(chosen, &area.x, &area.y, &area.width, &area.height);
+    if (area.width < 1 || area.height < 1) area = {0, 0, 1600, 900};   // no monitor information: the old fixed size
+    int left = 0, top = 0, right = 0, bottom = 0;
+    glfwGetWindowFrameSize(win, &left, &top, &right, &bottom);
+    return {area.x + left, area.y + top, std::max(area.width - left - right, 1), std::max(area.height - top - bottom, 1)};
+}
+
+// Sizes and places the (hidden) window from the monitor's work area, the rectangle remembered
+// from the last run or --window-size, always inside the work area, then shows it. Screen coordinates throughout, so the content scale
+// (HiDPI) stays the fonts' business.
+void placeWindowOnScreen(GLFWwindow* win, const ViewerOptions& opt, const fs::path& configDir) {
+    std::string error;
+    std::optional<WindowRect> remembered = loadWindowRect(configDir, &error);
+    if (!error.empty()) std::fprintf(stderr, "viewer: warning: %s\n", error.c_str());
+    WindowRect r = placeWindow(workAreaFor(win, remembered), remembered, opt.width, opt.height);
+    glfwSetWindowSize(win, r.width, r.height);
+    glfwSetWindowPos(win, r.x, r.y);
+    glfwShowWindow(win);
+}
+
+// Remembers the window's rectangle for the next run. Not when maximized or minimized (the next
+// run would open that way without being so), nor after a run sized by --window-size (tests,
+// documentation shots: a one-off that must not change the user's next window).
+void rememberWindow(GLFWwindow* win, const fs::path& configDir, const ViewerOptions& opt) {
+    if (configDir.empty() || (opt.width > 0 && opt.height > 0)) return;
+    if (glfwGetWindowAttrib(win, GLFW_MAXIMIZED) || glfwGetWindowAttrib(win, GLFW_ICONIFIED)) return;
+    WindowRect r;
+    glfwGetWindowPos(win, &r.x, &r.y);
+    glfwGetWindowSize(win, &r.width, &r.height);
+    if (std::string err = saveWindowRect(configDir, r); !err.empty())
+        std::fprintf(stderr, "viewer: warning: cannot remember the window size: %s\n", err.c_str());
 }
 
 // Connects the window to the viewer (callbacks), picks where the GL backend renders, reads the
@@ -505,10 +597,11 @@ void openInitialScene(ViewerState& st, const ViewerOptions& opt) {
 
 // Finishes the screenshots in flight, stops a running load, frees the GL objects while the
 // context is current, then ImGui, the window and GLFW.
-void shutDown(Viewer& v, GLFWwindow* win) {
+void shutDown(Viewer& v, GLFWwindow* win, const ViewerOptions& opt) {
     v.pollScreenshots(true);
     v.st.cancelLoad();   // a load still running stops soon instead of finishing for nobody
 
+    rememberWindow(win, v.st.config.dir, opt);
     v.releaseGL();
     ImGui_ImplOpenGL3_Shutdown();
     ImGui_ImplGlfw_Shutdown();
@@ -583,7 +676,7 @@ private:
             m_st.requestOpen(m_v.droppedFiles.front());
             m_v.droppedFiles.clear();
         }
-        m_st.pollLoad();
+        if (m_st.pollLoad()) m_v.forgetOldScene();   // before the script or the UI look at the images
         m_st.advanceAnimation(dt);
         m_v.pollScreenshots(false);
     }
@@ -610,7 +703,7 @@ private:
         Requests& r = m_st.ui.requests;
         if (r.screenshot) {
             r.screenshot = false;
-            m_v.startScreenshots(r.screenshotWidth, r.screenshotHeight, m_v.shotDir);
+            m_v.startScreenshots(r.screenshotWidth, r.screenshotHeight, m_st.ui.panels.shotDialog.dir);
             r.screenshotWidth = r.screenshotHeight = 0;
         }
     }
@@ -626,6 +719,7 @@ private:
         glClearColor(0.08f, 0.09f, 0.10f, 1.0f);
         glClear(GL_COLOR_BUFFER_BIT);
         ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+        drainGlErrors("the UI drawing");
         if (!m_automation.windowShot.empty()) {
             std::string err = saveWindowPng(m_win, m_automation.windowShot);
             if (!err.empty()) {
@@ -676,9 +770,10 @@ int runViewer(const ViewerOptions& opt) {
     if (!win) return 1;
     auto viewer = std::make_unique<Viewer>();   // outlives the ImGui context (it holds the ini path)
     setUpViewer(*viewer, win);
+    placeWindowOnScreen(win, opt, viewer->st.config.dir);
     openInitialScene(viewer->st, opt);
     int exitCode = MainLoop(*viewer, win, automation, opt).run();
-    shutDown(*viewer, win);
+    shutDown(*viewer, win, opt);
     return exitCode;
 }
 

@@ -33,6 +33,7 @@ void ViewerState::setScene(sg::Scene s, fs::path path) {
     anim.time = 0.0;
     anim.playing = false;
     ++doc.version;
+    ++doc.sceneSerial;
     resetView();
 }
 
@@ -859,8 +860,101 @@ std::string saveRecentFiles(const fs::path& dir, const std::vector<std::string>&
     return assets::writeFileAtomic(dir / "recent.txt", text, /*overwrite=*/true);
 }
 
+namespace {
+WindowRect centred(int width, int height, const WindowRect& area) {
+    return {area.x + (area.width - width) / 2, area.y + (area.height - height) / 2, width, height};
+}
+}   // namespace
+
+WindowRect placeWindow(const WindowRect& workArea, const std::optional<WindowRect>& remembered, int requestedWidth, int requestedHeight) {
+    WindowRect r;
+    if (requestedWidth > 0 && requestedHeight > 0)
+        r = centred(requestedWidth, requestedHeight, workArea);
+    else if (remembered && remembered->width > 0 && remembered->height > 0)
+        r = *remembered;
+    else
+        r = centred(workArea.width * 85 / 100, workArea.height * 85 / 100, workArea);
+    r.width = std::clamp(r.width, std::min(320, workArea.width), std::max(workArea.width, 1));
+    r.height = std::clamp(r.height, std::min(240, workArea.height), std::max(workArea.height, 1));
+    r.x = std::clamp(r.x, workArea.x, workArea.x + std::max(workArea.width - r.width, 0));
+    r.y = std::clamp(r.y, workArea.y, workArea.y + std::max(workArea.height - r.height, 0));
+    return r;
+}
+
+std::optional<WindowRect> loadWindowRect(const fs::path& dir, std::string* error) {
+    std::string text;
+    std::error_code ec;
+    if (dir.empty() || !fs::exists(dir / "window.txt", ec)) return std::nullopt;
+    std::string readError = assets::readFileLimited(dir / "window.txt", 4096, text);
+    std::istringstream in(text);
+    WindowRect r;
+    if (readError.empty() && (in >> r.x >> r.y >> r.width >> r.height) && r.width >= 1 && r.height >= 1 && r.width <= 100000 && r.height <= 100000)
+        return r;
+    if (error) *error = (dir / "window.txt").string() + ": " + (readError.empty() ? "expected 'x y width height'" : readError) + "; ignored";
+    return std::nullopt;
+}
+
+std::string saveWindowRect(const fs::path& dir, const WindowRect& r) {
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    std::string text = std::to_string(r.x) + " " + std::to_string(r.y) + " " + std::to_string(r.width) + " " + std::to_string(r.height) + "\n";
+    return assets::writeFileAtomic(dir / "window.txt", text, /*overwrite=*/true);
+}
+
 fs::path screenshotPath(const fs::path& dir, const std::string& backend, const std::string& stem) {
     return assets::uniquePath(dir / (stem + "-" + backend + ".png"));
+}
+
+std::string screenshotSummary(const std::vector<ScreenshotResult>& results) {
+    std::string saved, failed;
+    int count = 0;
+    fs::path dir;
+    for (const ScreenshotResult& r : results) {
+        if (!r.error.empty()) {
+            std::string_view why = r.error;
+            if (why.rfind(r.backend + ": ", 0) == 0) why.remove_prefix(r.backend.size() + 2);   // "gl: ..." from the renderer
+            failed += "; " + r.backend + " failed: " + std::string(why);
+            continue;
+        }
+        saved += (count++ ? ", " : "") + r.path.filename().string();
+        dir = r.path.parent_path();
+    }
+    std::string line = count == 0   ? "Screenshot failed"
+                       : count == 1 ? "Saved " + saved + " in " + dir.string()
+                                    : "Saved " + std::to_string(count) + " screenshots in " + dir.string() + ": " + saved;
+    return count == 0 && !failed.empty() ? line + ": " + failed.substr(2) : line + failed;
+}
+
+std::pair<int, int> screenshotSize(const ScreenshotDialogState& dialog, const View& view) {
+    if (dialog.windowSize) return {std::max(view.viewportWidth, 1), std::max(view.viewportHeight, 1)};
+    return {std::clamp(dialog.width, 1, 16384), std::clamp(dialog.height, 1, 16384)};
+}
+
+std::string screenshotSizeLabel(const ScreenshotDialogState& dialog, const View& view) {
+    ScreenshotDialogState viewport = dialog;
+    viewport.windowSize = true;
+    auto [w, h] = screenshotSize(viewport, view);
+    return "Viewport size (" + std::to_string(w) + "x" + std::to_string(h) + ")###viewportSize";
+}
+
+fs::path absoluteFolder(const fs::path& folder) {
+    std::error_code ec;
+    fs::path dir = fs::absolute(folder.empty() ? fs::path(".") : folder, ec).lexically_normal();
+    if (ec) return folder;
+    if (!dir.has_filename() && dir != dir.root_path()) dir = dir.parent_path();   // "/a/b/" -> "/a/b"
+    return dir;
+}
+
+fs::path prepareScreenshotFolder(const fs::path& folder, std::string* error) {
+    std::error_code ec;
+    fs::path dir = absoluteFolder(folder);
+    fs::create_directories(dir, ec);
+    if (!ec && !fs::is_directory(dir, ec)) ec = std::make_error_code(std::errc::not_a_directory);
+    if (ec) {
+        if (error) *error = "cannot use folder '" + folder.string() + "': " + ec.message();
+        return {};
+    }
+    return dir;
 }
 
 }   // namespace ui

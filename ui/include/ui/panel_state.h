@@ -28,6 +28,9 @@ struct ScreenshotDialogState {
     bool open = false;
     bool windowSize = true;   // render at the viewport size (else width x height)
     int width = 1920, height = 1080;
+    std::filesystem::path dir;   // where screenshots go, F12's too ("" = the folder the viewer started in)
+    std::string dirText;         // the folder field being edited (filled when the dialog opens)
+    std::string error;           // why Take was refused (a folder that cannot be made)
 };
 
 struct PanelState {
@@ -38,8 +41,9 @@ struct PanelState {
     // Scene tree: the node being renamed in place (F2, double click, context menu) and its text.
     sg::NodeId renaming = sg::kNoNode;
     std::string renameBuffer;
-    int dragDivider = -1;    // split view: the wipe divider being dragged (-1: none)
-    PixelProbeState probe;   // the pixel inspector: hovered or pinned point, per-backend answers
+    int dragDivider = -1;             // split view: the wipe divider being dragged (-1: none)
+    bool escapeClosedPopup = false;   // this frame's Escape closed a menu / combo: a dialog under it stays
+    PixelProbeState probe;            // the pixel inspector: hovered or pinned point, per-backend answers
 };
 
 }   // namespace ui

@@ -64,6 +64,11 @@ public:
     SlotStatus status() const;
     // Blocks until nothing is pending (tests, screenshots at exit).
     void waitIdle();
+    // Drops the shown image, its stats and every render pending or in flight (a different scene
+    // was loaded: the old one's picture and figures must not stay on screen). A render that
+    // finishes afterwards is thrown away; the next request() starts afresh.
+    void forget();
+    bool hasImage() const { return m_shown.width > 0; }
 
     int previewDivisor = 4;
 
@@ -74,11 +79,12 @@ private:
         uint64_t key = 0;
         bool previewOnly = false;
         bool interacting = false;   // no visibility while the camera moves
+        uint64_t generation = 0;    // m_generation when requested: forget() outdates it
     };
     void workerLoop();
     // Renders one job level by level; publishes each finished level. Returns false when cancelled.
     void runJob(const Job& job);
-    void publish(rnd::Framebuffer&& fb, const rnd::RenderStats& st, int level, std::shared_ptr<const sg::FrameInput> frame);
+    void publish(rnd::Framebuffer&& fb, const rnd::RenderStats& st, int level, uint64_t generation, std::shared_ptr<const sg::FrameInput> frame);
 
     std::string m_backend;
     bool m_threaded;
@@ -96,6 +102,7 @@ private:
     bool m_quit = false;
     rnd::RenderControl* m_control = nullptr;   // of the render in flight (guarded by m_mutex)
     bool m_haveNew = false;
+    uint64_t m_generation = 0;     // bumped by forget() (guarded by m_mutex)
     rnd::Framebuffer m_finished;   // published by the worker
     std::shared_ptr<const sg::FrameInput> m_finishedFrame;
     std::mutex m_renderMutex;                          // held while m_renderer renders (lightVisibility asks between renders)

@@ -8,10 +8,10 @@ namespace ui {
 // Window options. The automation fields are hidden command-line options (see app/main.cpp):
 // they let tests and docs drive the real window for a few frames and take screenshots.
 struct ViewerOptions {
-    std::string scene;   // file, or ""/"demo" for the bundled demo
-    int width = 1600, height = 900;
-    std::string backend;   // initial backend ("" = gl)
-    std::string view;      // initial view: single, split, split3, difference
+    std::string scene;           // file, or ""/"demo" for the bundled demo
+    int width = 0, height = 0;   // --window-size; 0: the remembered size, else from the monitor's work area
+    std::string backend;         // initial backend ("" = gl)
+    std::string view;            // initial view: single, split, split3, difference
     // Automation: a script of commands, one per line (see viewer.cpp, "automation"), or the
     // shorthand --frames N [--screenshot out.png] = "frames N / wait / window-shot out.png / quit".
     std::string script;

@@ -102,6 +102,7 @@ struct Document {
     bool dirty = false;           // unsaved edits (= !history.atSavedState() after every edit, undo, redo, save)
     UndoStack history;            // every scene edit, for Edit > Undo / Redo
     uint64_t version = 1;         // bumped on every scene change, edits and animation poses (re-render)
+    uint64_t sceneSerial = 1;     // bumped by setScene only: a different scene (drop the old one's images)
     sg::NodeId selected = sg::kNoNode;
     std::vector<std::string> loadWarnings;   // of the load that brought this scene
 };
@@ -337,7 +338,44 @@ float flySpeedFor(const sg::Scene& scene);
 std::filesystem::path defaultConfigDir();
 std::vector<std::string> loadRecentFiles(const std::filesystem::path& configDir);
 std::string saveRecentFiles(const std::filesystem::path& configDir, const std::vector<std::string>& files);
+// A window's place on the desktop in screen coordinates (GLFW's: pixels on X11 and Windows,
+// points on macOS; monitor work areas use the same units, so HiDPI needs no factor here).
+struct WindowRect {
+    int x = 0, y = 0, width = 0, height = 0;
+    bool operator==(const WindowRect&) const = default;
+};
+// Where the viewer window opens on a monitor whose work area (the desktop less panels and
+// docks) is `workArea`: the requested size when given (--window-size), else the remembered
+// rectangle, else 85% of the work area; centred unless remembered; always clamped so the whole
+// window lies inside the work area (a 1600x900 default never spills off a 1366x768 screen).
+WindowRect placeWindow(const WindowRect& workArea, const std::optional<WindowRect>& remembered, int requestedWidth = 0, int requestedHeight = 0);
+// The last window rectangle, kept in configDir/window.txt ("x y width height"); nullopt when
+// there is none or it does not parse (then the default applies, nothing fails; *error says
+// why a file that is there was not used).
+std::optional<WindowRect> loadWindowRect(const std::filesystem::path& configDir, std::string* error = nullptr);
+std::string saveWindowRect(const std::filesystem::path& configDir, const WindowRect& r);
+
 // dir/"<stem>-<backend>.png" or, when taken, the first free "-N" variant (assets::uniquePath).
 std::filesystem::path screenshotPath(const std::filesystem::path& dir, const std::string& backend, const std::string& stem = "screenshot");
+
+// One backend's screenshot, finished: the file written, or why not.
+struct ScreenshotResult {
+    std::string backend;
+    std::filesystem::path path;   // absolute
+    std::string error;            // "" when written
+};
+// The status line for a finished batch: every file written, the folder once (absolute), then
+// each failure ("Saved 2 screenshots in /home/me/shots: screenshot-gl.png, screenshot-raster.png",
+// "Saved screenshot-raster.png in /home/me/shots; gl failed: OpenGL error 0x502 ...").
+std::string screenshotSummary(const std::vector<ScreenshotResult>& results);
+// `folder` absolute and normalised, without a trailing separator ("" = the current folder).
+std::filesystem::path absoluteFolder(const std::filesystem::path& folder);
+// `folder` made absolute (empty = the current folder) and created when missing; empty with
+// *error set when it cannot be.
+std::filesystem::path prepareScreenshotFolder(const std::filesystem::path& folder, std::string* error);
+// The size a screenshot from the dialog is written at: the viewport's while "Viewport size" is
+// ticked, else the dialog's width x height; and the checkbox's label, which names it.
+std::pair<int, int> screenshotSize(const ScreenshotDialogState& dialog, const View& view);
+std::string screenshotSizeLabel(const ScreenshotDialogState& dialog, const View& view);
 
 }   // namespace ui
