@@ -314,3 +314,28 @@ TEST(PanelsTest, ScreenshotDialogFolderIsShownAndChecked) {
     EXPECT_EQ(h.st.ui.panels.shotDialog.dir, fs::absolute(base / "shots").lexically_normal());
     EXPECT_TRUE(fs::is_directory(base / "shots"));
 }
+
+// File > Open: a folder typed into the name field opens in the list (relative to the listed
+// folder or absolute) instead of being taken as a file; a file name is still opened.
+TEST(PanelsTest, TypingAFolderInTheFileDialogOpensIt) {
+    fs::path base = testing_support::outputDir("ui") / "browse_typed";
+    fs::remove_all(base);
+    fs::create_directories(base / "models" / "deep");
+    Headless h;
+    h.st.ui.requests.openDialog = true;
+    h.frame();
+    h.frame();
+    ASSERT_TRUE(h.st.ui.panels.browser.open);
+    h.st.ui.panels.browser.dir = base;
+    h.st.ui.panels.browser.fileName = "models";
+    h.click("browser/accept");
+    EXPECT_TRUE(h.st.ui.panels.browser.open) << "a folder is not a file to open";
+    EXPECT_EQ(h.st.ui.panels.browser.dir, fs::weakly_canonical(base / "models"));
+    EXPECT_TRUE(h.st.ui.panels.browser.fileName.empty());
+    h.st.ui.panels.browser.fileName = (base / "models" / "deep").string();   // absolute
+    h.click("browser/accept");
+    EXPECT_EQ(h.st.ui.panels.browser.dir, fs::weakly_canonical(base / "models" / "deep"));
+    h.st.ui.panels.browser.fileName = "missing.obj";   // not a folder: taken as the file (the load then reports it)
+    h.click("browser/accept");
+    EXPECT_FALSE(h.st.ui.panels.browser.open);
+}

@@ -33,6 +33,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 
 namespace fs = std::filesystem;
@@ -1642,7 +1643,20 @@ void drawFileBrowser(ViewerState& st) {
     bool enter = ImGui::InputText("##file", &browser.fileName, ImGuiInputTextFlags_EnterReturnsTrue);
     ImGui::SameLine();
     if (ImGui::Button(browser.saving ? "Save" : "Open", ImVec2(px(75), 0)) || enter) {
-        if (!browser.fileName.empty()) chosen = browser.dir / browser.fileName;
+        // A folder typed into the name field (relative to the listed one, or absolute; "~"
+        // is home) is opened in the list instead of being taken as the file.
+        std::error_code dirEc;
+        fs::path typed = browser.fileName;
+        if (browser.fileName == "~" || browser.fileName.rfind("~/", 0) == 0)
+            if (const char* home = std::getenv("HOME"))
+                typed = fs::path(home) / browser.fileName.substr(std::min<size_t>(2, browser.fileName.size()));
+        const fs::path target = typed.is_absolute() ? typed : browser.dir / typed;
+        if (!browser.fileName.empty() && fs::is_directory(target, dirEc)) {
+            browser.dir = fs::weakly_canonical(target, dirEc);
+            browser.fileName.clear();
+        } else if (!browser.fileName.empty()) {
+            chosen = target;
+        }
     }
     record(st, "browser/accept");
     ImGui::SameLine();
