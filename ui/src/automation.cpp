@@ -50,6 +50,7 @@
 //                         them; only |A - B| until both full-resolution images are there)
 //   print selection       viewer: selection NAME (or -)
 //   print view            viewer: view MODE DIAGNOSTIC (e.g. single depth)
+//   print memory          viewer: memory N kB (resident set size, from /proc/self/status; -1 unknown)
 //   print pixel           viewer: pixel BACKEND X Y rgb R G B node PATH triangle N depth D predicted R G B
 //                         (one line per shown backend: the pixel inspector's probe)
 //   print status          viewer: status TEXT (the status bar's line)
@@ -73,6 +74,22 @@
 #include <cstdlib>
 
 namespace ui {
+
+namespace {
+
+// Resident set size of this process (VmRSS), for the soak test's `print memory`; -1 unknown.
+long residentKilobytes() {
+    FILE* f = std::fopen("/proc/self/status", "r");
+    if (!f) return -1;
+    char line[256];
+    long kb = -1;
+    while (std::fgets(line, sizeof line, f))
+        if (std::sscanf(line, "VmRSS: %ld kB", &kb) == 1) break;
+    std::fclose(f);
+    return kb;
+}
+
+}   // namespace
 
 namespace {
 
@@ -327,6 +344,8 @@ Automation::Next Automation::printCommand(const std::string& what, AutomationHos
         std::printf("viewer: diff %s\n", st.view.diff.summary(b[0], b[1], st.view.compare.threshold).c_str());
     } else if (what == "selection") {
         std::printf("viewer: selection %s\n", st.doc.scene.valid(st.doc.selected) ? st.doc.scene.node(st.doc.selected).name.c_str() : "-");
+    } else if (what == "memory") {
+        std::printf("viewer: memory %ld kB\n", residentKilobytes());
     } else if (what == "view") {
         std::printf("viewer: view %s %s\n", st.viewName().c_str(), std::string(rnd::nameOf(st.view.diagnostic)).c_str());
     } else if (what == "pixel") {
@@ -340,7 +359,7 @@ Automation::Next Automation::printCommand(const std::string& what, AutomationHos
         const UndoStack& h = st.doc.history;
         std::printf("viewer: undo %s | redo %s\n", h.canUndo() ? h.undoLabel().c_str() : "-", h.canRedo() ? h.redoLabel().c_str() : "-");
     } else {
-        return fail("print " + what + ": expected dirty, tree, compare, diff, selection, pixel, view, status, undo, window or popup");
+        return fail("print " + what + ": expected dirty, tree, compare, diff, selection, pixel, view, memory, status, undo, window or popup");
     }
     return Next::Continue;
 }
