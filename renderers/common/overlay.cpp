@@ -102,7 +102,7 @@ struct Rgb {
     uint8_t r, g, b;
 };
 constexpr Rgb kGrid{120, 120, 120}, kAxisX{230, 50, 50}, kAxisY{50, 200, 50}, kAxisZ{60, 100, 245};
-constexpr Rgb kLight{255, 210, 40}, kCamera{190, 110, 255}, kBounds{40, 200, 220}, kSelection{255, 140, 0};
+constexpr Rgb kLight{255, 210, 40}, kCamera{255, 70, 200}, kBounds{40, 200, 220}, kSelection{255, 140, 0};
 constexpr float kDepthBias = 2e-4f;   // lines on a surface (the grid on a floor) stay visible
 constexpr int kLightRadius = 6;       // pixels
 
@@ -267,12 +267,12 @@ void drawCamera(Painter& paint, const CameraGizmo& cam, const SceneExtent& e) {
     paint.line(world(0.5f * w, h, -depth), world(0, 1.5f * h, -depth), kCamera, false);
 }
 
-void drawSelection(Painter& paint, const sg::FrameInput& f, sg::NodeId selected) {
-    if (selected == sg::kNoNode) return;
+void drawSelection(Painter& paint, const sg::FrameInput& f, const std::vector<sg::NodeId>& selected) {
+    auto isSelected = [&](sg::NodeId n) { return n != sg::kNoNode && std::find(selected.begin(), selected.end(), n) != selected.end(); };
     for (const auto& m : f.meshes)
-        if (m.node == selected) paint.box(meshBounds(m), kSelection, false);
+        if (isSelected(m.node)) paint.box(meshBounds(m), kSelection, false);
     for (const auto& a : f.analytics)
-        if (a.node == selected) paint.box(a.worldBounds, kSelection, false);
+        if (isSelected(a.node)) paint.box(a.worldBounds, kSelection, false);
 }
 
 }   // namespace
@@ -315,7 +315,8 @@ void drawOverlays(const sg::FrameInput& frame, const OverlayOptions& o, Framebuf
     }
     if (o.axes) drawAxes(paint, e);
     if (o.cameras)
-        for (const CameraGizmo& c : o.cameraGizmos) drawCamera(paint, c, e);
+        for (const CameraGizmo& c : o.cameraGizmos)   // not the camera the frame is seen through
+            if (glm::length(vec3(c.world[3]) - frame.camera.eye) > 1e-4f * e.size) drawCamera(paint, c, e);
     if (o.lights)
         for (const sg::DrawLight& l : frame.lights) drawLight(paint, l, e);
     if (o.selection) drawSelection(paint, frame, o.selected);

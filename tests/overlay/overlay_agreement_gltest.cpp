@@ -59,7 +59,7 @@ TEST(OverlayAgreementGLTest, AlwaysShownGizmosAreTheSamePixels) {
     ASSERT_FALSE(f.meshes.empty());
     rnd::OverlayOptions o;
     o.lights = o.cameras = o.selection = true;
-    o.selected = f.meshes.front().node;
+    o.selected = {f.meshes.front().node};
     o.cameraGizmos.push_back({glm::inverse(sg::lookAt({3, 2, 4}, {0, 0.5f, 0}, {0, 1, 0})), sg::Projection{}, 1.5f});
     const rnd::Framebuffer ref = overlayOnly("raster", f, o);
     for (std::string b : {"raycast", "gl"}) {

@@ -22,7 +22,7 @@ Pixels sorted(Pixels p) {
     return p;
 }
 
-// (0,0) -> (5,2): D starts at 2*2 - 5 = -1; per column D = -1, 3 (step), -3, 1 (step), -1, -5:
+// (0,0) -> (5,2): D starts at 2*2 - 5 = -1; at x = 0..4 D = -1, 3 (step), -3, 1 (step), -5:
 // y = 0, 0, 1, 1, 2, 2 (the nearest rows to y = 0.4 x).
 TEST(OverlayBresenhamTest, FirstOctantWorkedExample) {
     EXPECT_EQ(bresenhamPixels(0, 0, 5, 2), sorted({{0, 0}, {1, 0}, {2, 1}, {3, 1}, {4, 2}, {5, 2}}));
@@ -180,7 +180,7 @@ TEST(OverlaySelectionTest, OnlyTheSelectedNode) {
     std::fill(s.fb.depth.begin(), s.fb.depth.end(), 0.0f);
     rnd::OverlayOptions o;
     o.selection = true;
-    o.selected = 2;
+    o.selected = {2};
     rnd::drawOverlays(s.frame, o, s.fb);
     EXPECT_EQ(s.litPixels(0, 32), 0);
     EXPECT_GT(s.litPixels(32, 64), 20);

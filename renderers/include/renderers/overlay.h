@@ -29,7 +29,7 @@ struct CameraGizmo {
 
 struct OverlayOptions {
     bool grid = false, axes = false, lights = false, cameras = false, bounds = false, selection = false;
-    sg::NodeId selected = sg::kNoNode;       // selection: drawables of this node are outlined
+    std::vector<sg::NodeId> selected;        // selection: the drawables of these nodes (a node and its descendants)
     std::vector<CameraGizmo> cameraGizmos;   // cameras: the scene's cameras other than the viewing one
     bool any() const { return grid || axes || lights || cameras || bounds || selection; }
 };
