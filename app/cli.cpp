@@ -244,15 +244,10 @@ std::string overlayOptions(const RenderArgs& a, const sg::Scene& scene, float as
     std::string err;
     if (a.overlay.empty() && a.select.empty()) return {};
     if (!a.overlay.empty() && !rnd::parseOverlayList(a.overlay, o, err)) return err;
-    if (!a.select.empty()) {
-        const sg::NodeId id = scene.findByName(a.select);
-        if (id == sg::kNoNode) return "--select '" + a.select + "': no node of that name in " + a.scene;
-        for (sg::NodeId n : scene.depthFirstOrder())   // the node and its descendants
-            if (scene.isAncestor(id, n)) o.selected.push_back(n);
-    }
-    if (o.selection && o.selected.empty()) return "--overlay selection: name the node with --select NODE";
-    for (sg::NodeId id : scene.cameras())
-        o.cameraGizmos.push_back({scene.world(id), std::get<sg::Camera>(scene.node(id).payload).projection, aspect});
+    const sg::NodeId id = a.select.empty() ? sg::kNoNode : scene.findByName(a.select);
+    if (!a.select.empty() && id == sg::kNoNode) return "--select '" + a.select + "': no node of that name in " + a.scene;
+    if (o.selection && id == sg::kNoNode) return "--overlay selection: name the node with --select NODE";
+    rnd::setSceneOverlayInputs(scene, id, aspect, o);
     return {};
 }
 

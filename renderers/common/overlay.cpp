@@ -322,4 +322,14 @@ void drawOverlays(const sg::FrameInput& frame, const OverlayOptions& o, Framebuf
     if (o.selection) drawSelection(paint, frame, o.selected);
 }
 
+void setSceneOverlayInputs(const sg::Scene& scene, sg::NodeId node, float aspect, OverlayOptions& o) {
+    o.selected.clear();
+    o.cameraGizmos.clear();
+    if (scene.valid(node))
+        for (sg::NodeId n : scene.depthFirstOrder())
+            if (scene.isAncestor(node, n)) o.selected.push_back(n);
+    for (sg::NodeId id : scene.cameras())
+        if (const auto* cam = std::get_if<sg::Camera>(&scene.node(id).payload)) o.cameraGizmos.push_back({scene.world(id), cam->projection, aspect});
+}
+
 }   // namespace rnd
