@@ -140,6 +140,7 @@ public:
         vec4 ca = f_.camera.viewProj * vec4(a, 1.0f), cb = f_.camera.viewProj * vec4(b, 1.0f);
         if (!overlay::clipToNear(ca, cb)) return;
         WinPoint wa = toWindow(ca), wb = toWindow(cb);
+        if (!(finite(wa) && finite(wb))) return;   // overflowed: nothing sensible to draw
         if (!clipRect(wa, wb, -1.0f, -1.0f, float(fb_.width) + 1, float(fb_.height) + 1)) return;
         const int x0 = int(std::floor(wa.x)), y0 = int(std::floor(wa.y)), x1 = int(std::floor(wb.x)), y1 = int(std::floor(wb.y));
         const bool xMajor = std::abs(x1 - x0) >= std::abs(y1 - y0);
@@ -166,6 +167,7 @@ public:
     }
 
 private:
+    static bool finite(const WinPoint& p) { return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z); }
     WinPoint toWindow(const vec4& c) const {
         const float iw = 1.0f / c.w;
         return {(c.x * iw * 0.5f + 0.5f) * float(fb_.width), (c.y * iw * 0.5f + 0.5f) * float(fb_.height), c.z * iw * 0.5f + 0.5f};

@@ -194,6 +194,10 @@ TEST(OverlayRobustnessTest, BadInputIsIgnored) {
     o.bounds = o.grid = o.axes = o.lights = true;
     rnd::Framebuffer empty;
     rnd::drawOverlays(s.frame, o, empty);
+    Scene huge;   // coordinates that overflow to infinity in clip space
+    huge.addBox({-1e38f, -1e38f, -1e38f}, {1e38f, 1e38f, 3e38f});
+    huge.frame.lights.push_back(sg::DrawLight{sg::LightType::Point, {1e38f, 0, -3e38f}});
+    rnd::drawOverlays(huge.frame, o, huge.fb);
     s.frame.camera.viewProj[0][0] = std::numeric_limits<float>::quiet_NaN();
     rnd::drawOverlays(s.frame, o, s.fb);
     EXPECT_EQ(s.litPixels(0, 64), 0);
