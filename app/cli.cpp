@@ -10,6 +10,7 @@
 #include "assets/scene_io.h"
 #include "renderers/diagnostic.h"
 #include "renderers/inspect.h"
+#include "renderers/overlay.h"
 #include "renderers/renderer.h"
 #include "scenegraph/camera_model.h"
 #include "scenegraph/instances.h"
@@ -237,6 +238,19 @@ Shot renderWith(const std::string& backend, const sg::FrameInput& frame, int w, 
     return shot;
 }
 
+// --overlay / --select into the options for `scene`: the names, the selected node and the
+// scene's cameras as gizmos. "" or a one-line error.
+std::string overlayOptions(const RenderArgs& a, const sg::Scene& scene, float aspect, rnd::OverlayOptions& o) {
+    std::string err;
+    if (a.overlay.empty() && a.select.empty()) return {};
+    if (!a.overlay.empty() && !rnd::parseOverlayList(a.overlay, o, err)) return err;
+    const sg::NodeId id = a.select.empty() ? sg::kNoNode : scene.findByName(a.select);
+    if (!a.select.empty() && id == sg::kNoNode) return "--select '" + a.select + "': no node of that name in " + a.scene;
+    if (o.selection && id == sg::kNoNode) return "--overlay selection: name the node with --select NODE";
+    rnd::setSceneOverlayInputs(scene, id, aspect, o);
+    return {};
+}
+
 }   // namespace
 
 void addRenderOptions(CLI::App& cmd, RenderArgs& a, Command command) {
@@ -289,6 +303,10 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a, Command command) {
     cmd.add_option("--tessellation", a.tessellation, "Tessellation resolution for implicit shapes (4..512)");
     cmd.add_option("--time", a.time, "Pose the scene at this time (seconds) of its animation (skins, morph weights, transforms)");
     cmd.add_option("--animation", a.animation, "Which animation clip --time poses (0-based; default 0)");
+    if (command == Command::Inspect) return;
+    cmd.add_option("--overlay", a.overlay,
+                   std::string("Draw overlays on the image, the same pixels in every backend: a comma-separated list of ") + rnd::overlayNameList());
+    cmd.add_option("--select", a.select, "The node (by name) that --overlay selection outlines");
 }
 
 // --aov kinds and the file each writes next to OUT.png.
@@ -384,14 +402,17 @@ std::string writeAovs(const RenderArgs& a, const fs::path& out, const sg::Scene&
 }
 
 // One image of `viewer render`: render, write the PNG (or its diagnostic view) and the AOVs.
-std::string renderJob(const RenderArgs& a, const CameraJob& job, const sg::Scene& scene, rnd::DiagnosticView view) {
+std::string renderJob(const RenderArgs& a, const CameraJob& job, const sg::Scene& scene, rnd::DiagnosticView view,
+                      const rnd::OverlayOptions& overlays) {
     const int w = job.width, h = job.height;
     sg::FrameInput frame = sg::flatten(scene, float(w) / float(h));
     std::string err = applyCameraJob(a, job, frame);
     if (!err.empty()) return (job.index >= 0 ? job.out.string() + ": " : std::string()) + err;
     Shot shot = renderWith(a.backend, frame, w, h, needsVisibility(a) || view != rnd::DiagnosticView::Shaded);
     if (!shot.stats.ok) return shot.stats.error;   // starts with the backend's name
-    const rnd::DiagnosticImage shown = rnd::diagnosticImage(view, frame, shot.image);
+    rnd::DiagnosticImage shown = rnd::diagnosticImage(view, frame, shot.image);
+    shown.image.depth = shot.image.depth;   // overlays are hidden behind the rendered surfaces
+    rnd::drawOverlays(frame, overlays, shown.image);
     err = assets::writePng(job.out, shown.image.width, shown.image.height, shown.image.color.data(), a.overwrite);
     if (!err.empty()) return err;
     if (!(err = writeAovs(a, job.out, scene, frame, shot.image)).empty()) return err;
@@ -422,13 +443,15 @@ int runRender(const RenderArgs& a) {
     if (!scene) return fail(err);
     err = applyPose(a, clips, *scene);
     if (err.empty()) err = applyOverrides(a, *scene);
+    rnd::OverlayOptions overlays;
+    if (err.empty()) err = overlayOptions(a, *scene, jobs.empty() ? 1.0f : float(jobs.front().width) / float(jobs.front().height), overlays);
     if (!err.empty()) return fail(err);
     if (!jobs.empty() && jobs.front().index >= 0) {
         std::error_code ec;
         if (jobs.front().out.has_parent_path()) fs::create_directories(jobs.front().out.parent_path(), ec);
     }
     for (const CameraJob& job : jobs)
-        if (!(err = renderJob(a, job, *scene, view)).empty()) return fail(err);
+        if (!(err = renderJob(a, job, *scene, view, overlays)).empty()) return fail(err);
     return 0;
 }
 
@@ -441,6 +464,8 @@ int runCompare(const RenderArgs& a) {
     if (!scene) return fail(err);
     err = applyPose(a, clips, *scene);
     if (err.empty()) err = applyOverrides(a, *scene);
+    rnd::OverlayOptions overlays;
+    if (err.empty()) err = overlayOptions(a, *scene, float(w) / float(h), overlays);
     if (!err.empty()) return fail(err);
     fs::path dir = a.out;
     std::error_code ec;
@@ -463,6 +488,7 @@ int runCompare(const RenderArgs& a) {
             ++failures;
             continue;
         }
+        rnd::drawOverlays(frame, overlays, s.image);
         fs::path p = dir / (b + ".png");
         err = assets::writePng(p, w, h, s.image.color.data(), a.overwrite);
         if (!err.empty()) return fail(err);

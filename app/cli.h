@@ -28,6 +28,8 @@ struct RenderArgs {
     // Pose: clip `animation` (default 0) of the file at `time` seconds (default: the clip's start).
     std::optional<std::string> time;
     std::optional<int> animation;
+    // Overlays (renderers/overlay.h): --overlay LIST, and the node --select names for `selection`.
+    std::string overlay, select;
 };
 
 enum class Command { Render, Compare, Inspect };

@@ -34,6 +34,7 @@
 //   backend NAME          single view with that backend
 //   view single|split|split3|difference   as the View menu
 //   diagnostic NAME       View > Diagnostic view: shaded, depth, normal, id, uv, triangles
+//   overlay LIST|none     View > Overlays: grid, axes, lights, cameras, bounds, selection
 //   orbit DX DY | zoom STEPS | fit
 //   tab Inspector|Camera|Rendering|Compare
 //   gl-worker on|off      run the GL backend on a worker thread (own headless context)
@@ -406,6 +407,11 @@ Automation::Next Automation::viewCommand(const std::string& cmd, std::istringstr
     } else if (cmd == "diagnostic") {
         if (!rnd::parseDiagnosticView(arg, st.view.diagnostic))
             return fail("diagnostic " + arg + ": expected shaded, depth, normal, id, uv or triangles");
+    } else if (cmd == "overlay") {
+        rnd::OverlayOptions o;
+        std::string err;
+        if (arg != "none" && !rnd::parseOverlayList(arg, o, err)) return fail("overlay " + arg + ": " + err);
+        st.view.overlays = o;
     } else if (cmd == "orbit") {
         float dx = 0, dy = 0;
         args >> dx >> dy;

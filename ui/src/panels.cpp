@@ -340,6 +340,17 @@ void drawMainMenu(ViewerState& st) {
             }
             ImGui::EndMenu();
         }
+        if (ImGui::BeginMenu("Overlays")) {   // renderers/overlay.h; the selection is outlined already
+            rnd::OverlayOptions& o = st.view.overlays;
+            for (auto [label, flag] : {std::pair{"Grid", &o.grid},
+                                       {"Axes", &o.axes},
+                                       {"Lights", &o.lights},
+                                       {"Cameras", &o.cameras},
+                                       {"Bounding boxes", &o.bounds},
+                                       {"Selection bounds", &o.selection}})
+                ImGui::MenuItem(label, nullptr, flag);
+            ImGui::EndMenu();
+        }
         ImGui::MenuItem("Stats overlay", nullptr, &st.ui.panels.showOverlay);
         if (ImGui::BeginMenu("Scene cameras", !st.doc.scene.cameras().empty())) {
             for (sg::NodeId c : st.doc.scene.cameras())

@@ -128,6 +128,7 @@ struct BackendView {
     uint64_t outlinedVersion = 0;                                   // doc.version when it was outlined
     rnd::DiagnosticView diagnostic = rnd::DiagnosticView::Shaded;   // what the texture shows
     std::string legend;                                             // of that diagnostic view
+    uint64_t overlays = 0;                                          // overlayKey() when uploaded
 };
 
 // A screenshot in progress (CPU backends render it on a thread; GL right away).
@@ -213,14 +214,24 @@ public:
     void refreshTexture(BackendView& v) {
         const bool fresh = v.slot->poll();
         const sg::NodeId sel = st.doc.selected;
-        if (!fresh && sel == v.outlined && st.view.diagnostic == v.diagnostic && (sel == sg::kNoNode || v.outlinedVersion == st.doc.version)) return;
+        const uint64_t overlays = overlayKey();
+        if (!fresh && sel == v.outlined && st.view.diagnostic == v.diagnostic && overlays == v.overlays &&
+            (sel == sg::kNoNode || v.outlinedVersion == st.doc.version))
+            return;
+        v.overlays = overlays;
         v.outlined = sel;
         v.outlinedVersion = st.doc.version;
         v.diagnostic = st.view.diagnostic;
         const rnd::Framebuffer& img = v.slot->image();
         const bool visible = img.hasVisibility() && v.slot->imageFrame();
         if ((sel == sg::kNoNode && v.diagnostic == rnd::DiagnosticView::Shaded) || !visible) {
-            v.texture.upload(img);
+            if (overlays && v.slot->imageFrame()) {
+                rnd::Framebuffer shown = img;
+                drawViewOverlays(shown, *v.slot->imageFrame());
+                v.texture.upload(shown);
+            } else {
+                v.texture.upload(img);
+            }
             v.legend = v.diagnostic == rnd::DiagnosticView::Shaded ? "" : std::string(rnd::nameOf(v.diagnostic)) + ": waiting for the full image";
             return;
         }
@@ -229,7 +240,24 @@ public:
         shown.image.drawable = img.drawable;   // outlineNode reads the visibility
         shown.image.primitive = img.primitive;
         if (sel != sg::kNoNode) outlineNode(shown.image, *v.slot->imageFrame(), st.doc.scene, sel);
+        shown.image.depth = img.depth;
+        drawViewOverlays(shown.image, *v.slot->imageFrame());
         v.texture.upload(shown.image);
+    }
+
+    // View > Overlays: which are on (0 = none) and what they depend on, to redraw on a change.
+    uint64_t overlayKey() const {
+        const rnd::OverlayOptions& o = st.view.overlays;
+        if (!o.any()) return 0;
+        const uint64_t flags = uint64_t(o.grid) | uint64_t(o.axes) << 1 | uint64_t(o.lights) << 2 | uint64_t(o.cameras) << 3 |
+                               uint64_t(o.bounds) << 4 | uint64_t(o.selection) << 5;
+        return flags ^ (st.doc.version << 8) ^ (uint64_t(st.doc.selected) << 40);
+    }
+    void drawViewOverlays(rnd::Framebuffer& img, const sg::FrameInput& frame) const {
+        if (!st.view.overlays.any()) return;
+        rnd::OverlayOptions o = st.view.overlays;
+        rnd::setSceneOverlayInputs(st.doc.scene, st.doc.selected, float(img.width) / float(std::max(img.height, 1)), o);
+        rnd::drawOverlays(frame, o, img);
     }
 
     void updateDiff() {

@@ -21,6 +21,7 @@
 
 #include "assets/scene_io.h"
 #include "renderers/diagnostic.h"
+#include "renderers/overlay.h"
 #include "scenegraph/camera_model.h"
 #include "scenegraph/frame.h"
 #include "scenegraph/scene.h"
@@ -140,6 +141,9 @@ struct View {
     // What each shown image is drawn as: the shaded image, or a diagnostic view made from its
     // visibility (renderers/diagnostic.h), the same for every backend.
     rnd::DiagnosticView diagnostic = rnd::DiagnosticView::Shaded;
+    // View > Overlays: drawn on every shown image alike (renderers/overlay.h); the selection
+    // and the scene's cameras are filled in when drawn.
+    rnd::OverlayOptions overlays;
     CompareConfig compare;
     DiffFigures diff;
     // Per-backend anti-aliasing overrides for this session (backend -> "msaa4", ...); the
