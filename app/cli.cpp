@@ -15,6 +15,7 @@
 #include "scenegraph/camera_model.h"
 #include "scenegraph/instances.h"
 #include "scenegraph/setting_names.h"
+#include "ui/aov_export.h"
 #include "ui/viewer.h"
 
 #include <nlohmann/json.hpp>
@@ -309,96 +310,18 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a, Command command) {
     cmd.add_option("--select", a.select, "The node (by name) that --overlay selection outlines");
 }
 
-// --aov kinds and the file each writes next to OUT.png.
-const char* aovSuffix(const std::string& kind) {
-    if (kind == "depth") return ".depth.pfm";
-    if (kind == "normal") return ".normal.png";
-    if (kind == "id") return ".id.png";
-    return nullptr;
-}
-
-std::vector<std::string> aovKinds(const RenderArgs& a) {
-    std::vector<std::string> kinds;
-    std::stringstream list(a.aov);
-    for (std::string k; std::getline(list, k, ',');)
-        if (!k.empty() && std::find(kinds.begin(), kinds.end(), k) == kinds.end()) kinds.push_back(k);
-    return kinds;
-}
-
-bool needsVisibility(const RenderArgs& a) {
-    for (const std::string& k : aovKinds(a))
-        if (k != "depth") return true;
-    return false;
-}
+std::vector<std::string> aovKinds(const RenderArgs& a) { return ui::parseAovList(a.aov); }
 
 // --aov: the extra files next to `out` (P.png -> P.depth.pfm, P.normal.png, P.id.png, P.json).
 // Checked before rendering: known kinds only, and no existing file replaced without --overwrite.
 std::string checkAovs(const RenderArgs& a, const fs::path& out) {
-    fs::path base = out;
-    base.replace_extension();
-    std::vector<fs::path> files;
-    for (const std::string& k : aovKinds(a)) {
-        if (!aovSuffix(k)) return "--aov: unknown kind '" + k + "' (known: depth, normal, id)";
-        files.push_back(base.string() + aovSuffix(k));
-    }
-    if (!files.empty()) files.push_back(base.string() + ".json");
+    const std::vector<std::string> kinds = aovKinds(a);
+    for (const std::string& k : kinds)
+        if (!ui::aovSuffix(k)) return "--aov: unknown kind '" + k + "' (known: depth, normal, id)";
     std::error_code ec;
-    for (const fs::path& f : files)
+    for (const fs::path& f : ui::aovFiles(out, kinds))
         if (!a.overwrite && fs::exists(fs::symlink_status(f, ec))) return f.string() + ": file exists (use --overwrite to replace it)";
     return {};
-}
-
-// OUT.normal.png: 0.5 n + 0.5 as 8-bit RGB (opaque), black where nothing was drawn.
-std::string writeNormalAov(const fs::path& p, const sg::FrameInput& frame, const sg::InstanceTable& ids, const rnd::Framebuffer& img,
-                           bool overwrite) {
-    const std::vector<sg::vec3> n = rnd::normalImage(frame, ids, img);
-    std::vector<uint8_t> rgba(n.size() * 4, 0);
-    for (size_t k = 0; k < n.size(); ++k) {
-        rgba[4 * k + 3] = 255;
-        if (img.drawable[k] == 0 || glm::dot(n[k], n[k]) == 0.0f) continue;
-        for (int c = 0; c < 3; ++c) rgba[4 * k + size_t(c)] = uint8_t(std::lround(std::clamp(0.5f * n[k][c] + 0.5f, 0.0f, 1.0f) * 255.0f));
-    }
-    return assets::writePng(p, img.width, img.height, rgba.data(), overwrite);
-}
-
-// OUT.id.png: the instance id of each pixel (sg::instanceTable), 0 = nothing.
-std::string writeIdAov(const fs::path& p, const sg::InstanceTable& ids, const rnd::Framebuffer& img, bool overwrite) {
-    if (ids.node.size() > 65536) return p.string() + ": " + std::to_string(ids.node.size() - 1) + " instances do not fit a 16-bit id image";
-    std::vector<uint16_t> v(img.drawable.size());
-    for (size_t k = 0; k < v.size(); ++k) v[k] = uint16_t(ids.instanceOf(img.drawable[k]));
-    return assets::writePngGray16(p, img.width, img.height, v, overwrite);
-}
-
-std::string writeAovs(const RenderArgs& a, const fs::path& out, const sg::Scene& scene, const sg::FrameInput& frame, const rnd::Framebuffer& img) {
-    const std::vector<std::string> kinds = aovKinds(a);
-    if (kinds.empty()) return {};
-    const sg::InstanceTable ids = sg::instanceTable(frame);
-    fs::path base = out;
-    base.replace_extension();
-    assets::AovSidecar side;
-    side.width = img.width;
-    side.height = img.height;
-    side.backend = a.backend;
-    side.projection = std::string(sg::nameOf(frame.camera.projection.type));
-    side.camera = sg::cameraModelOf(frame.camera, img.width, img.height);
-    for (const std::string& k : kinds) {
-        const fs::path p = base.string() + aovSuffix(k);   // a known kind (checkAovs)
-        std::string e;
-        if (k == "depth")
-            e = assets::writePfm(p, img.width, img.height, sg::opticalDepthMap(frame.camera, img.width, img.height, img.depth), a.overwrite);
-        else if (k == "normal")
-            e = writeNormalAov(p, frame, ids, img, a.overwrite);
-        else
-            e = writeIdAov(p, ids, img, a.overwrite);
-        if (!e.empty()) return e;
-        side.files.push_back(p.filename().string());
-        side.hasIds = side.hasIds || k == "id";
-    }
-    for (uint32_t i = 1; side.hasIds && i < ids.node.size(); ++i) {
-        const sg::NodeId n = ids.node[i];
-        side.ids.push_back({i, scene.valid(n) ? scene.node(n).name : std::string(), sg::nodePath(scene, n)});
-    }
-    return assets::writeAovSidecar(base.string() + ".json", side, a.overwrite);
 }
 
 // One image of `viewer render`: render, write the PNG (or its diagnostic view) and the AOVs.
@@ -408,14 +331,19 @@ std::string renderJob(const RenderArgs& a, const CameraJob& job, const sg::Scene
     sg::FrameInput frame = sg::flatten(scene, float(w) / float(h));
     std::string err = applyCameraJob(a, job, frame);
     if (!err.empty()) return (job.index >= 0 ? job.out.string() + ": " : std::string()) + err;
-    Shot shot = renderWith(a.backend, frame, w, h, needsVisibility(a) || view != rnd::DiagnosticView::Shaded);
+    Shot shot = renderWith(a.backend, frame, w, h, ui::aovsNeedVisibility(aovKinds(a)) || view != rnd::DiagnosticView::Shaded);
     if (!shot.stats.ok) return shot.stats.error;   // starts with the backend's name
     rnd::DiagnosticImage shown = rnd::diagnosticImage(view, frame, shot.image);
     shown.image.depth = shot.image.depth;   // overlays are hidden behind the rendered surfaces
     rnd::drawOverlays(frame, overlays, shown.image);
     err = assets::writePng(job.out, shown.image.width, shown.image.height, shown.image.color.data(), a.overwrite);
     if (!err.empty()) return err;
-    if (!(err = writeAovs(a, job.out, scene, frame, shot.image)).empty()) return err;
+    const std::vector<std::string> kinds = aovKinds(a);
+    const bool ids = std::find(kinds.begin(), kinds.end(), "id") != kinds.end();   // the id -> node table only when it is written
+    if (!(err = ui::writeAovs(job.out, kinds, a.backend, ids ? ui::aovInstances(scene, frame) : std::vector<assets::AovInstance>{}, frame, shot.image,
+                              a.overwrite))
+             .empty())
+        return err;
     std::printf("%s: %dx%d, %s backend, %s, %.1f ms\n", job.out.string().c_str(), w, h, a.backend.c_str(), shot.stats.config.describe().c_str(),
                 shot.stats.milliseconds);
     if (!shown.legend.empty() && job.index <= 0) std::printf("%s view: %s\n", a.view.c_str(), shown.legend.c_str());

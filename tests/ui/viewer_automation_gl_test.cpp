@@ -3,15 +3,19 @@
 // and redo through keys, the Edit menu and script commands with the dirty flag following;
 // File > Open with the unsaved-changes question answered; `view` doing what the View menu
 // does; bad commands failing the script.
+#include "assets/aov_io.h"
 #include "assets/demo.h"
+#include "assets/image_io.h"
 #include "assets/scene_io.h"
 #include "test_support.h"
 #include "viewer_process.h"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 
@@ -432,4 +436,71 @@ TEST(ViewerAutomationGLTest, EscapeClosesMenusAndDialogs) {
     EXPECT_EQ(r.out[6], "popup no");
     EXPECT_EQ(r.out[7], "dirty yes");
     EXPECT_FALSE(fs::exists(dir / "screenshot-gl.png"));
+}
+
+// Issue 18 (export from the UI) and issue 19 (overlays in screenshots): F12 writes what the
+// viewport shows (here with the axes overlay); File > Export depth, normal, id... opens the
+// screenshot dialog with the export ticked, and Take writes the PNG with its depth, normal and id
+// files and the camera sidecar next to it, never over an existing file. Unticking "as shown"
+// writes the bare image: the two PNGs differ only by the overlay's pixels.
+TEST(ViewerAutomationGLTest, ScreenshotsAsShownAndTheExportFromTheWindow) {
+    if (!viewer_test::haveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+    fs::path dir = sceneFolder("automation_export");
+    ScriptRun r = runScript(dir,
+                            "wait\n"
+                            "overlay axes\n"
+                            "wait\n"
+                            "key F12\n"
+                            "wait\n"
+                            "print status\n"   // 0: screenshot-gl.png, as shown
+                            "click menu/file\n"
+                            "click file/exportDialog\n"
+                            "frames 2\n"
+                            "click shot/asShown\n"
+                            "click shot/take\n"
+                            "wait\n"
+                            "print status\n"   // 1: screenshot-gl-1.png, bare, with the export
+                            "quit\n");
+    ASSERT_EQ(r.rc, 0) << dump(r);
+    ASSERT_EQ(r.out.size(), 2u) << dump(r);
+    const std::string folder = fs::canonical(dir).string();
+    EXPECT_EQ(r.out[0], "status Saved screenshot-gl.png in " + folder) << dump(r);
+    EXPECT_EQ(r.out[1], "status Saved screenshot-gl-1.png in " + folder + "; with depth, normal, id and the camera .json") << dump(r);
+    for (const char* f : {"screenshot-gl-1.depth.pfm", "screenshot-gl-1.normal.png", "screenshot-gl-1.id.png", "screenshot-gl-1.json"})
+        EXPECT_TRUE(fs::exists(dir / f)) << f;
+    EXPECT_FALSE(fs::exists(dir / "screenshot-gl.json")) << "F12 before the export was ticked writes the PNG alone";
+
+    assets::ImageLoad shown = assets::loadImage(dir / "screenshot-gl.png"), bare = assets::loadImage(dir / "screenshot-gl-1.png");
+    ASSERT_TRUE(shown.texture && bare.texture) << shown.error << bare.error;
+    const int w = bare.texture->width, h = bare.texture->height;
+    ASSERT_EQ(shown.texture->width, w);
+    ASSERT_EQ(shown.texture->height, h);
+    size_t differ = 0;
+    for (size_t k = 0; k < size_t(w) * h; ++k) differ += std::memcmp(&shown.texture->rgba[4 * k], &bare.texture->rgba[4 * k], 3) != 0;
+    EXPECT_GT(differ, 100u) << "the axes overlay is in the as-shown screenshot";
+    EXPECT_LT(differ, size_t(w) * h / 20) << "and nothing else differs much";
+
+    int dw = 0, dh = 0, iw = 0, ih = 0;
+    std::vector<float> depth;
+    std::vector<uint16_t> ids;
+    ASSERT_EQ(assets::readPfm(dir / "screenshot-gl-1.depth.pfm", dw, dh, depth), "");
+    ASSERT_EQ(assets::readPngGray16(dir / "screenshot-gl-1.id.png", iw, ih, ids), "");
+    ASSERT_EQ(std::make_pair(dw, dh), std::make_pair(w, h));
+    ASSERT_EQ(std::make_pair(iw, ih), std::make_pair(w, h));
+    std::ifstream in(dir / "screenshot-gl-1.json");
+    nlohmann::json side = nlohmann::json::parse(in, nullptr, false);
+    ASSERT_TRUE(side.is_object());
+    EXPECT_EQ(side["backend"], "gl");
+    EXPECT_EQ(side["width"], w);
+    ASSERT_TRUE(side["ids"].is_array());
+    const size_t instances = side["ids"].size();
+    size_t covered = 0, agree = 0;
+    for (size_t k = 0; k < ids.size(); ++k) {
+        EXPECT_LE(ids[k], instances) << "pixel " << k;
+        if (ids[k] == 0) continue;
+        ++covered;
+        agree += depth[k] > 0.0f;
+    }
+    EXPECT_GT(covered, size_t(w) * h / 10) << "the demo covers the image";
+    EXPECT_GE(agree, covered * 99 / 100) << "depth where the id image sees geometry";
 }

@@ -259,6 +259,25 @@ TEST(ViewerStateTest, ScreenshotNamesNeverOverwrite) {
     EXPECT_EQ(b.extension(), ".png");
 }
 
+// With exports, a name is free only when the PNG and every file next to it are: a left-over
+// screenshot-gl.depth.pfm (its PNG deleted) is never overwritten by the next screenshot.
+TEST(ViewerStateTest, ScreenshotNamesWithExportsNeverOverwriteAnExportFile) {
+    fs::path dir = testing_support::outputDir("ui") / "shots_exports";
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const std::vector<std::string> exports = {"depth", "id"};
+    EXPECT_EQ(screenshotPath(dir, "gl", "screenshot", exports).filename(), "screenshot-gl.png");
+    ASSERT_EQ(assets::writeFileAtomic(dir / "screenshot-gl.depth.pfm", "x", false), "");
+    EXPECT_EQ(screenshotPath(dir, "gl").filename(), "screenshot-gl.png") << "without exports only the PNG counts";
+    EXPECT_EQ(screenshotPath(dir, "gl", "screenshot", exports).filename(), "screenshot-gl-1.png");
+    ASSERT_EQ(assets::writeFileAtomic(dir / "screenshot-gl-1.json", "{}", false), "");
+    EXPECT_EQ(screenshotPath(dir, "gl", "screenshot", exports).filename(), "screenshot-gl-2.png") << "the sidecar counts too";
+    ScreenshotDialogState dialog;
+    EXPECT_TRUE(screenshotExports(dialog).empty());
+    dialog.exportId = dialog.exportDepth = true;
+    EXPECT_EQ(screenshotExports(dialog), (std::vector<std::string>{"depth", "id"}));
+}
+
 // The screenshot dialog's size option says the size it writes; the status line names
 // every file written (the folder once, absolute) and every failure; a folder that cannot be
 // made is an error, not a silent "."
@@ -283,6 +302,8 @@ TEST(ViewerStateTest, ScreenshotSummaryNamesEveryFileAndFailure) {
     EXPECT_EQ(screenshotSummary({{"gl", dir / "screenshot-gl.png", "no context"}}), "Screenshot failed: gl failed: no context");
     EXPECT_EQ(screenshotSummary({{"gl", dir / "screenshot-gl.png", "gl: no context"}}), "Screenshot failed: gl failed: no context")
         << "the backend named once";
+    EXPECT_EQ(screenshotSummary({{"gl", dir / "screenshot-gl.png", "", {"depth", "id"}}}),
+              "Saved screenshot-gl.png in /home/me/shots; with depth, id and the camera .json");
 }
 
 TEST(ViewerStateTest, ScreenshotFolderIsAbsoluteAndABadOneIsAnError) {

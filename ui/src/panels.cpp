@@ -307,6 +307,8 @@ void drawMainMenu(ViewerState& st) {
         if (ImGui::MenuItem("Screenshot", "F12")) st.ui.requests.screenshot = true;
         if (ImGui::MenuItem("Screenshot at resolution...")) st.ui.requests.screenshotDialog = true;
         record(st, "file/screenshotDialog");
+        if (ImGui::MenuItem("Export depth, normal, id...")) st.ui.requests.exportDialog = true;
+        record(st, "file/exportDialog");
         ImGui::Separator();
         if (ImGui::MenuItem("Quit", "Ctrl+Q")) st.requestQuit();
         ImGui::EndMenu();
@@ -1751,10 +1753,24 @@ bool takeScreenshot(ViewerState& st, ScreenshotDialogState& dialog, std::string&
     return true;
 }
 
+// The export boxes: depth / normal / id files and the camera sidecar next to each PNG.
+void screenshotExportBoxes(ViewerState& st, ScreenshotDialogState& dialog) {
+    ImGui::TextUnformatted("Export next to each PNG (with the camera sidecar .json):");
+    ImGui::Checkbox("Depth (.depth.pfm)", &dialog.exportDepth);
+    record(st, "shot/depth");
+    ImGui::SameLine();
+    ImGui::Checkbox("Normal (.normal.png)", &dialog.exportNormal);
+    record(st, "shot/normal");
+    ImGui::SameLine();
+    ImGui::Checkbox("Id (.id.png)", &dialog.exportId);
+    record(st, "shot/id");
+}
+
 void drawScreenshotDialog(ViewerState& st) {
     ScreenshotDialogState& dialog = st.ui.panels.shotDialog;
-    if (st.ui.requests.screenshotDialog) {
-        st.ui.requests.screenshotDialog = false;
+    if (st.ui.requests.screenshotDialog || st.ui.requests.exportDialog) {
+        if (st.ui.requests.exportDialog && screenshotExports(dialog).empty()) dialog.exportDepth = dialog.exportNormal = dialog.exportId = true;
+        st.ui.requests.screenshotDialog = st.ui.requests.exportDialog = false;
         dialog.open = true;
         dialog.error.clear();
         dialog.dirText = absoluteFolder(dialog.dir).string();
@@ -1764,10 +1780,14 @@ void drawScreenshotDialog(ViewerState& st) {
     ImGui::Checkbox(screenshotSizeLabel(dialog, st.view).c_str(), &dialog.windowSize);
     record(st, "shot/viewportSize");
     screenshotSizeFields(dialog, st.view);
+    ImGui::Checkbox("As the viewport shows it (diagnostic view, overlays)", &dialog.asShown);
+    record(st, "shot/asShown");
+    screenshotExportBoxes(st, dialog);
     screenshotFolderPicker(st, dialog);
     if (!dialog.error.empty()) ImGui::TextColored(ImVec4(1.0f, 0.6f, 0.45f, 1.0f), "%s", dialog.error.c_str());
     ImGui::TextDisabled(
-        "One PNG per backend shown, rendered offscreen;\nnamed screenshot-<backend>[-N].png, never overwriting.\nF12 saves into the same folder.");
+        "One PNG per backend shown, rendered offscreen;\nnamed screenshot-<backend>[-N].png, never overwriting.\nF12 saves into the same folder "
+        "with the same choices.");
     if (ImGui::Button("Take", ImVec2(px(90), 0)) && takeScreenshot(st, dialog, dialog.error)) ImGui::CloseCurrentPopup();
     record(st, "shot/take");
     ImGui::SameLine();

@@ -18,6 +18,7 @@
 
 #include "assets/demo.h"
 #include "assets/image_io.h"
+#include "ui/aov_export.h"
 #include "ui/panels.h"
 #include "ui/render_slot.h"
 #include "ui/viewer_state.h"
@@ -135,6 +136,7 @@ struct BackendView {
 struct PendingShot {
     std::string backend;
     fs::path path;
+    std::vector<std::string> exports;
     std::future<std::string> result;   // "" or error
 };
 
@@ -313,31 +315,45 @@ public:
     }
 
     // Starts offscreen screenshots of every visible backend at w x h (0 = viewport size) into
-    // `dir` (made absolute, created when missing; a folder that cannot be made is a one-line
-    // error in the status bar).
-    void startScreenshots(int w, int h, const fs::path& folder) {
+    // the dialog's folder (made absolute, created when missing; a folder that cannot be made is a
+    // one-line error in the status bar). With the dialog's "as shown" the image is what the
+    // viewport shows (diagnostic view, View > Overlays); its export boxes add the depth / normal /
+    // id files and the camera sidecar next to each PNG (ui/aov_export.h).
+    void startScreenshots(int w, int h, const ScreenshotDialogState& dialog) {
         if (w < 1 || h < 1) {
             w = st.view.viewportWidth;
             h = st.view.viewportHeight;
         }
         std::string folderError;
-        fs::path dir = prepareScreenshotFolder(folder, &folderError);
+        fs::path dir = prepareScreenshotFolder(dialog.dir, &folderError);
         if (dir.empty()) {
             st.ui.status = "Screenshot failed: " + folderError;
             return;
         }
         float aspect = float(w) / float(h);
         auto base = std::make_shared<sg::FrameInput>(st.buildFrame(aspect));
+        const std::vector<std::string> exports = screenshotExports(dialog);
+        const bool ids = std::find(exports.begin(), exports.end(), "id") != exports.end();
+        // Everything read from the document is taken here, on the UI thread; the jobs see copies.
+        auto instances =
+            std::make_shared<const std::vector<assets::AovInstance>>(ids ? aovInstances(st.doc.scene, *base) : std::vector<assets::AovInstance>{});
+        const rnd::DiagnosticView view = dialog.asShown ? st.view.diagnostic : rnd::DiagnosticView::Shaded;
+        rnd::OverlayOptions overlays;
+        if (dialog.asShown && st.view.overlays.any()) {
+            overlays = st.view.overlays;
+            rnd::setSceneOverlayInputs(st.doc.scene, st.doc.selected, aspect, overlays);
+        }
+        const bool visibility = aovsNeedVisibility(exports) || view != rnd::DiagnosticView::Shaded;
         std::vector<std::string> names = visibleBackends(st);
         std::sort(names.begin(), names.end());
         names.erase(std::unique(names.begin(), names.end()), names.end());
         for (const std::string& n : names) {
             auto frame = std::make_shared<sg::FrameInput>(*base);
             frame->settings = st.settingsFor(n);
-            fs::path path = screenshotPath(dir, n);
+            fs::path path = screenshotPath(dir, n, "screenshot", exports);
             std::string err;
             std::shared_ptr<rnd::Renderer> r = rnd::makeRenderer(n, &err);
-            PendingShot p{n, path, {}};
+            PendingShot p{n, path, exports, {}};
             if (!r) {
                 std::promise<std::string> pr;
                 pr.set_value(err);
@@ -345,11 +361,18 @@ public:
                 shots.push_back(std::move(p));
                 continue;
             }
-            auto job = [n, r, frame, w, h, path]() -> std::string {
+            auto job = [n, r, frame, w, h, path, exports, instances, view, overlays, visibility]() -> std::string {
                 rnd::Framebuffer fb;
-                rnd::RenderStats s = r->render(*frame, w, h, fb, nullptr);
+                rnd::RenderRequest request;
+                request.visibility = visibility && r->capabilities().visibility;
+                rnd::RenderStats s = r->render(*frame, w, h, fb, nullptr, request);
                 if (!s.ok) return s.error.empty() ? n + ": render failed" : s.error;
-                return assets::writePng(path, fb.width, fb.height, fb.color.data(), /*overwrite=*/false);
+                rnd::DiagnosticImage shown = rnd::diagnosticImage(view, *frame, fb);
+                shown.image.depth = fb.depth;   // overlays are hidden behind the rendered surfaces
+                rnd::drawOverlays(*frame, overlays, shown.image);
+                std::string e = assets::writePng(path, shown.image.width, shown.image.height, shown.image.color.data(), /*overwrite=*/false);
+                if (e.empty()) e = writeAovs(path, exports, n, *instances, *frame, fb, /*overwrite=*/false);
+                return e;
             };
             if (r->capabilities().affinity == rnd::ContextAffinity::CurrentGLContext) {   // the window's context: here, now
                 drainGlErrors("the window's context before a GL screenshot");             // not this render's errors
@@ -373,7 +396,7 @@ public:
             }
             std::string err = shots[i].result.get();
             if (!err.empty()) std::fprintf(stderr, "viewer: screenshot: %s: %s\n", shots[i].backend.c_str(), err.c_str());
-            shotResults.push_back({shots[i].backend, shots[i].path, err});
+            shotResults.push_back({shots[i].backend, shots[i].path, err, shots[i].exports});
             shots.erase(shots.begin() + i);
         }
         if (shots.empty() && !shotResults.empty()) {   // the whole batch is done: one line naming every file
@@ -407,7 +430,11 @@ public:
     ViewerState& state() override { return st; }
     bool idle() override { return allIdle(); }
     void pollScreenshots() override { pollScreenshots(false); }
-    void startScreenshots(const fs::path& dir) override { startScreenshots(0, 0, dir); }
+    void startScreenshots(const fs::path& dir) override {   // F12 into `dir`, with the dialog's other choices
+        ScreenshotDialogState d = st.ui.panels.shotDialog;
+        d.dir = dir;
+        startScreenshots(0, 0, d);
+    }
     void printStats() override {
         for (const std::string& n : visibleBackends(st)) {
             const RenderSlot& slot = *viewFor(n).slot;
@@ -731,7 +758,7 @@ private:
         Requests& r = m_st.ui.requests;
         if (r.screenshot) {
             r.screenshot = false;
-            m_v.startScreenshots(r.screenshotWidth, r.screenshotHeight, m_st.ui.panels.shotDialog.dir);
+            m_v.startScreenshots(r.screenshotWidth, r.screenshotHeight, m_st.ui.panels.shotDialog);
             r.screenshotWidth = r.screenshotHeight = 0;
         }
     }

@@ -4,6 +4,8 @@
 // save), animation playback, config helpers.
 #include "ui/viewer_state.h"
 
+#include "ui/aov_export.h"
+
 #include "assets/files.h"
 #include "renderers/renderer.h"
 
@@ -901,8 +903,26 @@ std::string saveWindowRect(const fs::path& dir, const WindowRect& r) {
     return assets::writeFileAtomic(dir / "window.txt", text, /*overwrite=*/true);
 }
 
-fs::path screenshotPath(const fs::path& dir, const std::string& backend, const std::string& stem) {
-    return assets::uniquePath(dir / (stem + "-" + backend + ".png"));
+fs::path screenshotPath(const fs::path& dir, const std::string& backend, const std::string& stem, const std::vector<std::string>& exports) {
+    std::error_code ec;
+    auto taken = [&](const fs::path& png) {
+        if (fs::exists(fs::symlink_status(png, ec))) return true;
+        for (const fs::path& f : aovFiles(png, exports))
+            if (fs::exists(fs::symlink_status(f, ec))) return true;
+        return false;
+    };
+    const std::string name = stem + "-" + backend;
+    fs::path p = dir / (name + ".png");
+    for (int i = 1; taken(p) && i < 1000000; ++i) p = dir / (name + "-" + std::to_string(i) + ".png");
+    return p;
+}
+
+std::vector<std::string> screenshotExports(const ScreenshotDialogState& dialog) {
+    std::vector<std::string> kinds;
+    if (dialog.exportDepth) kinds.push_back("depth");
+    if (dialog.exportNormal) kinds.push_back("normal");
+    if (dialog.exportId) kinds.push_back("id");
+    return kinds;
 }
 
 std::string screenshotSummary(const std::vector<ScreenshotResult>& results) {
@@ -922,6 +942,13 @@ std::string screenshotSummary(const std::vector<ScreenshotResult>& results) {
     std::string line = count == 0   ? "Screenshot failed"
                        : count == 1 ? "Saved " + saved + " in " + dir.string()
                                     : "Saved " + std::to_string(count) + " screenshots in " + dir.string() + ": " + saved;
+    std::string exports;
+    for (const ScreenshotResult& r : results)
+        if (r.error.empty() && !r.exports.empty()) {
+            for (const std::string& k : r.exports) exports += (exports.empty() ? "" : ", ") + k;
+            break;   // one batch, one set of choices
+        }
+    if (!exports.empty()) line += "; with " + exports + " and the camera .json";
     return count == 0 && !failed.empty() ? line + ": " + failed.substr(2) : line + failed;
 }
 

@@ -23,14 +23,16 @@ struct FileBrowserState {
     std::string error;
 };
 
-// File > Screenshot at resolution...
+// File > Screenshot at resolution... and File > Export depth, normal, id...: what F12 writes too.
 struct ScreenshotDialogState {
     bool open = false;
     bool windowSize = true;   // render at the viewport size (else width x height)
     int width = 1920, height = 1080;
-    std::filesystem::path dir;   // where screenshots go, F12's too ("" = the folder the viewer started in)
-    std::string dirText;         // the folder field being edited (filled when the dialog opens)
-    std::string error;           // why Take was refused (a folder that cannot be made)
+    bool asShown = true;   // the image as the viewport shows it: View > Diagnostic view and View > Overlays (else shaded, bare)
+    bool exportDepth = false, exportNormal = false, exportId = false;   // the synthetic-data export next to each PNG
+    std::filesystem::path dir;                                          // where screenshots go, F12's too ("" = the folder the viewer started in)
+    std::string dirText;                                                // the folder field being edited (filled when the dialog opens)
+    std::string error;                                                  // why Take was refused (a folder that cannot be made)
 };
 
 struct PanelState {

@@ -72,6 +72,7 @@ struct Requests {
     bool openDialog = false;                         // show the file browser (open)
     bool saveAsDialog = false;                       // show the file browser (save as)
     bool screenshotDialog = false;
+    bool exportDialog = false;   // the screenshot dialog with the depth/normal/id export ticked
 };
 
 // What the unsaved-changes confirmation is about.
@@ -359,17 +360,22 @@ WindowRect placeWindow(const WindowRect& workArea, const std::optional<WindowRec
 std::optional<WindowRect> loadWindowRect(const std::filesystem::path& configDir, std::string* error = nullptr);
 std::string saveWindowRect(const std::filesystem::path& configDir, const WindowRect& r);
 
-// dir/"<stem>-<backend>.png" or, when taken, the first free "-N" variant (assets::uniquePath).
-std::filesystem::path screenshotPath(const std::filesystem::path& dir, const std::string& backend, const std::string& stem = "screenshot");
+// dir/"<stem>-<backend>.png" or, when taken, the first free "-N" variant: free for the PNG and
+// for every export file of `exports` next to it (ui/aov_export.h), so nothing is overwritten.
+std::filesystem::path screenshotPath(const std::filesystem::path& dir, const std::string& backend, const std::string& stem = "screenshot",
+                                     const std::vector<std::string>& exports = {});
+// The export kinds ("depth", "normal", "id") the screenshot dialog's boxes ask for.
+std::vector<std::string> screenshotExports(const ScreenshotDialogState& dialog);
 
 // One backend's screenshot, finished: the file written, or why not.
 struct ScreenshotResult {
     std::string backend;
-    std::filesystem::path path;   // absolute
-    std::string error;            // "" when written
+    std::filesystem::path path;              // absolute
+    std::string error;                       // "" when written
+    std::vector<std::string> exports = {};   // the export kinds written next to it ("depth", "normal", "id")
 };
-// The status line for a finished batch: every file written, the folder once (absolute), then
-// each failure ("Saved 2 screenshots in /home/me/shots: screenshot-gl.png, screenshot-raster.png",
+// The status line for a finished batch: every file written, the folder once (absolute), the
+// exports next to them ("; with depth, normal, id and the camera .json"), then each failure ("Saved 2 screenshots in /home/me/shots: screenshot-gl.png, screenshot-raster.png",
 // "Saved screenshot-raster.png in /home/me/shots; gl failed: OpenGL error 0x502 ...").
 std::string screenshotSummary(const std::vector<ScreenshotResult>& results);
 // `folder` absolute and normalised, without a trailing separator ("" = the current folder).
