@@ -84,3 +84,57 @@ TEST(PickingGLTest, ClickSelectsWhatTheInspectorNamesInEveryBackend) {
     EXPECT_TRUE(parsePixel(out[5]).background) << out[5];
     EXPECT_TRUE(parsePixel(out[6]).background) << out[6];
 }
+
+// Ctrl+click adds to the selection and takes out again, in the viewport and the scene tree;
+// the last added is the active node (listed first); Ctrl+click on empty space changes nothing;
+// Delete removes every selected node as one undo step, and Ctrl+Z brings them all back.
+TEST(PickingGLTest, CtrlClickAddsAndDeleteRemovesTheWholeSelection) {
+    if (!viewer_test::haveXvfb()) GTEST_FAIL() << "xvfb-run is missing (apt-get install xvfb): window tests cannot run";
+    fs::path dir = testing_support::outputDir("ui") / "picking_multi";
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    ASSERT_EQ(assets::saveSceneJson(assets::makeDemoScene(), dir / "demo.json", true), "");
+    const std::string pick = "frames 5\nwait\nprint selection\n";
+    const std::string script =
+        "wait\nframes 10\nwait\n"
+        "click viewport 236 366\n" +
+        pick +                                                  // 0: the red sphere
+        "click ctrl viewport 362 434\n" + pick +                // 1: + the blue sphere
+        "click ctrl tree/red sphere\n" + pick +                 // 2: - the red sphere (tree)
+        "click ctrl viewport 236 366\n" + pick +                // 3: + the red sphere again
+        "click ctrl viewport 12 12\n" + pick +                  // 4: empty space: unchanged
+        "key Delete\nframes 2\nprint tree\nprint undo\n"        // 5, 6
+        "key ctrl+z\nframes 2\nprint tree\nprint selection\n"   // 7, 8
+        "click viewport 12 12\n" +
+        pick +   // 9
+        "quit\n";
+    const int rc = viewer_test::runViewer(dir, script, "demo.json", /*separateStdout=*/true);
+    const std::string log = viewer_test::readLog(dir);
+    std::vector<std::string> out;   // a tree is one entry
+    {
+        std::istringstream in(viewer_test::readLog(dir, "out.txt"));
+        bool tree = false;
+        for (std::string line; std::getline(in, line);) {
+            if (line.rfind("viewer: ", 0) == 0) {
+                out.push_back(line.substr(8));
+                tree = line == "viewer: tree";
+            } else if (tree) {
+                out.back() += "\n" + line;
+            }
+        }
+    }
+    ASSERT_EQ(rc, 0) << log;
+    ASSERT_EQ(out.size(), 10u) << log;
+    EXPECT_EQ(out[0], "selection red sphere");
+    EXPECT_EQ(out[1], "selection blue sphere, red sphere");
+    EXPECT_EQ(out[2], "selection blue sphere");
+    EXPECT_EQ(out[3], "selection red sphere, blue sphere");
+    EXPECT_EQ(out[4], "selection red sphere, blue sphere");
+    EXPECT_EQ(out[5].find("sphere"), std::string::npos) << out[5];
+    EXPECT_NE(out[5].find("crate"), std::string::npos) << out[5];
+    EXPECT_EQ(out[6], "undo Delete 2 nodes | redo -");
+    EXPECT_NE(out[7].find("  red sphere\n"), std::string::npos) << out[7];
+    EXPECT_NE(out[7].find("  blue sphere\n"), std::string::npos) << out[7];
+    EXPECT_EQ(out[8], "selection red sphere") << "undo brings back the active node's selection";
+    EXPECT_EQ(out[9], "selection -");
+}

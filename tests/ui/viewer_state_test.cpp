@@ -474,3 +474,35 @@ TEST(ViewerStateTest, SaveAndReopenKeepsEditsAndView) {
     EXPECT_FLOAT_EQ(other.projection().fovyDeg, 52.0f);
     EXPECT_NEAR(glm::length(other.view.camera.eye() - eye), 0.0f, 1e-3f);
 }
+
+// Ctrl+click's selection set: toggling adds (the new node active) and takes out (the last added
+// takes over); a plain select replaces it; Delete removes a selected node and a selected
+// descendant of it once, as one undo step that brings both back; an edit never leaves a deleted
+// id in the set.
+TEST(ViewerStateTest, SelectionSetTogglesAndDeletesAsOneStep) {
+    ViewerState st = demoState();
+    const sg::Scene& s = st.doc.scene;
+    const sg::NodeId turntable = s.findByName("turntable"), torus = s.findByName("torus"), crate = s.findByName("crate");
+    ASSERT_TRUE(s.valid(turntable) && s.valid(torus) && s.valid(crate));
+    st.selectNode(crate);
+    st.toggleSelected(turntable);
+    st.toggleSelected(torus);
+    EXPECT_EQ(st.selection(), (std::vector<sg::NodeId>{torus, turntable, crate}));
+    EXPECT_EQ(st.doc.selected, torus);
+    st.toggleSelected(torus);
+    EXPECT_EQ(st.selection(), (std::vector<sg::NodeId>{turntable, crate})) << "taken out: the last added is active again";
+    st.toggleSelected(sg::kNoNode);
+    EXPECT_EQ(st.selection().size(), 2u);
+    st.toggleSelected(torus);
+    const size_t before = s.nodeCount();
+    ASSERT_TRUE(st.removeSelection());
+    EXPECT_FALSE(st.doc.scene.valid(turntable));
+    EXPECT_FALSE(st.doc.scene.valid(crate));
+    EXPECT_TRUE(st.selection().empty());
+    EXPECT_EQ(st.doc.history.undoLabel(), "Delete 2 nodes") << "the torus went with the turntable, once";
+    ASSERT_TRUE(st.undo());
+    EXPECT_EQ(st.doc.scene.nodeCount(), before);
+    EXPECT_TRUE(st.doc.scene.valid(torus) && st.doc.scene.valid(turntable) && st.doc.scene.valid(crate));
+    st.selectNode(crate);
+    EXPECT_EQ(st.selection(), std::vector<sg::NodeId>{crate}) << "a plain select replaces the set";
+}

@@ -18,6 +18,7 @@
 //                         coordinates, the menu bar at the top), at pixel (X, Y) of the 3D
 //                         viewport (from its top-left corner), or at the centre of a widget the
 //                         panels record (menu/edit, edit/undo, tree/crate, confirm/discard, ...)
+//   click ctrl ...        the same with Ctrl held (adds to / takes out of the selection)
 //   drag X0 Y0 X1 Y1      left drag in the 3D viewport (pixels from its top-left corner): press
 //                         at (X0, Y0), move to (X1, Y1) over 8 frames, release (an orbit)
 // The document (as the File and Edit menus do)
@@ -165,9 +166,9 @@ std::string restOfLine(std::istringstream& in) {
 }   // namespace
 
 bool Automation::step(AutomationHost& host) {
+    if (!m_mouse.empty()) return true;   // a click in progress: overrideMouse plays it (a held Ctrl stays down)
     for (auto it = m_held.rbegin(); it != m_held.rend(); ++it) host.keyEvent(it->first, /*press=*/false, it->second);
     m_held.clear();
-    if (!m_mouse.empty()) return true;   // a click in progress: overrideMouse plays it
     if (m_waitFrames > 0) {
         --m_waitFrames;
         return true;
@@ -222,7 +223,7 @@ Automation::Next Automation::runCommand(const std::string& cmd, std::istringstre
     }
     if (cmd == "quit") return Next::Quit;
     if (cmd == "key") return keyCommand(restOfLine(in), host);
-    if (cmd == "click") return clickCommand(in, host.state());
+    if (cmd == "click") return clickCommand(in, host);
     if (cmd == "drag") return dragCommand(restOfLine(in), host.state());
     if (cmd == "print") return printCommand(restOfLine(in), host);
     if (cmd == "resize") {
@@ -284,8 +285,11 @@ Automation::Next Automation::keyCommand(const std::string& spec, AutomationHost&
 
 // Three frames at the point: hover, press, release (ImGui acts on the release for menus and
 // buttons, on the press for tree nodes and the viewport).
-Automation::Next Automation::clickCommand(std::istringstream& in, const ViewerState& st) {
+Automation::Next Automation::clickCommand(std::istringstream& in, AutomationHost& host) {
+    const ViewerState& st = host.state();
     std::string first = restOfLine(in);
+    const bool ctrl = first.rfind("ctrl ", 0) == 0;   // Ctrl held from the hover to the release
+    if (ctrl) first = first.substr(5);
     float x = 0, y = 0;
     std::istringstream xy(first);
     if (first.rfind("viewport ", 0) == 0) {   // relative to the 3D viewport's top-left corner
@@ -301,6 +305,10 @@ Automation::Next Automation::clickCommand(std::istringstream& in, const ViewerSt
         y = it->second.cy();
     }
     m_mouse = {{x, y, false}, {x, y, true}, {x, y, false}};
+    if (ctrl) {
+        host.keyEvent(GLFW_KEY_LEFT_CONTROL, /*press=*/true, GLFW_MOD_CONTROL);
+        m_held.emplace_back(GLFW_KEY_LEFT_CONTROL, GLFW_MOD_CONTROL);   // released once the clicks are played
+    }
     m_waitFrames = 1;
     return Next::Yield;
 }
@@ -344,7 +352,9 @@ Automation::Next Automation::printCommand(const std::string& what, AutomationHos
         if (st.view.compare.mode != ViewMode::Difference || b.size() < 2) return fail("print diff: not in the difference view");
         std::printf("viewer: diff %s\n", st.view.diff.summary(b[0], b[1], st.view.compare.threshold).c_str());
     } else if (what == "selection") {
-        std::printf("viewer: selection %s\n", st.doc.scene.valid(st.doc.selected) ? st.doc.scene.node(st.doc.selected).name.c_str() : "-");
+        std::string names;   // the active node first
+        for (sg::NodeId id : st.selection()) names += (names.empty() ? "" : ", ") + st.doc.scene.node(id).name;
+        std::printf("viewer: selection %s\n", names.empty() ? "-" : names.c_str());
     } else if (what == "memory") {
         std::printf("viewer: memory %ld kB\n", residentKilobytes());
     } else if (what == "view") {

@@ -57,7 +57,7 @@ private:
 
     Next runCommand(const std::string& cmd, std::istringstream& in, AutomationHost& host);
     Next keyCommand(const std::string& spec, AutomationHost& host);
-    Next clickCommand(std::istringstream& in, const ViewerState& st);
+    Next clickCommand(std::istringstream& in, AutomationHost& host);
     Next dragCommand(const std::string& args, const ViewerState& st);
     Next printCommand(const std::string& what, AutomationHost& host);
     Next documentCommand(const std::string& cmd, std::istringstream& in, ViewerState& st);

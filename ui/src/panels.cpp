@@ -317,7 +317,7 @@ void drawMainMenu(ViewerState& st) {
     bool viewOpen = ImGui::BeginMenu("View");
     record(st, "menu/view");
     if (viewOpen) {
-        if (ImGui::MenuItem("Fit to scene / selection", "F")) st.fitView(st.doc.scene.valid(st.doc.selected));
+        if (ImGui::MenuItem("Fit to scene / selection", "F")) st.fitView(!st.selection().empty());
         if (ImGui::MenuItem("Reset to scene camera", "Home")) st.resetView();
         ImGui::Separator();
         // The same modes as the Compare tab, --view and the automation's `view` (showView).
@@ -434,7 +434,7 @@ void drawNode(ViewerState& st, sg::NodeId id, int depth) {
     ImGuiTreeNodeFlags flags = ImGuiTreeNodeFlags_OpenOnArrow | ImGuiTreeNodeFlags_OpenOnDoubleClick | ImGuiTreeNodeFlags_SpanAvailWidth;
     if (n.children.empty()) flags |= ImGuiTreeNodeFlags_Leaf;
     if (depth < 2) flags |= ImGuiTreeNodeFlags_DefaultOpen;
-    if (id == st.doc.selected) flags |= ImGuiTreeNodeFlags_Selected;
+    if (st.isSelected(id)) flags |= ImGuiTreeNodeFlags_Selected;
     bool dim = !st.doc.scene.effectiveVisible(id);
     if (dim) ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyle().Colors[ImGuiCol_TextDisabled]);
     std::string label = std::string(payloadIcon(n.payload)) + " " + n.name + (id == st.doc.scene.activeCamera ? "  (active)" : "");
@@ -453,7 +453,12 @@ void drawNode(ViewerState& st, sg::NodeId id, int depth) {
     } else {
         open = ImGui::TreeNodeEx("##node", flags, "%s", label.c_str());
         record(st, "tree/" + n.name);
-        if (ImGui::IsItemClicked() && !ImGui::IsItemToggledOpen()) st.selectNode(id);
+        if (ImGui::IsItemClicked() && !ImGui::IsItemToggledOpen()) {
+            if (ImGui::GetIO().KeyCtrl)
+                st.toggleSelected(id);   // Ctrl+click adds or takes out
+            else
+                st.selectNode(id);
+        }
         if (ImGui::IsItemHovered() && ImGui::IsMouseDoubleClicked(0) && n.children.empty() && id != st.doc.scene.root()) {
             st.ui.panels.renaming = id;
             st.ui.panels.renameBuffer = n.name;
@@ -510,7 +515,7 @@ void drawSceneTree(ViewerState& st) {
     ImGui::BeginDisabled(!canEdit);
     if (ImGui::Button("Duplicate")) st.duplicateNode(st.doc.selected);
     ImGui::SameLine();
-    if (ImGui::Button("Delete")) st.removeNode(st.doc.selected);
+    if (ImGui::Button("Delete")) st.removeSelection();
     ImGui::EndDisabled();
     ImGui::Separator();
 
@@ -991,7 +996,7 @@ void drawCameraPanel(ViewerState& st) {
             if (ImGui::Selectable(st.doc.scene.node(c).name.c_str(), c == st.doc.scene.activeCamera)) st.useSceneCamera(c);
         ImGui::EndCombo();
     }
-    if (ImGui::Button("Fit (F)")) st.fitView(st.doc.scene.valid(st.doc.selected));
+    if (ImGui::Button("Fit (F)")) st.fitView(!st.selection().empty());
     ImGui::SameLine();
     if (ImGui::Button("Reset (Home)")) st.resetView();
     ImGui::SameLine();
@@ -1527,6 +1532,7 @@ void pickAndProbe(ViewerState& st, const ViewportInput& view, ImVec2 a, ImVec2 a
         probe.u = u;
         probe.v = v;
         probe.pickPending = true;
+        probe.pickAdds = io.KeyCtrl;
         probe.pickViewVersion = st.view.version;
         probe.pickDocVersion = st.doc.version;
     } else if (!probe.pinned) {
@@ -1536,7 +1542,11 @@ void pickAndProbe(ViewerState& st, const ViewportInput& view, ImVec2 a, ImVec2 a
     if (probe.pickPending && (probe.pickViewVersion != st.view.version || probe.pickDocVersion != st.doc.version)) probe.pickPending = false;
     if (probe.pickPending)
         if (const SlotView* s = slotUnder(st, view, probe.u); s && s->probe.image && s->probe.image->hasVisibility()) {
-            st.selectNode(pickAt(s->probe, probe.u, probe.v));
+            const sg::NodeId picked = pickAt(s->probe, probe.u, probe.v);
+            if (probe.pickAdds)
+                st.toggleSelected(picked);   // Ctrl+click: adds or takes out; on empty space nothing changes
+            else
+                st.selectNode(picked);
             probe.pickPending = false;
         }
     probe.results.clear();
@@ -1921,10 +1931,10 @@ void handleShortcuts(ViewerState& st) {
             st.setBackendIndex(i);
             st.showView(ViewMode::Single);
         }
-    if (ImGui::IsKeyPressed(keys::F, false)) st.fitView(st.doc.scene.valid(st.doc.selected));
+    if (ImGui::IsKeyPressed(keys::F, false)) st.fitView(!st.selection().empty());
     if (ImGui::IsKeyPressed(keys::Home, false)) st.resetView();
     if (ImGui::IsKeyPressed(keys::F12, false)) st.ui.requests.screenshot = true;
-    if (ImGui::IsKeyPressed(keys::Delete, false) && st.doc.scene.valid(st.doc.selected)) st.removeNode(st.doc.selected);
+    if (ImGui::IsKeyPressed(keys::Delete, false)) st.removeSelection();
     if (ImGui::IsKeyPressed(keys::F2, false) && st.doc.scene.valid(st.doc.selected) && st.doc.selected != st.doc.scene.root()) {
         st.ui.panels.renaming = st.doc.selected;
         st.ui.panels.renameBuffer = st.doc.scene.node(st.doc.selected).name;

@@ -125,7 +125,7 @@ namespace {
 struct BackendView {
     std::unique_ptr<RenderSlot> slot;
     Texture texture;
-    sg::NodeId outlined = sg::kNoNode;                              // the selection outlined in the texture
+    std::vector<sg::NodeId> outlined;                               // the selection outlined in the texture
     uint64_t outlinedVersion = 0;                                   // doc.version when it was outlined
     rnd::DiagnosticView diagnostic = rnd::DiagnosticView::Shaded;   // what the texture shows
     std::string legend;                                             // of that diagnostic view
@@ -215,10 +215,10 @@ public:
     // every backend's image alike, from its visibility (ui/pixel_probe.h, renderers/diagnostic.h).
     void refreshTexture(BackendView& v) {
         const bool fresh = v.slot->poll();
-        const sg::NodeId sel = st.doc.selected;
+        const std::vector<sg::NodeId> sel = st.selection();
         const uint64_t overlays = overlayKey();
         if (!fresh && sel == v.outlined && st.view.diagnostic == v.diagnostic && overlays == v.overlays &&
-            (sel == sg::kNoNode || v.outlinedVersion == st.doc.version))
+            (sel.empty() || v.outlinedVersion == st.doc.version))
             return;
         v.overlays = overlays;
         v.outlined = sel;
@@ -226,7 +226,7 @@ public:
         v.diagnostic = st.view.diagnostic;
         const rnd::Framebuffer& img = v.slot->image();
         const bool visible = img.hasVisibility() && v.slot->imageFrame();
-        if ((sel == sg::kNoNode && v.diagnostic == rnd::DiagnosticView::Shaded) || !visible) {
+        if ((sel.empty() && v.diagnostic == rnd::DiagnosticView::Shaded) || !visible) {
             if (overlays && v.slot->imageFrame()) {
                 rnd::Framebuffer shown = img;
                 drawViewOverlays(shown, *v.slot->imageFrame());
@@ -241,7 +241,7 @@ public:
         v.legend = shown.legend;
         shown.image.drawable = img.drawable;   // outlineNode reads the visibility
         shown.image.primitive = img.primitive;
-        if (sel != sg::kNoNode) outlineNode(shown.image, *v.slot->imageFrame(), st.doc.scene, sel);
+        for (sg::NodeId n : sel) outlineNode(shown.image, *v.slot->imageFrame(), st.doc.scene, n);
         shown.image.depth = img.depth;
         drawViewOverlays(shown.image, *v.slot->imageFrame());
         v.texture.upload(shown.image);
@@ -253,13 +253,26 @@ public:
         if (!o.any()) return 0;
         const uint64_t flags = uint64_t(o.grid) | uint64_t(o.axes) << 1 | uint64_t(o.lights) << 2 | uint64_t(o.cameras) << 3 |
                                uint64_t(o.bounds) << 4 | uint64_t(o.selection) << 5;
-        return flags ^ (st.doc.version << 8) ^ (uint64_t(st.doc.selected) << 40);
+        uint64_t sel = 0;
+        for (sg::NodeId n : st.selection()) sel = sel * 1000003u + uint64_t(n) + 1;
+        return flags ^ (st.doc.version << 8) ^ (sel << 40);
     }
     void drawViewOverlays(rnd::Framebuffer& img, const sg::FrameInput& frame) const {
         if (!st.view.overlays.any()) return;
+        rnd::drawOverlays(frame, overlayOptions(float(img.width) / float(std::max(img.height, 1))), img);
+    }
+    // View > Overlays with what they need from the document: the selected nodes (each with its
+    // descendants) and the scene's cameras.
+    rnd::OverlayOptions overlayOptions(float aspect) const {
         rnd::OverlayOptions o = st.view.overlays;
-        rnd::setSceneOverlayInputs(st.doc.scene, st.doc.selected, float(img.width) / float(std::max(img.height, 1)), o);
-        rnd::drawOverlays(frame, o, img);
+        const std::vector<sg::NodeId> sel = st.selection();
+        rnd::setSceneOverlayInputs(st.doc.scene, sel.empty() ? sg::kNoNode : sel[0], aspect, o);
+        for (size_t i = 1; i < sel.size(); ++i) {
+            rnd::OverlayOptions more;
+            rnd::setSceneOverlayInputs(st.doc.scene, sel[i], aspect, more);
+            o.selected.insert(o.selected.end(), more.selected.begin(), more.selected.end());
+        }
+        return o;
     }
 
     void updateDiff() {
@@ -339,10 +352,7 @@ public:
             std::make_shared<const std::vector<assets::AovInstance>>(ids ? aovInstances(st.doc.scene, *base) : std::vector<assets::AovInstance>{});
         const rnd::DiagnosticView view = dialog.asShown ? st.view.diagnostic : rnd::DiagnosticView::Shaded;
         rnd::OverlayOptions overlays;
-        if (dialog.asShown && st.view.overlays.any()) {
-            overlays = st.view.overlays;
-            rnd::setSceneOverlayInputs(st.doc.scene, st.doc.selected, aspect, overlays);
-        }
+        if (dialog.asShown && st.view.overlays.any()) overlays = overlayOptions(aspect);
         const bool visibility = aovsNeedVisibility(exports) || view != rnd::DiagnosticView::Shaded;
         std::vector<std::string> names = visibleBackends(st);
         std::sort(names.begin(), names.end());

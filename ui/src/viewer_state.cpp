@@ -28,6 +28,7 @@ void ViewerState::setScene(sg::Scene s, fs::path path) {
     doc.path = std::move(path);
     doc.dirty = false;
     doc.selected = sg::kNoNode;
+    doc.alsoSelected.clear();
     doc.history.clear();
     ui.panels.renaming = sg::kNoNode;
     anim.clips.clear();   // a load puts its clips back after this
@@ -57,6 +58,7 @@ UndoStep ViewerState::newStep(std::string label) const {
 void ViewerState::commit(UndoStep step, std::string_view mergeKey) {
     if (step.changes.empty()) return;
     step.selectedAfter = doc.selected;
+    std::erase_if(doc.alsoSelected, [&](sg::NodeId id) { return !doc.scene.valid(id); });   // never a stale id a later add reuses
     doc.history.push(std::move(step), mergeKey);
     doc.dirty = !doc.history.atSavedState();
     ++doc.version;
@@ -66,7 +68,7 @@ namespace {
 // After undo / redo: the step's selection when its node is there, else none; an in-place
 // rename of a node that is gone ends.
 void afterHistoryMove(ViewerState& st, sg::NodeId selection, const std::string& what) {
-    st.doc.selected = st.doc.scene.valid(selection) ? selection : sg::kNoNode;
+    st.selectNode(selection);
     if (!st.doc.scene.valid(st.ui.panels.renaming)) st.ui.panels.renaming = sg::kNoNode;
     st.doc.dirty = !st.doc.history.atSavedState();
     ++st.doc.version;
@@ -96,7 +98,37 @@ bool ViewerState::redo() {
     return true;
 }
 
-void ViewerState::selectNode(sg::NodeId id) { doc.selected = doc.scene.valid(id) ? id : sg::kNoNode; }
+void ViewerState::selectNode(sg::NodeId id) {
+    doc.selected = doc.scene.valid(id) ? id : sg::kNoNode;
+    doc.alsoSelected.clear();
+}
+
+void ViewerState::toggleSelected(sg::NodeId id) {
+    if (!doc.scene.valid(id)) return;
+    std::vector<sg::NodeId> others = selection();
+    const bool had = std::find(others.begin(), others.end(), id) != others.end();
+    std::erase(others, id);
+    if (!had) {   // added: the new active node
+        doc.selected = id;
+        doc.alsoSelected = std::move(others);
+        return;
+    }
+    doc.selected = others.empty() ? sg::kNoNode : others.front();   // taken out: the last added (selection() is newest first) takes over
+    if (!others.empty()) others.erase(others.begin());
+    doc.alsoSelected = std::move(others);
+}
+
+std::vector<sg::NodeId> ViewerState::selection() const {
+    std::vector<sg::NodeId> s;
+    if (doc.scene.valid(doc.selected)) s.push_back(doc.selected);
+    for (sg::NodeId id : doc.alsoSelected)
+        if (doc.scene.valid(id) && std::find(s.begin(), s.end(), id) == s.end()) s.push_back(id);
+    return s;
+}
+
+bool ViewerState::isSelected(sg::NodeId id) const {
+    return doc.scene.valid(id) && (id == doc.selected || std::find(doc.alsoSelected.begin(), doc.alsoSelected.end(), id) != doc.alsoSelected.end());
+}
 
 bool ViewerState::renameNode(sg::NodeId id, const std::string& name) {
     if (!doc.scene.valid(id) || name.empty() || doc.scene.node(id).name == name) return false;
@@ -136,7 +168,7 @@ std::string uniqueName(const sg::Scene& s, const std::string& base) {
 sg::NodeId commitAdded(ViewerState& st, UndoStep step, sg::NodeId id) {
     step.label += " " + st.doc.scene.node(id).name;
     step.changes.insert(step.changes.begin(), SubtreeChange{id, /*added=*/true, {}});
-    st.doc.selected = id;
+    st.selectNode(id);
     st.commit(std::move(step));
     return id;
 }
@@ -216,6 +248,26 @@ bool ViewerState::removeNode(sg::NodeId id) {
     return true;
 }
 
+bool ViewerState::removeSelection() {
+    std::vector<sg::NodeId> del;   // the selected nodes no other selected node contains (a subtree goes once)
+    for (sg::NodeId id : selection()) {
+        if (id == doc.scene.root()) continue;
+        bool inside = false;
+        for (sg::NodeId other : selection()) inside = inside || (other != id && other != doc.scene.root() && doc.scene.isAncestor(other, id));
+        if (!inside) del.push_back(id);
+    }
+    if (del.empty()) return false;
+    if (del.size() == 1) return removeNode(del[0]);
+    UndoStep step = newStep("Delete " + std::to_string(del.size()) + " nodes");
+    for (sg::NodeId id : del) {
+        sg::DetachedSubtree d = doc.scene.detach(id);
+        if (d.id == id) step.changes.push_back(SubtreeChange{id, /*added=*/false, std::move(d)});
+    }
+    selectNode(sg::kNoNode);
+    commit(std::move(step));
+    return true;
+}
+
 sg::NodeId ViewerState::duplicateNode(sg::NodeId id) {
     if (!doc.scene.valid(id) || id == doc.scene.root()) return sg::kNoNode;
     UndoStep step = newStep("Duplicate " + doc.scene.node(id).name);
@@ -223,7 +275,7 @@ sg::NodeId ViewerState::duplicateNode(sg::NodeId id) {
     if (!doc.scene.valid(c)) return c;
     doc.scene.setName(c, uniqueName(doc.scene, doc.scene.node(id).name + " copy"));
     step.changes.push_back(SubtreeChange{c, /*added=*/true, {}});
-    doc.selected = c;
+    selectNode(c);
     commit(std::move(step));
     return c;
 }
@@ -472,11 +524,15 @@ sg::Projection ViewerState::viewProjection() const {
 
 void ViewerState::fitView(bool selectionOnly) {
     sg::Aabb b;
-    if (selectionOnly && doc.scene.valid(doc.selected)) {
-        // Bounds of the selected subtree.
-        for (sg::NodeId id : doc.scene.depthFirstOrder())
-            if (doc.scene.isAncestor(doc.selected, id)) b.extend(doc.scene.nodeWorldBounds(id));   // skinned meshes as posed
-        if (b.empty()) b = sg::Aabb{sg::vec3(doc.scene.world(doc.selected)[3]) - 0.5f, sg::vec3(doc.scene.world(doc.selected)[3]) + 0.5f};
+    if (selectionOnly) {
+        // Bounds of the selected subtrees (a node without geometry: a unit box about its origin).
+        for (sg::NodeId sel : selection()) {
+            sg::Aabb one;
+            for (sg::NodeId id : doc.scene.depthFirstOrder())
+                if (doc.scene.isAncestor(sel, id)) one.extend(doc.scene.nodeWorldBounds(id));   // skinned meshes as posed
+            if (one.empty()) one = sg::Aabb{sg::vec3(doc.scene.world(sel)[3]) - 0.5f, sg::vec3(doc.scene.world(sel)[3]) + 0.5f};
+            b.extend(one);
+        }
     }
     if (b.empty()) b = doc.scene.worldBounds();
     float aspect = float(std::max(view.viewportWidth, 1)) / float(std::max(view.viewportHeight, 1));

@@ -36,6 +36,7 @@ struct PixelProbeState {
     // A click on an image without visibility yet (a preview level): picked when the full image
     // arrives, unless the camera or the scene changed in between (versions at the click).
     bool pickPending = false;
+    bool pickAdds = false;   // Ctrl was down: the pick adds to (or takes out of) the selection
     uint64_t pickViewVersion = 0, pickDocVersion = 0;
 };
 

@@ -100,12 +100,13 @@ struct LoadControl {
 // path, clears the dirty flag, the selection and the history.
 struct Document {
     sg::Scene scene;
-    std::filesystem::path path;   // empty for the demo / a new scene
-    bool dirty = false;           // unsaved edits (= !history.atSavedState() after every edit, undo, redo, save)
-    UndoStack history;            // every scene edit, for Edit > Undo / Redo
-    uint64_t version = 1;         // bumped on every scene change, edits and animation poses (re-render)
-    uint64_t sceneSerial = 1;     // bumped by setScene only: a different scene (drop the old one's images)
-    sg::NodeId selected = sg::kNoNode;
+    std::filesystem::path path;              // empty for the demo / a new scene
+    bool dirty = false;                      // unsaved edits (= !history.atSavedState() after every edit, undo, redo, save)
+    UndoStack history;                       // every scene edit, for Edit > Undo / Redo
+    uint64_t version = 1;                    // bumped on every scene change, edits and animation poses (re-render)
+    uint64_t sceneSerial = 1;                // bumped by setScene only: a different scene (drop the old one's images)
+    sg::NodeId selected = sg::kNoNode;       // the active node: what the inspector edits, F2 renames, Ctrl+D duplicates
+    std::vector<sg::NodeId> alsoSelected;    // more nodes added with Ctrl+click (outlined, fitted, deleted with it)
     std::vector<std::string> loadWarnings;   // of the load that brought this scene
 };
 
@@ -226,7 +227,13 @@ struct ViewerState {
     // bring back the saved state.
     void markEdited();
 
-    void selectNode(sg::NodeId id);
+    void selectNode(sg::NodeId id);   // the selection becomes `id` alone (kNoNode: nothing)
+    // Ctrl+click: adds `id` (it becomes the active node) or, when selected, takes it out (the
+    // last one added becomes active). kNoNode changes nothing.
+    void toggleSelected(sg::NodeId id);
+    std::vector<sg::NodeId> selection() const;   // the active node first, then the others; valid ones only
+    bool isSelected(sg::NodeId id) const;
+    bool removeSelection();   // Delete: every selected node (a subtree once) as one undo step
     bool renameNode(sg::NodeId id, const std::string& name);
     void setVisible(sg::NodeId id, bool visible);
     // New nodes go under `parent` (the selection's parent-or-self when kNoNode). Return the id.
