@@ -101,7 +101,7 @@ namespace {
 struct Rgb {
     uint8_t r, g, b;
 };
-constexpr Rgb kGrid{120, 120, 120}, kAxisX{230, 50, 50}, kAxisY{50, 200, 50}, kAxisZ{60, 100, 245};
+constexpr Rgb kGrid{20, 175, 190}, kAxisX{230, 50, 50}, kAxisY{50, 200, 50}, kAxisZ{60, 100, 245};
 constexpr Rgb kLight{255, 210, 40}, kCamera{255, 70, 200}, kBounds{40, 200, 220}, kSelection{255, 140, 0};
 constexpr float kDepthBias = 2e-4f;   // lines on a surface (the grid on a floor) stay visible
 constexpr int kLightRadius = 6;       // pixels
