@@ -205,7 +205,8 @@ bool addDefaultCameraAndLight(sg::Scene& scene) {
         if (std::holds_alternative<sg::Light>(p)) hasLight = true;
         if (std::holds_alternative<sg::Camera>(p)) hasCamera = true;
     }
-    sg::Aabb b = scene.worldBounds();
+    const sg::Aabb bounds = scene.worldBounds();   // once: a light adds none (lights have no bounds)
+    sg::Aabb b = bounds;
     if (b.empty()) b = {sg::vec3(-1.0f), sg::vec3(1.0f)};
     bool added = false;
     if (!hasLight) {
@@ -222,7 +223,7 @@ bool addDefaultCameraAndLight(sg::Scene& scene) {
         added = true;
     }
     if (!hasCamera)
-        scene.addDefaultCamera();
+        scene.addDefaultCamera(bounds);
     else if (!scene.valid(scene.activeCamera))
         scene.activeCamera = scene.cameras().front();
     return added;

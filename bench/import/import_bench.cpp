@@ -10,8 +10,13 @@
 // machine is shared: CPU time is the steadier number) and the child's peak RSS growth
 // (VmHWM minus VmRSS at the start of the load) as
 //   bench: scene=<name> what=<metric> ours=<x>
+// The glTF files are also parsed by tinygltf alone (TinyGLTF::LoadASCIIFromFile into its Model,
+// nothing else; another forked child), the floor under our importer, which is built on it:
+//   bench: scene=<name> what=tinygltf_alone_<metric> ours=<x>
 // With testdata present it also times the largest real meshes (igea.ply, bunny OBJ/STL).
 #include "assets/scene_io.h"
+
+#include <tiny_gltf.h>
 
 #include <chrono>
 #include <cmath>
@@ -139,6 +144,42 @@ double cpuSeconds() {
     return double(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) + 1e-6 * double(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
 }
 
+// tinygltf alone on a .gltf (the parse our importer starts with), in a forked child: wall and
+// CPU time and peak RSS growth.
+bool measureTinygltf(const std::string& name, const fs::path& file) {
+    std::fflush(stdout);
+    pid_t pid = fork();
+    if (pid < 0) {
+        std::perror("fork");
+        return false;
+    }
+    if (pid > 0) {
+        int status = 0;
+        waitpid(pid, &status, 0);
+        return WIFEXITED(status) && WEXITSTATUS(status) == 0;
+    }
+    long rssBefore = statusKb("VmRSS:");
+    double cpu0 = cpuSeconds();
+    auto t0 = std::chrono::steady_clock::now();
+    tinygltf::TinyGLTF loader;
+    tinygltf::Model model;
+    std::string err, warn;
+    const bool ok = loader.LoadASCIIFromFile(&model, &err, &warn, file.string());
+    double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    double cpu = cpuSeconds() - cpu0;
+    long hwm = statusKb("VmHWM:");
+    if (!ok) {
+        std::printf("bench: scene=%s what=tinygltf_alone_error ours=\"%s\"\n", name.c_str(), err.c_str());
+        std::fflush(stdout);
+        _exit(1);
+    }
+    std::printf("bench: scene=%s what=tinygltf_alone_wall_s ours=%.3f\n", name.c_str(), dt);
+    std::printf("bench: scene=%s what=tinygltf_alone_cpu_s ours=%.3f\n", name.c_str(), cpu);
+    std::printf("bench: scene=%s what=tinygltf_alone_peak_rss_growth_mb ours=%.1f\n", name.c_str(), double(hwm - rssBefore) / 1024.0);
+    std::fflush(stdout);
+    _exit(0);
+}
+
 // Loads in a forked child so that its peak RSS (VmHWM) belongs to this load alone.
 bool measure(const std::string& name, const fs::path& file, uint64_t extraBytes = 0) {
     std::fflush(stdout);
@@ -207,12 +248,14 @@ int main(int argc, char** argv) {
     if (only.empty() || only == "nodes") {
         gen("gltf-1M-nodes", genNodes);
         ok &= measure("gltf-1M-nodes", dir / "nodes-1M.gltf");
-        fs::remove(dir / "nodes-1M.gltf");
+        ok &= measureTinygltf("gltf-1M-nodes", dir / "nodes-1M.gltf");
+        if (!keep) fs::remove(dir / "nodes-1M.gltf");
     }
     if (only.empty() || only == "tris") {
         gen("gltf-10M-tris", genTris);
         ok &= measure("gltf-10M-tris", dir / "tris-10M.gltf", fs::file_size(dir / "grid.bin"));
-        fs::remove(dir / "grid.bin");
+        ok &= measureTinygltf("gltf-10M-tris", dir / "tris-10M.gltf");
+        if (!keep) fs::remove(dir / "grid.bin");
     }
     if (only.empty() || only == "meshes") {
         fs::path td = fs::path(VIEWER_TESTDATA_DIR) / "meshes";

@@ -324,7 +324,9 @@ void Scene::lookAt(NodeId id, const vec3& eye, const vec3& center, const vec3& u
     if (!valid(id)) return;
     mat4 camToWorld = glm::inverse(sg::lookAt(eye, center, up));
     NodeId parent = m_nodes[id].parent;
-    mat4 local = parent == kNoNode ? camToWorld : glm::inverse(world(parent)) * camToWorld;
+    // The parent's world along its chain: adding a node and aiming it (an importer's default
+    // light and camera) must not rebuild the order of a scene of a million nodes each time.
+    mat4 local = parent == kNoNode ? camToWorld : glm::inverse(worldByChain(parent)) * camToWorld;
     LocalTransform lt = LocalTransform::fromMatrix(local);
     lt.tryMakeTRS();
     setLocal(id, lt);
@@ -399,6 +401,22 @@ inline void mulAffine(const mat4& a, const mat4& b, mat4& out) {
     }
 #endif
 }
+
+}   // namespace
+
+mat4 Scene::worldByChain(NodeId id) const {
+    std::vector<NodeId> chain;
+    for (NodeId p = id; p != kNoNode; p = m_nodes[p].parent) chain.push_back(p);
+    mat4 w = m_nodes[chain.back()].local.toMatrix();   // the root: world = local, as in WorldUpdater::serial
+    for (size_t i = chain.size() - 1; i-- > 0;) {
+        mat4 out;
+        mulAffine(w, m_nodes[chain[i]].local.toMatrix(), out);
+        w = out;
+    }
+    return w;
+}
+
+namespace {
 
 // Updates dirty subtrees. A subtree is the contiguous slot range [root, root + size); its
 // children's subtrees are consecutive sub-ranges. Large subtrees are split over threads by
@@ -600,8 +618,10 @@ const Material& Scene::material(int index) const {
     return materials[index];
 }
 
-Camera Scene::framingCamera(mat4& cameraWorld) const {
-    Aabb b = worldBounds();
+Camera Scene::framingCamera(mat4& cameraWorld) const { return framingCamera(worldBounds(), cameraWorld); }
+
+Camera Scene::framingCamera(const Aabb& bounds, mat4& cameraWorld) {
+    Aabb b = bounds;
     if (b.empty()) b = {vec3(-1.0f), vec3(1.0f)};
     vec3 c = b.center();
     float radius = std::max(0.5f * glm::length(b.extent()), 1e-3f);
@@ -617,9 +637,11 @@ Camera Scene::framingCamera(mat4& cameraWorld) const {
     return cam;
 }
 
-NodeId Scene::addDefaultCamera() {
+NodeId Scene::addDefaultCamera() { return addDefaultCamera(worldBounds()); }
+
+NodeId Scene::addDefaultCamera(const Aabb& bounds) {
     mat4 camWorld;
-    Camera cam = framingCamera(camWorld);
+    Camera cam = framingCamera(bounds, camWorld);
     NodeId id = addNode("default camera", root(), cam);
     vec3 eye = vec3(camWorld[3]), c = eye - vec3(camWorld[2]) * cam.focusDistance;
     lookAt(id, eye, c);

@@ -153,6 +153,10 @@ public:
     // --- structure ---------------------------------------------------------------------
     NodeId root() const { return 0; }
     NodeId addNode(std::string name, NodeId parent = 0, Payload payload = {});
+    // Room for `count` more nodes without moving the node array (an importer that knows how
+    // many it adds: one allocation instead of doubling, whose old and new arrays would both be
+    // alive at the peak).
+    void reserveNodes(size_t count) { m_nodes.reserve(m_nodes.size() + count); }
     // Removes the node and its subtree (not the root). Returns false for invalid ids.
     bool removeNode(NodeId id);
     // removeNode that keeps what it removed; an empty result (id kNoNode) for invalid ids / the root.
@@ -221,10 +225,17 @@ public:
 
     // Creates a camera node framing the visible geometry and makes it active. Returns it.
     NodeId addDefaultCamera();
+    // The same for bounds the caller already has (worldBounds(); an empty box frames -1..1).
+    NodeId addDefaultCamera(const Aabb& bounds);
     // The camera addDefaultCamera() would add, and its world matrix, without editing the scene.
     Camera framingCamera(mat4& cameraWorld) const;
+    static Camera framingCamera(const Aabb& bounds, mat4& cameraWorld);
 
 private:
+    // world(id) computed along its ancestor chain (the same products as the world update, so
+    // the same bits) without rebuilding the whole scene's order and matrices.
+    mat4 worldByChain(NodeId id) const;
+
     void markStructureDirty();
     void rebuildOrder() const;
     void markDirty(NodeId id);
