@@ -145,8 +145,9 @@ public:
     // Front-to-back traversal. leaf(first, count, tmax&) tests a leaf and may shrink tmax;
     // returns true to stop the traversal (any-hit queries).
     // AnyHit = true skips the front-to-back sort (any hit ends the query anyway).
-    // visited: when given, counts the inner nodes visited (the cost view).
-    template <bool AnyHit = false, class LeafFn>
+    // Count: add the inner nodes visited to *visited (the cost view; a separate instantiation,
+    // so the uncounted traversal is unchanged).
+    template <bool AnyHit = false, bool Count = false, class LeafFn>
     void traverse(const Ray& ray, float& tmax, LeafFn&& leaf, uint32_t* visited = nullptr) const;
 
 private:

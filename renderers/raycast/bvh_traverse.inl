@@ -36,7 +36,7 @@ inline RayPre::RayPre(const Ray& r, const float* boxAbsMax) {
     nearZ = (neg >> 2) & 1;
 }
 
-template <bool AnyHit, class LeafFn>
+template <bool AnyHit, bool Count, class LeafFn>
 void Bvh4::traverse(const Ray& ray, float& tmax, LeafFn&& leaf, uint32_t* visited) const {
     if (m_nodes.empty()) return;
     const RayPre pre(ray, nullptr);   // only org and rdir: this test is (b - org) * rdir
@@ -57,7 +57,7 @@ void Bvh4::traverse(const Ray& ray, float& tmax, LeafFn&& leaf, uint32_t* visite
     uint32_t cur = 0;   // root: node 0
     for (;;) {
         if (!(cur & Node4::kLeafBit)) {
-            if (visited) ++*visited;
+            if constexpr (Count) ++*visited;
             const Node4& n = m_nodes[cur];
             __m128 t0x = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(n.b[nx]), ox), rx);
             __m128 t1x = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(n.b[fx]), ox), rx);

@@ -169,28 +169,31 @@ bool SceneAccel::intersectInstance(const Instance& inst, const Ray& wr, float tm
     return true;
 }
 
-bool SceneAccel::intersect(const Ray& r, SceneHit& hit, sg::CullMode culling, TraversalCount* cost) const {
-    if (m_tlas.empty()) return false;
+template <bool Count>
+bool SceneAccel::closestHit(const Ray& r, SceneHit& hit, sg::CullMode culling, TraversalCount* cost) const {
     float tmax = r.tmax;
     bool found = false;
     const std::vector<uint32_t>& prims = m_tlas.primIndex();
-    m_tlas.traverse(
-        r, tmax,
-        [&](uint32_t first, uint32_t count, float& tm) {
-            for (uint32_t k = 0; k < count; ++k) {
-                SceneHit h;
-                const Instance& inst = m_instances[prims[first + k]];
-                const bool cull = inst.isMesh && sg::cullsBackFaces(culling, m_frame->meshes[inst.index].material.doubleSided);
-                if (intersectInstance(inst, r, tm, h, cull, cost) && h.t < tm) {
-                    tm = h.t;
-                    hit = h;
-                    found = true;
-                }
+    auto leaf = [&](uint32_t first, uint32_t count, float& tm) {
+        for (uint32_t k = 0; k < count; ++k) {
+            SceneHit h;
+            const Instance& inst = m_instances[prims[first + k]];
+            const bool cull = inst.isMesh && sg::cullsBackFaces(culling, m_frame->meshes[inst.index].material.doubleSided);
+            if (intersectInstance(inst, r, tm, h, cull, cost) && h.t < tm) {
+                tm = h.t;
+                hit = h;
+                found = true;
             }
-            return false;
-        },
-        cost ? &cost->nodes : nullptr);
+        }
+        return false;
+    };
+    m_tlas.traverse<false, Count>(r, tmax, leaf, Count ? &cost->nodes : nullptr);
     return found;
+}
+
+bool SceneAccel::intersect(const Ray& r, SceneHit& hit, sg::CullMode culling, TraversalCount* cost) const {
+    if (m_tlas.empty()) return false;
+    return cost ? closestHit<true>(r, hit, culling, cost) : closestHit<false>(r, hit, culling, nullptr);
 }
 
 bool SceneAccel::occluded(const Ray& r) const {

@@ -72,6 +72,10 @@ private:
         sg::mat4 invWorld{1.0f};
     };
 
+    // intersect() without and with counting (Count: the cost view), so rays that are not
+    // counted run the traversal without the counters.
+    template <bool Count>
+    bool closestHit(const Ray& r, SceneHit& hit, sg::CullMode culling, TraversalCount* cost) const;
     bool intersectInstance(const Instance& inst, const Ray& r, float tmax, SceneHit& hit, bool cull = false, TraversalCount* count = nullptr) const;
 
     const sg::FrameInput* m_frame = nullptr;
