@@ -213,7 +213,7 @@ struct Shot {
     std::unique_ptr<rnd::Renderer> renderer;   // kept for questions about the frame (lightVisibility)
 };
 
-Shot renderWith(const std::string& backend, const sg::FrameInput& frame, int w, int h, bool visibility = false) {
+Shot renderWith(const std::string& backend, const sg::FrameInput& frame, int w, int h, const rnd::RenderRequest& request = {}) {
     Shot shot;
     shot.backend = backend;
     std::string err;
@@ -223,8 +223,6 @@ Shot renderWith(const std::string& backend, const sg::FrameInput& frame, int w, 
         return shot;
     }
     auto t0 = std::chrono::steady_clock::now();
-    rnd::RenderRequest request;
-    request.visibility = visibility;
     shot.stats = r->render(frame, w, h, shot.image, nullptr, request);
     shot.renderer = std::move(r);
     if (shot.stats.milliseconds == 0)
@@ -272,8 +270,9 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a, Command command) {
         cmd.add_option("--turntable", a.turntable, "Render N frames around the camera's pivot: OUT_0000.png, ...");
         cmd.add_option("--shard", a.shard, "Render only frames k with k mod N == I (I/N), for a scheduler's array jobs");
         cmd.add_option("--view", a.view,
-                       "What OUT.png shows: shaded (default), depth, normal, id, uv or triangles (density); the diagnostic views are "
-                       "made from the backend's own visibility, and the legend is printed")
+                       "What OUT.png shows: shaded (default), depth, normal, id, uv, triangles (density), overdraw (fragments per pixel; "
+                       "rasterizers) or cost (BVH nodes + triangles tested per primary ray; ray caster); the diagnostic views are "
+                       "made from the backend's own visibility and counters, and the legend is printed")
             ->capture_default_str();
     }
     cmd.add_option("--size", a.size,
@@ -331,7 +330,10 @@ std::string renderJob(const RenderArgs& a, const CameraJob& job, const sg::Scene
     sg::FrameInput frame = sg::flatten(scene, float(w) / float(h));
     std::string err = applyCameraJob(a, job, frame);
     if (!err.empty()) return (job.index >= 0 ? job.out.string() + ": " : std::string()) + err;
-    Shot shot = renderWith(a.backend, frame, w, h, ui::aovsNeedVisibility(aovKinds(a)) || view != rnd::DiagnosticView::Shaded);
+    rnd::RenderRequest request;
+    request.visibility = ui::aovsNeedVisibility(aovKinds(a));
+    rnd::requestFor(view, request);
+    Shot shot = renderWith(a.backend, frame, w, h, request);
     if (!shot.stats.ok) return shot.stats.error;   // starts with the backend's name
     rnd::DiagnosticImage shown = rnd::diagnosticImage(view, frame, shot.image);
     shown.image.depth = shot.image.depth;   // overlays are hidden behind the rendered surfaces
@@ -365,6 +367,15 @@ int runRender(const RenderArgs& a) {
         std::string names;
         for (std::string_view n : rnd::diagnosticViewNames()) names += (names.empty() ? "" : ", ") + std::string(n);
         return fail("--view '" + a.view + "': expected one of " + names);
+    }
+    if (auto r = rnd::makeRenderer(a.backend); r && !rnd::diagnosticViewSupported(view, r->capabilities())) {
+        // Decided from capabilities, before any rendering; names the backends that can.
+        std::string can;
+        for (const std::string& b : rnd::rendererNames())
+            if (auto other = rnd::makeRenderer(b); other && rnd::diagnosticViewSupported(view, other->capabilities()))
+                can += (can.empty() ? "" : ", ") + b;
+        return fail("--view " + a.view + ": the " + a.backend + " backend cannot make this view" +
+                    (can.empty() ? std::string() : " (backends that can: " + can + ")"));
     }
     std::vector<assets::AnimationClip> clips;
     auto scene = loadSceneArg(a.scene, err, &clips);
@@ -534,7 +545,9 @@ int runInspect(const RenderArgs& a) {
     std::vector<std::pair<std::string, std::array<int, 3>>> rgb;
     int failures = 0;
     for (const std::string& b : backends) {
-        Shot s = renderWith(b, frame, w, h, /*visibility=*/true);
+        rnd::RenderRequest visibility;
+        visibility.visibility = true;
+        Shot s = renderWith(b, frame, w, h, visibility);
         if (!s.stats.ok) {
             out["backends"][b] = {{"error", s.stats.error}};
             ++failures;

@@ -17,12 +17,14 @@ namespace {
 using sg::vec3;
 using sg::vec4;
 
-constexpr std::array<std::pair<DiagnosticView, std::string_view>, 6> kNames = {{{DiagnosticView::Shaded, "shaded"},
+constexpr std::array<std::pair<DiagnosticView, std::string_view>, 8> kNames = {{{DiagnosticView::Shaded, "shaded"},
                                                                                 {DiagnosticView::Depth, "depth"},
                                                                                 {DiagnosticView::Normal, "normal"},
                                                                                 {DiagnosticView::Id, "id"},
                                                                                 {DiagnosticView::Uv, "uv"},
-                                                                                {DiagnosticView::Triangles, "triangles"}}};
+                                                                                {DiagnosticView::Triangles, "triangles"},
+                                                                                {DiagnosticView::Overdraw, "overdraw"},
+                                                                                {DiagnosticView::Cost, "cost"}}};
 
 void put(Framebuffer& fb, size_t k, float r, float g, float b) {
     uint8_t* p = &fb.color[4 * k];
@@ -94,13 +96,40 @@ std::string_view nameOf(DiagnosticView v) {
     return "shaded";
 }
 
+bool diagnosticViewSupported(DiagnosticView view, const Capabilities& caps) {
+    switch (view) {
+    case DiagnosticView::Shaded: return true;
+    case DiagnosticView::Overdraw: return caps.overdraw;
+    case DiagnosticView::Cost: return caps.traversalCost;
+    default: return caps.visibility;
+    }
+}
+
+void requestFor(DiagnosticView view, RenderRequest& request) {
+    switch (view) {
+    case DiagnosticView::Shaded: break;
+    case DiagnosticView::Overdraw: request.overdraw = true; break;
+    case DiagnosticView::Cost: request.traversalCost = true; break;
+    default: request.visibility = true; break;
+    }
+}
+
 DiagnosticImage diagnosticImage(DiagnosticView view, const sg::FrameInput& f, const Framebuffer& fb) {
     DiagnosticImage out;
-    if (view == DiagnosticView::Shaded || !fb.hasVisibility()) {
+    const bool counts = view == DiagnosticView::Overdraw ? fb.hasOverdraw()
+                        : view == DiagnosticView::Cost   ? fb.hasTraversalCost()
+                                                         : fb.hasVisibility();
+    if (view == DiagnosticView::Shaded || !counts) {
         out.image = fb;
         out.image.drawable.clear();
         out.image.primitive.clear();
-        out.legend = view == DiagnosticView::Shaded ? "" : std::string(nameOf(view)) + ": no visibility for this image yet";
+        out.image.overdraw.clear();
+        out.image.costNodes.clear();
+        out.image.costPrims.clear();
+        const char* missing = view == DiagnosticView::Overdraw ? "no fragment counts"
+                              : view == DiagnosticView::Cost   ? "no traversal counts"
+                                                               : "no visibility";
+        out.legend = view == DiagnosticView::Shaded ? "" : std::string(nameOf(view)) + ": " + missing + " for this image yet";
         return out;
     }
     const int w = fb.width, h = fb.height;
@@ -169,6 +198,41 @@ DiagnosticImage diagnosticImage(DiagnosticView view, const sg::FrameInput& f, co
             put(out.image, k, c.x, c.y, c.z);
         }
         out.legend = "triangles per pixel (1 / projected area), log scale: blue 0.001, cyan 0.006, green 0.03, yellow 0.18, red >= 1; grey: analytic";
+        break;
+    }
+    case DiagnosticView::Overdraw: {
+        uint32_t most = 0;
+        uint64_t sum = 0, covered = 0;
+        for (size_t k = 0; k < n; ++k) {
+            const uint32_t c = fb.overdraw[k];
+            if (!c) continue;
+            most = std::max(most, c);
+            sum += c;
+            ++covered;
+            const vec3 col = heat(float(std::min(c, 8u) - 1) / 7.0f);
+            put(out.image, k, col.x, col.y, col.z);
+        }
+        out.legend = "overdraw (fragments per pixel before the depth test): 1 blue, 2 cyan, 3-4 green, 5-6 yellow, 8+ red; black: none; max " +
+                     std::to_string(most) +
+                     format(", mean %.2f over %.0f covered pixels", covered ? double(sum) / double(covered) : 0.0, double(covered));
+        break;
+    }
+    case DiagnosticView::Cost: {
+        uint32_t most = 0;
+        uint64_t nodes = 0, prims = 0;
+        for (size_t k = 0; k < n; ++k) {
+            most = std::max(most, fb.costNodes[k] + fb.costPrims[k]);
+            nodes += fb.costNodes[k];
+            prims += fb.costPrims[k];
+        }
+        const float top = std::log(float(std::max(most, 2u)));
+        for (size_t k = 0; k < n; ++k)
+            if (const uint32_t work = fb.costNodes[k] + fb.costPrims[k]) {
+                const vec3 col = heat(std::log(float(work)) / top);
+                put(out.image, k, col.x, col.y, col.z);
+            }
+        out.legend = "cost (BVH nodes visited + triangles tested by the primary ray), log scale: 1 blue .. " + std::to_string(most) + " red" +
+                     format("; mean %.1f nodes, %.1f triangles per pixel", double(nodes) / double(n), double(prims) / double(n));
         break;
     }
     case DiagnosticView::Shaded: break;

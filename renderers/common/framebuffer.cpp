@@ -17,11 +17,21 @@ void Framebuffer::resize(int w, int h) {
     depth.assign(size_t(width) * height, 1.0f);
     drawable.clear();
     primitive.clear();
+    overdraw.clear();
+    costNodes.clear();
+    costPrims.clear();
 }
 
 void Framebuffer::resizeVisibility() {
     drawable.assign(size_t(width) * height, 0u);
     primitive.assign(size_t(width) * height, kNoPrimitive);
+}
+
+void Framebuffer::resizeOverdraw() { overdraw.assign(size_t(width) * height, 0u); }
+
+void Framebuffer::resizeTraversalCost() {
+    costNodes.assign(size_t(width) * height, 0u);
+    costPrims.assign(size_t(width) * height, 0u);
 }
 
 void Framebuffer::clear(const uint8_t rgba[4], float d) {

@@ -24,6 +24,7 @@ struct Provenance {
 void writeLinePixel(Framebuffer& fb, int i, int j, float z, const vec3& linear, float bias, const Provenance& from = {}) {
     int row = fb.height - 1 - j;
     const size_t at = size_t(row) * fb.width + i;
+    if (!fb.overdraw.empty()) ++fb.overdraw[at];   // the overdraw view: every fragment, before the depth test
     float& dst = fb.depth[at];
     if (!(z < dst + bias)) return;   // LESS (wireframe: LEQUAL with a small offset)
     dst = std::min(dst, z);

@@ -7,6 +7,8 @@
 //   Wireframe (settings.wireframe): every triangle edge in the wireframe colour, depth LEQUAL
 //   with a small offset toward the viewer (GL: glPolygonOffset(-1, -1)); culled faces draw
 //   no edges.
+// When the target has overdraw counters (Framebuffer::overdraw), every pixel written counts one
+// fragment, before its depth test (the overdraw diagnostic view).
 #pragma once
 
 #include "renderers/draw_list.h"

@@ -8,11 +8,14 @@ namespace rnd {
 
 namespace {
 
-// The one-sample configuration the visibility pass of an anti-aliased image renders with.
-RenderConfig visibilityPass(RenderConfig c) {
+// The one-sample configuration the second pass of an anti-aliased image renders with: the
+// visibility and the per-pixel counters that were asked for.
+RenderConfig onePixelPass(RenderConfig c, const RenderRequest& r) {
     c.aa = sg::AAMode::None;
     c.msaaSamples = c.ssaaFactor = c.samplesPerPixel = 1;
-    c.visibility = true;
+    c.visibility = r.visibility;
+    c.overdraw = r.overdraw;
+    c.traversalCost = r.traversalCost;
     return c;
 }
 
@@ -36,11 +39,23 @@ RenderStats Renderer::render(const sg::FrameInput& frame, int width, int height,
         stats.error = error;
         return finish(stats);
     }
-    if (request.visibility && !capabilities().visibility) {
+    const Capabilities caps = capabilities();
+    if (request.visibility && !caps.visibility) {
         stats.error = "cannot tell which surface each pixel shows (no visibility buffer)";
         return finish(stats);
     }
-    config.visibility = request.visibility && config.samplesPerPixel == 1;
+    if (request.overdraw && !caps.overdraw) {
+        stats.error = "cannot count fragments per pixel (the overdraw view)";
+        return finish(stats);
+    }
+    if (request.traversalCost && !caps.traversalCost) {
+        stats.error = "cannot count BVH nodes and triangles per ray (the cost view)";
+        return finish(stats);
+    }
+    const bool onePixel = config.samplesPerPixel == 1;
+    config.visibility = request.visibility && onePixel;
+    config.overdraw = request.overdraw && onePixel;
+    config.traversalCost = request.traversalCost && onePixel;
     stats.config = config;
     if (control && control->cancel.load()) {
         stats.cancelled = true;
@@ -53,10 +68,11 @@ RenderStats Renderer::render(const sg::FrameInput& frame, int width, int height,
         for (std::string& n : done.config.notes) stats.config.notes.push_back(std::move(n));
         done.config = std::move(stats.config);
         stats = std::move(done);
-        if (stats.ok && request.visibility && !config.visibility) {
-            // Anti-aliased: the visibility comes from a one-sample pass at the pixel centres.
+        if (stats.ok && !onePixel && (request.visibility || request.overdraw || request.traversalCost)) {
+            // Anti-aliased: the visibility and the counters come from a one-sample pass at the
+            // pixel centres.
             Framebuffer vis;
-            RenderStats v = doRender(frame, visibilityPass(config), vis, control);
+            RenderStats v = doRender(frame, onePixelPass(config, request), vis, control);
             if (!v.ok) {
                 stats.ok = false;
                 stats.cancelled = v.cancelled;
@@ -64,6 +80,9 @@ RenderStats Renderer::render(const sg::FrameInput& frame, int width, int height,
             } else {
                 target.drawable = std::move(vis.drawable);
                 target.primitive = std::move(vis.primitive);
+                target.overdraw = std::move(vis.overdraw);
+                target.costNodes = std::move(vis.costNodes);
+                target.costPrims = std::move(vis.costPrims);
                 stats.triangles += v.triangles;
                 stats.rays += v.rays;
             }
@@ -71,6 +90,14 @@ RenderStats Renderer::render(const sg::FrameInput& frame, int width, int height,
         if (stats.ok && request.visibility && !target.hasVisibility()) {
             stats.ok = false;
             stats.error = "the backend did not fill the visibility buffer";
+        }
+        if (stats.ok && request.overdraw && !target.hasOverdraw()) {
+            stats.ok = false;
+            stats.error = "the backend did not fill the overdraw counters";
+        }
+        if (stats.ok && request.traversalCost && !target.hasTraversalCost()) {
+            stats.ok = false;
+            stats.error = "the backend did not fill the traversal cost counters";
         }
     } catch (const std::bad_alloc&) {
         stats.ok = false;

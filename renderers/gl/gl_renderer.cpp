@@ -56,7 +56,7 @@ struct Program {
     GLint numLights = -1, lightPos = -1, lightDir = -1, lightRad = -1, lightCone = -1;
     GLint eye = -1, ambient = -1;
     GLint baseColor = -1, ka = -1, kd = -1, ks = -1, shininess = -1, specTinted = -1, specColor = -1, emissive = -1;
-    GLint texture = -1, hasTexture = -1, unlit = -1, solid = -1, solidColor = -1;
+    GLint texture = -1, hasTexture = -1, unlit = -1, solid = -1, solidColor = -1, overdraw = -1;
     // Material maps (texture units 1..4: emissive, occlusion, metallic-roughness, normal) and their factors.
     GLint maps[4] = {-1, -1, -1, -1}, hasMap[4] = {-1, -1, -1, -1}, occlusionStrength = -1, metallic = -1, roughness = -1, normalScale = -1;
     GLint specGloss = -1, glossiness = -1;
@@ -210,6 +210,7 @@ std::string buildProgram(const std::string& key, Program& p) {
     p.alphaMode = loc("uAlphaMode");
     p.alphaCutoff = loc("uAlphaCutoff");
     p.solid = loc("uSolid");
+    p.overdraw = loc("uOverdraw");
     p.solidColor = loc("uSolidColor");
     p.fogMode = loc("uFogMode");
     p.fogColor = loc("uFogColor");
@@ -445,6 +446,43 @@ struct RenderTarget {
     }
 };
 
+// The overdraw view's target: one R32F colour buffer (no depth), where additive blending of
+// 1.0 per fragment counts fragments exactly (up to 2^24 per pixel).
+struct CountTarget {
+    int width = 0, height = 0;
+    GLuint fbo = 0, count = 0;
+
+    void release() {
+        if (fbo) glDeleteFramebuffers(1, &fbo);
+        if (count) glDeleteRenderbuffers(1, &count);
+        fbo = count = 0;
+        width = height = 0;
+    }
+    std::string ensure(int w, int h) {
+        if (fbo && w == width && h == height) return {};
+        release();
+        width = w;
+        height = h;
+        glGenRenderbuffers(1, &count);
+        glBindRenderbuffer(GL_RENDERBUFFER, count);
+        glRenderbufferStorage(GL_RENDERBUFFER, GL_R32F, w, h);
+        glBindRenderbuffer(GL_RENDERBUFFER, 0);
+        glGenFramebuffers(1, &fbo);
+        glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+        glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, count);
+        glDrawBuffer(GL_COLOR_ATTACHMENT0);
+        glReadBuffer(GL_COLOR_ATTACHMENT0);
+        GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+        if (status != GL_FRAMEBUFFER_COMPLETE) {
+            char buf[160];
+            std::snprintf(buf, sizeof buf, "overdraw framebuffer %dx%d (R32F) is incomplete (status 0x%x)", w, h, status);
+            release();
+            return buf;
+        }
+        return {};
+    }
+};
+
 // --- 4. State guard --------------------------------------------------------------------------
 // Saves what a caller drawing its own UI relies on, and puts it back on scope exit.
 class StateGuard {
@@ -538,6 +576,7 @@ public:
         c.wireframe = true;
         c.pointsAndLines = true;
         c.visibility = true;   // a second colour attachment, RG32UI (mesh.frag's fragId)
+        c.overdraw = true;     // a second pass into an R32F target, additive (countOverdraw)
         // MSAA sample counts: those of 2/4/8 the driver allows once a context was made (before
         // that, all three; doRender reports a late reduction).
         for (int n : {2, 4, 8})
@@ -573,6 +612,7 @@ private:
     void setFrameUniforms(const Program& p, const FrameInput& f, int ssaa);
     std::vector<DrawItem> collectDraws(const FrameInput& frame, int tessellation);   // uploads what is new
     uint64_t drawAll(const Program& prog, const std::vector<DrawItem>& items, DrawPass pass, sg::CullMode culling);
+    std::string countOverdraw(const Program& prog, const std::vector<DrawItem>& items, const RenderSettings& s, int w, int h, Framebuffer& target);
     void readBack(GLuint fbo, int w, int h, Framebuffer& out);
     void setMaterial(const Program& p, const Material& m, const DrawItem& it, bool unlit);
     void evict();
@@ -585,6 +625,7 @@ private:
 
     std::unordered_map<std::string, Program> m_programs;   // by programKey()
     RenderTarget m_target, m_resolve;
+    CountTarget m_overdraw;
     std::unordered_map<uint64_t, GpuMesh> m_meshes;        // by Mesh::id
     std::unordered_map<uint64_t, GpuTexture> m_textures;   // by Texture::id
     TessellationCache m_tess;
@@ -641,6 +682,7 @@ void GlRenderer::forgetGLObjects() {
     m_programs.clear();
     m_target = RenderTarget{};
     m_resolve = RenderTarget{};
+    m_overdraw = CountTarget{};
     m_meshes.clear();
     m_textures.clear();
     m_loaded = false;
@@ -655,6 +697,7 @@ void GlRenderer::releaseAll() {
         for (auto& [key, p] : m_programs) glDeleteProgram(p.id);
         m_target.release();
         m_resolve.release();
+        m_overdraw.release();
         for (auto& [id, m] : m_meshes) releaseMesh(m);
         for (auto& [id, t] : m_textures)
             if (t.id) glDeleteTextures(1, &t.id);
@@ -719,6 +762,7 @@ void GlRenderer::setFrameUniforms(const Program& p, const FrameInput& f, int ssa
     glUniform3f(p.fogParams, s.fogStart, s.fogEnd, s.fogDensity);
     glUniform3fv(p.solidColor, 1, &s.wireframeColor[0]);
     glUniform1i(p.solid, 0);
+    glUniform1i(p.overdraw, 0);
 
     int n = int(std::min<size_t>(f.lights.size(), kMaxLights));
     std::vector<vec4> pos(n), dir(n), rad(n), cone(n);
@@ -855,6 +899,50 @@ uint64_t GlRenderer::drawAll(const Program& prog, const std::vector<DrawItem>& i
     }
     setCull(false);
     return triangles;
+}
+
+// The overdraw view (RenderConfig::overdraw, one sample per pixel): the frame's draws again
+// (surfaces of every alpha mode, lines, points, the wireframe; culled as in the frame) into
+// m_overdraw with the depth test off and additive blending, mesh.frag writing 1.0 for every
+// fragment before any discard, so each pixel holds the fragments rasterized in it; read into
+// target.overdraw. Returns "" or the reason it failed.
+std::string GlRenderer::countOverdraw(const Program& prog, const std::vector<DrawItem>& items, const RenderSettings& s, int w, int h,
+                                      Framebuffer& target) {
+    std::string err = m_overdraw.ensure(w, h);
+    if (!err.empty()) return err;
+    glBindFramebuffer(GL_FRAMEBUFFER, m_overdraw.fbo);
+    glViewport(0, 0, w, h);
+    const GLfloat zero[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+    glClearBufferfv(GL_COLOR, 0, zero);
+    glDisable(GL_DEPTH_TEST);
+    glDepthMask(GL_FALSE);
+    glEnable(GL_BLEND);
+    glBlendEquation(GL_FUNC_ADD);
+    glBlendFunc(GL_ONE, GL_ONE);
+    glUniform1i(prog.overdraw, 1);
+    drawAll(prog, items, DrawPass::Opaque, s.culling);
+    drawAll(prog, items, DrawPass::Blended, s.culling);
+    if (s.wireframe) {
+        glPolygonMode(GL_FRONT_AND_BACK, GL_LINE);
+        drawAll(prog, items, DrawPass::Wireframe, s.culling);
+        glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
+    }
+    glUniform1i(prog.overdraw, 0);
+    glBindVertexArray(0);
+    glDisable(GL_BLEND);
+    glDepthMask(GL_TRUE);
+    glEnable(GL_DEPTH_TEST);
+    std::vector<float> counts(size_t(w) * h);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, m_overdraw.fbo);
+    glReadBuffer(GL_COLOR_ATTACHMENT0);
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    glReadPixels(0, 0, w, h, GL_RED, GL_FLOAT, counts.data());
+    target.resizeOverdraw();
+    for (int y = 0; y < h; ++y) {
+        const float* src = &counts[size_t(h - 1 - y) * w];
+        for (int x = 0; x < w; ++x) target.overdraw[size_t(y) * w + x] = uint32_t(std::lround(std::max(src[x], 0.0f)));
+    }
+    return {};
 }
 
 // Reads colour and depth of `fbo` into `out` (GL rows are bottom-up, Framebuffer rows top-down).
@@ -1027,6 +1115,14 @@ RenderStats GlRenderer::doRender(const FrameInput& frame, const RenderConfig& cf
         if (visibility) readVisibility(readFbo, rw, rh, target);
     }
     if (visibility) glDrawBuffer(GL_COLOR_ATTACHMENT0);
+    if (cfg.overdraw && samples <= 1 && ssaa == 1) {   // render() asks only for one-sample frames
+        glUseProgram(prog.id);
+        err = countOverdraw(prog, items, s, rw, rh, target);
+        if (!err.empty()) {
+            stats.error = err;
+            return stats;
+        }
+    }
 
     GLenum glErr = glGetError();
     evict();

@@ -223,6 +223,7 @@ struct FrameContext {
     bool referenceShading = false;
     bool timing = false;       // VIEWER_RASTER_TIMING=1: print stage times to stderr
     bool visibility = false;   // fill target.drawable/primitive (one sample per pixel)
+    bool overdraw = false;     // count fragments per pixel into target.overdraw (one sample per pixel)
     std::vector<DrawItem>* draws = nullptr;
     std::vector<Chunk>* chunks = nullptr;
 };
@@ -611,6 +612,17 @@ inline void writeVisibility(const FrameContext& fc, Framebuffer& target, size_t 
 }
 void renderBlended(const FrameContext& fc, Framebuffer& target, TileBuffers& buf, int x0, int y0, int x1, int y1, int samples);
 
+// The overdraw view (RenderConfig::overdraw, one sample per pixel): every fragment the tile's
+// triangles rasterize, whatever their alpha mode and before any depth or alpha test, adds one
+// to its pixel's counter. A pass of its own, so that frames that do not ask pay nothing.
+void countOverdraw(int tile, const FrameContext& fc, Framebuffer& target, int x0, int y0, int x1, int y1) {
+    const auto& chunks = *fc.chunks;
+    for (const Chunk& ch : chunks)
+        for (uint32_t k = ch.tileStart[tile]; k < ch.tileStart[tile + 1]; ++k)
+            forEachCoveredPixel(ch.tris[ch.items[k]].s, x0, y0, x1, y1,
+                                [&](int i, int j) { ++target.overdraw[size_t(fc.height - 1 - j) * fc.width + i]; });
+}
+
 // Rasterizes the tile's triangles into its visibility buffer (opaque and masked ones; blended
 // ones are set aside), shades what is visible, then composites the blended surfaces.
 void renderTile(int tile, const FrameContext& fc, Framebuffer& target, TileBuffers& buf) {
@@ -653,6 +665,7 @@ void renderTile(int tile, const FrameContext& fc, Framebuffer& target, TileBuffe
             }
         }
     }
+    if (fc.overdraw) countOverdraw(tile, fc, target, x0, y0, x1, y1);
     if (fc.timing) g_rasterNs += nowNs() - tA;
     shadeOpaque(fc, target, buf, x0, y0, x1, y1, samples);
     if (!buf.blendTris.empty()) renderBlended(fc, target, buf, x0, y0, x1, y1, samples);
@@ -860,6 +873,7 @@ public:
         c.wireframe = true;
         c.pointsAndLines = true;
         c.visibility = true;   // the visibility buffer the tiles shade from
+        c.overdraw = true;     // counted per tile when asked (countOverdraw)
         c.msaaSamples = {4};   // one fixed 4-sample pattern (raster_core.h)
         c.ssaaFactors = {2, 3, 4};
         c.ssaaRendersLarger = true;
@@ -876,22 +890,25 @@ protected:
             stats = renderSingle(frame, cfg.width * r, cfg.height * r, cfg.tessellation, hi, false, control, r);
             if (stats.ok) target = downsample(hi, r);
         } else {
-            stats = renderSingle(frame, cfg.width, cfg.height, cfg.tessellation, target, cfg.msaaSamples > 1, control, 1, cfg.visibility);
+            stats =
+                renderSingle(frame, cfg.width, cfg.height, cfg.tessellation, target, cfg.msaaSamples > 1, control, 1, cfg.visibility, cfg.overdraw);
         }
         return stats;
     }
 
 private:
     // pointScale: the SSAA factor (points are 2 pixels wide at the output resolution, like GL).
-    // visibility: fill target.drawable/primitive (one sample per pixel only).
+    // visibility: fill target.drawable/primitive; overdraw: count fragments per pixel into
+    // target.overdraw (both one sample per pixel only).
     RenderStats renderSingle(const sg::FrameInput& frame, int width, int height, int tessRes, Framebuffer& target, bool msaa, RenderControl* control,
-                             int pointScale = 1, bool visibility = false) {
+                             int pointScale = 1, bool visibility = false, bool overdraw = false) {
         RenderStats stats;
         auto t0frame = std::chrono::steady_clock::now();
         m_samplers.beginFrame();
         m_tess.nextFrame();
         target.resize(width, height);
         if (visibility) target.resizeVisibility();
+        if (overdraw && !msaa) target.resizeOverdraw();
         const auto& st = frame.settings;
         const bool gouraud = st.shading == sg::ShadingModel::Gouraud;
 
@@ -952,6 +969,7 @@ private:
         fc.referenceShading = m_referenceShading;
         fc.timing = m_timing;
         fc.visibility = visibility && !msaa;
+        fc.overdraw = overdraw && !msaa;
         fc.draws = &draws;
         uint64_t chunkSize = std::max<uint64_t>(4096, (total + 4000) / 4000);
         if (chunkSize * 7 >= (1u << kChunkBits)) {

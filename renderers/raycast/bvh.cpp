@@ -940,8 +940,15 @@ namespace {
 int kernelWidth() { return kUseAvx2 ? 8 : 4; }
 }   // namespace
 
-bool TriangleBvh::intersect(const Ray& ray, TriHit& hit, bool cullBack) const {
+bool TriangleBvh::intersect(const Ray& ray, TriHit& hit, bool cullBack, TraversalCount* count) const {
     if (m_packets.empty()) return false;
+    if (count) {   // the cost view: the counting instantiations, so the plain ones stay as they are
+        if (!m_nodes8.empty())
+            return kern_avx2::traceTriangles8<false, true>(m_nodes8.data(), m_packets.data(), m_prims.data(), m_absMax, ray, &hit, cullBack, count);
+        return kUseAvx2
+                   ? kern_avx2::traceTriangles<false, true>(m_nodes4.data(), m_packets.data(), m_prims.data(), m_absMax, ray, &hit, cullBack, count)
+                   : kern_sse::traceTriangles<false, true>(m_nodes4.data(), m_packets.data(), m_prims.data(), m_absMax, ray, &hit, cullBack, count);
+    }
     if (!m_nodes8.empty()) return kern_avx2::traceTriangles8<false>(m_nodes8.data(), m_packets.data(), m_prims.data(), m_absMax, ray, &hit, cullBack);
     return kUseAvx2 ? kern_avx2::traceTriangles<false>(m_nodes4.data(), m_packets.data(), m_prims.data(), m_absMax, ray, &hit, cullBack)
                     : kern_sse::traceTriangles<false>(m_nodes4.data(), m_packets.data(), m_prims.data(), m_absMax, ray, &hit, cullBack);

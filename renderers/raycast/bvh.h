@@ -61,6 +61,13 @@ struct Ray {
     float tmax = std::numeric_limits<float>::infinity();
 };
 
+// Work of one ray (the cost view, rnd::Framebuffer::costNodes/costPrims): BVH nodes visited
+// (inner nodes whose child boxes were tested, top level and mesh BVHs alike) and primitives
+// tested (triangle lanes of the leaf packets; an analytic shape counts one).
+struct TraversalCount {
+    uint32_t nodes = 0, prims = 0;
+};
+
 // Closest hit: distance, primitive (triangle index in the mesh) and barycentrics (b1, b2) of
 // p = (1-b1-b2) p0 + b1 p1 + b2 p2.
 struct TriHit {
@@ -138,8 +145,10 @@ public:
     // Front-to-back traversal. leaf(first, count, tmax&) tests a leaf and may shrink tmax;
     // returns true to stop the traversal (any-hit queries).
     // AnyHit = true skips the front-to-back sort (any hit ends the query anyway).
-    template <bool AnyHit = false, class LeafFn>
-    void traverse(const Ray& ray, float& tmax, LeafFn&& leaf) const;
+    // Count: add the inner nodes visited to *visited (the cost view; a separate instantiation,
+    // so the uncounted traversal is unchanged).
+    template <bool AnyHit = false, bool Count = false, class LeafFn>
+    void traverse(const Ray& ray, float& tmax, LeafFn&& leaf, uint32_t* visited = nullptr) const;
 
 private:
     std::vector<Node4> m_nodes;   // m_nodes[0] is the root (a leaf root is wrapped in a node)
@@ -181,7 +190,8 @@ public:
     // cullBack: ignore triangles seen from their back (CW from the ray's side, in the BVH's
     // own frame; for an instance traced in object space this is the world-space back side
     // for mirrored transforms too, since mirroring flips both the winding and the cross product).
-    bool intersect(const Ray& ray, TriHit& hit, bool cullBack = false) const;
+    // count: when given, the nodes visited and triangles tested are added to it.
+    bool intersect(const Ray& ray, TriHit& hit, bool cullBack = false, TraversalCount* count = nullptr) const;
     // Any hit in (ray.tmin, ray.tmax).
     bool occluded(const Ray& ray) const;
 

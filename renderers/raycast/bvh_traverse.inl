@@ -36,8 +36,8 @@ inline RayPre::RayPre(const Ray& r, const float* boxAbsMax) {
     nearZ = (neg >> 2) & 1;
 }
 
-template <bool AnyHit, class LeafFn>
-void Bvh4::traverse(const Ray& ray, float& tmax, LeafFn&& leaf) const {
+template <bool AnyHit, bool Count, class LeafFn>
+void Bvh4::traverse(const Ray& ray, float& tmax, LeafFn&& leaf, uint32_t* visited) const {
     if (m_nodes.empty()) return;
     const RayPre pre(ray, nullptr);   // only org and rdir: this test is (b - org) * rdir
     const __m128 ox = _mm_set1_ps(pre.org[0]), oy = _mm_set1_ps(pre.org[1]), oz = _mm_set1_ps(pre.org[2]);
@@ -57,6 +57,7 @@ void Bvh4::traverse(const Ray& ray, float& tmax, LeafFn&& leaf) const {
     uint32_t cur = 0;   // root: node 0
     for (;;) {
         if (!(cur & Node4::kLeafBit)) {
+            if constexpr (Count) ++*visited;
             const Node4& n = m_nodes[cur];
             __m128 t0x = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(n.b[nx]), ox), rx);
             __m128 t1x = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(n.b[fx]), ox), rx);

@@ -142,6 +142,9 @@ struct Tracer {
     const std::vector<MeshMaps>& maps;                    // per f.meshes entry: emissive, occlusion, metallic-roughness
     uint64_t rays = 0;
     bool anyAlpha = false;   // some material is masked or blended (anyTranslucent())
+    // The cost view (RenderConfig::traversalCost): the BVH work of the primary ray (bounce 0,
+    // every layer it passes through; not shadow or reflection rays) is added here when set.
+    rt::TraversalCount* cost = nullptr;
 
     // Surfaces one ray may pass through (cut-outs, blended layers) before it counts as stopped.
     static constexpr int kMaxLayers = 64;
@@ -227,9 +230,10 @@ struct Tracer {
     // The surface the ray stops at: the first opaque or blended one, passing masked surfaces
     // where they are cut out (r.tmin moves behind them, layer counts them, at most kMaxLayers).
     // False when the ray leaves the scene. alpha: the blended surface's coverage (else 1).
-    bool firstSurface(rt::Ray& r, rt::SceneHit& h, float& alpha, int& layer, const PixelFootprint* footprint) {
+    // count: where the traversal cost is added (primary rays of the cost view), or null.
+    bool firstSurface(rt::Ray& r, rt::SceneHit& h, float& alpha, int& layer, const PixelFootprint* footprint, rt::TraversalCount* count = nullptr) {
         for (;;) {
-            if (!accel.intersect(r, h, f.settings.culling)) return false;
+            if (!accel.intersect(r, h, f.settings.culling, count)) return false;
             const Material& m = materialOf(h);
             if (m.alphaMode == AlphaMode::Opaque) return true;
             alpha = std::clamp(surfaceAlpha(h, footprint, m), 0.0f, 1.0f);
@@ -385,7 +389,7 @@ struct Tracer {
         rt::SceneHit h;
         rt::Ray r = ray;
         float alpha = 1.0f;
-        if (!firstSurface(r, h, alpha, layer, footprint)) return f.settings.background;
+        if (!firstSurface(r, h, alpha, layer, footprint, bounce == 0 ? cost : nullptr)) return f.settings.background;
         const bool blended = materialOf(h).alphaMode == AlphaMode::Blend;
         if (blended) alpha = std::clamp(alpha, 0.0f, 1.0f);
         SurfaceRecord* const ownHit = blended ? nullptr : hitPos;
@@ -452,6 +456,7 @@ public:
         c.wireframe = true;        // the CPU backends' overlay (common/line_overlay.h), after the rays
         c.pointsAndLines = true;   // the same pixel footprint as the rasterizers
         c.visibility = true;       // what each primary ray keeps
+        c.traversalCost = true;    // counted per primary ray when asked (Tracer::cost)
         // MSAA n and SSAA f are both taken as stratified jittered rays per pixel: n rays
         // (2 -> 2x1, 4 -> 2x2, 8 -> 4x2 strata) and f x f rays; each ray is shaded.
         c.msaaSamples = {2, 4, 8};
@@ -468,6 +473,8 @@ protected:
         const uint8_t bg[4] = {toByteSRGB(f.settings.background.x), toByteSRGB(f.settings.background.y), toByteSRGB(f.settings.background.z), 255};
         target.clear(bg, 1.0f);
         if (cfg.visibility) target.resizeVisibility();
+        const bool countCost = cfg.traversalCost && cfg.samplesPerPixel == 1;   // render() asks only for one-sample frames
+        if (countCost) target.resizeTraversalCost();
         rt::CameraRays cam(f.camera, w, h);
         if (!cam.valid() || !isFinite(f.camera.eye)) {
             stats.error = "camera matrices are not invertible";
@@ -532,7 +539,13 @@ protected:
                                 rt::Ray r = cam.ray(float(x) + ox, float(wy) + oy);
                                 SurfaceRecord hp;
                                 const PixelFootprint fp{&cam, float(x) + ox, float(wy) + oy};
+                                rt::TraversalCount count;
+                                if (countCost) tr.cost = &count;
                                 vec3 c = tr.trace(r, f.camera.eye, 0, &hp, &fp);
+                                if (countCost) {   // one centre ray per pixel, like the visibility
+                                    target.costNodes[size_t(row) * w + x] = count.nodes;
+                                    target.costPrims[size_t(row) * w + x] = count.prims;
+                                }
                                 if (!std::isnan(hp.p.x)) depth = std::min(depth, std::clamp(cam.depth(hp.p), 0.0f, 1.0f));
                                 if (cfg.visibility) {   // one centre ray per pixel (RenderConfig::visibility)
                                     target.drawable[size_t(row) * w + x] = hp.drawable;

@@ -97,7 +97,7 @@ int SceneAccel::update(const FrameInput& f) {
     return built;
 }
 
-bool SceneAccel::intersectInstance(const Instance& inst, const Ray& wr, float tmax, SceneHit& hit, bool cull) const {
+bool SceneAccel::intersectInstance(const Instance& inst, const Ray& wr, float tmax, SceneHit& hit, bool cull, TraversalCount* count) const {
     Ray lr;
     lr.org = vec3(inst.invWorld * vec4(wr.org, 1.0f));
     lr.dir = mat3(inst.invWorld) * wr.dir;
@@ -105,7 +105,7 @@ bool SceneAccel::intersectInstance(const Instance& inst, const Ray& wr, float tm
     lr.tmax = tmax;
     if (inst.isMesh) {
         TriHit th;
-        if (!inst.bvh->intersect(lr, th, cull)) return false;
+        if (!inst.bvh->intersect(lr, th, cull, count)) return false;
         hit.kind = SceneHit::Kind::Mesh;
         hit.t = th.t;
         hit.instance = inst.index;
@@ -114,6 +114,7 @@ bool SceneAccel::intersectInstance(const Instance& inst, const Ray& wr, float tm
         hit.b2 = th.b2;
         return true;
     }
+    if (count) ++count->prims;   // an analytic shape: one primitive test
     const DrawAnalytic& a = m_frame->analytics[inst.index];
     switch (a.kind) {
     case DrawAnalytic::Kind::Implicit: {
@@ -168,25 +169,31 @@ bool SceneAccel::intersectInstance(const Instance& inst, const Ray& wr, float tm
     return true;
 }
 
-bool SceneAccel::intersect(const Ray& r, SceneHit& hit, sg::CullMode culling) const {
-    if (m_tlas.empty()) return false;
+template <bool Count>
+bool SceneAccel::closestHit(const Ray& r, SceneHit& hit, sg::CullMode culling, TraversalCount* cost) const {
     float tmax = r.tmax;
     bool found = false;
     const std::vector<uint32_t>& prims = m_tlas.primIndex();
-    m_tlas.traverse(r, tmax, [&](uint32_t first, uint32_t count, float& tm) {
+    auto leaf = [&](uint32_t first, uint32_t count, float& tm) {
         for (uint32_t k = 0; k < count; ++k) {
             SceneHit h;
             const Instance& inst = m_instances[prims[first + k]];
             const bool cull = inst.isMesh && sg::cullsBackFaces(culling, m_frame->meshes[inst.index].material.doubleSided);
-            if (intersectInstance(inst, r, tm, h, cull) && h.t < tm) {
+            if (intersectInstance(inst, r, tm, h, cull, cost) && h.t < tm) {
                 tm = h.t;
                 hit = h;
                 found = true;
             }
         }
         return false;
-    });
+    };
+    m_tlas.traverse<false, Count>(r, tmax, leaf, Count ? &cost->nodes : nullptr);
     return found;
+}
+
+bool SceneAccel::intersect(const Ray& r, SceneHit& hit, sg::CullMode culling, TraversalCount* cost) const {
+    if (m_tlas.empty()) return false;
+    return cost ? closestHit<true>(r, hit, culling, cost) : closestHit<false>(r, hit, culling, nullptr);
 }
 
 bool SceneAccel::occluded(const Ray& r) const {

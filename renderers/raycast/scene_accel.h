@@ -41,7 +41,9 @@ public:
     // triangles seen from their back (RenderSettings::culling: every mesh, none, or those whose
     // material is single-sided; analytic solids are closed, so culling would not change what
     // they show).
-    bool intersect(const Ray& worldRay, SceneHit& hit, sg::CullMode culling = sg::CullMode::Off) const;
+    // count: when given, the BVH nodes visited (top level and mesh BVHs) and the primitives
+    // tested are added to it (the cost view; an analytic shape counts as one primitive).
+    bool intersect(const Ray& worldRay, SceneHit& hit, sg::CullMode culling = sg::CullMode::Off, TraversalCount* count = nullptr) const;
     // Any hit in (ray.tmin, ray.tmax).
     bool occluded(const Ray& worldRay) const;
 
@@ -70,7 +72,11 @@ private:
         sg::mat4 invWorld{1.0f};
     };
 
-    bool intersectInstance(const Instance& inst, const Ray& r, float tmax, SceneHit& hit, bool cull = false) const;
+    // intersect() without and with counting (Count: the cost view), so rays that are not
+    // counted run the traversal without the counters.
+    template <bool Count>
+    bool closestHit(const Ray& r, SceneHit& hit, sg::CullMode culling, TraversalCount* cost) const;
+    bool intersectInstance(const Instance& inst, const Ray& r, float tmax, SceneHit& hit, bool cull = false, TraversalCount* count = nullptr) const;
 
     const sg::FrameInput* m_frame = nullptr;
     std::unordered_map<uint64_t, MeshEntry> m_meshes;          // by Mesh::id

@@ -212,12 +212,21 @@ inline uint32_t pushFarReturnNear(const uint32_t* child, const float* dist, int 
     return uint32_t(key[k - 1]);
 }
 
+// Triangles in the n lanes from `lane` on (~0u marks an empty lane).
+inline uint32_t filledLanes(const uint32_t* lane, int n) {
+    uint32_t k = 0;
+    for (int i = 0; i < n; ++i) k += lane[i] != ~0u;
+    return k;
+}
+
 // Front-to-back BVH4 traversal with the packet test inlined (a leaf is 1-7 consecutive
 // packets). AnyHit: stop at the first hit and skip the ordering. Returns true on a hit (closest
 // hit written to *hit unless AnyHit).
-template <bool AnyHit>
+// Count (the cost view): add the nodes visited and the triangle lanes tested to *count; a
+// separate instantiation, so the uncounted traversal is unchanged.
+template <bool AnyHit, bool Count = false>
 inline bool traceTriangles(const Node4* nodes, const TriPacket4* packets, const uint32_t* prims, const float* absMax, const Ray& ray, TriHit* hit,
-                           bool cullBack) {
+                           bool cullBack, TraversalCount* count = nullptr) {
     const RayPre pre(ray, absMax);
     const __m128 rx = _mm_set1_ps(pre.rdir[0]), ry = _mm_set1_ps(pre.rdir[1]), rz = _mm_set1_ps(pre.rdir[2]);
     const __m128 orx = _mm_set1_ps(pre.orgRdirNear[0]), ory = _mm_set1_ps(pre.orgRdirNear[1]), orz = _mm_set1_ps(pre.orgRdirNear[2]);
@@ -237,6 +246,7 @@ inline bool traceTriangles(const Node4* nodes, const TriPacket4* packets, const 
     uint32_t cur = 0;
     for (;;) {
         if (!(cur & Node4::kLeafBit)) {
+            if constexpr (Count) ++count->nodes;
             const Node4& n = nodes[cur];
             // t = b * rdir - org * rdir (with RayPre's margins); the near/far planes per axis
             // come from the ray's signs.
@@ -273,6 +283,7 @@ inline bool traceTriangles(const Node4* nodes, const TriPacket4* packets, const 
             const TriPacket4* p = packets + ((cur & ~Node4::kLeafBit) >> 3);
             const TriPacket4* end = p + (cur & 7u);
             for (; p != end; ++p) {
+                if constexpr (Count) count->prims += filledLanes(prims + 4 * (p - packets), 4);
                 __m128 t, u, v;
                 int mask = intersectPacket(*p, o, d, tminV, tmaxV, t, u, v, cullBack);
                 if (!mask) continue;
@@ -304,9 +315,9 @@ inline __m256 loadPlane(const char* base, uint32_t ref) { return _mm256_load_ps(
 
 // The same traversal over 8-wide nodes: one AVX compare per node for 8 boxes (BVH8: fewer,
 // wider levels); leaf packets tested two at a time (8 lanes).
-template <bool AnyHit>
+template <bool AnyHit, bool Count = false>
 inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const uint32_t* prims, const float* absMax, const Ray& ray, TriHit* hit,
-                            bool cullBack) {
+                            bool cullBack, TraversalCount* count = nullptr) {
     const RayPre pre(ray, absMax);
     const __m256 rx = _mm256_set1_ps(pre.rdir[0]), ry = _mm256_set1_ps(pre.rdir[1]), rz = _mm256_set1_ps(pre.rdir[2]);
     const __m256 orx = _mm256_set1_ps(pre.orgRdirNear[0]), ory = _mm256_set1_ps(pre.orgRdirNear[1]), orz = _mm256_set1_ps(pre.orgRdirNear[2]);
@@ -340,6 +351,7 @@ inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const
     uint32_t cur = 0;
     for (;;) {
         if (!(cur & Node8::kLeafBit)) {
+            if constexpr (Count) ++count->nodes;
             const Node8& n = *reinterpret_cast<const Node8*>(nodeBytes + cur);
             const __m256 t0x = _mm256_fmsub_ps(loadPlane(pnx, cur), rx, orx), t1x = _mm256_fmsub_ps(loadPlane(pfx, cur), rx, orxf);
             const __m256 t0y = _mm256_fmsub_ps(loadPlane(pny, cur), ry, ory), t1y = _mm256_fmsub_ps(loadPlane(pfy, cur), ry, oryf);
@@ -383,6 +395,7 @@ inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const
             const TriPacket4* end = p + (cur & 7u);
             for (; p < end; p += 2) {   // two packets per AVX test; a last odd one paired with itself
                 const bool two = p + 1 < end;
+                if constexpr (Count) count->prims += filledLanes(prims + 4 * (p - packets), two ? 8 : 4);
                 __m256 t, u, v;
                 int mask = intersectPacketPair(p[0], p[two ? 1 : 0], o8, d8, tmin8, tmax8, t, u, v, cullBack) & (two ? 0xFF : 0x0F);
                 if (!mask) continue;

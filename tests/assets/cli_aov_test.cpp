@@ -2,7 +2,8 @@
 // executable: `viewer render demo --aov depth,normal,id` writes a 16-bit id image whose ids the
 // sidecar names, a normal image of unit normals on exactly the covered pixels, the same ids in
 // every backend; `viewer inspect demo --at X,Y` prints per backend a provenance whose terms add
-// up to the pixel; bad requests get one-line errors.
+// up to the pixel; bad requests get one-line errors; the diagnostic views (overdraw and cost
+// included) are written with their legends, and a view the backend cannot make is refused.
 #include "assets/aov_io.h"
 #include "assets/image_io.h"
 #include "test_support.h"
@@ -10,12 +11,14 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <set>
 #include <string>
+#include <tuple>
 
 namespace fs = std::filesystem;
 
@@ -174,5 +177,46 @@ TEST(CliView, DiagnosticViewsAreWrittenWithTheirLegend) {
         assets::ImageLoad img = assets::loadImage(out);
         ASSERT_TRUE(img.texture) << img.error;
         EXPECT_EQ(img.texture->width, 96);
+    }
+}
+
+// --view overdraw (the rasterizers) and --view cost (the ray caster) write their heat maps and
+// print their legends; asking a backend for a view it cannot make fails before rendering, with
+// one line naming the view, the backend and the backends that can, and writes no file.
+TEST(CliView, OverdrawAndCostViewsAndTheBackendsThatCannot) {
+    const fs::path dir = testing_support::outputDir("cli-aov");
+    fs::create_directories(dir);
+    for (auto [backend, view] : {std::pair{"gl", "overdraw"}, std::pair{"raster", "overdraw"}, std::pair{"raycast", "cost"}}) {
+        SCOPED_TRACE(std::string(backend) + " " + view);
+        const fs::path out = dir / (std::string("view-") + view + "-" + backend + ".png");
+        ViewerRun r =
+            runViewer("render demo --backend " + std::string(backend) + " --size 96x54 --overwrite --view " + view + " --out " + quoted(out));
+        ASSERT_EQ(r.status, 0) << r.output;
+        EXPECT_NE(r.output.find(std::string(view) + " view: " + view + " ("), std::string::npos) << r.output;
+        assets::ImageLoad img = assets::loadImage(out);
+        ASSERT_TRUE(img.texture) << img.error;
+        EXPECT_EQ(img.texture->width, 96);
+        EXPECT_EQ(img.texture->height, 54);
+        size_t coloured = 0;   // the heat map is not the shaded image: mostly saturated colours
+        for (size_t k = 0; k + 3 < img.texture->rgba.size(); k += 4) {
+            const uint8_t* p = &img.texture->rgba[k];
+            coloured += std::max({p[0], p[1], p[2]}) - std::min({p[0], p[1], p[2]}) > 100;
+        }
+        EXPECT_GT(coloured, size_t(96 * 54 / 2)) << "heat-map colours";
+    }
+    for (auto [backend, view, can] :
+         {std::tuple{"raycast", "overdraw", "gl, raster"}, std::tuple{"gl", "cost", "raycast"}, std::tuple{"raster", "cost", "raycast"}}) {
+        SCOPED_TRACE(std::string(backend) + " " + view);
+        const fs::path out = dir / (std::string("refused-") + view + "-" + backend + ".png");
+        fs::remove(out);
+        ViewerRun r =
+            runViewer("render demo --backend " + std::string(backend) + " --size 96x54 --overwrite --view " + view + " --out " + quoted(out));
+        EXPECT_NE(r.status, 0) << r.output;
+        EXPECT_NE(
+            r.output.find(std::string("--view ") + view + ": the " + backend + " backend cannot make this view (backends that can: " + can + ")"),
+            std::string::npos)
+            << r.output;
+        EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << "one line: " << r.output;
+        EXPECT_FALSE(fs::exists(out));
     }
 }

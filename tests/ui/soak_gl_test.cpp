@@ -35,7 +35,7 @@ fs::path folder(const std::string& name) {
 }
 
 const char* const kBackends[] = {"gl", "raster", "raycast"};
-const char* const kDiagnostics[] = {"shaded", "depth", "normal", "id", "uv", "triangles"};
+const char* const kDiagnostics[] = {"shaded", "depth", "normal", "id", "uv", "triangles", "overdraw", "cost"};
 const char* const kViews[] = {"single", "split", "split3", "difference"};
 
 }   // namespace
@@ -61,7 +61,7 @@ TEST(SoakGLTest, LongSessionKeepsTheEditAndItsMemoryFlat) {
         s << "orbit " << (r % 2 ? 25 : -18) << " " << (r % 5) - 2 << "\n";
         s << "frames 3\n";
         s << "set material.ks 0.1" << (r % 9) + 1 << "\nundo\n";   // 0.11 .. 0.19: never the crate's own 0.2 (a no-op set adds no step)
-        s << "diagnostic " << kDiagnostics[r % 6] << "\n";
+        s << "diagnostic " << kDiagnostics[r % 8] << "\n";
         s << "view " << kViews[r % 4] << "\nframes 2\n";
         s << "click viewport " << 200 + (r * 37) % 300 << " " << 150 + (r * 53) % 300 << "\nframes 2\nselect crate\n";
         if (r % 6 == 0) s << "open missing-" << r << ".obj\nanswer discard\nwait load\n";   // a failed load with an unsaved edit
@@ -118,7 +118,7 @@ TEST(SoakGLTest, RandomisedScriptFromAFixedSeed) {
         case 6: s << (pick(2) ? "undo\n" : "redo\n"); break;
         case 7: s << "key " << keys[pick(8)] << "\n"; break;
         case 8: s << "click viewport " << pick(600) << " " << pick(600) << "\n"; break;
-        case 9: s << "diagnostic " << kDiagnostics[pick(6)] << "\n"; break;
+        case 9: s << "diagnostic " << kDiagnostics[pick(8)] << "\n"; break;
         case 10: s << "frames " << 1 + pick(4) << "\n"; break;
         default:
             s << "print dirty\n";

@@ -2,7 +2,8 @@
 // scripts (ui/src/automation.cpp) whose `print` output is checked line by line: edits, undo
 // and redo through keys, the Edit menu and script commands with the dirty flag following;
 // File > Open with the unsaved-changes question answered; `view` doing what the View menu
-// does; bad commands failing the script.
+// does; the diagnostic views offered and drawn by capability; screenshots as shown and the
+// export from the window; bad commands failing the script.
 #include "assets/aov_io.h"
 #include "assets/demo.h"
 #include "assets/image_io.h"
@@ -17,6 +18,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 namespace fs = std::filesystem;
@@ -211,6 +213,48 @@ TEST(ViewerAutomationGLTest, ViewCommandDoesWhatTheViewMenuDoes) {
     EXPECT_EQ(r.out[0].rfind("compare split ", 0), 0u) << r.out[0];
     EXPECT_EQ(r.out[2].rfind("compare split3 ", 0), 0u) << r.out[2];
     EXPECT_EQ(r.out[4].rfind("compare difference ", 0), 0u) << r.out[4];
+}
+
+// View > Diagnostic view offers a view only where a shown backend can make it (from the
+// capabilities): overdraw with the rasterizer, cost with the ray caster, and a click on a
+// greyed-out entry changes nothing. In the three-way split each backend's legend says what its
+// image shows: the counts where it has them, and that it cannot make the view where it has not.
+TEST(ViewerAutomationGLTest, OverdrawAndCostViewsFollowTheCapabilities) {
+    if (!viewer_test::haveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+    fs::path dir = sceneFolder("automation_diagnostic");
+    const std::string script =
+        "wait\nbackend raster\nframes 2\nclick menu/view\nclick view/diagnostic\nclick diagnostic/overdraw\nprint view\n"
+        "backend raycast\nframes 2\nclick menu/view\nclick view/diagnostic\nclick diagnostic/cost\nprint view\n"
+        "diagnostic overdraw\nview split3\nframes 3\nwait\nframes 5\nwait\nframes 5\nprint compare\nprint legend\n"
+        "diagnostic cost\nframes 3\nwait\nframes 5\nwait\nframes 5\nprint legend\n"
+        "view single\nbackend raycast\ndiagnostic shaded\nframes 2\nclick menu/view\nclick view/diagnostic\nclick diagnostic/overdraw\nprint "
+        "view\nquit\n";
+    ScriptRun r = runScript(dir, script);
+    ASSERT_EQ(r.rc, 0) << dump(r);
+    ASSERT_EQ(r.out.size(), 10u) << dump(r);
+    EXPECT_EQ(r.out[0], "view single overdraw");
+    EXPECT_EQ(r.out[1], "view single cost");
+    EXPECT_EQ(r.out[2].rfind("compare split3 ", 0), 0u) << r.out[2];
+    // "legend BACKEND TEXT" lines, one per shown backend (in the split's order): by backend.
+    auto legends = [&](size_t first) {
+        std::map<std::string, std::string> m;
+        for (size_t i = first; i < first + 3; ++i) {
+            const std::string& line = r.out[i];
+            const size_t sp = line.find(' ', 7);
+            if (line.rfind("legend ", 0) == 0 && sp != std::string::npos) m[line.substr(7, sp - 7)] = line.substr(sp + 1);
+        }
+        return m;
+    };
+    std::map<std::string, std::string> od = legends(3), cost = legends(6);
+    ASSERT_EQ(od.size(), 3u) << dump(r);
+    ASSERT_EQ(cost.size(), 3u) << dump(r);
+    EXPECT_EQ(od["gl"].rfind("overdraw (fragments per pixel", 0), 0u) << od["gl"];
+    EXPECT_EQ(od["raster"].rfind("overdraw (fragments per pixel", 0), 0u) << od["raster"];
+    EXPECT_EQ(od["raycast"], "overdraw: the raycast backend cannot make this view (showing the shaded image)");
+    EXPECT_EQ(cost["gl"], "cost: the gl backend cannot make this view (showing the shaded image)");
+    EXPECT_EQ(cost["raster"], "cost: the raster backend cannot make this view (showing the shaded image)");
+    EXPECT_EQ(cost["raycast"].rfind("cost (BVH nodes visited + triangles tested", 0), 0u) << cost["raycast"];
+    EXPECT_EQ(r.out[9], "view single shaded") << "overdraw is greyed out for the ray caster alone";
 }
 
 TEST(ViewerAutomationGLTest, BadCommandsFailTheScript) {

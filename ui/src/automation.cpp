@@ -34,7 +34,7 @@
 // The view
 //   backend NAME          single view with that backend
 //   view single|split|split3|difference   as the View menu
-//   diagnostic NAME       View > Diagnostic view: shaded, depth, normal, id, uv, triangles
+//   diagnostic NAME       View > Diagnostic view: shaded, depth, normal, id, uv, triangles, overdraw, cost
 //   overlay LIST|none     View > Overlays: grid, axes, lights, cameras, bounds, selection
 //   orbit DX DY | zoom STEPS | fit
 //   tab Inspector|Camera|Rendering|Compare
@@ -52,6 +52,8 @@
 //                         them; only |A - B| until both full-resolution images are there)
 //   print selection       viewer: selection NAME (or -)
 //   print view            viewer: view MODE DIAGNOSTIC (e.g. single depth)
+//   print legend          viewer: legend BACKEND TEXT (one line per shown backend: the legend of
+//                         the diagnostic view as the viewport shows it, "-" for none)
 //   print memory          viewer: memory N kB (resident set size, from /proc/self/status; -1 unknown)
 //   print pixel           viewer: pixel BACKEND X Y rgb R G B node PATH triangle N depth D predicted R G B
 //                         (one line per shown backend: the pixel inspector's probe)
@@ -364,13 +366,18 @@ Automation::Next Automation::printCommand(const std::string& what, AutomationHos
         if (p.results.empty()) return fail("print pixel: nothing probed (hover or click the viewport first)");
         std::istringstream lines(probeSummary(p));
         for (std::string line; std::getline(lines, line);) std::printf("viewer: pixel %s\n", line.c_str());
+    } else if (what == "legend") {
+        for (const std::string& b : visibleBackends(st)) {
+            auto it = st.view.legends.find(b);
+            std::printf("viewer: legend %s %s\n", b.c_str(), it == st.view.legends.end() || it->second.empty() ? "-" : it->second.c_str());
+        }
     } else if (what == "status") {
         std::printf("viewer: status %s\n", st.ui.status.c_str());
     } else if (what == "undo") {
         const UndoStack& h = st.doc.history;
         std::printf("viewer: undo %s | redo %s\n", h.canUndo() ? h.undoLabel().c_str() : "-", h.canRedo() ? h.redoLabel().c_str() : "-");
     } else {
-        return fail("print " + what + ": expected dirty, tree, compare, diff, selection, pixel, view, memory, status, undo, window or popup");
+        return fail("print " + what + ": expected dirty, tree, compare, diff, selection, pixel, view, legend, memory, status, undo, window or popup");
     }
     return Next::Continue;
 }
@@ -415,8 +422,11 @@ Automation::Next Automation::viewCommand(const std::string& cmd, std::istringstr
     } else if (cmd == "view") {
         if (!st.showView(arg)) return fail("view " + arg + ": expected single, split, split3 or difference");
     } else if (cmd == "diagnostic") {
-        if (!rnd::parseDiagnosticView(arg, st.view.diagnostic))
-            return fail("diagnostic " + arg + ": expected shaded, depth, normal, id, uv or triangles");
+        if (!rnd::parseDiagnosticView(arg, st.view.diagnostic)) {
+            std::string names;
+            for (std::string_view n : rnd::diagnosticViewNames()) names += (names.empty() ? "" : ", ") + std::string(n);
+            return fail("diagnostic " + arg + ": expected " + names);
+        }
     } else if (cmd == "overlay") {
         rnd::OverlayOptions o;
         std::string err;

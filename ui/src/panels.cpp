@@ -35,6 +35,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <map>
+#include <mutex>
 
 namespace fs = std::filesystem;
 
@@ -200,6 +202,19 @@ void addMenuItems(ViewerState& st, sg::NodeId parent) {
 
 }   // namespace
 
+const rnd::Capabilities& backendCapabilities(const std::string& backend) {
+    static std::mutex mutex;
+    static std::map<std::string, rnd::Capabilities> known;
+    std::lock_guard<std::mutex> lock(mutex);
+    auto it = known.find(backend);
+    if (it == known.end()) {
+        rnd::Capabilities c;
+        if (auto r = rnd::makeRenderer(backend)) c = r->capabilities();   // a GL backend makes no context until it renders
+        it = known.emplace(backend, std::move(c)).first;
+    }
+    return it->second;
+}
+
 std::vector<std::string> visibleBackends(const ViewerState& st) {
     const CompareConfig& c = st.view.compare;
     // A view whose backends were never chosen (mode set without showView) shows its defaults.
@@ -334,11 +349,23 @@ void drawMainMenu(ViewerState& st) {
         bool diagOpen = ImGui::BeginMenu("Diagnostic view");
         record(st, "view/diagnostic");
         if (diagOpen) {
+            // A view no shown backend can make (overdraw: rasterizers, cost: the ray caster) is
+            // greyed out, with the backends that can in its tooltip.
+            const std::vector<std::string> shown = visibleBackends(st);
             for (std::string_view name : rnd::diagnosticViewNames()) {
                 rnd::DiagnosticView v{};
                 rnd::parseDiagnosticView(name, v);
-                if (ImGui::MenuItem(std::string(name).c_str(), nullptr, st.view.diagnostic == v)) st.view.diagnostic = v;
+                bool any = false;
+                for (const std::string& b : shown) any = any || rnd::diagnosticViewSupported(v, backendCapabilities(b));
+                if (ImGui::MenuItem(std::string(name).c_str(), nullptr, st.view.diagnostic == v, any)) st.view.diagnostic = v;
                 record(st, "diagnostic/" + std::string(name));
+                if (!any && ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled)) {
+                    std::string can;
+                    for (const std::string& b : rnd::rendererNames())
+                        if (rnd::diagnosticViewSupported(v, backendCapabilities(b))) can += (can.empty() ? "" : ", ") + b;
+                    ImGui::SetTooltip("%s: not available in the shown backends%s", std::string(name).c_str(),
+                                      can.empty() ? "" : (" (backends that can: " + can + ")").c_str());
+                }
             }
             ImGui::EndMenu();
         }

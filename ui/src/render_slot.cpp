@@ -31,13 +31,14 @@ bool RenderSlot::needs(uint64_t key, bool interacting) const {
     return !(key == m_lastKey && (interacting || !m_lastPreviewOnly));
 }
 
-void RenderSlot::request(std::shared_ptr<const sg::FrameInput> frame, int width, int height, uint64_t key, bool interacting) {
+void RenderSlot::request(std::shared_ptr<const sg::FrameInput> frame, int width, int height, uint64_t key, bool interacting,
+                         const rnd::RenderRequest& counters) {
     if (!m_renderer || width < 1 || height < 1) return;
     if (!needs(key, interacting)) return;   // nothing new to draw
     m_lastKey = key;
     m_lastPreviewOnly = interacting;
     std::lock_guard<std::mutex> lock(m_mutex);
-    m_pending = Job{std::move(frame), width, height, key, interacting, interacting, m_generation};
+    m_pending = Job{std::move(frame), width, height, key, interacting, interacting, counters.overdraw, counters.traversalCost, m_generation};
     if (m_control) m_control->cancel = true;   // restart with the new frame
     m_cv.notify_all();
 }
@@ -81,6 +82,10 @@ void RenderSlot::runJob(const Job& job) {
         // Visibility at full resolution; while the camera moves only when it is free (one pass,
         // no anti-aliasing), so a click right after an edit still picks.
         request.visibility = m_caps.visibility && d == 1 && (!job.interacting || job.frame->settings.aa == sg::AAMode::None);
+        // The diagnostic view's counters under the same rule (a second pass when anti-aliased).
+        const bool fullPass = d == 1 && (!job.interacting || job.frame->settings.aa == sg::AAMode::None);
+        request.overdraw = m_caps.overdraw && job.overdraw && fullPass;
+        request.traversalCost = m_caps.traversalCost && job.traversalCost && fullPass;
         try {
             std::lock_guard<std::mutex> rendering(m_renderMutex);
             m_renderedFrame = job.frame.get();

@@ -199,13 +199,17 @@ public:
         for (const std::string& n : names) {
             BackendView& v = viewFor(n);
             sg::RenderSettings settings = st.settingsFor(n);
-            uint64_t k = key ^ std::hash<std::string>{}(settings.aaName());
+            // The counters of the diagnostic view shown, where this backend has them.
+            rnd::RenderRequest counters;
+            if (rnd::diagnosticViewSupported(st.view.diagnostic, v.slot->capabilities())) rnd::requestFor(st.view.diagnostic, counters);
+            uint64_t k = key ^ std::hash<std::string>{}(settings.aaName()) ^ (counters.overdraw ? 0x5bd1e995ull << 8 : 0) ^
+                         (counters.traversalCost ? 0x27d4eb2full << 16 : 0);
             bool preview = interacting && v.slot->threaded();   // a synchronous render has no preview level
             if (!v.slot->needs(k, preview)) continue;
             if (!base) base = std::make_shared<sg::FrameInput>(st.buildFrame(aspect));   // flatten once per change
             auto frame = std::make_shared<sg::FrameInput>(*base);
             frame->settings = settings;
-            v.slot->request(std::move(frame), w, h, k, preview);
+            v.slot->request(std::move(frame), w, h, k, preview, counters);
         }
         for (auto& [name, v] : views) refreshTexture(v);
     }
@@ -225,8 +229,12 @@ public:
         v.outlinedVersion = st.doc.version;
         v.diagnostic = st.view.diagnostic;
         const rnd::Framebuffer& img = v.slot->image();
-        const bool visible = img.hasVisibility() && v.slot->imageFrame();
-        if ((sel.empty() && v.diagnostic == rnd::DiagnosticView::Shaded) || !visible) {
+        // What the view is made from: the counters for overdraw and cost, else the visibility.
+        const bool visible = v.slot->imageFrame() && (v.diagnostic == rnd::DiagnosticView::Overdraw ? img.hasOverdraw()
+                                                      : v.diagnostic == rnd::DiagnosticView::Cost   ? img.hasTraversalCost()
+                                                                                                    : img.hasVisibility());
+        const bool supported = rnd::diagnosticViewSupported(v.diagnostic, v.slot->capabilities());
+        if ((sel.empty() && v.diagnostic == rnd::DiagnosticView::Shaded) || !visible || !supported) {
             if (overlays && v.slot->imageFrame()) {
                 rnd::Framebuffer shown = img;
                 drawViewOverlays(shown, *v.slot->imageFrame());
@@ -234,7 +242,10 @@ public:
             } else {
                 v.texture.upload(img);
             }
-            v.legend = v.diagnostic == rnd::DiagnosticView::Shaded ? "" : std::string(rnd::nameOf(v.diagnostic)) + ": waiting for the full image";
+            const std::string view(rnd::nameOf(v.diagnostic));
+            v.legend = v.diagnostic == rnd::DiagnosticView::Shaded ? ""
+                       : supported                                 ? view + ": waiting for the full image"
+                                   : view + ": the " + v.slot->backend() + " backend cannot make this view (showing the shaded image)";
             return;
         }
         rnd::DiagnosticImage shown = rnd::diagnosticImage(v.diagnostic, *v.slot->imageFrame(), img);
@@ -317,6 +328,7 @@ public:
             s.status = v.slot->status();
             s.probe = ProbeImage{n, &v.slot->image(), v.slot->imageFrame(), v.slot.get()};
             s.legend = v.legend;
+            st.view.legends[n] = v.legend;
             in.slots.push_back(s);
         }
         if (st.view.compare.mode == ViewMode::Difference && st.view.diff.valid) {
@@ -353,7 +365,7 @@ public:
         const rnd::DiagnosticView view = dialog.asShown ? st.view.diagnostic : rnd::DiagnosticView::Shaded;
         rnd::OverlayOptions overlays;
         if (dialog.asShown && st.view.overlays.any()) overlays = overlayOptions(aspect);
-        const bool visibility = aovsNeedVisibility(exports) || view != rnd::DiagnosticView::Shaded;
+        const bool visibility = aovsNeedVisibility(exports);
         std::vector<std::string> names = visibleBackends(st);
         std::sort(names.begin(), names.end());
         names.erase(std::unique(names.begin(), names.end()), names.end());
@@ -371,13 +383,16 @@ public:
                 shots.push_back(std::move(p));
                 continue;
             }
-            auto job = [n, r, frame, w, h, path, exports, instances, view, overlays, visibility]() -> std::string {
+            // A view this backend cannot make: its shaded image, as the viewport shows it.
+            const rnd::DiagnosticView shotView = rnd::diagnosticViewSupported(view, r->capabilities()) ? view : rnd::DiagnosticView::Shaded;
+            auto job = [n, r, frame, w, h, path, exports, instances, shotView, overlays, visibility]() -> std::string {
                 rnd::Framebuffer fb;
                 rnd::RenderRequest request;
                 request.visibility = visibility && r->capabilities().visibility;
+                rnd::requestFor(shotView, request);
                 rnd::RenderStats s = r->render(*frame, w, h, fb, nullptr, request);
                 if (!s.ok) return s.error.empty() ? n + ": render failed" : s.error;
-                rnd::DiagnosticImage shown = rnd::diagnosticImage(view, *frame, fb);
+                rnd::DiagnosticImage shown = rnd::diagnosticImage(shotView, *frame, fb);
                 shown.image.depth = fb.depth;   // overlays are hidden behind the rendered surfaces
                 rnd::drawOverlays(*frame, overlays, shown.image);
                 std::string e = assets::writePng(path, shown.image.width, shown.image.height, shown.image.color.data(), /*overwrite=*/false);

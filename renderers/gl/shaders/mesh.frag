@@ -34,6 +34,7 @@ uniform bool uUnlit;        // colour = albedo + emissive (material unlit, lines
 uniform float uAlpha;       // material alpha (x texture alpha x vertex alpha)
 uniform int uAlphaMode;     // ALPHA_OPAQUE, ALPHA_MASK, ALPHA_BLEND (sg::AlphaMode values)
 uniform float uAlphaCutoff;
+uniform bool uOverdraw;     // the overdraw view's pass: 1.0 for every fragment, nothing else (additive blending counts them)
 uniform bool uSolid;        // wireframe overlay: uSolidColor (fogged)
 uniform vec3 uSolidColor;
 uniform int uFogMode;       // FOG_OFF, FOG_LINEAR, FOG_EXP, FOG_EXP2 (sg::FogMode values)
@@ -82,6 +83,10 @@ float fogVisibility(float d) {
 
 void main() {
     fragId = uvec2(uDrawable, uPrimitiveBase == 0xffffffffu ? uPrimitiveBase : uPrimitiveBase + uint(gl_PrimitiveID));
+    if (uOverdraw) {   // before any discard: a fragment counts whatever its alpha
+        fragColor = vec4(1.0);
+        return;
+    }
     vec3 c;
     float alpha = 1.0;
     if (uSolid) {

@@ -8,10 +8,24 @@
 //   triangles  triangle density: how many of the seen triangle fit in a pixel (1 / its
 //              projected area in pixels), log heat map: blue 0.001, cyan 0.006, green 0.03,
 //              yellow 0.18, red >= 1 (one triangle or more per pixel); grey: analytic shapes
-// Background pixels are black.
+//   overdraw   (rasterizers, Capabilities::overdraw) fragments rasterized per pixel before the
+//              depth test, at one sample per pixel: every covered pixel centre of every drawn
+//              triangle (opaque, masked and blended alike, after back-face culling; the
+//              fragments of clipped triangles once), line, point and wireframe edge counts one,
+//              whether it is then hidden, cut out or blended. Heat map: 1 blue, 2 cyan,
+//              3-4 green, 5-6 yellow, 8+ red; black: no fragment
+//   cost       (ray caster, Capabilities::traversalCost) the work of the pixel's primary ray
+//              through the centre: BVH nodes visited (the top level over instances and the
+//              meshes' BVHs; a node counts when its child boxes are tested) plus primitives
+//              tested (triangles of the leaves it opens; an analytic shape counts one),
+//              through every cut-out or blended layer it passes, not shadow or reflection
+//              rays. Heat map of nodes + primitives, log scale from 1 (blue) to the image's
+//              largest (red); the legend gives the range and the means of both
+// Background pixels are black (overdraw and cost: a background pixel shows its own count).
 #pragma once
 
 #include "renderers/framebuffer.h"
+#include "renderers/renderer.h"
 #include "scenegraph/frame.h"
 
 #include <string>
@@ -20,7 +34,7 @@
 
 namespace rnd {
 
-enum class DiagnosticView { Shaded, Depth, Normal, Id, Uv, Triangles };
+enum class DiagnosticView { Shaded, Depth, Normal, Id, Uv, Triangles, Overdraw, Cost };
 
 std::vector<std::string_view> diagnosticViewNames();   // "shaded", "depth", ...
 bool parseDiagnosticView(std::string_view name, DiagnosticView& out);
@@ -31,7 +45,14 @@ struct DiagnosticImage {
     std::string legend;   // one line: what the colours mean ("depth 2.10 (white) .. 14.30 (dark)")
 };
 
-// The view of `fb` (which needs visibility for every view but shaded) for `frame`.
+// Whether a backend with `caps` can make the view (overdraw and cost need their counters).
+bool diagnosticViewSupported(DiagnosticView view, const Capabilities& caps);
+// What the render behind the view must ask for (adds to `request`; visibility for all but
+// shaded, overdraw and cost; the counters for those two).
+void requestFor(DiagnosticView view, RenderRequest& request);
+
+// The view of `fb` (which needs visibility for every view but shaded, overdraw and cost, and
+// those two their counters) for `frame`.
 DiagnosticImage diagnosticImage(DiagnosticView view, const sg::FrameInput& frame, const Framebuffer& fb);
 
 }   // namespace rnd

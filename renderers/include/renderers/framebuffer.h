@@ -1,5 +1,6 @@
 // framebuffer.h - what every backend renders into: RGBA8 colour + float depth, any size, and on
-// request the visibility of each pixel (which drawable and which of its primitives it shows).
+// request the visibility of each pixel (which drawable and which of its primitives it shows)
+// and per-pixel counters for the overdraw and cost diagnostic views.
 // Rows are stored top to bottom (row 0 is the top of the image, as in PNG files).
 #pragma once
 
@@ -22,10 +23,20 @@ struct Framebuffer {
     //   primitive: triangle (points: point, lines: segment) index within that mesh;
     //              kNoPrimitive for analytic shapes and empty pixels
     std::vector<uint32_t> drawable, primitive;
+    // Per-pixel counters of the diagnostic views (empty unless render() was asked for them;
+    // counted at one sample per pixel, see renderers/diagnostic.h for the definitions):
+    //   overdraw:  fragments rasterized in the pixel before any depth test (rasterizers)
+    //   costNodes: BVH nodes the pixel's primary ray visited (ray caster)
+    //   costPrims: triangles (and analytic shapes) the primary ray was tested against
+    std::vector<uint32_t> overdraw, costNodes, costPrims;
 
-    void resize(int w, int h);   // colour and depth; drops the visibility
-    void resizeVisibility();     // visibility at the current size, all empty
+    void resize(int w, int h);    // colour and depth; drops the visibility and the counters
+    void resizeVisibility();      // visibility at the current size, all empty
+    void resizeOverdraw();        // overdraw counters at the current size, all 0
+    void resizeTraversalCost();   // costNodes/costPrims at the current size, all 0
     bool hasVisibility() const { return drawable.size() == size_t(width) * height && primitive.size() == drawable.size() && !drawable.empty(); }
+    bool hasOverdraw() const { return overdraw.size() == size_t(width) * height && !overdraw.empty(); }
+    bool hasTraversalCost() const { return costNodes.size() == size_t(width) * height && costPrims.size() == costNodes.size() && !costNodes.empty(); }
     void clear(const uint8_t rgba[4], float depthValue = 1.0f);
     uint8_t* pixel(int x, int y) { return &color[(size_t(y) * width + x) * 4]; }
     const uint8_t* pixel(int x, int y) const { return &color[(size_t(y) * width + x) * 4]; }

@@ -31,6 +31,10 @@ struct RenderConfig {
     // second pass when the image is anti-aliased), so backends write the one surface they
     // see through each pixel centre.
     bool visibility = false;
+    // Count per pixel, under the same one-sample rule as the visibility: fragments rasterized
+    // (Framebuffer::overdraw) and the primary ray's BVH work (Framebuffer::costNodes/costPrims).
+    bool overdraw = false;
+    bool traversalCost = false;
     std::string aaAsked = "none";   // RenderSettings::aaName() as asked
     std::string aaUsed = "none";    // the same spelling for what is used
     // Settings the backend does not honour as asked, one line each ("msaa8 -> msaa4: raster

@@ -4,8 +4,8 @@
 // Renderer::render() is the one entry point and is not virtual: it validates the settings,
 // checks the size against the backend's Capabilities, resolves one RenderConfig (AA mode and
 // the sample count actually used, SSAA factor, tessellation; see render_config.h), checks
-// for cancellation, calls the backend's doRender() (twice when visibility is asked for an
-// anti-aliased image: the second pass at one sample per pixel), times the call and fills
+// for cancellation, calls the backend's doRender() (twice when visibility or a per-pixel
+// counter is asked for an anti-aliased image: the second pass at one sample per pixel), times the call and fills
 // RenderStats with what was asked and what was used. Backends implement name(),
 // capabilities() and doRender().
 //
@@ -47,6 +47,8 @@ struct Capabilities {
     bool pointsAndLines = false;      // draws meshes of PrimitiveMode::Points / Lines
     bool depth = true;                // fills Framebuffer::depth (window depth in [0,1])
     bool visibility = false;          // fills Framebuffer::drawable/primitive when asked (RenderRequest)
+    bool overdraw = false;            // fills Framebuffer::overdraw when asked (fragments per pixel)
+    bool traversalCost = false;       // fills Framebuffer::costNodes/costPrims when asked (BVH work per primary ray)
     std::vector<int> msaaSamples;     // MSAA sample counts taken as asked, ascending ({} = no MSAA)
     std::vector<int> ssaaFactors;     // SSAA factors taken as asked, ascending ({} = no SSAA)
     bool ssaaRendersLarger = false;   // SSAA renders a factor x larger image (counts against maxImageSize)
@@ -67,6 +69,14 @@ struct RenderRequest {
     // one-sample pass, so they never mix surfaces; a backend without Capabilities::visibility
     // fails the render with an error saying so.
     bool visibility = false;
+    // Framebuffer::overdraw (Capabilities::overdraw) and Framebuffer::costNodes/costPrims
+    // (Capabilities::traversalCost): per-pixel counters of the diagnostic views "overdraw" and
+    // "cost" (renderers/diagnostic.h), counted at one sample per pixel like the visibility (in
+    // the same second pass when the image is anti-aliased). Backends count only when asked,
+    // so a render that does not ask pays nothing for them; a backend without the capability
+    // fails the render with an error saying so.
+    bool overdraw = false;
+    bool traversalCost = false;
 };
 
 struct RenderStats {

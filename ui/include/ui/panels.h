@@ -61,5 +61,8 @@ void handleShortcuts(ViewerState& st);
 
 // Backends shown by the current view mode (the slots the window must render).
 std::vector<std::string> visibleBackends(const ViewerState& st);
+// What a backend can do (made once per name and kept; empty for an unknown name). The menus
+// decide from these, never from names.
+const rnd::Capabilities& backendCapabilities(const std::string& backend);
 
 }   // namespace ui

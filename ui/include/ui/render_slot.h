@@ -46,7 +46,11 @@ public:
     bool threaded() const { return m_threaded; }                       // renders on a worker thread (else in poll())
     // Renders `frame` at width x height. `key` identifies the content (scene+view+size): an
     // unchanged key is ignored. interacting: render only the preview level (1/previewDivisor).
-    void request(std::shared_ptr<const sg::FrameInput> frame, int width, int height, uint64_t key, bool interacting);
+    // counters: the per-pixel counters the full-resolution image should carry (RenderRequest's
+    // overdraw / traversalCost, for the diagnostic view shown; asked only where the backend has
+    // them, and included in what `key` identifies).
+    void request(std::shared_ptr<const sg::FrameInput> frame, int width, int height, uint64_t key, bool interacting,
+                 const rnd::RenderRequest& counters = {});
     // True when request() with this key would start work (so callers can skip building frames).
     bool needs(uint64_t key, bool interacting) const;
     // Runs synchronous work and collects finished images; returns true when image() changed.
@@ -78,8 +82,9 @@ private:
         int width = 0, height = 0;
         uint64_t key = 0;
         bool previewOnly = false;
-        bool interacting = false;   // no visibility while the camera moves
-        uint64_t generation = 0;    // m_generation when requested: forget() outdates it
+        bool interacting = false;                       // no visibility while the camera moves
+        bool overdraw = false, traversalCost = false;   // counters asked for (with the visibility)
+        uint64_t generation = 0;                        // m_generation when requested: forget() outdates it
     };
     void workerLoop();
     // Renders one job level by level; publishes each finished level. Returns false when cancelled.

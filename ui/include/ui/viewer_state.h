@@ -143,6 +143,9 @@ struct View {
     // What each shown image is drawn as: the shaded image, or a diagnostic view made from its
     // visibility (renderers/diagnostic.h), the same for every backend.
     rnd::DiagnosticView diagnostic = rnd::DiagnosticView::Shaded;
+    // The diagnostic view's legend per shown backend (backend -> line; the window fills it as
+    // it draws the images, the automation's `print legend` reads it).
+    std::map<std::string, std::string> legends;
     // View > Overlays: drawn on every shown image alike (renderers/overlay.h); the selection
     // and the scene's cameras are filled in when drawn.
     rnd::OverlayOptions overlays;
