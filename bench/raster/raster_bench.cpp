@@ -358,10 +358,10 @@ int main(int argc, char** argv) {
         }
         Timing g = glBackend ? timeRenderer(*glBackend, f, w, h, frames, fbG, eg) : Timing{};
         Timing r;
+        std::vector<uint8_t> rgba;   // the minimal GL program's image, rows bottom to top
         {
             bench::MinimalGl mgl;
             std::string em = mgl.setup(f, w, h);
-            std::vector<uint8_t> rgba;
             if (em.empty())
                 r = timeFrames(
                     [&] {
@@ -384,7 +384,17 @@ int main(int argc, char** argv) {
                     tr / to);
         if (threads > 1) std::printf("bench: scene=%s what=scaling ours=%.2f ref=%.2f ratio=%.3f\n", n, o1.wallMs, to, o1.wallMs / to);
         std::printf("bench: scene=%s what=cold_ms ours=%.2f ref=%.2f ratio=%.3f\n", n, cold, to, cold / to);
-        std::printf("# %s: %zu triangles, %.0f covered pixels\n", n, b.triangles, cov);
+        // Same picture? Fraction of pixels whose channels all lie within 8 of the other's.
+        size_t close = 0;
+        if (rgba.size() == fbO.color.size())
+            for (int y = 0; y < h; ++y)
+                for (int x = 0; x < w; ++x) {
+                    const uint8_t* a = fbO.pixel(x, h - 1 - y);
+                    const uint8_t* c = &rgba[(size_t(y) * w + x) * 4];
+                    close += std::abs(a[0] - c[0]) <= 8 && std::abs(a[1] - c[1]) <= 8 && std::abs(a[2] - c[2]) <= 8;
+                }
+        std::printf("# %s: %zu triangles, %.0f covered pixels, %.2f%% of pixels within 8 of the minimal GL image\n", n, b.triangles, cov,
+                    100.0 * double(close) / (double(w) * h));
         std::fflush(stdout);
     }
     return 0;
