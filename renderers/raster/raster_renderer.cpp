@@ -120,6 +120,7 @@ struct DrawItem {
     std::vector<uint8_t> code;
     std::vector<vec4> win;   // window x, y, z, 1/w (valid when code == 0)
     std::vector<vec3> wpos, wnrm;
+    std::vector<vec3> weye;                       // eye-space position (fog), when fog is on
     std::vector<vec4> wtan;                       // world tangent (xyz, handedness; mirrored draws flip it), when hasTangents
     std::vector<vec3> gouraudA[2], gouraudB[2];   // front/back: colour = A * albedo + B
 
@@ -148,6 +149,8 @@ void runVertexStage(DrawItem& d, const sg::FrameInput& f, int width, int height,
     d.win.resize(n);
     d.wpos.resize(n);
     d.wnrm.assign(n, vec3(0.0f));
+    const bool fog = f.settings.fog != sg::FogMode::Off;
+    d.weye.resize(fog ? n : 0);
     d.wtan.resize(d.hasTangents ? n : 0);
     const float handedness = d.mirrored ? -1.0f : 1.0f;   // a mirroring transform flips cross(n, t)
     if (gouraud)
@@ -167,6 +170,7 @@ void runVertexStage(DrawItem& d, const sg::FrameInput& f, int width, int height,
             vec4 w = d.world * vec4(m.positions[mi], 1.0f);   // modelling: object -> world
             vec4 c = viewProj * w;                            // viewing + projection -> clip
             d.wpos[v] = vec3(w);
+            if (fog) d.weye[v] = vec3(f.camera.view * vec4(d.wpos[v], 1.0f));
             d.clip[v] = c;
             d.code[v] = outcode(c, g);
             if (d.code[v] == 0) d.win[v] = toWindow(c, width, height);
@@ -399,6 +403,10 @@ struct TriCache {
     vec3 p[3], pe[3], n[3];    // world positions, eye positions, normals
     bool faceNormal = false;   // flat (or no normals): n[0] is the normal
     bool gouraud = false;
+    // Plain lit fragment (no vertex colours, textures or maps, not Gouraud, not reference
+    // shading): prepareFragment takes the short path with the material's coefficients below.
+    bool simple = false;
+    PhongCoefficients coeff;
 
     void load(uint32_t newId, const Tri& tri, const Chunk& ch, const FrameContext& fc) {
         id = newId;
@@ -410,10 +418,12 @@ struct TriCache {
         for (int k = 0; k < 3; ++k) {
             v[k] = d->vertexOf(tri.prim, k);
             p[k] = d->wpos[v[k]];
-            if (f.settings.fog != sg::FogMode::Off) pe[k] = vec3(f.camera.view * vec4(p[k], 1.0f));
+            if (f.settings.fog != sg::FogMode::Off) pe[k] = d->weye[v[k]];
         }
         gouraud = f.settings.shading == sg::ShadingModel::Gouraud && !d->gouraudA[0].empty();
         faceNormal = f.settings.shading == sg::ShadingModel::Flat || !d->hasNormals;
+        simple = !gouraud && !fc.referenceShading && !d->hasColors && !(d->texture && d->hasUV) && !(d->hasUV && d->hasMaps());
+        if (simple) coeff = coefficientsOf(*mat);
         if (faceNormal) {
             // Face normal of the world-space triangle; outward = CCW side (CW for mirrored),
             // flipped toward the viewer when seen from the back (two-sided).
@@ -525,6 +535,19 @@ __attribute__((noinline)) float prepareFragment(const TriCache& tc, const FrameC
     const uint32_t* v = tc.v;
     vec3 pos = bo[0] * tc.p[0] + bo[1] * tc.p[1] + bo[2] * tc.p[2];
     const sg::Material& mat = *tc.mat;
+    if (tc.simple) {   // the general path below with everything it would skip left out
+        vec3 n;
+        if (tc.faceNormal) {
+            n = tc.n[0];
+        } else {
+            n = bo[0] * tc.n[0] + bo[1] * tc.n[1] + bo[2] * tc.n[2];
+            float len = glm::length(n);
+            n = len > 0 ? n / len : vec3(0, 0, 1);
+        }
+        sb.set(k, tc.coeff, pos, n, mat.baseColor, f.ambientLight);
+        if (f.settings.fog == sg::FogMode::Off) return 0.0f;
+        return glm::length(bo[0] * tc.pe[0] + bo[1] * tc.pe[1] + bo[2] * tc.pe[2]);
+    }
 
     vec3 albedo = mat.baseColor;
     const bool maps = d.hasUV && d.hasMaps();
@@ -731,11 +754,17 @@ void shadeOpaque(const FrameContext& fc, Framebuffer& target, TileBuffers& buf, 
     shadeBatch(buf.batch, nf, *fc.frame);
     if (fc.timing) g_lightNs += nowNs() - tC;
     const bool fog = st.fog != sg::FogMode::Off;
+    const bool linearFog = st.fog == sg::FogMode::Linear;
     const ShadeBatch& b = buf.batch;
     if (samples == 1) {
         for (size_t k = 0; k < nf; ++k) {
             vec3 c(b.cr[k], b.cg[k], b.cb[k]);
-            if (fog) c = applyFog(st, c, buf.fogDist[k]);
+            if (linearFog) {   // applyFog(), inlined: the same operations in the same order
+                const float vis = std::clamp((st.fogEnd - buf.fogDist[k]) / (st.fogEnd - st.fogStart), 0.0f, 1.0f);
+                c = vis * c + (1.0f - vis) * st.fogColor;
+            } else if (fog) {
+                c = applyFog(st, c, buf.fogDist[k]);
+            }
             int p = buf.fragPixel[k];
             uint8_t* out = target.pixel(x0 + p % kTileSize, fc.height - 1 - (y0 + p / kTileSize));
             out[0] = enc(c.x);
