@@ -23,7 +23,8 @@
 // grid as instances of one sphere mesh, plus a ground plane and a directional light) and bunny
 // (stanford-bunny.obj from shared/testdata, read by a tiny OBJ reader below).
 // LP_NUM_THREADS is set before any GL context is created; tbb is limited to the same count.
-// --quick: fewer frames and 960x540 (finishes well under a minute).
+// --quick: fewer frames and 960x540 (finishes well under a minute). --no-gl: raster only (for
+// profiling it, e.g. perf record ... bench_raster --no-gl --scenes mesh1M).
 #include "min_gl.h"
 #include "renderers/renderer.h"
 #include "scenegraph/frame.h"
@@ -272,7 +273,7 @@ double coveredPixels(const rnd::Framebuffer& fb) {
 }   // namespace
 
 int main(int argc, char** argv) {
-    bool quick = false;
+    bool quick = false, noGl = false;
     int threads = 2, frames = 15, w = 1280, h = 720;
     std::string shading = "phong", fog = "on", only;
     for (int i = 1; i < argc; ++i) {
@@ -280,6 +281,8 @@ int main(int argc, char** argv) {
         auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
         if (a == "--quick")
             quick = true;
+        else if (a == "--no-gl")
+            noGl = true;
         else if (a == "--threads")
             threads = std::max(1, std::atoi(next().c_str()));
         else if (a == "--frames")
@@ -314,7 +317,7 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "bench: %s\n", err.c_str());
         return 1;
     }
-    auto glBackend = rnd::makeRenderer("gl", &err);
+    auto glBackend = noGl ? nullptr : rnd::makeRenderer("gl", &err);
 
     std::vector<BenchScene> scenes;
     auto want = [&](const std::string& n) { return only.empty() || ("," + only + ",").find("," + n + ",") != std::string::npos; };
@@ -361,7 +364,7 @@ int main(int argc, char** argv) {
         std::vector<uint8_t> rgba;   // the minimal GL program's image, rows bottom to top
         {
             bench::MinimalGl mgl;
-            std::string em = mgl.setup(f, w, h);
+            std::string em = noGl ? "skipped (--no-gl)" : mgl.setup(f, w, h);
             if (em.empty())
                 r = timeFrames(
                     [&] {

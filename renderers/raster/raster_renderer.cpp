@@ -216,7 +216,11 @@ struct Chunk {
     std::vector<Tri> tris;
     std::vector<std::array<vec3, 3>> clipBary;
     std::vector<uint32_t> tileStart, items;   // CSR: tiles -> triangle indices in order
-    std::vector<uint32_t> fill;               // scratch for binning
+    struct TileRect {
+        uint16_t x0, y0, x1, y1;   // tiles a triangle's bbox touches, inclusive
+    };
+    std::vector<TileRect> rects;   // one per triangle: binning reads these, not the triangles
+    std::vector<uint32_t> fill;    // scratch for binning
 };
 
 struct FrameContext {
@@ -260,6 +264,19 @@ void runTriangleStage(Chunk& ch, const FrameContext& fc) {
     const std::vector<DrawItem>& draws = *fc.draws;
     const auto& st = fc.frame->settings;
     const GuardBand g = guardBand(fc.width, fc.height);
+    // Triangles are counted per tile as they are made (binning's first pass); `rects` keeps
+    // their tile ranges for the second.
+    const int nt = fc.tilesX * fc.tilesY;
+    ch.tileStart.assign(size_t(nt) + 1, 0);
+    ch.rects.clear();
+    auto emit = [&](const Tri& tri) {
+        ch.tris.push_back(tri);
+        const Chunk::TileRect r{uint16_t(tri.s.minX / kTileSize), uint16_t(tri.s.minY / kTileSize), uint16_t(tri.s.maxX / kTileSize),
+                                uint16_t(tri.s.maxY / kTileSize)};
+        ch.rects.push_back(r);
+        for (int ty = r.y0; ty <= r.y1; ++ty)
+            for (int tx = r.x0; tx <= r.x1; ++tx) ++ch.tileStart[size_t(ty) * fc.tilesX + tx + 1];
+    };
     // First draw containing ch.begin.
     size_t di =
         size_t(std::upper_bound(draws.begin(), draws.end(), ch.begin, [](uint64_t v, const DrawItem& d) { return v < d.firstTri; }) - draws.begin()) -
@@ -291,7 +308,7 @@ void runTriangleStage(Chunk& ch, const FrameContext& fc) {
             finishTri(tri, z, iw);
             tri.draw = uint32_t(di);
             tri.prim = t;
-            ch.tris.push_back(tri);
+            emit(tri);
             continue;
         }
         // Clip in homogeneous space, then fan-triangulate the polygon.
@@ -320,23 +337,18 @@ void runTriangleStage(Chunk& ch, const FrameContext& fc) {
             tri.prim = t;
             tri.clip = int32_t(ch.clipBary.size());
             ch.clipBary.push_back({poly[idx[tri.s.order[0]]].bary, poly[idx[tri.s.order[1]]].bary, poly[idx[tri.s.order[2]]].bary});
-            ch.tris.push_back(tri);
+            emit(tri);
         }
     }
     // Bin into tiles (counting sort keeps submission order within each tile).
-    int nt = fc.tilesX * fc.tilesY;
-    ch.tileStart.assign(size_t(nt) + 1, 0);
-    for (const Tri& t : ch.tris)
-        for (int ty = t.s.minY / kTileSize; ty <= t.s.maxY / kTileSize; ++ty)
-            for (int tx = t.s.minX / kTileSize; tx <= t.s.maxX / kTileSize; ++tx) ++ch.tileStart[size_t(ty) * fc.tilesX + tx + 1];
     for (int i = 0; i < nt; ++i) ch.tileStart[i + 1] += ch.tileStart[i];
     ch.items.resize(ch.tileStart[nt]);
     ch.fill.assign(ch.tileStart.begin(), ch.tileStart.end() - 1);
     std::vector<uint32_t>& fill = ch.fill;
-    for (uint32_t i = 0; i < ch.tris.size(); ++i) {
-        const Tri& t = ch.tris[i];
-        for (int ty = t.s.minY / kTileSize; ty <= t.s.maxY / kTileSize; ++ty)
-            for (int tx = t.s.minX / kTileSize; tx <= t.s.maxX / kTileSize; ++tx) ch.items[fill[size_t(ty) * fc.tilesX + tx]++] = i;
+    for (uint32_t i = 0; i < ch.rects.size(); ++i) {
+        const Chunk::TileRect r = ch.rects[i];
+        for (int ty = r.y0; ty <= r.y1; ++ty)
+            for (int tx = r.x0; tx <= r.x1; ++tx) ch.items[fill[size_t(ty) * fc.tilesX + tx]++] = i;
     }
 }
 
@@ -411,19 +423,26 @@ struct TriCache {
     void load(uint32_t newId, const Tri& tri, const Chunk& ch, const FrameContext& fc) {
         id = newId;
         t = &tri;
-        d = &(*fc.draws)[tri.draw];
-        mat = &d->materialOf(tri.prim);
-        cb = tri.clip >= 0 ? &ch.clipBary[size_t(tri.clip)] : nullptr;
         const sg::FrameInput& f = *fc.frame;
+        // Per draw (and material): the same for every triangle of a draw without per-triangle
+        // materials, so consecutive fragments of one mesh skip it.
+        const DrawItem* nd = &(*fc.draws)[tri.draw];
+        const sg::Material* nm = nd->triMat ? &nd->materialOf(tri.prim) : &nd->material;
+        if (nd != d || nm != mat) {
+            d = nd;
+            mat = nm;
+            gouraud = f.settings.shading == sg::ShadingModel::Gouraud && !d->gouraudA[0].empty();
+            faceNormal = f.settings.shading == sg::ShadingModel::Flat || !d->hasNormals;
+            simple = !gouraud && !fc.referenceShading && !d->hasColors && !(d->texture && d->hasUV) && !(d->hasUV && d->hasMaps());
+            if (simple) coeff = coefficientsOf(*mat);
+        }
+        cb = tri.clip >= 0 ? &ch.clipBary[size_t(tri.clip)] : nullptr;
+        const bool fog = f.settings.fog != sg::FogMode::Off;
         for (int k = 0; k < 3; ++k) {
             v[k] = d->vertexOf(tri.prim, k);
             p[k] = d->wpos[v[k]];
-            if (f.settings.fog != sg::FogMode::Off) pe[k] = d->weye[v[k]];
+            if (fog) pe[k] = d->weye[v[k]];
         }
-        gouraud = f.settings.shading == sg::ShadingModel::Gouraud && !d->gouraudA[0].empty();
-        faceNormal = f.settings.shading == sg::ShadingModel::Flat || !d->hasNormals;
-        simple = !gouraud && !fc.referenceShading && !d->hasColors && !(d->texture && d->hasUV) && !(d->hasUV && d->hasMaps());
-        if (simple) coeff = coefficientsOf(*mat);
         if (faceNormal) {
             // Face normal of the world-space triangle; outward = CCW side (CW for mirrored),
             // flipped toward the viewer when seen from the back (two-sided).
