@@ -28,6 +28,9 @@
 #include "renderers/tessellate.h"
 #include "renderers/texture_sampler.h"
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -419,6 +422,7 @@ struct TriCache {
     // shading): prepareFragment takes the short path with the material's coefficients below.
     bool simple = false;
     PhongCoefficients coeff;
+    vec3 simpleSpec, simpleBase;   // ShadeBatch::set's specular colour and ambient + emissive term (simple)
 
     void load(uint32_t newId, const Tri& tri, const Chunk& ch, const FrameContext& fc) {
         id = newId;
@@ -434,7 +438,13 @@ struct TriCache {
             gouraud = f.settings.shading == sg::ShadingModel::Gouraud && !d->gouraudA[0].empty();
             faceNormal = f.settings.shading == sg::ShadingModel::Flat || !d->hasNormals;
             simple = !gouraud && !fc.referenceShading && !d->hasColors && !(d->texture && d->hasUV) && !(d->hasUV && d->hasMaps());
-            if (simple) coeff = coefficientsOf(*mat);
+            if (simple) {
+                coeff = coefficientsOf(*mat);
+                simple = !coeff.unlit;
+                const vec3 albedo = mat->baseColor;   // ShadeBatch::set() with this albedo
+                simpleSpec = coeff.specularTinted ? albedo : coeff.specularColor;
+                simpleBase = coeff.ka * albedo * f.ambientLight + coeff.emissive;
+            }
         }
         cb = tri.clip >= 0 ? &ch.clipBary[size_t(tri.clip)] : nullptr;
         const bool fog = f.settings.fog != sg::FogMode::Off;
@@ -542,6 +552,145 @@ float fragmentAlpha(const TriCache& tc, int i, int j) {
     return a;
 }
 
+// Output pointers of a ShadeBatch (hoisted out of the per-fragment loop).
+struct BatchOut {
+    float *px, *py, *pz, *nx, *ny, *nz, *ar, *ag, *ab, *sr, *sg, *sb, *kd, *ks, *shin, *cr, *cg, *cb;
+    explicit BatchOut(ShadeBatch& b)
+        : px(b.px.data()),
+          py(b.py.data()),
+          pz(b.pz.data()),
+          nx(b.nx.data()),
+          ny(b.ny.data()),
+          nz(b.nz.data()),
+          ar(b.ar.data()),
+          ag(b.ag.data()),
+          ab(b.ab.data()),
+          sr(b.sr.data()),
+          sg(b.sg.data()),
+          sb(b.sb.data()),
+          kd(b.kd.data()),
+          ks(b.ks.data()),
+          shin(b.shin.data()),
+          cr(b.cr.data()),
+          cg(b.cg.data()),
+          cb(b.cb.data()) {}
+};
+
+// prepareFragment() for a TriCache::simple triangle, inlined into the fragment loop: the same
+// operations in the same order (so the same bits), with the per-material values precomputed.
+inline __attribute__((always_inline)) float prepareSimple(const TriCache& tc, bool fog, int i, int j, const BatchOut& o, size_t k) {
+    const FragBary fb = baryAt(tc, i, j);
+    const vec3& bo = fb.bo;
+    const vec3 pos = bo[0] * tc.p[0] + bo[1] * tc.p[1] + bo[2] * tc.p[2];
+    vec3 n;
+    if (tc.faceNormal) {
+        n = tc.n[0];
+    } else {
+        n = bo[0] * tc.n[0] + bo[1] * tc.n[1] + bo[2] * tc.n[2];
+        float len = glm::length(n);
+        n = len > 0 ? n / len : vec3(0, 0, 1);
+    }
+    const vec3& albedo = tc.mat->baseColor;
+    o.px[k] = pos.x;
+    o.py[k] = pos.y;
+    o.pz[k] = pos.z;
+    o.nx[k] = n.x;
+    o.ny[k] = n.y;
+    o.nz[k] = n.z;
+    o.ar[k] = albedo.x;
+    o.ag[k] = albedo.y;
+    o.ab[k] = albedo.z;
+    o.sr[k] = tc.simpleSpec.x;
+    o.sg[k] = tc.simpleSpec.y;
+    o.sb[k] = tc.simpleSpec.z;
+    o.kd[k] = tc.coeff.kd;
+    o.ks[k] = tc.coeff.ks;
+    o.shin[k] = tc.coeff.shininess;
+    o.cr[k] = tc.simpleBase.x;
+    o.cg[k] = tc.simpleBase.y;
+    o.cb[k] = tc.simpleBase.z;
+    if (!fog) return 0.0f;
+    return glm::length(bo[0] * tc.pe[0] + bo[1] * tc.pe[1] + bo[2] * tc.pe[2]);
+}
+
+#if defined(__SSE2__)
+// prepareSimple() for 4 fragments of the same triangle at pixels (i[l], j[l]), slots k..k+3:
+// each lane does prepareSimple's scalar operations in the same order (SSE's add, mul, div and
+// sqrt round as the scalar ones do), so the results are the same bits.
+inline void prepareSimple4(const TriCache& tc, bool fog, const int i[4], const int j[4], const BatchOut& o, float* fogDist, size_t k) {
+    using V = __m128;
+    const Tri& t = *tc.t;
+    auto set1 = [](float x) { return _mm_set1_ps(x); };
+    auto add = [](V a, V b) { return _mm_add_ps(a, b); };
+    auto mul = [](V a, V b) { return _mm_mul_ps(a, b); };
+    auto dot3 = [&](V a0, V a1, V a2, float c0, float c1, float c2) { return add(add(mul(a0, set1(c0)), mul(a1, set1(c1))), mul(a2, set1(c2))); };
+    const V di = _mm_cvtepi32_ps(_mm_setr_epi32(i[0] - t.s.minX, i[1] - t.s.minX, i[2] - t.s.minX, i[3] - t.s.minX));
+    const V dj = _mm_cvtepi32_ps(_mm_setr_epi32(j[0] - t.s.minY, j[1] - t.s.minY, j[2] - t.s.minY, j[3] - t.s.minY));
+    V u[3], sum = _mm_setzero_ps();
+    for (int q = 0; q < 3; ++q) {
+        u[q] = add(add(set1(t.uRef[q]), mul(set1(t.udx[q]), di)), mul(set1(t.udy[q]), dj));
+        sum = add(sum, u[q]);
+    }
+    const V inv = _mm_and_ps(_mm_cmpneq_ps(sum, _mm_setzero_ps()), _mm_div_ps(set1(1.0f), sum));
+    V b[3] = {mul(u[0], inv), mul(u[1], inv), mul(u[2], inv)};
+    V bo[3];
+    if (tc.cb) {
+        const std::array<vec3, 3>& cb = *tc.cb;
+        for (int c = 0; c < 3; ++c) bo[c] = dot3(b[0], b[1], b[2], cb[0][c], cb[1][c], cb[2][c]);
+    } else if (t.s.order[1] == 1) {   // setupTriangle's two orders: {0, 1, 2} or {0, 2, 1}
+        bo[0] = b[0];
+        bo[1] = b[1];
+        bo[2] = b[2];
+    } else {
+        bo[0] = b[0];
+        bo[1] = b[2];
+        bo[2] = b[1];
+    }
+    auto interp = [&](const vec3(&a)[3], int c) { return dot3(bo[0], bo[1], bo[2], a[0][c], a[1][c], a[2][c]); };
+    _mm_storeu_ps(o.px + k, interp(tc.p, 0));
+    _mm_storeu_ps(o.py + k, interp(tc.p, 1));
+    _mm_storeu_ps(o.pz + k, interp(tc.p, 2));
+    V nx, ny, nz;
+    if (tc.faceNormal) {
+        nx = set1(tc.n[0].x);
+        ny = set1(tc.n[0].y);
+        nz = set1(tc.n[0].z);
+    } else {
+        nx = interp(tc.n, 0);
+        ny = interp(tc.n, 1);
+        nz = interp(tc.n, 2);
+        const V len = _mm_sqrt_ps(add(add(mul(nx, nx), mul(ny, ny)), mul(nz, nz)));
+        const V pos = _mm_cmpgt_ps(len, _mm_setzero_ps());
+        auto sel = [](V m, V a, V c) { return _mm_or_ps(_mm_and_ps(m, a), _mm_andnot_ps(m, c)); };
+        nx = sel(pos, _mm_div_ps(nx, len), _mm_setzero_ps());
+        ny = sel(pos, _mm_div_ps(ny, len), _mm_setzero_ps());
+        nz = sel(pos, _mm_div_ps(nz, len), set1(1.0f));
+    }
+    _mm_storeu_ps(o.nx + k, nx);
+    _mm_storeu_ps(o.ny + k, ny);
+    _mm_storeu_ps(o.nz + k, nz);
+    const vec3& albedo = tc.mat->baseColor;
+    _mm_storeu_ps(o.ar + k, set1(albedo.x));
+    _mm_storeu_ps(o.ag + k, set1(albedo.y));
+    _mm_storeu_ps(o.ab + k, set1(albedo.z));
+    _mm_storeu_ps(o.sr + k, set1(tc.simpleSpec.x));
+    _mm_storeu_ps(o.sg + k, set1(tc.simpleSpec.y));
+    _mm_storeu_ps(o.sb + k, set1(tc.simpleSpec.z));
+    _mm_storeu_ps(o.kd + k, set1(tc.coeff.kd));
+    _mm_storeu_ps(o.ks + k, set1(tc.coeff.ks));
+    _mm_storeu_ps(o.shin + k, set1(tc.coeff.shininess));
+    _mm_storeu_ps(o.cr + k, set1(tc.simpleBase.x));
+    _mm_storeu_ps(o.cg + k, set1(tc.simpleBase.y));
+    _mm_storeu_ps(o.cb + k, set1(tc.simpleBase.z));
+    if (!fog) {
+        _mm_storeu_ps(fogDist + k, _mm_setzero_ps());
+        return;
+    }
+    const V ex = interp(tc.pe, 0), ey = interp(tc.pe, 1), ez = interp(tc.pe, 2);
+    _mm_storeu_ps(fogDist + k, _mm_sqrt_ps(add(add(mul(ex, ex), mul(ey, ey)), mul(ez, ez))));
+}
+#endif
+
 // Interpolates the attributes of the cached triangle at the centre of pixel (i, j) and fills
 // slot k of the shading batch (Gouraud: the final colour, with no lights left to add). Returns
 // the eye-space distance for fog.
@@ -554,20 +703,6 @@ __attribute__((noinline)) float prepareFragment(const TriCache& tc, const FrameC
     const uint32_t* v = tc.v;
     vec3 pos = bo[0] * tc.p[0] + bo[1] * tc.p[1] + bo[2] * tc.p[2];
     const sg::Material& mat = *tc.mat;
-    if (tc.simple) {   // the general path below with everything it would skip left out
-        vec3 n;
-        if (tc.faceNormal) {
-            n = tc.n[0];
-        } else {
-            n = bo[0] * tc.n[0] + bo[1] * tc.n[1] + bo[2] * tc.n[2];
-            float len = glm::length(n);
-            n = len > 0 ? n / len : vec3(0, 0, 1);
-        }
-        sb.set(k, tc.coeff, pos, n, mat.baseColor, f.ambientLight);
-        if (f.settings.fog == sg::FogMode::Off) return 0.0f;
-        return glm::length(bo[0] * tc.pe[0] + bo[1] * tc.pe[1] + bo[2] * tc.pe[2]);
-    }
-
     vec3 albedo = mat.baseColor;
     const bool maps = d.hasUV && d.hasMaps();
     MapSample ms;
@@ -762,11 +897,30 @@ void shadeOpaque(const FrameContext& fc, Framebuffer& target, TileBuffers& buf, 
     buf.batch.resize(nf);
     buf.fogDist.resize(nf);
     TriCache tc;
+    const BatchOut out(buf.batch);
+    const bool fogOn = st.fog != sg::FogMode::Off;
     for (size_t k = 0; k < nf; ++k) {
         uint32_t id = buf.fragTri[k];
         if (id != tc.id) tc.load(id, triById(chunks, id), chunks[id >> kChunkBits], fc);
+#if defined(__SSE2__)
+        // Four fragments of one triangle in a row (the common case for all but tiny triangles).
+        if (tc.simple && k + 4 <= nf && buf.fragTri[k + 1] == id && buf.fragTri[k + 2] == id && buf.fragTri[k + 3] == id) {
+            int ii[4], jj[4];
+            for (int l = 0; l < 4; ++l) {
+                const int p = buf.fragPixel[k + l];
+                ii[l] = x0 + p % kTileSize;
+                jj[l] = y0 + p / kTileSize;
+            }
+            prepareSimple4(tc, fogOn, ii, jj, out, buf.fogDist.data(), k);
+            k += 3;
+            continue;
+        }
+#endif
         int p = buf.fragPixel[k];
-        buf.fogDist[k] = prepareFragment(tc, fc, x0 + p % kTileSize, y0 + p / kTileSize, buf.batch, k);
+        if (tc.simple)
+            buf.fogDist[k] = prepareSimple(tc, fogOn, x0 + p % kTileSize, y0 + p / kTileSize, out, k);
+        else
+            buf.fogDist[k] = prepareFragment(tc, fc, x0 + p % kTileSize, y0 + p / kTileSize, buf.batch, k);
     }
     int64_t tC = fc.timing ? nowNs() : 0;
     if (fc.timing) g_prepareNs += tC - tB;
