@@ -122,8 +122,12 @@ struct DrawItem {
     std::vector<vec4> clip;
     std::vector<uint8_t> code;
     std::vector<vec4> win;   // window x, y, z, 1/w (valid when code == 0)
-    std::vector<vec3> wpos, wnrm;
-    std::vector<vec3> weye;                       // eye-space position (fog), when fog is on
+    // World position, world normal (0 without normals) and eye-space position (fog; 0 when
+    // fog is off) of a vertex, side by side: the fragment stage fetches all three per triangle.
+    struct VertexOut {
+        vec3 pos{0.0f}, nrm{0.0f}, eye{0.0f};
+    };
+    std::vector<VertexOut> wv;
     std::vector<vec4> wtan;                       // world tangent (xyz, handedness; mirrored draws flip it), when hasTangents
     std::vector<vec3> gouraudA[2], gouraudB[2];   // front/back: colour = A * albedo + B
 
@@ -150,10 +154,8 @@ void runVertexStage(DrawItem& d, const sg::FrameInput& f, int width, int height,
     d.clip.resize(n);
     d.code.resize(n);
     d.win.resize(n);
-    d.wpos.resize(n);
-    d.wnrm.assign(n, vec3(0.0f));
+    d.wv.resize(n);
     const bool fog = f.settings.fog != sg::FogMode::Off;
-    d.weye.resize(fog ? n : 0);
     d.wtan.resize(d.hasTangents ? n : 0);
     const float handedness = d.mirrored ? -1.0f : 1.0f;   // a mirroring transform flips cross(n, t)
     if (gouraud)
@@ -166,28 +168,32 @@ void runVertexStage(DrawItem& d, const sg::FrameInput& f, int width, int height,
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t v = r.begin(); v != r.end(); ++v) {
             uint32_t mi = d.meshIndex(uint32_t(v));
+            DrawItem::VertexOut& o = d.wv[v];
             if (mi >= m.positions.size()) {
                 d.code[v] = kClipNear;
+                o = DrawItem::VertexOut{};
                 continue;
             }
             vec4 w = d.world * vec4(m.positions[mi], 1.0f);   // modelling: object -> world
             vec4 c = viewProj * w;                            // viewing + projection -> clip
-            d.wpos[v] = vec3(w);
-            if (fog) d.weye[v] = vec3(f.camera.view * vec4(d.wpos[v], 1.0f));
+            o.pos = vec3(w);
+            o.eye = fog ? vec3(f.camera.view * vec4(o.pos, 1.0f)) : vec3(0.0f);
             d.clip[v] = c;
             d.code[v] = outcode(c, g);
             if (d.code[v] == 0) d.win[v] = toWindow(c, width, height);
             if (d.hasNormals) {
                 vec3 nn = d.normal * m.normals[mi];   // normal matrix (inverse transpose)
                 float len = glm::length(nn);
-                d.wnrm[v] = len > 0 ? nn / len : vec3(0, 0, 1);
+                o.nrm = len > 0 ? nn / len : vec3(0, 0, 1);
+            } else {
+                o.nrm = vec3(0.0f);
             }
             if (d.hasTangents) d.wtan[v] = vec4(mat3(d.world) * vec3(m.tangents[mi]), m.tangents[mi].w * handedness);
             if (gouraud) {
                 const sg::Material& mat = d.perCorner ? d.materialOf(uint32_t(v / 3)) : d.material;
                 // Gouraud: the model's two albedo-linear terms at the vertex, front and back side.
-                ShadeTerms front = shadeTerms(mat, d.wpos[v], d.wnrm[v], f.camera.eye, f);
-                ShadeTerms back = shadeTerms(mat, d.wpos[v], -d.wnrm[v], f.camera.eye, f);
+                ShadeTerms front = shadeTerms(mat, o.pos, o.nrm, f.camera.eye, f);
+                ShadeTerms back = shadeTerms(mat, o.pos, -o.nrm, f.camera.eye, f);
                 d.gouraudA[0][v] = front.mul;
                 d.gouraudB[0][v] = front.add;
                 d.gouraudA[1][v] = back.mul;
@@ -272,8 +278,7 @@ void runTriangleStage(Chunk& ch, const FrameContext& fc) {
     const int nt = fc.tilesX * fc.tilesY;
     ch.tileStart.assign(size_t(nt) + 1, 0);
     ch.rects.clear();
-    auto emit = [&](const Tri& tri) {
-        ch.tris.push_back(tri);
+    auto bin = [&](const Tri& tri) {   // counts ch.tris.back()
         const Chunk::TileRect r{uint16_t(tri.s.minX / kTileSize), uint16_t(tri.s.minY / kTileSize), uint16_t(tri.s.maxX / kTileSize),
                                 uint16_t(tri.s.maxY / kTileSize)};
         ch.rects.push_back(r);
@@ -299,19 +304,26 @@ void runTriangleStage(Chunk& ch, const FrameContext& fc) {
         if (c0 & c1 & c2) continue;                // all outside one plane
         if ((c0 | c1 | c2) & kInvalid) continue;   // non-finite vertex
         if ((c0 | c1 | c2) == 0) {
-            Tri tri;
-            float wx[3] = {d.win[v[0]].x, d.win[v[1]].x, d.win[v[2]].x};
-            float wy[3] = {d.win[v[0]].y, d.win[v[1]].y, d.win[v[2]].y};
-            if (!setupTriangle(wx, wy, fc.width, fc.height, tri.s, fc.msaa)) continue;
+            Tri& tri = ch.tris.emplace_back();   // made in place (dropped again when rejected)
+            const vec4 &w0 = d.win[v[0]], &w1 = d.win[v[1]], &w2 = d.win[v[2]];
+            float wx[3] = {w0.x, w1.x, w2.x};
+            float wy[3] = {w0.y, w1.y, w2.y};
+            if (!setupTriangle(wx, wy, fc.width, fc.height, tri.s, fc.msaa)) {
+                ch.tris.pop_back();
+                continue;
+            }
             tri.front = tri.s.flipped == d.mirrored;   // CCW is front; mirrored instances: CW
-            if (!tri.front && d.cullsBack(t, st.culling)) continue;
+            if (!tri.front && d.cullsBack(t, st.culling)) {
+                ch.tris.pop_back();
+                continue;
+            }
             tri.alpha = d.materialOf(t).alphaMode;
-            float z[3] = {d.win[v[0]].z, d.win[v[1]].z, d.win[v[2]].z};
-            float iw[3] = {d.win[v[0]].w, d.win[v[1]].w, d.win[v[2]].w};
+            float z[3] = {w0.z, w1.z, w2.z};
+            float iw[3] = {w0.w, w1.w, w2.w};
             finishTri(tri, z, iw);
             tri.draw = uint32_t(di);
             tri.prim = t;
-            emit(tri);
+            bin(tri);
             continue;
         }
         // Clip in homogeneous space, then fan-triangulate the polygon.
@@ -340,7 +352,7 @@ void runTriangleStage(Chunk& ch, const FrameContext& fc) {
             tri.prim = t;
             tri.clip = int32_t(ch.clipBary.size());
             ch.clipBary.push_back({poly[idx[tri.s.order[0]]].bary, poly[idx[tri.s.order[1]]].bary, poly[idx[tri.s.order[2]]].bary});
-            emit(tri);
+            bin(ch.tris.emplace_back(tri));
         }
     }
     // Bin into tiles (counting sort keeps submission order within each tile).
@@ -447,11 +459,13 @@ struct TriCache {
             }
         }
         cb = tri.clip >= 0 ? &ch.clipBary[size_t(tri.clip)] : nullptr;
-        const bool fog = f.settings.fog != sg::FogMode::Off;
+        vec3 nv[3];
         for (int k = 0; k < 3; ++k) {
             v[k] = d->vertexOf(tri.prim, k);
-            p[k] = d->wpos[v[k]];
-            if (fog) pe[k] = d->weye[v[k]];
+            const DrawItem::VertexOut& o = d->wv[v[k]];
+            p[k] = o.pos;
+            pe[k] = o.eye;
+            nv[k] = o.nrm;
         }
         if (faceNormal) {
             // Face normal of the world-space triangle; outward = CCW side (CW for mirrored),
@@ -461,7 +475,7 @@ struct TriCache {
             float len = glm::length(nn);
             n[0] = len > 0 ? nn / len : vec3(0, 0, 1);
         } else {
-            for (int k = 0; k < 3; ++k) n[k] = tri.front ? d->wnrm[v[k]] : -d->wnrm[v[k]];
+            for (int k = 0; k < 3; ++k) n[k] = tri.front ? nv[k] : -nv[k];
         }
     }
 };
