@@ -346,10 +346,11 @@ int main(int argc, char** argv) {
         std::string eo, eg;
         // Cold: the first frame of a new renderer (no caches, buffers sized on the way).
         double cold = NAN;
+        rnd::Framebuffer fbCold;
         {
             auto fresh = rnd::makeRenderer("raster", &err);
             auto t0 = std::chrono::steady_clock::now();
-            rnd::Framebuffer fb;
+            rnd::Framebuffer& fb = fbCold;
             if (fresh && fresh->render(f, w, h, fb).ok)
                 cold = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         }
@@ -396,8 +397,8 @@ int main(int argc, char** argv) {
                     const uint8_t* c = &rgba[(size_t(y) * w + x) * 4];
                     close += std::abs(a[0] - c[0]) <= 8 && std::abs(a[1] - c[1]) <= 8 && std::abs(a[2] - c[2]) <= 8;
                 }
-        std::printf("# %s: %zu triangles, %.0f covered pixels, %.2f%% of pixels within 8 of the minimal GL image\n", n, b.triangles, cov,
-                    100.0 * double(close) / (double(w) * h));
+        std::printf("# %s: %zu triangles, %.0f covered pixels, %.2f%% of pixels within 8 of the minimal GL image, warm frame %s the first\n", n,
+                    b.triangles, cov, 100.0 * double(close) / (double(w) * h), fbCold.color == fbO.color ? "identical to" : "DIFFERS from");
         std::fflush(stdout);
     }
     return 0;

@@ -131,6 +131,20 @@ struct DrawItem {
     std::vector<vec4> wtan;                       // world tangent (xyz, handedness; mirrored draws flip it), when hasTangents
     std::vector<vec3> gouraudA[2], gouraudB[2];   // front/back: colour = A * albedo + B
 
+    // Exchanges the vertex stage's buffers with `o` (the renderer keeps them between frames,
+    // so a frame neither allocates nor zero-fills them: large meshes page-faulted on them).
+    void swapBuffers(DrawItem& o) {
+        clip.swap(o.clip);
+        code.swap(o.code);
+        win.swap(o.win);
+        wv.swap(o.wv);
+        wtan.swap(o.wtan);
+        for (int s = 0; s < 2; ++s) {
+            gouraudA[s].swap(o.gouraudA[s]);
+            gouraudB[s].swap(o.gouraudB[s]);
+        }
+    }
+
     // Whether back faces of triangle `tri` are culled (RenderSettings::culling, per material).
     bool cullsBack(uint32_t tri, sg::CullMode mode) const {
         if (mode != sg::CullMode::Auto) return mode == sg::CullMode::On;
@@ -169,9 +183,13 @@ void runVertexStage(DrawItem& d, const sg::FrameInput& f, int width, int height,
         for (size_t v = r.begin(); v != r.end(); ++v) {
             uint32_t mi = d.meshIndex(uint32_t(v));
             DrawItem::VertexOut& o = d.wv[v];
-            if (mi >= m.positions.size()) {
+            if (mi >= m.positions.size()) {   // zeros, as in a new buffer
                 d.code[v] = kClipNear;
+                d.clip[v] = vec4(0.0f);
                 o = DrawItem::VertexOut{};
+                if (d.hasTangents) d.wtan[v] = vec4(0.0f);
+                if (gouraud)
+                    for (int s = 0; s < 2; ++s) d.gouraudA[s][v] = d.gouraudB[s][v] = vec3(0.0f);
                 continue;
             }
             vec4 w = d.world * vec4(m.positions[mi], 1.0f);   // modelling: object -> world
@@ -1140,10 +1158,20 @@ private:
                 d.triCount = uint32_t(p.mesh->indices.size() / 3);
                 if (d.triCount == 0) continue;
                 d.perCorner = gouraud && d.triMat;
+                if (draws.size() < m_vertexBuffers.size()) d.swapBuffers(m_vertexBuffers[draws.size()]);
                 draws.push_back(std::move(d));
             }   // points and lines: the overlay (step 5)
         }
         m_samplers.endFrame();
+        // Whatever way this frame ends, the vertex buffers go back for the next one.
+        struct GiveBack {
+            std::vector<DrawItem>& draws;
+            std::vector<DrawItem>& pool;
+            ~GiveBack() {
+                if (pool.size() < draws.size()) pool.resize(draws.size());
+                for (size_t i = 0; i < draws.size(); ++i) draws[i].swapBuffers(pool[i]);
+            }
+        } giveBack{draws, m_vertexBuffers};
 
         auto tStart = std::chrono::steady_clock::now();
         auto ms = [](auto a, auto b) { return std::chrono::duration<double, std::milli>(b - a).count(); };
@@ -1232,6 +1260,7 @@ private:
     SamplerCache m_samplers;
     TessellationCache m_tess;
     std::vector<Chunk> m_chunks;
+    std::vector<DrawItem> m_vertexBuffers;   // only their vertex-stage buffers (DrawItem::swapBuffers)
     // VIEWER_RASTER_REFERENCE_SHADING=1: shade every fragment with rnd::shade (slow; used to
     // check the batched path).
     bool m_timing = [] {
