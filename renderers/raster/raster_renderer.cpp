@@ -936,6 +936,26 @@ void shadeOpaque(const FrameContext& fc, Framebuffer& target, TileBuffers& buf, 
     const bool fogOn = st.fog != sg::FogMode::Off;
     for (size_t k = 0; k < nf; ++k) {
         uint32_t id = buf.fragTri[k];
+        // Tiny triangles (a big mesh) change every fragment and miss the cache on the triangle,
+        // its indices and its vertices: prefetch the triangle 16 fragments ahead, its indices 8
+        // ahead and its vertices 4 ahead (only where the triangle changes).
+        if (k + 16 < nf && buf.fragTri[k + 16] != buf.fragTri[k + 15]) __builtin_prefetch(&triById(chunks, buf.fragTri[k + 16]));
+        if (k + 8 < nf && buf.fragTri[k + 8] != buf.fragTri[k + 7]) {
+            const Tri& tn = triById(chunks, buf.fragTri[k + 8]);
+            const DrawItem& dn = (*fc.draws)[tn.draw];
+            if (!dn.perCorner && size_t(tn.prim) * 3 < dn.mesh->indices.size()) __builtin_prefetch(&dn.mesh->indices[size_t(tn.prim) * 3]);
+        }
+        if (k + 4 < nf && buf.fragTri[k + 4] != buf.fragTri[k + 3]) {
+            const Tri& tn = triById(chunks, buf.fragTri[k + 4]);
+            const DrawItem& dn = (*fc.draws)[tn.draw];
+            for (int q = 0; q < 3; ++q) {
+                const uint32_t vq = dn.vertexOf(tn.prim, q);
+                if (vq < dn.wv.size()) {
+                    __builtin_prefetch(&dn.wv[vq]);
+                    __builtin_prefetch(reinterpret_cast<const char*>(&dn.wv[vq]) + sizeof(DrawItem::VertexOut) - 1);
+                }
+            }
+        }
         if (id != tc.id) tc.load(id, triById(chunks, id), chunks[id >> kChunkBits], fc);
 #if defined(__SSE2__)
         // Four fragments of one triangle in a row (the common case for all but tiny triangles).
