@@ -406,7 +406,7 @@ inline void rasterizeTri(const Tri& t, uint32_t id, int tx0, int ty0, int tx1, i
     const Edge& e1 = t.s.e[1];
     const Edge& e2 = t.s.e[2];
     if (samples == 1) {
-        forEachCoveredPixel(t.s, x0, y0, x1, y1, [&](int i, int j) {
+        auto pixel = [&](int i, int j) {
             float z = t.zRef + t.zdx * float(i - t.s.minX) + t.zdy * float(j - t.s.minY);
             z = std::clamp(z, 0.0f, 1.0f);
             size_t p = size_t(j - ty0) * tw + (i - tx0);
@@ -414,7 +414,19 @@ inline void rasterizeTri(const Tri& t, uint32_t id, int tx0, int ty0, int tx1, i
                 depth[p] = z;
                 ids[p] = id;
             }
-        });
+        };
+        if (x1 - x0 <= 1 && y1 - y0 <= 1) {
+            // At most 2x2 pixels (most triangles of a big mesh): the edge functions at each pixel
+            // centre directly, as forEachCoveredPixelSimple; the same pixels in the same order
+            // as the block walk, without its setup.
+            for (int j = y0; j <= y1; ++j)
+                for (int i = x0; i <= x1; ++i) {
+                    const int64_t px = int64_t(i) * kSub + kHalf, py = int64_t(j) * kSub + kHalf;
+                    if (e0.at(px, py) >= e0.bias && e1.at(px, py) >= e1.bias && e2.at(px, py) >= e2.bias) pixel(i, j);
+                }
+            return;
+        }
+        forEachCoveredPixel(t.s, x0, y0, x1, y1, pixel);
         return;
     }
     for (int j = y0; j <= y1; ++j)
