@@ -16,8 +16,12 @@
 //   mpix_s_thread  the same per thread, ours vs the minimal GL program
 //   scaling     ours: ms on 1 thread (ours=) vs on --threads (ref=); ratio = the speed-up
 //   cold_ms     ours: the first frame of a new renderer (ours=) vs a warm one (ref=)
-// and a floor line per run: what=floor_bw: memory bandwidth (GB/s, read + write of a 256 MiB
-// copy) on 1 thread (ours=) and on --threads (ref=).
+//   floor_shade the lighting kernel alone (raster_shading.h's shadeBatch on as many fragments as
+//               the scene covers, same lights; ours=) vs the whole raster frame (ref=)
+// and floor lines per run: what=floor_bw: memory bandwidth (GB/s, read + write of a 256 MiB
+// copy) on 1 thread (ours=) and on --threads (ref=); what=floor_cpu: a fixed arithmetic loop
+// per thread, ms on 1 thread (ours=) and on --threads (ref=), ratio = the speed-up this machine
+// gives right now (below --threads when other work shares the cores: no renderer scales better).
 // Scenes: mesh10k / mesh100k / mesh1M (one mesh: a uv-sphere grid and its ground plane merged
 // into a single draw, one point light), spheres10k / spheres100k / spheres1M (the same kind of
 // grid as instances of one sphere mesh, plus a ground plane and a directional light) and bunny
@@ -26,6 +30,7 @@
 // --quick: fewer frames and 960x540 (finishes well under a minute). --no-gl: raster only (for
 // profiling it, e.g. perf record ... bench_raster --no-gl --scenes mesh1M).
 #include "min_gl.h"
+#include "raster/raster_shading.h"
 #include "renderers/renderer.h"
 #include "scenegraph/frame.h"
 #include "scenegraph/scene.h"
@@ -245,6 +250,51 @@ Timing timeRenderer(rnd::Renderer& r, const FrameInput& f, int w, int h, int fra
         frames);
 }
 
+// Parallelism the machine gives this process now: a fixed amount of pure arithmetic per thread
+// on 1 and on `threads` threads; returns {ms on 1 thread, ms on `threads`} (medians of 3).
+// Speed-up = threads * first / second; on a machine busy with other work it is below `threads`,
+// and no renderer can scale better than it.
+std::pair<double, double> computeScaling(int threads) {
+    auto run = [](int n) {
+        std::vector<double> ms;
+        for (int rep = 0; rep < 3; ++rep) {
+            auto t0 = std::chrono::steady_clock::now();
+            std::vector<double> sink(size_t(n) * 8);
+            tbb::parallel_for(0, n, [&](int k) {
+                double x = 1.0;
+                for (int i = 0; i < 20000000; ++i) x = x * 1.0000001 + 1e-9;
+                sink[size_t(k) * 8] = x;
+            });
+            ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+        }
+        return median(ms);
+    };
+    return {run(1), run(threads)};
+}
+
+// Shading-only floor: the rasterizer's lighting kernel (rnd::raster::shadeBatch, SSE, the same
+// lights and Phong model) on `fragments` fragments split over the threads, without coverage,
+// depth, attribute interpolation or output: ms per frame (median of 5).
+double shadeOnlyMs(const FrameInput& f, size_t fragments) {
+    const size_t parts = 64, per = (fragments + parts - 1) / parts;
+    std::vector<rnd::raster::ShadeBatch> batches(parts);
+    for (auto& b : batches) {
+        b.resize(per);
+        for (size_t i = 0; i < per; ++i) {
+            const float u = float(i) / float(per);
+            b.set(i, Material{}, vec3(u * 8.0f - 4.0f, 0.5f, u * 4.0f), glm::normalize(vec3(u - 0.5f, 1.0f, 0.3f)), vec3(0.8f, 0.3f, 0.2f),
+                  f.ambientLight);
+        }
+    }
+    std::vector<double> ms;
+    for (int rep = 0; rep < 5; ++rep) {
+        auto t0 = std::chrono::steady_clock::now();
+        tbb::parallel_for(size_t(0), parts, [&](size_t k) { rnd::raster::shadeBatch(batches[k], per, f); });
+        ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    }
+    return median(ms);
+}
+
 // Memory bandwidth floor: GB/s of read + write of a 256 MiB buffer copied in `threads` slices
 // (median of 5).
 double copyBandwidth(int threads) {
@@ -336,6 +386,8 @@ int main(int argc, char** argv) {
                 shading.c_str(), fog.c_str(), frames);
     const double bw1 = copyBandwidth(1), bwN = copyBandwidth(threads);
     std::printf("bench: scene=all what=floor_bw ours=%.2f ref=%.2f ratio=%.3f\n", bw1, bwN, bwN / bw1);
+    const auto [cpu1, cpuN] = computeScaling(threads);
+    std::printf("bench: scene=all what=floor_cpu ours=%.2f ref=%.2f ratio=%.3f\n", cpu1, cpuN, threads * cpu1 / cpuN);
     for (BenchScene& b : scenes) {
         parse(shading, b.scene.settings.shading);
         b.scene.settings.fog = fog == "on" ? FogMode::Linear : FogMode::Off;
@@ -387,6 +439,8 @@ int main(int argc, char** argv) {
         std::printf("bench: scene=%s what=mpix_s_thread ours=%.1f ref=%.1f ratio=%.3f\n", n, cov / (to * 1e3) / threads, cov / (tr * 1e3) / threads,
                     tr / to);
         if (threads > 1) std::printf("bench: scene=%s what=scaling ours=%.2f ref=%.2f ratio=%.3f\n", n, o1.wallMs, to, o1.wallMs / to);
+        const double shadeMs = shadeOnlyMs(f, size_t(cov));
+        std::printf("bench: scene=%s what=floor_shade ours=%.2f ref=%.2f ratio=%.3f\n", n, shadeMs, to, shadeMs / to);
         std::printf("bench: scene=%s what=cold_ms ours=%.2f ref=%.2f ratio=%.3f\n", n, cold, to, cold / to);
         // Same picture? Fraction of pixels whose channels all lie within 8 of the other's.
         size_t close = 0;
