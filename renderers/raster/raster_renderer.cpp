@@ -299,6 +299,10 @@ void runTriangleStage(Chunk& ch, const FrameContext& fc) {
     const int nt = fc.tilesX * fc.tilesY;
     ch.tileStart.assign(size_t(nt) + 1, 0);
     ch.rects.clear();
+    // One Tri per input triangle unless clipped: sized once, so a first frame does not grow
+    // (and copy) the vectors step by step.
+    ch.tris.reserve(size_t(ch.end - ch.begin));
+    ch.rects.reserve(size_t(ch.end - ch.begin));
     auto bin = [&](const Tri& tri) {   // counts ch.tris.back()
         const Chunk::TileRect r{uint16_t(tri.s.minX / kTileSize), uint16_t(tri.s.minY / kTileSize), uint16_t(tri.s.maxX / kTileSize),
                                 uint16_t(tri.s.maxY / kTileSize)};
