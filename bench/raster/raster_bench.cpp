@@ -1,5 +1,6 @@
-// raster_bench.cpp - frame time of our CPU rasterizer ("raster") vs the GL backend on Mesa
-// llvmpipe, same scene, camera, shading, size and thread count.
+// raster_bench.cpp - frame time of our CPU rasterizer ("raster") vs a minimal GL program on
+// Mesa llvmpipe (min_gl.h: one VBO, one glDrawArrays, the same Phong + linear fog, one
+// glReadPixels) and vs our GL backend on llvmpipe; same scene, camera, size and thread count.
 //
 //   cmake --build build/release -j2 --target bench_raster
 //   ./build/release/bench/raster/bench_raster [--quick] [--threads 2] [--frames 15]
@@ -7,17 +8,35 @@
 //
 // Prints one line per scene and metric:
 //   bench: scene=<name> what=<metric> ours=<x> ref=<y> ratio=<ours/ref>
-// metrics: ms (median wall ms per frame), cpu_ms (median process CPU ms per frame, all
-// threads), mpix_s (fill rate: covered pixels per wall second / 1e6).
-// Scenes: spheres10k / spheres100k / spheres1M (uv-sphere grids on a tessellated ground
-// plane) and bunny (stanford-bunny.obj from shared/testdata, read by a tiny OBJ reader below).
-// LP_NUM_THREADS is set before the GL context is created; tbb is limited to the same count.
-// --quick: fewer frames and 960x540 (finishes well under a minute).
+// metrics (medians of warm frames):
+//   ms          wall ms per frame, raster vs the minimal GL program (the goal: ratio <= 0.5)
+//   ms_gl       wall ms per frame, raster vs our GL backend
+//   cpu_ms      process CPU ms per frame (all threads), raster vs the minimal GL program
+//   mpix_s      fill rate: covered pixels per wall second / 1e6 (ratio = ref time / ours)
+//   mpix_s_thread  the same per thread, ours vs the minimal GL program
+//   scaling     ours: ms on 1 thread (ours=) vs on --threads (ref=); ratio = the speed-up
+//   cold_ms     ours: the first frame of a new renderer (ours=) vs a warm one (ref=)
+//   floor_shade the lighting kernel alone (raster_shading.h's shadeBatch on as many fragments as
+//               the scene covers, same lights; ours=) vs the whole raster frame (ref=)
+// and floor lines per run: what=floor_bw: memory bandwidth (GB/s, read + write of a 256 MiB
+// copy) on 1 thread (ours=) and on --threads (ref=); what=floor_cpu: a fixed arithmetic loop
+// per thread, ms on 1 thread (ours=) and on --threads (ref=), ratio = the speed-up this machine
+// gives right now (below --threads when other work shares the cores: no renderer scales better).
+// Scenes: mesh10k / mesh100k / mesh1M (one mesh: a uv-sphere grid and its ground plane merged
+// into a single draw, one point light), spheres10k / spheres100k / spheres1M (the same kind of
+// grid as instances of one sphere mesh, plus a ground plane and a directional light) and bunny
+// (stanford-bunny.obj from shared/testdata, read by a tiny OBJ reader below).
+// LP_NUM_THREADS is set before any GL context is created; tbb is limited to the same count.
+// --quick: fewer frames and 960x540 (finishes well under a minute). --no-gl: raster only (for
+// profiling it, e.g. perf record ... bench_raster --no-gl --scenes mesh1M).
+#include "min_gl.h"
+#include "raster/raster_shading.h"
 #include "renderers/renderer.h"
 #include "scenegraph/frame.h"
 #include "scenegraph/scene.h"
 
 #include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
 
 #include <sys/resource.h>
 
@@ -28,6 +47,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -115,6 +135,46 @@ BenchScene sphereGrid(const std::string& name, int grid, int seg) {
     return b;
 }
 
+// One mesh (a single draw): grid x grid uv-spheres of `seg` slices (seg/2 stacks) and a
+// ground plane of `groundSub` x `groundSub` quads, merged, one material, one point light.
+BenchScene singleMesh(const std::string& name, int grid, int seg, int groundSub) {
+    BenchScene b;
+    b.name = name;
+    Scene& s = b.scene;
+    float spacing = 1.0f, extent = grid * spacing;
+    auto m = std::make_shared<Mesh>(primitives::plane(extent, groundSub));
+    m->uv0.clear();
+    const Mesh sphere = primitives::uvSphere(0.4f * spacing, seg, seg / 2);
+    for (int i = 0; i < grid; ++i)
+        for (int j = 0; j < grid; ++j) {
+            const vec3 at((i - (grid - 1) * 0.5f) * spacing, 0.4f * spacing, (j - (grid - 1) * 0.5f) * spacing);
+            const uint32_t base = uint32_t(m->positions.size());
+            for (size_t v = 0; v < sphere.positions.size(); ++v) {
+                m->positions.push_back(sphere.positions[v] + at);
+                m->normals.push_back(sphere.normals[v]);
+            }
+            for (uint32_t idx : sphere.indices) m->indices.push_back(base + idx);
+        }
+    s.meshes = {m};
+    Material mat;
+    mat.baseColor = vec3(0.8f, 0.3f, 0.2f);
+    mat.ks = 0.5f;
+    s.materials = {mat};
+    s.addNode("mesh", s.root(), MeshInstance{0, 0});
+    b.triangles = m->triangleCount();
+    Camera cam;
+    cam.projection.fovyDeg = 50.0f;
+    cam.projection.zNear = 0.1f;
+    cam.projection.zFar = 4.0f * extent + 20.0f;
+    NodeId c = s.addNode("camera", s.root(), cam);
+    s.lookAt(c, vec3(0.0f, 0.55f * extent + 1.0f, 0.75f * extent + 1.5f), vec3(0.0f, 0.0f, 0.0f));
+    s.activeCamera = c;
+    NodeId key = s.addNode("key", s.root(), Light{LightType::Point, vec3(1.0f), 1.0f, false});
+    s.setLocal(key, LocalTransform::fromTRS(vec3(extent * 0.3f, extent, extent * 0.5f)));
+    s.ambientLight = vec3(0.3f);
+    return b;
+}
+
 bool bunnyScene(BenchScene& b) {
     b.name = "bunny";
     auto m = std::make_shared<Mesh>();
@@ -164,24 +224,93 @@ struct Timing {
     double wallMs = NAN, cpuMs = NAN;   // medians per frame
 };
 
-// Median wall and CPU ms per frame (after one warm-up frame); NAN when the renderer fails.
-// CPU time (summed over the process's threads: ours and llvmpipe's) is the steadier figure on
-// a shared, loaded machine.
-Timing timeFrames(rnd::Renderer& r, const FrameInput& f, int w, int h, int frames, rnd::Framebuffer& fb, std::string& err) {
-    rnd::RenderStats s = r.render(f, w, h, fb);   // warm-up: caches, textures, GL buffers
-    if (!s.ok) {
-        err = s.error;
-        return {};
-    }
+// Median wall and CPU ms per frame of `frame` (after one warm-up frame: caches, textures, GL
+// buffers); NAN when it fails. CPU time (summed over the process's threads: ours and
+// llvmpipe's) is the steadier figure on a shared, loaded machine.
+Timing timeFrames(const std::function<bool()>& frame, int frames) {
+    if (!frame()) return {};
     std::vector<double> t, c;
     for (int i = 0; i < frames; ++i) {
         auto t0 = std::chrono::steady_clock::now();
         double c0 = cpuMs();
-        s = r.render(f, w, h, fb);
+        frame();
         c.push_back(cpuMs() - c0);
         t.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     }
     return {median(t), median(c)};
+}
+
+Timing timeRenderer(rnd::Renderer& r, const FrameInput& f, int w, int h, int frames, rnd::Framebuffer& fb, std::string& err) {
+    return timeFrames(
+        [&] {
+            rnd::RenderStats s = r.render(f, w, h, fb);
+            if (!s.ok) err = s.error;
+            return s.ok;
+        },
+        frames);
+}
+
+// Parallelism the machine gives this process now: a fixed amount of pure arithmetic per thread
+// on 1 and on `threads` threads; returns {ms on 1 thread, ms on `threads`} (medians of 3).
+// Speed-up = threads * first / second; on a machine busy with other work it is below `threads`,
+// and no renderer can scale better than it.
+std::pair<double, double> computeScaling(int threads) {
+    auto run = [](int n) {
+        std::vector<double> ms;
+        for (int rep = 0; rep < 3; ++rep) {
+            auto t0 = std::chrono::steady_clock::now();
+            std::vector<double> sink(size_t(n) * 8);
+            tbb::parallel_for(0, n, [&](int k) {
+                double x = 1.0;
+                for (int i = 0; i < 20000000; ++i) x = x * 1.0000001 + 1e-9;
+                sink[size_t(k) * 8] = x;
+            });
+            ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+        }
+        return median(ms);
+    };
+    return {run(1), run(threads)};
+}
+
+// Shading-only floor: the rasterizer's lighting kernel (rnd::raster::shadeBatch, SSE, the same
+// lights and Phong model) on `fragments` fragments split over the threads, without coverage,
+// depth, attribute interpolation or output: ms per frame (median of 5).
+double shadeOnlyMs(const FrameInput& f, size_t fragments) {
+    const size_t parts = 64, per = (fragments + parts - 1) / parts;
+    std::vector<rnd::raster::ShadeBatch> batches(parts);
+    for (auto& b : batches) {
+        b.resize(per);
+        for (size_t i = 0; i < per; ++i) {
+            const float u = float(i) / float(per);
+            b.set(i, Material{}, vec3(u * 8.0f - 4.0f, 0.5f, u * 4.0f), glm::normalize(vec3(u - 0.5f, 1.0f, 0.3f)), vec3(0.8f, 0.3f, 0.2f),
+                  f.ambientLight);
+        }
+    }
+    std::vector<double> ms;
+    for (int rep = 0; rep < 5; ++rep) {
+        auto t0 = std::chrono::steady_clock::now();
+        tbb::parallel_for(size_t(0), parts, [&](size_t k) { rnd::raster::shadeBatch(batches[k], per, f); });
+        ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    }
+    return median(ms);
+}
+
+// Memory bandwidth floor: GB/s of read + write of a 256 MiB buffer copied in `threads` slices
+// (median of 5).
+double copyBandwidth(int threads) {
+    const size_t n = size_t(256) << 20;
+    std::vector<char> a(n, 1), b(n, 0);
+    std::vector<double> gbs;
+    for (int rep = 0; rep < 5; ++rep) {
+        auto t0 = std::chrono::steady_clock::now();
+        tbb::parallel_for(0, threads, [&](int k) {
+            size_t lo = n / threads * k, hi = k + 1 == threads ? n : n / threads * (k + 1);
+            std::memcpy(b.data() + lo, a.data() + lo, hi - lo);
+        });
+        double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        gbs.push_back(2.0 * double(n) / s * 1e-9);
+    }
+    return median(gbs);
 }
 
 // Pixels not equal to the background (covered by geometry).
@@ -194,7 +323,7 @@ double coveredPixels(const rnd::Framebuffer& fb) {
 }   // namespace
 
 int main(int argc, char** argv) {
-    bool quick = false;
+    bool quick = false, noGl = false;
     int threads = 2, frames = 15, w = 1280, h = 720;
     std::string shading = "phong", fog = "on", only;
     for (int i = 1; i < argc; ++i) {
@@ -202,6 +331,8 @@ int main(int argc, char** argv) {
         auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
         if (a == "--quick")
             quick = true;
+        else if (a == "--no-gl")
+            noGl = true;
         else if (a == "--threads")
             threads = std::max(1, std::atoi(next().c_str()));
         else if (a == "--frames")
@@ -232,43 +363,96 @@ int main(int argc, char** argv) {
 
     std::string err;
     auto ours = rnd::makeRenderer("raster", &err);
-    auto ref = rnd::makeRenderer("gl", &err);
     if (!ours) {
         std::fprintf(stderr, "bench: %s\n", err.c_str());
         return 1;
     }
+    auto glBackend = noGl ? nullptr : rnd::makeRenderer("gl", &err);
 
     std::vector<BenchScene> scenes;
     auto want = [&](const std::string& n) { return only.empty() || ("," + only + ",").find("," + n + ",") != std::string::npos; };
+    if (want("mesh10k")) scenes.push_back(singleMesh("mesh10k", 4, 22, 32));
+    if (want("mesh100k")) scenes.push_back(singleMesh("mesh100k", 10, 30, 64));
+    if (want("mesh1M")) scenes.push_back(singleMesh("mesh1M", 22, 46, 64));
     if (want("spheres10k")) scenes.push_back(sphereGrid("spheres10k", 4, 24));
     if (want("spheres100k")) scenes.push_back(sphereGrid("spheres100k", 10, 32));
-    if (want("spheres1M") && !quick) scenes.push_back(sphereGrid("spheres1M", 32, 32));
-    if (want("spheres1M") && quick) scenes.push_back(sphereGrid("spheres1M", 32, 32));
+    if (want("spheres1M")) scenes.push_back(sphereGrid("spheres1M", 32, 32));
     if (want("bunny")) {
         BenchScene b;
         if (bunnyScene(b)) scenes.push_back(std::move(b));
     }
 
-    std::printf("# raster vs gl(llvmpipe): %dx%d, %d threads, shading=%s fog=%s, median of %d frames\n", w, h, threads, shading.c_str(), fog.c_str(),
-                frames);
+    std::printf("# raster vs minimal GL and gl backend (llvmpipe): %dx%d, %d threads, shading=%s fog=%s, median of %d frames\n", w, h, threads,
+                shading.c_str(), fog.c_str(), frames);
+    const double bw1 = copyBandwidth(1), bwN = copyBandwidth(threads);
+    std::printf("bench: scene=all what=floor_bw ours=%.2f ref=%.2f ratio=%.3f\n", bw1, bwN, bwN / bw1);
+    const auto [cpu1, cpuN] = computeScaling(threads);
+    std::printf("bench: scene=all what=floor_cpu ours=%.2f ref=%.2f ratio=%.3f\n", cpu1, cpuN, threads * cpu1 / cpuN);
     for (BenchScene& b : scenes) {
         parse(shading, b.scene.settings.shading);
         b.scene.settings.fog = fog == "on" ? FogMode::Linear : FogMode::Off;
         b.scene.settings.fogStart = 2.0f;
         b.scene.settings.fogEnd = 60.0f;
         FrameInput f = flatten(b.scene, float(w) / h);
-        rnd::Framebuffer fbO, fbR;
-        std::string eo, er;
-        Timing o = timeFrames(*ours, f, w, h, frames, fbO, eo);
-        Timing r = ref ? timeFrames(*ref, f, w, h, frames, fbR, er) : Timing{};
-        double to = o.wallMs, tr = r.wallMs;
+        rnd::Framebuffer fbO, fbG;
+        std::string eo, eg;
+        // Cold: the first frame of a new renderer (no caches, buffers sized on the way).
+        double cold = NAN;
+        rnd::Framebuffer fbCold;
+        {
+            auto fresh = rnd::makeRenderer("raster", &err);
+            auto t0 = std::chrono::steady_clock::now();
+            rnd::Framebuffer& fb = fbCold;
+            if (fresh && fresh->render(f, w, h, fb).ok)
+                cold = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        }
+        Timing o = timeRenderer(*ours, f, w, h, frames, fbO, eo);
+        Timing o1;
+        if (threads > 1) {
+            tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+            o1 = timeRenderer(*ours, f, w, h, frames, fbO, eo);
+        }
+        Timing g = glBackend ? timeRenderer(*glBackend, f, w, h, frames, fbG, eg) : Timing{};
+        Timing r;
+        std::vector<uint8_t> rgba;   // the minimal GL program's image, rows bottom to top
+        {
+            bench::MinimalGl mgl;
+            std::string em = noGl ? "skipped (--no-gl)" : mgl.setup(f, w, h);
+            if (em.empty())
+                r = timeFrames(
+                    [&] {
+                        mgl.render(rgba);
+                        return true;
+                    },
+                    frames);
+            else
+                std::fprintf(stderr, "bench: minimal GL failed on %s: %s\n", b.name.c_str(), em.c_str());
+        }
         if (!eo.empty()) std::fprintf(stderr, "bench: raster failed on %s: %s\n", b.name.c_str(), eo.c_str());
-        if (!er.empty()) std::fprintf(stderr, "bench: gl failed on %s: %s\n", b.name.c_str(), er.c_str());
-        double cov = coveredPixels(fbO);
-        std::printf("bench: scene=%s what=ms ours=%.2f ref=%.2f ratio=%.3f\n", b.name.c_str(), to, tr, to / tr);
-        std::printf("bench: scene=%s what=cpu_ms ours=%.2f ref=%.2f ratio=%.3f\n", b.name.c_str(), o.cpuMs, r.cpuMs, o.cpuMs / r.cpuMs);
-        std::printf("bench: scene=%s what=mpix_s ours=%.1f ref=%.1f ratio=%.3f\n", b.name.c_str(), cov / (to * 1e3), cov / (tr * 1e3), tr / to);
-        std::printf("# %s: %zu triangles, %.0f covered pixels\n", b.name.c_str(), b.triangles, cov);
+        if (!eg.empty()) std::fprintf(stderr, "bench: gl failed on %s: %s\n", b.name.c_str(), eg.c_str());
+        const double to = o.wallMs, tr = r.wallMs, cov = coveredPixels(fbO);
+        const char* n = b.name.c_str();
+        std::printf("bench: scene=%s what=ms ours=%.2f ref=%.2f ratio=%.3f\n", n, to, tr, to / tr);
+        std::printf("bench: scene=%s what=ms_gl ours=%.2f ref=%.2f ratio=%.3f\n", n, to, g.wallMs, to / g.wallMs);
+        std::printf("bench: scene=%s what=cpu_ms ours=%.2f ref=%.2f ratio=%.3f\n", n, o.cpuMs, r.cpuMs, o.cpuMs / r.cpuMs);
+        std::printf("bench: scene=%s what=mpix_s ours=%.1f ref=%.1f ratio=%.3f\n", n, cov / (to * 1e3), cov / (tr * 1e3), tr / to);
+        std::printf("bench: scene=%s what=mpix_s_thread ours=%.1f ref=%.1f ratio=%.3f\n", n, cov / (to * 1e3) / threads, cov / (tr * 1e3) / threads,
+                    tr / to);
+        if (threads > 1) std::printf("bench: scene=%s what=scaling ours=%.2f ref=%.2f ratio=%.3f\n", n, o1.wallMs, to, o1.wallMs / to);
+        const double shadeMs = shadeOnlyMs(f, size_t(cov));
+        std::printf("bench: scene=%s what=floor_shade ours=%.2f ref=%.2f ratio=%.3f\n", n, shadeMs, to, shadeMs / to);
+        std::printf("bench: scene=%s what=cold_ms ours=%.2f ref=%.2f ratio=%.3f\n", n, cold, to, cold / to);
+        // Same picture? Fraction of pixels whose channels all lie within 8 of the other's.
+        size_t close = 0;
+        if (rgba.size() == fbO.color.size())
+            for (int y = 0; y < h; ++y)
+                for (int x = 0; x < w; ++x) {
+                    const uint8_t* a = fbO.pixel(x, h - 1 - y);
+                    const uint8_t* c = &rgba[(size_t(y) * w + x) * 4];
+                    close += std::abs(a[0] - c[0]) <= 8 && std::abs(a[1] - c[1]) <= 8 && std::abs(a[2] - c[2]) <= 8;
+                }
+        std::printf("# %s: %zu triangles, %.0f covered pixels, %.2f%% of pixels within 8 of the minimal GL image, warm frame %s the first\n", n,
+                    b.triangles, cov, 100.0 * double(close) / (double(w) * h), fbCold.color == fbO.color ? "identical to" : "DIFFERS from");
         std::fflush(stdout);
     }
     return 0;

@@ -28,6 +28,9 @@
 #include "renderers/tessellate.h"
 #include "renderers/texture_sampler.h"
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -119,9 +122,28 @@ struct DrawItem {
     std::vector<vec4> clip;
     std::vector<uint8_t> code;
     std::vector<vec4> win;   // window x, y, z, 1/w (valid when code == 0)
-    std::vector<vec3> wpos, wnrm;
+    // World position, world normal (0 without normals) and eye-space position (fog; 0 when
+    // fog is off) of a vertex, side by side: the fragment stage fetches all three per triangle.
+    struct VertexOut {
+        vec3 pos{0.0f}, nrm{0.0f}, eye{0.0f};
+    };
+    std::vector<VertexOut> wv;
     std::vector<vec4> wtan;                       // world tangent (xyz, handedness; mirrored draws flip it), when hasTangents
     std::vector<vec3> gouraudA[2], gouraudB[2];   // front/back: colour = A * albedo + B
+
+    // Exchanges the vertex stage's buffers with `o` (the renderer keeps them between frames,
+    // so a frame neither allocates nor zero-fills them: large meshes page-faulted on them).
+    void swapBuffers(DrawItem& o) {
+        clip.swap(o.clip);
+        code.swap(o.code);
+        win.swap(o.win);
+        wv.swap(o.wv);
+        wtan.swap(o.wtan);
+        for (int s = 0; s < 2; ++s) {
+            gouraudA[s].swap(o.gouraudA[s]);
+            gouraudB[s].swap(o.gouraudB[s]);
+        }
+    }
 
     // Whether back faces of triangle `tri` are culled (RenderSettings::culling, per material).
     bool cullsBack(uint32_t tri, sg::CullMode mode) const {
@@ -146,8 +168,8 @@ void runVertexStage(DrawItem& d, const sg::FrameInput& f, int width, int height,
     d.clip.resize(n);
     d.code.resize(n);
     d.win.resize(n);
-    d.wpos.resize(n);
-    d.wnrm.assign(n, vec3(0.0f));
+    d.wv.resize(n);
+    const bool fog = f.settings.fog != sg::FogMode::Off;
     d.wtan.resize(d.hasTangents ? n : 0);
     const float handedness = d.mirrored ? -1.0f : 1.0f;   // a mirroring transform flips cross(n, t)
     if (gouraud)
@@ -160,27 +182,36 @@ void runVertexStage(DrawItem& d, const sg::FrameInput& f, int width, int height,
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t v = r.begin(); v != r.end(); ++v) {
             uint32_t mi = d.meshIndex(uint32_t(v));
-            if (mi >= m.positions.size()) {
+            DrawItem::VertexOut& o = d.wv[v];
+            if (mi >= m.positions.size()) {   // zeros, as in a new buffer
                 d.code[v] = kClipNear;
+                d.clip[v] = vec4(0.0f);
+                o = DrawItem::VertexOut{};
+                if (d.hasTangents) d.wtan[v] = vec4(0.0f);
+                if (gouraud)
+                    for (int s = 0; s < 2; ++s) d.gouraudA[s][v] = d.gouraudB[s][v] = vec3(0.0f);
                 continue;
             }
             vec4 w = d.world * vec4(m.positions[mi], 1.0f);   // modelling: object -> world
             vec4 c = viewProj * w;                            // viewing + projection -> clip
-            d.wpos[v] = vec3(w);
+            o.pos = vec3(w);
+            o.eye = fog ? vec3(f.camera.view * vec4(o.pos, 1.0f)) : vec3(0.0f);
             d.clip[v] = c;
             d.code[v] = outcode(c, g);
             if (d.code[v] == 0) d.win[v] = toWindow(c, width, height);
             if (d.hasNormals) {
                 vec3 nn = d.normal * m.normals[mi];   // normal matrix (inverse transpose)
                 float len = glm::length(nn);
-                d.wnrm[v] = len > 0 ? nn / len : vec3(0, 0, 1);
+                o.nrm = len > 0 ? nn / len : vec3(0, 0, 1);
+            } else {
+                o.nrm = vec3(0.0f);
             }
             if (d.hasTangents) d.wtan[v] = vec4(mat3(d.world) * vec3(m.tangents[mi]), m.tangents[mi].w * handedness);
             if (gouraud) {
                 const sg::Material& mat = d.perCorner ? d.materialOf(uint32_t(v / 3)) : d.material;
                 // Gouraud: the model's two albedo-linear terms at the vertex, front and back side.
-                ShadeTerms front = shadeTerms(mat, d.wpos[v], d.wnrm[v], f.camera.eye, f);
-                ShadeTerms back = shadeTerms(mat, d.wpos[v], -d.wnrm[v], f.camera.eye, f);
+                ShadeTerms front = shadeTerms(mat, o.pos, o.nrm, f.camera.eye, f);
+                ShadeTerms back = shadeTerms(mat, o.pos, -o.nrm, f.camera.eye, f);
                 d.gouraudA[0][v] = front.mul;
                 d.gouraudB[0][v] = front.add;
                 d.gouraudA[1][v] = back.mul;
@@ -196,6 +227,9 @@ void runVertexStage(DrawItem& d, const sg::FrameInput& f, int width, int height,
 
 // One scan-converted triangle (a whole input triangle or a piece of a clipped one).
 struct Tri {
+    // User-provided, so emplace_back() does not zero all 192 bytes before the member
+    // initializers run (it did: 15% of the triangle stage); setup writes every other field.
+    Tri() {}
     TriSetup s;
     float zRef, zdx, zdy;   // window z at pixel centre (minX, minY) and per-pixel steps
     // u_k = lambda_k / w_k (screen-linear) at pixel centre (minX, minY) and per-pixel steps;
@@ -212,7 +246,11 @@ struct Chunk {
     std::vector<Tri> tris;
     std::vector<std::array<vec3, 3>> clipBary;
     std::vector<uint32_t> tileStart, items;   // CSR: tiles -> triangle indices in order
-    std::vector<uint32_t> fill;               // scratch for binning
+    struct TileRect {
+        uint16_t x0, y0, x1, y1;   // tiles a triangle's bbox touches, inclusive
+    };
+    std::vector<TileRect> rects;   // one per triangle: binning reads these, not the triangles
+    std::vector<uint32_t> fill;    // scratch for binning
 };
 
 struct FrameContext {
@@ -257,6 +295,22 @@ void runTriangleStage(Chunk& ch, const FrameContext& fc) {
     const std::vector<DrawItem>& draws = *fc.draws;
     const auto& st = fc.frame->settings;
     const GuardBand g = guardBand(fc.width, fc.height);
+    // Triangles are counted per tile as they are made (binning's first pass); `rects` keeps
+    // their tile ranges for the second.
+    const int nt = fc.tilesX * fc.tilesY;
+    ch.tileStart.assign(size_t(nt) + 1, 0);
+    ch.rects.clear();
+    // One Tri per input triangle unless clipped: sized once, so a first frame does not grow
+    // (and copy) the vectors step by step.
+    ch.tris.reserve(size_t(ch.end - ch.begin));
+    ch.rects.reserve(size_t(ch.end - ch.begin));
+    auto bin = [&](const Tri& tri) {   // counts ch.tris.back()
+        const Chunk::TileRect r{uint16_t(tri.s.minX / kTileSize), uint16_t(tri.s.minY / kTileSize), uint16_t(tri.s.maxX / kTileSize),
+                                uint16_t(tri.s.maxY / kTileSize)};
+        ch.rects.push_back(r);
+        for (int ty = r.y0; ty <= r.y1; ++ty)
+            for (int tx = r.x0; tx <= r.x1; ++tx) ++ch.tileStart[size_t(ty) * fc.tilesX + tx + 1];
+    };
     // First draw containing ch.begin.
     size_t di =
         size_t(std::upper_bound(draws.begin(), draws.end(), ch.begin, [](uint64_t v, const DrawItem& d) { return v < d.firstTri; }) - draws.begin()) -
@@ -276,19 +330,26 @@ void runTriangleStage(Chunk& ch, const FrameContext& fc) {
         if (c0 & c1 & c2) continue;                // all outside one plane
         if ((c0 | c1 | c2) & kInvalid) continue;   // non-finite vertex
         if ((c0 | c1 | c2) == 0) {
-            Tri tri;
-            float wx[3] = {d.win[v[0]].x, d.win[v[1]].x, d.win[v[2]].x};
-            float wy[3] = {d.win[v[0]].y, d.win[v[1]].y, d.win[v[2]].y};
-            if (!setupTriangle(wx, wy, fc.width, fc.height, tri.s, fc.msaa)) continue;
+            Tri& tri = ch.tris.emplace_back();   // made in place (dropped again when rejected)
+            const vec4 &w0 = d.win[v[0]], &w1 = d.win[v[1]], &w2 = d.win[v[2]];
+            float wx[3] = {w0.x, w1.x, w2.x};
+            float wy[3] = {w0.y, w1.y, w2.y};
+            if (!setupTriangle(wx, wy, fc.width, fc.height, tri.s, fc.msaa)) {
+                ch.tris.pop_back();
+                continue;
+            }
             tri.front = tri.s.flipped == d.mirrored;   // CCW is front; mirrored instances: CW
-            if (!tri.front && d.cullsBack(t, st.culling)) continue;
+            if (!tri.front && d.cullsBack(t, st.culling)) {
+                ch.tris.pop_back();
+                continue;
+            }
             tri.alpha = d.materialOf(t).alphaMode;
-            float z[3] = {d.win[v[0]].z, d.win[v[1]].z, d.win[v[2]].z};
-            float iw[3] = {d.win[v[0]].w, d.win[v[1]].w, d.win[v[2]].w};
+            float z[3] = {w0.z, w1.z, w2.z};
+            float iw[3] = {w0.w, w1.w, w2.w};
             finishTri(tri, z, iw);
             tri.draw = uint32_t(di);
             tri.prim = t;
-            ch.tris.push_back(tri);
+            bin(tri);
             continue;
         }
         // Clip in homogeneous space, then fan-triangulate the polygon.
@@ -317,23 +378,18 @@ void runTriangleStage(Chunk& ch, const FrameContext& fc) {
             tri.prim = t;
             tri.clip = int32_t(ch.clipBary.size());
             ch.clipBary.push_back({poly[idx[tri.s.order[0]]].bary, poly[idx[tri.s.order[1]]].bary, poly[idx[tri.s.order[2]]].bary});
-            ch.tris.push_back(tri);
+            bin(ch.tris.emplace_back(tri));
         }
     }
     // Bin into tiles (counting sort keeps submission order within each tile).
-    int nt = fc.tilesX * fc.tilesY;
-    ch.tileStart.assign(size_t(nt) + 1, 0);
-    for (const Tri& t : ch.tris)
-        for (int ty = t.s.minY / kTileSize; ty <= t.s.maxY / kTileSize; ++ty)
-            for (int tx = t.s.minX / kTileSize; tx <= t.s.maxX / kTileSize; ++tx) ++ch.tileStart[size_t(ty) * fc.tilesX + tx + 1];
     for (int i = 0; i < nt; ++i) ch.tileStart[i + 1] += ch.tileStart[i];
     ch.items.resize(ch.tileStart[nt]);
     ch.fill.assign(ch.tileStart.begin(), ch.tileStart.end() - 1);
     std::vector<uint32_t>& fill = ch.fill;
-    for (uint32_t i = 0; i < ch.tris.size(); ++i) {
-        const Tri& t = ch.tris[i];
-        for (int ty = t.s.minY / kTileSize; ty <= t.s.maxY / kTileSize; ++ty)
-            for (int tx = t.s.minX / kTileSize; tx <= t.s.maxX / kTileSize; ++tx) ch.items[fill[size_t(ty) * fc.tilesX + tx]++] = i;
+    for (uint32_t i = 0; i < ch.rects.size(); ++i) {
+        const Chunk::TileRect r = ch.rects[i];
+        for (int ty = r.y0; ty <= r.y1; ++ty)
+            for (int tx = r.x0; tx <= r.x1; ++tx) ch.items[fill[size_t(ty) * fc.tilesX + tx]++] = i;
     }
 }
 
@@ -355,7 +411,7 @@ inline void rasterizeTri(const Tri& t, uint32_t id, int tx0, int ty0, int tx1, i
     const Edge& e1 = t.s.e[1];
     const Edge& e2 = t.s.e[2];
     if (samples == 1) {
-        forEachCoveredPixel(t.s, x0, y0, x1, y1, [&](int i, int j) {
+        auto pixel = [&](int i, int j) {
             float z = t.zRef + t.zdx * float(i - t.s.minX) + t.zdy * float(j - t.s.minY);
             z = std::clamp(z, 0.0f, 1.0f);
             size_t p = size_t(j - ty0) * tw + (i - tx0);
@@ -363,7 +419,19 @@ inline void rasterizeTri(const Tri& t, uint32_t id, int tx0, int ty0, int tx1, i
                 depth[p] = z;
                 ids[p] = id;
             }
-        });
+        };
+        if (x1 - x0 <= 1 && y1 - y0 <= 1) {
+            // At most 2x2 pixels (most triangles of a big mesh): the edge functions at each pixel
+            // centre directly, as forEachCoveredPixelSimple; the same pixels in the same order
+            // as the block walk, without its setup.
+            for (int j = y0; j <= y1; ++j)
+                for (int i = x0; i <= x1; ++i) {
+                    const int64_t px = int64_t(i) * kSub + kHalf, py = int64_t(j) * kSub + kHalf;
+                    if (e0.at(px, py) >= e0.bias && e1.at(px, py) >= e1.bias && e2.at(px, py) >= e2.bias) pixel(i, j);
+                }
+            return;
+        }
+        forEachCoveredPixel(t.s, x0, y0, x1, y1, pixel);
         return;
     }
     for (int j = y0; j <= y1; ++j)
@@ -400,21 +468,43 @@ struct TriCache {
     vec3 p[3], pe[3], n[3];    // world positions, eye positions, normals
     bool faceNormal = false;   // flat (or no normals): n[0] is the normal
     bool gouraud = false;
+    // Plain lit fragment (no vertex colours, textures or maps, not Gouraud, not reference
+    // shading): prepareFragment takes the short path with the material's coefficients below.
+    bool simple = false;
+    PhongCoefficients coeff;
+    vec3 simpleSpec, simpleBase;   // ShadeBatch::set's specular colour and ambient + emissive term (simple)
 
     void load(uint32_t newId, const Tri& tri, const Chunk& ch, const FrameContext& fc) {
         id = newId;
         t = &tri;
-        d = &(*fc.draws)[tri.draw];
-        mat = &d->materialOf(tri.prim);
-        cb = tri.clip >= 0 ? &ch.clipBary[size_t(tri.clip)] : nullptr;
         const sg::FrameInput& f = *fc.frame;
+        // Per draw (and material): the same for every triangle of a draw without per-triangle
+        // materials, so consecutive fragments of one mesh skip it.
+        const DrawItem* nd = &(*fc.draws)[tri.draw];
+        const sg::Material* nm = nd->triMat ? &nd->materialOf(tri.prim) : &nd->material;
+        if (nd != d || nm != mat) {
+            d = nd;
+            mat = nm;
+            gouraud = f.settings.shading == sg::ShadingModel::Gouraud && !d->gouraudA[0].empty();
+            faceNormal = f.settings.shading == sg::ShadingModel::Flat || !d->hasNormals;
+            simple = !gouraud && !fc.referenceShading && !d->hasColors && !(d->texture && d->hasUV) && !(d->hasUV && d->hasMaps());
+            if (simple) {
+                coeff = coefficientsOf(*mat);
+                simple = !coeff.unlit;
+                const vec3 albedo = mat->baseColor;   // ShadeBatch::set() with this albedo
+                simpleSpec = coeff.specularTinted ? albedo : coeff.specularColor;
+                simpleBase = coeff.ka * albedo * f.ambientLight + coeff.emissive;
+            }
+        }
+        cb = tri.clip >= 0 ? &ch.clipBary[size_t(tri.clip)] : nullptr;
+        vec3 nv[3];
         for (int k = 0; k < 3; ++k) {
             v[k] = d->vertexOf(tri.prim, k);
-            p[k] = d->wpos[v[k]];
-            if (f.settings.fog != sg::FogMode::Off) pe[k] = vec3(f.camera.view * vec4(p[k], 1.0f));
+            const DrawItem::VertexOut& o = d->wv[v[k]];
+            p[k] = o.pos;
+            pe[k] = o.eye;
+            nv[k] = o.nrm;
         }
-        gouraud = f.settings.shading == sg::ShadingModel::Gouraud && !d->gouraudA[0].empty();
-        faceNormal = f.settings.shading == sg::ShadingModel::Flat || !d->hasNormals;
         if (faceNormal) {
             // Face normal of the world-space triangle; outward = CCW side (CW for mirrored),
             // flipped toward the viewer when seen from the back (two-sided).
@@ -423,7 +513,7 @@ struct TriCache {
             float len = glm::length(nn);
             n[0] = len > 0 ? nn / len : vec3(0, 0, 1);
         } else {
-            for (int k = 0; k < 3; ++k) n[k] = tri.front ? d->wnrm[v[k]] : -d->wnrm[v[k]];
+            for (int k = 0; k < 3; ++k) n[k] = tri.front ? nv[k] : -nv[k];
         }
     }
 };
@@ -514,6 +604,145 @@ float fragmentAlpha(const TriCache& tc, int i, int j) {
     return a;
 }
 
+// Output pointers of a ShadeBatch (hoisted out of the per-fragment loop).
+struct BatchOut {
+    float *px, *py, *pz, *nx, *ny, *nz, *ar, *ag, *ab, *sr, *sg, *sb, *kd, *ks, *shin, *cr, *cg, *cb;
+    explicit BatchOut(ShadeBatch& b)
+        : px(b.px.data()),
+          py(b.py.data()),
+          pz(b.pz.data()),
+          nx(b.nx.data()),
+          ny(b.ny.data()),
+          nz(b.nz.data()),
+          ar(b.ar.data()),
+          ag(b.ag.data()),
+          ab(b.ab.data()),
+          sr(b.sr.data()),
+          sg(b.sg.data()),
+          sb(b.sb.data()),
+          kd(b.kd.data()),
+          ks(b.ks.data()),
+          shin(b.shin.data()),
+          cr(b.cr.data()),
+          cg(b.cg.data()),
+          cb(b.cb.data()) {}
+};
+
+// prepareFragment() for a TriCache::simple triangle, inlined into the fragment loop: the same
+// operations in the same order (so the same bits), with the per-material values precomputed.
+inline __attribute__((always_inline)) float prepareSimple(const TriCache& tc, bool fog, int i, int j, const BatchOut& o, size_t k) {
+    const FragBary fb = baryAt(tc, i, j);
+    const vec3& bo = fb.bo;
+    const vec3 pos = bo[0] * tc.p[0] + bo[1] * tc.p[1] + bo[2] * tc.p[2];
+    vec3 n;
+    if (tc.faceNormal) {
+        n = tc.n[0];
+    } else {
+        n = bo[0] * tc.n[0] + bo[1] * tc.n[1] + bo[2] * tc.n[2];
+        float len = glm::length(n);
+        n = len > 0 ? n / len : vec3(0, 0, 1);
+    }
+    const vec3& albedo = tc.mat->baseColor;
+    o.px[k] = pos.x;
+    o.py[k] = pos.y;
+    o.pz[k] = pos.z;
+    o.nx[k] = n.x;
+    o.ny[k] = n.y;
+    o.nz[k] = n.z;
+    o.ar[k] = albedo.x;
+    o.ag[k] = albedo.y;
+    o.ab[k] = albedo.z;
+    o.sr[k] = tc.simpleSpec.x;
+    o.sg[k] = tc.simpleSpec.y;
+    o.sb[k] = tc.simpleSpec.z;
+    o.kd[k] = tc.coeff.kd;
+    o.ks[k] = tc.coeff.ks;
+    o.shin[k] = tc.coeff.shininess;
+    o.cr[k] = tc.simpleBase.x;
+    o.cg[k] = tc.simpleBase.y;
+    o.cb[k] = tc.simpleBase.z;
+    if (!fog) return 0.0f;
+    return glm::length(bo[0] * tc.pe[0] + bo[1] * tc.pe[1] + bo[2] * tc.pe[2]);
+}
+
+#if defined(__SSE2__)
+// prepareSimple() for 4 fragments of the same triangle at pixels (i[l], j[l]), slots k..k+3:
+// each lane does prepareSimple's scalar operations in the same order (SSE's add, mul, div and
+// sqrt round as the scalar ones do), so the results are the same bits.
+inline void prepareSimple4(const TriCache& tc, bool fog, const int i[4], const int j[4], const BatchOut& o, float* fogDist, size_t k) {
+    using V = __m128;
+    const Tri& t = *tc.t;
+    auto set1 = [](float x) { return _mm_set1_ps(x); };
+    auto add = [](V a, V b) { return _mm_add_ps(a, b); };
+    auto mul = [](V a, V b) { return _mm_mul_ps(a, b); };
+    auto dot3 = [&](V a0, V a1, V a2, float c0, float c1, float c2) { return add(add(mul(a0, set1(c0)), mul(a1, set1(c1))), mul(a2, set1(c2))); };
+    const V di = _mm_cvtepi32_ps(_mm_setr_epi32(i[0] - t.s.minX, i[1] - t.s.minX, i[2] - t.s.minX, i[3] - t.s.minX));
+    const V dj = _mm_cvtepi32_ps(_mm_setr_epi32(j[0] - t.s.minY, j[1] - t.s.minY, j[2] - t.s.minY, j[3] - t.s.minY));
+    V u[3], sum = _mm_setzero_ps();
+    for (int q = 0; q < 3; ++q) {
+        u[q] = add(add(set1(t.uRef[q]), mul(set1(t.udx[q]), di)), mul(set1(t.udy[q]), dj));
+        sum = add(sum, u[q]);
+    }
+    const V inv = _mm_and_ps(_mm_cmpneq_ps(sum, _mm_setzero_ps()), _mm_div_ps(set1(1.0f), sum));
+    V b[3] = {mul(u[0], inv), mul(u[1], inv), mul(u[2], inv)};
+    V bo[3];
+    if (tc.cb) {
+        const std::array<vec3, 3>& cb = *tc.cb;
+        for (int c = 0; c < 3; ++c) bo[c] = dot3(b[0], b[1], b[2], cb[0][c], cb[1][c], cb[2][c]);
+    } else if (t.s.order[1] == 1) {   // setupTriangle's two orders: {0, 1, 2} or {0, 2, 1}
+        bo[0] = b[0];
+        bo[1] = b[1];
+        bo[2] = b[2];
+    } else {
+        bo[0] = b[0];
+        bo[1] = b[2];
+        bo[2] = b[1];
+    }
+    auto interp = [&](const vec3(&a)[3], int c) { return dot3(bo[0], bo[1], bo[2], a[0][c], a[1][c], a[2][c]); };
+    _mm_storeu_ps(o.px + k, interp(tc.p, 0));
+    _mm_storeu_ps(o.py + k, interp(tc.p, 1));
+    _mm_storeu_ps(o.pz + k, interp(tc.p, 2));
+    V nx, ny, nz;
+    if (tc.faceNormal) {
+        nx = set1(tc.n[0].x);
+        ny = set1(tc.n[0].y);
+        nz = set1(tc.n[0].z);
+    } else {
+        nx = interp(tc.n, 0);
+        ny = interp(tc.n, 1);
+        nz = interp(tc.n, 2);
+        const V len = _mm_sqrt_ps(add(add(mul(nx, nx), mul(ny, ny)), mul(nz, nz)));
+        const V pos = _mm_cmpgt_ps(len, _mm_setzero_ps());
+        auto sel = [](V m, V a, V c) { return _mm_or_ps(_mm_and_ps(m, a), _mm_andnot_ps(m, c)); };
+        nx = sel(pos, _mm_div_ps(nx, len), _mm_setzero_ps());
+        ny = sel(pos, _mm_div_ps(ny, len), _mm_setzero_ps());
+        nz = sel(pos, _mm_div_ps(nz, len), set1(1.0f));
+    }
+    _mm_storeu_ps(o.nx + k, nx);
+    _mm_storeu_ps(o.ny + k, ny);
+    _mm_storeu_ps(o.nz + k, nz);
+    const vec3& albedo = tc.mat->baseColor;
+    _mm_storeu_ps(o.ar + k, set1(albedo.x));
+    _mm_storeu_ps(o.ag + k, set1(albedo.y));
+    _mm_storeu_ps(o.ab + k, set1(albedo.z));
+    _mm_storeu_ps(o.sr + k, set1(tc.simpleSpec.x));
+    _mm_storeu_ps(o.sg + k, set1(tc.simpleSpec.y));
+    _mm_storeu_ps(o.sb + k, set1(tc.simpleSpec.z));
+    _mm_storeu_ps(o.kd + k, set1(tc.coeff.kd));
+    _mm_storeu_ps(o.ks + k, set1(tc.coeff.ks));
+    _mm_storeu_ps(o.shin + k, set1(tc.coeff.shininess));
+    _mm_storeu_ps(o.cr + k, set1(tc.simpleBase.x));
+    _mm_storeu_ps(o.cg + k, set1(tc.simpleBase.y));
+    _mm_storeu_ps(o.cb + k, set1(tc.simpleBase.z));
+    if (!fog) {
+        _mm_storeu_ps(fogDist + k, _mm_setzero_ps());
+        return;
+    }
+    const V ex = interp(tc.pe, 0), ey = interp(tc.pe, 1), ez = interp(tc.pe, 2);
+    _mm_storeu_ps(fogDist + k, _mm_sqrt_ps(add(add(mul(ex, ex), mul(ey, ey)), mul(ez, ez))));
+}
+#endif
+
 // Interpolates the attributes of the cached triangle at the centre of pixel (i, j) and fills
 // slot k of the shading batch (Gouraud: the final colour, with no lights left to add). Returns
 // the eye-space distance for fog.
@@ -526,7 +755,6 @@ __attribute__((noinline)) float prepareFragment(const TriCache& tc, const FrameC
     const uint32_t* v = tc.v;
     vec3 pos = bo[0] * tc.p[0] + bo[1] * tc.p[1] + bo[2] * tc.p[2];
     const sg::Material& mat = *tc.mat;
-
     vec3 albedo = mat.baseColor;
     const bool maps = d.hasUV && d.hasMaps();
     MapSample ms;
@@ -733,22 +961,67 @@ void shadeOpaque(const FrameContext& fc, Framebuffer& target, TileBuffers& buf, 
     buf.batch.resize(nf);
     buf.fogDist.resize(nf);
     TriCache tc;
+    const BatchOut out(buf.batch);
+    const bool fogOn = st.fog != sg::FogMode::Off;
     for (size_t k = 0; k < nf; ++k) {
         uint32_t id = buf.fragTri[k];
+        // Tiny triangles (a big mesh) change every fragment and miss the cache on the triangle,
+        // its indices and its vertices: prefetch the triangle 16 fragments ahead, its indices 8
+        // ahead and its vertices 4 ahead (only where the triangle changes).
+        if (k + 16 < nf && buf.fragTri[k + 16] != buf.fragTri[k + 15]) __builtin_prefetch(&triById(chunks, buf.fragTri[k + 16]));
+        if (k + 8 < nf && buf.fragTri[k + 8] != buf.fragTri[k + 7]) {
+            const Tri& tn = triById(chunks, buf.fragTri[k + 8]);
+            const DrawItem& dn = (*fc.draws)[tn.draw];
+            if (!dn.perCorner && size_t(tn.prim) * 3 < dn.mesh->indices.size()) __builtin_prefetch(&dn.mesh->indices[size_t(tn.prim) * 3]);
+        }
+        if (k + 4 < nf && buf.fragTri[k + 4] != buf.fragTri[k + 3]) {
+            const Tri& tn = triById(chunks, buf.fragTri[k + 4]);
+            const DrawItem& dn = (*fc.draws)[tn.draw];
+            for (int q = 0; q < 3; ++q) {
+                const uint32_t vq = dn.vertexOf(tn.prim, q);
+                if (vq < dn.wv.size()) {
+                    __builtin_prefetch(&dn.wv[vq]);
+                    __builtin_prefetch(reinterpret_cast<const char*>(&dn.wv[vq]) + sizeof(DrawItem::VertexOut) - 1);
+                }
+            }
+        }
         if (id != tc.id) tc.load(id, triById(chunks, id), chunks[id >> kChunkBits], fc);
+#if defined(__SSE2__)
+        // Four fragments of one triangle in a row (the common case for all but tiny triangles).
+        if (tc.simple && k + 4 <= nf && buf.fragTri[k + 1] == id && buf.fragTri[k + 2] == id && buf.fragTri[k + 3] == id) {
+            int ii[4], jj[4];
+            for (int l = 0; l < 4; ++l) {
+                const int p = buf.fragPixel[k + l];
+                ii[l] = x0 + p % kTileSize;
+                jj[l] = y0 + p / kTileSize;
+            }
+            prepareSimple4(tc, fogOn, ii, jj, out, buf.fogDist.data(), k);
+            k += 3;
+            continue;
+        }
+#endif
         int p = buf.fragPixel[k];
-        buf.fogDist[k] = prepareFragment(tc, fc, x0 + p % kTileSize, y0 + p / kTileSize, buf.batch, k);
+        if (tc.simple)
+            buf.fogDist[k] = prepareSimple(tc, fogOn, x0 + p % kTileSize, y0 + p / kTileSize, out, k);
+        else
+            buf.fogDist[k] = prepareFragment(tc, fc, x0 + p % kTileSize, y0 + p / kTileSize, buf.batch, k);
     }
     int64_t tC = fc.timing ? nowNs() : 0;
     if (fc.timing) g_prepareNs += tC - tB;
     shadeBatch(buf.batch, nf, *fc.frame);
     if (fc.timing) g_lightNs += nowNs() - tC;
     const bool fog = st.fog != sg::FogMode::Off;
+    const bool linearFog = st.fog == sg::FogMode::Linear;
     const ShadeBatch& b = buf.batch;
     if (samples == 1) {
         for (size_t k = 0; k < nf; ++k) {
             vec3 c(b.cr[k], b.cg[k], b.cb[k]);
-            if (fog) c = applyFog(st, c, buf.fogDist[k]);
+            if (linearFog) {   // applyFog(), inlined: the same operations in the same order
+                const float vis = std::clamp((st.fogEnd - buf.fogDist[k]) / (st.fogEnd - st.fogStart), 0.0f, 1.0f);
+                c = vis * c + (1.0f - vis) * st.fogColor;
+            } else if (fog) {
+                c = applyFog(st, c, buf.fogDist[k]);
+            }
             int p = buf.fragPixel[k];
             uint8_t* out = target.pixel(x0 + p % kTileSize, fc.height - 1 - (y0 + p / kTileSize));
             out[0] = enc(c.x);
@@ -941,10 +1214,20 @@ private:
                 d.triCount = uint32_t(p.mesh->indices.size() / 3);
                 if (d.triCount == 0) continue;
                 d.perCorner = gouraud && d.triMat;
+                if (draws.size() < m_vertexBuffers.size()) d.swapBuffers(m_vertexBuffers[draws.size()]);
                 draws.push_back(std::move(d));
             }   // points and lines: the overlay (step 5)
         }
         m_samplers.endFrame();
+        // Whatever way this frame ends, the vertex buffers go back for the next one.
+        struct GiveBack {
+            std::vector<DrawItem>& draws;
+            std::vector<DrawItem>& pool;
+            ~GiveBack() {
+                if (pool.size() < draws.size()) pool.resize(draws.size());
+                for (size_t i = 0; i < draws.size(); ++i) draws[i].swapBuffers(pool[i]);
+            }
+        } giveBack{draws, m_vertexBuffers};
 
         auto tStart = std::chrono::steady_clock::now();
         auto ms = [](auto a, auto b) { return std::chrono::duration<double, std::milli>(b - a).count(); };
@@ -1034,6 +1317,7 @@ private:
     SamplerCache m_samplers;
     TessellationCache m_tess;
     std::vector<Chunk> m_chunks;
+    std::vector<DrawItem> m_vertexBuffers;   // only their vertex-stage buffers (DrawItem::swapBuffers)
     // VIEWER_RASTER_REFERENCE_SHADING=1: shade every fragment with rnd::shade (slow; used to
     // check the batched path).
     bool m_timing = [] {
