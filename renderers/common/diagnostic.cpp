@@ -209,10 +209,12 @@ DiagnosticImage diagnosticImage(DiagnosticView view, const sg::FrameInput& f, co
             most = std::max(most, c);
             sum += c;
             ++covered;
-            const vec3 col = heat(float(std::min(c, 8u) - 1) / 7.0f);
+            // Bands, as the legend names them: 1 blue, 2 cyan, 3-4 green, 5-7 yellow, 8+ red.
+            const float band = c == 1 ? 0.0f : c == 2 ? 0.25f : c <= 4 ? 0.5f : c <= 7 ? 0.75f : 1.0f;
+            const vec3 col = heat(band);
             put(out.image, k, col.x, col.y, col.z);
         }
-        out.legend = "overdraw (fragments per pixel before the depth test): 1 blue, 2 cyan, 3-4 green, 5-6 yellow, 8+ red; black: none; max " +
+        out.legend = "overdraw (fragments per pixel before the depth test): 1 blue, 2 cyan, 3-4 green, 5-7 yellow, 8+ red; black: none; max " +
                      std::to_string(most) +
                      format(", mean %.2f over %.0f covered pixels", covered ? double(sum) / double(covered) : 0.0, double(covered));
         break;

@@ -13,7 +13,7 @@
 //              triangle (opaque, masked and blended alike, after back-face culling; the
 //              fragments of clipped triangles once), line, point and wireframe edge counts one,
 //              whether it is then hidden, cut out or blended. Heat map: 1 blue, 2 cyan,
-//              3-4 green, 5-6 yellow, 8+ red; black: no fragment
+//              3-4 green, 5-7 yellow, 8+ red; black: no fragment
 //   cost       (ray caster, Capabilities::traversalCost) the work of the pixel's primary ray
 //              through the centre: BVH nodes visited (the top level over instances and the
 //              meshes' BVHs; a node counts when its child boxes are tested) plus primitives
