@@ -1836,6 +1836,8 @@ void drawScreenshotDialog(ViewerState& st) {
 // space-padded text never lined up).
 void drawControlsHelp(ViewerState& st) {
     static constexpr std::pair<const char*, const char*> kControls[] = {
+        {"Click", "select (empty space clears), pin the pixel inspector"},
+        {"Ctrl+click", "add to / take out of the selection"},
         {"Left drag", "orbit around the pivot"},
         {"Middle / Shift+left drag", "pan"},
         {"Wheel", "zoom"},
@@ -1843,7 +1845,7 @@ void drawControlsHelp(ViewerState& st) {
         {"F", "fit scene / selection"},
         {"Home", "reset to the scene camera"},
         {"1 / 2 / 3", "backend gl / raster / raycast"},
-        {"F12", "screenshot"},
+        {"F12", "screenshot (as set in File > Screenshot at resolution...)"},
         {"Space", "play / pause the animation (viewport)"},
         {"F2", "rename selection"},
         {"Del, Ctrl+D", "delete / duplicate selection"},
@@ -1852,8 +1854,8 @@ void drawControlsHelp(ViewerState& st) {
         {"Ctrl+N/O/S/Q", "new / open / save / quit"},
         {"Escape", "close a menu, list or dialog"},
     };
-    ImGui::SetNextWindowSize(ImVec2(px(460), 0), ImGuiCond_FirstUseEver);
-    if (ImGui::Begin("Controls", &st.ui.panels.showHelp)) {
+    // Sized to its table, so no row is ever cut off (a fixed width clipped the longer actions).
+    if (ImGui::Begin("Controls", &st.ui.panels.showHelp, ImGuiWindowFlags_AlwaysAutoResize)) {
         if (ImGui::BeginTable("controls", 2, ImGuiTableFlags_RowBg | ImGuiTableFlags_SizingFixedFit)) {
             for (const auto& [input, action] : kControls) {
                 ImGui::TableNextRow();
