@@ -5,17 +5,22 @@
 // ones README.md promises: GL vs raster mean below 1/255; ray caster vs raster >= 99% of pixels
 // within 4/255 (shadows off). GL vs ray caster is not promised directly; it is held to the
 // same 99% within 4/255 as ray caster vs raster (GL and raster agree to < 1/255 on average).
-// Images of every backend go to build/<preset>/test-output/agreement-matrix/.
+// Images of every backend go to build/<preset>/test-output/agreement-matrix/. cad_heat_sinks is
+// a CAD-like assembly (thin fins, vertices hundreds of mm from the origin, scaled matrix
+// transforms, single-sided materials).
 #include "assets/demo.h"
 #include "renderers/renderer.h"
 #include "scenegraph/frame.h"
+#include "scenegraph/scene.h"
 #include "test_scenes.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <map>
+#include <memory>
 
 using namespace sg;
 
@@ -27,6 +32,61 @@ struct MatrixScene {
     std::string name;
     FrameInput frame;
 };
+
+// A box [lo, hi] as 12 outward-facing triangles with flat normals, appended to `m`.
+void appendBox(Mesh& m, const vec3& lo, const vec3& hi) {
+    const vec3 c[8] = {{lo.x, lo.y, lo.z}, {hi.x, lo.y, lo.z}, {hi.x, hi.y, lo.z}, {lo.x, hi.y, lo.z},
+                       {lo.x, lo.y, hi.z}, {hi.x, lo.y, hi.z}, {hi.x, hi.y, hi.z}, {lo.x, hi.y, hi.z}};
+    const int faces[6][4] = {{1, 2, 6, 5}, {0, 4, 7, 3}, {3, 7, 6, 2}, {0, 1, 5, 4}, {4, 5, 6, 7}, {0, 3, 2, 1}};
+    const vec3 normals[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    for (int f = 0; f < 6; ++f) {
+        const uint32_t base = uint32_t(m.positions.size());
+        for (int k = 0; k < 4; ++k) {
+            m.positions.push_back(c[faces[f][k]]);
+            m.normals.push_back(normals[f]);
+        }
+        for (uint32_t k : {0u, 1u, 2u, 0u, 2u, 3u}) m.indices.push_back(base + k);
+    }
+}
+
+// What a CAD export looks like (issue 17's disagreement, not reproduced by this or any scene
+// here so far): six heat sinks whose vertices are in millimetres, hundreds from the origin
+// (a 60 x 4 x 40 base and twenty fins 0.4 thick, 25 high), placed by matrix transforms that
+// scale by 0.001 and turn a few degrees, single-sided materials, the default camera framing it.
+FrameInput cadHeatSinks() {
+    Scene scene;
+    for (int k = 0; k < 3; ++k) {
+        Material m;
+        m.baseColor = vec3(0.6f + 0.1f * float(k), 0.6f, 0.65f);
+        m.doubleSided = false;
+        scene.materials.push_back(m);
+    }
+    const NodeId assembly = scene.addNode("assembly");
+    for (int part = 0; part < 6; ++part) {
+        Mesh mesh;
+        const vec3 o(400.0f + float(part % 3) * 70.0f, 200.0f + float(part / 3) * 35.0f, 300.0f);
+        appendBox(mesh, o, o + vec3(60, 4, 40));
+        for (int fin = 0; fin < 20; ++fin) {
+            const float x = o.x + 1.0f + 3.0f * float(fin);
+            appendBox(mesh, vec3(x, o.y + 4, o.z), vec3(x + 0.4f, o.y + 25, o.z + 40));
+        }
+        scene.meshes.push_back(std::make_shared<Mesh>(std::move(mesh)));
+        const float a = radians(3.0f * float(part % 5 - 2));
+        mat4 m(1.0f);
+        m[0] = vec4(0.001f * std::cos(a), 0, -0.001f * std::sin(a), 0);
+        m[1] = vec4(0, 0.001f, 0, 0);
+        m[2] = vec4(0.001f * std::sin(a), 0, 0.001f * std::cos(a), 0);
+        m[3] = vec4(-0.4f, -0.2f, -0.3f, 1);
+        const NodeId n = scene.addNode("part " + std::to_string(part), assembly, MeshInstance{int(scene.meshes.size()) - 1, part % 3});
+        scene.setLocal(n, LocalTransform::fromMatrix(m));
+    }
+    Light key;
+    key.type = LightType::Directional;
+    const NodeId light = scene.addNode("key", scene.root(), key);
+    scene.lookAt(light, vec3(0.3f, 0.8f, 1.0f), vec3(0.0f));
+    scene.addDefaultCamera();
+    return flatten(scene, float(kW) / kH);
+}
 
 void offlineSettings(FrameInput& f) {
     f.settings.shadows = false;
@@ -55,6 +115,9 @@ std::vector<MatrixScene> scenes() {
     FrameInput tri = test_scenes::triangleAgreementFrame(Projection{}, kW, kH);
     offlineSettings(tri);
     s.push_back({"triangle_scene", tri});
+    FrameInput cad = cadHeatSinks();
+    offlineSettings(cad);
+    s.push_back({"cad_heat_sinks", cad});
     return s;
 }
 
