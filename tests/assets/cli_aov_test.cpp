@@ -24,24 +24,10 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct ViewerRun {
-    int status = -1;
-    std::string output;   // stdout (and stderr when asked)
-};
+using ViewerRun = testing_support::ProgramRun;
+ViewerRun runViewer(const std::string& args, bool withStderr = true) { return testing_support::runProgram(VIEWER_EXE, args, withStderr); }
 
-ViewerRun runViewer(const std::string& args, bool withStderr = true) {
-    ViewerRun r;
-    std::string cmd = std::string("\"") + VIEWER_EXE + "\" " + args + (withStderr ? " 2>&1" : " 2>/dev/null");
-    FILE* p = popen(cmd.c_str(), "r");
-    if (!p) return r;
-    char buf[4096];
-    size_t n;
-    while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
-    r.status = pclose(p);
-    return r;
-}
-
-std::string quoted(const fs::path& p) { return "\"" + p.string() + "\""; }
+using testing_support::quoted;
 
 struct Export {
     std::vector<uint16_t> ids;

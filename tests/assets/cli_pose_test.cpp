@@ -15,24 +15,10 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct ViewerRun {
-    int status = -1;
-    std::string output;   // stdout and stderr
-};
+using ViewerRun = testing_support::ProgramRun;
+ViewerRun runViewer(const std::string& args) { return testing_support::runProgram(VIEWER_EXE, args); }
 
-ViewerRun runViewer(const std::string& args) {
-    ViewerRun r;
-    std::string cmd = std::string("\"") + VIEWER_EXE + "\" " + args + " 2>&1";
-    FILE* p = popen(cmd.c_str(), "r");
-    if (!p) return r;
-    char buf[4096];
-    size_t n;
-    while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
-    r.status = pclose(p);
-    return r;
-}
-
-std::string quoted(const fs::path& p) { return "\"" + p.string() + "\""; }
+using testing_support::quoted;
 fs::path sample(const std::string& rel) { return testing_support::testdataDir() / "gltf" / rel; }
 
 // Renders `file` with the ray caster at --time t into dir/name.png; returns the image's bytes.

@@ -226,22 +226,8 @@ TEST(SettingsNameTableTest, JsonReaderTakesAliasesAndListsTheNames) {
 
 // --- the viewer's command line -------------------------------------------------------------------
 
-struct ViewerRun {
-    int status = -1;
-    std::string output;   // stdout and stderr
-};
-
-ViewerRun runViewer(const std::string& args) {
-    ViewerRun r;
-    std::string cmd = std::string("\"") + VIEWER_EXE + "\" " + args + " 2>&1";
-    FILE* p = popen(cmd.c_str(), "r");
-    if (!p) return r;
-    char buf[4096];
-    size_t n;
-    while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
-    r.status = pclose(p);
-    return r;
-}
+using ViewerRun = testing_support::ProgramRun;
+ViewerRun runViewer(const std::string& args) { return testing_support::runProgram(VIEWER_EXE, args); }
 
 template <class E>
 void expectAllNames(const std::string& text) {

@@ -167,4 +167,18 @@ std::shared_ptr<sg::Texture> checker(int size, int checks, const sg::vec3& a, co
     return imagesClose(actual, expected, tol, "gl-baselines", name);
 }
 
+ProgramRun runProgram(const std::string& exe, const std::string& args, bool withStderr) {
+    ProgramRun r;
+    const std::string cmd = testing_support::quoted(exe) + " " + args + (withStderr ? " 2>&1" : " 2>/dev/null");
+    FILE* p = popen(cmd.c_str(), "r");
+    if (!p) return r;
+    char buf[4096];
+    size_t n;
+    while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
+    r.status = pclose(p);
+    return r;
+}
+
+std::string quoted(const std::filesystem::path& p) { return "\"" + p.string() + "\""; }
+
 }   // namespace testing_support

@@ -62,6 +62,16 @@ struct PixelCheckSummary {
 // odd, b elsewhere (0..1, rounded to 8 bits). Default sampling settings.
 std::shared_ptr<sg::Texture> checker(int size, int checks, const sg::vec3& a, const sg::vec3& b);
 
+// A command-line run (the viewer's CLI tests): `exe args` through the shell, its exit status as
+// pclose() gives it (0 = success) and its stdout, plus stderr when `withStderr`.
+struct ProgramRun {
+    int status = -1;
+    std::string output;
+};
+ProgramRun runProgram(const std::string& exe, const std::string& args, bool withStderr = true);
+// `p` in double quotes, for a command line.
+std::string quoted(const std::filesystem::path& p);
+
 // Standard base64 with padding (for data URIs and embedded PNGs in generated files).
 std::string base64Encode(std::string_view bytes);
 
