@@ -9,7 +9,8 @@
 // and loads each with assets::loadScene in a forked child, reporting wall and CPU time (the
 // machine is shared: CPU time is the steadier number) and the child's peak RSS growth
 // (VmHWM minus VmRSS at the start of the load) as
-//   bench: scene=<name> what=<metric> ours=<x>
+//   bench: scene=<name> what=load_{wall_s,cpu_s,peak_rss_growth_mb} ours=<x>
+// (and input_mb, nodes, unique_triangles)
 // The glTF files are also parsed by tinygltf alone (TinyGLTF::LoadASCIIFromFile into its Model,
 // nothing else; another forked child), the floor under our importer, which is built on it:
 //   bench: scene=<name> what=tinygltf_alone_<metric> ours=<x>
@@ -24,6 +25,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -144,9 +146,12 @@ double cpuSeconds() {
     return double(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) + 1e-6 * double(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
 }
 
-// tinygltf alone on a .gltf (the parse our importer starts with), in a forked child: wall and
-// CPU time and peak RSS growth.
-bool measureTinygltf(const std::string& name, const fs::path& file) {
+// Runs `load` in a forked child, so that its peak RSS (VmHWM) belongs to this load alone, and
+// prints its wall and CPU time and peak RSS growth as <prefix>wall_s, <prefix>cpu_s and
+// <prefix>peak_rss_growth_mb. `load` returns "" (then prints its own figures with `report`)
+// or an error, printed as <prefix>error. True when the child succeeded.
+template <class Load>
+bool inChild(const std::string& name, const std::string& prefix, Load&& load) {
     std::fflush(stdout);
     pid_t pid = fork();
     if (pid < 0) {
@@ -158,63 +163,52 @@ bool measureTinygltf(const std::string& name, const fs::path& file) {
         waitpid(pid, &status, 0);
         return WIFEXITED(status) && WEXITSTATUS(status) == 0;
     }
-    long rssBefore = statusKb("VmRSS:");
-    double cpu0 = cpuSeconds();
-    auto t0 = std::chrono::steady_clock::now();
-    tinygltf::TinyGLTF loader;
-    tinygltf::Model model;
-    std::string err, warn;
-    const bool ok = loader.LoadASCIIFromFile(&model, &err, &warn, file.string());
-    double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    double cpu = cpuSeconds() - cpu0;
-    long hwm = statusKb("VmHWM:");
-    if (!ok) {
-        std::printf("bench: scene=%s what=tinygltf_alone_error ours=\"%s\"\n", name.c_str(), err.c_str());
+    const long rssBefore = statusKb("VmRSS:");
+    const double cpu0 = cpuSeconds();
+    const auto t0 = std::chrono::steady_clock::now();
+    std::function<void()> report;
+    const std::string err = load(report);
+    const double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const double cpu = cpuSeconds() - cpu0;
+    const long hwm = statusKb("VmHWM:");
+    if (!err.empty()) {
+        std::printf("bench: scene=%s what=%serror ours=\"%s\"\n", name.c_str(), prefix.c_str(), err.c_str());
         std::fflush(stdout);
         _exit(1);
     }
-    std::printf("bench: scene=%s what=tinygltf_alone_wall_s ours=%.3f\n", name.c_str(), dt);
-    std::printf("bench: scene=%s what=tinygltf_alone_cpu_s ours=%.3f\n", name.c_str(), cpu);
-    std::printf("bench: scene=%s what=tinygltf_alone_peak_rss_growth_mb ours=%.1f\n", name.c_str(), double(hwm - rssBefore) / 1024.0);
+    std::printf("bench: scene=%s what=%swall_s ours=%.3f\n", name.c_str(), prefix.c_str(), dt);
+    std::printf("bench: scene=%s what=%scpu_s ours=%.3f\n", name.c_str(), prefix.c_str(), cpu);
+    std::printf("bench: scene=%s what=%speak_rss_growth_mb ours=%.1f\n", name.c_str(), prefix.c_str(), double(hwm - rssBefore) / 1024.0);
+    if (report) report();
     std::fflush(stdout);
     _exit(0);
 }
 
-// Loads in a forked child so that its peak RSS (VmHWM) belongs to this load alone.
+// Our importer (assets::loadScene) on `file`.
 bool measure(const std::string& name, const fs::path& file, uint64_t extraBytes = 0) {
-    std::fflush(stdout);
-    pid_t pid = fork();
-    if (pid < 0) {
-        std::perror("fork");
-        return false;
-    }
-    if (pid > 0) {
-        int status = 0;
-        waitpid(pid, &status, 0);
-        return WIFEXITED(status) && WEXITSTATUS(status) == 0;
-    }
-    long rssBefore = statusKb("VmRSS:");
-    double cpu0 = cpuSeconds();
-    auto t0 = std::chrono::steady_clock::now();
-    assets::LoadResult r = assets::loadScene(file);
-    double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    double cpu = cpuSeconds() - cpu0;
-    long hwm = statusKb("VmHWM:");
-    if (!r.scene) {
-        std::printf("bench: scene=%s what=error ours=\"%s\"\n", name.c_str(), r.error.c_str());
-        std::fflush(stdout);
-        _exit(1);
-    }
-    size_t tris = 0;
-    for (const auto& m : r.scene->meshes) tris += m->triangleCount();
-    std::printf("bench: scene=%s what=load_wall_s ours=%.3f\n", name.c_str(), dt);
-    std::printf("bench: scene=%s what=load_cpu_s ours=%.3f\n", name.c_str(), cpu);
-    std::printf("bench: scene=%s what=peak_rss_growth_mb ours=%.1f\n", name.c_str(), double(hwm - rssBefore) / 1024.0);
-    std::printf("bench: scene=%s what=input_mb ours=%.1f\n", name.c_str(), double(fs::file_size(file) + extraBytes) / 1048576.0);
-    std::printf("bench: scene=%s what=nodes ours=%zu\n", name.c_str(), r.scene->nodeCount());
-    std::printf("bench: scene=%s what=unique_triangles ours=%zu\n", name.c_str(), tris);
-    std::fflush(stdout);
-    _exit(0);
+    assets::LoadResult r;
+    return inChild(name, "load_", [&](std::function<void()>& report) {
+        r = assets::loadScene(file);
+        if (!r.scene) return r.error;
+        report = [&] {
+            size_t tris = 0;
+            for (const auto& m : r.scene->meshes) tris += m->triangleCount();
+            std::printf("bench: scene=%s what=input_mb ours=%.1f\n", name.c_str(), double(fs::file_size(file) + extraBytes) / 1048576.0);
+            std::printf("bench: scene=%s what=nodes ours=%zu\n", name.c_str(), r.scene->nodeCount());
+            std::printf("bench: scene=%s what=unique_triangles ours=%zu\n", name.c_str(), tris);
+        };
+        return std::string();
+    });
+}
+
+// tinygltf alone on a .gltf: the parse our importer starts with, the floor under it.
+bool measureTinygltf(const std::string& name, const fs::path& file) {
+    tinygltf::Model model;
+    return inChild(name, "tinygltf_alone_", [&](std::function<void()>&) {
+        tinygltf::TinyGLTF loader;
+        std::string err, warn;
+        return loader.LoadASCIIFromFile(&model, &err, &warn, file.string()) ? std::string() : err.empty() ? std::string("failed") : err;
+    });
 }
 
 }   // namespace

@@ -98,6 +98,19 @@ struct BenchScene {
     size_t triangles = 0;
 };
 
+// The camera (looking down at the grid from the front) and the point key light of the grid scenes.
+void addGridCameraAndKey(Scene& s, float extent) {
+    Camera cam;
+    cam.projection.fovyDeg = 50.0f;
+    cam.projection.zNear = 0.1f;
+    cam.projection.zFar = 4.0f * extent + 20.0f;
+    NodeId c = s.addNode("camera", s.root(), cam);
+    s.lookAt(c, vec3(0.0f, 0.55f * extent + 1.0f, 0.75f * extent + 1.5f), vec3(0.0f, 0.0f, 0.0f));
+    s.activeCamera = c;
+    NodeId key = s.addNode("key", s.root(), Light{LightType::Point, vec3(1.0f), 1.0f, false});
+    s.setLocal(key, LocalTransform::fromTRS(vec3(extent * 0.3f, extent, extent * 0.5f)));
+}
+
 // grid x grid spheres with `seg` slices (seg/2 stacks) on a ground plane.
 BenchScene sphereGrid(const std::string& name, int grid, int seg) {
     BenchScene b;
@@ -120,15 +133,7 @@ BenchScene sphereGrid(const std::string& name, int grid, int seg) {
             s.setLocal(n, LocalTransform::fromTRS(vec3((i - (grid - 1) * 0.5f) * spacing, 0.4f * spacing, (j - (grid - 1) * 0.5f) * spacing)));
         }
     b.triangles = ground->triangleCount() + size_t(grid) * grid * sphere->triangleCount();
-    Camera cam;
-    cam.projection.fovyDeg = 50.0f;
-    cam.projection.zNear = 0.1f;
-    cam.projection.zFar = 4.0f * extent + 20.0f;
-    NodeId c = s.addNode("camera", s.root(), cam);
-    s.lookAt(c, vec3(0.0f, 0.55f * extent + 1.0f, 0.75f * extent + 1.5f), vec3(0.0f, 0.0f, 0.0f));
-    s.activeCamera = c;
-    NodeId key = s.addNode("key", s.root(), Light{LightType::Point, vec3(1.0f), 1.0f, false});
-    s.setLocal(key, LocalTransform::fromTRS(vec3(extent * 0.3f, extent, extent * 0.5f)));
+    addGridCameraAndKey(s, extent);
     NodeId sun = s.addNode("sun", s.root(), Light{LightType::Directional, vec3(0.6f, 0.7f, 0.9f), 0.4f, false});
     s.lookAt(sun, vec3(-1, 2, 1), vec3(0));
     s.ambientLight = vec3(0.3f);
@@ -162,15 +167,7 @@ BenchScene singleMesh(const std::string& name, int grid, int seg, int groundSub)
     s.materials = {mat};
     s.addNode("mesh", s.root(), MeshInstance{0, 0});
     b.triangles = m->triangleCount();
-    Camera cam;
-    cam.projection.fovyDeg = 50.0f;
-    cam.projection.zNear = 0.1f;
-    cam.projection.zFar = 4.0f * extent + 20.0f;
-    NodeId c = s.addNode("camera", s.root(), cam);
-    s.lookAt(c, vec3(0.0f, 0.55f * extent + 1.0f, 0.75f * extent + 1.5f), vec3(0.0f, 0.0f, 0.0f));
-    s.activeCamera = c;
-    NodeId key = s.addNode("key", s.root(), Light{LightType::Point, vec3(1.0f), 1.0f, false});
-    s.setLocal(key, LocalTransform::fromTRS(vec3(extent * 0.3f, extent, extent * 0.5f)));
+    addGridCameraAndKey(s, extent);
     s.ambientLight = vec3(0.3f);
     return b;
 }
