@@ -246,7 +246,7 @@ std::string overlayOptions(const RenderArgs& a, const sg::Scene& scene, float as
     const sg::NodeId id = a.select.empty() ? sg::kNoNode : scene.findByName(a.select);
     if (!a.select.empty() && id == sg::kNoNode) return "--select '" + a.select + "': no node of that name in " + a.scene;
     if (o.selection && id == sg::kNoNode) return "--overlay selection: name the node with --select NODE";
-    rnd::setSceneOverlayInputs(scene, id, aspect, o);
+    rnd::setSceneOverlayInputs(scene, {id}, aspect, o);
     return {};
 }
 

@@ -324,12 +324,19 @@ void drawOverlays(const sg::FrameInput& frame, const OverlayOptions& o, Framebuf
     if (o.selection) drawSelection(paint, frame, o.selected);
 }
 
-void setSceneOverlayInputs(const sg::Scene& scene, sg::NodeId node, float aspect, OverlayOptions& o) {
+void setSceneOverlayInputs(const sg::Scene& scene, const std::vector<sg::NodeId>& nodes, float aspect, OverlayOptions& o) {
     o.selected.clear();
     o.cameraGizmos.clear();
-    if (scene.valid(node))
-        for (sg::NodeId n : scene.depthFirstOrder())
-            if (scene.isAncestor(node, n)) o.selected.push_back(n);
+    std::vector<uint8_t> inside(scene.idCapacity(), 0);   // selected, or under a selected node
+    bool any = false;
+    for (sg::NodeId n : nodes)
+        if (scene.valid(n)) inside[n] = 1, any = true;
+    if (any)
+        for (sg::NodeId n : scene.depthFirstOrder()) {   // parents come first
+            const sg::NodeId p = scene.node(n).parent;
+            if (!inside[n] && scene.valid(p) && inside[p]) inside[n] = 1;
+            if (inside[n]) o.selected.push_back(n);
+        }
     for (sg::NodeId id : scene.cameras())
         if (const auto* cam = std::get_if<sg::Camera>(&scene.node(id).payload)) o.cameraGizmos.push_back({scene.world(id), cam->projection, aspect});
 }

@@ -1,4 +1,4 @@
-// pixel_probe.cpp - probeAt(), pickAt(), outlineNode(), probeSummary() (see pixel_probe.h).
+// pixel_probe.cpp - probeAt(), pickAt(), outlineNodes(), probeSummary() (see pixel_probe.h).
 #include "ui/pixel_probe.h"
 
 #include "renderers/shading.h"
@@ -65,11 +65,13 @@ sg::NodeId pickAt(const ProbeImage& im, float u, float v) {
     return d ? sg::instanceTable(*im.frame).nodeOf(d) : sg::kNoNode;
 }
 
-void outlineNode(rnd::Framebuffer& fb, const sg::FrameInput& frame, const sg::Scene& scene, sg::NodeId node) {
-    if (!fb.hasVisibility() || !scene.valid(node)) return;
+void outlineNodes(rnd::Framebuffer& fb, const sg::FrameInput& frame, const sg::Scene& scene, const std::vector<sg::NodeId>& nodes) {
+    if (!fb.hasVisibility() || nodes.empty()) return;
     const sg::InstanceTable ids = sg::instanceTable(frame);
     std::vector<uint8_t> drawableSelected(ids.ofDrawable.size(), 0);
-    for (size_t k = 1; k < ids.ofDrawable.size(); ++k) drawableSelected[k] = isUnder(scene, ids.nodeOf(uint32_t(k)), node);
+    for (size_t k = 1; k < ids.ofDrawable.size(); ++k)
+        for (sg::NodeId node : nodes)
+            drawableSelected[k] = drawableSelected[k] || (scene.valid(node) && isUnder(scene, ids.nodeOf(uint32_t(k)), node));
     const int w = fb.width, h = fb.height;
     std::vector<uint8_t> in(size_t(w) * h);
     for (size_t k = 0; k < in.size(); ++k) {

@@ -250,9 +250,9 @@ public:
         }
         rnd::DiagnosticImage shown = rnd::diagnosticImage(v.diagnostic, *v.slot->imageFrame(), img);
         v.legend = shown.legend;
-        shown.image.drawable = img.drawable;   // outlineNode reads the visibility
+        shown.image.drawable = img.drawable;   // outlineNodes reads the visibility
         shown.image.primitive = img.primitive;
-        for (sg::NodeId n : sel) outlineNode(shown.image, *v.slot->imageFrame(), st.doc.scene, n);
+        outlineNodes(shown.image, *v.slot->imageFrame(), st.doc.scene, sel);
         shown.image.depth = img.depth;
         drawViewOverlays(shown.image, *v.slot->imageFrame());
         v.texture.upload(shown.image);
@@ -276,13 +276,7 @@ public:
     // descendants) and the scene's cameras.
     rnd::OverlayOptions overlayOptions(float aspect) const {
         rnd::OverlayOptions o = st.view.overlays;
-        const std::vector<sg::NodeId> sel = st.selection();
-        rnd::setSceneOverlayInputs(st.doc.scene, sel.empty() ? sg::kNoNode : sel[0], aspect, o);
-        for (size_t i = 1; i < sel.size(); ++i) {
-            rnd::OverlayOptions more;
-            rnd::setSceneOverlayInputs(st.doc.scene, sel[i], aspect, more);
-            o.selected.insert(o.selected.end(), more.selected.begin(), more.selected.end());
-        }
+        rnd::setSceneOverlayInputs(st.doc.scene, st.selection(), aspect, o);
         return o;
     }
 

@@ -40,9 +40,10 @@ bool parseOverlayList(const std::string& list, OverlayOptions& out, std::string&
 const char* overlayNameList();   // "grid, axes, lights, cameras, bounds, selection"
 
 void drawOverlays(const sg::FrameInput& frame, const OverlayOptions& options, Framebuffer& fb);
-// Fills what the overlays need from the scene: `selected` becomes `node` and its descendants
-// (none for kNoNode), `cameraGizmos` the scene's cameras (their images' aspect: `aspect`).
-void setSceneOverlayInputs(const sg::Scene& scene, sg::NodeId node, float aspect, OverlayOptions& options);
+// Fills what the overlays need from the scene: `selected` becomes the `nodes` (a selection;
+// invalid ids ignored) and their descendants, each once, `cameraGizmos` the scene's cameras
+// (their images' aspect: `aspect`).
+void setSceneOverlayInputs(const sg::Scene& scene, const std::vector<sg::NodeId>& nodes, float aspect, OverlayOptions& options);
 
 // The building blocks, public for tests. Pixel coordinates are integers, y up or down as the
 // caller likes (the algorithms do not care).

@@ -56,8 +56,9 @@ ProbeResult probeAt(const ViewerState& st, const ProbeImage& image, float u, flo
 sg::NodeId pickAt(const ProbeImage& image, float u, float v);
 
 // Paints a 2-pixel outline around the pixels of `image` (which must have visibility) that show
-// `node` or a node below it, for the viewport (the selection, in every backend alike).
-void outlineNode(rnd::Framebuffer& image, const sg::FrameInput& frame, const sg::Scene& scene, sg::NodeId node);
+// one of `nodes` or a node below one, for the viewport (the selection, in every backend alike;
+// several selected nodes side by side get one outline around them all).
+void outlineNodes(rnd::Framebuffer& image, const sg::FrameInput& frame, const sg::Scene& scene, const std::vector<sg::NodeId>& nodes);
 
 // One line per result for the automation's `print pixel`.
 std::string probeSummary(const PixelProbeState& p);
