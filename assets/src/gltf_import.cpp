@@ -21,8 +21,8 @@
 //   normals (Mesh::computeNormals), non-indexed ones flat normals (vertices are unshared).
 //   COLOR_0 (vec3/vec4; float or normalised ints) -> colors (linear); TEXCOORD_0/1 -> uv0/uv1
 //   with v flipped (glTF: v = 0 at the image's top row; ours: v = 0 at the bottom, as GL/OBJ),
-//   except that uv0 always holds the set the material's textures sample: a texCoord of 1
-//   swaps the two sets for that primitive. Non-finite or |x| > 1e30 positions are dropped with
+//   after the material's UV channels are baked in (see KHR_texture_transform below).
+//   Non-finite or |x| > 1e30 positions are dropped with
 //   the triangles/lines/points that use them (one warning).
 // Skins and morph targets (posed on the CPU by sg::Scene::posedMesh, scenegraph/deform.h):
 //   JOINTS_0/1 + WEIGHTS_0/1 -> Mesh::joints0/1 + weights0/1 (up to 8 influences; JOINTS_2+
@@ -56,11 +56,12 @@
 //   KHR_materials_unlit -> Material::unlit. KHR_materials_pbrSpecularGlossiness: diffuseFactor
 //                / diffuseTexture -> baseColor / texture, ks = max(specularFactor),
 //                specularColor = specularFactor / ks, roughness = 1 - glossiness as above.
-//   KHR_texture_transform (offset, rotation, scale, texCoord) is applied to the UVs of each
-//                primitive using the material at import time (uv' = T * R * S * uv as in the
-//                extension): our meshes carry one UV set for all of a material's textures, the
-//                base colour texture's (else the first other one's); a texture asking for
-//                another set or transform samples that one (one warning).
+//   texCoord and KHR_texture_transform (offset, rotation, scale, texCoord) of each texture
+//                are applied to the UVs of each primitive using the material at import time
+//                (uv' = T * R * S * uv as in the extension): a material's textures may sample two
+//                (set, transform) channels; channel 0 (the base colour texture's, else the first
+//                other one's) goes to uv0, channel 1 to uv1 with Material::uv1Maps naming the
+//                maps that sample it. A third channel samples channel 0 (one warning).
 //                KHR_materials_pbrSpecularGlossiness: specularGlossinessTexture (sRGB specular, linear
 //                glossiness in A) -> metallicRoughnessTexture with Material::specularGlossiness.
 // Cameras: perspective -> Projection Perspective (fovy = yfov, zNear, zFar; infinite zfar ->
@@ -820,11 +821,19 @@ std::string readIndices(const tinygltf::Model& m, size_t ai, const Progress& pro
 }
 
 // ---- 6. Textures and materials -----------------------------------------------------------
+// One UV channel of a material: a TEXCOORD set with a KHR_texture_transform (glTF uv space).
+struct UvChannel {
+    int texCoord = 0;
+    sg::mat3 transform{1.0f};
+    bool operator==(const UvChannel&) const = default;
+};
 struct MaterialInfo {
     int sgIndex = -1;
-    int texCoord = 0;   // which TEXCOORD set the diffuse texture samples
-    bool hasUvTransform = false;
-    sg::mat3 uvTransform{1.0f};
+    // The channels its textures sample, at most two: channel 0 (the base colour texture's, else
+    // the first other texture's) becomes the primitives' uv0, channel 1 their uv1.
+    UvChannel channel[2];
+    int channels = 0;
+    uint8_t uv1Maps = 0;   // sg::Material::uv1Maps
 };
 
 struct Converter {
@@ -958,25 +967,36 @@ struct Converter {
         return T * R * S;
     }
 
-    // Our meshes carry one UV set for all of a material's textures: the base colour texture's
-    // (else the first other texture's), with its transform baked in (buildPrimitive). A texture
-    // that asks for another set or transform samples that one; one warning says so.
-    void chooseUvSet(size_t i, const std::vector<TexRef>& refs, MaterialInfo& info) {
-        const TexRef* first = nullptr;
-        for (const TexRef& r : refs) {
+    // Our meshes carry two UV sets, uv0 and uv1, with the texture transforms baked in
+    // (readAttributes): a material's textures may sample two different (TEXCOORD set,
+    // KHR_texture_transform) channels. refs: base colour, metallic-roughness, occlusion,
+    // emissive, normal. A texture asking for a third channel samples channel 0 (one warning);
+    // TEXCOORD_2 and above are read as TEXCOORD_0 (one warning).
+    void chooseUvChannels(size_t i, const std::vector<TexRef>& refs, MaterialInfo& info) {
+        static const uint8_t bit[5] = {0, sg::Material::MetallicRoughnessMap, sg::Material::OcclusionMap, sg::Material::EmissiveMap,
+                                       sg::Material::NormalMap};
+        for (size_t k = 0; k < refs.size() && k < 5; ++k) {
+            const TexRef& r = refs[k];
             if (r.index < 0) continue;
-            int tc = r.texCoord;
-            sg::mat3 t = r.transform ? uvTransformOf(*r.transform, tc) : sg::mat3(1.0f);
-            if (!first) {
-                first = &r;
-                info.texCoord = tc == 1 ? 1 : 0;
-                if (tc > 1) warnOnce("material " + std::to_string(i) + ": texCoord " + std::to_string(tc) + " is not supported (using TEXCOORD_0)");
-                info.hasUvTransform = r.transform != nullptr;
-                info.uvTransform = t;
-            } else if ((tc == 1 ? 1 : 0) != info.texCoord || t != info.uvTransform) {
-                warnOnce("material " + std::to_string(i) +
-                         ": its textures use different UV sets or texture transforms; all sample the base colour texture's");
+            UvChannel c;
+            c.texCoord = r.texCoord;
+            if (r.transform) c.transform = uvTransformOf(*r.transform, c.texCoord);
+            if (c.texCoord < 0 || c.texCoord > 1) {
+                warnOnce("material " + std::to_string(i) + ": texCoord " + std::to_string(c.texCoord) + " is not supported (using TEXCOORD_0)");
+                c.texCoord = 0;
             }
+            int found = -1;
+            for (int ch = 0; ch < info.channels; ++ch)
+                if (info.channel[ch] == c) found = ch;
+            if (found < 0 && info.channels < 2) {
+                found = info.channels++;
+                info.channel[found] = c;
+            }
+            if (found < 0)
+                warnOnce("material " + std::to_string(i) +
+                         ": its textures use more than two UV set / texture transform combinations; the others sample the base colour "
+                         "texture's");
+            if (found == 1) info.uv1Maps |= bit[k];
         }
     }
 
@@ -1050,7 +1070,8 @@ struct Converter {
         mat.normalTexture = texture(gm.normalTexture.index, false);
         mat.normalScale = std::isfinite(gm.normalTexture.scale) ? float(gm.normalTexture.scale) : 1.0f;
         MaterialInfo info;
-        chooseUvSet(i, refs, info);
+        chooseUvChannels(i, refs, info);
+        mat.uv1Maps = info.uv1Maps;
         scene.materials.push_back(std::move(mat));
         info.sgIndex = int(scene.materials.size() - 1);
         materials[i] = info;
@@ -1109,18 +1130,35 @@ struct Converter {
                 if (!sg::isFinite(sg::vec3(t)) || !std::isfinite(t.w) || glm::length(sg::vec3(t)) < 1e-12f) t = sg::vec4(1, 0, 0, 1);
             for (auto& t : mesh.tangents) t.w = t.w < 0.0f ? -1.0f : 1.0f;
         }
-        if (prim.material >= 0) {
-            const MaterialInfo& info = materials[size_t(prim.material)];
-            if (info.texCoord == 1 && !mesh.uv1.empty()) std::swap(mesh.uv0, mesh.uv1);
-            if (info.hasUvTransform)
-                for (auto& uv : mesh.uv0) uv = sg::vec2(info.uvTransform * sg::vec3(uv, 1.0f));
-        }
+        if (prim.material >= 0) bakeUvChannels(id, materials[size_t(prim.material)], mesh);
         // glTF puts uv (0,0) at the image's first (top-left) pixel, v down; our textures follow
         // GL and OBJ (v = 0 at the bottom row, sg::Texture row 0 at v = 1): v -> 1 - v, after
         // KHR_texture_transform, which is defined in glTF's uv space.
         for (auto& uv : mesh.uv0) uv.y = 1.0f - uv.y;
         for (auto& uv : mesh.uv1) uv.y = 1.0f - uv.y;
         return {};
+    }
+
+    // The material's UV channels (chooseUvChannels) into the mesh: uv0 = channel 0's set with
+    // its transform applied; uv1 = channel 1's likewise, or, with one channel, the other set as
+    // read. A channel whose set the primitive lacks reads TEXCOORD_0 (one warning).
+    void bakeUvChannels(const std::string& id, const MaterialInfo& info, sg::Mesh& mesh) {
+        if (info.channels == 0) return;
+        const std::vector<sg::vec2> raw[2] = {std::move(mesh.uv0), std::move(mesh.uv1)};
+        auto setOf = [&](const UvChannel& c) {
+            if (!raw[c.texCoord].empty() || raw[0].empty()) return c.texCoord;
+            warnOnce(id + "its material samples TEXCOORD_" + std::to_string(c.texCoord) + ", which it does not have (using TEXCOORD_0)");
+            return 0;
+        };
+        auto baked = [&](const UvChannel& c, int set) {
+            std::vector<sg::vec2> uv = raw[set];
+            if (c.transform != sg::mat3(1.0f))
+                for (auto& p : uv) p = sg::vec2(c.transform * sg::vec3(p, 1.0f));
+            return uv;
+        };
+        const int set0 = setOf(info.channel[0]);
+        mesh.uv0 = baked(info.channel[0], set0);
+        mesh.uv1 = info.channels == 2 ? baked(info.channel[1], setOf(info.channel[1])) : raw[set0 == 1 ? 0 : 1];
     }
 
     // JOINTS_0/1 + WEIGHTS_0/1, the morph targets' POSITION/NORMAL/TANGENT displacements and
@@ -1265,7 +1303,8 @@ struct Converter {
             }
             // A normal map needs tangents: generated from the UVs when the file has none.
             const bool normalMapped = prim.material >= 0 && m.materials[size_t(prim.material)].normalTexture.index >= 0;
-            if (normalMapped && mesh.tangents.empty()) mesh.computeTangents();
+            if (normalMapped && mesh.tangents.empty())
+                mesh.computeTangents((materials[size_t(prim.material)].uv1Maps & sg::Material::NormalMap) ? 1 : 0);
         } else {
             mesh.tangents.clear();
         }

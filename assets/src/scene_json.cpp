@@ -20,7 +20,8 @@
 //                     "metallicRoughnessTexture",
 //                     "metallic", "roughness", "specularGlossiness", "glossiness", "alpha",
 //                     "alphaMode": <AlphaMode>, "alphaCutoff", "unlit", "doubleSided",
-//                     "reflectivity"} ],
+//                     "reflectivity", "uv1Maps": the maps that sample the mesh's uv1, any of
+//                     ["emissive", "occlusion", "metallicRoughness", "normal"]} ],
 //     "meshes":    [ {"name", "file": "relative/model.obj"} |
 //                    {"name", "mode": "triangles|lines|points", "positions": [x,y,z,...],
 //                     "normals", "uv0", "uv1", "colors" (4 per vertex), "tangents" (4 per
@@ -76,6 +77,21 @@ constexpr size_t kMaxVertices = 100'000'000;
 constexpr size_t kMaxIndices = 300'000'000;
 constexpr size_t kMaxGridValues = 512ull * 512 * 512;
 constexpr size_t kMaxMorphTargets = 4096;
+
+// The names of sg::Material's map bits in "uv1Maps".
+struct MapBitName {
+    const char* name;
+    uint8_t bit;
+};
+constexpr MapBitName kMapBitNames[] = {{"emissive", sg::Material::EmissiveMap},
+                                       {"occlusion", sg::Material::OcclusionMap},
+                                       {"metallicRoughness", sg::Material::MetallicRoughnessMap},
+                                       {"normal", sg::Material::NormalMap}};
+const MapBitName* findMapBit(const std::string& name) {
+    for (const MapBitName& e : kMapBitNames)
+        if (name == e.name) return &e;
+    return nullptr;
+}
 
 struct ParseError {
     std::string path;   // JSON pointer, e.g. /nodes/3/transform
@@ -337,6 +353,14 @@ sg::Material Reader::readMaterial(const json& j, const std::string& p, size_t te
     optFloat(j, p, "normalScale", m.normalScale);
     if (!std::isfinite(m.normalScale)) fail(p + "/normalScale", "must be finite");
     optInt(j, p, "metallicRoughnessTexture", m.metallicRoughnessTexture, -1, (long long)textureCount - 1);
+    if (const json* v = optional(j, "uv1Maps")) {
+        if (!v->is_array()) fail(p + "/uv1Maps", "expected an array of map names");
+        for (const json& name : *v) {
+            const auto* e = name.is_string() ? findMapBit(name.get<std::string>()) : nullptr;
+            if (!e) fail(p + "/uv1Maps", "expected names among emissive, occlusion, metallicRoughness, normal");
+            m.uv1Maps |= e->bit;
+        }
+    }
     optFloat(j, p, "metallic", m.metallic);
     optFloat(j, p, "roughness", m.roughness);
     optBool(j, p, "specularGlossiness", m.specularGlossiness);
@@ -991,7 +1015,7 @@ std::string serializeSceneJson(const sg::Scene& s) {
         j["textures"].push_back(tj);
     }
     j["materials"] = json::array();
-    for (const auto& m : s.materials)
+    for (const auto& m : s.materials) {
         j["materials"].push_back({{"name", m.name},
                                   {"baseColor", vecJ(m.baseColor)},
                                   {"ka", m.ka},
@@ -1018,6 +1042,13 @@ std::string serializeSceneJson(const sg::Scene& s) {
                                   {"unlit", m.unlit},
                                   {"doubleSided", m.doubleSided},
                                   {"reflectivity", m.reflectivity}});
+        if (m.uv1Maps) {
+            json names = json::array();
+            for (const MapBitName& e : kMapBitNames)
+                if (m.uv1Maps & e.bit) names.push_back(e.name);
+            j["materials"].back()["uv1Maps"] = names;
+        }
+    }
     j["meshes"] = json::array();
     for (const auto& m : s.meshes) {
         const char* mode = m->mode == sg::PrimitiveMode::Triangles ? "triangles" : m->mode == sg::PrimitiveMode::Lines ? "lines" : "points";

@@ -47,21 +47,29 @@ PhongCoefficients coefficientsOf(const Material& m) {
     return c;
 }
 
-MapSample sampleMaps(const SampledTexture* em, const SampledTexture* occ, const SampledTexture* mr, const SampledTexture* nm, vec2 uv, vec2 ddx,
-                     vec2 ddy) {
+MapSample sampleMaps(const MapSamplers& maps, const UvFootprint uvs[2]) {
+    auto at = [&](uint8_t bit) -> const UvFootprint& { return uvs[(maps.uv1 & bit) ? 1 : 0]; };
     MapSample s;
-    if (nm) {
+    if (const SampledTexture* nm = maps.normal) {
+        const UvFootprint& f = at(sg::Material::NormalMap);
         s.hasNormal = true;
-        s.normalTexel = nm->sample(uv, ddx, ddy);
+        s.normalTexel = nm->sample(f.uv, f.ddx, f.ddy);
     }
-    if (em) s.emissive = em->sample(uv, ddx, ddy);
-    if (occ) s.occlusion = occ->sample(uv, ddx, ddy).x;
-    if (mr) {
-        const vec3 t = mr->sample(uv, ddx, ddy);
+    if (const SampledTexture* em = maps.emissive) {
+        const UvFootprint& f = at(sg::Material::EmissiveMap);
+        s.emissive = em->sample(f.uv, f.ddx, f.ddy);
+    }
+    if (const SampledTexture* occ = maps.occlusion) {
+        const UvFootprint& f = at(sg::Material::OcclusionMap);
+        s.occlusion = occ->sample(f.uv, f.ddx, f.ddy).x;
+    }
+    if (const SampledTexture* mr = maps.metallicRoughness) {
+        const UvFootprint& f = at(sg::Material::MetallicRoughnessMap);
+        const vec3 t = mr->sample(f.uv, f.ddx, f.ddy);
         s.hasMetallicRoughness = true;
         s.roughness = t.y;
         s.metallic = t.z;
-        s.pbrTexel = vec4(t, mr->sampleAlpha(uv, ddx, ddy));
+        s.pbrTexel = vec4(t, mr->sampleAlpha(f.uv, f.ddx, f.ddy));
     }
     return s;
 }

@@ -59,7 +59,7 @@ struct Program {
     GLint texture = -1, hasTexture = -1, unlit = -1, solid = -1, solidColor = -1, overdraw = -1;
     // Material maps (texture units 1..4: emissive, occlusion, metallic-roughness, normal) and their factors.
     GLint maps[4] = {-1, -1, -1, -1}, hasMap[4] = {-1, -1, -1, -1}, occlusionStrength = -1, metallic = -1, roughness = -1, normalScale = -1;
-    GLint specGloss = -1, glossiness = -1;
+    GLint specGloss = -1, glossiness = -1, uv1Maps = -1;
     GLint alpha = -1, alphaMode = -1, alphaCutoff = -1;
     GLint fogMode = -1, fogColor = -1, fogParams = -1;
     GLint drawable = -1, primitiveBase = -1;   // visibility output (location 1)
@@ -105,6 +105,11 @@ std::string glslEnumDefines() {
     all("FOG_", sg::nameTable<sg::FogMode>());
     all("LIGHT_", sg::nameTable<sg::LightType>());
     all("ALPHA_", sg::nameTable<sg::AlphaMode>());
+    // The map bits of sg::Material::uv1Maps (which maps sample the second UV set).
+    add("MAP_", "emissive", sg::Material::EmissiveMap);
+    add("MAP_", "occlusion", sg::Material::OcclusionMap);
+    add("MAP_", "metallic_roughness", sg::Material::MetallicRoughnessMap);
+    add("MAP_", "normal", sg::Material::NormalMap);
     return d;
 }
 
@@ -205,6 +210,7 @@ std::string buildProgram(const std::string& key, Program& p) {
     p.specGloss = loc("uSpecGloss");
     p.glossiness = loc("uGlossiness");
     p.normalScale = loc("uNormalScale");
+    p.uv1Maps = loc("uUv1Maps");
     p.unlit = loc("uUnlit");
     p.alpha = loc("uAlpha");
     p.alphaMode = loc("uAlphaMode");
@@ -229,7 +235,8 @@ struct IndexRange {
 struct GpuMesh {
     uint64_t version = 0;
     GLuint vao = 0, vbo = 0, ebo = 0;
-    GLuint tbo = 0;   // tangents (attribute 4), only for meshes that have them
+    GLuint tbo = 0;    // tangents (attribute 4), only for meshes that have them
+    GLuint u1bo = 0;   // the second UV set (attribute 5), only for meshes that have one
     GLenum primitive = GL_TRIANGLES;
     std::vector<IndexRange> ranges;
     size_t triangles = 0;
@@ -255,7 +262,8 @@ void releaseMesh(GpuMesh& m) {
     if (m.vbo) glDeleteBuffers(1, &m.vbo);
     if (m.ebo) glDeleteBuffers(1, &m.ebo);
     if (m.tbo) glDeleteBuffers(1, &m.tbo);
-    m.vao = m.vbo = m.ebo = m.tbo = 0;
+    if (m.u1bo) glDeleteBuffers(1, &m.u1bo);
+    m.vao = m.vbo = m.ebo = m.tbo = m.u1bo = 0;
 }
 
 // Builds (or rebuilds) the buffers of `mesh`; triangleMaterial (optional) groups the
@@ -345,6 +353,13 @@ void uploadMesh(GpuMesh& g, const Mesh& mesh, const std::vector<uint16_t>* trian
         glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(mesh.tangents.size() * sizeof(vec4)), mesh.tangents.data(), GL_STATIC_DRAW);
         glEnableVertexAttribArray(4);
         glVertexAttribPointer(4, 4, GL_FLOAT, GL_FALSE, sizeof(vec4), nullptr);
+    }
+    if (per == 3 && mesh.uv1.size() == mesh.positions.size()) {   // maps on a second UV set: own buffer too
+        glGenBuffers(1, &g.u1bo);
+        glBindBuffer(GL_ARRAY_BUFFER, g.u1bo);
+        glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(mesh.uv1.size() * sizeof(vec2)), mesh.uv1.data(), GL_STATIC_DRAW);
+        glEnableVertexAttribArray(5);
+        glVertexAttribPointer(5, 2, GL_FLOAT, GL_FALSE, sizeof(vec2), nullptr);
     }
     glBindVertexArray(0);
 }
@@ -797,6 +812,7 @@ void GlRenderer::setMaterial(const Program& p, const Material& m, const DrawItem
     const bool hasTexture = it.texture != nullptr;
     for (int k = 0; k < 4; ++k) glUniform1i(p.hasMap[k], it.maps[k] && !unlit ? 1 : 0);
     glUniform1f(p.normalScale, m.normalScale);
+    glUniform1i(p.uv1Maps, it.gpu && it.gpu->u1bo ? int(m.uv1Maps) : 0);
     glUniform1f(p.occlusionStrength, m.occlusionStrength);
     glUniform1f(p.metallic, m.metallic);
     glUniform1f(p.roughness, m.roughness);

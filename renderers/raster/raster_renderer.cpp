@@ -105,8 +105,8 @@ struct DrawItem {
     std::shared_ptr<const std::vector<uint16_t>> triMat;   // per-triangle material (CSG)
     std::shared_ptr<const std::vector<sg::Material>> materials;
     const SampledTexture* texture = nullptr;
-    const SampledTexture *emissiveMap = nullptr, *occlusionMap = nullptr, *metallicRoughnessMap = nullptr, *normalMap = nullptr;
-    bool hasMaps() const { return emissiveMap || occlusionMap || metallicRoughnessMap || normalMap; }
+    MapSamplers maps;   // maps.uv1 is cleared when the mesh has no uv1
+    bool hasMaps() const { return maps.any(); }
     bool hasTangents = false;   // normal map with mesh tangents: wtan filled
     bool mirrored = false;
     bool perCorner = false;   // Gouraud with per-triangle materials: one vertex per corner
@@ -554,12 +554,12 @@ inline FragBary baryAt(const TriCache& tc, int i, int j) {
 // implementations take them: finite differences over the fragment's 2x2 pixel quad (quads at
 // even window x and y), d/dx = uv(x0 + 1, y0) - uv(x0, y0) and d/dy = uv(x0, y0 + 1) - uv(x0, y0)
 // at pixel centres, the same for the four pixels (points outside the triangle extrapolate its
-// plane, like GL's helper invocations). Needs d.hasUV.
-inline void uvAt(const TriCache& tc, const FragBary& fb, const uint32_t mi[3], int i, int j, vec2& uv, vec2& ddx, vec2& ddy) {
+// plane, like GL's helper invocations). `set` is the mesh's uv0 (needs d.hasUV) or uv1.
+inline void uvAt(const TriCache& tc, const FragBary& fb, const uint32_t mi[3], int i, int j, const std::vector<vec2>& set, vec2& uv, vec2& ddx,
+                 vec2& ddy) {
     const Tri& t = *tc.t;
-    const sg::Mesh& m = *tc.d->mesh;
     const std::array<vec3, 3>* cb = tc.cb;
-    vec2 uvc[3] = {m.uv0[mi[0]], m.uv0[mi[1]], m.uv0[mi[2]]};
+    vec2 uvc[3] = {set[mi[0]], set[mi[1]], set[mi[2]]};
     vec2 uvk[3];   // uv at the setup vertices
     for (int q = 0; q < 3; ++q) {
         vec3 w = cb ? (*cb)[q] : vec3(t.s.order[q] == 0, t.s.order[q] == 1, t.s.order[q] == 2);
@@ -598,7 +598,7 @@ float fragmentAlpha(const TriCache& tc, int i, int j) {
     }
     if (texAlpha) {
         vec2 uv, ddx, ddy;
-        uvAt(tc, fb, mi, i, j, uv, ddx, ddy);
+        uvAt(tc, fb, mi, i, j, d.mesh->uv0, uv, ddx, ddy);
         a *= d.texture->sampleAlpha(uv, ddx, ddy);
     }
     return a;
@@ -763,10 +763,13 @@ __attribute__((noinline)) float prepareFragment(const TriCache& tc, const FrameC
         uint32_t mi[3] = {d.meshIndex(v[0]), d.meshIndex(v[1]), d.meshIndex(v[2])};
         if (d.hasColors) albedo *= vec3(bo[0] * m.colors[mi[0]] + bo[1] * m.colors[mi[1]] + bo[2] * m.colors[mi[2]]);
         if ((d.texture && d.hasUV) || maps) {
-            vec2 uv, ddx, ddy;
-            uvAt(tc, fb, mi, i, j, uv, ddx, ddy);
-            if (d.texture) albedo *= d.texture->sample(uv, ddx, ddy);
-            if (maps) ms = sampleMaps(d.emissiveMap, d.occlusionMap, d.metallicRoughnessMap, d.normalMap, uv, ddx, ddy);
+            UvFootprint uvs[2];
+            uvAt(tc, fb, mi, i, j, m.uv0, uvs[0].uv, uvs[0].ddx, uvs[0].ddy);
+            if (d.texture) albedo *= d.texture->sample(uvs[0].uv, uvs[0].ddx, uvs[0].ddy);
+            if (maps) {
+                if (d.maps.uv1) uvAt(tc, fb, mi, i, j, m.uv1, uvs[1].uv, uvs[1].ddx, uvs[1].ddy);
+                ms = sampleMaps(d.maps, uvs);
+            }
         }
     }
 
@@ -1198,11 +1201,9 @@ private:
             d.drawable = p.drawable;
             d.analytic = p.analytic;
             d.texture = m_samplers.get(p.texture);
-            d.emissiveMap = m_samplers.get(p.maps.emissive);
-            d.occlusionMap = m_samplers.get(p.maps.occlusion);
-            d.metallicRoughnessMap = m_samplers.get(p.maps.metallicRoughness);
-            d.normalMap = m_samplers.get(p.maps.normal);
-            d.hasTangents = d.normalMap && p.mesh->tangents.size() == p.mesh->positions.size();
+            d.maps = {m_samplers.get(p.maps.emissive), m_samplers.get(p.maps.occlusion), m_samplers.get(p.maps.metallicRoughness),
+                      m_samplers.get(p.maps.normal), p.mesh->uv1.size() == p.mesh->positions.size() ? p.material->uv1Maps : uint8_t(0)};
+            d.hasTangents = d.maps.normal && p.mesh->tangents.size() == p.mesh->positions.size();
             d.hasNormals = p.mesh->normals.size() == p.mesh->positions.size();
             d.hasUV = p.mesh->uv0.size() == p.mesh->positions.size();
             d.hasColors = p.mesh->colors.size() == p.mesh->positions.size();

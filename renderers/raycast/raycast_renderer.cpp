@@ -122,7 +122,6 @@ bool uvWithFootprint(const PixelFootprint* footprint, const vec3 P[3], const vec
 
 // --- Tracer --------------------------------------------------------------------------------------
 
-// A mesh's other material textures (null when absent).
 // The surface a primary ray keeps (see Tracer::trace): where, and what (Framebuffer's
 // visibility). p is NaN while the ray has met nothing that writes depth.
 struct SurfaceRecord {
@@ -130,16 +129,11 @@ struct SurfaceRecord {
     uint32_t drawable = 0, primitive = kNoPrimitive;
 };
 
-struct MeshMaps {
-    const SampledTexture *emissive = nullptr, *occlusion = nullptr, *metallicRoughness = nullptr, *normal = nullptr;
-    bool any() const { return emissive || occlusion || metallicRoughness || normal; }
-};
-
 struct Tracer {
     const FrameInput& f;
     const rt::SceneAccel& accel;
     const std::vector<const SampledTexture*>& textures;   // per f.meshes entry, null if none
-    const std::vector<MeshMaps>& maps;                    // per f.meshes entry: emissive, occlusion, metallic-roughness
+    const std::vector<MapSamplers>& maps;                 // per f.meshes entry: emissive, occlusion, metallic-roughness, normal
     uint64_t rays = 0;
     bool anyAlpha = false;   // some material is masked or blended (anyTranslucent())
     // The cost view (RenderConfig::traversalCost): the BVH work of the primary ray (bounce 0,
@@ -292,17 +286,24 @@ struct Tracer {
             albedoV[2] *= vec3(mesh.colors[i2]);
         }
         vec3 texColor(1.0f);
-        const MeshMaps& mm = maps[h.instance];
+        const MapSamplers& mm = maps[h.instance];
         const bool hasMaps = hasUV && mm.any();
         MapSample ms;
         if (const SampledTexture* tex = textures[h.instance]; (tex || hasMaps) && hasUV) {
             const vec2 UV[3] = {mesh.uv0[i0], mesh.uv0[i1], mesh.uv0[i2]};
             const float w[3] = {w0, w1, w2};
-            vec2 uv, ddx(0.0f), ddy(0.0f);
-            const bool footprinted = uvWithFootprint(footprint, P, UV, w, uv, ddx, ddy);
-            if (tex) texColor = footprinted ? tex->sample(uv, ddx, ddy) : tex->sampleLevel(uv, 0, tex->filter() != FilterMode::Nearest);
-            if (hasMaps)
-                ms = sampleMaps(mm.emissive, mm.occlusion, mm.metallicRoughness, mm.normal, uv, ddx, ddy);   // no footprint: derivatives 0, level 0
+            UvFootprint uvs[2];   // without a footprint the derivatives stay 0: level 0
+            const bool footprinted = uvWithFootprint(footprint, P, UV, w, uvs[0].uv, uvs[0].ddx, uvs[0].ddy);
+            if (tex)
+                texColor = footprinted ? tex->sample(uvs[0].uv, uvs[0].ddx, uvs[0].ddy)
+                                       : tex->sampleLevel(uvs[0].uv, 0, tex->filter() != FilterMode::Nearest);
+            if (hasMaps) {
+                if (mm.uv1) {
+                    const vec2 UV1[3] = {mesh.uv1[i0], mesh.uv1[i1], mesh.uv1[i2]};
+                    uvWithFootprint(footprint, P, UV1, w, uvs[1].uv, uvs[1].ddx, uvs[1].ddy);
+                }
+                ms = sampleMaps(mm, uvs);
+            }
         }
         vec3 Nv[3];
         for (int k = 0; k < 3; ++k) {
@@ -488,13 +489,16 @@ protected:
         // Samplers (mip chains) per texture, cached by id + version; one pointer per mesh.
         m_samplers.beginFrame();
         std::vector<const SampledTexture*>& textures = m_textures;
-        std::vector<MeshMaps>& maps = m_maps;
+        std::vector<MapSamplers>& maps = m_maps;
         textures.assign(f.meshes.size(), nullptr);
         maps.assign(f.meshes.size(), {});
         for (size_t i = 0; i < f.meshes.size(); ++i) {
             textures[i] = m_samplers.get(f.meshes[i].texture);
-            const sg::MaterialMaps& fm = f.meshes[i].maps;
-            maps[i] = {m_samplers.get(fm.emissive), m_samplers.get(fm.occlusion), m_samplers.get(fm.metallicRoughness), m_samplers.get(fm.normal)};
+            const sg::DrawMesh& dm = f.meshes[i];
+            const sg::MaterialMaps& fm = dm.maps;
+            const bool hasUv1 = dm.mesh && dm.mesh->uv1.size() == dm.mesh->positions.size();
+            maps[i] = {m_samplers.get(fm.emissive), m_samplers.get(fm.occlusion), m_samplers.get(fm.metallicRoughness), m_samplers.get(fm.normal),
+                       hasUv1 ? dm.material.uv1Maps : uint8_t(0)};
         }
         m_samplers.endFrame();
         const bool anyAlpha = anyTranslucent(f);
@@ -612,7 +616,7 @@ private:
     SamplerCache m_samplers;
     // The last frame's samplers per mesh (kept for lightVisibility).
     std::vector<const SampledTexture*> m_textures;
-    std::vector<MeshMaps> m_maps;
+    std::vector<MapSamplers> m_maps;
     TessellationCache m_tess;   // wireframe of analytic shapes only
 };
 

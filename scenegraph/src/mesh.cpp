@@ -35,16 +35,17 @@ void Mesh::computeNormals() {
     }
 }
 
-void Mesh::computeTangents() {
+void Mesh::computeTangents(int uvSet) {
     tangents.clear();
     const size_t n = positions.size();
-    if (mode != PrimitiveMode::Triangles || normals.size() != n || uv0.size() != n) return;
+    const std::vector<vec2>& uv = uvSet == 1 ? uv1 : uv0;
+    if (mode != PrimitiveMode::Triangles || normals.size() != n || uv.size() != n) return;
     std::vector<vec3> du(n, vec3(0.0f)), dv(n, vec3(0.0f));
     for (size_t i = 0; i + 2 < indices.size(); i += 3) {
         const uint32_t a = indices[i], b = indices[i + 1], c = indices[i + 2];
         if (a >= n || b >= n || c >= n) continue;
         const vec3 e1 = positions[b] - positions[a], e2 = positions[c] - positions[a];
-        const vec2 t1 = uv0[b] - uv0[a], t2 = uv0[c] - uv0[a];
+        const vec2 t1 = uv[b] - uv[a], t2 = uv[c] - uv[a];
         const float det = t1.x * t2.y - t2.x * t1.y;
         if (!(std::fabs(det) > 1e-20f)) continue;   // no uv area (or NaN): no direction
         const vec3 su = (e1 * t2.y - e2 * t1.y) / det, sv = (e2 * t1.x - e1 * t2.x) / det;

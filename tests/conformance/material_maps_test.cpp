@@ -267,6 +267,36 @@ TEST_P(MaterialMaps, SpecularGlossinessTextureGivesTheSpecularColourPerTexel) {
     }
 }
 
+// Each map samples its own UV set (sg::Material::uv1Maps; glTF texCoord): uv1 mirrors uv0 in
+// u, the emissive map reads uv1 and the occlusion map uv0 in the same draw, so the left half
+// shows the right texel's emission and its own texel's occlusion. A mesh without uv1 samples
+// uv0 for every map.
+TEST_P(MaterialMaps, EachMapSamplesItsOwnUvSet) {
+    for (bool hasUv1 : {true, false})
+        for (sg::ShadingModel model : kModels) {
+            sg::Material m;
+            m.baseColor = vec3(0.5f);
+            m.ka = 1.0f;
+            m.kd = m.ks = 0.0f;
+            m.emissive = vec3(1.0f);
+            m.uv1Maps = sg::Material::EmissiveMap;
+            sg::MaterialMaps maps;
+            maps.emissive = twoTexels({255, 0, 0}, {0, 0, 255}, true);
+            maps.occlusion = twoTexels({0, 0, 0}, {255, 255, 255}, false);
+            const vec3 La(0.4f);
+            sg::FrameInput f = mapsFrame(m, maps, model, La, vec3(0.0f));
+            sg::Mesh mesh = quad(1.0f);
+            if (hasUv1)
+                for (const sg::vec2& uv : mesh.uv0) mesh.uv1.push_back(sg::vec2(1.0f - uv.x, uv.y));
+            f.meshes.back().mesh = std::make_shared<sg::Mesh>(mesh);
+            const std::string name = std::string("uv-sets-") + (hasUv1 ? "two-" : "one-") + std::string(sg::nameOf(model));
+            rnd::Framebuffer fb = render(GetParam(), f, name);
+            const vec3 red(1, 0, 0), blue(0, 0, 1), ambient = La * m.baseColor;
+            EXPECT_TRUE(pixelIs(fb, kLeft, hasUv1 ? blue : red)) << GetParam() << " " << name;   // occlusion 0: no ambient
+            EXPECT_TRUE(pixelIs(fb, kRight, (hasUv1 ? red : blue) + ambient)) << GetParam() << " " << name;
+        }
+}
+
 INSTANTIATE_TEST_SUITE_P(EveryBackend, MaterialMaps, ::testing::ValuesIn(rnd::rendererNames()), [](const auto& info) { return info.param; });
 
 // The mapping itself at known points (docs/math.md).
@@ -339,6 +369,72 @@ TEST(MaterialMapsImport, GltfTexturesFactorsAndColourSpaces) {
     EXPECT_EQ(again.scene->materials, r.scene->materials);
     ASSERT_EQ(again.scene->textures.size(), tex.size());
     for (size_t i = 0; i < tex.size(); ++i) EXPECT_EQ(again.scene->textures[i]->srgb, tex[i]->srgb) << i;
+}
+
+// glTF import of two UV channels: the base colour on TEXCOORD_0, the occlusion texture on
+// TEXCOORD_1 with a KHR_texture_transform offset. uv0 and uv1 carry them (v flipped after the
+// transform), uv1Maps names the occlusion map, and the scene file keeps it. An emissive texture
+// on a third (set, transform) combination samples the base colour's channel, with a warning.
+TEST(MaterialMapsImport, TwoUvChannelsWithTheirTransforms) {
+    namespace fs = std::filesystem;
+    fs::path dir = testing_support::outputDir("conformance") / "maps-uv-sets";
+    fs::create_directories(dir);
+    const uint8_t rgba[8] = {255, 0, 0, 255, 0, 255, 0, 255};
+    std::string png;
+    ASSERT_EQ(assets::encodePng(2, 1, rgba, png), "");
+    const float pos[12] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
+    const float uvA[8] = {0, 1, 1, 1, 1, 0, 0, 0}, uvB[8] = {0.1f, 0.2f, 0.3f, 0.2f, 0.3f, 0.4f, 0.1f, 0.4f};
+    std::string buf(reinterpret_cast<const char*>(pos), sizeof pos);
+    buf.append(reinterpret_cast<const char*>(uvA), sizeof uvA);
+    buf.append(reinterpret_cast<const char*>(uvB), sizeof uvB);
+    const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
+    buf.append(reinterpret_cast<const char*>(idx), sizeof idx);
+    auto write = [&](const fs::path& file, const std::string& emissive) {
+        std::ofstream(file) << R"({"asset":{"version":"2.0"},"extensionsUsed":["KHR_texture_transform"],"scene":0,"scenes":[{"nodes":[0]}],
+"nodes":[{"mesh":0}],
+"meshes":[{"primitives":[{"attributes":{"POSITION":0,"TEXCOORD_0":1,"TEXCOORD_1":2},"indices":3,"material":0}]}],
+"materials":[{"pbrMetallicRoughness":{"baseColorTexture":{"index":0}},
+  "occlusionTexture":{"index":0,"texCoord":1,"extensions":{"KHR_texture_transform":{"offset":[0.5,0.25]}}})"
+                            << emissive << R"(}],
+"textures":[{"source":0}],
+"images":[{"uri":"data:image/png;base64,)"
+                            << testing_support::base64Encode(png) << R"("}],
+"buffers":[{"byteLength":124,"uri":"data:application/octet-stream;base64,)"
+                            << testing_support::base64Encode(buf) << R"("}],
+"bufferViews":[{"buffer":0,"byteLength":48},{"buffer":0,"byteOffset":48,"byteLength":32},{"buffer":0,"byteOffset":80,"byteLength":32},
+ {"buffer":0,"byteOffset":112,"byteLength":12}],
+"accessors":[{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3","min":[0,0,0],"max":[1,1,0]},
+ {"bufferView":1,"componentType":5126,"count":4,"type":"VEC2"},{"bufferView":2,"componentType":5126,"count":4,"type":"VEC2"},
+ {"bufferView":3,"componentType":5123,"count":6,"type":"SCALAR"}]})";
+    };
+    write(dir / "two.gltf", R"(,"emissiveTexture":{"index":0,"texCoord":1,"extensions":{"KHR_texture_transform":{"offset":[0.5,0.25]}}})");
+    assets::LoadResult r = assets::loadScene(dir / "two.gltf");
+    ASSERT_TRUE(r.scene) << r.error;
+    for (const std::string& w : r.warnings) ADD_FAILURE() << "unexpected warning: " << w;
+    ASSERT_EQ(r.scene->materials.size(), 1u);
+    EXPECT_EQ(r.scene->materials[0].uv1Maps, sg::Material::OcclusionMap | sg::Material::EmissiveMap);
+    ASSERT_EQ(r.scene->meshes.size(), 1u);
+    const sg::Mesh& mesh = *r.scene->meshes[0];
+    ASSERT_EQ(mesh.uv0.size(), 4u);
+    ASSERT_EQ(mesh.uv1.size(), 4u);
+    for (size_t i = 0; i < 4; ++i) {
+        EXPECT_NEAR(mesh.uv0[i].x, uvA[2 * i], 1e-6f) << i;
+        EXPECT_NEAR(mesh.uv0[i].y, 1.0f - uvA[2 * i + 1], 1e-6f) << i;
+        EXPECT_NEAR(mesh.uv1[i].x, uvB[2 * i] + 0.5f, 1e-6f) << i;
+        EXPECT_NEAR(mesh.uv1[i].y, 1.0f - (uvB[2 * i + 1] + 0.25f), 1e-6f) << i;
+    }
+    const fs::path json = dir / "two.scene.json";
+    ASSERT_EQ(assets::saveSceneJson(*r.scene, json, true), "");
+    assets::LoadResult again = assets::loadScene(json);
+    ASSERT_TRUE(again.scene) << again.error;
+    EXPECT_EQ(again.scene->materials, r.scene->materials);
+
+    write(dir / "three.gltf", R"(,"emissiveTexture":{"index":0,"extensions":{"KHR_texture_transform":{"scale":[2,2]}}})");
+    assets::LoadResult three = assets::loadScene(dir / "three.gltf");
+    ASSERT_TRUE(three.scene) << three.error;
+    EXPECT_EQ(three.scene->materials[0].uv1Maps, sg::Material::OcclusionMap);   // emissive samples channel 0
+    ASSERT_EQ(three.warnings.size(), 1u);
+    EXPECT_NE(three.warnings[0].find("more than two UV set"), std::string::npos) << three.warnings[0];
 }
 
 }   // namespace

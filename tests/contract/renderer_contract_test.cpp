@@ -213,7 +213,7 @@ TEST(GlslEnumGuardTest, ShadersHandleEveryEnumValueByName) {
         std::string name = (*it)[1];
         EXPECT_TRUE(std::regex_search(code, std::regex("\\b" + name + "\\b"))) << name << " is not handled by the shaders";
     }
-    EXPECT_EQ(count, 3 + 2 + 4 + 3 + 3);   // shading, reflection, fog, light types, alpha modes
+    EXPECT_EQ(count, 3 + 2 + 4 + 3 + 3 + 4);   // shading, reflection, fog, light types, alpha modes, material map bits
     EXPECT_NE(defines.find("#define FOG_EXP2 " + std::to_string(int(sg::FogMode::Exp2))), std::string::npos) << defines;
     EXPECT_NE(defines.find("#define SHADING_GOURAUD " + std::to_string(int(sg::ShadingModel::Gouraud))), std::string::npos) << defines;
     EXPECT_NE(defines.find("#define LIGHT_SPOT " + std::to_string(int(sg::LightType::Spot))), std::string::npos) << defines;

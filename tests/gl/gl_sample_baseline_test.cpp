@@ -8,7 +8,9 @@
 //    silhouettes; the specular-glossiness bottle has golden highlights;
 //  - TextureTransformTest: every square shows its arrow/pattern as the model's labels ask
 //    (offset, rotation, scale, texCoord override) - the model's own "correct" layout;
-//  - ClearCoatTest: the normal-mapped rows show their ribs, the labels their text.
+//  - ClearCoatTest: the normal-mapped rows show their ribs, the labels their text;
+//  - MultiUVTest: the emissive texture on TEXCOORD_1 puts a green glTF logo on each face (its
+//    "Multiple UVs not supported" text shows where a viewer reads TEXCOORD_0 instead).
 // VIEWER_ACCEPT_BASELINES=1 writes them instead (scripts/accept-baselines.sh). Needs
 // ../shared/testdata.
 #include "assets/image_io.h"
@@ -52,7 +54,8 @@ INSTANTIATE_TEST_SUITE_P(Samples, SampleBaselineGLTest,
                          ::testing::Values(Sample{"box_textured", "BoxTextured/glTF/BoxTextured.gltf"},
                                            Sample{"spec_gloss_vs_metal_rough", "SpecGlossVsMetalRough/glTF/SpecGlossVsMetalRough.gltf"},
                                            Sample{"texture_transform_test", "TextureTransformTest/glTF/TextureTransformTest.gltf"},
-                                           Sample{"clear_coat_test", "ClearCoatTest/glTF/ClearCoatTest.gltf"}),
+                                           Sample{"clear_coat_test", "ClearCoatTest/glTF/ClearCoatTest.gltf"},
+                                           Sample{"multi_uv_test", "MultiUVTest/glTF/MultiUVTest.gltf"}),
                          [](const ::testing::TestParamInfo<Sample>& i) { return std::string(i.param.name); });
 
 }   // namespace

@@ -162,6 +162,11 @@ TEST(GltfImportTest, MultiUvTexturesAndSamplers) {
     EXPECT_FALSE(r.scene->meshes[0]->uv0.empty());
     EXPECT_FALSE(r.scene->meshes[0]->uv1.empty());
     EXPECT_EQ(r.scene->cameras().size(), 1u);
+    // The base colour samples TEXCOORD_0, the emissive texture TEXCOORD_1: both honoured.
+    ASSERT_EQ(r.scene->materials.size(), 1u);
+    EXPECT_GE(r.scene->materials[0].emissiveTexture, 0);
+    EXPECT_EQ(r.scene->materials[0].uv1Maps, sg::Material::EmissiveMap);
+    for (const std::string& w : r.warnings) ADD_FAILURE() << "unexpected warning: " << w;
 
     for (const char* p :
          {"BoxTextured/glTF/BoxTextured.gltf", "BoxTextured/glTF-Binary/BoxTextured.glb", "BoxTextured/glTF-Embedded/BoxTextured.gltf"}) {

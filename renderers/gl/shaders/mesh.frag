@@ -4,6 +4,7 @@ in vec3 vWorldPos;
 in vec3 vEyePos;
 in vec3 vNormal;
 in vec2 vUv;
+in vec2 vUv1;
 in vec4 vColor;
 in vec4 vTangent;
 #if SHADING == SHADING_GOURAUD
@@ -25,6 +26,7 @@ uniform bool uHasMetalRoughMap;
 uniform sampler2D uNormalMap;       // tangent-space normal, linear RGB = 0.5 n + 0.5
 uniform bool uHasNormalMap;         // set only for meshes with tangents
 uniform float uNormalScale;
+uniform int uUv1Maps;               // sg::Material::uv1Maps: MAP_* bits of the maps that sample vUv1
 uniform float uOcclusionStrength;
 uniform float uMetallic;
 uniform float uRoughness;
@@ -48,6 +50,9 @@ layout(location = 0) out vec4 fragColor;
 // Visibility (written only when the target has the attachment, rnd::RenderConfig::visibility):
 // drawable, and the primitive index within its mesh.
 layout(location = 1) out uvec2 fragId;
+
+// The UV set a map samples (rnd::sampleMaps): vUv1 where its MAP_* bit is set in uUv1Maps.
+vec2 mapUv(int bit) { return (uUv1Maps & bit) != 0 ? vUv1 : vUv; }
 
 // rnd::perturbNormal() (renderers/common/shading.cpp): the normal map's normal at n (outward).
 vec3 perturbNormal(vec3 n, vec4 t, vec3 texel, float scale) {
@@ -100,14 +105,14 @@ void main() {
             alpha *= t.a;
         }
         // The maps, sampled before any discard (implicit derivatives): coefficientsAt().
-        float ao = uHasOcclusionMap ? texture(uOcclusionMap, vUv).r : 1.0;
-        vec3 em = uHasEmissiveMap ? texture(uEmissiveMap, vUv).rgb : vec3(1.0);
-        vec3 nt = uHasNormalMap ? texture(uNormalMap, vUv).rgb : vec3(0.5, 0.5, 1.0);
+        float ao = uHasOcclusionMap ? texture(uOcclusionMap, mapUv(MAP_OCCLUSION)).r : 1.0;
+        vec3 em = uHasEmissiveMap ? texture(uEmissiveMap, mapUv(MAP_EMISSIVE)).rgb : vec3(1.0);
+        vec3 nt = uHasNormalMap ? texture(uNormalMap, mapUv(MAP_NORMAL)).rgb : vec3(0.5, 0.5, 1.0);
         coefficientsOfMaterial();
         gKa *= 1.0 + uOcclusionStrength * (ao - 1.0);
         gEmissive *= em;
         if (uHasMetalRoughMap) {
-            vec4 mr = texture(uMetalRoughMap, vUv);
+            vec4 mr = texture(uMetalRoughMap, mapUv(MAP_METALLIC_ROUGHNESS));
             if (uSpecGloss) {   // rnd::coefficientsAt, specular-glossiness
                 vec3 spec = uKs * uSpecColor * mr.rgb;
                 float ks = max(spec.r, max(spec.g, spec.b));

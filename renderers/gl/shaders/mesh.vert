@@ -6,6 +6,7 @@ layout(location = 1) in vec3 aNormal;
 layout(location = 2) in vec2 aUv;
 layout(location = 3) in vec4 aColor;
 layout(location = 4) in vec4 aTangent;   // xyz, handedness (normal-mapped meshes only)
+layout(location = 5) in vec2 aUv1;       // the second UV set (meshes that have one)
 
 uniform mat4 uModel;
 uniform mat3 uNormalMatrix;
@@ -17,6 +18,7 @@ out vec3 vWorldPos;
 out vec3 vEyePos;
 out vec3 vNormal;
 out vec2 vUv;
+out vec2 vUv1;
 out vec4 vColor;
 out vec4 vTangent;   // world xyz; w: handedness, flipped by a mirroring model matrix
 #if SHADING == SHADING_GOURAUD
@@ -32,6 +34,7 @@ void main() {
     vEyePos = (uView * world).xyz;
     vNormal = uNormalMatrix * aNormal;
     vUv = aUv;
+    vUv1 = aUv1;
     vColor = aColor;
     vTangent = vec4(mat3(uModel) * aTangent.xyz, determinant(mat3(uModel)) < 0.0 ? -aTangent.w : aTangent.w);
     gl_Position = uViewProj * world;

@@ -68,10 +68,20 @@ struct MapSample {
     bool hasNormal = false;
     sg::vec3 normalTexel{0.5f, 0.5f, 1.0f};   // RGB as stored (0.5 n + 0.5)
 };
-// Samples the maps (null = absent) at uv with the screen-space derivatives of uv.
+// A texture coordinate and its screen-space derivatives (the change over one pixel in x and y;
+// zero derivatives sample the finest level).
+struct UvFootprint {
+    sg::vec2 uv{0.0f}, ddx{0.0f}, ddy{0.0f};
+};
+// A draw's material maps (null = absent) and the UV set each samples.
 class SampledTexture;
-MapSample sampleMaps(const SampledTexture* emissive, const SampledTexture* occlusion, const SampledTexture* metallicRoughness,
-                     const SampledTexture* normal, sg::vec2 uv, sg::vec2 ddx, sg::vec2 ddy);
+struct MapSamplers {
+    const SampledTexture *emissive = nullptr, *occlusion = nullptr, *metallicRoughness = nullptr, *normal = nullptr;
+    uint8_t uv1 = 0;   // sg::Material::MapBit set: that map reads the second UV set (uvs[1] below)
+    bool any() const { return emissive || occlusion || metallicRoughness || normal; }
+};
+// Samples the maps, each at uvs[0] (Mesh::uv0) or uvs[1] (Mesh::uv1) as `maps.uv1` says.
+MapSample sampleMaps(const MapSamplers& maps, const UvFootprint uvs[2]);
 // The normal map's normal at a point (glTF 3.9.3): with the unit interpolated normal n (world,
 // the surface's outward side), tangent t (world xyz, w = handedness) and the texel c,
 //   m = 2c - 1, m.xy *= scale;  T = normalize(t - n (n.t));  B = w cross(n, T)

@@ -27,8 +27,9 @@ struct Material {
     vec3 specularColor{1.0f};           // used when not tinted
     int diffuseTexture = -1;            // index into Scene::textures, -1 = none (base colour, sRGB)
     vec3 emissive{0.0f};                // emission factor, linear RGB (x emissiveTexture)
-    // glTF's other textures (indices into Scene::textures, -1 = none). They sample the same UV
-    // set as the diffuse texture. docs/math.md, "Material textures", has the formulas.
+    // glTF's other textures (indices into Scene::textures, -1 = none). Each samples Mesh::uv0,
+    // as the diffuse texture does, or Mesh::uv1 where its bit is set in `uv1Maps`.
+    // docs/math.md, "Material textures", has the formulas.
     int emissiveTexture = -1;    // sRGB colour, multiplies `emissive`
     int occlusionTexture = -1;   // R: ambient occlusion; ka_eff = ka (1 + strength (R - 1))
     float occlusionStrength = 1.0f;
@@ -41,6 +42,11 @@ struct Material {
     // specular-glossiness texture (sRGB specular RGB x ks specularColor, linear A x glossiness).
     bool specularGlossiness = false;
     float glossiness = 1.0f;
+    // Which of the textures above sample Mesh::uv1 (a MapBit each; clear: Mesh::uv0). A mesh
+    // without uv1 samples uv0 for all. The glTF importer fills uv0 and uv1 with the material's
+    // two UV channels (each a TEXCOORD set with its KHR_texture_transform applied).
+    enum MapBit : uint8_t { EmissiveMap = 1, OcclusionMap = 2, MetallicRoughnessMap = 4, NormalMap = 8 };
+    uint8_t uv1Maps = 0;
     float alpha = 1.0f;   // base colour alpha (glTF baseColorFactor.a)
     AlphaMode alphaMode = AlphaMode::Opaque;
     float alphaCutoff = 0.5f;    // Mask only

@@ -53,10 +53,11 @@ struct Mesh {
     Aabb bounds() const;
     // Area-weighted smooth normals from the triangles (replaces `normals`).
     void computeNormals();
-    // Per-vertex tangents from the positions, normals and uv0 (Lengyel's method: each
-    // triangle's dP/du and dP/dv summed at its corners, Gram-Schmidt against the normal,
-    // handedness from dP/dv). Needs normals and uv0; leaves `tangents` empty otherwise.
-    void computeTangents();
+    // Per-vertex tangents from the positions, normals and the UV set the normal map samples
+    // (uvSet 0: uv0, 1: uv1) (Lengyel's method: each triangle's dP/du and dP/dv summed at its
+    // corners, Gram-Schmidt against the normal, handedness from dP/dv). Needs normals and that
+    // UV set; leaves `tangents` empty otherwise.
+    void computeTangents(int uvSet = 0);
     // Checks index ranges and attribute counts; returns an empty string when valid.
     std::string validate() const;
     std::string validateDeformation() const;   // the skin and morph part of validate()
