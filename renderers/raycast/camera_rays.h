@@ -3,27 +3,47 @@
 // inverse(proj * view) at NDC z = -1 and z = +1; the ray is the segment between the two points
 // (t = 0 on the near plane, t = 1 on the far plane). This covers perspective, orthographic and
 // oblique projections uniformly, and clips exactly like the rasterizers' near/far planes.
+// The inverse and the two points are computed in double precision: with far/near ratios of
+// 1e6 and more (near planes of 1e-5 in a scene of hundreds) the float inverse loses the far
+// point entirely (w near 0), and a ray that is not finite anyway misses everything.
 #pragma once
 
 #include "raycast/bvh.h"
 #include "scenegraph/frame.h"
+
+#include <limits>
 
 namespace rnd::rt {
 
 class CameraRays {
 public:
     CameraRays(const sg::FrameCamera& cam, int width, int height)
-        : m_viewProj(cam.proj * cam.view), m_inv(glm::inverse(cam.proj * cam.view)), m_w(float(width)), m_h(float(height)) {}
+        : m_viewProj(cam.proj * cam.view),
+          m_inv(glm::inverse(glm::dmat4(cam.proj) * glm::dmat4(cam.view))),
+          m_forward(-glm::dvec3(cam.viewInverse[2])),
+          m_w(double(width)),
+          m_h(double(height)) {}
 
     // Ray through window position (wx, wy); framebuffer row = height - 1 - floor(wy).
+    // When the far plane lies at or beyond infinity in the float projection (far/near so large
+    // that -(f + n) / (f - n) rounds to -1 or past it, as the rasterizers also see it), the ray
+    // runs from the near plane through NDC z = 0 with no far end (tmax = FLT_MAX).
     Ray ray(float wx, float wy) const {
-        float x = 2.0f * wx / m_w - 1.0f, y = 2.0f * wy / m_h - 1.0f;
-        sg::vec4 a = m_inv * sg::vec4(x, y, -1.0f, 1.0f), b = m_inv * sg::vec4(x, y, 1.0f, 1.0f);
+        const double x = 2.0 * double(wx) / m_w - 1.0, y = 2.0 * double(wy) / m_h - 1.0;
+        const glm::dvec4 a = m_inv * glm::dvec4(x, y, -1.0, 1.0), b = m_inv * glm::dvec4(x, y, 1.0, 1.0);
+        const glm::dvec3 org = glm::dvec3(a) / a.w;
         Ray r;
-        r.org = sg::vec3(a) / a.w;
-        r.dir = sg::vec3(b) / b.w - r.org;
+        r.org = sg::vec3(org);
         r.tmin = 0.0f;
         r.tmax = 1.0f;
+        const glm::dvec3 far = glm::dvec3(b) / b.w;
+        r.dir = sg::vec3(far - org);
+        if (!sg::isFinite(r.dir) || glm::dot(far - org, m_forward) <= 0.0) {   // no far end: at infinity or "beyond" (behind the eye)
+            const glm::dvec4 c = m_inv * glm::dvec4(x, y, 0.0, 1.0);
+            r.dir = sg::vec3(glm::dvec3(c) / c.w - org);
+            r.tmax = std::numeric_limits<float>::max();
+        }
+        if (!sg::isFinite(r.org) || !sg::isFinite(r.dir)) r.tmax = -1.0f;   // meets nothing
         return r;
     }
     // Window depth (0.5 * ndc_z + 0.5) of a world point, as the rasterizers write it.
@@ -36,11 +56,13 @@ public:
         sg::vec4 c = m_viewProj * sg::vec4(p, 1.0f);
         return {(0.5f * c.x / c.w + 0.5f) * m_w, (0.5f * c.y / c.w + 0.5f) * m_h};
     }
-    bool valid() const { return sg::isFinite(m_inv); }
+    bool valid() const { return sg::isFinite(sg::mat4(m_inv)); }
 
 private:
-    sg::mat4 m_viewProj, m_inv;
-    float m_w, m_h;
+    sg::mat4 m_viewProj;
+    glm::dmat4 m_inv;
+    glm::dvec3 m_forward;   // the view direction (world)
+    double m_w, m_h;
 };
 
 }   // namespace rnd::rt

@@ -12,6 +12,7 @@
 #include "renderers/renderer.h"
 #include "scenegraph/frame.h"
 #include "scenegraph/scene.h"
+#include "scenegraph/transforms.h"
 #include "test_scenes.h"
 #include "test_support.h"
 
@@ -53,7 +54,7 @@ void appendBox(Mesh& m, const vec3& lo, const vec3& hi) {
 // here so far): six heat sinks whose vertices are in millimetres, hundreds from the origin
 // (a 60 x 4 x 40 base and twenty fins 0.4 thick, 25 high), placed by matrix transforms that
 // scale by 0.001 and turn a few degrees, single-sided materials, the default camera framing it.
-FrameInput cadHeatSinks() {
+FrameInput cadHeatSinks(float unit = 0.001f) {
     Scene scene;
     for (int k = 0; k < 3; ++k) {
         Material m;
@@ -73,10 +74,10 @@ FrameInput cadHeatSinks() {
         scene.meshes.push_back(std::make_shared<Mesh>(std::move(mesh)));
         const float a = radians(3.0f * float(part % 5 - 2));
         mat4 m(1.0f);
-        m[0] = vec4(0.001f * std::cos(a), 0, -0.001f * std::sin(a), 0);
-        m[1] = vec4(0, 0.001f, 0, 0);
-        m[2] = vec4(0.001f * std::sin(a), 0, 0.001f * std::cos(a), 0);
-        m[3] = vec4(-0.4f, -0.2f, -0.3f, 1);
+        m[0] = vec4(unit * std::cos(a), 0, -unit * std::sin(a), 0);
+        m[1] = vec4(0, unit, 0, 0);
+        m[2] = vec4(unit * std::sin(a), 0, unit * std::cos(a), 0);
+        m[3] = unit == 1.0f ? vec4(0, 0, 0, 1) : vec4(-0.4f, -0.2f, -0.3f, 1);   // millimetres: left where they are
         const NodeId n = scene.addNode("part " + std::to_string(part), assembly, MeshInstance{int(scene.meshes.size()) - 1, part % 3});
         scene.setLocal(n, LocalTransform::fromMatrix(m));
     }
@@ -118,6 +119,29 @@ std::vector<MatrixScene> scenes() {
     FrameInput cad = cadHeatSinks();
     offlineSettings(cad);
     s.push_back({"cad_heat_sinks", cad});
+    // The same with near planes of 1e-4 and 1e-5 (far 1000): far/near = 1e7 lost the ray
+    // caster's float inverse of proj * view (rays off by a fraction of a pixel: neighbouring
+    // surfaces at the fins' edges, 99.905% -> now 99.99%), and at 1e-5, where the float
+    // projection puts the far plane at infinity, it crashed. And moved 500 units from the origin.
+    for (float zNear : {1e-4f, 1e-5f}) {
+        FrameInput c = cad;
+        c.camera.projection.zNear = zNear;
+        c.camera.projection.zFar = 1e3f;
+        c.camera.proj = sg::perspective(radians(c.camera.projection.fovyDeg), c.camera.aspect, zNear, 1e3f);
+        c.camera.viewProj = c.camera.proj * c.camera.view;
+        s.push_back({zNear < 5e-5f ? "cad_near_1e-5" : "cad_near_1e-4", c});
+    }
+    FrameInput mm = cadHeatSinks(1.0f);   // left in millimetres: the camera hundreds of units from the origin
+    offlineSettings(mm);
+    s.push_back({"cad_millimetres", mm});
+    FrameInput far = cad;
+    const sg::mat4 T = sg::translation(vec3(500.0f, 150.0f, -100.0f));
+    for (auto& m : far.meshes) m.world = T * m.world;
+    far.camera.viewInverse = T * far.camera.viewInverse;
+    far.camera.view = glm::inverse(far.camera.viewInverse);
+    far.camera.eye = vec3(far.camera.viewInverse[3]);
+    far.camera.viewProj = far.camera.proj * far.camera.view;
+    s.push_back({"cad_500_from_origin", far});
     return s;
 }
 

@@ -545,6 +545,47 @@ TEST(RaycastTest, PrimaryRaysLineUpWithProjections) {
     }
 }
 
+// Far/near ratios of 1e7 and more, seen from hundreds of units from the origin (a CAD model in
+// millimetres with a tight near plane): the ray through the window position of a point, as the
+// rasterizers map it (the float matrices proj and view, applied exactly), passes within 0.1
+// pixel of that point (the float ray origin alone is off by up to 0.05 pixel at 5 cm here), and has its far end where that projection puts the far plane (at
+// infinity for 1e-5 and 1e-6: -(f + n) / (f - n) rounds to -1). The float inverse of
+// proj * view missed by half a pixel here, and gave no ray at all at infinity.
+TEST(RaycastTest, PrimaryRaysStayOnTheirPixelsWithExtremeNearFarRatios) {
+    const int w = 320, h = 200;
+    const vec3 eye(312.0f, 205.0f, 488.0f);
+    const mat4 camWorld = glm::inverse(glm::lookAt(eye, eye + vec3(-0.3f, -0.2f, -1.0f), vec3(0, 1, 0)));
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> U(-0.9f, 0.9f), D(0.05f, 1.0f);
+    for (float zNear : {1e-3f, 1e-4f, 1e-5f, 1e-6f}) {
+        Projection p;
+        p.zNear = zNear;
+        p.zFar = 1000.0f;
+        FrameCamera cam = makeFrameCamera(camWorld, p, float(w) / h, 5.0f);
+        CameraRays rays(cam, w, h);
+        const glm::dmat4 viewProj = glm::dmat4(cam.proj) * glm::dmat4(cam.view);
+        const glm::dvec3 fwd = -glm::dvec3(camWorld[2]);
+        const double tanHalf = std::tan(0.5 * double(radians(p.fovyDeg)));
+        double worst = 0.0;
+        for (int i = 0; i < 200; ++i) {
+            const double d = D(rng);
+            const glm::dvec3 X =
+                glm::dvec3(eye) + d * (fwd + double(U(rng)) * glm::dvec3(camWorld[0]) + double(U(rng)) * 0.6 * glm::dvec3(camWorld[1]));
+            const glm::dvec4 c = viewProj * glm::dvec4(X, 1.0);
+            const Ray r = rays.ray(float((0.5 * c.x / c.w + 0.5) * w), float((0.5 * c.y / c.w + 0.5) * h));
+            ASSERT_TRUE(isFinite(r.org) && isFinite(r.dir)) << zNear;
+            ASSERT_GT(r.tmax, 0.0f) << zNear;
+            const glm::dvec3 dir = glm::normalize(glm::dvec3(r.dir)), off = X - glm::dvec3(r.org);
+            EXPECT_GT(glm::dot(dir, fwd), 0.0) << zNear;
+            const double pixel = 2.0 * glm::dot(off, fwd) * tanHalf / h;   // a pixel's size at X's depth
+            worst = std::max(worst, glm::length(off - glm::dot(off, dir) * dir) / pixel);
+        }
+        EXPECT_LT(worst, 0.1) << "near " << zNear << ": a ray misses its pixel's points by " << worst << " pixels";
+        const bool farAtInfinity = -(p.zFar + zNear) / (p.zFar - zNear) == -1.0f;
+        EXPECT_EQ(rays.ray(0.5f * w, 0.5f * h).tmax, farAtInfinity ? std::numeric_limits<float>::max() : 1.0f) << zNear;
+    }
+}
+
 namespace {
 FrameInput triangleScene(int w, int h) {
     FrameInput f;
