@@ -261,7 +261,9 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a, Command command) {
         cmd.add_option("--backend", a.backend, "Backend: gl, raster, raycast or all")->capture_default_str();
     } else {
         cmd.add_option("--out", a.out, "Output PNG file")->required();
-        cmd.add_option("--backend", a.backend, "Backend: gl, raster or raycast")->capture_default_str();
+        cmd.add_option("--backend", a.backend,
+                       "Backend: gl, raster or raycast. Default: gl, or raster (with a note saying so) where OpenGL is software only "
+                       "(Mesa llvmpipe, no GPU) or cannot render; --backend gl always renders with GL");
         cmd.add_option("--aov", a.aov,
                        "Also write, next to OUT.png, any of: depth (OUT.depth.pfm, float32 depth along the optical axis, 0 = nothing), "
                        "normal (OUT.normal.png, world normal as 0.5 n + 0.5, black = nothing), id (OUT.id.png, 16-bit instance id, 0 = "
@@ -352,7 +354,13 @@ std::string renderJob(const RenderArgs& a, const CameraJob& job, const sg::Scene
     return {};
 }
 
-int runRender(const RenderArgs& a) {
+int runRender(const RenderArgs& args) {
+    RenderArgs a = args;
+    if (a.backend.empty()) {   // the registry decides from what GL runs on here, never from a name
+        const rnd::BackendChoice choice = rnd::defaultRenderBackend();
+        a.backend = choice.name;
+        if (!choice.note.empty()) std::fprintf(stderr, "viewer: note: %s\n", choice.note.c_str());
+    }
     std::string err;
     std::vector<CameraJob> jobs;
     if (!(err = planCameraJobs(a, jobs)).empty()) return fail(err);
