@@ -356,10 +356,11 @@ std::string renderJob(const RenderArgs& a, const CameraJob& job, const sg::Scene
 
 int runRender(const RenderArgs& args) {
     RenderArgs a = args;
+    std::string note;          // said once the arguments are known good: an error stays one line
     if (a.backend.empty()) {   // the registry decides from what GL runs on here, never from a name
-        const rnd::BackendChoice choice = rnd::defaultRenderBackend();
+        rnd::BackendChoice choice = rnd::defaultRenderBackend();
         a.backend = choice.name;
-        if (!choice.note.empty()) std::fprintf(stderr, "viewer: note: %s\n", choice.note.c_str());
+        note = std::move(choice.note);
     }
     std::string err;
     std::vector<CameraJob> jobs;
@@ -397,6 +398,7 @@ int runRender(const RenderArgs& args) {
         std::error_code ec;
         if (jobs.front().out.has_parent_path()) fs::create_directories(jobs.front().out.parent_path(), ec);
     }
+    if (!note.empty()) std::fprintf(stderr, "viewer: note: %s\n", note.c_str());
     for (const CameraJob& job : jobs)
         if (!(err = renderJob(a, job, *scene, view, overlays)).empty()) return fail(err);
     return 0;
