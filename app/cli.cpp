@@ -261,7 +261,9 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a, Command command) {
         cmd.add_option("--backend", a.backend, "Backend: gl, raster, raycast or all")->capture_default_str();
     } else {
         cmd.add_option("--out", a.out, "Output PNG file")->required();
-        cmd.add_option("--backend", a.backend, "Backend: gl, raster or raycast")->capture_default_str();
+        cmd.add_option("--backend", a.backend,
+                       "Backend: gl, raster or raycast. Default: gl, or raster (with a note saying so) where OpenGL is software only "
+                       "(Mesa llvmpipe, no GPU) or cannot render; --backend gl always renders with GL");
         cmd.add_option("--aov", a.aov,
                        "Also write, next to OUT.png, any of: depth (OUT.depth.pfm, float32 depth along the optical axis, 0 = nothing), "
                        "normal (OUT.normal.png, world normal as 0.5 n + 0.5, black = nothing), id (OUT.id.png, 16-bit instance id, 0 = "
@@ -352,7 +354,14 @@ std::string renderJob(const RenderArgs& a, const CameraJob& job, const sg::Scene
     return {};
 }
 
-int runRender(const RenderArgs& a) {
+int runRender(const RenderArgs& args) {
+    RenderArgs a = args;
+    std::string note;          // said once the arguments are known good: an error stays one line
+    if (a.backend.empty()) {   // the registry decides from what GL runs on here, never from a name
+        rnd::BackendChoice choice = rnd::defaultRenderBackend();
+        a.backend = choice.name;
+        note = std::move(choice.note);
+    }
     std::string err;
     std::vector<CameraJob> jobs;
     if (!(err = planCameraJobs(a, jobs)).empty()) return fail(err);
@@ -389,6 +398,7 @@ int runRender(const RenderArgs& a) {
         std::error_code ec;
         if (jobs.front().out.has_parent_path()) fs::create_directories(jobs.front().out.parent_path(), ec);
     }
+    if (!note.empty()) std::fprintf(stderr, "viewer: note: %s\n", note.c_str());
     for (const CameraJob& job : jobs)
         if (!(err = renderJob(a, job, *scene, view, overlays)).empty()) return fail(err);
     return 0;

@@ -11,8 +11,8 @@ namespace cli {
 struct RenderArgs {
     std::string scene;
     std::string out;
-    std::string backend = "gl";
-    std::string size;   // "" = 1280x720 (render: or the --camera-json camera's own size)
+    std::string backend;   // "" = render: rnd::defaultRenderBackend() (gl, or raster where GL is software only)
+    std::string size;      // "" = 1280x720 (render: or the --camera-json camera's own size)
     bool overwrite = false;
     int camera = -1;   // index into the scene's cameras, -1 = active
     // Settings overrides (unset = the scene's own setting).

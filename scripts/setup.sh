@@ -8,7 +8,7 @@ preset="${1:-release}"
 # Debian 12 packages the project needs. Keep in one place.
 packages=(
   build-essential cmake pkg-config python3 python3-glad
-  libglfw3-dev libimgui-dev libglm-dev libtinygltf-dev libopenmesh-dev libstb-dev
+  libglfw3-dev libimgui-dev libglm-dev libtinygltf-dev libopenmesh-dev libstb-dev zlib1g-dev
   libtbb-dev libcli11-dev nlohmann-json3-dev libgtest-dev libgmock-dev libbenchmark-dev libembree-dev
   libgl1-mesa-dri libegl-mesa0 libegl-dev libgl-dev libosmesa6-dev xvfb xauth fonts-dejavu-core clang-format
   # The Debian package: CPack computes Depends with dpkg-shlibdeps (dpkg-dev) and file; the

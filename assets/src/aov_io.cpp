@@ -2,19 +2,15 @@
 #include "assets/aov_io.h"
 
 #include "assets/files.h"
+#include "png_write.h"
 
 #include <stb_image.h>
-#include <stb_image_write.h>
 #include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <sstream>
-
-// Part of Debian's libstb (stb_image_write's deflate), declared only in its implementation
-// section of the header.
-extern "C" unsigned char* stbi_zlib_compress(unsigned char* data, int data_len, int* out_len, int quality);
 
 namespace assets {
 
@@ -104,55 +100,17 @@ std::string writeAovSidecar(const fs::path& path, const AovSidecar& s, bool over
     return writeFileAtomic(path, j.dump(2) + "\n", overwrite);
 }
 
-namespace {
-
-uint32_t crc32(const uint8_t* p, size_t n, uint32_t crc = 0) {
-    crc = ~crc;
-    for (size_t i = 0; i < n; ++i) {
-        crc ^= p[i];
-        for (int k = 0; k < 8; ++k) crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
-    }
-    return ~crc;
-}
-
-void putBE32(std::string& out, uint32_t v) {
-    for (int s = 24; s >= 0; s -= 8) out.push_back(char((v >> s) & 0xff));
-}
-
-void chunk(std::string& out, const char type[4], const std::string& data) {
-    putBE32(out, uint32_t(data.size()));
-    std::string body(type, 4);
-    body += data;
-    out += body;
-    putBE32(out, crc32(reinterpret_cast<const uint8_t*>(body.data()), body.size()));
-}
-
-}   // namespace
-
 std::string writePngGray16(const fs::path& path, int width, int height, const std::vector<uint16_t>& topDown, bool overwrite) {
     if (width <= 0 || height <= 0 || topDown.size() != size_t(width) * size_t(height)) return path.string() + ": image has no pixels";
-    // Rows: filter byte 0, then big-endian samples (PNG, 16-bit grey = colour type 0).
-    std::string raw;
-    raw.reserve(size_t(height) * (1 + size_t(width) * 2));
-    for (int j = 0; j < height; ++j) {
-        raw.push_back(0);
-        for (int i = 0; i < width; ++i) {
-            const uint16_t v = topDown[size_t(j) * width + i];
-            raw.push_back(char(v >> 8));
-            raw.push_back(char(v & 0xff));
-        }
+    // PNG's 16-bit samples are big-endian (16-bit grey = colour type 0).
+    std::vector<uint8_t> be(topDown.size() * 2);
+    for (size_t i = 0; i < topDown.size(); ++i) {
+        be[2 * i] = uint8_t(topDown[i] >> 8);
+        be[2 * i + 1] = uint8_t(topDown[i] & 0xff);
     }
-    int zlen = 0;
-    unsigned char* z = stbi_zlib_compress(reinterpret_cast<unsigned char*>(raw.data()), int(raw.size()), &zlen, 6);
-    if (!z) return path.string() + ": PNG compression failed";
-    std::string png("\x89PNG\r\n\x1a\n", 8), ihdr;
-    putBE32(ihdr, uint32_t(width));
-    putBE32(ihdr, uint32_t(height));
-    ihdr += std::string("\x10\x00\x00\x00\x00", 5);   // depth 16, grey, deflate, filter 0, no interlace
-    chunk(png, "IHDR", ihdr);
-    chunk(png, "IDAT", std::string(reinterpret_cast<const char*>(z), size_t(zlen)));
-    std::free(z);   // stb_image_write's default allocator
-    chunk(png, "IEND", {});
+    std::string png;
+    std::string err = detail::encodePngRows(width, height, 16, 0, 2, be.data(), size_t(width) * 2, png);
+    if (!err.empty()) return path.string() + ": " + err;
     return writeFileAtomic(path, png, overwrite);
 }
 

@@ -1,12 +1,12 @@
-// image_io.cpp - the one place stb_image and stb_image_write are used. Decoding is limited to
-// PNG and JPEG with a dimension cap; Debian's libstb ships the implementations, so this file
-// only includes the headers.
+// image_io.cpp - decoding with stb_image (limited to PNG and JPEG with a dimension cap; Debian's
+// libstb ships the implementation, so this file only includes the header); encoding with our
+// PNG writer on zlib (png_write.h).
 #include "assets/image_io.h"
 
 #include "assets/files.h"
+#include "png_write.h"
 
 #include <stb_image.h>
-#include <stb_image_write.h>
 
 #include <cstring>
 
@@ -95,9 +95,7 @@ std::string encodePng(int w, int h, const uint8_t* rgba, std::string& out) {
     if (w > kMaxImageDimension || h > kMaxImageDimension)
         return "image is " + std::to_string(w) + "x" + std::to_string(h) + ", limit " + std::to_string(kMaxImageDimension) + " per side";
     out.clear();
-    auto sink = [](void* ctx, void* data, int size) { static_cast<std::string*>(ctx)->append(static_cast<const char*>(data), size_t(size)); };
-    if (!stbi_write_png_to_func(sink, &out, w, h, 4, rgba, w * 4)) return "PNG encoding failed";
-    return {};
+    return detail::encodePngRows(w, h, 8, 6, 4, rgba, size_t(w) * 4, out);
 }
 
 std::string writePng(const std::filesystem::path& path, int w, int h, const uint8_t* rgba, bool overwrite) {

@@ -21,6 +21,8 @@ RenderConfig onePixelPass(RenderConfig c, const RenderRequest& r) {
 
 }   // namespace
 
+Device Renderer::device() const { return {true, false, "CPU"}; }
+
 RenderStats Renderer::render(const sg::FrameInput& frame, int width, int height, Framebuffer& target, RenderControl* control,
                              const RenderRequest& request) {
     const auto t0 = std::chrono::steady_clock::now();

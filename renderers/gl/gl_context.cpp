@@ -3,6 +3,7 @@
 //
 // Sections: 1. EGL display (process-wide)  2. EglContext  3. GlfwContext
 //           4. createHeadlessContext  5. current-context queries and GL loading
+//           6. what headless GL runs on (probeHeadlessGl)
 #include "gl/gl_context.h"
 
 #include <glad/egl.h>
@@ -15,6 +16,8 @@
 
 #include <cstdlib>
 #include <mutex>
+#include <sstream>
+#include <vector>
 
 namespace rnd::gl {
 
@@ -285,6 +288,76 @@ std::string describeCurrentContext() {
         return s ? std::string(reinterpret_cast<const char*>(s)) : std::string("?");
     };
     return "OpenGL " + str(GL_VERSION) + ", " + str(GL_RENDERER);
+}
+
+// --- 6. What headless GL runs on ------------------------------------------------------------
+bool isSoftwareRenderer(std::string_view r) {
+    for (std::string_view name : {"llvmpipe", "softpipe", "Software Rasterizer", "swrast", "SWR"})
+        if (r.find(name) != std::string_view::npos) return true;
+    return false;
+}
+
+namespace {
+
+bool hasToken(const char* list, std::string_view token) {
+    std::istringstream words(list ? list : "");
+    for (std::string w; words >> w;)
+        if (w == token) return true;
+    return false;
+}
+
+// Step 1 of probeHeadlessGl: true when Mesa's EGL, which the surfaceless display comes from,
+// lists only its software device. Lists devices without loading a driver.
+bool onlySoftwareEglDevices() {
+    std::lock_guard lock(g_eglMutex);
+    if (!loadEglLibrary()) return false;
+    const char* client = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
+    if (!hasToken(client, "EGL_EXT_device_enumeration") || !hasToken(client, "EGL_MESA_platform_surfaceless")) return false;
+    auto queryDevices = reinterpret_cast<PFNEGLQUERYDEVICESEXTPROC>(eglGetProcAddress("eglQueryDevicesEXT"));
+    auto queryDeviceString = reinterpret_cast<PFNEGLQUERYDEVICESTRINGEXTPROC>(eglGetProcAddress("eglQueryDeviceStringEXT"));
+    if (!queryDevices || !queryDeviceString) return false;
+    EGLint n = 0;
+    if (!queryDevices(0, nullptr, &n) || n <= 0) return false;
+    std::vector<EGLDeviceEXT> devices(size_t(n), nullptr);
+    if (!queryDevices(n, devices.data(), &n) || n <= 0) return false;
+    for (EGLint i = 0; i < n; ++i)
+        if (!hasToken(queryDeviceString(devices[size_t(i)], EGL_EXTENSIONS), "EGL_MESA_device_software")) return false;
+    return true;
+}
+
+HeadlessGl probeUncached() {
+    HeadlessGl r;
+    const char* env = std::getenv("VIEWER_GL_PLATFORM");
+    const std::string platform = env && *env ? env : "auto";
+    if ((platform == "auto" || platform == "egl") && onlySoftwareEglDevices()) {
+        r.usable = r.software = true;
+        r.renderer = "Mesa's software device, no GPU";
+        return r;
+    }
+    // A context current on this thread (the viewer's window) is the one the backend would use:
+    // read that one, and leave it current.
+    std::unique_ptr<GlContext> ctx;
+    if (!anyContextCurrent()) {
+        if (!(ctx = createHeadlessContext("", &r.error)) || !ctx->makeCurrent(&r.error)) return r;
+    }
+    r.error = loadGLFunctions();
+    if (r.error.empty()) {
+        const GLubyte* s = glGetString(GL_RENDERER);
+        r.renderer = s ? reinterpret_cast<const char*>(s) : "";
+        r.usable = true;
+        r.software = isSoftwareRenderer(r.renderer);
+    }
+    if (ctx) ctx->release();
+    return r;
+}
+
+}   // namespace
+
+HeadlessGl probeHeadlessGl() {
+    static std::once_flag once;
+    static HeadlessGl result;
+    std::call_once(once, [] { result = probeUncached(); });
+    return result;
 }
 
 }   // namespace rnd::gl

@@ -602,6 +602,11 @@ public:
         return c;
     }
 
+    Device device() const override {
+        const gl::HeadlessGl g = gl::probeHeadlessGl();
+        return {g.usable, g.software, g.usable ? g.renderer : g.error};
+    }
+
 protected:
     RenderStats doRender(const FrameInput& frame, const RenderConfig& cfg, Framebuffer& target, RenderControl* control) override;
 

@@ -146,3 +146,34 @@ TEST(GlContextGLTest, CallerContextIsUsedAndStateRestored) {
     glDeleteRenderbuffers(1, &rb);
     ctx->release();
 }
+
+TEST(GlContextTest, SoftwareRenderersAreRecognised) {
+    for (const char* r : {"llvmpipe (LLVM 15.0.6, 256 bits)", "softpipe", "Software Rasterizer", "zink (llvmpipe (LLVM 15.0.6))", "SWR (LLVM 11)"})
+        EXPECT_TRUE(rnd::gl::isSoftwareRenderer(r)) << r;
+    for (const char* r : {"NVIDIA H100 80GB HBM3/PCIe/SSE2", "AMD Radeon RX 6800 (navi21, LLVM 15.0.6, DRM 3.49)",
+                          "Mesa Intel(R) UHD Graphics 620 (KBL GT2)", "virgl", ""})
+        EXPECT_FALSE(rnd::gl::isSoftwareRenderer(r)) << r;
+}
+
+// What probeHeadlessGl says without rendering (here: from EGL's device list when Mesa has no
+// GPU device) agrees with the GL_RENDERER of the context a real render gets; the gl backend's
+// device() and the registry's default backend follow from it.
+TEST(GlContextGLTest, ProbeAgreesWithTheContextARenderGets) {
+    const rnd::gl::HeadlessGl probe = rnd::gl::probeHeadlessGl();
+    ASSERT_TRUE(probe.usable) << probe.error;
+    EXPECT_FALSE(rnd::gl::anyContextCurrent()) << "the probe leaves no context current";
+    auto r = rnd::makeGlRenderer();
+    rnd::Framebuffer fb;
+    ASSERT_TRUE(r->render(simpleFrame(), 64, 48, fb).ok);
+    const std::string context = rnd::glCacheCounters(*r).context;
+    std::printf("[gl] probe: %s (%s); a render's context: %s\n", probe.software ? "software" : "hardware", probe.renderer.c_str(), context.c_str());
+    EXPECT_EQ(probe.software, rnd::gl::isSoftwareRenderer(context)) << probe.renderer << " vs " << context;
+
+    const rnd::Device d = r->device();
+    EXPECT_TRUE(d.usable);
+    EXPECT_EQ(d.softwareEmulated, probe.software);
+    const rnd::BackendChoice choice = rnd::defaultRenderBackend();
+    EXPECT_EQ(choice.name, probe.software ? "raster" : "gl");
+    EXPECT_EQ(choice.note.empty(), !probe.software) << choice.note;
+    EXPECT_FALSE(rnd::makeRenderer("raster")->device().softwareEmulated);
+}

@@ -1,4 +1,4 @@
-// image_io.h - PNG/JPEG decoding (stb_image, restricted) and PNG encoding (stb_image_write).
+// image_io.h - PNG/JPEG decoding (stb_image, restricted) and PNG encoding (zlib).
 #pragma once
 
 #include "scenegraph/mesh.h"

@@ -55,6 +55,17 @@ struct Capabilities {
     int maxImageSize = 16384;         // largest width or height it renders
 };
 
+// What a backend runs on here (Renderer::device()). The CPU backends run natively on the CPU;
+// the gl backend runs on whatever OpenGL there is, which may be software emulation of a GPU
+// (Mesa llvmpipe/softpipe): every GPU stage then runs on the CPU, slower and larger than the
+// CPU rasterizer (docs/benchmarks.md). The command line picks its default backend from this
+// (defaultRenderBackend() below), never from a name.
+struct Device {
+    bool usable = true;              // false: the backend cannot render here (`detail` says why)
+    bool softwareEmulated = false;   // a GPU API emulated on the CPU
+    std::string detail;              // e.g. "CPU", "llvmpipe (LLVM 15.0.6, 256 bits)", a GPU's GL_RENDERER
+};
+
 // Shared between the caller and a render in progress (possibly on another thread).
 struct RenderControl {
     std::atomic<bool> cancel{false};
@@ -94,6 +105,10 @@ public:
     virtual ~Renderer() = default;
     virtual std::string_view name() const = 0;
     virtual Capabilities capabilities() const = 0;
+    // What it runs on here. The gl backend finds out once per process without rendering (it
+    // asks EGL for its devices, or makes a context and reads GL_RENDERER); the CPU backends
+    // answer {usable, not emulated, "CPU"}.
+    virtual Device device() const;
 
     // Renders the frame into `target` (resized to width x height on success). Thread-compatible:
     // one render at a time per renderer instance (see Capabilities::affinity for which thread).
@@ -119,5 +134,14 @@ std::vector<std::string> rendererNames();
 // Makes a backend by name; on an unknown name returns null and sets *error to a message that
 // lists the valid names.
 std::unique_ptr<Renderer> makeRenderer(std::string_view name, std::string* error = nullptr);
+
+// The backend `viewer render` uses when none is named: "gl", unless its device() here is
+// software emulation of a GPU (Mesa llvmpipe without a GPU) or unusable; then the CPU
+// rasterizer ("raster"), and `note` says so in one line (why, and how to force GL).
+struct BackendChoice {
+    std::string name;
+    std::string note;   // "" when the first backend was taken
+};
+BackendChoice defaultRenderBackend();
 
 }   // namespace rnd
