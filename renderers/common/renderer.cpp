@@ -54,6 +54,11 @@ RenderStats Renderer::render(const sg::FrameInput& frame, int width, int height,
         stats.error = "cannot count BVH nodes and triangles per ray (the cost view)";
         return finish(stats);
     }
+    if (request.singleSample && config.samplesPerPixel > 1) {
+        config.aa = sg::AAMode::None;
+        config.msaaSamples = config.ssaaFactor = config.samplesPerPixel = 1;
+        config.aaUsed = "none";
+    }
     const bool onePixel = config.samplesPerPixel == 1;
     config.visibility = request.visibility && onePixel;
     config.overdraw = request.overdraw && onePixel;

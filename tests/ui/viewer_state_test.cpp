@@ -394,6 +394,59 @@ TEST(RenderSlotTest, RendersCoarseToFineOrReportsError) {
     EXPECT_EQ(slot.status().level, 1);
 }
 
+// An anti-aliased frame refines: the preview, a full-resolution image at one sample per pixel
+// (with the visibility), then the anti-aliased image, which equals a direct render with the
+// same settings and keeps the one-sample step's visibility. Without anti-aliasing there is no
+// middle step.
+TEST(RenderSlotTest, AntiAliasedFramesRefineThroughAOneSampleImage) {
+    ViewerState st = demoState();
+    sg::FrameInput f = st.buildFrame(64.0f / 48.0f);
+    f.settings.aa = sg::AAMode::SSAA;
+    f.settings.aaRate = 2;
+    struct Step {
+        int level;
+        bool refining;
+        int samples;
+        bool visibility;
+    };
+    for (bool antialiased : {true, false}) {
+        sg::FrameInput g = f;
+        if (!antialiased) g.settings.aa = sg::AAMode::None;
+        auto frame = std::make_shared<sg::FrameInput>(g);
+        RenderSlot slot("raster");
+        std::vector<Step> steps;
+        slot.onPublish = [&](const rnd::Framebuffer& fb, const SlotStatus& s) {
+            steps.push_back({s.level, s.refining, s.stats.config.samplesPerPixel, fb.hasVisibility()});
+        };
+        slot.request(frame, 64, 48, 1, /*interacting=*/false);
+        slot.waitIdle();
+        slot.poll();
+        ASSERT_EQ(slot.status().error, "");
+        ASSERT_EQ(steps.size(), antialiased ? 3u : 2u);
+        EXPECT_EQ(steps[0].level, 4);
+        EXPECT_TRUE(steps[0].refining);
+        EXPECT_EQ(steps[0].samples, 1) << "the preview takes one sample per pixel";
+        if (antialiased) {
+            EXPECT_TRUE(steps[1].refining);
+            EXPECT_EQ(steps[1].level, 1);
+            EXPECT_EQ(steps[1].samples, 1);
+            EXPECT_TRUE(steps[1].visibility);
+        }
+        EXPECT_FALSE(steps.back().refining);
+        EXPECT_EQ(steps.back().samples, antialiased ? 4 : 1);
+        EXPECT_FALSE(slot.status().refining);
+        // The image shown is the backend's own, with the visibility of the pixel centres.
+        auto direct = rnd::makeRenderer("raster");
+        rnd::Framebuffer want;
+        rnd::RenderRequest vis;
+        vis.visibility = true;
+        ASSERT_TRUE(direct->render(g, 64, 48, want, nullptr, vis).ok);
+        EXPECT_EQ(slot.image().color, want.color);
+        EXPECT_EQ(slot.image().drawable, want.drawable);
+        EXPECT_EQ(slot.image().primitive, want.primitive);
+    }
+}
+
 // After a load the slot forgets the old scene's picture and figures, and a
 // render requested before forget() never shows up afterwards, however far it got.
 TEST(RenderSlotTest, ForgetDropsTheImageAndRendersInFlight) {

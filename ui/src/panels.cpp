@@ -1297,7 +1297,10 @@ std::string slotStats(const SlotView& v) {
         extra += r;
     }
     if (v.status.level > 1) extra += "  (1/" + std::to_string(v.status.level) + " res)";
-    if (s.ok || !s.config.aaUsed.empty()) extra += "  " + s.config.describe();
+    if (v.status.refining && s.config.samplesPerPixel == 1 && s.config.aaAsked != "none")   // a one-sample step of an anti-aliased image
+        extra += "  1 sample/pixel, " + s.config.aaAsked + " follows";
+    else if (s.ok || !s.config.aaUsed.empty())
+        extra += "  " + s.config.describe();
     if (!s.config.unsupported.empty()) {
         extra += "  no";
         for (const std::string& u : s.config.unsupported) extra += " " + u;

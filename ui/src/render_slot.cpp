@@ -43,7 +43,7 @@ void RenderSlot::request(std::shared_ptr<const sg::FrameInput> frame, int width,
     m_cv.notify_all();
 }
 
-void RenderSlot::publish(rnd::Framebuffer&& fb, const rnd::RenderStats& st, int level, uint64_t generation,
+void RenderSlot::publish(rnd::Framebuffer&& fb, const rnd::RenderStats& st, int level, bool refining, uint64_t generation,
                          std::shared_ptr<const sg::FrameInput> frame) {
     std::lock_guard<std::mutex> lock(m_mutex);
     if (generation != m_generation) return;   // rendered for a scene forget() dropped
@@ -53,20 +53,34 @@ void RenderSlot::publish(rnd::Framebuffer&& fb, const rnd::RenderStats& st, int 
         m_finished = std::move(fb);
         m_finishedFrame = std::move(frame);
         m_status.level = level;
+        m_status.refining = refining;
         m_haveNew = true;
+        if (onPublish) onPublish(m_finished, m_status);
     }
 }
 
+// The steps of a job: the preview (1/previewDivisor, one sample per pixel), then full
+// resolution. An anti-aliased frame on a worker thread gets a one-sample full-resolution step
+// before the anti-aliased one, so a sharp image shows in a fraction of the anti-aliased time
+// (SSAA 4x4 takes 16 times as long) and the viewport refines instead of waiting; the last step
+// keeps that step's visibility and counters instead of rendering a second pass for them.
 void RenderSlot::runJob(const Job& job) {
-    int divisors[2] = {previewDivisor, 1};
-    int levels = job.previewOnly ? 1 : 2;
+    struct Step {
+        int divisor;
+        bool singleSample;
+    };
+    std::vector<Step> steps;
     // A preview larger than ~1/16 of the pixels is pointless for tiny viewports.
-    if (previewDivisor <= 1 || (job.width / previewDivisor < 8)) {
-        divisors[0] = 1;
-        levels = 1;
+    const bool preview = previewDivisor > 1 && job.width / previewDivisor >= 8;
+    if (preview) steps.push_back({previewDivisor, true});
+    if (!preview || !job.previewOnly) {
+        if (m_threaded && job.frame->settings.aa != sg::AAMode::None) steps.push_back({1, true});
+        steps.push_back({1, false});
     }
-    for (int i = 0; i < levels; ++i) {
-        int d = divisors[i];
+    rnd::Framebuffer oneSample;   // the full-resolution one-sample step's image, for its visibility and counters
+    for (size_t i = 0; i < steps.size(); ++i) {
+        const int d = steps[i].divisor;
+        const bool last = i + 1 == steps.size();
         int w = std::max(1, job.width / d), h = std::max(1, job.height / d);
         rnd::RenderControl control;
         {
@@ -79,13 +93,16 @@ void RenderSlot::runJob(const Job& job) {
         rnd::Framebuffer fb;
         rnd::RenderStats st;
         rnd::RenderRequest request;
+        request.singleSample = steps[i].singleSample;
         // Visibility at full resolution; while the camera moves only when it is free (one pass,
         // no anti-aliasing), so a click right after an edit still picks.
-        request.visibility = m_caps.visibility && d == 1 && (!job.interacting || job.frame->settings.aa == sg::AAMode::None);
+        const bool onePass = steps[i].singleSample || job.frame->settings.aa == sg::AAMode::None;
+        const bool fullPass = d == 1 && (!job.interacting || onePass);
+        const bool reuse = d == 1 && !steps[i].singleSample && oneSample.width == w && oneSample.height == h;
+        request.visibility = m_caps.visibility && fullPass && !reuse;
         // The diagnostic view's counters under the same rule (a second pass when anti-aliased).
-        const bool fullPass = d == 1 && (!job.interacting || job.frame->settings.aa == sg::AAMode::None);
-        request.overdraw = m_caps.overdraw && job.overdraw && fullPass;
-        request.traversalCost = m_caps.traversalCost && job.traversalCost && fullPass;
+        request.overdraw = m_caps.overdraw && job.overdraw && fullPass && !reuse;
+        request.traversalCost = m_caps.traversalCost && job.traversalCost && fullPass && !reuse;
         try {
             std::lock_guard<std::mutex> rendering(m_renderMutex);
             m_renderedFrame = job.frame.get();
@@ -97,14 +114,30 @@ void RenderSlot::runJob(const Job& job) {
         {
             std::lock_guard<std::mutex> lock(m_mutex);
             m_control = nullptr;
-            m_status.rendering = false;
+            m_status.rendering = !last && st.ok && !control.cancel;
         }
         if (control.cancel || st.cancelled) return;
         if (st.ok && (fb.width != w || fb.height != h || fb.color.size() != size_t(w) * h * 4)) {
             st.ok = false;
             st.error = "backend returned a " + std::to_string(fb.width) + "x" + std::to_string(fb.height) + " image";
         }
-        publish(std::move(fb), st, d, job.generation, job.frame);
+        if (st.ok && reuse) {   // the same pixel centres as the one-sample step
+            fb.drawable = oneSample.drawable;
+            fb.primitive = oneSample.primitive;
+            fb.overdraw = oneSample.overdraw;
+            fb.costNodes = oneSample.costNodes;
+            fb.costPrims = oneSample.costPrims;
+        }
+        if (d == 1 && !last) {   // the one-sample step's visibility and counters, for the last step (fb itself moves on)
+            oneSample.width = fb.width;
+            oneSample.height = fb.height;
+            oneSample.drawable = fb.drawable;
+            oneSample.primitive = fb.primitive;
+            oneSample.overdraw = fb.overdraw;
+            oneSample.costNodes = fb.costNodes;
+            oneSample.costPrims = fb.costPrims;
+        }
+        publish(std::move(fb), st, d, !last, job.generation, job.frame);
         if (!st.ok) return;
     }
 }

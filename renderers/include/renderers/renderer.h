@@ -88,6 +88,11 @@ struct RenderRequest {
     // fails the render with an error saying so.
     bool overdraw = false;
     bool traversalCost = false;
+    // One sample per pixel at the pixel centres whatever the settings' anti-aliasing asks
+    // (stats.config says aa "none"): the first full-resolution image of a caller that refines
+    // progressively (ui::RenderSlot), the anti-aliased render following it. The visibility and
+    // counters then come from this one pass.
+    bool singleSample = false;
 };
 
 struct RenderStats {

@@ -12,6 +12,7 @@
 #include "renderers/renderer.h"
 
 #include <condition_variable>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -25,6 +26,7 @@ struct SlotStatus {
     bool rendering = false;   // a render is in flight
     float progress = 0.0f;    // of the render in flight, 0..1
     int level = 1;            // resolution divisor of the image shown (1 = full)
+    bool refining = false;    // a finer image follows: the one shown is a preview or a one-sample image
     rnd::RenderStats stats;   // of the image shown (or the last failure)
     std::string error;        // last render's error ("" when it worked)
 };
@@ -46,6 +48,8 @@ public:
     bool threaded() const { return m_threaded; }                       // renders on a worker thread (else in poll())
     // Renders `frame` at width x height. `key` identifies the content (scene+view+size): an
     // unchanged key is ignored. interacting: render only the preview level (1/previewDivisor).
+    // On a worker thread an anti-aliased frame refines in steps: the preview and a full-
+    // resolution image at one sample per pixel come first, then the anti-aliased image.
     // counters: the per-pixel counters the full-resolution image should carry (RenderRequest's
     // overdraw / traversalCost, for the diagnostic view shown; asked only where the backend has
     // them, and included in what `key` identifies).
@@ -75,6 +79,8 @@ public:
     bool hasImage() const { return m_shown.width > 0; }
 
     int previewDivisor = 4;
+    // Called on the rendering thread with every step published (tests watch the refinement).
+    std::function<void(const rnd::Framebuffer&, const SlotStatus&)> onPublish;
 
 private:
     struct Job {
@@ -87,9 +93,10 @@ private:
         uint64_t generation = 0;                        // m_generation when requested: forget() outdates it
     };
     void workerLoop();
-    // Renders one job level by level; publishes each finished level. Returns false when cancelled.
+    // Renders one job step by step (runJob in render_slot.cpp); publishes each finished step.
     void runJob(const Job& job);
-    void publish(rnd::Framebuffer&& fb, const rnd::RenderStats& st, int level, uint64_t generation, std::shared_ptr<const sg::FrameInput> frame);
+    void publish(rnd::Framebuffer&& fb, const rnd::RenderStats& st, int level, bool refining, uint64_t generation,
+                 std::shared_ptr<const sg::FrameInput> frame);
 
     std::string m_backend;
     bool m_threaded;
