@@ -5,6 +5,7 @@
 //   cmake --build build/release -j2 --target bench_raster
 //   ./build/release/bench/raster/bench_raster [--quick] [--threads 2] [--frames 15]
 //        [--size 1280x720] [--shading phong|gouraud|flat] [--fog on|off] [--scenes a,b,...]
+//        [--no-gl | --gl-only [--gl-side ours|minimal]]
 //
 // Prints one line per scene and metric:
 //   bench: scene=<name> what=<metric> ours=<x> ref=<y> ratio=<ours/ref>
@@ -31,8 +32,10 @@
 // LP_NUM_THREADS is set before any GL context is created; tbb is limited to the same count.
 // --quick: fewer frames and 960x540 (finishes well under a minute). --no-gl: raster only (for
 // profiling it, e.g. perf record ... bench_raster --no-gl --scenes mesh1M). --gl-only: our GL
-// backend and the minimal GL program only (gl_ms, gl_cpu_ms and the image check; for profiling
-// the GL backend).
+// backend and the minimal GL program only (gl_ms, gl_cpu_ms and the image check); with
+// --gl-side ours|minimal only one of them runs, for a profiler to count one side's instructions
+// (valgrind --tool=callgrind bench_raster --gl-only --gl-side ours --frames N: the difference
+// between two frame counts is the cost of those frames).
 #include "min_gl.h"
 #include "raster/raster_shading.h"
 #include "renderers/renderer.h"
@@ -326,7 +329,7 @@ double coveredPixels(const rnd::Framebuffer& fb) {
 int main(int argc, char** argv) {
     bool quick = false, noGl = false, glOnly = false;
     int threads = 2, frames = 15, w = 1280, h = 720;
-    std::string shading = "phong", fog = "on", only;
+    std::string shading = "phong", fog = "on", only, glSide = "both";
     for (int i = 1; i < argc; ++i) {
         std::string a = argv[i];
         auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
@@ -336,6 +339,8 @@ int main(int argc, char** argv) {
             noGl = true;
         else if (a == "--gl-only")
             glOnly = true;
+        else if (a == "--gl-side")
+            glSide = next();
         else if (a == "--threads")
             threads = std::max(1, std::atoi(next().c_str()));
         else if (a == "--frames")
@@ -423,7 +428,8 @@ int main(int argc, char** argv) {
         if (glOnly) {
             // Our GL backend, then the minimal GL program (each owns its context); the ratio
             // of the two medians, taken seconds apart, is the figure to compare.
-            Timing g = timeRenderer(*glBackend, f, w, h, frames, fbG, eg);
+            Timing g = glSide == "minimal" ? Timing{} : timeRenderer(*glBackend, f, w, h, frames, fbG, eg);
+            if (glSide == "ours") continue;
             bench::MinimalGl mgl;
             if (std::string em = mgl.setup(f, w, h); !em.empty()) {
                 std::fprintf(stderr, "bench: minimal GL failed on %s: %s\n", n, em.c_str());
