@@ -682,6 +682,7 @@ private:
     std::unordered_map<uint64_t, GpuMesh> m_meshes;        // by Mesh::id
     std::unordered_map<uint64_t, GpuTexture> m_textures;   // by Texture::id
     TessellationCache m_tess;
+    std::vector<uint8_t> m_readRows;   // read-back rows to flip (without GL_MESA_pack_invert)
     uint64_t m_frame = 0, m_meshUploads = 0, m_textureUploads = 0;
 };
 
@@ -1056,22 +1057,33 @@ std::string GlRenderer::countOverdraw(const std::vector<DrawItem>& items, const 
     return {};
 }
 
-// Reads colour and depth of `fbo` into `out` (GL rows are bottom-up, Framebuffer rows top-down).
+// Reads colour and depth of `fbo` into `out` (GL rows are bottom-up, Framebuffer rows
+// top-down). With GL_MESA_pack_invert (Mesa, llvmpipe included) the driver writes the rows
+// top-down straight into `out`; otherwise they pass through m_readRows (kept between frames, so
+// no allocation, zero-fill or page faults per frame) and are flipped. Alpha needs no pass: the
+// target's alpha is 1 everywhere (cleared to 1; every pass writes 1 or, blending, keeps it).
 void GlRenderer::readBack(GLuint fbo, int w, int h, Framebuffer& out) {
-    out.resize(w, h);
+    out.resizeForOverwrite(w, h);   // every pixel is written below
     glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    std::vector<uint8_t> rgba(size_t(w) * h * 4);
-    std::vector<float> depth(size_t(w) * h);
-    glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
-    glReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, depth.data());
-    size_t rowBytes = size_t(w) * 4;
-    for (int y = 0; y < h; ++y) {
-        int src = h - 1 - y;
-        std::memcpy(&out.color[size_t(y) * rowBytes], &rgba[size_t(src) * rowBytes], rowBytes);
-        std::memcpy(&out.depth[size_t(y) * w], &depth[size_t(src) * w], size_t(w) * sizeof(float));
+    if (GLAD_GL_MESA_pack_invert) {
+        GLint invert = GL_FALSE;
+        glGetIntegerv(GL_PACK_INVERT_MESA, &invert);
+        glPixelStorei(GL_PACK_INVERT_MESA, GL_TRUE);
+        glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, out.color.data());
+        glReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, out.depth.data());
+        glPixelStorei(GL_PACK_INVERT_MESA, invert);
+        return;
     }
-    for (size_t i = 3; i < out.color.size(); i += 4) out.color[i] = 255;
+    const size_t rowBytes = size_t(w) * 4;   // RGBA8 and float depth alike
+    m_readRows.resize(rowBytes * h);
+    auto flipInto = [&](uint8_t* dst) {
+        for (int y = 0; y < h; ++y) std::memcpy(dst + size_t(y) * rowBytes, &m_readRows[size_t(h - 1 - y) * rowBytes], rowBytes);
+    };
+    glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, m_readRows.data());
+    flipInto(out.color.data());
+    glReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, m_readRows.data());
+    flipInto(reinterpret_cast<uint8_t*>(out.depth.data()));
 }
 
 // Reads the visibility attachment (drawable, primitive) of `fbo` into `out` (already sized).
