@@ -2,7 +2,8 @@
 //
 // Sections:
 //   1. Shader programs (embedded GLSL from shaders/, one program per shading model,
-//      reflection model and light setup, compiled on first use)
+//      reflection model, fog mode, light setup and the draw's feature switches, compiled on
+//      first use)
 //   2. GPU cache: meshes (incl. tessellations) and textures keyed by id + version
 //   3. Render targets: multisampled / single-sample FBOs, read-back
 //   4. State guard: restores the caller's GL state when we borrow its context
