@@ -6,7 +6,7 @@ set(GLAD_SOURCES ${GLAD_OUT}/src/gl.c ${GLAD_OUT}/src/egl.c)
 add_custom_command(
   OUTPUT ${GLAD_SOURCES} ${GLAD_OUT}/include/glad/gl.h ${GLAD_OUT}/include/glad/egl.h
   COMMAND ${GLAD_EXECUTABLE} --quiet --reproducible --api "gl:core=4.5,egl=1.5"
-          --extensions "GL_KHR_debug,GL_ARB_texture_filter_anisotropic,EGL_EXT_platform_base,EGL_MESA_platform_surfaceless,EGL_KHR_surfaceless_context,EGL_KHR_no_config_context,EGL_EXT_device_base,EGL_EXT_device_enumeration,EGL_EXT_platform_device"
+          --extensions "GL_KHR_debug,GL_ARB_texture_filter_anisotropic,GL_MESA_pack_invert,EGL_EXT_platform_base,EGL_MESA_platform_surfaceless,EGL_KHR_surfaceless_context,EGL_KHR_no_config_context,EGL_EXT_device_base,EGL_EXT_device_enumeration,EGL_EXT_platform_device"
           --out-path ${GLAD_OUT} c --loader
   COMMENT "Generating GL/EGL loader with glad"
   VERBATIM)

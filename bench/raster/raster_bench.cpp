@@ -5,12 +5,15 @@
 //   cmake --build build/release -j2 --target bench_raster
 //   ./build/release/bench/raster/bench_raster [--quick] [--threads 2] [--frames 15]
 //        [--size 1280x720] [--shading phong|gouraud|flat] [--fog on|off] [--scenes a,b,...]
+//        [--no-gl | --gl-only [--gl-side ours|minimal]]
 //
 // Prints one line per scene and metric:
 //   bench: scene=<name> what=<metric> ours=<x> ref=<y> ratio=<ours/ref>
 // metrics (medians of warm frames):
 //   ms          wall ms per frame, raster vs the minimal GL program (the goal: ratio <= 0.5)
 //   ms_gl       wall ms per frame, raster vs our GL backend
+//   gl_ms       wall ms per frame, our GL backend vs the minimal GL program (issue 20: ratio <= 1.3)
+//   gl_cpu_ms   process CPU ms per frame, our GL backend vs the minimal GL program
 //   cpu_ms      process CPU ms per frame (all threads), raster vs the minimal GL program
 //   mpix_s      fill rate: covered pixels per wall second / 1e6 (ratio = ref time / ours)
 //   mpix_s_thread  the same per thread, ours vs the minimal GL program
@@ -28,7 +31,11 @@
 // (stanford-bunny.obj from shared/testdata, read by a tiny OBJ reader below).
 // LP_NUM_THREADS is set before any GL context is created; tbb is limited to the same count.
 // --quick: fewer frames and 960x540 (finishes well under a minute). --no-gl: raster only (for
-// profiling it, e.g. perf record ... bench_raster --no-gl --scenes mesh1M).
+// profiling it, e.g. perf record ... bench_raster --no-gl --scenes mesh1M). --gl-only: our GL
+// backend and the minimal GL program only (gl_ms, gl_cpu_ms and the image check); with
+// --gl-side ours|minimal only one of them runs, for a profiler to count one side's instructions
+// (valgrind --tool=callgrind bench_raster --gl-only --gl-side ours --frames N: the difference
+// between two frame counts is the cost of those frames).
 #include "min_gl.h"
 #include "raster/raster_shading.h"
 #include "renderers/renderer.h"
@@ -320,9 +327,9 @@ double coveredPixels(const rnd::Framebuffer& fb) {
 }   // namespace
 
 int main(int argc, char** argv) {
-    bool quick = false, noGl = false;
+    bool quick = false, noGl = false, glOnly = false;
     int threads = 2, frames = 15, w = 1280, h = 720;
-    std::string shading = "phong", fog = "on", only;
+    std::string shading = "phong", fog = "on", only, glSide = "both";
     for (int i = 1; i < argc; ++i) {
         std::string a = argv[i];
         auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
@@ -330,6 +337,10 @@ int main(int argc, char** argv) {
             quick = true;
         else if (a == "--no-gl")
             noGl = true;
+        else if (a == "--gl-only")
+            glOnly = true;
+        else if (a == "--gl-side")
+            glSide = next();
         else if (a == "--threads")
             threads = std::max(1, std::atoi(next().c_str()));
         else if (a == "--frames")
@@ -381,10 +392,16 @@ int main(int argc, char** argv) {
 
     std::printf("# raster vs minimal GL and gl backend (llvmpipe): %dx%d, %d threads, shading=%s fog=%s, median of %d frames\n", w, h, threads,
                 shading.c_str(), fog.c_str(), frames);
-    const double bw1 = copyBandwidth(1), bwN = copyBandwidth(threads);
-    std::printf("bench: scene=all what=floor_bw ours=%.2f ref=%.2f ratio=%.3f\n", bw1, bwN, bwN / bw1);
-    const auto [cpu1, cpuN] = computeScaling(threads);
-    std::printf("bench: scene=all what=floor_cpu ours=%.2f ref=%.2f ratio=%.3f\n", cpu1, cpuN, threads * cpu1 / cpuN);
+    if (glOnly && !glBackend) {
+        std::fprintf(stderr, "bench: --gl-only without a GL backend: %s\n", err.c_str());
+        return 1;
+    }
+    if (!glOnly) {
+        const double bw1 = copyBandwidth(1), bwN = copyBandwidth(threads);
+        std::printf("bench: scene=all what=floor_bw ours=%.2f ref=%.2f ratio=%.3f\n", bw1, bwN, bwN / bw1);
+        const auto [cpu1, cpuN] = computeScaling(threads);
+        std::printf("bench: scene=all what=floor_cpu ours=%.2f ref=%.2f ratio=%.3f\n", cpu1, cpuN, threads * cpu1 / cpuN);
+    }
     for (BenchScene& b : scenes) {
         parse(shading, b.scene.settings.shading);
         b.scene.settings.fog = fog == "on" ? FogMode::Linear : FogMode::Off;
@@ -393,6 +410,45 @@ int main(int argc, char** argv) {
         FrameInput f = flatten(b.scene, float(w) / h);
         rnd::Framebuffer fbO, fbG;
         std::string eo, eg;
+        Timing r;
+        std::vector<uint8_t> rgba;   // the minimal GL program's image, rows bottom to top
+        // Fraction of pixels whose channels all lie within 8 of the minimal GL image's.
+        auto closeToMinimal = [&](const rnd::Framebuffer& fb) {
+            size_t close = 0;
+            if (rgba.size() == fb.color.size())
+                for (int y = 0; y < h; ++y)
+                    for (int x = 0; x < w; ++x) {
+                        const uint8_t* a = fb.pixel(x, h - 1 - y);
+                        const uint8_t* c = &rgba[(size_t(y) * w + x) * 4];
+                        close += std::abs(a[0] - c[0]) <= 8 && std::abs(a[1] - c[1]) <= 8 && std::abs(a[2] - c[2]) <= 8;
+                    }
+            return 100.0 * double(close) / (double(w) * h);
+        };
+        const char* n = b.name.c_str();
+        if (glOnly) {
+            // Our GL backend, then the minimal GL program (each owns its context); the ratio
+            // of the two medians, taken seconds apart, is the figure to compare.
+            Timing g = glSide == "minimal" ? Timing{} : timeRenderer(*glBackend, f, w, h, frames, fbG, eg);
+            if (glSide == "ours") continue;
+            bench::MinimalGl mgl;
+            if (std::string em = mgl.setup(f, w, h); !em.empty()) {
+                std::fprintf(stderr, "bench: minimal GL failed on %s: %s\n", n, em.c_str());
+                continue;
+            }
+            r = timeFrames(
+                [&] {
+                    mgl.render(rgba);
+                    return true;
+                },
+                frames);
+            if (!eg.empty()) std::fprintf(stderr, "bench: gl failed on %s: %s\n", n, eg.c_str());
+            std::printf("bench: scene=%s what=gl_ms ours=%.2f ref=%.2f ratio=%.3f\n", n, g.wallMs, r.wallMs, g.wallMs / r.wallMs);
+            std::printf("bench: scene=%s what=gl_cpu_ms ours=%.2f ref=%.2f ratio=%.3f\n", n, g.cpuMs, r.cpuMs, g.cpuMs / r.cpuMs);
+            std::printf("# %s: %zu triangles, %.2f%% of our GL backend's pixels within 8 of the minimal GL image\n", n, b.triangles,
+                        closeToMinimal(fbG));
+            std::fflush(stdout);
+            continue;
+        }
         // Cold: the first frame of a new renderer (no caches, buffers sized on the way).
         double cold = NAN;
         rnd::Framebuffer fbCold;
@@ -410,8 +466,6 @@ int main(int argc, char** argv) {
             o1 = timeRenderer(*ours, f, w, h, frames, fbO, eo);
         }
         Timing g = glBackend ? timeRenderer(*glBackend, f, w, h, frames, fbG, eg) : Timing{};
-        Timing r;
-        std::vector<uint8_t> rgba;   // the minimal GL program's image, rows bottom to top
         {
             bench::MinimalGl mgl;
             std::string em = noGl ? "skipped (--no-gl)" : mgl.setup(f, w, h);
@@ -428,7 +482,6 @@ int main(int argc, char** argv) {
         if (!eo.empty()) std::fprintf(stderr, "bench: raster failed on %s: %s\n", b.name.c_str(), eo.c_str());
         if (!eg.empty()) std::fprintf(stderr, "bench: gl failed on %s: %s\n", b.name.c_str(), eg.c_str());
         const double to = o.wallMs, tr = r.wallMs, cov = coveredPixels(fbO);
-        const char* n = b.name.c_str();
         std::printf("bench: scene=%s what=ms ours=%.2f ref=%.2f ratio=%.3f\n", n, to, tr, to / tr);
         std::printf("bench: scene=%s what=ms_gl ours=%.2f ref=%.2f ratio=%.3f\n", n, to, g.wallMs, to / g.wallMs);
         std::printf("bench: scene=%s what=cpu_ms ours=%.2f ref=%.2f ratio=%.3f\n", n, o.cpuMs, r.cpuMs, o.cpuMs / r.cpuMs);
@@ -439,17 +492,8 @@ int main(int argc, char** argv) {
         const double shadeMs = shadeOnlyMs(f, size_t(cov));
         std::printf("bench: scene=%s what=floor_shade ours=%.2f ref=%.2f ratio=%.3f\n", n, shadeMs, to, shadeMs / to);
         std::printf("bench: scene=%s what=cold_ms ours=%.2f ref=%.2f ratio=%.3f\n", n, cold, to, cold / to);
-        // Same picture? Fraction of pixels whose channels all lie within 8 of the other's.
-        size_t close = 0;
-        if (rgba.size() == fbO.color.size())
-            for (int y = 0; y < h; ++y)
-                for (int x = 0; x < w; ++x) {
-                    const uint8_t* a = fbO.pixel(x, h - 1 - y);
-                    const uint8_t* c = &rgba[(size_t(y) * w + x) * 4];
-                    close += std::abs(a[0] - c[0]) <= 8 && std::abs(a[1] - c[1]) <= 8 && std::abs(a[2] - c[2]) <= 8;
-                }
         std::printf("# %s: %zu triangles, %.0f covered pixels, %.2f%% of pixels within 8 of the minimal GL image, warm frame %s the first\n", n,
-                    b.triangles, cov, 100.0 * double(close) / (double(w) * h), fbCold.color == fbO.color ? "identical to" : "DIFFERS from");
+                    b.triangles, cov, closeToMinimal(fbO), fbCold.color == fbO.color ? "identical to" : "DIFFERS from");
         std::fflush(stdout);
     }
     return 0;

@@ -11,10 +11,16 @@
 namespace rnd {
 
 void Framebuffer::resize(int w, int h) {
+    resizeForOverwrite(w, h);
+    std::fill(color.begin(), color.end(), uint8_t(0));
+    std::fill(depth.begin(), depth.end(), 1.0f);
+}
+
+void Framebuffer::resizeForOverwrite(int w, int h) {
     width = std::max(w, 0);
     height = std::max(h, 0);
-    color.assign(size_t(width) * height * 4, 0);
-    depth.assign(size_t(width) * height, 1.0f);
+    color.resize(size_t(width) * height * 4);
+    depth.resize(size_t(width) * height);
     drawable.clear();
     primitive.clear();
     overdraw.clear();

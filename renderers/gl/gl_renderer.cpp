@@ -2,7 +2,8 @@
 //
 // Sections:
 //   1. Shader programs (embedded GLSL from shaders/, one program per shading model,
-//      reflection model and light setup, compiled on first use)
+//      reflection model, fog mode, light setup and the draw's feature switches, compiled on
+//      first use)
 //   2. GPU cache: meshes (incl. tessellations) and textures keyed by id + version
 //   3. Render targets: multisampled / single-sample FBOs, read-back
 //   4. State guard: restores the caller's GL state when we borrow its context
@@ -46,22 +47,52 @@ using namespace sg;
 constexpr int kMaxLights = 32;          // lights beyond this are ignored (uniform arrays)
 constexpr int kMaxUnrolledLights = 8;   // more lights: one generic program with a loop
 constexpr uint64_t kEvictAfterFrames = 120;
+constexpr size_t kMaxPrograms = 64;   // beyond this, programs not used by the last frame are deleted
 
 // --- 1. Shader programs ----------------------------------------------------------------------
 
+// The compile-time switches of a draw (the list at the top of mesh.frag). A program is compiled
+// per frame setup (programKey) and combination of these, on first use.
+struct Features {
+    bool texture = false;                                                                       // base colour texture
+    bool emissiveMap = false, occlusionMap = false, metalRoughMap = false, normalMap = false;   // units 1..4
+    bool specGloss = false;                                                                     // the metal-rough slot holds specular-glossiness
+    bool uv1 = false;                                                                           // some map samples the mesh's uv1
+    bool vertexColors = false;
+    bool unlit = false;
+    sg::AlphaMode alphaMode = sg::AlphaMode::Opaque;
+    bool solid = false;        // the wireframe overlay
+    bool overdraw = false;     // the overdraw view's pass
+    bool visibility = false;   // writes the visibility attachment
+
+    // One character per switch (part of the program's key).
+    bool operator==(const Features&) const = default;
+    std::string key() const {
+        std::string k;
+        for (bool b :
+             {texture, emissiveMap, occlusionMap, metalRoughMap, normalMap, specGloss, uv1, vertexColors, unlit, solid, overdraw, visibility})
+            k += b ? '1' : '0';
+        return k + char('0' + int(alphaMode));
+    }
+};
+
 struct Program {
     GLuint id = 0;
-    // Uniform locations.
+    uint64_t frameUniforms = 0;   // the frame whose uniforms (camera, lights, fog) it holds
+    uint64_t lastUsed = 0;        // the frame that last drew with it
+    bool hasMaterial = false;     // lastMaterial's values are in its uniforms
+    Material lastMaterial;
+    // Uniform locations (-1 where this program's switches leave a uniform out).
     GLint model = -1, normalMatrix = -1, viewProj = -1, view = -1, pointSize = -1;
     GLint numLights = -1, lightPos = -1, lightDir = -1, lightRad = -1, lightCone = -1;
     GLint eye = -1, ambient = -1;
     GLint baseColor = -1, ka = -1, kd = -1, ks = -1, shininess = -1, specTinted = -1, specColor = -1, emissive = -1;
-    GLint texture = -1, hasTexture = -1, unlit = -1, solid = -1, solidColor = -1, overdraw = -1;
+    GLint texture = -1, solidColor = -1;
     // Material maps (texture units 1..4: emissive, occlusion, metallic-roughness, normal) and their factors.
-    GLint maps[4] = {-1, -1, -1, -1}, hasMap[4] = {-1, -1, -1, -1}, occlusionStrength = -1, metallic = -1, roughness = -1, normalScale = -1;
-    GLint specGloss = -1, glossiness = -1, uv1Maps = -1;
-    GLint alpha = -1, alphaMode = -1, alphaCutoff = -1;
-    GLint fogMode = -1, fogColor = -1, fogParams = -1;
+    GLint maps[4] = {-1, -1, -1, -1}, occlusionStrength = -1, metallic = -1, roughness = -1, normalScale = -1;
+    GLint glossiness = -1, uv1Maps = -1;
+    GLint alpha = -1, alphaCutoff = -1;
+    GLint fogColor = -1, fogParams = -1;
     GLint drawable = -1, primitiveBase = -1;   // visibility output (location 1)
 };
 
@@ -113,18 +144,28 @@ std::string glslEnumDefines() {
     return d;
 }
 
+// "#define NAME PREFIX_VALUE\n" for a settings enum value: the name glslEnumDefines() gives it.
+template <class E>
+std::string glslEnumDefine(const char* name, const char* prefix, E value) {
+    const auto* e = sg::nameTable<E>().find(value);
+    std::string v = e ? std::string(e->name) : std::to_string(int(value));   // an unnamed value reaches the shader's #error
+    for (char& c : v) c = (c >= 'a' && c <= 'z') ? char(c - 'a' + 'A') : (c == '-' ? '_' : c);
+    return std::string("#define ") + name + " " + (e ? prefix + v : v) + "\n";
+}
+
 std::string glslSources() { return std::string(gl::kShader_lighting_glsl) + "\n" + gl::kShader_mesh_vert + "\n" + gl::kShader_mesh_frag; }
 
 namespace {
 
 // Programs are specialised per frame setup (see lighting.glsl): the key is the shading model,
-// the reflection model and one letter per light (p/P point, d directional, s/S spot; upper
-// case = inverse square), or '*' for the generic loop when there are many lights (a 30-light
-// unrolled program takes seconds to compile on llvmpipe).
+// the reflection model, the fog mode and one letter per light (p/P point, d directional, s/S
+// spot; upper case = inverse square), or '*' for the generic loop when there are many lights (a
+// 30-light unrolled program takes seconds to compile on llvmpipe).
 std::string programKey(const FrameInput& f) {
     std::string key;
     key += char('0' + int(f.settings.shading));
     key += char('0' + int(f.settings.reflection));
+    key += char('0' + int(f.settings.fog));
     size_t n = std::min<size_t>(f.lights.size(), kMaxLights);
     if (n > size_t(kMaxUnrolledLights)) return key + '*';
     for (size_t i = 0; i < n; ++i) {
@@ -136,18 +177,27 @@ std::string programKey(const FrameInput& f) {
     return key;
 }
 
-std::string buildProgram(const std::string& key, Program& p) {
+// Builds the program of frame setup `key` (programKey) with the draw's switches `ft` for frame `f`.
+std::string buildProgram(const std::string& key, const Features& ft, const FrameInput& f, Program& p) {
+    constexpr size_t kLights = 3;   // where the lights start in the key
     std::string calls;
-    if (key.size() > 2 && key[2] == '*')
+    if (key.size() > kLights && key[kLights] == '*')
         calls = "for (int i = 0; i < uNumLights; ++i) lightTerms(i, int(uLightPos[i].w + 0.5), uLightDir[i].w > 0.5, n, p, v, mul, add);";
-    for (size_t i = 2; i < key.size() && key[2] != '*'; ++i) {
+    for (size_t i = kLights; i < key.size() && key[kLights] != '*'; ++i) {
         char c = char(key[i] | 0x20);
         const char* type = c == 'p' ? "LIGHT_POINT" : c == 'd' ? "LIGHT_DIRECTIONAL" : "LIGHT_SPOT";
         bool invSq = key[i] >= 'A' && key[i] <= 'Z';
-        calls += "lightTerms(" + std::to_string(i - 2) + ", " + type + ", " + (invSq ? "true" : "false") + ", n, p, v, mul, add); ";
+        calls += "lightTerms(" + std::to_string(i - kLights) + ", " + type + ", " + (invSq ? "true" : "false") + ", n, p, v, mul, add); ";
     }
+    auto flag = [](const char* name, bool on) { return std::string("#define ") + name + (on ? " 1\n" : " 0\n"); };
+    const bool uv = ft.texture || ft.emissiveMap || ft.occlusionMap || ft.metalRoughMap || ft.normalMap;
     std::string prefix = "#version 330 core\n" + glslEnumDefines() + "#define SHADING " + key[0] + "\n#define REFLECTION " + key[1] +
-                         "\n#define MAX_LIGHTS " + std::to_string(kMaxLights) + "\n#define LIGHT_CALLS " + calls + "\n";
+                         "\n#define MAX_LIGHTS " + std::to_string(kMaxLights) + "\n#define LIGHT_CALLS " + calls + "\n" +
+                         glslEnumDefine("FOG", "FOG_", f.settings.fog) + glslEnumDefine("ALPHA_MODE", "ALPHA_", ft.alphaMode) +
+                         flag("HAS_TEXTURE", ft.texture) + flag("HAS_EMISSIVE_MAP", ft.emissiveMap) + flag("HAS_OCCLUSION_MAP", ft.occlusionMap) +
+                         flag("HAS_METAL_ROUGH_MAP", ft.metalRoughMap) + flag("HAS_NORMAL_MAP", ft.normalMap) + flag("SPEC_GLOSS", ft.specGloss) +
+                         flag("USES_UV", uv) + flag("USES_UV1", uv && ft.uv1) + flag("VERTEX_COLORS", ft.vertexColors) + flag("UNLIT", ft.unlit) +
+                         flag("SOLID", ft.solid) + flag("OVERDRAW", ft.overdraw) + flag("VISIBILITY", ft.visibility);
     std::string common = prefix + gl::kShader_lighting_glsl + "\n";
     GLuint vs = 0, fs = 0;
     std::string err = compileShader(GL_VERTEX_SHADER, common + gl::kShader_mesh_vert, vs);
@@ -195,32 +245,23 @@ std::string buildProgram(const std::string& key, Program& p) {
     p.specColor = loc("uSpecColor");
     p.emissive = loc("uEmissive");
     p.texture = loc("uTexture");
-    p.hasTexture = loc("uHasTexture");
-    const char* mapNames[4][2] = {{"uEmissiveMap", "uHasEmissiveMap"},
-                                  {"uOcclusionMap", "uHasOcclusionMap"},
-                                  {"uMetalRoughMap", "uHasMetalRoughMap"},
-                                  {"uNormalMap", "uHasNormalMap"}};
-    for (int k = 0; k < 4; ++k) {
-        p.maps[k] = loc(mapNames[k][0]);
-        p.hasMap[k] = loc(mapNames[k][1]);
-    }
+    const char* mapNames[4] = {"uEmissiveMap", "uOcclusionMap", "uMetalRoughMap", "uNormalMap"};
+    for (int k = 0; k < 4; ++k) p.maps[k] = loc(mapNames[k]);
     p.occlusionStrength = loc("uOcclusionStrength");
     p.metallic = loc("uMetallic");
     p.roughness = loc("uRoughness");
-    p.specGloss = loc("uSpecGloss");
     p.glossiness = loc("uGlossiness");
     p.normalScale = loc("uNormalScale");
     p.uv1Maps = loc("uUv1Maps");
-    p.unlit = loc("uUnlit");
     p.alpha = loc("uAlpha");
-    p.alphaMode = loc("uAlphaMode");
     p.alphaCutoff = loc("uAlphaCutoff");
-    p.solid = loc("uSolid");
-    p.overdraw = loc("uOverdraw");
     p.solidColor = loc("uSolidColor");
-    p.fogMode = loc("uFogMode");
     p.fogColor = loc("uFogColor");
     p.fogParams = loc("uFogParams");
+    // Samplers: fixed units.
+    glUseProgram(p.id);
+    glUniform1i(p.texture, 0);
+    for (int k = 0; k < 4; ++k) glUniform1i(p.maps[k], 1 + k);
     return {};
 }
 
@@ -240,8 +281,9 @@ struct GpuMesh {
     GLenum primitive = GL_TRIANGLES;
     std::vector<IndexRange> ranges;
     size_t triangles = 0;
-    vec3 centre{0.0f};    // centre of the local bounding box (front-to-back sorting)
-    bool valid = false;   // false: the mesh failed validation and is skipped
+    bool colors = false;   // has vertex colours (else the buffer holds 1s, which no shader reads)
+    vec3 centre{0.0f};     // centre of the local bounding box (front-to-back sorting)
+    bool valid = false;    // false: the mesh failed validation and is skipped
     uint64_t lastUsed = 0;
 };
 
@@ -275,6 +317,7 @@ void uploadMesh(GpuMesh& g, const Mesh& mesh, const std::vector<uint16_t>* trian
     g.triangles = 0;
     g.valid = mesh.validate().empty() && !mesh.positions.empty();
     if (!g.valid) return;
+    g.colors = !mesh.colors.empty();
 
     // Triangle meshes without normals get smooth ones (flat shading ignores them anyway).
     const std::vector<vec3>* normals = &mesh.normals;
@@ -624,17 +667,20 @@ public:
 
 private:
     std::string prepareContext(bool& madeCurrent);
-    const Program* programFor(const FrameInput& f, std::string& error);   // compiles on first use
-    void forgetGLObjects();                                               // drops names without deleting (their context is gone or not current)
+    Program* programFor(const Features& ft, std::string& error);   // for this frame; compiles on first use
+    bool useProgram(const Features& ft, std::string& error);       // makes it m_current, frame uniforms set
+    void forgetGLObjects();                                        // drops names without deleting (their context is gone or not current)
     void releaseAll();
     GpuMesh* meshFor(const Mesh& mesh, const std::vector<uint16_t>* triangleMaterial);
     GpuTexture* textureFor(const TexturePtr& t);
     void setFrameUniforms(const Program& p, const FrameInput& f, int ssaa);
+    Features featuresOf(const DrawItem& it, const Material& m, DrawPass pass) const;
     std::vector<DrawItem> collectDraws(const FrameInput& frame, int tessellation);   // uploads what is new
-    uint64_t drawAll(const Program& prog, const std::vector<DrawItem>& items, DrawPass pass, sg::CullMode culling);
-    std::string countOverdraw(const Program& prog, const std::vector<DrawItem>& items, const RenderSettings& s, int w, int h, Framebuffer& target);
+    uint64_t drawAll(const std::vector<DrawItem>& items, DrawPass pass, sg::CullMode culling, std::string& error);
+    std::string countOverdraw(const std::vector<DrawItem>& items, const RenderSettings& s, int w, int h, Framebuffer& target);
     void readBack(GLuint fbo, int w, int h, Framebuffer& out);
-    void setMaterial(const Program& p, const Material& m, const DrawItem& it, bool unlit);
+    void setMaterial(Program& p, const Material& m);
+    void bindTextures(const DrawItem& it);
     void evict();
 
     std::unique_ptr<gl::GlContext> m_own;     // our headless context, made on first need
@@ -643,12 +689,23 @@ private:
     std::string m_contextDescription, m_platform;
     int m_maxSamples = 0, m_maxSize = 0;
 
-    std::unordered_map<std::string, Program> m_programs;   // by programKey()
+    std::unordered_map<std::string, Program> m_programs;   // by programKey() + Features::key()
+    // The frame being drawn: its input, setup key, SSAA factor and what the passes draw.
+    const FrameInput* m_frameInput = nullptr;
+    std::string m_frameKey;
+    int m_ssaa = 1;
+    bool m_visibility = false;      // the target has the visibility attachment
+    bool m_countPass = false;       // drawing the overdraw view's pass
+    Program* m_current = nullptr;   // the program in use and its switches
+    Features m_currentFeatures;
+    static constexpr GLuint kUnknownTexture = ~0u;
+    GLuint m_boundTexture[5] = {kUnknownTexture, kUnknownTexture, kUnknownTexture, kUnknownTexture, kUnknownTexture};   // units 0..4
     RenderTarget m_target, m_resolve;
     CountTarget m_overdraw;
     std::unordered_map<uint64_t, GpuMesh> m_meshes;        // by Mesh::id
     std::unordered_map<uint64_t, GpuTexture> m_textures;   // by Texture::id
     TessellationCache m_tess;
+    std::vector<uint8_t> m_readRows;   // read-back rows to flip (without GL_MESA_pack_invert)
     uint64_t m_frame = 0, m_meshUploads = 0, m_textureUploads = 0;
 };
 
@@ -683,19 +740,31 @@ std::string GlRenderer::prepareContext(bool& madeCurrent) {
     return {};
 }
 
-const Program* GlRenderer::programFor(const FrameInput& f, std::string& error) {
-    std::string key = programKey(f);
+Program* GlRenderer::programFor(const Features& ft, std::string& error) {
+    std::string key = m_frameKey + ft.key();
     auto it = m_programs.find(key);
-    if (it != m_programs.end()) return &it->second;
-    Program p;
-    error = buildProgram(key, p);
-    if (!error.empty()) { return nullptr; }
-    // Light setups come and go while editing: keep a bounded number of programs.
-    if (m_programs.size() >= 64) {
-        for (auto& [k, old] : m_programs) glDeleteProgram(old.id);
-        m_programs.clear();
+    if (it == m_programs.end()) {
+        Program p;
+        error = buildProgram(m_frameKey, ft, *m_frameInput, p);
+        if (!error.empty()) return nullptr;
+        it = m_programs.emplace(key, p).first;
     }
-    return &m_programs.emplace(key, p).first->second;
+    it->second.lastUsed = m_frame;
+    return &it->second;
+}
+
+bool GlRenderer::useProgram(const Features& ft, std::string& error) {
+    if (m_current && ft == m_currentFeatures) return true;
+    Program* p = programFor(ft, error);
+    if (!p) return false;
+    if (p != m_current) glUseProgram(p->id);
+    if (p->frameUniforms != m_frame) {
+        setFrameUniforms(*p, *m_frameInput, m_ssaa);
+        p->frameUniforms = m_frame;
+    }
+    m_current = p;
+    m_currentFeatures = ft;
+    return true;
 }
 
 void GlRenderer::forgetGLObjects() {
@@ -766,6 +835,18 @@ void GlRenderer::evict() {
         }
     }
     m_tess.nextFrame(int(kEvictAfterFrames));
+    // Light setups and materials come and go while editing: keep a bounded number of programs
+    // (those this frame drew with stay).
+    if (m_programs.size() > kMaxPrograms)
+        for (auto it = m_programs.begin(); it != m_programs.end();) {
+            if (it->second.lastUsed != m_frame) {
+                glDeleteProgram(it->second.id);
+                it = m_programs.erase(it);
+            } else {
+                ++it;
+            }
+        }
+    m_current = nullptr;
 }
 
 void GlRenderer::setFrameUniforms(const Program& p, const FrameInput& f, int ssaa) {
@@ -775,14 +856,9 @@ void GlRenderer::setFrameUniforms(const Program& p, const FrameInput& f, int ssa
     glUniform3fv(p.eye, 1, &f.camera.eye[0]);
     glUniform3fv(p.ambient, 1, &f.ambientLight[0]);
     glUniform1f(p.pointSize, 2.0f * float(ssaa));
-    glUniform1i(p.texture, 0);
-    for (int k = 0; k < 4; ++k) glUniform1i(p.maps[k], 1 + k);
-    glUniform1i(p.fogMode, int(s.fog));
     glUniform3fv(p.fogColor, 1, &s.fogColor[0]);
     glUniform3f(p.fogParams, s.fogStart, s.fogEnd, s.fogDensity);
     glUniform3fv(p.solidColor, 1, &s.wireframeColor[0]);
-    glUniform1i(p.solid, 0);
-    glUniform1i(p.overdraw, 0);
 
     int n = int(std::min<size_t>(f.lights.size(), kMaxLights));
     std::vector<vec4> pos(n), dir(n), rad(n), cone(n);
@@ -804,24 +880,30 @@ void GlRenderer::setFrameUniforms(const Program& p, const FrameInput& f, int ssa
 }
 
 // The draw's textures: the base colour on unit 0, its maps on units 1..4 (unit 0 left active).
-void bindTextures(const DrawItem& it) {
-    for (int k = 0; k < 4; ++k) {
-        glActiveTexture(GLenum(GL_TEXTURE1 + k));
-        glBindTexture(GL_TEXTURE_2D, it.maps[k] ? it.maps[k]->id : 0);
+// Units already holding the texture are left alone (each bind makes llvmpipe revalidate the
+// samplers at the next draw).
+void GlRenderer::bindTextures(const DrawItem& it) {
+    const GpuTexture* want[5] = {it.texture, it.maps[0], it.maps[1], it.maps[2], it.maps[3]};
+    for (int u = 4; u >= 0; --u) {
+        const GLuint id = want[u] ? want[u]->id : 0;
+        if (id == m_boundTexture[u]) continue;
+        glActiveTexture(GLenum(GL_TEXTURE0 + u));
+        glBindTexture(GL_TEXTURE_2D, id);
+        m_boundTexture[u] = id;
     }
     glActiveTexture(GL_TEXTURE0);
-    glBindTexture(GL_TEXTURE_2D, it.texture ? it.texture->id : 0);
 }
 
-void GlRenderer::setMaterial(const Program& p, const Material& m, const DrawItem& it, bool unlit) {
-    const bool hasTexture = it.texture != nullptr;
-    for (int k = 0; k < 4; ++k) glUniform1i(p.hasMap[k], it.maps[k] && !unlit ? 1 : 0);
+// The material's uniforms, unless the program holds them already (instances of one material).
+void GlRenderer::setMaterial(Program& p, const Material& m) {
+    if (p.hasMaterial && p.lastMaterial == m) return;
+    p.hasMaterial = true;
+    p.lastMaterial = m;
     glUniform1f(p.normalScale, m.normalScale);
-    glUniform1i(p.uv1Maps, it.gpu && it.gpu->u1bo ? int(m.uv1Maps) : 0);
+    glUniform1i(p.uv1Maps, int(m.uv1Maps));   // read only by USES_UV1 programs: meshes that have uv1
     glUniform1f(p.occlusionStrength, m.occlusionStrength);
     glUniform1f(p.metallic, m.metallic);
     glUniform1f(p.roughness, m.roughness);
-    glUniform1i(p.specGloss, m.specularGlossiness ? 1 : 0);
     glUniform1f(p.glossiness, m.glossiness);
     glUniform3fv(p.baseColor, 1, &m.baseColor[0]);
     glUniform1f(p.ka, m.ka);
@@ -831,12 +913,40 @@ void GlRenderer::setMaterial(const Program& p, const Material& m, const DrawItem
     glUniform1i(p.specTinted, m.specularTinted ? 1 : 0);
     glUniform3fv(p.specColor, 1, &m.specularColor[0]);
     glUniform3fv(p.emissive, 1, &m.emissive[0]);
-    glUniform1i(p.hasTexture, hasTexture ? 1 : 0);
-    glUniform1i(p.unlit, (unlit || m.unlit) ? 1 : 0);
     glUniform1f(p.alpha, m.alpha);
-    // ALPHA_OPAQUE, ALPHA_MASK, ALPHA_BLEND; lines and points are always opaque (as in the CPU backends)
-    glUniform1i(p.alphaMode, int(unlit ? sg::AlphaMode::Opaque : m.alphaMode));
     glUniform1f(p.alphaCutoff, m.alphaCutoff);
+}
+
+// The switches of range material `m` of `it` in `pass` (mesh.frag). Lines and points are unlit
+// and opaque (as in the CPU backends) and use no maps; unlit surfaces use only the texture and
+// the emissive map.
+Features GlRenderer::featuresOf(const DrawItem& it, const Material& m, DrawPass pass) const {
+    Features f;
+    if (m_countPass) {
+        f.overdraw = true;
+        return f;
+    }
+    if (pass == DrawPass::Wireframe) {
+        f.solid = true;
+        return f;
+    }
+    const bool primitiveUnlit = it.gpu->primitive != GL_TRIANGLES;
+    f.unlit = primitiveUnlit || m.unlit;
+    f.texture = it.texture != nullptr;
+    f.vertexColors = it.gpu->colors;
+    f.alphaMode = primitiveUnlit ? sg::AlphaMode::Opaque : m.alphaMode;
+    if (!primitiveUnlit) {
+        f.emissiveMap = it.maps[0] != nullptr;
+        f.occlusionMap = it.maps[1] && !f.unlit;
+        f.metalRoughMap = it.maps[2] && !f.unlit;
+        f.normalMap = it.maps[3] && !f.unlit;
+        f.specGloss = f.metalRoughMap && m.specularGlossiness;
+        const uint8_t used = (f.emissiveMap ? sg::Material::EmissiveMap : 0) | (f.occlusionMap ? sg::Material::OcclusionMap : 0) |
+                             (f.metalRoughMap ? sg::Material::MetallicRoughnessMap : 0) | (f.normalMap ? sg::Material::NormalMap : 0);
+        f.uv1 = it.gpu->u1bo != 0 && (m.uv1Maps & used) != 0;
+    }
+    f.visibility = m_visibility && pass == DrawPass::Opaque;   // the other passes mask attachment 1
+    return f;
 }
 
 // Draws for the frame from the shared draw list (renderers/draw_list.h), nearest first so
@@ -872,9 +982,10 @@ std::vector<DrawItem> GlRenderer::collectDraws(const FrameInput& frame, int tess
     return sorted;
 }
 
-// Draws every item (wireframe: the triangle meshes again as lines, no material changes).
-// Returns the triangles submitted.
-uint64_t GlRenderer::drawAll(const Program& prog, const std::vector<DrawItem>& items, DrawPass pass, sg::CullMode culling) {
+// Draws every item (wireframe: the triangle meshes again as lines, no material changes), each
+// range with the program of its switches (featuresOf). Returns the triangles submitted; on a
+// program that does not build, sets `error` and stops.
+uint64_t GlRenderer::drawAll(const std::vector<DrawItem>& items, DrawPass pass, sg::CullMode culling, std::string& error) {
     const bool wireframe = pass == DrawPass::Wireframe;
     uint64_t triangles = 0;
     bool cullOn = false;
@@ -887,28 +998,35 @@ uint64_t GlRenderer::drawAll(const Program& prog, const std::vector<DrawItem>& i
         else
             glDisable(GL_CULL_FACE);
     };
+    std::fill(std::begin(m_boundTexture), std::end(m_boundTexture), kUnknownTexture);
     // Blended surfaces after everything else, farthest first (items come nearest first).
     for (size_t k = 0; k < items.size(); ++k) {
         const DrawItem& it = items[pass == DrawPass::Blended ? items.size() - 1 - k : k];
         if (wireframe && it.gpu->primitive != GL_TRIANGLES) continue;
         bool bound = false;
+        const Program* itemProgram = nullptr;   // the program holding this item's transform
         const bool unlit = it.gpu->primitive != GL_TRIANGLES;
         for (const IndexRange& r : it.gpu->ranges) {
             const Material* m = it.material;
             if (it.rangeMaterials && r.material >= 0 && size_t(r.material) < it.rangeMaterials->size()) m = &(*it.rangeMaterials)[r.material];
             const bool blended = m->alphaMode == sg::AlphaMode::Blend && !unlit;
             if (!wireframe && blended != (pass == DrawPass::Blended)) continue;
-            if (!bound) {
+            if (!useProgram(featuresOf(it, *m, pass), error)) return triangles;
+            Program& prog = *m_current;
+            if (itemProgram != &prog) {
                 glUniformMatrix4fv(prog.model, 1, GL_FALSE, &(*it.world)[0][0]);
                 glUniformMatrix3fv(prog.normalMatrix, 1, GL_FALSE, &it.normal[0][0]);
-                glFrontFace(it.mirrored ? GL_CW : GL_CCW);
                 glUniform1ui(prog.drawable, it.drawable);
+                itemProgram = &prog;
+            }
+            if (!bound) {
+                glFrontFace(it.mirrored ? GL_CW : GL_CCW);
                 if (!wireframe) bindTextures(it);
                 glBindVertexArray(it.gpu->vao);
                 bound = true;
             }
             if (!wireframe) {
-                setMaterial(prog, *m, it, unlit);
+                setMaterial(prog, *m);
                 if (!unlit) triangles += uint64_t(r.count / 3);
             }
             setCull(!unlit && sg::cullsBackFaces(culling, m->doubleSided));
@@ -924,11 +1042,10 @@ uint64_t GlRenderer::drawAll(const Program& prog, const std::vector<DrawItem>& i
 
 // The overdraw view (RenderConfig::overdraw, one sample per pixel): the frame's draws again
 // (surfaces of every alpha mode, lines, points, the wireframe; culled as in the frame) into
-// m_overdraw with the depth test off and additive blending, mesh.frag writing 1.0 for every
-// fragment before any discard, so each pixel holds the fragments rasterized in it; read into
-// target.overdraw. Returns "" or the reason it failed.
-std::string GlRenderer::countOverdraw(const Program& prog, const std::vector<DrawItem>& items, const RenderSettings& s, int w, int h,
-                                      Framebuffer& target) {
+// m_overdraw with the depth test off and additive blending, with mesh.frag's OVERDRAW variant
+// writing 1.0 for every fragment (it never discards), so each pixel holds the fragments
+// rasterized in it; read into target.overdraw. Returns "" or the reason it failed.
+std::string GlRenderer::countOverdraw(const std::vector<DrawItem>& items, const RenderSettings& s, int w, int h, Framebuffer& target) {
     std::string err = m_overdraw.ensure(w, h);
     if (!err.empty()) return err;
     glBindFramebuffer(GL_FRAMEBUFFER, m_overdraw.fbo);
@@ -940,19 +1057,20 @@ std::string GlRenderer::countOverdraw(const Program& prog, const std::vector<Dra
     glEnable(GL_BLEND);
     glBlendEquation(GL_FUNC_ADD);
     glBlendFunc(GL_ONE, GL_ONE);
-    glUniform1i(prog.overdraw, 1);
-    drawAll(prog, items, DrawPass::Opaque, s.culling);
-    drawAll(prog, items, DrawPass::Blended, s.culling);
-    if (s.wireframe) {
+    m_countPass = true;
+    drawAll(items, DrawPass::Opaque, s.culling, err);
+    if (err.empty()) drawAll(items, DrawPass::Blended, s.culling, err);
+    if (err.empty() && s.wireframe) {
         glPolygonMode(GL_FRONT_AND_BACK, GL_LINE);
-        drawAll(prog, items, DrawPass::Wireframe, s.culling);
+        drawAll(items, DrawPass::Wireframe, s.culling, err);
         glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
     }
-    glUniform1i(prog.overdraw, 0);
+    m_countPass = false;
     glBindVertexArray(0);
     glDisable(GL_BLEND);
     glDepthMask(GL_TRUE);
     glEnable(GL_DEPTH_TEST);
+    if (!err.empty()) return err;
     std::vector<float> counts(size_t(w) * h);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, m_overdraw.fbo);
     glReadBuffer(GL_COLOR_ATTACHMENT0);
@@ -966,22 +1084,33 @@ std::string GlRenderer::countOverdraw(const Program& prog, const std::vector<Dra
     return {};
 }
 
-// Reads colour and depth of `fbo` into `out` (GL rows are bottom-up, Framebuffer rows top-down).
+// Reads colour and depth of `fbo` into `out` (GL rows are bottom-up, Framebuffer rows
+// top-down). With GL_MESA_pack_invert (Mesa, llvmpipe included) the driver writes the rows
+// top-down straight into `out`; otherwise they pass through m_readRows (kept between frames, so
+// no allocation, zero-fill or page faults per frame) and are flipped. Alpha needs no pass: the
+// target's alpha is 1 everywhere (cleared to 1; every pass writes 1 or, blending, keeps it).
 void GlRenderer::readBack(GLuint fbo, int w, int h, Framebuffer& out) {
-    out.resize(w, h);
+    out.resizeForOverwrite(w, h);   // every pixel is written below
     glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    std::vector<uint8_t> rgba(size_t(w) * h * 4);
-    std::vector<float> depth(size_t(w) * h);
-    glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
-    glReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, depth.data());
-    size_t rowBytes = size_t(w) * 4;
-    for (int y = 0; y < h; ++y) {
-        int src = h - 1 - y;
-        std::memcpy(&out.color[size_t(y) * rowBytes], &rgba[size_t(src) * rowBytes], rowBytes);
-        std::memcpy(&out.depth[size_t(y) * w], &depth[size_t(src) * w], size_t(w) * sizeof(float));
+    if (GLAD_GL_MESA_pack_invert) {
+        GLint invert = GL_FALSE;
+        glGetIntegerv(GL_PACK_INVERT_MESA, &invert);
+        glPixelStorei(GL_PACK_INVERT_MESA, GL_TRUE);
+        glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, out.color.data());
+        glReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, out.depth.data());
+        glPixelStorei(GL_PACK_INVERT_MESA, invert);
+        return;
     }
-    for (size_t i = 3; i < out.color.size(); i += 4) out.color[i] = 255;
+    const size_t rowBytes = size_t(w) * 4;   // RGBA8 and float depth alike
+    m_readRows.resize(rowBytes * h);
+    auto flipInto = [&](uint8_t* dst) {
+        for (int y = 0; y < h; ++y) std::memcpy(dst + size_t(y) * rowBytes, &m_readRows[size_t(h - 1 - y) * rowBytes], rowBytes);
+    };
+    glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, m_readRows.data());
+    flipInto(out.color.data());
+    glReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, m_readRows.data());
+    flipInto(reinterpret_cast<uint8_t*>(out.depth.data()));
 }
 
 // Reads the visibility attachment (drawable, primitive) of `fbo` into `out` (already sized).
@@ -1056,11 +1185,6 @@ RenderStats GlRenderer::doRender(const FrameInput& frame, const RenderConfig& cf
 
     StateGuard guard;
     ++m_frame;
-    const Program* program = programFor(frame, err);
-    if (!program) {
-        stats.error = err;
-        return stats;
-    }
 
     // Anti-aliasing as resolved (render_config.h); the driver's limits are known only now.
     const RenderSettings& s = frame.settings;
@@ -1088,10 +1212,20 @@ RenderStats GlRenderer::doRender(const FrameInput& frame, const RenderConfig& cf
     beginFrameState(s, m_target.fbo, rw, rh, samples);
     if (visibility) beginVisibility();
     const std::vector<DrawItem> items = collectDraws(frame, cfg.tessellation);
-    const Program& prog = *program;
-    glUseProgram(prog.id);
-    setFrameUniforms(prog, frame, ssaa);
-    stats.triangles = drawAll(prog, items, DrawPass::Opaque, s.culling);
+    // The programs of this frame (useProgram): its setup, and uniforms set once per program.
+    m_frameInput = &frame;
+    m_frameKey = programKey(frame);
+    m_ssaa = ssaa;
+    m_visibility = visibility;
+    m_current = nullptr;
+    struct EndOfFrame {
+        GlRenderer& r;
+        ~EndOfFrame() {
+            r.m_frameInput = nullptr;
+            r.m_current = nullptr;
+        }
+    } endOfFrame{*this};
+    stats.triangles = drawAll(items, DrawPass::Opaque, s.culling, err);
     // Blended surfaces (glTF alphaMode BLEND): "over" in linear light (the sRGB framebuffer
     // blends decoded values), sorted per draw back to front, depth tested but not written
     // (nor is the visibility, which belongs to the surface that wrote depth).
@@ -1099,24 +1233,27 @@ RenderStats GlRenderer::doRender(const FrameInput& frame, const RenderConfig& cf
     glEnable(GL_BLEND);
     glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE);
     glDepthMask(GL_FALSE);
-    stats.triangles += drawAll(prog, items, DrawPass::Blended, s.culling);
+    if (err.empty()) stats.triangles += drawAll(items, DrawPass::Blended, s.culling, err);
     glDepthMask(GL_TRUE);
     glDisable(GL_BLEND);
 
     // Wireframe overlay: the same triangles as lines, pulled slightly toward the viewer.
-    if (s.wireframe) {
-        glUniform1i(prog.solid, 1);
+    if (s.wireframe && err.empty()) {
         glPolygonMode(GL_FRONT_AND_BACK, GL_LINE);
         glEnable(GL_POLYGON_OFFSET_LINE);
         glPolygonOffset(-1.0f, -1.0f);
         glDepthFunc(GL_LEQUAL);
-        drawAll(prog, items, DrawPass::Wireframe, s.culling);
+        drawAll(items, DrawPass::Wireframe, s.culling, err);
         glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
         glDisable(GL_POLYGON_OFFSET_LINE);
-        glUniform1i(prog.solid, 0);
     }
     glBindVertexArray(0);
     glColorMaski(1, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    if (!err.empty()) {
+        if (visibility) glDrawBuffer(GL_COLOR_ATTACHMENT0);
+        stats.error = err;
+        return stats;
+    }
 
     // Resolve MSAA (reading a multisampled buffer directly would give an aliased image).
     GLuint readFbo = m_target.fbo;
@@ -1137,8 +1274,7 @@ RenderStats GlRenderer::doRender(const FrameInput& frame, const RenderConfig& cf
     }
     if (visibility) glDrawBuffer(GL_COLOR_ATTACHMENT0);
     if (cfg.overdraw && samples <= 1 && ssaa == 1) {   // render() asks only for one-sample frames
-        glUseProgram(prog.id);
-        err = countOverdraw(prog, items, s, rw, rh, target);
+        err = countOverdraw(items, s, rw, rh, target);
         if (!err.empty()) {
             stats.error = err;
             return stats;

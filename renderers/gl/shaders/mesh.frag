@@ -1,12 +1,37 @@
 // mesh.frag - per-fragment part of every shading model, texture, unlit, fog, wireframe.
 // Prefix as in mesh.vert. Output is linear; the sRGB framebuffer encodes it.
+//
+// The draw's features are compile-time switches of the prefix (one program per combination,
+// compiled on first use; see Features in gl_renderer.cpp), not uniform branches: llvmpipe runs
+// both sides of every branch under a mask, and cannot test depth before a shader that may
+// discard, so an uber-shader pays for every feature on every fragment, hidden ones included.
+//   HAS_TEXTURE, HAS_EMISSIVE_MAP, HAS_OCCLUSION_MAP, HAS_METAL_ROUGH_MAP, HAS_NORMAL_MAP: 0 or 1
+//   SPEC_GLOSS     1: the metal-rough slot holds a specular-glossiness texture
+//   USES_UV1       1: some map samples the mesh's second UV set (uUv1Maps says which)
+//   VERTEX_COLORS  1: the mesh has vertex colours (else they are 1)
+//   UNLIT          1: colour = albedo + emissive (unlit material, lines, points)
+//   ALPHA_MODE     ALPHA_OPAQUE, ALPHA_MASK or ALPHA_BLEND (sg::AlphaMode values)
+//   FOG            FOG_OFF, FOG_LINEAR, FOG_EXP or FOG_EXP2 (sg::FogMode values)
+//   SOLID          1: the wireframe overlay: uSolidColor (fogged)
+//   OVERDRAW       1: the overdraw view's pass: 1.0 for every fragment, nothing else
+//   VISIBILITY     1: also write fragId (the target has the visibility attachment)
 in vec3 vWorldPos;
+#if FOG != FOG_OFF
 in vec3 vEyePos;
+#endif
 in vec3 vNormal;
+#if USES_UV
 in vec2 vUv;
+#endif
+#if USES_UV1
 in vec2 vUv1;
+#endif
+#if VERTEX_COLORS
 in vec4 vColor;
+#endif
+#if HAS_NORMAL_MAP
 in vec4 vTangent;
+#endif
 #if SHADING == SHADING_GOURAUD
 in vec3 vMulFront;
 in vec3 vAddFront;
@@ -15,44 +40,41 @@ in vec3 vAddBack;
 #endif
 
 uniform sampler2D uTexture;
-uniform bool uHasTexture;
 // Material maps (rnd::sampleMaps / coefficientsAt in renderers/common/shading.cpp).
 uniform sampler2D uEmissiveMap;     // sRGB colour, x uEmissive
 uniform sampler2D uOcclusionMap;    // R: ambient occlusion
-uniform sampler2D uMetalRoughMap;   // G: roughness, B: metallic (linear)
-uniform bool uHasEmissiveMap;
-uniform bool uHasOcclusionMap;
-uniform bool uHasMetalRoughMap;
-uniform sampler2D uNormalMap;       // tangent-space normal, linear RGB = 0.5 n + 0.5
-uniform bool uHasNormalMap;         // set only for meshes with tangents
+uniform sampler2D uMetalRoughMap;   // G: roughness, B: metallic (linear); or specular-glossiness (SPEC_GLOSS)
+uniform sampler2D uNormalMap;       // tangent-space normal, linear RGB = 0.5 n + 0.5 (meshes with tangents only)
 uniform float uNormalScale;
 uniform int uUv1Maps;               // sg::Material::uv1Maps: MAP_* bits of the maps that sample vUv1
 uniform float uOcclusionStrength;
 uniform float uMetallic;
 uniform float uRoughness;
-uniform bool uSpecGloss;            // uMetalRoughMap holds a specular-glossiness texture (sRGB RGB, A glossiness)
 uniform float uGlossiness;
-uniform bool uUnlit;        // colour = albedo + emissive (material unlit, lines, points)
 uniform float uAlpha;       // material alpha (x texture alpha x vertex alpha)
-uniform int uAlphaMode;     // ALPHA_OPAQUE, ALPHA_MASK, ALPHA_BLEND (sg::AlphaMode values)
 uniform float uAlphaCutoff;
-uniform bool uOverdraw;     // the overdraw view's pass: 1.0 for every fragment, nothing else (additive blending counts them)
-uniform bool uSolid;        // wireframe overlay: uSolidColor (fogged)
 uniform vec3 uSolidColor;
-uniform int uFogMode;       // FOG_OFF, FOG_LINEAR, FOG_EXP, FOG_EXP2 (sg::FogMode values)
 uniform vec3 uFogColor;
 uniform vec3 uFogParams;    // start, end, density
 
+layout(location = 0) out vec4 fragColor;
+#if VISIBILITY
 uniform uint uDrawable;        // Framebuffer::drawable of this draw
 uniform uint uPrimitiveBase;   // the draw call's first primitive in its mesh (0xffffffff: analytic)
-
-layout(location = 0) out vec4 fragColor;
-// Visibility (written only when the target has the attachment, rnd::RenderConfig::visibility):
-// drawable, and the primitive index within its mesh.
+// Visibility (rnd::RenderConfig::visibility): drawable, and the primitive index within its mesh.
 layout(location = 1) out uvec2 fragId;
+#endif
 
 // The UV set a map samples (rnd::sampleMaps): vUv1 where its MAP_* bit is set in uUv1Maps.
-vec2 mapUv(int bit) { return (uUv1Maps & bit) != 0 ? vUv1 : vUv; }
+#if USES_UV
+vec2 mapUv(int bit) {
+#if USES_UV1
+    return (uUv1Maps & bit) != 0 ? vUv1 : vUv;
+#else
+    return vUv;
+#endif
+}
+#endif
 
 // rnd::perturbNormal() (renderers/common/shading.cpp): the normal map's normal at n (outward).
 vec3 perturbNormal(vec3 n, vec4 t, vec3 texel, float scale) {
@@ -80,88 +102,115 @@ void phongFromMetallicRoughness(float metallic, float roughness) {
 
 // sg::fogVisibility(): f(d) in [0,1], 1 = no fog.
 float fogVisibility(float d) {
-    if (uFogMode == FOG_LINEAR) return clamp((uFogParams.y - d) / (uFogParams.y - uFogParams.x), 0.0, 1.0);
-    if (uFogMode == FOG_EXP) return exp(-uFogParams.z * d);
-    if (uFogMode == FOG_EXP2) { float x = uFogParams.z * d; return exp(-x * x); }
+#if FOG == FOG_LINEAR
+    return clamp((uFogParams.y - d) / (uFogParams.y - uFogParams.x), 0.0, 1.0);
+#elif FOG == FOG_EXP
+    return exp(-uFogParams.z * d);
+#elif FOG == FOG_EXP2
+    float x = uFogParams.z * d;
+    return exp(-x * x);
+#else
     return 1.0;
+#endif
 }
 
 void main() {
+#if VISIBILITY
     fragId = uvec2(uDrawable, uPrimitiveBase == 0xffffffffu ? uPrimitiveBase : uPrimitiveBase + uint(gl_PrimitiveID));
-    if (uOverdraw) {   // before any discard: a fragment counts whatever its alpha
-        fragColor = vec4(1.0);
-        return;
-    }
+#endif
+#if OVERDRAW
+    fragColor = vec4(1.0);   // whatever its alpha: this variant never discards
+    return;
+#else
     vec3 c;
     float alpha = 1.0;
-    if (uSolid) {
-        c = uSolidColor;
-    } else {
-        vec3 albedo = uBaseColor * vColor.rgb;
-        alpha = uAlpha * vColor.a;
-        if (uHasTexture) {
-            vec4 t = texture(uTexture, vUv);   // sRGB texture: colour decoded to linear, alpha as stored
-            albedo *= t.rgb;
-            alpha *= t.a;
-        }
-        // The maps, sampled before any discard (implicit derivatives): coefficientsAt().
-        float ao = uHasOcclusionMap ? texture(uOcclusionMap, mapUv(MAP_OCCLUSION)).r : 1.0;
-        vec3 em = uHasEmissiveMap ? texture(uEmissiveMap, mapUv(MAP_EMISSIVE)).rgb : vec3(1.0);
-        vec3 nt = uHasNormalMap ? texture(uNormalMap, mapUv(MAP_NORMAL)).rgb : vec3(0.5, 0.5, 1.0);
-        coefficientsOfMaterial();
-        gKa *= 1.0 + uOcclusionStrength * (ao - 1.0);
-        gEmissive *= em;
-        if (uHasMetalRoughMap) {
-            vec4 mr = texture(uMetalRoughMap, mapUv(MAP_METALLIC_ROUGHNESS));
-            if (uSpecGloss) {   // rnd::coefficientsAt, specular-glossiness
-                vec3 spec = uKs * uSpecColor * mr.rgb;
-                float ks = max(spec.r, max(spec.g, spec.b));
-                phongFromMetallicRoughness(0.0, 1.0 - uGlossiness * mr.a);   // for the exponent
-                gKd = 1.0;
-                gKs = ks;
-                gSpecColor = ks > 0.0 ? spec / ks : vec3(1.0);
-                gSpecTinted = false;
-            } else {
-                phongFromMetallicRoughness(uMetallic * mr.b, uRoughness * mr.g);
-            }
-        }
-        if (uAlphaMode == ALPHA_MASK) {
-            if (alpha < uAlphaCutoff) discard;   // cut-out
-            alpha = 1.0;
-        } else if (uAlphaMode == ALPHA_OPAQUE) {
-            alpha = 1.0;
-        } else if (uAlphaMode != ALPHA_BLEND) {
-            alpha = 0.0;   // unreachable: every sg::AlphaMode is handled above
-        }
-        if (uUnlit) {
-            c = albedo + gEmissive;
-        } else {
-            vec3 mul, add;
+#if SOLID
+    c = uSolidColor;
+#else
+    vec3 albedo = uBaseColor;
+    alpha = uAlpha;
+#if VERTEX_COLORS
+    albedo *= vColor.rgb;
+    alpha *= vColor.a;
+#endif
+#if HAS_TEXTURE
+    vec4 t = texture(uTexture, vUv);   // sRGB texture: colour decoded to linear, alpha as stored
+    albedo *= t.rgb;
+    alpha *= t.a;
+#endif
+    // The maps, sampled before any discard (implicit derivatives): coefficientsAt().
+    coefficientsOfMaterial();
+#if HAS_OCCLUSION_MAP
+    float ao = texture(uOcclusionMap, mapUv(MAP_OCCLUSION)).r;
+    gKa *= 1.0 + uOcclusionStrength * (ao - 1.0);
+#endif
+#if HAS_EMISSIVE_MAP
+    vec3 em = texture(uEmissiveMap, mapUv(MAP_EMISSIVE)).rgb;
+    gEmissive *= em;
+#endif
+#if HAS_NORMAL_MAP
+    vec3 nt = texture(uNormalMap, mapUv(MAP_NORMAL)).rgb;
+#endif
+#if HAS_METAL_ROUGH_MAP
+    vec4 mr = texture(uMetalRoughMap, mapUv(MAP_METALLIC_ROUGHNESS));
+#if SPEC_GLOSS   // rnd::coefficientsAt, specular-glossiness
+    vec3 spec = uKs * uSpecColor * mr.rgb;
+    float ks = max(spec.r, max(spec.g, spec.b));
+    phongFromMetallicRoughness(0.0, 1.0 - uGlossiness * mr.a);   // for the exponent
+    gKd = 1.0;
+    gKs = ks;
+    gSpecColor = ks > 0.0 ? spec / ks : vec3(1.0);
+    gSpecTinted = false;
+#else
+    phongFromMetallicRoughness(uMetallic * mr.b, uRoughness * mr.g);
+#endif
+#endif
+#if ALPHA_MODE == ALPHA_MASK
+    if (alpha < uAlphaCutoff) discard;   // cut-out
+    alpha = 1.0;
+#elif ALPHA_MODE == ALPHA_OPAQUE
+    alpha = 1.0;
+#elif ALPHA_MODE != ALPHA_BLEND
+#error "ALPHA_MODE: a sg::AlphaMode value this shader does not handle"
+#endif
+#if UNLIT
+    c = albedo + gEmissive;
+#else
+    vec3 mul, add;
 #if SHADING == SHADING_FLAT
-            // Face normal of the world-space triangle; cross(dp/dx, dp/dy) always points to
-            // the side being seen, i.e. it is already flipped toward the viewer.
-            vec3 n = normalize(cross(dFdx(vWorldPos), dFdy(vWorldPos)));
-            shadeTerms(n, vWorldPos, mul, add);
+    // Face normal of the world-space triangle; cross(dp/dx, dp/dy) always points to
+    // the side being seen, i.e. it is already flipped toward the viewer.
+    vec3 n = normalize(cross(dFdx(vWorldPos), dFdy(vWorldPos)));
+    shadeTerms(n, vWorldPos, mul, add);
 #elif SHADING == SHADING_GOURAUD
-            // Lit at the vertices with the material's coefficients; occlusion and emissive maps
-            // still apply exactly here (applyMapsToTerms): both terms are additive.
-            mul = (gl_FrontFacing ? vMulFront : vMulBack) - uKa * uOcclusionStrength * (1.0 - ao) * uAmbient;
-            add = (gl_FrontFacing ? vAddFront : vAddBack) + uEmissive * (em - 1.0);
+    // Lit at the vertices with the material's coefficients; occlusion and emissive maps
+    // still apply exactly here (applyMapsToTerms): both terms are additive.
+    mul = gl_FrontFacing ? vMulFront : vMulBack;
+    add = gl_FrontFacing ? vAddFront : vAddBack;
+#if HAS_OCCLUSION_MAP
+    mul -= uKa * uOcclusionStrength * (1.0 - ao) * uAmbient;
+#endif
+#if HAS_EMISSIVE_MAP
+    add += uEmissive * (em - 1.0);
+#endif
 #elif SHADING == SHADING_PHONG
-            float len = length(vNormal);
-            vec3 n = len > 0.0 ? vNormal / len : vec3(0.0, 0.0, 1.0);
-            if (uHasNormalMap) n = perturbNormal(n, vTangent, nt, uNormalScale);   // on the outward side
-            if (!gl_FrontFacing) n = -n;                 // two-sided: seen from the back
-            shadeTerms(n, vWorldPos, mul, add);
+    float len = length(vNormal);
+    vec3 n = len > 0.0 ? vNormal / len : vec3(0.0, 0.0, 1.0);
+#if HAS_NORMAL_MAP
+    n = perturbNormal(n, vTangent, nt, uNormalScale);   // on the outward side
+#endif
+    if (!gl_FrontFacing) n = -n;   // two-sided: seen from the back
+    shadeTerms(n, vWorldPos, mul, add);
 #else
 #error "SHADING: a sg::ShadingModel value this shader does not handle"
 #endif
-            c = albedo * mul + add;
-        }
-    }
-    if (uFogMode != FOG_OFF) {
-        float f = fogVisibility(length(vEyePos));   // eye-space distance, not just z
-        c = f * c + (1.0 - f) * uFogColor;
-    }
+    c = albedo * mul + add;
+#endif   // UNLIT
+#endif   // SOLID
+#if FOG != FOG_OFF
+    float f = fogVisibility(length(vEyePos));   // eye-space distance, not just z
+    c = f * c + (1.0 - f) * uFogColor;
+#endif
     fragColor = vec4(clamp(c, 0.0, 1.0), clamp(alpha, 0.0, 1.0));
+#endif   // OVERDRAW
 }

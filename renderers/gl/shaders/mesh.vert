@@ -1,6 +1,9 @@
 // mesh.vert - world-space transform for all shading models; Gouraud lights the vertices here
 // (front and back side, chosen per fragment by gl_FrontFacing). The renderer prepends
-// "#version 330 core", SHADING (SHADING_FLAT, SHADING_GOURAUD or SHADING_PHONG), MAX_LIGHTS and lighting.glsl.
+// "#version 330 core", SHADING (SHADING_FLAT, SHADING_GOURAUD or SHADING_PHONG), MAX_LIGHTS, the
+// draw's feature switches (see mesh.frag) and lighting.glsl. Outputs the fragment shader of the
+// same features does not read are not written (each one costs llvmpipe setup per triangle and
+// interpolation per fragment).
 layout(location = 0) in vec3 aPosition;
 layout(location = 1) in vec3 aNormal;
 layout(location = 2) in vec2 aUv;
@@ -15,12 +18,22 @@ uniform mat4 uView;
 uniform float uPointSize;
 
 out vec3 vWorldPos;
+#if FOG != FOG_OFF
 out vec3 vEyePos;
+#endif
 out vec3 vNormal;
+#if USES_UV
 out vec2 vUv;
+#endif
+#if USES_UV1
 out vec2 vUv1;
+#endif
+#if VERTEX_COLORS
 out vec4 vColor;
+#endif
+#if HAS_NORMAL_MAP
 out vec4 vTangent;   // world xyz; w: handedness, flipped by a mirroring model matrix
+#endif
 #if SHADING == SHADING_GOURAUD
 out vec3 vMulFront;
 out vec3 vAddFront;
@@ -31,12 +44,22 @@ out vec3 vAddBack;
 void main() {
     vec4 world = uModel * vec4(aPosition, 1.0);
     vWorldPos = world.xyz;
+#if FOG != FOG_OFF
     vEyePos = (uView * world).xyz;
+#endif
     vNormal = uNormalMatrix * aNormal;
+#if USES_UV
     vUv = aUv;
+#endif
+#if USES_UV1
     vUv1 = aUv1;
+#endif
+#if VERTEX_COLORS
     vColor = aColor;
+#endif
+#if HAS_NORMAL_MAP
     vTangent = vec4(mat3(uModel) * aTangent.xyz, determinant(mat3(uModel)) < 0.0 ? -aTangent.w : aTangent.w);
+#endif
     gl_Position = uViewProj * world;
     gl_PointSize = uPointSize;
 #if SHADING == SHADING_GOURAUD

@@ -30,7 +30,10 @@ struct Framebuffer {
     //   costPrims: triangles (and analytic shapes) the primary ray was tested against
     std::vector<uint32_t> overdraw, costNodes, costPrims;
 
-    void resize(int w, int h);    // colour and depth; drops the visibility and the counters
+    void resize(int w, int h);   // colour and depth; drops the visibility and the counters
+    // As resize(), but colour and depth keep whatever they held (unspecified values): for a
+    // backend that writes every pixel next, so a frame of the same size costs no fill.
+    void resizeForOverwrite(int w, int h);
     void resizeVisibility();      // visibility at the current size, all empty
     void resizeOverdraw();        // overdraw counters at the current size, all 0
     void resizeTraversalCost();   // costNodes/costPrims at the current size, all 0
