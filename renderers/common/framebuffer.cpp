@@ -40,6 +40,14 @@ void Framebuffer::resizeTraversalCost() {
     costPrims.assign(size_t(width) * height, 0u);
 }
 
+void Framebuffer::takeVisibilityAndCounters(Framebuffer&& src) {
+    drawable = std::move(src.drawable);
+    primitive = std::move(src.primitive);
+    overdraw = std::move(src.overdraw);
+    costNodes = std::move(src.costNodes);
+    costPrims = std::move(src.costPrims);
+}
+
 void Framebuffer::clear(const uint8_t rgba[4], float d) {
     for (size_t i = 0; i < color.size(); i += 4) std::copy(rgba, rgba + 4, &color[i]);
     std::fill(depth.begin(), depth.end(), d);

@@ -85,11 +85,7 @@ RenderStats Renderer::render(const sg::FrameInput& frame, int width, int height,
                 stats.cancelled = v.cancelled;
                 stats.error = v.error.empty() ? "visibility pass failed" : v.error;
             } else {
-                target.drawable = std::move(vis.drawable);
-                target.primitive = std::move(vis.primitive);
-                target.overdraw = std::move(vis.overdraw);
-                target.costNodes = std::move(vis.costNodes);
-                target.costPrims = std::move(vis.costPrims);
+                target.takeVisibilityAndCounters(std::move(vis));
                 stats.triangles += v.triangles;
                 stats.rays += v.rays;
             }

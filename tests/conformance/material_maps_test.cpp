@@ -314,20 +314,31 @@ TEST(PhongFromMetallicRoughness, KnownValues) {
     EXPECT_NEAR(sg::phongFromMetallicRoughness(0.0f, 0.0f).ks, 0.29f, 1e-6f);
 }
 
+// The import tests' glTF data: a 2x1 PNG (red, green), and the buffer of a unit quad in z = 0:
+// 4 positions, then each UV set (4 vec2), then 6 uint16 indices.
+using UvSet = std::array<float, 8>;
+std::string redGreenPng() {
+    const uint8_t rgba[8] = {255, 0, 0, 255, 0, 255, 0, 255};
+    std::string png;
+    EXPECT_EQ(assets::encodePng(2, 1, rgba, png), "");
+    return png;
+}
+std::string quadBuffer(std::initializer_list<UvSet> uvSets) {
+    const float pos[12] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
+    const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
+    std::string buf(reinterpret_cast<const char*>(pos), sizeof pos);
+    for (const UvSet& uv : uvSets) buf.append(reinterpret_cast<const char*>(uv.data()), sizeof(float) * uv.size());
+    buf.append(reinterpret_cast<const char*>(idx), sizeof idx);
+    return buf;
+}
+
 // glTF import: the maps, their factors and colour spaces reach the material (one glTF texture
 // used as colour and as data becomes two textures), and the scene file keeps them.
 TEST(MaterialMapsImport, GltfTexturesFactorsAndColourSpaces) {
     namespace fs = std::filesystem;
     fs::path dir = testing_support::outputDir("conformance") / "maps-import";
     fs::create_directories(dir);
-    const uint8_t rgba[8] = {255, 0, 0, 255, 0, 255, 0, 255};
-    std::string png;
-    ASSERT_EQ(assets::encodePng(2, 1, rgba, png), "");
-    const float pos[12] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0}, uv[8] = {0, 1, 1, 1, 1, 0, 0, 0};
-    std::string buf(reinterpret_cast<const char*>(pos), sizeof pos);
-    buf.append(reinterpret_cast<const char*>(uv), sizeof uv);
-    const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
-    buf.append(reinterpret_cast<const char*>(idx), sizeof idx);
+    const std::string png = redGreenPng(), buf = quadBuffer({{0, 1, 1, 1, 1, 0, 0, 0}});
     fs::path file = dir / "maps.gltf";
     std::ofstream(file) << R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],
 "meshes":[{"primitives":[{"attributes":{"POSITION":0,"TEXCOORD_0":1},"indices":2,"material":0}]}],
@@ -379,16 +390,8 @@ TEST(MaterialMapsImport, TwoUvChannelsWithTheirTransforms) {
     namespace fs = std::filesystem;
     fs::path dir = testing_support::outputDir("conformance") / "maps-uv-sets";
     fs::create_directories(dir);
-    const uint8_t rgba[8] = {255, 0, 0, 255, 0, 255, 0, 255};
-    std::string png;
-    ASSERT_EQ(assets::encodePng(2, 1, rgba, png), "");
-    const float pos[12] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
-    const float uvA[8] = {0, 1, 1, 1, 1, 0, 0, 0}, uvB[8] = {0.1f, 0.2f, 0.3f, 0.2f, 0.3f, 0.4f, 0.1f, 0.4f};
-    std::string buf(reinterpret_cast<const char*>(pos), sizeof pos);
-    buf.append(reinterpret_cast<const char*>(uvA), sizeof uvA);
-    buf.append(reinterpret_cast<const char*>(uvB), sizeof uvB);
-    const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
-    buf.append(reinterpret_cast<const char*>(idx), sizeof idx);
+    const UvSet uvA = {0, 1, 1, 1, 1, 0, 0, 0}, uvB = {0.1f, 0.2f, 0.3f, 0.2f, 0.3f, 0.4f, 0.1f, 0.4f};
+    const std::string png = redGreenPng(), buf = quadBuffer({uvA, uvB});
     auto write = [&](const fs::path& file, const std::string& emissive) {
         std::ofstream(file) << R"({"asset":{"version":"2.0"},"extensionsUsed":["KHR_texture_transform"],"scene":0,"scenes":[{"nodes":[0]}],
 "nodes":[{"mesh":0}],

@@ -121,17 +121,11 @@ void RenderSlot::runJob(const Job& job) {
             st.ok = false;
             st.error = "backend returned a " + std::to_string(fb.width) + "x" + std::to_string(fb.height) + " image";
         }
-        if (st.ok && reuse) {   // the same pixel centres as the one-sample step
-            fb.drawable = oneSample.drawable;
-            fb.primitive = oneSample.primitive;
-            fb.overdraw = oneSample.overdraw;
-            fb.costNodes = oneSample.costNodes;
-            fb.costPrims = oneSample.costPrims;
-        }
+        if (st.ok && reuse) fb.takeVisibilityAndCounters(std::move(oneSample));   // the same pixel centres
         if (d == 1 && !last) {   // the one-sample step's visibility and counters, for the last step (fb itself moves on)
             oneSample.width = fb.width;
             oneSample.height = fb.height;
-            oneSample.drawable = fb.drawable;
+            oneSample.drawable = fb.drawable;   // copies: fb (colour and all) is published below
             oneSample.primitive = fb.primitive;
             oneSample.overdraw = fb.overdraw;
             oneSample.costNodes = fb.costNodes;

@@ -40,6 +40,9 @@ struct Framebuffer {
     bool hasVisibility() const { return drawable.size() == size_t(width) * height && primitive.size() == drawable.size() && !drawable.empty(); }
     bool hasOverdraw() const { return overdraw.size() == size_t(width) * height && !overdraw.empty(); }
     bool hasTraversalCost() const { return costNodes.size() == size_t(width) * height && costPrims.size() == costNodes.size() && !costNodes.empty(); }
+    // Takes the visibility and the counters of `src` (an image of the same pixel centres: the
+    // one-sample pass of an anti-aliased image), leaving colour and depth as they are.
+    void takeVisibilityAndCounters(Framebuffer&& src);
     void clear(const uint8_t rgba[4], float depthValue = 1.0f);
     uint8_t* pixel(int x, int y) { return &color[(size_t(y) * width + x) * 4]; }
     const uint8_t* pixel(int x, int y) const { return &color[(size_t(y) * width + x) * 4]; }
