@@ -142,6 +142,11 @@ ShadeTerms lightTerms(const PhongCoefficients& m, const vec3& n, const vec3& v, 
     return t;
 }
 
+bool lightReaches(const DrawLight& light, const vec3& p, const vec3& n) {
+    const LightSample l = sampleLight(light, p);
+    return glm::dot(n, l.toLight) > 0.0f && l.radiance != vec3(0.0f);
+}
+
 ShadeTerms shadeTerms(const PhongCoefficients& m, const vec3& p, const vec3& n, const vec3& eye, const FrameInput& f, const float* visible) {
     ShadeTerms t;
     if (m.unlit) {

@@ -410,13 +410,14 @@ ParametricAccel::ParametricAccel(const ParametricSurface& s) : m_surface(s) {
     m_bvh.build(m_boxMin.data(), m_boxMax.data(), m_boxMin.size(), o);
 }
 
-bool ParametricAccel::intersect(const Ray& r, float& tOut, float& uOut, float& vOut) const {
+template <bool AnyHit>
+bool ParametricAccel::trace(const Ray& r, float& tOut, float& uOut, float& vOut) const {
     float tmax = r.tmax;
     bool found = false;
     const float dd = glm::dot(r.dir, r.dir);
     if (!(dd > 0)) return false;
     const std::vector<uint32_t>& prims = m_bvh.primIndex();
-    m_bvh.traverse(r, tmax, [&](uint32_t first, uint32_t count, float& tm) {
+    m_bvh.traverse<AnyHit>(r, tmax, [&](uint32_t first, uint32_t count, float& tm) {
         for (uint32_t q = 0; q < count; ++q) {
             uint32_t patch = prims[first + q];
             int i = int(patch % uint32_t(m_nu)), j = int(patch / uint32_t(m_nu));
@@ -432,12 +433,13 @@ bool ParametricAccel::intersect(const Ray& r, float& tOut, float& uOut, float& v
             for (const auto& st : starts) {
                 if (patchHit) break;
                 float u = u0 + st[0] * (u1 - u0), v = v0 + st[1] * (v1 - v0);
-                float t = glm::dot(m_surface.evaluate(u, v) - r.org, r.dir) / dd;
+                vec3 Pu, Pv;
+                vec3 P = m_surface.evaluate(u, v, Pu, Pv);
+                float t = glm::dot(P - r.org, r.dir) / dd;
                 bool ok = false;
                 float prevErr = std::numeric_limits<float>::infinity();
                 for (int it = 0; it < 16; ++it) {
-                    vec3 P = m_surface.evaluate(u, v), Pu, Pv;
-                    m_surface.partials(u, v, Pu, Pv);
+                    if (it > 0) P = m_surface.evaluate(u, v, Pu, Pv);
                     vec3 F = r.org + t * r.dir - P;
                     const float err = glm::length(F);
                     if (err < 1e-6f * (scale + 1.0f)) {
@@ -471,6 +473,7 @@ bool ParametricAccel::intersect(const Ray& r, float& tOut, float& uOut, float& v
                     uOut = std::clamp(u, 0.0f, 1.0f);
                     vOut = std::clamp(v, 0.0f, 1.0f);
                     found = true;
+                    if constexpr (AnyHit) return true;
                 }
             }
         }
@@ -478,6 +481,8 @@ bool ParametricAccel::intersect(const Ray& r, float& tOut, float& uOut, float& v
     });
     return found;
 }
+template bool ParametricAccel::trace<false>(const Ray&, float&, float&, float&) const;
+template bool ParametricAccel::trace<true>(const Ray&, float&, float&, float&) const;
 
 // --- density grids ----------------------------------------------------------------------------------
 

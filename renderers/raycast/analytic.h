@@ -68,10 +68,18 @@ class ParametricAccel {
 public:
     explicit ParametricAccel(const sg::ParametricSurface& s);
     // Closest hit of the local ray in (tmin, tmax): t and (u, v).
-    bool intersect(const Ray& localRay, float& t, float& u, float& v) const;
+    bool intersect(const Ray& localRay, float& t, float& u, float& v) const { return trace<false>(localRay, t, u, v); }
+    // Any hit in (tmin, tmax), for shadow rays: true exactly when intersect() finds one, but
+    // stops at the first sub-patch that has one.
+    bool occluded(const Ray& localRay) const {
+        float t, u, v;
+        return trace<true>(localRay, t, u, v);
+    }
     const sg::ParametricSurface& surface() const { return m_surface; }
 
 private:
+    template <bool AnyHit>
+    bool trace(const Ray& localRay, float& t, float& u, float& v) const;
     sg::ParametricSurface m_surface;
     int m_nu = 8, m_nv = 8;
     std::vector<sg::vec3> m_boxMin, m_boxMax;

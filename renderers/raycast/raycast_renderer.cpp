@@ -195,11 +195,19 @@ struct Tracer {
 
     static float offsetScale(const vec3& p) { return 1e-4f * (1.0f + std::max(std::abs(p.x), std::max(std::abs(p.y), std::abs(p.z)))); }
 
-    // Shadow rays to every light from p (geometric normal ng facing the viewer side).
-    void lightVisibility(const vec3& p, const vec3& ng, float* visible) {
+    // Shadow rays to every light from p (geometric normal ng facing the viewer side). With
+    // shading points (positions q and normals n where the lights are evaluated: the hit, or a
+    // Gouraud triangle's vertices), a light that reaches none of them gets no ray: its terms
+    // are zero there whatever the visibility (lightReaches), so the image is the same.
+    void lightVisibility(const vec3& p, const vec3& ng, float* visible, const vec3* q = nullptr, const vec3* n = nullptr, int points = 0) {
         for (size_t i = 0; i < f.lights.size(); ++i) {
             visible[i] = 1.0f;
             if (!f.settings.shadows) continue;
+            if (points > 0) {
+                bool reaches = false;
+                for (int k = 0; k < points && !reaches; ++k) reaches = lightReaches(f.lights[i], q[k], n[k]);
+                if (!reaches) continue;
+            }
             LightSample ls = sampleLight(f.lights[i], p);
             float side = glm::dot(ng, ls.toLight) >= 0 ? 1.0f : -1.0f;
             float eps = offsetScale(p);
@@ -320,7 +328,7 @@ struct Tracer {
             // interpolated with the hit's barycentrics (perspective-correct by
             // construction), as the rasterizers do; texture and vertex colours apply per
             // hit. The shadow rays of the hit point scale each light at every vertex.
-            lightVisibility(p, ng, vis);
+            lightVisibility(p, ng, vis, P, Nv, 3);
             const float wk[3] = {w0, w1, w2};
             ShadeTerms t;
             for (int k = 0; k < 3; ++k) {
@@ -341,7 +349,7 @@ struct Tracer {
                 n = l > 1e-20f ? n / l : ng;
                 if (ms.hasNormal && mesh.tangents.size() == mesh.positions.size()) n = mappedNormal(dm, i0, i1, i2, w0, w1, w2, n, back, ms);
             }
-            if (!mat->unlit) lightVisibility(p, ng, vis);
+            if (!mat->unlit) lightVisibility(p, ng, vis, &p, &n, 1);
             const PhongCoefficients coeff = hasMaps ? coefficientsAt(*mat, ms) : coefficientsOf(*mat);
             color = shade(coeff, SurfacePoint{p, n, albedo}, eye, f, mat->unlit ? nullptr : vis);
         }
@@ -357,7 +365,7 @@ struct Tracer {
         n = h.normal;
         if (glm::dot(n, r.dir) > 0) n = -n;   // analytic surfaces: face the ray
         ng = n;
-        if (!mat->unlit) lightVisibility(p, ng, vis);
+        if (!mat->unlit) lightVisibility(p, ng, vis, &p, &n, 1);
         color = shade(*mat, SurfacePoint{p, n, mat->baseColor}, eye, f, mat->unlit ? nullptr : vis);
     }
 

@@ -97,12 +97,20 @@ int SceneAccel::update(const FrameInput& f) {
     return built;
 }
 
-bool SceneAccel::intersectInstance(const Instance& inst, const Ray& wr, float tmax, SceneHit& hit, bool cull, TraversalCount* count) const {
+namespace {
+// The world ray in the instance's object space (the direction not normalised, so t is shared).
+Ray localRay(const mat4& invWorld, const Ray& wr, float tmax) {
     Ray lr;
-    lr.org = vec3(inst.invWorld * vec4(wr.org, 1.0f));
-    lr.dir = mat3(inst.invWorld) * wr.dir;
+    lr.org = vec3(invWorld * vec4(wr.org, 1.0f));
+    lr.dir = mat3(invWorld) * wr.dir;
     lr.tmin = wr.tmin;
     lr.tmax = tmax;
+    return lr;
+}
+}   // namespace
+
+bool SceneAccel::intersectInstance(const Instance& inst, const Ray& wr, float tmax, SceneHit& hit, bool cull, TraversalCount* count) const {
+    const Ray lr = localRay(inst.invWorld, wr, tmax);
     if (inst.isMesh) {
         TriHit th;
         if (!inst.bvh->intersect(lr, th, cull, count)) return false;
@@ -204,13 +212,9 @@ bool SceneAccel::occluded(const Ray& r) const {
     m_tlas.traverse<true>(r, tmax, [&](uint32_t first, uint32_t count, float&) {
         for (uint32_t k = 0; k < count; ++k) {
             const Instance& inst = m_instances[prims[first + k]];
-            if (inst.isMesh) {
-                Ray lr;
-                lr.org = vec3(inst.invWorld * vec4(r.org, 1.0f));
-                lr.dir = mat3(inst.invWorld) * r.dir;
-                lr.tmin = r.tmin;
-                lr.tmax = r.tmax;
-                if (inst.bvh->occluded(lr)) {
+            if (inst.isMesh || inst.param) {   // any-hit tests; a parametric surface's stops at its first sub-patch hit
+                const Ray lr = localRay(inst.invWorld, r, r.tmax);
+                if (inst.isMesh ? inst.bvh->occluded(lr) : inst.param->occluded(lr)) {
                     any = true;
                     return true;
                 }

@@ -152,6 +152,29 @@ void ParametricSurface::partials(float u, float v, vec3& dPdu, vec3& dPdv) const
         }
 }
 
+vec3 ParametricSurface::evaluate(float u, float v, vec3& dPdu, vec3& dPdv) const {
+    if (type == ParametricType::Torus) {
+        float a = 2 * kPi * u, b = 2 * kPi * v;
+        float sa = std::sin(a), ca = std::cos(a), sb = std::sin(b), cb = std::cos(b);
+        vec3 dir(sa, 0, ca), ddir(ca, 0, -sa);
+        dPdu = 2 * kPi * (majorRadius + minorRadius * cb) * ddir;
+        dPdv = 2 * kPi * minorRadius * (-sb * dir + vec3(0, cb, 0));
+        return majorRadius * dir + minorRadius * (cb * dir + vec3(0, sb, 0));
+    }
+    float bu[4], dbu[4], bv[4], dbv[4];
+    bernstein(u, bu, dbu);
+    bernstein(v, bv, dbv);
+    vec3 p(0.0f);
+    dPdu = dPdv = vec3(0.0f);
+    for (int j = 0; j < 4; ++j)
+        for (int i = 0; i < 4; ++i) {
+            p += bu[i] * bv[j] * control[j * 4 + i];
+            dPdu += dbu[i] * bv[j] * control[j * 4 + i];
+            dPdv += bu[i] * dbv[j] * control[j * 4 + i];
+        }
+    return p;
+}
+
 vec3 ParametricSurface::normal(float u, float v) const {
     vec3 du, dv;
     partials(u, v, du, dv);

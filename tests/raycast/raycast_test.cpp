@@ -6,7 +6,9 @@
 #include "raycast/bvh.h"
 #include "raycast/camera_rays.h"
 #include "raycast/scene_accel.h"
+#include "renderers/inspect.h"
 #include "renderers/renderer.h"
+#include "renderers/shading.h"
 #include "scenegraph/frame.h"
 #include "test_support.h"
 
@@ -606,6 +608,73 @@ FrameInput triangleScene(int w, int h) {
     return f;
 }
 }   // namespace
+
+// Shadow rays go only where a light can add something (lightReaches): a directional light
+// from below reaches hardly any visible point, a narrow spot a small patch, so most hits
+// trace one shadow ray (the point light's), not three. The pixels stay what full visibility
+// gives: each one matches the inspector's terms with Renderer::lightVisibility (which
+// traces every light), shadows of all three lights included.
+TEST(RaycastTest, ShadowRaysOnlyWhereALightCanAddSomething) {
+    const int w = 160, h = 120;
+    FrameInput f = triangleScene(w, h);
+    DrawLight below;
+    below.type = LightType::Directional;
+    below.direction = vec3(0, 1, 0);   // travels upward: lights undersides only
+    f.lights.push_back(below);
+    DrawLight spot;
+    spot.type = LightType::Spot;
+    spot.position = vec3(-1.5f, 4, 0.5f);
+    spot.direction = glm::normalize(vec3(0.5f, -1, 0));   // at the sphere's left side and the floor
+    spot.cosInner = std::cos(glm::radians(12.0f));
+    spot.cosOuter = std::cos(glm::radians(18.0f));
+    f.lights.push_back(spot);
+    const InstanceTable ids = instanceTable(f);
+    for (ShadingModel model : {ShadingModel::Phong, ShadingModel::Flat, ShadingModel::Gouraud}) {
+        SCOPED_TRACE(std::string(toString(model)));
+        f.settings.shading = model;
+        auto r = makeRenderer("raycast");
+        Framebuffer fb;
+        RenderRequest req;
+        req.visibility = true;
+        const RenderStats st = r->render(f, w, h, fb, nullptr, req);
+        ASSERT_TRUE(st.ok) << st.error;
+        size_t hits = 0, reachedBySpot = 0, checked = 0, close = 0, shadowed = 0;
+        for (int y = 1; y < h - 1; ++y)
+            for (int x = 1; x < w - 1; ++x) {
+                const SurfaceAt s = surfaceAt(f, ids, fb, x, y);
+                if (!s.hit) continue;
+                ++hits;
+                reachedBySpot += lightReaches(f.lights[2], s.position, s.normal);
+                if (model == ShadingModel::Gouraud) continue;   // the inspector does not reproduce Gouraud
+                bool interior = true;
+                for (int k = 0; k < 4; ++k) {
+                    const int i = x + (k == 0) - (k == 1), j = y + (k == 2) - (k == 3);
+                    interior = interior && fb.drawable[size_t(j) * w + i] == s.drawable;
+                }
+                if (!interior) continue;
+                const std::vector<float> vis = r->lightVisibility(f, s.position, s.geometricNormal);
+                ASSERT_EQ(vis.size(), 3u);
+                shadowed += vis[0] == 0.0f || vis[2] == 0.0f;
+                const PixelTerms t = pixelTerms(f, s, vis);
+                const uint8_t* px = fb.pixel(x, y);
+                int worst = 0;
+                for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(int(px[c]) - int(toByteSRGB(t.predicted[c]))));
+                ++checked;
+                close += worst <= 2;
+            }
+        ASSERT_GT(hits, size_t(w * h / 2));
+        EXPECT_GT(reachedBySpot, hits / 20);   // the spot lights a real part of the image
+        EXPECT_LT(reachedBySpot, hits / 2);
+        // Primary rays for every pixel, then per hit: the point light's ray where it reaches,
+        // the spot's inside its cone, the light from below almost never.
+        EXPECT_GT(st.rays, uint64_t(w * h + hits / 2));
+        EXPECT_LT(st.rays, uint64_t(w * h + 2 * hits));
+        if (model != ShadingModel::Gouraud) {
+            EXPECT_GT(shadowed, checked / 50);   // shadows are in the picture
+            EXPECT_GE(double(close) / double(checked), 0.99) << close << " of " << checked;
+        }
+    }
+}
 
 TEST(RaycastTest, RendersProgressCancelAndCaches) {
     const int w = 160, h = 120;

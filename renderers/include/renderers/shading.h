@@ -104,6 +104,11 @@ void applyMapsToTerms(ShadeTerms& t, const sg::Material& m, const MapSample& s, 
 // direction toEye (unit). No ambient, no emissive.
 ShadeTerms lightTerms(const PhongCoefficients& m, const sg::vec3& n, const sg::vec3& toEye, const LightSample& l, sg::ReflectionModel model);
 
+// Whether the light can add anything at p with unit normal n: lightTerms() is exactly zero
+// when n.l <= 0 or no radiance arrives (outside a spot's cone), and then the light's
+// visibility changes nothing (the ray caster skips its shadow ray).
+bool lightReaches(const sg::DrawLight& light, const sg::vec3& p, const sg::vec3& n);
+
 // All of the local model's terms at p with normal n seen from `eye`: ambient + emissive + every
 // light. `lightVisible` (optional) scales light i by a visibility in [0,1] (the ray caster's
 // shadow rays). Unlit materials: mul = 1, add = emissive.

@@ -56,6 +56,8 @@ struct ParametricSurface {
     vec3 evaluate(float u, float v) const;
     // Partial derivatives dP/du and dP/dv; the normal is dPdu x dPdv.
     void partials(float u, float v, vec3& dPdu, vec3& dPdv) const;
+    // evaluate() and partials() in one pass (the same values, bit for bit), for Newton's method.
+    vec3 evaluate(float u, float v, vec3& dPdu, vec3& dPdv) const;
     vec3 normal(float u, float v) const;
     Aabb localBounds() const;
     static ParametricSurface defaultPatch();   // a gentle hill over [-1,1]^2
