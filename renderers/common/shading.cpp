@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 namespace rnd {
@@ -186,7 +187,54 @@ float encodeSRGB(float x) {
 
 float decodeSRGB(float x) { return x <= 0.04045f ? x / 12.92f : std::pow((x + 0.055f) / 1.055f, 2.4f); }
 
-uint8_t toByteSRGB(float linear) { return uint8_t(encodeSRGB(linear) * 255.0f + 0.5f); }
+namespace {
+// The formula that defines the byte, for finite x in [0, 1].
+uint8_t byteByFormula(float x) { return uint8_t(encodeSRGB(x) * 255.0f + 0.5f); }
+
+uint32_t bitsOf(float x) {
+    uint32_t b;
+    std::memcpy(&b, &x, 4);
+    return b;
+}
+
+// The byte without pow. Non-negative floats order like their bits, so the floats in [2^-13, 1)
+// fall into buckets by exponent and the top 8 mantissa bits; a bucket's first float gives a
+// first guess and the thresholds (the smallest float of each byte, found by bisection on the
+// formula itself) finish it: exact wherever the formula is monotonic, which the unit test
+// checks for every float in [0, 1]. Below 2^-13 the formula gives 0 (255 * 12.92 x < 0.5).
+struct SrgbByteTable {
+    static constexpr int kMinExp = -13;
+    float first[257];                // first[b]: smallest x with byte >= b; first[256] above 1
+    uint8_t guess[-kMinExp * 256];   // byte of each bucket's first float
+    SrgbByteTable() {
+        first[0] = 0.0f;
+        for (int b = 1; b < 256; ++b) {
+            uint32_t lo = 0, hi = bitsOf(1.0f);   // byte(lo) < b <= byte(hi)
+            while (hi - lo > 1) {
+                const uint32_t mid = lo + (hi - lo) / 2;
+                float x;
+                std::memcpy(&x, &mid, 4);
+                (byteByFormula(x) >= b ? hi : lo) = mid;
+            }
+            std::memcpy(&first[b], &hi, 4);
+        }
+        first[256] = 2.0f;
+        for (int i = 0; i < -kMinExp * 256; ++i) guess[i] = byteByFormula(std::ldexp(1.0f + float(i % 256) / 256.0f, kMinExp + i / 256));
+    }
+    uint8_t operator()(float x) const {
+        if (!(x >= 0x1p-13f)) return 0;   // also NaN
+        if (x >= 1.0f) return 255;
+        int b = guess[(bitsOf(x) - bitsOf(0x1p-13f)) >> 15];
+        while (x >= first[b + 1]) ++b;
+        return uint8_t(b);
+    }
+};
+}   // namespace
+
+uint8_t toByteSRGB(float linear) {
+    static const SrgbByteTable table;
+    return table(linear);
+}
 
 vec3 srgbBytesToLinear(const uint8_t* rgb) {
     static const auto table = [] {

@@ -10,6 +10,9 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstring>
+#include <limits>
+#include <random>
 #include <sstream>
 
 using namespace rnd;
@@ -276,4 +279,91 @@ TEST(ShadeTermsTest, ShadeIsTheTermsAppliedToTheAlbedo) {
                 for (int k = 0; k < 3; ++k) EXPECT_NEAR(zero[k], t.add[k], 1e-6f);
                 if (tinted) { EXPECT_EQ(t.add, m.emissive); }
             }
+}
+
+// lightReaches() is what lets the ray caster skip a shadow ray: wherever it says no, the
+// light's terms are exactly zero for every material and reflection model (so the visibility
+// cannot matter), and it says yes on a fair share of random points, for every light type.
+TEST(ShadeTermsTest, ALightThatDoesNotReachAddsExactlyNothing) {
+    sg::DrawLight point, dir, spot;
+    point.type = sg::LightType::Point;
+    point.position = {2, 3, 4};
+    point.radiance = {3, 2, 1};
+    point.inverseSquare = true;
+    dir.type = sg::LightType::Directional;
+    dir.direction = glm::normalize(sg::vec3(-1, -2, -1));
+    dir.radiance = {0.5f, 0.6f, 0.7f};
+    spot.type = sg::LightType::Spot;
+    spot.position = {0, 4, 1};
+    spot.direction = glm::normalize(sg::vec3(0, -1, -0.2f));
+    spot.cosInner = 0.95f;
+    spot.cosOuter = 0.8f;
+    spot.radiance = {2, 2, 2};
+    PhongCoefficients m;
+    m.ka = 0.3f;
+    m.kd = 0.6f;
+    m.ks = 0.5f;
+    m.shininess = 12;
+    m.specularColor = {0.9f, 0.8f, 0.7f};
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> u(-3.0f, 3.0f);
+    for (const sg::DrawLight& light : {point, dir, spot}) {
+        int reached = 0, notReached = 0;
+        for (int i = 0; i < 4000; ++i) {
+            const sg::vec3 p(u(rng), u(rng) * 0.3f, u(rng)), n = glm::normalize(sg::vec3(u(rng), u(rng), u(rng)));
+            const sg::vec3 toEye = glm::normalize(sg::vec3(u(rng), u(rng), u(rng)));
+            if (lightReaches(light, p, n)) {
+                ++reached;
+                continue;
+            }
+            ++notReached;
+            for (bool tinted : {false, true})
+                for (auto model : {sg::ReflectionModel::Phong, sg::ReflectionModel::BlinnPhong}) {
+                    m.specularTinted = tinted;
+                    const ShadeTerms t = lightTerms(m, n, toEye, sampleLight(light, p), model);
+                    ASSERT_EQ(t.mul, sg::vec3(0.0f)) << "light type " << int(light.type) << " at " << i;
+                    ASSERT_EQ(t.add, sg::vec3(0.0f)) << "light type " << int(light.type) << " at " << i;
+                }
+        }
+        EXPECT_GT(reached, 200) << int(light.type);
+        EXPECT_GT(notReached, 200) << int(light.type);
+    }
+}
+
+// toByteSRGB's table gives the formula's byte round(255 encodeSRGB(x)) for every float in
+// [0, 1] (all of them near the 255 byte thresholds, every 61st elsewhere), and clamps
+// outside (negative, above 1, infinities, NaN to 0).
+TEST(ShadeTermsTest, SrgbBytesFromTheTableAreTheFormulas) {
+    auto formula = [](float x) { return int(uint8_t(encodeSRGB(x) * 255.0f + 0.5f)); };
+    auto fromBits = [](uint32_t b) {
+        float x;
+        std::memcpy(&x, &b, 4);
+        return x;
+    };
+    uint32_t one;
+    const float oneF = 1.0f;
+    std::memcpy(&one, &oneF, 4);
+    size_t checked = 0;
+    for (uint32_t b = 0; b <= one; b += 61) {
+        const float x = fromBits(b);
+        ASSERT_EQ(int(toByteSRGB(x)), formula(x)) << x;
+        ++checked;
+    }
+    for (int byte = 1; byte < 256; ++byte) {   // each threshold: bisect, then every float around it
+        uint32_t lo = 0, hi = one;
+        while (hi - lo > 1) {
+            const uint32_t mid = lo + (hi - lo) / 2;
+            (formula(fromBits(mid)) >= byte ? hi : lo) = mid;
+        }
+        for (uint32_t b = hi - 2000; b <= hi + 2000 && b <= one; ++b) {
+            ASSERT_EQ(int(toByteSRGB(fromBits(b))), formula(fromBits(b))) << fromBits(b);
+            ++checked;
+        }
+    }
+    EXPECT_GT(checked, size_t(16'000'000));
+    EXPECT_EQ(toByteSRGB(-0.5f), 0);
+    EXPECT_EQ(toByteSRGB(1.5f), 255);
+    EXPECT_EQ(toByteSRGB(std::numeric_limits<float>::infinity()), 255);
+    EXPECT_EQ(toByteSRGB(-std::numeric_limits<float>::infinity()), 0);
+    EXPECT_EQ(toByteSRGB(std::numeric_limits<float>::quiet_NaN()), 0);
 }

@@ -131,7 +131,9 @@ sg::vec3 applyFog(const sg::RenderSettings& s, const sg::vec3& color, float eyeD
 
 float encodeSRGB(float linear);   // [0,1] -> [0,1]
 float decodeSRGB(float encoded);
-uint8_t toByteSRGB(float linear);   // clamp, encode, round
+// Clamp, encode, round: the byte round(255 encodeSRGB(clamp(x, 0, 1))), found without pow
+// through a table made from that formula (exactly its value for every float; NaN gives 0).
+uint8_t toByteSRGB(float linear);
 sg::vec3 srgbBytesToLinear(const uint8_t* rgb);
 
 }   // namespace rnd
