@@ -1,10 +1,11 @@
-// interactive_bench.cpp - what the user waits for in the window after a camera move, per CPU
+// interactive_bench.cpp - what the user waits for in the window after a camera move, per
 // backend, on the bundled demo (issue 20, goal 5), through the viewport's own code: ViewerState
 // builds the frame from the orbit camera (sg::flatten, as the window does on every change) and
-// a RenderSlot renders it on its worker thread, coarse to fine.
+// a RenderSlot renders it on a worker thread, coarse to fine (GL there in its own headless
+// context, as the window runs it where OpenGL is software only).
 //
 //   ./build/release/bench/interactive/bench_interactive [--size 960x850] [--moves 9]
-//       [--backends raycast,raster] [--shadows on|off] [--aa none|ssaa4|...]
+//       [--backends raycast,raster,gl] [--shadows on|off] [--aa none|ssaa4|...]
 //
 // Each move is a 25-pixel orbit drag followed by the release, as in the window:
 //   coarse_ms: from the drag (frame built, request(interacting)) to the first image shown,
@@ -60,7 +61,7 @@ std::vector<std::string> split(const std::string& s) {
 
 int main(int argc, char** argv) {
     int width = 960, height = 850, moves = 9;
-    std::vector<std::string> backends = {"raycast", "raster"};
+    std::vector<std::string> backends = {"raycast", "raster", "gl"};
     bool shadows = true;
     std::string aa = "none";
     for (int i = 1; i < argc; ++i) {
