@@ -115,4 +115,10 @@ RenderStats Renderer::render(const sg::FrameInput& frame, int width, int height,
 
 std::vector<float> Renderer::lightVisibility(const sg::FrameInput&, const sg::vec3&, const sg::vec3&) { return {}; }
 
+bool isSoftwareGLRenderer(std::string_view r) {
+    for (std::string_view name : {"llvmpipe", "softpipe", "Software Rasterizer", "swrast", "SWR"})
+        if (r.find(name) != std::string_view::npos) return true;
+    return false;
+}
+
 }   // namespace rnd

@@ -6,6 +6,8 @@
 //           6. what headless GL runs on (probeHeadlessGl)
 #include "gl/gl_context.h"
 
+#include "renderers/renderer.h"
+
 #include <glad/egl.h>
 #include <glad/gl.h>
 // GLFW must not pull in a GL header of its own (glad's gl.h is already there).
@@ -291,12 +293,6 @@ std::string describeCurrentContext() {
 }
 
 // --- 6. What headless GL runs on ------------------------------------------------------------
-bool isSoftwareRenderer(std::string_view r) {
-    for (std::string_view name : {"llvmpipe", "softpipe", "Software Rasterizer", "swrast", "SWR"})
-        if (r.find(name) != std::string_view::npos) return true;
-    return false;
-}
-
 namespace {
 
 bool hasToken(const char* list, std::string_view token) {
@@ -345,7 +341,7 @@ HeadlessGl probeUncached() {
         const GLubyte* s = glGetString(GL_RENDERER);
         r.renderer = s ? reinterpret_cast<const char*>(s) : "";
         r.usable = true;
-        r.software = isSoftwareRenderer(r.renderer);
+        r.software = isSoftwareGLRenderer(r.renderer);
     }
     if (ctx) ctx->release();
     return r;

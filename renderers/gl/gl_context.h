@@ -46,17 +46,13 @@ std::string loadGLFunctions();
 // "OpenGL 4.5 (Core Profile) Mesa ..., llvmpipe" of the current context (after loading).
 std::string describeCurrentContext();
 
-// Whether a GL_RENDERER string names a software rasterizer: Mesa's llvmpipe, softpipe, swrast
-// or OpenSWR (and zink running on one of them), i.e. OpenGL emulated on the CPU.
-bool isSoftwareRenderer(std::string_view glRenderer);
-
 // What the OpenGL that createHeadlessContext("") would give runs on, found without rendering;
 // probed once per process (thread-safe), for choosing a default backend.
 //   1. When the platform is auto or egl and Mesa's EGL lists its devices (EGL_EXT_device_
 //      enumeration) and every one is its software device (EGL_MESA_device_software: no GPU
 //      render node), GL here is software. This loads libEGL only (~4 MB, a few ms); making a
 //      context would load llvmpipe and LLVM (~60 MB resident, ~50 ms).
-//   2. Otherwise makes a headless context and reads its GL_RENDERER (isSoftwareRenderer).
+//   2. Otherwise makes a headless context and reads its GL_RENDERER (rnd::isSoftwareGLRenderer).
 struct HeadlessGl {
     bool usable = false;     // a context can be made (step 1 does not try: true there)
     bool software = false;   // usable, and emulated on the CPU

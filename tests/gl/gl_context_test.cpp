@@ -149,10 +149,10 @@ TEST(GlContextGLTest, CallerContextIsUsedAndStateRestored) {
 
 TEST(GlContextTest, SoftwareRenderersAreRecognised) {
     for (const char* r : {"llvmpipe (LLVM 15.0.6, 256 bits)", "softpipe", "Software Rasterizer", "zink (llvmpipe (LLVM 15.0.6))", "SWR (LLVM 11)"})
-        EXPECT_TRUE(rnd::gl::isSoftwareRenderer(r)) << r;
+        EXPECT_TRUE(rnd::isSoftwareGLRenderer(r)) << r;
     for (const char* r : {"NVIDIA H100 80GB HBM3/PCIe/SSE2", "AMD Radeon RX 6800 (navi21, LLVM 15.0.6, DRM 3.49)",
                           "Mesa Intel(R) UHD Graphics 620 (KBL GT2)", "virgl", ""})
-        EXPECT_FALSE(rnd::gl::isSoftwareRenderer(r)) << r;
+        EXPECT_FALSE(rnd::isSoftwareGLRenderer(r)) << r;
 }
 
 // What probeHeadlessGl says without rendering (here: from EGL's device list when Mesa has no
@@ -167,7 +167,7 @@ TEST(GlContextGLTest, ProbeAgreesWithTheContextARenderGets) {
     ASSERT_TRUE(r->render(simpleFrame(), 64, 48, fb).ok);
     const std::string context = rnd::glCacheCounters(*r).context;
     std::printf("[gl] probe: %s (%s); a render's context: %s\n", probe.software ? "software" : "hardware", probe.renderer.c_str(), context.c_str());
-    EXPECT_EQ(probe.software, rnd::gl::isSoftwareRenderer(context)) << probe.renderer << " vs " << context;
+    EXPECT_EQ(probe.software, rnd::isSoftwareGLRenderer(context)) << probe.renderer << " vs " << context;
 
     const rnd::Device d = r->device();
     EXPECT_TRUE(d.usable);

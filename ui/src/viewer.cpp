@@ -632,10 +632,7 @@ void setUpViewer(Viewer& v, GLFWwindow* win) {
     // On a software GL (Mesa llvmpipe/softpipe) a GL frame of a big scene takes hundreds of
     // milliseconds: render it on a worker thread with its own context so the UI never freezes.
     // On a hardware GL the window's context on the UI thread is the fast path.
-    if (const char* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER))) {
-        std::string r = renderer;
-        st.view.glOnWorker = r.find("llvmpipe") != std::string::npos || r.find("softpipe") != std::string::npos;
-    }
+    if (const char* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER))) st.view.glOnWorker = rnd::isSoftwareGLRenderer(renderer);
 
     // Config: imgui.ini (layout) and recent files in the per-user config folder.
     st.config.dir = defaultConfigDir();

@@ -66,6 +66,11 @@ struct Device {
     std::string detail;              // e.g. "CPU", "llvmpipe (LLVM 15.0.6, 256 bits)", a GPU's GL_RENDERER
 };
 
+// Whether a GL_RENDERER string names OpenGL emulated on the CPU: Mesa's llvmpipe, softpipe,
+// swrast or OpenSWR (and zink running on one of them). The gl backend's device() uses it for
+// its own contexts; the window asks it of the context it made itself.
+bool isSoftwareGLRenderer(std::string_view glRenderer);
+
 // Shared between the caller and a render in progress (possibly on another thread).
 struct RenderControl {
     std::atomic<bool> cancel{false};
