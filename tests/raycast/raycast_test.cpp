@@ -479,6 +479,105 @@ TEST(RaycastTest, BvhKeepsGrazingRaysOnFlatFarGeometry) {
     EXPECT_GT(hits, 3000);
 }
 
+// Packets (intersectPacket / occludedPacket) give exactly the single-ray results for every active
+// ray and leave inactive lanes alone: camera-like packets (one origin, zero direction components
+// included), shadow-like packets (many origins, one target), origins inside the boxes, tmin/tmax
+// limits, rays that cannot join the packet (other direction signs, non-finite, empty segment), on
+// BVH8 (or BVH4 with the SSE kernel) and on a tree forced to BVH4.
+TEST(RaycastTest, BvhPacketsEqualSingleRays) {
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> U(-1, 1);
+    std::vector<vec3> pos;
+    std::vector<uint32_t> idx;
+    for (int t = 0; t < 3000; ++t) {
+        const vec3 c(U(rng) * 5, U(rng) * 5, U(rng) * 5);
+        for (int k = 0; k < 3; ++k) {
+            pos.push_back(c + 0.4f * vec3(U(rng), U(rng), U(rng)));
+            idx.push_back(uint32_t(pos.size() - 1));
+        }
+    }
+    // A flat grid with shared edges (rays along its lines meet two triangles at once).
+    const uint32_t g0 = uint32_t(pos.size());
+    for (int j = 0; j <= 16; ++j)
+        for (int i = 0; i <= 16; ++i) pos.push_back(vec3(-4.0f + 0.5f * float(i), -5.5f, -4.0f + 0.5f * float(j)));
+    for (int j = 0; j < 16; ++j)
+        for (int i = 0; i < 16; ++i) {
+            const uint32_t a = g0 + uint32_t(j * 17 + i), b = a + 1, c = a + 17, d = c + 1;
+            idx.insert(idx.end(), {a, c, b, b, c, d});
+        }
+    const size_t count = idx.size() / 3;
+    Bvh4::BuildOptions opts[2] = {TriangleBvh::defaultOptions(), TriangleBvh::defaultOptions()};
+    opts[1].maxWideNodes = 1;   // BVH4: the packet calls fall back to single rays
+    for (const Bvh4::BuildOptions& opt : opts) {
+        TriangleBvh bvh;
+        bvh.build(pos.data(), idx.data(), count, opt);
+        int hits = 0, ties = 0, tested = 0;
+        for (int p = 0; p < 400; ++p) {
+            const int n = p % 5 == 0 ? 1 + int(rng() % kMaxPacket) : (p % 2 ? 16 : kMaxPacket);
+            std::vector<Ray> rays(static_cast<size_t>(n));
+            const int kind = p % 4;   // 0, 1: camera-like; 2: shadow-like; 3: random (incoherent)
+            const vec3 eye(U(rng) * 8, U(rng) * 8, U(rng) * 8 + (p % 3 == 0 ? 0.0f : 12.0f));
+            const vec3 aim(U(rng) * 3, U(rng) * 3, U(rng) * 3), light(U(rng) * 9, 9.0f, U(rng) * 9);
+            for (int i = 0; i < n; ++i) {
+                Ray& r = rays[size_t(i)];
+                if (kind <= 1) {
+                    const vec3 d = aim + 0.05f * float(i % 8) * vec3(1, 0, 0) + 0.05f * float(i / 8) * vec3(0, 1, 0) - eye;
+                    r = mkRay(eye, kind == 1 ? glm::normalize(d) : d);
+                } else if (kind == 2) {
+                    const vec3 o = aim + 0.1f * vec3(float(i % 8), U(rng), float(i / 8));
+                    r = mkRay(o, light - o);
+                    r.tmax = 0.9999f;
+                } else {
+                    const vec3 o(U(rng) * 6, U(rng) * 6, U(rng) * 6);   // often inside boxes
+                    r = mkRay(o, vec3(U(rng), U(rng), U(rng)));
+                }
+                if (i % 9 == 3) r.dir.x = 0.0f;   // degenerate directions: zero components
+                if (i % 13 == 5) r.dir = vec3(0.0f, 0.0f, r.dir.z < 0 ? -1.0f : 1.0f);
+                if (i % 13 == 6) r.dir = vec3(0.0f, -1.0f, 0.0f);   // straight down onto the grid
+                if (i % 7 == 2) r.tmax = std::min(r.tmax, 3.0f + U(rng));
+                if (i % 11 == 4) r.tmin = 1.0f + U(rng);
+                if (i % 17 == 8) r.tmin = -2.0f;
+                if (p % 10 == 7 && i == n / 2) r.dir = -r.dir;   // other signs than the packet
+                if (p % 20 == 9 && i == 1) r.org.x = std::numeric_limits<float>::quiet_NaN();
+                if (p % 20 == 19 && i == 2) r.tmax = 0.5f * r.tmin - 1.0f;   // empty segment
+            }
+            uint64_t active = (uint64_t(rng()) << 32) | rng();
+            if (p % 3 == 0) active = ~uint64_t(0);
+            std::vector<TriHit> ph(static_cast<size_t>(n));
+            for (TriHit& h : ph) h.t = -7.0f;   // inactive lanes and misses: untouched
+            const uint64_t found = bvh.intersectPacket(rays.data(), n, active, ph.data());
+            const uint64_t occ = bvh.occludedPacket(rays.data(), n, active);
+            for (int i = 0; i < n; ++i) {
+                const bool on = (active >> i) & 1;
+                TriHit a;
+                const bool ha = bvh.intersect(rays[size_t(i)], a);
+                const TriHit& b = ph[size_t(i)];
+                if (!on || !ha) {
+                    EXPECT_FALSE((found >> i) & 1) << "packet " << p << " ray " << i;
+                    EXPECT_EQ(b.t, -7.0f) << "packet " << p << " ray " << i;
+                    EXPECT_EQ(b.prim, ~0u);
+                    if (!on) { EXPECT_FALSE((occ >> i) & 1); }
+                    if (on) { EXPECT_EQ(bool((occ >> i) & 1), bvh.occluded(rays[size_t(i)])) << "packet " << p << " ray " << i; }
+                    continue;
+                }
+                ++tested;
+                ++hits;
+                ASSERT_TRUE((found >> i) & 1) << "packet " << p << " ray " << i;
+                EXPECT_EQ(bool((occ >> i) & 1), bvh.occluded(rays[size_t(i)])) << "packet " << p << " ray " << i;
+                EXPECT_EQ(b.t, a.t) << "packet " << p << " ray " << i;
+                if (b.prim != a.prim) {   // exact ties between two triangles may keep either
+                    ++ties;
+                    continue;
+                }
+                EXPECT_EQ(b.b1, a.b1);
+                EXPECT_EQ(b.b2, a.b2);
+            }
+        }
+        EXPECT_GT(hits, 2000);
+        EXPECT_LE(ties, tested / 1000 + 2);
+    }
+}
+
 TEST(RaycastTest, BvhHandlesEmptyAndNonFinite) {
     TriangleBvh bvh;
     bvh.build(nullptr, nullptr, 0);
