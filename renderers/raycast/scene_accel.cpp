@@ -3,6 +3,8 @@
 
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
+
 namespace rnd::rt {
 
 using namespace sg;
@@ -194,6 +196,114 @@ bool SceneAccel::closestHit(const Ray& r, SceneHit& hit, sg::CullMode culling, T
 bool SceneAccel::intersect(const Ray& r, SceneHit& hit, sg::CullMode culling, TraversalCount* cost) const {
     if (m_tlas.empty()) return false;
     return cost ? closestHit<true>(r, hit, culling, cost) : closestHit<false>(r, hit, culling, nullptr);
+}
+
+uint64_t SceneAccel::intersectPacket(const Ray* rays, int n, uint64_t active, SceneHit* hits, sg::CullMode culling) const {
+    n = std::clamp(n, 0, kMaxPacket);
+    if (n < kMaxPacket) active &= (uint64_t(1) << n) - 1;
+    if (m_tlas.empty() || !active) return 0;
+    const std::vector<uint32_t>& prims = m_tlas.primIndex();
+    // Phase 1: the mesh instances whose world boxes the rays reach (each ray's own top-level
+    // traversal, not cut short by hits), in the order the rays meet them, and which rays reach
+    // each; each is traced once as a packet, every ray limited to the closest mesh hit found so
+    // far, and its hits are kept per ray.
+    constexpr int kMaxMeshes = 16;
+    struct Touched {
+        uint32_t instance;
+        uint64_t rays, found;
+    };
+    Touched touched[kMaxMeshes];
+    int k = 0;
+    bool overflow = false;
+    for (uint64_t m = active; m && !overflow; m &= m - 1) {
+        const int i = __builtin_ctzll(m);
+        float tmax = rays[i].tmax;
+        m_tlas.traverse<false>(rays[i], tmax, [&](uint32_t first, uint32_t count, float&) {
+            for (uint32_t c = 0; c < count; ++c) {
+                const uint32_t j = prims[first + c];
+                if (!m_instances[j].isMesh) continue;
+                int s = 0;
+                while (s < k && touched[s].instance != j) ++s;
+                if (s == k) {
+                    if (k == kMaxMeshes) {
+                        overflow = true;
+                        return true;
+                    }
+                    touched[k++] = {j, 0, 0};
+                }
+                touched[s].rays |= uint64_t(1) << i;
+            }
+            return false;
+        });
+    }
+    uint64_t found = 0;
+    if (overflow) {   // too many meshes under one packet: one ray at a time
+        for (uint64_t m = active; m; m &= m - 1) {
+            const int i = __builtin_ctzll(m);
+            if (intersect(rays[i], hits[i], culling)) found |= uint64_t(1) << i;
+        }
+        return found;
+    }
+    TriHit meshHits[kMaxMeshes][kMaxPacket];
+    float bound[kMaxPacket];
+    for (int i = 0; i < n; ++i) bound[i] = rays[i].tmax;
+    for (int s = 0; s < k; ++s) {
+        const Instance& inst = m_instances[touched[s].instance];
+        Ray lr[kMaxPacket];
+        for (uint64_t m = touched[s].rays; m; m &= m - 1) {
+            const int i = __builtin_ctzll(m);
+            lr[i].org = vec3(inst.invWorld * vec4(rays[i].org, 1.0f));   // as intersectInstance
+            lr[i].dir = mat3(inst.invWorld) * rays[i].dir;
+            lr[i].tmin = rays[i].tmin;
+            lr[i].tmax = bound[i];
+        }
+        const bool cull = sg::cullsBackFaces(culling, m_frame->meshes[inst.index].material.doubleSided);
+        touched[s].found = inst.bvh->intersectPacket(lr, n, touched[s].rays, meshHits[s], cull);
+        for (uint64_t m = touched[s].found; m; m &= m - 1) {
+            const int i = __builtin_ctzll(m);
+            bound[i] = std::min(bound[i], meshHits[s][i].t);
+        }
+    }
+    // Phase 2: each ray's closestHit, with a mesh instance's hit looked up instead of traced. The
+    // kept hit is the instance's closest below the bound it was traced with; closestHit asks for
+    // its closest below tm, the closest hit so far. Where tm exceeds that bound, a mesh hit
+    // at or below the bound is still to come, so a hit in between would not be kept either.
+    for (uint64_t m = active; m; m &= m - 1) {
+        const int i = __builtin_ctzll(m);
+        const Ray& r = rays[i];
+        float tmax = r.tmax;
+        bool any = false;
+        m_tlas.traverse<false>(r, tmax, [&](uint32_t first, uint32_t count, float& tm) {
+            for (uint32_t c = 0; c < count; ++c) {
+                const uint32_t j = prims[first + c];
+                const Instance& inst = m_instances[j];
+                SceneHit h;
+                if (inst.isMesh) {
+                    int s = 0;
+                    while (s < k && touched[s].instance != j) ++s;
+                    if (s == k || !((touched[s].found >> i) & 1)) continue;
+                    const TriHit& th = meshHits[s][i];
+                    if (!(th.t < tm)) continue;
+                    h.kind = SceneHit::Kind::Mesh;
+                    h.t = th.t;
+                    h.instance = inst.index;
+                    h.prim = th.prim;
+                    h.b1 = th.b1;
+                    h.b2 = th.b2;
+                } else if (!intersectInstance(inst, r, tm, h)) {
+                    continue;
+                }
+                if (h.t < tm) {
+                    tm = h.t;
+                    hits[i] = h;
+                    any = true;
+                }
+            }
+            return false;
+        });
+        if (any) found |= uint64_t(1) << i;
+    }
+    return found;
 }
 
 bool SceneAccel::occluded(const Ray& r) const {
