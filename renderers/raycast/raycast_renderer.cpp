@@ -543,6 +543,7 @@ protected:
 
         tbb::parallel_for(tbb::blocked_range<int>(0, ntiles, 1), [&](const tbb::blocked_range<int>& range) {
             std::vector<Tracer::FirstHit> tileHits(packets ? size_t(tile) * tile : 0);
+            std::vector<rt::Ray> tileRays(tileHits.size());
             const unsigned old = _mm_getcsr();
             _mm_setcsr(old | 0x8040);   // FTZ | DAZ in this worker
             for (int ti = range.begin(); ti != range.end(); ++ti) {
@@ -567,6 +568,7 @@ protected:
                             n = 0;
                             for (int row = py; row < std::min(py + kPacket, y1); ++row)
                                 for (int x = px; x < std::min(px + kPacket, x1); ++x, ++n) {
+                                    tileRays[size_t(row - y0) * tile + size_t(x - x0)] = pr[n];
                                     Tracer::FirstHit& fh = tileHits[size_t(row - y0) * tile + size_t(x - x0)];
                                     fh.found = (found >> n) & 1;
                                     if (fh.found) fh.hit = ph[n];
@@ -586,7 +588,9 @@ protected:
                                     ox = (float(i) + rand01(seed)) / float(sx);
                                     oy = (float(j) + rand01(seed)) / float(sy);
                                 }
-                                rt::Ray r = cam.ray(float(x) + ox, float(wy) + oy);
+                                // (the packet's ray: the same call with ox = oy = 0.5)
+                                const rt::Ray r =
+                                    packets ? tileRays[size_t(row - y0) * tile + size_t(x - x0)] : cam.ray(float(x) + ox, float(wy) + oy);
                                 SurfaceRecord hp;
                                 const PixelFootprint fp{&cam, float(x) + ox, float(wy) + oy};
                                 rt::TraversalCount count;

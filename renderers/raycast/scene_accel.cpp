@@ -4,16 +4,22 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <memory>
 
 namespace rnd::rt {
 
 using namespace sg;
+
+namespace {
+constexpr size_t kPacketMinTriangles = 1024;   // meshes traced as packets by intersectPacket
+}   // namespace
 
 int SceneAccel::update(const FrameInput& f) {
     m_frame = &f;
     ++m_frameCounter;
     int built = 0;
     m_instances.clear();
+    m_anyPacketMesh = false;
     std::vector<vec3> bmin, bmax;
 
     // Mesh BVHs: (id, version) keyed, built in parallel when several are missing.
@@ -51,6 +57,10 @@ int SceneAccel::update(const FrameInput& f) {
         inst.isMesh = true;
         inst.index = i;
         inst.bvh = &it->second.bvh;
+        // Packets pay where a ray's own traversal is more than a few nodes (measured on the demo:
+        // sharing small meshes' traversals costs more than it saves).
+        inst.packets = d.mesh->triangleCount() >= kPacketMinTriangles;
+        m_anyPacketMesh |= inst.packets;
         inst.invWorld = glm::inverse(d.world);
         Aabb wb = it->second.bvh.bounds().transformed(d.world);
         m_instances.push_back(inst);
@@ -202,8 +212,16 @@ uint64_t SceneAccel::intersectPacket(const Ray* rays, int n, uint64_t active, Sc
     n = std::clamp(n, 0, kMaxPacket);
     if (n < kMaxPacket) active &= (uint64_t(1) << n) - 1;
     if (m_tlas.empty() || !active) return 0;
+    uint64_t found = 0;
+    if (!m_anyPacketMesh) {   // no mesh to share: one ray at a time
+        for (uint64_t m = active; m; m &= m - 1) {
+            const int i = __builtin_ctzll(m);
+            if (intersect(rays[i], hits[i], culling)) found |= uint64_t(1) << i;
+        }
+        return found;
+    }
     const std::vector<uint32_t>& prims = m_tlas.primIndex();
-    // Phase 1: the mesh instances whose world boxes the rays reach (each ray's own top-level
+    // Phase 1: the big mesh instances (Instance::packets) whose world boxes the rays reach (each ray's own top-level
     // traversal, not cut short by hits), in the order the rays meet them, and which rays reach
     // each; each is traced once as a packet, every ray limited to the closest mesh hit found so
     // far, and its hits are kept per ray.
@@ -221,7 +239,7 @@ uint64_t SceneAccel::intersectPacket(const Ray* rays, int n, uint64_t active, Sc
         m_tlas.traverse<false>(rays[i], tmax, [&](uint32_t first, uint32_t count, float&) {
             for (uint32_t c = 0; c < count; ++c) {
                 const uint32_t j = prims[first + c];
-                if (!m_instances[j].isMesh) continue;
+                if (!m_instances[j].packets) continue;
                 int s = 0;
                 while (s < k && touched[s].instance != j) ++s;
                 if (s == k) {
@@ -236,7 +254,6 @@ uint64_t SceneAccel::intersectPacket(const Ray* rays, int n, uint64_t active, Sc
             return false;
         });
     }
-    uint64_t found = 0;
     if (overflow) {   // too many meshes under one packet: one ray at a time
         for (uint64_t m = active; m; m &= m - 1) {
             const int i = __builtin_ctzll(m);
@@ -244,7 +261,10 @@ uint64_t SceneAccel::intersectPacket(const Ray* rays, int n, uint64_t active, Sc
         }
         return found;
     }
-    TriHit meshHits[kMaxMeshes][kMaxPacket];
+    // Hits per touched mesh and ray, read only where found (constructed only for the k used).
+    alignas(TriHit) unsigned char hitBytes[sizeof(TriHit) * kMaxMeshes * kMaxPacket];
+    TriHit* const meshHits = reinterpret_cast<TriHit*>(hitBytes);
+    std::uninitialized_default_construct_n(meshHits, size_t(k) * kMaxPacket);
     float bound[kMaxPacket];
     for (int i = 0; i < n; ++i) bound[i] = rays[i].tmax;
     for (int s = 0; s < k; ++s) {
@@ -258,10 +278,10 @@ uint64_t SceneAccel::intersectPacket(const Ray* rays, int n, uint64_t active, Sc
             lr[i].tmax = bound[i];
         }
         const bool cull = sg::cullsBackFaces(culling, m_frame->meshes[inst.index].material.doubleSided);
-        touched[s].found = inst.bvh->intersectPacket(lr, n, touched[s].rays, meshHits[s], cull);
+        touched[s].found = inst.bvh->intersectPacket(lr, n, touched[s].rays, meshHits + s * kMaxPacket, cull);
         for (uint64_t m = touched[s].found; m; m &= m - 1) {
             const int i = __builtin_ctzll(m);
-            bound[i] = std::min(bound[i], meshHits[s][i].t);
+            bound[i] = std::min(bound[i], meshHits[s * kMaxPacket + i].t);
         }
     }
     // Phase 2: each ray's closestHit, with a mesh instance's hit looked up instead of traced. The
@@ -278,11 +298,11 @@ uint64_t SceneAccel::intersectPacket(const Ray* rays, int n, uint64_t active, Sc
                 const uint32_t j = prims[first + c];
                 const Instance& inst = m_instances[j];
                 SceneHit h;
-                if (inst.isMesh) {
-                    int s = 0;
-                    while (s < k && touched[s].instance != j) ++s;
-                    if (s == k || !((touched[s].found >> i) & 1)) continue;
-                    const TriHit& th = meshHits[s][i];
+                int s = 0;
+                while (s < k && touched[s].instance != j) ++s;
+                if (s < k && ((touched[s].rays >> i) & 1)) {   // a mesh this ray was traced through in phase 1
+                    if (!((touched[s].found >> i) & 1)) continue;
+                    const TriHit& th = meshHits[s * kMaxPacket + i];
                     if (!(th.t < tm)) continue;
                     h.kind = SceneHit::Kind::Mesh;
                     h.t = th.t;
@@ -290,8 +310,9 @@ uint64_t SceneAccel::intersectPacket(const Ray* rays, int n, uint64_t active, Sc
                     h.prim = th.prim;
                     h.b1 = th.b1;
                     h.b2 = th.b2;
-                } else if (!intersectInstance(inst, r, tm, h)) {
-                    continue;
+                } else {   // as closestHit
+                    const bool cull = inst.isMesh && sg::cullsBackFaces(culling, m_frame->meshes[inst.index].material.doubleSided);
+                    if (!intersectInstance(inst, r, tm, h, cull)) continue;
                 }
                 if (h.t < tm) {
                     tm = h.t;

@@ -73,6 +73,7 @@ private:
         bool isMesh = true;
         uint32_t index = 0;   // into frame meshes / analytics
         const TriangleBvh* bvh = nullptr;
+        bool packets = false;   // a mesh big enough to trace as packets (intersectPacket)
         const ParametricAccel* param = nullptr;
         const GridAccel* grid = nullptr;
         sg::mat4 invWorld{1.0f};
@@ -88,6 +89,7 @@ private:
     std::unordered_map<uint64_t, MeshEntry> m_meshes;          // by Mesh::id
     std::unordered_map<uint64_t, AnalyticEntry> m_analytics;   // by geometryKey
     std::vector<Instance> m_instances;
+    bool m_anyPacketMesh = false;   // some instance has packets set
     Bvh4 m_tlas;
     uint64_t m_frameCounter = 0;
     uint64_t m_buildsTotal = 0;

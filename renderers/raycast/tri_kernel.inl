@@ -314,10 +314,11 @@ inline const char* planeBase(const char* nodeBytes, int k) { return nodeBytes + 
 inline __m256 loadPlane(const char* base, uint32_t ref) { return _mm256_load_ps(reinterpret_cast<const float*>(base + ref)); }
 
 // The same traversal over 8-wide nodes: one AVX compare per node for 8 boxes (BVH8: fewer,
-// wider levels); leaf packets tested two at a time (8 lanes).
+// wider levels); leaf packets tested two at a time (8 lanes). start: the node to begin at (byte
+// offset; tracePacket8 continues a ray alone in a subtree).
 template <bool AnyHit, bool Count = false>
 inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const uint32_t* prims, const float* absMax, const Ray& ray, TriHit* hit,
-                            bool cullBack, TraversalCount* count = nullptr) {
+                            bool cullBack, TraversalCount* count = nullptr, uint32_t start = 0) {
     const RayPre pre(ray, absMax);
     const __m256 rx = _mm256_set1_ps(pre.rdir[0]), ry = _mm256_set1_ps(pre.rdir[1]), rz = _mm256_set1_ps(pre.rdir[2]);
     const __m256 orx = _mm256_set1_ps(pre.orgRdirNear[0]), ory = _mm256_set1_ps(pre.orgRdirNear[1]), orz = _mm256_set1_ps(pre.orgRdirNear[2]);
@@ -348,7 +349,7 @@ inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const
 
     StackEntry stack[512];
     int sp = 0;
-    uint32_t cur = 0;
+    uint32_t cur = start;   // the root, or a subtree's node (packets hand single rays over there)
     for (;;) {
         if (!(cur & Node8::kLeafBit)) {
             if constexpr (Count) ++count->nodes;
@@ -599,7 +600,40 @@ inline uint64_t tracePacket8(const Node8* nodes, const TriPacket4* packets, cons
     int sp = 0;
     uint32_t cur = 0, curParent = 0, curSlot = 0;
     for (;;) {
-        if (!(cur & Node8::kLeafBit)) {
+        bool enter = true;
+        if (!(cur & Node8::kLeafBit) && cur != 0) {
+            // The rays that enter this node (their own box tests, current tmax): none left skips
+            // it, a single one goes on alone (traceTriangles8 from here: the packet's interval
+            // test has nothing left to share).
+            uint64_t am = 0;
+            const Node8& parent = *reinterpret_cast<const Node8*>(nodeBytes + curParent);
+            for (unsigned gm = groups; gm; gm &= gm - 1) {
+                const int g = __builtin_ctz(gm);
+                am |= uint64_t(leafRayMask(parent, curSlot, nx, ny, nz, pr, g)) << (8 * g);
+            }
+            am &= pm;
+            if (__builtin_popcountll(am) <= 1) {
+                enter = false;
+                if (am) {
+                    const int i = __builtin_ctzll(am);
+                    Ray r = rays[i];
+                    r.tmax = pr.tmax[i];
+                    if (traceTriangles8<AnyHit>(nodes, packets, prims, absMax, r, AnyHit ? nullptr : &hits[i], cullBack, nullptr, cur)) {
+                        found |= uint64_t(1) << i;
+                        if constexpr (AnyHit) {
+                            pm &= ~(uint64_t(1) << i);
+                            if (!pm) return found;
+                        } else {
+                            pr.tmax[i] = hits[i].t;
+                            tmaxP = packetTmax(pr, groups);
+                            tmax8 = _mm256_set1_ps(tmaxP);
+                        }
+                    }
+                }
+            }
+        }
+        if (!enter) {
+        } else if (!(cur & Node8::kLeafBit)) {
             const Node8& nd = *reinterpret_cast<const Node8*>(nodeBytes + cur);
             const __m256 t0x = packetLower(loadPlane(pnx, cur), rlx, rhx, onx), t1x = packetUpper(loadPlane(pfx, cur), rlx, rhx, ofx);
             const __m256 t0y = packetLower(loadPlane(pny, cur), rly, rhy, ony), t1y = packetUpper(loadPlane(pfy, cur), rly, rhy, ofy);
