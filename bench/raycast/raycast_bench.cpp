@@ -9,7 +9,7 @@
 //   valgrind --tool=callgrind --toggle-collect='rnd::rt::TriangleBvh::build*'), --pairs N (ours/Embree
 //   alternations per ray measure), --leaf-packets N / --trav-cost X (our build options, for
 //   trying other trees; default TriangleBvh::defaultOptions()), --tile WxH (pixels per packet
-//   in the packet measures, default 8x8, at most 64)
+//   in the packet measures, default 4x4, at most 64)
 //
 // Prints one line per scene and measure:
 //   bench: scene=<name> what=<metric> ours=<x> ref=<y> ratio=<ours/ref>
@@ -328,7 +328,7 @@ struct BuildTimes {
 };
 // Our build options: TriangleBvh::defaultOptions() unless --leaf-packets / --trav-cost say otherwise.
 rnd::rt::Bvh4::BuildOptions g_options = TriangleBvh::defaultOptions();
-int g_tileW = 8, g_tileH = 8;   // --tile WxH: pixels per packet (at most 64)
+int g_tileW = 4, g_tileH = 4;   // --tile WxH: pixels per packet (at most 64)
 int g_pairs = 0;                // --pairs: ours/Embree alternations per ray measure (0: 3 quick, 5 full)
 // --against LEAF,COST: the throughput reference is our own traversal on a second tree built
 // with these maxLeafBlocks / traversalCost, alternated with the first in one process (tree

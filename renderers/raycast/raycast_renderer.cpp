@@ -538,7 +538,7 @@ protected:
             return !(e && e[0] == '0');
         }();
         const bool packets = packetsOn && sx * sy == 1 && !countCost;
-        constexpr int kPacket = 8;   // pixels per packet side
+        constexpr int kPacket = 4;   // pixels per packet side (4x4: the benchmark's best, docs/benchmarks.md)
         static_assert(kPacket * kPacket <= rt::kMaxPacket);
 
         tbb::parallel_for(tbb::blocked_range<int>(0, ntiles, 1), [&](const tbb::blocked_range<int>& range) {
