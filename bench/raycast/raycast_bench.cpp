@@ -580,7 +580,8 @@ void runScene(const Scene& s, bool quick, const std::string& rayClass) {
             bvh.intersect(tiled[i], a);
             e1.intersect(tiled[i], b);
             okE += sameHit(ph[i], b);
-            const bool same = ph[i].valid() == a.valid() && (!a.valid() || (ph[i].t == a.t && ph[i].prim == a.prim && ph[i].b1 == a.b1 && ph[i].b2 == a.b2));
+            const bool same =
+                ph[i].valid() == a.valid() && (!a.valid() || (ph[i].t == a.t && ph[i].prim == a.prim && ph[i].b1 == a.b1 && ph[i].b2 == a.b2));
             okS += same;
             // An exact tie (two triangles at the same t, e.g. a ray through a shared edge): either may be kept.
             ties += !same && ph[i].valid() && a.valid() && ph[i].t == a.t;

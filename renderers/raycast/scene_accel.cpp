@@ -233,13 +233,17 @@ uint64_t SceneAccel::intersectPacket(const Ray* rays, int n, uint64_t active, Sc
     Touched touched[kMaxMeshes];
     int k = 0;
     bool overflow = false;
+    uint64_t others = 0;   // rays that reach an instance not traced as a packet (phase 2 needs their traversal)
     for (uint64_t m = active; m && !overflow; m &= m - 1) {
         const int i = __builtin_ctzll(m);
         float tmax = rays[i].tmax;
         m_tlas.traverse<false>(rays[i], tmax, [&](uint32_t first, uint32_t count, float&) {
             for (uint32_t c = 0; c < count; ++c) {
                 const uint32_t j = prims[first + c];
-                if (!m_instances[j].packets) continue;
+                if (!m_instances[j].packets) {
+                    others |= uint64_t(1) << i;
+                    continue;
+                }
                 int s = 0;
                 while (s < k && touched[s].instance != j) ++s;
                 if (s == k) {
@@ -288,7 +292,26 @@ uint64_t SceneAccel::intersectPacket(const Ray* rays, int n, uint64_t active, Sc
     // kept hit is the instance's closest below the bound it was traced with; closestHit asks for
     // its closest below tm, the closest hit so far. Where tm exceeds that bound, a mesh hit
     // at or below the bound is still to come, so a hit in between would not be kept either.
-    for (uint64_t m = active; m; m &= m - 1) {
+    // Rays that reach packet meshes only: their closest hit is the closest kept one (the first
+    // found of equal ones, as closestHit keeps the first it visits).
+    for (uint64_t m = active & ~others; m; m &= m - 1) {
+        const int i = __builtin_ctzll(m);
+        int best = -1;
+        for (int s = 0; s < k; ++s)
+            if (((touched[s].found >> i) & 1) && (best < 0 || meshHits[s * kMaxPacket + i].t < meshHits[best * kMaxPacket + i].t)) best = s;
+        if (best < 0) continue;
+        const TriHit& th = meshHits[best * kMaxPacket + i];
+        SceneHit& h = hits[i];
+        h = SceneHit{};
+        h.kind = SceneHit::Kind::Mesh;
+        h.t = th.t;
+        h.instance = m_instances[touched[best].instance].index;
+        h.prim = th.prim;
+        h.b1 = th.b1;
+        h.b2 = th.b2;
+        found |= uint64_t(1) << i;
+    }
+    for (uint64_t m = active & others; m; m &= m - 1) {
         const int i = __builtin_ctzll(m);
         const Ray& r = rays[i];
         float tmax = r.tmax;

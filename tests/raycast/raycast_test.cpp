@@ -754,6 +754,71 @@ TEST(RaycastTest, TransformEditDoesNotRebuildMeshBvh) {
     EXPECT_EQ(acc.update(f), 1);   // new version: rebuilt
 }
 
+// SceneAccel::intersectPacket: for every ray exactly SceneAccel::intersect's hit, with big meshes
+// traced as packets (one mirrored, one single-sided under culling), a small mesh and an analytic
+// sphere traced one ray at a time, and packets that reach only the big meshes.
+TEST(RaycastTest, SceneAccelPacketsEqualSingleRays) {
+    FrameInput f = triangleScene(64, 64);
+    DrawMesh big;
+    big.mesh = std::make_shared<Mesh>(primitives::uvSphere(0.8f, 64, 32));
+    big.world = glm::translate(mat4(1.0f), vec3(-1.5f, 0.8f, 0.5f));
+    big.normal = normalMatrix(big.world);
+    f.meshes.push_back(big);
+    DrawMesh mirrored = big;
+    mirrored.world = glm::scale(glm::translate(mat4(1.0f), vec3(1.6f, 0.9f, -0.4f)), vec3(-1.0f, 1.0f, 1.2f));
+    mirrored.normal = normalMatrix(mirrored.world);
+    mirrored.mirrored = true;
+    mirrored.material.doubleSided = false;
+    f.meshes.push_back(mirrored);
+    DrawAnalytic s;
+    s.kind = DrawAnalytic::Kind::Implicit;
+    s.implicit.type = ImplicitType::Sphere;
+    s.implicit.radius = 0.4f;
+    s.world = glm::translate(mat4(1.0f), vec3(0.3f, 1.2f, 1.5f));
+    s.invWorld = glm::inverse(s.world);
+    s.normal = normalMatrix(s.world);
+    s.worldBounds = s.implicit.localBounds().transformed(s.world);
+    f.analytics.push_back(s);
+    for (const CullMode culling : {CullMode::Off, CullMode::On, CullMode::Auto}) {
+        SceneAccel acc;
+        acc.update(f);
+        const CameraRays cam(f.camera, 96, 96);
+        int hits = 0, ties = 0;
+        for (int ty = 0; ty < 96; ty += 4)
+            for (int tx = 0; tx < 96; tx += 8) {
+                Ray rays[32];
+                int n = 0;
+                for (int y = ty; y < ty + 4; ++y)
+                    for (int x = tx; x < tx + 8; ++x) rays[n++] = cam.ray(float(x) + 0.5f, float(y) + 0.5f);
+                const uint64_t active = (tx / 8 + ty / 4) % 3 ? ~uint64_t(0) : 0xF0F0F0F0F0ull;   // some inactive lanes
+                SceneHit ph[32];
+                const uint64_t found = acc.intersectPacket(rays, n, active, ph, culling);
+                for (int i = 0; i < n; ++i) {
+                    SceneHit a;
+                    const bool ha = acc.intersect(rays[i], a, culling);
+                    const bool on = (active >> i) & 1;
+                    ASSERT_EQ(bool((found >> i) & 1), on && ha) << "ray " << i << " tile " << tx << "," << ty;
+                    if (!on || !ha) {
+                        EXPECT_EQ(ph[i].kind, SceneHit::Kind::None);
+                        continue;
+                    }
+                    ++hits;
+                    EXPECT_EQ(ph[i].t, a.t);
+                    EXPECT_EQ(ph[i].kind, a.kind);
+                    if (ph[i].instance != a.instance || ph[i].prim != a.prim) {   // exact ties may keep either
+                        ++ties;
+                        continue;
+                    }
+                    EXPECT_EQ(ph[i].b1, a.b1);
+                    EXPECT_EQ(ph[i].b2, a.b2);
+                    expectVec(ph[i].normal, a.normal, 0.0f);
+                }
+            }
+        EXPECT_GT(hits, 3000);
+        EXPECT_LE(ties, 3);
+    }
+}
+
 TEST(RaycastTest, AntiAliasingAndShadingModelsRun) {
     const int w = 64, h = 48;
     FrameInput f = triangleScene(w, h);
