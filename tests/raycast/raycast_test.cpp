@@ -754,13 +754,13 @@ TEST(RaycastTest, TransformEditDoesNotRebuildMeshBvh) {
     EXPECT_EQ(acc.update(f), 1);   // new version: rebuilt
 }
 
-// SceneAccel::intersectPacket: for every ray exactly SceneAccel::intersect's hit, with big meshes
+// SceneAccel::intersectPacket: for every ray exactly SceneAccel::intersect's hit, with big meshes (16k triangles)
 // traced as packets (one mirrored, one single-sided under culling), a small mesh and an analytic
 // sphere traced one ray at a time, and packets that reach only the big meshes.
 TEST(RaycastTest, SceneAccelPacketsEqualSingleRays) {
     FrameInput f = triangleScene(64, 64);
     DrawMesh big;
-    big.mesh = std::make_shared<Mesh>(primitives::uvSphere(0.8f, 64, 32));
+    big.mesh = std::make_shared<Mesh>(primitives::uvSphere(0.8f, 128, 64));
     big.world = glm::translate(mat4(1.0f), vec3(-1.5f, 0.8f, 0.5f));
     big.normal = normalMatrix(big.world);
     f.meshes.push_back(big);
@@ -784,12 +784,18 @@ TEST(RaycastTest, SceneAccelPacketsEqualSingleRays) {
         acc.update(f);
         const CameraRays cam(f.camera, 96, 96);
         int hits = 0, ties = 0;
-        for (int ty = 0; ty < 96; ty += 4)
+        for (int ty = 0; ty < 96 + 16; ty += 4)
             for (int tx = 0; tx < 96; tx += 8) {
                 Ray rays[32];
                 int n = 0;
                 for (int y = ty; y < ty + 4; ++y)
-                    for (int x = tx; x < tx + 8; ++x) rays[n++] = cam.ray(float(x) + 0.5f, float(y) + 0.5f);
+                    for (int x = tx; x < tx + 8; ++x) {
+                        if (ty < 96) {
+                            rays[n++] = cam.ray(float(x) + 0.5f, float(y) + 0.5f);
+                        } else {   // level rays from the side at the big sphere: they reach no other instance
+                            rays[n++] = mkRay(vec3(-5.0f, 0.2f + 0.1f * float(y - 96), -0.5f + 0.03f * float(x)), vec3(1.0f, 0.01f, 0.0f));
+                        }
+                    }
                 const uint64_t active = (tx / 8 + ty / 4) % 3 ? ~uint64_t(0) : 0xF0F0F0F0F0ull;   // some inactive lanes
                 SceneHit ph[32];
                 const uint64_t found = acc.intersectPacket(rays, n, active, ph, culling);
