@@ -8,7 +8,8 @@
 //   builds, ours and Embree alternating --reps N times, medians; also for profilers, e.g.
 //   valgrind --tool=callgrind --toggle-collect='rnd::rt::TriangleBvh::build*'), --pairs N (ours/Embree
 //   alternations per ray measure), --leaf-packets N / --trav-cost X (our build options, for
-//   trying other trees; default TriangleBvh::defaultOptions())
+//   trying other trees; default TriangleBvh::defaultOptions()), --tile WxH (pixels per packet
+//   in the packet measures, default 4x4, at most 64)
 //
 // Prints one line per scene and measure:
 //   bench: scene=<name> what=<metric> ours=<x> ref=<y> ratio=<ours/ref>
@@ -24,6 +25,10 @@
 // alternating runs; 1-thread builds run inside a 1-thread TBB arena (see measureBuilds: before
 // that, Embree's threads=1 build borrowed idle TBB workers and was timed on one thread while
 // using two). BENCH_DEBUG=1 prints each 1-thread build's thread CPU, wall and process CPU time.
+// Packet measures (primary_packet_*, shadow_packet_*): the same camera rays ordered by pixel
+// tiles (--tile), each tile one TriangleBvh::intersectPacket, against rtcIntersect1 on the same
+// rays in the same order; shadow rays of a tile's hits one occludedPacket against
+// rtcOccluded1; agreement_*_packet_vs_single_pct: packet results identical to our single rays.
 // Ray classes: primary = 1280x720 pinhole camera rays; shadow = from each primary hit toward a
 // point light; incoherent = from each primary hit in a random cosine-weighted hemisphere
 // direction about the geometric normal.
@@ -240,7 +245,8 @@ double threadCpuSeconds() {
 // Runs fn(i) for i in [0, n) on `threads` threads, repeated until minSeconds; returns Mrays/s.
 // One thread: timed by the thread's CPU clock (this machine is shared, so wall time includes
 // other people's work); two threads: wall time.
-double measure(size_t n, int threads, double minSeconds, const std::function<void(size_t, size_t)>& fn) {
+// grain: items per task on two threads (packets: fewer, bigger items).
+double measure(size_t n, int threads, double minSeconds, const std::function<void(size_t, size_t)>& fn, size_t grain = 1024) {
     tbb::task_arena arena(threads);
     size_t total = 0;
     if (threads == 1) {
@@ -258,7 +264,7 @@ double measure(size_t n, int threads, double minSeconds, const std::function<voi
     do {
         {
             arena.execute([&] {
-                tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1024), [&](const tbb::blocked_range<size_t>& r) {
+                tbb::parallel_for(tbb::blocked_range<size_t>(0, n, grain), [&](const tbb::blocked_range<size_t>& r) {
                     setFtzDaz();
                     fn(r.begin(), r.end());
                 });
@@ -285,11 +291,11 @@ struct PairResult {
     double ours, ref, ratio;
 };
 PairResult measurePair(size_t n, int threads, double minSeconds, int reps, const std::function<void(size_t, size_t)>& ours,
-                       const std::function<void(size_t, size_t)>& ref) {
+                       const std::function<void(size_t, size_t)>& ref, size_t grain = 1024) {
     std::vector<double> o, r, q;
     for (int i = 0; i < reps; ++i) {
-        o.push_back(measure(n, threads, minSeconds, ours));
-        r.push_back(measure(n, threads, minSeconds, ref));
+        o.push_back(measure(n, threads, minSeconds, ours, grain));
+        r.push_back(measure(n, threads, minSeconds, ref, grain));
         q.push_back(o.back() / r.back());
     }
     return {median(o), median(r), median(q)};
@@ -322,7 +328,8 @@ struct BuildTimes {
 };
 // Our build options: TriangleBvh::defaultOptions() unless --leaf-packets / --trav-cost say otherwise.
 rnd::rt::Bvh4::BuildOptions g_options = TriangleBvh::defaultOptions();
-int g_pairs = 0;   // --pairs: ours/Embree alternations per ray measure (0: 3 quick, 5 full)
+int g_tileW = 4, g_tileH = 4;   // --tile WxH: pixels per packet (at most 64)
+int g_pairs = 0;                // --pairs: ours/Embree alternations per ray measure (0: 3 quick, 5 full)
 // --against LEAF,COST: the throughput reference is our own traversal on a second tree built
 // with these maxLeafBlocks / traversalCost, alternated with the first in one process (tree
 // tuning: differences of 1-2% that separate runs against Embree cannot resolve).
@@ -523,6 +530,117 @@ void runScene(const Scene& s, bool quick, const std::string& rayClass) {
             line(s.name, std::string(c.name) + "_" + std::to_string(threads) + "t_Mrays/s", m.ours, m.ref, m.ratio);
         }
     }
+    if (g_againstTree || rayClass == "incoherent") return;
+
+    // --- packets: the same camera rays in pixel tiles of g_tileW x g_tileH, each tile one packet
+    // (TriangleBvh::intersectPacket) against Embree's rtcIntersect1 on the same rays in the same
+    // order; shadow rays of a tile's hits (to the one point light) one packet
+    // (occludedPacket) against rtcOccluded1.
+    std::vector<Ray> tiled;
+    std::vector<std::pair<uint32_t, uint32_t>> primaryPk, shadowPk;   // (first ray, count)
+    std::vector<Ray> shadowT;
+    for (int ty = 0; ty < H; ty += g_tileH)
+        for (int tx = 0; tx < W; tx += g_tileW) {
+            const uint32_t first = uint32_t(tiled.size()), firstS = uint32_t(shadowT.size());
+            for (int y = ty; y < std::min(ty + g_tileH, H); ++y)
+                for (int x = tx; x < std::min(tx + g_tileW, W); ++x) {
+                    const Ray& pr = primary[size_t(y) * W + x];
+                    tiled.push_back(pr);
+                    const TriHit& h = refHits[size_t(y) * W + x];
+                    if (!h.valid()) continue;
+                    // The shadow ray of the single-ray measure above, for this pixel.
+                    vec3 p = pr.org + h.t * pr.dir;
+                    const vec3 &p0 = s.pos[s.idx[3 * h.prim]], &p1 = s.pos[s.idx[3 * h.prim + 1]], &p2 = s.pos[s.idx[3 * h.prim + 2]];
+                    vec3 nrm = glm::normalize(glm::cross(p1 - p0, p2 - p0));
+                    if (glm::dot(nrm, pr.dir) > 0) nrm = -nrm;
+                    float eps = 1e-4f * (1.0f + glm::length(p));
+                    Ray sr;
+                    sr.org = p + eps * nrm;
+                    vec3 toL = s.light - sr.org;
+                    sr.tmax = glm::length(toL);
+                    sr.dir = toL / sr.tmax;
+                    sr.tmax *= 0.9999f;
+                    shadowT.push_back(sr);
+                }
+            primaryPk.push_back({first, uint32_t(tiled.size()) - first});
+            if (shadowT.size() > firstS) shadowPk.push_back({firstS, uint32_t(shadowT.size()) - firstS});
+        }
+    // Agreement: packet vs Embree (as above) and packet vs our single rays (must be 100%).
+    {
+        std::vector<TriHit> ph(tiled.size());
+        std::vector<uint8_t> po(shadowT.size());
+        for (const auto& [b, c] : primaryPk) bvh.intersectPacket(&tiled[b], int(c), ~uint64_t(0), &ph[b]);
+        for (const auto& [b, c] : shadowPk) {
+            const uint64_t m = bvh.occludedPacket(&shadowT[b], int(c), ~uint64_t(0));
+            for (uint32_t i = 0; i < c; ++i) po[b + i] = (m >> i) & 1;
+        }
+        size_t okE = 0, okS = 0, shE = 0, shS = 0, ties = 0;
+        for (size_t i = 0; i < tiled.size(); ++i) {
+            TriHit a, b;
+            bvh.intersect(tiled[i], a);
+            e1.intersect(tiled[i], b);
+            okE += sameHit(ph[i], b);
+            const bool same =
+                ph[i].valid() == a.valid() && (!a.valid() || (ph[i].t == a.t && ph[i].prim == a.prim && ph[i].b1 == a.b1 && ph[i].b2 == a.b2));
+            okS += same;
+            // An exact tie (two triangles at the same t, e.g. a ray through a shared edge): either may be kept.
+            ties += !same && ph[i].valid() && a.valid() && ph[i].t == a.t;
+            if (!same && std::getenv("BENCH_DEBUG"))
+                std::printf("bench: packet differs: ray %zu t %.9g / %.9g prim %u / %u\n", i, double(ph[i].t), double(a.t), ph[i].prim, a.prim);
+        }
+        for (size_t i = 0; i < shadowT.size(); ++i) {
+            shE += bool(po[i]) == e1.occluded(shadowT[i]);
+            shS += bool(po[i]) == bvh.occluded(shadowT[i]);
+        }
+        const double np = double(std::max<size_t>(tiled.size(), 1)), ns = double(std::max<size_t>(shadowT.size(), 1));
+        line(s.name, "agreement_primary_packet_pct", 100.0 * double(okE) / np, 100.0);
+        line(s.name, "agreement_shadow_packet_pct", 100.0 * double(shE) / ns, 100.0);
+        line(s.name, "agreement_primary_packet_vs_single_pct", 100.0 * double(okS) / np, 100.0);
+        std::printf("bench: scene=%s info packet hits differing from single rays: %zu, all exact ties (same t): %s\n", s.name.c_str(),
+                    tiled.size() - okS, ties == tiled.size() - okS ? "yes" : "no");
+        line(s.name, "agreement_shadow_packet_vs_single_pct", 100.0 * double(shS) / ns, 100.0);
+    }
+    std::vector<TriHit> outT(tiled.size());
+    std::vector<uint8_t> occT(shadowT.size());
+    for (int cls = 0; cls < 2; ++cls) {
+        const bool sh = cls == 1;
+        if (!rayClass.empty() && rayClass != (sh ? "shadow" : "primary")) continue;
+        const auto& pk = sh ? shadowPk : primaryPk;
+        const std::vector<Ray>& rays = sh ? shadowT : tiled;
+        const double perPacket = double(rays.size()) / double(std::max<size_t>(pk.size(), 1));
+        for (int threads : {1, 2}) {
+            const Embree& E = threads == 1 ? e1 : e2;
+            if (threads == 2) e2.build(s);
+            PairResult m;
+            if (sh)
+                m = measurePair(
+                    pk.size(), threads, minT, reps,
+                    [&](size_t b, size_t e) {
+                        for (size_t k = b; k < e; ++k) {
+                            const uint64_t o = bvh.occludedPacket(&rays[pk[k].first], int(pk[k].second), ~uint64_t(0));
+                            occT[pk[k].first] = uint8_t(o);
+                        }
+                    },
+                    [&](size_t b, size_t e) {
+                        for (size_t k = b; k < e; ++k)
+                            for (uint32_t i = pk[k].first; i < pk[k].first + pk[k].second; ++i) occT[i] = E.occluded(rays[i]);
+                    },
+                    16);
+            else
+                m = measurePair(
+                    pk.size(), threads, minT, reps,
+                    [&](size_t b, size_t e) {
+                        for (size_t k = b; k < e; ++k) bvh.intersectPacket(&rays[pk[k].first], int(pk[k].second), ~uint64_t(0), &outT[pk[k].first]);
+                    },
+                    [&](size_t b, size_t e) {
+                        for (size_t k = b; k < e; ++k)
+                            for (uint32_t i = pk[k].first; i < pk[k].first + pk[k].second; ++i) E.intersect(rays[i], outT[i]);
+                    },
+                    16);
+            line(s.name, std::string(sh ? "shadow" : "primary") + "_packet_" + std::to_string(threads) + "t_Mrays/s", m.ours * perPacket,
+                 m.ref * perPacket, m.ratio);
+        }
+    }
 }
 
 }   // namespace
@@ -545,7 +663,12 @@ int main(int argc, char** argv) {
             rayClass = argv[++i];
         else if (a == "--reps" && i + 1 < argc)
             reps = std::max(1, std::atoi(argv[++i]));
-        else if (a == "--pairs" && i + 1 < argc)
+        else if (a == "--tile" && i + 1 < argc) {
+            if (std::sscanf(argv[++i], "%dx%d", &g_tileW, &g_tileH) != 2 || g_tileW < 1 || g_tileH < 1 || g_tileW * g_tileH > rnd::rt::kMaxPacket) {
+                std::fprintf(stderr, "bench: --tile wants WxH with W*H <= %d, got '%s'\n", rnd::rt::kMaxPacket, argv[i]);
+                return 2;
+            }
+        } else if (a == "--pairs" && i + 1 < argc)
             g_pairs = std::max(1, std::atoi(argv[++i]));
         else if (a == "--leaf-packets" && i + 1 < argc)
             g_options.maxLeafBlocks = std::clamp(std::atoi(argv[++i]), 1, 7);
@@ -564,7 +687,7 @@ int main(int argc, char** argv) {
         } else {
             std::fprintf(stderr,
                          "usage: %s [--quick] [--scene NAME] [--testdata DIR] [--rays primary|shadow|incoherent] [--build-only [--reps N]] [--pairs "
-                         "N] [--leaf-packets N] [--trav-cost X] [--against LEAF,COST]\n",
+                         "N] [--tile WxH] [--leaf-packets N] [--trav-cost X] [--against LEAF,COST]\n",
                          argv[0]);
             return 2;
         }

@@ -7,7 +7,10 @@
 // Sections: Ray/Hit, Bvh4 (generic: boxes in, leaves of up to 4 primitive indices out),
 // TriangleBvh (Bvh4 + triangle packets, closest hit and any hit).
 //
-// What it is not: no packet/stream tracing, no motion blur, no spatial splits.
+// Coherent rays (camera rays of a pixel tile, shadow rays of neighbouring pixels to one light)
+// can be traced as a packet of up to kMaxPacket rays (TriangleBvh::intersectPacket /
+// occludedPacket), with exactly the single-ray results. What it is not: no motion blur, no
+// spatial splits.
 #pragma once
 
 #include "scenegraph/math.h"
@@ -51,6 +54,9 @@ struct HugePageAllocator {
 };
 template <class T>
 using HugeVector = std::vector<T, HugePageAllocator<T>>;
+
+// Most rays in one packet (TriangleBvh::intersectPacket / occludedPacket).
+inline constexpr int kMaxPacket = 64;
 
 // A ray segment org + t*dir, t in [tmin, tmax]. dir need not be unit length. TriangleBvh
 // treats a negative (or NaN) tmin as 0: its box test relies on tmin >= 0 (see traceTriangles8).
@@ -194,6 +200,15 @@ public:
     bool intersect(const Ray& ray, TriHit& hit, bool cullBack = false, TraversalCount* count = nullptr) const;
     // Any hit in (ray.tmin, ray.tmax).
     bool occluded(const Ray& ray) const;
+    // Packets: rays[0, n) (n <= kMaxPacket), those with bit i of `active` set. For each such ray
+    // exactly what intersect(rays[i], hits[i], cullBack) / occluded(rays[i]) gives; returns the
+    // mask of rays that hit (hits[i] is written only for them). Pays off for coherent rays whose
+    // directions share their signs (a ray with other signs is traced on its own): the packet
+    // shares inner-node tests and each ray is tested alone only at the leaves its packet reaches
+    // (BVH8 with AVX2; otherwise one ray at a time). The closest hit is the same; only between
+    // triangles at exactly the same distance can the one kept differ (the first found is kept).
+    uint64_t intersectPacket(const Ray* rays, int n, uint64_t active, TriHit* hits, bool cullBack = false) const;
+    uint64_t occludedPacket(const Ray* rays, int n, uint64_t active) const;
 
     bool empty() const { return m_packets.empty(); }
     const sg::Aabb& bounds() const { return m_bounds; }

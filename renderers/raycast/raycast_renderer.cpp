@@ -30,6 +30,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cstdlib>
 
 namespace rnd {
 
@@ -139,6 +140,13 @@ struct Tracer {
     // The cost view (RenderConfig::traversalCost): the BVH work of the primary ray (bounce 0,
     // every layer it passes through; not shadow or reflection rays) is added here when set.
     rt::TraversalCount* cost = nullptr;
+    // The primary ray's first hit when it was already traced (a tile's camera rays go through
+    // SceneAccel::intersectPacket): used once, by the next firstSurface call, instead of tracing.
+    struct FirstHit {
+        bool found = false;
+        rt::SceneHit hit;
+    };
+    const FirstHit* firstHit = nullptr;
 
     // Surfaces one ray may pass through (cut-outs, blended layers) before it counts as stopped.
     static constexpr int kMaxLayers = 64;
@@ -235,7 +243,14 @@ struct Tracer {
     // count: where the traversal cost is added (primary rays of the cost view), or null.
     bool firstSurface(rt::Ray& r, rt::SceneHit& h, float& alpha, int& layer, const PixelFootprint* footprint, rt::TraversalCount* count = nullptr) {
         for (;;) {
-            if (!accel.intersect(r, h, f.settings.culling, count)) return false;
+            if (firstHit) {
+                const FirstHit* pre = firstHit;
+                firstHit = nullptr;
+                if (!pre->found) return false;
+                h = pre->hit;
+            } else if (!accel.intersect(r, h, f.settings.culling, count)) {
+                return false;
+            }
             const Material& m = materialOf(h);
             if (m.alphaMode == AlphaMode::Opaque) return true;
             alpha = std::clamp(surfaceAlpha(h, footprint, m), 0.0f, 1.0f);
@@ -524,7 +539,19 @@ protected:
         std::atomic<bool> cancelled{false};
         if (control) control->progress = 0.0f;
 
+        // Camera rays in packets where each pixel has one (the cost view counts rays one by one);
+        // VIEWER_RAYCAST_PACKETS=0 traces them one by one (timing comparisons: the same image).
+        static const bool packetsOn = [] {
+            const char* e = std::getenv("VIEWER_RAYCAST_PACKETS");
+            return !(e && e[0] == '0');
+        }();
+        const bool packets = packetsOn && sx * sy == 1 && !countCost;
+        constexpr int kPacket = 4;   // pixels per packet side (4x4: the benchmark's best, docs/benchmarks.md)
+        static_assert(kPacket * kPacket <= rt::kMaxPacket);
+
         tbb::parallel_for(tbb::blocked_range<int>(0, ntiles, 1), [&](const tbb::blocked_range<int>& range) {
+            std::vector<Tracer::FirstHit> tileHits(packets ? size_t(tile) * tile : 0);
+            std::vector<rt::Ray> tileRays(tileHits.size());
             const unsigned old = _mm_getcsr();
             _mm_setcsr(old | 0x8040);   // FTZ | DAZ in this worker
             for (int ti = range.begin(); ti != range.end(); ++ti) {
@@ -535,6 +562,27 @@ protected:
                 Tracer tr{f, m_accel, textures, maps, 0, anyAlpha};
                 const int x0 = (ti % tx) * tile, y0 = (ti / tx) * tile;   // y0: framebuffer row (top-down)
                 const int x1 = std::min(x0 + tile, w), y1 = std::min(y0 + tile, h);
+                // One sample per pixel: the tile's camera rays traced first, kPacket x kPacket
+                // pixels at a time (SceneAccel::intersectPacket: the same hits as one by one).
+                if (packets) {
+                    for (int py = y0; py < y1; py += kPacket)
+                        for (int px = x0; px < x1; px += kPacket) {
+                            rt::Ray pr[kPacket * kPacket];
+                            rt::SceneHit ph[kPacket * kPacket];
+                            int n = 0;
+                            for (int row = py; row < std::min(py + kPacket, y1); ++row)
+                                for (int x = px; x < std::min(px + kPacket, x1); ++x) pr[n++] = cam.ray(float(x) + 0.5f, float(h - 1 - row) + 0.5f);
+                            const uint64_t found = m_accel.intersectPacket(pr, n, ~uint64_t(0), ph, f.settings.culling);
+                            n = 0;
+                            for (int row = py; row < std::min(py + kPacket, y1); ++row)
+                                for (int x = px; x < std::min(px + kPacket, x1); ++x, ++n) {
+                                    tileRays[size_t(row - y0) * tile + size_t(x - x0)] = pr[n];
+                                    Tracer::FirstHit& fh = tileHits[size_t(row - y0) * tile + size_t(x - x0)];
+                                    fh.found = (found >> n) & 1;
+                                    if (fh.found) fh.hit = ph[n];
+                                }
+                        }
+                }
                 for (int row = y0; row < y1; ++row) {
                     const int wy = h - 1 - row;   // GL window y of this row
                     for (int x = x0; x < x1; ++x) {
@@ -548,11 +596,14 @@ protected:
                                     ox = (float(i) + rand01(seed)) / float(sx);
                                     oy = (float(j) + rand01(seed)) / float(sy);
                                 }
-                                rt::Ray r = cam.ray(float(x) + ox, float(wy) + oy);
+                                // (the packet's ray: the same call with ox = oy = 0.5)
+                                const rt::Ray r =
+                                    packets ? tileRays[size_t(row - y0) * tile + size_t(x - x0)] : cam.ray(float(x) + ox, float(wy) + oy);
                                 SurfaceRecord hp;
                                 const PixelFootprint fp{&cam, float(x) + ox, float(wy) + oy};
                                 rt::TraversalCount count;
                                 if (countCost) tr.cost = &count;
+                                if (packets) tr.firstHit = &tileHits[size_t(row - y0) * tile + size_t(x - x0)];
                                 vec3 c = tr.trace(r, f.camera.eye, 0, &hp, &fp);
                                 if (countCost) {   // one centre ray per pixel, like the visibility
                                     target.costNodes[size_t(row) * w + x] = count.nodes;

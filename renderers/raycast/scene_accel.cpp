@@ -3,15 +3,23 @@
 
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
+#include <memory>
+
 namespace rnd::rt {
 
 using namespace sg;
+
+namespace {
+constexpr size_t kPacketMinTriangles = 8192;   // meshes traced as packets by intersectPacket
+}   // namespace
 
 int SceneAccel::update(const FrameInput& f) {
     m_frame = &f;
     ++m_frameCounter;
     int built = 0;
     m_instances.clear();
+    m_anyPacketMesh = false;
     std::vector<vec3> bmin, bmax;
 
     // Mesh BVHs: (id, version) keyed, built in parallel when several are missing.
@@ -49,6 +57,12 @@ int SceneAccel::update(const FrameInput& f) {
         inst.isMesh = true;
         inst.index = i;
         inst.bvh = &it->second.bvh;
+        // Packets pay where a ray's own traversal is more than a few nodes. Measured on the demo
+        // (960x850, medians of 5): with its floor (1152 triangles) and torus (3072) as packets
+        // the frame took 5% longer (541 against 515 ms): finding the instances and tracing them
+        // without the other instances' hits as bounds cost more than sharing saved.
+        inst.packets = d.mesh->triangleCount() >= kPacketMinTriangles;
+        m_anyPacketMesh |= inst.packets;
         inst.invWorld = glm::inverse(d.world);
         Aabb wb = it->second.bvh.bounds().transformed(d.world);
         m_instances.push_back(inst);
@@ -202,6 +216,148 @@ bool SceneAccel::closestHit(const Ray& r, SceneHit& hit, sg::CullMode culling, T
 bool SceneAccel::intersect(const Ray& r, SceneHit& hit, sg::CullMode culling, TraversalCount* cost) const {
     if (m_tlas.empty()) return false;
     return cost ? closestHit<true>(r, hit, culling, cost) : closestHit<false>(r, hit, culling, nullptr);
+}
+
+uint64_t SceneAccel::intersectPacket(const Ray* rays, int n, uint64_t active, SceneHit* hits, sg::CullMode culling) const {
+    n = std::clamp(n, 0, kMaxPacket);
+    if (n < kMaxPacket) active &= (uint64_t(1) << n) - 1;
+    if (m_tlas.empty() || !active) return 0;
+    uint64_t found = 0;
+    if (!m_anyPacketMesh) {   // no mesh to share: one ray at a time
+        for (uint64_t m = active; m; m &= m - 1) {
+            const int i = __builtin_ctzll(m);
+            if (intersect(rays[i], hits[i], culling)) found |= uint64_t(1) << i;
+        }
+        return found;
+    }
+    const std::vector<uint32_t>& prims = m_tlas.primIndex();
+    // Phase 1: the big mesh instances (Instance::packets) whose world boxes the rays reach (each ray's own top-level
+    // traversal, not cut short by hits), in the order the rays meet them, and which rays reach
+    // each; each is traced once as a packet, every ray limited to the closest mesh hit found so
+    // far, and its hits are kept per ray.
+    constexpr int kMaxMeshes = 16;
+    struct Touched {
+        uint32_t instance;
+        uint64_t rays, found;
+    };
+    Touched touched[kMaxMeshes];
+    int k = 0;
+    bool overflow = false;
+    uint64_t others = 0;   // rays that reach an instance not traced as a packet (phase 2 needs their traversal)
+    for (uint64_t m = active; m && !overflow; m &= m - 1) {
+        const int i = __builtin_ctzll(m);
+        float tmax = rays[i].tmax;
+        m_tlas.traverse<false>(rays[i], tmax, [&](uint32_t first, uint32_t count, float&) {
+            for (uint32_t c = 0; c < count; ++c) {
+                const uint32_t j = prims[first + c];
+                if (!m_instances[j].packets) {
+                    others |= uint64_t(1) << i;
+                    continue;
+                }
+                int s = 0;
+                while (s < k && touched[s].instance != j) ++s;
+                if (s == k) {
+                    if (k == kMaxMeshes) {
+                        overflow = true;
+                        return true;
+                    }
+                    touched[k++] = {j, 0, 0};
+                }
+                touched[s].rays |= uint64_t(1) << i;
+            }
+            return false;
+        });
+    }
+    if (overflow) {   // too many meshes under one packet: one ray at a time
+        for (uint64_t m = active; m; m &= m - 1) {
+            const int i = __builtin_ctzll(m);
+            if (intersect(rays[i], hits[i], culling)) found |= uint64_t(1) << i;
+        }
+        return found;
+    }
+    // Hits per touched mesh and ray, read only where found (constructed only for the k used).
+    alignas(TriHit) unsigned char hitBytes[sizeof(TriHit) * kMaxMeshes * kMaxPacket];
+    TriHit* const meshHits = reinterpret_cast<TriHit*>(hitBytes);
+    std::uninitialized_default_construct_n(meshHits, size_t(k) * kMaxPacket);
+    float bound[kMaxPacket];
+    for (int i = 0; i < n; ++i) bound[i] = rays[i].tmax;
+    for (int s = 0; s < k; ++s) {
+        const Instance& inst = m_instances[touched[s].instance];
+        Ray lr[kMaxPacket];
+        for (uint64_t m = touched[s].rays; m; m &= m - 1) {
+            const int i = __builtin_ctzll(m);
+            lr[i].org = vec3(inst.invWorld * vec4(rays[i].org, 1.0f));   // as intersectInstance
+            lr[i].dir = mat3(inst.invWorld) * rays[i].dir;
+            lr[i].tmin = rays[i].tmin;
+            lr[i].tmax = bound[i];
+        }
+        const bool cull = sg::cullsBackFaces(culling, m_frame->meshes[inst.index].material.doubleSided);
+        touched[s].found = inst.bvh->intersectPacket(lr, n, touched[s].rays, meshHits + s * kMaxPacket, cull);
+        for (uint64_t m = touched[s].found; m; m &= m - 1) {
+            const int i = __builtin_ctzll(m);
+            bound[i] = std::min(bound[i], meshHits[s * kMaxPacket + i].t);
+        }
+    }
+    // Phase 2: each ray's closestHit, with a mesh instance's hit looked up instead of traced. The
+    // kept hit is the instance's closest below the bound it was traced with; closestHit asks for
+    // its closest below tm, the closest hit so far. Where tm exceeds that bound, a mesh hit
+    // at or below the bound is still to come, so a hit in between would not be kept either.
+    // Rays that reach packet meshes only: their closest hit is the closest kept one (the first
+    // found of equal ones, as closestHit keeps the first it visits).
+    for (uint64_t m = active & ~others; m; m &= m - 1) {
+        const int i = __builtin_ctzll(m);
+        int best = -1;
+        for (int s = 0; s < k; ++s)
+            if (((touched[s].found >> i) & 1) && (best < 0 || meshHits[s * kMaxPacket + i].t < meshHits[best * kMaxPacket + i].t)) best = s;
+        if (best < 0) continue;
+        const TriHit& th = meshHits[best * kMaxPacket + i];
+        SceneHit& h = hits[i];
+        h = SceneHit{};
+        h.kind = SceneHit::Kind::Mesh;
+        h.t = th.t;
+        h.instance = m_instances[touched[best].instance].index;
+        h.prim = th.prim;
+        h.b1 = th.b1;
+        h.b2 = th.b2;
+        found |= uint64_t(1) << i;
+    }
+    for (uint64_t m = active & others; m; m &= m - 1) {
+        const int i = __builtin_ctzll(m);
+        const Ray& r = rays[i];
+        float tmax = r.tmax;
+        bool any = false;
+        m_tlas.traverse<false>(r, tmax, [&](uint32_t first, uint32_t count, float& tm) {
+            for (uint32_t c = 0; c < count; ++c) {
+                const uint32_t j = prims[first + c];
+                const Instance& inst = m_instances[j];
+                SceneHit h;
+                int s = 0;
+                while (s < k && touched[s].instance != j) ++s;
+                if (s < k && ((touched[s].rays >> i) & 1)) {   // a mesh this ray was traced through in phase 1
+                    if (!((touched[s].found >> i) & 1)) continue;
+                    const TriHit& th = meshHits[s * kMaxPacket + i];
+                    if (!(th.t < tm)) continue;
+                    h.kind = SceneHit::Kind::Mesh;
+                    h.t = th.t;
+                    h.instance = inst.index;
+                    h.prim = th.prim;
+                    h.b1 = th.b1;
+                    h.b2 = th.b2;
+                } else {   // as closestHit
+                    const bool cull = inst.isMesh && sg::cullsBackFaces(culling, m_frame->meshes[inst.index].material.doubleSided);
+                    if (!intersectInstance(inst, r, tm, h, cull)) continue;
+                }
+                if (h.t < tm) {
+                    tm = h.t;
+                    hits[i] = h;
+                    any = true;
+                }
+            }
+            return false;
+        });
+        if (any) found |= uint64_t(1) << i;
+    }
+    return found;
 }
 
 bool SceneAccel::occluded(const Ray& r) const {

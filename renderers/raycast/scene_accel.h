@@ -46,6 +46,12 @@ public:
     bool intersect(const Ray& worldRay, SceneHit& hit, sg::CullMode culling = sg::CullMode::Off, TraversalCount* count = nullptr) const;
     // Any hit in (ray.tmin, ray.tmax).
     bool occluded(const Ray& worldRay) const;
+    // Closest hits of a packet of coherent world rays (camera rays of a pixel tile): rays[0, n)
+    // (n <= kMaxPacket) with bit i of `active` set; for each, exactly what intersect(rays[i],
+    // hits[i], culling) gives. Mesh instances are traced as packets (TriangleBvh::intersectPacket,
+    // the rays in each instance's object space), analytic shapes one ray at a time. Returns the
+    // mask of rays that hit (hits[i] is written only for them).
+    uint64_t intersectPacket(const Ray* worldRays, int n, uint64_t active, SceneHit* hits, sg::CullMode culling = sg::CullMode::Off) const;
 
     size_t cachedMeshes() const { return m_meshes.size(); }
     uint64_t buildsTotal() const { return m_buildsTotal; }
@@ -67,6 +73,7 @@ private:
         bool isMesh = true;
         uint32_t index = 0;   // into frame meshes / analytics
         const TriangleBvh* bvh = nullptr;
+        bool packets = false;   // a mesh big enough to trace as packets (intersectPacket)
         const ParametricAccel* param = nullptr;
         const GridAccel* grid = nullptr;
         sg::mat4 invWorld{1.0f};
@@ -82,6 +89,7 @@ private:
     std::unordered_map<uint64_t, MeshEntry> m_meshes;          // by Mesh::id
     std::unordered_map<uint64_t, AnalyticEntry> m_analytics;   // by geometryKey
     std::vector<Instance> m_instances;
+    bool m_anyPacketMesh = false;   // some instance has packets set
     Bvh4 m_tlas;
     uint64_t m_frameCounter = 0;
     uint64_t m_buildsTotal = 0;

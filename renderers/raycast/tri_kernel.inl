@@ -314,10 +314,11 @@ inline const char* planeBase(const char* nodeBytes, int k) { return nodeBytes + 
 inline __m256 loadPlane(const char* base, uint32_t ref) { return _mm256_load_ps(reinterpret_cast<const float*>(base + ref)); }
 
 // The same traversal over 8-wide nodes: one AVX compare per node for 8 boxes (BVH8: fewer,
-// wider levels); leaf packets tested two at a time (8 lanes).
+// wider levels); leaf packets tested two at a time (8 lanes). start: the node to begin at (byte
+// offset; tracePacket8 continues a ray alone in a subtree).
 template <bool AnyHit, bool Count = false>
 inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const uint32_t* prims, const float* absMax, const Ray& ray, TriHit* hit,
-                            bool cullBack, TraversalCount* count = nullptr) {
+                            bool cullBack, TraversalCount* count = nullptr, uint32_t start = 0) {
     const RayPre pre(ray, absMax);
     const __m256 rx = _mm256_set1_ps(pre.rdir[0]), ry = _mm256_set1_ps(pre.rdir[1]), rz = _mm256_set1_ps(pre.rdir[2]);
     const __m256 orx = _mm256_set1_ps(pre.orgRdirNear[0]), ory = _mm256_set1_ps(pre.orgRdirNear[1]), orz = _mm256_set1_ps(pre.orgRdirNear[2]);
@@ -348,7 +349,7 @@ inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const
 
     StackEntry stack[512];
     int sp = 0;
-    uint32_t cur = 0;
+    uint32_t cur = start;   // the root, or a subtree's node (packets hand single rays over there)
     for (;;) {
         if (!(cur & Node8::kLeafBit)) {
             if constexpr (Count) ++count->nodes;
@@ -413,6 +414,324 @@ inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const
             const StackEntry& e = stack[--sp];
             if (AnyHit || e.t <= tmax) {
                 cur = e.ref;
+                break;
+            }
+        }
+    }
+}
+
+// --- packets of coherent rays (BVH8, AVX2) ----------------------------------------------------
+//
+// Up to kMaxPacket rays whose directions share their signs (camera rays of a pixel tile, shadow
+// rays of neighbouring pixels to one light) traverse the tree together: an inner node tests its
+// 8 child boxes once against the whole packet with interval arithmetic (one box test for all
+// rays, about twice a single ray's work), and only at a leaf is each ray tested on its own: its
+// box test with the ray's current tmax, then the leaf's triangles exactly as traceTriangles8
+// tests them (the same packet-pair kernel, the ray broadcast), so every hit is bit for bit the
+// single-ray hit. Only the order in which leaves are visited can differ from the single ray's,
+// which matters only for exact ties of t between triangles (the first found is kept, as there).
+//
+// Interval test, conservative for every ray of the packet: the slab distance of plane b for ray i
+// is (b - o_i) * rdir_i. With the origins in [olo, ohi] and rdir in [rlo, rhi] per axis (one
+// sign), for rdir > 0 it is at least min((b - ohi) * rlo, (b - ohi) * rhi) and at most
+// max((b - olo) * rlo, (b - olo) * rhi) (mirrored for rdir < 0): a frustum for camera rays (one
+// origin), a swept box for rays from several origins. The origin bounds are widened by
+// d = 2^-19 (max |o| + max |b|) per axis (oNear / oFar below), so the packet's interval contains
+// each ray's own computed interval (RayPre's margin is 2^-20 (|o| + max |b|) |rdir|, the
+// rounding of either computation a few 2^-24 (|b| + |o|) |rdir|): the packet enters at least
+// every box some ray's own test enters.
+
+// A packet's per-ray data, SoA in groups of 8 rays (one AVX register per group). Rays outside
+// the packet get tmax = -1 (a negative integer: their box tests always fail).
+struct PacketRays {
+    alignas(32) float rd[3][kMaxPacket];   // reciprocal directions (RayPre, nudged zeros)
+    alignas(32) float on[3][kMaxPacket];   // orgRdirNear
+    alignas(32) float of[3][kMaxPacket];   // orgRdirFar
+    alignas(32) float tmin[kMaxPacket];    // max(tmin, 0)
+    alignas(32) float tmax[kMaxPacket];    // shrinks as closer hits are found
+};
+
+// Packet stack entry: node or leaf reference, the packet's entry distance, and where its box is
+// (parent node byte offset and child slot: the leaf's per-ray box test reads it from there).
+struct PacketEntry {
+    uint32_t ref;
+    float t;
+    uint32_t parent, slot;
+};
+
+// The interval bounds of a slab distance (b - o) * rdir over rdir in [r0, r1] (see above).
+inline __m256 packetLower(__m256 b, __m256 r0, __m256 r1, __m256 o) {
+    const __m256 x = _mm256_sub_ps(b, o);
+    return _mm256_min_ps(_mm256_mul_ps(x, r0), _mm256_mul_ps(x, r1));
+}
+inline __m256 packetUpper(__m256 b, __m256 r0, __m256 r1, __m256 o) {
+    const __m256 x = _mm256_sub_ps(b, o);
+    return _mm256_max_ps(_mm256_mul_ps(x, r0), _mm256_mul_ps(x, r1));
+}
+inline __m256 bcast(const float* p) { return _mm256_broadcast_ss(p); }
+
+// The leaf's box (slot of parent) against the rays in group g: mask of rays whose own box test
+// (the single-ray test with their current tmax) passes.
+inline unsigned leafRayMask(const Node8& parent, uint32_t slot, int nx, int ny, int nz, const PacketRays& pr, int g) {
+    const int fx = 1 - nx, fy = 5 - ny, fz = 9 - nz;   // ny = 2 + s, fy = 3 - s; nz = 4 + s, fz = 5 - s
+    const int o = 8 * g;
+    const __m256 t0x = _mm256_fmsub_ps(bcast(&parent.b[nx][slot]), _mm256_load_ps(pr.rd[0] + o), _mm256_load_ps(pr.on[0] + o));
+    const __m256 t1x = _mm256_fmsub_ps(bcast(&parent.b[fx][slot]), _mm256_load_ps(pr.rd[0] + o), _mm256_load_ps(pr.of[0] + o));
+    const __m256 t0y = _mm256_fmsub_ps(bcast(&parent.b[ny][slot]), _mm256_load_ps(pr.rd[1] + o), _mm256_load_ps(pr.on[1] + o));
+    const __m256 t1y = _mm256_fmsub_ps(bcast(&parent.b[fy][slot]), _mm256_load_ps(pr.rd[1] + o), _mm256_load_ps(pr.of[1] + o));
+    const __m256 t0z = _mm256_fmsub_ps(bcast(&parent.b[nz][slot]), _mm256_load_ps(pr.rd[2] + o), _mm256_load_ps(pr.on[2] + o));
+    const __m256 t1z = _mm256_fmsub_ps(bcast(&parent.b[fz][slot]), _mm256_load_ps(pr.rd[2] + o), _mm256_load_ps(pr.of[2] + o));
+    const __m256i tn = _mm256_max_epi32(_mm256_max_epi32(_mm256_castps_si256(t0x), _mm256_castps_si256(t0y)),
+                                        _mm256_max_epi32(_mm256_castps_si256(t0z), _mm256_load_si256(reinterpret_cast<const __m256i*>(pr.tmin + o))));
+    const __m256i tf = _mm256_min_epi32(_mm256_min_epi32(_mm256_castps_si256(t1x), _mm256_castps_si256(t1y)),
+                                        _mm256_min_epi32(_mm256_castps_si256(t1z), _mm256_load_si256(reinterpret_cast<const __m256i*>(pr.tmax + o))));
+    return unsigned(_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpgt_epi32(tn, tf)))) ^ 0xFFu;
+}
+
+// Max of pr.tmax over the groups in `groups` (bit g: group g has packet rays).
+inline float packetTmax(const PacketRays& pr, unsigned groups) {
+    __m256 m = _mm256_set1_ps(-std::numeric_limits<float>::infinity());
+    for (unsigned gm = groups; gm; gm &= gm - 1) m = _mm256_max_ps(m, _mm256_load_ps(pr.tmax + 8 * __builtin_ctz(gm)));
+    __m128 h = _mm_max_ps(_mm256_castps256_ps128(m), _mm256_extractf128_ps(m, 1));
+    h = _mm_max_ps(h, _mm_movehl_ps(h, h));
+    h = _mm_max_ss(h, _mm_shuffle_ps(h, h, 1));
+    return _mm_cvtss_f32(h);
+}
+
+// Traces rays[i] for the bits i of `active` (n <= kMaxPacket); hits[i] gets exactly what
+// traceTriangles8 writes for that ray. Rays that do not fit the packet (other direction signs
+// than the first, non-finite data, an empty [tmin, tmax]) are traced one by one. Returns the
+// mask of rays that hit.
+template <bool AnyHit>
+inline uint64_t tracePacket8(const Node8* nodes, const TriPacket4* packets, const uint32_t* prims, const float* absMax, const Ray* rays, int n,
+                             uint64_t active, TriHit* hits, bool cullBack) {
+    if (n < kMaxPacket) active &= (uint64_t(1) << n) - 1;
+    PacketRays pr;
+    uint64_t pm = 0, single = 0, found = 0;
+    int sign = -1;
+    __m128 rlo = _mm_set1_ps(std::numeric_limits<float>::infinity()), rhi = _mm_set1_ps(-std::numeric_limits<float>::infinity());
+    __m128 olo = rlo, ohi = rhi;
+    float tminP = std::numeric_limits<float>::infinity(), tmaxP = -std::numeric_limits<float>::infinity();
+    const int groupsN = (n + 7) / 8;
+    for (int i = 0; i < 8 * groupsN; ++i) {
+        const bool in = (active >> i) & 1;
+        bool fits = false;
+        if (in) {
+            const Ray& r = rays[i];
+            const RayPre pre(r, absMax);
+            const float tmin = r.tmin > 0.0f ? r.tmin : 0.0f;
+            const __m128 rd = _mm_load_ps(pre.rdir), on = _mm_load_ps(pre.orgRdirNear), of = _mm_load_ps(pre.orgRdirFar);
+            // Finite: x - x == 0 (lanes 0-2).
+            const __m128 z = _mm_add_ps(_mm_add_ps(_mm_sub_ps(rd, rd), _mm_sub_ps(on, on)),
+                                        _mm_add_ps(_mm_sub_ps(of, of), _mm_sub_ps(_mm_load_ps(pre.org), _mm_load_ps(pre.org))));
+            const int s = pre.nearX | (pre.nearY << 1) | (pre.nearZ << 2);
+            if ((_mm_movemask_ps(_mm_cmpeq_ps(z, _mm_setzero_ps())) & 7) == 7 && sg::isFinite(r.dir) && r.tmax > tmin && (sign < 0 || s == sign)) {
+                sign = s;
+                fits = true;
+                pm |= uint64_t(1) << i;
+                alignas(16) float a[4], b[4], c[4];
+                _mm_store_ps(a, rd);
+                _mm_store_ps(b, on);
+                _mm_store_ps(c, of);
+                for (int k = 0; k < 3; ++k) {
+                    pr.rd[k][i] = a[k];
+                    pr.on[k][i] = b[k];
+                    pr.of[k][i] = c[k];
+                }
+                pr.tmin[i] = tmin;
+                pr.tmax[i] = r.tmax;
+                rlo = _mm_min_ps(rlo, rd);
+                rhi = _mm_max_ps(rhi, rd);
+                olo = _mm_min_ps(olo, _mm_load_ps(pre.org));
+                ohi = _mm_max_ps(ohi, _mm_load_ps(pre.org));
+                tminP = std::min(tminP, tmin);
+                tmaxP = std::max(tmaxP, r.tmax);
+            } else {
+                single |= uint64_t(1) << i;
+            }
+        }
+        if (!fits) {   // never enters a box
+            for (int k = 0; k < 3; ++k) pr.rd[k][i] = 1.0f, pr.on[k][i] = 0.0f, pr.of[k][i] = 0.0f;
+            pr.tmin[i] = 0.0f;
+            pr.tmax[i] = -1.0f;
+        }
+    }
+    for (uint64_t m = single; m; m &= m - 1) {
+        const int i = __builtin_ctzll(m);
+        if (traceTriangles8<AnyHit>(nodes, packets, prims, absMax, rays[i], AnyHit ? nullptr : &hits[i], cullBack)) found |= uint64_t(1) << i;
+    }
+    if (!pm) return found;
+    if (__builtin_popcountll(pm) == 1) {   // nothing to share
+        const int i = __builtin_ctzll(pm);
+        if (traceTriangles8<AnyHit>(nodes, packets, prims, absMax, rays[i], AnyHit ? nullptr : &hits[i], cullBack)) found |= uint64_t(1) << i;
+        return found;
+    }
+    unsigned groups = 0;
+    for (int g = 0; g < groupsN; ++g)
+        if ((pm >> (8 * g)) & 0xFF) groups |= 1u << g;
+
+    const int nearX = sign & 1, nearY = (sign >> 1) & 1, nearZ = (sign >> 2) & 1;
+    const int nx = nearX, ny = 2 + nearY, nz = 4 + nearZ;
+    const int fx = 1 - nearX, fy = 3 - nearY, fz = 5 - nearZ;
+    alignas(16) float lo[4], hi[4], oL[4], oH[4];
+    _mm_store_ps(lo, rlo);
+    _mm_store_ps(hi, rhi);
+    _mm_store_ps(oL, olo);
+    _mm_store_ps(oH, ohi);
+    float oNear[3], oFar[3];   // widened origin bounds (see above): entry uses oNear, exit oFar
+    for (int k = 0; k < 3; ++k) {
+        const float d = 0x1p-19f * (std::max(std::abs(oL[k]), std::abs(oH[k])) + absMax[k]);
+        const bool neg = (sign >> k) & 1;
+        oNear[k] = neg ? oL[k] - d : oH[k] + d;
+        oFar[k] = neg ? oH[k] + d : oL[k] - d;
+    }
+    const __m256 rlx = _mm256_set1_ps(lo[0]), rly = _mm256_set1_ps(lo[1]), rlz = _mm256_set1_ps(lo[2]);
+    const __m256 rhx = _mm256_set1_ps(hi[0]), rhy = _mm256_set1_ps(hi[1]), rhz = _mm256_set1_ps(hi[2]);
+    const __m256 onx = _mm256_set1_ps(oNear[0]), ony = _mm256_set1_ps(oNear[1]), onz = _mm256_set1_ps(oNear[2]);
+    const __m256 ofx = _mm256_set1_ps(oFar[0]), ofy = _mm256_set1_ps(oFar[1]), ofz = _mm256_set1_ps(oFar[2]);
+    const __m256i tmin8i = _mm256_castps_si256(_mm256_set1_ps(tminP));
+    __m256 tmax8 = _mm256_set1_ps(tmaxP);
+
+    const char* const nodeBytes = reinterpret_cast<const char*>(nodes);
+    const char *pnx = planeBase(nodeBytes, nx), *pfx = planeBase(nodeBytes, fx), *pny = planeBase(nodeBytes, ny);
+    const char *pfy = planeBase(nodeBytes, fy), *pnz = planeBase(nodeBytes, nz), *pfz = planeBase(nodeBytes, fz);
+
+    PacketEntry stack[512];
+    int sp = 0;
+    uint32_t cur = 0, curParent = 0, curSlot = 0;
+    for (;;) {
+        bool enter = true;
+        if (!(cur & Node8::kLeafBit) && cur != 0) {
+            // The rays that enter this node (their own box tests, current tmax): none left skips
+            // it, a single one goes on alone (traceTriangles8 from here: the packet's interval
+            // test has nothing left to share).
+            uint64_t am = 0;
+            const Node8& parent = *reinterpret_cast<const Node8*>(nodeBytes + curParent);
+            for (unsigned gm = groups; gm; gm &= gm - 1) {
+                const int g = __builtin_ctz(gm);
+                am |= uint64_t(leafRayMask(parent, curSlot, nx, ny, nz, pr, g)) << (8 * g);
+            }
+            am &= pm;
+            if (__builtin_popcountll(am) <= 1) {
+                enter = false;
+                if (am) {
+                    const int i = __builtin_ctzll(am);
+                    Ray r = rays[i];
+                    r.tmax = pr.tmax[i];
+                    if (traceTriangles8<AnyHit>(nodes, packets, prims, absMax, r, AnyHit ? nullptr : &hits[i], cullBack, nullptr, cur)) {
+                        found |= uint64_t(1) << i;
+                        if constexpr (AnyHit) {
+                            pm &= ~(uint64_t(1) << i);
+                            if (!pm) return found;
+                        } else {
+                            pr.tmax[i] = hits[i].t;
+                            tmaxP = packetTmax(pr, groups);
+                            tmax8 = _mm256_set1_ps(tmaxP);
+                        }
+                    }
+                }
+            }
+        }
+        if (!enter) {
+        } else if (!(cur & Node8::kLeafBit)) {
+            const Node8& nd = *reinterpret_cast<const Node8*>(nodeBytes + cur);
+            const __m256 t0x = packetLower(loadPlane(pnx, cur), rlx, rhx, onx), t1x = packetUpper(loadPlane(pfx, cur), rlx, rhx, ofx);
+            const __m256 t0y = packetLower(loadPlane(pny, cur), rly, rhy, ony), t1y = packetUpper(loadPlane(pfy, cur), rly, rhy, ofy);
+            const __m256 t0z = packetLower(loadPlane(pnz, cur), rlz, rhz, onz), t1z = packetUpper(loadPlane(pfz, cur), rlz, rhz, ofz);
+            const __m256i tn = _mm256_max_epi32(_mm256_max_epi32(_mm256_castps_si256(t0x), _mm256_castps_si256(t0y)),
+                                                _mm256_max_epi32(_mm256_castps_si256(t0z), tmin8i));
+            const __m256i tf = _mm256_min_epi32(_mm256_min_epi32(_mm256_castps_si256(t1x), _mm256_castps_si256(t1y)),
+                                                _mm256_min_epi32(_mm256_castps_si256(t1z), _mm256_castps_si256(tmax8)));
+            unsigned mask = unsigned(_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpgt_epi32(tn, tf)))) ^ 0xFFu;
+            if (mask != 0) {
+                alignas(32) float dist[8];
+                _mm256_store_si256(reinterpret_cast<__m256i*>(dist), tn);
+                const unsigned c0 = unsigned(__builtin_ctz(mask));
+                mask &= mask - 1;
+                if (mask == 0) {
+                    curParent = cur;
+                    curSlot = c0;
+                    cur = nd.child[c0];
+                    continue;
+                }
+                // Front to back by the packet's entry distance: keys (distance, slot), far first.
+                uint64_t key[8];
+                int k = 0;
+                key[k++] = sortKey(dist[c0], c0);
+                do {
+                    const int c = __builtin_ctz(mask);
+                    mask &= mask - 1;
+                    key[k++] = sortKey(dist[c], uint32_t(c));
+                } while (mask);
+                if (k == 2) {
+                    if (key[0] < key[1]) std::swap(key[0], key[1]);
+                } else {
+                    sortFarFirst(key, k);
+                }
+                for (int i = 0; i < k - 1; ++i) {
+                    const uint32_t s = uint32_t(key[i]);
+                    stack[sp++] = {nd.child[s], keyDistance(key[i]), cur, s};
+                }
+                curParent = cur;
+                curSlot = uint32_t(key[k - 1]);
+                cur = nd.child[curSlot];
+                continue;
+            }
+        } else {
+            const Node8& parent = *reinterpret_cast<const Node8*>(nodeBytes + curParent);
+            const TriPacket4* first = packets + ((cur & ~Node8::kLeafBit) >> 3);
+            const TriPacket4* end = first + (cur & 7u);
+            bool shrunk = false;
+            for (unsigned gm = groups; gm; gm &= gm - 1) {
+                const int g = __builtin_ctz(gm);
+                unsigned rm = leafRayMask(parent, curSlot, nx, ny, nz, pr, g) & unsigned(pm >> (8 * g)) & 0xFFu;
+                while (rm) {
+                    const int i = 8 * g + __builtin_ctz(rm);
+                    rm &= rm - 1;
+                    const Ray& r = rays[i];
+                    const __m256 o8[3] = {_mm256_set1_ps(r.org.x), _mm256_set1_ps(r.org.y), _mm256_set1_ps(r.org.z)};
+                    const __m256 d8[3] = {_mm256_set1_ps(r.dir.x), _mm256_set1_ps(r.dir.y), _mm256_set1_ps(r.dir.z)};
+                    const __m256 rtmin = _mm256_set1_ps(pr.tmin[i]);
+                    __m256 rtmax = _mm256_set1_ps(pr.tmax[i]);
+                    for (const TriPacket4* p = first; p < end; p += 2) {
+                        const bool two = p + 1 < end;
+                        __m256 t, u, v;
+                        const int hm = intersectPacketPair(p[0], p[two ? 1 : 0], o8, d8, rtmin, rtmax, t, u, v, cullBack) & (two ? 0xFF : 0x0F);
+                        if (!hm) continue;
+                        if constexpr (AnyHit) {
+                            found |= uint64_t(1) << i;
+                            pm &= ~(uint64_t(1) << i);
+                            break;
+                        } else {
+                            alignas(32) float ta[8], ua[8], va[8];
+                            _mm256_store_ps(ta, t);
+                            _mm256_store_ps(ua, u);
+                            _mm256_store_ps(va, v);
+                            if (closestLane(hm, ta, ua, va, prims + 4 * (p - packets), pr.tmax[i], &hits[i])) {
+                                found |= uint64_t(1) << i;
+                                shrunk = true;
+                            }
+                            rtmax = _mm256_set1_ps(pr.tmax[i]);
+                        }
+                    }
+                }
+                if constexpr (AnyHit)
+                    if (!((pm >> (8 * g)) & 0xFF)) groups &= ~(1u << g);
+            }
+            if constexpr (AnyHit) {
+                if (!pm) return found;
+            } else if (shrunk) {
+                tmaxP = packetTmax(pr, groups);
+                tmax8 = _mm256_set1_ps(tmaxP);
+            }
+        }
+        for (;;) {
+            if (sp == 0) return found;
+            const PacketEntry& e = stack[--sp];
+            if (AnyHit || e.t <= tmaxP) {
+                cur = e.ref;
+                curParent = e.parent;
+                curSlot = e.slot;
                 break;
             }
         }

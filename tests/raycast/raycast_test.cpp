@@ -481,6 +481,105 @@ TEST(RaycastTest, BvhKeepsGrazingRaysOnFlatFarGeometry) {
     EXPECT_GT(hits, 3000);
 }
 
+// Packets (intersectPacket / occludedPacket) give exactly the single-ray results for every active
+// ray and leave inactive lanes alone: camera-like packets (one origin, zero direction components
+// included), shadow-like packets (many origins, one target), origins inside the boxes, tmin/tmax
+// limits, rays that cannot join the packet (other direction signs, non-finite, empty segment), on
+// BVH8 (or BVH4 with the SSE kernel) and on a tree forced to BVH4.
+TEST(RaycastTest, BvhPacketsEqualSingleRays) {
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> U(-1, 1);
+    std::vector<vec3> pos;
+    std::vector<uint32_t> idx;
+    for (int t = 0; t < 3000; ++t) {
+        const vec3 c(U(rng) * 5, U(rng) * 5, U(rng) * 5);
+        for (int k = 0; k < 3; ++k) {
+            pos.push_back(c + 0.4f * vec3(U(rng), U(rng), U(rng)));
+            idx.push_back(uint32_t(pos.size() - 1));
+        }
+    }
+    // A flat grid with shared edges (rays along its lines meet two triangles at once).
+    const uint32_t g0 = uint32_t(pos.size());
+    for (int j = 0; j <= 16; ++j)
+        for (int i = 0; i <= 16; ++i) pos.push_back(vec3(-4.0f + 0.5f * float(i), -5.5f, -4.0f + 0.5f * float(j)));
+    for (int j = 0; j < 16; ++j)
+        for (int i = 0; i < 16; ++i) {
+            const uint32_t a = g0 + uint32_t(j * 17 + i), b = a + 1, c = a + 17, d = c + 1;
+            idx.insert(idx.end(), {a, c, b, b, c, d});
+        }
+    const size_t count = idx.size() / 3;
+    Bvh4::BuildOptions opts[2] = {TriangleBvh::defaultOptions(), TriangleBvh::defaultOptions()};
+    opts[1].maxWideNodes = 1;   // BVH4: the packet calls fall back to single rays
+    for (const Bvh4::BuildOptions& opt : opts) {
+        TriangleBvh bvh;
+        bvh.build(pos.data(), idx.data(), count, opt);
+        int hits = 0, ties = 0, tested = 0;
+        for (int p = 0; p < 400; ++p) {
+            const int n = p % 5 == 0 ? 1 + int(rng() % kMaxPacket) : (p % 2 ? 16 : kMaxPacket);
+            std::vector<Ray> rays(static_cast<size_t>(n));
+            const int kind = p % 4;   // 0, 1: camera-like; 2: shadow-like; 3: random (incoherent)
+            const vec3 eye(U(rng) * 8, U(rng) * 8, U(rng) * 8 + (p % 3 == 0 ? 0.0f : 12.0f));
+            const vec3 aim(U(rng) * 3, U(rng) * 3, U(rng) * 3), light(U(rng) * 9, 9.0f, U(rng) * 9);
+            for (int i = 0; i < n; ++i) {
+                Ray& r = rays[size_t(i)];
+                if (kind <= 1) {
+                    const vec3 d = aim + 0.05f * float(i % 8) * vec3(1, 0, 0) + 0.05f * float(i / 8) * vec3(0, 1, 0) - eye;
+                    r = mkRay(eye, kind == 1 ? glm::normalize(d) : d);
+                } else if (kind == 2) {
+                    const vec3 o = aim + 0.1f * vec3(float(i % 8), U(rng), float(i / 8));
+                    r = mkRay(o, light - o);
+                    r.tmax = 0.9999f;
+                } else {
+                    const vec3 o(U(rng) * 6, U(rng) * 6, U(rng) * 6);   // often inside boxes
+                    r = mkRay(o, vec3(U(rng), U(rng), U(rng)));
+                }
+                if (i % 9 == 3) r.dir.x = 0.0f;   // degenerate directions: zero components
+                if (i % 13 == 5) r.dir = vec3(0.0f, 0.0f, r.dir.z < 0 ? -1.0f : 1.0f);
+                if (i % 13 == 6) r.dir = vec3(0.0f, -1.0f, 0.0f);   // straight down onto the grid
+                if (i % 7 == 2) r.tmax = std::min(r.tmax, 3.0f + U(rng));
+                if (i % 11 == 4) r.tmin = 1.0f + U(rng);
+                if (i % 17 == 8) r.tmin = -2.0f;
+                if (p % 10 == 7 && i == n / 2) r.dir = -r.dir;   // other signs than the packet
+                if (p % 20 == 9 && i == 1) r.org.x = std::numeric_limits<float>::quiet_NaN();
+                if (p % 20 == 19 && i == 2) r.tmax = 0.5f * r.tmin - 1.0f;   // empty segment
+            }
+            uint64_t active = (uint64_t(rng()) << 32) | rng();
+            if (p % 3 == 0) active = ~uint64_t(0);
+            std::vector<TriHit> ph(static_cast<size_t>(n));
+            for (TriHit& h : ph) h.t = -7.0f;   // inactive lanes and misses: untouched
+            const uint64_t found = bvh.intersectPacket(rays.data(), n, active, ph.data());
+            const uint64_t occ = bvh.occludedPacket(rays.data(), n, active);
+            for (int i = 0; i < n; ++i) {
+                const bool on = (active >> i) & 1;
+                TriHit a;
+                const bool ha = bvh.intersect(rays[size_t(i)], a);
+                const TriHit& b = ph[size_t(i)];
+                if (!on || !ha) {
+                    EXPECT_FALSE((found >> i) & 1) << "packet " << p << " ray " << i;
+                    EXPECT_EQ(b.t, -7.0f) << "packet " << p << " ray " << i;
+                    EXPECT_EQ(b.prim, ~0u);
+                    if (!on) { EXPECT_FALSE((occ >> i) & 1); }
+                    if (on) { EXPECT_EQ(bool((occ >> i) & 1), bvh.occluded(rays[size_t(i)])) << "packet " << p << " ray " << i; }
+                    continue;
+                }
+                ++tested;
+                ++hits;
+                ASSERT_TRUE((found >> i) & 1) << "packet " << p << " ray " << i;
+                EXPECT_EQ(bool((occ >> i) & 1), bvh.occluded(rays[size_t(i)])) << "packet " << p << " ray " << i;
+                EXPECT_EQ(b.t, a.t) << "packet " << p << " ray " << i;
+                if (b.prim != a.prim) {   // exact ties between two triangles may keep either
+                    ++ties;
+                    continue;
+                }
+                EXPECT_EQ(b.b1, a.b1);
+                EXPECT_EQ(b.b2, a.b2);
+            }
+        }
+        EXPECT_GT(hits, 2000);
+        EXPECT_LE(ties, tested / 1000 + 2);
+    }
+}
+
 TEST(RaycastTest, BvhHandlesEmptyAndNonFinite) {
     TriangleBvh bvh;
     bvh.build(nullptr, nullptr, 0);
@@ -722,6 +821,77 @@ TEST(RaycastTest, TransformEditDoesNotRebuildMeshBvh) {
     edited->touch();
     f.meshes[0].mesh = edited;
     EXPECT_EQ(acc.update(f), 1);   // new version: rebuilt
+}
+
+// SceneAccel::intersectPacket: for every ray exactly SceneAccel::intersect's hit, with big meshes (16k triangles)
+// traced as packets (one mirrored, one single-sided under culling), a small mesh and an analytic
+// sphere traced one ray at a time, and packets that reach only the big meshes.
+TEST(RaycastTest, SceneAccelPacketsEqualSingleRays) {
+    FrameInput f = triangleScene(64, 64);
+    DrawMesh big;
+    big.mesh = std::make_shared<Mesh>(primitives::uvSphere(0.8f, 128, 64));
+    big.world = glm::translate(mat4(1.0f), vec3(-1.5f, 0.8f, 0.5f));
+    big.normal = normalMatrix(big.world);
+    f.meshes.push_back(big);
+    DrawMesh mirrored = big;
+    mirrored.world = glm::scale(glm::translate(mat4(1.0f), vec3(1.6f, 0.9f, -0.4f)), vec3(-1.0f, 1.0f, 1.2f));
+    mirrored.normal = normalMatrix(mirrored.world);
+    mirrored.mirrored = true;
+    mirrored.material.doubleSided = false;
+    f.meshes.push_back(mirrored);
+    DrawAnalytic s;
+    s.kind = DrawAnalytic::Kind::Implicit;
+    s.implicit.type = ImplicitType::Sphere;
+    s.implicit.radius = 0.4f;
+    s.world = glm::translate(mat4(1.0f), vec3(0.3f, 1.2f, 1.5f));
+    s.invWorld = glm::inverse(s.world);
+    s.normal = normalMatrix(s.world);
+    s.worldBounds = s.implicit.localBounds().transformed(s.world);
+    f.analytics.push_back(s);
+    for (const CullMode culling : {CullMode::Off, CullMode::On, CullMode::Auto}) {
+        SceneAccel acc;
+        acc.update(f);
+        const CameraRays cam(f.camera, 96, 96);
+        int hits = 0, ties = 0;
+        for (int ty = 0; ty < 96 + 16; ty += 4)
+            for (int tx = 0; tx < 96; tx += 8) {
+                Ray rays[32];
+                int n = 0;
+                for (int y = ty; y < ty + 4; ++y)
+                    for (int x = tx; x < tx + 8; ++x) {
+                        if (ty < 96) {
+                            rays[n++] = cam.ray(float(x) + 0.5f, float(y) + 0.5f);
+                        } else {   // level rays from the side at the big sphere: they reach no other instance
+                            rays[n++] = mkRay(vec3(-5.0f, 0.2f + 0.1f * float(y - 96), -0.5f + 0.03f * float(x)), vec3(1.0f, 0.01f, 0.0f));
+                        }
+                    }
+                const uint64_t active = (tx / 8 + ty / 4) % 3 ? ~uint64_t(0) : 0xF0F0F0F0F0ull;   // some inactive lanes
+                SceneHit ph[32];
+                const uint64_t found = acc.intersectPacket(rays, n, active, ph, culling);
+                for (int i = 0; i < n; ++i) {
+                    SceneHit a;
+                    const bool ha = acc.intersect(rays[i], a, culling);
+                    const bool on = (active >> i) & 1;
+                    ASSERT_EQ(bool((found >> i) & 1), on && ha) << "ray " << i << " tile " << tx << "," << ty;
+                    if (!on || !ha) {
+                        EXPECT_EQ(ph[i].kind, SceneHit::Kind::None);
+                        continue;
+                    }
+                    ++hits;
+                    EXPECT_EQ(ph[i].t, a.t);
+                    EXPECT_EQ(ph[i].kind, a.kind);
+                    if (ph[i].instance != a.instance || ph[i].prim != a.prim) {   // exact ties may keep either
+                        ++ties;
+                        continue;
+                    }
+                    EXPECT_EQ(ph[i].b1, a.b1);
+                    EXPECT_EQ(ph[i].b2, a.b2);
+                    expectVec(ph[i].normal, a.normal, 0.0f);
+                }
+            }
+        EXPECT_GT(hits, 3000);
+        EXPECT_LE(ties, 3);
+    }
 }
 
 TEST(RaycastTest, AntiAliasingAndShadingModelsRun) {
