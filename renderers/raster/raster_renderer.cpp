@@ -227,10 +227,10 @@ void runVertexStage(DrawItem& d, const sg::FrameInput& f, int width, int height,
 
 // One scan-converted triangle (a whole input triangle or a piece of a clipped one).
 struct Tri {
-    // User-provided, so emplace_back() does not zero all 192 bytes before the member
-    // initializers run (it did: 15% of the triangle stage); setup writes every other field.
+    // User-provided, so emplace_back() does not zero the record before the member initializers
+    // run (it did: 15% of the triangle stage); setup writes every other field.
     Tri() {}
-    TriSetup s;
+    TriCoverage s;          // edges (top-left bias folded in) and pixel bbox; 128 bytes in all, not 192
     float zRef, zdx, zdy;   // window z at pixel centre (minX, minY) and per-pixel steps
     // u_k = lambda_k / w_k (screen-linear) at pixel centre (minX, minY) and per-pixel steps;
     // perspective-correct barycentrics are u_k / sum(u).
@@ -239,7 +239,9 @@ struct Tri {
     int32_t clip = -1;   // index into Chunk::clipBary (bary of setup vertices), -1 = none
     bool front = true;
     sg::AlphaMode alpha = sg::AlphaMode::Opaque;   // of its material
+    uint8_t order[3] = {0, 1, 2};                  // TriSetup::order
 };
+static_assert(sizeof(Tri) <= 128, "a Tri is two cache lines");
 
 struct Chunk {
     uint64_t begin = 0, end = 0;   // global triangle range
@@ -266,24 +268,27 @@ struct FrameContext {
     std::vector<Chunk>* chunks = nullptr;
 };
 
-bool finishTri(Tri& t, const float z[3], const float iw[3]) {
+// Stores setup `s` into t (coverage, z and 1/w planes).
+bool finishTri(Tri& t, const TriSetup& s, const float z[3], const float iw[3]) {
+    t.s.set(s);
+    for (int k = 0; k < 3; ++k) t.order[k] = s.order[k];
     float tz[3], tw[3];   // per setup vertex
     for (int k = 0; k < 3; ++k) {
-        tz[k] = z[t.s.order[k]];
-        tw[k] = iw[t.s.order[k]];
+        tz[k] = z[s.order[k]];
+        tw[k] = iw[s.order[k]];
     }
     // z = (e1 z0 + e2 z1 + e0 z2) / area2, e_i linear in the fixed-point sample position.
-    double inv = 1.0 / double(t.s.area2);
-    double ax = (double(t.s.e[1].a) * tz[0] + double(t.s.e[2].a) * tz[1] + double(t.s.e[0].a) * tz[2]) * inv;
-    double ay = (double(t.s.e[1].b) * tz[0] + double(t.s.e[2].b) * tz[1] + double(t.s.e[0].b) * tz[2]) * inv;
-    int64_t px = int64_t(t.s.minX) * kSub + kHalf, py = int64_t(t.s.minY) * kSub + kHalf;
-    double zr = (double(t.s.e[1].at(px, py)) * tz[0] + double(t.s.e[2].at(px, py)) * tz[1] + double(t.s.e[0].at(px, py)) * tz[2]) * inv;
+    double inv = 1.0 / double(s.area2);
+    double ax = (double(s.e[1].a) * tz[0] + double(s.e[2].a) * tz[1] + double(s.e[0].a) * tz[2]) * inv;
+    double ay = (double(s.e[1].b) * tz[0] + double(s.e[2].b) * tz[1] + double(s.e[0].b) * tz[2]) * inv;
+    int64_t px = int64_t(s.minX) * kSub + kHalf, py = int64_t(s.minY) * kSub + kHalf;
+    double zr = (double(s.e[1].at(px, py)) * tz[0] + double(s.e[2].at(px, py)) * tz[1] + double(s.e[0].at(px, py)) * tz[2]) * inv;
     t.zRef = float(zr);
     t.zdx = float(ax * kSub);
     t.zdy = float(ay * kSub);
     // Setup vertex (k+2)%3 <- edge k.
     for (int k = 0; k < 3; ++k) {
-        const Edge& e = t.s.e[(k + 1) % 3];
+        const Edge& e = s.e[(k + 1) % 3];
         t.uRef[k] = float(double(e.at(px, py)) * inv * tw[k]);
         t.udx[k] = float(double(e.a) * kSub * inv * tw[k]);
         t.udy[k] = float(double(e.b) * kSub * inv * tw[k]);
@@ -330,23 +335,19 @@ void runTriangleStage(Chunk& ch, const FrameContext& fc) {
         if (c0 & c1 & c2) continue;                // all outside one plane
         if ((c0 | c1 | c2) & kInvalid) continue;   // non-finite vertex
         if ((c0 | c1 | c2) == 0) {
-            Tri& tri = ch.tris.emplace_back();   // made in place (dropped again when rejected)
             const vec4 &w0 = d.win[v[0]], &w1 = d.win[v[1]], &w2 = d.win[v[2]];
             float wx[3] = {w0.x, w1.x, w2.x};
             float wy[3] = {w0.y, w1.y, w2.y};
-            if (!setupTriangle(wx, wy, fc.width, fc.height, tri.s, fc.msaa)) {
-                ch.tris.pop_back();
-                continue;
-            }
-            tri.front = tri.s.flipped == d.mirrored;   // CCW is front; mirrored instances: CW
-            if (!tri.front && d.cullsBack(t, st.culling)) {
-                ch.tris.pop_back();
-                continue;
-            }
+            TriSetup s;   // full setup on the stack; the record keeps its compact part
+            if (!setupTriangle(wx, wy, fc.width, fc.height, s, fc.msaa)) continue;
+            const bool front = s.flipped == d.mirrored;   // CCW is front; mirrored instances: CW
+            if (!front && d.cullsBack(t, st.culling)) continue;
+            Tri& tri = ch.tris.emplace_back();   // made in place
+            tri.front = front;
             tri.alpha = d.materialOf(t).alphaMode;
             float z[3] = {w0.z, w1.z, w2.z};
             float iw[3] = {w0.w, w1.w, w2.w};
-            finishTri(tri, z, iw);
+            finishTri(tri, s, z, iw);
             tri.draw = uint32_t(di);
             tri.prim = t;
             bin(tri);
@@ -369,15 +370,16 @@ void runTriangleStage(Chunk& ch, const FrameContext& fc) {
                 z[q] = w[idx[q]].z;
                 iw[q] = w[idx[q]].w;
             }
-            if (!setupTriangle(wx, wy, fc.width, fc.height, tri.s, fc.msaa)) continue;
-            tri.front = tri.s.flipped == d.mirrored;
+            TriSetup s;
+            if (!setupTriangle(wx, wy, fc.width, fc.height, s, fc.msaa)) continue;
+            tri.front = s.flipped == d.mirrored;
             if (!tri.front && d.cullsBack(t, st.culling)) continue;
             tri.alpha = d.materialOf(t).alphaMode;
-            finishTri(tri, z, iw);
+            finishTri(tri, s, z, iw);
             tri.draw = uint32_t(di);
             tri.prim = t;
             tri.clip = int32_t(ch.clipBary.size());
-            ch.clipBary.push_back({poly[idx[tri.s.order[0]]].bary, poly[idx[tri.s.order[1]]].bary, poly[idx[tri.s.order[2]]].bary});
+            ch.clipBary.push_back({poly[idx[tri.order[0]]].bary, poly[idx[tri.order[1]]].bary, poly[idx[tri.order[2]]].bary});
             bin(ch.tris.emplace_back(tri));
         }
     }
@@ -403,13 +405,13 @@ void runTriangleStage(Chunk& ch, const FrameContext& fc) {
 // samples that pass the depth test.
 template <class Keep>
 inline void rasterizeTri(const Tri& t, uint32_t id, int tx0, int ty0, int tx1, int ty1, int samples, float* depth, uint32_t* ids, Keep&& keep) {
-    int x0 = std::max(tx0, t.s.minX), x1 = std::min(tx1, t.s.maxX);
-    int y0 = std::max(ty0, t.s.minY), y1 = std::min(ty1, t.s.maxY);
+    int x0 = std::max(tx0, int(t.s.minX)), x1 = std::min(tx1, int(t.s.maxX));
+    int y0 = std::max(ty0, int(t.s.minY)), y1 = std::min(ty1, int(t.s.maxY));
     if (x0 > x1 || y0 > y1) return;
     const int tw = kTileSize;
-    const Edge& e0 = t.s.e[0];
-    const Edge& e1 = t.s.e[1];
-    const Edge& e2 = t.s.e[2];
+    const PackedEdge& e0 = t.s.e[0];
+    const PackedEdge& e1 = t.s.e[1];
+    const PackedEdge& e2 = t.s.e[2];
     if (samples == 1) {
         auto pixel = [&](int i, int j) {
             float z = t.zRef + t.zdx * float(i - t.s.minX) + t.zdy * float(j - t.s.minY);
@@ -543,9 +545,9 @@ inline FragBary baryAt(const TriCache& tc, int i, int j) {
     if (cb)
         fb.bo = fb.b[0] * (*cb)[0] + fb.b[1] * (*cb)[1] + fb.b[2] * (*cb)[2];
     else {
-        fb.bo[t.s.order[0]] = fb.b[0];
-        fb.bo[t.s.order[1]] = fb.b[1];
-        fb.bo[t.s.order[2]] = fb.b[2];
+        fb.bo[t.order[0]] = fb.b[0];
+        fb.bo[t.order[1]] = fb.b[1];
+        fb.bo[t.order[2]] = fb.b[2];
     }
     return fb;
 }
@@ -562,7 +564,7 @@ inline void uvAt(const TriCache& tc, const FragBary& fb, const uint32_t mi[3], i
     vec2 uvc[3] = {set[mi[0]], set[mi[1]], set[mi[2]]};
     vec2 uvk[3];   // uv at the setup vertices
     for (int q = 0; q < 3; ++q) {
-        vec3 w = cb ? (*cb)[q] : vec3(t.s.order[q] == 0, t.s.order[q] == 1, t.s.order[q] == 2);
+        vec3 w = cb ? (*cb)[q] : vec3(t.order[q] == 0, t.order[q] == 1, t.order[q] == 2);
         uvk[q] = w[0] * uvc[0] + w[1] * uvc[1] + w[2] * uvc[2];
     }
     uv = fb.b[0] * uvk[0] + fb.b[1] * uvk[1] + fb.b[2] * uvk[2];
@@ -689,7 +691,7 @@ inline void prepareSimple4(const TriCache& tc, bool fog, const int i[4], const i
     if (tc.cb) {
         const std::array<vec3, 3>& cb = *tc.cb;
         for (int c = 0; c < 3; ++c) bo[c] = dot3(b[0], b[1], b[2], cb[0][c], cb[1][c], cb[2][c]);
-    } else if (t.s.order[1] == 1) {   // setupTriangle's two orders: {0, 1, 2} or {0, 2, 1}
+    } else if (t.order[1] == 1) {   // setupTriangle's two orders: {0, 1, 2} or {0, 2, 1}
         bo[0] = b[0];
         bo[1] = b[1];
         bo[2] = b[2];
@@ -1069,8 +1071,8 @@ void renderBlended(const FrameContext& fc, Framebuffer& target, TileBuffers& buf
         const uint32_t id = buf.blendTris[order];
         const Tri& t = triById(chunks, id);
         tc.load(id, t, chunks[id >> kChunkBits], fc);
-        const int bx0 = std::max(x0, t.s.minX), bx1 = std::min(x1, t.s.maxX);
-        const int by0 = std::max(y0, t.s.minY), by1 = std::min(y1, t.s.maxY);
+        const int bx0 = std::max(x0, int(t.s.minX)), bx1 = std::min(x1, int(t.s.maxX));
+        const int by0 = std::max(y0, int(t.s.minY)), by1 = std::min(y1, int(t.s.maxY));
         if (bx0 > bx1 || by0 > by1) continue;
         auto zAt = [&](float i, float j) { return std::clamp(t.zRef + t.zdx * (i - float(t.s.minX)) + t.zdy * (j - float(t.s.minY)), 0.0f, 1.0f); };
         auto add = [&](int i, int j, int coverage) {
@@ -1084,9 +1086,9 @@ void renderBlended(const FrameContext& fc, Framebuffer& target, TileBuffers& buf
             });
             continue;
         }
-        const Edge& e0 = t.s.e[0];
-        const Edge& e1 = t.s.e[1];
-        const Edge& e2 = t.s.e[2];
+        const PackedEdge& e0 = t.s.e[0];
+        const PackedEdge& e1 = t.s.e[1];
+        const PackedEdge& e2 = t.s.e[2];
         for (int j = by0; j <= by1; ++j)
             for (int i = bx0; i <= bx1; ++i) {
                 int covered = 0;
