@@ -922,46 +922,67 @@ void shadeOpaque(const FrameContext& fc, Framebuffer& target, TileBuffers& buf, 
     }
     size_t nf = 0;
     const int tw = x1 - x0 + 1, th = y1 - y0 + 1;
-    for (int jj = 0; jj < th; ++jj)
-        for (int ii = 0; ii < tw; ++ii) {
-            int p = jj * kTileSize + ii;
-            int row = fc.height - 1 - (y0 + jj);
-            uint8_t* out = target.pixel(x0 + ii, row);
-            out[0] = bgBytes[0];
-            out[1] = bgBytes[1];
-            out[2] = bgBytes[2];
-            out[3] = 255;
-            float* dOut = &target.depth[size_t(row) * fc.width + x0 + ii];
-            if (samples == 1) {
-                *dOut = buf.depth[p];
-                if (buf.ids[p] == kNoTri) continue;
-                if (fc.visibility) writeVisibility(fc, target, size_t(row) * fc.width + x0 + ii, triById(chunks, buf.ids[p]));
-                buf.fragPixel[nf] = uint16_t(p);
-                buf.fragTri[nf] = buf.ids[p];
-                buf.fragCount[nf++] = 1;
-                continue;
+    if (samples == 1 && !fc.visibility) {
+        // Row by row: background, depth copied as a whole row, the covered pixels' fragments
+        // appended without a branch (written at nf, kept by advancing nf; nf < 64 * 64 there).
+        const uint8_t bgPixel[4] = {bgBytes[0], bgBytes[1], bgBytes[2], 255};
+        uint32_t bgWord;
+        std::memcpy(&bgWord, bgPixel, 4);
+        for (int jj = 0; jj < th; ++jj) {
+            const int row = fc.height - 1 - (y0 + jj);
+            uint8_t* out = target.pixel(x0, row);
+            for (int ii = 0; ii < tw; ++ii) std::memcpy(out + 4 * ii, &bgWord, 4);
+            std::memcpy(&target.depth[size_t(row) * fc.width + x0], &buf.depth[size_t(jj) * kTileSize], size_t(tw) * sizeof(float));
+            const uint32_t* ids = &buf.ids[size_t(jj) * kTileSize];
+            for (int ii = 0; ii < tw; ++ii) {
+                const uint32_t id = ids[ii];
+                buf.fragPixel[nf] = uint16_t(jj * kTileSize + ii);
+                buf.fragTri[nf] = id;
+                buf.fragCount[nf] = 1;
+                nf += id != kNoTri;
             }
-            float dmin = 1.0f;
-            uint32_t seen[4];
-            int nseen = 0;
-            size_t first = nf;
-            for (int s = 0; s < 4; ++s) {
-                dmin = std::min(dmin, buf.depth[p * 4 + s]);
-                uint32_t id = buf.ids[p * 4 + s];
-                if (id == kNoTri) continue;
-                int q = 0;
-                while (q < nseen && seen[q] != id) ++q;
-                if (q == nseen) {
-                    seen[nseen++] = id;
-                    buf.fragPixel[nf] = uint16_t(p);
-                    buf.fragTri[nf] = id;
-                    buf.fragCount[nf++] = 1;
-                } else {
-                    ++buf.fragCount[first + q];
-                }
-            }
-            *dOut = dmin;
         }
+    } else
+        for (int jj = 0; jj < th; ++jj)
+            for (int ii = 0; ii < tw; ++ii) {
+                int p = jj * kTileSize + ii;
+                int row = fc.height - 1 - (y0 + jj);
+                uint8_t* out = target.pixel(x0 + ii, row);
+                out[0] = bgBytes[0];
+                out[1] = bgBytes[1];
+                out[2] = bgBytes[2];
+                out[3] = 255;
+                float* dOut = &target.depth[size_t(row) * fc.width + x0 + ii];
+                if (samples == 1) {
+                    *dOut = buf.depth[p];
+                    if (buf.ids[p] == kNoTri) continue;
+                    if (fc.visibility) writeVisibility(fc, target, size_t(row) * fc.width + x0 + ii, triById(chunks, buf.ids[p]));
+                    buf.fragPixel[nf] = uint16_t(p);
+                    buf.fragTri[nf] = buf.ids[p];
+                    buf.fragCount[nf++] = 1;
+                    continue;
+                }
+                float dmin = 1.0f;
+                uint32_t seen[4];
+                int nseen = 0;
+                size_t first = nf;
+                for (int s = 0; s < 4; ++s) {
+                    dmin = std::min(dmin, buf.depth[p * 4 + s]);
+                    uint32_t id = buf.ids[p * 4 + s];
+                    if (id == kNoTri) continue;
+                    int q = 0;
+                    while (q < nseen && seen[q] != id) ++q;
+                    if (q == nseen) {
+                        seen[nseen++] = id;
+                        buf.fragPixel[nf] = uint16_t(p);
+                        buf.fragTri[nf] = id;
+                        buf.fragCount[nf++] = 1;
+                    } else {
+                        ++buf.fragCount[first + q];
+                    }
+                }
+                *dOut = dmin;
+            }
     if (nf == 0) return;
     buf.batch.resize(nf);
     buf.fogDist.resize(nf);
