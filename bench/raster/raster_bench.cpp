@@ -276,9 +276,10 @@ std::pair<double, double> computeScaling(int threads) {
     return {run(1), run(threads)};
 }
 
-// Shading-only floor: the rasterizer's lighting kernel (rnd::raster::shadeBatch, SSE, the same
-// lights and Phong model) on `fragments` fragments split over the threads, without coverage,
-// depth, attribute interpolation or output: ms per frame (median of 5).
+// Shading-only floor: the rasterizer's lighting kernel (rnd::raster::shadeBatch, SSE2 or AVX2
+// as the renderer picks it, the same lights and Phong model) on `fragments` fragments split
+// over the threads, without coverage, depth, attribute interpolation or output: ms per frame
+// (median of 5).
 double shadeOnlyMs(const FrameInput& f, size_t fragments) {
     const size_t parts = 64, per = (fragments + parts - 1) / parts;
     std::vector<rnd::raster::ShadeBatch> batches(parts);
