@@ -84,6 +84,23 @@ struct SrgbEncoder {
         uint8_t b = table[idx];
         return uint8_t(b + (x >= next[b]));
     }
+#if defined(__SSE2__)
+    // operator() on four values. Clamping to [2^-13, largest float below 1] first gives the same
+    // bytes without branches: 2^-13 encodes to 0 (so do smaller values and NaN, which maxps
+    // turns into the bound), 0x1.fffffep-1f to 255 (as do values >= 1).
+    void encode4(__m128 x, uint8_t out[4]) const {
+        x = _mm_min_ps(_mm_max_ps(x, _mm_set1_ps(0x1p-13f)), _mm_set1_ps(0x1.fffffep-1f));
+        const __m128i idx = _mm_srli_epi32(_mm_sub_epi32(_mm_castps_si128(x), _mm_set1_epi32(0x39000000)), 15);
+        alignas(16) float xs[4];
+        alignas(16) uint32_t is[4];
+        _mm_store_ps(xs, x);
+        _mm_store_si128(reinterpret_cast<__m128i*>(is), idx);
+        for (int l = 0; l < 4; ++l) {
+            const uint8_t b = table[is[l]];
+            out[l] = uint8_t(b + (xs[l] >= next[b]));
+        }
+    }
+#endif
 };
 const SrgbEncoder& srgbEncoder() {
     static const SrgbEncoder e;
@@ -933,12 +950,14 @@ void shadeOpaque(const FrameContext& fc, Framebuffer& target, TileBuffers& buf, 
             uint8_t* out = target.pixel(x0, row);
             for (int ii = 0; ii < tw; ++ii) std::memcpy(out + 4 * ii, &bgWord, 4);
             std::memcpy(&target.depth[size_t(row) * fc.width + x0], &buf.depth[size_t(jj) * kTileSize], size_t(tw) * sizeof(float));
+            // Raw pointers: stores through the vectors' own pointers made the compiler reload them.
             const uint32_t* ids = &buf.ids[size_t(jj) * kTileSize];
-            for (int ii = 0; ii < tw; ++ii) {
+            uint16_t* fragPixel = buf.fragPixel.data();
+            uint32_t* fragTri = buf.fragTri.data();
+            for (int ii = 0; ii < tw; ++ii) {   // fragCount: MSAA only
                 const uint32_t id = ids[ii];
-                buf.fragPixel[nf] = uint16_t(jj * kTileSize + ii);
-                buf.fragTri[nf] = id;
-                buf.fragCount[nf] = 1;
+                fragPixel[nf] = uint16_t(jj * kTileSize + ii);
+                fragTri[nf] = id;
                 nf += id != kNoTri;
             }
         }
@@ -1040,7 +1059,44 @@ void shadeOpaque(const FrameContext& fc, Framebuffer& target, TileBuffers& buf, 
     const bool linearFog = st.fog == sg::FogMode::Linear;
     const ShadeBatch& b = buf.batch;
     if (samples == 1) {
-        for (size_t k = 0; k < nf; ++k) {
+        size_t k = 0;
+#if defined(__SSE2__)
+        if (linearFog || !fog) {   // four fragments at a time: the scalar loop's operations per lane
+            const float* cr = b.cr.data();
+            const float* cg = b.cg.data();
+            const float* cb = b.cb.data();
+            const float* dist = buf.fogDist.data();
+            const uint16_t* fragPixel = buf.fragPixel.data();
+            const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f), fogEnd = _mm_set1_ps(st.fogEnd);
+            const __m128 fogRange = _mm_set1_ps(st.fogEnd - st.fogStart);
+            const __m128 fr = _mm_set1_ps(st.fogColor.x), fg = _mm_set1_ps(st.fogColor.y), fb = _mm_set1_ps(st.fogColor.z);
+            for (; k + 4 <= nf; k += 4) {
+                __m128 r = _mm_loadu_ps(cr + k), g = _mm_loadu_ps(cg + k), bl = _mm_loadu_ps(cb + k);
+                if (linearFog) {
+                    __m128 vis = _mm_div_ps(_mm_sub_ps(fogEnd, _mm_loadu_ps(dist + k)), fogRange);
+                    // std::clamp(vis, 0, 1): vis < 0 ? 0 : (1 < vis ? 1 : vis) (NaN stays NaN)
+                    const __m128 lt = _mm_cmplt_ps(vis, zero), gt = _mm_cmplt_ps(one, vis);
+                    vis = _mm_andnot_ps(lt, _mm_or_ps(_mm_and_ps(gt, one), _mm_andnot_ps(gt, vis)));
+                    const __m128 rest = _mm_sub_ps(one, vis);
+                    r = _mm_add_ps(_mm_mul_ps(vis, r), _mm_mul_ps(rest, fr));
+                    g = _mm_add_ps(_mm_mul_ps(vis, g), _mm_mul_ps(rest, fg));
+                    bl = _mm_add_ps(_mm_mul_ps(vis, bl), _mm_mul_ps(rest, fb));
+                }
+                uint8_t er[4], eg[4], eb[4];
+                enc.encode4(r, er);
+                enc.encode4(g, eg);
+                enc.encode4(bl, eb);
+                for (int l = 0; l < 4; ++l) {
+                    const int p = fragPixel[k + l];
+                    uint8_t* out = target.pixel(x0 + p % kTileSize, fc.height - 1 - (y0 + p / kTileSize));
+                    out[0] = er[l];
+                    out[1] = eg[l];
+                    out[2] = eb[l];
+                }
+            }
+        }
+#endif
+        for (; k < nf; ++k) {
             vec3 c(b.cr[k], b.cg[k], b.cb[k]);
             if (linearFog) {   // applyFog(), inlined: the same operations in the same order
                 const float vis = std::clamp((st.fogEnd - buf.fogDist[k]) / (st.fogEnd - st.fogStart), 0.0f, 1.0f);
