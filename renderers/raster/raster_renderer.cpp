@@ -1261,7 +1261,9 @@ private:
         auto t0frame = std::chrono::steady_clock::now();
         m_samplers.beginFrame();
         m_tess.nextFrame();
-        target.resize(width, height);
+        // The tiles write every pixel's colour and depth (background where nothing is drawn), so
+        // the buffers are not cleared first: a serial pass over ~7 MB at 1280x720.
+        target.resizeForOverwrite(width, height);
         if (visibility) target.resizeVisibility();
         if (overdraw && !msaa) target.resizeOverdraw();
         const auto& st = frame.settings;
@@ -1336,6 +1338,7 @@ private:
         fc.draws = &draws;
         uint64_t chunkSize = std::max<uint64_t>(4096, (total + 4000) / 4000);
         if (chunkSize * 7 >= (1u << kChunkBits)) {
+            target.resize(width, height);
             stats.error = "too many triangles (" + std::to_string(total) + ")";
             return stats;
         }
@@ -1373,6 +1376,7 @@ private:
             }
         });
         if (cancelled) {
+            target.resize(width, height);   // tiles left unwritten: cleared, as before
             stats.cancelled = true;
             stats.error = "cancelled";
             return stats;
