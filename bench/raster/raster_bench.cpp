@@ -17,10 +17,15 @@
 //   cpu_ms      process CPU ms per frame (all threads), raster vs the minimal GL program
 //   mpix_s      fill rate: covered pixels per wall second / 1e6 (ratio = ref time / ours)
 //   mpix_s_thread  the same per thread, ours vs the minimal GL program
-//   scaling     ours: ms on 1 thread (ours=) vs on --threads (ref=); ratio = the speed-up
+//   scaling     ours: ms on 1 thread (ours=) vs on --threads (ref=); ratio = the speed-up; the
+//               frames of the two alternate (one on 1 thread, one on --threads, ...), so a
+//               change in the machine's load falls on both
 //   cold_ms     ours: the first frame of a new renderer (ours=) vs a warm one (ref=)
 //   floor_shade the lighting kernel alone (raster_shading.h's shadeBatch on as many fragments as
 //               the scene covers, same lights; ours=) vs the whole raster frame (ref=)
+//   floor_shade_scaling  the same kernel on 1 thread (ours=) vs on --threads (ref=), ratio =
+//               its speed-up: what a compute-bound SIMD loop gets from the extra threads now
+//               (below floor_cpu where the cores share execution units, e.g. SMT siblings)
 // and floor lines per run: what=floor_bw: memory bandwidth (GB/s, read + write of a 256 MiB
 // copy) on 1 thread (ours=) and on --threads (ref=); what=floor_cpu: a fixed arithmetic loop
 // per thread, ms on 1 thread (ours=) and on --threads (ref=), ratio = the speed-up this machine
@@ -55,6 +60,7 @@
 #include <cstring>
 #include <fstream>
 #include <functional>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -276,10 +282,11 @@ std::pair<double, double> computeScaling(int threads) {
     return {run(1), run(threads)};
 }
 
-// Shading-only floor: the rasterizer's lighting kernel (rnd::raster::shadeBatch, SSE, the same
-// lights and Phong model) on `fragments` fragments split over the threads, without coverage,
-// depth, attribute interpolation or output: ms per frame (median of 5).
-double shadeOnlyMs(const FrameInput& f, size_t fragments) {
+// Shading-only floor: the rasterizer's lighting kernel (rnd::raster::shadeBatch, SSE2 or AVX2
+// as the renderer picks it, the same lights and Phong model) on `fragments` fragments split
+// over the threads, without coverage, depth, attribute interpolation or output: ms per frame
+// (median of 5).
+double shadeOnlyMs(const FrameInput& f, size_t fragments, int threads = 0) {
     const size_t parts = 64, per = (fragments + parts - 1) / parts;
     std::vector<rnd::raster::ShadeBatch> batches(parts);
     for (auto& b : batches) {
@@ -291,6 +298,8 @@ double shadeOnlyMs(const FrameInput& f, size_t fragments) {
         }
     }
     std::vector<double> ms;
+    std::optional<tbb::global_control> limit;
+    if (threads > 0) limit.emplace(tbb::global_control::max_allowed_parallelism, size_t(threads));
     for (int rep = 0; rep < 5; ++rep) {
         auto t0 = std::chrono::steady_clock::now();
         tbb::parallel_for(size_t(0), parts, [&](size_t k) { rnd::raster::shadeBatch(batches[k], per, f); });
@@ -459,11 +468,28 @@ int main(int argc, char** argv) {
             if (fresh && fresh->render(f, w, h, fb).ok)
                 cold = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         }
-        Timing o = timeRenderer(*ours, f, w, h, frames, fbO, eo);
-        Timing o1;
+        Timing o, o1;
         if (threads > 1) {
-            tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
-            o1 = timeRenderer(*ours, f, w, h, frames, fbO, eo);
+            // Frames on --threads and on 1 thread alternate (both after a warm-up frame).
+            std::vector<double> tN, cN, t1;
+            auto frame = [&](std::vector<double>* cpu) {
+                auto t0 = std::chrono::steady_clock::now();
+                const double c0 = cpuMs();
+                rnd::RenderStats st = ours->render(f, w, h, fbO);
+                if (!st.ok) eo = st.error;
+                if (cpu) cpu->push_back(cpuMs() - c0);
+                return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+            };
+            frame(nullptr);
+            for (int i = 0; i < frames; ++i) {
+                tN.push_back(frame(&cN));
+                tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+                t1.push_back(frame(nullptr));
+            }
+            o = {median(tN), median(cN)};
+            o1 = {median(t1), NAN};
+        } else {
+            o = timeRenderer(*ours, f, w, h, frames, fbO, eo);
         }
         Timing g = glBackend ? timeRenderer(*glBackend, f, w, h, frames, fbG, eg) : Timing{};
         {
@@ -491,6 +517,10 @@ int main(int argc, char** argv) {
         if (threads > 1) std::printf("bench: scene=%s what=scaling ours=%.2f ref=%.2f ratio=%.3f\n", n, o1.wallMs, to, o1.wallMs / to);
         const double shadeMs = shadeOnlyMs(f, size_t(cov));
         std::printf("bench: scene=%s what=floor_shade ours=%.2f ref=%.2f ratio=%.3f\n", n, shadeMs, to, shadeMs / to);
+        if (threads > 1) {
+            const double shade1 = shadeOnlyMs(f, size_t(cov), 1), shadeN = shadeOnlyMs(f, size_t(cov), threads);
+            std::printf("bench: scene=%s what=floor_shade_scaling ours=%.2f ref=%.2f ratio=%.3f\n", n, shade1, shadeN, shade1 / shadeN);
+        }
         std::printf("bench: scene=%s what=cold_ms ours=%.2f ref=%.2f ratio=%.3f\n", n, cold, to, cold / to);
         std::printf("# %s: %zu triangles, %.0f covered pixels, %.2f%% of pixels within 8 of the minimal GL image, warm frame %s the first\n", n,
                     b.triangles, cov, closeToMinimal(fbO), fbCold.color == fbO.color ? "identical to" : "DIFFERS from");

@@ -64,6 +64,32 @@ struct TriSetup {
     uint8_t order[3] = {0, 1, 2};   // input vertex index of each setup vertex
 };
 
+// The part of a TriSetup that scan conversion needs, as the renderer stores it per triangle
+// (56 bytes instead of 128: a large mesh keeps one per triangle, and the tile stage streams
+// them from memory). Each edge's top-left bias is folded into c (E(p) - bias >= 0 exactly,
+// in integers), so `bias` is 0; the fixed-point vertices and the area are dropped.
+struct PackedEdge {
+    int32_t a = 0, b = 0;
+    int64_t c = 0;   // TriSetup's c - bias
+    static constexpr int32_t bias = 0;
+    int64_t at(int64_t px, int64_t py) const { return a * px + b * py + c; }
+};
+struct TriCoverage {
+    PackedEdge e[3];
+    int16_t minX = 0, minY = 0, maxX = -1, maxY = -1;   // as TriSetup's (pixel indices < 32768: the renderer's maxImageSize)
+    void set(const TriSetup& t) {
+        for (int k = 0; k < 3; ++k) {
+            e[k].a = t.e[k].a;
+            e[k].b = t.e[k].b;
+            e[k].c = t.e[k].c - t.e[k].bias;
+        }
+        minX = int16_t(t.minX);
+        minY = int16_t(t.minY);
+        maxX = int16_t(t.maxX);
+        maxY = int16_t(t.maxY);
+    }
+};
+
 // Round to nearest fixed-point unit (halves away from zero); inputs lie within the guard band.
 inline int32_t toFixed(float v) {
     float f = v * float(kSub);
@@ -134,15 +160,16 @@ inline bool setupTriangle(const float wx[3], const float wy[3], int width, int h
 // tested against each edge at their extreme corners (reject the block when an edge is
 // negative everywhere, accept it whole when all edges are non-negative everywhere); only
 // partly covered blocks evaluate the edge functions per pixel, incrementally.
-template <class Fn>
-inline void forEachCoveredPixel(const TriSetup& t, int x0, int y0, int x1, int y1, Fn&& fn) {
+// T: TriSetup or TriCoverage.
+template <class T, class Fn>
+inline void forEachCoveredPixel(const T& t, int x0, int y0, int x1, int y1, Fn&& fn) {
     constexpr int kB = 8;
-    x0 = std::max(x0, t.minX);
-    x1 = std::min(x1, t.maxX);
-    y0 = std::max(y0, t.minY);
-    y1 = std::min(y1, t.maxY);
+    x0 = std::max(x0, int(t.minX));
+    x1 = std::min(x1, int(t.maxX));
+    y0 = std::max(y0, int(t.minY));
+    y1 = std::min(y1, int(t.maxY));
     if (x0 > x1 || y0 > y1) return;
-    const Edge* e = t.e;
+    const auto* e = t.e;
     const int64_t sx[3] = {int64_t(e[0].a) * kSub, int64_t(e[1].a) * kSub, int64_t(e[2].a) * kSub};
     const int64_t sy[3] = {int64_t(e[0].b) * kSub, int64_t(e[1].b) * kSub, int64_t(e[2].b) * kSub};
     // Offsets from a block's first sample to the sample that maximises / minimises each edge.

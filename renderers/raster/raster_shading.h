@@ -1,8 +1,10 @@
-// raster_shading.h - the rasterizer's batched (SoA, SSE2) evaluation of rnd::shade() for many
+// raster_shading.h - the rasterizer's batched (SoA) evaluation of rnd::shade() for many
 // fragments at once. It is the same formula as renderers/common/shading.cpp (Phong or
 // Blinn-Phong, specular times max(n.l, 0), 1/d^2 attenuation, smoothstep spot cones, ambient
-// and emissive) computed 4 fragments per instruction, with pow(s, m) as exp2(m log2 s) from
-// polynomials (relative error < 1e-5). tests/raster checks it against rnd::shade.
+// and emissive) computed 4 fragments per instruction with SSE2, or 8 with AVX2 where the CPU
+// has it (chosen at run time; VIEWER_RASTER_SSE=1 forces SSE2; both give the same bits), with
+// pow(s, m) as exp2(m log2 s) from polynomials (relative error < 1e-5). tests/raster checks it
+// against rnd::shade.
 #pragma once
 
 #include "scenegraph/frame.h"
@@ -12,7 +14,7 @@
 
 namespace rnd::raster {
 
-// Structure of arrays for n fragments (n padded to a multiple of 4 by resize()).
+// Structure of arrays for n fragments (n padded to a multiple of 8 by resize()).
 struct ShadeBatch {
     // inputs
     std::vector<float> px, py, pz;     // world position
