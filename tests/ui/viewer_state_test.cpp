@@ -447,6 +447,33 @@ TEST(RenderSlotTest, AntiAliasedFramesRefineThroughAOneSampleImage) {
     }
 }
 
+// When the camera stops, the preview of that very view is already on screen: the release
+// renders only the full-resolution image (and a new view still starts with its preview).
+TEST(RenderSlotTest, TheReleaseDoesNotRenderThePreviewShownAgain) {
+    ViewerState st = demoState();
+    auto frame = std::make_shared<sg::FrameInput>(st.buildFrame(64.0f / 48.0f));
+    RenderSlot slot("raster");
+    std::vector<int> levels;
+    slot.onPublish = [&](const rnd::Framebuffer&, const SlotStatus& s) { levels.push_back(s.level); };
+    slot.request(frame, 64, 48, 7, /*interacting=*/true);   // dragging
+    slot.waitIdle();
+    slot.request(frame, 64, 48, 7, /*interacting=*/false);   // released on the same view
+    slot.waitIdle();
+    slot.poll();
+    ASSERT_EQ(slot.status().error, "");
+    EXPECT_EQ(levels, (std::vector<int>{4, 1}));
+    EXPECT_EQ(slot.image().width, 64);
+    levels.clear();
+    slot.request(frame, 64, 48, 8, /*interacting=*/false);   // another view (key): preview first
+    slot.waitIdle();
+    EXPECT_EQ(levels, (std::vector<int>{4, 1}));
+    levels.clear();
+    slot.forget();   // a new scene: nothing of the old one counts as shown
+    slot.request(frame, 64, 48, 8, /*interacting=*/false);
+    slot.waitIdle();
+    EXPECT_EQ(levels, (std::vector<int>{4, 1}));
+}
+
 // After a load the slot forgets the old scene's picture and figures, and a
 // render requested before forget() never shows up afterwards, however far it got.
 TEST(RenderSlotTest, ForgetDropsTheImageAndRendersInFlight) {

@@ -43,15 +43,16 @@ void RenderSlot::request(std::shared_ptr<const sg::FrameInput> frame, int width,
     m_cv.notify_all();
 }
 
-void RenderSlot::publish(rnd::Framebuffer&& fb, const rnd::RenderStats& st, int level, bool refining, uint64_t generation,
-                         std::shared_ptr<const sg::FrameInput> frame) {
+void RenderSlot::publish(rnd::Framebuffer&& fb, const rnd::RenderStats& st, int level, bool refining, const Job& job) {
     std::lock_guard<std::mutex> lock(m_mutex);
-    if (generation != m_generation) return;   // rendered for a scene forget() dropped
+    if (job.generation != m_generation) return;   // rendered for a scene forget() dropped
     m_status.stats = st;
     m_status.error = st.ok ? std::string() : (st.error.empty() ? "render failed" : st.error);
     if (st.ok) {
         m_finished = std::move(fb);
-        m_finishedFrame = std::move(frame);
+        m_finishedFrame = job.frame;
+        m_publishedKey = job.key;
+        m_publishedLevel = level;
         m_status.level = level;
         m_status.refining = refining;
         m_haveNew = true;
@@ -71,7 +72,11 @@ void RenderSlot::runJob(const Job& job) {
     };
     std::vector<Step> steps;
     // A preview larger than ~1/16 of the pixels is pointless for tiny viewports.
-    const bool preview = previewDivisor > 1 && job.width / previewDivisor >= 8;
+    bool preview = previewDivisor > 1 && job.width / previewDivisor >= 8;
+    if (preview && !job.previewOnly) {   // the camera stopped: its preview may be on screen already
+        std::lock_guard<std::mutex> lock(m_mutex);
+        if (m_publishedKey == job.key && m_publishedLevel == previewDivisor) preview = false;
+    }
     if (preview) steps.push_back({previewDivisor, true});
     if (!preview || !job.previewOnly) {
         if (m_threaded && job.frame->settings.aa != sg::AAMode::None) steps.push_back({1, true});
@@ -131,7 +136,7 @@ void RenderSlot::runJob(const Job& job) {
             oneSample.costNodes = fb.costNodes;
             oneSample.costPrims = fb.costPrims;
         }
-        publish(std::move(fb), st, d, !last, job.generation, job.frame);
+        publish(std::move(fb), st, d, !last, job);
         if (!st.ok) return;
     }
 }
@@ -206,6 +211,7 @@ void RenderSlot::forget() {
     m_status.error.clear();
     m_status.level = 1;
     m_lastKey = ~uint64_t(0);
+    m_publishedKey = ~uint64_t(0);
     if (!m_renderer) m_status.error = m_makeError.empty() ? "unknown backend " + m_backend : m_makeError;
 }
 

@@ -95,8 +95,7 @@ private:
     void workerLoop();
     // Renders one job step by step (runJob in render_slot.cpp); publishes each finished step.
     void runJob(const Job& job);
-    void publish(rnd::Framebuffer&& fb, const rnd::RenderStats& st, int level, bool refining, uint64_t generation,
-                 std::shared_ptr<const sg::FrameInput> frame);
+    void publish(rnd::Framebuffer&& fb, const rnd::RenderStats& st, int level, bool refining, const Job& job);
 
     std::string m_backend;
     bool m_threaded;
@@ -114,7 +113,11 @@ private:
     bool m_quit = false;
     rnd::RenderControl* m_control = nullptr;   // of the render in flight (guarded by m_mutex)
     bool m_haveNew = false;
-    uint64_t m_generation = 0;     // bumped by forget() (guarded by m_mutex)
+    uint64_t m_generation = 0;   // bumped by forget() (guarded by m_mutex)
+    // The key and level of the last image published (guarded by m_mutex): when the camera stops,
+    // the preview of that very view is already on screen and is not rendered again.
+    uint64_t m_publishedKey = ~uint64_t(0);
+    int m_publishedLevel = 0;
     rnd::Framebuffer m_finished;   // published by the worker
     std::shared_ptr<const sg::FrameInput> m_finishedFrame;
     std::mutex m_renderMutex;                          // held while m_renderer renders (lightVisibility asks between renders)
