@@ -462,9 +462,10 @@ public:
                 std::printf("viewer: stats %s %dx%d: no image yet\n", n.c_str(), st.view.viewportWidth, st.view.viewportHeight);
                 continue;
             }
-            std::printf("viewer: stats %s %dx%d level %d: %.1f ms, %llu triangles, %llu rays%s%s\n", n.c_str(), st.view.viewportWidth,
+            std::printf("viewer: stats %s %dx%d level %d: %.1f ms, %llu triangles, %llu rays%s%s%s%s\n", n.c_str(), st.view.viewportWidth,
                         st.view.viewportHeight, s.level, s.stats.milliseconds, (unsigned long long)s.stats.triangles,
-                        (unsigned long long)s.stats.rays, s.error.empty() ? "" : ", error: ", s.error.c_str());
+                        (unsigned long long)s.stats.rays, s.refining ? ", refining" : "", s.rendering ? ", rendering" : "",
+                        s.error.empty() ? "" : ", error: ", s.error.c_str());
         }
         std::fflush(stdout);
     }
