@@ -121,6 +121,16 @@ Ray localRay(const mat4& invWorld, const Ray& wr, float tmax) {
     lr.tmax = tmax;
     return lr;
 }
+
+// A triangle hit of mesh draw `instance` as a scene hit.
+void setMeshHit(SceneHit& hit, const TriHit& th, uint32_t instance) {
+    hit.kind = SceneHit::Kind::Mesh;
+    hit.t = th.t;
+    hit.instance = instance;
+    hit.prim = th.prim;
+    hit.b1 = th.b1;
+    hit.b2 = th.b2;
+}
 }   // namespace
 
 bool SceneAccel::intersectInstance(const Instance& inst, const Ray& wr, float tmax, SceneHit& hit, bool cull, TraversalCount* count) const {
@@ -128,12 +138,7 @@ bool SceneAccel::intersectInstance(const Instance& inst, const Ray& wr, float tm
     if (inst.isMesh) {
         TriHit th;
         if (!inst.bvh->intersect(lr, th, cull, count)) return false;
-        hit.kind = SceneHit::Kind::Mesh;
-        hit.t = th.t;
-        hit.instance = inst.index;
-        hit.prim = th.prim;
-        hit.b1 = th.b1;
-        hit.b2 = th.b2;
+        setMeshHit(hit, th, inst.index);
         return true;
     }
     if (count) ++count->prims;   // an analytic shape: one primitive test
@@ -337,12 +342,7 @@ uint64_t SceneAccel::intersectPacket(const Ray* rays, int n, uint64_t active, Sc
                     if (!((touched[s].found >> i) & 1)) continue;
                     const TriHit& th = meshHits[s * kMaxPacket + i];
                     if (!(th.t < tm)) continue;
-                    h.kind = SceneHit::Kind::Mesh;
-                    h.t = th.t;
-                    h.instance = inst.index;
-                    h.prim = th.prim;
-                    h.b1 = th.b1;
-                    h.b2 = th.b2;
+                    setMeshHit(h, th, inst.index);
                 } else {   // as closestHit
                     const bool cull = inst.isMesh && sg::cullsBackFaces(culling, m_frame->meshes[inst.index].material.doubleSided);
                     if (!intersectInstance(inst, r, tm, h, cull)) continue;

@@ -233,12 +233,9 @@ TEST(GlslEnumGuardTest, ShadersHandleEveryEnumValueByName) {
     EXPECT_NE(defines.find("#define LIGHT_SPOT " + std::to_string(int(sg::LightType::Spot))), std::string::npos) << defines;
 }
 
-// One shading source: shade() is shadeTerms() applied to the albedo, and the terms do not
-// depend on the albedo (what lets Gouraud interpolate them and texture per pixel), for tinted
-// and untinted specular, both reflection models, every light type, with and without shadows.
-TEST(ShadeTermsTest, ShadeIsTheTermsAppliedToTheAlbedo) {
-    sg::FrameInput f;
-    f.ambientLight = sg::vec3(0.2f, 0.25f, 0.3f);
+namespace {
+// A point light (inverse square), a directional light and a spot, for the shading tests.
+std::vector<sg::DrawLight> threeLights() {
     sg::DrawLight point, dir, spot;
     point.type = sg::LightType::Point;
     point.position = {2, 3, 4};
@@ -253,7 +250,17 @@ TEST(ShadeTermsTest, ShadeIsTheTermsAppliedToTheAlbedo) {
     spot.cosInner = 0.95f;
     spot.cosOuter = 0.8f;
     spot.radiance = {2, 2, 2};
-    f.lights = {point, dir, spot};
+    return {point, dir, spot};
+}
+}   // namespace
+
+// One shading source: shade() is shadeTerms() applied to the albedo, and the terms do not
+// depend on the albedo (what lets Gouraud interpolate them and texture per pixel), for tinted
+// and untinted specular, both reflection models, every light type, with and without shadows.
+TEST(ShadeTermsTest, ShadeIsTheTermsAppliedToTheAlbedo) {
+    sg::FrameInput f;
+    f.ambientLight = sg::vec3(0.2f, 0.25f, 0.3f);
+    f.lights = threeLights();
     const float visible[3] = {1.0f, 0.0f, 0.5f};
     for (bool tinted : {false, true})
         for (auto model : {sg::ReflectionModel::Phong, sg::ReflectionModel::BlinnPhong})
@@ -285,20 +292,6 @@ TEST(ShadeTermsTest, ShadeIsTheTermsAppliedToTheAlbedo) {
 // light's terms are exactly zero for every material and reflection model (so the visibility
 // cannot matter), and it says yes on a fair share of random points, for every light type.
 TEST(ShadeTermsTest, ALightThatDoesNotReachAddsExactlyNothing) {
-    sg::DrawLight point, dir, spot;
-    point.type = sg::LightType::Point;
-    point.position = {2, 3, 4};
-    point.radiance = {3, 2, 1};
-    point.inverseSquare = true;
-    dir.type = sg::LightType::Directional;
-    dir.direction = glm::normalize(sg::vec3(-1, -2, -1));
-    dir.radiance = {0.5f, 0.6f, 0.7f};
-    spot.type = sg::LightType::Spot;
-    spot.position = {0, 4, 1};
-    spot.direction = glm::normalize(sg::vec3(0, -1, -0.2f));
-    spot.cosInner = 0.95f;
-    spot.cosOuter = 0.8f;
-    spot.radiance = {2, 2, 2};
     PhongCoefficients m;
     m.ka = 0.3f;
     m.kd = 0.6f;
@@ -307,7 +300,7 @@ TEST(ShadeTermsTest, ALightThatDoesNotReachAddsExactlyNothing) {
     m.specularColor = {0.9f, 0.8f, 0.7f};
     std::mt19937 rng(7);
     std::uniform_real_distribution<float> u(-3.0f, 3.0f);
-    for (const sg::DrawLight& light : {point, dir, spot}) {
+    for (const sg::DrawLight& light : threeLights()) {
         int reached = 0, notReached = 0;
         for (int i = 0; i < 4000; ++i) {
             const sg::vec3 p(u(rng), u(rng) * 0.3f, u(rng)), n = glm::normalize(sg::vec3(u(rng), u(rng), u(rng)));
