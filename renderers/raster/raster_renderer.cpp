@@ -492,6 +492,7 @@ struct TriCache {
     bool simple = false;
     PhongCoefficients coeff;
     vec3 simpleSpec, simpleBase;   // ShadeBatch::set's specular colour and ambient + emissive term (simple)
+    int32_t slot = -1;             // the material's ShadeBatch constant block (simple; -1: not added yet)
 
     void load(uint32_t newId, const Tri& tri, const Chunk& ch, const FrameContext& fc) {
         id = newId;
@@ -504,6 +505,7 @@ struct TriCache {
         if (nd != d || nm != mat) {
             d = nd;
             mat = nm;
+            slot = -1;
             gouraud = f.settings.shading == sg::ShadingModel::Gouraud && !d->gouraudA[0].empty();
             faceNormal = f.settings.shading == sg::ShadingModel::Flat || !d->hasNormals;
             simple = !gouraud && !fc.referenceShading && !d->hasColors && !(d->texture && d->hasUV) && !(d->hasUV && d->hasMaps());
@@ -625,26 +627,10 @@ float fragmentAlpha(const TriCache& tc, int i, int j) {
 
 // Output pointers of a ShadeBatch (hoisted out of the per-fragment loop).
 struct BatchOut {
-    float *px, *py, *pz, *nx, *ny, *nz, *ar, *ag, *ab, *sr, *sg, *sb, *kd, *ks, *shin, *cr, *cg, *cb;
+    float *px, *py, *pz, *nx, *ny, *nz;
+    int32_t* mat;
     explicit BatchOut(ShadeBatch& b)
-        : px(b.px.data()),
-          py(b.py.data()),
-          pz(b.pz.data()),
-          nx(b.nx.data()),
-          ny(b.ny.data()),
-          nz(b.nz.data()),
-          ar(b.ar.data()),
-          ag(b.ag.data()),
-          ab(b.ab.data()),
-          sr(b.sr.data()),
-          sg(b.sg.data()),
-          sb(b.sb.data()),
-          kd(b.kd.data()),
-          ks(b.ks.data()),
-          shin(b.shin.data()),
-          cr(b.cr.data()),
-          cg(b.cg.data()),
-          cb(b.cb.data()) {}
+        : px(b.px.data()), py(b.py.data()), pz(b.pz.data()), nx(b.nx.data()), ny(b.ny.data()), nz(b.nz.data()), mat(b.mat.data()) {}
 };
 
 // prepareFragment() for a TriCache::simple triangle, inlined into the fragment loop: the same
@@ -661,25 +647,13 @@ inline __attribute__((always_inline)) float prepareSimple(const TriCache& tc, bo
         float len = glm::length(n);
         n = len > 0 ? n / len : vec3(0, 0, 1);
     }
-    const vec3& albedo = tc.mat->baseColor;
     o.px[k] = pos.x;
     o.py[k] = pos.y;
     o.pz[k] = pos.z;
     o.nx[k] = n.x;
     o.ny[k] = n.y;
     o.nz[k] = n.z;
-    o.ar[k] = albedo.x;
-    o.ag[k] = albedo.y;
-    o.ab[k] = albedo.z;
-    o.sr[k] = tc.simpleSpec.x;
-    o.sg[k] = tc.simpleSpec.y;
-    o.sb[k] = tc.simpleSpec.z;
-    o.kd[k] = tc.coeff.kd;
-    o.ks[k] = tc.coeff.ks;
-    o.shin[k] = tc.coeff.shininess;
-    o.cr[k] = tc.simpleBase.x;
-    o.cg[k] = tc.simpleBase.y;
-    o.cb[k] = tc.simpleBase.z;
+    o.mat[k] = tc.slot;   // albedo, coefficients and ambient + emissive: the material's constant block
     if (!fog) return 0.0f;
     return glm::length(bo[0] * tc.pe[0] + bo[1] * tc.pe[1] + bo[2] * tc.pe[2]);
 }
@@ -688,15 +662,19 @@ inline __attribute__((always_inline)) float prepareSimple(const TriCache& tc, bo
 // prepareSimple() for 4 fragments of the same triangle at pixels (i[l], j[l]), slots k..k+3:
 // each lane does prepareSimple's scalar operations in the same order (SSE's add, mul, div and
 // sqrt round as the scalar ones do), so the results are the same bits.
-inline void prepareSimple4(const TriCache& tc, bool fog, const int i[4], const int j[4], const BatchOut& o, float* fogDist, size_t k) {
+// The pixels come as the tile's 4 pixel indices at fragPixel (x0, y0: the tile's corner).
+inline void prepareSimple4(const TriCache& tc, bool fog, const uint16_t* fragPixel, int x0, int y0, const BatchOut& o, float* fogDist, size_t k) {
     using V = __m128;
     const Tri& t = *tc.t;
     auto set1 = [](float x) { return _mm_set1_ps(x); };
     auto add = [](V a, V b) { return _mm_add_ps(a, b); };
     auto mul = [](V a, V b) { return _mm_mul_ps(a, b); };
     auto dot3 = [&](V a0, V a1, V a2, float c0, float c1, float c2) { return add(add(mul(a0, set1(c0)), mul(a1, set1(c1))), mul(a2, set1(c2))); };
-    const V di = _mm_cvtepi32_ps(_mm_setr_epi32(i[0] - t.s.minX, i[1] - t.s.minX, i[2] - t.s.minX, i[3] - t.s.minX));
-    const V dj = _mm_cvtepi32_ps(_mm_setr_epi32(j[0] - t.s.minY, j[1] - t.s.minY, j[2] - t.s.minY, j[3] - t.s.minY));
+    // i - minX and j - minY in 32-bit lanes: x0 + p % kTileSize, y0 + p / kTileSize (the same integers)
+    static_assert(kTileSize == 64, "p % kTileSize and p / kTileSize as & 63 and >> 6");
+    const __m128i pix = _mm_unpacklo_epi16(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(fragPixel)), _mm_setzero_si128());
+    const V di = _mm_cvtepi32_ps(_mm_add_epi32(_mm_and_si128(pix, _mm_set1_epi32(kTileSize - 1)), _mm_set1_epi32(x0 - t.s.minX)));
+    const V dj = _mm_cvtepi32_ps(_mm_add_epi32(_mm_srli_epi32(pix, 6), _mm_set1_epi32(y0 - t.s.minY)));
     V u[3], sum = _mm_setzero_ps();
     for (int q = 0; q < 3; ++q) {
         u[q] = add(add(set1(t.uRef[q]), mul(set1(t.udx[q]), di)), mul(set1(t.udy[q]), dj));
@@ -740,19 +718,7 @@ inline void prepareSimple4(const TriCache& tc, bool fog, const int i[4], const i
     _mm_storeu_ps(o.nx + k, nx);
     _mm_storeu_ps(o.ny + k, ny);
     _mm_storeu_ps(o.nz + k, nz);
-    const vec3& albedo = tc.mat->baseColor;
-    _mm_storeu_ps(o.ar + k, set1(albedo.x));
-    _mm_storeu_ps(o.ag + k, set1(albedo.y));
-    _mm_storeu_ps(o.ab + k, set1(albedo.z));
-    _mm_storeu_ps(o.sr + k, set1(tc.simpleSpec.x));
-    _mm_storeu_ps(o.sg + k, set1(tc.simpleSpec.y));
-    _mm_storeu_ps(o.sb + k, set1(tc.simpleSpec.z));
-    _mm_storeu_ps(o.kd + k, set1(tc.coeff.kd));
-    _mm_storeu_ps(o.ks + k, set1(tc.coeff.ks));
-    _mm_storeu_ps(o.shin + k, set1(tc.coeff.shininess));
-    _mm_storeu_ps(o.cr + k, set1(tc.simpleBase.x));
-    _mm_storeu_ps(o.cg + k, set1(tc.simpleBase.y));
-    _mm_storeu_ps(o.cb + k, set1(tc.simpleBase.z));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(o.mat + k), _mm_set1_epi32(tc.slot));
     if (!fog) {
         _mm_storeu_ps(fogDist + k, _mm_setzero_ps());
         return;
@@ -1030,17 +996,15 @@ void shadeOpaque(const FrameContext& fc, Framebuffer& target, TileBuffers& buf, 
                 }
             }
         }
-        if (id != tc.id) tc.load(id, triById(chunks, id), chunks[id >> kChunkBits], fc);
+        if (id != tc.id) {
+            tc.load(id, triById(chunks, id), chunks[id >> kChunkBits], fc);
+            if (tc.simple && tc.slot < 0)   // once per material run: its constants for the kernel
+                tc.slot = buf.batch.addConstants(tc.mat->baseColor, tc.simpleSpec, tc.coeff.kd, tc.coeff.ks, tc.coeff.shininess, tc.simpleBase);
+        }
 #if defined(__SSE2__)
         // Four fragments of one triangle in a row (the common case for all but tiny triangles).
         if (tc.simple && k + 4 <= nf && buf.fragTri[k + 1] == id && buf.fragTri[k + 2] == id && buf.fragTri[k + 3] == id) {
-            int ii[4], jj[4];
-            for (int l = 0; l < 4; ++l) {
-                const int p = buf.fragPixel[k + l];
-                ii[l] = x0 + p % kTileSize;
-                jj[l] = y0 + p / kTileSize;
-            }
-            prepareSimple4(tc, fogOn, ii, jj, out, buf.fogDist.data(), k);
+            prepareSimple4(tc, fogOn, buf.fragPixel.data() + k, x0, y0, out, buf.fogDist.data(), k);
             k += 3;
             continue;
         }

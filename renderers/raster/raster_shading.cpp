@@ -21,6 +21,8 @@ void ShadeBatch::resize(size_t n) {
     size_t cap = (n + 7) & ~size_t(7);   // whole vectors of 8 (the AVX2 kernel)
     for (auto* v : {&px, &py, &pz, &nx, &ny, &nz, &ar, &ag, &ab, &sr, &sg, &sb, &kd, &ks, &shin, &cr, &cg, &cb})
         if (v->size() < cap) v->resize(cap, 0.0f);
+    if (mat.size() < cap) mat.resize(cap, -1);
+    mats.clear();
     // Padding lanes: harmless values (normal up, zero coefficients).
     for (size_t i = n; i < cap; ++i) {
         px[i] = py[i] = pz[i] = 0;
@@ -28,6 +30,7 @@ void ShadeBatch::resize(size_t n) {
         ny[i] = 1;
         kd[i] = ks[i] = 0;
         shin[i] = 1;
+        mat[i] = -1;
     }
 }
 
@@ -136,6 +139,7 @@ void shadeBatch(ShadeBatch& b, size_t n, const sg::FrameInput& f) {
 
 void shadeBatch(ShadeBatch& b, size_t n, const sg::FrameInput& f) {
     for (size_t i = 0; i < n; ++i) {
+        if (b.mat[i] >= 0) b.expand(i);
         if (b.kd[i] == 0 && b.ks[i] == 0) continue;
         sg::Material m;
         m.kd = b.kd[i];

@@ -10,6 +10,7 @@
 #include "scenegraph/frame.h"
 
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 namespace rnd::raster {
@@ -24,9 +25,39 @@ struct ShadeBatch {
     std::vector<float> kd, ks, shin;   // coefficients; kd = ks = 0 for unlit
     // in: ambient + emissive (ka * albedo * L_ambient + emissive); out: the shaded colour
     std::vector<float> cr, cg, cb;
+    // Per-batch constants: fragment i with mat[i] >= 0 takes ar..shin and the input cr/cg/cb
+    // from mats[mat[i]] (the arrays above are not filled for it); mat[i] = -1: from the arrays.
+    // A plain-material fragment then writes 7 values instead of 18 (position, normal, index).
+    struct Constants {
+        float ar, ag, ab, sr, sg, sb, kd, ks, shin, cr, cg, cb;
+    };
+    std::vector<int32_t> mat;
+    std::vector<Constants> mats;
     size_t size = 0;
 
+    // Sets n fragments (all mat = -1 until set) and empties mats.
     void resize(size_t n);
+    // Adds a constant block (albedo, specular colour, kd, ks, shininess, ambient + emissive).
+    int32_t addConstants(const sg::vec3& albedo, const sg::vec3& spec, float kd_, float ks_, float shin_, const sg::vec3& base) {
+        mats.push_back({albedo.x, albedo.y, albedo.z, spec.x, spec.y, spec.z, kd_, ks_, shin_, base.x, base.y, base.z});
+        return int32_t(mats.size() - 1);
+    }
+    // Copies fragment i's constant block (mat[i] >= 0) into the per-fragment arrays.
+    void expand(size_t i) {
+        const Constants& c = mats[size_t(mat[i])];
+        ar[i] = c.ar;
+        ag[i] = c.ag;
+        ab[i] = c.ab;
+        sr[i] = c.sr;
+        sg[i] = c.sg;
+        sb[i] = c.sb;
+        kd[i] = c.kd;
+        ks[i] = c.ks;
+        shin[i] = c.shin;
+        cr[i] = c.cr;
+        cg[i] = c.cg;
+        cb[i] = c.cb;
+    }
     // Fills fragment i from a material's coefficients (rnd::PhongCoefficients, or an
     // sg::Material: the same field names), position, normal, albedo (as rnd::shade sees them).
     template <class Coefficients>
@@ -40,6 +71,7 @@ struct ShadeBatch {
         ar[i] = albedo.x;
         ag[i] = albedo.y;
         ab[i] = albedo.z;
+        mat[i] = -1;
         if (m.unlit) {   // shade(): albedo + emissive, no lights
             setColor(i, albedo + m.emissive);
             return;
@@ -64,6 +96,7 @@ struct ShadeBatch {
         ar[i] = ag[i] = ab[i] = sr[i] = sg[i] = sb[i] = 0;
         kd[i] = ks[i] = 0;
         shin[i] = 1;
+        mat[i] = -1;
         cr[i] = c.x;
         cg[i] = c.y;
         cb[i] = c.z;

@@ -47,12 +47,30 @@ inline void shadeKernel(ShadeBatch& b, size_t n, const sg::FrameInput& f) {
     const sg::vec3 eye = f.camera.eye;
     const bool blinn = f.settings.reflection == sg::ReflectionModel::BlinnPhong;
     const V zero = zeroV(), one = set1(1.0f);
+    const int32_t* mi = b.mat.data();
     for (size_t i = 0; i < n; i += kW) {
         V px = loadu(&b.px[i]), py = loadu(&b.py[i]), pz = loadu(&b.pz[i]);
         V nx = loadu(&b.nx[i]), ny = loadu(&b.ny[i]), nz = loadu(&b.nz[i]);
-        V kd = loadu(&b.kd[i]), ks = loadu(&b.ks[i]), shin = loadu(&b.shin[i]);
-        V ar = loadu(&b.ar[i]), ag = loadu(&b.ag[i]), ab = loadu(&b.ab[i]);
-        V sr = loadu(&b.sr[i]), sgc = loadu(&b.sg[i]), sb = loadu(&b.sb[i]);
+        // One constant block for all kW fragments (the common case: one material): broadcast
+        // it; otherwise copy each lane's block into the arrays and load those (the same values).
+        const int32_t m0 = mi[i];
+        bool uniform = m0 >= 0;
+        for (size_t l = 1; l < kW; ++l) uniform &= mi[i + l] == m0;
+        V kd, ks, shin, ar, ag, ab, sr, sgc, sb, cr, cg, cb;
+        if (uniform) {
+            const ShadeBatch::Constants& c = b.mats[size_t(m0)];
+            kd = set1(c.kd), ks = set1(c.ks), shin = set1(c.shin);
+            ar = set1(c.ar), ag = set1(c.ag), ab = set1(c.ab);
+            sr = set1(c.sr), sgc = set1(c.sg), sb = set1(c.sb);
+            cr = set1(c.cr), cg = set1(c.cg), cb = set1(c.cb);
+        } else {
+            for (size_t l = 0; l < kW; ++l)
+                if (mi[i + l] >= 0) b.expand(i + l);
+            kd = loadu(&b.kd[i]), ks = loadu(&b.ks[i]), shin = loadu(&b.shin[i]);
+            ar = loadu(&b.ar[i]), ag = loadu(&b.ag[i]), ab = loadu(&b.ab[i]);
+            sr = loadu(&b.sr[i]), sgc = loadu(&b.sg[i]), sb = loadu(&b.sb[i]);
+            cr = loadu(&b.cr[i]), cg = loadu(&b.cg[i]), cb = loadu(&b.cb[i]);
+        }
         // diffuse and specular colour factors: kd * albedo, ks * specColor
         V dr = mul(kd, ar), dg = mul(kd, ag), db = mul(kd, ab);
         V qr = mul(ks, sr), qg = mul(ks, sgc), qb = mul(ks, sb);
@@ -64,9 +82,15 @@ inline void shadeKernel(ShadeBatch& b, size_t n, const sg::FrameInput& f) {
         vx = sel(vpos, mul(vx, ivl), zero);
         vy = sel(vpos, mul(vy, ivl), zero);
         vz = sel(vpos, mul(vz, ivl), one);
-        V cr = loadu(&b.cr[i]), cg = loadu(&b.cg[i]), cb = loadu(&b.cb[i]);
         V lit = vor(cmpgt(kd, zero), cmpgt(ks, zero));
-        if (movemask(lit) == 0) continue;
+        if (movemask(lit) == 0) {
+            if (uniform) {   // the input colour is the output
+                storeu(&b.cr[i], cr);
+                storeu(&b.cg[i], cg);
+                storeu(&b.cb[i], cb);
+            }
+            continue;
+        }
         for (const sg::DrawLight& L : f.lights) {
             V lx, ly, lz, rr = set1(L.radiance.x), rg = set1(L.radiance.y), rb = set1(L.radiance.z);
             if (L.type == sg::LightType::Directional) {
