@@ -23,6 +23,8 @@
 #include "common/line_overlay.h"
 #include "raster/raster_core.h"
 #include "raster/raster_shading.h"
+#include "raster/simd.h"
+#include "raster/tile_kernels.h"
 #include "renderers/draw_list.h"
 #include "renderers/shading.h"
 #include "renderers/tessellate.h"
@@ -247,11 +249,8 @@ struct Tri {
     // User-provided, so emplace_back() does not zero the record before the member initializers
     // run (it did: 15% of the triangle stage); setup writes every other field.
     Tri() {}
-    TriCoverage s;          // edges (top-left bias folded in) and pixel bbox; 128 bytes in all, not 192
-    float zRef, zdx, zdy;   // window z at pixel centre (minX, minY) and per-pixel steps
-    // u_k = lambda_k / w_k (screen-linear) at pixel centre (minX, minY) and per-pixel steps;
-    // perspective-correct barycentrics are u_k / sum(u).
-    float uRef[3], udx[3], udy[3];
+    TriCoverage s;   // edges (top-left bias folded in) and pixel bbox; 128 bytes in all, not 192
+    TriPlanes pl;    // window z and u_k = lambda_k / w_k at pixel centre (minX, minY) and per-pixel steps
     uint32_t draw = 0, prim = 0;
     int32_t clip = -1;   // index into Chunk::clipBary (bary of setup vertices), -1 = none
     bool front = true;
@@ -289,27 +288,7 @@ struct FrameContext {
 bool finishTri(Tri& t, const TriSetup& s, const float z[3], const float iw[3]) {
     t.s.set(s);
     for (int k = 0; k < 3; ++k) t.order[k] = s.order[k];
-    float tz[3], tw[3];   // per setup vertex
-    for (int k = 0; k < 3; ++k) {
-        tz[k] = z[s.order[k]];
-        tw[k] = iw[s.order[k]];
-    }
-    // z = (e1 z0 + e2 z1 + e0 z2) / area2, e_i linear in the fixed-point sample position.
-    double inv = 1.0 / double(s.area2);
-    double ax = (double(s.e[1].a) * tz[0] + double(s.e[2].a) * tz[1] + double(s.e[0].a) * tz[2]) * inv;
-    double ay = (double(s.e[1].b) * tz[0] + double(s.e[2].b) * tz[1] + double(s.e[0].b) * tz[2]) * inv;
-    int64_t px = int64_t(s.minX) * kSub + kHalf, py = int64_t(s.minY) * kSub + kHalf;
-    double zr = (double(s.e[1].at(px, py)) * tz[0] + double(s.e[2].at(px, py)) * tz[1] + double(s.e[0].at(px, py)) * tz[2]) * inv;
-    t.zRef = float(zr);
-    t.zdx = float(ax * kSub);
-    t.zdy = float(ay * kSub);
-    // Setup vertex (k+2)%3 <- edge k.
-    for (int k = 0; k < 3; ++k) {
-        const Edge& e = s.e[(k + 1) % 3];
-        t.uRef[k] = float(double(e.at(px, py)) * inv * tw[k]);
-        t.udx[k] = float(double(e.a) * kSub * inv * tw[k]);
-        t.udy[k] = float(double(e.b) * kSub * inv * tw[k]);
-    }
+    t.pl = makeTriPlanes(s, z, iw);
     return true;
 }
 
@@ -431,7 +410,7 @@ inline void rasterizeTri(const Tri& t, uint32_t id, int tx0, int ty0, int tx1, i
     const PackedEdge& e2 = t.s.e[2];
     if (samples == 1) {
         auto pixel = [&](int i, int j) {
-            float z = t.zRef + t.zdx * float(i - t.s.minX) + t.zdy * float(j - t.s.minY);
+            float z = t.pl.zRef + t.pl.zdx * float(i - t.s.minX) + t.pl.zdy * float(j - t.s.minY);
             z = std::clamp(z, 0.0f, 1.0f);
             size_t p = size_t(j - ty0) * tw + (i - tx0);
             if (z < depth[p] && keep(i, j)) {
@@ -459,8 +438,8 @@ inline void rasterizeTri(const Tri& t, uint32_t id, int tx0, int ty0, int tx1, i
             for (int s = 0; s < 4; ++s) {
                 int64_t px = int64_t(i) * kSub + kMsaa4X[s], py = int64_t(j) * kSub + kMsaa4Y[s];
                 if (e0.at(px, py) < e0.bias || e1.at(px, py) < e1.bias || e2.at(px, py) < e2.bias) continue;
-                float z = t.zRef + t.zdx * (float(i - t.s.minX) + float(kMsaa4X[s] - kHalf) / kSub) +
-                          t.zdy * (float(j - t.s.minY) + float(kMsaa4Y[s] - kHalf) / kSub);
+                float z = t.pl.zRef + t.pl.zdx * (float(i - t.s.minX) + float(kMsaa4X[s] - kHalf) / kSub) +
+                          t.pl.zdy * (float(j - t.s.minY) + float(kMsaa4Y[s] - kHalf) / kSub);
                 z = std::clamp(z, 0.0f, 1.0f);
                 if (z < depth[p + s] && keep(i, j)) {
                     depth[p + s] = z;
@@ -472,27 +451,39 @@ inline void rasterizeTri(const Tri& t, uint32_t id, int tx0, int ty0, int tx1, i
 
 __attribute__((noinline)) void rasterizeIntoTile(const Tri& t, uint32_t id, int tx0, int ty0, int tx1, int ty1, int samples, float* depth,
                                                  uint32_t* ids) {
+#if defined(RASTER_HAVE_SSE2)
+    // One sample per pixel, bigger than 2x2 pixels (rasterizeTri's own short path): a row of an
+    // 8x8 block per vector step, the same pixels and depths.
+    if (samples == 1) {
+        const int x0 = std::max(tx0, int(t.s.minX)), x1 = std::min(tx1, int(t.s.maxX));
+        const int y0 = std::max(ty0, int(t.s.minY)), y1 = std::min(ty1, int(t.s.maxY));
+        if (x0 > x1 || y0 > y1) return;
+        if ((x1 - x0 > 1 || y1 - y0 > 1) && coverageFits32(t.s)) {
+            rasterizeOpaque(t.s, t.pl, id, tx0, ty0, x0, y0, x1, y1, depth, ids);
+            return;
+        }
+    }
+#endif
     rasterizeTri(t, id, tx0, ty0, tx1, ty1, samples, depth, ids, [](int, int) { return true; });
 }
 
 // Per-triangle data of the fragment stage, fetched once per run of fragments of the same
 // triangle (consecutive pixels of a tile mostly share one).
-struct TriCache {
+// PlainTri (tile_kernels.h) holds the planes, clip barycentrics (cb), world and eye positions
+// (p, pe), normals (n: n[0] alone when faceNormal) and the material's constant block (slot).
+struct TriCache : PlainTri {
     uint32_t id = kNoTri;
     const Tri* t = nullptr;
     const DrawItem* d = nullptr;
     const sg::Material* mat = nullptr;
-    const std::array<vec3, 3>* cb = nullptr;   // clip barycentrics or null
     uint32_t v[3] = {0, 0, 0};
-    vec3 p[3], pe[3], n[3];    // world positions, eye positions, normals
-    bool faceNormal = false;   // flat (or no normals): n[0] is the normal
     bool gouraud = false;
     // Plain lit fragment (no vertex colours, textures or maps, not Gouraud, not reference
     // shading): prepareFragment takes the short path with the material's coefficients below.
     bool simple = false;
     PhongCoefficients coeff;
     vec3 simpleSpec, simpleBase;   // ShadeBatch::set's specular colour and ambient + emissive term (simple)
-    int32_t slot = -1;             // the material's ShadeBatch constant block (simple; -1: not added yet)
+    // slot: the material's ShadeBatch constant block (simple; -1: not added yet)
 
     void load(uint32_t newId, const Tri& tri, const Chunk& ch, const FrameContext& fc) {
         id = newId;
@@ -518,6 +509,10 @@ struct TriCache {
             }
         }
         cb = tri.clip >= 0 ? &ch.clipBary[size_t(tri.clip)] : nullptr;
+        pl = &tri.pl;
+        minX = tri.s.minX;
+        minY = tri.s.minY;
+        swapped = tri.order[1] != 1;   // setupTriangle's two orders: {0, 1, 2} or {0, 2, 1}
         vec3 nv[3];
         for (int k = 0; k < 3; ++k) {
             v[k] = d->vertexOf(tri.prim, k);
@@ -554,7 +549,7 @@ inline FragBary baryAt(const TriCache& tc, int i, int j) {
     // Perspective correction: lambda/w is linear in screen space; divide by the sum (1/w).
     float u[3], sum = 0;
     for (int q = 0; q < 3; ++q) {
-        u[q] = t.uRef[q] + t.udx[q] * di + t.udy[q] * dj;
+        u[q] = t.pl.uRef[q] + t.pl.udx[q] * di + t.pl.udy[q] * dj;
         sum += u[q];
     }
     fb.invSum = sum != 0 ? 1.0f / sum : 0.0f;
@@ -592,7 +587,7 @@ inline void uvAt(const TriCache& tc, const FragBary& fb, const uint32_t mi[3], i
         const float di = float(pi - t.s.minX), dj = float(pj - t.s.minY);
         float u[3], sum = 0;
         for (int q = 0; q < 3; ++q) {
-            u[q] = t.uRef[q] + t.udx[q] * di + t.udy[q] * dj;
+            u[q] = t.pl.uRef[q] + t.pl.udx[q] * di + t.pl.udy[q] * dj;
             sum += u[q];
         }
         const float inv = sum != 0 ? 1.0f / sum : 0.0f;
@@ -625,14 +620,6 @@ float fragmentAlpha(const TriCache& tc, int i, int j) {
     return a;
 }
 
-// Output pointers of a ShadeBatch (hoisted out of the per-fragment loop).
-struct BatchOut {
-    float *px, *py, *pz, *nx, *ny, *nz;
-    int32_t* mat;
-    explicit BatchOut(ShadeBatch& b)
-        : px(b.px.data()), py(b.py.data()), pz(b.pz.data()), nx(b.nx.data()), ny(b.ny.data()), nz(b.nz.data()), mat(b.mat.data()) {}
-};
-
 // prepareFragment() for a TriCache::simple triangle, inlined into the fragment loop: the same
 // operations in the same order (so the same bits), with the per-material values precomputed.
 inline __attribute__((always_inline)) float prepareSimple(const TriCache& tc, bool fog, int i, int j, const BatchOut& o, size_t k) {
@@ -657,76 +644,6 @@ inline __attribute__((always_inline)) float prepareSimple(const TriCache& tc, bo
     if (!fog) return 0.0f;
     return glm::length(bo[0] * tc.pe[0] + bo[1] * tc.pe[1] + bo[2] * tc.pe[2]);
 }
-
-#if defined(__SSE2__)
-// prepareSimple() for 4 fragments of the same triangle at pixels (i[l], j[l]), slots k..k+3:
-// each lane does prepareSimple's scalar operations in the same order (SSE's add, mul, div and
-// sqrt round as the scalar ones do), so the results are the same bits.
-// The pixels come as the tile's 4 pixel indices at fragPixel (x0, y0: the tile's corner).
-inline void prepareSimple4(const TriCache& tc, bool fog, const uint16_t* fragPixel, int x0, int y0, const BatchOut& o, float* fogDist, size_t k) {
-    using V = __m128;
-    const Tri& t = *tc.t;
-    auto set1 = [](float x) { return _mm_set1_ps(x); };
-    auto add = [](V a, V b) { return _mm_add_ps(a, b); };
-    auto mul = [](V a, V b) { return _mm_mul_ps(a, b); };
-    auto dot3 = [&](V a0, V a1, V a2, float c0, float c1, float c2) { return add(add(mul(a0, set1(c0)), mul(a1, set1(c1))), mul(a2, set1(c2))); };
-    // i - minX and j - minY in 32-bit lanes: x0 + p % kTileSize, y0 + p / kTileSize (the same integers)
-    static_assert(kTileSize == 64, "p % kTileSize and p / kTileSize as & 63 and >> 6");
-    const __m128i pix = _mm_unpacklo_epi16(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(fragPixel)), _mm_setzero_si128());
-    const V di = _mm_cvtepi32_ps(_mm_add_epi32(_mm_and_si128(pix, _mm_set1_epi32(kTileSize - 1)), _mm_set1_epi32(x0 - t.s.minX)));
-    const V dj = _mm_cvtepi32_ps(_mm_add_epi32(_mm_srli_epi32(pix, 6), _mm_set1_epi32(y0 - t.s.minY)));
-    V u[3], sum = _mm_setzero_ps();
-    for (int q = 0; q < 3; ++q) {
-        u[q] = add(add(set1(t.uRef[q]), mul(set1(t.udx[q]), di)), mul(set1(t.udy[q]), dj));
-        sum = add(sum, u[q]);
-    }
-    const V inv = _mm_and_ps(_mm_cmpneq_ps(sum, _mm_setzero_ps()), _mm_div_ps(set1(1.0f), sum));
-    V b[3] = {mul(u[0], inv), mul(u[1], inv), mul(u[2], inv)};
-    V bo[3];
-    if (tc.cb) {
-        const std::array<vec3, 3>& cb = *tc.cb;
-        for (int c = 0; c < 3; ++c) bo[c] = dot3(b[0], b[1], b[2], cb[0][c], cb[1][c], cb[2][c]);
-    } else if (t.order[1] == 1) {   // setupTriangle's two orders: {0, 1, 2} or {0, 2, 1}
-        bo[0] = b[0];
-        bo[1] = b[1];
-        bo[2] = b[2];
-    } else {
-        bo[0] = b[0];
-        bo[1] = b[2];
-        bo[2] = b[1];
-    }
-    auto interp = [&](const vec3(&a)[3], int c) { return dot3(bo[0], bo[1], bo[2], a[0][c], a[1][c], a[2][c]); };
-    _mm_storeu_ps(o.px + k, interp(tc.p, 0));
-    _mm_storeu_ps(o.py + k, interp(tc.p, 1));
-    _mm_storeu_ps(o.pz + k, interp(tc.p, 2));
-    V nx, ny, nz;
-    if (tc.faceNormal) {
-        nx = set1(tc.n[0].x);
-        ny = set1(tc.n[0].y);
-        nz = set1(tc.n[0].z);
-    } else {
-        nx = interp(tc.n, 0);
-        ny = interp(tc.n, 1);
-        nz = interp(tc.n, 2);
-        const V len = _mm_sqrt_ps(add(add(mul(nx, nx), mul(ny, ny)), mul(nz, nz)));
-        const V pos = _mm_cmpgt_ps(len, _mm_setzero_ps());
-        auto sel = [](V m, V a, V c) { return _mm_or_ps(_mm_and_ps(m, a), _mm_andnot_ps(m, c)); };
-        nx = sel(pos, _mm_div_ps(nx, len), _mm_setzero_ps());
-        ny = sel(pos, _mm_div_ps(ny, len), _mm_setzero_ps());
-        nz = sel(pos, _mm_div_ps(nz, len), set1(1.0f));
-    }
-    _mm_storeu_ps(o.nx + k, nx);
-    _mm_storeu_ps(o.ny + k, ny);
-    _mm_storeu_ps(o.nz + k, nz);
-    _mm_storeu_si128(reinterpret_cast<__m128i*>(o.mat + k), _mm_set1_epi32(tc.slot));
-    if (!fog) {
-        _mm_storeu_ps(fogDist + k, _mm_setzero_ps());
-        return;
-    }
-    const V ex = interp(tc.pe, 0), ey = interp(tc.pe, 1), ez = interp(tc.pe, 2);
-    _mm_storeu_ps(fogDist + k, _mm_sqrt_ps(add(add(mul(ex, ex), mul(ey, ey)), mul(ez, ez))));
-}
-#endif
 
 // Interpolates the attributes of the cached triangle at the centre of pixel (i, j) and fills
 // slot k of the shading batch (Gouraud: the final colour, with no lights left to add). Returns
@@ -799,14 +716,25 @@ struct BlendFrag {
     uint32_t order;   // submission order (ties in depth: the later one on top, as GL)
 };
 
+// A run of fragments of one triangle: slots [begin, begin + count) of the tile's fragments.
+struct FragRun {
+    uint32_t tri;   // global triangle id (chunk << kChunkBits | index)
+    uint32_t begin, count;
+};
+
 struct TileBuffers {
     std::vector<float> depth;
     std::vector<uint32_t> blendTris;   // blended triangles of this tile, in submission order
     std::vector<BlendFrag> blendFrags;
+    // The visibility buffer: per pixel (or MSAA sample) an index into tileTris, the global ids of
+    // the tile's opaque and masked triangles in submission order (kNoTri: none).
     std::vector<uint32_t> ids;
+    std::vector<uint32_t> tileTris;
+    std::vector<uint32_t> runStart;    // per entry of tileTris: its fragments' first slot
+    std::vector<FragRun> runs;         // the fragments, grouped by triangle
     std::vector<uint16_t> fragPixel;   // pixel index in the tile
-    std::vector<uint32_t> fragTri;
-    std::vector<uint8_t> fragCount;   // MSAA samples covered
+    std::vector<uint32_t> fragTri;     // MSAA: global triangle id
+    std::vector<uint8_t> fragCount;    // MSAA samples covered
     std::vector<float> fogDist;
     std::vector<vec3> accum;   // MSAA: linear colour sum per pixel
     ShadeBatch batch;
@@ -848,19 +776,31 @@ void renderTile(int tile, const FrameContext& fc, Framebuffer& target, TileBuffe
     const int x1 = std::min(x0 + kTileSize, fc.width) - 1, y1 = std::min(y0 + kTileSize, fc.height) - 1;
     const int samples = fc.msaa ? 4 : 1;
     const size_t n = size_t(kTileSize) * kTileSize * samples;
-    buf.depth.assign(n, 1.0f);
-    buf.ids.assign(n, kNoTri);
+    buf.depth.assign(n + kTilePad, 1.0f);
+    buf.ids.assign(n + kTilePad, kNoTri);
     const auto& chunks = *fc.chunks;
     buf.blendTris.clear();
+    buf.tileTris.clear();
     TriCache masked;
     for (size_t c = 0; c < chunks.size(); ++c) {
         const Chunk& ch = chunks[c];
-        for (uint32_t k = ch.tileStart[tile]; k < ch.tileStart[tile + 1]; ++k) {
+        const uint32_t kEnd = ch.tileStart[tile + 1];
+        for (uint32_t k = ch.tileStart[tile]; k < kEnd; ++k) {
+            // A tile reads its triangles' records scattered over the chunk (only those that touch
+            // it): fetch them ahead, or each one is a miss (most of the coverage time of a mesh of
+            // small triangles such as the bunny).
+            if (k + 6 < kEnd) {
+                const char* ahead = reinterpret_cast<const char*>(&ch.tris[ch.items[k + 6]]);
+                __builtin_prefetch(ahead);
+                __builtin_prefetch(ahead + sizeof(Tri) - 1);
+            }
             uint32_t idx = ch.items[k];
             const Tri& t = ch.tris[idx];
             const uint32_t id = uint32_t(c << kChunkBits) | idx;
+            const uint32_t local = uint32_t(buf.tileTris.size());   // what the visibility buffer stores
             if (t.alpha == sg::AlphaMode::Opaque) {
-                rasterizeIntoTile(t, id, x0, y0, x1, y1, samples, buf.depth.data(), buf.ids.data());
+                buf.tileTris.push_back(id);
+                rasterizeIntoTile(t, local, x0, y0, x1, y1, samples, buf.depth.data(), buf.ids.data());
             } else if (t.alpha == sg::AlphaMode::Blend) {
                 buf.blendTris.push_back(id);   // after the opaque surfaces, in renderBlended
             } else {
@@ -870,7 +810,8 @@ void renderTile(int tile, const FrameContext& fc, Framebuffer& target, TileBuffe
                 int li = -1, lj = -1;
                 bool lastKeep = false;
                 const float cutoff = masked.mat->alphaCutoff;
-                rasterizeTri(t, id, x0, y0, x1, y1, samples, buf.depth.data(), buf.ids.data(), [&](int i, int j) {
+                buf.tileTris.push_back(id);
+                rasterizeTri(t, local, x0, y0, x1, y1, samples, buf.depth.data(), buf.ids.data(), [&](int i, int j) {
                     if (i != li || j != lj) {
                         li = i;
                         lj = j;
@@ -898,16 +839,22 @@ void shadeOpaque(const FrameContext& fc, Framebuffer& target, TileBuffers& buf, 
     // Fragments: one per covered pixel (MSAA: per distinct triangle in the pixel).
     // Sized for the worst case (every sample its own triangle); filled by index, no push_back.
     const size_t maxFrags = size_t(kTileSize) * kTileSize * samples;
-    if (buf.fragTri.size() < maxFrags) {
-        buf.fragPixel.resize(maxFrags);
+    if (buf.fragPixel.size() < maxFrags + kTilePad) {   // slack: preparePlainRun reads whole vectors
+        buf.fragPixel.resize(maxFrags + kTilePad);
         buf.fragTri.resize(maxFrags);
         buf.fragCount.resize(maxFrags);
     }
     size_t nf = 0;
     const int tw = x1 - x0 + 1, th = y1 - y0 + 1;
-    if (samples == 1 && !fc.visibility) {
-        // Row by row: background, depth copied as a whole row, the covered pixels' fragments
-        // appended without a branch (written at nf, kept by advancing nf; nf < 64 * 64 there).
+    const uint32_t* tileTris = buf.tileTris.data();
+    std::vector<FragRun>& runs = buf.runs;
+    runs.clear();
+    if (samples == 1) {
+        // Row by row: background, depth copied as a whole row, visibility; each tile triangle's
+        // fragments counted (runStart[nt] counts the uncovered pixels).
+        const uint32_t nt = uint32_t(buf.tileTris.size());
+        buf.runStart.assign(size_t(nt) + 1, 0);
+        uint32_t* start = buf.runStart.data();
         const uint8_t bgPixel[4] = {bgBytes[0], bgBytes[1], bgBytes[2], 255};
         uint32_t bgWord;
         std::memcpy(&bgWord, bgPixel, 4);
@@ -916,18 +863,32 @@ void shadeOpaque(const FrameContext& fc, Framebuffer& target, TileBuffers& buf, 
             uint8_t* out = target.pixel(x0, row);
             for (int ii = 0; ii < tw; ++ii) std::memcpy(out + 4 * ii, &bgWord, 4);
             std::memcpy(&target.depth[size_t(row) * fc.width + x0], &buf.depth[size_t(jj) * kTileSize], size_t(tw) * sizeof(float));
-            // Raw pointers: stores through the vectors' own pointers made the compiler reload them.
             const uint32_t* ids = &buf.ids[size_t(jj) * kTileSize];
-            uint16_t* fragPixel = buf.fragPixel.data();
-            uint32_t* fragTri = buf.fragTri.data();
-            for (int ii = 0; ii < tw; ++ii) {   // fragCount: MSAA only
-                const uint32_t id = ids[ii];
-                fragPixel[nf] = uint16_t(jj * kTileSize + ii);
-                fragTri[nf] = id;
-                nf += id != kNoTri;
-            }
+            for (int ii = 0; ii < tw; ++ii) ++start[std::min(ids[ii], nt)];
+            if (fc.visibility)
+                for (int ii = 0; ii < tw; ++ii)
+                    if (ids[ii] != kNoTri) writeVisibility(fc, target, size_t(row) * fc.width + x0 + ii, triById(chunks, tileTris[ids[ii]]));
         }
-    } else
+        // Fragments grouped by triangle, in the tile's submission order, each triangle's pixels in
+        // row order (a counting sort): the preparation below loads each triangle once and takes
+        // its fragments a vector at a time. Uncovered pixels go past the fragments (< 64 * 64).
+        uint32_t pos = 0;
+        for (uint32_t l = 0; l < nt; ++l) {
+            const uint32_t count = start[l];
+            start[l] = pos;
+            if (count) runs.push_back(FragRun{tileTris[l], pos, count});
+            pos += count;
+        }
+        nf = pos;
+        start[nt] = pos;
+        uint16_t* fragPixel = buf.fragPixel.data();
+        for (int jj = 0; jj < th; ++jj) {
+            const uint32_t* ids = &buf.ids[size_t(jj) * kTileSize];
+            for (int ii = 0; ii < tw; ++ii) fragPixel[start[std::min(ids[ii], nt)]++] = uint16_t(jj * kTileSize + ii);
+        }
+    } else {
+        // MSAA: a fragment per pixel and distinct triangle among its samples, with the number of
+        // samples it covers.
         for (int jj = 0; jj < th; ++jj)
             for (int ii = 0; ii < tw; ++ii) {
                 int p = jj * kTileSize + ii;
@@ -937,16 +898,6 @@ void shadeOpaque(const FrameContext& fc, Framebuffer& target, TileBuffers& buf, 
                 out[1] = bgBytes[1];
                 out[2] = bgBytes[2];
                 out[3] = 255;
-                float* dOut = &target.depth[size_t(row) * fc.width + x0 + ii];
-                if (samples == 1) {
-                    *dOut = buf.depth[p];
-                    if (buf.ids[p] == kNoTri) continue;
-                    if (fc.visibility) writeVisibility(fc, target, size_t(row) * fc.width + x0 + ii, triById(chunks, buf.ids[p]));
-                    buf.fragPixel[nf] = uint16_t(p);
-                    buf.fragTri[nf] = buf.ids[p];
-                    buf.fragCount[nf++] = 1;
-                    continue;
-                }
                 float dmin = 1.0f;
                 uint32_t seen[4];
                 int nseen = 0;
@@ -955,6 +906,7 @@ void shadeOpaque(const FrameContext& fc, Framebuffer& target, TileBuffers& buf, 
                     dmin = std::min(dmin, buf.depth[p * 4 + s]);
                     uint32_t id = buf.ids[p * 4 + s];
                     if (id == kNoTri) continue;
+                    id = tileTris[id];
                     int q = 0;
                     while (q < nseen && seen[q] != id) ++q;
                     if (q == nseen) {
@@ -966,27 +918,34 @@ void shadeOpaque(const FrameContext& fc, Framebuffer& target, TileBuffers& buf, 
                         ++buf.fragCount[first + q];
                     }
                 }
-                *dOut = dmin;
+                target.depth[size_t(row) * fc.width + x0 + ii] = dmin;
             }
+        for (size_t k = 0; k < nf;) {   // runs of consecutive fragments of one triangle
+            size_t e = k + 1;
+            while (e < nf && buf.fragTri[e] == buf.fragTri[k]) ++e;
+            runs.push_back(FragRun{buf.fragTri[k], uint32_t(k), uint32_t(e - k)});
+            k = e;
+        }
+    }
     if (nf == 0) return;
     buf.batch.resize(nf);
-    buf.fogDist.resize(nf);
+    buf.fogDist.resize(nf + ShadeBatch::kSlack);
     TriCache tc;
     const BatchOut out(buf.batch);
     const bool fogOn = st.fog != sg::FogMode::Off;
-    for (size_t k = 0; k < nf; ++k) {
-        uint32_t id = buf.fragTri[k];
+    const size_t nr = runs.size();
+    for (size_t r = 0; r < nr; ++r) {
         // Tiny triangles (a big mesh) change every fragment and miss the cache on the triangle,
-        // its indices and its vertices: prefetch the triangle 16 fragments ahead, its indices 8
-        // ahead and its vertices 4 ahead (only where the triangle changes).
-        if (k + 16 < nf && buf.fragTri[k + 16] != buf.fragTri[k + 15]) __builtin_prefetch(&triById(chunks, buf.fragTri[k + 16]));
-        if (k + 8 < nf && buf.fragTri[k + 8] != buf.fragTri[k + 7]) {
-            const Tri& tn = triById(chunks, buf.fragTri[k + 8]);
+        // its indices and its vertices: prefetch the triangle 16 runs ahead, its indices 8 ahead
+        // and its vertices 4 ahead.
+        if (r + 16 < nr) __builtin_prefetch(&triById(chunks, runs[r + 16].tri));
+        if (r + 8 < nr) {
+            const Tri& tn = triById(chunks, runs[r + 8].tri);
             const DrawItem& dn = (*fc.draws)[tn.draw];
             if (!dn.perCorner && size_t(tn.prim) * 3 < dn.mesh->indices.size()) __builtin_prefetch(&dn.mesh->indices[size_t(tn.prim) * 3]);
         }
-        if (k + 4 < nf && buf.fragTri[k + 4] != buf.fragTri[k + 3]) {
-            const Tri& tn = triById(chunks, buf.fragTri[k + 4]);
+        if (r + 4 < nr) {
+            const Tri& tn = triById(chunks, runs[r + 4].tri);
             const DrawItem& dn = (*fc.draws)[tn.draw];
             for (int q = 0; q < 3; ++q) {
                 const uint32_t vq = dn.vertexOf(tn.prim, q);
@@ -996,25 +955,27 @@ void shadeOpaque(const FrameContext& fc, Framebuffer& target, TileBuffers& buf, 
                 }
             }
         }
-        if (id != tc.id) {
-            tc.load(id, triById(chunks, id), chunks[id >> kChunkBits], fc);
+        const FragRun run = runs[r];
+        if (run.tri != tc.id) {
+            tc.load(run.tri, triById(chunks, run.tri), chunks[run.tri >> kChunkBits], fc);
             if (tc.simple && tc.slot < 0)   // once per material run: its constants for the kernel
                 tc.slot = buf.batch.addConstants(tc.mat->baseColor, tc.simpleSpec, tc.coeff.kd, tc.coeff.ks, tc.coeff.shininess, tc.simpleBase);
         }
-#if defined(__SSE2__)
-        // Four fragments of one triangle in a row (the common case for all but tiny triangles).
-        if (tc.simple && k + 4 <= nf && buf.fragTri[k + 1] == id && buf.fragTri[k + 2] == id && buf.fragTri[k + 3] == id) {
-            prepareSimple4(tc, fogOn, buf.fragPixel.data() + k, x0, y0, out, buf.fogDist.data(), k);
-            k += 3;
+#if defined(RASTER_HAVE_SSE2)
+        if (tc.simple) {   // a vector of fragments per step (whole vectors: up to 7 slots past the run, rewritten later)
+            preparePlainRun(tc, fogOn, buf.fragPixel.data(), x0, y0, run.begin, run.count, out, buf.fogDist.data());
             continue;
         }
 #endif
-        int p = buf.fragPixel[k];
-        if (tc.simple)
-            buf.fogDist[k] = prepareSimple(tc, fogOn, x0 + p % kTileSize, y0 + p / kTileSize, out, k);
-        else
-            buf.fogDist[k] = prepareFragment(tc, fc, x0 + p % kTileSize, y0 + p / kTileSize, buf.batch, k);
+        for (size_t k = run.begin; k < size_t(run.begin) + run.count; ++k) {
+            const int p = buf.fragPixel[k];
+            if (tc.simple)
+                buf.fogDist[k] = prepareSimple(tc, fogOn, x0 + p % kTileSize, y0 + p / kTileSize, out, k);
+            else
+                buf.fogDist[k] = prepareFragment(tc, fc, x0 + p % kTileSize, y0 + p / kTileSize, buf.batch, k);
+        }
     }
+    buf.batch.pad();   // the vector stores may have run past nf
     int64_t tC = fc.timing ? nowNs() : 0;
     if (fc.timing) g_prepareNs += tC - tB;
     shadeBatch(buf.batch, nf, *fc.frame);
@@ -1115,7 +1076,9 @@ void renderBlended(const FrameContext& fc, Framebuffer& target, TileBuffers& buf
         const int bx0 = std::max(x0, int(t.s.minX)), bx1 = std::min(x1, int(t.s.maxX));
         const int by0 = std::max(y0, int(t.s.minY)), by1 = std::min(y1, int(t.s.maxY));
         if (bx0 > bx1 || by0 > by1) continue;
-        auto zAt = [&](float i, float j) { return std::clamp(t.zRef + t.zdx * (i - float(t.s.minX)) + t.zdy * (j - float(t.s.minY)), 0.0f, 1.0f); };
+        auto zAt = [&](float i, float j) {
+            return std::clamp(t.pl.zRef + t.pl.zdx * (i - float(t.s.minX)) + t.pl.zdy * (j - float(t.s.minY)), 0.0f, 1.0f);
+        };
         auto add = [&](int i, int j, int coverage) {
             const float a = fragmentAlpha(tc, i, j);
             if (!(a > 0.0f)) return;

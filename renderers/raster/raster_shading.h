@@ -35,8 +35,12 @@ struct ShadeBatch {
     std::vector<Constants> mats;
     size_t size = 0;
 
-    // Sets n fragments (all mat = -1 until set) and empties mats.
+    // Sets n fragments and empties mats. The arrays hold n rounded up to 8 (the padding lanes set
+    // to harmless values, mat = -1) plus kSlack values that a vector store may write past the end.
+    static constexpr size_t kSlack = 8;
     void resize(size_t n);
+    // Sets the padding lanes again (after stores that ran past `size`).
+    void pad();
     // Adds a constant block (albedo, specular colour, kd, ks, shininess, ambient + emissive).
     int32_t addConstants(const sg::vec3& albedo, const sg::vec3& spec, float kd_, float ks_, float shin_, const sg::vec3& base) {
         mats.push_back({albedo.x, albedo.y, albedo.z, spec.x, spec.y, spec.z, kd_, ks_, shin_, base.x, base.y, base.z});

@@ -1,6 +1,6 @@
 // shade_kernel.inl - the body of raster::shadeBatch (raster_shading.cpp), written once over
-// vector wrappers (V, VI, kW, set1, add, ...) that raster_shading.cpp defines for SSE2 (4
-// lanes) and for AVX2 (8 lanes, chosen at run time) before including it. Every lane performs
+// simd.h's vector wrappers (V, VI, kW, set1, add, ...), which raster_shading.cpp brings in for
+// SSE2 (4 lanes) and for AVX2 (8 lanes, chosen at run time) before including it. Every lane performs
 // the same IEEE operations in the same order in both (no FMA: the AVX2 region enables avx2
 // only), so the two give the same bits.
 // NOLINTBEGIN

@@ -1,0 +1,53 @@
+// tile_kernels.cpp - tile_kernels.h's functions: tile_kernels.inl compiled for SSE2 and for AVX2,
+// chosen at run time by useAvx2() (simd.h).
+#include "raster/tile_kernels.h"
+
+#include "raster/simd.h"
+
+#include <algorithm>
+
+namespace rnd::raster {
+
+#if defined(RASTER_HAVE_SSE2)
+namespace tile_sse {
+using namespace simd_sse;
+#include "raster/tile_kernels.inl"
+}   // namespace tile_sse
+
+#if defined(RASTER_HAVE_AVX2)
+#pragma GCC push_options
+#pragma GCC target("avx2")
+namespace tile_avx2 {
+using namespace simd_avx2;
+#include "raster/tile_kernels.inl"
+void rasterizeOpaqueAvx2(const TriCoverage& s, const TriPlanes& pl, uint32_t id, int tx0, int ty0, int x0, int y0, int x1, int y1, float* depth,
+                         uint32_t* ids) {
+    rasterizeOpaqueKernel(s, pl, id, tx0, ty0, x0, y0, x1, y1, depth, ids);
+}
+void preparePlainRunAvx2(const PlainTri& t, bool fog, const uint16_t* fragPixel, int x0, int y0, size_t k, size_t count, const BatchOut& o,
+                         float* fogDist) {
+    preparePlainKernel(t, fog, fragPixel, x0, y0, k, count, o, fogDist);
+}
+}   // namespace tile_avx2
+#pragma GCC pop_options
+#endif
+
+void rasterizeOpaque(const TriCoverage& s, const TriPlanes& pl, uint32_t id, int tx0, int ty0, int x0, int y0, int x1, int y1, float* depth,
+                     uint32_t* ids) {
+#if defined(RASTER_HAVE_AVX2)
+    if (useAvx2()) return tile_avx2::rasterizeOpaqueAvx2(s, pl, id, tx0, ty0, x0, y0, x1, y1, depth, ids);
+#endif
+    tile_sse::rasterizeOpaqueKernel(s, pl, id, tx0, ty0, x0, y0, x1, y1, depth, ids);
+}
+
+void preparePlainRun(const PlainTri& t, bool fog, const uint16_t* fragPixel, int x0, int y0, size_t k, size_t count, const BatchOut& o,
+                     float* fogDist) {
+#if defined(RASTER_HAVE_AVX2)
+    if (useAvx2()) return tile_avx2::preparePlainRunAvx2(t, fog, fragPixel, x0, y0, k, count, o, fogDist);
+#endif
+    tile_sse::preparePlainKernel(t, fog, fragPixel, x0, y0, k, count, o, fogDist);
+}
+
+#endif   // without SSE2 (not x86-64) the renderer keeps to its scalar loops
+
+}   // namespace rnd::raster

@@ -1,0 +1,176 @@
+// tile_kernels.inl - the bodies of tile_kernels.h's functions, written once over simd.h's vector
+// wrappers (V, VI, kW, set1, add, ...); tile_kernels.cpp includes it for SSE2 and for AVX2. Each
+// lane performs the scalar code's IEEE operations in the same order (see tile_kernels.h).
+// NOLINTBEGIN
+
+inline void rasterizeOpaqueKernel(const TriCoverage& s, const TriPlanes& pl, uint32_t id, int tx0, int ty0, int x0, int y0, int x1, int y1,
+                                  float* depth, uint32_t* ids) {
+    constexpr int kB = 8;                           // block size, as forEachCoveredPixel
+    constexpr int kV = kB / int(kW);                // vectors per block row
+    constexpr int64_t kInside = int64_t(1) << 30;   // an edge that holds over the whole block
+    const PackedEdge* e = s.e;
+    int64_t sx[3], sy[3], hi[3], lo[3];
+    for (int k = 0; k < 3; ++k) {
+        sx[k] = int64_t(e[k].a) * kSub;
+        sy[k] = int64_t(e[k].b) * kSub;
+        hi[k] = std::max<int64_t>(sx[k], 0) * (kB - 1) + std::max<int64_t>(sy[k], 0) * (kB - 1);
+        lo[k] = std::min<int64_t>(sx[k], 0) * (kB - 1) + std::min<int64_t>(sy[k], 0) * (kB - 1);
+    }
+    // Edge k's change from a block row's first pixel to each lane's pixel (|.| < 2^30).
+    VI stepX[3][kV];
+    for (int k = 0; k < 3; ++k)
+        for (int c = 0; c < kV; ++c) {
+            alignas(32) int32_t lanes[kW];
+            for (int l = 0; l < int(kW); ++l) lanes[l] = int32_t(sx[k] * (c * int(kW) + l));
+            stepX[k][c] = loaduI(lanes);
+        }
+    const VI lane = laneIndex();
+    const VI minusOne = set1I(-1);
+    const VI idv = set1I(int32_t(id));
+    const V zRef = set1(pl.zRef), zdx = set1(pl.zdx), zdy = set1(pl.zdy), zero = zeroV(), one = set1(1.0f);
+    const bool small = (x1 - x0) < kB && (y1 - y0) < kB;
+    for (int by = small ? y0 : (y0 & ~(kB - 1)); by <= y1; by += kB) {
+        for (int bx = small ? x0 : (x0 & ~(kB - 1)); bx <= x1; bx += kB) {
+            const int64_t px = int64_t(bx) * kSub + kHalf, py = int64_t(by) * kSub + kHalf;
+            int64_t b[3];
+            for (int k = 0; k < 3; ++k) b[k] = e[k].at(px, py);
+            if (b[0] + hi[0] < 0 || b[1] + hi[1] < 0 || b[2] + hi[2] < 0) continue;   // block outside an edge
+            const bool full = b[0] + lo[0] >= 0 && b[1] + lo[1] >= 0 && b[2] + lo[2] >= 0;
+            // Not rejected: b >= -hi > -2^30. An edge that holds over the whole block may be far
+            // larger; it is clamped (it stays >= 0 over the block), so every value fits 32 bits.
+            int64_t row[3];   // at the current row's first pixel (within 32 bits on the block's rows)
+            for (int k = 0; k < 3; ++k) row[k] = b[k] + lo[k] >= 0 ? kInside : b[k];
+            const int ia = std::max(bx, x0), ib = std::min(bx + kB - 1, x1);
+            const int ja = std::max(by, y0), jb = std::min(by + kB - 1, y1);
+            for (int k = 0; k < 3; ++k) row[k] += sy[k] * (ja - by);
+            // Per vector: the lanes inside [ia, ib], and z's x part zRef + zdx * (i - minX).
+            VI colMask[kV];
+            V zx[kV];
+            int cBegin = kV, cEnd = 0;
+            for (int c = 0; c < kV; ++c) {
+                const int first = bx + c * int(kW);
+                const VI col = addI(set1I(first), lane);
+                colMask[c] = andI(cmpgtI(col, set1I(ia - 1)), cmpgtI(set1I(ib + 1), col));
+                zx[c] = add(zRef, mul(zdx, cvtF(addI(set1I(first - s.minX), lane))));
+                if (first <= ib && first + int(kW) - 1 >= ia) {
+                    cBegin = std::min(cBegin, c);
+                    cEnd = c + 1;
+                }
+            }
+            for (int j = ja; j <= jb; ++j) {
+                const V zy = mul(zdy, set1(float(j - s.minY)));
+                const size_t rowOff = size_t(j - ty0) * kTileSize + size_t(bx - tx0);
+                for (int c = cBegin; c < cEnd; ++c) {
+                    VI m = colMask[c];
+                    if (!full) {
+                        const VI e0 = addI(set1I(int32_t(row[0])), stepX[0][c]);
+                        const VI e1 = addI(set1I(int32_t(row[1])), stepX[1][c]);
+                        const VI e2 = addI(set1I(int32_t(row[2])), stepX[2][c]);
+                        m = andI(m, cmpgtI(orI(orI(e0, e1), e2), minusOne));   // all three >= 0
+                    }
+                    const V mf = castF(m);
+                    if (movemask(mf) == 0) continue;
+                    // clamp(z, 0, 1) as std::clamp: min(z, 1) takes 1 for NaN (which fails z < depth
+                    // as NaN does), max(0, .) keeps -0.
+                    const V z = vmax(zero, vmin(add(zx[c], zy), one));
+                    float* dp = depth + rowOff + size_t(c) * kW;
+                    uint32_t* ip = ids + rowOff + size_t(c) * kW;
+                    const V d = loadu(dp);
+                    const V pass = vand(mf, cmplt(z, d));
+                    storeu(dp, sel(pass, z, d));
+                    storeuI(ip, selI(castI(pass), idv, loaduI(ip)));
+                }
+                for (int k = 0; k < 3; ++k) row[k] += sy[k];
+            }
+        }
+    }
+}
+
+// (a0 c0 + a1 c1) + a2 c2, as glm's scalar * vec3 sums (no lambdas: they would not inherit the
+// AVX2 target of this region).
+inline V dot3(V a0, V a1, V a2, V c0, V c1, V c2) { return add(add(mul(a0, c0), mul(a1, c1)), mul(a2, c2)); }
+// Component c of the attribute a[corner][component] at the corner weights bo.
+inline V interp(const V (&bo)[3], const V (&a)[3][3], int c) { return dot3(bo[0], bo[1], bo[2], a[0][c], a[1][c], a[2][c]); }
+
+inline void preparePlainKernel(const PlainTri& t, bool fog, const uint16_t* fragPixel, int x0, int y0, size_t k, size_t count, const BatchOut& o,
+                               float* fogDist) {
+    static_assert(kTileSize == 64, "pixel p of a tile: x = p & 63, y = p >> 6");
+    const TriPlanes& pl = *t.pl;
+    const VI offX = set1I(x0 - t.minX), offY = set1I(y0 - t.minY), low = set1I(kTileSize - 1);
+    V uRef[3], udx[3], udy[3];
+    for (int q = 0; q < 3; ++q) {
+        uRef[q] = set1(pl.uRef[q]);
+        udx[q] = set1(pl.udx[q]);
+        udy[q] = set1(pl.udy[q]);
+    }
+    // Weights of the input corners from the setup vertices' barycentrics b: through the clipped
+    // piece's barycentrics, or a permutation.
+    V cw[3][3];
+    if (t.cb)
+        for (int q = 0; q < 3; ++q)
+            for (int c = 0; c < 3; ++c) cw[q][c] = set1((*t.cb)[q][c]);
+    V pv[3][3], ev[3][3], nv[3][3];   // [corner][component]
+    for (int q = 0; q < 3; ++q)
+        for (int c = 0; c < 3; ++c) {
+            pv[q][c] = set1(t.p[q][c]);
+            ev[q][c] = set1(t.pe[q][c]);
+            nv[q][c] = set1(t.n[q][c]);
+        }
+    const VI slot = set1I(t.slot);
+    const V zero = zeroV(), one = set1(1.0f);
+    for (size_t g = 0; g < count; g += kW) {
+        const size_t i = k + g;
+        const VI pix = loadU16(fragPixel + i);
+        const V di = cvtF(addI(andI(pix, low), offX));
+        const V dj = cvtF(addI(srliI(pix, 6), offY));
+        V u[3], sum = zero;
+        for (int q = 0; q < 3; ++q) {
+            u[q] = add(add(uRef[q], mul(udx[q], di)), mul(udy[q], dj));
+            sum = add(sum, u[q]);
+        }
+        const V inv = vand(cmpneq(sum, zero), div(one, sum));
+        const V b[3] = {mul(u[0], inv), mul(u[1], inv), mul(u[2], inv)};
+        V bo[3];
+        if (t.cb) {
+            for (int c = 0; c < 3; ++c) bo[c] = dot3(b[0], b[1], b[2], cw[0][c], cw[1][c], cw[2][c]);
+        } else if (!t.swapped) {
+            bo[0] = b[0];
+            bo[1] = b[1];
+            bo[2] = b[2];
+        } else {
+            bo[0] = b[0];
+            bo[1] = b[2];
+            bo[2] = b[1];
+        }
+        storeu(o.px + i, interp(bo, pv, 0));
+        storeu(o.py + i, interp(bo, pv, 1));
+        storeu(o.pz + i, interp(bo, pv, 2));
+        V nx, ny, nz;
+        if (t.faceNormal) {
+            nx = nv[0][0];
+            ny = nv[0][1];
+            nz = nv[0][2];
+        } else {
+            nx = interp(bo, nv, 0);
+            ny = interp(bo, nv, 1);
+            nz = interp(bo, nv, 2);
+            const V len = vsqrt(add(add(mul(nx, nx), mul(ny, ny)), mul(nz, nz)));
+            const V pos = cmpgt(len, zero);
+            nx = sel(pos, div(nx, len), zero);
+            ny = sel(pos, div(ny, len), zero);
+            nz = sel(pos, div(nz, len), one);
+        }
+        storeu(o.nx + i, nx);
+        storeu(o.ny + i, ny);
+        storeu(o.nz + i, nz);
+        storeuI(o.mat + i, slot);
+        if (!fog) {
+            storeu(fogDist + i, zero);
+            continue;
+        }
+        const V ex = interp(bo, ev, 0), ey = interp(bo, ev, 1), ez = interp(bo, ev, 2);
+        storeu(fogDist + i, vsqrt(add(add(mul(ex, ex), mul(ey, ey)), mul(ez, ez))));
+    }
+}
+
+// NOLINTEND

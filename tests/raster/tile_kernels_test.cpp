@@ -1,0 +1,276 @@
+// tile_kernels_test.cpp - the CPU rasterizer's vectorised tile kernels (raster/tile_kernels.h)
+// against the scalar loops they replace, bit for bit: the depth-tested coverage of an opaque
+// triangle (forEachCoveredPixel with the renderer's depth test) and the preparation of a run of
+// plain fragments (the renderer's scalar prepareSimple). The kernels run with the instruction set
+// the process picks (AVX2 where the CPU has it); CTest runs this binary a second time with
+// VIEWER_RASTER_SSE=1 for the SSE2 kernels (raster_tile_kernels_sse2).
+#include "raster/tile_kernels.h"
+#include "raster/raster_core.h"
+#include "raster/simd.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <random>
+#include <vector>
+
+using namespace rnd::raster;
+using sg::vec3;
+
+namespace {
+
+constexpr int W = 1280, H = 720;
+constexpr size_t kTileValues = size_t(kTileSize) * kTileSize + kTilePad;
+
+// The scalar loop: forEachCoveredPixel with the renderer's depth test (LESS on the window z
+// clamped to [0, 1]).
+void rasterizeScalar(const TriCoverage& s, const TriPlanes& pl, uint32_t id, int tx0, int ty0, int x0, int y0, int x1, int y1, float* depth,
+                     uint32_t* ids) {
+    forEachCoveredPixel(s, x0, y0, x1, y1, [&](int i, int j) {
+        float z = pl.zRef + pl.zdx * float(i - s.minX) + pl.zdy * float(j - s.minY);
+        z = std::clamp(z, 0.0f, 1.0f);
+        const size_t p = size_t(j - ty0) * kTileSize + size_t(i - tx0);
+        if (z < depth[p]) {
+            depth[p] = z;
+            ids[p] = id;
+        }
+    });
+}
+
+bool sameBits(const std::vector<float>& a, const std::vector<float>& b) { return std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0; }
+
+}   // namespace
+
+// Tells which kernels this run checks; under VIEWER_RASTER_SSE=1 they must be the SSE2 ones.
+TEST(RasterTileKernelTest, InstructionSetIsTheOneAskedFor) {
+    const char* e = std::getenv("VIEWER_RASTER_SSE");
+    const bool forcedSse = e && e[0] == '1';
+    if (forcedSse) { EXPECT_FALSE(useAvx2()); }
+    RecordProperty("kernels", useAvx2() ? "avx2" : "sse2");
+    std::printf("tile kernels under test: %s\n", useAvx2() ? "AVX2" : "SSE2");
+}
+
+// Random triangles from sub-pixel slivers to ones larger than the viewport (in the guard band),
+// each against a tile it touches, over a depth buffer with random contents: the same depth bits
+// and ids everywhere (the slack included) as the scalar loop.
+TEST(RasterTileKernelTest, OpaqueCoverageMatchesTheScalarLoop) {
+    std::mt19937 rng(2024);
+    std::uniform_real_distribution<float> U(0.0f, 1.0f);
+    const float sizes[] = {1.5f, 3.0f, 7.0f, 12.0f, 40.0f, 150.0f, 700.0f, 2500.0f};
+    int tested = 0, wide = 0, rejected32 = 0, clampedZ = 0;
+    for (int iter = 0; iter < 6000; ++iter) {
+        const float size = sizes[iter % 8];
+        const float cx = -100 + (W + 200) * U(rng), cy = -100 + (H + 200) * U(rng);
+        float xs[3], ys[3];
+        for (int k = 0; k < 3; ++k) {
+            xs[k] = cx + size * (U(rng) - 0.5f);
+            ys[k] = cy + size * (U(rng) - 0.5f);
+        }
+        if (iter % 13 == 0) ys[1] = ys[0];   // a horizontal edge (the top-left rule)
+        if (iter % 17 == 0) xs[2] = xs[0];   // a vertical one
+        TriSetup ts;
+        if (!setupTriangle(xs, ys, W, H, ts)) continue;
+        TriCoverage cov;
+        cov.set(ts);
+        // Depths partly outside [0, 1] (clamped), 1/w of very different sizes (perspective).
+        const float z[3] = {-0.2f + 1.4f * U(rng), -0.2f + 1.4f * U(rng), -0.2f + 1.4f * U(rng)};
+        const float iw[3] = {0.05f + 4 * U(rng), 0.05f + 4 * U(rng), 0.05f + 4 * U(rng)};
+        const TriPlanes pl = makeTriPlanes(ts, z, iw);
+        if (!coverageFits32(cov)) {
+            ++rejected32;
+            continue;
+        }
+        // A tile the bbox touches.
+        const int pi = cov.minX + int(U(rng) * float(cov.maxX - cov.minX + 1));
+        const int pj = cov.minY + int(U(rng) * float(cov.maxY - cov.minY + 1));
+        const int tx0 = std::min(pi, int(cov.maxX)) & ~(kTileSize - 1), ty0 = std::min(pj, int(cov.maxY)) & ~(kTileSize - 1);
+        const int tx1 = std::min(tx0 + kTileSize, W) - 1, ty1 = std::min(ty0 + kTileSize, H) - 1;
+        const int rx0 = std::max(tx0, int(cov.minX)), rx1 = std::min(tx1, int(cov.maxX));
+        const int ry0 = std::max(ty0, int(cov.minY)), ry1 = std::min(ty1, int(cov.maxY));
+        if (rx0 > rx1 || ry0 > ry1) continue;
+        std::vector<float> depthA(kTileValues), depthB;
+        std::vector<uint32_t> idsA(kTileValues), idsB;
+        for (size_t p = 0; p < kTileValues; ++p) {
+            depthA[p] = p % 7 == 0 ? 1.0f : U(rng);
+            idsA[p] = uint32_t(rng());
+        }
+        depthB = depthA;
+        idsB = idsA;
+        const uint32_t id = uint32_t(iter);
+        rasterizeScalar(cov, pl, id, tx0, ty0, rx0, ry0, rx1, ry1, depthA.data(), idsA.data());
+        rasterizeOpaque(cov, pl, id, tx0, ty0, rx0, ry0, rx1, ry1, depthB.data(), idsB.data());
+        ASSERT_TRUE(sameBits(depthA, depthB)) << "iteration " << iter << ", triangle size " << size;
+        ASSERT_EQ(idsA, idsB) << "iteration " << iter << ", triangle size " << size;
+        ++tested;
+        wide += (rx1 - rx0 >= 8 || ry1 - ry0 >= 8);
+        clampedZ += std::count(depthB.begin(), depthB.end(), 0.0f) > 0;
+    }
+    EXPECT_GT(tested, 3000);
+    EXPECT_GT(wide, 1000);       // several 8x8 blocks per triangle
+    EXPECT_GT(rejected32, 50);   // the largest triangles go to the 64-bit loop
+    EXPECT_GT(clampedZ, 100);    // z below 0 stored as 0
+}
+
+// The 32-bit limit is safe right at its edge: triangles whose edge steps sit just below the
+// bound (|a| + |b| up to 2^30 / (7 kSub) fixed-point units), in every tile they touch.
+TEST(RasterTileKernelTest, OpaqueCoverageAtThe32BitLimit) {
+    std::mt19937 rng(77);
+    std::uniform_real_distribution<float> U(0.0f, 1.0f);
+    int tested = 0;
+    const float limitPx = float((int64_t(1) << 30) / (7 * kSub)) / kSub;   // |dx| + |dy| in pixels
+    for (int iter = 0; iter < 40; ++iter) {
+        // A long thin triangle whose longest edge has |dx| + |dy| just under the limit.
+        const float len = limitPx * (0.97f + 0.029f * U(rng));
+        const float t = U(rng);
+        const float dx = len * t, dy = len * (1 - t);
+        const float ax = -600 + 200 * U(rng), ay = -600 + 200 * U(rng);
+        float xs[3] = {ax, ax + dx, ax + dx * 0.5f + 30 * U(rng)};
+        float ys[3] = {ay, ay + dy, ay + dy * 0.5f - 30 - 30 * U(rng)};
+        TriSetup ts;
+        if (!setupTriangle(xs, ys, W, H, ts)) continue;
+        TriCoverage cov;
+        cov.set(ts);
+        if (!coverageFits32(cov)) continue;
+        const float z[3] = {0.3f, 0.6f, 0.9f}, iw[3] = {1, 0.5f, 0.25f};
+        const TriPlanes pl = makeTriPlanes(ts, z, iw);
+        for (int ty0 = 0; ty0 < H; ty0 += kTileSize)
+            for (int tx0 = 0; tx0 < W; tx0 += kTileSize) {
+                const int rx0 = std::max(tx0, int(cov.minX)), rx1 = std::min(std::min(tx0 + kTileSize, W) - 1, int(cov.maxX));
+                const int ry0 = std::max(ty0, int(cov.minY)), ry1 = std::min(std::min(ty0 + kTileSize, H) - 1, int(cov.maxY));
+                if (rx0 > rx1 || ry0 > ry1) continue;
+                std::vector<float> depthA(kTileValues, 1.0f), depthB(kTileValues, 1.0f);
+                std::vector<uint32_t> idsA(kTileValues, 0xFFFFFFFFu), idsB(kTileValues, 0xFFFFFFFFu);
+                rasterizeScalar(cov, pl, 5, tx0, ty0, rx0, ry0, rx1, ry1, depthA.data(), idsA.data());
+                rasterizeOpaque(cov, pl, 5, tx0, ty0, rx0, ry0, rx1, ry1, depthB.data(), idsB.data());
+                ASSERT_TRUE(sameBits(depthA, depthB)) << "iteration " << iter << " tile " << tx0 << "," << ty0;
+                ASSERT_EQ(idsA, idsB) << "iteration " << iter << " tile " << tx0 << "," << ty0;
+                tested += std::count(idsA.begin(), idsA.end(), 5u) > 0;
+            }
+    }
+    EXPECT_GT(tested, 100);
+}
+
+namespace {
+
+// The renderer's scalar preparation of a plain fragment (prepareSimple with baryAt), written out.
+struct PreparedRef {
+    vec3 pos, n;
+    float fog;
+};
+PreparedRef prepareScalar(const PlainTri& t, bool fog, int i, int j) {
+    const TriPlanes& pl = *t.pl;
+    const float di = float(i - t.minX), dj = float(j - t.minY);
+    float u[3], sum = 0;
+    for (int q = 0; q < 3; ++q) {
+        u[q] = pl.uRef[q] + pl.udx[q] * di + pl.udy[q] * dj;
+        sum += u[q];
+    }
+    const float invSum = sum != 0 ? 1.0f / sum : 0.0f;
+    float b[3];
+    for (int q = 0; q < 3; ++q) b[q] = u[q] * invSum;
+    vec3 bo;
+    if (t.cb)
+        bo = b[0] * (*t.cb)[0] + b[1] * (*t.cb)[1] + b[2] * (*t.cb)[2];
+    else if (!t.swapped)
+        bo = vec3(b[0], b[1], b[2]);
+    else
+        bo = vec3(b[0], b[2], b[1]);
+    PreparedRef r;
+    r.pos = bo[0] * t.p[0] + bo[1] * t.p[1] + bo[2] * t.p[2];
+    if (t.faceNormal) {
+        r.n = t.n[0];
+    } else {
+        vec3 n = bo[0] * t.n[0] + bo[1] * t.n[1] + bo[2] * t.n[2];
+        const float len = glm::length(n);
+        r.n = len > 0 ? n / len : vec3(0, 0, 1);
+    }
+    r.fog = fog ? glm::length(bo[0] * t.pe[0] + bo[1] * t.pe[1] + bo[2] * t.pe[2]) : 0.0f;
+    return r;
+}
+
+bool sameFloat(float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+}   // namespace
+
+// Runs of every length at unaligned starts, clipped and whole triangles, both setup orders, flat
+// and interpolated normals (a zero normal among them), with and without fog: each slot of the run
+// holds the scalar code's bits, and nothing before the run or past its vector slack is touched.
+TEST(RasterTileKernelTest, PlainFragmentsMatchTheScalarFormula) {
+    std::mt19937 rng(31);
+    std::uniform_real_distribution<float> U(-1.0f, 1.0f), P(0.0f, 1.0f);
+    const size_t slots = 200;
+    int checked = 0;
+    for (int iter = 0; iter < 3000; ++iter) {
+        // A triangle with a perspective 1/w, set up as the renderer sets it up.
+        const float cx = 40 + 1200 * P(rng), cy = 40 + 640 * P(rng), size = 4 + 60 * P(rng);
+        float xs[3], ys[3];
+        for (int k = 0; k < 3; ++k) {
+            xs[k] = cx + size * U(rng);
+            ys[k] = cy + size * U(rng);
+        }
+        TriSetup ts;
+        if (!setupTriangle(xs, ys, W, H, ts)) continue;
+        const float z[3] = {P(rng), P(rng), P(rng)};
+        const float iw[3] = {0.1f + P(rng), 0.1f + 3 * P(rng), 0.1f + 9 * P(rng)};
+        const TriPlanes pl = makeTriPlanes(ts, z, iw);
+        std::array<vec3, 3> clipBary;
+        PlainTri t;
+        t.pl = &pl;
+        t.minX = ts.minX;
+        t.minY = ts.minY;
+        t.swapped = ts.order[1] != 1;
+        if (iter % 3 == 0) {   // a clipped piece: its vertices' weights of the input corners
+            for (auto& c : clipBary) {
+                const float a = P(rng), b = P(rng) * (1 - a);
+                c = vec3(a, b, 1 - a - b);
+            }
+            t.cb = &clipBary;
+        }
+        for (int q = 0; q < 3; ++q) {
+            t.p[q] = vec3(5 * U(rng), 5 * U(rng), 5 * U(rng));
+            t.pe[q] = vec3(5 * U(rng), 5 * U(rng), -1 - 20 * P(rng));
+            t.n[q] = glm::normalize(vec3(U(rng), U(rng), U(rng)) + vec3(0, 0, 0.1f));
+        }
+        if (iter % 29 == 0) t.n[1] = t.n[2] = -t.n[0];   // normals that cancel somewhere
+        t.faceNormal = iter % 4 == 1;
+        t.slot = int32_t(iter % 5);
+        const bool fog = iter % 2 == 0;
+        // Fragments: pixels of the tile at (x0, y0) around the triangle (outside it too: the
+        // planes extrapolate, and a run's slack lanes read whatever follows).
+        const int tx0 = std::max(0, int(cx) - 32) & ~(kTileSize - 1), ty0 = std::max(0, int(cy) - 32) & ~(kTileSize - 1);
+        std::vector<uint16_t> fragPixel(slots + 8);
+        for (auto& p : fragPixel) p = uint16_t(rng() % (kTileSize * kTileSize));
+        ShadeBatch batch;
+        batch.resize(slots);
+        const float sentinel = -12345.0f;
+        for (auto* v : {&batch.px, &batch.py, &batch.pz, &batch.nx, &batch.ny, &batch.nz}) std::fill(v->begin(), v->end(), sentinel);
+        std::fill(batch.mat.begin(), batch.mat.end(), -7);
+        std::vector<float> fogDist(slots + ShadeBatch::kSlack, sentinel);
+        const size_t k = rng() % 100, count = 1 + rng() % 60;
+        preparePlainRun(t, fog, fragPixel.data(), tx0, ty0, k, count, BatchOut(batch), fogDist.data());
+        for (size_t s = 0; s < slots; ++s) {
+            const bool inRun = s >= k && s < k + count;
+            if (!inRun) {   // before the run or past its slack: untouched
+                if (s < k || s >= k + count + 7) {
+                    ASSERT_EQ(batch.px[s], sentinel) << "slot " << s << " outside run " << k << "+" << count;
+                    ASSERT_EQ(batch.mat[s], -7);
+                    ASSERT_EQ(fogDist[s], sentinel);
+                }
+                continue;
+            }
+            const int p = fragPixel[s];
+            const PreparedRef r = prepareScalar(t, fog, tx0 + p % kTileSize, ty0 + p / kTileSize);
+            const float got[7] = {batch.px[s], batch.py[s], batch.pz[s], batch.nx[s], batch.ny[s], batch.nz[s], fogDist[s]};
+            const float want[7] = {r.pos.x, r.pos.y, r.pos.z, r.n.x, r.n.y, r.n.z, r.fog};
+            for (int c = 0; c < 7; ++c)
+                ASSERT_TRUE(sameFloat(got[c], want[c]))
+                    << "iteration " << iter << " slot " << s << " value " << c << ": " << got[c] << " vs " << want[c];
+            ASSERT_EQ(batch.mat[s], t.slot);
+            ++checked;
+        }
+    }
+    EXPECT_GT(checked, 50000);
+}
