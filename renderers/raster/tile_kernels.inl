@@ -17,14 +17,17 @@ inline void rasterizeOpaqueKernel(const TriCoverage& s, const TriPlanes& pl, uin
         lo[k] = std::min<int64_t>(sx[k], 0) * (kB - 1) + std::min<int64_t>(sy[k], 0) * (kB - 1);
     }
     // Edge k's change from a block row's first pixel to each lane's pixel (|.| < 2^30).
-    VI stepX[3][kV];
-    for (int k = 0; k < 3; ++k)
-        for (int c = 0; c < kV; ++c) {
-            alignas(32) int32_t lanes[kW];
-            for (int l = 0; l < int(kW); ++l) lanes[l] = int32_t(sx[k] * (c * int(kW) + l));
-            stepX[k][c] = loaduI(lanes);
-        }
+    // Built in registers (lane * sx from the lane index's bits): eight scalar stores read back as
+    // one vector stall on store forwarding.
     const VI lane = laneIndex();
+    const VI bit1 = cmpgtI(andI(lane, set1I(1)), set1I(0)), bit2 = cmpgtI(andI(lane, set1I(2)), set1I(0));
+    const VI bit4 = cmpgtI(andI(lane, set1I(4)), set1I(0));
+    VI stepX[3][kV];
+    for (int k = 0; k < 3; ++k) {
+        const int32_t s1 = int32_t(sx[k]);
+        const VI times = addI(addI(andI(bit1, set1I(s1)), andI(bit2, set1I(2 * s1))), andI(bit4, set1I(4 * s1)));
+        for (int c = 0; c < kV; ++c) stepX[k][c] = addI(times, set1I(s1 * c * int(kW)));
+    }
     const VI minusOne = set1I(-1);
     const VI idv = set1I(int32_t(id));
     const V zRef = set1(pl.zRef), zdx = set1(pl.zdx), zdy = set1(pl.zdy), zero = zeroV(), one = set1(1.0f);
