@@ -45,6 +45,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <mutex>
+#include <type_traits>
 #include <unordered_map>
 
 namespace rnd {
@@ -117,6 +118,9 @@ constexpr int kChunkBits = 20;   // triangle id = chunk << 20 | index in chunk
 // ---------------------------------------------------------------------------------------
 
 struct DrawItem {
+    DrawItem() = default;
+    DrawItem(DrawItem&&) noexcept = default;
+    DrawItem& operator=(DrawItem&&) noexcept = default;
     std::shared_ptr<const sg::Mesh> mesh;
     mat4 world{1.0f};
     mat3 normal{1.0f};
@@ -176,6 +180,10 @@ struct DrawItem {
     uint32_t meshIndex(uint32_t v) const { return perCorner ? mesh->indices[v] : v; }
     uint32_t vertexOf(uint32_t tri, int k) const { return perCorner ? tri * 3 + k : mesh->indices[size_t(tri) * 3 + k]; }
 };
+
+// A vector of DrawItems that grows moves them only if the move cannot throw; otherwise it
+// copies, vertex buffers included (glm's vectors do not declare noexcept).
+static_assert(std::is_nothrow_move_constructible_v<DrawItem>, "DrawItem must move without copying its buffers");
 
 // ---------------------------------------------------------------------------------------
 // [vertex stage]
@@ -1237,6 +1245,7 @@ private:
         // 1. gather (the draw list shared with the GL backend)
         std::vector<DrawItem> draws;
         const std::vector<PreparedDraw> prepared = prepareDraws(frame, tessRes, m_tess);
+        draws.reserve(prepared.size());
         for (const PreparedDraw& p : prepared) {
             DrawItem d;
             d.mesh = p.mesh;
