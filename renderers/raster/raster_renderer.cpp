@@ -24,15 +24,13 @@
 #include "raster/raster_core.h"
 #include "raster/raster_shading.h"
 #include "raster/simd.h"
+#include "raster/srgb_encoder.h"
 #include "raster/tile_kernels.h"
 #include "renderers/draw_list.h"
 #include "renderers/shading.h"
 #include "renderers/tessellate.h"
 #include "renderers/texture_sampler.h"
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -61,54 +59,6 @@ using sg::vec4;
 // ---------------------------------------------------------------------------------------
 // [helpers]
 // ---------------------------------------------------------------------------------------
-
-// toByteSRGB without pow, exactly: a table indexed by the float's exponent and top 8 mantissa
-// bits gives the byte at the start of the bucket; a bucket is narrower than the gap between
-// two byte thresholds decode((b + 0.5)/255) (checked: >= 0.39% vs <= 0.9% relative), so one
-// comparison finishes the job. Values below 2^-13 encode to 0, values >= 1 to 255.
-struct SrgbEncoder {
-    static constexpr int kMinExp = -13;
-    float next[256];   // next[b]: smallest linear value that encodes to b + 1
-    uint8_t table[13 * 256];
-    SrgbEncoder() {
-        for (int b = 0; b < 255; ++b) next[b] = decodeSRGB((b + 0.5f) / 255.0f);
-        next[255] = 2.0f;
-        for (int i = 0; i < 13 * 256; ++i) {
-            float x = std::ldexp(1.0f + (i % 256) / 256.0f, kMinExp + i / 256);
-            table[i] = toByteSRGB(x);
-        }
-    }
-    uint8_t operator()(float x) const {
-        if (!(x >= 0x1p-13f)) return 0;   // also NaN
-        if (x >= 1.0f) return 255;
-        uint32_t bits;
-        std::memcpy(&bits, &x, 4);
-        uint32_t idx = (bits - 0x39000000u) >> 15;   // 0x39000000 = bits of 2^-13
-        uint8_t b = table[idx];
-        return uint8_t(b + (x >= next[b]));
-    }
-#if defined(__SSE2__)
-    // operator() on four values. Clamping to [2^-13, largest float below 1] first gives the same
-    // bytes without branches: 2^-13 encodes to 0 (so do smaller values and NaN, which maxps
-    // turns into the bound), 0x1.fffffep-1f to 255 (as do values >= 1).
-    void encode4(__m128 x, uint8_t out[4]) const {
-        x = _mm_min_ps(_mm_max_ps(x, _mm_set1_ps(0x1p-13f)), _mm_set1_ps(0x1.fffffep-1f));
-        const __m128i idx = _mm_srli_epi32(_mm_sub_epi32(_mm_castps_si128(x), _mm_set1_epi32(0x39000000)), 15);
-        alignas(16) float xs[4];
-        alignas(16) uint32_t is[4];
-        _mm_store_ps(xs, x);
-        _mm_store_si128(reinterpret_cast<__m128i*>(is), idx);
-        for (int l = 0; l < 4; ++l) {
-            const uint8_t b = table[is[l]];
-            out[l] = uint8_t(b + (xs[l] >= next[b]));
-        }
-    }
-#endif
-};
-const SrgbEncoder& srgbEncoder() {
-    static const SrgbEncoder e;
-    return e;
-}
 
 constexpr uint32_t kNoTri = 0xFFFFFFFFu;
 constexpr int kChunkBits = 20;   // triangle id = chunk << 20 | index in chunk
@@ -1040,34 +990,11 @@ void shadeOpaque(const FrameContext& fc, Framebuffer& target, TileBuffers& buf, 
             return w;
         };
         size_t k = 0;
-#if defined(__SSE2__)
-        if (linearFog || !fog) {   // four fragments at a time: the scalar loop's operations per lane
-            const float* cr = b.cr.data();
-            const float* cg = b.cg.data();
-            const float* cb = b.cb.data();
-            const float* dist = buf.fogDist.data();
-            const uint16_t* fragPixel = buf.fragPixel.data();
-            const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f), fogEnd = _mm_set1_ps(st.fogEnd);
-            const __m128 fogRange = _mm_set1_ps(st.fogEnd - st.fogStart);
-            const __m128 fr = _mm_set1_ps(st.fogColor.x), fg = _mm_set1_ps(st.fogColor.y), fb = _mm_set1_ps(st.fogColor.z);
-            for (; k + 4 <= nf; k += 4) {
-                __m128 r = _mm_loadu_ps(cr + k), g = _mm_loadu_ps(cg + k), bl = _mm_loadu_ps(cb + k);
-                if (linearFog) {
-                    __m128 vis = _mm_div_ps(_mm_sub_ps(fogEnd, _mm_loadu_ps(dist + k)), fogRange);
-                    // std::clamp(vis, 0, 1): vis < 0 ? 0 : (1 < vis ? 1 : vis) (NaN stays NaN)
-                    const __m128 lt = _mm_cmplt_ps(vis, zero), gt = _mm_cmplt_ps(one, vis);
-                    vis = _mm_andnot_ps(lt, _mm_or_ps(_mm_and_ps(gt, one), _mm_andnot_ps(gt, vis)));
-                    const __m128 rest = _mm_sub_ps(one, vis);
-                    r = _mm_add_ps(_mm_mul_ps(vis, r), _mm_mul_ps(rest, fr));
-                    g = _mm_add_ps(_mm_mul_ps(vis, g), _mm_mul_ps(rest, fg));
-                    bl = _mm_add_ps(_mm_mul_ps(vis, bl), _mm_mul_ps(rest, fb));
-                }
-                uint8_t er[4], eg[4], eb[4];
-                enc.encode4(r, er);
-                enc.encode4(g, eg);
-                enc.encode4(bl, eb);
-                for (int l = 0; l < 4; ++l) color[fragPixel[k + l]] = packRgba(er[l], eg[l], eb[l]);
-            }
+#if defined(RASTER_HAVE_SSE2)
+        if (linearFog || !fog) {   // a vector of fragments at a time: the scalar loop's operations per lane
+            const LinearFog lf{linearFog, st.fogEnd, st.fogEnd - st.fogStart, st.fogColor};
+            writeFragments(b.cr.data(), b.cg.data(), b.cb.data(), buf.fogDist.data(), buf.fragPixel.data(), nf, lf, enc, color);
+            k = nf;
         }
 #endif
         for (; k < nf; ++k) {

@@ -1,11 +1,13 @@
 #include "raster/raster_shading.h"
 
 #include "raster/simd.h"
+#include "raster/srgb_encoder.h"
 #include "renderers/shading.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 
 namespace rnd::raster {
 
@@ -32,6 +34,41 @@ void ShadeBatch::pad() {
         shin[i] = 1;
         mat[i] = -1;
     }
+}
+
+SrgbEncoder::SrgbEncoder() {
+    // The thresholds of rnd::toByteSRGB itself (bisection over the float bits of [0, 1]; the
+    // byte is monotonic), so that this encoder gives its byte for every float. (Thresholds from
+    // decodeSRGB((b + 0.5) / 255) differ from it in the last bit on 225 floats of [2^-14, 1].)
+    for (int b = 0; b < 255; ++b) {
+        uint32_t lo = 0, hi = 0x3F800000u;   // toByteSRGB(lo) <= b < toByteSRGB(hi)
+        while (hi - lo > 1) {
+            const uint32_t mid = lo + (hi - lo) / 2;
+            float x;
+            std::memcpy(&x, &mid, 4);
+            (toByteSRGB(x) > b ? hi : lo) = mid;
+        }
+        std::memcpy(&next[b], &hi, 4);
+    }
+    next[255] = 2.0f;
+    for (int i = 0; i < kBuckets; ++i) {
+        const float first = std::ldexp(1.0f + float(i % 256) / 256.0f, kMinExp + i / 256);
+        table[i] = toByteSRGB(first);
+        const uint32_t start = 0x39000000u + (uint32_t(i) << 15), end = start + 0x8000u;
+        uint32_t thr;
+        std::memcpy(&thr, &next[table[i]], 4);
+        if (thr <= start)   // the whole bucket is above the threshold: operator() adds one everywhere
+            packed[i] = uint32_t(table[i] + 1) << 16 | 0x8000u;
+        else if (thr < end)
+            packed[i] = uint32_t(table[i]) << 16 | (thr - start);
+        else
+            packed[i] = uint32_t(table[i]) << 16 | 0x8000u;
+    }
+}
+
+const SrgbEncoder& srgbEncoder() {
+    static const SrgbEncoder e;
+    return e;
 }
 
 bool useAvx2() {

@@ -68,6 +68,13 @@ inline void storeuI(void* p, VI a) { _mm_storeu_si128(static_cast<__m128i*>(p), 
 inline VI loadU16(const uint16_t* p) { return _mm_unpacklo_epi16(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p)), _mm_setzero_si128()); }
 inline V cvtF(VI a) { return _mm_cvtepi32_ps(a); }
 inline VI cvttI(V a) { return _mm_cvttps_epi32(a); }
+// Table lookup per lane (SSE2 has no gather: four loads).
+inline VI gatherI(const int32_t* table, VI idx) {
+    alignas(16) int32_t i[4];
+    _mm_store_si128(reinterpret_cast<__m128i*>(i), idx);
+    return _mm_setr_epi32(table[i[0]], table[i[1]], table[i[2]], table[i[3]]);
+}
+inline void storeI(int32_t* p, VI a) { _mm_storeu_si128(reinterpret_cast<__m128i*>(p), a); }
 }   // namespace simd_sse
 #endif
 
@@ -114,6 +121,9 @@ inline void storeuI(void* p, VI a) { _mm256_storeu_si256(static_cast<__m256i*>(p
 inline VI loadU16(const uint16_t* p) { return _mm256_cvtepu16_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(p))); }
 inline V cvtF(VI a) { return _mm256_cvtepi32_ps(a); }
 inline VI cvttI(V a) { return _mm256_cvttps_epi32(a); }
+// Table lookup per lane.
+inline VI gatherI(const int32_t* table, VI idx) { return _mm256_i32gather_epi32(table, idx, 4); }
+inline void storeI(int32_t* p, VI a) { _mm256_storeu_si256(reinterpret_cast<__m256i*>(p), a); }
 }   // namespace simd_avx2
 #pragma GCC pop_options
 #endif

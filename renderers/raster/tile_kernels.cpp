@@ -28,6 +28,10 @@ void preparePlainRunAvx2(const PlainTri& t, bool fog, const uint16_t* fragPixel,
                          float* fogDist) {
     preparePlainKernel(t, fog, fragPixel, x0, y0, k, count, o, fogDist);
 }
+void writeFragmentsAvx2(const float* cr, const float* cg, const float* cb, const float* fogDist, const uint16_t* fragPixel, size_t n,
+                        const LinearFog& fog, const SrgbEncoder& srgb, uint32_t* color) {
+    writeFragmentsKernel(cr, cg, cb, fogDist, fragPixel, n, fog, srgb, color);
+}
 }   // namespace tile_avx2
 #pragma GCC pop_options
 #endif
@@ -46,6 +50,14 @@ void preparePlainRun(const PlainTri& t, bool fog, const uint16_t* fragPixel, int
     if (useAvx2()) return tile_avx2::preparePlainRunAvx2(t, fog, fragPixel, x0, y0, k, count, o, fogDist);
 #endif
     tile_sse::preparePlainKernel(t, fog, fragPixel, x0, y0, k, count, o, fogDist);
+}
+
+void writeFragments(const float* cr, const float* cg, const float* cb, const float* fogDist, const uint16_t* fragPixel, size_t n,
+                    const LinearFog& fog, const SrgbEncoder& srgb, uint32_t* color) {
+#if defined(RASTER_HAVE_AVX2)
+    if (useAvx2()) return tile_avx2::writeFragmentsAvx2(cr, cg, cb, fogDist, fragPixel, n, fog, srgb, color);
+#endif
+    tile_sse::writeFragmentsKernel(cr, cg, cb, fogDist, fragPixel, n, fog, srgb, color);
 }
 
 #endif   // without SSE2 (not x86-64) the renderer keeps to its scalar loops

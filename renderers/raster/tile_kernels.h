@@ -13,6 +13,7 @@
 
 #include "raster/raster_core.h"
 #include "raster/raster_shading.h"
+#include "raster/srgb_encoder.h"
 
 #include <array>
 #include <cstddef>
@@ -107,5 +108,19 @@ struct PlainTri {
 // caller provides; a later run overwrites them).
 void preparePlainRun(const PlainTri& t, bool fog, const uint16_t* fragPixel, int x0, int y0, size_t k, size_t count, const BatchOut& o,
                      float* fogDist);
+
+// Linear fog as the renderer applies it: vis = clamp((end - d) / (end - start), 0, 1),
+// c = vis c + (1 - vis) fogColour. `on` false: no fog.
+struct LinearFog {
+    bool on = false;
+    float end = 0, range = 1;   // range = end - start
+    sg::vec3 color{0.0f};
+};
+
+// The output of a one-sample tile: fragments [0, n) with linear colour (cr, cg, cb) and eye
+// distance fogDist, fogged, encoded to sRGB bytes (srgb's byte, bit for bit) and stored as RGBA8 (alpha 255) at
+// color[fragPixel[k]]. Reads the inputs in whole vectors (up to 7 values past n).
+void writeFragments(const float* cr, const float* cg, const float* cb, const float* fogDist, const uint16_t* fragPixel, size_t n,
+                    const LinearFog& fog, const SrgbEncoder& srgb, uint32_t* color);
 
 }   // namespace rnd::raster

@@ -176,4 +176,41 @@ inline void preparePlainKernel(const PlainTri& t, bool fog, const uint16_t* frag
     }
 }
 
+// SrgbEncoder::operator() per lane, branch-free and with one table lookup: values are clamped
+// to [2^-13, largest float below 1] first (which encode to 0 and 255 as smaller values, NaN and
+// values >= 1 do), then the bucket's packed word gives the byte and where in the bucket it
+// steps up (non-negative floats order like their bits).
+inline VI encodeSrgb(V x, const SrgbEncoder& t) {
+    x = vmin(vmax(x, set1(0x1p-13f)), set1(0x1.fffffep-1f));
+    const VI bits = castI(x);
+    const VI word = gatherI(reinterpret_cast<const int32_t*>(t.packed), srliI(subI(bits, set1I(0x39000000)), 15));
+    const VI step = addI(andI(bits, set1I(~0x7FFF)), andI(word, set1I(0xFFFF)));   // first float of byte + 1
+    return subI(srliI(word, 16), cmpgtI(bits, subI(step, set1I(1))));              // + 1 where bits >= step
+}
+
+inline void writeFragmentsKernel(const float* cr, const float* cg, const float* cb, const float* fogDist, const uint16_t* fragPixel, size_t n,
+                                 const LinearFog& fog, const SrgbEncoder& srgb, uint32_t* color) {
+    const V zero = zeroV(), one = set1(1.0f), fogEnd = set1(fog.end), fogRange = set1(fog.range);
+    const V fr = set1(fog.color.x), fg = set1(fog.color.y), fb = set1(fog.color.z);
+    const VI alpha = set1I(int32_t(0xFF000000u));
+    for (size_t k = 0; k < n; k += kW) {
+        V r = loadu(cr + k), g = loadu(cg + k), bl = loadu(cb + k);
+        if (fog.on) {
+            V vis = div(sub(fogEnd, loadu(fogDist + k)), fogRange);
+            // std::clamp(vis, 0, 1): vis < 0 ? 0 : (1 < vis ? 1 : vis) (NaN stays NaN)
+            const V lt = cmplt(vis, zero), gt = cmplt(one, vis);
+            vis = sel(lt, zero, sel(gt, one, vis));
+            const V rest = sub(one, vis);
+            r = add(mul(vis, r), mul(rest, fr));
+            g = add(mul(vis, g), mul(rest, fg));
+            bl = add(mul(vis, bl), mul(rest, fb));
+        }
+        const VI word = orI(orI(encodeSrgb(r, srgb), slliI(encodeSrgb(g, srgb), 8)), orI(slliI(encodeSrgb(bl, srgb), 16), alpha));
+        alignas(32) int32_t words[kW];
+        storeI(words, word);
+        const size_t m = std::min(n - k, kW);
+        for (size_t l = 0; l < m; ++l) color[fragPixel[k + l]] = uint32_t(words[l]);
+    }
+}
+
 // NOLINTEND

@@ -7,6 +7,8 @@
 #include "raster/tile_kernels.h"
 #include "raster/raster_core.h"
 #include "raster/simd.h"
+#include "raster/srgb_encoder.h"
+#include "renderers/shading.h"
 
 #include <gtest/gtest.h>
 
@@ -14,6 +16,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -273,4 +276,91 @@ TEST(RasterTileKernelTest, PlainFragmentsMatchTheScalarFormula) {
         }
     }
     EXPECT_GT(checked, 50000);
+}
+
+// Every float from 2^-14 to 1 (the range the encoder's buckets cover, and a little below it),
+// plus values outside [0, 1], NaN and infinities, through the output kernel without fog: the
+// byte SrgbEncoder::operator() gives (which is rnd::toByteSRGB's), in each of R, G and B.
+TEST(RasterTileKernelTest, OutputEncodesEveryFloatLikeTheScalarEncoder) {
+    const SrgbEncoder& enc = srgbEncoder();
+    constexpr size_t kBatch = 4096;
+    std::vector<float> r(kBatch + 8), g(kBatch + 8), b(kBatch + 8), fogDist(kBatch + 8, 0.0f);
+    std::vector<uint16_t> fragPixel(kBatch + 8);
+    for (size_t i = 0; i < kBatch + 8; ++i) fragPixel[i] = uint16_t(i % kBatch);
+    std::vector<uint32_t> color(kBatch);
+    auto check = [&](size_t n, const char* what) {
+        // G and B get the values in another order, so that each lane sees different buckets.
+        for (size_t i = 0; i < n; ++i) {
+            g[i] = r[n - 1 - i];
+            b[i] = r[(i * 7) % n];
+        }
+        writeFragments(r.data(), g.data(), b.data(), fogDist.data(), fragPixel.data(), n, LinearFog{}, enc, color.data());
+        for (size_t i = 0; i < n; ++i) {
+            const uint32_t want = uint32_t(enc(r[i])) | uint32_t(enc(g[i])) << 8 | uint32_t(enc(b[i])) << 16 | 0xFF000000u;
+            if (color[i] != want) {
+                ADD_FAILURE() << what << ": " << r[i] << " (bits " << std::hex << *reinterpret_cast<const uint32_t*>(&r[i]) << ") gives " << color[i]
+                              << ", want " << want;
+                return false;
+            }
+        }
+        return true;
+    };
+    size_t mismatchToByte = 0;
+    uint32_t bits = 0x38800000u;        // 2^-14
+    const uint32_t end = 0x3F800000u;   // 1.0
+    while (bits <= end) {
+        size_t n = 0;
+        for (; n < kBatch && bits <= end; ++n, ++bits) std::memcpy(&r[n], &bits, 4);
+        for (size_t i = 0; i < n; ++i) mismatchToByte += enc(r[i]) != rnd::toByteSRGB(r[i]);
+        ASSERT_TRUE(check(n, "float in [2^-14, 1]"));
+    }
+    EXPECT_EQ(mismatchToByte, 0u) << "SrgbEncoder and rnd::toByteSRGB disagree";
+    const float specials[] = {0.0f,
+                              -0.0f,
+                              -1.0f,
+                              1e-30f,
+                              0x1p-13f,
+                              1.0f,
+                              1.0000001f,
+                              2.0f,
+                              1e30f,
+                              std::numeric_limits<float>::infinity(),
+                              -std::numeric_limits<float>::infinity(),
+                              std::numeric_limits<float>::quiet_NaN(),
+                              0x1p-20f,
+                              0.5f};
+    size_t n = 0;
+    for (float v : specials) r[n++] = v;
+    EXPECT_TRUE(check(n, "special value"));
+}
+
+// Linear fog in the output kernel: the renderer's scalar formula (vis clamped to [0, 1]) on each
+// channel before encoding, distances before the start, inside and past the end.
+TEST(RasterTileKernelTest, OutputAppliesLinearFogLikeTheScalarFormula) {
+    const SrgbEncoder& enc = srgbEncoder();
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> P(0.0f, 1.0f);
+    const size_t n = 1003;
+    std::vector<float> r(n + 8), g(n + 8), b(n + 8), dist(n + 8);
+    std::vector<uint16_t> fragPixel(n + 8);
+    for (size_t i = 0; i < n + 8; ++i) {
+        r[i] = 1.2f * P(rng);
+        g[i] = P(rng);
+        b[i] = P(rng) * P(rng);
+        dist[i] = 60.0f * P(rng);
+        fragPixel[i] = uint16_t((i * 37) % 4096);
+    }
+    LinearFog fog;
+    fog.on = true;
+    fog.end = 40.0f;
+    fog.range = 40.0f - 5.0f;
+    fog.color = vec3(0.6f, 0.7f, 0.8f);
+    std::vector<uint32_t> color(4096, 0);
+    writeFragments(r.data(), g.data(), b.data(), dist.data(), fragPixel.data(), n, fog, enc, color.data());
+    for (size_t i = 0; i < n; ++i) {
+        const float vis = std::clamp((fog.end - dist[i]) / fog.range, 0.0f, 1.0f);
+        const vec3 c = vis * vec3(r[i], g[i], b[i]) + (1.0f - vis) * fog.color;
+        const uint32_t want = uint32_t(enc(c.x)) | uint32_t(enc(c.y)) << 8 | uint32_t(enc(c.z)) << 16 | 0xFF000000u;
+        ASSERT_EQ(color[fragPixel[i]], want) << "fragment " << i << " at distance " << dist[i];
+    }
 }
