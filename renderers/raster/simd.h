@@ -61,6 +61,10 @@ inline VI orI(VI a, VI b) { return _mm_or_si128(a, b); }
 inline VI selI(VI mask, VI a, VI b) { return _mm_or_si128(_mm_and_si128(mask, a), _mm_andnot_si128(mask, b)); }
 inline VI cmpgtI(VI a, VI b) { return _mm_cmpgt_epi32(a, b); }
 inline VI set1I(int x) { return _mm_set1_epi32(x); }
+// Whether the kW values at p all equal v.
+inline bool allEqualI(const int32_t* p, int32_t v) {
+    return _mm_movemask_epi8(_mm_cmpeq_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(p)), _mm_set1_epi32(v))) == 0xFFFF;
+}
 inline VI laneIndex() { return _mm_setr_epi32(0, 1, 2, 3); }
 inline VI loaduI(const void* p) { return _mm_loadu_si128(static_cast<const __m128i*>(p)); }
 inline void storeuI(void* p, VI a) { _mm_storeu_si128(static_cast<__m128i*>(p), a); }
@@ -95,7 +99,8 @@ inline V vmin(V a, V b) { return _mm256_min_ps(a, b); }
 inline V vsqrt(V a) { return _mm256_sqrt_ps(a); }
 inline V vand(V a, V b) { return _mm256_and_ps(a, b); }
 inline V vor(V a, V b) { return _mm256_or_ps(a, b); }
-inline V sel(V mask, V a, V b) { return _mm256_or_ps(_mm256_and_ps(mask, a), _mm256_andnot_ps(mask, b)); }
+// mask ? a : b per lane (masks are all ones or all zeros: blendv reads the sign bit only).
+inline V sel(V mask, V a, V b) { return _mm256_blendv_ps(b, a, mask); }
 inline V cmpgt(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_GT_OS); }
 inline V cmpge(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_GE_OS); }
 inline V cmplt(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_LT_OS); }
@@ -115,6 +120,9 @@ inline VI orI(VI a, VI b) { return _mm256_or_si256(a, b); }
 inline VI selI(VI mask, VI a, VI b) { return _mm256_blendv_epi8(b, a, mask); }
 inline VI cmpgtI(VI a, VI b) { return _mm256_cmpgt_epi32(a, b); }
 inline VI set1I(int x) { return _mm256_set1_epi32(x); }
+inline bool allEqualI(const int32_t* p, int32_t v) {
+    return _mm256_movemask_epi8(_mm256_cmpeq_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(p)), _mm256_set1_epi32(v))) == -1;
+}
 inline VI laneIndex() { return _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7); }
 inline VI loaduI(const void* p) { return _mm256_loadu_si256(static_cast<const __m256i*>(p)); }
 inline void storeuI(void* p, VI a) { _mm256_storeu_si256(static_cast<__m256i*>(p), a); }
