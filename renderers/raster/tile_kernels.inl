@@ -3,18 +3,67 @@
 // lane performs the scalar code's IEEE operations in the same order (see tile_kernels.h).
 // NOLINTBEGIN
 
+// The rows ja..jb of one block (a row of kV vectors starting at depth/ids + off): the edge values
+// of its vectors (ev) step by syv from row to row, and j - minY by 1.0 (exact: small integers),
+// so the z of a lane is the scalar code's (zRef + zdx (i - minX)) + zdy (j - minY). `full`: the
+// block lies inside all three edges (only the column masks apply).
+template <int kV>
+inline void blockRows(int ja, int jb, size_t off, int minY, bool full, const VI* colMask, const V* zx, VI (&ev)[3][kV], const VI (&syv)[3],
+                      int cBegin, int cEnd, V zdy, VI idv, float* depth, uint32_t* ids) {
+    const V zero = zeroV(), one = set1(1.0f);
+    const VI minusOne = set1I(-1);
+    V dj = set1(float(ja - minY));
+    for (int j = ja; j <= jb; ++j, off += kTileSize) {
+        const V zy = mul(zdy, dj);
+        dj = add(dj, one);
+        for (int c = cBegin; c < cEnd; ++c) {
+            VI m = colMask[c];
+            if (!full) m = andI(m, cmpgtI(orI(orI(ev[0][c], ev[1][c]), ev[2][c]), minusOne));   // all three >= 0
+            for (int k = 0; k < 3; ++k) ev[k][c] = addI(ev[k][c], syv[k]);
+            const V mf = castF(m);
+            if (movemask(mf) == 0) continue;
+            // clamp(z, 0, 1) as std::clamp: min(z, 1) takes 1 for NaN (which fails z < depth as NaN
+            // does), max(0, .) keeps -0.
+            const V z = vmax(zero, vmin(add(zx[c], zy), one));
+            float* dp = depth + off + size_t(c) * kW;
+            uint32_t* ip = ids + off + size_t(c) * kW;
+            const V d = loadu(dp);
+            const V pass = vand(mf, cmplt(z, d));
+            storeu(dp, sel(pass, z, d));
+            storeuI(ip, selI(castI(pass), idv, loaduI(ip)));
+        }
+    }
+}
+
+// The lanes of each vector of a block row starting at pixel bx that lie inside [ia, ib], the x
+// part of their z, zRef + zdx (i - minX), and the range of vectors that has any.
+template <int kV>
+inline void blockColumns(int bx, int ia, int ib, int minX, V zRef, V zdx, VI (&colMask)[kV], V (&zx)[kV], int& cBegin, int& cEnd) {
+    const VI lane = laneIndex();
+    cBegin = kV;
+    cEnd = 0;
+    for (int c = 0; c < kV; ++c) {
+        const int first = bx + c * int(kW);
+        const VI col = addI(set1I(first), lane);
+        colMask[c] = andI(cmpgtI(col, set1I(ia - 1)), cmpgtI(set1I(ib + 1), col));
+        zx[c] = add(zRef, mul(zdx, cvtF(addI(set1I(first - minX), lane))));
+        if (first <= ib && first + int(kW) - 1 >= ia) {
+            cBegin = std::min(cBegin, c);
+            cEnd = c + 1;
+        }
+    }
+}
+
 inline void rasterizeOpaqueKernel(const TriCoverage& s, const TriPlanes& pl, uint32_t id, int tx0, int ty0, int x0, int y0, int x1, int y1,
                                   float* depth, uint32_t* ids) {
     constexpr int kB = 8;                           // block size, as forEachCoveredPixel
     constexpr int kV = kB / int(kW);                // vectors per block row
     constexpr int64_t kInside = int64_t(1) << 30;   // an edge that holds over the whole block
     const PackedEdge* e = s.e;
-    int64_t sx[3], sy[3], hi[3], lo[3];
+    int64_t sx[3], sy[3];
     for (int k = 0; k < 3; ++k) {
         sx[k] = int64_t(e[k].a) * kSub;
         sy[k] = int64_t(e[k].b) * kSub;
-        hi[k] = std::max<int64_t>(sx[k], 0) * (kB - 1) + std::max<int64_t>(sy[k], 0) * (kB - 1);
-        lo[k] = std::min<int64_t>(sx[k], 0) * (kB - 1) + std::min<int64_t>(sy[k], 0) * (kB - 1);
     }
     // Edge k's change from a block row's first pixel to each lane's pixel (|.| < 2^30).
     // Built in registers (lane * sx from the lane index's bits): eight scalar stores read back as
@@ -28,9 +77,34 @@ inline void rasterizeOpaqueKernel(const TriCoverage& s, const TriPlanes& pl, uin
         const VI times = addI(addI(andI(bit1, set1I(s1)), andI(bit2, set1I(2 * s1))), andI(bit4, set1I(4 * s1)));
         for (int c = 0; c < kV; ++c) stepX[k][c] = addI(times, set1I(s1 * c * int(kW)));
     }
-    const VI minusOne = set1I(-1);
     const VI idv = set1I(int32_t(id));
-    const V zRef = set1(pl.zRef), zdx = set1(pl.zdx), zdy = set1(pl.zdy), zero = zeroV(), one = set1(1.0f);
+    const V zRef = set1(pl.zRef), zdx = set1(pl.zdx), zdy = set1(pl.zdy);
+    const VI syv[3] = {set1I(int32_t(sy[0])), set1I(int32_t(sy[1])), set1I(int32_t(sy[2]))};
+    // A small triangle (most of a detailed mesh's): every edge shorter than 16 pixels in |dx| + |dy|
+    // and its part in the tile at most 8 pixels wide: one block at (x0, y0), any number of rows,
+    // without the block tests. Its vertices lie within 16 pixels of every pixel of its bbox, so its
+    // edge values there stay below (16 * 256)^2: 32 bits. (The bbox alone would not do: a large
+    // triangle's bbox clipped to the viewport can be small.)
+    constexpr int64_t kShort = 16 * kSub;
+    if (x1 - x0 < kB && std::abs(int64_t(e[0].a)) + std::abs(int64_t(e[0].b)) < kShort &&
+        std::abs(int64_t(e[1].a)) + std::abs(int64_t(e[1].b)) < kShort && std::abs(int64_t(e[2].a)) + std::abs(int64_t(e[2].b)) < kShort) {
+        const int64_t px = int64_t(x0) * kSub + kHalf, py = int64_t(y0) * kSub + kHalf;
+        VI ev[3][kV];
+        for (int k = 0; k < 3; ++k)
+            for (int c = 0; c < kV; ++c) ev[k][c] = addI(set1I(int32_t(e[k].at(px, py))), stepX[k][c]);
+        VI colMask[kV];
+        V zx[kV];
+        int cBegin, cEnd;
+        blockColumns<kV>(x0, x0, x1, s.minX, zRef, zdx, colMask, zx, cBegin, cEnd);
+        blockRows<kV>(y0, y1, size_t(y0 - ty0) * kTileSize + size_t(x0 - tx0), s.minY, false, colMask, zx, ev, syv, cBegin, cEnd, zdy, idv, depth,
+                      ids);
+        return;
+    }
+    int64_t hi[3], lo[3];   // offsets from a block's first pixel to where each edge is largest / smallest
+    for (int k = 0; k < 3; ++k) {
+        hi[k] = std::max<int64_t>(sx[k], 0) * (kB - 1) + std::max<int64_t>(sy[k], 0) * (kB - 1);
+        lo[k] = std::min<int64_t>(sx[k], 0) * (kB - 1) + std::min<int64_t>(sy[k], 0) * (kB - 1);
+    }
     const bool small = (x1 - x0) < kB && (y1 - y0) < kB;
     for (int by = small ? y0 : (y0 & ~(kB - 1)); by <= y1; by += kB) {
         for (int bx = small ? x0 : (x0 & ~(kB - 1)); bx <= x1; bx += kB) {
@@ -39,52 +113,22 @@ inline void rasterizeOpaqueKernel(const TriCoverage& s, const TriPlanes& pl, uin
             for (int k = 0; k < 3; ++k) b[k] = e[k].at(px, py);
             if (b[0] + hi[0] < 0 || b[1] + hi[1] < 0 || b[2] + hi[2] < 0) continue;   // block outside an edge
             const bool full = b[0] + lo[0] >= 0 && b[1] + lo[1] >= 0 && b[2] + lo[2] >= 0;
-            // Not rejected: b >= -hi > -2^30. An edge that holds over the whole block may be far
-            // larger; it is clamped (it stays >= 0 over the block), so every value fits 32 bits.
-            int64_t row[3];   // at the current row's first pixel (within 32 bits on the block's rows)
-            for (int k = 0; k < 3; ++k) row[k] = b[k] + lo[k] >= 0 ? kInside : b[k];
             const int ia = std::max(bx, x0), ib = std::min(bx + kB - 1, x1);
             const int ja = std::max(by, y0), jb = std::min(by + kB - 1, y1);
-            for (int k = 0; k < 3; ++k) row[k] += sy[k] * (ja - by);
-            // Per vector: the lanes inside [ia, ib], and z's x part zRef + zdx * (i - minX).
+            // Not rejected: b >= -hi > -2^30. An edge that holds over the whole block may be far
+            // larger; it is clamped (it stays >= 0 over the block), so every value on the block's
+            // rows fits 32 bits.
+            VI ev[3][kV];
+            for (int k = 0; k < 3; ++k) {
+                const int64_t row = (b[k] + lo[k] >= 0 ? kInside : b[k]) + sy[k] * (ja - by);
+                for (int c = 0; c < kV; ++c) ev[k][c] = addI(set1I(int32_t(row)), stepX[k][c]);
+            }
             VI colMask[kV];
             V zx[kV];
-            int cBegin = kV, cEnd = 0;
-            for (int c = 0; c < kV; ++c) {
-                const int first = bx + c * int(kW);
-                const VI col = addI(set1I(first), lane);
-                colMask[c] = andI(cmpgtI(col, set1I(ia - 1)), cmpgtI(set1I(ib + 1), col));
-                zx[c] = add(zRef, mul(zdx, cvtF(addI(set1I(first - s.minX), lane))));
-                if (first <= ib && first + int(kW) - 1 >= ia) {
-                    cBegin = std::min(cBegin, c);
-                    cEnd = c + 1;
-                }
-            }
-            for (int j = ja; j <= jb; ++j) {
-                const V zy = mul(zdy, set1(float(j - s.minY)));
-                const size_t rowOff = size_t(j - ty0) * kTileSize + size_t(bx - tx0);
-                for (int c = cBegin; c < cEnd; ++c) {
-                    VI m = colMask[c];
-                    if (!full) {
-                        const VI e0 = addI(set1I(int32_t(row[0])), stepX[0][c]);
-                        const VI e1 = addI(set1I(int32_t(row[1])), stepX[1][c]);
-                        const VI e2 = addI(set1I(int32_t(row[2])), stepX[2][c]);
-                        m = andI(m, cmpgtI(orI(orI(e0, e1), e2), minusOne));   // all three >= 0
-                    }
-                    const V mf = castF(m);
-                    if (movemask(mf) == 0) continue;
-                    // clamp(z, 0, 1) as std::clamp: min(z, 1) takes 1 for NaN (which fails z < depth
-                    // as NaN does), max(0, .) keeps -0.
-                    const V z = vmax(zero, vmin(add(zx[c], zy), one));
-                    float* dp = depth + rowOff + size_t(c) * kW;
-                    uint32_t* ip = ids + rowOff + size_t(c) * kW;
-                    const V d = loadu(dp);
-                    const V pass = vand(mf, cmplt(z, d));
-                    storeu(dp, sel(pass, z, d));
-                    storeuI(ip, selI(castI(pass), idv, loaduI(ip)));
-                }
-                for (int k = 0; k < 3; ++k) row[k] += sy[k];
-            }
+            int cBegin, cEnd;
+            blockColumns<kV>(bx, ia, ib, s.minX, zRef, zdx, colMask, zx, cBegin, cEnd);
+            blockRows<kV>(ja, jb, size_t(ja - ty0) * kTileSize + size_t(bx - tx0), s.minY, full, colMask, zx, ev, syv, cBegin, cEnd, zdy, idv, depth,
+                          ids);
         }
     }
 }

@@ -156,6 +156,50 @@ TEST(RasterTileKernelTest, OpaqueCoverageAtThe32BitLimit) {
     EXPECT_GT(tested, 100);
 }
 
+// Large triangles whose part inside the viewport is a few pixels (a corner or an edge of the
+// image): their bbox is clipped to the viewport and small, but their edge functions are not.
+TEST(RasterTileKernelTest, OpaqueCoverageOfLargeTrianglesClippedToASmallCorner) {
+    std::mt19937 rng(8);
+    std::uniform_real_distribution<float> U(0.0f, 1.0f);
+    int tested = 0;
+    for (int iter = 0; iter < 400; ++iter) {
+        // Right angle a few pixels inside the bottom-left (or top-right) corner, the other two
+        // vertices far outside the image: the bbox clipped to the viewport is a few pixels, the
+        // edges are hundreds of pixels long (up to ~1150: the 32-bit path).
+        const float far = 150 + 400 * U(rng), reach = 2 + 5 * U(rng);
+        float xs[3] = {-far, reach, reach}, ys[3] = {reach, reach, -far};
+        if (iter % 2) {
+            for (int k = 0; k < 3; ++k) {
+                xs[k] = W - xs[k];
+                ys[k] = H - ys[k];
+            }
+        }
+        xs[1] += U(rng);
+        ys[2] += U(rng);
+        TriSetup ts;
+        if (!setupTriangle(xs, ys, W, H, ts)) continue;
+        TriCoverage cov;
+        cov.set(ts);
+        if (!coverageFits32(cov)) continue;
+        const float z[3] = {0.2f, 0.5f, 0.7f}, iw[3] = {1, 1, 1};
+        const TriPlanes pl = makeTriPlanes(ts, z, iw);
+        // The tile of the image corner the triangle reaches.
+        const int tx0 = iter % 2 ? (W - 1) & ~(kTileSize - 1) : 0, ty0 = iter % 2 ? (H - 1) & ~(kTileSize - 1) : 0;
+        const int rx0 = std::max(tx0, int(cov.minX)), rx1 = std::min(std::min(tx0 + kTileSize, W) - 1, int(cov.maxX));
+        const int ry0 = std::max(ty0, int(cov.minY)), ry1 = std::min(std::min(ty0 + kTileSize, H) - 1, int(cov.maxY));
+        if (rx0 > rx1 || ry0 > ry1) continue;
+        std::vector<float> depthA(kTileValues, 1.0f), depthB(kTileValues, 1.0f);
+        std::vector<uint32_t> idsA(kTileValues, 0xFFFFFFFFu), idsB(kTileValues, 0xFFFFFFFFu);
+        rasterizeScalar(cov, pl, 9, tx0, ty0, rx0, ry0, rx1, ry1, depthA.data(), idsA.data());
+        rasterizeOpaque(cov, pl, 9, tx0, ty0, rx0, ry0, rx1, ry1, depthB.data(), idsB.data());
+        ASSERT_TRUE(sameBits(depthA, depthB)) << "iteration " << iter << ", bbox " << cov.minX << ".." << cov.maxX << " x " << cov.minY << ".."
+                                              << cov.maxY;
+        ASSERT_EQ(idsA, idsB) << "iteration " << iter;
+        tested += std::count(idsA.begin(), idsA.end(), 9u) > 0;
+    }
+    EXPECT_GT(tested, 300);
+}
+
 namespace {
 
 // The renderer's scalar preparation of a plain fragment (prepareSimple with baryAt), written out.
