@@ -129,13 +129,16 @@ inline bool setupTriangle(const float wx[3], const float wy[3], int width, int h
     int32_t lo = msaa ? 32 : kHalf, hi = msaa ? 224 : kHalf;
     int32_t fx0 = std::min({x[0], x[1], x[2]}), fx1 = std::max({x[0], x[1], x[2]});
     int32_t fy0 = std::min({y[0], y[1], y[2]}), fy1 = std::max({y[0], y[1], y[2]});
-    // smallest i with i*kSub + hi >= fx0 ; largest i with i*kSub + lo <= fx1
-    auto ceilDiv = [](int64_t a, int64_t b) { return a >= 0 ? (a + b - 1) / b : -((-a) / b); };
-    auto floorDiv = [](int64_t a, int64_t b) { return a >= 0 ? a / b : -((-a + b - 1) / b); };
-    t.minX = int(std::max<int64_t>(0, ceilDiv(int64_t(fx0) - hi, kSub)));
-    t.maxX = int(std::min<int64_t>(width - 1, floorDiv(int64_t(fx1) - lo, kSub)));
-    t.minY = int(std::max<int64_t>(0, ceilDiv(int64_t(fy0) - hi, kSub)));
-    t.maxY = int(std::min<int64_t>(height - 1, floorDiv(int64_t(fy1) - lo, kSub)));
+    // smallest i with i*kSub + hi >= fx0 ; largest i with i*kSub + lo <= fx1. kSub is a power of
+    // two: floor division is an arithmetic shift (also for negative values), ceil(a / kSub) =
+    // floor((a + kSub - 1) / kSub).
+    static_assert((kSub & (kSub - 1)) == 0, "kSub is a power of two");
+    auto ceilDiv = [](int64_t a) { return (a + kSub - 1) >> kSubBits; };
+    auto floorDiv = [](int64_t a) { return a >> kSubBits; };
+    t.minX = int(std::max<int64_t>(0, ceilDiv(int64_t(fx0) - hi)));
+    t.maxX = int(std::min<int64_t>(width - 1, floorDiv(int64_t(fx1) - lo)));
+    t.minY = int(std::max<int64_t>(0, ceilDiv(int64_t(fy0) - hi)));
+    t.maxY = int(std::min<int64_t>(height - 1, floorDiv(int64_t(fy1) - lo)));
     if (t.minX > t.maxX || t.minY > t.maxY) return false;
     for (int i = 0; i < 3; ++i) {
         int j = (i + 1) % 3;
