@@ -3,54 +3,52 @@
 // lane performs the scalar code's IEEE operations in the same order (see tile_kernels.h).
 // NOLINTBEGIN
 
-// The rows ja..jb of one block (a row of kV vectors starting at depth/ids + off): the edge values
-// of its vectors (ev) step by syv from row to row, and j - minY by 1.0 (exact: small integers),
-// so the z of a lane is the scalar code's (zRef + zdx (i - minX)) + zdy (j - minY). `full`: the
-// block lies inside all three edges (only the column masks apply).
-template <int kV>
-inline void blockRows(int ja, int jb, size_t off, int minY, bool full, const VI* colMask, const V* zx, VI (&ev)[3][kV], const VI (&syv)[3],
-                      int cBegin, int cEnd, V zdy, VI idv, float* depth, uint32_t* ids) {
+// The rows ja..jb of one vector column of a block (kW pixels from depth/ids + off): e0..e2 are
+// the edge values of its lanes on row ja and step by sy0..sy2 from row to row, and j - minY by
+// 1.0 (exact: small integers), so the z of a lane is the scalar code's
+// (zRef + zdx (i - minX)) + zdy (j - minY), zx holding the first part. colMask: the lanes inside
+// the rectangle; `full`: the column lies inside all three edges (only colMask applies).
+// Everything by value, so that it stays in registers.
+inline void columnRows(int ja, int jb, size_t off, int minY, bool full, VI colMask, V zx, VI e0, VI e1, VI e2, VI sy0, VI sy1, VI sy2, V zdy, VI idv,
+                       float* depth, uint32_t* ids) {
     const V zero = zeroV(), one = set1(1.0f);
     const VI minusOne = set1I(-1);
     V dj = set1(float(ja - minY));
     for (int j = ja; j <= jb; ++j, off += kTileSize) {
         const V zy = mul(zdy, dj);
         dj = add(dj, one);
-        for (int c = cBegin; c < cEnd; ++c) {
-            VI m = colMask[c];
-            if (!full) m = andI(m, cmpgtI(orI(orI(ev[0][c], ev[1][c]), ev[2][c]), minusOne));   // all three >= 0
-            for (int k = 0; k < 3; ++k) ev[k][c] = addI(ev[k][c], syv[k]);
-            const V mf = castF(m);
-            if (movemask(mf) == 0) continue;
-            // clamp(z, 0, 1) as std::clamp: min(z, 1) takes 1 for NaN (which fails z < depth as NaN
-            // does), max(0, .) keeps -0.
-            const V z = vmax(zero, vmin(add(zx[c], zy), one));
-            float* dp = depth + off + size_t(c) * kW;
-            uint32_t* ip = ids + off + size_t(c) * kW;
-            const V d = loadu(dp);
-            const V pass = vand(mf, cmplt(z, d));
-            storeu(dp, sel(pass, z, d));
-            storeuI(ip, selI(castI(pass), idv, loaduI(ip)));
-        }
+        const VI m = full ? colMask : andI(colMask, cmpgtI(orI(orI(e0, e1), e2), minusOne));   // all three >= 0
+        e0 = addI(e0, sy0);
+        e1 = addI(e1, sy1);
+        e2 = addI(e2, sy2);
+        const V mf = castF(m);
+        if (movemask(mf) == 0) continue;
+        // clamp(z, 0, 1) as std::clamp: min(z, 1) takes 1 for NaN (which fails z < depth as NaN
+        // does), max(0, .) keeps -0.
+        const V z = vmax(zero, vmin(add(zx, zy), one));
+        const V d = loadu(depth + off);
+        const V pass = vand(mf, cmplt(z, d));
+        storeu(depth + off, sel(pass, z, d));
+        storeuI(ids + off, selI(castI(pass), idv, loaduI(ids + off)));
     }
 }
 
-// The lanes of each vector of a block row starting at pixel bx that lie inside [ia, ib], the x
-// part of their z, zRef + zdx (i - minX), and the range of vectors that has any.
+// The vector columns of a block whose first pixel is (bx, ja) (blocks are kB = 8 pixels wide:
+// one AVX2 vector, two SSE2 ones): each column that has a pixel in [ia, ib] runs columnRows.
+// e[k]: edge k's value at the block row's first pixel (32 bits), stepX[k][c]: its change to each
+// lane of column c.
 template <int kV>
-inline void blockColumns(int bx, int ia, int ib, int minX, V zRef, V zdx, VI (&colMask)[kV], V (&zx)[kV], int& cBegin, int& cEnd) {
+inline void blockRows(int bx, int ia, int ib, int ja, int jb, int tx0, int ty0, const TriCoverage& s, bool full, const int32_t (&e)[3],
+                      const VI (&stepX)[3][kV], const VI (&syv)[3], V zRef, V zdx, V zdy, VI idv, float* depth, uint32_t* ids) {
     const VI lane = laneIndex();
-    cBegin = kV;
-    cEnd = 0;
     for (int c = 0; c < kV; ++c) {
         const int first = bx + c * int(kW);
+        if (first > ib || first + int(kW) - 1 < ia) continue;
         const VI col = addI(set1I(first), lane);
-        colMask[c] = andI(cmpgtI(col, set1I(ia - 1)), cmpgtI(set1I(ib + 1), col));
-        zx[c] = add(zRef, mul(zdx, cvtF(addI(set1I(first - minX), lane))));
-        if (first <= ib && first + int(kW) - 1 >= ia) {
-            cBegin = std::min(cBegin, c);
-            cEnd = c + 1;
-        }
+        const VI colMask = andI(cmpgtI(col, set1I(ia - 1)), cmpgtI(set1I(ib + 1), col));
+        const V zx = add(zRef, mul(zdx, cvtF(addI(set1I(first - s.minX), lane))));
+        columnRows(ja, jb, size_t(ja - ty0) * kTileSize + size_t(first - tx0), s.minY, full, colMask, zx, addI(set1I(e[0]), stepX[0][c]),
+                   addI(set1I(e[1]), stepX[1][c]), addI(set1I(e[2]), stepX[2][c]), syv[0], syv[1], syv[2], zdy, idv, depth, ids);
     }
 }
 
@@ -89,15 +87,8 @@ inline void rasterizeOpaqueKernel(const TriCoverage& s, const TriPlanes& pl, uin
     if (x1 - x0 < kB && std::abs(int64_t(e[0].a)) + std::abs(int64_t(e[0].b)) < kShort &&
         std::abs(int64_t(e[1].a)) + std::abs(int64_t(e[1].b)) < kShort && std::abs(int64_t(e[2].a)) + std::abs(int64_t(e[2].b)) < kShort) {
         const int64_t px = int64_t(x0) * kSub + kHalf, py = int64_t(y0) * kSub + kHalf;
-        VI ev[3][kV];
-        for (int k = 0; k < 3; ++k)
-            for (int c = 0; c < kV; ++c) ev[k][c] = addI(set1I(int32_t(e[k].at(px, py))), stepX[k][c]);
-        VI colMask[kV];
-        V zx[kV];
-        int cBegin, cEnd;
-        blockColumns<kV>(x0, x0, x1, s.minX, zRef, zdx, colMask, zx, cBegin, cEnd);
-        blockRows<kV>(y0, y1, size_t(y0 - ty0) * kTileSize + size_t(x0 - tx0), s.minY, false, colMask, zx, ev, syv, cBegin, cEnd, zdy, idv, depth,
-                      ids);
+        const int32_t ev[3] = {int32_t(e[0].at(px, py)), int32_t(e[1].at(px, py)), int32_t(e[2].at(px, py))};
+        blockRows<kV>(x0, x0, x1, y0, y1, tx0, ty0, s, false, ev, stepX, syv, zRef, zdx, zdy, idv, depth, ids);
         return;
     }
     int64_t hi[3], lo[3];   // offsets from a block's first pixel to where each edge is largest / smallest
@@ -118,17 +109,9 @@ inline void rasterizeOpaqueKernel(const TriCoverage& s, const TriPlanes& pl, uin
             // Not rejected: b >= -hi > -2^30. An edge that holds over the whole block may be far
             // larger; it is clamped (it stays >= 0 over the block), so every value on the block's
             // rows fits 32 bits.
-            VI ev[3][kV];
-            for (int k = 0; k < 3; ++k) {
-                const int64_t row = (b[k] + lo[k] >= 0 ? kInside : b[k]) + sy[k] * (ja - by);
-                for (int c = 0; c < kV; ++c) ev[k][c] = addI(set1I(int32_t(row)), stepX[k][c]);
-            }
-            VI colMask[kV];
-            V zx[kV];
-            int cBegin, cEnd;
-            blockColumns<kV>(bx, ia, ib, s.minX, zRef, zdx, colMask, zx, cBegin, cEnd);
-            blockRows<kV>(ja, jb, size_t(ja - ty0) * kTileSize + size_t(bx - tx0), s.minY, full, colMask, zx, ev, syv, cBegin, cEnd, zdy, idv, depth,
-                          ids);
+            int32_t ev[3];
+            for (int k = 0; k < 3; ++k) ev[k] = int32_t((b[k] + lo[k] >= 0 ? kInside : b[k]) + sy[k] * (ja - by));
+            blockRows<kV>(bx, ia, ib, ja, jb, tx0, ty0, s, full, ev, stepX, syv, zRef, zdx, zdy, idv, depth, ids);
         }
     }
 }
