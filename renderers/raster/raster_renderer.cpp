@@ -9,9 +9,12 @@
 //                 far exactly, x/y outside a guard band), perspective divide, viewport, fixed-
 //                 point setup, culling, binning into 64x64 tiles
 //   4. tiles      per tile, in parallel: rasterize the tile's triangles in order into a
-//                 visibility buffer (depth LESS + triangle id per pixel or per MSAA sample),
-//                 then shade each visible fragment once (deferred): perspective-correct
-//                 barycentrics -> attributes -> rnd::shade / applyFog -> sRGB bytes
+//                 visibility buffer (depth LESS + an index into the tile's triangle list per
+//                 pixel or per MSAA sample), group the visible fragments by triangle, then
+//                 shade each once (deferred): perspective-correct barycentrics -> attributes
+//                 -> rnd::shade / applyFog -> sRGB bytes. The hot loops (coverage, plain
+//                 fragments' attributes, lighting, output) are vector kernels, AVX2 or SSE2
+//                 (tile_kernels.h, raster_shading.h), equal bit for bit to the scalar code.
 //   5. lines      Lines/Points meshes and the wireframe overlay with the DDA line rasterizer
 // SSAA renders at aaRate x the size and box-filters down; MSAA 4x keeps 4 samples per pixel
 // (coverage + depth per sample) and shades once per pixel and triangle at the pixel centre.
