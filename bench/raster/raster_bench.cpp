@@ -5,7 +5,7 @@
 //   cmake --build build/release -j2 --target bench_raster
 //   ./build/release/bench/raster/bench_raster [--quick] [--threads 2] [--frames 15]
 //        [--size 1280x720] [--shading phong|gouraud|flat] [--fog on|off] [--scenes a,b,...]
-//        [--no-gl | --gl-only [--gl-side ours|minimal]]
+//        [--no-gl | --gl-only [--gl-side ours|minimal]] [--mesh FILE ...]
 //
 // Prints one line per scene and metric:
 //   bench: scene=<name> what=<metric> ours=<x> ref=<y> ratio=<ours/ref>
@@ -33,7 +33,10 @@
 // Scenes: mesh10k / mesh100k / mesh1M (one mesh: a uv-sphere grid and its ground plane merged
 // into a single draw, one point light), spheres10k / spheres100k / spheres1M (the same kind of
 // grid as instances of one sphere mesh, plus a ground plane and a directional light) and bunny
-// (stanford-bunny.obj from shared/testdata, read by a tiny OBJ reader below).
+// (stanford-bunny.obj from shared/testdata, read by a tiny OBJ reader below). --mesh FILE (any
+// number) adds a scene of that mesh file, read by the viewer's importer and framed like the
+// bunny, named after the file (with --scenes NAME,... selecting the built-in ones: --scenes none
+// runs only the files).
 // LP_NUM_THREADS is set before any GL context is created; tbb is limited to the same count.
 // --quick: fewer frames and 960x540 (finishes well under a minute). --no-gl: raster only (for
 // profiling it, e.g. perf record ... bench_raster --no-gl --scenes mesh1M). --gl-only: our GL
@@ -41,6 +44,7 @@
 // --gl-side ours|minimal only one of them runs, for a profiler to count one side's instructions
 // (valgrind --tool=callgrind bench_raster --gl-only --gl-side ours --frames N: the difference
 // between two frame counts is the cost of those frames).
+#include "assets/scene_io.h"
 #include "min_gl.h"
 #include "raster/raster_shading.h"
 #include "renderers/renderer.h"
@@ -185,15 +189,11 @@ BenchScene singleMesh(const std::string& name, int grid, int seg, int groundSub)
     return b;
 }
 
-bool bunnyScene(BenchScene& b) {
-    b.name = "bunny";
-    auto m = std::make_shared<Mesh>();
-    std::string path = std::string(VIEWER_TESTDATA_DIR) + "/meshes/common-3d-test-models/stanford-bunny/stanford-bunny.obj";
-    if (const char* env = std::getenv("VIEWER_TESTDATA")) path = std::string(env) + "/meshes/common-3d-test-models/stanford-bunny/stanford-bunny.obj";
-    if (!readObj(path, *m)) {
-        std::fprintf(stderr, "bench: %s: cannot read (skipping the bunny scene)\n", path.c_str());
-        return false;
-    }
+// One mesh on a ground plane, scaled to a 2-unit diagonal, seen from the front with a point light
+// (the bunny scene, and --mesh FILE).
+BenchScene meshScene(const std::string& name, std::shared_ptr<Mesh> m) {
+    BenchScene b;
+    b.name = name;
     Scene& s = b.scene;
     Aabb bb = m->bounds();
     auto ground = std::make_shared<Mesh>(primitives::plane(1.0f, 32));
@@ -201,7 +201,7 @@ bool bunnyScene(BenchScene& b) {
     Material mb;
     mb.baseColor = vec3(0.75f, 0.7f, 0.6f);
     s.materials = {mb};
-    NodeId n = s.addNode("bunny", s.root(), MeshInstance{0, 0});
+    NodeId n = s.addNode(name, s.root(), MeshInstance{0, 0});
     float scale = 2.0f / glm::length(bb.extent());
     s.setLocal(n, LocalTransform::fromTRS(-bb.center() * scale + vec3(0, 0.5f * bb.extent().y * scale, 0), quat(1, 0, 0, 0), vec3(scale)));
     s.addNode("ground", s.root(), MeshInstance{1, 0});
@@ -214,6 +214,32 @@ bool bunnyScene(BenchScene& b) {
     NodeId key = s.addNode("key", s.root(), Light{LightType::Point, vec3(1.0f), 1.0f, false});
     s.setLocal(key, LocalTransform::fromTRS(vec3(1, 3, 2)));
     b.triangles = m->triangleCount() + ground->triangleCount();
+    return b;
+}
+
+bool bunnyScene(BenchScene& b) {
+    auto m = std::make_shared<Mesh>();
+    std::string path = std::string(VIEWER_TESTDATA_DIR) + "/meshes/common-3d-test-models/stanford-bunny/stanford-bunny.obj";
+    if (const char* env = std::getenv("VIEWER_TESTDATA")) path = std::string(env) + "/meshes/common-3d-test-models/stanford-bunny/stanford-bunny.obj";
+    if (!readObj(path, *m)) {
+        std::fprintf(stderr, "bench: %s: cannot read (skipping the bunny scene)\n", path.c_str());
+        return false;
+    }
+    b = meshScene("bunny", m);
+    return true;
+}
+
+// --mesh FILE: any mesh file the viewer reads (OBJ, OFF, PLY, STL; the first mesh of a glTF),
+// through the viewer's own importer (normals as it makes them), framed like the bunny.
+bool fileScene(const std::string& path, BenchScene& b) {
+    assets::LoadResult r = assets::loadScene(path);
+    if (!r.scene || r.scene->meshes.empty() || !r.scene->meshes.front() || r.scene->meshes.front()->triangleCount() == 0) {
+        std::fprintf(stderr, "bench: %s: %s\n", path.c_str(), r.scene ? "no triangle mesh" : r.error.c_str());
+        return false;
+    }
+    std::string name = path.substr(path.find_last_of('/') + 1);
+    name = name.substr(0, name.find_last_of('.'));
+    b = meshScene(name, r.scene->meshes.front());
     return true;
 }
 
@@ -339,6 +365,7 @@ int main(int argc, char** argv) {
     bool quick = false, noGl = false, glOnly = false;
     int threads = 2, frames = 15, w = 1280, h = 720;
     std::string shading = "phong", fog = "on", only, glSide = "both";
+    std::vector<std::string> meshFiles;
     for (int i = 1; i < argc; ++i) {
         std::string a = argv[i];
         auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
@@ -362,6 +389,8 @@ int main(int argc, char** argv) {
             fog = next();
         else if (a == "--scenes")
             only = next();
+        else if (a == "--mesh")
+            meshFiles.push_back(next());
         else {
             std::fprintf(stderr, "bench: unknown argument %s\n", a.c_str());
             return 2;
@@ -397,6 +426,11 @@ int main(int argc, char** argv) {
     if (want("bunny")) {
         BenchScene b;
         if (bunnyScene(b)) scenes.push_back(std::move(b));
+    }
+    for (const std::string& file : meshFiles) {
+        BenchScene b;
+        if (!fileScene(file, b)) return 1;
+        scenes.push_back(std::move(b));
     }
 
     std::printf("# raster vs minimal GL and gl backend (llvmpipe): %dx%d, %d threads, shading=%s fog=%s, median of %d frames\n", w, h, threads,
