@@ -692,6 +692,7 @@ struct TileBuffers {
     std::vector<uint32_t> ids;
     std::vector<uint32_t> tileTris;
     std::vector<uint32_t> runStart;                                                       // per entry of tileTris: its fragments' first slot
+    std::vector<uint32_t> runEnd;                                                         // per entry of tileTris: one past its fragments\' last slot
     std::vector<FragRun> runs;                                                            // the fragments, grouped by triangle
     std::vector<uint64_t> rowRuns = std::vector<uint64_t>(kTileSize);                     // per row: bit i = a run of equal ids starts at pixel i
     std::vector<uint32_t> color = std::vector<uint32_t>(size_t(kTileSize) * kTileSize);   // RGBA8 of the tile (one sample per pixel)
@@ -855,15 +856,21 @@ void shadeOpaque(const FrameContext& fc, Framebuffer& target, TileBuffers& buf, 
         // Fragments grouped by triangle, in the tile's submission order, each triangle's pixels in
         // row order (a counting sort): the preparation below loads each triangle once and takes
         // its fragments a vector at a time.
+        buf.runEnd.resize(nt);
+        uint32_t* end = buf.runEnd.data();
         uint32_t pos = 0;
         for (uint32_t l = 0; l < nt; ++l) {
             const uint32_t count = start[l];
             start[l] = pos;
             if (count) runs.push_back(FragRun{tileTris[l], pos, count});
             pos += count;
+            end[l] = pos;
         }
         nf = pos;
         uint16_t* fragPixel = buf.fragPixel.data();
+#if defined(RASTER_HAVE_SSE2)
+        const __m128i iota = _mm_setr_epi16(0, 1, 2, 3, 4, 5, 6, 7);
+#endif
         for (int jj = 0; jj < th; ++jj) {
             const uint32_t* ids = &buf.ids[size_t(jj) * kTileSize];
             for (uint64_t m = buf.rowRuns[size_t(jj)]; m;) {
@@ -872,9 +879,21 @@ void shadeOpaque(const FrameContext& fc, Framebuffer& target, TileBuffers& buf, 
                 const int ie = m ? __builtin_ctzll(m) : tw;
                 const uint32_t id = ids[ib];
                 if (id == kNoTri) continue;
-                uint16_t* outSlots = fragPixel + start[id];
-                start[id] += uint32_t(ie - ib);
-                for (int ii = ib; ii < ie; ++ii) *outSlots++ = uint16_t(jj * kTileSize + ii);
+                const uint32_t slot = start[id], len = uint32_t(ie - ib);
+                start[id] = slot + len;
+                const int first = jj * kTileSize + ib;
+#if defined(RASTER_HAVE_SSE2)
+                // Whole vectors of 8 indices where they stay inside this triangle's slots: what
+                // they write past the run is rewritten by its later runs (a loop per run
+                // mispredicts its exit).
+                if (slot + ((len + 7) & ~7u) <= end[id]) {
+                    for (uint32_t q = 0; q < len; q += 8)
+                        _mm_storeu_si128(reinterpret_cast<__m128i*>(fragPixel + slot + q),
+                                         _mm_add_epi16(iota, _mm_set1_epi16(short(first + int(q)))));
+                    continue;
+                }
+#endif
+                for (uint32_t q = 0; q < len; ++q) fragPixel[slot + q] = uint16_t(first + int(q));
             }
         }
     } else {
