@@ -99,7 +99,8 @@ inline int32_t toFixed(float v) {
 // Sets up the triangle with window-space vertices (x, y) for a width x height viewport.
 // Returns false when it is degenerate (zero area) or its bounding box misses every pixel
 // centre (or sample, with `msaa`). Coordinates must lie within the guard band.
-inline bool setupTriangle(const float wx[3], const float wy[3], int width, int height, TriSetup& t, bool msaa = false) {
+__attribute__((always_inline)) inline bool setupTriangle(const float wx[3], const float wy[3], int width, int height, TriSetup& t,
+                                                         bool msaa = false) {
     int32_t x[3], y[3];
     for (int i = 0; i < 3; ++i) {
         x[i] = toFixed(wx[i]);
