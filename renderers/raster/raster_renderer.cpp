@@ -739,10 +739,29 @@ void renderTile(int tile, const FrameContext& fc, Framebuffer& target, TileBuffe
     const int x0 = tx * kTileSize, y0 = ty * kTileSize;
     const int x1 = std::min(x0 + kTileSize, fc.width) - 1, y1 = std::min(y0 + kTileSize, fc.height) - 1;
     const int samples = fc.msaa ? 4 : 1;
+    const auto& chunks = *fc.chunks;
+    // No triangle touches the tile (sky, margins): background and far depth straight into the
+    // framebuffer, without the tile's buffers.
+    bool empty = true;
+    for (const Chunk& ch : chunks) empty = empty && ch.tileStart[tile] == ch.tileStart[tile + 1];
+    if (empty) {
+        const SrgbEncoder& enc = srgbEncoder();
+        const vec3 bg = fc.frame->settings.background;
+        const uint8_t bgPixel[4] = {enc(bg.x), enc(bg.y), enc(bg.z), 255};
+        uint32_t bgWord;
+        std::memcpy(&bgWord, bgPixel, 4);
+        for (int j = y0; j <= y1; ++j) {
+            const int row = fc.height - 1 - j;
+            uint8_t* out = target.pixel(x0, row);
+            for (int i = x0; i <= x1; ++i, out += 4) std::memcpy(out, &bgWord, 4);
+            std::fill_n(&target.depth[size_t(row) * fc.width + x0], x1 - x0 + 1, 1.0f);
+        }
+        if (fc.timing) g_rasterNs += nowNs() - tA;
+        return;
+    }
     const size_t n = size_t(kTileSize) * kTileSize * samples;
     buf.depth.assign(n + kTilePad, 1.0f);
     buf.ids.assign(n + kTilePad, kNoTri);
-    const auto& chunks = *fc.chunks;
     buf.blendTris.clear();
     buf.tileTris.clear();
     TriCache masked;
