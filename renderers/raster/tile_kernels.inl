@@ -52,6 +52,21 @@ inline void blockRows(int bx, int ia, int ib, int ja, int jb, int tx0, int ty0, 
     }
 }
 
+// Edge k's change from a block row's first pixel to each lane's pixel, for each vector column c
+// (|.| < 2^30 where used). Built in registers (lane * sx from the lane index's bits): eight
+// scalar stores read back as one vector stall on store forwarding.
+template <int kV>
+inline void laneSteps(const int64_t (&sx)[3], VI (&stepX)[3][kV]) {
+    const VI lane = laneIndex();
+    const VI bit1 = cmpgtI(andI(lane, set1I(1)), set1I(0)), bit2 = cmpgtI(andI(lane, set1I(2)), set1I(0));
+    const VI bit4 = cmpgtI(andI(lane, set1I(4)), set1I(0));
+    for (int k = 0; k < 3; ++k) {
+        const int32_t s1 = int32_t(sx[k]);
+        const VI times = addI(addI(andI(bit1, set1I(s1)), andI(bit2, set1I(2 * s1))), andI(bit4, set1I(4 * s1)));
+        for (int c = 0; c < kV; ++c) stepX[k][c] = addI(times, set1I(s1 * c * int(kW)));
+    }
+}
+
 inline void rasterizeOpaqueKernel(const TriCoverage& s, const TriPlanes& pl, uint32_t id, int tx0, int ty0, int x0, int y0, int x1, int y1,
                                   float* depth, uint32_t* ids) {
     constexpr int kB = 8;                           // block size, as forEachCoveredPixel
@@ -63,34 +78,29 @@ inline void rasterizeOpaqueKernel(const TriCoverage& s, const TriPlanes& pl, uin
         sx[k] = int64_t(e[k].a) * kSub;
         sy[k] = int64_t(e[k].b) * kSub;
     }
-    // Edge k's change from a block row's first pixel to each lane's pixel (|.| < 2^30).
-    // Built in registers (lane * sx from the lane index's bits): eight scalar stores read back as
-    // one vector stall on store forwarding.
-    const VI lane = laneIndex();
-    const VI bit1 = cmpgtI(andI(lane, set1I(1)), set1I(0)), bit2 = cmpgtI(andI(lane, set1I(2)), set1I(0));
-    const VI bit4 = cmpgtI(andI(lane, set1I(4)), set1I(0));
-    VI stepX[3][kV];
-    for (int k = 0; k < 3; ++k) {
-        const int32_t s1 = int32_t(sx[k]);
-        const VI times = addI(addI(andI(bit1, set1I(s1)), andI(bit2, set1I(2 * s1))), andI(bit4, set1I(4 * s1)));
-        for (int c = 0; c < kV; ++c) stepX[k][c] = addI(times, set1I(s1 * c * int(kW)));
-    }
-    const VI idv = set1I(int32_t(id));
-    const V zRef = set1(pl.zRef), zdx = set1(pl.zdx), zdy = set1(pl.zdy);
-    const VI syv[3] = {set1I(int32_t(sy[0])), set1I(int32_t(sy[1])), set1I(int32_t(sy[2]))};
     // A small triangle (most of a detailed mesh's): every edge shorter than 16 pixels in |dx| + |dy|
     // and its part in the tile at most 8 pixels wide: one block at (x0, y0), any number of rows,
     // without the block tests. Its vertices lie within 16 pixels of every pixel of its bbox, so its
     // edge values there stay below (16 * 256)^2: 32 bits. (The bbox alone would not do: a large
-    // triangle's bbox clipped to the viewport can be small.)
+    // triangle's bbox clipped to the viewport can be small.) Tested first, so that its path sets
+    // up only what it uses.
     constexpr int64_t kShort = 16 * kSub;
     if (x1 - x0 < kB && std::abs(int64_t(e[0].a)) + std::abs(int64_t(e[0].b)) < kShort &&
         std::abs(int64_t(e[1].a)) + std::abs(int64_t(e[1].b)) < kShort && std::abs(int64_t(e[2].a)) + std::abs(int64_t(e[2].b)) < kShort) {
+        VI stepX[3][kV];
+        laneSteps<kV>(sx, stepX);
+        const VI syv[3] = {set1I(int32_t(sy[0])), set1I(int32_t(sy[1])), set1I(int32_t(sy[2]))};
         const int64_t px = int64_t(x0) * kSub + kHalf, py = int64_t(y0) * kSub + kHalf;
         const int32_t ev[3] = {int32_t(e[0].at(px, py)), int32_t(e[1].at(px, py)), int32_t(e[2].at(px, py))};
-        blockRows<kV>(x0, x0, x1, y0, y1, tx0, ty0, s, false, ev, stepX, syv, zRef, zdx, zdy, idv, depth, ids);
+        blockRows<kV>(x0, x0, x1, y0, y1, tx0, ty0, s, false, ev, stepX, syv, set1(pl.zRef), set1(pl.zdx), set1(pl.zdy), set1I(int32_t(id)), depth,
+                      ids);
         return;
     }
+    VI stepX[3][kV];
+    laneSteps<kV>(sx, stepX);
+    const VI idv = set1I(int32_t(id));
+    const V zRef = set1(pl.zRef), zdx = set1(pl.zdx), zdy = set1(pl.zdy);
+    const VI syv[3] = {set1I(int32_t(sy[0])), set1I(int32_t(sy[1])), set1I(int32_t(sy[2]))};
     int64_t hi[3], lo[3];   // offsets from a block's first pixel to where each edge is largest / smallest
     for (int k = 0; k < 3; ++k) {
         hi[k] = std::max<int64_t>(sx[k], 0) * (kB - 1) + std::max<int64_t>(sy[k], 0) * (kB - 1);
