@@ -229,12 +229,16 @@ struct SrgbByteTable {
         return uint8_t(b);
     }
 };
+
+const SrgbByteTable& srgbByteTable() {
+    static const SrgbByteTable table;
+    return table;
+}
 }   // namespace
 
-uint8_t toByteSRGB(float linear) {
-    static const SrgbByteTable table;
-    return table(linear);
-}
+uint8_t toByteSRGB(float linear) { return srgbByteTable()(linear); }
+
+float srgbByteThreshold(int b) { return srgbByteTable().first[std::clamp(b, 0, 256)]; }
 
 vec3 srgbBytesToLinear(const uint8_t* rgb) {
     static const auto table = [] {

@@ -37,20 +37,9 @@ void ShadeBatch::pad() {
 }
 
 SrgbEncoder::SrgbEncoder() {
-    // The thresholds of rnd::toByteSRGB itself (bisection over the float bits of [0, 1]; the
-    // byte is monotonic), so that this encoder gives its byte for every float. (Thresholds from
-    // decodeSRGB((b + 0.5) / 255) differ from it in the last bit on 225 floats of [2^-14, 1].)
-    for (int b = 0; b < 255; ++b) {
-        uint32_t lo = 0, hi = 0x3F800000u;   // toByteSRGB(lo) <= b < toByteSRGB(hi)
-        while (hi - lo > 1) {
-            const uint32_t mid = lo + (hi - lo) / 2;
-            float x;
-            std::memcpy(&x, &mid, 4);
-            (toByteSRGB(x) > b ? hi : lo) = mid;
-        }
-        std::memcpy(&next[b], &hi, 4);
-    }
-    next[255] = 2.0f;
+    // rnd::toByteSRGB's own thresholds, so that this encoder gives its byte for every float.
+    // (decodeSRGB((b + 0.5) / 255) differs from them in the last bit on 225 floats of [2^-14, 1].)
+    for (int b = 0; b < 256; ++b) next[b] = srgbByteThreshold(b + 1);   // next[255] = 2: never reached
     for (int i = 0; i < kBuckets; ++i) {
         const float first = std::ldexp(1.0f + float(i % 256) / 256.0f, kMinExp + i / 256);
         table[i] = toByteSRGB(first);

@@ -134,6 +134,9 @@ float decodeSRGB(float encoded);
 // Clamp, encode, round: the byte round(255 encodeSRGB(clamp(x, 0, 1))), found without pow
 // through a table made from that formula (exactly its value for every float; NaN gives 0).
 uint8_t toByteSRGB(float linear);
+// The smallest float whose toByteSRGB is >= b, for b in 1..255 (the thresholds its table uses);
+// 0 for b <= 0, 2 for b >= 256.
+float srgbByteThreshold(int b);
 sg::vec3 srgbBytesToLinear(const uint8_t* rgb);
 
 }   // namespace rnd
