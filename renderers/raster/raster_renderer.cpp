@@ -692,7 +692,7 @@ struct TileBuffers {
     std::vector<uint32_t> ids;
     std::vector<uint32_t> tileTris;
     std::vector<uint32_t> runStart;                                                       // per entry of tileTris: its fragments' first slot
-    std::vector<uint32_t> runEnd;                                                         // per entry of tileTris: one past its fragments\' last slot
+    std::vector<uint32_t> runEnd;                                                         // per entry of tileTris: one past its fragments' last slot
     std::vector<FragRun> runs;                                                            // the fragments, grouped by triangle
     std::vector<uint64_t> rowRuns = std::vector<uint64_t>(kTileSize);                     // per row: bit i = a run of equal ids starts at pixel i
     std::vector<uint32_t> color = std::vector<uint32_t>(size_t(kTileSize) * kTileSize);   // RGBA8 of the tile (one sample per pixel)
@@ -731,6 +731,15 @@ void countOverdraw(int tile, const FrameContext& fc, Framebuffer& target, int x0
                                 [&](int i, int j) { ++target.overdraw[size_t(fc.height - 1 - j) * fc.width + i]; });
 }
 
+// The background colour as the tiles store it: sRGB bytes and alpha 255 in one RGBA8 word.
+uint32_t backgroundWord(const sg::RenderSettings& st) {
+    const SrgbEncoder& enc = srgbEncoder();
+    const uint8_t px[4] = {enc(st.background.x), enc(st.background.y), enc(st.background.z), 255};
+    uint32_t word;
+    std::memcpy(&word, px, 4);
+    return word;
+}
+
 // Rasterizes the tile's triangles into its visibility buffer (opaque and masked ones; blended
 // ones are set aside), shades what is visible, then composites the blended surfaces.
 void renderTile(int tile, const FrameContext& fc, Framebuffer& target, TileBuffers& buf) {
@@ -745,11 +754,7 @@ void renderTile(int tile, const FrameContext& fc, Framebuffer& target, TileBuffe
     bool empty = true;
     for (const Chunk& ch : chunks) empty = empty && ch.tileStart[tile] == ch.tileStart[tile + 1];
     if (empty) {
-        const SrgbEncoder& enc = srgbEncoder();
-        const vec3 bg = fc.frame->settings.background;
-        const uint8_t bgPixel[4] = {enc(bg.x), enc(bg.y), enc(bg.z), 255};
-        uint32_t bgWord;
-        std::memcpy(&bgWord, bgPixel, 4);
+        const uint32_t bgWord = backgroundWord(fc.frame->settings);
         for (int j = y0; j <= y1; ++j) {
             const int row = fc.height - 1 - j;
             uint8_t* out = target.pixel(x0, row);
@@ -818,7 +823,7 @@ void shadeOpaque(const FrameContext& fc, Framebuffer& target, TileBuffers& buf, 
     const auto& st = fc.frame->settings;
     const SrgbEncoder& enc = srgbEncoder();
     const vec3 bg = st.background;
-    const uint8_t bgBytes[3] = {enc(bg.x), enc(bg.y), enc(bg.z)};
+    const uint32_t bgWord = backgroundWord(st);
     // Fragments: one per covered pixel (MSAA: per distinct triangle in the pixel).
     // Sized for the worst case (every sample its own triangle); filled by index, no push_back.
     const size_t maxFrags = size_t(kTileSize) * kTileSize * samples;
@@ -840,9 +845,6 @@ void shadeOpaque(const FrameContext& fc, Framebuffer& target, TileBuffers& buf, 
         const uint32_t nt = uint32_t(buf.tileTris.size());
         buf.runStart.assign(size_t(nt) + 1, 0);   // [nt]: uncovered pixels
         uint32_t* start = buf.runStart.data();
-        const uint8_t bgPixel[4] = {bgBytes[0], bgBytes[1], bgBytes[2], 255};
-        uint32_t bgWord;
-        std::memcpy(&bgWord, bgPixel, 4);
         std::fill(buf.color.begin(), buf.color.end(), bgWord);
         const uint64_t rowMask = tw == 64 ? ~uint64_t(0) : (uint64_t(1) << tw) - 1;
         for (int jj = 0; jj < th; ++jj) {
@@ -922,11 +924,7 @@ void shadeOpaque(const FrameContext& fc, Framebuffer& target, TileBuffers& buf, 
             for (int ii = 0; ii < tw; ++ii) {
                 int p = jj * kTileSize + ii;
                 int row = fc.height - 1 - (y0 + jj);
-                uint8_t* out = target.pixel(x0 + ii, row);
-                out[0] = bgBytes[0];
-                out[1] = bgBytes[1];
-                out[2] = bgBytes[2];
-                out[3] = 255;
+                std::memcpy(target.pixel(x0 + ii, row), &bgWord, 4);
                 float dmin = 1.0f;
                 uint32_t seen[4];
                 int nseen = 0;
