@@ -45,6 +45,35 @@ void rasterizeScalar(const TriCoverage& s, const TriPlanes& pl, uint32_t id, int
 
 bool sameBits(const std::vector<float>& a, const std::vector<float>& b) { return std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0; }
 
+// The part [rx0, rx1] x [ry0, ry1] of the tile at (tx0, ty0) that triangle s's bbox covers, as
+// the renderer clips it; false when empty.
+bool tileRect(const TriCoverage& s, int tx0, int ty0, int& rx0, int& ry0, int& rx1, int& ry1) {
+    rx0 = std::max(tx0, int(s.minX));
+    rx1 = std::min(std::min(tx0 + kTileSize, W) - 1, int(s.maxX));
+    ry0 = std::max(ty0, int(s.minY));
+    ry1 = std::min(std::min(ty0 + kTileSize, H) - 1, int(s.maxY));
+    return rx0 <= rx1 && ry0 <= ry1;
+}
+
+// The scalar loop and rasterizeOpaque, each on its own copy of the tile buffers (depth, ids):
+// success when the depths are the same bits and the ids the same everywhere, the slack included.
+// `depthOut` and `idsOut` get the kernel's buffers.
+testing::AssertionResult kernelMatchesScalar(const TriCoverage& s, const TriPlanes& pl, uint32_t id, int tx0, int ty0,
+                                             const std::vector<float>& depth, const std::vector<uint32_t>& ids,
+                                             std::vector<float>* depthOut = nullptr, std::vector<uint32_t>* idsOut = nullptr) {
+    int rx0, ry0, rx1, ry1;
+    if (!tileRect(s, tx0, ty0, rx0, ry0, rx1, ry1)) return testing::AssertionFailure() << "the triangle misses the tile";
+    std::vector<float> depthA = depth, depthB = depth;
+    std::vector<uint32_t> idsA = ids, idsB = ids;
+    rasterizeScalar(s, pl, id, tx0, ty0, rx0, ry0, rx1, ry1, depthA.data(), idsA.data());
+    rasterizeOpaque(s, pl, id, tx0, ty0, rx0, ry0, rx1, ry1, depthB.data(), idsB.data());
+    if (depthOut) *depthOut = depthB;
+    if (idsOut) *idsOut = idsB;
+    if (!sameBits(depthA, depthB)) return testing::AssertionFailure() << "depths differ";
+    if (idsA != idsB) return testing::AssertionFailure() << "ids differ";
+    return testing::AssertionSuccess();
+}
+
 }   // namespace
 
 // Tells which kernels this run checks; under VIEWER_RASTER_SSE=1 they must be the SSE2 ones.
@@ -90,23 +119,16 @@ TEST(RasterTileKernelTest, OpaqueCoverageMatchesTheScalarLoop) {
         const int pi = cov.minX + int(U(rng) * float(cov.maxX - cov.minX + 1));
         const int pj = cov.minY + int(U(rng) * float(cov.maxY - cov.minY + 1));
         const int tx0 = std::min(pi, int(cov.maxX)) & ~(kTileSize - 1), ty0 = std::min(pj, int(cov.maxY)) & ~(kTileSize - 1);
-        const int tx1 = std::min(tx0 + kTileSize, W) - 1, ty1 = std::min(ty0 + kTileSize, H) - 1;
-        const int rx0 = std::max(tx0, int(cov.minX)), rx1 = std::min(tx1, int(cov.maxX));
-        const int ry0 = std::max(ty0, int(cov.minY)), ry1 = std::min(ty1, int(cov.maxY));
-        if (rx0 > rx1 || ry0 > ry1) continue;
-        std::vector<float> depthA(kTileValues), depthB;
-        std::vector<uint32_t> idsA(kTileValues), idsB;
+        int rx0, ry0, rx1, ry1;
+        if (!tileRect(cov, tx0, ty0, rx0, ry0, rx1, ry1)) continue;
+        std::vector<float> depth(kTileValues), depthB;
+        std::vector<uint32_t> ids(kTileValues);
         for (size_t p = 0; p < kTileValues; ++p) {
-            depthA[p] = p % 7 == 0 ? 1.0f : U(rng);
-            idsA[p] = uint32_t(rng());
+            depth[p] = p % 7 == 0 ? 1.0f : U(rng);
+            ids[p] = uint32_t(rng());
         }
-        depthB = depthA;
-        idsB = idsA;
-        const uint32_t id = uint32_t(iter);
-        rasterizeScalar(cov, pl, id, tx0, ty0, rx0, ry0, rx1, ry1, depthA.data(), idsA.data());
-        rasterizeOpaque(cov, pl, id, tx0, ty0, rx0, ry0, rx1, ry1, depthB.data(), idsB.data());
-        ASSERT_TRUE(sameBits(depthA, depthB)) << "iteration " << iter << ", triangle size " << size;
-        ASSERT_EQ(idsA, idsB) << "iteration " << iter << ", triangle size " << size;
+        ASSERT_TRUE(kernelMatchesScalar(cov, pl, uint32_t(iter), tx0, ty0, depth, ids, &depthB))
+            << "iteration " << iter << ", triangle size " << size;
         ++tested;
         wide += (rx1 - rx0 >= 8 || ry1 - ry0 >= 8);
         clampedZ += std::count(depthB.begin(), depthB.end(), 0.0f) > 0;
@@ -139,18 +161,16 @@ TEST(RasterTileKernelTest, OpaqueCoverageAtThe32BitLimit) {
         if (!coverageFits32(cov)) continue;
         const float z[3] = {0.3f, 0.6f, 0.9f}, iw[3] = {1, 0.5f, 0.25f};
         const TriPlanes pl = makeTriPlanes(ts, z, iw);
+        const std::vector<float> depth(kTileValues, 1.0f);
+        const std::vector<uint32_t> ids(kTileValues, 0xFFFFFFFFu);
         for (int ty0 = 0; ty0 < H; ty0 += kTileSize)
             for (int tx0 = 0; tx0 < W; tx0 += kTileSize) {
-                const int rx0 = std::max(tx0, int(cov.minX)), rx1 = std::min(std::min(tx0 + kTileSize, W) - 1, int(cov.maxX));
-                const int ry0 = std::max(ty0, int(cov.minY)), ry1 = std::min(std::min(ty0 + kTileSize, H) - 1, int(cov.maxY));
-                if (rx0 > rx1 || ry0 > ry1) continue;
-                std::vector<float> depthA(kTileValues, 1.0f), depthB(kTileValues, 1.0f);
-                std::vector<uint32_t> idsA(kTileValues, 0xFFFFFFFFu), idsB(kTileValues, 0xFFFFFFFFu);
-                rasterizeScalar(cov, pl, 5, tx0, ty0, rx0, ry0, rx1, ry1, depthA.data(), idsA.data());
-                rasterizeOpaque(cov, pl, 5, tx0, ty0, rx0, ry0, rx1, ry1, depthB.data(), idsB.data());
-                ASSERT_TRUE(sameBits(depthA, depthB)) << "iteration " << iter << " tile " << tx0 << "," << ty0;
-                ASSERT_EQ(idsA, idsB) << "iteration " << iter << " tile " << tx0 << "," << ty0;
-                tested += std::count(idsA.begin(), idsA.end(), 5u) > 0;
+                int rx0, ry0, rx1, ry1;
+                if (!tileRect(cov, tx0, ty0, rx0, ry0, rx1, ry1)) continue;
+                std::vector<uint32_t> idsB;
+                ASSERT_TRUE(kernelMatchesScalar(cov, pl, 5, tx0, ty0, depth, ids, nullptr, &idsB))
+                    << "iteration " << iter << " tile " << tx0 << "," << ty0;
+                tested += std::count(idsB.begin(), idsB.end(), 5u) > 0;
             }
     }
     EXPECT_GT(tested, 100);
@@ -185,17 +205,13 @@ TEST(RasterTileKernelTest, OpaqueCoverageOfLargeTrianglesClippedToASmallCorner) 
         const TriPlanes pl = makeTriPlanes(ts, z, iw);
         // The tile of the image corner the triangle reaches.
         const int tx0 = iter % 2 ? (W - 1) & ~(kTileSize - 1) : 0, ty0 = iter % 2 ? (H - 1) & ~(kTileSize - 1) : 0;
-        const int rx0 = std::max(tx0, int(cov.minX)), rx1 = std::min(std::min(tx0 + kTileSize, W) - 1, int(cov.maxX));
-        const int ry0 = std::max(ty0, int(cov.minY)), ry1 = std::min(std::min(ty0 + kTileSize, H) - 1, int(cov.maxY));
-        if (rx0 > rx1 || ry0 > ry1) continue;
-        std::vector<float> depthA(kTileValues, 1.0f), depthB(kTileValues, 1.0f);
-        std::vector<uint32_t> idsA(kTileValues, 0xFFFFFFFFu), idsB(kTileValues, 0xFFFFFFFFu);
-        rasterizeScalar(cov, pl, 9, tx0, ty0, rx0, ry0, rx1, ry1, depthA.data(), idsA.data());
-        rasterizeOpaque(cov, pl, 9, tx0, ty0, rx0, ry0, rx1, ry1, depthB.data(), idsB.data());
-        ASSERT_TRUE(sameBits(depthA, depthB)) << "iteration " << iter << ", bbox " << cov.minX << ".." << cov.maxX << " x " << cov.minY << ".."
-                                              << cov.maxY;
-        ASSERT_EQ(idsA, idsB) << "iteration " << iter;
-        tested += std::count(idsA.begin(), idsA.end(), 9u) > 0;
+        int rx0, ry0, rx1, ry1;
+        if (!tileRect(cov, tx0, ty0, rx0, ry0, rx1, ry1)) continue;
+        std::vector<uint32_t> idsB;
+        ASSERT_TRUE(kernelMatchesScalar(cov, pl, 9, tx0, ty0, std::vector<float>(kTileValues, 1.0f), std::vector<uint32_t>(kTileValues, 0xFFFFFFFFu),
+                                        nullptr, &idsB))
+            << "iteration " << iter << ", bbox " << cov.minX << ".." << cov.maxX << " x " << cov.minY << ".." << cov.maxY;
+        tested += std::count(idsB.begin(), idsB.end(), 9u) > 0;
     }
     EXPECT_GT(tested, 300);
 }
