@@ -11,24 +11,36 @@ namespace assets {
 
 std::vector<std::string> supportedSceneExtensions() { return {".json", ".gltf", ".glb", ".obj", ".off", ".ply", ".stl"}; }
 
-LoadResult loadScene(const fs::path& path, const LoadOptions& options) {
+namespace {
+std::string lowerExtension(const fs::path& path) {
     std::string ext = path.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    return ext;
+}
+}   // namespace
+
+std::string checkSceneFile(const fs::path& path) {
     std::error_code ec;
+    if (!fs::exists(path, ec)) return path.string() + ": no such file";
+    if (fs::is_directory(path, ec)) return path.string() + ": is a folder, not a scene file";
+    std::vector<std::string> exts = supportedSceneExtensions();
+    std::string ext = lowerExtension(path);
+    if (std::find(exts.begin(), exts.end(), ext) == exts.end()) {
+        std::string list;
+        for (const std::string& e : exts) list += (list.empty() ? "" : " ") + e;
+        return path.string() + ": unsupported file type '" + ext + "' (supported: " + list + ")";
+    }
+    return {};
+}
+
+LoadResult loadScene(const fs::path& path, const LoadOptions& options) {
     LoadResult r;
-    if (!fs::exists(path, ec)) {
-        r.error = path.string() + ": no such file";
-        return r;
-    }
-    if (fs::is_directory(path, ec)) {
-        r.error = path.string() + ": is a folder, not a scene file";
-        return r;
-    }
+    r.error = checkSceneFile(path);
+    if (!r.error.empty()) return r;
+    std::string ext = lowerExtension(path);
     if (ext == ".json") return loadSceneJson(path);
     if (ext == ".gltf" || ext == ".glb") return detail::loadGltf(path, options);
-    if (ext == ".obj" || ext == ".off" || ext == ".ply" || ext == ".stl") return detail::loadMeshFile(path, options);
-    r.error = path.string() + ": unsupported file type '" + ext + "' (supported: .json .gltf .glb .obj .off .ply .stl)";
-    return r;
+    return detail::loadMeshFile(path, options);
 }
 
 }   // namespace assets

@@ -319,7 +319,7 @@ TEST(ViewerUndoTest, DirtyFlagFollowsTheSavedStateAcrossSave) {
     fs::create_directories(dir);
     ViewerState st = demoState();
     st.addShape(sg::ImplicitType::Sphere, st.doc.scene.root());
-    ASSERT_EQ(st.save(dir / "scene.json"), "");
+    ASSERT_EQ(st.saveAs(dir / "scene.json"), SaveOutcome::Saved);
     EXPECT_FALSE(st.doc.dirty);
     st.undo();   // the sphere goes: differs from the file
     EXPECT_TRUE(st.doc.dirty);

@@ -163,6 +163,10 @@ TEST(ViewerAutomationGLTest, ClicksReachTheTreeAndTheEditMenu) {
 TEST(ViewerAutomationGLTest, OpenAsksAboutUnsavedChangesAndAnswersWork) {
     if (!viewer_test::haveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
     fs::path dir = sceneFolder("automation_open");
+    {
+        std::ofstream out(dir / "broken.json");
+        out << "{ \"nodes\": [";
+    }
     ScriptRun r = runScript(dir,
                             "wait\n"
                             "set shading flat\n"
@@ -179,7 +183,7 @@ TEST(ViewerAutomationGLTest, OpenAsksAboutUnsavedChangesAndAnswersWork) {
                             "print dirty\n"   // 4
                             "print undo\n"    // 5: a new document has no history
                             "set shading flat\n"
-                            "open missing.json\n"   // asks; discard; the load fails
+                            "open broken.json\n"   // asks; discard; the load fails
                             "answer discard\n"
                             "wait\n"
                             "print tree\n"    // 6: still the small scene, edits kept
@@ -197,6 +201,71 @@ TEST(ViewerAutomationGLTest, OpenAsksAboutUnsavedChangesAndAnswersWork) {
     EXPECT_EQ(r.out[6], "tree\nroot\n  only child");
     EXPECT_EQ(r.out[7], "dirty yes") << "a failed load keeps the edits and the flag";
     EXPECT_EQ(r.out[8], "undo Change shading | redo -") << "... and the history";
+}
+
+// Nothing on disk is replaced without a question, driven as a user does: Save As onto an earlier
+// scene asks (Cancel keeps it, Replace writes it); Ctrl+S on an imported file opens Save As
+// instead of writing NAME.obj.json beside it; Ctrl+S on the document's own .json just saves.
+TEST(ViewerAutomationGLTest, SaveAsAndCtrlSNeverReplaceAFileWithoutAsking) {
+    if (!viewer_test::haveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+    fs::path dir = sceneFolder("automation_save");
+    {
+        std::ofstream out(dir / "tri.obj");
+        out << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    }
+    {
+        std::ofstream out(dir / "tri.obj.json");
+        out << "an earlier scene";
+    }
+    auto text = [&](const std::string& name) {
+        std::ifstream in(dir / name, std::ios::binary);
+        return std::string(std::istreambuf_iterator<char>(in), {});
+    };
+    const std::string small = text("small.json");
+    ScriptRun r = runScript(dir,
+                            "wait\n"
+                            "set shading flat\n"
+                            "save-as small.json\n"
+                            "print popup\n"   // 0: the replace question
+                            "answer cancel\n"
+                            "frames 2\n"
+                            "print popup\n"   // 1
+                            "print dirty\n"   // 2: not saved
+                            "save-as small.json\n"
+                            "answer replace\n"
+                            "frames 2\n"
+                            "print dirty\n"   // 3: saved over small.json, now the document
+                            "set shading gouraud\n"
+                            "key ctrl+s\n"   // the document's own .json: no question
+                            "frames 2\n"
+                            "print popup\n"   // 4
+                            "print dirty\n"   // 5
+                            "open tri.obj\n"
+                            "wait\n"
+                            "set shading flat\n"
+                            "key ctrl+s\n"   // an import: Save As opens, nothing written
+                            "frames 2\n"
+                            "print popup\n"   // 6
+                            "print dirty\n"   // 7
+                            "key Escape\n"
+                            "frames 2\n"
+                            "print popup\n"   // 8
+                            "quit\n",
+                            "demo.json");
+    ASSERT_EQ(r.rc, 0) << dump(r);
+    ASSERT_EQ(r.out.size(), 9u) << dump(r);
+    EXPECT_EQ(r.out[0], "popup yes");
+    EXPECT_EQ(r.out[1], "popup no");
+    EXPECT_EQ(r.out[2], "dirty yes");
+    EXPECT_EQ(r.out[3], "dirty no");
+    EXPECT_EQ(r.out[4], "popup no");
+    EXPECT_EQ(r.out[5], "dirty no");
+    EXPECT_EQ(r.out[6], "popup yes") << "Ctrl+S on an import opens Save As";
+    EXPECT_EQ(r.out[7], "dirty yes");
+    EXPECT_EQ(r.out[8], "popup no");
+    EXPECT_EQ(text("tri.obj.json"), "an earlier scene");
+    EXPECT_NE(text("small.json"), small);
+    EXPECT_NE(text("small.json").find("gouraud"), std::string::npos) << "Ctrl+S wrote the document's own file";
 }
 
 TEST(ViewerAutomationGLTest, ViewCommandDoesWhatTheViewMenuDoes) {

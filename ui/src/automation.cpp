@@ -24,6 +24,10 @@
 // The document (as the File and Edit menus do)
 //   open PATH             File > Open, asking first when there are unsaved changes
 //   answer save|discard|cancel   answers the unsaved-changes question
+//   save-as PATH          File > Save As with PATH typed (relative to the document's folder,
+//                         where the dialog starts; ".json" appended for another extension); asks
+//                         before replacing an existing file
+//   answer replace|cancel answers the replace question
 //   set KEY VALUE         a setting by its scene-JSON name (shading flat, fog.mode linear,
 //                         fog.end 40, aa ssaa2, ambientLight [0.2,0.2,0.2]) or material.FIELD of
 //                         the selection (material.kd 0.3, material.baseColor [1,0,0]); an undo
@@ -76,6 +80,9 @@
 #include <cctype>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
+
+namespace fs = std::filesystem;
 
 namespace ui {
 
@@ -249,7 +256,7 @@ Automation::Next Automation::runCommand(const std::string& cmd, std::istringstre
         windowShot = restOfLine(in);
         return windowShot.empty() ? fail("window-shot: no path") : Next::Yield;
     }
-    if (cmd == "open" || cmd == "answer" || cmd == "set" || cmd == "select" || cmd == "undo" || cmd == "redo")
+    if (cmd == "open" || cmd == "answer" || cmd == "save-as" || cmd == "set" || cmd == "select" || cmd == "undo" || cmd == "redo")
         return documentCommand(cmd, in, host.state());
     return viewCommand(cmd, in, host.state());
 }
@@ -391,6 +398,17 @@ Automation::Next Automation::documentCommand(const std::string& cmd, std::istrin
     if (cmd == "open") {
         if (arg.empty()) return fail("open: no path");
         st.requestOpen(arg);
+    } else if (cmd == "save-as") {
+        if (arg.empty()) return fail("save-as: no path");
+        std::error_code ec;
+        fs::path folder = st.doc.path.empty() ? fs::current_path(ec) : fs::absolute(st.doc.path, ec).parent_path();
+        fs::path typed = arg;
+        st.saveAs(typed.is_absolute() ? typed : folder / typed);
+        m_waitFrames = 2;   // a question opens on the next frame
+        return Next::Yield;
+    } else if (cmd == "answer" && st.ui.replaceOpen) {
+        if (arg != "replace" && arg != "cancel") return fail("answer " + arg + ": the replace question expects replace or cancel");
+        st.confirmReplace(arg == "replace");
     } else if (cmd == "answer") {
         ConfirmChoice c = arg == "save" ? ConfirmChoice::Save : arg == "discard" ? ConfirmChoice::Discard : ConfirmChoice::Cancel;
         if (arg != "save" && arg != "discard" && arg != "cancel") return fail("answer " + arg + ": expected save, discard or cancel");

@@ -1631,7 +1631,8 @@ void openBrowser(bool saving, ViewerState& st) {
     browser.error.clear();
     std::error_code ec;
     fs::path start = st.doc.path.empty() ? fs::current_path(ec) : fs::absolute(st.doc.path, ec).parent_path();
-    if (browser.dir.empty() || !fs::is_directory(browser.dir, ec)) browser.dir = start;
+    // Save As starts in the document's own folder; Open where the browser was last.
+    if ((saving && !st.doc.path.empty()) || browser.dir.empty() || !fs::is_directory(browser.dir, ec)) browser.dir = start;
     browser.fileName = saving ? (st.doc.path.empty() ? st.doc.scene.name + ".json" : st.doc.path.stem().string() + ".json") : "";
 }
 
@@ -1648,7 +1649,10 @@ void drawFileBrowser(ViewerState& st) {
     ImGui::SetNextWindowPos(ImVec2(ds.x * 0.5f, ds.y * 0.5f), ImGuiCond_Appearing, ImVec2(0.5f, 0.5f));
     bool keep = true;
     if (!ImGui::BeginPopupModal(title, &keep)) {
-        if (!keep) browser.open = false;
+        if (!keep) {
+            browser.open = false;
+            if (browser.saving) st.saveAsCancelled();
+        }
         return;
     }
     std::error_code ec;
@@ -1715,6 +1719,7 @@ void drawFileBrowser(ViewerState& st) {
     ImGui::SameLine();
     if (ImGui::Button("Cancel", ImVec2(px(75), 0)) || escapeCancels(st)) {
         browser.open = false;
+        if (browser.saving) st.saveAsCancelled();
         ImGui::CloseCurrentPopup();
     }
     ImGui::TextDisabled(browser.saving ? "Native JSON scene (.json)" : "Formats: .json .gltf .glb .obj .off .ply .stl");
@@ -1722,7 +1727,7 @@ void drawFileBrowser(ViewerState& st) {
         browser.open = false;
         ImGui::CloseCurrentPopup();
         if (browser.saving)
-            st.save(chosen);
+            st.saveAs(chosen);
         else
             st.requestOpen(chosen);
     }
@@ -1913,6 +1918,27 @@ void drawDialogs(ViewerState& st) {
             ImGui::CloseCurrentPopup();
         }
         record(st, "confirm/cancel");
+        ImGui::EndPopup();
+    }
+
+    // Save As onto an existing file: nothing is replaced without this question.
+    if (st.ui.replaceOpen && !ImGui::IsPopupOpen("Replace file?")) ImGui::OpenPopup("Replace file?");
+    if (ImGui::BeginPopupModal("Replace file?", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
+        if (!st.ui.replaceOpen) ImGui::CloseCurrentPopup();   // answered elsewhere (automation's `answer`)
+        ImGui::Text("%s already exists.\nReplace it with this scene?", st.ui.replacePath.filename().string().c_str());
+        ImGui::TextDisabled("%s", st.ui.replacePath.parent_path().string().c_str());
+        ImGui::Spacing();
+        if (ImGui::Button("Replace", ImVec2(px(90), 0))) {
+            st.confirmReplace(true);
+            ImGui::CloseCurrentPopup();
+        }
+        record(st, "replace/replace");
+        ImGui::SameLine();
+        if (ImGui::Button("Cancel", ImVec2(px(90), 0)) || escapeCancels(st)) {
+            st.confirmReplace(false);
+            ImGui::CloseCurrentPopup();
+        }
+        record(st, "replace/cancel");
         ImGui::EndPopup();
     }
 

@@ -645,7 +645,25 @@ sg::RenderSettings ViewerState::settingsFor(const std::string& b) const {
 
 // --- files -----------------------------------------------------------------------------------
 
+namespace {
+// Where Save As writes for a chosen path: a native .json scene, so another extension gains one
+// ("engine.gltf" -> "engine.gltf.json"): an import is never written over.
+fs::path nativeTarget(const fs::path& path) {
+    fs::path target = path;
+    if (target.extension() != ".json") target += ".json";
+    return target;
+}
+
+bool isNativeScene(const fs::path& path) { return !path.empty() && path.extension() == ".json"; }
+}   // namespace
+
 bool ViewerState::requestOpen(const fs::path& path) {
+    // A file that cannot be opened is refused before any question about unsaved changes.
+    if (std::string err = assets::checkSceneFile(path); !err.empty()) {
+        ui.errorPopup = "Could not open " + path.string() + ":\n" + err;
+        ui.status = "Open failed; the current scene is unchanged";
+        return false;
+    }
     if (doc.dirty) {
         ui.pending = PendingAction::Open;
         ui.pendingPath = path;
@@ -701,13 +719,17 @@ void ViewerState::confirm(ConfirmChoice choice) {
         return;
     }
     if (choice == ConfirmChoice::Save) {
-        if (doc.path.empty() || doc.path.extension() != ".json") {
-            // Needs a file name first: ask for one, then the user repeats the action.
+        if (!isNativeScene(doc.path)) {
+            // Needs a file name first: Save As asks for one, and the action follows the save.
+            ui.afterSave = action;
+            ui.afterSavePath = ui.pendingPath;
             ui.requests.saveAsDialog = true;
-            ui.status = "Choose where to save, then repeat the action";
+            ui.status = "Choose where to save; then " + std::string(action == PendingAction::Quit  ? "the viewer quits"
+                                                                    : action == PendingAction::New ? "the new scene opens"
+                                                                                                   : "the file opens");
             return;
         }
-        if (!save().empty()) return;   // failed: keep everything, the error is shown
+        if (save() != SaveOutcome::Saved) return;   // failed: keep everything, the error is shown
     }
     // The dirty flag stays as it is: only a scene that actually replaces this one (setScene
     // after a successful load, a new scene) clears it. A failed or cancelled load after
@@ -778,29 +800,77 @@ void ViewerState::cancelLoad() {
     ui.status = "Cancelling loading " + load.path.filename().string() + " ...";
 }
 
-std::string ViewerState::save(const fs::path& path) {
-    fs::path target = path.empty() ? doc.path : path;
-    if (target.empty()) {
+SaveOutcome ViewerState::save() {
+    if (!isNativeScene(doc.path)) {
+        // New, or imported from another format: the first save chooses a native file.
         ui.requests.saveAsDialog = true;
-        return "no file name";
+        ui.status = doc.path.empty() ? "Choose where to save the scene"
+                                     : "Choose where to save: " + doc.path.filename().string() + " is kept as it is, the scene is saved as .json";
+        return SaveOutcome::Asked;
     }
-    if (target.extension() != ".json") target += ".json";   // imports are never overwritten
+    return writeScene(doc.path, /*replace=*/true);
+}
+
+SaveOutcome ViewerState::saveAs(const fs::path& path) {
+    if (path.empty()) {
+        ui.requests.saveAsDialog = true;
+        return SaveOutcome::Asked;
+    }
+    fs::path target = nativeTarget(path);
+    std::error_code ec;
+    if (fs::exists(fs::symlink_status(target, ec))) {
+        ui.replacePath = target;
+        ui.replaceOpen = true;
+        ui.status = target.filename().string() + " exists: replace it?";
+        return SaveOutcome::Asked;
+    }
+    return writeScene(target, /*replace=*/false);
+}
+
+void ViewerState::confirmReplace(bool replace) {
+    fs::path target = ui.replacePath;
+    ui.replacePath.clear();
+    ui.replaceOpen = false;
+    if (target.empty()) return;
+    if (!replace) {
+        ui.afterSave = PendingAction::None;
+        ui.status = "Not saved; " + target.string() + " is unchanged";
+        return;
+    }
+    writeScene(target, /*replace=*/true);
+}
+
+void ViewerState::saveAsCancelled() {
+    if (ui.afterSave != PendingAction::None) ui.status = "Not saved; cancelled";
+    ui.afterSave = PendingAction::None;
+}
+
+SaveOutcome ViewerState::writeScene(const fs::path& target, bool replace) {
     storeViewInCamera();
     std::string err;
     try {
-        err = assets::saveSceneJson(doc.scene, target, /*overwrite=*/true);
+        err = assets::saveSceneJson(doc.scene, target, replace);
     } catch (const std::exception& e) { err = target.string() + ": " + e.what(); }
     if (!err.empty()) {
+        ui.afterSave = PendingAction::None;
         ui.errorPopup = "Could not save:\n" + err;
         ui.status = "Save failed";
-        return err;
+        return SaveOutcome::Failed;
     }
     doc.path = target;
     doc.history.markSaved();
     doc.dirty = false;
     addRecent(fs::absolute(target).lexically_normal().string());
     ui.status = "Saved " + target.string();
-    return {};
+    // The unsaved-changes question's Save was waiting on this file name: go on with its action.
+    PendingAction after = std::exchange(ui.afterSave, PendingAction::None);
+    switch (after) {
+    case PendingAction::Open: startLoad(ui.afterSavePath); break;
+    case PendingAction::New: newScene(); break;
+    case PendingAction::Quit: ui.requests.quit = true; break;
+    case PendingAction::None: break;
+    }
+    return SaveOutcome::Saved;
 }
 
 void ViewerState::addRecent(const std::string& path) {

@@ -46,5 +46,8 @@ std::string saveSceneJson(const sg::Scene& scene, const std::filesystem::path& p
 
 // Which extensions loadScene understands (lower case, with dot).
 std::vector<std::string> supportedSceneExtensions();
+// What loadScene would refuse before reading a byte (no such file, a folder, an unsupported
+// type), as its one-line error; "" when the file may be opened.
+std::string checkSceneFile(const std::filesystem::path& path);
 
 }   // namespace assets

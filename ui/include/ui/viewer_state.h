@@ -78,6 +78,9 @@ struct Requests {
 // What the unsaved-changes confirmation is about.
 enum class PendingAction { None, Open, New, Quit };
 enum class ConfirmChoice { Save, Discard, Cancel };
+// What a save did: wrote the file, is waiting for an answer (a file name, or whether to replace
+// an existing file), or failed (the error is in UiState::errorPopup).
+enum class SaveOutcome { Saved, Asked, Failed };
 
 // Item rectangles recorded by the panels (name -> min/max in screen pixels), so tests can
 // click real ImGui widgets by position.
@@ -187,6 +190,14 @@ struct UiState {
     PendingAction pending = PendingAction::None;
     std::filesystem::path pendingPath;
     bool confirmOpen = false;   // the modal should be shown
+    // Save As never replaces a file without a question: the existing file it would replace,
+    // while the question is shown.
+    std::filesystem::path replacePath;
+    bool replaceOpen = false;
+    // The action the unsaved-changes question's Save is waiting on while Save As asks for a
+    // file name: it runs once the scene is saved and is dropped when Save As is cancelled.
+    PendingAction afterSave = PendingAction::None;
+    std::filesystem::path afterSavePath;
     Requests requests;
     PanelState panels;
 };
@@ -319,9 +330,22 @@ struct ViewerState {
     float loadProgress() const { return load.control ? load.control->progress.load() : 0.0f; }
     // Finishes a completed load (non-blocking); returns true when a load finished.
     bool pollLoad(bool wait = false);
-    // Saves to doc.path (or `path`), writing the view into the active camera first.
-    // Returns "" or an error (also put in errorPopup).
-    std::string save(const std::filesystem::path& path = {});
+    // Saving. Nothing on disk is replaced without a question, except the document's own native
+    // file by Save. Each writes the view into the active camera first.
+    //
+    // Save (Ctrl+S): writes the document's own .json scene; a document without one (new, or
+    // imported from glTF/OBJ/...) opens Save As instead, in the document's folder.
+    SaveOutcome save();
+    // Save As with `path` chosen (".json" appended when it has another extension): writes it,
+    // or, when the file exists, asks first (ui.replaceOpen) and returns Asked.
+    SaveOutcome saveAs(const std::filesystem::path& path);
+    // Answers the replace question: Replace writes over the file, Cancel leaves it as it is.
+    void confirmReplace(bool replace);
+    // Save As closed without a file: an action waiting on the save is dropped.
+    void saveAsCancelled();
+    // Writes the scene to `target` (over an existing file only with `replace`), then runs the
+    // action a save was waiting on.
+    SaveOutcome writeScene(const std::filesystem::path& target, bool replace);
 
     void addRecent(const std::string& path);
 
