@@ -14,6 +14,7 @@
 #include "renderers/renderer.h"
 #include "scenegraph/camera_model.h"
 #include "scenegraph/instances.h"
+#include "scenegraph/params.h"
 #include "scenegraph/setting_names.h"
 #include "ui/aov_export.h"
 #include "ui/viewer.h"
@@ -56,57 +57,6 @@ bool parseSize(const std::string& s, int& w, int& h, std::string& err) {
     return true;
 }
 
-bool parseOnOff(const std::string& v, bool& out) {
-    if (v == "on" || v == "true" || v == "1") {
-        out = true;
-        return true;
-    }
-    if (v == "off" || v == "false" || v == "0") {
-        out = false;
-        return true;
-    }
-    return false;
-}
-
-// A settings value named in its table (setting_names.h). Returns "" or an error that lists the
-// valid names, e.g. "--fog: 'fgo' is not one of off, linear, exp, exp2".
-std::string notOneOf(const char* option, const std::string& value, const std::string& names) {
-    return std::string(option) + ": '" + value + "' is not one of " + names;
-}
-template <class E>
-std::string parseNamed(const char* option, const std::string& value, E& out) {
-    return sg::parseName(value, out) ? std::string() : notOneOf(option, value, sg::nameList<E>());
-}
-
-// --projection takes a projection type or an oblique preset.
-std::string projectionNames() { return sg::nameList<sg::ProjectionType>() + ", " + sg::nameList<sg::ObliquePreset>(); }
-
-// Option help for a named setting: the names on the first line, then one line per name.
-template <class E>
-void addValueLines(std::string& out, size_t width) {
-    for (const auto& e : sg::nameTable<E>().entries)
-        out += "\n  " + std::string(e.name) + std::string(width + 2 - e.name.size(), ' ') + std::string(e.help);
-}
-template <class E>
-size_t longestName() {
-    size_t n = 0;
-    for (const auto& e : sg::nameTable<E>().entries) n = std::max(n, e.name.size());
-    return n;
-}
-template <class E>
-std::string namedHelp(const std::string& title) {
-    std::string out = title + ": " + sg::nameList<E>();
-    addValueLines<E>(out, longestName<E>());
-    return out;
-}
-std::string projectionHelp() {
-    std::string out = "Projection: " + projectionNames();
-    size_t width = std::max(longestName<sg::ProjectionType>(), longestName<sg::ObliquePreset>());
-    addValueLines<sg::ProjectionType>(out, width);
-    addValueLines<sg::ObliquePreset>(out, width);
-    return out;
-}
-
 std::optional<sg::Scene> loadSceneArg(const std::string& arg, std::string& err, std::vector<assets::AnimationClip>* clips = nullptr) {
     if (arg.empty() || arg == "demo") return assets::makeDemoScene();
     assets::LoadResult r = assets::loadScene(arg);
@@ -142,28 +92,33 @@ std::string applyPose(const RenderArgs& a, const std::vector<assets::AnimationCl
     return {};
 }
 
+// The option a table row has on the command line ("--fog-start").
+template <class T>
+std::string flagOf(const sg::Param<T>& p) {
+    return "--" + std::string(p.flag);
+}
+
+// Applies the rows of T's table that were given on the command line to `object`, in table
+// order. "" or the first error ("--fog: 'fgo' is not one of off, linear, exp, exp2").
+template <class T>
+std::string applyTableOverrides(const std::map<std::string, std::optional<std::string>>& given, T& object) {
+    for (const sg::Param<T>& p : sg::params<T>()) {
+        auto it = given.find(std::string(p.key));
+        if (it == given.end() || !it->second) continue;
+        if (std::string err = sg::setParamFromText(object, p, *it->second); !err.empty())
+            return flagOf(p) + err.substr(std::min(err.size(), p.key.size()));
+    }
+    return {};
+}
+
+bool anyGiven(const std::map<std::string, std::optional<std::string>>& given) {
+    return std::any_of(given.begin(), given.end(), [](const auto& kv) { return kv.second.has_value(); });
+}
+
 // Applies command-line overrides to the scene's settings and camera. Returns "" or an error.
 std::string applyOverrides(const RenderArgs& a, sg::Scene& scene) {
     sg::RenderSettings& s = scene.settings;
-    auto named = [](const std::optional<std::string>& v, auto& dst, const char* option) -> std::string {
-        return v ? parseNamed(option, *v, dst) : std::string();
-    };
-    for (auto e : {named(a.shading, s.shading, "--shading"), named(a.reflection, s.reflection, "--reflection"), named(a.fog, s.fog, "--fog"),
-                   named(a.culling, s.culling, "--culling")})
-        if (!e.empty()) return e;
-    if (a.aa && !s.setAA(*a.aa)) return notOneOf("--aa", *a.aa, sg::nameList<sg::AAChoice>());
-    auto onOff = [](const std::optional<std::string>& v, bool& dst, const char* name) -> std::string {
-        if (v && !parseOnOff(*v, dst)) return std::string(name) + " '" + *v + "': expected on or off";
-        return {};
-    };
-    for (auto e : {onOff(a.shadows, s.shadows, "--shadows"), onOff(a.reflections, s.reflections, "--reflections"),
-                   onOff(a.wireframe, s.wireframe, "--wireframe"), onOff(a.attenuation, s.attenuation, "--attenuation")})
-        if (!e.empty()) return e;
-    if (a.fogStart) s.fogStart = *a.fogStart;
-    if (a.fogEnd) s.fogEnd = *a.fogEnd;
-    if (a.fogDensity) s.fogDensity = *a.fogDensity;
-    if (a.tessellation) s.tessellation = *a.tessellation;
-    if (a.bounces) s.maxBounces = *a.bounces;
+    if (std::string err = applyTableOverrides(a.settings, s); !err.empty()) return err;
     std::string err = s.validate();
     if (!err.empty()) return "invalid settings: " + err;
 
@@ -173,7 +128,7 @@ std::string applyOverrides(const RenderArgs& a, sg::Scene& scene) {
             return "--camera " + std::to_string(a.camera) + ": the scene has " + std::to_string(cams.size()) + " camera(s)";
         scene.activeCamera = cams[a.camera];
     }
-    if (a.projection || a.fovy || a.obliqueAngle || a.obliqueFactor) {
+    if (anyGiven(a.projection)) {
         if (!scene.valid(scene.activeCamera) || !std::holds_alternative<sg::Camera>(scene.node(scene.activeCamera).payload)) {
             if (cams.empty())
                 scene.addDefaultCamera();
@@ -181,27 +136,8 @@ std::string applyOverrides(const RenderArgs& a, sg::Scene& scene) {
                 scene.activeCamera = cams.front();
         }
         auto& cam = std::get<sg::Camera>(scene.editPayload(scene.activeCamera));
-        if (a.projection) {
-            const std::string& p = *a.projection;
-            sg::ObliquePreset name;
-            if (sg::parseName(p, name)) {
-                sg::Projection preset = sg::obliquePreset(name);
-                cam.projection.type = preset.type;
-                cam.projection.obliqueAngleDeg = preset.obliqueAngleDeg;
-                cam.projection.obliqueFactor = preset.obliqueFactor;
-            } else if (!sg::parseName(p, cam.projection.type)) {
-                return notOneOf("--projection", p, projectionNames());
-            }
-        }
-        if (a.fovy) {
-            if (!(*a.fovy > 0.5f && *a.fovy < 179.5f)) return "--fovy must be in (0.5, 179.5) degrees";
-            cam.projection.fovyDeg = *a.fovy;
-        }
-        if (a.obliqueAngle) cam.projection.obliqueAngleDeg = *a.obliqueAngle;
-        if (a.obliqueFactor) {
-            if (!(*a.obliqueFactor >= 0.0f && *a.obliqueFactor <= 4.0f)) return "--oblique-factor must be in [0, 4]";
-            cam.projection.obliqueFactor = *a.obliqueFactor;
-        }
+        if (std::string e = applyTableOverrides(a.projection, cam.projection); !e.empty()) return e;
+        if (!(cam.projection.zNear < cam.projection.zFar)) return "--near / --far: the camera needs near < far";
     }
     return {};
 }
@@ -252,18 +188,104 @@ std::string overlayOptions(const RenderArgs& a, const sg::Scene& scene, float as
 
 }   // namespace
 
+namespace {
+
+// "Backend: gl, raster or raycast", then one line per backend.
+std::string backendHelp() {
+    std::string out = "Backend: " + rnd::rendererNameList("or");
+    for (const rnd::BackendInfo& b : rnd::backends()) out += "\n  " + std::string(b.name) + "  " + std::string(b.help);
+    return out;
+}
+
+// Help for a table row: its help line, the range or the choices (one line each).
+template <class T>
+std::string optionHelp(const sg::Param<T>& p) {
+    std::string out(p.help);
+    switch (p.kind) {
+    case sg::ParamKind::Bool: out += ": on, off"; break;
+    case sg::ParamKind::Int:
+    case sg::ParamKind::Float: out += " (" + sg::formatParamValue(float(p.min)) + ".." + sg::formatParamValue(float(p.max)) + ")"; break;
+    case sg::ParamKind::Color: out += ": r,g,b"; break;
+    case sg::ParamKind::Choice: {
+        size_t width = 0;
+        for (const sg::ParamChoice& c : p.choices) width = std::max(width, c.name.size());
+        for (const sg::ParamChoice& c : p.choices)
+            out += "\n  " + std::string(c.name) + std::string(width + 2 - c.name.size(), ' ') + std::string(c.help);
+        break;
+    }
+    }
+    return out;
+}
+
+// One option per row of T's table that has a flag; the text lands in given[KEY].
+template <class T>
+void addTableOptions(CLI::App& cmd, std::map<std::string, std::optional<std::string>>& given) {
+    for (const sg::Param<T>& p : sg::params<T>())
+        if (!p.flag.empty()) cmd.add_option(flagOf(p), given[std::string(p.key)], optionHelp(p));
+}
+
+}   // namespace
+
+namespace {
+
+// Roff text: '-' as "\-" (a minus, as man pages write options), a leading '.' or '\'' escaped.
+std::string roff(std::string_view text) {
+    std::string out;
+    for (char c : text) {
+        if (c == '-')
+            out += "\\-";
+        else if (c == '\\')
+            out += "\\e";
+        else
+            out += c;
+    }
+    if (!out.empty() && (out[0] == '.' || out[0] == '\'')) out = "\\&" + out;
+    return out;
+}
+
+template <class T>
+void printManOptions(std::string& out) {
+    for (const sg::Param<T>& p : sg::params<T>()) {
+        if (p.flag.empty()) continue;
+        const char* arg = p.kind == sg::ParamKind::Bool    ? nullptr
+                          : p.kind == sg::ParamKind::Int   ? " N"
+                          : p.kind == sg::ParamKind::Float ? " X"
+                          : p.kind == sg::ParamKind::Color ? " R,G,B"
+                                                           : " NAME";
+        out += ".TP\n";
+        out += arg ? ".BI " + roff(flagOf(p)) + " \"" + arg + "\"\n" : ".BR " + roff(flagOf(p)) + " \" on|off\"\n";
+        out += roff(p.help);
+        if (p.kind == sg::ParamKind::Int || p.kind == sg::ParamKind::Float)
+            out += ", " + roff(sg::formatParamValue(float(p.min))) + " to " + roff(sg::formatParamValue(float(p.max)));
+        if (p.kind == sg::ParamKind::Color) out += " (linear, three numbers)";
+        out += p.kind == sg::ParamKind::Choice ? ":\n" : ".\n";
+        for (size_t i = 0; i < p.choices.size(); ++i)
+            out += ".B " + roff(p.choices[i].name) + "\n(" + roff(p.choices[i].help) + ")" + (i + 1 < p.choices.size() ? ",\n" : ".\n");
+    }
+}
+
+}   // namespace
+
+std::string manPageOptions() {
+    std::string out;
+    printManOptions<sg::RenderSettings>(out);
+    printManOptions<sg::Projection>(out);
+    return out;
+}
+
 void addRenderOptions(CLI::App& cmd, RenderArgs& a, Command command) {
     cmd.add_option("scene", a.scene, "Scene file (.json .gltf .glb .obj .off .ply .stl) or 'demo'")->required();
     if (command == Command::Compare) {
         cmd.add_option("--out", a.out, "Output folder (created if missing)")->required();
     } else if (command == Command::Inspect) {
         cmd.add_option("--at", a.at, "Pixel X,Y (from the top-left corner of the image)")->required();
-        cmd.add_option("--backend", a.backend, "Backend: gl, raster, raycast or all")->capture_default_str();
+        cmd.add_option("--backend", a.backend, "Backend: " + rnd::rendererNameList("or") + " (or all)")->capture_default_str();
     } else {
         cmd.add_option("--out", a.out, "Output PNG file")->required();
         cmd.add_option("--backend", a.backend,
-                       "Backend: gl, raster or raycast. Default: gl, or raster (with a note saying so) where OpenGL is software only "
-                       "(Mesa llvmpipe, no GPU) or cannot render; --backend gl always renders with GL");
+                       backendHelp() +
+                           "\nDefault: gl, or raster (with a note saying so) where OpenGL is software only "
+                           "(Mesa llvmpipe, no GPU) or cannot render; --backend gl always renders with GL");
         cmd.add_option("--aov", a.aov,
                        "Also write, next to OUT.png, any of: depth (OUT.depth.pfm, float32 depth along the optical axis, 0 = nothing), "
                        "normal (OUT.normal.png, world normal as 0.5 n + 0.5, black = nothing), id (OUT.id.png, 16-bit instance id, 0 = "
@@ -285,24 +307,8 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a, Command command) {
     cmd.add_option("--camera-json", a.cameraJson, "Render from exactly this camera: a sidecar P.json (or its camera object)");
     cmd.add_flag("--overwrite", a.overwrite, "Replace existing output files");
     cmd.add_option("--camera", a.camera, "Use the scene's N-th camera (0-based; default: the active one)");
-    cmd.add_option("--shading", a.shading, namedHelp<sg::ShadingModel>("Shading model"));
-    cmd.add_option("--reflection", a.reflection, namedHelp<sg::ReflectionModel>("Reflection model"));
-    cmd.add_option("--fog", a.fog, namedHelp<sg::FogMode>("Fog"));
-    cmd.add_option("--fog-start", a.fogStart, "Linear fog start distance");
-    cmd.add_option("--fog-end", a.fogEnd, "Linear fog end distance");
-    cmd.add_option("--fog-density", a.fogDensity, "Fog density of the exponential modes");
-    cmd.add_option("--aa", a.aa, namedHelp<sg::AAChoice>("Anti-aliasing"));
-    cmd.add_option("--projection", a.projection, projectionHelp());
-    cmd.add_option("--fovy", a.fovy, "Perspective vertical field of view in degrees");
-    cmd.add_option("--oblique-angle", a.obliqueAngle, "Oblique receding-axis angle in degrees");
-    cmd.add_option("--oblique-factor", a.obliqueFactor, "Oblique foreshortening factor (see the presets of --projection)");
-    cmd.add_option("--shadows", a.shadows, "Ray caster shadow rays: on, off");
-    cmd.add_option("--reflections", a.reflections, "Ray caster mirror reflections: on, off");
-    cmd.add_option("--bounces", a.bounces, "Ray caster reflection depth limit");
-    cmd.add_option("--culling", a.culling, namedHelp<sg::CullMode>("Back-face culling"));
-    cmd.add_option("--wireframe", a.wireframe, "Wireframe overlay: on, off");
-    cmd.add_option("--attenuation", a.attenuation, "Inverse-square light attenuation: on, off");
-    cmd.add_option("--tessellation", a.tessellation, "Tessellation resolution for implicit shapes (4..512)");
+    addTableOptions<sg::RenderSettings>(cmd, a.settings);
+    addTableOptions<sg::Projection>(cmd, a.projection);
     cmd.add_option("--time", a.time, "Pose the scene at this time (seconds) of its animation (skins, morph weights, transforms)");
     cmd.add_option("--animation", a.animation, "Which animation clip --time poses (0-based; default 0)");
     if (command == Command::Inspect) return;
@@ -521,8 +527,6 @@ int runConvert(const std::string& sceneArg, const std::string& out, bool overwri
     std::printf("%s\n", out.c_str());
     return 0;
 }
-
-int runWindow(const std::string& scene) { return ui::runViewer(scene); }
 
 int runInspect(const RenderArgs& a) {
     int w = 0, h = 0, x = -1, y = -1;

@@ -3,6 +3,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <map>
 #include <optional>
 #include <string>
 
@@ -15,13 +16,13 @@ struct RenderArgs {
     std::string size;      // "" = 1280x720 (render: or the --camera-json camera's own size)
     bool overwrite = false;
     int camera = -1;   // index into the scene's cameras, -1 = active
-    // Settings overrides (unset = the scene's own setting).
-    std::optional<std::string> shading, reflection, fog, aa, projection, shadows, reflections, culling, wireframe, attenuation;
-    std::optional<float> fogStart, fogEnd, fogDensity, fovy, obliqueAngle, obliqueFactor;
-    std::optional<int> tessellation, bounces;
-    std::string aov;               // comma-separated list of extra outputs (render only): depth, normal, id
-    std::string at;                // inspect: pixel "X,Y" from the top-left corner
-    std::string view = "shaded";   // render: the diagnostic view written (rnd::DiagnosticView names)
+    // Overrides of the scene's own values, one per row of the parameter tables that has a
+    // command-line flag (scenegraph/params.h), keyed by the row's key; unset = the scene's own.
+    std::map<std::string, std::optional<std::string>> settings;     // render settings: --fog, --fog-start, ...
+    std::map<std::string, std::optional<std::string>> projection;   // the camera's projection: --projection, --fovy, ...
+    std::string aov;                                                // comma-separated list of extra outputs (render only): depth, normal, id
+    std::string at;                                                 // inspect: pixel "X,Y" from the top-left corner
+    std::string view = "shaded";                                    // render: the diagnostic view written (rnd::DiagnosticView names)
     // Cameras (app/camera_jobs.h): --intrinsics, --camera-json, --cameras, --turntable, --shard.
     std::string intrinsics, cameraJson, cameras, shard;
     int turntable = 0;
@@ -41,6 +42,8 @@ int runInspect(const RenderArgs& args);
 int runCompare(const RenderArgs& args);
 int runDemoShots(const std::string& outDir, const std::string& size);
 int runConvert(const std::string& scene, const std::string& out, bool overwrite);
-int runWindow(const std::string& scene);
+// The man page's entries for the options that come from the parameter tables (roff), which the
+// build puts into docs/viewer.1 at its "@TABLE_OPTIONS@" line (packaging/manpage.cmake).
+std::string manPageOptions();
 
 }   // namespace cli

@@ -38,6 +38,8 @@ int main(int argc, char** argv) {
     app.add_option("--view", windowOpts.view, "Initial view: single, split, split3, difference")->group("");
     app.add_option("--window-size", windowSize, "Window size WxH")->group("");
     app.add_option("--timeout", windowOpts.timeoutSeconds, "Automation time limit in seconds")->group("");
+    bool manOptions = false;   // the build's man page: the parameter tables' options as roff
+    app.add_flag("--man-options", manOptions, "Print the settings options as man page text")->group("");
 
     cli::RenderArgs renderArgs;
     CLI::App* render = app.add_subcommand("render", "Render SCENE offscreen to a PNG (no window needed)");
@@ -70,6 +72,10 @@ int main(int argc, char** argv) {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) { return app.exit(e); }
 
+    if (manOptions) {
+        std::fputs(cli::manPageOptions().c_str(), stdout);
+        return 0;
+    }
     if (*render) return cli::runRender(renderArgs);
     if (*compare) return cli::runCompare(compareArgs);
     if (*inspect) return cli::runInspect(inspectArgs);

@@ -47,7 +47,7 @@ int addMesh(Scene& s, Mesh m) {
 Scene makeDemoScene() {
     Scene s;
     s.name = "demo room";
-    s.ambientLight = vec3(0.35f, 0.37f, 0.42f);
+    s.settings.ambientLight = vec3(0.35f, 0.37f, 0.42f);
     s.settings.background = vec3(0.05f, 0.055f, 0.07f);
     s.settings.fogColor = s.settings.background;
     s.settings.fogStart = 8.0f;

@@ -2,6 +2,8 @@
 
 #include "importers.h"
 
+#include "scenegraph/scene_defaults.h"
+
 #include <algorithm>
 #include <cctype>
 
@@ -38,9 +40,14 @@ LoadResult loadScene(const fs::path& path, const LoadOptions& options) {
     r.error = checkSceneFile(path);
     if (!r.error.empty()) return r;
     std::string ext = lowerExtension(path);
-    if (ext == ".json") return loadSceneJson(path);
-    if (ext == ".gltf" || ext == ".glb") return detail::loadGltf(path, options);
-    return detail::loadMeshFile(path, options);
+    if (ext == ".json")
+        r = loadSceneJson(path);
+    else if (ext == ".gltf" || ext == ".glb")
+        r = detail::loadGltf(path, options);
+    else
+        r = detail::loadMeshFile(path, options);
+    if (r.scene) sg::applySceneDefaults(*r.scene);   // the same defaults wherever a file is opened
+    return r;
 }
 
 }   // namespace assets

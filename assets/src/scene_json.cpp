@@ -4,24 +4,20 @@
 // column-major order (as GLM stores them); quaternions are [x, y, z, w]; colours linear RGB.
 //   {
 //     "format": "sceneviewer", "version": 1, "name": "...",
-//     "ambientLight": [r,g,b], "activeCamera": <node index or null>,
-//     "settings":  { "shading": <ShadingModel>, "reflection": <ReflectionModel>,
+//     "activeCamera": <node index or null>,
+//     "settings":  { every row of the render-settings table in scenegraph/params.h by its key:
+//                    "shading": <ShadingModel>, "reflection", "attenuation", "ambientLight",
 //                    "fog": {"mode": <FogMode>, "color": [..], "start", "end", "density"},
-//                    "attenuation": bool, "aa": <AAChoice>,
-//                    "aaRate", "culling": <CullMode> (older files: "cullBackFaces": bool),
-//                    "wireframe", "wireframeColor", "background",
-//                    "shadows", "reflections", "maxBounces", "tessellation" },
+//                    "aa": <AAChoice>, "aaRate", "culling": <CullMode>, "wireframe", ... }
+//                  (older files: "cullBackFaces": bool; "ambientLight" at the top level),
 //     "textures":  [ {"name", "file": "relative/path.png"} | {"name", "png": "<base64 PNG>"},
 //                    + "wrapS"/"wrapT": <WrapMode>, "filter": <FilterMode>,
 //                    "srgb": false for data textures (metallic-roughness, occlusion) ],
-//     "materials": [ {"name", "baseColor", "ka", "kd", "ks", "shininess", "specularTinted",
-//                     "specularColor", "diffuseTexture", "emissive", "emissiveTexture",
-//                     "occlusionTexture", "occlusionStrength", "normalTexture", "normalScale",
-//                     "metallicRoughnessTexture",
-//                     "metallic", "roughness", "specularGlossiness", "glossiness", "alpha",
-//                     "alphaMode": <AlphaMode>, "alphaCutoff", "unlit", "doubleSided",
-//                     "reflectivity", "uv1Maps": the maps that sample the mesh's uv1, any of
-//                     ["emissive", "occlusion", "metallicRoughness", "normal"]} ],
+//     "materials": [ {"name", the texture indices "diffuseTexture", "emissiveTexture",
+//                     "occlusionTexture", "normalTexture", "metallicRoughnessTexture",
+//                     "uv1Maps": the maps that sample the mesh's uv1, any of ["emissive",
+//                     "occlusion", "metallicRoughness", "normal"], and every row of the
+//                     material table in params.h ("baseColor", "ka", "kd", "ks", ...)} ],
 //     "meshes":    [ {"name", "file": "relative/model.obj"} |
 //                    {"name", "mode": "triangles|lines|points", "positions": [x,y,z,...],
 //                     "normals", "uv0", "uv1", "colors" (4 per vertex), "tangents" (4 per
@@ -41,6 +37,9 @@
 //   }
 // Animation clips are not part of the format (convert says so); a skinned or morphed scene is
 // saved in the pose it has (node transforms and MeshInstance weights as they are).
+// Camera payloads hold the projection table's rows plus "frustum": [l, r, b, t] and
+// "focusDistance"; light payloads the light table's rows. Every value of a table row is checked
+// against the row's range, and the error names its JSON path.
 // <Enum> is a name from that enum's table in scenegraph/setting_names.h (camera "type":
 // <ProjectionType>, light "type": <LightType>); the writer writes the table's name, the reader
 // also accepts the table's aliases.
@@ -52,6 +51,7 @@
 
 #include "assets/files.h"
 #include "assets/image_io.h"
+#include "scenegraph/params.h"
 #include "scenegraph/setting_names.h"
 
 #include <nlohmann/json.hpp>
@@ -248,6 +248,47 @@ private:
         if (!sg::parseName(s, e)) fail(path, "unknown value \"" + s + "\" (valid: " + sg::nameList<E>() + ")");
         return e;
     }
+    // Every row of T's parameter table (scenegraph/params.h) present in `obj`: its kind and
+    // range checked, the error naming the JSON path; absent keys leave `object` alone.
+    template <class T>
+    void readParams(const json& obj, const std::string& p, T& object) {
+        if (!obj.is_object()) fail(p, "expected an object");
+        for (const sg::Param<T>& row : sg::params<T>()) {
+            const json* v = &obj;
+            std::string path = p;
+            std::string_view key = row.key;
+            while (v) {
+                const size_t dot = key.find('.');
+                const std::string part(key.substr(0, dot));
+                if (!v->is_object()) fail(path, "expected an object");
+                v = optional(*v, part.c_str());
+                path += "/" + part;
+                if (dot == std::string_view::npos) break;
+                key.remove_prefix(dot + 1);
+            }
+            if (!v) continue;
+            sg::ParamValue value;
+            switch (row.kind) {
+            case sg::ParamKind::Bool: value = boolean(*v, path); break;
+            case sg::ParamKind::Int: value = integer(*v, path, (long long)row.min, (long long)row.max); break;
+            case sg::ParamKind::Float: value = number(*v, path); break;
+            case sg::ParamKind::Color: value = sg::vec3(vec<3>(*v, path)); break;
+            case sg::ParamKind::Choice: value = string(*v, path); break;
+            }
+            if (row.kind == sg::ParamKind::Choice) {
+                std::string names;
+                for (const sg::ParamChoice& c : row.choices) names += (names.empty() ? "" : ", ") + std::string(c.name);
+                if (!row.set(object, value)) fail(path, "unknown value \"" + std::get<std::string>(value) + "\" (valid: " + names + ")");
+                continue;
+            }
+            if (std::string err = sg::checkValue(row, value); !err.empty()) {
+                std::string_view why = std::string_view(err).substr(row.key.size());
+                while (!why.empty() && (why.front() == ':' || why.front() == ' ')) why.remove_prefix(1);
+                fail(path, std::string(why));
+            }
+            row.set(object, value);
+        }
+    }
     // Optional field helpers: leave `dst` alone when the key is absent.
     void optFloat(const json& o, const std::string& p, const char* k, float& dst) {
         if (auto* v = optional(o, k)) dst = number(*v, p + "/" + k);
@@ -301,32 +342,9 @@ private:
 
 void Reader::readSettings(const json& j, const std::string& p, sg::RenderSettings& s) {
     if (!j.is_object()) fail(p, "expected an object");
-    if (auto* v = optional(j, "shading")) s.shading = named<sg::ShadingModel>(*v, p + "/shading");
-    if (auto* v = optional(j, "reflection")) s.reflection = named<sg::ReflectionModel>(*v, p + "/reflection");
-    if (auto* f = optional(j, "fog")) {
-        std::string fp = p + "/fog";
-        if (!f->is_object()) fail(fp, "expected an object");
-        if (auto* v = optional(*f, "mode")) s.fog = named<sg::FogMode>(*v, fp + "/mode");
-        optVec3(*f, fp, "color", s.fogColor);
-        optFloat(*f, fp, "start", s.fogStart);
-        optFloat(*f, fp, "end", s.fogEnd);
-        optFloat(*f, fp, "density", s.fogDensity);
-    }
-    optBool(j, p, "attenuation", s.attenuation);
-    if (auto* v = optional(j, "aa")) {
-        std::string a = string(*v, p + "/aa");
-        if (!s.setAA(a)) fail(p + "/aa", "unknown value \"" + a + "\" (valid: " + sg::nameList<sg::AAChoice>() + ")");
-    }
-    if (s.aa == sg::AAMode::None) optInt(j, p, "aaRate", s.aaRate, 1, 8);
+    // Older files: a bool instead of the culling mode (a "culling" in the same file wins).
     if (auto* v = optional(j, "cullBackFaces")) s.culling = boolean(*v, p + "/cullBackFaces") ? sg::CullMode::On : sg::CullMode::Off;
-    if (auto* v = optional(j, "culling")) s.culling = named<sg::CullMode>(*v, p + "/culling");
-    optBool(j, p, "wireframe", s.wireframe);
-    optVec3(j, p, "wireframeColor", s.wireframeColor);
-    optVec3(j, p, "background", s.background);
-    optBool(j, p, "shadows", s.shadows);
-    optBool(j, p, "reflections", s.reflections);
-    optInt(j, p, "maxBounces", s.maxBounces, 0, 16);
-    optInt(j, p, "tessellation", s.tessellation, 4, 512);
+    readParams(j, p, s);
     std::string err = s.validate();
     if (!err.empty()) fail(p, err);
 }
@@ -335,23 +353,12 @@ sg::Material Reader::readMaterial(const json& j, const std::string& p, size_t te
     if (!j.is_object()) fail(p, "expected an object");
     sg::Material m;
     if (auto* v = optional(j, "name")) m.name = string(*v, p + "/name");
-    optVec3(j, p, "baseColor", m.baseColor);
-    optFloat(j, p, "ka", m.ka);
-    optFloat(j, p, "kd", m.kd);
-    optFloat(j, p, "ks", m.ks);
-    optFloat(j, p, "shininess", m.shininess);
-    if (m.shininess < 0 || m.shininess > 1e5f) fail(p + "/shininess", "must be in [0, 100000]");
-    optBool(j, p, "specularTinted", m.specularTinted);
-    optVec3(j, p, "specularColor", m.specularColor);
+    readParams(j, p, m);
+    // The texture references (indices into "textures"), checked against the texture count.
     optInt(j, p, "diffuseTexture", m.diffuseTexture, -1, (long long)textureCount - 1);
-    optVec3(j, p, "emissive", m.emissive);
     optInt(j, p, "emissiveTexture", m.emissiveTexture, -1, (long long)textureCount - 1);
     optInt(j, p, "occlusionTexture", m.occlusionTexture, -1, (long long)textureCount - 1);
-    optFloat(j, p, "occlusionStrength", m.occlusionStrength);
-    if (!(m.occlusionStrength >= 0 && m.occlusionStrength <= 1)) fail(p + "/occlusionStrength", "must be in [0, 1]");
     optInt(j, p, "normalTexture", m.normalTexture, -1, (long long)textureCount - 1);
-    optFloat(j, p, "normalScale", m.normalScale);
-    if (!std::isfinite(m.normalScale)) fail(p + "/normalScale", "must be finite");
     optInt(j, p, "metallicRoughnessTexture", m.metallicRoughnessTexture, -1, (long long)textureCount - 1);
     if (const json* v = optional(j, "uv1Maps")) {
         if (!v->is_array()) fail(p + "/uv1Maps", "expected an array of map names");
@@ -361,21 +368,6 @@ sg::Material Reader::readMaterial(const json& j, const std::string& p, size_t te
             m.uv1Maps |= e->bit;
         }
     }
-    optFloat(j, p, "metallic", m.metallic);
-    optFloat(j, p, "roughness", m.roughness);
-    optBool(j, p, "specularGlossiness", m.specularGlossiness);
-    optFloat(j, p, "glossiness", m.glossiness);
-    if (!(m.glossiness >= 0 && m.glossiness <= 1)) fail(p + "/glossiness", "must be in [0, 1]");
-    if (!(m.metallic >= 0 && m.metallic <= 1)) fail(p + "/metallic", "must be in [0, 1]");
-    if (!(m.roughness >= 0 && m.roughness <= 1)) fail(p + "/roughness", "must be in [0, 1]");
-    optFloat(j, p, "alpha", m.alpha);
-    if (m.alpha < 0 || m.alpha > 1) fail(p + "/alpha", "must be in [0, 1]");
-    if (auto* v = optional(j, "alphaMode")) m.alphaMode = named<sg::AlphaMode>(*v, p + "/alphaMode");
-    optFloat(j, p, "alphaCutoff", m.alphaCutoff);
-    if (!(m.alphaCutoff >= 0)) fail(p + "/alphaCutoff", "must be >= 0");
-    optBool(j, p, "unlit", m.unlit);
-    optBool(j, p, "doubleSided", m.doubleSided);
-    optFloat(j, p, "reflectivity", m.reflectivity);
     return m;
 }
 
@@ -619,11 +611,7 @@ sg::Payload Reader::readPayload(const json& j, const std::string& p, const sg::S
     if (k == "camera") {
         sg::Camera c;
         sg::Projection& pr = c.projection;
-        if (auto* t = optional(v, "type")) pr.type = named<sg::ProjectionType>(*t, kp + "/type");
-        optFloat(v, kp, "fovy", pr.fovyDeg);
-        optFloat(v, kp, "near", pr.zNear);
-        optFloat(v, kp, "far", pr.zFar);
-        optBool(v, kp, "useFrustum", pr.useFrustum);
+        readParams(v, kp, pr);
         if (auto* fr = optional(v, "frustum")) {
             sg::vec4 f = vec<4>(*fr, kp + "/frustum");
             pr.left = f[0];
@@ -631,24 +619,14 @@ sg::Payload Reader::readPayload(const json& j, const std::string& p, const sg::S
             pr.bottom = f[2];
             pr.top = f[3];
         }
-        optFloat(v, kp, "orthoHalfHeight", pr.orthoHalfHeight);
-        optFloat(v, kp, "obliqueAngle", pr.obliqueAngleDeg);
-        optFloat(v, kp, "obliqueFactor", pr.obliqueFactor);
         optFloat(v, kp, "focusDistance", c.focusDistance);
-        if (!(pr.zNear > 0) || !(pr.zFar > pr.zNear)) fail(kp, "needs 0 < near < far");
-        if (!(pr.fovyDeg > 0.01f && pr.fovyDeg < 179.99f)) fail(kp + "/fovy", "must be in (0, 180) degrees");
-        if (!(pr.orthoHalfHeight > 0)) fail(kp + "/orthoHalfHeight", "must be positive");
+        if (!(pr.zFar > pr.zNear)) fail(kp, "needs 0 < near < far");
         if (pr.useFrustum && (!(pr.right > pr.left) || !(pr.top > pr.bottom))) fail(kp + "/frustum", "needs left < right and bottom < top");
         return c;
     }
     if (k == "light") {
         sg::Light l;
-        if (auto* t = optional(v, "type")) l.type = named<sg::LightType>(*t, kp + "/type");
-        optVec3(v, kp, "color", l.color);
-        optFloat(v, kp, "intensity", l.intensity);
-        optBool(v, kp, "inverseSquare", l.inverseSquare);
-        optFloat(v, kp, "spotInner", l.spotInnerDeg);
-        optFloat(v, kp, "spotOuter", l.spotOuterDeg);
+        readParams(v, kp, l);
         return l;
     }
     if (k == "implicit") {
@@ -715,7 +693,12 @@ sg::Scene Reader::read() {
     }
     sg::Scene s;
     if (auto* v = optional(j, "name")) s.name = string(*v, "/name");
-    optVec3(j, "", "ambientLight", s.ambientLight);
+    // Older files keep the ambient light at the top level; "settings" has it now (and wins).
+    if (auto* v = optional(j, "ambientLight")) {
+        s.settings.ambientLight = vec<3>(*v, "/ambientLight");
+        if (std::string err = sg::checkValue(*sg::findParam<sg::RenderSettings>("ambientLight"), s.settings.ambientLight); !err.empty())
+            fail("/ambientLight", "each component must be in [0, 1000]");
+    }
     if (auto* v = optional(j, "settings")) readSettings(*v, "/settings", s.settings);
 
     auto array = [&](const char* key) -> const json* {
@@ -868,6 +851,25 @@ json implicitJ(const sg::ImplicitShape& s) {
     return j;
 }
 
+// Every row of T's parameter table into `obj` (a dotted key makes nested objects).
+template <class T>
+void writeParams(json& obj, const T& object) {
+    for (const sg::Param<T>& row : sg::params<T>()) {
+        json* dst = &obj;
+        std::string_view key = row.key;
+        for (size_t dot; (dot = key.find('.')) != std::string_view::npos; key.remove_prefix(dot + 1)) dst = &(*dst)[std::string(key.substr(0, dot))];
+        json& out = (*dst)[std::string(key)];
+        std::visit(
+            [&](const auto& v) {
+                if constexpr (std::is_same_v<std::decay_t<decltype(v)>, sg::vec3>)
+                    out = vecJ(v);
+                else
+                    out = v;
+            },
+            row.get(object));
+    }
+}
+
 json payloadJ(const sg::Payload& p) {
     json j;
     std::visit(
@@ -879,19 +881,15 @@ json payloadJ(const sg::Payload& p) {
                 if (!v.weights.empty()) j["mesh"]["weights"] = v.weights;
             } else if constexpr (std::is_same_v<T, sg::Camera>) {
                 const sg::Projection& pr = v.projection;
-                j["camera"] = {{"type", sg::nameOf(pr.type)},
-                               {"fovy", pr.fovyDeg},
-                               {"near", pr.zNear},
-                               {"far", pr.zFar},
-                               {"useFrustum", pr.useFrustum},
-                               {"frustum", {pr.left, pr.right, pr.bottom, pr.top}},
-                               {"orthoHalfHeight", pr.orthoHalfHeight},
-                               {"obliqueAngle", pr.obliqueAngleDeg},
-                               {"obliqueFactor", pr.obliqueFactor},
-                               {"focusDistance", v.focusDistance}};
+                json c = json::object();
+                writeParams(c, pr);
+                c["frustum"] = {pr.left, pr.right, pr.bottom, pr.top};
+                c["focusDistance"] = v.focusDistance;
+                j["camera"] = c;
             } else if constexpr (std::is_same_v<T, sg::Light>) {
-                j["light"] = {{"type", sg::nameOf(v.type)},       {"color", vecJ(v.color)},      {"intensity", v.intensity},
-                              {"inverseSquare", v.inverseSquare}, {"spotInner", v.spotInnerDeg}, {"spotOuter", v.spotOuterDeg}};
+                json l = json::object();
+                writeParams(l, v);
+                j["light"] = l;
             } else if constexpr (std::is_same_v<T, sg::ImplicitPayload>) {
                 json s = implicitJ(v.shape);
                 s["material"] = v.material;
@@ -988,23 +986,8 @@ std::string serializeSceneJson(const sg::Scene& s) {
     j["format"] = "sceneviewer";
     j["version"] = 1;
     j["name"] = s.name;
-    j["ambientLight"] = vecJ(s.ambientLight);
-    const sg::RenderSettings& r = s.settings;
-    j["settings"] = {
-        {"shading", sg::nameOf(r.shading)},
-        {"reflection", sg::nameOf(r.reflection)},
-        {"fog", {{"mode", sg::nameOf(r.fog)}, {"color", vecJ(r.fogColor)}, {"start", r.fogStart}, {"end", r.fogEnd}, {"density", r.fogDensity}}},
-        {"attenuation", r.attenuation},
-        {"aa", r.aaName()},
-        {"culling", sg::nameOf(r.culling)},
-        {"wireframe", r.wireframe},
-        {"wireframeColor", vecJ(r.wireframeColor)},
-        {"background", vecJ(r.background)},
-        {"shadows", r.shadows},
-        {"reflections", r.reflections},
-        {"maxBounces", r.maxBounces},
-        {"tessellation", r.tessellation}};
-    j["settings"]["aaRate"] = r.aaRate;   // kept while AA is off, so switching it back on restores it
+    j["settings"] = json::object();
+    writeParams(j["settings"], s.settings);   // aaRate too: kept while AA is off, so switching it back on restores it
     j["textures"] = json::array();
     for (const auto& t : s.textures) {
         json tj = {{"name", t->name}, {"wrapS", sg::nameOf(t->wrapS)}, {"wrapT", sg::nameOf(t->wrapT)}, {"filter", sg::nameOf(t->filter)}};
@@ -1016,32 +999,14 @@ std::string serializeSceneJson(const sg::Scene& s) {
     }
     j["materials"] = json::array();
     for (const auto& m : s.materials) {
-        j["materials"].push_back({{"name", m.name},
-                                  {"baseColor", vecJ(m.baseColor)},
-                                  {"ka", m.ka},
-                                  {"kd", m.kd},
-                                  {"ks", m.ks},
-                                  {"shininess", m.shininess},
-                                  {"specularTinted", m.specularTinted},
-                                  {"specularColor", vecJ(m.specularColor)},
-                                  {"diffuseTexture", m.diffuseTexture},
-                                  {"emissive", vecJ(m.emissive)},
-                                  {"emissiveTexture", m.emissiveTexture},
-                                  {"occlusionTexture", m.occlusionTexture},
-                                  {"occlusionStrength", m.occlusionStrength},
-                                  {"normalTexture", m.normalTexture},
-                                  {"normalScale", m.normalScale},
-                                  {"metallicRoughnessTexture", m.metallicRoughnessTexture},
-                                  {"metallic", m.metallic},
-                                  {"roughness", m.roughness},
-                                  {"specularGlossiness", m.specularGlossiness},
-                                  {"glossiness", m.glossiness},
-                                  {"alpha", m.alpha},
-                                  {"alphaMode", sg::nameOf(m.alphaMode)},
-                                  {"alphaCutoff", m.alphaCutoff},
-                                  {"unlit", m.unlit},
-                                  {"doubleSided", m.doubleSided},
-                                  {"reflectivity", m.reflectivity}});
+        json mj = {{"name", m.name},
+                   {"diffuseTexture", m.diffuseTexture},
+                   {"emissiveTexture", m.emissiveTexture},
+                   {"occlusionTexture", m.occlusionTexture},
+                   {"normalTexture", m.normalTexture},
+                   {"metallicRoughnessTexture", m.metallicRoughnessTexture}};
+        writeParams(mj, m);
+        j["materials"].push_back(mj);
         if (m.uv1Maps) {
             json names = json::array();
             for (const MapBitName& e : kMapBitNames)

@@ -12,7 +12,7 @@
 // metrics (medians of warm frames):
 //   ms          wall ms per frame, raster vs the minimal GL program (the goal: ratio <= 0.5)
 //   ms_gl       wall ms per frame, raster vs our GL backend
-//   gl_ms       wall ms per frame, our GL backend vs the minimal GL program (issue 20: ratio <= 1.3)
+//   gl_ms       wall ms per frame, our GL backend vs the minimal GL program (goal: ratio <= 1.3)
 //   gl_cpu_ms   process CPU ms per frame, our GL backend vs the minimal GL program
 //   cpu_ms      process CPU ms per frame (all threads), raster vs the minimal GL program
 //   mpix_s      fill rate: covered pixels per wall second / 1e6 (ratio = ref time / ours)
@@ -153,7 +153,7 @@ BenchScene sphereGrid(const std::string& name, int grid, int seg) {
     addGridCameraAndKey(s, extent);
     NodeId sun = s.addNode("sun", s.root(), Light{LightType::Directional, vec3(0.6f, 0.7f, 0.9f), 0.4f, false});
     s.lookAt(sun, vec3(-1, 2, 1), vec3(0));
-    s.ambientLight = vec3(0.3f);
+    s.settings.ambientLight = vec3(0.3f);
     return b;
 }
 
@@ -185,7 +185,7 @@ BenchScene singleMesh(const std::string& name, int grid, int seg, int groundSub)
     s.addNode("mesh", s.root(), MeshInstance{0, 0});
     b.triangles = m->triangleCount();
     addGridCameraAndKey(s, extent);
-    s.ambientLight = vec3(0.3f);
+    s.settings.ambientLight = vec3(0.3f);
     return b;
 }
 

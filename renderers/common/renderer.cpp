@@ -115,6 +115,16 @@ RenderStats Renderer::render(const sg::FrameInput& frame, int width, int height,
 
 std::vector<float> Renderer::lightVisibility(const sg::FrameInput&, const sg::vec3&, const sg::vec3&) { return {}; }
 
+bool hasFeature(const Capabilities& caps, sg::Feature feature) {
+    switch (feature) {
+    case sg::Feature::None: return true;
+    case sg::Feature::Shadows: return caps.shadows;
+    case sg::Feature::Reflections: return caps.reflections;
+    case sg::Feature::Wireframe: return caps.wireframe;
+    }
+    return true;
+}
+
 bool isSoftwareGLRenderer(std::string_view r) {
     for (std::string_view name : {"llvmpipe", "softpipe", "Software Rasterizer", "swrast", "SWR"})
         if (r.find(name) != std::string_view::npos) return true;

@@ -119,7 +119,7 @@ bool drawMeshOf(const Scene& scene, NodeId id, const MeshInstance& mi, const mat
 FrameInput flatten(const Scene& scene, float aspect, NodeId cameraNode) {
     FrameInput f;
     f.settings = scene.settings;
-    f.ambientLight = scene.ambientLight;
+    f.ambientLight = scene.settings.ambientLight;
     const auto& order = scene.depthFirstOrder();
     scene.updateWorld();
     scene.trimPoseCache();

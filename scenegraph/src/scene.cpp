@@ -122,7 +122,6 @@ Scene& Scene::operator=(const Scene& o) {
     materials = o.materials;
     textures = o.textures;
     skins = o.skins;
-    ambientLight = o.ambientLight;
     settings = o.settings;
     activeCamera = o.activeCamera;
     // Meshes are deep-copied so editing one scene never changes the other.
@@ -681,7 +680,6 @@ std::string skinDifference(const Scene& a, const Scene& b, const std::vector<Nod
 std::string sceneDifference(const Scene& a, const Scene& b) {
     std::ostringstream why;
     if (a.name != b.name) return "scene name differs";
-    if (a.ambientLight != b.ambientLight) return "ambient light differs";
     if (!(a.settings == b.settings)) return "render settings differ";
     if (a.materials != b.materials) return "materials differ";
     if (a.meshes.size() != b.meshes.size()) return "mesh count differs";

@@ -1,4 +1,5 @@
 #include "scenegraph/settings.h"
+#include "scenegraph/params.h"
 #include "scenegraph/setting_names.h"
 
 #include <algorithm>
@@ -7,15 +8,10 @@
 namespace sg {
 
 std::string RenderSettings::validate() const {
-    auto finite = [](float v) { return std::isfinite(v); };
-    if (!finite(fogStart) || !finite(fogEnd) || !finite(fogDensity)) return "fog parameters must be finite";
+    if (std::string err = checkParams(*this); !err.empty()) return err;
     if (fog == FogMode::Linear && !(fogEnd > fogStart)) return "linear fog needs end > start";
-    if (fogDensity < 0) return "fog density must be >= 0";
     if (aa == AAMode::MSAA && aaRate != 2 && aaRate != 4 && aaRate != 8) return "MSAA rate must be 2, 4 or 8";
     if (aa == AAMode::SSAA && (aaRate < 2 || aaRate > 4)) return "SSAA rate must be 2, 3 or 4";
-    if (maxBounces < 0 || maxBounces > 16) return "max bounces must be in 0..16";
-    if (tessellation < 4 || tessellation > 512) return "tessellation must be in 4..512";
-    if (!isFinite(fogColor) || !isFinite(background) || !isFinite(wireframeColor)) return "colours must be finite";
     return {};
 }
 

@@ -1,4 +1,4 @@
-// scene_defaults_test.cpp - defaults that make the first hour work (issue 19): a new scene has a
+// scene_defaults_test.cpp - defaults that make the first hour work: a new scene has a
 // light and a camera, so the first shape added is lit and in view; a loaded scene's unused fog
 // follows its size; a refused setting's message goes once the value is valid; fly speed follows
 // the scene's size.

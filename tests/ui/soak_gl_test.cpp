@@ -10,6 +10,8 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
+
 #include <algorithm>
 #include <random>
 #include <sstream>
@@ -31,6 +33,7 @@ fs::path folder(const std::string& name) {
     fs::remove_all(dir);
     fs::create_directories(dir);
     EXPECT_EQ(assets::saveSceneJson(assets::makeDemoScene(), dir / "demo.json", true), "");
+    std::ofstream(dir / "broken.obj") << "this is not an obj file\nf 1 2 3 4 5\n";   // opens, then fails to load
     return dir;
 }
 
@@ -64,8 +67,8 @@ TEST(SoakGLTest, LongSessionKeepsTheEditAndItsMemoryFlat) {
         s << "diagnostic " << kDiagnostics[r % 8] << "\n";
         s << "view " << kViews[r % 4] << "\nframes 2\n";
         s << "click viewport " << 200 + (r * 37) % 300 << " " << 150 + (r * 53) % 300 << "\nframes 2\nselect crate\n";
-        if (r % 6 == 0) s << "open missing-" << r << ".obj\nanswer discard\nwait load\n";   // a failed load with an unsaved edit
-        if (r % 6 == 3) s << "open demo.json\nanswer cancel\n";                             // a cancelled one
+        if (r % 6 == 0) s << "open broken.obj\nanswer discard\nwait load\n";   // a failed load with an unsaved edit
+        if (r % 6 == 3) s << "open demo.json\nanswer cancel\n";                // a cancelled one
         if (r % 6 == 5) s << "frames 3\nprint memory\n";
     }
     s << "wait\nprint dirty\nprint undo\nquit\n";

@@ -4,6 +4,7 @@
 // flag across save, loads that clear or keep the history) and through the panels in headless
 // ImGui frames (a drag is one step, Ctrl+Z / Ctrl+Shift+Z / Ctrl+Y, the Edit menu).
 #include "ui/undo.h"
+#include "scenegraph/params.h"
 #include "ui/viewer_state.h"
 
 #include "assets/demo.h"
@@ -244,7 +245,7 @@ TEST(ViewerUndoTest, EveryKindOfEditUndoesAndRedoesExactly) {
              s.shading = sg::ShadingModel::Flat;
              EXPECT_EQ(st.setSettings(s), "");
          }},
-        {"ambient", [&] { st.setAmbientLight(sg::vec3(0.1f, 0.2f, 0.3f)); }},
+        {"ambient", [&] { EXPECT_EQ(st.setByName("ambientLight", "0.1,0.2,0.3"), ""); }},
         {"projection",
          [&] {
              sg::Projection p = st.projection();
@@ -371,7 +372,16 @@ TEST(ViewerUndoTest, SetByNameTakesSceneFileNamesAndIsUndoable) {
     EXPECT_NE(st.setByName("shading", "plastic").find("plastic"), std::string::npos);
     EXPECT_NE(st.setByName("no.such", "1").find("unknown setting"), std::string::npos);
     EXPECT_EQ(st.setByName("ambientLight", "[0.1, 0.2, 0.3]"), "");
-    EXPECT_EQ(st.doc.scene.ambientLight, sg::vec3(0.1f, 0.2f, 0.3f));
+    EXPECT_EQ(st.doc.scene.settings.ambientLight, sg::vec3(0.1f, 0.2f, 0.3f));
+    EXPECT_EQ(st.doc.history.undoLabel(), "Change ambientLight");
+    EXPECT_NE(st.setByName("ambientLight", "[-1, 0, 0]").find("ambientLight"), std::string::npos) << "out of range";
+    EXPECT_NE(st.setByName("tessellation", "600").find("[4, 512]"), std::string::npos) << "the table's range";
+
+    // camera.KEY: the projection; light.KEY: the selected light.
+    EXPECT_EQ(st.setByName("camera.fovy", "30"), "");
+    EXPECT_EQ(st.projection().fovyDeg, 30.0f);
+    EXPECT_NE(st.setByName("camera.fovy", "200"), "");
+    EXPECT_NE(st.setByName("light.intensity", "2").find("not a light"), std::string::npos);
 
     // material.FIELD: the selection's material.
     EXPECT_NE(st.setByName("material.kd", "0.5").find("no material"), std::string::npos) << "nothing selected";
@@ -398,11 +408,11 @@ TEST(ViewerUndoTest, SetByNameTakesSceneFileNamesAndIsUndoable) {
 
 TEST(ViewerUndoTest, SettingNamesAreTheSceneFileNames) {
     sg::RenderSettings a, b = a;
-    EXPECT_EQ(settingNames(a, b), "");
+    EXPECT_EQ(sg::changedParams(a, b), "");
     b.fog = sg::FogMode::Exp;
     b.fogDensity = 0.2f;
     b.shadows = !a.shadows;
-    std::string names = settingNames(a, b);
+    std::string names = sg::changedParams(a, b);
     EXPECT_NE(names.find("fog.mode"), std::string::npos) << names;
     EXPECT_NE(names.find("fog.density"), std::string::npos) << names;
     EXPECT_NE(names.find("shadows"), std::string::npos) << names;

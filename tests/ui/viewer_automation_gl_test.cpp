@@ -379,7 +379,7 @@ TEST(ViewerAutomationGLTest, ComparisonDefaultsCompareDifferentBackendsAndEachVi
     EXPECT_EQ(r.out[5], "compare split raycast gl") << "the split view kept its own";
 }
 
-// Issue 19, items 11 and 8: File > New (Ctrl+N) then Add > Sphere gives a lit sphere in view
+// File > New (Ctrl+N) then Add > Sphere gives a lit sphere in view
 // (the new scene has a light and a camera); a refused value's message leaves the status bar
 // once the value is valid.
 TEST(ViewerAutomationGLTest, NewSceneThenAddSphereAndRefusalsThatClear) {
@@ -441,7 +441,7 @@ TEST(ViewerAutomationGLTest, ScreenshotAfterAnOrbitSavesEveryShownBackend) {
     }
 }
 
-// Issue 19, item 12: right after a load the viewport shows nothing of the previous scene: no
+// Right after a load the viewport shows nothing of the previous scene: no
 // image (it says "rendering...") and no figures, in the single and the split view; once
 // rendered, the new scene's.
 TEST(ViewerAutomationGLTest, AfterALoadNothingOfThePreviousSceneIsShown) {
@@ -470,7 +470,7 @@ TEST(ViewerAutomationGLTest, AfterALoadNothingOfThePreviousSceneIsShown) {
     for (int i : {5, 6}) EXPECT_NE(r.out[size_t(i)].find(", 0 triangles"), std::string::npos) << r.out[size_t(i)];
 }
 
-// Issue 19, item 4: on a 1366x768 screen the window opens inside the work area, sized from it;
+// On a 1366x768 screen the window opens inside the work area, sized from it;
 // it reopens at the size it had (remembered in the config folder); a remembered rectangle too
 // big or off the screen, or a window.txt that does not parse, still gives a window that fits;
 // a run sized by --window-size is not remembered.
@@ -512,7 +512,7 @@ TEST(ViewerAutomationGLTest, WindowFitsASmallScreenAndRemembersItsSize) {
     }
 }
 
-// Issue 19: Escape closes menus and dialogs: the File menu, a submenu level at a time, the
+// Escape closes menus and dialogs: the File menu, a submenu level at a time, the
 // screenshot dialog (as Cancel: nothing is taken), the unsaved-changes question (as Cancel:
 // the edits stay).
 TEST(ViewerAutomationGLTest, EscapeClosesMenusAndDialogs) {
@@ -551,7 +551,7 @@ TEST(ViewerAutomationGLTest, EscapeClosesMenusAndDialogs) {
     EXPECT_FALSE(fs::exists(dir / "screenshot-gl.png"));
 }
 
-// Issue 18 (export from the UI) and issue 19 (overlays in screenshots): F12 writes what the
+// Export from the UI and overlays in screenshots: F12 writes what the
 // viewport shows (here with the axes overlay); File > Export depth, normal, id... opens the
 // screenshot dialog with the export ticked, and Take writes the PNG with its depth, normal and id
 // files and the camera sidecar next to it, never over an existing file. Unticking "as shown"

@@ -28,10 +28,11 @@
 //                         where the dialog starts; ".json" appended for another extension); asks
 //                         before replacing an existing file
 //   answer replace|cancel answers the replace question
-//   set KEY VALUE         a setting by its scene-JSON name (shading flat, fog.mode linear,
-//                         fog.end 40, aa ssaa2, ambientLight [0.2,0.2,0.2]) or material.FIELD of
-//                         the selection (material.kd 0.3, material.baseColor [1,0,0]); an undo
-//                         step. A refused value prints "viewer: set KEY: refused: REASON" and
+//   set KEY VALUE         a parameter by its key in scenegraph/params.h (shading flat,
+//                         fog.mode linear, fog.end 40, aa ssaa2, ambientLight 0.2,0.2,0.2),
+//                         material.KEY of the selection (material.kd 0.3, material.baseColor
+//                         [1,0,0]), light.KEY of the selected light, camera.KEY of the
+//                         projection (camera.fovy 30); an undo step. A refused value prints "viewer: set KEY: refused: REASON" and
 //                         the script goes on (the status line shows it too)
 //   select NAME           select the first node of that name (depth-first)
 //   undo | redo           Edit > Undo / Redo
@@ -425,7 +426,9 @@ Automation::Next Automation::documentCommand(const std::string& cmd, std::istrin
         std::string value = restOfLine(kv);
         if (key.empty() || value.empty()) return fail("set: expected KEY VALUE");
         std::string err = st.setByName(key, value);
-        if (err.find("unknown setting") != std::string::npos || err.find("no material") != std::string::npos) return fail(err);
+        if (err.find("unknown setting") != std::string::npos || err.find("no material") != std::string::npos ||
+            err.find("not a light") != std::string::npos)
+            return fail(err);
         if (!err.empty()) std::printf("viewer: set %s: refused: %s\n", key.c_str(), err.c_str());
     }
     return Next::Continue;

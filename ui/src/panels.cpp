@@ -22,6 +22,8 @@
 #include "renderers/renderer.h"
 #include "scenegraph/camera_model.h"
 #include "scenegraph/deform.h"
+#include "scenegraph/params.h"
+#include "scenegraph/scene_defaults.h"
 #include "scenegraph/setting_names.h"
 #include "scenegraph/transforms.h"
 
@@ -106,13 +108,6 @@ template <class E>
 bool enumCombo(ViewerState& st, const char* label, E& value) {
     return enumCombo(st, label, value, sg::nameTable<E>().entries);
 }
-// Enums without a name table (shapes): labels given here.
-template <class E>
-bool enumCombo(ViewerState& st, const char* label, E& value, std::initializer_list<std::pair<E, const char*>> items) {
-    std::vector<sg::NamedValue<E>> entries;
-    for (auto& [v, n] : items) entries.push_back({v, n, n, {}});
-    return enumCombo(st, label, value, std::span<const sg::NamedValue<E>>(entries));
-}
 
 // A row of radio buttons over a name table; each recorded as key/entry label.
 template <class E>
@@ -130,6 +125,105 @@ bool enumRadios(ViewerState& st, const std::string& key, E& value) {
         record(st, key + "/" + name);
     }
     ImGui::PopID();
+    return changed;
+}
+
+// The names of the shown backends that do not draw `feature` ("" when all do).
+std::string backendsWithout(const ViewerState& st, sg::Feature feature);
+
+// One parameter's widget from its table row (scenegraph/params.h): checkbox, slider or drag
+// over the row's range, colour editor, combo or radio buttons; the help as tooltip; a note when
+// a shown backend does not draw it. Recorded as `prefix`/KEY (a choice's entries as
+// prefix/KEY/LABEL). Returns true when the value changed (written into `object`).
+template <class T>
+bool paramWidget(ViewerState& st, const std::string& prefix, const sg::Param<T>& p, T& object) {
+    if (p.label.empty() || (p.shown && !p.shown(object))) return false;
+    const std::string label(p.label), key = prefix + "/" + std::string(p.key);
+    sg::ParamValue v = p.get(object);
+    bool changed = false;
+    ImGuiSliderFlags flags = ImGuiSliderFlags_AlwaysClamp | (p.logScale ? ImGuiSliderFlags_Logarithmic : 0);
+    switch (p.kind) {
+    case sg::ParamKind::Bool: {
+        bool b = std::get<bool>(v);
+        changed = ImGui::Checkbox(label.c_str(), &b);
+        v = b;
+        break;
+    }
+    case sg::ParamKind::Int: {
+        int i = std::get<int>(v);
+        changed = ImGui::SliderInt(label.c_str(), &i, int(p.min), int(p.max), "%d", flags);
+        v = i;
+        break;
+    }
+    case sg::ParamKind::Float: {
+        float f = std::get<float>(v);
+        if (p.drag)
+            changed = ImGui::DragFloat(label.c_str(), &f, std::max(std::abs(f), 1e-3f) * 0.01f, float(p.min), float(p.max),
+                                       p.format ? p.format : "%.3f", flags);
+        else
+            changed = ImGui::SliderFloat(label.c_str(), &f, float(p.min), float(p.max), p.format ? p.format : "%.3f", flags);
+        v = f;
+        break;
+    }
+    case sg::ParamKind::Color: {
+        sg::vec3 c = std::get<sg::vec3>(v);
+        changed = srgbColorEdit(label.c_str(), c, p.max > 1.0 ? ImGuiColorEditFlags_HDR : 0);
+        if (changed) c = glm::clamp(c, sg::vec3(float(p.min)), sg::vec3(float(p.max)));
+        v = c;
+        break;
+    }
+    case sg::ParamKind::Choice: {
+        const std::string cur = std::get<std::string>(v);
+        const sg::ParamChoice* shown = nullptr;
+        for (const sg::ParamChoice& c : p.choices)
+            if (c.name == cur) shown = &c;
+        ImGui::PushID(key.c_str());
+        if (p.radios) {
+            for (const sg::ParamChoice& c : p.choices) {
+                if (&c != p.choices.data()) ImGui::SameLine();
+                if (ImGui::RadioButton(std::string(c.label).c_str(), &c == shown) && &c != shown) {
+                    v = std::string(c.name);
+                    changed = true;
+                }
+                tooltip(c.help);
+                record(st, key + "/" + std::string(c.label));
+            }
+            ImGui::SameLine();
+            ImGui::TextUnformatted(label.c_str());
+            tooltip(p.help);
+        } else if (ImGui::BeginCombo(label.c_str(), shown ? std::string(shown->label).c_str() : cur.c_str())) {
+            for (const sg::ParamChoice& c : p.choices) {
+                if (ImGui::Selectable(std::string(c.label).c_str(), &c == shown) && &c != shown) {
+                    v = std::string(c.name);
+                    changed = true;
+                }
+                tooltip(c.help);
+                record(st, key + "/" + std::string(c.label));
+            }
+            ImGui::EndCombo();
+        }
+        ImGui::PopID();
+        break;
+    }
+    }
+    if (p.kind != sg::ParamKind::Choice || !p.radios) {
+        tooltip(p.help);
+        record(st, key);
+    }
+    if (p.needs != sg::Feature::None)
+        if (std::string without = backendsWithout(st, p.needs); !without.empty()) {
+            ImGui::SameLine();
+            ImGui::TextDisabled("(not drawn by %s)", without.c_str());
+        }
+    return changed && p.set(object, v);
+}
+
+// Every row of T's table in `section` (all rows when empty), in table order.
+template <class T>
+bool paramSection(ViewerState& st, const std::string& prefix, std::string_view section, T& object) {
+    bool changed = false;
+    for (const sg::Param<T>& p : sg::params<T>())
+        if (section.empty() || p.section == section) changed |= paramWidget(st, prefix, p, object);
     return changed;
 }
 
@@ -174,26 +268,20 @@ const char* payloadIcon(const sg::Payload& p) {
     }
 }
 
-const std::pair<sg::ImplicitType, const char*> kShapes[] = {{sg::ImplicitType::Sphere, "Sphere"},
-                                                            {sg::ImplicitType::Box, "Box"},
-                                                            {sg::ImplicitType::Cylinder, "Cylinder"},
-                                                            {sg::ImplicitType::Cone, "Cone"},
-                                                            {sg::ImplicitType::Torus, "Torus"},
-                                                            {sg::ImplicitType::Plane, "Plane"},
-                                                            {sg::ImplicitType::Quadric, "Quadric (hyperboloid)"}};
-
 // The "Add" menu items (shared by the toolbar popup and the context menu).
 void addMenuItems(ViewerState& st, sg::NodeId parent) {
     if (ImGui::MenuItem("Group")) st.addGroup(parent);
     ImGui::Separator();
-    for (auto& [t, name] : kShapes) {
+    for (const auto& e : sg::nameTable<sg::ImplicitType>().entries) {
+        const sg::ImplicitType t = e.value;
+        const std::string label(e.label);
+        const char* name = label.c_str();
         if (ImGui::MenuItem(name)) st.addShape(t, parent);
         record(st, std::string("add/") + name);
     }
     ImGui::Separator();
-    if (ImGui::MenuItem("CSG union")) st.addCsg(sg::CsgOp::Union, parent);
-    if (ImGui::MenuItem("CSG intersection")) st.addCsg(sg::CsgOp::Intersection, parent);
-    if (ImGui::MenuItem("CSG difference")) st.addCsg(sg::CsgOp::Difference, parent);
+    for (const auto& e : sg::nameTable<sg::CsgOp>().entries)
+        if (ImGui::MenuItem(("CSG " + std::string(e.name)).c_str())) st.addCsg(e.value, parent);
     ImGui::Separator();
     for (const auto& e : sg::nameTable<sg::LightType>().entries)
         if (ImGui::MenuItem((std::string(e.label) + " light").c_str())) st.addLight(e.value, parent);
@@ -232,6 +320,15 @@ std::vector<std::string> visibleBackends(const ViewerState& st) {
     }
     return {st.view.backend};
 }
+
+namespace {
+std::string backendsWithout(const ViewerState& st, sg::Feature feature) {
+    std::string names;
+    for (const std::string& b : visibleBackends(st))
+        if (!rnd::hasFeature(backendCapabilities(b), feature) && names.find(b) == std::string::npos) names += (names.empty() ? "" : ", ") + b;
+    return names;
+}
+}   // namespace
 
 // --- 2. style ----------------------------------------------------------------------------------
 
@@ -600,45 +697,20 @@ bool materialEditor(ViewerState& st, sg::NodeId id, int& index) {
     sg::Material m = st.doc.scene.materials[index];
     bool ch = false;
     ch |= ImGui::InputText("Name##mat", &m.name, ImGuiInputTextFlags_EnterReturnsTrue);
-    ch |= srgbColorEdit("Base colour", m.baseColor);
-    ch |= ImGui::SliderFloat("ka (ambient)", &m.ka, 0.0f, 1.0f);
-    record(st, "material/ka");
-    ch |= ImGui::SliderFloat("kd (diffuse)", &m.kd, 0.0f, 1.0f);
-    record(st, "material/kd");
-    ch |= ImGui::SliderFloat("ks (specular)", &m.ks, 0.0f, 1.0f);
-    ch |= ImGui::SliderFloat("Shininess n", &m.shininess, 1.0f, 512.0f, "%.1f", ImGuiSliderFlags_Logarithmic);
-    ch |= ImGui::Checkbox("Specular tinted by base colour", &m.specularTinted);
-    ImGui::BeginDisabled(m.specularTinted);
-    ch |= srgbColorEdit("Specular colour", m.specularColor);
-    ImGui::EndDisabled();
+    ch |= paramSection(st, "material", "Phong", m);
     int tex = m.diffuseTexture;
     if (ImGui::InputInt("Texture index", &tex)) {
         m.diffuseTexture = std::clamp(tex, -1, int(st.doc.scene.textures.size()) - 1);
         ch = true;
     }
     helpMarker("-1 = none; index into the scene's textures");
-    ch |= srgbColorEdit("Emissive", m.emissive);
-    ch |= ImGui::SliderFloat("Reflectivity", &m.reflectivity, 0.0f, 1.0f);
-    ch |= ImGui::Checkbox("Unlit", &m.unlit);
-    ImGui::SameLine();
-    ch |= ImGui::Checkbox("Double-sided", &m.doubleSided);
-    helpMarker("Off: the back face is not drawn when back faces are culled per material (Render > Back faces: auto)");
-    ch |= enumCombo(st, "Alpha mode", m.alphaMode);
-    if (m.alphaMode != sg::AlphaMode::Opaque) ch |= ImGui::SliderFloat("Alpha", &m.alpha, 0.0f, 1.0f);
-    if (m.alphaMode == sg::AlphaMode::Mask) ch |= ImGui::SliderFloat("Alpha cutoff", &m.alphaCutoff, 0.0f, 1.0f);
+    ch |= paramSection(st, "material", "Alpha", m);
     if (ch) st.setMaterial(index, m, "material " + std::to_string(index));
     return indexChanged;
 }
 
 bool implicitEditor(ViewerState& st, sg::ImplicitShape& s) {
-    bool ch = enumCombo(st, "Shape", s.type,
-                        {{sg::ImplicitType::Sphere, "sphere"},
-                         {sg::ImplicitType::Box, "box"},
-                         {sg::ImplicitType::Cylinder, "cylinder"},
-                         {sg::ImplicitType::Cone, "cone"},
-                         {sg::ImplicitType::Torus, "torus"},
-                         {sg::ImplicitType::Plane, "plane"},
-                         {sg::ImplicitType::Quadric, "quadric"}});
+    bool ch = enumCombo(st, "Shape", s.type);
     switch (s.type) {
     case sg::ImplicitType::Sphere: ch |= ImGui::DragFloat("Radius", &s.radius, 0.01f, 0.001f, 1e4f); break;
     case sg::ImplicitType::Box: ch |= ImGui::DragFloat3("Half extents", &s.halfExtents.x, 0.01f, 0.001f, 1e4f); break;
@@ -747,8 +819,8 @@ void sceneSummary(ViewerState& st) {
     ImGui::Text("Scene: %s", scene.name.c_str());
     ImGui::Text("Nodes: %zu   meshes: %zu   materials: %zu   textures: %zu", scene.nodeCount(), scene.meshes.size(), scene.materials.size(),
                 scene.textures.size());
-    sg::vec3 ambient = scene.ambientLight;
-    if (srgbColorEdit("Ambient light", ambient)) st.setAmbientLight(ambient, "ambient");
+    sg::RenderSettings s = scene.settings;
+    if (paramWidget(st, "render", *sg::findParam<sg::RenderSettings>("ambientLight"), s)) st.setSettings(s, "settings");
 }
 
 // Name, kind and id, visibility.
@@ -800,13 +872,12 @@ bool meshSection(const ViewerState& st, sg::MeshInstance& mi) {
 // Operation, and a menu adding implicit operands under the node `id`.
 bool csgSection(ViewerState& st, sg::NodeId id, sg::CsgPayload& cp) {
     if (!ImGui::CollapsingHeader("CSG", ImGuiTreeNodeFlags_DefaultOpen)) return false;
-    bool ch = enumCombo(st, "Operation", cp.csg.op,
-                        {{sg::CsgOp::Union, "union"}, {sg::CsgOp::Intersection, "intersection"}, {sg::CsgOp::Difference, "difference"}});
+    bool ch = enumCombo(st, "Operation", cp.csg.op);
     ImGui::TextDisabled("Children combine left to right (first child minus the others for difference).");
     if (ImGui::Button("Add operand")) ImGui::OpenPopup("csg_add");
     if (ImGui::BeginPopup("csg_add")) {
-        for (auto& [t, nm] : kShapes)
-            if (ImGui::MenuItem(nm)) st.addShape(t, id);
+        for (const auto& e : sg::nameTable<sg::ImplicitType>().entries)
+            if (ImGui::MenuItem(std::string(e.label).c_str())) st.addShape(e.value, id);
         ImGui::EndPopup();
     }
     return ch;
@@ -814,15 +885,8 @@ bool csgSection(ViewerState& st, sg::NodeId id, sg::CsgPayload& cp) {
 
 bool lightSection(ViewerState& st, sg::Light& l) {
     if (!ImGui::CollapsingHeader("Light", ImGuiTreeNodeFlags_DefaultOpen)) return false;
-    bool ch = enumCombo(st, "Type", l.type);
-    ch |= srgbColorEdit("Colour", l.color);
-    ch |= ImGui::DragFloat("Intensity", &l.intensity, 0.05f, 0.0f, 1e5f);
-    ch |= ImGui::Checkbox("Inverse-square falloff", &l.inverseSquare);
-    if (l.type == sg::LightType::Spot) {
-        ch |= ImGui::SliderFloat("Inner angle", &l.spotInnerDeg, 0.0f, 90.0f);
-        ch |= ImGui::SliderFloat("Outer angle", &l.spotOuterDeg, 0.0f, 90.0f);
-        l.spotInnerDeg = std::min(l.spotInnerDeg, l.spotOuterDeg);
-    }
+    bool ch = paramSection(st, "light", "", l);
+    l.spotInnerDeg = std::min(l.spotInnerDeg, l.spotOuterDeg);
     ImGui::TextDisabled("Lights point down their local -z axis.");
     return ch;
 }
@@ -837,7 +901,7 @@ bool cameraSection(ViewerState& st, sg::NodeId id, sg::Camera& cam) {
 
 bool parametricSection(ViewerState& st, sg::ParametricPayload& pp) {
     if (!ImGui::CollapsingHeader("Parametric surface", ImGuiTreeNodeFlags_DefaultOpen)) return false;
-    bool ch = enumCombo(st, "Surface", pp.surface.type, {{sg::ParametricType::Torus, "torus"}, {sg::ParametricType::BezierPatch, "bezier patch"}});
+    bool ch = enumCombo(st, "Surface", pp.surface.type);
     if (pp.surface.type == sg::ParametricType::Torus) {
         ch |= ImGui::DragFloat("Major radius", &pp.surface.majorRadius, 0.01f, 0.001f, 1e4f);
         ch |= ImGui::DragFloat("Minor radius", &pp.surface.minorRadius, 0.01f, 0.001f, 1e4f);
@@ -1036,37 +1100,19 @@ void drawCameraPanel(ViewerState& st) {
 
     section("Projection");
     sg::Projection p = st.projection();
-    bool ch = enumCombo(st, "Type", p.type);
-    switch (p.type) {
-    case sg::ProjectionType::Perspective:
-        ch |= ImGui::Checkbox("General frustum (l, r, b, t)", &p.useFrustum);
-        if (p.useFrustum) {
-            ch |= ImGui::DragFloat2("Left / right", &p.left, 0.001f);
-            ch |= ImGui::DragFloat2("Bottom / top", &p.bottom, 0.001f);
-        } else {
-            ch |= ImGui::SliderFloat("Field of view y", &p.fovyDeg, 1.0f, 170.0f, "%.1f deg");
-        }
-        break;
-    case sg::ProjectionType::Orthographic: ch |= ImGui::DragFloat("Half height", &p.orthoHalfHeight, 0.01f, 0.001f, 1e5f); break;
-    case sg::ProjectionType::Oblique:
-        for (const auto& e : sg::nameTable<sg::ObliquePreset>().entries) {
-            if (&e != sg::nameTable<sg::ObliquePreset>().entries.data()) ImGui::SameLine();
-            if (ImGui::Button(std::string(e.label).c_str())) {
-                sg::Projection preset = sg::obliquePreset(e.value);
-                p.obliqueFactor = preset.obliqueFactor;
-                p.obliqueAngleDeg = preset.obliqueAngleDeg;
-                ch = true;
+    bool ch = false;
+    for (const sg::Param<sg::Projection>& row : sg::params<sg::Projection>()) {
+        // The type's combo also offers the oblique presets (cavalier, cabinet). The frustum's
+        // four sides (one JSON array, not table rows) come before the clip planes.
+        if (row.key == "near") {
+            if (p.type == sg::ProjectionType::Perspective && p.useFrustum) {
+                ch |= ImGui::DragFloat2("Left / right", &p.left, 0.001f);
+                ch |= ImGui::DragFloat2("Bottom / top", &p.bottom, 0.001f);
             }
-            tooltip(e.help);
         }
-        ch |= ImGui::SliderFloat("Angle", &p.obliqueAngleDeg, 0.0f, 90.0f, "%.1f deg");
-        ch |= ImGui::SliderFloat("Factor", &p.obliqueFactor, 0.0f, 2.0f);
-        ch |= ImGui::DragFloat("Half height", &p.orthoHalfHeight, 0.01f, 0.001f, 1e5f);
-        break;
+        ch |= paramWidget(st, "camera", row, p);
     }
-    ch |= ImGui::DragFloatRange2("Near / far", &p.zNear, &p.zFar, 0.01f, 1e-4f, 1e6f, "%.3f", "%.3f", ImGuiSliderFlags_Logarithmic);
     if (ch) {
-        p.zNear = std::max(p.zNear, 1e-4f);
         p.zFar = std::max(p.zFar, p.zNear * 1.001f);
         st.setProjection(p, "projection");
     }
@@ -1143,58 +1189,22 @@ void aaOverrideCombos(ViewerState& st) {
 void drawRenderingPanel(ViewerState& st) {
     sg::RenderSettings s = st.doc.scene.settings;
     bool ch = false;
-    section("Shading");
-    ch |= enumRadios(st, "render/shading", s.shading);
-    ch |= enumRadios(st, "render/reflection", s.reflection);
-    ch |= ImGui::Checkbox("Light attenuation (1/r^2)", &s.attenuation);
-    record(st, "render/attenuation");
-    sg::vec3 amb = st.doc.scene.ambientLight;
-    if (srgbColorEdit("Ambient light", amb)) st.setAmbientLight(amb, "ambient");
-
-    section("Fog");
-    ch |= enumCombo(st, "Fog", s.fog);
-    if (s.fog != sg::FogMode::Off) {
-        ch |= srgbColorEdit("Fog colour", s.fogColor);
-        if (s.fog == sg::FogMode::Linear)
-            ch |= ImGui::DragFloatRange2("Start / end", &s.fogStart, &s.fogEnd, 0.05f, 0.0f, 1e5f);
-        else
-            ch |= ImGui::SliderFloat("Density", &s.fogDensity, 0.0f, 1.0f, "%.4f", ImGuiSliderFlags_Logarithmic);
+    // The rows of the render-settings table, section by section; what is not a scene setting
+    // (per-backend AA overrides, where GL renders) sits in its section after them.
+    std::vector<std::string_view> sections;
+    for (const auto& p : sg::params<sg::RenderSettings>())
+        if (!p.label.empty() && std::find(sections.begin(), sections.end(), p.section) == sections.end()) sections.push_back(p.section);
+    for (std::string_view name : sections) {
+        section(std::string(name).c_str());
+        ch |= paramSection(st, "render", name, s);
+        if (name == "Anti-aliasing") {
+            aaOverrideCombos(st);
+            if (ImGui::Checkbox("GL on a worker thread", &st.view.glOnWorker)) st.markViewChanged();
+            helpMarker(
+                "The gl backend renders on its own thread with a headless context: the UI never waits, even with software GL.\nOff: it renders "
+                "on the UI thread with the window's context.");
+        }
     }
-
-    section("Anti-aliasing");
-    sg::AAChoice aa = sg::aaChoice(s);
-    if (enumCombo(st, "Scene AA", aa)) ch |= s.setAA(sg::nameOf(aa));   // none keeps the rate
-    helpMarker("Saved with the scene. The ray caster uses SSAA-style jittered rays for either mode.");
-    aaOverrideCombos(st);
-
-    if (ImGui::Checkbox("GL on a worker thread", &st.view.glOnWorker)) st.markViewChanged();
-    helpMarker(
-        "The gl backend renders on its own thread with a headless context: the UI never waits, even with software GL.\nOff: it renders on the UI "
-        "thread with the window's context.");
-
-    section("Rasterizers");
-    ch |= ImGui::Checkbox("Wireframe", &s.wireframe);
-    record(st, "render/wireframe");
-    if (s.wireframe) {
-        ImGui::SameLine();
-        ch |= srgbColorEdit("##wirecol", s.wireframeColor, ImGuiColorEditFlags_NoInputs);
-    }
-    ch |= enumCombo(st, "Back faces", s.culling);
-    record(st, "render/culling");
-    ch |= ImGui::SliderInt("Tessellation", &s.tessellation, 4, 256);
-    helpMarker("Segments / marching-cubes resolution for implicit shapes, CSG, parametric surfaces and grids");
-
-    section("Ray caster");
-    ch |= ImGui::Checkbox("Shadows", &s.shadows);
-    record(st, "render/shadows");
-    ImGui::SameLine();
-    ch |= ImGui::Checkbox("Reflections", &s.reflections);
-    record(st, "render/reflections");
-    ch |= ImGui::SliderInt("Max bounces", &s.maxBounces, 0, 16);
-
-    section("Background");
-    ch |= srgbColorEdit("Background", s.background);
-
     if (ch) st.setSettings(s, "settings");   // refused values: the reason goes to the status line
 }
 
@@ -1270,14 +1280,12 @@ void centeredText(ImDrawList* dl, ImVec2 a, ImVec2 b, const std::string& text, I
 }
 
 // Draws one backend's image over [a, b] showing the u-range [u0, u1] of the image.
-void drawSlotImage(ImDrawList* dl, const SlotView& v, ImVec2 a, ImVec2 b, float u0, float u1, ImVec2 full0, ImVec2 full1) {
+void drawSlotImage(ImDrawList* dl, const SlotView& v, ImVec2 a, ImVec2 b, float u0, float u1) {
     if (v.texture && v.width > 0) {
         dl->AddImage(v.texture, a, b, ImVec2(u0, 0), ImVec2(u1, 1));
     } else {
         dl->AddRectFilled(a, b, IM_COL32(24, 25, 29, 255));
     }
-    (void)full0;
-    (void)full1;
     std::string msg;
     if (!v.status.error.empty())
         msg = v.status.backend + ": " + v.status.error;
@@ -1375,7 +1383,7 @@ void cameraInput(ViewerState& st, ImVec2 a, ImVec2 b, double time, float dt) {
     // Fly mode: right mouse held + WASD (QE down/up), Shift = faster.
     bool wasFlying = st.view.flyMode;
     st.view.flyMode = active && io.MouseDown[1];
-    if (st.view.flyMode && !wasFlying) st.view.flySpeed = flySpeedFor(st.doc.scene);   // the scene's size, once per flight
+    if (st.view.flyMode && !wasFlying) st.view.flySpeed = sg::flySpeedFor(st.doc.scene);   // the scene's size, once per flight
     if (st.view.flyMode) {
         float speed = st.view.flySpeed * dt * (io.KeyShift ? 4.0f : 1.0f);
         sg::vec3 o(0.0f);
@@ -1408,7 +1416,7 @@ void drawSplitView(ImDrawList* dl, const ViewerState& st, const ViewportInput& v
         float u0 = edges[i], u1 = edges[i + 1];
         if (u1 <= u0) continue;
         ImVec2 p0(a.x + u0 * avail.x, a.y), p1(a.x + u1 * avail.x, b.y);
-        drawSlotImage(dl, view.slots[i], p0, p1, u0, u1, a, b);
+        drawSlotImage(dl, view.slots[i], p0, p1, u0, u1);
         // Backend label at the top of its region.
         const std::string& name = view.slots[i].status.backend;
         ImVec2 ts = ImGui::CalcTextSize(name.c_str());
@@ -1610,7 +1618,7 @@ void drawViewport(ViewerState& st, const ViewportInput& view, double time, float
     dl->PushClipRect(a, b, true);
     switch (st.view.compare.mode) {
     case ViewMode::Single:
-        if (!view.slots.empty()) drawSlotImage(dl, view.slots[0], a, b, 0, 1, a, b);
+        if (!view.slots.empty()) drawSlotImage(dl, view.slots[0], a, b, 0, 1);
         break;
     case ViewMode::Split: drawSplitView(dl, st, view, a, avail); break;
     case ViewMode::Difference: drawDifferenceView(dl, st, view, a, avail); break;

@@ -1,34 +1,15 @@
-// set_by_name.cpp - ViewerState::setByName: one scene value by its scene-JSON name (the
-// automation's `set KEY VALUE`), and settingNames: the scene-JSON names of what differs
-// between two RenderSettings (undo labels: "Change fog.mode").
-//
-// No parser of its own: the values the key may name (settings, ambient light, one material)
-// go into a small scene, out through assets::serializeSceneJson, the key's JSON value is
-// replaced, and the text comes back through assets::parseSceneJson, which checks names against
-// the tables in scenegraph/setting_names.h, ranges and RenderSettings::validate exactly as it
-// does for a scene file. Only what the key names is then applied, as one undoable edit.
+// set_by_name.cpp - ViewerState::setByName: one parameter by its key in the tables of
+// scenegraph/params.h (the automation's `set KEY VALUE`). The key names the table: a render
+// setting as is (fog.mode), `material.KEY`, `light.KEY` or `camera.KEY`; the value is parsed by
+// sg::parseParamText and checked against the row's range (and RenderSettings::validate), then
+// applied through the same setter the panels use, as one undoable edit.
 #include "ui/viewer_state.h"
 
-#include <nlohmann/json.hpp>
-
-#include <algorithm>
+#include "scenegraph/params.h"
 
 namespace ui {
 
 namespace {
-
-using nlohmann::json;
-
-// The JSON pointer of a key in a serialized scene: material.kd -> /materials/0/kd,
-// ambientLight -> /ambientLight, fog.mode -> /settings/fog/mode.
-std::string pointerOf(const std::string& key, bool material) {
-    std::string rest = material ? key.substr(std::string("material.").size()) : key;
-    for (char& c : rest)
-        if (c == '.') c = '/';
-    if (material) return "/materials/0/" + rest;
-    if (key == "ambientLight") return "/ambientLight";
-    return "/settings/" + rest;
-}
 
 // The material index of the selection's payload (-1: none, or no material of its own).
 int selectedMaterial(const ViewerState& st) {
@@ -43,71 +24,79 @@ int selectedMaterial(const ViewerState& st) {
         st.doc.scene.node(st.doc.selected).payload);
 }
 
-// The key set to `value` (JSON, or a bare word taken as a string) in `text`; "" or an error.
-std::string patch(std::string& text, const std::string& key, const std::string& pointer, const std::string& value) {
-    try {
-        json j = json::parse(text);
-        json::json_pointer ptr(pointer);
-        if (!j.contains(ptr)) return "unknown setting '" + key + "' (names as in the scene file: shading, fog.mode, aa, material.kd, ...)";
-        json v = json::parse(value, nullptr, /*allow_exceptions=*/false);
-        j[ptr] = v.is_discarded() ? json(value) : v;
-        text = j.dump();
-        return {};
-    } catch (const std::exception& e) { return "set " + key + ": " + e.what(); }
+template <class T>
+std::string unknownKey(const std::string& key, const std::string& prefix) {
+    std::string names;
+    for (const sg::Param<T>& p : sg::params<T>()) names += (names.empty() ? "" : ", ") + prefix + std::string(p.key);
+    return "unknown setting '" + key + "' (known: " + names + ")";
+}
+
+// `object` with `key` set from `value`; "" or the refusal.
+template <class T>
+std::string setIn(T& object, const std::string& key, const std::string& prefix, const std::string& value) {
+    const sg::Param<T>* p = sg::findParam<T>(std::string_view(key).substr(prefix.size()));
+    if (!p) return unknownKey<T>(key, prefix);
+    return sg::setParamFromText(object, *p, value);
+}
+
+bool startsWith(const std::string& s, const char* prefix) { return s.rfind(prefix, 0) == 0; }
+
+// A material's texture references: indices into the scene's textures, -1 = none (not table
+// rows: their range is the scene's texture count).
+int* textureSlot(sg::Material& m, std::string_view key) {
+    if (key == "diffuseTexture") return &m.diffuseTexture;
+    if (key == "emissiveTexture") return &m.emissiveTexture;
+    if (key == "occlusionTexture") return &m.occlusionTexture;
+    if (key == "normalTexture") return &m.normalTexture;
+    if (key == "metallicRoughnessTexture") return &m.metallicRoughnessTexture;
+    return nullptr;
 }
 
 }   // namespace
 
 std::string ViewerState::setByName(const std::string& key, const std::string& value) {
-    bool isMaterial = key.rfind("material.", 0) == 0;
-    sg::Scene values;   // only what the key may name
-    values.settings = doc.scene.settings;
-    values.ambientLight = doc.scene.ambientLight;
-    int index = isMaterial ? selectedMaterial(*this) : -1;
-    if (isMaterial) {
+    auto refused = [&](const std::string& err) {
+        ui.status = "Setting refused: " + err;
+        return err;
+    };
+    if (startsWith(key, "material.")) {
+        int index = selectedMaterial(*this);
         if (index < 0 || size_t(index) >= doc.scene.materials.size()) return key + ": the selection has no material of its own";
-        values.materials = {doc.scene.materials[size_t(index)]};
-        // The texture index is checked against the textures, which are written as PNGs: only
-        // carried along when the key names it.
-        if (key == "material.diffuseTexture")
-            values.textures = doc.scene.textures;
-        else
-            values.materials[0].diffuseTexture = -1;
-    }
-    std::string text = assets::serializeSceneJson(values);
-    if (std::string err = patch(text, key, pointerOf(key, isMaterial), value); !err.empty()) return err;
-    assets::LoadResult r = assets::parseSceneJson(text, "set " + key);
-    if (!r.scene) {
-        ui.status = "Setting refused: " + r.error;
-        return r.error;
-    }
-    if (isMaterial) {
-        sg::Material m = r.scene->materials.at(0);
-        if (key != "material.diffuseTexture") m.diffuseTexture = doc.scene.materials[size_t(index)].diffuseTexture;
+        sg::Material m = doc.scene.materials[size_t(index)];
+        if (int* slot = textureSlot(m, std::string_view(key).substr(9))) {
+            std::string err;
+            std::optional<sg::ParamValue> v = sg::parseParamText(sg::ParamKind::Int, value, err);
+            const int last = int(doc.scene.textures.size()) - 1;
+            if (!v || std::get<int>(*v) < -1 || std::get<int>(*v) > last)
+                return refused(key + ": expected a texture index in [-1, " + std::to_string(last) + "] (-1 = none)");
+            *slot = std::get<int>(*v);
+        } else if (!sg::findParam<sg::Material>(std::string_view(key).substr(9))) {
+            return unknownKey<sg::Material>(key, "material.");
+        } else if (std::string err = setIn(m, key, "material.", value); !err.empty()) {
+            return refused(err);
+        }
         setMaterial(index, m);
-    } else if (key == "ambientLight") {
-        setAmbientLight(r.scene->ambientLight);
+    } else if (startsWith(key, "light.")) {
+        if (!doc.scene.valid(doc.selected) || !std::holds_alternative<sg::Light>(doc.scene.node(doc.selected).payload))
+            return key + ": the selection is not a light";
+        if (!sg::findParam<sg::Light>(std::string_view(key).substr(6))) return unknownKey<sg::Light>(key, "light.");
+        sg::Payload payload = doc.scene.node(doc.selected).payload;
+        if (std::string err = setIn(std::get<sg::Light>(payload), key, "light.", value); !err.empty()) return refused(err);
+        setPayload(doc.selected, payload);
+    } else if (startsWith(key, "camera.")) {
+        if (!sg::findParam<sg::Projection>(std::string_view(key).substr(7))) return unknownKey<sg::Projection>(key, "camera.");
+        sg::Projection p = projection();
+        if (std::string err = setIn(p, key, "camera.", value); !err.empty()) return refused(err);
+        if (!(p.zNear < p.zFar)) return refused("camera needs near < far");
+        setProjection(p);
     } else {
-        return setSettings(r.scene->settings);   // also clears an earlier refusal
+        if (!sg::findParam<sg::RenderSettings>(key)) return unknownKey<sg::RenderSettings>(key, "");
+        sg::RenderSettings s = doc.scene.settings;
+        if (std::string err = setIn(s, key, "", value); !err.empty()) return refused(err);
+        return setSettings(s);   // validates the rules between values; clears an earlier refusal
     }
     if (ui.status.rfind("Setting refused", 0) == 0) ui.status.clear();
     return {};
-}
-
-std::string settingNames(const sg::RenderSettings& a, const sg::RenderSettings& b) {
-    sg::Scene sa, sb;
-    sa.settings = a;
-    sb.settings = b;
-    json diff = json::diff(json::parse(assets::serializeSceneJson(sa)), json::parse(assets::serializeSceneJson(sb)));
-    std::string names;
-    for (const json& op : diff) {
-        std::string path = op.value("path", "");
-        if (path.rfind("/settings/", 0) != 0) continue;
-        std::string name = path.substr(std::string("/settings/").size());
-        std::replace(name.begin(), name.end(), '/', '.');
-        if (names.find(name) == std::string::npos) names += (names.empty() ? "" : ", ") + name;
-    }
-    return names;
 }
 
 }   // namespace ui

@@ -91,10 +91,6 @@ bool applyChange(Change& change, sg::Scene& scene, bool forward) {
                               scene.settings = forward ? c.after : c.before;
                               return true;
                           },
-                          [&](AmbientChange& c) {
-                              scene.ambientLight = forward ? c.after : c.before;
-                              return true;
-                          },
                           [&](ActiveCameraChange& c) {
                               sg::NodeId to = forward ? c.after : c.before;
                               if (to != sg::kNoNode && !scene.valid(to)) return false;
@@ -154,7 +150,7 @@ bool sameTarget(const Change& a, const Change& b) {
             const T& y = std::get<T>(b);
             if constexpr (std::is_same_v<T, MaterialChange>)
                 return x.index == y.index;
-            else if constexpr (std::is_same_v<T, SettingsChange> || std::is_same_v<T, AmbientChange> || std::is_same_v<T, ActiveCameraChange>)
+            else if constexpr (std::is_same_v<T, SettingsChange> || std::is_same_v<T, ActiveCameraChange>)
                 return true;
             else if constexpr (std::is_same_v<T, SubtreeChange> || std::is_same_v<T, MoveChange>)
                 return false;   // structure never merges

@@ -829,12 +829,6 @@ private:
 
 }   // namespace
 
-int runViewer(const std::string& scenePath) {
-    ViewerOptions o;
-    o.scene = scenePath;
-    return runViewer(o);
-}
-
 int runViewer(const ViewerOptions& opt) {
     Automation automation;
     if (!loadAutomation(opt, automation)) return 1;

@@ -363,20 +363,12 @@ std::string ViewerState::setSettings(const sg::RenderSettings& s, std::string_vi
     }
     clearRefusal(*this);   // valid again (also when dragged back to the value it had)
     if (s == doc.scene.settings) return {};
-    std::string names = settingNames(doc.scene.settings, s);
+    std::string names = sg::changedParams(doc.scene.settings, s);
     UndoStep step = newStep("Change " + (names.empty() ? std::string("rendering settings") : names));
     step.changes.push_back(SettingsChange{doc.scene.settings, s});
     doc.scene.settings = s;
     commit(std::move(step), mergeKey);
     return {};
-}
-
-void ViewerState::setAmbientLight(const sg::vec3& color, std::string_view mergeKey) {
-    if (color == doc.scene.ambientLight) return;
-    UndoStep step = newStep("Change ambient light");
-    step.changes.push_back(AmbientChange{doc.scene.ambientLight, color});
-    doc.scene.ambientLight = color;
-    commit(std::move(step), mergeKey);
 }
 
 // --- backend ---------------------------------------------------------------------------------
@@ -778,13 +770,7 @@ bool ViewerState::pollLoad(bool wait) {
         ui.status = "Open failed; the current scene is unchanged";
         return true;
     }
-    sg::Scene& loaded = *r.scene;
-    if (loaded.settings.fog == sg::FogMode::Off) {   // fog unused: defaults for when it is turned on
-        sg::RenderSettings defaults;
-        if (loaded.settings.fogStart == defaults.fogStart && loaded.settings.fogEnd == defaults.fogEnd &&
-            loaded.settings.fogDensity == defaults.fogDensity)
-            fitFogToScene(loaded.settings, sceneRadius(loaded));
-    }
+    sg::Scene& loaded = *r.scene;   // its size-dependent defaults are set (assets::loadScene)
     setScene(std::move(loaded), load.path);
     anim.clips = std::move(r.animations);
     if (!anim.clips.empty()) anim.time = anim.clips.front().start;
@@ -943,23 +929,6 @@ void ViewerState::advanceAnimation(double dt) {
     anim.time = std::clamp(t, start, end);
     applyPose(*this, *c, anim.time);
 }
-
-// --- defaults from the scene's size ----------------------------------------------------------
-
-float sceneRadius(const sg::Scene& scene) {
-    sg::Aabb b = scene.worldBounds();
-    if (b.empty()) return 1.0f;
-    float r = 0.5f * glm::length(b.extent());
-    return std::isfinite(r) && r > 1e-6f ? r : 1.0f;
-}
-
-void fitFogToScene(sg::RenderSettings& s, float r) {
-    s.fogStart = r;
-    s.fogEnd = 6.0f * r;
-    s.fogDensity = std::log(2.0f) / (3.0f * r);
-}
-
-float flySpeedFor(const sg::Scene& scene) { return sceneRadius(scene); }
 
 // --- config helpers --------------------------------------------------------------------------
 

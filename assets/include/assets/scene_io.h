@@ -33,6 +33,8 @@ struct LoadResult {
     int loadedScene = -1;
 };
 
+// The scene comes with its size-dependent defaults set (scenegraph/scene_defaults.h), so the
+// window and every command show the same file the same way.
 LoadResult loadScene(const std::filesystem::path& path, const LoadOptions& options = {});
 
 // Native JSON scene file.

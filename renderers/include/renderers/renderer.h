@@ -18,10 +18,12 @@
 #include "renderers/framebuffer.h"
 #include "renderers/render_config.h"
 #include "scenegraph/frame.h"
+#include "scenegraph/params.h"
 
 #include <atomic>
 #include <functional>
 #include <memory>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -70,6 +72,9 @@ struct Device {
 // swrast or OpenSWR (and zink running on one of them). The gl backend's device() uses it for
 // its own contexts; the window asks it of the context it made itself.
 bool isSoftwareGLRenderer(std::string_view glRenderer);
+
+// Whether a backend with these capabilities draws what a parameter needs (params.h).
+bool hasFeature(const Capabilities& caps, sg::Feature feature);
 
 // Shared between the caller and a render in progress (possibly on another thread).
 struct RenderControl {
@@ -139,8 +144,19 @@ protected:
     virtual RenderStats doRender(const sg::FrameInput& frame, const RenderConfig& config, Framebuffer& target, RenderControl* control) = 0;
 };
 
-// Backend names in display order: {"gl", "raster", "raycast"} (those built).
+// The backends, one row each in registry.cpp (the only list of them in the code): name, one
+// line of help (CLI help, UI tooltips) and the factory. Adding a backend is its folder under
+// renderers/ (its CMakeLists.txt registers it with the build) plus one row there.
+struct BackendInfo {
+    std::string_view name;
+    std::string_view help;
+    std::unique_ptr<Renderer> (*make)();
+};
+std::span<const BackendInfo> backends();
+// Backend names in display order: {"gl", "raster", "raycast"} (the rows of backends()).
 std::vector<std::string> rendererNames();
+// "gl, raster or raycast" (with `last` between the last two), for help texts.
+std::string rendererNameList(std::string_view last = "or");
 // Makes a backend by name; on an unknown name returns null and sets *error to a message that
 // lists the valid names.
 std::unique_ptr<Renderer> makeRenderer(std::string_view name, std::string* error = nullptr);

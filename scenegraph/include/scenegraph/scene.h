@@ -146,7 +146,6 @@ public:
     std::vector<Material> materials;
     std::vector<std::shared_ptr<Texture>> textures;
     std::vector<Skin> skins;
-    vec3 ambientLight{1.0f};   // L_ambient of docs/math.md (scaled per material by ka)
     RenderSettings settings;
     NodeId activeCamera = kNoNode;
 

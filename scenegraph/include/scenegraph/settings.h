@@ -34,6 +34,7 @@ struct RenderSettings {
     float fogDensity = 0.05f;
 
     bool attenuation = true;   // honour Light::inverseSquare
+    vec3 ambientLight{1.0f};   // L_ambient of docs/math.md (scaled per material by ka)
 
     // Anti-aliasing. MSAA: aaRate samples per pixel (2, 4, 8). SSAA: aaRate x aaRate samples
     // per pixel (2 -> 4 spp, 4 -> 16 spp); the ray caster uses aaRate x aaRate jittered rays.
@@ -56,7 +57,8 @@ struct RenderSettings {
 
     bool operator==(const RenderSettings&) const = default;
 
-    // Returns an empty string when the settings are usable, else the reason.
+    // Returns an empty string when the settings are usable, else the reason: every value in its
+    // range (the parameter table, params.h), then the rules that tie values together.
     std::string validate() const;
     // The name of aa/aaRate used by the command line and the JSON file (the AAChoice table in
     // setting_names.h); setAA accepts the table's names and aliases, false for anything else.

@@ -59,9 +59,6 @@ struct MaterialChange {
 struct SettingsChange {
     sg::RenderSettings before, after;
 };
-struct AmbientChange {
-    sg::vec3 before, after;
-};
 struct ActiveCameraChange {
     sg::NodeId before, after;
 };
@@ -83,8 +80,8 @@ struct MoveChange {
     NodePlace before, after;
 };
 
-using Change = std::variant<NodeNameChange, NodeVisibleChange, NodeLocalChange, NodePayloadChange, MaterialChange, SettingsChange, AmbientChange,
-                            ActiveCameraChange, SubtreeChange, MoveChange>;
+using Change = std::variant<NodeNameChange, NodeVisibleChange, NodeLocalChange, NodePayloadChange, MaterialChange, SettingsChange, ActiveCameraChange,
+                            SubtreeChange, MoveChange>;
 
 // One user action: "Delete crate" (the menu shows "Undo Delete crate").
 struct UndoStep {

@@ -20,9 +20,8 @@ struct ViewerOptions {
     double timeoutSeconds = 120;   // automation: give up (exit code 3) after this long
 };
 
-// Opens the window on `scenePath` (a file, or empty/"demo" for the bundled demo) and runs the
+// Opens the window on options.scene (a file, or empty/"demo" for the bundled demo) and runs the
 // event loop until the window closes. Returns the process exit code.
-int runViewer(const std::string& scenePath);
 int runViewer(const ViewerOptions& options);
 
 }   // namespace ui

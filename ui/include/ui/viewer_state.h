@@ -268,12 +268,13 @@ struct ViewerState {
     int addMaterialFor(sg::NodeId id, const sg::Material& m);
     // Refused (the reason returned, also in the status line) when s.validate() fails.
     std::string setSettings(const sg::RenderSettings& s, std::string_view mergeKey = {});
-    void setAmbientLight(const sg::vec3& color, std::string_view mergeKey = {});
 
-    // A render setting, `ambientLight` or `material.FIELD` of the selection's material, named
-    // and written as in the scene JSON (fog.mode, shading, aa, material.kd, material.baseColor
-    // [1,0,0]; see assets/src/scene_json.cpp): read and checked by the scene file's own writer
-    // and reader, then applied as one undoable edit. "" or the reason it was refused.
+    // One parameter by its key in the tables of scenegraph/params.h: a render setting (fog.mode,
+    // shading, aa, ambientLight), `material.KEY` of the selection's material (material.kd,
+    // material.baseColor [1,0,0]), `light.KEY` of the selected light or `camera.KEY` of the
+    // projection (camera.fovy 30). The value as typed (sg::parseParamText), checked against the
+    // table's range and RenderSettings::validate, applied as one undoable edit. "" or the
+    // reason it was refused.
     std::string setByName(const std::string& key, const std::string& value);
 
     // The view modes, one way for the View menu, the Compare tab, --view and the automation:
@@ -360,18 +361,6 @@ struct ViewerState {
     // the end) and applies the clip.
     void advanceAnimation(double dt);
 };
-
-// The scene-JSON names of the settings that differ between a and b ("fog.mode, fog.end"; ""
-// when equal), for undo labels.
-std::string settingNames(const sg::RenderSettings& a, const sg::RenderSettings& b);
-
-// Defaults that follow the scene's size (half the diagonal of its visible bounds, r; 1 when it
-// has no geometry): fog from r to 6 r (linear) or halving at 3 r (exp: density ln 2 / 3 r),
-// set when a loaded scene's fog is off and still at RenderSettings' defaults; fly speed r per
-// second (Shift: 4 r).
-float sceneRadius(const sg::Scene& scene);
-void fitFogToScene(sg::RenderSettings& settings, float radius);
-float flySpeedFor(const sg::Scene& scene);
 
 // Per-user config folder: $XDG_CONFIG_HOME/sceneviewer, else $HOME/.config/sceneviewer.
 std::filesystem::path defaultConfigDir();
