@@ -7,12 +7,32 @@
 
 namespace rnd {
 
-std::vector<std::string> rendererNames() { return {"gl", "raster", "raycast"}; }
+namespace {
+const BackendInfo kBackends[] = {
+    {"gl", "OpenGL 3.3+ core rasterization (the window's context, or headless EGL)", &makeGlRenderer},
+    {"raster", "our CPU rasterizer: clipping, fixed-point edge functions, z-buffer, tiles on oneTBB", &makeRasterRenderer},
+    {"raycast", "our CPU ray caster: BVH, exact implicit surfaces and CSG, shadow rays, reflections", &makeRaycastRenderer},
+};
+}   // namespace
+
+std::span<const BackendInfo> backends() { return kBackends; }
+
+std::vector<std::string> rendererNames() {
+    std::vector<std::string> names;
+    for (const BackendInfo& b : kBackends) names.emplace_back(b.name);
+    return names;
+}
+
+std::string rendererNameList(std::string_view last) {
+    std::string out;
+    const std::vector<std::string> names = rendererNames();
+    for (size_t i = 0; i < names.size(); ++i) out += (i == 0 ? "" : i + 1 == names.size() ? " " + std::string(last) + " " : ", ") + names[i];
+    return out;
+}
 
 std::unique_ptr<Renderer> makeRenderer(std::string_view name, std::string* error) {
-    if (name == "gl") return makeGlRenderer();
-    if (name == "raster") return makeRasterRenderer();
-    if (name == "raycast") return makeRaycastRenderer();
+    for (const BackendInfo& b : kBackends)
+        if (b.name == name) return b.make();
     if (error) {
         std::string valid;
         for (const auto& n : rendererNames()) valid += (valid.empty() ? "" : ", ") + n;

@@ -76,7 +76,44 @@ constexpr NamedValue<FilterMode> kFilter[] = {
     {FilterMode::Trilinear, "trilinear", "Trilinear", "bilinear on the two nearest mipmap levels, blended"},
 };
 
+constexpr NamedValue<ImplicitType> kImplicit[] = {
+    {ImplicitType::Sphere, "sphere", "Sphere", "all points at the radius from the centre"},
+    {ImplicitType::Box, "box", "Box", "an axis-aligned box of the given half extents"},
+    {ImplicitType::Cylinder, "cylinder", "Cylinder", "a capped cylinder along y"},
+    {ImplicitType::Cone, "cone", "Cone", "a capped cone along y"},
+    {ImplicitType::Torus, "torus", "Torus", "a ring around y: major and minor radius"},
+    {ImplicitType::Plane, "plane", "Plane", "the infinite plane y = 0"},
+    {ImplicitType::Quadric, "quadric", "Quadric (hyperboloid)", "x^T Q x = 0 for a symmetric 4x4 Q, clipped to its bounds"},
+};
+
+constexpr NamedValue<CsgOp> kCsg[] = {
+    {CsgOp::Union, "union", "Union", "inside either operand"},
+    {CsgOp::Intersection, "intersection", "Intersection", "inside both operands"},
+    {CsgOp::Difference, "difference", "Difference", "inside the first operand and outside the second"},
+};
+
+constexpr NamedValue<ParametricType> kParametric[] = {
+    {ParametricType::Torus, "torus", "Torus", "a torus parametrised by two angles"},
+    {ParametricType::BezierPatch, "bezier", "Bezier patch", "a bicubic Bezier patch of 4x4 control points"},
+};
+
 }   // namespace
+
+template <>
+const NameTable<ImplicitType>& nameTable<ImplicitType>() {
+    static const NameTable<ImplicitType> t{kImplicit};
+    return t;
+}
+template <>
+const NameTable<CsgOp>& nameTable<CsgOp>() {
+    static const NameTable<CsgOp> t{kCsg};
+    return t;
+}
+template <>
+const NameTable<ParametricType>& nameTable<ParametricType>() {
+    static const NameTable<ParametricType> t{kParametric};
+    return t;
+}
 
 template <>
 const NameTable<ShadingModel>& nameTable<ShadingModel>() {

@@ -1,4 +1,5 @@
 #include "scenegraph/shapes.h"
+#include "scenegraph/setting_names.h"
 
 namespace sg {
 
@@ -258,56 +259,13 @@ DensityGrid DensityGrid::metaballs(int n) {
     return g;
 }
 
-// --- names --------------------------------------------------------------------------------
+// --- names (the tables are in setting_names.cpp) ---------------------------------------------
 
-std::string_view toString(ImplicitType t) {
-    switch (t) {
-    case ImplicitType::Plane: return "plane";
-    case ImplicitType::Sphere: return "sphere";
-    case ImplicitType::Box: return "box";
-    case ImplicitType::Cylinder: return "cylinder";
-    case ImplicitType::Cone: return "cone";
-    case ImplicitType::Torus: return "torus";
-    case ImplicitType::Quadric: return "quadric";
-    }
-    return "?";
-}
-bool parse(std::string_view s, ImplicitType& out) {
-    for (auto t : {ImplicitType::Plane, ImplicitType::Sphere, ImplicitType::Box, ImplicitType::Cylinder, ImplicitType::Cone, ImplicitType::Torus,
-                   ImplicitType::Quadric})
-        if (s == toString(t)) {
-            out = t;
-            return true;
-        }
-    return false;
-}
-std::string_view toString(CsgOp op) {
-    switch (op) {
-    case CsgOp::Union: return "union";
-    case CsgOp::Intersection: return "intersection";
-    case CsgOp::Difference: return "difference";
-    }
-    return "?";
-}
-bool parse(std::string_view s, CsgOp& out) {
-    for (auto t : {CsgOp::Union, CsgOp::Intersection, CsgOp::Difference})
-        if (s == toString(t)) {
-            out = t;
-            return true;
-        }
-    return false;
-}
-std::string_view toString(ParametricType t) { return t == ParametricType::Torus ? "torus" : "bezier"; }
-bool parse(std::string_view s, ParametricType& out) {
-    if (s == "torus") {
-        out = ParametricType::Torus;
-        return true;
-    }
-    if (s == "bezier") {
-        out = ParametricType::BezierPatch;
-        return true;
-    }
-    return false;
-}
+std::string_view toString(ImplicitType t) { return nameOf(t); }
+bool parse(std::string_view s, ImplicitType& out) { return parseName(s, out); }
+std::string_view toString(CsgOp op) { return nameOf(op); }
+bool parse(std::string_view s, CsgOp& out) { return parseName(s, out); }
+std::string_view toString(ParametricType t) { return nameOf(t); }
+bool parse(std::string_view s, ParametricType& out) { return parseName(s, out); }
 
 }   // namespace sg

@@ -12,6 +12,7 @@
 #include "scenegraph/mesh.h"
 #include "scenegraph/projection.h"
 #include "scenegraph/settings.h"
+#include "scenegraph/shapes.h"
 
 #include <span>
 #include <string>
@@ -99,6 +100,12 @@ template <>
 const NameTable<WrapMode>& nameTable<WrapMode>();
 template <>
 const NameTable<FilterMode>& nameTable<FilterMode>();
+template <>
+const NameTable<ImplicitType>& nameTable<ImplicitType>();
+template <>
+const NameTable<CsgOp>& nameTable<CsgOp>();
+template <>
+const NameTable<ParametricType>& nameTable<ParametricType>();
 
 // The name of a value ("?" when it is not in the table) and the value of a name or alias.
 template <class E>
