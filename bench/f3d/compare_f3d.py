@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""compare_f3d.py - `viewer render` with its defaults against F3D, side by side (issue 20, goal 4).
+"""compare_f3d.py - `viewer render` with its defaults against F3D, side by side.
 
 For each model it runs both programs alternately --runs times (default 5; ours first in odd
 runs, F3D first in even ones), each in a fresh child process that renders the file at the same
@@ -34,7 +34,7 @@ import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
-# The models of issue 20's goal 4, relative to shared/testdata (MANIFEST.md there).
+# The models of the F3D comparison, relative to shared/testdata (MANIFEST.md there).
 MODELS = {
     "Box": "gltf/Box/glTF/Box.gltf",
     "bunny": "meshes/common-3d-test-models/stanford-bunny/stanford-bunny.obj",

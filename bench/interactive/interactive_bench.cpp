@@ -1,5 +1,5 @@
 // interactive_bench.cpp - what the user waits for in the window after a camera move, per
-// backend, on the bundled demo (issue 20, goal 5), through the viewport's own code: ViewerState
+// backend, on the bundled demo, through the viewport's own code: ViewerState
 // builds the frame from the orbit camera (sg::flatten, as the window does on every change) and
 // a RenderSlot renders it on a worker thread, coarse to fine (GL there in its own headless
 // context, as the window runs it where OpenGL is software only).

@@ -707,7 +707,7 @@ struct TileBuffers {
 const Tri& triById(const std::vector<Chunk>& chunks, uint32_t id) { return chunks[id >> kChunkBits].tris[id & ((1u << kChunkBits) - 1)]; }
 
 // Per-stage time of the tile stage (ns, summed over threads), for VIEWER_RASTER_TIMING.
-std::atomic<int64_t> g_rasterNs{0}, g_prepareNs{0}, g_lightNs{0}, g_outputNs{0};
+std::atomic<int64_t> g_rasterNs{0}, g_prepareNs{0}, g_lightNs{0};
 inline int64_t nowNs() { return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
 
 void shadeOpaque(const FrameContext& fc, Framebuffer& target, TileBuffers& buf, int x0, int y0, int x1, int y1, int samples);

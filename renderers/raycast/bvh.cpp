@@ -12,18 +12,6 @@
 // its best split plus a node visit (traversalCost * halfArea): Embree's leaf rule, deciding
 // whether a child gets a node of its own. Every other child becomes an inner node, recursively.
 #include "raycast/bvh.h"
-#ifdef BVH_TIMING
-#include <cstdio>
-#include <ctime>
-static double cpuNow() {
-    timespec ts;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-#define PROBE(name) std::printf("  %s %.1f ms\n", name, (cpuNow() - tProbe) * 1e3), tProbe = cpuNow()
-#else
-#define PROBE(name)
-#endif
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -628,13 +616,9 @@ void buildFromRefs(PrimRef* refs, size_t n, const Bvh4::BuildOptions& opt, int m
         Builder<W>::setBounds(r, 0, root.bounds);
         r.child[0] = b.makeLeaf(root);
     } else {
-#ifdef BVH_TIMING
-        double tProbe = cpuNow();
-#endif
         typename Builder<W>::Kid rootKid;
         rootKid.r = root;
         b.buildInner(0, rootKid, 0);
-        PROBE("inner");
     }
     const uint32_t count = b.nodeCount.load();
     // Layout: each node's inner children side by side (the traversal tests a node's child
@@ -786,9 +770,6 @@ int kernelWidth();
 void TriangleBvh::build(const vec3* pos, const uint32_t* idx, size_t triCount, const Bvh4::BuildOptions& opt) {
     // Leaf references hold (first << 3) in 31 bits: 2^28 primitives at most per BVH.
     if (triCount >= (size_t(1) << 28)) triCount = 0;
-#ifdef BVH_TIMING
-    double tProbe = cpuNow();
-#endif
     // Refs without zero-filling (every slot is written), compacted in place only when some
     // triangle has a non-finite coordinate (keeps the tree sane on bad input).
     const size_t refBytes = std::max<size_t>(triCount, 1) * sizeof(PrimRef);
@@ -825,7 +806,6 @@ void TriangleBvh::build(const vec3* pos, const uint32_t* idx, size_t triCount, c
             if (sg::isFinite(pos[idx[3 * t]]) && sg::isFinite(pos[idx[3 * t + 1]]) && sg::isFinite(pos[idx[3 * t + 2]])) refs[w++] = refs[t];
         refCount = w;
     }
-    PROBE("refs");
 
     std::vector<uint32_t> prims;
     std::vector<LeafRec> leaves;
@@ -838,7 +818,6 @@ void TriangleBvh::build(const vec3* pos, const uint32_t* idx, size_t triCount, c
     bool wide = kernelWidth() == 8;
     if (wide) {
         detail::buildFromRefs<8>(refs.get(), refCount, opt, maxLeaf, m_nodes8, prims, leaves, m_bounds);
-        PROBE("tree");
         // Inner children by byte offset (see bvh.h), which must stay below the leaf bit.
         static_assert(sizeof(Node8) << 23 == size_t(1) << 31);
         if (m_nodes8.size() <= std::min<uint32_t>(opt.maxWideNodes, 1u << 23)) {
@@ -846,7 +825,6 @@ void TriangleBvh::build(const vec3* pos, const uint32_t* idx, size_t triCount, c
             for (Node8& nd : m_nodes8)
                 for (uint32_t& c : nd.child)
                     if (c != NodeBits::kEmpty && !(c & NodeBits::kLeafBit)) c *= uint32_t(sizeof(Node8));
-            PROBE("packets");
         } else {   // too many nodes to address that way: a BVH4 (same kernels, 4-wide nodes)
             m_nodes8 = {};
             wide = false;

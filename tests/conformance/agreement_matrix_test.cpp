@@ -50,7 +50,7 @@ void appendBox(Mesh& m, const vec3& lo, const vec3& hi) {
     }
 }
 
-// What a CAD export looks like (issue 17's disagreement at thin fins' edges; the cause found is
+// What a CAD export looks like (the disagreement at thin fins' edges; the cause found is
 // the ray caster's float unprojection, shown by the rows with tight near planes and far from the
 // origin below, and by RaycastTest.PrimaryRaysStayOnTheirPixelsWithExtremeNearFarRatios): six heat sinks whose vertices are in millimetres, hundreds from the origin
 // (a 60 x 4 x 40 base and twenty fins 0.4 thick, 25 high), placed by matrix transforms that

@@ -1,6 +1,6 @@
 // sweep_test.cpp - every model in shared/testdata (glTF, OBJ, PLY, OFF, STL; not the invalid
 // ones) rendered by gl, raster and raycast at 320x180 with shadows off and AA off, compared
-// pairwise (issue 17's acceptance numbers):
+// pairwise:
 //   gl ~ raster:      mean |difference| <= 1/255 and >= 99.5% of pixels within 3/255;
 //   raster ~ raycast: >= 99% of pixels within 4/255.
 // One test per model. Models that differ for a documented reason are listed in kKnown with
