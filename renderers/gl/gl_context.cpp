@@ -5,6 +5,7 @@
 //           4. createHeadlessContext  5. current-context queries and GL loading
 //           6. what headless GL runs on (probeHeadlessGl)
 #include "gl/gl_context.h"
+#include "renderers/debug_switches.h"
 
 #include "renderers/renderer.h"
 
@@ -191,10 +192,7 @@ std::unique_ptr<GlContext> createGlfw(std::string& error) {
 // --- 4. createHeadlessContext ----------------------------------------------------------------
 std::unique_ptr<GlContext> createHeadlessContext(const std::string& requested, std::string* error) {
     std::string platform = requested;
-    if (platform.empty()) {
-        const char* env = std::getenv("VIEWER_GL_PLATFORM");
-        platform = env && *env ? env : "auto";
-    }
+    if (platform.empty()) { platform = debugSwitches().glPlatform; }
     std::string eglError, glfwError;
     if (platform == "egl" || platform == "auto") {
         if (auto c = createEgl(eglError)) return c;
@@ -323,8 +321,7 @@ bool onlySoftwareEglDevices() {
 
 HeadlessGl probeUncached() {
     HeadlessGl r;
-    const char* env = std::getenv("VIEWER_GL_PLATFORM");
-    const std::string platform = env && *env ? env : "auto";
+    const std::string platform = debugSwitches().glPlatform;
     if ((platform == "auto" || platform == "egl") && onlySoftwareEglDevices()) {
         r.usable = r.software = true;
         r.renderer = "Mesa's software device, no GPU";

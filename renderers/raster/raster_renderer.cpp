@@ -22,6 +22,7 @@
 // Sections: [helpers] [draw items] [vertex stage] [triangle stage] [tile stage] [lines]
 //           [renderer]
 #include "raster/raster_renderer.h"
+#include "renderers/debug_switches.h"
 
 #include "common/line_overlay.h"
 #include "raster/raster_core.h"
@@ -1344,14 +1345,8 @@ private:
     std::vector<DrawItem> m_vertexBuffers;   // only their vertex-stage buffers (DrawItem::swapBuffers)
     // VIEWER_RASTER_REFERENCE_SHADING=1: shade every fragment with rnd::shade (slow; used to
     // check the batched path).
-    bool m_timing = [] {
-        const char* e = std::getenv("VIEWER_RASTER_TIMING");
-        return e && *e == '1';
-    }();
-    bool m_referenceShading = [] {
-        const char* e = std::getenv("VIEWER_RASTER_REFERENCE_SHADING");
-        return e && *e == '1';
-    }();
+    bool m_timing = debugSwitches().rasterTiming;
+    bool m_referenceShading = debugSwitches().rasterReferenceShading;
 };
 
 }   // namespace

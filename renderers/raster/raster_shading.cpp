@@ -1,4 +1,5 @@
 #include "raster/raster_shading.h"
+#include "renderers/debug_switches.h"
 
 #include "raster/simd.h"
 #include "raster/srgb_encoder.h"
@@ -63,7 +64,7 @@ const SrgbEncoder& srgbEncoder() {
 bool useAvx2() {
 #if defined(RASTER_HAVE_AVX2)
     static const bool use = [] {
-        if (const char* e = std::getenv("VIEWER_RASTER_SSE")) return !(e[0] == '1');
+        if (debugSwitches().rasterForceSse) return false;
         __builtin_cpu_init();
         return bool(__builtin_cpu_supports("avx2"));
     }();

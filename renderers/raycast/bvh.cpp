@@ -12,6 +12,7 @@
 // its best split plus a node visit (traversalCost * halfArea): Embree's leaf rule, deciding
 // whether a child gets a node of its own. Every other child becomes an inner node, recursively.
 #include "raycast/bvh.h"
+#include "renderers/debug_switches.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -907,7 +908,7 @@ namespace kern_avx2 {
 
 namespace {
 const bool kUseAvx2 = [] {
-    if (const char* e = std::getenv("VIEWER_RAYCAST_SSE")) return !(e[0] == '1');   // force the SSE path
+    if (rnd::debugSwitches().raycastForceSse) return false;   // force the SSE path
     __builtin_cpu_init();
     return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
 }();

@@ -13,6 +13,7 @@
 // for mirror-reflected ones - texels decoded from sRGB before filtering; analytic surfaces
 // are untextured.
 #include "raycast/raycast_renderer.h"
+#include "renderers/debug_switches.h"
 
 #include "common/line_overlay.h"
 #include "raycast/camera_rays.h"
@@ -541,10 +542,7 @@ protected:
 
         // Camera rays in packets where each pixel has one (the cost view counts rays one by one);
         // VIEWER_RAYCAST_PACKETS=0 traces them one by one (timing comparisons: the same image).
-        static const bool packetsOn = [] {
-            const char* e = std::getenv("VIEWER_RAYCAST_PACKETS");
-            return !(e && e[0] == '0');
-        }();
+        const bool packetsOn = debugSwitches().raycastPackets;
         const bool packets = packetsOn && sx * sy == 1 && !countCost;
         constexpr int kPacket = 4;   // pixels per packet side (4x4: the benchmark's best, docs/benchmarks.md)
         static_assert(kPacket * kPacket <= rt::kMaxPacket);

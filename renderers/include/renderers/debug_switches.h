@@ -1,0 +1,32 @@
+// debug_switches.h - the environment variables that change how a backend works, for
+// benchmarks, debugging and tests of the code paths only; read once, here and nowhere else in
+// renderers/. None changes what an image should be: each forces one of two paths that the tests
+// hold to the same pixels (or times a stage).
+//
+//   VIEWER_GL_PLATFORM=egl|glfw|auto      headless GL: EGL surfaceless, a hidden GLFW window, or
+//                                         EGL then GLFW (default auto)
+//   VIEWER_RASTER_TIMING=1                the CPU rasterizer prints its per-stage times per frame
+//   VIEWER_RASTER_REFERENCE_SHADING=1     the CPU rasterizer shades every fragment with rnd::shade
+//                                         (slow; checks the batched path)
+//   VIEWER_RASTER_SSE=1                   the CPU rasterizer's SSE2 kernels even where AVX2 runs
+//   VIEWER_RAYCAST_SSE=1                  the ray caster's BVH4/SSE traversal even where AVX2 runs
+//   VIEWER_RAYCAST_PACKETS=0              the ray caster traces camera rays one by one (no packets)
+#pragma once
+
+#include <string>
+
+namespace rnd {
+
+struct DebugSwitches {
+    std::string glPlatform = "auto";
+    bool rasterTiming = false;
+    bool rasterReferenceShading = false;
+    bool rasterForceSse = false;
+    bool raycastForceSse = false;
+    bool raycastPackets = true;
+};
+
+// The switches as the environment set them when first asked (then fixed for the process).
+const DebugSwitches& debugSwitches();
+
+}   // namespace rnd
