@@ -1,4 +1,4 @@
-// debug_switches.cpp - reads the environment variables of debug_switches.h, once.
+// debug_switches.cpp - reads the environment variables of debug_switches.h.
 #include "renderers/debug_switches.h"
 
 #include <cstdlib>
@@ -12,18 +12,15 @@ bool is(const char* name, char value) {
 }
 }   // namespace
 
-const DebugSwitches& debugSwitches() {
-    static const DebugSwitches s = [] {
-        DebugSwitches d;
-        if (const char* e = std::getenv("VIEWER_GL_PLATFORM"); e && *e) d.glPlatform = e;
-        d.rasterTiming = is("VIEWER_RASTER_TIMING", '1');
-        d.rasterReferenceShading = is("VIEWER_RASTER_REFERENCE_SHADING", '1');
-        d.rasterForceSse = is("VIEWER_RASTER_SSE", '1');
-        d.raycastForceSse = is("VIEWER_RAYCAST_SSE", '1');
-        d.raycastPackets = !is("VIEWER_RAYCAST_PACKETS", '0');
-        return d;
-    }();
-    return s;
+DebugSwitches debugSwitches() {
+    DebugSwitches d;
+    if (const char* e = std::getenv("VIEWER_GL_PLATFORM"); e && *e) d.glPlatform = e;
+    d.rasterTiming = is("VIEWER_RASTER_TIMING", '1');
+    d.rasterReferenceShading = is("VIEWER_RASTER_REFERENCE_SHADING", '1');
+    d.rasterForceSse = is("VIEWER_RASTER_SSE", '1');
+    d.raycastForceSse = is("VIEWER_RAYCAST_SSE", '1');
+    d.raycastPackets = !is("VIEWER_RAYCAST_PACKETS", '0');
+    return d;
 }
 
 }   // namespace rnd

@@ -17,6 +17,7 @@
 
 #include <dlfcn.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <mutex>
 #include <sstream>
@@ -345,6 +346,26 @@ HeadlessGl probeUncached() {
 }
 
 }   // namespace
+
+GlLimits glLimits() {
+    static std::once_flag once;
+    static GlLimits result;
+    std::call_once(once, [] {
+        std::unique_ptr<GlContext> ctx;
+        std::string error;
+        if (!anyContextCurrent() && (!(ctx = createHeadlessContext("", &error)) || !ctx->makeCurrent(&error))) return;
+        if (loadGLFunctions().empty()) {
+            GLint samples = 0, rb = 0, dims[2] = {0, 0};
+            glGetIntegerv(GL_MAX_SAMPLES, &samples);
+            glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &rb);
+            glGetIntegerv(GL_MAX_VIEWPORT_DIMS, dims);
+            result.maxSamples = samples;
+            result.maxSize = std::min({rb, dims[0], dims[1]});
+        }
+        if (ctx) ctx->release();
+    });
+    return result;
+}
 
 HeadlessGl probeHeadlessGl() {
     static std::once_flag once;

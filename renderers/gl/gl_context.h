@@ -61,4 +61,13 @@ struct HeadlessGl {
 };
 HeadlessGl probeHeadlessGl();
 
+// The driver's limits the backend's Capabilities state (MSAA samples, largest image side), read
+// once per process from the context current on this thread (the window's) or from a headless
+// context made for it; 0 where no context can be made (then nothing is known to be limited).
+struct GlLimits {
+    int maxSamples = 0;
+    int maxSize = 0;
+};
+GlLimits glLimits();
+
 }   // namespace rnd::gl

@@ -635,13 +635,14 @@ public:
         c.pointsAndLines = true;
         c.visibility = true;   // a second colour attachment, RG32UI (mesh.frag's fragId)
         c.overdraw = true;     // a second pass into an R32F target, additive (countOverdraw)
-        // MSAA sample counts: those of 2/4/8 the driver allows once a context was made (before
-        // that, all three; doRender reports a late reduction).
+        // Constant for the life of the backend (callers may cache them): the driver's limits,
+        // read once per process (gl::glLimits), whether or not this instance has rendered.
+        const gl::GlLimits limits = gl::glLimits();
         for (int n : {2, 4, 8})
-            if (m_maxSamples == 0 || n <= m_maxSamples) c.msaaSamples.push_back(n);
+            if (limits.maxSamples == 0 || n <= limits.maxSamples) c.msaaSamples.push_back(n);
         c.ssaaFactors = {2, 3, 4};
         c.ssaaRendersLarger = true;
-        c.maxImageSize = m_maxSize > 0 ? m_maxSize : 16384;
+        c.maxImageSize = limits.maxSize > 0 ? std::min(limits.maxSize, 16384) : 16384;
         return c;
     }
 

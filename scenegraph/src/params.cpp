@@ -50,37 +50,36 @@ bool fogExponential(const RenderSettings& s) { return s.fog == FogMode::Exp || s
 std::vector<Param<RenderSettings>> renderTable() {
     using S = RenderSettings;
     return concat<S>({
-        inSection<S>("Shading",
-                     {
-                         field<&S::shading>("shading", "shading", "Shading", "Where lighting is computed: per face, per vertex or per pixel")
-                             .asRadios(),
-                         field<&S::reflection>("reflection", "reflection", "Reflection", "The specular term of the reflection model").asRadios(),
-                         field<&S::attenuation>("attenuation", "attenuation", "Light attenuation (1/r^2)",
-                                                "Honour the inverse-square falloff of lights that have it"),
-                         field<&S::ambientLight>("ambientLight", "ambient", "Ambient light",
-                                                 "L_ambient: light from everywhere, scaled per material by ka (linear RGB)")
-                             .range(0.0, 1000.0),
-                     }),
-        inSection<S>("Fog",
-                     {
-                         field<&S::fog>("fog.mode", "fog", "Fog", "Fog: visibility falls with the eye-space distance"),
-                         field<&S::fogColor>("fog.color", "fog-color", "Fog colour", "The colour fog blends toward (linear RGB)")
-                             .range(0.0, 1.0)
-                             .when(fogOn),
-                         field<&S::fogStart>("fog.start", "fog-start", "Fog start", "Linear fog: distance where it begins")
-                             .range(0.0, 1e9)
-                             .dragged("%.3f")
-                             .when(fogLinear),
-                         field<&S::fogEnd>("fog.end", "fog-end", "Fog end", "Linear fog: distance where nothing is left visible")
-                             .range(0.0, 1e9)
-                             .dragged("%.3f")
-                             .when(fogLinear),
-                         field<&S::fogDensity>("fog.density", "fog-density", "Fog density", "Exponential fog: density per unit distance")
-                             .range(0.0, 1e4)
-                             .log()
-                             .fmt("%.4f")
-                             .when(fogExponential),
-                     }),
+        inSection<S>(
+            "Shading",
+            {
+                field<&S::shading>("shading", "shading", "Shading", "Where lighting is computed: per face, per vertex or per pixel").asRadios(),
+                field<&S::reflection>("reflection", "reflection", "Reflection", "The specular term of the reflection model").asRadios(),
+                field<&S::attenuation>("attenuation", "attenuation", "Light attenuation (1/r^2)",
+                                       "Honour the inverse-square falloff of lights that have it"),
+                field<&S::ambientLight>("ambientLight", "ambient", "Ambient light",
+                                        "L_ambient: light from everywhere, scaled per material by ka (linear RGB)")
+                    .range(0.0, 1000.0),
+            }),
+        inSection<S>(
+            "Fog",
+            {
+                field<&S::fog>("fog.mode", "fog", "Fog", "Fog: visibility falls with the eye-space distance"),
+                field<&S::fogColor>("fog.color", "fog-color", "Fog colour", "The colour fog blends toward (linear RGB)").range(0.0, 1.0).when(fogOn),
+                field<&S::fogStart>("fog.start", "fog-start", "Fog start", "Linear fog: distance where it begins")
+                    .range(0.0, 1e9)
+                    .dragged("%.3f")
+                    .when(fogLinear),
+                field<&S::fogEnd>("fog.end", "fog-end", "Fog end", "Linear fog: distance where nothing is left visible")
+                    .range(0.0, 1e9)
+                    .dragged("%.3f")
+                    .when(fogLinear),
+                field<&S::fogDensity>("fog.density", "fog-density", "Fog density", "Exponential fog: density per unit distance")
+                    .range(0.0, 1e4)
+                    .log()
+                    .fmt("%.4f")
+                    .when(fogExponential),
+            }),
         inSection<S>("Anti-aliasing",
                      {
                          // The rate first, so a file's "aa" name wins over a stray rate.
@@ -146,33 +145,32 @@ std::vector<Param<Projection>> projectionTable() {
     auto frustumOnly = [](const P& p) { return p.type == ProjectionType::Perspective; };
     auto parallel = [](const P& p) { return p.type != ProjectionType::Perspective; };
     auto oblique = [](const P& p) { return p.type == ProjectionType::Oblique; };
-    return inSection<P>("Projection",
-                        {
-                            projectionTypeParam(),
-                            field<&P::useFrustum>("useFrustum", "", "General frustum (l, r, b, t)",
-                                                  "Perspective from the frustum's sides at the near plane instead of the field of view")
-                                .when(frustumOnly),
-                            field<&P::fovyDeg>("fovy", "fovy", "Field of view y", "Perspective: vertical angle of view in degrees")
-                                .range(0.1, 179.0)
-                                .fmt("%.1f deg")
-                                .when(perspective),
-                            field<&P::orthoHalfHeight>("orthoHalfHeight", "ortho-half-height", "Half height",
-                                                       "Orthographic and oblique: half the visible height in view units")
-                                .range(1e-6, 1e9)
-                                .dragged("%.4g")
-                                .when(parallel),
-                            field<&P::obliqueAngleDeg>("obliqueAngle", "oblique-angle", "Oblique angle",
-                                                       "Oblique: angle of the receding axis in degrees")
-                                .range(-90.0, 90.0)
-                                .fmt("%.1f deg")
-                                .when(oblique),
-                            field<&P::obliqueFactor>("obliqueFactor", "oblique-factor", "Oblique factor",
-                                                     "Oblique: foreshortening of the receding axis (1 cavalier, 0.5 cabinet)")
-                                .range(0.0, 4.0)
-                                .when(oblique),
-                            field<&P::zNear>("near", "near", "Near", "Near clipping distance").range(1e-6, 1e9).dragged("%.4g").log(),
-                            field<&P::zFar>("far", "far", "Far", "Far clipping distance").range(1e-6, 1e9).dragged("%.4g").log(),
-                        });
+    return inSection<P>("Projection", {
+                                          projectionTypeParam(),
+                                          field<&P::useFrustum>("useFrustum", "", "General frustum (l, r, b, t)",
+                                                                "Perspective from the frustum's sides at the near plane instead of the field of view")
+                                              .when(frustumOnly),
+                                          field<&P::fovyDeg>("fovy", "fovy", "Field of view y", "Perspective: vertical angle of view in degrees")
+                                              .range(0.1, 179.0)
+                                              .fmt("%.1f deg")
+                                              .when(perspective),
+                                          field<&P::orthoHalfHeight>("orthoHalfHeight", "ortho-half-height", "Half height",
+                                                                     "Orthographic and oblique: half the visible height in view units")
+                                              .range(1e-6, 1e9)
+                                              .dragged("%.4g")
+                                              .when(parallel),
+                                          field<&P::obliqueAngleDeg>("obliqueAngle", "oblique-angle", "Oblique angle",
+                                                                     "Oblique: angle of the receding axis in degrees")
+                                              .range(-90.0, 90.0)
+                                              .fmt("%.1f deg")
+                                              .when(oblique),
+                                          field<&P::obliqueFactor>("obliqueFactor", "oblique-factor", "Oblique factor",
+                                                                   "Oblique: foreshortening of the receding axis (1 cavalier, 0.5 cabinet)")
+                                              .range(0.0, 4.0)
+                                              .when(oblique),
+                                          field<&P::zNear>("near", "near", "Near", "Near clipping distance").range(1e-6, 1e9).dragged("%.4g").log(),
+                                          field<&P::zFar>("far", "far", "Far", "Far clipping distance").range(1e-6, 1e9).dragged("%.4g").log(),
+                                      });
 }
 
 // --- material ----------------------------------------------------------------------------------
@@ -182,36 +180,35 @@ std::vector<Param<Material>> materialTable() {
     auto notOpaque = [](const M& m) { return m.alphaMode != AlphaMode::Opaque; };
     auto masked = [](const M& m) { return m.alphaMode == AlphaMode::Mask; };
     return concat<M>({
-        inSection<M>("Phong",
-                     {
-                         field<&M::baseColor>("baseColor", "", "Base colour", "rho: the surface colour (linear RGB; x the base colour texture)")
-                             .range(0.0, 1.0),
-                         field<&M::ka>("ka", "", "ka (ambient)", "Ambient coefficient").range(0.0, 1.0),
-                         field<&M::kd>("kd", "", "kd (diffuse)", "Diffuse coefficient").range(0.0, 1.0),
-                         field<&M::ks>("ks", "", "ks (specular)", "Specular coefficient").range(0.0, 1.0),
-                         field<&M::shininess>("shininess", "", "Shininess n", "Phong exponent of the highlight").range(0.0, 1e5).log().fmt("%.1f"),
-                         field<&M::specularTinted>("specularTinted", "", "Specular tinted by base colour",
-                                                   "On: highlights take the base colour (metals); off: the specular colour"),
-                         field<&M::specularColor>("specularColor", "", "Specular colour", "Colour of the highlights when not tinted (linear RGB)")
-                             .range(0.0, 1.0)
-                             .when([](const M& m) { return !m.specularTinted; }),
-                         field<&M::emissive>("emissive", "", "Emissive", "Light the surface gives off (linear RGB; x the emissive texture)")
-                             .range(0.0, 1e4),
-                         field<&M::reflectivity>("reflectivity", "", "Reflectivity", "Mirror reflection weight (ray caster)")
-                             .range(0.0, 1.0)
-                             .needing(Feature::Reflections),
-                         field<&M::unlit>("unlit", "", "Unlit", "Colour = base colour (x texture), no lighting"),
-                         field<&M::doubleSided>("doubleSided", "", "Double-sided",
-                                                "Off: the back face is not drawn when back faces are culled per material (Back faces: auto)"),
-                     }),
-        inSection<M>("Alpha",
-                     {
-                         field<&M::alphaMode>("alphaMode", "", "Alpha mode", "How alpha is used"),
-                         field<&M::alpha>("alpha", "", "Alpha", "Base colour alpha (x texture and vertex alpha)").range(0.0, 1.0).when(notOpaque),
-                         field<&M::alphaCutoff>("alphaCutoff", "", "Alpha cutoff", "Mask: drawn where alpha >= the cutoff")
-                             .range(0.0, 1.0)
-                             .when(masked),
-                     }),
+        inSection<M>(
+            "Phong",
+            {
+                field<&M::baseColor>("baseColor", "", "Base colour", "rho: the surface colour (linear RGB; x the base colour texture)")
+                    .range(0.0, 1.0),
+                field<&M::ka>("ka", "", "ka (ambient)", "Ambient coefficient").range(0.0, 1.0),
+                field<&M::kd>("kd", "", "kd (diffuse)", "Diffuse coefficient").range(0.0, 1.0),
+                field<&M::ks>("ks", "", "ks (specular)", "Specular coefficient").range(0.0, 1.0),
+                field<&M::shininess>("shininess", "", "Shininess n", "Phong exponent of the highlight").range(0.0, 1e5).log().fmt("%.1f"),
+                field<&M::specularTinted>("specularTinted", "", "Specular tinted by base colour",
+                                          "On: highlights take the base colour (metals); off: the specular colour"),
+                field<&M::specularColor>("specularColor", "", "Specular colour", "Colour of the highlights when not tinted (linear RGB)")
+                    .range(0.0, 1.0)
+                    .when([](const M& m) { return !m.specularTinted; }),
+                field<&M::emissive>("emissive", "", "Emissive", "Light the surface gives off (linear RGB; x the emissive texture)").range(0.0, 1e4),
+                field<&M::reflectivity>("reflectivity", "", "Reflectivity", "Mirror reflection weight (ray caster)")
+                    .range(0.0, 1.0)
+                    .needing(Feature::Reflections),
+                field<&M::unlit>("unlit", "", "Unlit", "Colour = base colour (x texture), no lighting"),
+                field<&M::doubleSided>("doubleSided", "", "Double-sided",
+                                       "Off: the back face is not drawn when back faces are culled per material (Back faces: auto)"),
+            }),
+        inSection<M>(
+            "Alpha",
+            {
+                field<&M::alphaMode>("alphaMode", "", "Alpha mode", "How alpha is used"),
+                field<&M::alpha>("alpha", "", "Alpha", "Base colour alpha (x texture and vertex alpha)").range(0.0, 1.0).when(notOpaque),
+                field<&M::alphaCutoff>("alphaCutoff", "", "Alpha cutoff", "Mask: drawn where alpha >= the cutoff").range(0.0, 1.0).when(masked),
+            }),
         // glTF's physically based parameters and map strengths: read and written with the file,
         // used per texel (docs/math.md, "Material textures"); not in the panel.
         inSection<M>("Maps",
@@ -231,19 +228,16 @@ std::vector<Param<Material>> materialTable() {
 std::vector<Param<Light>> lightTable() {
     using L = Light;
     auto spot = [](const L& l) { return l.type == LightType::Spot; };
-    return inSection<L>("Light", {
-                                     field<&L::type>("type", "", "Type", "Point, directional or spot"),
-                                     field<&L::color>("color", "", "Colour", "Light colour (linear RGB)").range(0.0, 1.0),
-                                     field<&L::intensity>("intensity", "", "Intensity", "Scales the colour").range(0.0, 1e6).dragged("%.3f"),
-                                     field<&L::inverseSquare>("inverseSquare", "", "Inverse-square falloff",
-                                                              "Falls off as 1/r^2 (when the scene's attenuation is on)"),
-                                     field<&L::spotInnerDeg>("spotInner", "", "Inner angle", "Spot: full intensity inside (degrees)")
-                                         .range(0.0, 90.0)
-                                         .when(spot),
-                                     field<&L::spotOuterDeg>("spotOuter", "", "Outer angle", "Spot: nothing outside (degrees)")
-                                         .range(0.0, 90.0)
-                                         .when(spot),
-                                 });
+    return inSection<L>(
+        "Light",
+        {
+            field<&L::type>("type", "", "Type", "Point, directional or spot"),
+            field<&L::color>("color", "", "Colour", "Light colour (linear RGB)").range(0.0, 1.0),
+            field<&L::intensity>("intensity", "", "Intensity", "Scales the colour").range(0.0, 1e6).dragged("%.3f"),
+            field<&L::inverseSquare>("inverseSquare", "", "Inverse-square falloff", "Falls off as 1/r^2 (when the scene's attenuation is on)"),
+            field<&L::spotInnerDeg>("spotInner", "", "Inner angle", "Spot: full intensity inside (degrees)").range(0.0, 90.0).when(spot),
+            field<&L::spotOuterDeg>("spotOuter", "", "Outer angle", "Spot: nothing outside (degrees)").range(0.0, 90.0).when(spot),
+        });
 }
 
 std::string number(double v) {

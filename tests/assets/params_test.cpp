@@ -3,9 +3,9 @@
 // carry every row; every flagged row is a command-line option that takes its text form; a value
 // outside a row's range is refused with the range; the size-dependent defaults are the same for
 // the command line and the window (assets::loadScene), so `--fog linear` on a mesh shows fog.
+#include "scenegraph/params.h"
 #include "assets/image_io.h"
 #include "assets/scene_io.h"
-#include "scenegraph/params.h"
 #include "scenegraph/scene_defaults.h"
 #include "test_support.h"
 
@@ -26,9 +26,7 @@ void expectComplete(std::set<std::string>& flags) {
     for (const sg::Param<T>& p : sg::params<T>()) {
         SCOPED_TRACE(std::string(p.key));
         EXPECT_TRUE(keys.insert(p.key).second) << "duplicate key";
-        if (!p.flag.empty()) {
-            EXPECT_TRUE(flags.insert(std::string(p.flag)).second) << "duplicate flag";
-        }
+        if (!p.flag.empty()) { EXPECT_TRUE(flags.insert(std::string(p.flag)).second) << "duplicate flag"; }
         EXPECT_FALSE(p.help.empty());
         ASSERT_TRUE(p.get && p.set);
         if (p.kind == sg::ParamKind::Choice) {
@@ -79,7 +77,7 @@ TEST(ParamTablesTest, TheSceneFileCarriesEveryRenderSetting) {
         sg::Scene s;
         s.settings.fog = sg::FogMode::Exp;   // every fog row means something, linear's rule holds
         sg::ParamValue v = another(p.kind, p.min, p.max, p.get(s.settings), p.choices);
-        if (p.key == "aaRate") continue;     // carried, but only meaningful with aa none (below)
+        if (p.key == "aaRate") continue;   // carried, but only meaningful with aa none (below)
         ASSERT_TRUE(p.set(s.settings, v));
         if (!s.settings.validate().empty()) continue;   // a combination the rules refuse (MSAA rate)
         assets::LoadResult r = assets::parseSceneJson(assets::serializeSceneJson(s), "roundtrip");
@@ -118,8 +116,8 @@ TEST(ParamTablesTest, EveryFlaggedRowIsACommandLineOption) {
     testing_support::ProgramRun ok = testing_support::runProgram(
         quoted(VIEWER_EXE), "render demo --backend raster --size 32x18 --overwrite --out " + quoted(dir / "all-flags.png") + args);
     EXPECT_EQ(ok.status, 0) << ok.output;
-    testing_support::ProgramRun bad =
-        testing_support::runProgram(quoted(VIEWER_EXE), "render demo --backend raster --size 32x18 --tessellation 600 --out " + quoted(dir / "bad.png"));
+    testing_support::ProgramRun bad = testing_support::runProgram(
+        quoted(VIEWER_EXE), "render demo --backend raster --size 32x18 --tessellation 600 --out " + quoted(dir / "bad.png"));
     EXPECT_NE(bad.status, 0);
     EXPECT_NE(bad.output.find("--tessellation must be in [4, 512]"), std::string::npos) << bad.output;
 }

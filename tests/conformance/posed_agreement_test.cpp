@@ -54,7 +54,8 @@ TEST_P(PosedAgreement, ThreeBackendsAgree) {
         ASSERT_TRUE(st.ok) << b << ": " << st.error;
         testing_support::writeImage(img[b], "posed-agreement", std::string(c.name) + "-" + b);
     }
-    testing_support::ImageTolerance glRaster{1.0, 0.995, 3}, rasterRay{255.0, 0.99, 4};
+    const testing_support::ImageTolerance glRaster = testing_support::agreementTolerance(testing_support::Agreement::SameMethod);
+    const testing_support::ImageTolerance rasterRay = testing_support::agreementTolerance(testing_support::Agreement::AcrossMethods);
     EXPECT_TRUE(testing_support::imagesClose(img["gl"], img["raster"], glRaster, "posed-agreement", std::string(c.name) + "-gl-vs-raster"));
     EXPECT_TRUE(
         testing_support::imagesClose(img["raycast"], img["raster"], rasterRay, "posed-agreement", std::string(c.name) + "-raycast-vs-raster"));

@@ -182,7 +182,7 @@ TEST_P(BackendContractTest, StatsSayWhatWasAskedAndUsed) {
         EXPECT_EQ(fb.height, 30);
         EXPECT_GT(st.milliseconds, 0.0);
         EXPECT_EQ(st.config.aaAsked, aa);
-        // Capabilities (asked after the render, when GL knows its driver) tell the truth: a
+        // Capabilities (the same before and after a render) tell the truth: a
         // mode is taken as asked exactly when the backend lists it, else a note says why.
         Capabilities caps = r->capabilities();
         const std::vector<int>& list = s.aa == sg::AAMode::MSAA ? caps.msaaSamples : caps.ssaaFactors;
@@ -197,6 +197,30 @@ TEST_P(BackendContractTest, StatsSayWhatWasAskedAndUsed) {
     ASSERT_TRUE(st.ok) << st.error;
     bool listed = std::find(st.config.unsupported.begin(), st.config.unsupported.end(), "shadows") != st.config.unsupported.end();
     EXPECT_EQ(listed, !r->capabilities().shadows);
+}
+
+// Capabilities are constant for the life of a backend (the UI caches them per backend): the
+// same before its first render (GL: before it has a context) and after.
+TEST_P(BackendContractTest, CapabilitiesDoNotChangeWhenItRenders) {
+    std::string err;
+    std::unique_ptr<Renderer> r = makeRenderer(GetParam(), &err);
+    ASSERT_TRUE(r) << err;
+    const Capabilities before = r->capabilities();
+    Framebuffer fb;
+    sg::RenderSettings msaa;
+    msaa.aa = sg::AAMode::MSAA;
+    msaa.aaRate = 4;
+    (void)r->render(frameWith(msaa), 32, 32, fb);
+    const Capabilities after = r->capabilities();
+    EXPECT_EQ(before.affinity, after.affinity);
+    EXPECT_EQ(before.msaaSamples, after.msaaSamples);
+    EXPECT_EQ(before.ssaaFactors, after.ssaaFactors);
+    EXPECT_EQ(before.maxImageSize, after.maxImageSize);
+    EXPECT_EQ(before.visibility, after.visibility);
+    EXPECT_EQ(before.overdraw, after.overdraw);
+    EXPECT_EQ(before.traversalCost, after.traversalCost);
+    EXPECT_EQ(before.shadows, after.shadows);
+    EXPECT_EQ(before.wireframe, after.wireframe);
 }
 
 INSTANTIATE_TEST_SUITE_P(EveryBackend, BackendContractTest, ::testing::ValuesIn(rendererNames()), [](const auto& info) { return info.param; });

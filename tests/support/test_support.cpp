@@ -181,4 +181,9 @@ ProgramRun runProgram(const std::string& exe, const std::string& args, bool with
 
 std::string quoted(const std::filesystem::path& p) { return "\"" + p.string() + "\""; }
 
+Agreement agreementBetween(const std::string& a, const std::string& b) {
+    auto rasterizes = [](const std::string& n) { return n != "raycast"; };
+    return rasterizes(a) && rasterizes(b) ? Agreement::SameMethod : Agreement::AcrossMethods;
+}
+
 }   // namespace testing_support

@@ -28,6 +28,20 @@ struct ImageTolerance {
     int channelTolerance = 3;   // per-pixel tolerance for the fraction
 };
 
+// How closely two backends' images must agree, by how they make them (README: "Same scene,
+// camera and settings give the same image wherever the methods agree"); every test that holds
+// backends together takes its tolerance from here:
+//   SameMethod:   two rasterizers (GL ~ CPU rasterizer): mean below 1/255 and >= 99.5% of pixels
+//                 within 3/255 (a small, badly wrong region fails the fraction);
+//   AcrossMethods: ray caster ~ a rasterizer, shadows and reflections off: >= 99% of pixels
+//                 within 4/255 (silhouette pixels of tessellated vs exact surfaces may differ).
+enum class Agreement { SameMethod, AcrossMethods };
+inline ImageTolerance agreementTolerance(Agreement a) {
+    return a == Agreement::SameMethod ? ImageTolerance{1.0, 0.995, 3} : ImageTolerance{255.0, 0.99, 4};
+}
+// Whether `a` and `b` are made the same way (both rasterizers) or not.
+Agreement agreementBetween(const std::string& a, const std::string& b);
+
 // Compares and reports the figures; on failure writes <name>-actual.png, <name>-expected.png
 // and <name>-diff.png into outputDir(suite).
 ::testing::AssertionResult imagesClose(const rnd::Framebuffer& actual, const rnd::Framebuffer& expected, const ImageTolerance& tol,

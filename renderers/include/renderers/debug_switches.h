@@ -1,5 +1,5 @@
 // debug_switches.h - the environment variables that change how a backend works, for
-// benchmarks, debugging and tests of the code paths only; read once, here and nowhere else in
+// benchmarks, debugging and tests of the code paths only; read here and nowhere else in
 // renderers/. None changes what an image should be: each forces one of two paths that the tests
 // hold to the same pixels (or times a stage).
 //
@@ -26,7 +26,8 @@ struct DebugSwitches {
     bool raycastPackets = true;
 };
 
-// The switches as the environment set them when first asked (then fixed for the process).
-const DebugSwitches& debugSwitches();
+// The switches as the environment sets them now (a few getenv calls: backends ask when they
+// are made or start a frame; the kernel choices are fixed at the first ask).
+DebugSwitches debugSwitches();
 
 }   // namespace rnd

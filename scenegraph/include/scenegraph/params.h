@@ -53,11 +53,11 @@ struct Param {
     std::string_view help;      // one line: CLI help, UI tooltip
     std::string_view section;   // UI group ("Fog")
     ParamKind kind = ParamKind::Float;
-    double min = 0.0, max = 0.0;   // Int and Float: valid range, inclusive (Float: finite too)
-    bool logScale = false;         // UI: logarithmic slider
-    bool drag = false;             // UI: a drag field (open-ended ranges) instead of a slider
-    bool radios = false;           // UI: a Choice as a row of radio buttons instead of a combo
-    const char* format = nullptr;  // UI number format ("%.1f deg"); nullptr = ImGui's default
+    double min = 0.0, max = 0.0;    // Int and Float: valid range, inclusive (Float: finite too)
+    bool logScale = false;          // UI: logarithmic slider
+    bool drag = false;              // UI: a drag field (open-ended ranges) instead of a slider
+    bool radios = false;            // UI: a Choice as a row of radio buttons instead of a combo
+    const char* format = nullptr;   // UI number format ("%.1f deg"); nullptr = ImGui's default
     Feature needs = Feature::None;
     ParamValue (*get)(const T&) = nullptr;
     // Sets a value of the param's kind (false for another kind or an unknown choice name);
