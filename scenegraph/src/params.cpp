@@ -145,32 +145,39 @@ std::vector<Param<Projection>> projectionTable() {
     auto frustumOnly = [](const P& p) { return p.type == ProjectionType::Perspective; };
     auto parallel = [](const P& p) { return p.type != ProjectionType::Perspective; };
     auto oblique = [](const P& p) { return p.type == ProjectionType::Oblique; };
-    return inSection<P>("Projection", {
-                                          projectionTypeParam(),
-                                          field<&P::useFrustum>("useFrustum", "", "General frustum (l, r, b, t)",
-                                                                "Perspective from the frustum's sides at the near plane instead of the field of view")
-                                              .when(frustumOnly),
-                                          field<&P::fovyDeg>("fovy", "fovy", "Field of view y", "Perspective: vertical angle of view in degrees")
-                                              .range(0.1, 179.0)
-                                              .fmt("%.1f deg")
-                                              .when(perspective),
-                                          field<&P::orthoHalfHeight>("orthoHalfHeight", "ortho-half-height", "Half height",
-                                                                     "Orthographic and oblique: half the visible height in view units")
-                                              .range(1e-6, 1e9)
-                                              .dragged("%.4g")
-                                              .when(parallel),
-                                          field<&P::obliqueAngleDeg>("obliqueAngle", "oblique-angle", "Oblique angle",
-                                                                     "Oblique: angle of the receding axis in degrees")
-                                              .range(-90.0, 90.0)
-                                              .fmt("%.1f deg")
-                                              .when(oblique),
-                                          field<&P::obliqueFactor>("obliqueFactor", "oblique-factor", "Oblique factor",
-                                                                   "Oblique: foreshortening of the receding axis (1 cavalier, 0.5 cabinet)")
-                                              .range(0.0, 4.0)
-                                              .when(oblique),
-                                          field<&P::zNear>("near", "near", "Near", "Near clipping distance").range(1e-6, 1e9).dragged("%.4g").log(),
-                                          field<&P::zFar>("far", "far", "Far", "Far clipping distance").range(1e-6, 1e9).dragged("%.4g").log(),
-                                      });
+    return inSection<P>(
+        "Projection",
+        {
+            projectionTypeParam(),
+            field<&P::useFrustum>("useFrustum", "", "General frustum (l, r, b, t)",
+                                  "Perspective from the frustum's sides at the near plane instead of the field of view")
+                .when(frustumOnly),
+            field<&P::fovyDeg>("fovy", "fovy", "Field of view y", "Perspective: vertical angle of view in degrees")
+                .range(0.1, 179.0)
+                .fmt("%.1f deg")
+                .when(perspective),
+            field<&P::aspectRatio>("aspectRatio", "", "Framed aspect",
+                                   "Perspective: the width/height the author framed (0 = none); a narrower viewport widens "
+                                   "the vertical field so nothing framed is cut")
+                .range(0.0, 100.0)
+                .fmt("%.3f")
+                .when(perspective),
+            field<&P::orthoHalfHeight>("orthoHalfHeight", "ortho-half-height", "Half height",
+                                       "Orthographic and oblique: half the visible height in view units")
+                .range(1e-6, 1e9)
+                .dragged("%.4g")
+                .when(parallel),
+            field<&P::obliqueAngleDeg>("obliqueAngle", "oblique-angle", "Oblique angle", "Oblique: angle of the receding axis in degrees")
+                .range(-90.0, 90.0)
+                .fmt("%.1f deg")
+                .when(oblique),
+            field<&P::obliqueFactor>("obliqueFactor", "oblique-factor", "Oblique factor",
+                                     "Oblique: foreshortening of the receding axis (1 cavalier, 0.5 cabinet)")
+                .range(0.0, 4.0)
+                .when(oblique),
+            field<&P::zNear>("near", "near", "Near", "Near clipping distance").range(1e-6, 1e9).dragged("%.4g").log(),
+            field<&P::zFar>("far", "far", "Far", "Far clipping distance").range(1e-6, 1e9).dragged("%.4g").log(),
+        });
 }
 
 // --- material ----------------------------------------------------------------------------------

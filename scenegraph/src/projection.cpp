@@ -2,14 +2,24 @@
 
 #include "scenegraph/transforms.h"
 
+#include <algorithm>
+#include <cmath>
+
 namespace sg {
+
+float Projection::effectiveFovyDeg(float aspect) const {
+    if (!(aspectRatio > 0.0f) || !(aspect > 0.0f) || aspect >= aspectRatio) return fovyDeg;
+    // tan(fovy'/2) aspect = tan(fovy/2) aspectRatio: the same horizontal half-angle.
+    const float t = std::tan(radians(fovyDeg) * 0.5f) * aspectRatio / aspect;
+    return std::min(degrees(2.0f * std::atan(t)), 179.0f);
+}
 
 mat4 Projection::matrix(float aspect, float focusDistance) const {
     if (!(aspect > 0.0f) || !std::isfinite(aspect)) aspect = 1.0f;
     switch (type) {
     case ProjectionType::Perspective:
         if (useFrustum) return frustum(left, right, bottom, top, zNear, zFar);
-        return perspective(radians(fovyDeg), aspect, zNear, zFar);
+        return perspective(radians(effectiveFovyDeg(aspect)), aspect, zNear, zFar);
     case ProjectionType::Orthographic: {
         float h = orthoHalfHeight, w = h * aspect;
         return orthographic(-w, w, -h, h, zNear, zFar);

@@ -255,3 +255,20 @@ TEST(TransformsTest, NormalMatrixKeepsNormalsPerpendicular) {
     // Degenerate matrices give identity rather than NaNs.
     EXPECT_TRUE(matNear(mat4(normalMatrix(scaling(vec3(1, 0, 1)))), mat4(1.0f)));
 }
+
+// A glTF camera's aspectRatio: a narrower viewport widens the vertical angle so the author's
+// horizontal field stays whole; a wider one keeps the vertical angle.
+TEST(ProjectionTest, AuthoredAspectKeepsTheFramedFieldWhole) {
+    sg::Projection p;
+    p.fovyDeg = 40.0f;
+    p.aspectRatio = 16.0f / 9.0f;
+    EXPECT_FLOAT_EQ(p.effectiveFovyDeg(2.0f), 40.0f);
+    const float portrait = 0.6f;
+    const float fovy = p.effectiveFovyDeg(portrait);
+    const float halfX = std::atan(std::tan(sg::radians(fovy) * 0.5f) * portrait);
+    const float authoredHalfX = std::atan(std::tan(sg::radians(40.0f) * 0.5f) * p.aspectRatio);
+    EXPECT_NEAR(halfX, authoredHalfX, 1e-5f);
+    EXPECT_NEAR(p.matrix(portrait, 1.0f)[1][1], 1.0f / std::tan(sg::radians(fovy) * 0.5f), 1e-4f);
+    p.aspectRatio = 0.0f;
+    EXPECT_FLOAT_EQ(p.effectiveFovyDeg(portrait), 40.0f);
+}

@@ -512,6 +512,90 @@ TEST(ViewerAutomationGLTest, WindowFitsASmallScreenAndRemembersItsSize) {
     }
 }
 
+// A file camera far from its model with a focus distance in front of itself (as glTF files
+// have): the orbit pivot is on the model, so an orbit keeps it in view; keypad 7 looks down,
+// keypad 5 switches to orthographic; the panels follow the window and Viewport only hides them.
+TEST(ViewerAutomationGLTest, OrbitStaysOnTheModelAndTheLayoutFollowsTheWindow) {
+    if (!viewer_test::haveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+    fs::path dir = sceneFolder("automation_orbit");
+    {
+        sg::Scene s;
+        sg::ImplicitShape box;
+        box.type = sg::ImplicitType::Box;
+        box.halfExtents = sg::vec3(50.0f);
+        s.addNode("engine", s.root(), sg::ImplicitPayload{box, -1});
+        sg::Camera cam;
+        cam.focusDistance = 5.0f;   // 5 units ahead of a camera 1500 away
+        cam.projection.zNear = 1.0f;
+        cam.projection.zFar = 5000.0f;
+        sg::NodeId c = s.addNode("file camera", s.root(), cam);
+        sg::LocalTransform t;
+        t.translation = sg::vec3(0.0f, 0.0f, 1500.0f);
+        s.setLocal(c, t);
+        s.activeCamera = c;
+        ASSERT_EQ(assets::saveSceneJson(s, dir / "far.json", true), "");
+    }
+    auto camera = [](const std::string& line, sg::vec3& eye, sg::vec3& centre, std::string& proj) {
+        char name[64] = {};
+        const bool ok = std::sscanf(line.c_str(), "camera eye %f %f %f centre %f %f %f up %*f %*f %*f projection %63s", &eye.x, &eye.y, &eye.z,
+                                    &centre.x, &centre.y, &centre.z, name) == 7;
+        proj = name;
+        return ok;
+    };
+    auto viewport = [](const std::string& line, int& x, int& y, int& w, int& h) {
+        return std::sscanf(line.c_str(), "viewport %d %d %d %d", &x, &y, &w, &h) == 4;
+    };
+    ScriptRun r = runScript(dir,
+                            "wait\n"
+                            "print camera\n"   // 0: pivot on the model
+                            "drag 300 300 340 300\n"
+                            "print camera\n"   // 1: orbited about it
+                            "key kp7\n"
+                            "print camera\n"   // 2: top view
+                            "key kp5\n"
+                            "print camera\n"     // 3: orthographic
+                            "print viewport\n"   // 4
+                            "print window\n"     // 8 (printed here; the index below)
+                            "panels hide\n"
+                            "print viewport\n"   // 5: the whole width
+                            "panels show\n"
+                            "resize 800 500\n"
+                            "print viewport\n"   // 6
+                            "resize 1366 700\n"
+                            "print viewport\n"   // 7
+                            "quit\n",
+                            "far.json", "1366x768x24");
+    ASSERT_EQ(r.rc, 0) << dump(r);
+    ASSERT_EQ(r.out.size(), 9u) << dump(r);
+    int winX, winY, winW = 0, winH;
+    ASSERT_EQ(std::sscanf(r.out[5].c_str(), "window %d %d %d %d", &winX, &winY, &winW, &winH), 4) << r.out[5];
+    r.out.erase(r.out.begin() + 5);
+    sg::vec3 eye, centre;
+    std::string proj;
+    ASSERT_TRUE(camera(r.out[0], eye, centre, proj)) << r.out[0];
+    EXPECT_LT(glm::length(centre), 1.0f) << "the pivot is on the model, not 5 units ahead of the camera: " << r.out[0];
+    EXPECT_NEAR(glm::length(eye - centre), 1500.0f, 1.0f) << r.out[0];
+    ASSERT_TRUE(camera(r.out[1], eye, centre, proj)) << r.out[1];
+    EXPECT_LT(glm::length(centre), 1.0f) << r.out[1];
+    EXPECT_GT(std::abs(eye.x), 50.0f) << "the drag orbited: " << r.out[1];
+    ASSERT_TRUE(camera(r.out[2], eye, centre, proj)) << r.out[2];
+    EXPECT_GT(eye.y - centre.y, 0.99f * glm::length(eye - centre)) << "keypad 7 looks down from above: " << r.out[2];
+    ASSERT_TRUE(camera(r.out[3], eye, centre, proj)) << r.out[3];
+    EXPECT_EQ(proj, "orthographic") << r.out[3];
+    int x, y, w, h;
+    ASSERT_TRUE(viewport(r.out[4], x, y, w, h)) << r.out[4];
+    EXPECT_GE(w, winW / 2) << "the viewport keeps at least half the width: " << r.out[4];
+    ASSERT_TRUE(viewport(r.out[5], x, y, w, h)) << r.out[5];
+    EXPECT_EQ(x, 0);
+    EXPECT_EQ(w, winW) << "Viewport only: " << r.out[5];
+    ASSERT_TRUE(viewport(r.out[6], x, y, w, h)) << r.out[6];
+    EXPECT_GE(w, 400) << "800 px wide window: " << r.out[6];
+    int w7;
+    ASSERT_TRUE(viewport(r.out[7], x, y, w7, h)) << r.out[7];
+    EXPECT_GE(w7, 1366 / 2) << "grown back, the panels follow: " << r.out[7];
+    EXPECT_LE(w7, 1366 * 3 / 4) << "grown back, the panels take their share again: " << r.out[7];
+}
+
 // Escape closes menus and dialogs: the File menu, a submenu level at a time, the
 // screenshot dialog (as Cancel: nothing is taken), the unsaved-changes question (as Cancel:
 // the edits stay).

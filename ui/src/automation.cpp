@@ -12,7 +12,8 @@
 // Input, through the paths the user's input takes
 //   key [MOD+]...KEY      press for one frame: MOD ctrl|shift|alt|super, KEY a letter, a digit,
 //                         F1..F12, Home, End, Delete, Escape, Enter, Space, Tab, Backspace,
-//                         Insert, Left, Right, Up, Down, PageUp, PageDown or a GLFW key code
+//                         Insert, Left, Right, Up, Down, PageUp, PageDown, Kp1, Kp3, Kp5, Kp7,
+//                         KpDecimal or a GLFW key code
 //                         (key ctrl+z, key ctrl+shift+z, key Delete, key 2)
 //   click X Y | click viewport X Y | click ITEM   left click at window pixel (X, Y) (ImGui
 //                         coordinates, the menu bar at the top), at pixel (X, Y) of the 3D
@@ -42,6 +43,7 @@
 //   diagnostic NAME       View > Diagnostic view: shaded, depth, normal, id, uv, triangles, overdraw, cost
 //   overlay LIST|none     View > Overlays: grid, axes, lights, cameras, bounds, selection
 //   orbit DX DY | zoom STEPS | fit
+//   panels hide|show      View > Viewport only
 //   tab Inspector|Camera|Rendering|Compare
 //   gl-worker on|off      run the GL backend on a worker thread (own headless context)
 //   anim play|pause|time T   animation of the loaded file: play, pause, or pose at T seconds
@@ -63,6 +65,9 @@
 //   print pixel           viewer: pixel BACKEND X Y rgb R G B node PATH triangle N depth D predicted R G B
 //                         (one line per shown backend: the pixel inspector's probe)
 //   print status          viewer: status TEXT (the status bar's line)
+//   print viewport        viewer: viewport X Y W H (the 3D viewport in window pixels)
+//   print camera          viewer: camera eye X Y Z centre X Y Z up X Y Z projection NAME (centre:
+//                         the orbit pivot)
 //   print undo            viewer: undo LABEL | redo LABEL (what Edit > Undo / Redo would do, "-")
 //   print window          viewer: window X Y W H in work area X Y W H (screen coordinates)
 //   print popup           viewer: popup yes|no (a menu, combo or dialog is open)
@@ -79,6 +84,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -136,7 +142,12 @@ int keyCode(const std::string& name) {
                                                              {"up", GLFW_KEY_UP},
                                                              {"down", GLFW_KEY_DOWN},
                                                              {"pageup", GLFW_KEY_PAGE_UP},
-                                                             {"pagedown", GLFW_KEY_PAGE_DOWN}};
+                                                             {"pagedown", GLFW_KEY_PAGE_DOWN},
+                                                             {"kp1", GLFW_KEY_KP_1},
+                                                             {"kp3", GLFW_KEY_KP_3},
+                                                             {"kp5", GLFW_KEY_KP_5},
+                                                             {"kp7", GLFW_KEY_KP_7},
+                                                             {"kpdecimal", GLFW_KEY_KP_DECIMAL}};
     for (const auto& [n, code] : kNamed)
         if (k == n) return code;
     if (!k.empty() && std::all_of(k.begin(), k.end(), [](unsigned char c) { return std::isdigit(c); })) {
@@ -379,13 +390,22 @@ Automation::Next Automation::printCommand(const std::string& what, AutomationHos
             auto it = st.view.legends.find(b);
             std::printf("viewer: legend %s %s\n", b.c_str(), it == st.view.legends.end() || it->second.empty() ? "-" : it->second.c_str());
         }
+    } else if (what == "viewport") {
+        const ItemRect& r = st.hooks.viewportRect;
+        std::printf("viewer: viewport %d %d %d %d\n", int(std::lround(r.x0)), int(std::lround(r.y0)), int(std::lround(r.x1 - r.x0)),
+                    int(std::lround(r.y1 - r.y0)));
+    } else if (what == "camera") {
+        const sg::vec3 e = st.view.camera.eye(), c = st.view.camera.pivot, u = st.view.camera.up();
+        std::printf("viewer: camera eye %.4g %.4g %.4g centre %.4g %.4g %.4g up %.4g %.4g %.4g projection %s\n", e.x, e.y, e.z, c.x, c.y, c.z, u.x,
+                    u.y, u.z, std::string(sg::nameOf(st.projection().type)).c_str());
     } else if (what == "status") {
         std::printf("viewer: status %s\n", st.ui.status.c_str());
     } else if (what == "undo") {
         const UndoStack& h = st.doc.history;
         std::printf("viewer: undo %s | redo %s\n", h.canUndo() ? h.undoLabel().c_str() : "-", h.canRedo() ? h.redoLabel().c_str() : "-");
     } else {
-        return fail("print " + what + ": expected dirty, tree, compare, diff, selection, pixel, view, legend, memory, status, undo, window or popup");
+        return fail("print " + what +
+                    ": expected dirty, tree, compare, diff, selection, pixel, view, legend, memory, status, undo, viewport, camera, window or popup");
     }
     return Next::Continue;
 }
@@ -467,6 +487,11 @@ Automation::Next Automation::viewCommand(const std::string& cmd, std::istringstr
         st.fitView(false);
     } else if (cmd == "gl-worker") {
         st.view.glOnWorker = arg == "on";
+    } else if (cmd == "panels") {
+        if (arg != "hide" && arg != "show") return fail("panels " + arg + ": expected hide or show");
+        st.view.panelsHidden = arg == "hide";
+        m_waitFrames = 2;
+        return Next::Yield;
     } else if (cmd == "tab") {
         st.hooks.requestedTab = arg;
     } else if (cmd == "anim") {

@@ -45,7 +45,9 @@ namespace fs = std::filesystem;
 
 static_assert(ui::keys::F == GLFW_KEY_F && ui::keys::Num1 == GLFW_KEY_1 && ui::keys::Home == GLFW_KEY_HOME && ui::keys::F12 == GLFW_KEY_F12 &&
                   ui::keys::Delete == GLFW_KEY_DELETE && ui::keys::W == GLFW_KEY_W && ui::keys::F2 == GLFW_KEY_F2 && ui::keys::Q == GLFW_KEY_Q &&
-                  ui::keys::Space == GLFW_KEY_SPACE && ui::keys::Y == GLFW_KEY_Y && ui::keys::Z == GLFW_KEY_Z,
+                  ui::keys::Space == GLFW_KEY_SPACE && ui::keys::Y == GLFW_KEY_Y && ui::keys::Z == GLFW_KEY_Z && ui::keys::Kp1 == GLFW_KEY_KP_1 &&
+                  ui::keys::Kp3 == GLFW_KEY_KP_3 && ui::keys::Kp5 == GLFW_KEY_KP_5 && ui::keys::Kp7 == GLFW_KEY_KP_7 &&
+                  ui::keys::KpDecimal == GLFW_KEY_KP_DECIMAL && ui::keys::Escape == GLFW_KEY_ESCAPE,
               "panel key codes must match GLFW's");
 
 namespace ui {

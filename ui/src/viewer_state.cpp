@@ -528,7 +528,7 @@ void ViewerState::fitView(bool selectionOnly) {
     }
     if (b.empty()) b = doc.scene.worldBounds();
     float aspect = float(std::max(view.viewportWidth, 1)) / float(std::max(view.viewportHeight, 1));
-    view.camera.fit(b, projection().fovyDeg, aspect, projection().orthoHalfHeight);
+    view.camera.fit(b, projection().effectiveFovyDeg(aspect), aspect, projection().orthoHalfHeight);
     markViewChanged();
 }
 
@@ -555,17 +555,72 @@ std::string ViewerState::setViewFromCameraModel(const sg::CameraModel& m, const 
     const sg::mat4 flip = glm::scale(sg::mat4(1.0f), sg::vec3(1.0f, -1.0f, -1.0f));
     const sg::mat4 cameraWorld = m.cameraToWorld * flip;   // computer-vision axes -> the camera's own (looks down -z)
     if (!sg::isFinite(cameraWorld)) return "the pose is not finite";
-    view.camera.setFromWorld(cameraWorld, view.camera.distance);
+    view.camera.setFromWorld(cameraWorld, pivotDistance(cameraWorld, view.camera.distance));
     view.camera.orthoScale = 1.0f;
     setProjection(p, "");
     markViewChanged();
     return {};
 }
 
+void ViewerState::viewAlong(AxisView v) {
+    // yaw 0 puts the eye on +z of the pivot (looking toward -z: the front), pitch + above it.
+    constexpr float kPi = 3.14159265358979f, kUp = 89.0f * kPi / 180.0f;
+    float yaw = 0.0f, pitch = 0.0f;
+    switch (v) {
+    case AxisView::Front: break;
+    case AxisView::Back: yaw = kPi; break;
+    case AxisView::Right: yaw = 0.5f * kPi; break;
+    case AxisView::Left: yaw = -0.5f * kPi; break;
+    case AxisView::Top: pitch = kUp; break;
+    case AxisView::Bottom: pitch = -kUp; break;
+    case AxisView::Isometric:
+        yaw = 0.25f * kPi;
+        pitch = std::atan(1.0f / std::sqrt(2.0f));   // 35.26 degrees: the three axes equally foreshortened
+        break;
+    }
+    view.camera.yaw = yaw;
+    view.camera.pitch = pitch;
+    markViewChanged();
+}
+
+void ViewerState::togglePerspective() {
+    sg::Projection p = projection();
+    const float aspect = float(std::max(view.viewportWidth, 1)) / float(std::max(view.viewportHeight, 1));
+    const float d = view.camera.distance;
+    if (p.type == sg::ProjectionType::Perspective) {
+        // The orthographic view shows what the perspective showed at the pivot's depth.
+        p.type = sg::ProjectionType::Orthographic;
+        p.orthoHalfHeight = std::max(d * std::tan(sg::radians(p.effectiveFovyDeg(aspect)) * 0.5f), 1e-6f);
+        view.camera.orthoScale = 1.0f;
+    } else {
+        p.type = sg::ProjectionType::Perspective;
+        const float h = p.orthoHalfHeight * view.camera.orthoScale;
+        view.camera.distance = std::max(h / std::tan(sg::radians(p.effectiveFovyDeg(aspect)) * 0.5f), OrbitCamera::kMinDistance);
+        view.camera.orthoScale = 1.0f;
+    }
+    setProjection(p, "");
+    ui.status = std::string("Projection: ") + std::string(sg::nameOf(p.type));
+    markViewChanged();
+}
+
+float ViewerState::pivotDistance(const sg::mat4& cameraWorld, float stored) const {
+    const sg::Aabb b = doc.scene.worldBounds();
+    if (b.empty()) return stored;
+    const sg::vec3 eye(cameraWorld[3]), fwd = glm::normalize(-sg::vec3(cameraWorld[2]));
+    const sg::vec3 grow = 0.1f * b.extent() + sg::vec3(1e-6f);
+    const sg::vec3 at = eye + fwd * stored;
+    const bool inside = glm::all(glm::greaterThanEqual(at, b.min - grow)) && glm::all(glm::lessThanEqual(at, b.max + grow));
+    if (std::isfinite(stored) && stored > 0.0f && inside) return stored;
+    // The bounds' centre on the view ray: the model stays in view while orbiting.
+    const float t = glm::dot(b.center() - eye, fwd);
+    return t > OrbitCamera::kMinDistance && std::isfinite(t) ? t : stored;
+}
+
 void ViewerState::resetView() {
     const sg::Camera* c = activeCam(doc.scene);
     if (c) {
-        view.camera.setFromWorld(doc.scene.world(doc.scene.activeCamera), c->focusDistance);
+        const sg::mat4 world = doc.scene.world(doc.scene.activeCamera);
+        view.camera.setFromWorld(world, pivotDistance(world, c->focusDistance));
     } else {
         if (doc.scene.cameras().empty()) {
             view.camera = OrbitCamera{};
@@ -594,7 +649,8 @@ void ViewerState::useSceneCamera(sg::NodeId id) {
         doc.scene.activeCamera = id;
         commit(std::move(step));
     }
-    view.camera.setFromWorld(doc.scene.world(id), std::get<sg::Camera>(doc.scene.node(id).payload).focusDistance);
+    const sg::mat4 world = doc.scene.world(id);
+    view.camera.setFromWorld(world, pivotDistance(world, std::get<sg::Camera>(doc.scene.node(id).payload).focusDistance));
     markViewChanged();
 }
 

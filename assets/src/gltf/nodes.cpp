@@ -2,6 +2,7 @@
 // glTF node with its local transform, the MeshInstances of its mesh's primitives (with skin and
 // morph weights), its camera and its KHR_lights_punctual light.
 #include "gltf_internal.h"
+#include "scenegraph/params.h"
 
 #include <cmath>
 
@@ -61,8 +62,12 @@ sg::Camera Converter::camera(int ci) const {
     sg::Camera cam;
     if (c.type == "perspective") {
         cam.projection.type = sg::ProjectionType::Perspective;
-        cam.projection.fovyDeg = std::clamp(sg::degrees(float(c.perspective.yfov)), 0.01f, 179.0f);
-        cam.projection.zNear = float(c.perspective.znear);
+        const sg::Param<sg::Projection>& fovy = *sg::findParam<sg::Projection>("fovy");
+        cam.projection.fovyDeg = std::clamp(sg::degrees(float(c.perspective.yfov)), float(fovy.min), float(fovy.max));
+        // The author's framing: a narrower viewport widens the vertical field to keep it whole.
+        if (c.perspective.aspectRatio > 0 && std::isfinite(c.perspective.aspectRatio))
+            cam.projection.aspectRatio = std::clamp(float(c.perspective.aspectRatio), 0.01f, 100.0f);
+        cam.projection.zNear = std::max(float(c.perspective.znear), float(sg::findParam<sg::Projection>("near")->min));
         cam.projection.zFar = c.perspective.zfar > 0 ? float(c.perspective.zfar) : std::max(1000.0f * cam.projection.zNear, 100.0f);
     } else {
         cam.projection.type = sg::ProjectionType::Orthographic;

@@ -12,6 +12,10 @@ enum class ProjectionType { Perspective, Orthographic, Oblique };
 struct Projection {
     ProjectionType type = ProjectionType::Perspective;
     float fovyDeg = 45.0f;   // perspective: total vertical angle of view
+    // Perspective: the width / height the author framed for (glTF's aspectRatio; 0 = none). A
+    // viewport narrower than that widens the vertical angle so the author's horizontal field
+    // stays whole (nothing framed is cut); a wider one keeps fovyDeg and shows more at the sides.
+    float aspectRatio = 0.0f;
     float zNear = 0.1f;
     float zFar = 100.0f;
     // Perspective: when true, the general frustum (l, r, b, t at zNear) is used instead of
@@ -29,6 +33,9 @@ struct Projection {
     // Projection matrix for a viewport of the given aspect (width / height). focusDistance is
     // the distance of the oblique projection's fixed plane in front of the camera.
     mat4 matrix(float aspect, float focusDistance) const;
+    // The vertical angle a perspective renders with at that viewport aspect (fovyDeg, widened
+    // by aspectRatio as above).
+    float effectiveFovyDeg(float aspect) const;
 
     static Projection cavalier() {
         Projection p;

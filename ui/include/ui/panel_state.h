@@ -38,8 +38,9 @@ struct ScreenshotDialogState {
 struct PanelState {
     FileBrowserState browser;
     ScreenshotDialogState shotDialog;
-    bool showOverlay = true;   // View > Stats overlay
-    bool showHelp = false;     // Help > Controls
+    bool showOverlay = true;                            // View > Stats overlay
+    bool showHelp = false;                              // Help > Controls
+    bool resizingLeft = false, resizingRight = false;   // the user is dragging a panel's edge
     // Scene tree: the node being renamed in place (F2, double click, context menu) and its text.
     sg::NodeId renaming = sg::kNoNode;
     std::string renameBuffer;

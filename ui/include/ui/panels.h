@@ -22,7 +22,10 @@ namespace ui {
 namespace keys {
 constexpr int Space = 32, Num1 = 49, Num2 = 50, Num3 = 51;
 constexpr int A = 65, D = 68, E = 69, F = 70, N = 78, O = 79, Q = 81, S = 83, W = 87, Y = 89, Z = 90;
-constexpr int Delete = 261, Home = 268, F2 = 291, F12 = 301;
+constexpr int Delete = 261, Home = 268, F2 = 291, F12 = 301, Escape = 256;
+// The numeric keypad (Blender's view keys): 1 front, 3 right, 7 top (Ctrl: the opposite side),
+// 5 perspective / orthographic, . (decimal) frame the selection.
+constexpr int Kp1 = 321, Kp3 = 323, Kp5 = 325, Kp7 = 327, KpDecimal = 330;
 }   // namespace keys
 
 // One backend's picture for the viewport.

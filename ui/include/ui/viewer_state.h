@@ -160,7 +160,15 @@ struct View {
     // Run the GL backend on a worker thread with its own headless context (never blocks the
     // UI with software GL); off = on the UI thread with the window's context.
     bool glOnWorker = false;
+    bool panelsHidden = false;   // View > Viewport only (Ctrl+Space): the panels hidden
+    // Widths of the Scene and Properties panels as fractions of the window's width (they follow
+    // the window; dragging a panel's edge sets its fraction). Clamped to sensible pixel limits.
+    float leftFraction = 0.19f, rightFraction = 0.27f;
 };
+
+// The axis views of View > Front ... Isometric and the keypad (Blender's 1/3/7, Ctrl for the
+// opposite side): the orbit camera turned to look along an axis at the same pivot and distance.
+enum class AxisView { Front, Back, Right, Left, Top, Bottom, Isometric };
 
 // A scene load running off the UI thread: startLoad starts it, pollLoad finishes it (the
 // document changes only then, and only when it succeeded).
@@ -212,6 +220,7 @@ struct UserConfig {
 // widgets by position) and the tab an automation script wants shown.
 struct TestHooks {
     std::map<std::string, ItemRect> itemRects;
+    ItemRect viewportRect;      // the 3D viewport's window, in window pixels (automation's `print viewport`)
     std::string requestedTab;   // select this right-panel tab next frame
 };
 
@@ -293,8 +302,14 @@ struct ViewerState {
     // The active scene camera's projection (an edit), or the viewer's fallback (a view change).
     void setProjection(const sg::Projection& p, std::string_view mergeKey = {});
     float focusDistance() const;
-    void fitView(bool selectionOnly);             // F
+    void fitView(bool selectionOnly);   // F
+    // The orbit pivot's distance ahead of a camera at cameraWorld, so orbiting keeps the model in
+    // view: `stored` (the camera's focus distance) when that point is within the scene's bounds
+    // (grown by 10%), else the bounds' centre projected onto the view ray (when ahead).
+    float pivotDistance(const sg::mat4& cameraWorld, float stored) const;
     void resetView();                             // Home: back to the active scene camera
+    void viewAlong(AxisView v);                   // keypad 1/3/7 (Ctrl: opposite), View > Front ...
+    void togglePerspective();                     // keypad 5: perspective <-> orthographic, same framing at the pivot
     void useSceneCamera(sg::NodeId cameraNode);   // make active and look through it
     void storeViewInCamera();                     // writes the orbit view into the active camera
     // Camera > Paste camera: the view (pose and projection) from a computer-vision camera model

@@ -247,6 +247,10 @@ void drawControlsHelp(ViewerState& st) {
         {"Right drag + WASD", "fly (Q/E down/up, Shift faster)"},
         {"F", "fit scene / selection"},
         {"Home", "reset to the scene camera"},
+        {"Keypad 1 / 3 / 7", "front / right / top view (Ctrl: back / left / bottom)"},
+        {"Keypad 5", "perspective / orthographic"},
+        {"Keypad .", "frame the selection"},
+        {"Ctrl+Space", "viewport only (hide the panels)"},
         {"1 / 2 / 3", "backend gl / raster / raycast"},
         {"F12", "screenshot (as set in File > Screenshot at resolution...)"},
         {"Space", "play / pause the animation (viewport)"},
@@ -255,7 +259,7 @@ void drawControlsHelp(ViewerState& st) {
         {"Ctrl+Z", "undo (Edit menu names the step)"},
         {"Ctrl+Shift+Z, Ctrl+Y", "redo"},
         {"Ctrl+N/O/S/Q", "new / open / save / quit"},
-        {"Escape", "close a menu, list or dialog"},
+        {"Escape", "close a menu, list, dialog or this window"},
     };
     // Sized to its table, so no row is ever cut off (a fixed width clipped the longer actions).
     if (ImGui::Begin("Controls", &st.ui.panels.showHelp, ImGuiWindowFlags_AlwaysAutoResize)) {

@@ -35,8 +35,18 @@ void handleShortcuts(ViewerState& st) {
                 st.undo();
         }
         if (ImGui::IsKeyPressed(keys::Y, false)) st.redo();
+        if (ImGui::IsKeyPressed(keys::Kp1, false)) st.viewAlong(AxisView::Back);
+        if (ImGui::IsKeyPressed(keys::Kp3, false)) st.viewAlong(AxisView::Left);
+        if (ImGui::IsKeyPressed(keys::Kp7, false)) st.viewAlong(AxisView::Bottom);
+        if (ImGui::IsKeyPressed(keys::Space, false)) st.view.panelsHidden = !st.view.panelsHidden;
         return;
     }
+    if (ImGui::IsKeyPressed(keys::Kp1, false)) st.viewAlong(AxisView::Front);
+    if (ImGui::IsKeyPressed(keys::Kp3, false)) st.viewAlong(AxisView::Right);
+    if (ImGui::IsKeyPressed(keys::Kp7, false)) st.viewAlong(AxisView::Top);
+    if (ImGui::IsKeyPressed(keys::Kp5, false)) st.togglePerspective();
+    if (ImGui::IsKeyPressed(keys::KpDecimal, false)) st.fitView(!st.selection().empty());
+    if (ImGui::IsKeyPressed(keys::Escape, false) && st.ui.panels.showHelp) st.ui.panels.showHelp = false;   // Help > Controls
     for (int i = 0; i < 3; ++i)
         if (ImGui::IsKeyPressed(keys::Num1 + i, false)) {
             st.setBackendIndex(i);
@@ -56,14 +66,45 @@ namespace {
 
 constexpr ImGuiWindowFlags kPanelFlags = ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoBringToFrontOnFocus;
 
-// Left: the scene tree (width resizable and persisted in imgui.ini). Returns its width.
+// The two panels' widths for this window: each its fraction of the width, within pixel limits
+// that scale with the UI; when the window is too narrow for both at their minimum beside a
+// viewport of half the width, both shrink in proportion (the viewport keeps at least half).
+struct PanelWidths {
+    float left, right;
+};
+PanelWidths panelWidths(const View& v, float windowW) {
+    float left = std::clamp(v.leftFraction * windowW, px(150), px(360));
+    float right = std::clamp(v.rightFraction * windowW, px(240), px(520));
+    const float room = 0.5f * windowW;   // what the panels may take together
+    if (left + right > room) {
+        const float k = room / (left + right);
+        left *= k;
+        right *= k;
+    }
+    return {left, right};
+}
+
+// A panel's width this frame (call inside its Begin); while the user drags its edge, the width
+// they drag to sets its fraction of the window.
+float placePanel(float& fraction, bool& resizing, float windowW) {
+    const float w = ImGui::GetWindowWidth();
+    resizing = ImGui::GetCurrentWindow()->ResizeBorderHeld != -1;
+    if (resizing) fraction = std::clamp(w / std::max(windowW, 1.0f), 0.05f, 0.45f);
+    return w;
+}
+
+// Left: the scene tree. Returns its width.
 float drawScenePanel(ViewerState& st, float top, float bodyH) {
     ImGuiIO& io = ImGui::GetIO();
+    const float width = panelWidths(st.view, io.DisplaySize.x).left;
     ImGui::SetNextWindowPos(ImVec2(0, top), ImGuiCond_Always);
-    ImGui::SetNextWindowSize(ImVec2(px(260), bodyH), ImGuiCond_FirstUseEver);
-    ImGui::SetNextWindowSizeConstraints(ImVec2(px(160), bodyH), ImVec2(std::max(px(160), io.DisplaySize.x * 0.45f), bodyH));
-    if (ImGui::Begin("Scene", nullptr, kPanelFlags)) drawSceneTree(st);
-    float w = ImGui::GetWindowWidth();
+    if (!st.ui.panels.resizingLeft) ImGui::SetNextWindowSize(ImVec2(width, bodyH), ImGuiCond_Always);
+    ImGui::SetNextWindowSizeConstraints(ImVec2(px(80), bodyH), ImVec2(io.DisplaySize.x * 0.45f, bodyH));
+    float w = width;
+    if (ImGui::Begin("Scene", nullptr, kPanelFlags | ImGuiWindowFlags_NoSavedSettings)) {
+        w = placePanel(st.view.leftFraction, st.ui.panels.resizingLeft, io.DisplaySize.x);
+        drawSceneTree(st);
+    }
     ImGui::End();
     return w;
 }
@@ -82,10 +123,13 @@ void drawTab(ViewerState& st, const char* name, void (*draw)(ViewerState&)) {
 // Right: the animation bar (scenes with clips) above the tabs. Returns its width.
 float drawPropertiesPanel(ViewerState& st, float top, float bodyH) {
     ImGuiIO& io = ImGui::GetIO();
+    const float width = panelWidths(st.view, io.DisplaySize.x).right;
     ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x, top), ImGuiCond_Always, ImVec2(1.0f, 0.0f));
-    ImGui::SetNextWindowSize(ImVec2(px(380), bodyH), ImGuiCond_FirstUseEver);
-    ImGui::SetNextWindowSizeConstraints(ImVec2(px(220), bodyH), ImVec2(std::max(px(220), io.DisplaySize.x * 0.45f), bodyH));
-    if (ImGui::Begin("Properties", nullptr, kPanelFlags)) {
+    if (!st.ui.panels.resizingRight) ImGui::SetNextWindowSize(ImVec2(width, bodyH), ImGuiCond_Always);
+    ImGui::SetNextWindowSizeConstraints(ImVec2(px(120), bodyH), ImVec2(io.DisplaySize.x * 0.45f, bodyH));
+    float w = width;
+    if (ImGui::Begin("Properties", nullptr, kPanelFlags | ImGuiWindowFlags_NoSavedSettings)) {
+        w = placePanel(st.view.rightFraction, st.ui.panels.resizingRight, io.DisplaySize.x);
         ImGui::PushItemWidth(-px(150));   // room for the labels on the right
         drawAnimationPanel(st);           // only when the scene has clips
         if (ImGui::BeginTabBar("tabs")) {
@@ -99,7 +143,6 @@ float drawPropertiesPanel(ViewerState& st, float top, float bodyH) {
         st.hooks.requestedTab.clear();
         ImGui::PopItemWidth();
     }
-    float w = ImGui::GetWindowWidth();
     ImGui::End();
     return w;
 }
@@ -207,9 +250,12 @@ void drawUi(ViewerState& st, const ViewportInput& view, double time, float dt) {
     float menuH = ImGui::GetFrameHeight();
     float statusH = ImGui::GetFrameHeight() + px(4);
     float bodyH = std::max(io.DisplaySize.y - menuH - statusH, 50.0f);
-    float leftW = drawScenePanel(st, menuH, bodyH);
-    float rightW = drawPropertiesPanel(st, menuH, bodyH);
-    drawViewportWindow(st, view, time, dt, ImVec2(leftW, menuH), ImVec2(std::max(io.DisplaySize.x - leftW - rightW, 1.0f), bodyH));
+    // View > Viewport only (Ctrl+Space) hides both panels.
+    float leftW = st.view.panelsHidden ? 0.0f : drawScenePanel(st, menuH, bodyH);
+    float rightW = st.view.panelsHidden ? 0.0f : drawPropertiesPanel(st, menuH, bodyH);
+    const ImVec2 vpPos(leftW, menuH), vpSize(std::max(io.DisplaySize.x - leftW - rightW, 1.0f), bodyH);
+    st.hooks.viewportRect = ItemRect{vpPos.x, vpPos.y, vpPos.x + vpSize.x, vpPos.y + vpSize.y};
+    drawViewportWindow(st, view, time, dt, vpPos, vpSize);
     drawStatusBar(st, view, statusH);
     drawDialogs(st);
     handleShortcuts(st);

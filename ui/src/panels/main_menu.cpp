@@ -69,6 +69,24 @@ void drawMainMenu(ViewerState& st) {
     if (viewOpen) {
         if (ImGui::MenuItem("Fit to scene / selection", "F")) st.fitView(!st.selection().empty());
         if (ImGui::MenuItem("Reset to scene camera", "Home")) st.resetView();
+        if (ImGui::BeginMenu("Axis view")) {
+            // Blender's keypad: 1 front, 3 right, 7 top; Ctrl for the opposite side.
+            static constexpr std::pair<AxisView, std::pair<const char*, const char*>> kViews[] = {
+                {AxisView::Front, {"Front", "Keypad 1"}},     {AxisView::Back, {"Back", "Ctrl+Keypad 1"}},
+                {AxisView::Right, {"Right", "Keypad 3"}},     {AxisView::Left, {"Left", "Ctrl+Keypad 3"}},
+                {AxisView::Top, {"Top", "Keypad 7"}},         {AxisView::Bottom, {"Bottom", "Ctrl+Keypad 7"}},
+                {AxisView::Isometric, {"Isometric", nullptr}}};
+            for (const auto& [v, text] : kViews) {
+                if (ImGui::MenuItem(text.first, text.second)) st.viewAlong(v);
+                record(st, std::string("view/axis/") + text.first);
+            }
+            ImGui::EndMenu();
+        }
+        record(st, "view/axis");
+        if (ImGui::MenuItem("Perspective / orthographic", "Keypad 5", st.projection().type == sg::ProjectionType::Perspective))
+            st.togglePerspective();
+        if (ImGui::MenuItem("Viewport only", "Ctrl+Space", st.view.panelsHidden)) st.view.panelsHidden = !st.view.panelsHidden;
+        record(st, "view/panels");
         ImGui::Separator();
         // The same modes as the Compare tab, --view and the automation's `view` (showView).
         std::string mode = st.viewName();

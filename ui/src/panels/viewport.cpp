@@ -95,7 +95,9 @@ void cameraInput(ViewerState& st, ImVec2 a, ImVec2 b, double time, float dt) {
             st.view.camera.look(io.MouseDelta.x, io.MouseDelta.y);
             moved = true;
         } else if (panning) {
-            st.view.camera.pan(io.MouseDelta.x, io.MouseDelta.y, st.view.camera.panScale(proj.fovyDeg, b.y - a.y, ortho, proj.orthoHalfHeight));
+            st.view.camera.pan(
+                io.MouseDelta.x, io.MouseDelta.y,
+                st.view.camera.panScale(proj.effectiveFovyDeg((b.x - a.x) / std::max(b.y - a.y, 1.0f)), b.y - a.y, ortho, proj.orthoHalfHeight));
             moved = true;
         } else if (io.MouseDown[0]) {
             st.view.camera.orbit(io.MouseDelta.x, io.MouseDelta.y);
@@ -336,8 +338,10 @@ void drawViewport(ViewerState& st, const ViewportInput& view, double time, float
     record(st, "viewport");
     cameraInput(st, a, b, time, dt);
     pickAndProbe(st, view, a, avail);
-    // Space: play / pause the animation while the viewport has focus (not while typing).
-    if (!st.anim.clips.empty() && ImGui::IsWindowFocused() && !ImGui::GetIO().WantTextInput && ImGui::IsKeyPressed(keys::Space, false))
+    // Space: play / pause the animation while the pointer is over the viewport or it has focus
+    // (not while typing, not with Ctrl: Ctrl+Space is Viewport only).
+    if (!st.anim.clips.empty() && (ImGui::IsWindowHovered() || ImGui::IsWindowFocused()) && !ImGui::GetIO().WantTextInput &&
+        !ImGui::GetIO().KeyCtrl && ImGui::IsKeyPressed(keys::Space, false))
         st.toggleAnimation();
 
     ImDrawList* dl = ImGui::GetWindowDrawList();
