@@ -1,3 +1,8 @@
+// files.cpp - safe file access (see files.h): writeFileAtomic (temporary file beside the
+// target, fsync, then link() where it must not overwrite or rename() where it may, then fsync
+// of the folder), readFileLimited (regular files only, opened non-blocking so a FIFO cannot
+// hang it, within a byte budget), readFully, and uniquePath (name-1.ext, name-2.ext, ... so
+// that a new file never replaces another).
 #include "assets/files.h"
 
 #include <fcntl.h>

@@ -1,3 +1,7 @@
+// scene_io.cpp - the one entry point for opening a scene file (see scene_io.h):
+// checkSceneFile() (exists, not a folder, a supported extension), then loadScene() hands the
+// file by extension to the JSON reader, the glTF importer or the mesh importers and applies the
+// scene defaults to whatever loaded, so every format opens alike.
 #include "assets/scene_io.h"
 
 #include "importers.h"

@@ -1,3 +1,8 @@
+// framebuffer.cpp - Framebuffer storage (see framebuffer.h: sizing, growing a large image's
+// colour and depth side by side, the visibility and counter buffers, clear) and the image tools
+// built on it: compareImages() (mean and max difference, fraction within a tolerance, PSNR) for
+// the tests and the difference view, diffImage() (a heat map of the differences over a dim
+// copy), and downsample() (the SSAA resolve: a box filter in linear light).
 #include "renderers/framebuffer.h"
 
 #include "renderers/shading.h"

@@ -1,3 +1,8 @@
+// shading.cpp - the Phong evaluation of shading.h shared by the CPU rasterizer and the ray
+// caster: light samples (direction, 1/r^2, spot smoothstep), material coefficients and the
+// texture maps applied to them (normal, emissive, occlusion, metallic-roughness), the light
+// terms (Phong or Blinn-Phong), fog, and sRGB encode/decode, with an exact table-driven
+// linear-to-byte conversion so that no pixel pays for pow().
 #include "renderers/shading.h"
 
 #include "renderers/texture_sampler.h"

@@ -1,3 +1,7 @@
+// texture_sampler.cpp - SampledTexture (see texture_sampler.h): the mip chain built as
+// glGenerateMipmap builds it, GL's wrap modes, nearest / bilinear / trilinear lookups of colour
+// and alpha with the level chosen from the uv derivatives as GL chooses it, and SamplerCache,
+// which keeps one SampledTexture per texture version and drops those unused for 8 frames.
 #include "renderers/texture_sampler.h"
 
 #include "renderers/shading.h"

@@ -1,3 +1,9 @@
+// frame.cpp - flatten(): the scene graph turned into the FrameInput every renderer draws (see
+// frame.h), in one pass over the pre-order that skips hidden subtrees: posed meshes with their
+// world and normal matrices, lights in world space, analytic shapes (implicit, parametric,
+// density grid, and the CSG tree built below each CSG node, with a geometry key for the
+// backends' caches) and the camera (the one asked for, else the active one, else the first,
+// else a view framing the geometry). Also makeFrameCamera(), the camera matrices of one frame.
 #include "scenegraph/frame.h"
 
 #include "scenegraph/transforms.h"

@@ -1,3 +1,6 @@
+// math.cpp - the out-of-line helpers of math.h: Aabb::transformed() (the box around the eight
+// transformed corners), isFinite() for vectors and matrices, normalMatrix() (inverse transpose
+// of the upper 3x3, identity when degenerate) and isInvertible().
 #include "scenegraph/math.h"
 
 namespace sg {

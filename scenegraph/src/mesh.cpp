@@ -1,3 +1,8 @@
+// mesh.cpp - Mesh's own operations (see mesh.h): bounds, area-weighted vertex normals,
+// per-vertex tangents from a uv set (for normal maps), validate() and validateDeformation()
+// (attribute counts, index ranges, finite positions, skin weights, morph targets),
+// newResourceId() for the backends' cache keys, and the primitives (box, plane, uv sphere,
+// cylinder, cone, torus).
 #include "scenegraph/mesh.h"
 
 #include <atomic>

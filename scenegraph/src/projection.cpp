@@ -1,3 +1,6 @@
+// projection.cpp - Projection::matrix(): the projection matrix of a camera's parameters
+// (perspective from fovy or an explicit frustum, orthographic, oblique sheared about the focus
+// distance), built from the transforms of transforms.h.
 #include "scenegraph/projection.h"
 
 #include "scenegraph/transforms.h"

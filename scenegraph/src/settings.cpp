@@ -1,3 +1,7 @@
+// settings.cpp - RenderSettings::validate() (the parameter table's ranges plus the rules that
+// span fields: linear fog needs end > start, MSAA 2/4/8, SSAA 2 to 4), the anti-aliasing choice
+// by name (aaName / setAA; the names are in setting_names.cpp) and fogVisibility(), the fog
+// factor f(d) of docs/math.md.
 #include "scenegraph/settings.h"
 #include "scenegraph/params.h"
 #include "scenegraph/setting_names.h"

@@ -1,3 +1,8 @@
+// shapes.cpp - evaluation of the analytic shapes of shapes.h: bounds, implicit value (negative
+// inside) and normal of plane, sphere, box, cylinder, cone, torus and bounded quadric; point
+// and partial derivatives of the parametric torus and bicubic Bezier patch (and the default
+// patch); trilinear sampling and gradient of density grids (and the metaballs grid); the enums'
+// names.
 #include "scenegraph/shapes.h"
 #include "scenegraph/setting_names.h"
 

@@ -1,3 +1,6 @@
+// transforms.cpp - the 4x4 matrices of docs/math.md written entry by entry (row, column as
+// printed there): translation, rotations, scaling, mirrors, shear, lookAt, perspective,
+// frustum, orthographic, oblique (orthographic times a shear) and the viewport transform.
 #include "scenegraph/transforms.h"
 
 namespace sg {

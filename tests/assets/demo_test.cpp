@@ -1,4 +1,6 @@
-// The bundled demo scene has what the product promises at first launch.
+// demo_test.cpp - the bundled demo scene (assets/demo.h) has what the product promises at first
+// launch: every kind of content (meshes, textures, lights, cameras, implicit shapes, quadrics,
+// CSG, parametric surfaces, density grids).
 #include "assets/demo.h"
 #include "scenegraph/frame.h"
 

@@ -1,4 +1,8 @@
-// Atomic writes and unique names.
+// files_test.cpp - safe file writes and reads (assets/files.h) and PNG output: atomic writes
+// that refuse to overwrite unless asked and leave the old file or the complete new one on a
+// full disk, in a read-only folder or when the writer is killed; a clear error for a missing
+// folder; limited reads that refuse devices and large files; unique names; PNG round trips
+// and the size caps.
 #include "assets/files.h"
 #include "assets/image_io.h"
 #include "test_support.h"

@@ -1,4 +1,7 @@
-// Native JSON scene file: round trips and bad-file errors (file + JSON path, nothing loaded).
+// scene_json_test.cpp - the native JSON scene file: round trips (the demo, skins and morph
+// targets, edited settings and transforms, an empty scene and a deep chain), saves that never
+// overwrite without permission, and bad files: one clear error naming the file and the JSON
+// path, nothing loaded (a missing texture is a warning with a placeholder).
 #include "assets/demo.h"
 #include "assets/scene_io.h"
 #include "test_support.h"

@@ -1,6 +1,7 @@
-// Name tables of the settings enums (scenegraph/setting_names.h): every value's name parses back
-// to it, names are unique, the JSON writer writes the table's names (and the reader takes the
-// aliases of older files), and the viewer's --help-all and errors list every name.
+// setting_names_test.cpp - the name tables of the settings enums (scenegraph/setting_names.h):
+// every value's name parses back to it, names are unique, the JSON writer writes the table's
+// names (and the reader takes the aliases of older files), and the viewer's --help-all and
+// errors list every name.
 #include "scenegraph/setting_names.h"
 #include "assets/demo.h"
 #include "assets/scene_io.h"

@@ -1,4 +1,5 @@
-// glTF material rules in every backend, held to the specification's answers:
+// material_conformance_test.cpp - glTF material rules in every backend, held to the
+// specification's answers:
 //  - doubleSided / back-face culling: RenderSettings::culling auto culls the back faces of
 //    single-sided materials only, on culls every back face, off none; a double-sided surface
 //    seen from its back is lit with the flipped normal (as bright as its front);

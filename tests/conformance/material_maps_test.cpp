@@ -1,5 +1,6 @@
-// glTF material maps in every backend, held to the formulas of docs/math.md ("Material
-// textures"; rnd::coefficientsAt / applyMapsToTerms in renderers/common/shading.cpp):
+// material_maps_test.cpp - glTF material maps in every backend, held to the formulas of
+// docs/math.md ("Material textures"; rnd::coefficientsAt / applyMapsToTerms in
+// renderers/common/shading.cpp):
 //  - emissiveTexture: emissive_eff = emissiveFactor (x) texel (sRGB colour);
 //  - occlusionTexture: ka_eff = ka (1 + strength (R - 1)) on the ambient term only (linear data);
 //  - metallicRoughnessTexture: per texel (kd, ks, n, tint) = phongFromMetallicRoughness(

@@ -1,8 +1,9 @@
-// Texture orientation of real files, in every backend: glTF puts uv (0,0) at the image's first
-// (top-left) pixel with v going down; OBJ puts v = 0 at the image's bottom row. A quad whose
-// image is red | green on the top row and blue | white on the bottom, mapped so that the image
-// appears upright, must show red at the top left, green top right, blue bottom left and white
-// bottom right, seen from the front, in all three backends and from both formats.
+// texture_orientation_test.cpp - texture orientation of real files, in every backend: glTF puts
+// uv (0,0) at the image's first (top-left) pixel with v going down; OBJ puts v = 0 at the
+// image's bottom row. A quad whose image is red | green on the top row and blue | white on the
+// bottom, mapped so that the image appears upright, must show red at the top left, green top
+// right, blue bottom left and white bottom right, seen from the front, in all three backends
+// and from both formats.
 #include "assets/image_io.h"
 #include "assets/scene_io.h"
 #include "renderers/renderer.h"

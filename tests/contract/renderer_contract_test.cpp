@@ -1,5 +1,7 @@
-// The renderer contract: resolveRenderConfig() rules, Renderer::render() checks that are the
-// same for every backend, truthful capabilities, and the GLSL enum guard.
+// renderer_contract_test.cpp - the renderer contract: resolveRenderConfig() rules (honoured
+// settings, reported substitutions, features not drawn, sizes checked once), Renderer::render()
+// checks that are the same for every backend, truthful stats, capabilities that do not change
+// when a backend renders, the GLSL enum guard, and the shared shading terms.
 #include "gl/gl_renderer.h"
 #include "renderers/render_config.h"
 #include "renderers/renderer.h"

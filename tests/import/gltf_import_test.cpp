@@ -1,6 +1,6 @@
-// glTF import: the Khronos/assimp sample models in testdata/gltf (structure against what the
-// files contain, see testdata/MANIFEST.md) and every file of testdata/invalid-gltf (a load or
-// a clear error naming the file, each within 5 s).
+// gltf_import_test.cpp - glTF import: the Khronos/assimp sample models in testdata/gltf
+// (structure against what the files contain, see testdata/MANIFEST.md) and every file of
+// testdata/invalid-gltf (a load or a clear error naming the file, each within 5 s).
 #include "import_test_util.h"
 
 #include "assets/animation.h"

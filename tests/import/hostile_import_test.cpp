@@ -1,8 +1,8 @@
-// Hostile inputs generated at run time: absurd counts, deep JSON nesting, path traversal in
-// every spelling, symlinks and FIFOs, devices, MTL files pointing elsewhere. Each must be
-// refused quickly with a clear error (or, for textures/MTL, a warning and a fallback), and
-// nothing outside the model's folder may be opened (checked with inotify on the folder that
-// holds the bait files).
+// hostile_import_test.cpp - hostile inputs generated at run time: absurd counts, deep JSON
+// nesting, path traversal in every spelling, symlinks and FIFOs, devices, MTL files pointing
+// elsewhere. Each must be refused quickly with a clear error (or, for textures/MTL, a warning
+// and a fallback), and nothing outside the model's folder may be opened (checked with inotify
+// on the folder that holds the bait files).
 #include "import_test_util.h"
 
 #include "assets/animation.h"

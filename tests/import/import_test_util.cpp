@@ -1,3 +1,6 @@
+// import_test_util.cpp - the importer tests' helpers (see import_test_util.h): triangle counts
+// (unique and drawn), payload counts, a timed load with a hang guard, a fresh scratch folder
+// and text files written into it.
 #include "import_test_util.h"
 
 #include "test_support.h"

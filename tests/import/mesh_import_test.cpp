@@ -1,6 +1,6 @@
-// Mesh import (OBJ/MTL, OFF, PLY, STL): every mesh in testdata/meshes against the triangle
-// counts of MANIFEST.md, plus materials, textures, point clouds, lines, tristrips and the
-// malformed files of meshes/invalid.
+// mesh_import_test.cpp - mesh import (OBJ/MTL, OFF, PLY, STL): every mesh in testdata/meshes
+// against the triangle counts of MANIFEST.md, plus materials, textures, point clouds, lines,
+// tristrips and the malformed files of meshes/invalid.
 #include "import_test_util.h"
 
 #include "test_support.h"

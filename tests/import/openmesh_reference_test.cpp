@@ -1,4 +1,5 @@
-// OpenMesh as the reference implementation for our own mesh parsers.
+// openmesh_reference_test.cpp - OpenMesh as the reference implementation for our own mesh
+// parsers.
 //
 // The importers read OBJ/OFF/PLY/STL with small bounded parsers of our own, because Debian's
 // OpenMesh 9.0 cannot be used on files from strangers (it follows OBJ mtllib paths anywhere,

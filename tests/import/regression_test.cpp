@@ -1,5 +1,6 @@
-// Every input a fuzzer ever crashed or hung on stays here (tests/import/regressions) and must
-// load into valid meshes or fail with a one-line error naming the file, within seconds.
+// regression_test.cpp - every input a fuzzer ever crashed or hung on stays here
+// (tests/import/regressions) and must load into valid meshes or fail with a one-line error
+// naming the file, within seconds.
 #include "assets/image_io.h"
 #include "assets/scene_io.h"
 #include "test_support.h"

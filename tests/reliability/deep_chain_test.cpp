@@ -1,8 +1,8 @@
-// A 1M-deep chain of nodes (deep scene graphs must load, update and render without stack
-// overflow). The chain is written as a native JSON scene file and as a glTF file, loaded
-// through assets::loadScene like the viewer does, and rendered by every backend. Nothing may
-// recurse per level: a 1M-deep recursion overflows the 8 MB main-thread stack (and the much
-// smaller worker-thread stacks) many times over.
+// deep_chain_test.cpp - a 1M-deep chain of nodes (deep scene graphs must load, update and
+// render without stack overflow). The chain is written as a native JSON scene file and as a
+// glTF file, loaded through assets::loadScene like the viewer does, and rendered by every
+// backend. Nothing may recurse per level: a 1M-deep recursion overflows the 8 MB main-thread
+// stack (and the much smaller worker-thread stacks) many times over.
 //
 // The chain's links alternate translations of +1 and -1 along y (exact in float), with one
 // link halfway down moving +1 along x, so the red unlit quad at the leaf shows up exactly at

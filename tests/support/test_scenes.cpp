@@ -1,3 +1,7 @@
+// test_scenes.cpp - the shared test frames of test_scenes.h, built directly as sg::FrameInput:
+// frame, mesh, light and material helpers, the GL baseline scenes, textured floors, near-plane
+// and triangle-agreement frames, and the BackendConformance reference scenes (lit sphere, fog
+// plane, textured quad, projected box, anti-aliased edge).
 #include "test_scenes.h"
 
 #include "scenegraph/transforms.h"

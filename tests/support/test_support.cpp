@@ -1,3 +1,7 @@
+// test_support.cpp - the tests' shared helpers (see test_support.h): test data and output
+// folders, image and pixel comparisons that write actual / expected / diff PNGs on failure, the
+// GL baselines (compared, or rewritten with VIEWER_ACCEPT_BASELINES=1), checker textures,
+// base64, running a program, and which agreement tolerance two backends are held to.
 #include "test_support.h"
 
 #include "assets/image_io.h"

@@ -1,4 +1,5 @@
-// ViewerState animation playback and cancellable loading with progress.
+// animation_load_test.cpp - ViewerState animation playback and cancellable loading with
+// progress.
 //   Animation: a tiny glTF written by the test (embedded base64 buffer) with a node "mover"
 //   translated linearly from (0,0,0) at t=0 to (4,0,0) at t=2 ("slide") and the same keys
 //   with STEP interpolation ("step"); play / pause / scrub / loop move the node, re-render

@@ -1,4 +1,4 @@
-// Colours as the user sees them: the colour editors show sRGB-encoded values
+// colour_test.cpp - colours as the user sees them: the colour editors show sRGB-encoded values
 // of the linear colours the scene stores, so the background swatch matches the viewport's
 // pixels; every 8-bit value the editor can show or take round-trips, and a value set by name
 // shows as the bytes it was made from.

@@ -1,5 +1,6 @@
-// Orbit camera math: orbit keeps the distance to the pivot, pan moves the pivot in the view
-// plane, zoom scales the distance, fit frames a bounding box, setFromWorld round-trips.
+// orbit_camera_test.cpp - orbit camera math: orbit keeps the distance to the pivot, pan moves
+// the pivot in the view plane, zoom scales the distance, fit frames a bounding box,
+// setFromWorld round-trips.
 #include "ui/orbit_camera.h"
 
 #include <gtest/gtest.h>

@@ -1,6 +1,6 @@
-// The ImGui panels in headless frames (no window, no renderer backend): real clicks at the
-// positions of recorded widgets change the scene and settings; keys switch backends; drags
-// in the viewport move the camera; the unsaved-changes modal appears and works.
+// panels_test.cpp - the ImGui panels in headless frames (no window, no renderer backend): real
+// clicks at the positions of recorded widgets change the scene and settings; keys switch
+// backends; drags in the viewport move the camera; the unsaved-changes modal appears and works.
 #include "headless_ui.h"
 #include "test_support.h"
 

@@ -1,7 +1,8 @@
-// Drives the real viewer window under Xvfb (xvfb-run) with an automation script: waits for
-// the images, switches backends with keys 1/2/3, opens the split and difference views, takes
-// offscreen backend screenshots (F12 path) and a PNG of the whole window, then quits.
-// Never hangs: the viewer has its own --timeout and the command runs under `timeout`.
+// viewer_gl_test.cpp - drives the real viewer window under Xvfb (xvfb-run) with an automation
+// script: waits for the images, switches backends with keys 1/2/3, opens the split and
+// difference views, takes offscreen backend screenshots (F12 path) and a PNG of the whole
+// window, then quits. Never hangs: the viewer has its own --timeout and the command runs under
+// `timeout`.
 #include "assets/image_io.h"
 #include "test_support.h"
 #include "viewer_process.h"

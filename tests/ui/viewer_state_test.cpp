@@ -1,6 +1,7 @@
-// ViewerState actions (scene edits, reparent refusal, backend), the unsaved-changes guard,
-// asynchronous loading that keeps the scene on failure, screenshot naming, recent files, the
-// frame handed to the renderers and RenderSlot's threaded coarse-to-fine rendering.
+// viewer_state_test.cpp - ViewerState actions (scene edits, reparent refusal, backend), the
+// unsaved-changes guard, asynchronous loading that keeps the scene on failure, screenshot
+// naming, recent files, the frame handed to the renderers and RenderSlot's threaded
+// coarse-to-fine rendering.
 #include "ui/viewer_state.h"
 #include "ui/render_slot.h"
 
