@@ -5,6 +5,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 namespace sg {
 
@@ -335,7 +336,7 @@ std::optional<ParamValue> parseParamText(ParamKind kind, std::string_view text, 
     }
     case ParamKind::Float: {
         double d = 0;
-        if (!parseDouble(s, d) || !std::isfinite(float(d))) {
+        if (!parseDouble(s, d) || !(std::abs(d) <= double(std::numeric_limits<float>::max()))) {
             error = "'" + std::string(text) + "': expected a finite number";
             return std::nullopt;
         }
@@ -349,7 +350,7 @@ std::optional<ParamValue> parseParamText(ParamKind kind, std::string_view text, 
             size_t comma = body.find(',');
             std::string_view part = i < 2 ? body.substr(0, comma) : body;
             double d = 0;
-            if ((i < 2 && comma == std::string_view::npos) || !parseDouble(part, d) || !std::isfinite(float(d))) {
+            if ((i < 2 && comma == std::string_view::npos) || !parseDouble(part, d) || !(std::abs(d) <= double(std::numeric_limits<float>::max()))) {
                 error = "'" + std::string(text) + "': expected a colour r,g,b (three finite numbers, linear)";
                 return std::nullopt;
             }

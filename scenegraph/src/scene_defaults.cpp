@@ -21,8 +21,11 @@ void fitFogToScene(RenderSettings& s, float r) {
 void applySceneDefaults(Scene& scene) {
     RenderSettings& s = scene.settings;
     const RenderSettings defaults;
-    if (s.fog == FogMode::Off && s.fogStart == defaults.fogStart && s.fogEnd == defaults.fogEnd && s.fogDensity == defaults.fogDensity)
+    if (s.fog == FogMode::Off && s.fogStart == defaults.fogStart && s.fogEnd == defaults.fogEnd && s.fogDensity == defaults.fogDensity) {
         fitFogToScene(s, sceneRadius(scene));
+        // Fog that fades into the background, unless the file chose a fog colour.
+        if (s.fogColor == defaults.fogColor) s.fogColor = s.background;
+    }
 }
 
 float flySpeedFor(const Scene& scene) { return sceneRadius(scene); }

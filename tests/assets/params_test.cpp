@@ -94,6 +94,8 @@ TEST(ParamTablesTest, ValuesOutsideARowsRangeAreRefusedWithTheRange) {
     EXPECT_EQ(s.tessellation, sg::RenderSettings{}.tessellation);
     EXPECT_EQ(sg::setParamFromText(s, *tess, "12"), "");
     EXPECT_EQ(s.tessellation, 12);
+    EXPECT_NE(sg::setParamFromText(s, *sg::findParam<sg::RenderSettings>("fog.density"), "1e300"), "") << "beyond a float";
+    EXPECT_NE(sg::setParamFromText(s, *sg::findParam<sg::RenderSettings>("background"), "0.1,0.2"), "") << "two components";
     s.fogDensity = -1.0f;
     EXPECT_NE(s.validate().find("fog.density"), std::string::npos) << s.validate();
     assets::LoadResult r = assets::parseSceneJson(R"({"settings": {"fog": {"density": -2}}})", "bad.json");
@@ -138,6 +140,7 @@ TEST(SceneDefaultsTest, FogFollowsTheFilesSizeOnTheCommandLineAsInTheWindow) {
     EXPECT_FLOAT_EQ(r.scene->settings.fogStart, radius);
     EXPECT_FLOAT_EQ(r.scene->settings.fogEnd, 6.0f * radius);
     EXPECT_EQ(r.scene->settings.fog, sg::FogMode::Off) << "fitted, not turned on";
+    EXPECT_EQ(r.scene->settings.fogColor, r.scene->settings.background) << "fog fades into the background";
 
     auto render = [&](const std::string& name, const std::string& flags) {
         testing_support::ProgramRun run = testing_support::runProgram(

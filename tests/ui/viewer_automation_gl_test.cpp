@@ -596,6 +596,19 @@ TEST(ViewerAutomationGLTest, OrbitStaysOnTheModelAndTheLayoutFollowsTheWindow) {
     EXPECT_LE(w7, 1366 * 3 / 4) << "grown back, the panels take their share again: " << r.out[7];
 }
 
+// `viewer FOLDER` (or a file of an unsupported type) opens the demo instead and says why.
+TEST(ViewerAutomationGLTest, APathThatCannotBeOpenedKeepsTheDemoAndSaysWhy) {
+    if (!viewer_test::haveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+    fs::path dir = sceneFolder("automation_folder_arg");
+    fs::create_directories(dir / "models");
+    ScriptRun r = runScript(dir, "frames 2\nprint status\nprint tree\nquit\n", "models");
+    ASSERT_EQ(r.rc, 0) << dump(r);
+    ASSERT_EQ(r.out.size(), 2u) << dump(r);
+    EXPECT_EQ(r.out[0], "status Could not open models: is a folder, not a scene file; showing the demo scene") << dump(r);
+    EXPECT_TRUE(treeHas(r.out[1], "crate")) << r.out[1];
+    EXPECT_NE(r.log.find("viewer: error: models: is a folder"), std::string::npos) << dump(r);
+}
+
 // Escape closes menus and dialogs: the File menu, a submenu level at a time, the
 // screenshot dialog (as Cancel: nothing is taken), the unsaved-changes question (as Cancel:
 // the edits stay).

@@ -657,9 +657,16 @@ void setUpViewer(Viewer& v, GLFWwindow* win) {
 
 // The demo, or the file (loaded off the UI thread); then the initial backend and view.
 void openInitialScene(ViewerState& st, const ViewerOptions& opt) {
-    if (opt.scene.empty() || opt.scene == "demo") {
+    // A path that cannot be opened (a folder, a missing file, an unsupported type) opens the demo
+    // instead and says why, on the status line and on standard error.
+    const std::string refused = opt.scene.empty() || opt.scene == "demo" ? std::string() : assets::checkSceneFile(opt.scene);
+    if (opt.scene.empty() || opt.scene == "demo" || !refused.empty()) {
         st.setScene(assets::makeDemoScene(), {});
         st.ui.status = "Demo scene. Drop a file on the window or use File > Open.";
+        if (!refused.empty()) {
+            std::fprintf(stderr, "viewer: error: %s\n", refused.c_str());
+            st.ui.status = "Could not open " + refused + "; showing the demo scene";
+        }
     } else {
         st.doc.scene = sg::Scene{};
         st.startLoad(opt.scene);

@@ -5,7 +5,8 @@
 // r = half the diagonal of the scene's visible world bounds (1 when it has no geometry).
 //   fog: linear from r to 6 r; exponential halving at 3 r (density ln 2 / 3 r); set when the
 //        scene's fog is off and still at RenderSettings' defaults (so a file's own fog is kept
-//        and turning fog on later shows something in a 1 mm or a 1 km scene);
+//        and turning fog on later shows something in a 1 mm or a 1 km scene); the fog colour
+//        is then the background colour, unless the file set one;
 //   fly speed: r per second.
 // A scene without a camera gets its framing view from Scene::addDefaultCamera (clip planes
 // around the same sphere).
