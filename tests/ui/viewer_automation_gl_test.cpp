@@ -9,6 +9,7 @@
 #include "assets/image_io.h"
 #include "assets/scene_io.h"
 #include "test_support.h"
+#include "ui/viewer_state.h"
 #include "viewer_process.h"
 
 #include <gtest/gtest.h>
@@ -594,6 +595,23 @@ TEST(ViewerAutomationGLTest, OrbitStaysOnTheModelAndTheLayoutFollowsTheWindow) {
     ASSERT_TRUE(viewport(r.out[7], x, y, w7, h)) << r.out[7];
     EXPECT_GE(w7, 1366 / 2) << "grown back, the panels follow: " << r.out[7];
     EXPECT_LE(w7, 1366 * 3 / 4) << "grown back, the panels take their share again: " << r.out[7];
+}
+
+// At View > UI scale 200% (kept in the config folder) on a 1920x1080 screen the viewport still
+// gets at least half the window.
+TEST(ViewerAutomationGLTest, DoubleUiScaleLeavesTheViewportHalfTheWindow) {
+    if (!viewer_test::haveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+    fs::path dir = sceneFolder("automation_ui_scale");
+    fs::create_directories(dir / "config" / "sceneviewer");
+    ASSERT_EQ(ui::saveUiScale(dir / "config" / "sceneviewer", 2.0f), "");
+    EXPECT_FLOAT_EQ(ui::loadUiScale(dir / "config" / "sceneviewer"), 2.0f);
+    ScriptRun r = runScript(dir, "frames 3\nprint window\nprint viewport\nquit\n", "demo.json", "1920x1080x24");
+    ASSERT_EQ(r.rc, 0) << dump(r);
+    ASSERT_EQ(r.out.size(), 2u) << dump(r);
+    int wx, wy, ww = 0, wh, x, y, w = 0, h;
+    ASSERT_EQ(std::sscanf(r.out[0].c_str(), "window %d %d %d %d", &wx, &wy, &ww, &wh), 4) << r.out[0];
+    ASSERT_EQ(std::sscanf(r.out[1].c_str(), "viewport %d %d %d %d", &x, &y, &w, &h), 4) << r.out[1];
+    EXPECT_GE(w, ww / 2) << r.out[1] << " in " << r.out[0];
 }
 
 // `viewer FOLDER` (or a file of an unsupported type) opens the demo instead and says why.

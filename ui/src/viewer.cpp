@@ -152,6 +152,7 @@ public:
     std::vector<PendingShot> shots;
     std::vector<std::string> droppedFiles;
     float newContentScale = 0.0f;   // set by the content-scale callback, applied between frames
+    float contentScale = 1.0f;      // the monitor's, as last applied (times View > UI scale)
     std::string iniPath;            // imgui.ini; ImGui keeps the char pointer, so it lives here
     double now = 0;
 
@@ -650,7 +651,9 @@ void setUpViewer(Viewer& v, GLFWwindow* win) {
     io.IniFilename = ec ? nullptr : v.iniPath.c_str();
     float xs = 1.0f, ys = 1.0f;
     glfwGetWindowContentScale(win, &xs, &ys);
-    setupStyle(std::max(xs, ys), kFontPath);
+    v.contentScale = std::max(xs, ys);
+    st.view.uiScale = loadUiScale(st.config.dir);
+    setupStyle(v.contentScale * st.view.uiScale, kFontPath);
     ImGui_ImplGlfw_InitForOpenGL(win, true);
     ImGui_ImplOpenGL3_Init("#version 330");
 }
@@ -763,8 +766,10 @@ private:
     }
 
     void drawUiFrame(float dt) {
-        if (m_v.newContentScale > 0.0f) {   // HiDPI change: rebuild fonts and style at the new scale
-            setupStyle(m_v.newContentScale, kFontPath);
+        if (m_v.newContentScale > 0.0f || m_st.view.uiScaleChanged) {   // HiDPI or UI scale change: fonts and style anew
+            if (m_v.newContentScale > 0.0f) m_v.contentScale = m_v.newContentScale;
+            m_st.view.uiScaleChanged = false;
+            setupStyle(m_v.contentScale * m_st.view.uiScale, kFontPath);
             ImGui_ImplOpenGL3_DestroyFontsTexture();
             ImGui_ImplOpenGL3_CreateFontsTexture();
             m_v.newContentScale = 0.0f;

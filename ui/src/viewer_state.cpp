@@ -988,6 +988,23 @@ void ViewerState::advanceAnimation(double dt) {
 
 // --- config helpers --------------------------------------------------------------------------
 
+float loadUiScale(const fs::path& dir) {
+    std::string text;
+    if (dir.empty() || !assets::readFileLimited(dir / "ui-scale.txt", 64, text).empty()) return 1.0f;
+    char* end = nullptr;
+    const float v = std::strtof(text.c_str(), &end);
+    return std::isfinite(v) && v >= 0.5f && v <= 3.0f ? v : 1.0f;
+}
+
+std::string saveUiScale(const fs::path& dir, float scale) {
+    if (dir.empty()) return {};
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g\n", double(scale));
+    return assets::writeFileAtomic(dir / "ui-scale.txt", buf, /*overwrite=*/true);
+}
+
 fs::path defaultConfigDir() {
     if (const char* x = std::getenv("XDG_CONFIG_HOME"); x && *x) return fs::path(x) / "sceneviewer";
     if (const char* h = std::getenv("HOME"); h && *h) return fs::path(h) / ".config" / "sceneviewer";

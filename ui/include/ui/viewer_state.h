@@ -161,6 +161,10 @@ struct View {
     // UI with software GL); off = on the UI thread with the window's context.
     bool glOnWorker = false;
     bool panelsHidden = false;   // View > Viewport only (Ctrl+Space): the panels hidden
+    // View > UI scale: a factor on the monitor's content scale (GLFW), which the window follows
+    // on its own; kept per user (ui-scale.txt in the config folder).
+    float uiScale = 1.0f;
+    bool uiScaleChanged = false;   // set by the menu, applied by the window between frames
     // Widths of the Scene and Properties panels as fractions of the window's width (they follow
     // the window; dragging a panel's edge sets its fraction). Clamped to sensible pixel limits.
     float leftFraction = 0.19f, rightFraction = 0.27f;
@@ -397,6 +401,9 @@ WindowRect placeWindow(const WindowRect& workArea, const std::optional<WindowRec
 // why a file that is there was not used).
 std::optional<WindowRect> loadWindowRect(const std::filesystem::path& configDir, std::string* error = nullptr);
 std::string saveWindowRect(const std::filesystem::path& configDir, const WindowRect& r);
+// View > UI scale, kept in ui-scale.txt (one number, 0.5..3); 1 when absent or unreadable.
+float loadUiScale(const std::filesystem::path& configDir);
+std::string saveUiScale(const std::filesystem::path& configDir, float scale);
 
 // dir/"<stem>-<backend>.png" or, when taken, the first free "-N" variant: free for the PNG and
 // for every export file of `exports` next to it (ui/aov_export.h), so nothing is overwritten.

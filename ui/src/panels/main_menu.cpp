@@ -87,6 +87,18 @@ void drawMainMenu(ViewerState& st) {
             st.togglePerspective();
         if (ImGui::MenuItem("Viewport only", "Ctrl+Space", st.view.panelsHidden)) st.view.panelsHidden = !st.view.panelsHidden;
         record(st, "view/panels");
+        if (ImGui::BeginMenu("UI scale")) {   // on top of the monitor's content scale
+            for (float f : {0.75f, 1.0f, 1.25f, 1.5f, 2.0f}) {
+                char label[16];
+                std::snprintf(label, sizeof label, "%.0f%%", 100.0f * f);
+                if (ImGui::MenuItem(label, nullptr, std::abs(st.view.uiScale - f) < 1e-3f) && std::abs(st.view.uiScale - f) >= 1e-3f) {
+                    st.view.uiScale = f;
+                    st.view.uiScaleChanged = true;
+                    saveUiScale(st.config.dir, f);
+                }
+            }
+            ImGui::EndMenu();
+        }
         ImGui::Separator();
         // The same modes as the Compare tab, --view and the automation's `view` (showView).
         std::string mode = st.viewName();
