@@ -63,7 +63,9 @@ TEST(SoakGLTest, LongSessionKeepsTheEditAndItsMemoryFlat) {
         s << "backend " << kBackends[r % 3] << "\n";
         s << "orbit " << (r % 2 ? 25 : -18) << " " << (r % 5) - 2 << "\n";
         s << "frames 3\n";
-        s << "set material.ks 0.1" << (r % 9) + 1 << "\nundo\n";   // 0.11 .. 0.19: never the crate's own 0.2 (a no-op set adds no step)
+        // Selected right before the edit: a click's pick resolves when its image arrives, which may
+        // be after a later `select` (the edit and the select run in the same step, no frame between).
+        s << "select crate\nset material.ks 0.1" << (r % 9) + 1 << "\nundo\n";   // 0.11 .. 0.19: never the crate's own 0.2 (a no-op set adds no step)
         s << "diagnostic " << kDiagnostics[r % 8] << "\n";
         s << "view " << kViews[r % 4] << "\nframes 2\n";
         s << "click viewport " << 200 + (r * 37) % 300 << " " << 150 + (r * 53) % 300 << "\nframes 2\nselect crate\n";
