@@ -1,13 +1,13 @@
-// tile_kernels.h - the vectorised inner loops of the CPU rasterizer's tile stage
-// (raster_renderer.cpp, step 4), written once over simd.h's wrappers in tile_kernels.inl and
-// compiled for SSE2 and AVX2 (chosen at run time, as the lighting kernel):
+// tile_kernels.h - the vectorised inner loops of the CPU rasterizer's tile stage (step 4:
+// raster_tile.cpp and raster_shade.cpp), written once over simd.h's wrappers in tile_kernels.inl
+// and compiled for SSE2 and AVX2 (chosen at run time, as the lighting kernel):
 //   * rasterizeOpaque: the depth-tested coverage of one opaque triangle in a tile, a row of an
 //     8x8 block per vector step (32-bit edge functions relative to the block);
 //   * preparePlainRun: the attributes (world position, normal, fog distance) of a run of
 //     fragments of one plain lit triangle, a vector of fragments per step, for the lighting
 //     kernel (raster_shading.h).
 // Both give the bits of the scalar code they replace (raster_core.h's forEachCoveredPixel with
-// the renderer's depth test; prepareSimple in raster_renderer.cpp): the same IEEE operations in
+// the renderer's depth test; prepareSimple in raster_shade.cpp): the same IEEE operations in
 // the same order per lane. tests/raster checks them against it.
 #pragma once
 

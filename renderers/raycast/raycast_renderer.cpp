@@ -467,6 +467,105 @@ float rand01(uint32_t& s) {
     return float(s >> 8) * (1.0f / 16777216.0f);
 }
 
+// --- a frame's tiles ----------------------------------------------------------------------------
+
+// What every tile of a frame shares (RaycastRenderer::doRender sets it up).
+struct FrameJob {
+    const FrameInput& f;
+    const RenderConfig& cfg;
+    const rt::CameraRays& cam;
+    int w, h;
+    int sx, sy;                         // strata per pixel (see RaycastRenderer::capabilities)
+    bool packets;                       // the tile's camera rays are traced first, in packets
+    bool countCost;                     // the cost view: one centre ray per pixel, counted
+    static constexpr int kTile = 32;    // pixels per tile side
+    static constexpr int kPacket = 4;   // pixels per packet side (4x4: the benchmark's best, docs/benchmarks.md)
+    static_assert(kPacket * kPacket <= rt::kMaxPacket);
+};
+
+// The strata per pixel of cfg: MSAA n as n jittered rays (2 -> 2x1, 4 -> 2x2, 8 -> 4x2), SSAA f
+// as f x f.
+void strataOf(const RenderConfig& cfg, int& sx, int& sy) {
+    sx = cfg.ssaaFactor;
+    sy = cfg.ssaaFactor;
+    if (cfg.msaaSamples > 1) {
+        sx = cfg.msaaSamples >= 4 ? (cfg.msaaSamples >= 8 ? 4 : 2) : cfg.msaaSamples;
+        sy = cfg.msaaSamples / sx;
+    }
+}
+
+// One sample per pixel: the camera rays of tile [x0, x1) x [y0, y1) (rows top-down) traced
+// kPacket x kPacket pixels at a time (SceneAccel::intersectPacket: the same hits as one by one),
+// into tileRays and tileHits (kTile per row).
+void traceCameraPackets(const FrameJob& job, const rt::SceneAccel& accel, int x0, int y0, int x1, int y1, std::vector<rt::Ray>& tileRays,
+                        std::vector<Tracer::FirstHit>& tileHits) {
+    constexpr int kPacket = FrameJob::kPacket, tile = FrameJob::kTile;
+    for (int py = y0; py < y1; py += kPacket)
+        for (int px = x0; px < x1; px += kPacket) {
+            rt::Ray pr[kPacket * kPacket];
+            rt::SceneHit ph[kPacket * kPacket];
+            int n = 0;
+            for (int row = py; row < std::min(py + kPacket, y1); ++row)
+                for (int x = px; x < std::min(px + kPacket, x1); ++x) pr[n++] = job.cam.ray(float(x) + 0.5f, float(job.h - 1 - row) + 0.5f);
+            const uint64_t found = accel.intersectPacket(pr, n, ~uint64_t(0), ph, job.f.settings.culling);
+            n = 0;
+            for (int row = py; row < std::min(py + kPacket, y1); ++row)
+                for (int x = px; x < std::min(px + kPacket, x1); ++x, ++n) {
+                    tileRays[size_t(row - y0) * tile + size_t(x - x0)] = pr[n];
+                    Tracer::FirstHit& fh = tileHits[size_t(row - y0) * tile + size_t(x - x0)];
+                    fh.found = (found >> n) & 1;
+                    if (fh.found) fh.hit = ph[n];
+                }
+        }
+}
+
+// Pixel (x, row) of the tile with corner (x0, y0): its sx x sy stratified rays traced and
+// shaded, the mean colour as sRGB bytes, the nearest depth, and (centre ray) the visibility and
+// the traversal cost when asked.
+void shadePixel(const FrameJob& job, Tracer& tr, int x, int row, int x0, int y0, const std::vector<rt::Ray>& tileRays,
+                const std::vector<Tracer::FirstHit>& tileHits, Framebuffer& target) {
+    constexpr int tile = FrameJob::kTile;
+    const int w = job.w, h = job.h, sx = job.sx, sy = job.sy;
+    const int wy = h - 1 - row;   // GL window y of this row
+    vec3 sum(0.0f);
+    float depth = 1.0f;
+    uint32_t seed = hash32(uint32_t(x) * 73856093u ^ uint32_t(wy) * 19349663u);
+    for (int j = 0; j < sy; ++j)
+        for (int i = 0; i < sx; ++i) {
+            float ox = 0.5f, oy = 0.5f;
+            if (sx * sy > 1) {
+                ox = (float(i) + rand01(seed)) / float(sx);
+                oy = (float(j) + rand01(seed)) / float(sy);
+            }
+            // (the packet's ray: the same call with ox = oy = 0.5)
+            const rt::Ray r = job.packets ? tileRays[size_t(row - y0) * tile + size_t(x - x0)] : job.cam.ray(float(x) + ox, float(wy) + oy);
+            SurfaceRecord hp;
+            const PixelFootprint fp{&job.cam, float(x) + ox, float(wy) + oy};
+            rt::TraversalCount count;
+            if (job.countCost) tr.cost = &count;
+            if (job.packets) tr.firstHit = &tileHits[size_t(row - y0) * tile + size_t(x - x0)];
+            vec3 c = tr.trace(r, job.f.camera.eye, 0, &hp, &fp);
+            if (job.countCost) {   // one centre ray per pixel, like the visibility
+                target.costNodes[size_t(row) * w + x] = count.nodes;
+                target.costPrims[size_t(row) * w + x] = count.prims;
+            }
+            if (!std::isnan(hp.p.x)) depth = std::min(depth, std::clamp(job.cam.depth(hp.p), 0.0f, 1.0f));
+            if (job.cfg.visibility) {   // one centre ray per pixel (RenderConfig::visibility)
+                target.drawable[size_t(row) * w + x] = hp.drawable;
+                target.primitive[size_t(row) * w + x] = hp.primitive;
+            }
+            sum += c;
+        }
+    sum /= float(sx * sy);
+    if (!isFinite(sum)) sum = vec3(1, 0, 1);   // never feed NaN to the byte conversion
+    uint8_t* px = target.pixel(x, row);
+    px[0] = toByteSRGB(sum.x);
+    px[1] = toByteSRGB(sum.y);
+    px[2] = toByteSRGB(sum.z);
+    px[3] = 255;
+    target.depth[size_t(row) * w + x] = depth;
+}
+
 // --- RaycastRenderer --------------------------------------------------------------------------------
 
 class RaycastRenderer final : public Renderer {
@@ -510,133 +609,19 @@ protected:
         const unsigned csr = _mm_getcsr();
         m_accel.update(f);
         stats.triangles = f.triangleCount();
-        // Samplers (mip chains) per texture, cached by id + version; one pointer per mesh.
-        m_samplers.beginFrame();
-        std::vector<const SampledTexture*>& textures = m_textures;
-        std::vector<MapSamplers>& maps = m_maps;
-        textures.assign(f.meshes.size(), nullptr);
-        maps.assign(f.meshes.size(), {});
-        for (size_t i = 0; i < f.meshes.size(); ++i) {
-            textures[i] = m_samplers.get(f.meshes[i].texture);
-            const sg::DrawMesh& dm = f.meshes[i];
-            const sg::MaterialMaps& fm = dm.maps;
-            const bool hasUv1 = dm.mesh && dm.mesh->uv1.size() == dm.mesh->positions.size();
-            maps[i] = {m_samplers.get(fm.emissive), m_samplers.get(fm.occlusion), m_samplers.get(fm.metallicRoughness), m_samplers.get(fm.normal),
-                       hasUv1 ? dm.material.uv1Maps : uint8_t(0)};
-        }
-        m_samplers.endFrame();
-        const bool anyAlpha = anyTranslucent(f);
+        prepareSamplers(f);
 
-        // Strata per pixel (see capabilities()).
-        int sx = cfg.ssaaFactor, sy = cfg.ssaaFactor;
-        if (cfg.msaaSamples > 1) {
-            sx = cfg.msaaSamples >= 4 ? (cfg.msaaSamples >= 8 ? 4 : 2) : cfg.msaaSamples;
-            sy = cfg.msaaSamples / sx;
-        }
-        const int tile = 32;
-        const int tx = (w + tile - 1) / tile, ty = (h + tile - 1) / tile, ntiles = tx * ty;
-        std::atomic<int> done{0};
-        std::atomic<uint64_t> rays{0};
-        std::atomic<bool> cancelled{false};
-        if (control) control->progress = 0.0f;
-
+        int sx = 1, sy = 1;
+        strataOf(cfg, sx, sy);
         // Camera rays in packets where each pixel has one (the cost view counts rays one by one);
         // VIEWER_RAYCAST_PACKETS=0 traces them one by one (timing comparisons: the same image).
-        const bool packetsOn = debugSwitches().raycastPackets;
-        const bool packets = packetsOn && sx * sy == 1 && !countCost;
-        constexpr int kPacket = 4;   // pixels per packet side (4x4: the benchmark's best, docs/benchmarks.md)
-        static_assert(kPacket * kPacket <= rt::kMaxPacket);
-
-        tbb::parallel_for(tbb::blocked_range<int>(0, ntiles, 1), [&](const tbb::blocked_range<int>& range) {
-            std::vector<Tracer::FirstHit> tileHits(packets ? size_t(tile) * tile : 0);
-            std::vector<rt::Ray> tileRays(tileHits.size());
-            const unsigned old = _mm_getcsr();
-            _mm_setcsr(old | 0x8040);   // FTZ | DAZ in this worker
-            for (int ti = range.begin(); ti != range.end(); ++ti) {
-                if (control && control->cancel.load(std::memory_order_relaxed)) {
-                    cancelled = true;
-                    break;
-                }
-                Tracer tr{f, m_accel, textures, maps, 0, anyAlpha};
-                const int x0 = (ti % tx) * tile, y0 = (ti / tx) * tile;   // y0: framebuffer row (top-down)
-                const int x1 = std::min(x0 + tile, w), y1 = std::min(y0 + tile, h);
-                // One sample per pixel: the tile's camera rays traced first, kPacket x kPacket
-                // pixels at a time (SceneAccel::intersectPacket: the same hits as one by one).
-                if (packets) {
-                    for (int py = y0; py < y1; py += kPacket)
-                        for (int px = x0; px < x1; px += kPacket) {
-                            rt::Ray pr[kPacket * kPacket];
-                            rt::SceneHit ph[kPacket * kPacket];
-                            int n = 0;
-                            for (int row = py; row < std::min(py + kPacket, y1); ++row)
-                                for (int x = px; x < std::min(px + kPacket, x1); ++x) pr[n++] = cam.ray(float(x) + 0.5f, float(h - 1 - row) + 0.5f);
-                            const uint64_t found = m_accel.intersectPacket(pr, n, ~uint64_t(0), ph, f.settings.culling);
-                            n = 0;
-                            for (int row = py; row < std::min(py + kPacket, y1); ++row)
-                                for (int x = px; x < std::min(px + kPacket, x1); ++x, ++n) {
-                                    tileRays[size_t(row - y0) * tile + size_t(x - x0)] = pr[n];
-                                    Tracer::FirstHit& fh = tileHits[size_t(row - y0) * tile + size_t(x - x0)];
-                                    fh.found = (found >> n) & 1;
-                                    if (fh.found) fh.hit = ph[n];
-                                }
-                        }
-                }
-                for (int row = y0; row < y1; ++row) {
-                    const int wy = h - 1 - row;   // GL window y of this row
-                    for (int x = x0; x < x1; ++x) {
-                        vec3 sum(0.0f);
-                        float depth = 1.0f;
-                        uint32_t seed = hash32(uint32_t(x) * 73856093u ^ uint32_t(wy) * 19349663u);
-                        for (int j = 0; j < sy; ++j)
-                            for (int i = 0; i < sx; ++i) {
-                                float ox = 0.5f, oy = 0.5f;
-                                if (sx * sy > 1) {
-                                    ox = (float(i) + rand01(seed)) / float(sx);
-                                    oy = (float(j) + rand01(seed)) / float(sy);
-                                }
-                                // (the packet's ray: the same call with ox = oy = 0.5)
-                                const rt::Ray r =
-                                    packets ? tileRays[size_t(row - y0) * tile + size_t(x - x0)] : cam.ray(float(x) + ox, float(wy) + oy);
-                                SurfaceRecord hp;
-                                const PixelFootprint fp{&cam, float(x) + ox, float(wy) + oy};
-                                rt::TraversalCount count;
-                                if (countCost) tr.cost = &count;
-                                if (packets) tr.firstHit = &tileHits[size_t(row - y0) * tile + size_t(x - x0)];
-                                vec3 c = tr.trace(r, f.camera.eye, 0, &hp, &fp);
-                                if (countCost) {   // one centre ray per pixel, like the visibility
-                                    target.costNodes[size_t(row) * w + x] = count.nodes;
-                                    target.costPrims[size_t(row) * w + x] = count.prims;
-                                }
-                                if (!std::isnan(hp.p.x)) depth = std::min(depth, std::clamp(cam.depth(hp.p), 0.0f, 1.0f));
-                                if (cfg.visibility) {   // one centre ray per pixel (RenderConfig::visibility)
-                                    target.drawable[size_t(row) * w + x] = hp.drawable;
-                                    target.primitive[size_t(row) * w + x] = hp.primitive;
-                                }
-                                sum += c;
-                            }
-                        sum /= float(sx * sy);
-                        if (!isFinite(sum)) sum = vec3(1, 0, 1);   // never feed NaN to the byte conversion
-                        uint8_t* px = target.pixel(x, row);
-                        px[0] = toByteSRGB(sum.x);
-                        px[1] = toByteSRGB(sum.y);
-                        px[2] = toByteSRGB(sum.z);
-                        px[3] = 255;
-                        target.depth[size_t(row) * w + x] = depth;
-                    }
-                }
-                rays += tr.rays;
-                int d = ++done;
-                if (control) {
-                    control->progress = float(d) / float(ntiles);
-                    if (control->onTileDone) control->onTileDone();
-                }
-            }
-            _mm_setcsr(old);
-        });
+        const bool packets = debugSwitches().raycastPackets && sx * sy == 1 && !countCost;
+        const FrameJob job{f, cfg, cam, w, h, sx, sy, packets, countCost};
+        uint64_t rays = 0;
+        stats.cancelled = !renderTiles(job, target, control, rays);
         _mm_setcsr(csr);
 
-        stats.rays = rays.load();
-        stats.cancelled = cancelled.load();
+        stats.rays = rays;
         if (!stats.cancelled) drawOverlay(f, cfg, target);
         stats.ok = !stats.cancelled;
         if (stats.cancelled) stats.error = "cancelled";
@@ -653,6 +638,64 @@ public:
     }
 
 private:
+    // Samplers (mip chains) per texture, cached by id + version; one pointer per mesh (m_textures,
+    // m_maps: the material maps).
+    void prepareSamplers(const FrameInput& f) {
+        m_samplers.beginFrame();
+        m_textures.assign(f.meshes.size(), nullptr);
+        m_maps.assign(f.meshes.size(), {});
+        for (size_t i = 0; i < f.meshes.size(); ++i) {
+            m_textures[i] = m_samplers.get(f.meshes[i].texture);
+            const sg::DrawMesh& dm = f.meshes[i];
+            const sg::MaterialMaps& fm = dm.maps;
+            const bool hasUv1 = dm.mesh && dm.mesh->uv1.size() == dm.mesh->positions.size();
+            m_maps[i] = {m_samplers.get(fm.emissive), m_samplers.get(fm.occlusion), m_samplers.get(fm.metallicRoughness), m_samplers.get(fm.normal),
+                         hasUv1 ? dm.material.uv1Maps : uint8_t(0)};
+        }
+        m_samplers.endFrame();
+    }
+
+    // The frame's 32x32 tiles, in parallel (FTZ/DAZ in each worker), with progress and
+    // cancellation; adds the rays traced to `rays`. Returns false when cancelled.
+    bool renderTiles(const FrameJob& job, Framebuffer& target, RenderControl* control, uint64_t& rays) {
+        const FrameInput& f = job.f;
+        const bool anyAlpha = anyTranslucent(f);
+        constexpr int tile = FrameJob::kTile;
+        const int tx = (job.w + tile - 1) / tile, ty = (job.h + tile - 1) / tile, ntiles = tx * ty;
+        std::atomic<int> done{0};
+        std::atomic<uint64_t> rayCount{0};
+        std::atomic<bool> cancelled{false};
+        if (control) control->progress = 0.0f;
+
+        tbb::parallel_for(tbb::blocked_range<int>(0, ntiles, 1), [&](const tbb::blocked_range<int>& range) {
+            std::vector<Tracer::FirstHit> tileHits(job.packets ? size_t(tile) * tile : 0);
+            std::vector<rt::Ray> tileRays(tileHits.size());
+            const unsigned old = _mm_getcsr();
+            _mm_setcsr(old | 0x8040);   // FTZ | DAZ in this worker
+            for (int ti = range.begin(); ti != range.end(); ++ti) {
+                if (control && control->cancel.load(std::memory_order_relaxed)) {
+                    cancelled = true;
+                    break;
+                }
+                Tracer tr{f, m_accel, m_textures, m_maps, 0, anyAlpha};
+                const int x0 = (ti % tx) * tile, y0 = (ti / tx) * tile;   // y0: framebuffer row (top-down)
+                const int x1 = std::min(x0 + tile, job.w), y1 = std::min(y0 + tile, job.h);
+                if (job.packets) traceCameraPackets(job, m_accel, x0, y0, x1, y1, tileRays, tileHits);
+                for (int row = y0; row < y1; ++row)
+                    for (int x = x0; x < x1; ++x) shadePixel(job, tr, x, row, x0, y0, tileRays, tileHits, target);
+                rayCount += tr.rays;
+                int d = ++done;
+                if (control) {
+                    control->progress = float(d) / float(ntiles);
+                    if (control->onTileDone) control->onTileDone();
+                }
+            }
+            _mm_setcsr(old);
+        });
+        rays = rayCount.load();
+        return !cancelled.load();
+    }
+
     // Points, lines and the wireframe, rasterized over the ray-cast image against its depth
     // exactly as the CPU rasterizer draws them (rays cannot hit zero-width primitives). The
     // wireframe of analytic shapes is their tessellation's, as in the rasterizers. Drawn at the

@@ -498,20 +498,39 @@ inline float packetTmax(const PacketRays& pr, unsigned groups) {
     return _mm_cvtss_f32(h);
 }
 
-// Traces rays[i] for the bits i of `active` (n <= kMaxPacket); hits[i] gets exactly what
-// traceTriangles8 writes for that ray. Rays that do not fit the packet (other direction signs
-// than the first, non-finite data, an empty [tmin, tmax]) are traced one by one. Returns the
-// mask of rays that hit.
-template <bool AnyHit>
-inline uint64_t tracePacket8(const Node8* nodes, const TriPacket4* packets, const uint32_t* prims, const float* absMax, const Ray* rays, int n,
-                             uint64_t active, TriHit* hits, bool cullBack) {
-    if (n < kMaxPacket) active &= (uint64_t(1) << n) - 1;
-    PacketRays pr;
-    uint64_t pm = 0, single = 0, found = 0;
+// The fixed inputs of one tracePacket8 call, shared by its phases below.
+struct PacketScene {
+    const Node8* nodes;
+    const TriPacket4* packets;
+    const uint32_t* prims;
+    const float* absMax;
+    const Ray* rays;
+    TriHit* hits;
+    bool cullBack;
+};
+
+// What gatherPacket learns of the rays: those in the packet (pm) and those traced alone
+// (single), the packet's direction signs (bit k: axis k negative; -1 before the first ray), the
+// bounds of its reciprocal directions (rlo, rhi) and origins (olo, ohi) per axis, and its
+// smallest tmin and largest tmax.
+struct PacketGather {
+    uint64_t pm = 0, single = 0;
     int sign = -1;
-    __m128 rlo = _mm_set1_ps(std::numeric_limits<float>::infinity()), rhi = _mm_set1_ps(-std::numeric_limits<float>::infinity());
-    __m128 olo = rlo, ohi = rhi;
-    float tminP = std::numeric_limits<float>::infinity(), tmaxP = -std::numeric_limits<float>::infinity();
+    __m128 rlo, rhi, olo, ohi;
+    float tminP, tmaxP;
+};
+
+// Sorts the active rays into the packet (the first ray's direction signs, finite data, a
+// non-empty [tmin, tmax]; their RayPre values into pr) and the rest; every other slot of pr is
+// set to never enter a box.
+[[gnu::always_inline]] inline PacketGather gatherPacket(const Ray* rays, int n, uint64_t active, const float* absMax, PacketRays& pr) {
+    PacketGather g;
+    g.rlo = _mm_set1_ps(std::numeric_limits<float>::infinity());
+    g.rhi = _mm_set1_ps(-std::numeric_limits<float>::infinity());
+    g.olo = g.rlo;
+    g.ohi = g.rhi;
+    g.tminP = std::numeric_limits<float>::infinity();
+    g.tmaxP = -std::numeric_limits<float>::infinity();
     const int groupsN = (n + 7) / 8;
     for (int i = 0; i < 8 * groupsN; ++i) {
         const bool in = (active >> i) & 1;
@@ -525,10 +544,11 @@ inline uint64_t tracePacket8(const Node8* nodes, const TriPacket4* packets, cons
             const __m128 z = _mm_add_ps(_mm_add_ps(_mm_sub_ps(rd, rd), _mm_sub_ps(on, on)),
                                         _mm_add_ps(_mm_sub_ps(of, of), _mm_sub_ps(_mm_load_ps(pre.org), _mm_load_ps(pre.org))));
             const int s = pre.nearX | (pre.nearY << 1) | (pre.nearZ << 2);
-            if ((_mm_movemask_ps(_mm_cmpeq_ps(z, _mm_setzero_ps())) & 7) == 7 && sg::isFinite(r.dir) && r.tmax > tmin && (sign < 0 || s == sign)) {
-                sign = s;
+            if ((_mm_movemask_ps(_mm_cmpeq_ps(z, _mm_setzero_ps())) & 7) == 7 && sg::isFinite(r.dir) && r.tmax > tmin &&
+                (g.sign < 0 || s == g.sign)) {
+                g.sign = s;
                 fits = true;
-                pm |= uint64_t(1) << i;
+                g.pm |= uint64_t(1) << i;
                 alignas(16) float a[4], b[4], c[4];
                 _mm_store_ps(a, rd);
                 _mm_store_ps(b, on);
@@ -540,14 +560,14 @@ inline uint64_t tracePacket8(const Node8* nodes, const TriPacket4* packets, cons
                 }
                 pr.tmin[i] = tmin;
                 pr.tmax[i] = r.tmax;
-                rlo = _mm_min_ps(rlo, rd);
-                rhi = _mm_max_ps(rhi, rd);
-                olo = _mm_min_ps(olo, _mm_load_ps(pre.org));
-                ohi = _mm_max_ps(ohi, _mm_load_ps(pre.org));
-                tminP = std::min(tminP, tmin);
-                tmaxP = std::max(tmaxP, r.tmax);
+                g.rlo = _mm_min_ps(g.rlo, rd);
+                g.rhi = _mm_max_ps(g.rhi, rd);
+                g.olo = _mm_min_ps(g.olo, _mm_load_ps(pre.org));
+                g.ohi = _mm_max_ps(g.ohi, _mm_load_ps(pre.org));
+                g.tminP = std::min(g.tminP, tmin);
+                g.tmaxP = std::max(g.tmaxP, r.tmax);
             } else {
-                single |= uint64_t(1) << i;
+                g.single |= uint64_t(1) << i;
             }
         }
         if (!fits) {   // never enters a box
@@ -556,28 +576,45 @@ inline uint64_t tracePacket8(const Node8* nodes, const TriPacket4* packets, cons
             pr.tmax[i] = -1.0f;
         }
     }
-    for (uint64_t m = single; m; m &= m - 1) {
-        const int i = __builtin_ctzll(m);
-        if (traceTriangles8<AnyHit>(nodes, packets, prims, absMax, rays[i], AnyHit ? nullptr : &hits[i], cullBack)) found |= uint64_t(1) << i;
-    }
-    if (!pm) return found;
-    if (__builtin_popcountll(pm) == 1) {   // nothing to share
-        const int i = __builtin_ctzll(pm);
-        if (traceTriangles8<AnyHit>(nodes, packets, prims, absMax, rays[i], AnyHit ? nullptr : &hits[i], cullBack)) found |= uint64_t(1) << i;
-        return found;
-    }
-    unsigned groups = 0;
-    for (int g = 0; g < groupsN; ++g)
-        if ((pm >> (8 * g)) & 0xFF) groups |= 1u << g;
+    return g;
+}
 
+// Traces the rays of mask m one by one from the root (traceTriangles8); returns those that hit.
+template <bool AnyHit>
+[[gnu::always_inline]] inline uint64_t traceAlone(const PacketScene& sc, uint64_t m) {
+    uint64_t found = 0;
+    for (; m; m &= m - 1) {
+        const int i = __builtin_ctzll(m);
+        if (traceTriangles8<AnyHit>(sc.nodes, sc.packets, sc.prims, sc.absMax, sc.rays[i], AnyHit ? nullptr : &sc.hits[i], sc.cullBack))
+            found |= uint64_t(1) << i;
+    }
+    return found;
+}
+
+// The packet's interval test, per axis (see above): the bounds of the reciprocal directions
+// (rl*, rh*) and the widened origin bounds (entry on*, exit of*) broadcast, its smallest tmin,
+// and the near planes (nx, ny, nz: rows of Node8::b) with a base pointer per plane.
+struct PacketFrustum {
+    int nx, ny, nz;
+    __m256 rlx, rly, rlz, rhx, rhy, rhz;
+    __m256 onx, ony, onz, ofx, ofy, ofz;
+    __m256i tmin8i;
+    const char *pnx, *pfx, *pny, *pfy, *pnz, *pfz;
+};
+
+[[gnu::always_inline]] inline PacketFrustum makePacketFrustum(const PacketGather& g, const float* absMax, const Node8* nodes) {
+    PacketFrustum f;
+    const int sign = g.sign;
     const int nearX = sign & 1, nearY = (sign >> 1) & 1, nearZ = (sign >> 2) & 1;
-    const int nx = nearX, ny = 2 + nearY, nz = 4 + nearZ;
+    f.nx = nearX;
+    f.ny = 2 + nearY;
+    f.nz = 4 + nearZ;
     const int fx = 1 - nearX, fy = 3 - nearY, fz = 5 - nearZ;
     alignas(16) float lo[4], hi[4], oL[4], oH[4];
-    _mm_store_ps(lo, rlo);
-    _mm_store_ps(hi, rhi);
-    _mm_store_ps(oL, olo);
-    _mm_store_ps(oH, ohi);
+    _mm_store_ps(lo, g.rlo);
+    _mm_store_ps(hi, g.rhi);
+    _mm_store_ps(oL, g.olo);
+    _mm_store_ps(oH, g.ohi);
     float oNear[3], oFar[3];   // widened origin bounds (see above): entry uses oNear, exit oFar
     for (int k = 0; k < 3; ++k) {
         const float d = 0x1p-19f * (std::max(std::abs(oL[k]), std::abs(oH[k])) + absMax[k]);
@@ -585,156 +622,228 @@ inline uint64_t tracePacket8(const Node8* nodes, const TriPacket4* packets, cons
         oNear[k] = neg ? oL[k] - d : oH[k] + d;
         oFar[k] = neg ? oH[k] + d : oL[k] - d;
     }
-    const __m256 rlx = _mm256_set1_ps(lo[0]), rly = _mm256_set1_ps(lo[1]), rlz = _mm256_set1_ps(lo[2]);
-    const __m256 rhx = _mm256_set1_ps(hi[0]), rhy = _mm256_set1_ps(hi[1]), rhz = _mm256_set1_ps(hi[2]);
-    const __m256 onx = _mm256_set1_ps(oNear[0]), ony = _mm256_set1_ps(oNear[1]), onz = _mm256_set1_ps(oNear[2]);
-    const __m256 ofx = _mm256_set1_ps(oFar[0]), ofy = _mm256_set1_ps(oFar[1]), ofz = _mm256_set1_ps(oFar[2]);
-    const __m256i tmin8i = _mm256_castps_si256(_mm256_set1_ps(tminP));
-    __m256 tmax8 = _mm256_set1_ps(tmaxP);
+    f.rlx = _mm256_set1_ps(lo[0]), f.rly = _mm256_set1_ps(lo[1]), f.rlz = _mm256_set1_ps(lo[2]);
+    f.rhx = _mm256_set1_ps(hi[0]), f.rhy = _mm256_set1_ps(hi[1]), f.rhz = _mm256_set1_ps(hi[2]);
+    f.onx = _mm256_set1_ps(oNear[0]), f.ony = _mm256_set1_ps(oNear[1]), f.onz = _mm256_set1_ps(oNear[2]);
+    f.ofx = _mm256_set1_ps(oFar[0]), f.ofy = _mm256_set1_ps(oFar[1]), f.ofz = _mm256_set1_ps(oFar[2]);
+    f.tmin8i = _mm256_castps_si256(_mm256_set1_ps(g.tminP));
 
     const char* const nodeBytes = reinterpret_cast<const char*>(nodes);
-    const char *pnx = planeBase(nodeBytes, nx), *pfx = planeBase(nodeBytes, fx), *pny = planeBase(nodeBytes, ny);
-    const char *pfy = planeBase(nodeBytes, fy), *pnz = planeBase(nodeBytes, nz), *pfz = planeBase(nodeBytes, fz);
+    f.pnx = planeBase(nodeBytes, f.nx), f.pfx = planeBase(nodeBytes, fx), f.pny = planeBase(nodeBytes, f.ny);
+    f.pfy = planeBase(nodeBytes, fy), f.pnz = planeBase(nodeBytes, f.nz), f.pfz = planeBase(nodeBytes, fz);
+    return f;
+}
 
-    PacketEntry stack[512];
-    int sp = 0;
-    uint32_t cur = 0, curParent = 0, curSlot = 0;
-    for (;;) {
-        bool enter = true;
-        if (!(cur & Node8::kLeafBit) && cur != 0) {
-            // The rays that enter this node (their own box tests, current tmax): none left skips
-            // it, a single one goes on alone (traceTriangles8 from here: the packet's interval
-            // test has nothing left to share).
-            uint64_t am = 0;
-            const Node8& parent = *reinterpret_cast<const Node8*>(nodeBytes + curParent);
-            for (unsigned gm = groups; gm; gm &= gm - 1) {
-                const int g = __builtin_ctz(gm);
-                am |= uint64_t(leafRayMask(parent, curSlot, nx, ny, nz, pr, g)) << (8 * g);
-            }
-            am &= pm;
-            if (__builtin_popcountll(am) <= 1) {
-                enter = false;
-                if (am) {
-                    const int i = __builtin_ctzll(am);
-                    Ray r = rays[i];
-                    r.tmax = pr.tmax[i];
-                    if (traceTriangles8<AnyHit>(nodes, packets, prims, absMax, r, AnyHit ? nullptr : &hits[i], cullBack, nullptr, cur)) {
-                        found |= uint64_t(1) << i;
-                        if constexpr (AnyHit) {
-                            pm &= ~(uint64_t(1) << i);
-                            if (!pm) return found;
-                        } else {
-                            pr.tmax[i] = hits[i].t;
-                            tmaxP = packetTmax(pr, groups);
-                            tmax8 = _mm256_set1_ps(tmaxP);
-                        }
-                    }
-                }
-            }
-        }
-        if (!enter) {
-        } else if (!(cur & Node8::kLeafBit)) {
-            const Node8& nd = *reinterpret_cast<const Node8*>(nodeBytes + cur);
-            const __m256 t0x = packetLower(loadPlane(pnx, cur), rlx, rhx, onx), t1x = packetUpper(loadPlane(pfx, cur), rlx, rhx, ofx);
-            const __m256 t0y = packetLower(loadPlane(pny, cur), rly, rhy, ony), t1y = packetUpper(loadPlane(pfy, cur), rly, rhy, ofy);
-            const __m256 t0z = packetLower(loadPlane(pnz, cur), rlz, rhz, onz), t1z = packetUpper(loadPlane(pfz, cur), rlz, rhz, ofz);
-            const __m256i tn = _mm256_max_epi32(_mm256_max_epi32(_mm256_castps_si256(t0x), _mm256_castps_si256(t0y)),
-                                                _mm256_max_epi32(_mm256_castps_si256(t0z), tmin8i));
-            const __m256i tf = _mm256_min_epi32(_mm256_min_epi32(_mm256_castps_si256(t1x), _mm256_castps_si256(t1y)),
-                                                _mm256_min_epi32(_mm256_castps_si256(t1z), _mm256_castps_si256(tmax8)));
-            unsigned mask = unsigned(_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpgt_epi32(tn, tf)))) ^ 0xFFu;
-            if (mask != 0) {
-                alignas(32) float dist[8];
-                _mm256_store_si256(reinterpret_cast<__m256i*>(dist), tn);
-                const unsigned c0 = unsigned(__builtin_ctz(mask));
-                mask &= mask - 1;
-                if (mask == 0) {
-                    curParent = cur;
-                    curSlot = c0;
-                    cur = nd.child[c0];
-                    continue;
-                }
-                // Front to back by the packet's entry distance: keys (distance, slot), far first.
-                uint64_t key[8];
-                int k = 0;
-                key[k++] = sortKey(dist[c0], c0);
-                do {
-                    const int c = __builtin_ctz(mask);
-                    mask &= mask - 1;
-                    key[k++] = sortKey(dist[c], uint32_t(c));
-                } while (mask);
-                if (k == 2) {
-                    if (key[0] < key[1]) std::swap(key[0], key[1]);
-                } else {
-                    sortFarFirst(key, k);
-                }
-                for (int i = 0; i < k - 1; ++i) {
-                    const uint32_t s = uint32_t(key[i]);
-                    stack[sp++] = {nd.child[s], keyDistance(key[i]), cur, s};
-                }
-                curParent = cur;
-                curSlot = uint32_t(key[k - 1]);
-                cur = nd.child[curSlot];
-                continue;
-            }
-        } else {
-            const Node8& parent = *reinterpret_cast<const Node8*>(nodeBytes + curParent);
-            const TriPacket4* first = packets + ((cur & ~Node8::kLeafBit) >> 3);
-            const TriPacket4* end = first + (cur & 7u);
-            bool shrunk = false;
-            for (unsigned gm = groups; gm; gm &= gm - 1) {
-                const int g = __builtin_ctz(gm);
-                unsigned rm = leafRayMask(parent, curSlot, nx, ny, nz, pr, g) & unsigned(pm >> (8 * g)) & 0xFFu;
-                while (rm) {
-                    const int i = 8 * g + __builtin_ctz(rm);
-                    rm &= rm - 1;
-                    const Ray& r = rays[i];
-                    const __m256 o8[3] = {_mm256_set1_ps(r.org.x), _mm256_set1_ps(r.org.y), _mm256_set1_ps(r.org.z)};
-                    const __m256 d8[3] = {_mm256_set1_ps(r.dir.x), _mm256_set1_ps(r.dir.y), _mm256_set1_ps(r.dir.z)};
-                    const __m256 rtmin = _mm256_set1_ps(pr.tmin[i]);
-                    __m256 rtmax = _mm256_set1_ps(pr.tmax[i]);
-                    for (const TriPacket4* p = first; p < end; p += 2) {
-                        const bool two = p + 1 < end;
-                        __m256 t, u, v;
-                        const int hm = intersectPacketPair(p[0], p[two ? 1 : 0], o8, d8, rtmin, rtmax, t, u, v, cullBack) & (two ? 0xFF : 0x0F);
-                        if (!hm) continue;
-                        if constexpr (AnyHit) {
-                            found |= uint64_t(1) << i;
-                            pm &= ~(uint64_t(1) << i);
-                            break;
-                        } else {
-                            alignas(32) float ta[8], ua[8], va[8];
-                            _mm256_store_ps(ta, t);
-                            _mm256_store_ps(ua, u);
-                            _mm256_store_ps(va, v);
-                            if (closestLane(hm, ta, ua, va, prims + 4 * (p - packets), pr.tmax[i], &hits[i])) {
-                                found |= uint64_t(1) << i;
-                                shrunk = true;
-                            }
-                            rtmax = _mm256_set1_ps(pr.tmax[i]);
-                        }
-                    }
-                }
-                if constexpr (AnyHit)
-                    if (!((pm >> (8 * g)) & 0xFF)) groups &= ~(1u << g);
-            }
+// Bit g: group g of 8 rays has packet rays (pm), for the groupsN groups.
+[[gnu::always_inline]] inline unsigned packetGroups(uint64_t pm, int groupsN) {
+    unsigned groups = 0;
+    for (int g = 0; g < groupsN; ++g)
+        if ((pm >> (8 * g)) & 0xFF) groups |= 1u << g;
+    return groups;
+}
+
+// At inner node cur (not the root), entered from slot curSlot of curParent: the rays that enter
+// it (their own box tests, current tmax). Two or more: returns true, the packet goes on. None
+// or one: returns false, and the one goes on alone (traceTriangles8 from here: the packet's
+// interval test has nothing left to share); its hit updates found and pm (AnyHit: it leaves the
+// packet) or its tmax and the packet's (tmaxP, tmax8).
+template <bool AnyHit>
+[[gnu::always_inline]] inline bool packetEnters(const PacketScene& sc, const PacketFrustum& fr, PacketRays& pr, uint32_t cur, uint32_t curParent,
+                                                uint32_t curSlot, unsigned groups, uint64_t& pm, uint64_t& found, float& tmaxP, __m256& tmax8) {
+    uint64_t am = 0;
+    const Node8& parent = *reinterpret_cast<const Node8*>(reinterpret_cast<const char*>(sc.nodes) + curParent);
+    for (unsigned gm = groups; gm; gm &= gm - 1) {
+        const int g = __builtin_ctz(gm);
+        am |= uint64_t(leafRayMask(parent, curSlot, fr.nx, fr.ny, fr.nz, pr, g)) << (8 * g);
+    }
+    am &= pm;
+    if (__builtin_popcountll(am) > 1) return true;
+    if (am) {
+        const int i = __builtin_ctzll(am);
+        Ray r = sc.rays[i];
+        r.tmax = pr.tmax[i];
+        if (traceTriangles8<AnyHit>(sc.nodes, sc.packets, sc.prims, sc.absMax, r, AnyHit ? nullptr : &sc.hits[i], sc.cullBack, nullptr, cur)) {
+            found |= uint64_t(1) << i;
             if constexpr (AnyHit) {
-                if (!pm) return found;
-            } else if (shrunk) {
+                pm &= ~(uint64_t(1) << i);
+            } else {
+                pr.tmax[i] = sc.hits[i].t;
                 tmaxP = packetTmax(pr, groups);
                 tmax8 = _mm256_set1_ps(tmaxP);
             }
         }
-        for (;;) {
-            if (sp == 0) return found;
-            const PacketEntry& e = stack[--sp];
-            if (AnyHit || e.t <= tmaxP) {
-                cur = e.ref;
-                curParent = e.parent;
-                curSlot = e.slot;
-                break;
+    }
+    return false;
+}
+
+// Inner node cur: the packet's interval test against its 8 child boxes. The children it enters,
+// front to back by the packet's entry distance: the nearest becomes cur (with its parent and
+// slot), the others go on the stack. False when it enters none.
+[[gnu::always_inline]] inline bool descendPacket(const PacketFrustum& fr, const char* nodeBytes, __m256 tmax8, PacketEntry* stack, int& sp,
+                                                 uint32_t& cur, uint32_t& curParent, uint32_t& curSlot) {
+    const Node8& nd = *reinterpret_cast<const Node8*>(nodeBytes + cur);
+    const __m256 t0x = packetLower(loadPlane(fr.pnx, cur), fr.rlx, fr.rhx, fr.onx), t1x = packetUpper(loadPlane(fr.pfx, cur), fr.rlx, fr.rhx, fr.ofx);
+    const __m256 t0y = packetLower(loadPlane(fr.pny, cur), fr.rly, fr.rhy, fr.ony), t1y = packetUpper(loadPlane(fr.pfy, cur), fr.rly, fr.rhy, fr.ofy);
+    const __m256 t0z = packetLower(loadPlane(fr.pnz, cur), fr.rlz, fr.rhz, fr.onz), t1z = packetUpper(loadPlane(fr.pfz, cur), fr.rlz, fr.rhz, fr.ofz);
+    const __m256i tn =
+        _mm256_max_epi32(_mm256_max_epi32(_mm256_castps_si256(t0x), _mm256_castps_si256(t0y)), _mm256_max_epi32(_mm256_castps_si256(t0z), fr.tmin8i));
+    const __m256i tf = _mm256_min_epi32(_mm256_min_epi32(_mm256_castps_si256(t1x), _mm256_castps_si256(t1y)),
+                                        _mm256_min_epi32(_mm256_castps_si256(t1z), _mm256_castps_si256(tmax8)));
+    unsigned mask = unsigned(_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpgt_epi32(tn, tf)))) ^ 0xFFu;
+    if (mask == 0) return false;
+    alignas(32) float dist[8];
+    _mm256_store_si256(reinterpret_cast<__m256i*>(dist), tn);
+    const unsigned c0 = unsigned(__builtin_ctz(mask));
+    mask &= mask - 1;
+    if (mask == 0) {
+        curParent = cur;
+        curSlot = c0;
+        cur = nd.child[c0];
+        return true;
+    }
+    // Front to back by the packet's entry distance: keys (distance, slot), far first.
+    uint64_t key[8];
+    int k = 0;
+    key[k++] = sortKey(dist[c0], c0);
+    do {
+        const int c = __builtin_ctz(mask);
+        mask &= mask - 1;
+        key[k++] = sortKey(dist[c], uint32_t(c));
+    } while (mask);
+    if (k == 2) {
+        if (key[0] < key[1]) std::swap(key[0], key[1]);
+    } else {
+        sortFarFirst(key, k);
+    }
+    for (int i = 0; i < k - 1; ++i) {
+        const uint32_t s = uint32_t(key[i]);
+        stack[sp++] = {nd.child[s], keyDistance(key[i]), cur, s};
+    }
+    curParent = cur;
+    curSlot = uint32_t(key[k - 1]);
+    cur = nd.child[curSlot];
+    return true;
+}
+
+// Packet ray i against the triangles of a leaf [first, end), exactly as traceTriangles8 tests
+// them (the same packet-pair kernel, the ray broadcast). Returns whether it hit (AnyHit) or found
+// a closer hit (then pr.tmax[i] and hits[i] hold it).
+template <bool AnyHit>
+[[gnu::always_inline]] inline bool intersectLeafRay(const PacketScene& sc, const TriPacket4* first, const TriPacket4* end, PacketRays& pr, int i) {
+    const Ray& r = sc.rays[i];
+    const __m256 o8[3] = {_mm256_set1_ps(r.org.x), _mm256_set1_ps(r.org.y), _mm256_set1_ps(r.org.z)};
+    const __m256 d8[3] = {_mm256_set1_ps(r.dir.x), _mm256_set1_ps(r.dir.y), _mm256_set1_ps(r.dir.z)};
+    const __m256 rtmin = _mm256_set1_ps(pr.tmin[i]);
+    __m256 rtmax = _mm256_set1_ps(pr.tmax[i]);
+    bool hit = false;
+    for (const TriPacket4* p = first; p < end; p += 2) {
+        const bool two = p + 1 < end;
+        __m256 t, u, v;
+        const int hm = intersectPacketPair(p[0], p[two ? 1 : 0], o8, d8, rtmin, rtmax, t, u, v, sc.cullBack) & (two ? 0xFF : 0x0F);
+        if (!hm) continue;
+        if constexpr (AnyHit) {
+            return true;
+        } else {
+            alignas(32) float ta[8], ua[8], va[8];
+            _mm256_store_ps(ta, t);
+            _mm256_store_ps(ua, u);
+            _mm256_store_ps(va, v);
+            if (closestLane(hm, ta, ua, va, sc.prims + 4 * (p - sc.packets), pr.tmax[i], &sc.hits[i])) hit = true;
+            rtmax = _mm256_set1_ps(pr.tmax[i]);
+        }
+    }
+    return hit;
+}
+
+// Leaf cur (its box: slot curSlot of curParent): each packet ray whose own box test passes there
+// tests the leaf's triangles on its own. Hits update found; AnyHit: the ray leaves the packet
+// (pm, groups); closest hit: the packet's tmax shrinks with the rays'.
+template <bool AnyHit>
+[[gnu::always_inline]] inline void intersectLeafRays(const PacketScene& sc, const PacketFrustum& fr, PacketRays& pr, uint32_t cur, uint32_t curParent,
+                                                     uint32_t curSlot, unsigned& groups, uint64_t& pm, uint64_t& found, float& tmaxP, __m256& tmax8) {
+    const Node8& parent = *reinterpret_cast<const Node8*>(reinterpret_cast<const char*>(sc.nodes) + curParent);
+    const TriPacket4* first = sc.packets + ((cur & ~Node8::kLeafBit) >> 3);
+    const TriPacket4* end = first + (cur & 7u);
+    bool shrunk = false;
+    for (unsigned gm = groups; gm; gm &= gm - 1) {
+        const int g = __builtin_ctz(gm);
+        unsigned rm = leafRayMask(parent, curSlot, fr.nx, fr.ny, fr.nz, pr, g) & unsigned(pm >> (8 * g)) & 0xFFu;
+        while (rm) {
+            const int i = 8 * g + __builtin_ctz(rm);
+            rm &= rm - 1;
+            if (intersectLeafRay<AnyHit>(sc, first, end, pr, i)) {
+                found |= uint64_t(1) << i;
+                if constexpr (AnyHit)
+                    pm &= ~(uint64_t(1) << i);
+                else
+                    shrunk = true;
             }
         }
+        if constexpr (AnyHit)
+            if (!((pm >> (8 * g)) & 0xFF)) groups &= ~(1u << g);
+    }
+    if constexpr (!AnyHit) {
+        if (shrunk) {
+            tmaxP = packetTmax(pr, groups);
+            tmax8 = _mm256_set1_ps(tmaxP);
+        }
+    }
+}
+
+// The next stack entry that can still hold a closer hit (any entry, for AnyHit) becomes cur, with
+// its parent and slot; false when none is left.
+template <bool AnyHit>
+[[gnu::always_inline]] inline bool popPacketEntry(const PacketEntry* stack, int& sp, float tmaxP, uint32_t& cur, uint32_t& curParent,
+                                                  uint32_t& curSlot) {
+    for (;;) {
+        if (sp == 0) return false;
+        const PacketEntry& e = stack[--sp];
+        if (AnyHit || e.t <= tmaxP) {
+            cur = e.ref;
+            curParent = e.parent;
+            curSlot = e.slot;
+            return true;
+        }
+    }
+}
+
+// Traces rays[i] for the bits i of `active` (n <= kMaxPacket); hits[i] gets exactly what
+// traceTriangles8 writes for that ray. Rays that do not fit the packet (other direction signs
+// than the first, non-finite data, an empty [tmin, tmax]) are traced one by one. Returns the
+// mask of rays that hit. The phases above are force-inlined: this is one loop, as it was written.
+template <bool AnyHit>
+inline uint64_t tracePacket8(const Node8* nodes, const TriPacket4* packets, const uint32_t* prims, const float* absMax, const Ray* rays, int n,
+                             uint64_t active, TriHit* hits, bool cullBack) {
+    if (n < kMaxPacket) active &= (uint64_t(1) << n) - 1;
+    const PacketScene sc{nodes, packets, prims, absMax, rays, hits, cullBack};
+    PacketRays pr;
+    const PacketGather pg = gatherPacket(rays, n, active, absMax, pr);
+    uint64_t found = traceAlone<AnyHit>(sc, pg.single);
+    if (!pg.pm) return found;
+    if (__builtin_popcountll(pg.pm) == 1) return found | traceAlone<AnyHit>(sc, pg.pm);   // nothing to share
+    uint64_t pm = pg.pm;
+    unsigned groups = packetGroups(pm, (n + 7) / 8);
+    const PacketFrustum fr = makePacketFrustum(pg, absMax, nodes);
+    float tmaxP = pg.tmaxP;
+    __m256 tmax8 = _mm256_set1_ps(tmaxP);
+
+    const char* const nodeBytes = reinterpret_cast<const char*>(nodes);
+    PacketEntry stack[512];
+    int sp = 0;
+    uint32_t cur = 0, curParent = 0, curSlot = 0;
+    for (;;) {
+        const bool inner = !(cur & Node8::kLeafBit);
+        if (inner && cur != 0 && !packetEnters<AnyHit>(sc, fr, pr, cur, curParent, curSlot, groups, pm, found, tmaxP, tmax8)) {
+            if constexpr (AnyHit)
+                if (!pm) return found;
+        } else if (inner) {
+            if (descendPacket(fr, nodeBytes, tmax8, stack, sp, cur, curParent, curSlot)) continue;
+        } else {
+            intersectLeafRays<AnyHit>(sc, fr, pr, cur, curParent, curSlot, groups, pm, found, tmaxP, tmax8);
+            if constexpr (AnyHit)
+                if (!pm) return found;
+        }
+        if (!popPacketEntry<AnyHit>(stack, sp, tmaxP, cur, curParent, curSlot)) return found;
     }
 }
 #endif

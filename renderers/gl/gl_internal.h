@@ -1,0 +1,267 @@
+// gl_internal.h - what the files of the OpenGL 3.3+ core backend ("gl") share (private to
+// renderers/gl/): the shader programs' switches and uniform locations, the GPU cache's records,
+// the render targets, the draw items and the GlRenderer class itself. By file:
+//   gl_programs.cpp   shader programs: embedded GLSL (shaders/) specialised per frame setup
+//                     and per draw's switches, compiled on first use; frame and material uniforms
+//   gl_resources.cpp  GPU cache (meshes, tessellations and textures keyed by id + version, evicted
+//                     when unused), render targets (multisampled / single-sample FBOs, the
+//                     overdraw count target), the frame's draw list, read-back
+//   gl_passes.cpp     the draw passes: opaque (with the visibility attachment), blended,
+//                     wireframe, the overdraw view; frame state, MSAA resolve
+//   gl_renderer.cpp   GlRenderer: context, capabilities, state guard, doRender
+//
+// Conventions (shared with the CPU backends, see renderers/shading.h): lighting in linear
+// space in world coordinates, sRGB8_ALPHA8 targets with GL_FRAMEBUFFER_SRGB, sRGB textures
+// decoded on sampling, two-sided lighting by gl_FrontFacing (glFrontFace(GL_CW) for mirrored
+// instances), fog on the eye-space distance. Gouraud lights the vertices with the albedo
+// factored out (colour = rho * mul + add, see lighting.glsl), so textures still apply per
+// fragment. Lines and points are drawn unlit (base colour x vertex colour + emissive).
+// Texture filters: nearest = GL_NEAREST, bilinear = GL_LINEAR without mipmaps, trilinear =
+// GL_LINEAR_MIPMAP_LINEAR. Draws are sorted nearest first (early depth test on llvmpipe).
+#pragma once
+
+#include "gl/gl_context.h"
+#include "gl/gl_renderer.h"
+#include "renderers/framebuffer.h"
+#include "renderers/renderer.h"
+#include "renderers/tessellate.h"
+#include "scenegraph/frame.h"
+
+#include <glad/gl.h>
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+namespace rnd::gl {
+
+extern const char* const kShader_lighting_glsl;
+extern const char* const kShader_mesh_vert;
+extern const char* const kShader_mesh_frag;
+
+constexpr int kMaxLights = 32;          // lights beyond this are ignored (uniform arrays)
+constexpr int kMaxUnrolledLights = 8;   // more lights: one generic program with a loop
+constexpr uint64_t kEvictAfterFrames = 120;
+constexpr size_t kMaxPrograms = 64;   // beyond this, programs not used by the last frame are deleted
+
+// --- shader programs (gl_programs.cpp) -------------------------------------------------------
+
+// The compile-time switches of a draw (the list at the top of mesh.frag). A program is compiled
+// per frame setup (programKey) and combination of these, on first use.
+struct Features {
+    bool texture = false;                                                                       // base colour texture
+    bool emissiveMap = false, occlusionMap = false, metalRoughMap = false, normalMap = false;   // units 1..4
+    bool specGloss = false;                                                                     // the metal-rough slot holds specular-glossiness
+    bool uv1 = false;                                                                           // some map samples the mesh's uv1
+    bool vertexColors = false;
+    bool unlit = false;
+    sg::AlphaMode alphaMode = sg::AlphaMode::Opaque;
+    bool solid = false;        // the wireframe overlay
+    bool overdraw = false;     // the overdraw view's pass
+    bool visibility = false;   // writes the visibility attachment
+
+    // One character per switch (part of the program's key).
+    bool operator==(const Features&) const = default;
+    std::string key() const {
+        std::string k;
+        for (bool b :
+             {texture, emissiveMap, occlusionMap, metalRoughMap, normalMap, specGloss, uv1, vertexColors, unlit, solid, overdraw, visibility})
+            k += b ? '1' : '0';
+        return k + char('0' + int(alphaMode));
+    }
+};
+
+struct Program {
+    GLuint id = 0;
+    uint64_t frameUniforms = 0;   // the frame whose uniforms (camera, lights, fog) it holds
+    uint64_t lastUsed = 0;        // the frame that last drew with it
+    bool hasMaterial = false;     // lastMaterial's values are in its uniforms
+    sg::Material lastMaterial;
+    // Uniform locations (-1 where this program's switches leave a uniform out).
+    GLint model = -1, normalMatrix = -1, viewProj = -1, view = -1, pointSize = -1;
+    GLint numLights = -1, lightPos = -1, lightDir = -1, lightRad = -1, lightCone = -1;
+    GLint eye = -1, ambient = -1;
+    GLint baseColor = -1, ka = -1, kd = -1, ks = -1, shininess = -1, specTinted = -1, specColor = -1, emissive = -1;
+    GLint texture = -1, solidColor = -1;
+    // Material maps (texture units 1..4: emissive, occlusion, metallic-roughness, normal) and their factors.
+    GLint maps[4] = {-1, -1, -1, -1}, occlusionStrength = -1, metallic = -1, roughness = -1, normalScale = -1;
+    GLint glossiness = -1, uv1Maps = -1;
+    GLint alpha = -1, alphaCutoff = -1;
+    GLint fogColor = -1, fogParams = -1;
+    GLint drawable = -1, primitiveBase = -1;   // visibility output (location 1)
+};
+
+// The frame setup part of a program's key: shading model, reflection model, fog mode and one
+// letter per light (see gl_programs.cpp).
+std::string programKey(const sg::FrameInput& f);
+// Builds the program of frame setup `key` (programKey) with the draw's switches `ft` for frame
+// `f` into p (id and uniform locations). Returns "" or the compiler's or linker's message.
+std::string buildProgram(const std::string& key, const Features& ft, const sg::FrameInput& f, Program& p);
+
+// --- GPU cache and render targets (gl_resources.cpp) -----------------------------------------
+
+// A run of indices drawn with one material (tessellations with per-triangle materials).
+struct IndexRange {
+    GLsizei first = 0, count = 0;
+    int material = -1;   // index into Tessellation::materials, -1 = the drawable's material
+};
+
+struct GpuMesh {
+    uint64_t version = 0;
+    GLuint vao = 0, vbo = 0, ebo = 0;
+    GLuint tbo = 0;    // tangents (attribute 4), only for meshes that have them
+    GLuint u1bo = 0;   // the second UV set (attribute 5), only for meshes that have one
+    GLenum primitive = GL_TRIANGLES;
+    std::vector<IndexRange> ranges;
+    size_t triangles = 0;
+    bool colors = false;     // has vertex colours (else the buffer holds 1s, which no shader reads)
+    sg::vec3 centre{0.0f};   // centre of the local bounding box (front-to-back sorting)
+    bool valid = false;      // false: the mesh failed validation and is skipped
+    uint64_t lastUsed = 0;
+};
+
+struct GpuTexture {
+    uint64_t version = 0;
+    bool srgb = true;
+    GLuint id = 0;
+    uint64_t lastUsed = 0;
+};
+
+void releaseMesh(GpuMesh& m);
+// Builds (or rebuilds) the buffers of `mesh`; triangleMaterial (optional) groups the
+// triangles into per-material index ranges.
+void uploadMesh(GpuMesh& g, const sg::Mesh& mesh, const std::vector<uint16_t>* triangleMaterial);
+// Builds (or rebuilds) texture g from t; false when t holds no image.
+bool uploadTexture(GpuTexture& g, const sg::Texture& t);
+
+struct RenderTarget {
+    int width = 0, height = 0, samples = 0;
+    GLuint fbo = 0, color = 0, depth = 0;
+    GLuint ids = 0;   // RG32UI visibility (drawable, primitive) at attachment 1, when asked
+
+    void release();
+    // (Re)creates the FBO when the size, sample count or visibility changed. Returns "" or the
+    // reason. Only attachment 0 is a draw buffer; the frame enables 1 when it wants ids.
+    std::string ensure(int w, int h, int s, bool withIds = false);
+};
+
+// The overdraw view's target: one R32F colour buffer (no depth), where additive blending of
+// 1.0 per fragment counts fragments exactly (up to 2^24 per pixel).
+struct CountTarget {
+    int width = 0, height = 0;
+    GLuint fbo = 0, count = 0;
+
+    void release();
+    std::string ensure(int w, int h);
+};
+
+// Reads the visibility attachment (drawable, primitive) of `fbo` into `out` (already sized).
+void readVisibility(GLuint fbo, int w, int h, Framebuffer& out);
+
+// --- draws and passes (gl_passes.cpp) ---------------------------------------------------------
+
+// One draw: a cached GPU mesh with a transform and a material (per range for tessellations).
+// Opaque: opaque and masked surfaces, lines, points; Blended: alphaMode BLEND surfaces only;
+// Wireframe: every triangle mesh again as lines (no material changes).
+enum class DrawPass { Opaque, Blended, Wireframe };
+
+struct DrawItem {
+    GpuMesh* gpu = nullptr;
+    const sg::mat4* world = nullptr;
+    sg::mat3 normal{1.0f};
+    bool mirrored = false;
+    const sg::Material* material = nullptr;
+    const std::vector<sg::Material>* rangeMaterials = nullptr;   // tessellation's per-range materials
+    GpuTexture* texture = nullptr;
+    GpuTexture* maps[4] = {nullptr, nullptr, nullptr, nullptr};   // emissive, occlusion, metallic-roughness, normal (units 1..4)
+    uint32_t drawable = 0;                                        // Framebuffer::drawable (PreparedDraw::drawable)
+    bool analytic = false;                                        // tessellated: no primitive index in the visibility
+};
+
+// Makes attachment 1 (visibility) a draw buffer and clears it to "nothing".
+void beginVisibility();
+// Sets the fixed-function state of a frame and clears the target (background is linear; the
+// sRGB framebuffer encodes it).
+void beginFrameState(const sg::RenderSettings& s, GLuint fbo, int w, int h, int samples);
+
+// --- the renderer (gl_renderer.cpp; its members are spread over the files above) --------------
+
+class GlRenderer final : public Renderer {
+public:
+    ~GlRenderer() override { releaseAll(); }
+
+    std::string_view name() const override { return "gl"; }
+    Capabilities capabilities() const override;
+    Device device() const override;
+
+protected:
+    RenderStats doRender(const sg::FrameInput& frame, const RenderConfig& cfg, Framebuffer& target, RenderControl* control) override;
+
+public:
+    GlCacheCounters counters() const {
+        GlCacheCounters c;
+        c.meshUploads = m_meshUploads;
+        c.textureUploads = m_textureUploads;
+        c.meshesCached = m_meshes.size();
+        c.texturesCached = m_textures.size();
+        c.context = m_contextDescription;
+        c.platform = m_platform;
+        return c;
+    }
+
+private:
+    // gl_renderer.cpp
+    std::string prepareContext(bool& madeCurrent);
+    void forgetGLObjects();   // drops names without deleting (their context is gone or not current)
+    void releaseAll();
+    // gl_programs.cpp
+    void beginFramePrograms(const sg::FrameInput& frame, int ssaa, bool visibility);   // the frame useProgram serves
+    Program* programFor(const Features& ft, std::string& error);                       // for this frame; compiles on first use
+    bool useProgram(const Features& ft, std::string& error);                           // makes it m_current, frame uniforms set
+    void setFrameUniforms(const Program& p, const sg::FrameInput& f, int ssaa);
+    void setMaterial(Program& p, const sg::Material& m);
+    Features featuresOf(const DrawItem& it, const sg::Material& m, DrawPass pass) const;
+    // gl_resources.cpp
+    GpuMesh* meshFor(const sg::Mesh& mesh, const std::vector<uint16_t>* triangleMaterial);
+    GpuTexture* textureFor(const sg::TexturePtr& t);
+    std::vector<DrawItem> collectDraws(const sg::FrameInput& frame, int tessellation);   // uploads what is new
+    void bindTextures(const DrawItem& it);
+    void readBack(GLuint fbo, int w, int h, Framebuffer& out);
+    void evict();
+    // gl_passes.cpp
+    uint64_t drawAll(const std::vector<DrawItem>& items, DrawPass pass, sg::CullMode culling, std::string& error);
+    uint64_t drawFramePasses(const std::vector<DrawItem>& items, const sg::RenderSettings& s, std::string& error);
+    uint64_t drawBlendedPass(const std::vector<DrawItem>& items, const sg::RenderSettings& s, std::string& error);
+    void drawWireframePass(const std::vector<DrawItem>& items, const sg::RenderSettings& s, std::string& error);
+    std::string countOverdraw(const std::vector<DrawItem>& items, const sg::RenderSettings& s, int w, int h, Framebuffer& target);
+    void resolveAndRead(int w, int h, int samples, int ssaa, bool visibility, Framebuffer& target);
+
+    std::unique_ptr<GlContext> m_own;         // our headless context, made on first need
+    const void* m_objectsContext = nullptr;   // the context our GL objects live in
+    bool m_loaded = false;
+    std::string m_contextDescription, m_platform;
+    int m_maxSamples = 0, m_maxSize = 0;
+
+    std::unordered_map<std::string, Program> m_programs;   // by programKey() + Features::key()
+    // The frame being drawn: its input, setup key, SSAA factor and what the passes draw.
+    const sg::FrameInput* m_frameInput = nullptr;
+    std::string m_frameKey;
+    int m_ssaa = 1;
+    bool m_visibility = false;      // the target has the visibility attachment
+    bool m_countPass = false;       // drawing the overdraw view's pass
+    Program* m_current = nullptr;   // the program in use and its switches
+    Features m_currentFeatures;
+    static constexpr GLuint kUnknownTexture = ~0u;
+    GLuint m_boundTexture[5] = {kUnknownTexture, kUnknownTexture, kUnknownTexture, kUnknownTexture, kUnknownTexture};   // units 0..4
+    RenderTarget m_target, m_resolve;
+    CountTarget m_overdraw;
+    std::unordered_map<uint64_t, GpuMesh> m_meshes;        // by Mesh::id
+    std::unordered_map<uint64_t, GpuTexture> m_textures;   // by Texture::id
+    TessellationCache m_tess;
+    std::vector<uint8_t> m_readRows;   // read-back rows to flip (without GL_MESA_pack_invert)
+    uint64_t m_frame = 0, m_meshUploads = 0, m_textureUploads = 0;
+};
+
+}   // namespace rnd::gl
