@@ -38,7 +38,12 @@ PixelLine parsePixel(const std::string& line) {
     while (in >> word) {
         if (word == "rgb") in >> p.rgb[0] >> p.rgb[1] >> p.rgb[2];
         if (word == "predicted") in >> p.predicted[0] >> p.predicted[1] >> p.predicted[2];
-        if (word == "node") in >> p.node;
+        if (word == "node") {   // the path may hold spaces ("/red sphere"): up to " triangle"
+            std::string part;
+            in >> p.node;
+            while (in >> part && part != "triangle") p.node += " " + part;
+            if (part == "triangle") in >> p.triangle;
+        }
         if (word == "triangle") in >> p.triangle;
         if (word == "background") p.background = true;
     }
