@@ -5,6 +5,11 @@ target_compile_options(viewer_options INTERFACE -Wall -Wextra $<$<COMPILE_LANGUA
 if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU" AND CMAKE_CXX_COMPILER_VERSION VERSION_LESS 13)
   target_compile_options(viewer_options INTERFACE $<$<COMPILE_LANGUAGE:CXX>:-Wno-restrict>)
 endif()
+# The release preset (./test, CI) builds warning-free. The sanitizer build is not held to it:
+# GCC 12 reports -Wmaybe-uninitialized false positives inside std::variant under ASan.
+if(VIEWER_WERROR)
+  target_compile_options(viewer_options INTERFACE -Werror)
+endif()
 if(VIEWER_NATIVE)
   target_compile_options(viewer_options INTERFACE -march=native)
 endif()
