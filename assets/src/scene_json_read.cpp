@@ -588,8 +588,8 @@ sg::Scene Reader::read() {
     // Older files keep the ambient light at the top level; "settings" has it now (and wins).
     if (auto* v = optional(j, "ambientLight")) {
         s.settings.ambientLight = vec<3>(*v, "/ambientLight");
-        if (std::string err = sg::checkValue(*sg::findParam<sg::RenderSettings>("ambientLight"), s.settings.ambientLight); !err.empty())
-            fail("/ambientLight", "each component must be in [0, 1000]");
+        const sg::Param<sg::RenderSettings>& row = *sg::findParam<sg::RenderSettings>("ambientLight");
+        if (std::string err = sg::checkValue(row, s.settings.ambientLight); !err.empty()) fail("/ambientLight", err.substr(row.key.size() + 2));
     }
     if (auto* v = optional(j, "settings")) readSettings(*v, "/settings", s.settings);
 

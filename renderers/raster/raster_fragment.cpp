@@ -46,18 +46,11 @@ __attribute__((noinline)) float prepareFragment(const TriCache& tc, const FrameC
         if (maps) applyMapsToTerms(terms, mat, ms, f.ambientLight);
         sb.setColor(k, terms.apply(albedo));
     } else {
-        vec3 n;
-        if (tc.faceNormal) {
-            n = tc.n[0];
-        } else {
-            n = bo[0] * tc.n[0] + bo[1] * tc.n[1] + bo[2] * tc.n[2];
-            float len = glm::length(n);
-            n = len > 0 ? n / len : vec3(0, 0, 1);
-            if (ms.hasNormal && d.hasTangents) {   // the map's normal, on the outward side, then flipped back
-                const vec4 tan = bo[0] * d.wtan[v[0]] + bo[1] * d.wtan[v[1]] + bo[2] * d.wtan[v[2]];
-                const vec4 tw(vec3(tan), d.wtan[v[0]].w);
-                n = t.front ? perturbNormal(n, tw, ms.normalTexel, mat.normalScale) : -perturbNormal(-n, tw, ms.normalTexel, mat.normalScale);
-            }
+        vec3 n = tc.normalAt(bo);
+        if (!tc.faceNormal && ms.hasNormal && d.hasTangents) {   // the map's normal, on the outward side, then flipped back
+            const vec4 tan = bo[0] * d.wtan[v[0]] + bo[1] * d.wtan[v[1]] + bo[2] * d.wtan[v[2]];
+            const vec4 tw(vec3(tan), d.wtan[v[0]].w);
+            n = t.front ? perturbNormal(n, tw, ms.normalTexel, mat.normalScale) : -perturbNormal(-n, tw, ms.normalTexel, mat.normalScale);
         }
         const PhongCoefficients coeff = maps ? coefficientsAt(mat, ms) : coefficientsOf(mat);
         if (fc.referenceShading)

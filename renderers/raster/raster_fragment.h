@@ -29,6 +29,15 @@ struct TriCache : PlainTri {
     sg::vec3 simpleSpec, simpleBase;   // ShadeBatch::set's specular colour and ambient + emissive term (simple)
     // slot: the material's ShadeBatch constant block (simple; -1: not added yet)
 
+    // The unit shading normal at barycentrics bo: the face normal (flat, or a mesh without
+    // normals), else the vertex normals mixed and normalised (+z where they cancel).
+    __attribute__((always_inline)) sg::vec3 normalAt(const sg::vec3& bo) const {
+        if (faceNormal) return n[0];
+        const sg::vec3 m = bo[0] * n[0] + bo[1] * n[1] + bo[2] * n[2];
+        const float len = glm::length(m);
+        return len > 0 ? m / len : sg::vec3(0, 0, 1);
+    }
+
     void load(uint32_t newId, const Tri& tri, const Chunk& ch, const FrameContext& fc) {
         id = newId;
         t = &tri;

@@ -30,14 +30,7 @@ inline __attribute__((always_inline)) float prepareSimple(const TriCache& tc, bo
     const FragBary fb = baryAt(tc, i, j);
     const vec3& bo = fb.bo;
     const vec3 pos = bo[0] * tc.p[0] + bo[1] * tc.p[1] + bo[2] * tc.p[2];
-    vec3 n;
-    if (tc.faceNormal) {
-        n = tc.n[0];
-    } else {
-        n = bo[0] * tc.n[0] + bo[1] * tc.n[1] + bo[2] * tc.n[2];
-        float len = glm::length(n);
-        n = len > 0 ? n / len : vec3(0, 0, 1);
-    }
+    const vec3 n = tc.normalAt(bo);
     o.px[k] = pos.x;
     o.py[k] = pos.y;
     o.pz[k] = pos.z;

@@ -421,10 +421,8 @@ Automation::Next Automation::documentCommand(const std::string& cmd, std::istrin
         st.requestOpen(arg);
     } else if (cmd == "save-as") {
         if (arg.empty()) return fail("save-as: no path");
-        std::error_code ec;
-        fs::path folder = st.doc.path.empty() ? fs::current_path(ec) : fs::absolute(st.doc.path, ec).parent_path();
-        fs::path typed = arg;
-        st.saveAs(typed.is_absolute() ? typed : folder / typed);
+        const fs::path typed = arg;
+        st.saveAs(typed.is_absolute() ? typed : st.documentFolder() / typed);
         m_waitFrames = 2;   // a question opens on the next frame
         return Next::Yield;
     } else if (cmd == "answer" && st.ui.replaceOpen) {

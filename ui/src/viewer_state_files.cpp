@@ -182,6 +182,11 @@ SaveOutcome ViewerState::save() {
     return writeScene(doc.path, /*replace=*/true);
 }
 
+fs::path ViewerState::documentFolder() const {
+    std::error_code ec;
+    return doc.path.empty() ? fs::current_path(ec) : fs::absolute(doc.path, ec).parent_path();
+}
+
 SaveOutcome ViewerState::saveAs(const fs::path& path) {
     if (path.empty()) {
         ui.requests.saveAsDialog = true;

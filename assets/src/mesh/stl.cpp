@@ -110,11 +110,7 @@ LoadResult loadStl(const fs::path& path, const std::string& data, Ctx& ctx) {
     }
     if (mesh.indices.empty())
         throw Fail{badFacets ? "no triangles: every facet has a non-finite corner or one with a |coordinate| > 1e30" : "no triangles"};
-    std::vector<std::pair<sg::Mesh, int>> parts;
-    parts.push_back({std::move(mesh), -1});
-    LoadResult r;
-    r.scene = makeScene(path, parts, {}, {});
-    return r;
+    return singleMeshScene(path, std::move(mesh));
 }
 
 }   // namespace assets::detail::meshfile

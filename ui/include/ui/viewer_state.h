@@ -359,6 +359,9 @@ struct ViewerState {
     // Save As with `path` chosen (".json" appended when it has another extension): writes it,
     // or, when the file exists, asks first (ui.replaceOpen) and returns Asked.
     SaveOutcome saveAs(const std::filesystem::path& path);
+    // Where Save As starts and a typed relative path lands: the document's own folder (the
+    // working directory for a document never saved or loaded).
+    std::filesystem::path documentFolder() const;
     // Answers the replace question: Replace writes over the file, Cancel leaves it as it is.
     void confirmReplace(bool replace);
     // Save As closed without a file: an action waiting on the save is dropped.

@@ -25,7 +25,7 @@ void openBrowser(bool saving, ViewerState& st) {
     browser.saving = saving;
     browser.error.clear();
     std::error_code ec;
-    fs::path start = st.doc.path.empty() ? fs::current_path(ec) : fs::absolute(st.doc.path, ec).parent_path();
+    const fs::path start = st.documentFolder();
     // Save As starts in the document's own folder; Open where the browser was last.
     if ((saving && !st.doc.path.empty()) || browser.dir.empty() || !fs::is_directory(browser.dir, ec)) browser.dir = start;
     browser.fileName = saving ? (st.doc.path.empty() ? st.doc.scene.name + ".json" : st.doc.path.stem().string() + ".json") : "";
