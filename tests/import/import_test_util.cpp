@@ -35,8 +35,11 @@ assets::LoadResult timedLoad(const std::filesystem::path& p, double limit, doubl
     EXPECT_LT(dt, limit) << p << " took " << dt << " s (hang guard)";
     return r;
 }
+// One folder per test: CTest runs the tests of one binary as parallel processes, and a folder
+// shared by two of them would be emptied by one while the other reads it.
 std::filesystem::path scratchDir(const std::string& name) {
     auto d = testing_support::outputDir("import") / name;
+    if (const auto* info = ::testing::UnitTest::GetInstance()->current_test_info()) d /= std::string(info->test_suite_name()) + "." + info->name();
     std::error_code ec;
     std::filesystem::remove_all(d, ec);
     std::filesystem::create_directories(d);

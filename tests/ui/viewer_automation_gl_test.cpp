@@ -80,7 +80,7 @@ std::string dump(const ScriptRun& r) {
 }   // namespace
 
 TEST(ViewerAutomationGLTest, EditsUndoAndRedoMoveTheDirtyFlag) {
-    if (!viewer_test::haveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+    if (!viewer_test::haveXvfb()) GTEST_FAIL() << "xvfb-run is missing (apt-get install xvfb): window tests cannot run";
     fs::path dir = sceneFolder("automation_undo");
     ScriptRun r = runScript(dir,
                             "wait\n"
@@ -135,7 +135,7 @@ TEST(ViewerAutomationGLTest, EditsUndoAndRedoMoveTheDirtyFlag) {
 }
 
 TEST(ViewerAutomationGLTest, ClicksReachTheTreeAndTheEditMenu) {
-    if (!viewer_test::haveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+    if (!viewer_test::haveXvfb()) GTEST_FAIL() << "xvfb-run is missing (apt-get install xvfb): window tests cannot run";
     fs::path dir = sceneFolder("automation_click");
     ScriptRun r = runScript(dir,
                             "wait\n"
@@ -162,7 +162,7 @@ TEST(ViewerAutomationGLTest, ClicksReachTheTreeAndTheEditMenu) {
 }
 
 TEST(ViewerAutomationGLTest, OpenAsksAboutUnsavedChangesAndAnswersWork) {
-    if (!viewer_test::haveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+    if (!viewer_test::haveXvfb()) GTEST_FAIL() << "xvfb-run is missing (apt-get install xvfb): window tests cannot run";
     fs::path dir = sceneFolder("automation_open");
     {
         std::ofstream out(dir / "broken.json");
@@ -208,7 +208,7 @@ TEST(ViewerAutomationGLTest, OpenAsksAboutUnsavedChangesAndAnswersWork) {
 // scene asks (Cancel keeps it, Replace writes it); Ctrl+S on an imported file opens Save As
 // instead of writing NAME.obj.json beside it; Ctrl+S on the document's own .json just saves.
 TEST(ViewerAutomationGLTest, SaveAsAndCtrlSNeverReplaceAFileWithoutAsking) {
-    if (!viewer_test::haveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+    if (!viewer_test::haveXvfb()) GTEST_FAIL() << "xvfb-run is missing (apt-get install xvfb): window tests cannot run";
     fs::path dir = sceneFolder("automation_save");
     {
         std::ofstream out(dir / "tri.obj");
@@ -270,7 +270,7 @@ TEST(ViewerAutomationGLTest, SaveAsAndCtrlSNeverReplaceAFileWithoutAsking) {
 }
 
 TEST(ViewerAutomationGLTest, ViewCommandDoesWhatTheViewMenuDoes) {
-    if (!viewer_test::haveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+    if (!viewer_test::haveXvfb()) GTEST_FAIL() << "xvfb-run is missing (apt-get install xvfb): window tests cannot run";
     fs::path dir = sceneFolder("automation_view");
     std::string script = "frames 2\n";
     for (const char* mode : {"split", "split3", "difference", "single"})
@@ -290,7 +290,7 @@ TEST(ViewerAutomationGLTest, ViewCommandDoesWhatTheViewMenuDoes) {
 // greyed-out entry changes nothing. In the three-way split each backend's legend says what its
 // image shows: the counts where it has them, and that it cannot make the view where it has not.
 TEST(ViewerAutomationGLTest, OverdrawAndCostViewsFollowTheCapabilities) {
-    if (!viewer_test::haveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+    if (!viewer_test::haveXvfb()) GTEST_FAIL() << "xvfb-run is missing (apt-get install xvfb): window tests cannot run";
     fs::path dir = sceneFolder("automation_diagnostic");
     const std::string script =
         "wait\nbackend raster\nframes 2\nclick menu/view\nclick view/diagnostic\nclick diagnostic/overdraw\nprint view\n"
@@ -328,7 +328,7 @@ TEST(ViewerAutomationGLTest, OverdrawAndCostViewsFollowTheCapabilities) {
 }
 
 TEST(ViewerAutomationGLTest, BadCommandsFailTheScript) {
-    if (!viewer_test::haveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+    if (!viewer_test::haveXvfb()) GTEST_FAIL() << "xvfb-run is missing (apt-get install xvfb): window tests cannot run";
     fs::path dir = sceneFolder("automation_bad");
     for (const auto& [line, message] : std::vector<std::pair<std::string, std::string>>{{"answer discard", "no question is pending"},
                                                                                         {"set no.such.setting 1", "unknown setting"},
@@ -348,7 +348,7 @@ TEST(ViewerAutomationGLTest, BadCommandsFailTheScript) {
 // backend; split3 started from raycast shows three different ones; each view keeps its own
 // choice; the figures are written one way (and only say 100% when every pixel is within).
 TEST(ViewerAutomationGLTest, ComparisonDefaultsCompareDifferentBackendsAndEachViewKeepsItsOwn) {
-    if (!viewer_test::haveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+    if (!viewer_test::haveXvfb()) GTEST_FAIL() << "xvfb-run is missing (apt-get install xvfb): window tests cannot run";
     fs::path dir = sceneFolder("automation_compare");
     ScriptRun r = runScript(dir,
                             "wait\n"
@@ -384,7 +384,7 @@ TEST(ViewerAutomationGLTest, ComparisonDefaultsCompareDifferentBackendsAndEachVi
 // (the new scene has a light and a camera); a refused value's message leaves the status bar
 // once the value is valid.
 TEST(ViewerAutomationGLTest, NewSceneThenAddSphereAndRefusalsThatClear) {
-    if (!viewer_test::haveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+    if (!viewer_test::haveXvfb()) GTEST_FAIL() << "xvfb-run is missing (apt-get install xvfb): window tests cannot run";
     fs::path dir = sceneFolder("automation_new_scene");
     ScriptRun r = runScript(dir,
                             "wait\n"
@@ -418,7 +418,7 @@ TEST(ViewerAutomationGLTest, NewSceneThenAddSphereAndRefusalsThatClear) {
 // frame's UI still drew it; the GL error that left in the window's context stayed there, in
 // whatever view came next, until a GL screenshot read it as its own failure.)
 TEST(ViewerAutomationGLTest, ScreenshotAfterAnOrbitSavesEveryShownBackend) {
-    if (!viewer_test::haveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+    if (!viewer_test::haveXvfb()) GTEST_FAIL() << "xvfb-run is missing (apt-get install xvfb): window tests cannot run";
     const std::pair<std::string, std::string> cases[] = {
         {"split", "view split\n"}, {"difference", "view difference\n"}, {"difference_then_split", "view difference\n"}};
     for (const auto& [name, view] : cases) {
@@ -446,7 +446,7 @@ TEST(ViewerAutomationGLTest, ScreenshotAfterAnOrbitSavesEveryShownBackend) {
 // image (it says "rendering...") and no figures, in the single and the split view; once
 // rendered, the new scene's.
 TEST(ViewerAutomationGLTest, AfterALoadNothingOfThePreviousSceneIsShown) {
-    if (!viewer_test::haveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+    if (!viewer_test::haveXvfb()) GTEST_FAIL() << "xvfb-run is missing (apt-get install xvfb): window tests cannot run";
     fs::path dir = sceneFolder("automation_load_clears");
     ScriptRun r = runScript(dir,
                             "wait\n"
@@ -476,7 +476,7 @@ TEST(ViewerAutomationGLTest, AfterALoadNothingOfThePreviousSceneIsShown) {
 // big or off the screen, or a window.txt that does not parse, still gives a window that fits;
 // a run sized by --window-size is not remembered.
 TEST(ViewerAutomationGLTest, WindowFitsASmallScreenAndRemembersItsSize) {
-    if (!viewer_test::haveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+    if (!viewer_test::haveXvfb()) GTEST_FAIL() << "xvfb-run is missing (apt-get install xvfb): window tests cannot run";
     fs::path dir = sceneFolder("automation_window");
     auto fits = [](const std::string& line) {
         int x, y, w, h, ax, ay, aw, ah;
@@ -517,7 +517,7 @@ TEST(ViewerAutomationGLTest, WindowFitsASmallScreenAndRemembersItsSize) {
 // have): the orbit pivot is on the model, so an orbit keeps it in view; keypad 7 looks down,
 // keypad 5 switches to orthographic; the panels follow the window and Viewport only hides them.
 TEST(ViewerAutomationGLTest, OrbitStaysOnTheModelAndTheLayoutFollowsTheWindow) {
-    if (!viewer_test::haveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+    if (!viewer_test::haveXvfb()) GTEST_FAIL() << "xvfb-run is missing (apt-get install xvfb): window tests cannot run";
     fs::path dir = sceneFolder("automation_orbit");
     {
         sg::Scene s;
@@ -600,7 +600,7 @@ TEST(ViewerAutomationGLTest, OrbitStaysOnTheModelAndTheLayoutFollowsTheWindow) {
 // At View > UI scale 200% (kept in the config folder) on a 1920x1080 screen the viewport still
 // gets at least half the window.
 TEST(ViewerAutomationGLTest, DoubleUiScaleLeavesTheViewportHalfTheWindow) {
-    if (!viewer_test::haveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+    if (!viewer_test::haveXvfb()) GTEST_FAIL() << "xvfb-run is missing (apt-get install xvfb): window tests cannot run";
     fs::path dir = sceneFolder("automation_ui_scale");
     fs::create_directories(dir / "config" / "sceneviewer");
     ASSERT_EQ(ui::saveUiScale(dir / "config" / "sceneviewer", 2.0f), "");
@@ -616,7 +616,7 @@ TEST(ViewerAutomationGLTest, DoubleUiScaleLeavesTheViewportHalfTheWindow) {
 
 // `viewer FOLDER` (or a file of an unsupported type) opens the demo instead and says why.
 TEST(ViewerAutomationGLTest, APathThatCannotBeOpenedKeepsTheDemoAndSaysWhy) {
-    if (!viewer_test::haveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+    if (!viewer_test::haveXvfb()) GTEST_FAIL() << "xvfb-run is missing (apt-get install xvfb): window tests cannot run";
     fs::path dir = sceneFolder("automation_folder_arg");
     fs::create_directories(dir / "models");
     ScriptRun r = runScript(dir, "frames 2\nprint status\nprint tree\nquit\n", "models");
@@ -631,7 +631,7 @@ TEST(ViewerAutomationGLTest, APathThatCannotBeOpenedKeepsTheDemoAndSaysWhy) {
 // screenshot dialog (as Cancel: nothing is taken), the unsaved-changes question (as Cancel:
 // the edits stay).
 TEST(ViewerAutomationGLTest, EscapeClosesMenusAndDialogs) {
-    if (!viewer_test::haveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+    if (!viewer_test::haveXvfb()) GTEST_FAIL() << "xvfb-run is missing (apt-get install xvfb): window tests cannot run";
     fs::path dir = sceneFolder("automation_escape");
     ScriptRun r = runScript(dir,
                             "frames 2\n"
@@ -672,7 +672,7 @@ TEST(ViewerAutomationGLTest, EscapeClosesMenusAndDialogs) {
 // files and the camera sidecar next to it, never over an existing file. Unticking "as shown"
 // writes the bare image: the two PNGs differ only by the overlay's pixels.
 TEST(ViewerAutomationGLTest, ScreenshotsAsShownAndTheExportFromTheWindow) {
-    if (!viewer_test::haveXvfb()) GTEST_SKIP() << "xvfb-run not installed";
+    if (!viewer_test::haveXvfb()) GTEST_FAIL() << "xvfb-run is missing (apt-get install xvfb): window tests cannot run";
     fs::path dir = sceneFolder("automation_export");
     ScriptRun r = runScript(dir,
                             "wait\n"
