@@ -206,6 +206,7 @@ std::string optionHelp(const sg::Param<T>& p) {
     case sg::ParamKind::Int:
     case sg::ParamKind::Float: out += " (" + sg::formatParamValue(float(p.min)) + ".." + sg::formatParamValue(float(p.max)) + ")"; break;
     case sg::ParamKind::Color: out += ": r,g,b"; break;
+    case sg::ParamKind::Text: break;
     case sg::ParamKind::Choice: {
         size_t width = 0;
         for (const sg::ParamChoice& c : p.choices) width = std::max(width, c.name.size());
@@ -251,6 +252,7 @@ void printManOptions(std::string& out) {
                           : p.kind == sg::ParamKind::Int   ? " N"
                           : p.kind == sg::ParamKind::Float ? " X"
                           : p.kind == sg::ParamKind::Color ? " R,G,B"
+                          : p.kind == sg::ParamKind::Text  ? " TEXT"
                                                            : " NAME";
         out += ".TP\n";
         out += arg ? ".BI " + roff(flagOf(p)) + " \"" + arg + "\"\n" : ".BR " + roff(flagOf(p)) + " \" on|off\"\n";

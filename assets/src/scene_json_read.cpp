@@ -165,7 +165,8 @@ private:
             case sg::ParamKind::Int: value = integer(*v, path, (long long)row.min, (long long)row.max); break;
             case sg::ParamKind::Float: value = number(*v, path); break;
             case sg::ParamKind::Color: value = sg::vec3(vec<3>(*v, path)); break;
-            case sg::ParamKind::Choice: value = string(*v, path); break;
+            case sg::ParamKind::Choice:
+            case sg::ParamKind::Text: value = string(*v, path); break;
             }
             if (row.kind == sg::ParamKind::Choice) {
                 std::string names;

@@ -221,7 +221,7 @@ PixelTerms pixelTerms(const sg::FrameInput& f, const SurfaceAt& s, const std::ve
     }
     if (tex && s.hasUv) rho *= SampledTexture(*tex).sample(s.uv, s.uvDx, s.uvDy);
     t.albedo = rho;
-    const PhongCoefficients c = coefficientsOf(*mat);
+    const SurfaceCoefficients c = coefficientsOf(*mat);
     t.emissive = c.emissive;
     t.lit = !c.unlit && glm::dot(s.normal, s.normal) > 0;
     if (!t.lit) {

@@ -5,6 +5,7 @@
 // linear-to-byte conversion so that no pixel pays for pow().
 #include "renderers/shading.h"
 
+#include "renderers/pbr.h"
 #include "renderers/texture_sampler.h"
 
 #include <algorithm>
@@ -40,8 +41,8 @@ LightSample sampleLight(const DrawLight& light, const vec3& p) {
     return s;
 }
 
-PhongCoefficients coefficientsOf(const Material& m) {
-    PhongCoefficients c;
+SurfaceCoefficients coefficientsOf(const Material& m) {
+    SurfaceCoefficients c;
     c.ka = m.ka;
     c.kd = m.kd;
     c.ks = m.ks;
@@ -50,6 +51,16 @@ PhongCoefficients coefficientsOf(const Material& m) {
     c.unlit = m.unlit;
     c.specularColor = m.specularColor;
     c.emissive = m.emissive;
+    c.metallic = m.metallic;
+    c.roughness = m.roughness;
+    const float f = (m.ior - 1.0f) / (m.ior + 1.0f);
+    c.f0Dielectric = glm::min(f * f * m.specularColorFactor, vec3(1.0f)) * m.specularFactor;
+    c.f90Dielectric = m.specularFactor;
+    c.specularGlossiness = m.specularGlossiness;
+    if (m.specularGlossiness) {   // the importer keeps the specular colour as ks x specularColor
+        c.specularF0 = m.ks * m.specularColor;
+        c.roughness = 1.0f - m.glossiness;
+    }
     return c;
 }
 
@@ -94,11 +105,14 @@ vec3 perturbNormal(const vec3& n, const vec4& t, const vec3& texel, float scale)
     return lp > 1e-12f ? p / lp : n;
 }
 
-PhongCoefficients coefficientsAt(const Material& m, const MapSample& s) {
-    PhongCoefficients c = coefficientsOf(m);
-    c.ka *= 1.0f + m.occlusionStrength * (s.occlusion - 1.0f);
+SurfaceCoefficients coefficientsAt(const Material& m, const MapSample& s) {
+    SurfaceCoefficients c = coefficientsOf(m);
+    c.occlusion = 1.0f + m.occlusionStrength * (s.occlusion - 1.0f);
+    c.ka *= c.occlusion;
     c.emissive *= s.emissive;
     if (s.hasMetallicRoughness && m.specularGlossiness) {
+        c.specularF0 = m.ks * m.specularColor * vec3(s.pbrTexel);
+        c.roughness = 1.0f - m.glossiness * s.pbrTexel.w;
         const vec3 spec = m.ks * m.specularColor * vec3(s.pbrTexel);
         const float ks = std::max({spec.x, spec.y, spec.z});
         c.kd = 1.0f;
@@ -107,6 +121,8 @@ PhongCoefficients coefficientsAt(const Material& m, const MapSample& s) {
         c.specularTinted = false;
         c.shininess = phongFromMetallicRoughness(0.0f, 1.0f - m.glossiness * s.pbrTexel.w).shininess;
     } else if (s.hasMetallicRoughness) {
+        c.metallic = m.metallic * s.metallic;
+        c.roughness = m.roughness * s.roughness;
         const PhongFromPbr p = phongFromMetallicRoughness(m.metallic * s.metallic, m.roughness * s.roughness);
         c.kd = p.kd;
         c.ks = p.ks;
@@ -116,8 +132,8 @@ PhongCoefficients coefficientsAt(const Material& m, const MapSample& s) {
     return c;
 }
 
-void applyMapsToTerms(ShadeTerms& t, const Material& m, const MapSample& s, const vec3& ambient) {
-    if (m.unlit) {
+void applyMapsToTerms(ShadeTerms& t, const Material& m, const MapSample& s, const vec3& ambient, ReflectionModel model) {
+    if (m.unlit || model == ReflectionModel::Pbr) {   // pbr: the occlusion needs per-pixel shading
         t.add += m.emissive * (s.emissive - 1.0f);
         return;
     }
@@ -125,7 +141,7 @@ void applyMapsToTerms(ShadeTerms& t, const Material& m, const MapSample& s, cons
     t.add += m.emissive * (s.emissive - 1.0f);
 }
 
-ShadeTerms lightTerms(const PhongCoefficients& m, const vec3& n, const vec3& v, const LightSample& l, ReflectionModel model) {
+ShadeTerms lightTerms(const SurfaceCoefficients& m, const vec3& n, const vec3& v, const LightSample& l, ReflectionModel model) {
     ShadeTerms t;
     float nl = glm::dot(n, l.toLight);
     if (nl <= 0.0f) return t;
@@ -148,12 +164,13 @@ ShadeTerms lightTerms(const PhongCoefficients& m, const vec3& n, const vec3& v, 
     return t;
 }
 
-bool lightReaches(const DrawLight& light, const vec3& p, const vec3& n) {
-    const LightSample l = sampleLight(light, p);
+bool lightReaches(const DrawLight& light, const vec3& p, const vec3& n, ReflectionModel model) {
+    const LightSample l = model == ReflectionModel::Pbr ? samplePunctualLight(light, p) : sampleLight(light, p);
     return glm::dot(n, l.toLight) > 0.0f && l.radiance != vec3(0.0f);
 }
 
-ShadeTerms shadeTerms(const PhongCoefficients& m, const vec3& p, const vec3& n, const vec3& eye, const FrameInput& f, const float* visible) {
+ShadeTerms shadeTerms(const SurfaceCoefficients& m, const vec3& p, const vec3& n, const vec3& eye, const FrameInput& f, const float* visible,
+                      const ShadeExtras& x) {
     ShadeTerms t;
     if (m.unlit) {
         t.mul = vec3(1.0f);
@@ -163,6 +180,23 @@ ShadeTerms shadeTerms(const PhongCoefficients& m, const vec3& p, const vec3& n, 
     vec3 v = eye - p;
     float len = glm::length(v);
     v = len > 0 ? v / len : vec3(0, 0, 1);
+    if (f.settings.reflection == ReflectionModel::Pbr) {   // renderers/pbr.h
+        const PbrPoint pt = pbrPoint(m, x.albedo);
+        t.add = m.emissive;
+        for (size_t i = 0; i < f.lights.size(); ++i) {
+            if (visible && visible[i] <= 0.0f) continue;
+            ShadeTerms li = pbrLightTerms(pt, n, v, samplePunctualLight(f.lights[i], p));
+            float w = visible ? visible[i] : 1.0f;
+            t.mul += w * li.mul;
+            t.add += w * li.add;
+        }
+        if (x.environment && x.environment->map) {
+            ShadeTerms e = pbrEnvironmentTerms(pt, n, v, *x.environment, m.occlusion);
+            t.mul += e.mul;
+            t.add += e.add;
+        }
+        return t;
+    }
     t.mul = m.ka * f.ambientLight;
     t.add = m.emissive;
     for (size_t i = 0; i < f.lights.size(); ++i) {
@@ -175,8 +209,9 @@ ShadeTerms shadeTerms(const PhongCoefficients& m, const vec3& p, const vec3& n, 
     return t;
 }
 
-vec3 shade(const PhongCoefficients& m, const SurfacePoint& s, const vec3& eye, const FrameInput& f, const float* visible) {
-    return shadeTerms(m, s.position, s.normal, eye, f, visible).apply(s.albedo);
+vec3 shade(const SurfaceCoefficients& m, const SurfacePoint& s, const vec3& eye, const FrameInput& f, const float* visible,
+           const EnvironmentLight* environment) {
+    return shadeTerms(m, s.position, s.normal, eye, f, visible, {s.albedo, environment}).apply(s.albedo);
 }
 
 vec3 applyFog(const RenderSettings& s, const vec3& color, float d) {

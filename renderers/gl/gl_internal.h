@@ -22,6 +22,7 @@
 
 #include "gl/gl_context.h"
 #include "gl/gl_renderer.h"
+#include "renderers/environment.h"
 #include "renderers/framebuffer.h"
 #include "renderers/renderer.h"
 #include "renderers/tessellate.h"
@@ -38,6 +39,7 @@
 namespace rnd::gl {
 
 extern const char* const kShader_lighting_glsl;
+extern const char* const kShader_pbr_glsl;
 extern const char* const kShader_mesh_vert;
 extern const char* const kShader_mesh_frag;
 
@@ -58,16 +60,17 @@ struct Features {
     bool vertexColors = false;
     bool unlit = false;
     sg::AlphaMode alphaMode = sg::AlphaMode::Opaque;
-    bool solid = false;        // the wireframe overlay
-    bool overdraw = false;     // the overdraw view's pass
-    bool visibility = false;   // writes the visibility attachment
+    bool solid = false;         // the wireframe overlay
+    bool overdraw = false;      // the overdraw view's pass
+    bool visibility = false;    // writes the visibility attachment
+    bool environment = false;   // pbr's environment light is bound (units 5 and 6)
 
     // One character per switch (part of the program's key).
     bool operator==(const Features&) const = default;
     std::string key() const {
         std::string k;
-        for (bool b :
-             {texture, emissiveMap, occlusionMap, metalRoughMap, normalMap, specGloss, uv1, vertexColors, unlit, solid, overdraw, visibility})
+        for (bool b : {texture, emissiveMap, occlusionMap, metalRoughMap, normalMap, specGloss, uv1, vertexColors, unlit, solid, overdraw, visibility,
+                       environment})
             k += b ? '1' : '0';
         return k + char('0' + int(alphaMode));
     }
@@ -84,6 +87,9 @@ struct Program {
     GLint numLights = -1, lightPos = -1, lightDir = -1, lightRad = -1, lightCone = -1;
     GLint eye = -1, ambient = -1;
     GLint baseColor = -1, ka = -1, kd = -1, ks = -1, shininess = -1, specTinted = -1, specColor = -1, emissive = -1;
+    // pbr (pbr.glsl): the dielectric's parameters and the environment (units 5 and 6).
+    GLint ior = -1, specularFactor = -1, specularColorFactor = -1, specularGlossiness = -1;
+    GLint envMap = -1, splitSum = -1, envSH = -1, envIntensity = -1, envRotation = -1, envLevels = -1;
     GLint texture = -1, solidColor = -1;
     // Material maps (texture units 1..4: emissive, occlusion, metallic-roughness, normal) and their factors.
     GLint maps[4] = {-1, -1, -1, -1}, occlusionStrength = -1, metallic = -1, roughness = -1, normalScale = -1;
@@ -259,6 +265,15 @@ private:
     CountTarget m_overdraw;
     std::unordered_map<uint64_t, GpuMesh> m_meshes;        // by Mesh::id
     std::unordered_map<uint64_t, GpuTexture> m_textures;   // by Texture::id
+    // pbr's environment light: this frame's (environmentFor), and its textures: the prefiltered
+    // levels as one mipmapped texture (for the map uploaded last) and the split-sum table.
+    EnvironmentLight m_environment;
+    const EnvironmentMap* m_envUploaded = nullptr;
+    GLuint m_envTexture = 0, m_splitSumTexture = 0, m_backgroundProgram = 0, m_backgroundVao = 0;
+    void prepareEnvironment(const sg::FrameInput& frame, RenderStats& stats);
+    void drawEnvironmentBackground(const sg::FrameInput& frame, std::string& error);
+    void releaseEnvironment();   // deletes the objects above (their context current)
+    void forgetEnvironment();    // forgets them (their context is gone)
     TessellationCache m_tess;
     std::vector<uint8_t> m_readRows;   // read-back rows to flip (without GL_MESA_pack_invert)
     uint64_t m_frame = 0, m_meshUploads = 0, m_textureUploads = 0;

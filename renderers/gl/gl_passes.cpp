@@ -110,6 +110,7 @@ uint64_t GlRenderer::drawAll(const std::vector<DrawItem>& items, DrawPass pass, 
 // `error` and stops.
 uint64_t GlRenderer::drawFramePasses(const std::vector<DrawItem>& items, const RenderSettings& s, std::string& error) {
     uint64_t triangles = drawAll(items, DrawPass::Opaque, s.culling, error);
+    if (error.empty() && m_environment.map && m_environment.background && m_frameInput) drawEnvironmentBackground(*m_frameInput, error);
     triangles += drawBlendedPass(items, s, error);
     if (s.wireframe && error.empty()) drawWireframePass(items, s, error);
     glBindVertexArray(0);

@@ -72,7 +72,9 @@ std::string glslEnumDefine(const char* name, const char* prefix, E value) {
     return std::string("#define ") + name + " " + (e ? prefix + v : v) + "\n";
 }
 
-std::string glslSources() { return std::string(gl::kShader_lighting_glsl) + "\n" + gl::kShader_mesh_vert + "\n" + gl::kShader_mesh_frag; }
+std::string glslSources() {
+    return std::string(gl::kShader_pbr_glsl) + "\n" + gl::kShader_lighting_glsl + "\n" + gl::kShader_mesh_vert + "\n" + gl::kShader_mesh_frag;
+}
 
 namespace gl {
 
@@ -118,8 +120,9 @@ std::string buildProgram(const std::string& key, const Features& ft, const Frame
                          flag("HAS_TEXTURE", ft.texture) + flag("HAS_EMISSIVE_MAP", ft.emissiveMap) + flag("HAS_OCCLUSION_MAP", ft.occlusionMap) +
                          flag("HAS_METAL_ROUGH_MAP", ft.metalRoughMap) + flag("HAS_NORMAL_MAP", ft.normalMap) + flag("SPEC_GLOSS", ft.specGloss) +
                          flag("USES_UV", uv) + flag("USES_UV1", uv && ft.uv1) + flag("VERTEX_COLORS", ft.vertexColors) + flag("UNLIT", ft.unlit) +
-                         flag("SOLID", ft.solid) + flag("OVERDRAW", ft.overdraw) + flag("VISIBILITY", ft.visibility);
-    std::string common = prefix + gl::kShader_lighting_glsl + "\n";
+                         flag("SOLID", ft.solid) + flag("OVERDRAW", ft.overdraw) + flag("VISIBILITY", ft.visibility) +
+                         flag("HAS_ENVIRONMENT", ft.environment);
+    std::string common = prefix + gl::kShader_pbr_glsl + "\n" + gl::kShader_lighting_glsl + "\n";
     GLuint vs = 0, fs = 0;
     std::string err = compileShader(GL_VERTEX_SHADER, common + gl::kShader_mesh_vert, vs);
     if (err.empty()) err = compileShader(GL_FRAGMENT_SHADER, common + gl::kShader_mesh_frag, fs);
@@ -165,6 +168,16 @@ std::string buildProgram(const std::string& key, const Features& ft, const Frame
     p.specTinted = loc("uSpecTinted");
     p.specColor = loc("uSpecColor");
     p.emissive = loc("uEmissive");
+    p.ior = loc("uIor");
+    p.specularFactor = loc("uSpecularFactor");
+    p.specularColorFactor = loc("uSpecularColorFactor");
+    p.specularGlossiness = loc("uSpecularGlossiness");
+    p.envMap = loc("uEnvMap");
+    p.splitSum = loc("uSplitSum");
+    p.envSH = loc("uEnvSH");
+    p.envIntensity = loc("uEnvIntensity");
+    p.envRotation = loc("uEnvRotation");
+    p.envLevels = loc("uEnvLevels");
     p.texture = loc("uTexture");
     const char* mapNames[4] = {"uEmissiveMap", "uOcclusionMap", "uMetalRoughMap", "uNormalMap"};
     for (int k = 0; k < 4; ++k) p.maps[k] = loc(mapNames[k]);
@@ -183,6 +196,8 @@ std::string buildProgram(const std::string& key, const Features& ft, const Frame
     glUseProgram(p.id);
     glUniform1i(p.texture, 0);
     for (int k = 0; k < 4; ++k) glUniform1i(p.maps[k], 1 + k);
+    glUniform1i(p.envMap, 5);
+    glUniform1i(p.splitSum, 6);
     return {};
 }
 
@@ -233,6 +248,12 @@ void GlRenderer::setFrameUniforms(const Program& p, const FrameInput& f, int ssa
     glUniform3fv(p.fogColor, 1, &s.fogColor[0]);
     glUniform3f(p.fogParams, s.fogStart, s.fogEnd, s.fogDensity);
     glUniform3fv(p.solidColor, 1, &s.wireframeColor[0]);
+    if (m_environment.map) {
+        glUniform3fv(p.envSH, 9, &m_environment.map->sh()[0][0]);
+        glUniform1f(p.envIntensity, m_environment.intensity);
+        glUniform2f(p.envRotation, m_environment.cosRot, m_environment.sinRot);
+        glUniform1f(p.envLevels, float(EnvironmentMap::kLevels));
+    }
 
     int n = int(std::min<size_t>(f.lights.size(), kMaxLights));
     std::vector<vec4> pos(n), dir(n), rad(n), cone(n);
@@ -242,7 +263,7 @@ void GlRenderer::setFrameUniforms(const Program& p, const FrameInput& f, int ssa
         pos[i] = vec4(l.position, type);
         dir[i] = vec4(l.direction, l.inverseSquare ? 1.0f : 0.0f);
         rad[i] = vec4(l.radiance, 0.0f);
-        cone[i] = vec4(l.cosInner, l.cosOuter, 0.0f, 0.0f);
+        cone[i] = vec4(l.cosInner, l.cosOuter, l.range, 0.0f);
     }
     glUniform1i(p.numLights, n);
     if (n > 0) {
@@ -272,6 +293,10 @@ void GlRenderer::setMaterial(Program& p, const Material& m) {
     glUniform1i(p.specTinted, m.specularTinted ? 1 : 0);
     glUniform3fv(p.specColor, 1, &m.specularColor[0]);
     glUniform3fv(p.emissive, 1, &m.emissive[0]);
+    glUniform1f(p.ior, m.ior);
+    glUniform1f(p.specularFactor, m.specularFactor);
+    glUniform3fv(p.specularColorFactor, 1, &m.specularColorFactor[0]);
+    glUniform1i(p.specularGlossiness, m.specularGlossiness ? 1 : 0);
     glUniform1f(p.alpha, m.alpha);
     glUniform1f(p.alphaCutoff, m.alphaCutoff);
 }
@@ -305,6 +330,7 @@ Features GlRenderer::featuresOf(const DrawItem& it, const Material& m, DrawPass 
         f.uv1 = it.gpu->u1bo != 0 && (m.uv1Maps & used) != 0;
     }
     f.visibility = m_visibility && pass == DrawPass::Opaque;   // the other passes mask attachment 1
+    f.environment = m_environment.map && !f.unlit && m_frameInput && m_frameInput->settings.reflection == sg::ReflectionModel::Pbr;
     return f;
 }
 

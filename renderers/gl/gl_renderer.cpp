@@ -153,6 +153,7 @@ void GlRenderer::forgetGLObjects() {
     m_overdraw = CountTarget{};
     m_meshes.clear();
     m_textures.clear();
+    forgetEnvironment();
     m_loaded = false;
 }
 
@@ -169,6 +170,7 @@ void GlRenderer::releaseAll() {
         for (auto& [id, m] : m_meshes) releaseMesh(m);
         for (auto& [id, t] : m_textures)
             if (t.id) glDeleteTextures(1, &t.id);
+        releaseEnvironment();
     }
     forgetGLObjects();
     if (madeCurrent) m_own->release();
@@ -215,6 +217,7 @@ RenderStats GlRenderer::doRender(const FrameInput& frame, const RenderConfig& cf
     beginFrameState(s, m_target.fbo, rw, rh, samples);
     if (visibility) beginVisibility();
     const std::vector<DrawItem> items = collectDraws(frame, cfg.tessellation);
+    prepareEnvironment(frame, stats);   // pbr: textures on units 5 and 6
     // The programs of this frame (useProgram): its setup, and uniforms set once per program.
     beginFramePrograms(frame, ssaa, visibility);
     struct EndOfFrame {

@@ -43,7 +43,7 @@ __attribute__((noinline)) float prepareFragment(const TriCache& tc, const FrameC
         ShadeTerms terms;
         terms.mul = bo[0] * d.gouraudA[side][v[0]] + bo[1] * d.gouraudA[side][v[1]] + bo[2] * d.gouraudA[side][v[2]];
         terms.add = bo[0] * d.gouraudB[side][v[0]] + bo[1] * d.gouraudB[side][v[1]] + bo[2] * d.gouraudB[side][v[2]];
-        if (maps) applyMapsToTerms(terms, mat, ms, f.ambientLight);
+        if (maps) applyMapsToTerms(terms, mat, ms, f.ambientLight, f.settings.reflection);
         sb.setColor(k, terms.apply(albedo));
     } else {
         vec3 n = tc.normalAt(bo);
@@ -52,9 +52,9 @@ __attribute__((noinline)) float prepareFragment(const TriCache& tc, const FrameC
             const vec4 tw(vec3(tan), d.wtan[v[0]].w);
             n = t.front ? perturbNormal(n, tw, ms.normalTexel, mat.normalScale) : -perturbNormal(-n, tw, ms.normalTexel, mat.normalScale);
         }
-        const PhongCoefficients coeff = maps ? coefficientsAt(mat, ms) : coefficientsOf(mat);
-        if (fc.referenceShading)
-            sb.setColor(k, shade(coeff, SurfacePoint{pos, n, albedo}, f.camera.eye, f));   // rnd::shade itself
+        const SurfaceCoefficients coeff = maps ? coefficientsAt(mat, ms) : coefficientsOf(mat);
+        if (fc.referenceShading || fc.pbr)
+            sb.setColor(k, shade(coeff, SurfacePoint{pos, n, albedo}, f.camera.eye, f, nullptr, fc.environment));   // rnd::shade itself
         else
             sb.set(k, coeff, pos, n, albedo, f.ambientLight);
     }

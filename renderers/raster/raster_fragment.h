@@ -25,7 +25,7 @@ struct TriCache : PlainTri {
     // Plain lit fragment (no vertex colours, textures or maps, not Gouraud, not reference
     // shading): prepareFragment takes the short path with the material's coefficients below.
     bool simple = false;
-    PhongCoefficients coeff;
+    SurfaceCoefficients coeff;
     sg::vec3 simpleSpec, simpleBase;   // ShadeBatch::set's specular colour and ambient + emissive term (simple)
     // slot: the material's ShadeBatch constant block (simple; -1: not added yet)
 
@@ -52,7 +52,7 @@ struct TriCache : PlainTri {
             slot = -1;
             gouraud = f.settings.shading == sg::ShadingModel::Gouraud && !d->gouraudA[0].empty();
             faceNormal = f.settings.shading == sg::ShadingModel::Flat || !d->hasNormals;
-            simple = !gouraud && !fc.referenceShading && !d->hasColors && !(d->texture && d->hasUV) && !(d->hasUV && d->hasMaps());
+            simple = !gouraud && !fc.referenceShading && !fc.pbr && !d->hasColors && !(d->texture && d->hasUV) && !(d->hasUV && d->hasMaps());
             if (simple) {
                 coeff = coefficientsOf(*mat);
                 simple = !coeff.unlit;

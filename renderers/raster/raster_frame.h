@@ -27,6 +27,7 @@
 #include "raster/raster_shading.h"
 #include "raster/srgb_encoder.h"
 #include "raster/tile_kernels.h"
+#include "renderers/environment.h"
 #include "renderers/framebuffer.h"
 #include "renderers/shading.h"
 #include "renderers/texture_sampler.h"
@@ -155,9 +156,11 @@ struct FrameContext {
     int tilesX = 0, tilesY = 0;
     bool msaa = false;
     bool referenceShading = false;
-    bool timing = false;       // VIEWER_RASTER_TIMING=1: print stage times to stderr
-    bool visibility = false;   // fill target.drawable/primitive (one sample per pixel)
-    bool overdraw = false;     // count fragments per pixel into target.overdraw (one sample per pixel)
+    bool pbr = false;                                // settings.reflection == pbr: every fragment by rnd::shade
+    const EnvironmentLight* environment = nullptr;   // pbr's environment light (empty map: none)
+    bool timing = false;                             // VIEWER_RASTER_TIMING=1: print stage times to stderr
+    bool visibility = false;                         // fill target.drawable/primitive (one sample per pixel)
+    bool overdraw = false;                           // count fragments per pixel into target.overdraw (one sample per pixel)
     std::vector<DrawItem>* draws = nullptr;
     std::vector<Chunk>* chunks = nullptr;
 };
@@ -225,7 +228,7 @@ inline int64_t nowNs() { return std::chrono::duration_cast<std::chrono::nanoseco
 
 // Step 2 (raster_vertex.cpp): transforms, outcodes and window coordinates of d's vertices
 // (Gouraud: the lighting terms of both sides too).
-void runVertexStage(DrawItem& d, const sg::FrameInput& f, int width, int height, bool gouraud);
+void runVertexStage(DrawItem& d, const sg::FrameInput& f, int width, int height, bool gouraud, const EnvironmentLight* env);
 
 // Step 3 (raster_setup.cpp): clips, sets up and culls the chunk's triangles and bins them into
 // the tiles (ch.tileStart / ch.items, submission order within each tile).

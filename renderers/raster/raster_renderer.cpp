@@ -179,7 +179,10 @@ private:
             total += d.triCount;
         }
         stats.triangles = total;
-        tbb::parallel_for(size_t(0), draws.size(), [&](size_t i) { runVertexStage(draws[i], frame, width, height, gouraud); });
+        std::string envError;
+        const EnvironmentLight environment = environmentFor(frame.settings, &envError);
+        if (!envError.empty()) stats.config.notes.push_back("environment " + envError + " (lit without it)");
+        tbb::parallel_for(size_t(0), draws.size(), [&](size_t i) { runVertexStage(draws[i], frame, width, height, gouraud, &environment); });
 
         auto tVert = std::chrono::steady_clock::now();
         // 3. triangles
@@ -191,6 +194,8 @@ private:
         fc.tilesY = (height + kTileSize - 1) / kTileSize;
         fc.msaa = msaa;
         fc.referenceShading = m_referenceShading;
+        fc.pbr = frame.settings.reflection == sg::ReflectionModel::Pbr;
+        fc.environment = &environment;
         fc.timing = m_timing;
         fc.visibility = visibility && !msaa;
         fc.overdraw = overdraw && !msaa;
@@ -215,6 +220,11 @@ private:
             return stats;
         }
 
+        if (environment.map && environment.background) {   // pbr: the environment where nothing was drawn
+            const uint8_t bg[3] = {toByteSRGB(frame.settings.background.x), toByteSRGB(frame.settings.background.y),
+                                   toByteSRGB(frame.settings.background.z)};
+            drawEnvironmentBackground(target, frame.camera, environment, bg);
+        }
         auto tTiles = std::chrono::steady_clock::now();
         // 5. lines, points, wireframe
         drawPointsLinesWireframe(prepared, frame, target, 2.0f * float(pointScale));

@@ -62,7 +62,7 @@ struct ShadeBatch {
         cg[i] = c.cg;
         cb[i] = c.cb;
     }
-    // Fills fragment i from a material's coefficients (rnd::PhongCoefficients, or an
+    // Fills fragment i from a material's coefficients (rnd::SurfaceCoefficients, or an
     // sg::Material: the same field names), position, normal, albedo (as rnd::shade sees them).
     template <class Coefficients>
     void set(size_t i, const Coefficients& m, const sg::vec3& p, const sg::vec3& n, const sg::vec3& albedo, const sg::vec3& ambient) {

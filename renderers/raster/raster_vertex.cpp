@@ -17,7 +17,7 @@ using sg::mat4;
 using sg::vec3;
 using sg::vec4;
 
-void runVertexStage(DrawItem& d, const sg::FrameInput& f, int width, int height, bool gouraud) {
+void runVertexStage(DrawItem& d, const sg::FrameInput& f, int width, int height, bool gouraud, const EnvironmentLight* env) {
     const sg::Mesh& m = *d.mesh;
     size_t n = d.perCorner ? m.indices.size() : m.positions.size();
     d.clip.resize(n);
@@ -65,8 +65,10 @@ void runVertexStage(DrawItem& d, const sg::FrameInput& f, int width, int height,
             if (gouraud) {
                 const sg::Material& mat = d.perCorner ? d.materialOf(uint32_t(v / 3)) : d.material;
                 // Gouraud: the model's two albedo-linear terms at the vertex, front and back side.
-                ShadeTerms front = shadeTerms(mat, o.pos, o.nrm, f.camera.eye, f);
-                ShadeTerms back = shadeTerms(mat, o.pos, -o.nrm, f.camera.eye, f);
+                // pbr: with the vertex's albedo (base colour x vertex colour; F0 of metals needs it).
+                const ShadeExtras x{d.hasColors ? mat.baseColor * vec3(m.colors[mi]) : mat.baseColor, env};
+                ShadeTerms front = shadeTerms(mat, o.pos, o.nrm, f.camera.eye, f, nullptr, x);
+                ShadeTerms back = shadeTerms(mat, o.pos, -o.nrm, f.camera.eye, f, nullptr, x);
                 d.gouraudA[0][v] = front.mul;
                 d.gouraudB[0][v] = front.add;
                 d.gouraudA[1][v] = back.mul;

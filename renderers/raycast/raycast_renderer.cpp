@@ -19,6 +19,7 @@
 #include "raycast/camera_rays.h"
 #include "raycast/scene_accel.h"
 #include "renderers/draw_list.h"
+#include "renderers/environment.h"
 #include "renderers/shading.h"
 #include "renderers/texture_sampler.h"
 
@@ -148,6 +149,14 @@ struct Tracer {
         rt::SceneHit hit;
     };
     const FirstHit* firstHit = nullptr;
+    // The pbr model's environment light (null or empty map: none): it lights surfaces and is what
+    // rays that leave the scene see (reflection rays always, camera rays when it is the background).
+    const EnvironmentLight* env = nullptr;
+
+    vec3 missed(const rt::Ray& r, int bounce) const {
+        if (env && env->map && (bounce > 0 || env->background)) return env->backgroundRadiance(glm::normalize(r.dir));
+        return f.settings.background;
+    }
 
     // Surfaces one ray may pass through (cut-outs, blended layers) before it counts as stopped.
     static constexpr int kMaxLayers = 64;
@@ -214,7 +223,7 @@ struct Tracer {
             if (!f.settings.shadows) continue;
             if (points > 0) {
                 bool reaches = false;
-                for (int k = 0; k < points && !reaches; ++k) reaches = lightReaches(f.lights[i], q[k], n[k]);
+                for (int k = 0; k < points && !reaches; ++k) reaches = lightReaches(f.lights[i], q[k], n[k], f.settings.reflection);
                 if (!reaches) continue;
             }
             LightSample ls = sampleLight(f.lights[i], p);
@@ -348,11 +357,11 @@ struct Tracer {
             const float wk[3] = {w0, w1, w2};
             ShadeTerms t;
             for (int k = 0; k < 3; ++k) {
-                ShadeTerms tk = shadeTerms(*mat, P[k], Nv[k], eye, f, vis);
+                ShadeTerms tk = shadeTerms(*mat, P[k], Nv[k], eye, f, vis, {albedoV[k], env});
                 t.mul += wk[k] * tk.mul;
                 t.add += wk[k] * tk.add;
             }
-            if (hasMaps) applyMapsToTerms(t, *mat, ms, f.ambientLight);
+            if (hasMaps) applyMapsToTerms(t, *mat, ms, f.ambientLight, f.settings.reflection);
             color = t.apply(albedo);
             n = w0 * Nv[0] + w1 * Nv[1] + w2 * Nv[2];
             n = glm::length(n) > 0 ? glm::normalize(n) : ng;
@@ -366,8 +375,8 @@ struct Tracer {
                 if (ms.hasNormal && mesh.tangents.size() == mesh.positions.size()) n = mappedNormal(dm, i0, i1, i2, w0, w1, w2, n, back, ms);
             }
             if (!mat->unlit) lightVisibility(p, ng, vis, &p, &n, 1);
-            const PhongCoefficients coeff = hasMaps ? coefficientsAt(*mat, ms) : coefficientsOf(*mat);
-            color = shade(coeff, SurfacePoint{p, n, albedo}, eye, f, mat->unlit ? nullptr : vis);
+            const SurfaceCoefficients coeff = hasMaps ? coefficientsAt(*mat, ms) : coefficientsOf(*mat);
+            color = shade(coeff, SurfacePoint{p, n, albedo}, eye, f, mat->unlit ? nullptr : vis, env);
         }
     }
 
@@ -382,7 +391,7 @@ struct Tracer {
         if (glm::dot(n, r.dir) > 0) n = -n;   // analytic surfaces: face the ray
         ng = n;
         if (!mat->unlit) lightVisibility(p, ng, vis, &p, &n, 1);
-        color = shade(*mat, SurfacePoint{p, n, mat->baseColor}, eye, f, mat->unlit ? nullptr : vis);
+        color = shade(*mat, SurfacePoint{p, n, mat->baseColor}, eye, f, mat->unlit ? nullptr : vis, env);
     }
 
     // The colour seen in the mirror direction at s (dirN: the incoming ray, normalized), the
@@ -414,7 +423,7 @@ struct Tracer {
         rt::SceneHit h;
         rt::Ray r = ray;
         float alpha = 1.0f;
-        if (!firstSurface(r, h, alpha, layer, footprint, bounce == 0 ? cost : nullptr)) return f.settings.background;
+        if (!firstSurface(r, h, alpha, layer, footprint, bounce == 0 ? cost : nullptr)) return missed(r, bounce);
         const bool blended = materialOf(h).alphaMode == AlphaMode::Blend;
         if (blended) alpha = std::clamp(alpha, 0.0f, 1.0f);
         SurfaceRecord* const ownHit = blended ? nullptr : hitPos;
@@ -610,6 +619,9 @@ protected:
         m_accel.update(f);
         stats.triangles = f.triangleCount();
         prepareSamplers(f);
+        std::string envError;
+        m_environment = environmentFor(f.settings, &envError);
+        if (!envError.empty()) stats.config.notes.push_back("environment " + envError + " (lit without it)");
 
         int sx = 1, sy = 1;
         strataOf(cfg, sx, sy);
@@ -678,6 +690,7 @@ private:
                     break;
                 }
                 Tracer tr{f, m_accel, m_textures, m_maps, 0, anyAlpha};
+                tr.env = &m_environment;
                 const int x0 = (ti % tx) * tile, y0 = (ti / tx) * tile;   // y0: framebuffer row (top-down)
                 const int x1 = std::min(x0 + tile, job.w), y1 = std::min(y0 + tile, job.h);
                 if (job.packets) traceCameraPackets(job, m_accel, x0, y0, x1, y1, tileRays, tileHits);
@@ -717,7 +730,8 @@ private:
     // The last frame's samplers per mesh (kept for lightVisibility).
     std::vector<const SampledTexture*> m_textures;
     std::vector<MapSamplers> m_maps;
-    TessellationCache m_tess;   // wireframe of analytic shapes only
+    EnvironmentLight m_environment;   // this frame's (environmentFor)
+    TessellationCache m_tess;         // wireframe of analytic shapes only
 };
 
 }   // namespace

@@ -157,6 +157,7 @@ FrameInput flatten(const Scene& scene, float aspect, NodeId cameraNode) {
             l.inverseSquare = lp->inverseSquare && scene.settings.attenuation;
             l.cosInner = std::cos(radians(std::min(lp->spotInnerDeg, lp->spotOuterDeg)));
             l.cosOuter = std::cos(radians(lp->spotOuterDeg));
+            l.range = lp->range;
             f.lights.push_back(l);
         } else if (!inCsg) {
             DrawAnalytic a;

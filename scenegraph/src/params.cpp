@@ -45,6 +45,9 @@ Param<RenderSettings> aaParam() {
 }
 
 bool fogOn(const RenderSettings& s) { return s.fog != FogMode::Off; }
+bool pbr(const RenderSettings& s) { return s.reflection == ReflectionModel::Pbr; }
+bool notPbr(const RenderSettings& s) { return s.reflection != ReflectionModel::Pbr; }
+bool pbrEnvironment(const RenderSettings& s) { return pbr(s) && s.environment != "none"; }
 bool fogLinear(const RenderSettings& s) { return s.fog == FogMode::Linear; }
 bool fogExponential(const RenderSettings& s) { return s.fog == FogMode::Exp || s.fog == FogMode::Exp2; }
 
@@ -59,8 +62,29 @@ std::vector<Param<RenderSettings>> renderTable() {
                 field<&S::attenuation>("attenuation", "attenuation", "Light attenuation (1/r^2)",
                                        "Honour the inverse-square falloff of lights that have it"),
                 field<&S::ambientLight>("ambientLight", "ambient", "Ambient light",
-                                        "L_ambient: light from everywhere, scaled per material by ka (linear RGB)")
-                    .range(0.0, 1000.0),
+                                        "L_ambient: light from everywhere, scaled per material by ka (linear RGB; Phong and Blinn-Phong)")
+                    .range(0.0, 1000.0)
+                    .when(notPbr),
+            }),
+        inSection<S>(
+            "Environment",
+            {
+                field<&S::environment>("environment.map", "environment", "Environment",
+                                       "Image-based light of the pbr model: none, default (a neutral studio) or an equirectangular .hdr file")
+                    .when(pbr),
+                field<&S::environmentIntensity>("environment.intensity", "environment-intensity", "Intensity", "Scales the environment's radiance")
+                    .range(0.0, 1e5)
+                    .log()
+                    .fmt("%.3f")
+                    .when(pbrEnvironment),
+                field<&S::environmentRotationDeg>("environment.rotation", "environment-rotation", "Rotation",
+                                                  "Turns the environment about the vertical (+y) axis, degrees")
+                    .range(-360.0, 360.0)
+                    .fmt("%.1f deg")
+                    .when(pbrEnvironment),
+                field<&S::environmentBackground>("environment.background", "environment-background", "Show as background",
+                                                 "Draw the environment behind the scene instead of the background colour")
+                    .when(pbrEnvironment),
             }),
         inSection<S>(
             "Fog",
@@ -217,16 +241,27 @@ std::vector<Param<Material>> materialTable() {
                 field<&M::alpha>("alpha", "", "Alpha", "Base colour alpha (x texture and vertex alpha)").range(0.0, 1.0).when(notOpaque),
                 field<&M::alphaCutoff>("alphaCutoff", "", "Alpha cutoff", "Mask: drawn where alpha >= the cutoff").range(0.0, 1.0).when(masked),
             }),
-        // glTF's physically based parameters and map strengths: read and written with the file,
-        // used per texel (docs/math.md, "Material textures"); not in the panel.
+        // glTF's physically based parameters: what the pbr reflection model uses (the panel shows
+        // this section under pbr), and per texel of a metallic-roughness map under Phong
+        // (docs/math.md, "Material textures").
+        inSection<M>(
+            "Physically based",
+            {
+                field<&M::metallic>("metallic", "", "Metallic", "glTF metallic factor: 0 dielectric, 1 metal").range(0.0, 1.0),
+                field<&M::roughness>("roughness", "", "Roughness", "glTF roughness factor (GGX alpha = roughness^2)").range(0.0, 1.0),
+                field<&M::ior>("ior", "", "IOR", "KHR_materials_ior: index of refraction of the dielectric (1.5: F0 = 0.04)").range(1.0, 5.0),
+                field<&M::specularFactor>("specularFactor", "", "Specular", "KHR_materials_specular: strength of the dielectric's specular")
+                    .range(0.0, 1.0),
+                field<&M::specularColorFactor>("specularColorFactor", "", "Specular colour",
+                                               "KHR_materials_specular: tints the dielectric's F0 (linear RGB)")
+                    .range(0.0, 1e4),
+                field<&M::specularGlossiness>("specularGlossiness", "", "", "KHR_materials_pbrSpecularGlossiness material"),
+                field<&M::glossiness>("glossiness", "", "", "Specular-glossiness: glossiness factor").range(0.0, 1.0),
+            }),
         inSection<M>("Maps",
                      {
                          field<&M::occlusionStrength>("occlusionStrength", "", "", "Occlusion map strength").range(0.0, 1.0),
                          field<&M::normalScale>("normalScale", "", "", "Normal map x/y scale").range(-1000.0, 1000.0),
-                         field<&M::metallic>("metallic", "", "", "glTF metallic factor").range(0.0, 1.0),
-                         field<&M::roughness>("roughness", "", "", "glTF roughness factor").range(0.0, 1.0),
-                         field<&M::specularGlossiness>("specularGlossiness", "", "", "KHR_materials_pbrSpecularGlossiness material"),
-                         field<&M::glossiness>("glossiness", "", "", "Specular-glossiness: glossiness factor").range(0.0, 1.0),
                      }),
     });
 }
@@ -245,6 +280,10 @@ std::vector<Param<Light>> lightTable() {
             field<&L::inverseSquare>("inverseSquare", "", "Inverse-square falloff", "Falls off as 1/r^2 (when the scene's attenuation is on)"),
             field<&L::spotInnerDeg>("spotInner", "", "Inner angle", "Spot: full intensity inside (degrees)").range(0.0, 90.0).when(spot),
             field<&L::spotOuterDeg>("spotOuter", "", "Outer angle", "Spot: nothing outside (degrees)").range(0.0, 90.0).when(spot),
+            field<&L::range>("range", "", "Range", "KHR_lights_punctual range: the pbr model fades the light to 0 there (0 = none)")
+                .range(0.0, 1e9)
+                .dragged("%.3f")
+                .when([](const L& l) { return l.type != LightType::Directional; }),
         });
 }
 
@@ -314,6 +353,10 @@ std::string checkValue(std::string_view key, ParamKind kind, double min, double 
     case ParamKind::Choice:
         if (!std::holds_alternative<std::string>(v)) return k + ": expected a name";
         return {};
+    case ParamKind::Text:
+        if (!std::holds_alternative<std::string>(v)) return k + ": expected text";
+        if (std::get<std::string>(v).size() > 4096) return k + ": longer than 4096 characters";
+        return {};
     }
     return {};
 }
@@ -360,6 +403,7 @@ std::optional<ParamValue> parseParamText(ParamKind kind, std::string_view text, 
         return ParamValue(c);
     }
     case ParamKind::Choice:
+    case ParamKind::Text:
         if (s.size() >= 2 && s.front() == '"' && s.back() == '"') s = s.substr(1, s.size() - 2);
         if (s.empty()) {
             error = "expected a name";

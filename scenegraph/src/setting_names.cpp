@@ -14,6 +14,8 @@ constexpr NamedValue<ShadingModel> kShading[] = {
 constexpr NamedValue<ReflectionModel> kReflection[] = {
     {ReflectionModel::Phong, "phong", "Phong", "specular from the mirrored light and the view vector: (r.v)^s"},
     {ReflectionModel::BlinnPhong, "blinn", "Blinn-Phong", "specular from the half vector: (n.h)^s"},
+    {ReflectionModel::Pbr, "pbr", "PBR (glTF)",
+     "glTF 2.0's metal/roughness BRDF (Lambert + GGX, Smith, Schlick), lit by the lights and the environment"},
 };
 constexpr NameAlias<ReflectionModel> kReflectionAliases[] = {{"blinn-phong", ReflectionModel::BlinnPhong}};
 

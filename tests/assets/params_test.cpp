@@ -31,7 +31,7 @@ void expectComplete(std::set<std::string>& flags) {
         ASSERT_TRUE(p.get && p.set);
         if (p.kind == sg::ParamKind::Choice) {
             EXPECT_FALSE(p.choices.empty());
-        } else if (p.kind != sg::ParamKind::Bool) {
+        } else if (p.kind != sg::ParamKind::Bool && p.kind != sg::ParamKind::Text) {
             EXPECT_LT(p.min, p.max);
         }
         EXPECT_EQ(sg::checkValue(p, p.get(defaults)), "") << "the default is outside the row's range";
@@ -55,6 +55,8 @@ sg::ParamValue another(const sg::ParamKind kind, double lo, double hi, const sg:
     case sg::ParamKind::Choice:
         for (const sg::ParamChoice& c : choices)
             if (c.name != std::get<std::string>(v)) return std::string(c.name);
+        break;
+    case sg::ParamKind::Text: return std::get<std::string>(v) == "none" ? std::string("default") : std::string("none");
     }
     return v;
 }

@@ -29,7 +29,7 @@ constexpr int valueCount<sg::ShadingModel>() {
 }
 template <>
 constexpr int valueCount<sg::ReflectionModel>() {
-    return 2;
+    return 3;
 }
 template <>
 constexpr int valueCount<sg::FogMode>() {

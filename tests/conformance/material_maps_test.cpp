@@ -138,7 +138,7 @@ TEST_P(MaterialMaps, OcclusionTextureScalesTheAmbientTermOnly) {
 // Left texel: dielectric (B = 0), rough (G = 255); right: metal (B = 255), rough. With the
 // factors metallic 1, roughness 1: colour = L (kd rho + ks spec), spec = 1, untinted (white)
 // for the dielectric, tinted (rho) for the metal. Gouraud keeps the material's coefficients.
-TEST_P(MaterialMaps, MetallicRoughnessTextureGivesPhongCoefficientsPerTexel) {
+TEST_P(MaterialMaps, MetallicRoughnessTextureGivesSurfaceCoefficientsPerTexel) {
     for (sg::ShadingModel model : kModels) {
         sg::Material m;
         m.baseColor = vec3(0.4f, 0.2f, 0.1f);

@@ -253,7 +253,7 @@ TEST(GlslEnumGuardTest, ShadersHandleEveryEnumValueByName) {
         ++count;
         EXPECT_TRUE(hasWord(name)) << name << " is not handled by the shaders";
     }
-    EXPECT_EQ(count, 3 + 2 + 4 + 3 + 3 + 4);   // shading, reflection, fog, light types, alpha modes, material map bits
+    EXPECT_EQ(count, 3 + 3 + 4 + 3 + 3 + 4);   // shading, reflection, fog, light types, alpha modes, material map bits
     EXPECT_NE(defines.find("#define FOG_EXP2 " + std::to_string(int(sg::FogMode::Exp2))), std::string::npos) << defines;
     EXPECT_NE(defines.find("#define SHADING_GOURAUD " + std::to_string(int(sg::ShadingModel::Gouraud))), std::string::npos) << defines;
     EXPECT_NE(defines.find("#define LIGHT_SPOT " + std::to_string(int(sg::LightType::Spot))), std::string::npos) << defines;
@@ -318,7 +318,7 @@ TEST(ShadeTermsTest, ShadeIsTheTermsAppliedToTheAlbedo) {
 // light's terms are exactly zero for every material and reflection model (so the visibility
 // cannot matter), and it says yes on a fair share of random points, for every light type.
 TEST(ShadeTermsTest, ALightThatDoesNotReachAddsExactlyNothing) {
-    PhongCoefficients m;
+    SurfaceCoefficients m;
     m.ka = 0.3f;
     m.kd = 0.6f;
     m.ks = 0.5f;

@@ -2,10 +2,12 @@
 // known, held against tests/baselines/gl/sample_<name>.png (thresholds of
 // gl_baseline_test.cpp). Agreement between the backends is the sweep's job (tests/sweep);
 // these hold the picture itself, since all three backends were once wrong together (upside-
-// down textures). Each baseline was looked at by eye:
+// down textures). They render with the pbr model in the default environment. Each baseline was
+// looked at by eye:
 //  - BoxTextured: the glTF logo reads upright and unmirrored on the faces in view;
 //  - SpecGlossVsMetalRough: two textured water bottles (labels, red logo, dark caps), not white
-//    silhouettes; the specular-glossiness bottle has golden highlights;
+//    silhouettes; under pbr (how glTF files open) the specular-glossiness bottle and the
+//    metal-roughness one look alike, as the model's authors made them;
 //  - TextureTransformTest: every square shows its arrow/pattern as the model's labels ask
 //    (offset, rotation, scale, texCoord override) - the model's own "correct" layout;
 //  - ClearCoatTest: the normal-mapped rows show their ribs, the labels their text;

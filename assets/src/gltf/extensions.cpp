@@ -39,16 +39,19 @@ int nodeLight(const tinygltf::Node& n) {
     return int(d);
 }
 
+namespace {
+const char* const kSupported[] = {
+    "KHR_materials_unlit", "KHR_texture_transform",  "KHR_lights_punctual",  "KHR_materials_pbrSpecularGlossiness", "KHR_materials_emissive_strength",
+    "KHR_materials_ior",   "KHR_materials_specular", "KHR_mesh_quantization"};   // quantized attributes: any component type is read
+}   // namespace
+
+bool honouredExtension(const std::string& ext) {
+    return std::any_of(std::begin(kSupported), std::end(kSupported), [&](const char* s) { return ext == s; });
+}
+
 std::string checkRequiredExtensions(const tinygltf::Model& model) {
-    static const char* kSupported[] = {"KHR_materials_unlit",
-                                       "KHR_texture_transform",
-                                       "KHR_lights_punctual",
-                                       "KHR_materials_pbrSpecularGlossiness",
-                                       "KHR_materials_emissive_strength",
-                                       "KHR_mesh_quantization"};   // quantized attributes: any component type is read
     for (const std::string& ext : model.extensionsRequired)
-        if (std::none_of(std::begin(kSupported), std::end(kSupported), [&](const char* s) { return ext == s; }))
-            return "requires the unsupported extension " + ext;
+        if (!honouredExtension(ext)) return "requires the unsupported extension " + ext;
     if (model.asset.version.rfind("2.", 0) != 0) return "glTF version '" + model.asset.version + "' is not 2.x";
     return {};
 }

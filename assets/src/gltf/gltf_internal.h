@@ -154,6 +154,8 @@ bool numberArray(const tinygltf::Value& obj, const char* key, size_t n, double* 
 // The node's KHR_lights_punctual light index, -1 without one, -2 when it is not a valid index.
 int nodeLight(const tinygltf::Node& n);
 // Required extensions we cannot honour make the file unloadable (the spec says so). "" or why.
+// Whether the viewer honours this extension (the others are drawn without; one warning).
+bool honouredExtension(const std::string& ext);
 std::string checkRequiredExtensions(const tinygltf::Model& model);
 
 // ---- Validation (validate.cpp) -----------------------------------------------------------------

@@ -184,6 +184,7 @@ std::string convertModel(tinygltf::Model& model, Ctx& ctx, const Progress& progr
     Converter conv(model, ctx, progress);
     conv.file = file;
     conv.scene.name = path.stem().string();
+    conv.scene.settings.reflection = sg::ReflectionModel::Pbr;   // glTF's own material model (the demo and meshes keep Phong)
     conv.textureOf.assign(model.textures.size(), {-2, -2});
     conv.decodedImage.assign(model.images.size(), nullptr);
     conv.imageTried.assign(model.images.size(), 0);
@@ -191,6 +192,10 @@ std::string convertModel(tinygltf::Model& model, Ctx& ctx, const Progress& progr
     conv.meshDone.assign(model.meshes.size(), 0);
     try {
         conv.convertMaterials();
+        std::string ignored;
+        for (const std::string& ext : model.extensionsUsed)
+            if (!honouredExtension(ext)) ignored += (ignored.empty() ? "" : ", ") + ext;
+        if (!ignored.empty()) conv.warnOnce("drawn without the extensions it uses that this viewer does not honour: " + ignored);
         progress.set(0.4f);
         std::string e = conv.buildNodes(chooseRoots(model, file, result));
         if (!e.empty()) return e;

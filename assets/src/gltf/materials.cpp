@@ -203,6 +203,18 @@ void Converter::convertMaterial(size_t i) {
         if (const tinygltf::Value* es = extensionObject(gm.extensions, "KHR_materials_emissive_strength"))
             mat.emissive *= float(std::clamp(numberOr(*es, "emissiveStrength", 1.0), 0.0, 1e6));
     }
+    if (const tinygltf::Value* ior = extensionObject(gm.extensions, "KHR_materials_ior")) {
+        const double v = numberOr(*ior, "ior", 1.5);
+        mat.ior = v >= 1.0 && v <= 5.0 ? float(v) : 1.5f;   // 0 (an infinite ior) and beyond the table's range: the default
+    }
+    if (const tinygltf::Value* sp = extensionObject(gm.extensions, "KHR_materials_specular")) {
+        mat.specularFactor = float(std::clamp(numberOr(*sp, "specularFactor", 1.0), 0.0, 1.0));
+        double c[3] = {1, 1, 1};
+        numberArray(*sp, "specularColorFactor", 3, c);
+        mat.specularColorFactor = glm::clamp(sg::vec3(float(c[0]), float(c[1]), float(c[2])), sg::vec3(0.0f), sg::vec3(1e4f));
+        if (sp->Has("specularTexture") || sp->Has("specularColorTexture"))
+            warnOnce("material " + std::to_string(i) + ": KHR_materials_specular's textures are not honoured (its factors are)");
+    }
     mat.alpha = base.a;   // baseColorFactor.a (diffuseFactor.a); texture and vertex alpha multiply it when drawn
     mat.alphaMode = gm.alphaMode == "BLEND" ? sg::AlphaMode::Blend : gm.alphaMode == "MASK" ? sg::AlphaMode::Mask : sg::AlphaMode::Opaque;
     if (gm.alphaMode != "OPAQUE" && gm.alphaMode != "BLEND" && gm.alphaMode != "MASK")

@@ -85,6 +85,7 @@ sg::Light Converter::light(int li) const {
     if (l.color.size() == 3) o.color = glm::max(sg::vec3(float(l.color[0]), float(l.color[1]), float(l.color[2])), sg::vec3(0.0f));
     o.intensity = float(std::min(l.intensity, 1e6));
     o.inverseSquare = o.type != sg::LightType::Directional;
+    if (o.type != sg::LightType::Directional && std::isfinite(l.range) && l.range > 0) o.range = float(std::min(l.range, 1e9));
     if (o.type == sg::LightType::Spot) {
         o.spotOuterDeg = sg::degrees(float(l.spot.outerConeAngle));
         o.spotInnerDeg = std::min(sg::degrees(float(l.spot.innerConeAngle)), o.spotOuterDeg);

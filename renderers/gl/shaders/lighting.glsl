@@ -1,6 +1,6 @@
-// lighting.glsl - the Phong model of renderers/common/shading.cpp, function for function and
-// name for name (sampleLight, lightTerms, shadeTerms; keep the two in step). Shared by
-// mesh.vert (Gouraud) and mesh.frag (flat, Phong).
+// lighting.glsl - the reflection models of renderers/common/shading.cpp, function for function
+// and name for name (sampleLight, lightTerms, shadeTerms; keep the two in step; pbr's pieces are
+// in pbr.glsl). Shared by mesh.vert (Gouraud) and mesh.frag (flat, Phong).
 //
 // shade() is linear in the albedo rho, so it is evaluated as two terms (ShadeTerms in C++):
 //   colour = rho * mul + add
@@ -20,7 +20,7 @@ uniform int uNumLights;                // lights used by the loop form of LIGHT_
 uniform vec4 uLightPos[MAX_LIGHTS];    // xyz: world position; w: type (LIGHT_POINT ...)
 uniform vec4 uLightDir[MAX_LIGHTS];    // xyz: world direction the light travels; w: 1 = 1/r^2
 uniform vec4 uLightRad[MAX_LIGHTS];    // xyz: radiance (colour * intensity)
-uniform vec4 uLightCone[MAX_LIGHTS];   // x: cos inner, y: cos outer
+uniform vec4 uLightCone[MAX_LIGHTS];   // x: cos inner, y: cos outer, z: range (pbr; 0 = none)
 
 uniform vec3 uEye;          // camera position, world
 uniform vec3 uAmbient;      // L_ambient
@@ -48,6 +48,7 @@ void coefficientsOfMaterial() {
     gSpecTinted = uSpecTinted;
     gSpecColor = uSpecColor;
     gEmissive = uEmissive;
+    pbrCoefficientsOfMaterial(uKs, uSpecColor);   // pbr.glsl
 }
 
 // LIGHT_POINT, LIGHT_DIRECTIONAL, LIGHT_SPOT, SHADING_*, REFLECTION_* and FOG_* are defined by the
@@ -79,10 +80,50 @@ void sampleLight(int i, int type, bool inverseSquare, vec3 p, out vec3 toLight, 
     }
 }
 
+// rnd::samplePunctualLight (pbr): KHR_lights_punctual's range window and spot falloff.
+void samplePunctualLight(int i, int type, bool inverseSquare, vec3 p, out vec3 toLight, out vec3 radiance) {
+    radiance = uLightRad[i].xyz;
+    if (type == LIGHT_DIRECTIONAL) {
+        toLight = -uLightDir[i].xyz;
+        return;
+    }
+    if (type != LIGHT_POINT && type != LIGHT_SPOT) {
+        toLight = vec3(0.0, 1.0, 0.0);
+        radiance = vec3(0.0);
+        return;
+    }
+    vec3 d = uLightPos[i].xyz - p;
+    float dist2 = dot(d, d);
+    float dist = sqrt(dist2);
+    toLight = dist > 0.0 ? d / dist : vec3(0.0, 1.0, 0.0);
+    if (inverseSquare) radiance /= max(dist2, 1e-8);
+    float range = uLightCone[i].z;
+    if (range > 0.0) {
+        float q = dist2 / (range * range);
+        float w = clamp(1.0 - q * q, 0.0, 1.0);
+        radiance *= w * w;
+    }
+    if (type == LIGHT_SPOT) {
+        float scale = 1.0 / max(uLightCone[i].x - uLightCone[i].y, 1e-3);
+        float t = clamp((dot(-toLight, uLightDir[i].xyz) - uLightCone[i].y) * scale, 0.0, 1.0);
+        radiance *= t * t;
+    }
+}
+
+#if REFLECTION == REFLECTION_PBR
+PbrPoint gPbr;   // pbrPoint(gAlbedo), set by shadeTerms for the light calls
+#endif
+
 // lightTerms() of shading.h for light i, added to mul and add; v = unit vector to the eye.
 void lightTerms(int i, int type, bool inverseSquare, vec3 n, vec3 p, vec3 v, inout vec3 mul, inout vec3 add) {
     vec3 l, radiance;
+#if REFLECTION == REFLECTION_PBR
+    samplePunctualLight(i, type, inverseSquare, p, l, radiance);
+    pbrLightTerms(gPbr, n, v, l, radiance, mul, add);
+    return;
+#else
     sampleLight(i, type, inverseSquare, p, l, radiance);
+#endif
     float nl = dot(n, l);
     if (nl <= 0.0) return;
 #if REFLECTION == REFLECTION_PHONG
@@ -92,6 +133,8 @@ void lightTerms(int i, int type, bool inverseSquare, vec3 n, vec3 p, vec3 v, ino
     vec3 h = l + v;
     float hl = length(h);
     float spec = hl > 0.0 ? max(dot(n, h / hl), 0.0) : 0.0;
+#elif REFLECTION == REFLECTION_PBR
+    float spec = 0.0;   // (returned above)
 #else
 #error "REFLECTION: a sg::ReflectionModel value this shader does not handle"
 #endif
@@ -108,7 +151,17 @@ void shadeTerms(vec3 n, vec3 p, out vec3 mul, out vec3 add) {
     vec3 v = uEye - p;
     float len = length(v);
     v = len > 0.0 ? v / len : vec3(0.0, 0.0, 1.0);
+#if REFLECTION == REFLECTION_PBR
+    mul = vec3(0.0);
+    add = gEmissive;
+    gPbr = pbrPoint(gAlbedo);
+    LIGHT_CALLS
+#if HAS_ENVIRONMENT
+    pbrEnvironmentTerms(gPbr, n, v, gOcclusion, mul, add);
+#endif
+#else
     mul = gKa * uAmbient;
     add = gEmissive;
     LIGHT_CALLS
+#endif
 }

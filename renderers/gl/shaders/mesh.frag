@@ -48,9 +48,6 @@ uniform sampler2D uNormalMap;       // tangent-space normal, linear RGB = 0.5 n 
 uniform float uNormalScale;
 uniform int uUv1Maps;               // sg::Material::uv1Maps: MAP_* bits of the maps that sample vUv1
 uniform float uOcclusionStrength;
-uniform float uMetallic;
-uniform float uRoughness;
-uniform float uGlossiness;
 uniform float uAlpha;       // material alpha (x texture alpha x vertex alpha)
 uniform float uAlphaCutoff;
 uniform vec3 uSolidColor;
@@ -142,7 +139,8 @@ void main() {
     coefficientsOfMaterial();
 #if HAS_OCCLUSION_MAP
     float ao = texture(uOcclusionMap, mapUv(MAP_OCCLUSION)).r;
-    gKa *= 1.0 + uOcclusionStrength * (ao - 1.0);
+    gOcclusion = 1.0 + uOcclusionStrength * (ao - 1.0);
+    gKa *= gOcclusion;
 #endif
 #if HAS_EMISSIVE_MAP
     vec3 em = texture(uEmissiveMap, mapUv(MAP_EMISSIVE)).rgb;
@@ -154,6 +152,8 @@ void main() {
 #if HAS_METAL_ROUGH_MAP
     vec4 mr = texture(uMetalRoughMap, mapUv(MAP_METALLIC_ROUGHNESS));
 #if SPEC_GLOSS   // rnd::coefficientsAt, specular-glossiness
+    gSpecularF0 = uKs * uSpecColor * mr.rgb;
+    gRoughness = 1.0 - uGlossiness * mr.a;
     vec3 spec = uKs * uSpecColor * mr.rgb;
     float ks = max(spec.r, max(spec.g, spec.b));
     phongFromMetallicRoughness(0.0, 1.0 - uGlossiness * mr.a);   // for the exponent
@@ -162,6 +162,8 @@ void main() {
     gSpecColor = ks > 0.0 ? spec / ks : vec3(1.0);
     gSpecTinted = false;
 #else
+    gMetallic = uMetallic * mr.b;
+    gRoughness = uRoughness * mr.g;
     phongFromMetallicRoughness(uMetallic * mr.b, uRoughness * mr.g);
 #endif
 #endif
@@ -177,6 +179,7 @@ void main() {
     c = albedo + gEmissive;
 #else
     vec3 mul, add;
+    gAlbedo = albedo;   // pbr: F0 of metals
 #if SHADING == SHADING_FLAT
     // Face normal of the world-space triangle; cross(dp/dx, dp/dy) always points to
     // the side being seen, i.e. it is already flipped toward the viewer.
@@ -187,7 +190,7 @@ void main() {
     // still apply exactly here (applyMapsToTerms): both terms are additive.
     mul = gl_FrontFacing ? vMulFront : vMulBack;
     add = gl_FrontFacing ? vAddFront : vAddBack;
-#if HAS_OCCLUSION_MAP
+#if HAS_OCCLUSION_MAP && REFLECTION != REFLECTION_PBR
     mul -= uKa * uOcclusionStrength * (1.0 - ao) * uAmbient;
 #endif
 #if HAS_EMISSIVE_MAP

@@ -64,6 +64,11 @@ void main() {
     gl_PointSize = uPointSize;
 #if SHADING == SHADING_GOURAUD
     coefficientsOfMaterial();   // the maps apply per fragment (mesh.frag)
+#if VERTEX_COLORS
+    gAlbedo = uBaseColor * aColor.rgb;   // pbr: the vertex's albedo (rnd::ShadeExtras)
+#else
+    gAlbedo = uBaseColor;
+#endif
     float len = length(vNormal);
     vec3 n = len > 0.0 ? vNormal / len : vec3(0.0, 0.0, 1.0);
     shadeTerms(n, world.xyz, vMulFront, vAddFront);

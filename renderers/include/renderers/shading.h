@@ -12,9 +12,13 @@
 
 #include "scenegraph/frame.h"
 
+#include <memory>
+
 #include <cstdint>
 
 namespace rnd {
+
+struct EnvironmentLight;   // renderers/environment.h
 
 struct SurfacePoint {
     sg::vec3 position;   // world
@@ -45,17 +49,27 @@ struct ShadeTerms {
     sg::vec3 apply(const sg::vec3& albedo) const { return albedo * mul + add; }
 };
 
-// The coefficients the local model uses at one surface point: the material's, changed per
+// The coefficients the reflection models use at one surface point: the material's, changed per
 // texel by its occlusion, emissive and metallic-roughness textures (docs/math.md, "Material
-// textures"). Field names as in sg::Material.
-struct PhongCoefficients {
+// textures"). Field names as in sg::Material. Phong and Blinn-Phong read ka ... specularColor;
+// pbr reads metallic ... occlusion (renderers/pbr.h).
+struct SurfaceCoefficients {
     float ka = 0.2f, kd = 0.8f, ks = 0.3f, shininess = 32.0f;
     bool specularTinted = false;
     bool unlit = false;
     sg::vec3 specularColor{1.0f};
     sg::vec3 emissive{0.0f};
+    // pbr: metallic-roughness with the dielectric's F0/F90 (KHR_materials_ior, _specular), or
+    // specular-glossiness (specularF0 and roughness = 1 - glossiness); occlusion scales the
+    // environment light.
+    float metallic = 0.0f, roughness = 1.0f;
+    sg::vec3 f0Dielectric{0.04f};
+    float f90Dielectric = 1.0f;
+    bool specularGlossiness = false;
+    sg::vec3 specularF0{0.04f};
+    float occlusion = 1.0f;
 };
-PhongCoefficients coefficientsOf(const sg::Material& m);
+SurfaceCoefficients coefficientsOf(const sg::Material& m);
 
 // What a material's maps hold at one point, linear: occlusion (R), emissive colour (RGB),
 // roughness (G) and metallic (B); a missing map leaves its neutral value.
@@ -93,37 +107,48 @@ sg::vec3 perturbNormal(const sg::vec3& n, const sg::vec4& t, const sg::vec3& tex
 //   metallic-roughness texture: (kd, ks, n, tint) = phongFromMetallicRoughness(metallic x B, roughness x G);
 //   specular-glossiness texture: spec = ks specularColor (x) RGB, gloss = glossiness x A:
 //   kd = 1, ks = max(spec), specularColor = spec / ks, n = phongFromMetallicRoughness(0, 1 - gloss).n.
-PhongCoefficients coefficientsAt(const sg::Material& m, const MapSample& s);
+SurfaceCoefficients coefficientsAt(const sg::Material& m, const MapSample& s);
 // Gouraud shading lights the vertices with the material's own coefficients; the occlusion and
 // emissive maps still apply per pixel, exactly, because both terms are additive:
 //   mul -= ka (1 - ao_eff) L_ambient,  add += emissive (x) (emissive texel - 1).
 // (The metallic-roughness map needs per-pixel lighting: flat and Phong shading.)
-void applyMapsToTerms(ShadeTerms& t, const sg::Material& m, const MapSample& s, const sg::vec3& ambient);
+// pbr: only the emissive map (the occlusion scales the environment's terms, which Gouraud has
+// summed at the vertices).
+void applyMapsToTerms(ShadeTerms& t, const sg::Material& m, const MapSample& s, const sg::vec3& ambient,
+                      sg::ReflectionModel model = sg::ReflectionModel::Phong);
 
 // One light's terms at world position p with unit normal n (facing the viewer), seen from
 // direction toEye (unit). No ambient, no emissive.
-ShadeTerms lightTerms(const PhongCoefficients& m, const sg::vec3& n, const sg::vec3& toEye, const LightSample& l, sg::ReflectionModel model);
+ShadeTerms lightTerms(const SurfaceCoefficients& m, const sg::vec3& n, const sg::vec3& toEye, const LightSample& l, sg::ReflectionModel model);
 
 // Whether the light can add anything at p with unit normal n: lightTerms() is exactly zero
-// when n.l <= 0 or no radiance arrives (outside a spot's cone), and then the light's
+// when n.l <= 0 or no radiance arrives (outside a spot's cone or range), and then the light's
 // visibility changes nothing (the ray caster skips its shadow ray).
-bool lightReaches(const sg::DrawLight& light, const sg::vec3& p, const sg::vec3& n);
+bool lightReaches(const sg::DrawLight& light, const sg::vec3& p, const sg::vec3& n, sg::ReflectionModel model = sg::ReflectionModel::Phong);
 
-// All of the local model's terms at p with normal n seen from `eye`: ambient + emissive + every
-// light. `lightVisible` (optional) scales light i by a visibility in [0,1] (the ray caster's
-// shadow rays). Unlit materials: mul = 1, add = emissive.
-ShadeTerms shadeTerms(const PhongCoefficients& m, const sg::vec3& p, const sg::vec3& n, const sg::vec3& eye, const sg::FrameInput& f,
-                      const float* lightVisible = nullptr);
+// What the pbr model needs beyond Phong's inputs: the albedo rho (F0 of metals depends on it;
+// Gouraud passes the vertex's) and the environment light (null or empty: none).
+struct ShadeExtras {
+    sg::vec3 albedo{1.0f};
+    const EnvironmentLight* environment = nullptr;
+};
+
+// All of the reflection model's terms at p with normal n seen from `eye`: ambient (Phong) or the
+// environment (pbr) + emissive + every light. `lightVisible` (optional) scales light i by a
+// visibility in [0,1] (the ray caster's shadow rays). Unlit materials: mul = 1, add = emissive.
+ShadeTerms shadeTerms(const SurfaceCoefficients& m, const sg::vec3& p, const sg::vec3& n, const sg::vec3& eye, const sg::FrameInput& f,
+                      const float* lightVisible = nullptr, const ShadeExtras& extras = {});
 inline ShadeTerms shadeTerms(const sg::Material& m, const sg::vec3& p, const sg::vec3& n, const sg::vec3& eye, const sg::FrameInput& f,
-                             const float* lightVisible = nullptr) {
-    return shadeTerms(coefficientsOf(m), p, n, eye, f, lightVisible);
+                             const float* lightVisible = nullptr, const ShadeExtras& extras = {}) {
+    return shadeTerms(coefficientsOf(m), p, n, eye, f, lightVisible, extras);
 }
 
-// The full local model: shadeTerms(...).apply(s.albedo).
-sg::vec3 shade(const PhongCoefficients& m, const SurfacePoint& s, const sg::vec3& eye, const sg::FrameInput& f, const float* lightVisible = nullptr);
-inline sg::vec3 shade(const sg::Material& m, const SurfacePoint& s, const sg::vec3& eye, const sg::FrameInput& f,
-                      const float* lightVisible = nullptr) {
-    return shade(coefficientsOf(m), s, eye, f, lightVisible);
+// The full model: shadeTerms(..., {s.albedo, environment}).apply(s.albedo).
+sg::vec3 shade(const SurfaceCoefficients& m, const SurfacePoint& s, const sg::vec3& eye, const sg::FrameInput& f, const float* lightVisible = nullptr,
+               const EnvironmentLight* environment = nullptr);
+inline sg::vec3 shade(const sg::Material& m, const SurfacePoint& s, const sg::vec3& eye, const sg::FrameInput& f, const float* lightVisible = nullptr,
+                      const EnvironmentLight* environment = nullptr) {
+    return shade(coefficientsOf(m), s, eye, f, lightVisible, environment);
 }
 
 // Fog on eye-space distance d, then clamp.

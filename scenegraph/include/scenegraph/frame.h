@@ -36,6 +36,7 @@ struct DrawLight {
     vec3 radiance{1.0f};                      // colour * intensity
     bool inverseSquare = false;               // 1/r^2 applies (already combined with settings.attenuation)
     float cosInner = 1.0f, cosOuter = 1.0f;   // spot cone
+    float range = 0.0f;                       // Light::range (pbr only; 0 = none)
 };
 
 // CSG tree flattened into an array; leaves are implicit shapes in world space.

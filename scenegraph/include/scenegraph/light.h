@@ -18,6 +18,9 @@ struct Light {
     bool inverseSquare = false;
     float spotInnerDeg = 20.0f;   // full intensity inside
     float spotOuterDeg = 30.0f;   // zero outside, smooth in between
+    // KHR_lights_punctual's range (point and spot): the pbr model fades the light to zero at this
+    // distance by (clamp(1 - (d/range)^4, 0, 1))^2 / d^2; 0 = no range (1/d^2 only).
+    float range = 0.0f;
 
     bool operator==(const Light&) const = default;
 };

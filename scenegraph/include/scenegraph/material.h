@@ -38,6 +38,12 @@ struct Material {
     int metallicRoughnessTexture = -1;   // B: metallic, G: roughness (x the factors below), mapped
     float metallic = 0.0f;               // per texel to kd, ks, shininess, tint by phongFromMetallicRoughness()
     float roughness = 1.0f;
+    // KHR_materials_ior and KHR_materials_specular (the pbr model's dielectric reflectance):
+    //   F0_dielectric = min(((ior - 1)/(ior + 1))^2 specularColorFactor, 1) specularFactor,
+    //   F90_dielectric = specularFactor. ior 1.5 and factors 1 give glTF's core 0.04.
+    float ior = 1.5f;
+    float specularFactor = 1.0f;
+    vec3 specularColorFactor{1.0f};
     // KHR_materials_pbrSpecularGlossiness: metallicRoughnessTexture then holds the
     // specular-glossiness texture (sRGB specular RGB x ks specularColor, linear A x glossiness).
     bool specularGlossiness = false;

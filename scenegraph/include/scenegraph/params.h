@@ -31,9 +31,10 @@
 
 namespace sg {
 
-enum class ParamKind : uint8_t { Bool, Int, Float, Color, Choice };
+// Text: a free string (a file name, or one of a few words the row's help names).
+enum class ParamKind : uint8_t { Bool, Int, Float, Color, Choice, Text };
 
-// A parameter's value: bool, int, float, colour (linear RGB) or a choice by its name.
+// A parameter's value: bool, int, float, colour (linear RGB), a choice by its name or text.
 using ParamValue = std::variant<bool, int, float, vec3, std::string>;
 
 // A renderer feature a parameter needs to have any effect; renderers say which they have
@@ -244,8 +245,10 @@ Param<param_detail::Owner<P>> field(std::string_view key, std::string_view flag,
         p.kind = ParamKind::Float;
     else if constexpr (std::is_same_v<V, vec3>)
         p.kind = ParamKind::Color;
+    else if constexpr (std::is_same_v<V, std::string>)
+        p.kind = ParamKind::Text;
     else {
-        static_assert(std::is_enum_v<V>, "a parameter is bool, int, float, vec3 or an enum with a name table");
+        static_assert(std::is_enum_v<V>, "a parameter is bool, int, float, vec3, std::string or an enum with a name table");
         p.kind = ParamKind::Choice;
         p.choices = param_detail::choicesOf<V>();
     }

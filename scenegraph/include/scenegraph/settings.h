@@ -10,7 +10,10 @@
 namespace sg {
 
 enum class ShadingModel { Flat, Gouraud, Phong };
-enum class ReflectionModel { Phong, BlinnPhong };
+// Phong and BlinnPhong: the seeds' local model with ka, kd, ks and the ambient light. Pbr: glTF
+// 2.0's BRDF (Appendix B) on the material's metallic/roughness parameters, lit by the lights in
+// KHR_lights_punctual's units and by the environment (image-based light); no ambient term.
+enum class ReflectionModel { Phong, BlinnPhong, Pbr };
 enum class FogMode { Off, Linear, Exp, Exp2 };
 enum class AAMode { None, MSAA, SSAA };
 // Back-face culling: Auto culls the back faces of single-sided materials (Material::doubleSided
@@ -35,6 +38,15 @@ struct RenderSettings {
 
     bool attenuation = true;   // honour Light::inverseSquare
     vec3 ambientLight{1.0f};   // L_ambient of docs/math.md (scaled per material by ka)
+
+    // Environment light of the pbr model (image-based light): "none", "default" (a built-in
+    // neutral studio) or the path of an equirectangular Radiance .hdr. Radiance is scaled by
+    // environmentIntensity and turned about the world's +y axis by environmentRotationDeg;
+    // environmentBackground draws it behind the scene instead of the background colour.
+    std::string environment = "default";
+    float environmentIntensity = 1.0f;
+    float environmentRotationDeg = 0.0f;
+    bool environmentBackground = false;
 
     // Anti-aliasing. MSAA: aaRate samples per pixel (2, 4, 8). SSAA: aaRate x aaRate samples
     // per pixel (2 -> 4 spp, 4 -> 16 spp); the ray caster uses aaRate x aaRate jittered rays.

@@ -51,7 +51,15 @@ bool materialEditor(ViewerState& st, sg::NodeId id, int& index) {
     sg::Material m = st.doc.scene.materials[index];
     bool ch = false;
     ch |= ImGui::InputText("Name##mat", &m.name, ImGuiInputTextFlags_EnterReturnsTrue);
-    ch |= paramSection(st, "material", "Phong", m);
+    if (st.doc.scene.settings.reflection == sg::ReflectionModel::Pbr) {
+        // glTF's parameters: base colour, metallic, roughness, ... (ka, kd, ks and n are Phong's).
+        for (std::string_view key : {"baseColor"}) ch |= paramWidget(st, "material", *sg::findParam<sg::Material>(key), m);
+        ch |= paramSection(st, "material", "Physically based", m);
+        for (std::string_view key : {"emissive", "reflectivity", "unlit", "doubleSided"})
+            ch |= paramWidget(st, "material", *sg::findParam<sg::Material>(key), m);
+    } else {
+        ch |= paramSection(st, "material", "Phong", m);
+    }
     int tex = m.diffuseTexture;
     if (ImGui::InputInt("Texture index", &tex)) {
         m.diffuseTexture = std::clamp(tex, -1, int(st.doc.scene.textures.size()) - 1);

@@ -11,6 +11,7 @@
 #include "ui/panels.h"
 
 #include <imgui.h>
+#include <cstdio>
 
 #include <algorithm>
 #include <cmath>
@@ -166,6 +167,16 @@ bool paramWidget(ViewerState& st, const std::string& prefix, const sg::Param<T>&
             ImGui::EndCombo();
         }
         ImGui::PopID();
+        break;
+    }
+    case sg::ParamKind::Text: {
+        // Applied on Enter (a file name typed letter by letter is not a file until then).
+        char buf[1024];
+        std::snprintf(buf, sizeof buf, "%s", std::get<std::string>(v).c_str());
+        if (ImGui::InputText(label.c_str(), buf, sizeof buf, ImGuiInputTextFlags_EnterReturnsTrue)) {
+            v = std::string(buf);
+            changed = std::get<std::string>(v) != std::get<std::string>(p.get(object));
+        }
         break;
     }
     }
