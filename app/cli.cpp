@@ -9,6 +9,7 @@
 #include "assets/image_io.h"
 #include "assets/scene_io.h"
 #include "renderers/diagnostic.h"
+#include "renderers/environment.h"
 #include "renderers/inspect.h"
 #include "renderers/overlay.h"
 #include "renderers/renderer.h"
@@ -121,6 +122,12 @@ std::string applyOverrides(const RenderArgs& a, sg::Scene& scene) {
     if (std::string err = applyTableOverrides(a.settings, s); !err.empty()) return err;
     std::string err = s.validate();
     if (!err.empty()) return "invalid settings: " + err;
+    // An environment file that cannot be read is refused here, not rendered without it.
+    if (s.reflection == sg::ReflectionModel::Pbr && s.environment != "none" && s.environment != "default") {
+        std::string why;
+        rnd::environmentFor(s, &why);
+        if (!why.empty()) return "--environment " + why;
+    }
 
     std::vector<sg::NodeId> cams = scene.cameras();
     if (a.camera >= 0) {

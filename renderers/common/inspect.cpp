@@ -1,6 +1,8 @@
 // inspect.cpp - surfaceAt(), pixelTerms(), normalImage() (see inspect.h).
 #include "renderers/inspect.h"
 
+#include "renderers/pbr.h"
+
 #include "renderers/shading.h"
 #include "renderers/texture_sampler.h"
 #include "scenegraph/camera_model.h"
@@ -214,6 +216,18 @@ PixelTerms pixelTerms(const sg::FrameInput& f, const SurfaceAt& s, const std::ve
         }
     }
     vec3 rho = mat->baseColor;
+    // Where the model is evaluated: the point, or (flat shading) the triangle's first vertex,
+    // with that vertex's albedo for pbr's F0 (as the backends do).
+    vec3 at = s.position, rhoAt = mat->baseColor;
+    if (f.settings.shading == sg::ShadingModel::Flat && s.triangle && mesh && s.drawable <= M) {
+        const uint32_t i0 = mesh->indices[3 * size_t(s.primitive)];
+        at = vec3(f.meshes[s.drawable - 1].world * sg::vec4(mesh->positions[i0], 1.0f));
+        if (mesh->colors.size() == mesh->positions.size()) rhoAt *= vec3(mesh->colors[i0]);
+    } else if (s.triangle && mesh && mesh->colors.size() == mesh->positions.size()) {
+        const uint32_t* i = &mesh->indices[3 * size_t(s.primitive)];
+        const vec3& w = s.barycentric;
+        rhoAt *= w.x * vec3(mesh->colors[i[0]]) + w.y * vec3(mesh->colors[i[1]]) + w.z * vec3(mesh->colors[i[2]]);
+    }
     if (s.triangle && mesh && mesh->colors.size() == mesh->positions.size()) {
         const uint32_t* i = &mesh->indices[3 * size_t(s.primitive)];
         const vec3& w = s.barycentric;
@@ -221,18 +235,39 @@ PixelTerms pixelTerms(const sg::FrameInput& f, const SurfaceAt& s, const std::ve
     }
     if (tex && s.hasUv) rho *= SampledTexture(*tex).sample(s.uv, s.uvDx, s.uvDy);
     t.albedo = rho;
+    if (f.settings.shading != sg::ShadingModel::Flat) rhoAt = rho;
     const SurfaceCoefficients c = coefficientsOf(*mat);
     t.emissive = c.emissive;
     t.lit = !c.unlit && glm::dot(s.normal, s.normal) > 0;
     if (!t.lit) {
         t.beforeFog = rho + c.emissive;
+    } else if (f.settings.reflection == sg::ReflectionModel::Pbr) {
+        // pbr: "ambient" is the environment's share; each light's diffuse is its rho-linear term.
+        vec3 v = f.camera.eye - at;
+        v = glm::length(v) > 0 ? glm::normalize(v) : vec3(0, 0, 1);
+        const PbrPoint pt = pbrPoint(c, rhoAt);
+        const EnvironmentLight env = environmentFor(f.settings);
+        t.ambient = pbrEnvironmentTerms(pt, s.normal, v, env, c.occlusion).apply(rho);
+        t.beforeFog = t.ambient + t.emissive;
+        for (size_t i = 0; i < f.lights.size(); ++i) {
+            const LightSample ls = samplePunctualLight(f.lights[i], at);
+            LightPart part;
+            part.radiance = ls.radiance;
+            part.visibility = i < lightVisibility.size() ? lightVisibility[i] : 1.0f;
+            part.nDotL = std::max(glm::dot(s.normal, ls.toLight), 0.0f);
+            const ShadeTerms lt = pbrLightTerms(pt, s.normal, v, ls);
+            part.diffuse = part.visibility * lt.mul * rho;
+            part.specular = part.visibility * lt.add;
+            t.beforeFog += part.diffuse + part.specular;
+            t.lights.push_back(part);
+        }
     } else {
         t.ambient = c.ka * rho * f.ambientLight;
-        vec3 v = f.camera.eye - s.position;
+        vec3 v = f.camera.eye - at;
         v = glm::length(v) > 0 ? glm::normalize(v) : vec3(0, 0, 1);
         t.beforeFog = t.ambient + t.emissive;
         for (size_t i = 0; i < f.lights.size(); ++i) {
-            const LightSample ls = sampleLight(f.lights[i], s.position);
+            const LightSample ls = sampleLight(f.lights[i], at);
             LightPart part;
             part.radiance = ls.radiance;
             part.visibility = i < lightVisibility.size() ? lightVisibility[i] : 1.0f;

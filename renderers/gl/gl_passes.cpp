@@ -34,7 +34,8 @@ void beginFrameState(const RenderSettings& s, GLuint fbo, int w, int h, int samp
     glDepthFunc(GL_LESS);
     glEnable(GL_PROGRAM_POINT_SIZE);
     glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
-    glCullFace(GL_BACK);   // enabled per material in drawAll (RenderSettings::culling)
+    glCullFace(GL_BACK);                             // enabled per material in drawAll (RenderSettings::culling)
+    glProvokingVertex(GL_FIRST_VERTEX_CONVENTION);   // flat shading's vertex: a triangle's first, as in the CPU backends
     glDisable(GL_CULL_FACE);
     glActiveTexture(GL_TEXTURE0);
 }

@@ -43,6 +43,7 @@ public:
         glGetBooleanv(GL_DEPTH_WRITEMASK, &m_depthMask);
         glGetBooleanv(GL_COLOR_WRITEMASK, m_colorMask);
         glGetFloatv(GL_COLOR_CLEAR_VALUE, m_clearColor);
+        glGetIntegerv(GL_PROVOKING_VERTEX, &m_provoking);
         for (size_t i = 0; i < std::size(kCaps); ++i) m_enabled[i] = glIsEnabled(kCaps[i]);
     }
     ~StateGuard() {
@@ -53,6 +54,7 @@ public:
         glDepthFunc(GLenum(m_depthFunc));
         glCullFace(GLenum(m_cullMode));
         glFrontFace(GLenum(m_frontFace));
+        glProvokingVertex(GLenum(m_provoking));
         glPolygonMode(GL_FRONT_AND_BACK, GLenum(m_polygonMode[0]));
         glPixelStorei(GL_PACK_ALIGNMENT, m_pack);
         glPixelStorei(GL_UNPACK_ALIGNMENT, m_unpack);
@@ -74,6 +76,7 @@ private:
                                        GL_POLYGON_OFFSET_LINE, GL_PROGRAM_POINT_SIZE};
     GLint m_drawFbo = 0, m_readFbo = 0, m_viewport[4] = {}, m_program = 0, m_vao = 0, m_arrayBuffer = 0;
     GLint m_renderbuffer = 0, m_activeTexture = GL_TEXTURE0, m_texture0 = 0, m_pack = 4, m_unpack = 4;
+    GLint m_provoking = GL_LAST_VERTEX_CONVENTION;
     GLint m_polygonMode[2] = {GL_FILL, GL_FILL}, m_frontFace = GL_CCW, m_cullMode = GL_BACK, m_depthFunc = GL_LESS;
     GLboolean m_depthMask = GL_TRUE, m_colorMask[4] = {GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE};
     GLfloat m_clearColor[4] = {};

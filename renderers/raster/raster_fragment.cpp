@@ -38,7 +38,11 @@ __attribute__((noinline)) float prepareFragment(const TriCache& tc, const FrameC
         }
     }
 
-    if (tc.gouraud) {
+    if (tc.flat) {   // one evaluation per triangle (TriCache::faceTerms); occlusion and emission per pixel
+        ShadeTerms terms = tc.faceTerms;
+        if (maps) applyMapsToTerms(terms, mat, ms, f.ambientLight, f.settings.reflection);
+        sb.setColor(k, terms.apply(albedo));
+    } else if (tc.gouraud) {
         int side = t.front ? 0 : 1;
         ShadeTerms terms;
         terms.mul = bo[0] * d.gouraudA[side][v[0]] + bo[1] * d.gouraudA[side][v[1]] + bo[2] * d.gouraudA[side][v[2]];

@@ -22,6 +22,10 @@ struct TriCache : PlainTri {
     const sg::Material* mat = nullptr;
     uint32_t v[3] = {0, 0, 0};
     bool gouraud = false;
+    // Flat shading: the model evaluated once per triangle, at its first vertex with the face
+    // normal (faceTerms); the albedo (texture, vertex colours) still applies per pixel.
+    bool flat = false;
+    ShadeTerms faceTerms;
     // Plain lit fragment (no vertex colours, textures or maps, not Gouraud, not reference
     // shading): prepareFragment takes the short path with the material's coefficients below.
     bool simple = false;
@@ -52,7 +56,9 @@ struct TriCache : PlainTri {
             slot = -1;
             gouraud = f.settings.shading == sg::ShadingModel::Gouraud && !d->gouraudA[0].empty();
             faceNormal = f.settings.shading == sg::ShadingModel::Flat || !d->hasNormals;
-            simple = !gouraud && !fc.referenceShading && !fc.pbr && !d->hasColors && !(d->texture && d->hasUV) && !(d->hasUV && d->hasMaps());
+            flat = f.settings.shading == sg::ShadingModel::Flat && !mat->unlit;
+            simple =
+                !gouraud && !flat && !fc.referenceShading && !fc.pbr && !d->hasColors && !(d->texture && d->hasUV) && !(d->hasUV && d->hasMaps());
             if (simple) {
                 coeff = coefficientsOf(*mat);
                 simple = !coeff.unlit;
@@ -83,6 +89,10 @@ struct TriCache : PlainTri {
             n[0] = len > 0 ? nn / len : sg::vec3(0, 0, 1);
         } else {
             for (int k = 0; k < 3; ++k) n[k] = tri.front ? nv[k] : -nv[k];
+        }
+        if (flat) {   // the first vertex: GL's provoking vertex (glProvokingVertex(GL_FIRST_VERTEX_CONVENTION))
+            const sg::vec3 albedo0 = d->hasColors ? mat->baseColor * sg::vec3(d->mesh->colors[d->meshIndex(v[0])]) : mat->baseColor;
+            faceTerms = shadeTerms(*mat, p[0], n[0], f.camera.eye, f, nullptr, {albedo0, fc.environment});
         }
     }
 };

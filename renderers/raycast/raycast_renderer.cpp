@@ -365,6 +365,14 @@ struct Tracer {
             color = t.apply(albedo);
             n = w0 * Nv[0] + w1 * Nv[1] + w2 * Nv[2];
             n = glm::length(n) > 0 ? glm::normalize(n) : ng;
+        } else if (model == ShadingModel::Flat && !mat->unlit) {
+            // One evaluation per triangle, at its first vertex with the face normal (as the
+            // rasterizers, whose provoking vertex it is); the hit's shadow rays scale the lights.
+            n = ng;
+            lightVisibility(p, ng, vis, &P[0], &ng, 1);
+            ShadeTerms t = shadeTerms(*mat, P[0], ng, eye, f, vis, {albedoV[0], env});
+            if (hasMaps) applyMapsToTerms(t, *mat, ms, f.ambientLight, f.settings.reflection);
+            color = t.apply(albedo);
         } else {
             if (model == ShadingModel::Flat || !hasN)
                 n = ng;

@@ -7,8 +7,9 @@
 //                 (n.v > 0.3, away from the silhouette) equals the formula at the exact sphere
 //                 hit of its camera ray, within 3/255. Flat and Gouraud differ from that by
 //                 construction, so they are checked for what they must be on a coarse 24 x 12
-//                 sphere whose triangles are 15-25 px wide: flat = the formula with the hit
-//                 triangle's face normal at the pixel's point on that triangle; Gouraud = the
+//                 sphere whose triangles are 15-25 px wide: flat = the formula once per
+//                 triangle, at its first vertex with its face normal (the seeds: evaluated
+//                 at one vertex, every fragment takes that colour); Gouraud = the
 //                 formula at the three vertices (vertex normal, vertex position, per-vertex
 //                 view vector), interpolated with the hit's barycentrics (perspective-correct);
 //                 both within 2/255 at pixels >= 1 px from every triangle edge.
@@ -150,7 +151,7 @@ void checkLitSphere(const std::string& backend, ShadingModel shading, Reflection
             if (shading == ShadingModel::Flat) {
                 vec3 n = glm::normalize(glm::cross(P[i1] - P[i0], P[i2] - P[i0]));
                 if (glm::dot(n, eye - p) < 0.0f) n = -n;
-                c = phongRadiance(m, m.baseColor, p, n, eye, f);
+                c = phongRadiance(m, m.baseColor, P[i0], n, eye, f);
             } else {
                 c = bary.x * vertexColour[i0] + bary.y * vertexColour[i1] + bary.z * vertexColour[i2];
             }

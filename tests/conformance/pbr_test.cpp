@@ -19,6 +19,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 
 namespace {
 
@@ -101,7 +102,7 @@ TEST_P(Pbr, CameraFacingQuadsAreAppendixB) {
     };
     const vec3 toLight = glm::normalize(vec3(0.35f, 0.25f, 1.0f));
     const vec3 lux(2.5f);
-    for (sg::ShadingModel model : {sg::ShadingModel::Phong, sg::ShadingModel::Flat}) {
+    for (sg::ShadingModel model : {sg::ShadingModel::Phong}) {   // per pixel (flat: FlatShadingGivesEachTriangleOneColour)
         int i = 0;
         for (const Case& c : cases) {
             sg::Projection p;
@@ -217,6 +218,51 @@ TEST_P(Pbr, DefaultEnvironmentLightsAndCanBeTheBackground) {
     f.settings.environmentBackground = true;
     fb = render(GetParam(), f, "default-env-background");
     EXPECT_GT(fb.pixel(1, 1)[1], 20) << GetParam() << ": the environment behind the sphere";
+}
+
+// Flat shading as the seeds define it: the model evaluated once per triangle (at its first
+// vertex, with the face normal), so every pixel of a triangle has one colour even where a
+// highlight falls on it; Phong and pbr, a shiny sphere under a point light.
+TEST_P(Pbr, FlatShadingGivesEachTriangleOneColour) {
+    for (sg::ReflectionModel reflection : {sg::ReflectionModel::Phong, sg::ReflectionModel::Pbr}) {
+        sg::Projection p;
+        sg::FrameInput f = makeFrame(64, 64, p, vec3(0, 0, 3.2f), vec3(0.0f));
+        f.settings.reflection = reflection;
+        f.settings.shading = sg::ShadingModel::Flat;
+        f.settings.environment = "default";
+        f.ambientLight = vec3(0.1f);
+        f.lights.push_back(point(vec3(1.5f, 1.5f, 3.0f), vec3(1.0f), false));
+        sg::Material m;
+        m.baseColor = vec3(0.7f, 0.4f, 0.2f);
+        m.ks = 0.8f;
+        m.shininess = 40.0f;
+        m.roughness = 0.3f;
+        m.metallic = 0.5f;
+        addMesh(f, sg::primitives::uvSphere(1.0f, 12, 6), m);
+        std::string err;
+        auto r = rnd::makeRenderer(GetParam(), &err);
+        ASSERT_TRUE(r) << err;
+        rnd::Framebuffer fb;
+        rnd::RenderRequest req;
+        req.visibility = true;
+        ASSERT_TRUE(r->render(f, 64, 64, fb, nullptr, req).ok);
+        testing_support::writeImage(fb, "conformance", "flat-" + GetParam() + "-" + std::string(sg::nameOf(reflection)));
+        std::map<uint32_t, std::pair<std::array<int, 3>, std::array<int, 3>>> range;   // primitive -> min, max per channel
+        for (int y = 0; y < 64; ++y)
+            for (int x = 0; x < 64; ++x) {
+                const size_t i = size_t(y) * 64 + size_t(x);
+                if (fb.drawable[i] == 0) continue;
+                auto it = range.try_emplace(fb.primitive[i], std::array<int, 3>{255, 255, 255}, std::array<int, 3>{0, 0, 0}).first;
+                for (int c = 0; c < 3; ++c) {
+                    it->second.first[size_t(c)] = std::min(it->second.first[size_t(c)], int(fb.pixel(x, y)[c]));
+                    it->second.second[size_t(c)] = std::max(it->second.second[size_t(c)], int(fb.pixel(x, y)[c]));
+                }
+            }
+        EXPECT_GT(range.size(), 20u);
+        for (const auto& [prim, mm] : range)
+            for (int c = 0; c < 3; ++c)
+                EXPECT_LE(mm.second[size_t(c)] - mm.first[size_t(c)], 1) << GetParam() << " " << sg::nameOf(reflection) << " triangle " << prim;
+    }
 }
 
 INSTANTIATE_TEST_SUITE_P(EveryBackend, Pbr, ::testing::ValuesIn(rnd::rendererNames()), [](const auto& info) { return info.param; });

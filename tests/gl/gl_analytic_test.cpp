@@ -320,14 +320,13 @@ TEST(GlCacheGLTest, InvalidMeshIsSkipped) {
 
 // Every pixel of a plane lit by a point (1/r^2), a spot (partly inside its cone falloff) and a
 // directional light, with fog, equals rnd::shade() + rnd::applyFog() evaluated on the CPU at
-// the same surface point: the shaders mirror renderers/common/shading.cpp. (A plane has one
-// normal, so flat and Phong shading are both exact; Gouraud is checked at the sphere centre.)
+// the same surface point: the shaders mirror renderers/common/shading.cpp. (Phong shading;
+// flat shading's one colour per triangle is FlatShadingGivesEachTriangleOneColour's.)
 TEST(GlShadingGLTest, PlaneMatchesSharedShadingFunctionEverywhere) {
     const int W = 96, H = 72;
     for (bool generic : {false, true})
-        for (ShadingModel model : {ShadingModel::Phong, ShadingModel::Flat})
+        for (ShadingModel model : {ShadingModel::Phong})
             for (ReflectionModel refl : {ReflectionModel::Phong, ReflectionModel::BlinnPhong}) {
-                if (generic && model == ShadingModel::Flat) continue;
                 FrameInput f = makeFrame(W, H, Projection{}, vec3(0.6f, 0.4f, 4.0f), vec3(0.0f));
                 f.ambientLight = vec3(0.2f, 0.22f, 0.25f);
                 f.settings.shading = model;

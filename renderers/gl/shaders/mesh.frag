@@ -32,6 +32,10 @@ in vec4 vColor;
 #if HAS_NORMAL_MAP
 in vec4 vTangent;
 #endif
+#if SHADING == SHADING_FLAT
+flat in vec3 vFlatPos;
+flat in vec3 vFlatAlbedo;
+#endif
 #if SHADING == SHADING_GOURAUD
 in vec3 vMulFront;
 in vec3 vAddFront;
@@ -181,10 +185,19 @@ void main() {
     vec3 mul, add;
     gAlbedo = albedo;   // pbr: F0 of metals
 #if SHADING == SHADING_FLAT
-    // Face normal of the world-space triangle; cross(dp/dx, dp/dy) always points to
-    // the side being seen, i.e. it is already flipped toward the viewer.
+    // One evaluation per triangle: at its first (provoking) vertex with the face normal and the
+    // material's own coefficients; occlusion and emission maps apply here as for Gouraud.
+    // cross(dp/dx, dp/dy) always points to the side being seen (flipped toward the viewer).
     vec3 n = normalize(cross(dFdx(vWorldPos), dFdy(vWorldPos)));
-    shadeTerms(n, vWorldPos, mul, add);
+    coefficientsOfMaterial();
+    gAlbedo = vFlatAlbedo;
+    shadeTerms(n, vFlatPos, mul, add);
+#if HAS_OCCLUSION_MAP && REFLECTION != REFLECTION_PBR
+    mul -= uKa * uOcclusionStrength * (1.0 - ao) * uAmbient;
+#endif
+#if HAS_EMISSIVE_MAP
+    add += uEmissive * (em - 1.0);
+#endif
 #elif SHADING == SHADING_GOURAUD
     // Lit at the vertices with the material's coefficients; occlusion and emissive maps
     // still apply exactly here (applyMapsToTerms): both terms are additive.

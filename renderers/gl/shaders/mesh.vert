@@ -34,6 +34,10 @@ out vec4 vColor;
 #if HAS_NORMAL_MAP
 out vec4 vTangent;   // world xyz; w: handedness, flipped by a mirroring model matrix
 #endif
+#if SHADING == SHADING_FLAT
+flat out vec3 vFlatPos;      // the provoking (first) vertex: where flat shading evaluates the model
+flat out vec3 vFlatAlbedo;   // and its albedo (pbr: F0 of metals)
+#endif
 #if SHADING == SHADING_GOURAUD
 out vec3 vMulFront;
 out vec3 vAddFront;
@@ -62,6 +66,14 @@ void main() {
 #endif
     gl_Position = uViewProj * world;
     gl_PointSize = uPointSize;
+#if SHADING == SHADING_FLAT
+    vFlatPos = world.xyz;
+#if VERTEX_COLORS
+    vFlatAlbedo = uBaseColor * aColor.rgb;
+#else
+    vFlatAlbedo = uBaseColor;
+#endif
+#endif
 #if SHADING == SHADING_GOURAUD
     coefficientsOfMaterial();   // the maps apply per fragment (mesh.frag)
 #if VERTEX_COLORS
