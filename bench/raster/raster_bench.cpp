@@ -21,12 +21,15 @@
 //               frames of the two alternate (one on 1 thread, one on --threads, ...), so a
 //               change in the machine's load falls on both
 //   cold_ms     ours: the first frame of a new renderer (ours=) vs a warm one (ref=)
+//   pbr_ms      ours: the frame with the pbr model and the default environment (ours=) vs Phong (ref=;
+//               the goal: ratio <= 1.5)
 //   floor_shade the lighting kernel alone (raster_shading.h's shadeBatch on as many fragments as
 //               the scene covers, same lights; ours=) vs the whole raster frame (ref=)
 //   floor_shade_scaling  the same kernel on 1 thread (ours=) vs on --threads (ref=), ratio =
 //               its speed-up: what a compute-bound SIMD loop gets from the extra threads now
 //               (below floor_cpu where the cores share execution units, e.g. SMT siblings)
-// and floor lines per run: what=floor_bw: memory bandwidth (GB/s, read + write of a 256 MiB
+// and per run: what=prefilter_ms: building an environment light from a 2048x1024 image on
+// --threads (goal: under 1000 ms); what=floor_bw: memory bandwidth (GB/s, read + write of a 256 MiB
 // copy) on 1 thread (ours=) and on --threads (ref=); what=floor_cpu: a fixed arithmetic loop
 // per thread, ms on 1 thread (ours=) and on --threads (ref=), ratio = the speed-up this machine
 // gives right now (below --threads when other work shares the cores: no renderer scales better).
@@ -47,6 +50,7 @@
 #include "assets/scene_io.h"
 #include "min_gl.h"
 #include "raster/raster_shading.h"
+#include "renderers/environment.h"
 #include "renderers/renderer.h"
 #include "scenegraph/frame.h"
 #include "scenegraph/scene.h"
@@ -444,6 +448,18 @@ int main(int argc, char** argv) {
         std::printf("bench: scene=all what=floor_bw ours=%.2f ref=%.2f ratio=%.3f\n", bw1, bwN, bwN / bw1);
         const auto [cpu1, cpuN] = computeScaling(threads);
         std::printf("bench: scene=all what=floor_cpu ours=%.2f ref=%.2f ratio=%.3f\n", cpu1, cpuN, threads * cpu1 / cpuN);
+        // Image-based light: building the environment (resample, SH, GGX prefilter) from a
+        // 2048x1024 equirectangular image on --threads, against the 1 s goal.
+        {
+            const std::vector<float> img = rnd::defaultEnvironmentImage(2048, 1024);
+            std::vector<double> ms;
+            for (int i = 0; i < 3; ++i) {
+                auto t0 = std::chrono::steady_clock::now();
+                rnd::EnvironmentMap map("bench", 2048, 1024, img.data());
+                ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+            }
+            std::printf("bench: scene=all what=prefilter_ms ours=%.2f ref=1000 ratio=%.3f\n", median(ms), median(ms) / 1000.0);
+        }
     }
     for (BenchScene& b : scenes) {
         parse(shading, b.scene.settings.shading);
@@ -556,6 +572,17 @@ int main(int argc, char** argv) {
             std::printf("bench: scene=%s what=floor_shade_scaling ours=%.2f ref=%.2f ratio=%.3f\n", n, shade1, shadeN, shade1 / shadeN);
         }
         std::printf("bench: scene=%s what=cold_ms ours=%.2f ref=%.2f ratio=%.3f\n", n, cold, to, cold / to);
+        {
+            // The pbr model lit by the default environment (image-based light) vs the same frame in Phong.
+            FrameInput fp = f;
+            fp.settings.reflection = ReflectionModel::Pbr;
+            fp.settings.environment = "default";
+            rnd::Framebuffer fbP;
+            std::string ep;
+            const Timing p = timeRenderer(*ours, fp, w, h, frames, fbP, ep);
+            if (!ep.empty()) std::fprintf(stderr, "bench: raster pbr failed on %s: %s\n", n, ep.c_str());
+            std::printf("bench: scene=%s what=pbr_ms ours=%.2f ref=%.2f ratio=%.3f\n", n, p.wallMs, to, p.wallMs / to);
+        }
         std::printf("# %s: %zu triangles, %.0f covered pixels, %.2f%% of pixels within 8 of the minimal GL image, warm frame %s the first\n", n,
                     b.triangles, cov, closeToMinimal(fbO), fbCold.color == fbO.color ? "identical to" : "DIFFERS from");
         std::fflush(stdout);

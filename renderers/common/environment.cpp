@@ -154,9 +154,34 @@ void prefilter(const std::vector<EnvironmentMap::Level>& pyramid, float roughnes
 
 }   // namespace
 
+namespace {
+// atan2(y, x) by range reduction to [0, 1] and a degree-11 odd minimax polynomial (error below
+// 1e-5 rad, a fiftieth of a texel of a 1024-wide level): every shaded pixel reads the map.
+float fastAtan2(float y, float x) {
+    const float ax = std::abs(x), ay = std::abs(y);
+    const float mx = std::max(ax, ay), mn = std::min(ax, ay);
+    if (!(mx > 0.0f)) return 0.0f;
+    const float a = mn / mx, s = a * a;
+    float r = ((((-0.0117212f * s + 0.05265332f) * s - 0.11643287f) * s + 0.19354346f) * s - 0.33262348f) * s + 0.99997723f;
+    r *= a;
+    if (ay > ax) r = 1.57079637f - r;
+    if (x < 0.0f) r = 3.14159274f - r;
+    return y < 0.0f ? -r : r;
+}
+// acos(x) as sqrt(1 - |x|) times a degree-7 polynomial (Abramowitz and Stegun 4.4.46, error
+// below 2e-8), mirrored for x < 0.
+float fastAcos(float x) {
+    const float a = std::min(std::abs(x), 1.0f);
+    float p = -0.0012624911f;
+    for (float c : {0.0066700901f, -0.0170881256f, 0.0308918810f, -0.0501743046f, 0.0889789874f, -0.2145988016f, 1.5707963050f}) p = p * a + c;
+    const float r = std::sqrt(1.0f - a) * p;
+    return x < 0.0f ? kPi - r : r;
+}
+}   // namespace
+
 vec2 equirectUv(const vec3& d) {
-    const float u = 0.5f + std::atan2(d.x, -d.z) / (2.0f * kPi);
-    const float v = std::acos(std::clamp(d.y, -1.0f, 1.0f)) / kPi;
+    const float u = 0.5f + fastAtan2(d.x, -d.z) * (1.0f / (2.0f * kPi));
+    const float v = fastAcos(std::clamp(d.y, -1.0f, 1.0f)) * (1.0f / kPi);
     return {u, v};
 }
 
@@ -164,9 +189,11 @@ vec3 sampleLevel(const EnvironmentMap::Level& l, float u, float v) {
     const float x = u * float(l.width) - 0.5f, y = v * float(l.height) - 0.5f;
     const float fx = std::floor(x), fy = std::floor(y);
     const float tx = x - fx, ty = y - fy;
-    auto wrap = [&](int i) { return ((i % l.width) + l.width) % l.width; };
-    auto clampY = [&](int j) { return std::clamp(j, 0, l.height - 1); };
-    const int x0 = wrap(int(fx)), x1 = wrap(int(fx) + 1), y0 = clampY(int(fy)), y1 = clampY(int(fy) + 1);
+    // u in [0, 1] (equirectUv) puts floor(x) in [-1, width - 1]; anything else wraps the slow way.
+    int x0 = int(fx);
+    if (x0 < 0 || x0 >= l.width) x0 = ((x0 % l.width) + l.width) % l.width;
+    const int x1 = x0 + 1 == l.width ? 0 : x0 + 1;
+    const int y0 = std::clamp(int(fy), 0, l.height - 1), y1 = std::min(std::max(int(fy) + 1, 0), l.height - 1);
     auto at = [&](int xx, int yy) {
         const float* p = &l.rgb[(size_t(yy) * size_t(l.width) + size_t(xx)) * 3];
         return vec3(p[0], p[1], p[2]);

@@ -132,7 +132,8 @@ ShadeTerms pbrLightTerms(const PbrPoint& p, const vec3& n, const vec3& v, const 
     const float hl = glm::length(h);
     h = hl > 0.0f ? h / hl : n;
     const float vh = std::max(glm::dot(v, h), 0.0f), nh = std::max(glm::dot(n, h), 0.0f);
-    const vec3 F = p.f0 + (vec3(p.f90) - p.f0) * std::pow(1.0f - vh, 5.0f);
+    const float c = 1.0f - vh, c2 = c * c;
+    const vec3 F = p.f0 + (vec3(p.f90) - p.f0) * (c2 * c2 * c);
     const float a2 = p.alpha * p.alpha;
     const float q = nh * nh * (a2 - 1.0f) + 1.0f;
     const float D = a2 / (kPi * q * q);
