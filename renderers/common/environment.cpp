@@ -275,14 +275,15 @@ std::vector<float> defaultEnvironmentImage(int w, int h) {
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
             const vec3 d = texelDirection(x, y, w, h);
-            // Walls: a grey that brightens toward the horizon; floor darker; ceiling soft white.
+            // Dim grey walls (darker toward the ceiling), a darker floor, and softboxes: what a
+            // metal reflects reads as a metal, a dielectric gets soft light from all around.
             const float up = d.y;
-            vec3 c = up >= 0.0f ? glm::mix(vec3(0.55f, 0.56f, 0.58f), vec3(0.85f, 0.86f, 0.88f), up) : glm::mix(vec3(0.42f), vec3(0.18f), -up);
+            vec3 c = up >= 0.0f ? glm::mix(vec3(0.30f, 0.31f, 0.33f), vec3(0.20f, 0.21f, 0.23f), up) : glm::mix(vec3(0.16f), vec3(0.05f), -up);
             const float key = lobe(d, vec3(-0.6f, 0.7f, 0.6f), 0.93f);    // warm key, front left, high
             const float fill = lobe(d, vec3(0.8f, 0.35f, 0.3f), 0.85f);   // cool fill, right
             const float top = lobe(d, vec3(0.0f, 1.0f, 0.0f), 0.80f);     // overhead softbox
             const float rim = lobe(d, vec3(0.2f, 0.4f, -0.9f), 0.95f);    // rim, behind
-            c += key * key * vec3(6.0f, 5.6f, 5.0f) + fill * fill * vec3(1.4f, 1.5f, 1.7f) + top * vec3(1.6f) + rim * rim * vec3(2.5f);
+            c += key * key * vec3(9.0f, 8.4f, 7.5f) + fill * fill * vec3(1.8f, 2.0f, 2.3f) + top * vec3(2.4f) + rim * rim * vec3(3.5f);
             float* o = &img[(size_t(y) * size_t(w) + size_t(x)) * 3];
             o[0] = c.x;
             o[1] = c.y;
