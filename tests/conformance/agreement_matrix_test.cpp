@@ -111,6 +111,21 @@ std::vector<MatrixScene> scenes() {
     FrameInput sphere = test_scenes::litSphereFrame(kW, kH, ShadingModel::Phong, ReflectionModel::Phong, test_scenes::SphereLight::Directional, 256);
     offlineSettings(sphere);
     s.push_back({"lit_sphere", sphere});
+    // The pbr model: the lit sphere's scene as glTF sees it (metallic 0.5, roughness 0.4, the
+    // lights in their units), without an environment and in the default one.
+    for (const char* env : {"none", "default"}) {
+        FrameInput p = sphere;
+        p.settings.reflection = ReflectionModel::Pbr;
+        p.settings.environment = env;
+        for (auto& m : p.meshes) {
+            m.material.metallic = 0.5f;
+            m.material.roughness = 0.4f;
+        }
+        s.push_back({std::string("pbr_sphere_env_") + env, p});
+    }
+    FrameInput pbrDemo = meshesOnly;
+    pbrDemo.settings.reflection = ReflectionModel::Pbr;
+    s.push_back({"pbr_demo_meshes_default_env", pbrDemo});
     FrameInput quad = test_scenes::texturedQuadFrame(kW, kH, true);
     offlineSettings(quad);
     s.push_back({"textured_quad", quad});
