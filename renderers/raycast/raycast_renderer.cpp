@@ -20,6 +20,7 @@
 #include "raycast/scene_accel.h"
 #include "renderers/draw_list.h"
 #include "renderers/environment.h"
+#include "renderers/pbr.h"
 #include "renderers/shading.h"
 #include "renderers/texture_sampler.h"
 
@@ -245,6 +246,11 @@ struct Tracer {
     struct ShadedHit {
         vec3 p, n, ng, color;
         const Material* mat = nullptr;
+        // pbr, per-pixel shading: the coefficients and albedo the colour was shaded with (the
+        // traced reflection replaces the environment's prefiltered one by them); lit false otherwise.
+        bool lit = false;
+        SurfaceCoefficients coeff;
+        vec3 albedo{0.0f};
     };
 
     // The surface the ray stops at: the first opaque or blended one, passing masked surfaces
@@ -385,6 +391,9 @@ struct Tracer {
             if (!mat->unlit) lightVisibility(p, ng, vis, &p, &n, 1);
             const SurfaceCoefficients coeff = hasMaps ? coefficientsAt(*mat, ms) : coefficientsOf(*mat);
             color = shade(coeff, SurfacePoint{p, n, albedo}, eye, f, mat->unlit ? nullptr : vis, env);
+            s.lit = !mat->unlit;
+            s.coeff = coeff;
+            s.albedo = albedo;
         }
     }
 
@@ -399,7 +408,27 @@ struct Tracer {
         if (glm::dot(n, r.dir) > 0) n = -n;   // analytic surfaces: face the ray
         ng = n;
         if (!mat->unlit) lightVisibility(p, ng, vis, &p, &n, 1);
-        color = shade(*mat, SurfacePoint{p, n, mat->baseColor}, eye, f, mat->unlit ? nullptr : vis, env);
+        s.coeff = coefficientsOf(*mat);
+        s.lit = !mat->unlit;
+        s.albedo = mat->baseColor;
+        color = shade(s.coeff, SurfacePoint{p, n, mat->baseColor}, eye, f, mat->unlit ? nullptr : vis, env);
+    }
+
+    // pbr with reflections on: smooth surfaces reflect the scene itself. The environment's
+    // specular term ao FssEss R(r, roughness) (pbr.h) is replaced by ao FssEss L(r), L traced
+    // along the mirror direction (what a ray that leaves the scene sees is the environment),
+    // fully up to roughness 0.05 and fading out by 0.25, where the prefiltered blur takes over.
+    // Returns what to add to the shaded colour.
+    vec3 tracedSpecular(const ShadedHit& s, const vec3& dirN, int bounce, const PixelFootprint* footprint) {
+        const float w = std::clamp((0.25f - s.coeff.roughness) / 0.2f, 0.0f, 1.0f);
+        if (w <= 0.0f) return vec3(0.0f);
+        const PbrPoint pt = pbrPoint(s.coeff, s.albedo);
+        const vec3 v = -dirN;
+        const float ndv = glm::dot(s.n, v);
+        const vec2 ab = splitSum(std::clamp(ndv, 0.0f, 1.0f), pt.roughness);
+        const vec3 fssEss = pt.f0 * ab.x + vec3(pt.f90 * ab.y);
+        const vec3 prefiltered = env && env->map ? env->specular(2.0f * ndv * s.n - v, pt.roughness) : vec3(0.0f);
+        return w * s.coeff.occlusion * fssEss * (reflection(s, dirN, bounce, footprint) - prefiltered);
     }
 
     // The colour seen in the mirror direction at s (dirN: the incoming ray, normalized), the
@@ -460,6 +489,8 @@ struct Tracer {
 
         if (f.settings.reflections && s.mat->reflectivity > 0.0f && bounce < f.settings.maxBounces)
             color = glm::mix(color, reflection(s, dirN, bounce, footprint), std::clamp(s.mat->reflectivity, 0.0f, 1.0f));
+        else if (f.settings.reflections && f.settings.reflection == ReflectionModel::Pbr && s.lit && bounce < f.settings.maxBounces)
+            color += tracedSpecular(s, dirN, bounce, footprint);
         if (bounce == 0) color = applyFog(f.settings, color, glm::length(vec3(f.camera.view * vec4(s.p, 1.0f))));
         if (blended && (alpha < 1.0f || hitPos) && layer + 1 < kMaxLayers) {
             rt::Ray behind = r;
