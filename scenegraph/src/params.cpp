@@ -81,6 +81,15 @@ std::vector<Param<RenderSettings>> renderTable() {
                     .fmt("%.4f")
                     .when(fogExponential),
             }),
+        inSection<S>("Exposure and tone mapping",
+                     {
+                         field<&S::exposure>("exposure", "exposure", "Exposure",
+                                             "Exposure in EV: the linear colour is multiplied by 2^EV before the tone mapping")
+                             .range(-10.0, 10.0)
+                             .fmt("%.2f EV"),
+                         field<&S::toneMapping>("toneMapping", "tone-mapping", "Tone mapping",
+                                                "Maps the exposed linear colour to the display's range, before the sRGB encoding"),
+                     }),
         inSection<S>("Anti-aliasing",
                      {
                          // The rate first, so a file's "aa" name wins over a stray rate.

@@ -58,6 +58,14 @@ constexpr NamedValue<CullMode> kCull[] = {
     {CullMode::Off, "off", "Off", "draw every back face"},
 };
 
+constexpr NamedValue<ToneMapping> kToneMapping[] = {
+    {ToneMapping::None, "none", "None", "the exposed linear colour as it is, clipped at 1 by the sRGB encoding"},
+    {ToneMapping::Aces, "aces", "ACES filmic",
+     "Stephen Hill's fit of the ACES RRT + sRGB ODT, as the Khronos glTF Sample Viewer applies it (input / 0.6)"},
+    {ToneMapping::KhrNeutral, "khr-neutral", "Khronos PBR Neutral",
+     "Khronos PBR Neutral: base colours 0.08..0.8 kept (less 0.04), highlights compressed toward white without hue shifts"},
+};
+
 constexpr NamedValue<AlphaMode> kAlphaMode[] = {
     {AlphaMode::Opaque, "opaque", "Opaque", "alpha is ignored: the surface is fully opaque"},
     {AlphaMode::Mask, "mask", "Mask", "cut-out: drawn where alpha >= the cutoff, not drawn elsewhere"},
@@ -156,6 +164,11 @@ const NameTable<CullMode>& nameTable<CullMode>() {
     return t;
 }
 template <>
+const NameTable<ToneMapping>& nameTable<ToneMapping>() {
+    static const NameTable<ToneMapping> t{kToneMapping};
+    return t;
+}
+template <>
 const NameTable<AlphaMode>& nameTable<AlphaMode>() {
     static const NameTable<AlphaMode> t{kAlphaMode};
     return t;
@@ -179,6 +192,7 @@ std::string_view toString(ShadingModel m) { return nameOf(m); }
 std::string_view toString(ReflectionModel m) { return nameOf(m); }
 std::string_view toString(FogMode m) { return nameOf(m); }
 std::string_view toString(CullMode m) { return nameOf(m); }
+std::string_view toString(ToneMapping m) { return nameOf(m); }
 std::string_view toString(ProjectionType t) { return nameOf(t); }
 std::string_view toString(LightType t) { return nameOf(t); }
 bool parse(std::string_view s, ShadingModel& out) { return parseName(s, out); }

@@ -124,6 +124,29 @@ TEST(ParamTablesTest, EveryFlaggedRowIsACommandLineOption) {
     EXPECT_NE(bad.output.find("--tessellation must be in [4, 512]"), std::string::npos) << bad.output;
 }
 
+// The display transform's rows on the command line: a negative exposure in EV is a value, not
+// an option; the operator by name; bad values name the flag with the range or the names.
+TEST(ParamTablesTest, ExposureAndToneMappingOnTheCommandLine) {
+    fs::path dir = testing_support::outputDir("params");
+    testing_support::ProgramRun ok = testing_support::runProgram(
+        quoted(VIEWER_EXE),
+        "render demo --backend raster --size 32x18 --overwrite --exposure -1.5 --tone-mapping khr-neutral --out " + quoted(dir / "tone.png"));
+    EXPECT_EQ(ok.status, 0) << ok.output;
+    testing_support::ProgramRun far =
+        testing_support::runProgram(quoted(VIEWER_EXE), "render demo --backend raster --size 32x18 --exposure 11 --out " + quoted(dir / "bad.png"));
+    EXPECT_NE(far.status, 0);
+    EXPECT_NE(far.output.find("--exposure must be in [-10, 10]"), std::string::npos) << far.output;
+    testing_support::ProgramRun name = testing_support::runProgram(
+        quoted(VIEWER_EXE), "render demo --backend raster --size 32x18 --tone-mapping filmic --out " + quoted(dir / "bad.png"));
+    EXPECT_NE(name.status, 0);
+    EXPECT_NE(name.output.find("none, aces, khr-neutral"), std::string::npos) << name.output;
+    sg::RenderSettings s;
+    EXPECT_EQ(sg::setParamFromText(s, *sg::findParam<sg::RenderSettings>("toneMapping"), "aces"), "");
+    EXPECT_EQ(s.toneMapping, sg::ToneMapping::Aces);
+    EXPECT_EQ(sg::setParamFromText(s, *sg::findParam<sg::RenderSettings>("exposure"), "-2.5"), "");
+    EXPECT_EQ(s.exposure, -2.5f);
+}
+
 // A mesh file's fog follows its size wherever it is opened: loadScene fits it (the window's
 // load and every command call it), so `viewer render FILE --fog linear` shows fog.
 TEST(SceneDefaultsTest, FogFollowsTheFilesSizeOnTheCommandLineAsInTheWindow) {

@@ -95,6 +95,8 @@ const NameTable<LightType>& nameTable<LightType>();
 template <>
 const NameTable<CullMode>& nameTable<CullMode>();
 template <>
+const NameTable<ToneMapping>& nameTable<ToneMapping>();
+template <>
 const NameTable<AlphaMode>& nameTable<AlphaMode>();
 template <>
 const NameTable<WrapMode>& nameTable<WrapMode>();
