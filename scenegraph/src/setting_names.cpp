@@ -46,6 +46,11 @@ constexpr NamedValue<ObliquePreset> kObliquePreset[] = {
     {ObliquePreset::Cabinet, "cabinet", "Cabinet", "oblique at 45 degrees, receding axis at half length (factor 0.5)"},
 };
 
+constexpr NamedValue<AxonometricPreset> kAxonometricPreset[] = {
+    {AxonometricPreset::Isometric, "isometric", "Isometric",
+     "orthographic, seen along (-1,-1,-1) so the three axes are equally foreshortened (the camera turns there too)"},
+};
+
 constexpr NamedValue<LightType> kLight[] = {
     {LightType::Point, "point", "Point", "shines from the node's position in every direction"},
     {LightType::Directional, "directional", "Directional", "parallel light along the node's -z axis"},
@@ -151,6 +156,11 @@ const NameTable<ProjectionType>& nameTable<ProjectionType>() {
 template <>
 const NameTable<ObliquePreset>& nameTable<ObliquePreset>() {
     static const NameTable<ObliquePreset> t{kObliquePreset};
+    return t;
+}
+template <>
+const NameTable<AxonometricPreset>& nameTable<AxonometricPreset>() {
+    static const NameTable<AxonometricPreset> t{kAxonometricPreset};
     return t;
 }
 template <>

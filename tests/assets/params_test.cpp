@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 #include <set>
 
@@ -145,6 +146,16 @@ TEST(ParamTablesTest, ExposureAndToneMappingOnTheCommandLine) {
     EXPECT_EQ(s.toneMapping, sg::ToneMapping::Aces);
     EXPECT_EQ(sg::setParamFromText(s, *sg::findParam<sg::RenderSettings>("exposure"), "-2.5"), "");
     EXPECT_EQ(s.exposure, -2.5f);
+}
+
+// The isometric preset of the projection row: orthographic (the command line turns the camera).
+TEST(ParamTablesTest, IsometricPresetIsOrthographic) {
+    sg::Projection p;
+    const sg::Param<sg::Projection>* type = sg::findParam<sg::Projection>("type");
+    ASSERT_TRUE(type);
+    EXPECT_EQ(sg::setParamFromText(p, *type, "isometric"), "");
+    EXPECT_EQ(p.type, sg::ProjectionType::Orthographic);
+    EXPECT_TRUE(std::any_of(type->choices.begin(), type->choices.end(), [](const sg::ParamChoice& c) { return c.name == "isometric"; }));
 }
 
 // A mesh file's fog follows its size wherever it is opened: loadScene fits it (the window's

@@ -48,6 +48,10 @@ constexpr int valueCount<sg::ObliquePreset>() {
     return 2;
 }
 template <>
+constexpr int valueCount<sg::AxonometricPreset>() {
+    return 1;
+}
+template <>
 constexpr int valueCount<sg::LightType>() {
     return 3;
 }
@@ -63,7 +67,7 @@ constexpr int valueCount<sg::FilterMode>() {
 template <class E>
 class SettingsNameTableTest : public ::testing::Test {};
 using NamedEnums = ::testing::Types<sg::ShadingModel, sg::ReflectionModel, sg::FogMode, sg::ToneMapping, sg::AAChoice, sg::ProjectionType,
-                                    sg::ObliquePreset, sg::LightType, sg::WrapMode, sg::FilterMode>;
+                                    sg::ObliquePreset, sg::AxonometricPreset, sg::LightType, sg::WrapMode, sg::FilterMode>;
 TYPED_TEST_SUITE(SettingsNameTableTest, NamedEnums);
 
 TYPED_TEST(SettingsNameTableTest, NamesParseBackAndAreUnique) {
@@ -257,6 +261,7 @@ TEST(CliSettingNamesTest, HelpAllListsEveryName) {
     expectAllNames<sg::AAChoice>(r.output);
     expectAllNames<sg::ProjectionType>(r.output);
     expectAllNames<sg::ObliquePreset>(r.output);
+    expectAllNames<sg::AxonometricPreset>(r.output);
     expectAllNames<sg::ToneMapping>(r.output);
 }
 
@@ -272,7 +277,7 @@ TEST(CliSettingNamesTest, BadValuesListTheValidNames) {
                           Case{"--aa fxaa", "--aa: 'fxaa' is not one of " + sg::nameList<sg::AAChoice>()},
                           Case{"--tone-mapping reinhard", "--tone-mapping: 'reinhard' is not one of " + sg::nameList<sg::ToneMapping>()},
                           Case{"--projection fisheye", "--projection: 'fisheye' is not one of " + sg::nameList<sg::ProjectionType>() + ", " +
-                                                           sg::nameList<sg::ObliquePreset>()}}) {
+                                                           sg::nameList<sg::ObliquePreset>() + ", " + sg::nameList<sg::AxonometricPreset>()}}) {
         ViewerRun r = runViewer(base + c.args);
         EXPECT_NE(r.status, 0) << c.args;
         EXPECT_NE(r.output.find(c.message), std::string::npos) << c.args << "\n" << r.output;
