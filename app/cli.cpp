@@ -116,6 +116,31 @@ bool anyGiven(const std::map<std::string, std::optional<std::string>>& given) {
     return std::any_of(given.begin(), given.end(), [](const auto& kv) { return kv.second.has_value(); });
 }
 
+// Whether --projection names the isometric preset (the projection row takes it as orthographic).
+bool isometricAsked(const RenderArgs& a) {
+    auto it = a.projection.find("type");
+    if (it == a.projection.end() || !it->second) return false;
+    std::string err;
+    const std::optional<sg::ParamValue> v = sg::parseParamText(sg::ParamKind::Choice, *it->second, err);
+    sg::AxonometricPreset preset;
+    return v && sg::parseName(std::get<std::string>(*v), preset);
+}
+
+// --projection isometric: camera `id` turned to look along the isometric direction
+// (sg::isometricViewDirection) at its pivot - its focus distance ahead - from as far. A camera
+// that was perspective (`before`) keeps the size of its view at the pivot, d tan(fovy / 2), as
+// the window's perspective / orthographic switch does, unless --ortho-half-height is given.
+void turnIsometric(sg::Scene& scene, sg::NodeId id, sg::ProjectionType before, bool halfHeightGiven) {
+    const sg::mat4 world = scene.world(id);
+    auto& cam = std::get<sg::Camera>(scene.editPayload(id));
+    const float d = cam.focusDistance > 0.0f && std::isfinite(cam.focusDistance) ? cam.focusDistance : 1.0f;
+    const sg::vec3 eye(world[3]), forward = glm::normalize(-sg::vec3(world[2]));
+    const sg::vec3 pivot = eye + d * forward;
+    if (before == sg::ProjectionType::Perspective && !halfHeightGiven)
+        cam.projection.orthoHalfHeight = std::max(d * std::tan(sg::radians(cam.projection.fovyDeg) * 0.5f), 1e-6f);
+    scene.lookAt(id, pivot - d * sg::isometricViewDirection(), pivot);
+}
+
 // Applies command-line overrides to the scene's settings and camera. Returns "" or an error.
 std::string applyOverrides(const RenderArgs& a, sg::Scene& scene) {
     sg::RenderSettings& s = scene.settings;
@@ -143,8 +168,13 @@ std::string applyOverrides(const RenderArgs& a, sg::Scene& scene) {
                 scene.activeCamera = cams.front();
         }
         auto& cam = std::get<sg::Camera>(scene.editPayload(scene.activeCamera));
+        const sg::ProjectionType before = cam.projection.type;
         if (std::string e = applyTableOverrides(a.projection, cam.projection); !e.empty()) return e;
         if (!(cam.projection.zNear < cam.projection.zFar)) return "--near / --far: the camera needs near < far";
+        if (isometricAsked(a)) {
+            auto given = a.projection.find("orthoHalfHeight");
+            turnIsometric(scene, scene.activeCamera, before, given != a.projection.end() && given->second.has_value());
+        }
     }
     return {};
 }

@@ -10,6 +10,7 @@
 //     "settings":  { every row of the render-settings table in scenegraph/params.h by its key:
 //                    "shading": <ShadingModel>, "reflection", "attenuation", "ambientLight",
 //                    "fog": {"mode": <FogMode>, "color": [..], "start", "end", "density"},
+//                    "exposure": EV, "toneMapping": <ToneMapping>,
 //                    "aa": <AAChoice>, "aaRate", "culling": <CullMode>, "wireframe", ... }
 //                  (older files: "cullBackFaces": bool; "ambientLight" at the top level),
 //     "textures":  [ {"name", "file": "relative/path.png"} | {"name", "png": "<base64 PNG>"},

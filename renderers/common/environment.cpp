@@ -321,19 +321,26 @@ std::string loadRadianceHdr(const std::string& path, int& width, int& height, st
     return {};
 }
 
-void drawEnvironmentBackground(Framebuffer& target, const sg::FrameCamera& camera, const EnvironmentLight& env, const uint8_t bg[3]) {
+void drawEnvironmentBackground(Framebuffer& target, const sg::FrameCamera& camera, const EnvironmentLight& env, const uint8_t bg[3], vec3* linear,
+                               const vec3& bgLinear) {
     if (!env.map) return;
     const sg::mat4 inv = glm::inverse(camera.viewProj);
     const int w = target.width, h = target.height;
     tbb::parallel_for(0, h, [&](int row) {
         const float ny = 1.0f - (float(row) + 0.5f) / float(h) * 2.0f;   // row 0 at the top
         for (int x = 0; x < w; ++x) {
+            const size_t i = size_t(row) * size_t(w) + size_t(x);
             uint8_t* p = target.pixel(x, row);
-            if (target.depth[size_t(row) * size_t(w) + size_t(x)] < 1.0f || p[0] != bg[0] || p[1] != bg[1] || p[2] != bg[2]) continue;
+            if (target.depth[i] < 1.0f) continue;
+            if (linear ? linear[i] != bgLinear : (p[0] != bg[0] || p[1] != bg[1] || p[2] != bg[2])) continue;
             const float nx = (float(x) + 0.5f) / float(w) * 2.0f - 1.0f;
             const sg::vec4 a = inv * sg::vec4(nx, ny, -1.0f, 1.0f), b = inv * sg::vec4(nx, ny, 1.0f, 1.0f);
             const vec3 dir = glm::normalize(vec3(b) / b.w - vec3(a) / a.w);
             const vec3 c = env.backgroundRadiance(dir);
+            if (linear) {
+                linear[i] = c;
+                continue;
+            }
             p[0] = toByteSRGB(c.x);
             p[1] = toByteSRGB(c.y);
             p[2] = toByteSRGB(c.z);

@@ -5,6 +5,7 @@
 
 #include "renderers/shading.h"
 #include "renderers/texture_sampler.h"
+#include "renderers/tone_map.h"
 #include "scenegraph/camera_model.h"
 
 #include <algorithm>
@@ -280,7 +281,8 @@ PixelTerms pixelTerms(const sg::FrameInput& f, const SurfaceAt& s, const std::ve
         }
     }
     if (f.settings.fog != sg::FogMode::Off) t.fogVisibility = sg::fogVisibility(f.settings, s.eyeDistance);
-    t.predicted = glm::clamp(t.fogVisibility * t.beforeFog + (1.0f - t.fogVisibility) * f.settings.fogColor, vec3(0.0f), vec3(1.0f));
+    const vec3 fogged = t.fogVisibility * t.beforeFog + (1.0f - t.fogVisibility) * f.settings.fogColor;
+    t.predicted = glm::clamp(DisplayTransform(f.settings)(fogged), vec3(0.0f), vec3(1.0f));
     return t;
 }
 

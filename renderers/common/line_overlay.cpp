@@ -3,6 +3,7 @@
 
 #include "common/window_lines.h"
 #include "renderers/shading.h"
+#include "renderers/tone_map.h"
 
 #include <algorithm>
 #include <cmath>
@@ -21,7 +22,17 @@ struct Provenance {
     uint32_t drawable = 0, primitive = kNoPrimitive;
 };
 
-void writeLinePixel(Framebuffer& fb, int i, int j, float z, const vec3& linear, float bias, const Provenance& from = {}) {
+// Where line pixels go: the framebuffer's depth and visibility, and their colour either as bytes
+// through the frame's display transform or, when the caller keeps a linear frame (`linear`, rows
+// top-down), into it for the caller to encode.
+struct LineTarget {
+    Framebuffer& fb;
+    vec3* linear = nullptr;
+    DisplayTransform display;
+};
+
+void writeLinePixel(LineTarget& t, int i, int j, float z, const vec3& linear, float bias, const Provenance& from = {}) {
+    Framebuffer& fb = t.fb;
     int row = fb.height - 1 - j;
     const size_t at = size_t(row) * fb.width + i;
     if (!fb.overdraw.empty()) ++fb.overdraw[at];   // the overdraw view: every fragment, before the depth test
@@ -32,10 +43,15 @@ void writeLinePixel(Framebuffer& fb, int i, int j, float z, const vec3& linear, 
         fb.drawable[at] = from.drawable;
         fb.primitive[at] = from.primitive;
     }
+    if (t.linear) {
+        t.linear[at] = linear;
+        return;
+    }
+    const vec3 shown = t.display(linear);
     uint8_t* p = fb.pixel(i, row);
-    p[0] = toByteSRGB(linear.x);
-    p[1] = toByteSRGB(linear.y);
-    p[2] = toByteSRGB(linear.z);
+    p[0] = toByteSRGB(shown.x);
+    p[1] = toByteSRGB(shown.y);
+    p[2] = toByteSRGB(shown.z);
     p[3] = 255;
 }
 
@@ -48,7 +64,8 @@ struct LineEnd {
 
 // Draws segment a-b: clipped in clip space, DDA in window space; depth, colour and fog
 // distance interpolated perspective-correctly per pixel, fog applied per pixel (as GL does).
-void drawSegment(Framebuffer& fb, LineEnd a, LineEnd b, const GuardBand& g, const sg::RenderSettings& st, float bias, const Provenance& from = {}) {
+void drawSegment(LineTarget& lt, LineEnd a, LineEnd b, const GuardBand& g, const sg::RenderSettings& st, float bias, const Provenance& from = {}) {
+    const Framebuffer& fb = lt.fb;
     vec4 ca = a.clip, cb = b.clip;
     float t0 = 0, t1 = 1;
     {
@@ -77,7 +94,7 @@ void drawSegment(Framebuffer& fb, LineEnd a, LineEnd b, const GuardBand& g, cons
         float tp = t * wb.w / ((1 - t) * wa.w + t * wb.w);            // perspective-correct
         vec3 c = ea.color + tp * (eb.color - ea.color);
         if (fog) c = applyFog(st, c, ea.eyeDist + tp * (eb.eyeDist - ea.eyeDist));
-        writeLinePixel(fb, i, j, z, c, bias, from);
+        writeLinePixel(lt, i, j, z, c, bias, from);
     });
 }
 
@@ -103,7 +120,8 @@ Vertices transform(const PreparedDraw& d, const sg::FrameInput& f, const GuardBa
     return v;
 }
 
-void drawPointsAndLines(const PreparedDraw& d, const Vertices& v, const sg::FrameInput& f, Framebuffer& fb, float pointSize, const GuardBand& g) {
+void drawPointsAndLines(const PreparedDraw& d, const Vertices& v, const sg::FrameInput& f, LineTarget& lt, float pointSize, const GuardBand& g) {
+    const Framebuffer& fb = lt.fb;
     const sg::Mesh& m = *d.mesh;
     const auto& st = f.settings;
     const bool hasColors = m.colors.size() == m.positions.size();
@@ -118,7 +136,7 @@ void drawPointsAndLines(const PreparedDraw& d, const Vertices& v, const sg::Fram
         for (size_t k = 0; k + 1 < n; k += 2) {
             uint32_t ia = idx(k), ib = idx(k + 1);
             if (ia >= v.clip.size() || ib >= v.clip.size() || ((v.code[ia] | v.code[ib]) & kInvalid)) continue;
-            drawSegment(fb, end(ia), end(ib), g, st, 0.0f, Provenance{d.drawable, uint32_t(k / 2)});
+            drawSegment(lt, end(ia), end(ib), g, st, 0.0f, Provenance{d.drawable, uint32_t(k / 2)});
         }
         return;
     }
@@ -133,7 +151,7 @@ void drawPointsAndLines(const PreparedDraw& d, const Vertices& v, const sg::Fram
         int j0 = int(std::ceil(w.y - h - 0.5f)), j1 = int(std::ceil(w.y + h - 0.5f)) - 1;
         for (int j = std::max(j0, 0); j <= std::min(j1, fb.height - 1); ++j)
             for (int i = std::max(i0, 0); i <= std::min(i1, fb.width - 1); ++i)
-                writeLinePixel(fb, i, j, std::clamp(w.z, 0.0f, 1.0f), c, 0.0f, Provenance{d.drawable, uint32_t(k)});
+                writeLinePixel(lt, i, j, std::clamp(w.z, 0.0f, 1.0f), c, 0.0f, Provenance{d.drawable, uint32_t(k)});
     }
 }
 
@@ -143,7 +161,8 @@ const sg::Material& materialOf(const PreparedDraw& d, size_t tri) {
     return *d.material;
 }
 
-void drawWireframe(const PreparedDraw& d, const Vertices& v, const sg::FrameInput& f, Framebuffer& fb, const GuardBand& g) {
+void drawWireframe(const PreparedDraw& d, const Vertices& v, const sg::FrameInput& f, LineTarget& lt, const GuardBand& g) {
+    const Framebuffer& fb = lt.fb;
     const sg::Mesh& m = *d.mesh;
     const auto& st = f.settings;
     auto eyeDist = [&](const vec3& wpos) { return glm::length(vec3(f.camera.view * vec4(wpos, 1.0f))); };
@@ -162,23 +181,24 @@ void drawWireframe(const PreparedDraw& d, const Vertices& v, const sg::FrameInpu
         for (int k = 0; k < 3; ++k) {
             LineEnd a{v.clip[i[k]], st.wireframeColor, eyeDist(v.world[i[k]])};
             LineEnd b{v.clip[i[(k + 1) % 3]], st.wireframeColor, eyeDist(v.world[i[(k + 1) % 3]])};
-            drawSegment(fb, a, b, g, st, 2e-4f);
+            drawSegment(lt, a, b, g, st, 2e-4f);
         }
     }
 }
 
 }   // namespace
 
-void drawPointsLinesWireframe(const std::vector<PreparedDraw>& draws, const sg::FrameInput& f, Framebuffer& fb, float pointSize) {
+void drawPointsLinesWireframe(const std::vector<PreparedDraw>& draws, const sg::FrameInput& f, Framebuffer& fb, float pointSize, sg::vec3* linear) {
     const GuardBand g = guardBand(fb.width, fb.height);
+    LineTarget lt{fb, linear, DisplayTransform(f.settings)};
     for (const PreparedDraw& d : draws) {
         const bool tris = d.mesh->mode == sg::PrimitiveMode::Triangles;
         if (tris && !f.settings.wireframe) continue;
         const Vertices v = transform(d, f, g);
         if (tris)
-            drawWireframe(d, v, f, fb, g);
+            drawWireframe(d, v, f, lt, g);
         else
-            drawPointsAndLines(d, v, f, fb, pointSize, g);
+            drawPointsAndLines(d, v, f, lt, pointSize, g);
     }
 }
 

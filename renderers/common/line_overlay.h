@@ -9,6 +9,10 @@
 //   no edges.
 // When the target has overdraw counters (Framebuffer::overdraw), every pixel written counts one
 // fragment, before its depth test (the overdraw diagnostic view).
+// Colour: written as bytes through the frame's display transform (renderers/tone_map.h), or,
+// when `linear` is given (the rasterizer's linear frame while the transform is not the
+// identity: fb.width x fb.height, rows top-down), as linear colour into it, for the caller to
+// resolve and encode.
 #pragma once
 
 #include "renderers/draw_list.h"
@@ -18,6 +22,7 @@
 
 namespace rnd {
 
-void drawPointsLinesWireframe(const std::vector<PreparedDraw>& draws, const sg::FrameInput& f, Framebuffer& fb, float pointSize);
+void drawPointsLinesWireframe(const std::vector<PreparedDraw>& draws, const sg::FrameInput& f, Framebuffer& fb, float pointSize,
+                              sg::vec3* linear = nullptr);
 
 }   // namespace rnd

@@ -29,7 +29,7 @@ layout(location = 0) out vec4 fragColor;
 void main() {
     vec4 a = uInvViewProj * vec4(vNdc, -1.0, 1.0), b = uInvViewProj * vec4(vNdc, 1.0, 1.0);
     vec3 dir = normalize(b.xyz / b.w - a.xyz / a.w);
-    fragColor = vec4(clamp(envSpecular(dir, 0.0), 0.0, 1.0), 1.0);
+    fragColor = vec4(max(envSpecular(dir, 0.0), 0.0), 1.0);   // unclamped for the linear target (tone mapping)
 }
 )GLSL";
 

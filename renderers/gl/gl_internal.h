@@ -2,12 +2,13 @@
 // renderers/gl/): the shader programs' switches and uniform locations, the GPU cache's records,
 // the render targets, the draw items and the GlRenderer class itself. By file:
 //   gl_programs.cpp   shader programs: embedded GLSL (shaders/) specialised per frame setup
-//                     and per draw's switches, compiled on first use; frame and material uniforms
+//                     and per draw's switches, compiled on first use; frame and material
+//                     uniforms; the display pass's programs (one per tone-mapping operator)
 //   gl_resources.cpp  GPU cache (meshes, tessellations and textures keyed by id + version, evicted
 //                     when unused), render targets (multisampled / single-sample FBOs, the
 //                     overdraw count target), the frame's draw list, read-back
 //   gl_passes.cpp     the draw passes: opaque (with the visibility attachment), blended,
-//                     wireframe, the overdraw view; frame state, MSAA resolve
+//                     wireframe, the overdraw view; frame state, MSAA resolve, the display pass
 //   gl_renderer.cpp   GlRenderer: context, capabilities, state guard, doRender
 //
 // Conventions (shared with the CPU backends, see renderers/shading.h): lighting in linear
@@ -16,6 +17,10 @@
 // instances), fog on the eye-space distance. Gouraud lights the vertices with the albedo
 // factored out (colour = rho * mul + add, see lighting.glsl), so textures still apply per
 // fragment. Lines and points are drawn unlit (base colour x vertex colour + emissive).
+// Exposure and tone mapping (renderers/tone_map.h), when they are not the identity: the frame
+// is drawn into linear RGBA16F targets instead (not clamped at 1, blended in float), resolved,
+// and the display pass (shaders/display.frag, tone_map.glsl) box-filters SSAA, applies the
+// transform and writes an sRGB8 target of the output size, which is read back.
 // Texture filters: nearest = GL_NEAREST, bilinear = GL_LINEAR without mipmaps, trilinear =
 // GL_LINEAR_MIPMAP_LINEAR. Draws are sorted nearest first (early depth test on llvmpipe).
 #pragma once
@@ -42,6 +47,9 @@ extern const char* const kShader_lighting_glsl;
 extern const char* const kShader_pbr_glsl;
 extern const char* const kShader_mesh_vert;
 extern const char* const kShader_mesh_frag;
+extern const char* const kShader_tone_map_glsl;
+extern const char* const kShader_display_vert;
+extern const char* const kShader_display_frag;
 
 constexpr int kMaxLights = 32;          // lights beyond this are ignored (uniform arrays)
 constexpr int kMaxUnrolledLights = 8;   // more lights: one generic program with a loop
@@ -60,17 +68,18 @@ struct Features {
     bool vertexColors = false;
     bool unlit = false;
     sg::AlphaMode alphaMode = sg::AlphaMode::Opaque;
-    bool solid = false;         // the wireframe overlay
-    bool overdraw = false;      // the overdraw view's pass
-    bool visibility = false;    // writes the visibility attachment
-    bool environment = false;   // pbr's environment light is bound (units 5 and 6)
+    bool solid = false;          // the wireframe overlay
+    bool overdraw = false;       // the overdraw view's pass
+    bool visibility = false;     // writes the visibility attachment
+    bool environment = false;    // pbr's environment light is bound (units 5 and 6)
+    bool linearTarget = false;   // draws into the linear float target: colour not clamped at 1
 
     // One character per switch (part of the program's key).
     bool operator==(const Features&) const = default;
     std::string key() const {
         std::string k;
         for (bool b : {texture, emissiveMap, occlusionMap, metalRoughMap, normalMap, specGloss, uv1, vertexColors, unlit, solid, overdraw, visibility,
-                       environment})
+                       environment, linearTarget})
             k += b ? '1' : '0';
         return k + char('0' + int(alphaMode));
     }
@@ -105,6 +114,15 @@ std::string programKey(const sg::FrameInput& f);
 // Builds the program of frame setup `key` (programKey) with the draw's switches `ft` for frame
 // `f` into p (id and uniform locations). Returns "" or the compiler's or linker's message.
 std::string buildProgram(const std::string& key, const Features& ft, const sg::FrameInput& f, Program& p);
+
+// The display pass's program (shaders/display.vert, display.frag with tone_map.glsl) for one
+// tone-mapping operator, and its uniform locations.
+struct DisplayProgram {
+    GLuint id = 0;
+    GLint frame = -1, ssaa = -1, exposureScale = -1;
+};
+// Builds the display program of operator `op` into p. Returns "" or the compiler's or linker's message.
+std::string buildDisplayProgram(sg::ToneMapping op, DisplayProgram& p);
 
 // --- GPU cache and render targets (gl_resources.cpp) -----------------------------------------
 
@@ -144,13 +162,16 @@ bool uploadTexture(GpuTexture& g, const sg::Texture& t);
 
 struct RenderTarget {
     int width = 0, height = 0, samples = 0;
+    bool hdr = false;   // linear RGBA16F colour (the display pass reads it), else sRGB8_ALPHA8
     GLuint fbo = 0, color = 0, depth = 0;
-    GLuint ids = 0;   // RG32UI visibility (drawable, primitive) at attachment 1, when asked
+    GLuint colorTexture = 0;   // the colour as a texture instead of `color`: single-sampled linear targets
+    GLuint ids = 0;            // RG32UI visibility (drawable, primitive) at attachment 1, when asked
 
     void release();
-    // (Re)creates the FBO when the size, sample count or visibility changed. Returns "" or the
-    // reason. Only attachment 0 is a draw buffer; the frame enables 1 when it wants ids.
-    std::string ensure(int w, int h, int s, bool withIds = false);
+    // (Re)creates the FBO when the size, sample count, visibility or colour format changed.
+    // Returns "" or the reason. Only attachment 0 is a draw buffer; the frame enables 1 when it
+    // wants ids.
+    std::string ensure(int w, int h, int s, bool withIds = false, bool linear = false);
 };
 
 // The overdraw view's target: one R32F colour buffer (no depth), where additive blending of
@@ -234,7 +255,7 @@ private:
     GpuTexture* textureFor(const sg::TexturePtr& t);
     std::vector<DrawItem> collectDraws(const sg::FrameInput& frame, int tessellation);   // uploads what is new
     void bindTextures(const DrawItem& it);
-    void readBack(GLuint fbo, int w, int h, Framebuffer& out);
+    void readBack(GLuint fbo, int w, int h, Framebuffer& out, bool withDepth = true);
     void evict();
     // gl_passes.cpp
     uint64_t drawAll(const std::vector<DrawItem>& items, DrawPass pass, sg::CullMode culling, std::string& error);
@@ -242,7 +263,8 @@ private:
     uint64_t drawBlendedPass(const std::vector<DrawItem>& items, const sg::RenderSettings& s, std::string& error);
     void drawWireframePass(const std::vector<DrawItem>& items, const sg::RenderSettings& s, std::string& error);
     std::string countOverdraw(const std::vector<DrawItem>& items, const sg::RenderSettings& s, int w, int h, Framebuffer& target);
-    void resolveAndRead(int w, int h, int samples, int ssaa, bool visibility, Framebuffer& target);
+    std::string resolveAndRead(int w, int h, int samples, int ssaa, bool visibility, Framebuffer& target);
+    std::string displayPass(const sg::RenderSettings& s, GLuint frameTexture, int ssaa, int w, int h);   // linear frames only
 
     std::unique_ptr<GlContext> m_own;         // our headless context, made on first need
     const void* m_objectsContext = nullptr;   // the context our GL objects live in
@@ -257,11 +279,15 @@ private:
     int m_ssaa = 1;
     bool m_visibility = false;      // the target has the visibility attachment
     bool m_countPass = false;       // drawing the overdraw view's pass
+    bool m_linear = false;          // this frame draws into linear targets (exposure or tone mapping)
     Program* m_current = nullptr;   // the program in use and its switches
     Features m_currentFeatures;
     static constexpr GLuint kUnknownTexture = ~0u;
     GLuint m_boundTexture[5] = {kUnknownTexture, kUnknownTexture, kUnknownTexture, kUnknownTexture, kUnknownTexture};   // units 0..4
     RenderTarget m_target, m_resolve;
+    RenderTarget m_display;                // the display pass's sRGB8 output (linear frames)
+    DisplayProgram m_displayPrograms[3];   // by sg::ToneMapping, built on first use
+    GLuint m_emptyVao = 0;                 // the display pass's triangle needs no vertex data
     CountTarget m_overdraw;
     std::unordered_map<uint64_t, GpuMesh> m_meshes;        // by Mesh::id
     std::unordered_map<uint64_t, GpuTexture> m_textures;   // by Texture::id

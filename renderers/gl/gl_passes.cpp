@@ -1,9 +1,12 @@
 // gl_passes.cpp - the GL backend's draw passes (gl_internal.h) and the frame state around
 // them: the opaque pass (opaque and masked surfaces, lines and points; it alone writes the
 // visibility attachment), the blended pass ("over" in linear light, far to near, depth tested
-// but not written), the wireframe overlay, the overdraw view's counting pass, and the MSAA
-// resolve with the read-back of colour, depth and visibility.
+// but not written), the wireframe overlay, the overdraw view's counting pass, the MSAA
+// resolve with the read-back of colour, depth and visibility, and the display pass of linear
+// frames (exposure and tone mapping).
 #include "gl/gl_internal.h"
+
+#include "renderers/tone_map.h"
 
 #include <algorithm>
 #include <cmath>
@@ -192,15 +195,18 @@ std::string GlRenderer::countOverdraw(const std::vector<DrawItem>& items, const 
 
 // Resolves MSAA (reading a multisampled buffer directly would give an aliased image) and reads
 // the frame into `target`: colour and depth, box-filtered down with SSAA, the visibility when
-// the frame has it. Leaves attachment 0 the only draw buffer.
-void GlRenderer::resolveAndRead(int w, int h, int samples, int ssaa, bool visibility, Framebuffer& target) {
+// the frame has it. A linear frame's colour comes from the display pass instead, its depth as
+// above. Leaves attachment 0 the only draw buffer. Returns "" or the reason it failed.
+std::string GlRenderer::resolveAndRead(int w, int h, int samples, int ssaa, bool visibility, Framebuffer& target) {
     GLuint readFbo = m_target.fbo;
+    GLuint frameTexture = m_target.colorTexture;
     if (samples > 1) {
         glBindFramebuffer(GL_READ_FRAMEBUFFER, m_target.fbo);
         glBindFramebuffer(GL_DRAW_FRAMEBUFFER, m_resolve.fbo);
         glBlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
         glBlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL_DEPTH_BUFFER_BIT, GL_NEAREST);
         readFbo = m_resolve.fbo;
+        frameTexture = m_resolve.colorTexture;
     }
     if (ssaa > 1) {
         Framebuffer full;
@@ -211,6 +217,43 @@ void GlRenderer::resolveAndRead(int w, int h, int samples, int ssaa, bool visibi
         if (visibility) readVisibility(readFbo, w, h, target);
     }
     if (visibility) glDrawBuffer(GL_COLOR_ATTACHMENT0);
+    if (!m_linear) return {};
+    // The colour read above is the linear frame's, clamped to bytes: replaced by the display pass's.
+    const int ow = w / ssaa, oh = h / ssaa;
+    std::string err = displayPass(m_frameInput->settings, frameTexture, ssaa, ow, oh);
+    if (err.empty()) readBack(m_display.fbo, ow, oh, target, false);
+    return err;
+}
+
+// The display pass (linear frames): the resolved linear frame `frameTexture` (ssaa x the output
+// size w x h) box-filtered, through exposure and the tone-mapping operator (display.frag with
+// tone_map.glsl), into m_display's sRGB8 colour. Returns "" or the reason it could not.
+std::string GlRenderer::displayPass(const RenderSettings& s, GLuint frameTexture, int ssaa, int w, int h) {
+    std::string err = m_display.ensure(w, h, 0);
+    if (!err.empty()) return err;
+    DisplayProgram& p = m_displayPrograms[std::clamp(int(s.toneMapping), 0, 2)];
+    if (!p.id && !(err = buildDisplayProgram(s.toneMapping, p)).empty()) return err;
+    if (!m_emptyVao) glGenVertexArrays(1, &m_emptyVao);
+    glBindFramebuffer(GL_FRAMEBUFFER, m_display.fbo);
+    glViewport(0, 0, w, h);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_BLEND);
+    glDisable(GL_CULL_FACE);
+    glDisable(GL_MULTISAMPLE);
+    glEnable(GL_FRAMEBUFFER_SRGB);
+    glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
+    glUseProgram(p.id);
+    m_current = nullptr;   // useProgram must bind a mesh program again
+    glUniform1i(p.ssaa, ssaa);
+    glUniform1f(p.exposureScale, exposureScale(s.exposure));
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, frameTexture);
+    m_boundTexture[0] = kUnknownTexture;
+    glBindVertexArray(m_emptyVao);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glBindVertexArray(0);
+    glEnable(GL_DEPTH_TEST);
+    return {};
 }
 
 }   // namespace rnd::gl

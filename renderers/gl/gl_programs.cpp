@@ -2,7 +2,8 @@
 // (embedded at build time) specialised per frame setup - shading model, reflection model, fog
 // mode, light setup - and per draw's feature switches (textures, maps, alpha mode, the
 // wireframe, overdraw and visibility variants), compiled on first use and cached by key; the
-// uniforms a frame sets once per program (camera, lights, fog) and those a material sets.
+// uniforms a frame sets once per program (camera, lights, fog) and those a material sets; the
+// display pass's programs (exposure, tone mapping, SSAA box filter of linear frames).
 #include "gl/gl_internal.h"
 
 #include "scenegraph/setting_names.h"
@@ -55,6 +56,7 @@ std::string glslEnumDefines() {
     all("FOG_", sg::nameTable<sg::FogMode>());
     all("LIGHT_", sg::nameTable<sg::LightType>());
     all("ALPHA_", sg::nameTable<sg::AlphaMode>());
+    all("TONE_MAPPING_", sg::nameTable<sg::ToneMapping>());
     // The map bits of sg::Material::uv1Maps (which maps sample the second UV set).
     add("MAP_", "emissive", sg::Material::EmissiveMap);
     add("MAP_", "occlusion", sg::Material::OcclusionMap);
@@ -73,7 +75,8 @@ std::string glslEnumDefine(const char* name, const char* prefix, E value) {
 }
 
 std::string glslSources() {
-    return std::string(gl::kShader_pbr_glsl) + "\n" + gl::kShader_lighting_glsl + "\n" + gl::kShader_mesh_vert + "\n" + gl::kShader_mesh_frag;
+    return std::string(gl::kShader_pbr_glsl) + "\n" + gl::kShader_lighting_glsl + "\n" + gl::kShader_mesh_vert + "\n" + gl::kShader_mesh_frag + "\n" +
+           gl::kShader_tone_map_glsl + "\n" + gl::kShader_display_vert + "\n" + gl::kShader_display_frag;
 }
 
 namespace gl {
@@ -121,7 +124,7 @@ std::string buildProgram(const std::string& key, const Features& ft, const Frame
                          flag("HAS_METAL_ROUGH_MAP", ft.metalRoughMap) + flag("HAS_NORMAL_MAP", ft.normalMap) + flag("SPEC_GLOSS", ft.specGloss) +
                          flag("USES_UV", uv) + flag("USES_UV1", uv && ft.uv1) + flag("VERTEX_COLORS", ft.vertexColors) + flag("UNLIT", ft.unlit) +
                          flag("SOLID", ft.solid) + flag("OVERDRAW", ft.overdraw) + flag("VISIBILITY", ft.visibility) +
-                         flag("HAS_ENVIRONMENT", ft.environment);
+                         flag("HAS_ENVIRONMENT", ft.environment) + flag("LINEAR_TARGET", ft.linearTarget);
     std::string common = prefix + gl::kShader_pbr_glsl + "\n" + gl::kShader_lighting_glsl + "\n";
     GLuint vs = 0, fs = 0;
     std::string err = compileShader(GL_VERTEX_SHADER, common + gl::kShader_mesh_vert, vs);
@@ -198,6 +201,38 @@ std::string buildProgram(const std::string& key, const Features& ft, const Frame
     for (int k = 0; k < 4; ++k) glUniform1i(p.maps[k], 1 + k);
     glUniform1i(p.envMap, 5);
     glUniform1i(p.splitSum, 6);
+    return {};
+}
+
+std::string buildDisplayProgram(sg::ToneMapping op, DisplayProgram& p) {
+    const std::string prefix = "#version 330 core\n" + glslEnumDefines() + glslEnumDefine("TONE_MAPPING", "TONE_MAPPING_", op);
+    GLuint vs = 0, fs = 0;
+    std::string err = compileShader(GL_VERTEX_SHADER, prefix + kShader_display_vert, vs);
+    if (err.empty()) err = compileShader(GL_FRAGMENT_SHADER, prefix + kShader_tone_map_glsl + "\n" + kShader_display_frag, fs);
+    if (err.empty()) {
+        p.id = glCreateProgram();
+        glAttachShader(p.id, vs);
+        glAttachShader(p.id, fs);
+        glLinkProgram(p.id);
+        GLint ok = 0;
+        glGetProgramiv(p.id, GL_LINK_STATUS, &ok);
+        if (!ok) {
+            char log[2048] = {};
+            glGetProgramInfoLog(p.id, sizeof log, nullptr, log);
+            err = std::string("display shader link: ") + log;
+            std::replace(err.begin(), err.end(), '\n', ' ');
+            glDeleteProgram(p.id);
+            p.id = 0;
+        }
+    }
+    if (vs) glDeleteShader(vs);
+    if (fs) glDeleteShader(fs);
+    if (!err.empty()) return err;
+    p.frame = glGetUniformLocation(p.id, "uFrame");
+    p.ssaa = glGetUniformLocation(p.id, "uSsaa");
+    p.exposureScale = glGetUniformLocation(p.id, "uExposureScale");
+    glUseProgram(p.id);
+    glUniform1i(p.frame, 0);
     return {};
 }
 
@@ -310,6 +345,7 @@ Features GlRenderer::featuresOf(const DrawItem& it, const Material& m, DrawPass 
         f.overdraw = true;
         return f;
     }
+    f.linearTarget = m_linear;
     if (pass == DrawPass::Wireframe) {
         f.solid = true;
         return f;

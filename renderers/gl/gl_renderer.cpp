@@ -153,6 +153,9 @@ void GlRenderer::forgetGLObjects() {
     m_programs.clear();
     m_target = RenderTarget{};
     m_resolve = RenderTarget{};
+    m_display = RenderTarget{};
+    for (DisplayProgram& p : m_displayPrograms) p = DisplayProgram{};
+    m_emptyVao = 0;
     m_overdraw = CountTarget{};
     m_meshes.clear();
     m_textures.clear();
@@ -169,6 +172,10 @@ void GlRenderer::releaseAll() {
         for (auto& [key, p] : m_programs) glDeleteProgram(p.id);
         m_target.release();
         m_resolve.release();
+        m_display.release();
+        for (DisplayProgram& p : m_displayPrograms)
+            if (p.id) glDeleteProgram(p.id);
+        if (m_emptyVao) glDeleteVertexArrays(1, &m_emptyVao);
         m_overdraw.release();
         for (auto& [id, m] : m_meshes) releaseMesh(m);
         for (auto& [id, t] : m_textures)
@@ -210,8 +217,10 @@ RenderStats GlRenderer::doRender(const FrameInput& frame, const RenderConfig& cf
         return stats;
     }
     const bool visibility = cfg.visibility && samples <= 1 && ssaa == 1;   // render() asks only for one-sample frames
-    err = m_target.ensure(rw, rh, samples > 1 ? samples : 0, visibility);
-    if (err.empty() && samples > 1) err = m_resolve.ensure(rw, rh, 0);
+    // Exposure or tone mapping: linear float targets, and the display pass at the end.
+    m_linear = !s.displayTransformIsIdentity();
+    err = m_target.ensure(rw, rh, samples > 1 ? samples : 0, visibility, m_linear);
+    if (err.empty() && samples > 1) err = m_resolve.ensure(rw, rh, 0, false, m_linear);
     if (!err.empty()) {
         stats.error = err;
         return stats;
@@ -236,7 +245,11 @@ RenderStats GlRenderer::doRender(const FrameInput& frame, const RenderConfig& cf
         stats.error = err;
         return stats;
     }
-    resolveAndRead(rw, rh, samples, ssaa, visibility, target);
+    err = resolveAndRead(rw, rh, samples, ssaa, visibility, target);
+    if (!err.empty()) {
+        stats.error = err;
+        return stats;
+    }
     if (cfg.overdraw && samples <= 1 && ssaa == 1) {   // render() asks only for one-sample frames
         err = countOverdraw(items, s, rw, rh, target);
         if (!err.empty()) {

@@ -1,8 +1,8 @@
 // gl_resources.cpp - the GL backend's GPU objects (gl_internal.h): the cache of meshes
 // (tessellations included) and textures, uploaded once per (id, version), reused by every
 // instance and frame and evicted after kEvictAfterFrames unused frames; the render targets
-// (multisampled or single-sample colour + depth FBOs with an optional visibility attachment,
-// the overdraw view's count target); the frame's draw list, sorted nearest first; texture
+// (multisampled or single-sample colour + depth FBOs, sRGB8 or linear float, with an optional
+// visibility attachment, the overdraw view's count target); the frame's draw list, sorted nearest first; texture
 // binding; and reading images back.
 #include "gl/gl_internal.h"
 
@@ -177,29 +177,43 @@ bool uploadTexture(GpuTexture& g, const Texture& t) {
 void RenderTarget::release() {
     if (fbo) glDeleteFramebuffers(1, &fbo);
     if (color) glDeleteRenderbuffers(1, &color);
+    if (colorTexture) glDeleteTextures(1, &colorTexture);
     if (depth) glDeleteRenderbuffers(1, &depth);
     if (ids) glDeleteRenderbuffers(1, &ids);
-    fbo = color = depth = ids = 0;
+    fbo = color = colorTexture = depth = ids = 0;
     width = height = samples = 0;
+    hdr = false;
 }
 
-std::string RenderTarget::ensure(int w, int h, int s, bool withIds) {
-    if (fbo && w == width && h == height && s == samples && withIds == (ids != 0)) return {};
+std::string RenderTarget::ensure(int w, int h, int s, bool withIds, bool linear) {
+    if (fbo && w == width && h == height && s == samples && withIds == (ids != 0) && linear == hdr) return {};
     release();
     width = w;
     height = h;
     samples = s;
+    hdr = linear;
     if (withIds) {   // single-sampled only (RenderConfig::visibility)
         glGenRenderbuffers(1, &ids);
         glBindRenderbuffer(GL_RENDERBUFFER, ids);
         glRenderbufferStorage(GL_RENDERBUFFER, GL_RG32UI, w, h);
     }
-    glGenRenderbuffers(1, &color);
-    glBindRenderbuffer(GL_RENDERBUFFER, color);
-    if (s > 1)
-        glRenderbufferStorageMultisample(GL_RENDERBUFFER, s, GL_SRGB8_ALPHA8, w, h);
-    else
-        glRenderbufferStorage(GL_RENDERBUFFER, GL_SRGB8_ALPHA8, w, h);
+    const GLenum format = linear ? GL_RGBA16F : GL_SRGB8_ALPHA8;
+    if (linear && s <= 1) {   // a texture, for the display pass to read
+        glGenTextures(1, &colorTexture);
+        glBindTexture(GL_TEXTURE_2D, colorTexture);
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA16F, w, h, 0, GL_RGBA, GL_FLOAT, nullptr);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, 0);
+        glBindTexture(GL_TEXTURE_2D, 0);
+    } else {
+        glGenRenderbuffers(1, &color);
+        glBindRenderbuffer(GL_RENDERBUFFER, color);
+        if (s > 1)
+            glRenderbufferStorageMultisample(GL_RENDERBUFFER, s, format, w, h);
+        else
+            glRenderbufferStorage(GL_RENDERBUFFER, format, w, h);
+    }
     glGenRenderbuffers(1, &depth);
     glBindRenderbuffer(GL_RENDERBUFFER, depth);
     if (s > 1)
@@ -209,7 +223,10 @@ std::string RenderTarget::ensure(int w, int h, int s, bool withIds) {
     glBindRenderbuffer(GL_RENDERBUFFER, 0);
     glGenFramebuffers(1, &fbo);
     glBindFramebuffer(GL_FRAMEBUFFER, fbo);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, color);
+    if (colorTexture)
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, colorTexture, 0);
+    else
+        glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, color);
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth);
     if (ids) glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_RENDERBUFFER, ids);
     glDrawBuffer(GL_COLOR_ATTACHMENT0);
@@ -217,7 +234,7 @@ std::string RenderTarget::ensure(int w, int h, int s, bool withIds) {
     GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
     if (status != GL_FRAMEBUFFER_COMPLETE) {
         char buf[160];
-        std::snprintf(buf, sizeof buf, "framebuffer %dx%d with %d samples is incomplete (status 0x%x)", w, h, s, status);
+        std::snprintf(buf, sizeof buf, "%sframebuffer %dx%d with %d samples is incomplete (status 0x%x)", linear ? "float " : "", w, h, s, status);
         release();
         return buf;
     }
@@ -363,8 +380,10 @@ std::vector<DrawItem> GlRenderer::collectDraws(const FrameInput& frame, int tess
 // top-down straight into `out`; otherwise they pass through m_readRows (kept between frames, so
 // no allocation, zero-fill or page faults per frame) and are flipped. Alpha needs no pass: the
 // target's alpha is 1 everywhere (cleared to 1; every pass writes 1 or, blending, keeps it).
-void GlRenderer::readBack(GLuint fbo, int w, int h, Framebuffer& out) {
-    out.resizeForOverwrite(w, h);   // every pixel is written below
+// withDepth false: the colour only, into `out` as it is (already w x h; the display pass's
+// target, whose depth means nothing).
+void GlRenderer::readBack(GLuint fbo, int w, int h, Framebuffer& out, bool withDepth) {
+    if (withDepth) out.resizeForOverwrite(w, h);   // every pixel is written below
     glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
     if (GLAD_GL_MESA_pack_invert) {
@@ -372,7 +391,7 @@ void GlRenderer::readBack(GLuint fbo, int w, int h, Framebuffer& out) {
         glGetIntegerv(GL_PACK_INVERT_MESA, &invert);
         glPixelStorei(GL_PACK_INVERT_MESA, GL_TRUE);
         glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, out.color.data());
-        glReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, out.depth.data());
+        if (withDepth) glReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, out.depth.data());
         glPixelStorei(GL_PACK_INVERT_MESA, invert);
         return;
     }
@@ -383,6 +402,7 @@ void GlRenderer::readBack(GLuint fbo, int w, int h, Framebuffer& out) {
     };
     glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, m_readRows.data());
     flipInto(out.color.data());
+    if (!withDepth) return;
     glReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, m_readRows.data());
     flipInto(reinterpret_cast<uint8_t*>(out.depth.data()));
 }

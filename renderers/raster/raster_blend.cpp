@@ -2,7 +2,9 @@
 // (raster_frame.h), order-correct per pixel: every blended fragment in front of the opaque depth
 // is kept (depth is not written), a pixel's fragments are sorted far to near and composited
 // "over" in linear light onto the pixel, each step re-encoded to 8-bit sRGB as an SRGB8
-// framebuffer blends. With MSAA a fragment weighs by the samples it covers.
+// framebuffer blends (with a linear frame, FrameContext::linear: onto its linear colour, neither
+// clamped at 1 nor re-encoded, as GL's float target blends). With MSAA a fragment weighs by the
+// samples it covers.
 #include "raster/raster_fragment.h"
 #include "raster/raster_frame.h"
 
@@ -84,11 +86,16 @@ void compositeBlendFragments(const FrameContext& fc, Framebuffer& target, TileBu
     for (size_t k = 0; k < n; ++k) {
         vec3 c(b.cr[k], b.cg[k], b.cb[k]);
         if (fog) c = applyFog(st, c, buf.fogDist[k]);
-        c = glm::clamp(c, 0.0f, 1.0f);
         const int p = frags[k].pixel;
+        const float w = frags[k].alpha * float(frags[k].coverage) / float(samples);
+        if (fc.linear) {
+            vec3& dst = linearAt(fc, x0 + p % tw, y0 + p / tw);
+            dst += w * (glm::max(c, vec3(0.0f)) - dst);
+            continue;
+        }
+        c = glm::clamp(c, 0.0f, 1.0f);
         uint8_t* out = target.pixel(x0 + p % tw, fc.height - 1 - (y0 + p / tw));
         const vec3 dst = srgbBytesToLinear(out);
-        const float w = frags[k].alpha * float(frags[k].coverage) / float(samples);
         const vec3 r = dst + w * (c - dst);
         out[0] = enc(r.x);
         out[1] = enc(r.y);

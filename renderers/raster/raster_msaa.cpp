@@ -3,11 +3,13 @@
 // and shades once per pixel and triangle at the pixel centre. Here: gathering those fragments
 // from the per-sample visibility buffer (one per pixel and distinct triangle among its samples,
 // with the number of samples it covers), and the resolve, which averages the samples of a pixel
-// in linear light.
+// in linear light (into the framebuffer's bytes, or into the linear frame when the display
+// transform comes after it).
 #include "raster/raster_frame.h"
 
 #include <algorithm>
 #include <cstring>
+#include <limits>
 
 namespace rnd::raster {
 
@@ -61,13 +63,17 @@ void resolveMsaa(const FrameContext& fc, Framebuffer& target, TileBuffers& buf, 
     const bool fog = st.fog != sg::FogMode::Off;
     const ShadeBatch& b = buf.batch;
     const int tw = x1 - x0 + 1, th = y1 - y0 + 1;
-    // Average the samples in linear space (background where uncovered).
+    // Average the samples in linear space (background where uncovered). Into bytes each sample
+    // is clamped to [0, 1] first, as GL's sRGB8 samples are; into the linear frame it is not
+    // (the display transform comes after the resolve, and exposure or tone mapping may bring
+    // values above 1 back into range).
+    const float hi = fc.linear ? std::numeric_limits<float>::max() : 1.0f;
     buf.accum.assign(size_t(kTileSize) * kTileSize, vec3(0.0f));
     std::vector<uint8_t> covered(size_t(kTileSize) * kTileSize, 0);
     for (size_t k = 0; k < nf; ++k) {
         vec3 c(b.cr[k], b.cg[k], b.cb[k]);
         if (fog) c = applyFog(st, c, buf.fogDist[k]);
-        c = glm::clamp(c, 0.0f, 1.0f);
+        c = glm::clamp(c, 0.0f, hi);
         buf.accum[buf.fragPixel[k]] += float(buf.fragCount[k]) * c;
         covered[buf.fragPixel[k]] += buf.fragCount[k];
     }
@@ -76,6 +82,10 @@ void resolveMsaa(const FrameContext& fc, Framebuffer& target, TileBuffers& buf, 
             int p = jj * kTileSize + ii;
             if (!covered[p]) continue;
             vec3 c = (buf.accum[p] + float(4 - covered[p]) * bg) * 0.25f;
+            if (fc.linear) {   // uncovered pixels hold the background already (shadeOpaque)
+                linearAt(fc, x0 + ii, y0 + jj) = c;
+                continue;
+            }
             uint8_t* out = target.pixel(x0 + ii, fc.height - 1 - (y0 + jj));
             out[0] = enc(c.x);
             out[1] = enc(c.y);

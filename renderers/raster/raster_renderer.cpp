@@ -10,6 +10,9 @@
 //                 the hot loops are vector kernels, AVX2 or SSE2 (tile_kernels.h,
 //                 raster_shading.h), equal bit for bit to the scalar code
 //   5. lines      Lines/Points meshes and the wireframe overlay with the DDA line rasterizer (here)
+//   6. display    exposure and tone mapping (renderers/tone_map.h), only when they are not the
+//                 identity: steps 4 and 5 then write linear colour into a linear frame, which
+//                 raster_shade.cpp's encodeLinearFrame resolves (SSAA), maps and encodes
 // SSAA renders at aaRate x the size and box-filters down; MSAA 4x keeps 4 samples per pixel
 // (coverage + depth per sample) and shades once per pixel and triangle at the pixel centre.
 #include "raster/raster_renderer.h"
@@ -56,14 +59,18 @@ protected:
     RenderStats doRender(const sg::FrameInput& frame, const RenderConfig& cfg, Framebuffer& target, RenderControl* control) override {
         RenderStats stats;
         const int r = cfg.ssaaFactor;
+        // Exposure or tone mapping: the frame in linear colour first, bytes at the end (step 6).
+        const DisplayTransform display(frame.settings);
+        LinearFrame* linear = display.identity ? nullptr : &m_linear;
         if (r > 1) {
             Framebuffer hi;
-            stats = renderSingle(frame, cfg.width * r, cfg.height * r, cfg.tessellation, hi, false, control, r);
-            if (stats.ok) target = downsample(hi, r);
+            stats = renderSingle(frame, cfg.width * r, cfg.height * r, cfg.tessellation, hi, false, control, r, false, false, linear);
+            if (stats.ok) target = downsample(hi, r);   // depth (and the colour, unless the linear frame replaces it)
         } else {
-            stats =
-                renderSingle(frame, cfg.width, cfg.height, cfg.tessellation, target, cfg.msaaSamples > 1, control, 1, cfg.visibility, cfg.overdraw);
+            stats = renderSingle(frame, cfg.width, cfg.height, cfg.tessellation, target, cfg.msaaSamples > 1, control, 1, cfg.visibility,
+                                 cfg.overdraw, linear);
         }
+        if (stats.ok && linear) encodeLinearFrame(linear->pixels(0), r, display, target);
         return stats;
     }
 
@@ -143,9 +150,10 @@ private:
 
     // pointScale: the SSAA factor (points are 2 pixels wide at the output resolution, like GL).
     // visibility: fill target.drawable/primitive; overdraw: count fragments per pixel into
-    // target.overdraw (both one sample per pixel only).
+    // target.overdraw (both one sample per pixel only). linear: the linear frame to write
+    // colour into instead of target's bytes (FrameContext::linear), sized here.
     RenderStats renderSingle(const sg::FrameInput& frame, int width, int height, int tessRes, Framebuffer& target, bool msaa, RenderControl* control,
-                             int pointScale = 1, bool visibility = false, bool overdraw = false) {
+                             int pointScale = 1, bool visibility = false, bool overdraw = false, LinearFrame* linear = nullptr) {
         RenderStats stats;
         auto t0frame = std::chrono::steady_clock::now();
         m_samplers.beginFrame();
@@ -199,6 +207,7 @@ private:
         fc.timing = m_timing;
         fc.visibility = visibility && !msaa;
         fc.overdraw = overdraw && !msaa;
+        if (linear) fc.linear = linear->pixels(size_t(width) * height);   // every pixel is written by its tile
         fc.draws = &draws;
         uint64_t chunkSize = std::max<uint64_t>(4096, (total + 4000) / 4000);
         if (chunkSize * 7 >= (1u << kChunkBits)) {
@@ -223,11 +232,11 @@ private:
         if (environment.map && environment.background) {   // pbr: the environment where nothing was drawn
             const uint8_t bg[3] = {toByteSRGB(frame.settings.background.x), toByteSRGB(frame.settings.background.y),
                                    toByteSRGB(frame.settings.background.z)};
-            drawEnvironmentBackground(target, frame.camera, environment, bg);
+            drawEnvironmentBackground(target, frame.camera, environment, bg, fc.linear, frame.settings.background);
         }
         auto tTiles = std::chrono::steady_clock::now();
         // 5. lines, points, wireframe
-        drawPointsLinesWireframe(prepared, frame, target, 2.0f * float(pointScale));
+        drawPointsLinesWireframe(prepared, frame, target, 2.0f * float(pointScale), fc.linear);
         if (m_timing) {
             auto ms = [](auto a, auto b) { return std::chrono::duration<double, std::milli>(b - a).count(); };
             size_t ntri = 0;
@@ -246,6 +255,7 @@ private:
     TessellationCache m_tess;
     std::vector<Chunk> m_chunks;
     std::vector<DrawItem> m_vertexBuffers;   // only their vertex-stage buffers (DrawItem::swapBuffers)
+    LinearFrame m_linear;                    // the linear frame of step 6, kept between frames
     // VIEWER_RASTER_REFERENCE_SHADING=1: shade every fragment with rnd::shade (slow; used to
     // check the batched path).
     bool m_timing = debugSwitches().rasterTiming;

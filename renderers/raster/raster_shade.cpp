@@ -8,12 +8,16 @@
 //                (plain materials: the vector kernel preparePlainRun, tile_kernels.h)
 //   3. light     shadeBatch (raster_shading.h)
 //   4. output    fog, sRGB bytes, into the tile's colour buffer and then the framebuffer (MSAA:
-//                resolveMsaa)
+//                resolveMsaa); with a linear frame (FrameContext::linear) the fogged linear
+//                colour into it instead, for encodeLinearFrame (below) to encode at the end
 // The helpers below were one function; they stay force-inlined into shadeOpaque, the SSE2
 // parts in small named functions of their own.
 #include "raster/raster_fragment.h"
 #include "raster/raster_frame.h"
 #include "raster/simd.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cstring>
@@ -259,6 +263,20 @@ inline void writeVisibility(const FrameContext& fc, Framebuffer& target, size_t 
     }
 }
 
+// The linear frame's path (FrameContext::linear): the shaded fragments [0, nf), fogged, into the
+// linear frame; the tile's other pixels keep the background shadeOpaque put there.
+[[gnu::always_inline]] inline void writeFragmentLinear(const FrameContext& fc, const TileBuffers& buf, int x0, int y0, size_t nf) {
+    const auto& st = fc.frame->settings;
+    const bool fog = st.fog != sg::FogMode::Off;
+    const ShadeBatch& b = buf.batch;
+    for (size_t k = 0; k < nf; ++k) {
+        vec3 c(b.cr[k], b.cg[k], b.cb[k]);
+        if (fog) c = applyFog(st, c, buf.fogDist[k]);
+        const int p = buf.fragPixel[k];
+        linearAt(fc, x0 + p % kTileSize, y0 + p / kTileSize) = c;
+    }
+}
+
 // The tile's colour buffer to the framebuffer, a row at a time.
 [[gnu::always_inline]] inline void writeColorRows(const FrameContext& fc, Framebuffer& target, const TileBuffers& buf, int x0, int y0, int tw,
                                                   int th) {
@@ -279,6 +297,7 @@ void shadeOpaque(const FrameContext& fc, Framebuffer& target, TileBuffers& buf, 
         buf.fragCount.resize(maxFrags);
     }
     const int tw = x1 - x0 + 1, th = y1 - y0 + 1;
+    if (fc.linear) fillLinearBackground(fc, x0, y0, x1, y1);
     buf.runs.clear();
     size_t nf = 0;
     if (samples == 1) {
@@ -290,7 +309,7 @@ void shadeOpaque(const FrameContext& fc, Framebuffer& target, TileBuffers& buf, 
         nf = gatherMsaaFragments(fc, target, buf, x0, y0, x1, y1);
     }
     if (nf == 0) {
-        if (samples == 1) writeColorRows(fc, target, buf, x0, y0, tw, th);
+        if (samples == 1 && !fc.linear) writeColorRows(fc, target, buf, x0, y0, tw, th);
         return;
     }
     buf.batch.resize(nf);
@@ -301,12 +320,42 @@ void shadeOpaque(const FrameContext& fc, Framebuffer& target, TileBuffers& buf, 
     if (fc.timing) g_prepareNs += tC - tB;
     shadeBatch(buf.batch, nf, *fc.frame);
     if (fc.timing) g_lightNs += nowNs() - tC;
+    if (samples == 1 && fc.linear) {
+        writeFragmentLinear(fc, buf, x0, y0, nf);
+        return;
+    }
     if (samples == 1) {
         writeFragmentColors(fc, buf, nf);
         writeColorRows(fc, target, buf, x0, y0, tw, th);
         return;
     }
     resolveMsaa(fc, target, buf, x0, y0, x1, y1, nf);
+}
+
+void encodeLinearFrame(const sg::vec3* linear, int factor, const DisplayTransform& display, Framebuffer& target) {
+    const SrgbEncoder& enc = srgbEncoder();
+    const int w = target.width, r = std::max(factor, 1);
+    const size_t stride = size_t(w) * r;   // pixels per row of the linear frame
+    const float inv = 1.0f / float(r * r);
+    tbb::parallel_for(tbb::blocked_range<int>(0, target.height), [&](const tbb::blocked_range<int>& rows) {
+        for (int y = rows.begin(); y != rows.end(); ++y) {
+            uint8_t* out = target.pixel(0, y);
+            for (int x = 0; x < w; ++x, out += 4) {
+                vec3 c = linear[size_t(y) * r * stride + size_t(x) * r];
+                if (r > 1) {   // the mean of the block in linear light, as downsample() averages
+                    c = vec3(0.0f);
+                    for (int sy = 0; sy < r; ++sy)
+                        for (int sx = 0; sx < r; ++sx) c += linear[(size_t(y) * r + sy) * stride + size_t(x) * r + sx];
+                    c *= inv;
+                }
+                c = display(c);
+                out[0] = enc(c.x);
+                out[1] = enc(c.y);
+                out[2] = enc(c.z);
+                out[3] = 255;
+            }
+        }
+    });
 }
 
 }   // namespace rnd::raster

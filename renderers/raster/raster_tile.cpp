@@ -129,6 +129,11 @@ bool tileIsEmpty(int tile, const std::vector<Chunk>& chunks) {
 // An empty tile (sky, margins): background and far depth straight into the framebuffer, without
 // the tile's buffers.
 void fillEmptyTile(const FrameContext& fc, Framebuffer& target, int x0, int y0, int x1, int y1) {
+    if (fc.linear) {   // bytes come from the linear frame at the end (encodeLinearFrame)
+        fillLinearBackground(fc, x0, y0, x1, y1);
+        for (int j = y0; j <= y1; ++j) std::fill_n(&target.depth[size_t(fc.height - 1 - j) * fc.width + x0], x1 - x0 + 1, 1.0f);
+        return;
+    }
     const uint32_t bgWord = backgroundWord(fc.frame->settings);
     for (int j = y0; j <= y1; ++j) {
         const int row = fc.height - 1 - j;

@@ -1,6 +1,7 @@
 // raycast_renderer.cpp - the "raycast" backend: CPU ray casting (docs/math.md) with the
 // shared Phong shading (renderers/shading.h), shadow rays, optional mirror reflections and
-// stratified supersampling; tile-parallel (oneTBB), progressive and cancellable.
+// stratified supersampling, and the display transform (renderers/tone_map.h) on each pixel's
+// mean colour; tile-parallel (oneTBB), progressive and cancellable.
 //
 // Sections: texture footprint, Tracer (hit shading: meshes flat/Gouraud/Phong, analytics),
 // RaycastRenderer::render (tiles, AA, progress, cancellation).
@@ -23,6 +24,7 @@
 #include "renderers/pbr.h"
 #include "renderers/shading.h"
 #include "renderers/texture_sampler.h"
+#include "renderers/tone_map.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -526,6 +528,7 @@ struct FrameJob {
     int sx, sy;                         // strata per pixel (see RaycastRenderer::capabilities)
     bool packets;                       // the tile's camera rays are traced first, in packets
     bool countCost;                     // the cost view: one centre ray per pixel, counted
+    DisplayTransform display;           // exposure and tone mapping of each pixel's mean colour
     static constexpr int kTile = 32;    // pixels per tile side
     static constexpr int kPacket = 4;   // pixels per packet side (4x4: the benchmark's best, docs/benchmarks.md)
     static_assert(kPacket * kPacket <= rt::kMaxPacket);
@@ -568,7 +571,7 @@ void traceCameraPackets(const FrameJob& job, const rt::SceneAccel& accel, int x0
 }
 
 // Pixel (x, row) of the tile with corner (x0, y0): its sx x sy stratified rays traced and
-// shaded, the mean colour as sRGB bytes, the nearest depth, and (centre ray) the visibility and
+// shaded, the mean colour through the display transform as sRGB bytes, the nearest depth, and (centre ray) the visibility and
 // the traversal cost when asked.
 void shadePixel(const FrameJob& job, Tracer& tr, int x, int row, int x0, int y0, const std::vector<rt::Ray>& tileRays,
                 const std::vector<Tracer::FirstHit>& tileHits, Framebuffer& target) {
@@ -605,6 +608,7 @@ void shadePixel(const FrameJob& job, Tracer& tr, int x, int row, int x0, int y0,
             sum += c;
         }
     sum /= float(sx * sy);
+    sum = job.display(sum);                    // after the resolve, as every backend (tone_map.h)
     if (!isFinite(sum)) sum = vec3(1, 0, 1);   // never feed NaN to the byte conversion
     uint8_t* px = target.pixel(x, row);
     px[0] = toByteSRGB(sum.x);
@@ -642,7 +646,9 @@ protected:
         RenderStats stats;
         const int w = cfg.width, h = cfg.height;
         target.resize(w, h);
-        const uint8_t bg[4] = {toByteSRGB(f.settings.background.x), toByteSRGB(f.settings.background.y), toByteSRGB(f.settings.background.z), 255};
+        const DisplayTransform display(f.settings);
+        const vec3 background = display(f.settings.background);
+        const uint8_t bg[4] = {toByteSRGB(background.x), toByteSRGB(background.y), toByteSRGB(background.z), 255};
         target.clear(bg, 1.0f);
         if (cfg.visibility) target.resizeVisibility();
         const bool countCost = cfg.traversalCost && cfg.samplesPerPixel == 1;   // render() asks only for one-sample frames
@@ -667,7 +673,7 @@ protected:
         // Camera rays in packets where each pixel has one (the cost view counts rays one by one);
         // VIEWER_RAYCAST_PACKETS=0 traces them one by one (timing comparisons: the same image).
         const bool packets = debugSwitches().raycastPackets && sx * sy == 1 && !countCost;
-        const FrameJob job{f, cfg, cam, w, h, sx, sy, packets, countCost};
+        const FrameJob job{f, cfg, cam, w, h, sx, sy, packets, countCost, display};
         uint64_t rays = 0;
         stats.cancelled = !renderTiles(job, target, control, rays);
         _mm_setcsr(csr);

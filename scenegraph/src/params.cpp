@@ -105,6 +105,15 @@ std::vector<Param<RenderSettings>> renderTable() {
                     .fmt("%.4f")
                     .when(fogExponential),
             }),
+        inSection<S>("Exposure and tone mapping",
+                     {
+                         field<&S::exposure>("exposure", "exposure", "Exposure",
+                                             "Exposure in EV: the linear colour is multiplied by 2^EV before the tone mapping")
+                             .range(-10.0, 10.0)
+                             .fmt("%.2f EV"),
+                         field<&S::toneMapping>("toneMapping", "tone-mapping", "Tone mapping",
+                                                "Maps the exposed linear colour to the display's range, before the sRGB encoding"),
+                     }),
         inSection<S>("Anti-aliasing",
                      {
                          // The rate first, so a file's "aa" name wins over a stray rate.
@@ -143,10 +152,11 @@ std::vector<Param<RenderSettings>> renderTable() {
 // --- projection --------------------------------------------------------------------------------
 
 // The projection type; also takes the oblique presets (cavalier, cabinet), which set the angle
-// and factor too.
+// and factor too, and the axonometric one (isometric), which is orthographic here (the command
+// line turns the camera as well).
 Param<Projection> projectionTypeParam() {
     Param<Projection> p = field<&Projection::type>("type", "projection", "Type",
-                                                   "Projection: perspective, orthographic or oblique (or an oblique preset: cavalier, cabinet)");
+                                                   "Projection: perspective, orthographic or oblique (or a preset: cavalier, cabinet, isometric)");
     p.set = [](Projection& pr, const ParamValue& v) {
         const std::string* name = std::get_if<std::string>(&v);
         if (!name) return false;
@@ -158,9 +168,15 @@ Param<Projection> projectionTypeParam() {
             pr.obliqueFactor = q.obliqueFactor;
             return true;
         }
+        AxonometricPreset axonometric;
+        if (parseName(*name, axonometric)) {
+            pr.type = ProjectionType::Orthographic;
+            return true;
+        }
         return parseName(*name, pr.type);
     };
     for (const ParamChoice& c : param_detail::choicesOf<ObliquePreset>()) p.choices.push_back(c);
+    for (const ParamChoice& c : param_detail::choicesOf<AxonometricPreset>()) p.choices.push_back(c);
     return p;
 }
 

@@ -1,6 +1,6 @@
 // projection.cpp - Projection::matrix(): the projection matrix of a camera's parameters
 // (perspective from fovy or an explicit frustum, orthographic, oblique sheared about the focus
-// distance), built from the transforms of transforms.h.
+// distance), built from the transforms of transforms.h; the isometric view's camera.
 #include "scenegraph/projection.h"
 
 #include "scenegraph/transforms.h"
@@ -33,6 +33,17 @@ mat4 Projection::matrix(float aspect, float focusDistance) const {
     }
     }
     return mat4(1.0f);
+}
+
+vec3 isometricViewDirection() {
+    const float yaw = radians(kIsometricYawDeg), pitch = radians(kIsometricPitchDeg);
+    // The eye's direction from the pivot: yaw about +y from +z, pitch above the horizon.
+    return -vec3(std::cos(pitch) * std::sin(yaw), std::sin(pitch), std::cos(pitch) * std::cos(yaw));
+}
+
+mat4 isometricCameraWorld(const vec3& pivot, float distance) {
+    const vec3 eye = pivot - distance * isometricViewDirection();
+    return glm::inverse(lookAt(eye, pivot, vec3(0.0f, 1.0f, 0.0f)));
 }
 
 }   // namespace sg

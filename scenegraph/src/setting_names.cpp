@@ -48,6 +48,11 @@ constexpr NamedValue<ObliquePreset> kObliquePreset[] = {
     {ObliquePreset::Cabinet, "cabinet", "Cabinet", "oblique at 45 degrees, receding axis at half length (factor 0.5)"},
 };
 
+constexpr NamedValue<AxonometricPreset> kAxonometricPreset[] = {
+    {AxonometricPreset::Isometric, "isometric", "Isometric",
+     "orthographic, seen along (-1,-1,-1) so the three axes are equally foreshortened (the camera turns there too)"},
+};
+
 constexpr NamedValue<LightType> kLight[] = {
     {LightType::Point, "point", "Point", "shines from the node's position in every direction"},
     {LightType::Directional, "directional", "Directional", "parallel light along the node's -z axis"},
@@ -58,6 +63,14 @@ constexpr NamedValue<CullMode> kCull[] = {
     {CullMode::Auto, "auto", "Auto (per material)", "cull the back faces of single-sided materials, draw double-sided ones from both sides"},
     {CullMode::On, "on", "On", "cull every back face"},
     {CullMode::Off, "off", "Off", "draw every back face"},
+};
+
+constexpr NamedValue<ToneMapping> kToneMapping[] = {
+    {ToneMapping::None, "none", "None", "the exposed linear colour as it is, clipped at 1 by the sRGB encoding"},
+    {ToneMapping::Aces, "aces", "ACES filmic",
+     "Stephen Hill's fit of the ACES RRT + sRGB ODT, as the Khronos glTF Sample Viewer applies it (input / 0.6)"},
+    {ToneMapping::KhrNeutral, "khr-neutral", "Khronos PBR Neutral",
+     "Khronos PBR Neutral: base colours 0.08..0.8 kept (less 0.04), highlights compressed toward white without hue shifts"},
 };
 
 constexpr NamedValue<AlphaMode> kAlphaMode[] = {
@@ -148,6 +161,11 @@ const NameTable<ObliquePreset>& nameTable<ObliquePreset>() {
     return t;
 }
 template <>
+const NameTable<AxonometricPreset>& nameTable<AxonometricPreset>() {
+    static const NameTable<AxonometricPreset> t{kAxonometricPreset};
+    return t;
+}
+template <>
 const NameTable<LightType>& nameTable<LightType>() {
     static const NameTable<LightType> t{kLight};
     return t;
@@ -155,6 +173,11 @@ const NameTable<LightType>& nameTable<LightType>() {
 template <>
 const NameTable<CullMode>& nameTable<CullMode>() {
     static const NameTable<CullMode> t{kCull};
+    return t;
+}
+template <>
+const NameTable<ToneMapping>& nameTable<ToneMapping>() {
+    static const NameTable<ToneMapping> t{kToneMapping};
     return t;
 }
 template <>
@@ -181,6 +204,7 @@ std::string_view toString(ShadingModel m) { return nameOf(m); }
 std::string_view toString(ReflectionModel m) { return nameOf(m); }
 std::string_view toString(FogMode m) { return nameOf(m); }
 std::string_view toString(CullMode m) { return nameOf(m); }
+std::string_view toString(ToneMapping m) { return nameOf(m); }
 std::string_view toString(ProjectionType t) { return nameOf(t); }
 std::string_view toString(LightType t) { return nameOf(t); }
 bool parse(std::string_view s, ShadingModel& out) { return parseName(s, out); }

@@ -9,11 +9,14 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <vector>
 
 namespace fs = std::filesystem;
 
@@ -52,6 +55,46 @@ TEST(CliCamera, SidecarCameraReproducesTheImageExactly) {
             EXPECT_NE(r.output.find("160x90"), std::string::npos) << "the sidecar's size is used: " << r.output;
             EXPECT_TRUE(bytes(a) == bytes(b)) << "--camera-json did not reproduce the image";
         }
+}
+
+// --projection isometric: the written camera is orthographic and looks along -(1, 1, 1), so the
+// world axes land on its image plane equally long (sqrt(2/3) per unit) and 120 degrees apart;
+// the scene stays in view (the depth AOV has surface pixels). The demo has a camera of its own;
+// the teapot (when the test data is there) gets the default one.
+TEST(CliCamera, IsometricProjectionTurnsTheCamera) {
+    const fs::path dir = dirFor("isometric");
+    std::vector<std::string> scenes = {"demo"};
+    const fs::path teapot = testing_support::testdataDir() / "meshes/common-3d-test-models/teapot/teapot.obj";
+    if (fs::exists(teapot)) scenes.push_back(teapot.string());
+    for (const std::string& scene : scenes) {
+        SCOPED_TRACE(scene);
+        ViewerRun r = runViewer("render " + (scene == "demo" ? scene : quoted(fs::path(scene))) +
+                                " --backend raster --size 160x90 --projection isometric --aov depth --overwrite --out " + quoted(dir / "iso.png"));
+        ASSERT_EQ(r.status, 0) << r.output;
+        std::ifstream in(dir / "iso.json");
+        const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+        ASSERT_TRUE(j.is_object());
+        EXPECT_EQ(j["camera"]["projection"], "orthographic");
+        const auto& m = j["camera"]["world_to_camera"];   // rows; camera x right, y down, z forward
+        double len[3], x[3], y[3];
+        for (int a = 0; a < 3; ++a) {
+            x[a] = m[0][a].get<double>();
+            y[a] = m[1][a].get<double>();
+            len[a] = std::hypot(x[a], y[a]);
+            EXPECT_NEAR(len[a], std::sqrt(2.0 / 3.0), 1e-4) << "axis " << a;
+            EXPECT_NEAR(m[2][a].get<double>(), -1.0 / std::sqrt(3.0), 1e-4) << "looks along -(1, 1, 1)";
+        }
+        for (int a = 0; a < 3; ++a) {
+            const int b = (a + 1) % 3;
+            EXPECT_NEAR(std::acos((x[a] * x[b] + y[a] * y[b]) / (len[a] * len[b])) * 180.0 / 3.14159265358979, 120.0, 0.01) << a << ", " << b;
+        }
+        int w = 0, h = 0;
+        std::vector<float> depth;
+        ASSERT_EQ(assets::readPfm(dir / "iso.depth.pfm", w, h, depth), "");
+        const auto surface = std::count_if(depth.begin(), depth.end(), [](float d) { return d > 0.0f; });
+        EXPECT_GT(surface, long(depth.size() / 50)) << "the scene is in view (framed as the perspective view was at its pivot)";
+        EXPECT_LT(surface, long(depth.size())) << "and framed with some background around it";
+    }
 }
 
 TEST(CliCamera, IntrinsicsComeBackInTheSidecar) {

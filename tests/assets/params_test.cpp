@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 #include <set>
 
@@ -124,6 +125,39 @@ TEST(ParamTablesTest, EveryFlaggedRowIsACommandLineOption) {
         quoted(VIEWER_EXE), "render demo --backend raster --size 32x18 --tessellation 600 --out " + quoted(dir / "bad.png"));
     EXPECT_NE(bad.status, 0);
     EXPECT_NE(bad.output.find("--tessellation must be in [4, 512]"), std::string::npos) << bad.output;
+}
+
+// The display transform's rows on the command line: a negative exposure in EV is a value, not
+// an option; the operator by name; bad values name the flag with the range or the names.
+TEST(ParamTablesTest, ExposureAndToneMappingOnTheCommandLine) {
+    fs::path dir = testing_support::outputDir("params");
+    testing_support::ProgramRun ok = testing_support::runProgram(
+        quoted(VIEWER_EXE),
+        "render demo --backend raster --size 32x18 --overwrite --exposure -1.5 --tone-mapping khr-neutral --out " + quoted(dir / "tone.png"));
+    EXPECT_EQ(ok.status, 0) << ok.output;
+    testing_support::ProgramRun far =
+        testing_support::runProgram(quoted(VIEWER_EXE), "render demo --backend raster --size 32x18 --exposure 11 --out " + quoted(dir / "bad.png"));
+    EXPECT_NE(far.status, 0);
+    EXPECT_NE(far.output.find("--exposure must be in [-10, 10]"), std::string::npos) << far.output;
+    testing_support::ProgramRun name = testing_support::runProgram(
+        quoted(VIEWER_EXE), "render demo --backend raster --size 32x18 --tone-mapping filmic --out " + quoted(dir / "bad.png"));
+    EXPECT_NE(name.status, 0);
+    EXPECT_NE(name.output.find("none, aces, khr-neutral"), std::string::npos) << name.output;
+    sg::RenderSettings s;
+    EXPECT_EQ(sg::setParamFromText(s, *sg::findParam<sg::RenderSettings>("toneMapping"), "aces"), "");
+    EXPECT_EQ(s.toneMapping, sg::ToneMapping::Aces);
+    EXPECT_EQ(sg::setParamFromText(s, *sg::findParam<sg::RenderSettings>("exposure"), "-2.5"), "");
+    EXPECT_EQ(s.exposure, -2.5f);
+}
+
+// The isometric preset of the projection row: orthographic (the command line turns the camera).
+TEST(ParamTablesTest, IsometricPresetIsOrthographic) {
+    sg::Projection p;
+    const sg::Param<sg::Projection>* type = sg::findParam<sg::Projection>("type");
+    ASSERT_TRUE(type);
+    EXPECT_EQ(sg::setParamFromText(p, *type, "isometric"), "");
+    EXPECT_EQ(p.type, sg::ProjectionType::Orthographic);
+    EXPECT_TRUE(std::any_of(type->choices.begin(), type->choices.end(), [](const sg::ParamChoice& c) { return c.name == "isometric"; }));
 }
 
 // A mesh file's fog follows its size wherever it is opened: loadScene fits it (the window's

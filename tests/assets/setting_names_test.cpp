@@ -36,12 +36,20 @@ constexpr int valueCount<sg::FogMode>() {
     return 4;
 }
 template <>
+constexpr int valueCount<sg::ToneMapping>() {
+    return 3;
+}
+template <>
 constexpr int valueCount<sg::ProjectionType>() {
     return 3;
 }
 template <>
 constexpr int valueCount<sg::ObliquePreset>() {
     return 2;
+}
+template <>
+constexpr int valueCount<sg::AxonometricPreset>() {
+    return 1;
 }
 template <>
 constexpr int valueCount<sg::LightType>() {
@@ -58,8 +66,8 @@ constexpr int valueCount<sg::FilterMode>() {
 
 template <class E>
 class SettingsNameTableTest : public ::testing::Test {};
-using NamedEnums = ::testing::Types<sg::ShadingModel, sg::ReflectionModel, sg::FogMode, sg::AAChoice, sg::ProjectionType, sg::ObliquePreset,
-                                    sg::LightType, sg::WrapMode, sg::FilterMode>;
+using NamedEnums = ::testing::Types<sg::ShadingModel, sg::ReflectionModel, sg::FogMode, sg::ToneMapping, sg::AAChoice, sg::ProjectionType,
+                                    sg::ObliquePreset, sg::AxonometricPreset, sg::LightType, sg::WrapMode, sg::FilterMode>;
 TYPED_TEST_SUITE(SettingsNameTableTest, NamedEnums);
 
 TYPED_TEST(SettingsNameTableTest, NamesParseBackAndAreUnique) {
@@ -167,6 +175,12 @@ TEST(SettingsNameTableTest, JsonWriterWritesTheTableNames) {
         EXPECT_EQ(written(s)["settings"]["fog"]["mode"], e.name);
         EXPECT_EQ(reread(s).settings.fog, e.value) << e.name;
     }
+    for (const auto& e : sg::nameTable<sg::ToneMapping>().entries) {
+        sg::Scene s = demo;
+        s.settings.toneMapping = e.value;
+        EXPECT_EQ(written(s)["settings"]["toneMapping"], e.name);
+        EXPECT_EQ(reread(s).settings.toneMapping, e.value) << e.name;
+    }
     for (const auto& e : sg::nameTable<sg::AAChoice>().entries) {
         sg::Scene s = demo;
         ASSERT_TRUE(s.settings.setAA(e.name));
@@ -247,6 +261,8 @@ TEST(CliSettingNamesTest, HelpAllListsEveryName) {
     expectAllNames<sg::AAChoice>(r.output);
     expectAllNames<sg::ProjectionType>(r.output);
     expectAllNames<sg::ObliquePreset>(r.output);
+    expectAllNames<sg::AxonometricPreset>(r.output);
+    expectAllNames<sg::ToneMapping>(r.output);
 }
 
 TEST(CliSettingNamesTest, BadValuesListTheValidNames) {
@@ -259,8 +275,9 @@ TEST(CliSettingNamesTest, BadValuesListTheValidNames) {
                           Case{"--shading toon", "--shading: 'toon' is not one of " + sg::nameList<sg::ShadingModel>()},
                           Case{"--reflection cook", "--reflection: 'cook' is not one of " + sg::nameList<sg::ReflectionModel>()},
                           Case{"--aa fxaa", "--aa: 'fxaa' is not one of " + sg::nameList<sg::AAChoice>()},
+                          Case{"--tone-mapping reinhard", "--tone-mapping: 'reinhard' is not one of " + sg::nameList<sg::ToneMapping>()},
                           Case{"--projection fisheye", "--projection: 'fisheye' is not one of " + sg::nameList<sg::ProjectionType>() + ", " +
-                                                           sg::nameList<sg::ObliquePreset>()}}) {
+                                                           sg::nameList<sg::ObliquePreset>() + ", " + sg::nameList<sg::AxonometricPreset>()}}) {
         ViewerRun r = runViewer(base + c.args);
         EXPECT_NE(r.status, 0) << c.args;
         EXPECT_NE(r.output.find(c.message), std::string::npos) << c.args << "\n" << r.output;

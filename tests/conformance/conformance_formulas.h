@@ -3,7 +3,8 @@
 // shading.h, scenegraph/include/scenegraph/settings.h, transforms.h) rather than calling the
 // renderers' own shading code, so a shared bug cannot hide: Phong / Blinn-Phong radiance, fog
 // visibility, sRGB encoding, the projections, camera rays and ray-sphere / ray-triangle hits,
-// and the exact area of a pixel square covered by a convex polygon.
+// the exact area of a pixel square covered by a convex polygon, exposure and the tone-mapping
+// operators.
 #pragma once
 
 #include "scenegraph/frame.h"
@@ -31,6 +32,61 @@ inline std::array<uint8_t, 3> toBytes(const vec3& linear) {
     std::array<uint8_t, 3> b{};
     for (int c = 0; c < 3; ++c) b[size_t(c)] = uint8_t(std::lround(srgbEncode(linear[c]) * 255.0f));
     return b;
+}
+
+// --- Exposure and tone mapping (renderers/tone_map.h, docs/math.md), in double precision from
+// the published formulas, written in their own form rather than the renderers' (the Neutral
+// operator as its specification's cases, not the reference GLSL's mix()).
+
+// Stephen Hill's ACES fit (RRT + sRGB ODT) with the Khronos glTF Sample Viewer's input scale
+// 1/0.6: M_out fit(M_in c / 0.6), clamped to [0, 1]. Matrices by rows (the GLSL source lists
+// them by columns): sRGB -> AP1 with the RRT's desaturation, and the ODT's back to sRGB.
+inline std::array<double, 3> acesReference(const std::array<double, 3>& c) {
+    static constexpr double in[3][3] = {{0.59719, 0.35458, 0.04823}, {0.07600, 0.90834, 0.01566}, {0.02840, 0.13383, 0.83777}};
+    static constexpr double out[3][3] = {{1.60475, -0.53108, -0.07367}, {-0.10208, 1.10813, -0.00605}, {-0.00327, -0.07276, 1.07602}};
+    std::array<double, 3> v{}, f{}, r{};
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) v[size_t(i)] += in[i][j] * c[size_t(j)] / 0.6;
+    for (int i = 0; i < 3; ++i) {
+        const double x = v[size_t(i)];
+        f[size_t(i)] = (x * (x + 0.0245786) - 0.000090537) / (x * (0.983729 * x + 0.4329510) + 0.238081);
+    }
+    for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j) r[size_t(i)] += out[i][j] * f[size_t(j)];
+        r[size_t(i)] = std::clamp(r[size_t(i)], 0.0, 1.0);
+    }
+    return r;
+}
+
+// Khronos PBR Neutral, as its specification (KhronosGroup/ToneMapping, PBR_Neutral) writes it:
+// F90 = 0.04, Ks = 0.8 - F90, Kd = 0.15; x = min(c); f = x - x^2 / (4 F90) for x <= 2 F90, else
+// F90; p = max(c - f); p_n = 1 - (1 - Ks)^2 / (p + 1 - 2 Ks); g = 1 / (Kd (p - p_n) + 1);
+// out = c - f for p <= Ks, else (c - f) (p_n / p) g + p_n (1 - g).
+inline std::array<double, 3> khrNeutralReference(const std::array<double, 3>& c) {
+    const double F90 = 0.04, Ks = 0.8 - F90, Kd = 0.15;
+    const double x = std::min({c[0], c[1], c[2]});
+    const double f = x <= 2 * F90 ? x - x * x / (4 * F90) : F90;
+    const double p = std::max({c[0] - f, c[1] - f, c[2] - f});
+    std::array<double, 3> r{};
+    if (p <= Ks) {
+        for (int i = 0; i < 3; ++i) r[size_t(i)] = c[size_t(i)] - f;
+        return r;
+    }
+    const double pn = 1 - (1 - Ks) * (1 - Ks) / (p + 1 - 2 * Ks);
+    const double g = 1 / (Kd * (p - pn) + 1);
+    for (int i = 0; i < 3; ++i) r[size_t(i)] = (c[size_t(i)] - f) * (pn / p) * g + pn * (1 - g);
+    return r;
+}
+
+// What the display shows of linear colour c at exposure ev with operator op, before the sRGB
+// encoding: T(2^ev max(c, 0)), clamped to [0, 1] (none: the scaled colour, clipped).
+inline vec3 displayReference(const vec3& c, float ev, sg::ToneMapping op) {
+    const double s = std::pow(2.0, double(ev));
+    std::array<double, 3> x{};
+    for (int i = 0; i < 3; ++i) x[size_t(i)] = s * std::max(double(c[i]), 0.0);
+    if (op == sg::ToneMapping::Aces) x = acesReference(x);
+    if (op == sg::ToneMapping::KhrNeutral) x = khrNeutralReference(x);
+    return vec3(float(std::clamp(x[0], 0.0, 1.0)), float(std::clamp(x[1], 0.0, 1.0)), float(std::clamp(x[2], 0.0, 1.0)));
 }
 
 // Seeds 3.1 (shading.h), directional and point lights:

@@ -27,6 +27,17 @@
 //                 lit exactly where the pixel centre is inside; with MSAA 4 / SSAA 2x2 / SSAA
 //                 4x4 every pixel's linear value is the covered area of its square (clipped
 //                 exactly), within a bound for its sample count (below).
+//   tonemap_*     exposure and tone mapping (renderers/tone_map.h): an unlit quad of linear
+//                 colour (2.4, 0.6, 0.05) - above 1 in red - over the left half of an
+//                 orthographic view, the background (0.9, 0.6, 0.3) on the right: every pixel
+//                 away from the edge is encodeSRGB(T(2^EV c)) of its colour (surface and
+//                 background alike) within 1/255, for each operator at a few exposures, and
+//                 with MSAA / SSAA (a constant colour resolves to itself).
+//   aa_*_ev2      the aa_* edge at +2 EV (no operator): the display transform comes after the
+//                 resolve, so a pixel whose square the quad covers by c shows min(4 c, 1) -
+//                 white from c = 1/4 on - where mapping each sample before averaging would show
+//                 c: the pixels 30-70% covered must be white, the others within the aa_* bound
+//                 mapped through the transform.
 // A failure prints the pixels (position, expected, actual) and writes -actual/-expected/-diff
 // PNGs to build/<preset>/test-output/conformance/. When the GL backend cannot get a context
 // its instances fail with the reason (RenderStats::error); nothing is skipped silently.
@@ -421,6 +432,91 @@ void checkAntiAliasing(const std::string& backend, AAMode aa, int rate, const st
                                     << (meanGamma < mean ? " (the pixels match an sRGB-space average better: the resolve is not linear)" : "");
 }
 
+// Whether `backend` offers the anti-aliasing mode and rate (else the case is skipped with the reason).
+bool offersAA(const std::string& backend, AAMode aa, int rate) {
+    if (aa == AAMode::None) return true;
+    std::string err;
+    auto r = rnd::makeRenderer(backend, &err);
+    if (!r) return true;   // renderWith reports it
+    const rnd::Capabilities caps = r->capabilities();
+    const std::vector<int>& offered = aa == AAMode::MSAA ? caps.msaaSamples : caps.ssaaFactors;
+    return std::find(offered.begin(), offered.end(), rate) != offered.end();
+}
+
+// ---------------------------------------------------------------------------------------
+// Exposure and tone mapping.
+
+void checkToneMapped(const std::string& backend, ToneMapping op, float ev, AAMode aa, int rate, const std::string& scene) {
+    const int W = 96, H = 64;
+    Projection ortho;
+    ortho.type = ProjectionType::Orthographic;
+    ortho.orthoHalfHeight = 1.0f;
+    FrameInput f = test_scenes::makeFrame(W, H, ortho, vec3(0, 0, 5), vec3(0.0f));
+    Material m = test_scenes::unlit(vec3(0.9f, 0.5f, 0.05f));
+    m.emissive = vec3(1.5f, 0.1f, 0.0f);   // unlit colour = base colour + emissive = (2.4, 0.6, 0.05)
+    test_scenes::addMesh(f, test_scenes::quad(2.0f), m, glm::translate(mat4(1.0f), vec3(-2.0f, 0.0f, 0.0f)));   // x in [-4, 0]
+    f.settings.background = vec3(0.9f, 0.6f, 0.3f);
+    f.settings.exposure = ev;
+    f.settings.toneMapping = op;
+    f.settings.aa = aa;
+    if (aa != AAMode::None) f.settings.aaRate = rate;
+    if (!offersAA(backend, aa, rate)) GTEST_SKIP() << backend << " does not offer " << f.settings.aaName() << " (Capabilities)";
+    rnd::Framebuffer actual;
+    ASSERT_TRUE(renderWith(backend, f, W, H, actual));
+
+    const auto surface = toBytes(displayReference(m.baseColor + m.emissive, ev, op));
+    const auto background = toBytes(displayReference(f.settings.background, ev, op));
+    rnd::Framebuffer expected = blankImage(W, H, vec3(0.0f));
+    std::vector<PixelCheck> checks;
+    for (int row = 0; row < H; ++row)
+        for (int x = 0; x < W; ++x) {
+            const auto& want = 2 * x + 1 < W ? surface : background;   // the quad's edge is x = 0: the window's middle
+            setPixel(expected, x, row, want);
+            if (std::abs(float(x) + 0.5f - 0.5f * W) > 2.0f) checks.push_back(check(x, row, want, 1));
+        }
+    std::printf("[tonemap] %s: surface (%d, %d, %d), background (%d, %d, %d)\n", scene.c_str(), surface[0], surface[1], surface[2], background[0],
+                background[1], background[2]);
+    EXPECT_TRUE(testing_support::pixelsMatch(actual, expected, checks, kSuite, caseName(backend, scene)));
+}
+
+void checkExposedEdge(const std::string& backend, AAMode aa, int rate, const std::string& scene) {
+    const int W = 160, H = 120;
+    FrameInput f = test_scenes::aaEdgeFrame(W, H, aa, rate);
+    f.settings.exposure = 2.0f;
+    if (!offersAA(backend, aa, rate)) GTEST_SKIP() << backend << " does not offer " << f.settings.aaName() << " (Capabilities)";
+    rnd::Framebuffer actual;
+    ASSERT_TRUE(renderWith(backend, f, W, H, actual));
+    std::vector<vec2> quadCorners;
+    const DrawMesh& dm = f.meshes[0];
+    for (const vec3& p : dm.mesh->positions) quadCorners.push_back(toWindow(f.camera.viewProj, vec3(dm.world * vec4(p, 1.0f)), W, H));
+    const std::vector<vec2> poly = convexHull(quadCorners);
+    const int samples = aa == AAMode::MSAA ? rate : rate * rate;
+    const double maxErr = 0.5 / std::sqrt(double(samples)) + 1.0 / samples;   // as checkAntiAliasing
+    auto shown = [&](double cov) { return displayReference(vec3(float(std::clamp(cov, 0.0, 1.0))), f.settings.exposure, f.settings.toneMapping).x; };
+    rnd::Framebuffer expected = blankImage(W, H, f.settings.background);
+    std::vector<PixelCheck> checks;
+    int halfCovered = 0, white = 0;
+    for (int row = 0; row < H; ++row)
+        for (int x = 0; x < W; ++x) {
+            const double cov = coveredFraction(poly, float(x), float(H - 1 - row));
+            const uint8_t v = uint8_t(std::lround(srgbEncode(shown(cov)) * 255.0f));
+            setPixel(expected, x, row, {v, v, v});
+            const auto lo = uint8_t(std::lround(srgbEncode(shown(cov - maxErr)) * 255.0f));
+            const auto hi = uint8_t(std::lround(srgbEncode(shown(cov + maxErr)) * 255.0f));
+            checks.push_back(check(x, row, {v, v, v}, cov <= 0.0 || cov >= 1.0 ? 1 : std::max(v - lo, hi - v)));
+            if (cov >= 0.3 && cov <= 0.7) {
+                ++halfCovered;
+                const uint8_t* p = actual.pixel(x, row);
+                white += p[0] == 255 && p[1] == 255 && p[2] == 255;
+            }
+        }
+    std::printf("[aa+ev2] %s: %d of the %d pixels 30-70%% covered are white\n", scene.c_str(), white, halfCovered);
+    EXPECT_TRUE(testing_support::pixelsMatch(actual, expected, checks, kSuite, caseName(backend, scene)));
+    EXPECT_GT(halfCovered, 50);
+    EXPECT_GE(white, halfCovered * 95 / 100) << "an edge pixel covered 30-70% is 4 x that after the resolve, so white; not white: the "
+                                                "samples were mapped (clamped) before they were averaged";
+}
+
 // ---------------------------------------------------------------------------------------
 
 std::map<std::string, std::function<void(const std::string&)>> referenceScenes() {
@@ -449,6 +545,31 @@ std::map<std::string, std::function<void(const std::string&)>> referenceScenes()
                                     std::tuple{"aa_ssaa2", AAMode::SSAA, 2}, std::tuple{"aa_ssaa4", AAMode::SSAA, 4}}) {
         const std::string n = name;
         s[n] = [=](const std::string& b) { checkAntiAliasing(b, mode, rate, n); };
+    }
+    struct ToneCase {
+        const char* name;
+        ToneMapping op;
+        float ev;
+        AAMode aa;
+        int rate;
+    };
+    for (const ToneCase& c : {ToneCase{"tonemap_none_ev0", ToneMapping::None, 0.0f, AAMode::None, 1},
+                              ToneCase{"tonemap_none_ev1", ToneMapping::None, 1.0f, AAMode::None, 1},
+                              ToneCase{"tonemap_none_ev_minus2", ToneMapping::None, -2.0f, AAMode::None, 1},
+                              ToneCase{"tonemap_aces_ev0", ToneMapping::Aces, 0.0f, AAMode::None, 1},
+                              ToneCase{"tonemap_aces_ev_minus1", ToneMapping::Aces, -1.0f, AAMode::None, 1},
+                              ToneCase{"tonemap_aces_ev0_msaa4", ToneMapping::Aces, 0.0f, AAMode::MSAA, 4},
+                              ToneCase{"tonemap_aces_ev0_ssaa2", ToneMapping::Aces, 0.0f, AAMode::SSAA, 2},
+                              ToneCase{"tonemap_khr_neutral_ev0", ToneMapping::KhrNeutral, 0.0f, AAMode::None, 1},
+                              ToneCase{"tonemap_khr_neutral_ev0_5", ToneMapping::KhrNeutral, 0.5f, AAMode::None, 1},
+                              ToneCase{"tonemap_khr_neutral_ev1_msaa4", ToneMapping::KhrNeutral, 1.0f, AAMode::MSAA, 4}}) {
+        const std::string n = c.name;
+        s[n] = [=](const std::string& b) { checkToneMapped(b, c.op, c.ev, c.aa, c.rate, n); };
+    }
+    for (auto [name, mode, rate] :
+         {std::tuple{"aa_msaa4_ev2", AAMode::MSAA, 4}, std::tuple{"aa_ssaa2_ev2", AAMode::SSAA, 2}, std::tuple{"aa_ssaa4_ev2", AAMode::SSAA, 4}}) {
+        const std::string n = name;
+        s[n] = [=](const std::string& b) { checkExposedEdge(b, mode, rate, n); };
     }
     return s;
 }

@@ -219,6 +219,11 @@ TEST_P(Pbr, DefaultEnvironmentLightsAndCanBeTheBackground) {
     f.settings.environmentBackground = true;
     fb = render(GetParam(), f, "default-env-background");
     EXPECT_GT(fb.pixel(1, 1)[1], 20) << GetParam() << ": the environment behind the sphere";
+    // With a tone mapper the backends draw into a linear frame first: the background still shows.
+    f.settings.toneMapping = sg::ToneMapping::KhrNeutral;
+    fb = render(GetParam(), f, "default-env-background-neutral");
+    EXPECT_GT(fb.pixel(1, 1)[1], 20) << GetParam() << ": the environment behind the sphere, tone mapped";
+    EXPECT_GT(fb.pixel(W / 2, H / 2)[1], 60) << GetParam();
 }
 
 // Flat shading as the seeds define it: the model evaluated once per triangle (at its first

@@ -253,10 +253,11 @@ TEST(GlslEnumGuardTest, ShadersHandleEveryEnumValueByName) {
         ++count;
         EXPECT_TRUE(hasWord(name)) << name << " is not handled by the shaders";
     }
-    EXPECT_EQ(count, 3 + 3 + 4 + 3 + 3 + 4);   // shading, reflection, fog, light types, alpha modes, material map bits
+    EXPECT_EQ(count, 3 + 3 + 4 + 3 + 3 + 3 + 4);   // shading, reflection, fog, light types, alpha modes, tone mapping, material map bits
     EXPECT_NE(defines.find("#define FOG_EXP2 " + std::to_string(int(sg::FogMode::Exp2))), std::string::npos) << defines;
     EXPECT_NE(defines.find("#define SHADING_GOURAUD " + std::to_string(int(sg::ShadingModel::Gouraud))), std::string::npos) << defines;
     EXPECT_NE(defines.find("#define LIGHT_SPOT " + std::to_string(int(sg::LightType::Spot))), std::string::npos) << defines;
+    EXPECT_NE(defines.find("#define TONE_MAPPING_KHR_NEUTRAL " + std::to_string(int(sg::ToneMapping::KhrNeutral))), std::string::npos) << defines;
 }
 
 namespace {

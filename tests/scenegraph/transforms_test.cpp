@@ -10,6 +10,9 @@
 #include <glm/gtc/matrix_inverse.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
+#include <algorithm>
+#include <cmath>
+
 using namespace sg;
 
 namespace {
@@ -271,4 +274,51 @@ TEST(ProjectionTest, AuthoredAspectKeepsTheFramedFieldWhole) {
     EXPECT_NEAR(p.matrix(portrait, 1.0f)[1][1], 1.0f / std::tan(sg::radians(fovy) * 0.5f), 1e-4f);
     p.aspectRatio = 0.0f;
     EXPECT_FLOAT_EQ(p.effectiveFovyDeg(portrait), 40.0f);
+}
+
+// The isometric view (projection.h): an orthographic camera looking along -(1, 1, 1) projects
+// the three world axes to equal lengths sqrt(2/3) on the picture plane, 120 degrees apart, with
+// +y straight up; in the image (through the projection and the viewport) too, for any pivot,
+// distance and aspect.
+TEST(ProjectionTest, IsometricViewForeshortensTheAxesEquallyAt120Degrees) {
+    const vec3 dir = isometricViewDirection();
+    EXPECT_NEAR(glm::length(dir), 1.0f, 1e-6f);
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(dir[k], -1.0f / std::sqrt(3.0f), 1e-6f) << k;
+    EXPECT_NEAR(kIsometricPitchDeg, degrees(std::atan(1.0f / std::sqrt(2.0f))), 1e-4f);
+    Projection ortho;
+    ortho.type = ProjectionType::Orthographic;
+    ortho.orthoHalfHeight = 3.0f;
+    for (const vec3& pivot : {vec3(0.0f), vec3(2.0f, -1.0f, 5.0f)})
+        for (float distance : {1.0f, 40.0f})
+            for (float aspect : {1.0f, 16.0f / 9.0f}) {
+                SCOPED_TRACE(::testing::Message() << "pivot " << pivot.x << "," << pivot.y << "," << pivot.z << " distance " << distance << " aspect "
+                                                  << aspect);
+                const mat4 world = isometricCameraWorld(pivot, distance);
+                EXPECT_NEAR(glm::length(vec3(world[3]) - pivot), distance, 1e-4f * distance);
+                EXPECT_TRUE(matNear(mat4(glm::mat3(world)) * glm::transpose(mat4(glm::mat3(world))), mat4(1.0f))) << "a rotation";
+                const mat4 view = glm::inverse(world);
+                // Picture-plane (eye x, y) images of the unit axes at the pivot, and their images
+                // in a viewport of that aspect (pixels: 100 per view unit vertically).
+                const float w = 200.0f * aspect, h = 200.0f;
+                const mat4 clip = ortho.matrix(aspect, distance) * view;
+                vec2 plane[3], image[3];
+                for (int a = 0; a < 3; ++a) {
+                    vec3 e(0.0f);
+                    e[a] = 1.0f;
+                    plane[a] = vec2(view * vec4(pivot + e, 1.0f)) - vec2(view * vec4(pivot, 1.0f));
+                    const vec4 p = clip * vec4(pivot + e, 1.0f), o = clip * vec4(pivot, 1.0f);
+                    image[a] = vec2((p.x / p.w - o.x / o.w) * 0.5f * w, (p.y / p.w - o.y / o.w) * 0.5f * h);
+                }
+                for (int a = 0; a < 3; ++a) {
+                    EXPECT_NEAR(glm::length(plane[a]), std::sqrt(2.0f / 3.0f), 1e-5f) << "axis " << a;
+                    EXPECT_NEAR(glm::length(image[a]), 100.0f / ortho.orthoHalfHeight * std::sqrt(2.0f / 3.0f), 1e-3f) << "axis " << a;
+                    const int b = (a + 1) % 3;
+                    for (const vec2* v : {plane, image}) {
+                        const float cosAngle = glm::dot(v[a], v[b]) / (glm::length(v[a]) * glm::length(v[b]));
+                        EXPECT_NEAR(degrees(std::acos(std::clamp(cosAngle, -1.0f, 1.0f))), 120.0f, 1e-3f) << "axes " << a << " and " << b;
+                    }
+                }
+                EXPECT_NEAR(plane[1].x, 0.0f, 1e-6f) << "+y is drawn straight up";
+                EXPECT_GT(plane[1].y, 0.0f);
+            }
 }

@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 
 using namespace ui;
@@ -126,6 +127,41 @@ TEST(ViewerStateTest, BuildFrameUsesOrbitCameraAndSceneProjection) {
     st.view.aaOverride["raster"] = "ssaa2";
     EXPECT_EQ(st.settingsFor("raster").aa, sg::AAMode::SSAA);
     EXPECT_EQ(st.settingsFor("gl").aa, st.doc.scene.settings.aa);
+}
+
+// View > Axis view > Isometric is a true isometric view: orthographic (a perspective view at the
+// pivot keeps its size), looking along -(1, 1, 1), the world axes equally long on screen and 120
+// degrees apart in the frame the renderers get.
+TEST(ViewerStateTest, IsometricAxisViewIsOrthographicAlongTheDiagonal) {
+    for (sg::ProjectionType start : {sg::ProjectionType::Perspective, sg::ProjectionType::Oblique}) {
+        ViewerState st = demoState();
+        sg::Projection p = st.projection();
+        p.type = start;
+        st.setProjection(p);
+        st.view.camera.orbit(40.0f, -25.0f);
+        const float before = st.view.camera.distance;
+        st.viewAlong(AxisView::Isometric);
+        EXPECT_EQ(st.projection().type, sg::ProjectionType::Orthographic) << sg::toString(start);
+        EXPECT_FLOAT_EQ(st.view.camera.distance, before) << "the pivot and distance stay";
+        const sg::vec3 forward = st.view.camera.forward();
+        for (int k = 0; k < 3; ++k) EXPECT_NEAR(forward[k], -1.0f / std::sqrt(3.0f), 1e-5f) << k;
+        const float aspect = float(st.view.viewportWidth) / float(st.view.viewportHeight);
+        const sg::FrameInput f = st.buildFrame(aspect);
+        float len[3];
+        sg::vec2 axis[3];
+        for (int a = 0; a < 3; ++a) {
+            sg::vec3 e(0.0f);
+            e[a] = 1.0f;
+            const sg::vec4 q = f.camera.viewProj * sg::vec4(st.view.camera.pivot + e, 1.0f),
+                           o = f.camera.viewProj * sg::vec4(st.view.camera.pivot, 1.0f);
+            axis[a] = sg::vec2((q.x / q.w - o.x / o.w) * st.view.viewportWidth, (q.y / q.w - o.y / o.w) * st.view.viewportHeight);   // pixels x 2
+            len[a] = glm::length(axis[a]);
+        }
+        EXPECT_NEAR(len[1] / len[0], 1.0f, 1e-4f);
+        EXPECT_NEAR(len[2] / len[0], 1.0f, 1e-4f);
+        for (int a = 0; a < 3; ++a)
+            EXPECT_NEAR(sg::degrees(std::acos(glm::dot(axis[a], axis[(a + 1) % 3]) / (len[a] * len[(a + 1) % 3]))), 120.0f, 1e-2f) << a;
+    }
 }
 
 TEST(ViewerStateTest, SceneWithoutCameraGetsFramingView) {

@@ -569,14 +569,25 @@ void ViewerState::viewAlong(AxisView v) {
     case AxisView::Left: yaw = -0.5f * kPi; break;
     case AxisView::Top: pitch = kUp; break;
     case AxisView::Bottom: pitch = -kUp; break;
-    case AxisView::Isometric:
-        yaw = 0.25f * kPi;
-        pitch = std::atan(1.0f / std::sqrt(2.0f));   // 35.26 degrees: the three axes equally foreshortened
+    case AxisView::Isometric:   // along -(1, 1, 1): the three axes equally foreshortened (projection.h)
+        yaw = sg::radians(sg::kIsometricYawDeg);
+        pitch = sg::radians(sg::kIsometricPitchDeg);
         break;
     }
     view.camera.yaw = yaw;
     view.camera.pitch = pitch;
     markViewChanged();
+    if (v != AxisView::Isometric) return;
+    // Isometric is a parallel projection: a perspective one becomes orthographic with the same
+    // framing at the pivot (as keypad 5 switches), an oblique one orthographic.
+    if (projection().type == sg::ProjectionType::Perspective) {
+        togglePerspective();
+    } else if (projection().type == sg::ProjectionType::Oblique) {
+        sg::Projection p = projection();
+        p.type = sg::ProjectionType::Orthographic;
+        setProjection(p, "");
+    }
+    ui.status = "Isometric view (orthographic)";
 }
 
 void ViewerState::togglePerspective() {

@@ -1,5 +1,6 @@
 // mesh.frag - per-fragment part of every shading model, texture, unlit, fog, wireframe.
-// Prefix as in mesh.vert. Output is linear; the sRGB framebuffer encodes it.
+// Prefix as in mesh.vert. Output is linear; the sRGB framebuffer encodes it (or, into a linear
+// target, the display pass maps and encodes it: display.frag).
 //
 // The draw's features are compile-time switches of the prefix (one program per combination,
 // compiled on first use; see Features in gl_renderer.cpp), not uniform branches: llvmpipe runs
@@ -15,6 +16,8 @@
 //   SOLID          1: the wireframe overlay: uSolidColor (fogged)
 //   OVERDRAW       1: the overdraw view's pass: 1.0 for every fragment, nothing else
 //   VISIBILITY     1: also write fragId (the target has the visibility attachment)
+//   LINEAR_TARGET  1: the target is linear float (exposure or tone mapping follow): colour not
+//                  clamped at 1
 in vec3 vWorldPos;
 #if FOG != FOG_OFF
 in vec3 vEyePos;
@@ -227,6 +230,10 @@ void main() {
     float f = fogVisibility(length(vEyePos));   // eye-space distance, not just z
     c = f * c + (1.0 - f) * uFogColor;
 #endif
+#if LINEAR_TARGET
+    fragColor = vec4(max(c, vec3(0.0)), clamp(alpha, 0.0, 1.0));
+#else
     fragColor = vec4(clamp(c, 0.0, 1.0), clamp(alpha, 0.0, 1.0));
+#endif
 #endif   // OVERDRAW
 }

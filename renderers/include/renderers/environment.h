@@ -76,9 +76,12 @@ struct EnvironmentLight {
 
 // Writes the environment (backgroundRadiance along each pixel centre's view ray, sRGB bytes)
 // into the pixels where nothing was drawn (depth 1 and still the background colour `bg`; a
-// blended surface over the background changed it): the CPU rasterizer's background pass.
+// blended surface over the background changed it): the CPU rasterizer's background pass. With
+// a linear frame (exposure or tone mapping on: its pixels, rows top-down) the radiance goes
+// there instead, where the pixel still holds the linear background colour `bgLinear`.
 class Framebuffer;
-void drawEnvironmentBackground(Framebuffer& target, const sg::FrameCamera& camera, const EnvironmentLight& env, const uint8_t bg[3]);
+void drawEnvironmentBackground(Framebuffer& target, const sg::FrameCamera& camera, const EnvironmentLight& env, const uint8_t bg[3],
+                               sg::vec3* linear = nullptr, const sg::vec3& bgLinear = sg::vec3(0.0f));
 
 // The environment the settings ask for, or none (an empty map) for reflection models other than
 // pbr and for "none". Maps are built once per name and kept (the last few); a file that cannot

@@ -68,7 +68,7 @@ struct PixelTerms {
     std::vector<LightPart> lights;
     float fogVisibility = 1.0f;   // f(d): 1 = no fog
     sg::vec3 beforeFog{0.0f};     // ambient + emissive + sum(diffuse + specular)
-    sg::vec3 predicted{0.0f};     // f beforeFog + (1 - f) fogColour, clamped
+    sg::vec3 predicted{0.0f};     // f beforeFog + (1 - f) fogColour, through the display transform (tone_map.h), clamped
 };
 // lightVisibility: one value per frame light (empty: every light reaches the point).
 PixelTerms pixelTerms(const sg::FrameInput& frame, const SurfaceAt& s, const std::vector<float>& lightVisibility = {});

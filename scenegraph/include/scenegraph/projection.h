@@ -53,6 +53,19 @@ struct Projection {
     }
 };
 
+// Isometric view (docs/math.md, "Isometric view"): an orthographic projection seen along
+// -(1, 1, 1) / sqrt(3) with world +y up - turned 45 degrees about the vertical, then looking
+// down arctan(1 / sqrt(2)) = 35.264 degrees - so that the three world axes are foreshortened
+// alike (a unit axis is sqrt(2/3) = 0.8165 long on the picture plane) and drawn 120 degrees
+// apart. The presets (--projection isometric, View > Axis view > Isometric) set both.
+constexpr float kIsometricYawDeg = 45.0f;                  // about +y, from looking down -z
+constexpr float kIsometricPitchDeg = 35.26438968275466f;   // down from the horizon: atan(1 / sqrt(2))
+// The unit direction an isometric camera looks along: -(1, 1, 1) / sqrt(3).
+vec3 isometricViewDirection();
+// The world matrix (camera -> world; the camera looks down its -z, +y up) of an isometric camera
+// looking at `pivot` from `distance` away, its eye on the (+x, +y, +z) side of the pivot.
+mat4 isometricCameraWorld(const vec3& pivot, float distance);
+
 std::string_view toString(ProjectionType t);
 bool parse(std::string_view s, ProjectionType& out);
 

@@ -76,6 +76,11 @@ AAChoice aaChoice(const RenderSettings& s);
 enum class ObliquePreset { Cavalier, Cabinet };
 Projection obliquePreset(ObliquePreset p);
 
+// Axonometric presets, also --projection values: isometric. As a projection it is orthographic;
+// the command line (--projection isometric) and View > Axis view > Isometric also turn the camera
+// to look along the isometric direction (projection.h).
+enum class AxonometricPreset { Isometric };
+
 template <class E>
 const NameTable<E>& nameTable();
 template <>
@@ -91,9 +96,13 @@ const NameTable<ProjectionType>& nameTable<ProjectionType>();
 template <>
 const NameTable<ObliquePreset>& nameTable<ObliquePreset>();
 template <>
+const NameTable<AxonometricPreset>& nameTable<AxonometricPreset>();
+template <>
 const NameTable<LightType>& nameTable<LightType>();
 template <>
 const NameTable<CullMode>& nameTable<CullMode>();
+template <>
+const NameTable<ToneMapping>& nameTable<ToneMapping>();
 template <>
 const NameTable<AlphaMode>& nameTable<AlphaMode>();
 template <>

@@ -20,6 +20,8 @@ enum class AAMode { None, MSAA, SSAA };
 // false, glTF's default) and draws double-sided ones from both sides; On culls every back face;
 // Off draws every back face.
 enum class CullMode { Auto, On, Off };
+// The tone-mapping operator of the display transform (see RenderSettings::exposure).
+enum class ToneMapping { None, Aces, KhrNeutral };
 
 // Whether a triangle of a material with this doubleSided flag loses its back face.
 inline bool cullsBackFaces(CullMode m, bool doubleSided) { return m == CullMode::On || (m == CullMode::Auto && !doubleSided); }
@@ -58,6 +60,14 @@ struct RenderSettings {
     vec3 wireframeColor{0.05f, 0.05f, 0.05f};
     vec3 background{0.08f, 0.09f, 0.11f};
 
+    // Display transform, the last step of every backend (docs/math.md, "Exposure and tone
+    // mapping"; renderers/tone_map.h): a pixel's linear colour L - after fog, blending and the
+    // anti-aliasing resolve - is shown as encodeSRGB(T(2^exposure L)), T the operator. With
+    // exposure 0 and no operator the backends encode L as they always did.
+    float exposure = 0.0f;   // EV: the linear colour is multiplied by 2^exposure
+    ToneMapping toneMapping = ToneMapping::None;
+    bool displayTransformIsIdentity() const { return exposure == 0.0f && toneMapping == ToneMapping::None; }
+
     // Ray caster only.
     bool shadows = true;
     bool reflections = false;
@@ -83,6 +93,7 @@ std::string_view toString(ShadingModel m);
 std::string_view toString(ReflectionModel m);
 std::string_view toString(FogMode m);
 std::string_view toString(CullMode m);
+std::string_view toString(ToneMapping m);
 bool parse(std::string_view s, ShadingModel& out);
 bool parse(std::string_view s, ReflectionModel& out);
 bool parse(std::string_view s, FogMode& out);

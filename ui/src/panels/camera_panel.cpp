@@ -112,16 +112,28 @@ void drawCameraPanel(ViewerState& st) {
     sg::Projection p = st.projection();
     bool ch = false;
     for (const sg::Param<sg::Projection>& row : sg::params<sg::Projection>()) {
-        // The type's combo also offers the oblique presets (cavalier, cabinet). The frustum's
-        // four sides (one JSON array, not table rows) come before the clip planes.
+        // The type's combo also offers the oblique presets (cavalier, cabinet); the isometric
+        // preset turns the camera too, so it is the button below rather than a combo entry. The
+        // frustum's four sides (one JSON array, not table rows) come before the clip planes.
         if (row.key == "near") {
             if (p.type == sg::ProjectionType::Perspective && p.useFrustum) {
                 ch |= ImGui::DragFloat2("Left / right", &p.left, 0.001f);
                 ch |= ImGui::DragFloat2("Bottom / top", &p.bottom, 0.001f);
             }
         }
+        if (row.key == "type") {
+            sg::Param<sg::Projection> type = row;
+            std::erase_if(type.choices, [](const sg::ParamChoice& c) {
+                sg::AxonometricPreset preset;
+                return sg::parseName(c.name, preset);
+            });
+            ch |= paramWidget(st, "camera", type, p);
+            continue;
+        }
         ch |= paramWidget(st, "camera", row, p);
     }
+    if (ImGui::Button("Isometric view")) st.viewAlong(AxisView::Isometric);
+    tooltip("Orthographic, looking along (-1,-1,-1) at the pivot: the three axes equally foreshortened (View > Axis view > Isometric)");
     if (ch) {
         p.zFar = std::max(p.zFar, p.zNear * 1.001f);
         st.setProjection(p, "projection");
