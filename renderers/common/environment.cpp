@@ -186,6 +186,8 @@ vec2 equirectUv(const vec3& d) {
 }
 
 vec3 sampleLevel(const EnvironmentMap::Level& l, float u, float v) {
+    if (!(u >= -1.0f && u <= 2.0f)) u = 0.0f;   // NaN (a degenerate direction) reads somewhere, never out of range
+    if (!(v >= 0.0f && v <= 1.0f)) v = v > 1.0f ? 1.0f : 0.0f;
     const float x = u * float(l.width) - 0.5f, y = v * float(l.height) - 0.5f;
     const float fx = std::floor(x), fy = std::floor(y);
     const float tx = x - fx, ty = y - fy;
@@ -251,7 +253,7 @@ EnvironmentMap::EnvironmentMap(std::string name, int width, int height, const fl
 
 vec3 EnvironmentMap::specular(const vec3& dir, float roughness) const {
     const vec2 uv = equirectUv(dir);
-    const float lod = std::clamp(roughness, 0.0f, 1.0f) * float(kLevels - 1);
+    const float lod = (roughness > 0.0f ? std::min(roughness, 1.0f) : 0.0f) * float(kLevels - 1);   // NaN: level 0
     const int k0 = std::min(int(lod), kLevels - 1), k1 = std::min(k0 + 1, kLevels - 1);
     const float f = lod - float(k0);
     const vec3 a = sampleLevel(levels_[size_t(k0)], uv.x, uv.y);

@@ -731,3 +731,32 @@ TEST(ViewerStateTest, SelectionSetTogglesAndDeletesAsOneStep) {
     st.selectNode(crate);
     EXPECT_EQ(st.selection(), std::vector<sg::NodeId>{crate}) << "a plain select replaces the set";
 }
+
+// An environment file is read when it is set: one that cannot be read is refused with the
+// file and the reason, and the scene keeps its environment (nothing to undo); a good one is
+// one undo step.
+TEST(ViewerStateTest, EnvironmentFileIsCheckedWhenSet) {
+    ViewerState st = demoState();
+    const fs::path dir = testing_support::outputDir("ui") / "environment";
+    fs::create_directories(dir);
+    std::ofstream(dir / "broken.hdr") << "not a radiance file";
+    {
+        std::ofstream o(dir / "grey.hdr", std::ios::binary);
+        o << "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 4 +X 8\n";
+        for (int i = 0; i < 32; ++i) o << char(128) << char(128) << char(128) << char(128);
+    }
+    sg::RenderSettings s = st.doc.scene.settings;
+    s.reflection = sg::ReflectionModel::Pbr;
+    s.environment = (dir / "broken.hdr").string();
+    const std::string err = st.setSettings(s);
+    EXPECT_NE(err.find("broken.hdr: "), std::string::npos) << err;
+    EXPECT_NE(st.ui.status.find("broken.hdr"), std::string::npos) << st.ui.status;
+    EXPECT_EQ(st.doc.scene.settings.environment, "default");
+    EXPECT_EQ(st.doc.scene.settings.reflection, sg::ReflectionModel::Phong);
+    EXPECT_FALSE(st.doc.dirty);
+    s.environment = (dir / "grey.hdr").string();
+    EXPECT_EQ(st.setSettings(s), "");
+    EXPECT_EQ(st.doc.scene.settings.environment, s.environment);
+    EXPECT_TRUE(st.undo());
+    EXPECT_EQ(st.doc.scene.settings.environment, "default");
+}

@@ -18,6 +18,7 @@
 
 #include "assets/demo.h"
 #include "assets/image_io.h"
+#include "renderers/environment.h"
 #include "ui/aov_export.h"
 #include "ui/panels.h"
 #include "ui/render_slot.h"
@@ -31,9 +32,11 @@
 #include <backends/imgui_impl_opengl3.h>
 #include <imgui.h>
 
+#include <cctype>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <future>
 #include <map>
@@ -754,11 +757,36 @@ private:
         return dt;
     }
 
+    static bool isRadianceHdr(const std::string& path) {
+        std::string ext = std::filesystem::path(path).extension().string();
+        for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+        return ext == ".hdr";
+    }
+
+    // A dropped .hdr lights the scene: the environment of the pbr model (switched to it), one undo
+    // step; a file that cannot be read leaves everything as it was and says why.
+    void useEnvironment(const std::string& path) {
+        sg::RenderSettings s = m_st.doc.scene.settings;
+        s.environment = path;
+        s.reflection = sg::ReflectionModel::Pbr;
+        std::string why;
+        rnd::environmentFor(s, &why);
+        if (!why.empty()) {
+            m_st.ui.status = "Environment refused: " + why;
+            return;
+        }
+        if (m_st.setSettings(s, "environment").empty()) m_st.ui.status = "Environment: " + path + " (pbr reflection model)";
+    }
+
     // Events that arrived through callbacks, a finished load, animation time, screenshots.
     void handleEvents(float dt) {
         if (!m_v.droppedFiles.empty()) {
-            m_st.requestOpen(m_v.droppedFiles.front());
+            const std::string path = m_v.droppedFiles.front();
             m_v.droppedFiles.clear();
+            if (isRadianceHdr(path))
+                useEnvironment(path);
+            else
+                m_st.requestOpen(path);
         }
         if (m_st.pollLoad()) m_v.forgetOldScene();   // before the script or the UI look at the images
         m_st.advanceAnimation(dt);

@@ -4,6 +4,7 @@
 #include "ui/viewer_state.h"
 
 #include "assets/files.h"
+#include "renderers/environment.h"
 #include "renderers/renderer.h"
 
 #include <algorithm>
@@ -353,6 +354,11 @@ int ViewerState::addMaterialFor(sg::NodeId id, const sg::Material& m) {
 
 std::string ViewerState::setSettings(const sg::RenderSettings& s, std::string_view mergeKey) {
     std::string err = s.validate();
+    // A new environment file is read now (and kept for the renderers): one that cannot be read
+    // is refused with the reason, the scene keeps the environment it had.
+    if (err.empty() && s.environment != doc.scene.settings.environment && s.reflection == sg::ReflectionModel::Pbr && s.environment != "none" &&
+        s.environment != "default")
+        rnd::environmentFor(s, &err);
     if (!err.empty()) {
         ui.status = "Setting refused: " + err;
         return err;
