@@ -353,6 +353,18 @@ void drawViewport(ViewerState& st, const ViewportInput& view, double time, float
     case ViewMode::Split: drawSplitView(dl, st, view, a, avail); break;
     case ViewMode::Difference: drawDifferenceView(dl, st, view, a, avail); break;
     }
+    // The pixel the inspector is pinned to: a ring with a gap at its centre (the pixel stays
+    // visible), dark under light so it shows on any image.
+    if (const PixelProbeState& probe = st.ui.panels.probe; probe.pinned && probe.u >= 0.0f) {
+        const ImVec2 c(a.x + probe.u * avail.x, a.y + probe.v * avail.y);
+        for (int pass = 0; pass < 2; ++pass) {
+            const ImU32 col = pass == 0 ? IM_COL32(0, 0, 0, 200) : IM_COL32(255, 255, 255, 230);
+            const float w = pass == 0 ? px(3) : px(1.5f);
+            dl->AddCircle(c, px(7), col, 24, w);
+            for (const ImVec2 d : {ImVec2(1, 0), ImVec2(-1, 0), ImVec2(0, 1), ImVec2(0, -1)})
+                dl->AddLine(ImVec2(c.x + d.x * px(3), c.y + d.y * px(3)), ImVec2(c.x + d.x * px(11), c.y + d.y * px(11)), col, w);
+        }
+    }
     if (st.ui.panels.showOverlay) drawStatsOverlay(dl, st, view, a, avail);
     dl->PopClipRect();
 }
