@@ -57,9 +57,10 @@ std::string slotStats(const SlotView& v) {
         extra += "  no";
         for (const std::string& u : s.config.unsupported) extra += " " + u;
     }
-    if (v.status.rendering) extra += "  " + std::to_string(int(v.status.progress * 100)) + "%";
-    std::snprintf(buf, sizeof buf, "%-8s %7.1f ms  %6.1fk tris%s", v.status.backend.c_str(), s.milliseconds, double(s.triangles) / 1000.0,
-                  extra.c_str());
+    // The progress first, after the name: a long line is cut at the viewport's edge, never it.
+    const std::string progress = v.status.rendering ? std::to_string(int(v.status.progress * 100)) + "%  " : "";
+    std::snprintf(buf, sizeof buf, "%-8s %s%7.1f ms  %6.1fk tris%s", v.status.backend.c_str(), progress.c_str(), s.milliseconds,
+                  double(s.triangles) / 1000.0, extra.c_str());
     return buf;
 }
 
@@ -184,14 +185,21 @@ HeatColours heatColours() {
     return h;
 }
 
-// Legend (top right of the heat map): what grey and the red-to-white ramp mean.
-void drawDiffLegend(ImDrawList* dl, ViewerState& st, ImVec2 a, ImVec2 avail) {
+// A box in window pixels (an overlay's), Min = Max: none.
+struct OverlayBox {
+    ImVec2 Min{0, 0}, Max{0, 0};
+};
+
+// Legend (top right of the heat map): what grey and the red-to-white ramp mean; below the stats
+// box (`avoid`, empty when it is hidden) where the viewport is too narrow for both side by side.
+void drawDiffLegend(ImDrawList* dl, ViewerState& st, ImVec2 a, ImVec2 avail, const OverlayBox& avoid) {
     const HeatColours heat = heatColours();
     int t = std::clamp(st.view.compare.threshold, 0, 255);
     const std::string title = "|A - B|, largest channel (0-255)", within = "0-" + std::to_string(t) + ": within threshold (A, dimmed)";
     float lh = ImGui::GetTextLineHeight(), barH = px(12), pad = px(8);
     float w = std::max(ImGui::CalcTextSize(title.c_str()).x, px(26) + ImGui::CalcTextSize(within.c_str()).x) + 2 * pad;
     ImVec2 o(a.x + std::max(avail.x - w - px(10), 0.0f), a.y + px(10));
+    if (avoid.Max.x > avoid.Min.x && o.x < avoid.Max.x + px(10)) o.y = avoid.Max.y + px(10);
     ImVec2 end(o.x + w, o.y + pad * 2 + lh * 3 + barH + px(8));
     dl->AddRectFilled(o, end, IM_COL32(0, 0, 0, 190), px(4));
     ImU32 text = IM_COL32(230, 230, 235, 255);
@@ -218,7 +226,7 @@ void drawDiffLegend(ImDrawList* dl, ViewerState& st, ImVec2 a, ImVec2 avail) {
 
 // Difference view: the heat map (or why there is none yet), its legend and the figures at the
 // bottom (DiffFigures::summary, as the Compare tab writes them).
-void drawDifferenceView(ImDrawList* dl, ViewerState& st, const ViewportInput& view, ImVec2 a, ImVec2 avail) {
+void drawDifferenceView(ImDrawList* dl, ViewerState& st, const ViewportInput& view, ImVec2 a, ImVec2 avail, const OverlayBox& statsBox) {
     ImVec2 b(a.x + avail.x, a.y + avail.y);
     SlotView d = view.diff;
     if (!d.texture) {
@@ -230,7 +238,7 @@ void drawDifferenceView(ImDrawList* dl, ViewerState& st, const ViewportInput& vi
         centeredText(dl, a, b, msg, IM_COL32(255, 170, 140, 255));
     } else {
         dl->AddImage(d.texture, a, b);
-        drawDiffLegend(dl, st, a, avail);
+        drawDiffLegend(dl, st, a, avail, statsBox);
     }
     if (view.slots.size() >= 2) {
         std::string line = st.view.diff.summary(view.slots[0].status.backend, view.slots[1].status.backend, st.view.compare.threshold);
@@ -241,21 +249,35 @@ void drawDifferenceView(ImDrawList* dl, ViewerState& st, const ViewportInput& vi
     }
 }
 
-// Stats overlay (top-left): one line per shown backend and the viewport size; progress bars
-// at the bottom for renders in flight.
-void drawStatsOverlay(ImDrawList* dl, const ViewerState& st, const ViewportInput& view, ImVec2 a, ImVec2 avail) {
-    ImVec2 b(a.x + avail.x, a.y + avail.y);
+// The stats overlay's lines (one per shown backend, the viewport size, the diagnostic legend).
+std::vector<std::string> statsLines(const ViewerState& st, const ViewportInput& view) {
     std::vector<std::string> lines;
     for (const SlotView& v : view.slots) lines.push_back(slotStats(v));
     char buf[128];
     std::snprintf(buf, sizeof buf, "%d x %d   %s", st.view.viewportWidth, st.view.viewportHeight, st.view.flyMode ? "FLY (WASD QE)" : "");
     lines.emplace_back(buf);
     if (!view.slots.empty() && !view.slots[0].legend.empty()) lines.push_back(view.slots[0].legend);   // the diagnostic view's
-    float h = ImGui::GetTextLineHeightWithSpacing();
+    return lines;
+}
+
+// Where the stats overlay's box goes (top left; clipped to the viewport's width).
+OverlayBox statsBoxOf(const ViewerState& st, const std::vector<std::string>& lines, ImVec2 a, ImVec2 avail) {
+    const float h = ImGui::GetTextLineHeightWithSpacing();
     float w = 0;
     for (auto& l : lines) w = std::max(w, ImGui::CalcTextSize(l.c_str()).x);
-    ImVec2 o(a.x + px(10), a.y + (st.view.compare.mode == ViewMode::Split ? px(36) : px(10)));
-    dl->AddRectFilled(o, ImVec2(o.x + w + px(16), o.y + h * lines.size() + px(10)), IM_COL32(0, 0, 0, 150), px(4));
+    const ImVec2 o(a.x + px(10), a.y + (st.view.compare.mode == ViewMode::Split ? px(36) : px(10)));
+    return OverlayBox{o, ImVec2(std::min(o.x + w + px(16), a.x + avail.x), o.y + h * float(lines.size()) + px(10))};
+}
+
+// Stats overlay (top-left): one line per shown backend and the viewport size; progress bars
+// at the bottom for renders in flight.
+void drawStatsOverlay(ImDrawList* dl, const ViewerState& st, const ViewportInput& view, ImVec2 a, ImVec2 avail) {
+    ImVec2 b(a.x + avail.x, a.y + avail.y);
+    const std::vector<std::string> lines = statsLines(st, view);
+    const float h = ImGui::GetTextLineHeightWithSpacing();
+    const OverlayBox box = statsBoxOf(st, lines, a, avail);
+    const ImVec2 o = box.Min;
+    dl->AddRectFilled(box.Min, box.Max, IM_COL32(0, 0, 0, 150), px(4));
     for (size_t i = 0; i < lines.size(); ++i) {
         bool rendering = i < view.slots.size() && view.slots[i].status.rendering;
         dl->AddText(ImVec2(o.x + px(8), o.y + px(5) + h * i), rendering ? IM_COL32(255, 220, 120, 255) : IM_COL32(220, 230, 240, 255),
@@ -351,7 +373,9 @@ void drawViewport(ViewerState& st, const ViewportInput& view, double time, float
         if (!view.slots.empty()) drawSlotImage(dl, view.slots[0], a, b, 0, 1);
         break;
     case ViewMode::Split: drawSplitView(dl, st, view, a, avail); break;
-    case ViewMode::Difference: drawDifferenceView(dl, st, view, a, avail); break;
+    case ViewMode::Difference:
+        drawDifferenceView(dl, st, view, a, avail, st.ui.panels.showOverlay ? statsBoxOf(st, statsLines(st, view), a, avail) : OverlayBox{});
+        break;
     }
     // The pixel the inspector is pinned to: a ring with a gap at its centre (the pixel stays
     // visible), dark under light so it shows on any image.
