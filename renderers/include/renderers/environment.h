@@ -79,7 +79,7 @@ struct EnvironmentLight {
 // blended surface over the background changed it): the CPU rasterizer's background pass. With
 // a linear frame (exposure or tone mapping on: its pixels, rows top-down) the radiance goes
 // there instead, where the pixel still holds the linear background colour `bgLinear`.
-class Framebuffer;
+struct Framebuffer;
 void drawEnvironmentBackground(Framebuffer& target, const sg::FrameCamera& camera, const EnvironmentLight& env, const uint8_t bg[3],
                                sg::vec3* linear = nullptr, const sg::vec3& bgLinear = sg::vec3(0.0f));
 
