@@ -1,3 +1,7 @@
+// raster_shading.cpp - the CPU rasterizer's batched lighting (raster_shading.h): ShadeBatch's
+// sizing and padding, the sRGB byte encoder's tables (srgb_encoder.h), the run-time choice of
+// AVX2 or SSE2, and shadeBatch itself, whose body is shade_kernel.inl compiled once per
+// instruction set (a scalar loop over rnd::lightTerms where neither is available).
 #include "raster/raster_shading.h"
 #include "renderers/debug_switches.h"
 
