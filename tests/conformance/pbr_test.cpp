@@ -73,9 +73,15 @@ rnd::Framebuffer render(const std::string& backend, const sg::FrameInput& f, con
     return ::testing::AssertionSuccess();
 }
 
-// A Radiance .hdr of constant radiance 1 (8 x 4, flat RGBE scanlines: 128 128 128 129 = 1.0).
+// A Radiance .hdr of constant radiance 1 (8 x 4, flat RGBE scanlines: 128 128 128 129 = 1.0),
+// one file per test (CTest runs the backends' instances as parallel processes: a shared file
+// would be rewritten under another's reader).
 fs::path constantHdr() {
-    const fs::path p = testing_support::outputDir("conformance") / "constant-1.hdr";
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    std::string name = std::string(info->test_suite_name()) + "-" + info->name();
+    for (char& c : name)
+        if (c == '/') c = '-';
+    const fs::path p = testing_support::outputDir("conformance") / (name + "-constant-1.hdr");
     std::ofstream o(p, std::ios::binary);
     o << "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 4 +X 8\n";
     for (int i = 0; i < 32; ++i) o << char(128) << char(128) << char(128) << char(129);
