@@ -4,6 +4,7 @@
 #include "renderers/environment.h"
 
 #include "renderers/framebuffer.h"
+#include "renderers/pbr.h"
 #include "renderers/shading.h"
 
 #include <stb_image.h>
@@ -83,15 +84,6 @@ EnvironmentMap::Level resample(int sw, int sh, const float* src, int w, int h) {
     return out;
 }
 
-float radicalInverse(uint32_t i) {
-    i = (i << 16u) | (i >> 16u);
-    i = ((i & 0x55555555u) << 1u) | ((i & 0xAAAAAAAAu) >> 1u);
-    i = ((i & 0x33333333u) << 2u) | ((i & 0xCCCCCCCCu) >> 2u);
-    i = ((i & 0x0F0F0F0Fu) << 4u) | ((i & 0xF0F0F0F0u) >> 4u);
-    i = ((i & 0x00FF00FFu) << 8u) | ((i & 0xFF00FF00u) >> 8u);
-    return float(i) * 2.3283064365386963e-10f;
-}
-
 // An orthonormal frame around unit n.
 void frameOf(const vec3& n, vec3& t, vec3& b) {
     const vec3 up = std::abs(n.y) < 0.999f ? vec3(0, 1, 0) : vec3(1, 0, 0);
@@ -112,10 +104,8 @@ void prefilter(const std::vector<EnvironmentMap::Level>& pyramid, float roughnes
     std::vector<Sample> samples;
     const float texelSolidAngle = 4.0f * kPi / float(pyramid[0].width * pyramid[0].height);
     for (int i = 0; i < kSamples; ++i) {
-        const float e1 = (float(i) + 0.5f) / float(kSamples), e2 = radicalInverse(uint32_t(i));
-        const float cosT = std::sqrt((1.0f - e1) / (1.0f + (a2 - 1.0f) * e1)), sinT = std::sqrt(1.0f - cosT * cosT);
-        const float phi = 2.0f * kPi * e2;
-        const vec3 h(sinT * std::cos(phi), sinT * std::sin(phi), cosT);
+        const vec3 h = ggxHalfVector(i, kSamples, a2);
+        const float cosT = h.z;
         // pdf of l = 2 h (n.h) - n with n = v: D(h) (n.h) / (4 (v.h)) = D / 4.
         const float d = a2 / (kPi * std::pow(cosT * cosT * (a2 - 1.0f) + 1.0f, 2.0f));
         const float sampleSolidAngle = 1.0f / (float(kSamples) * d * 0.25f + 1e-20f);

@@ -13,15 +13,6 @@ using sg::vec3;
 namespace {
 constexpr float kPi = 3.14159265358979323846f;
 
-float radicalInverse(uint32_t i) {
-    i = (i << 16u) | (i >> 16u);
-    i = ((i & 0x55555555u) << 1u) | ((i & 0xAAAAAAAAu) >> 1u);
-    i = ((i & 0x33333333u) << 2u) | ((i & 0xCCCCCCCCu) >> 2u);
-    i = ((i & 0x0F0F0F0Fu) << 4u) | ((i & 0xF0F0F0F0u) >> 4u);
-    i = ((i & 0x00FF00FFu) << 8u) | ((i & 0xFF00FF00u) >> 8u);
-    return float(i) * 2.3283064365386963e-10f;
-}
-
 // The height-correlated Smith visibility V = G / (4 n.l n.v).
 float visibility(float nl, float nv, float a2) {
     const float gv = nl * std::sqrt(nv * nv * (1.0f - a2) + a2);
@@ -32,7 +23,23 @@ float visibility(float nl, float nv, float a2) {
 
 // The roughness the BRDF uses: at least 1e-3 (alpha 1e-6), where the GGX peak still fits a float.
 float usableRoughness(float r) { return std::clamp(r, 1e-3f, 1.0f); }
+
+float radicalInverse(uint32_t i) {
+    i = (i << 16u) | (i >> 16u);
+    i = ((i & 0x55555555u) << 1u) | ((i & 0xAAAAAAAAu) >> 1u);
+    i = ((i & 0x33333333u) << 2u) | ((i & 0xCCCCCCCCu) >> 2u);
+    i = ((i & 0x0F0F0F0Fu) << 4u) | ((i & 0xF0F0F0F0u) >> 4u);
+    i = ((i & 0x00FF00FFu) << 8u) | ((i & 0xFF00FF00u) >> 8u);
+    return float(i) * 2.3283064365386963e-10f;
+}
 }   // namespace
+
+vec3 ggxHalfVector(int i, int n, float a2) {
+    const float e1 = (float(i) + 0.5f) / float(n), e2 = radicalInverse(uint32_t(i));
+    const float cosT = std::sqrt((1.0f - e1) / (1.0f + (a2 - 1.0f) * e1)), sinT = std::sqrt(std::max(0.0f, 1.0f - cosT * cosT));
+    const float phi = 2.0f * kPi * e2;
+    return {sinT * std::cos(phi), sinT * std::sin(phi), cosT};
+}
 
 vec2 splitSumIntegral(float nv, float roughness, int samples) {
     nv = std::clamp(nv, 1e-4f, 1.0f);
@@ -40,10 +47,7 @@ vec2 splitSumIntegral(float nv, float roughness, int samples) {
     const vec3 v(std::sqrt(1.0f - nv * nv), 0.0f, nv);   // n = +z
     double A = 0.0, B = 0.0;
     for (int i = 0; i < samples; ++i) {
-        const float e1 = (float(i) + 0.5f) / float(samples), e2 = radicalInverse(uint32_t(i));
-        const float cosT = std::sqrt((1.0f - e1) / (1.0f + (a2 - 1.0f) * e1)), sinT = std::sqrt(std::max(0.0f, 1.0f - cosT * cosT));
-        const float phi = 2.0f * kPi * e2;
-        const vec3 h(sinT * std::cos(phi), sinT * std::sin(phi), cosT);
+        const vec3 h = ggxHalfVector(i, samples, a2);
         const float vh = glm::dot(v, h);
         const vec3 l = 2.0f * vh * h - v;
         const float nl = l.z, nh = h.z;

@@ -33,23 +33,6 @@ void main() {
 }
 )GLSL";
 
-GLuint compile(GLenum type, const std::string& src, std::string& error) {
-    GLuint s = glCreateShader(type);
-    const char* p = src.c_str();
-    glShaderSource(s, 1, &p, nullptr);
-    glCompileShader(s);
-    GLint ok = 0;
-    glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
-    if (!ok) {
-        char log[2048] = {};
-        glGetShaderInfoLog(s, sizeof log, nullptr, log);
-        error = std::string("environment background shader: ") + log;
-        glDeleteShader(s);
-        return 0;
-    }
-    return s;
-}
-
 }   // namespace
 
 void GlRenderer::prepareEnvironment(const FrameInput& frame, RenderStats& stats) {
@@ -93,26 +76,9 @@ void GlRenderer::prepareEnvironment(const FrameInput& frame, RenderStats& stats)
 void GlRenderer::drawEnvironmentBackground(const FrameInput& frame, std::string& error) {
     if (!m_backgroundProgram) {
         const std::string head = "#version 330 core\n#define HAS_ENVIRONMENT 1\n";
-        GLuint vs = compile(GL_VERTEX_SHADER, head + kBackgroundVert, error);
-        GLuint fs = vs ? compile(GL_FRAGMENT_SHADER, head + kShader_pbr_glsl + "\n" + kBackgroundFrag, error) : 0;
-        if (!vs || !fs) {
-            if (vs) glDeleteShader(vs);
-            return;
-        }
-        m_backgroundProgram = glCreateProgram();
-        glAttachShader(m_backgroundProgram, vs);
-        glAttachShader(m_backgroundProgram, fs);
-        glLinkProgram(m_backgroundProgram);
-        glDeleteShader(vs);
-        glDeleteShader(fs);
-        GLint ok = 0;
-        glGetProgramiv(m_backgroundProgram, GL_LINK_STATUS, &ok);
-        if (!ok) {
-            error = "environment background shader did not link";
-            glDeleteProgram(m_backgroundProgram);
-            m_backgroundProgram = 0;
-            return;
-        }
+        error = linkProgram(head + kBackgroundVert, head + kShader_pbr_glsl + "\n" + kBackgroundFrag, "environment background shader",
+                            m_backgroundProgram);
+        if (!error.empty()) return;
         glGenVertexArrays(1, &m_backgroundVao);
     }
     glUseProgram(m_backgroundProgram);

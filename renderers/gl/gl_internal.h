@@ -123,6 +123,9 @@ struct DisplayProgram {
 };
 // Builds the display program of operator `op` into p. Returns "" or the compiler's or linker's message.
 std::string buildDisplayProgram(sg::ToneMapping op, DisplayProgram& p);
+// Compiles and links a program from its two sources: "" and `id`, or the reason (naming `what`)
+// and id 0.
+std::string linkProgram(const std::string& vertex, const std::string& fragment, const char* what, GLuint& id);
 
 // --- GPU cache and render targets (gl_resources.cpp) -----------------------------------------
 

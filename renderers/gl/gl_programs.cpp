@@ -31,6 +31,34 @@ std::string compileShader(GLenum type, const std::string& src, GLuint& out) {
 }
 
 }   // namespace
+
+std::string linkProgram(const std::string& vertex, const std::string& fragment, const char* what, GLuint& id) {
+    id = 0;
+    GLuint vs = 0, fs = 0;
+    std::string err = compileShader(GL_VERTEX_SHADER, vertex, vs);
+    if (err.empty()) err = compileShader(GL_FRAGMENT_SHADER, fragment, fs);
+    if (err.empty()) {
+        id = glCreateProgram();
+        glAttachShader(id, vs);
+        glAttachShader(id, fs);
+        glLinkProgram(id);
+        GLint ok = 0;
+        glGetProgramiv(id, GL_LINK_STATUS, &ok);
+        if (!ok) {
+            char log[2048] = {};
+            glGetProgramInfoLog(id, sizeof log, nullptr, log);
+            err = std::string(what) + " link: " + log;
+            std::replace(err.begin(), err.end(), '\n', ' ');
+            glDeleteProgram(id);
+            id = 0;
+        }
+    } else {
+        err = std::string(what) + ", " + err;
+    }
+    if (vs) glDeleteShader(vs);
+    if (fs) glDeleteShader(fs);
+    return err;
+}
 }   // namespace gl
 
 // Every settings enum value the shaders see, as a named constant with the C++ enum's own value
@@ -126,28 +154,7 @@ std::string buildProgram(const std::string& key, const Features& ft, const Frame
                          flag("SOLID", ft.solid) + flag("OVERDRAW", ft.overdraw) + flag("VISIBILITY", ft.visibility) +
                          flag("HAS_ENVIRONMENT", ft.environment) + flag("LINEAR_TARGET", ft.linearTarget);
     std::string common = prefix + gl::kShader_pbr_glsl + "\n" + gl::kShader_lighting_glsl + "\n";
-    GLuint vs = 0, fs = 0;
-    std::string err = compileShader(GL_VERTEX_SHADER, common + gl::kShader_mesh_vert, vs);
-    if (err.empty()) err = compileShader(GL_FRAGMENT_SHADER, common + gl::kShader_mesh_frag, fs);
-    if (err.empty()) {
-        p.id = glCreateProgram();
-        glAttachShader(p.id, vs);
-        glAttachShader(p.id, fs);
-        glLinkProgram(p.id);
-        GLint ok = 0;
-        glGetProgramiv(p.id, GL_LINK_STATUS, &ok);
-        if (!ok) {
-            char log[2048] = {};
-            glGetProgramInfoLog(p.id, sizeof log, nullptr, log);
-            err = std::string("shader link: ") + log;
-            std::replace(err.begin(), err.end(), '\n', ' ');
-            glDeleteProgram(p.id);
-            p.id = 0;
-        }
-    }
-    if (vs) glDeleteShader(vs);
-    if (fs) glDeleteShader(fs);
-    if (!err.empty()) return err;
+    if (std::string err = linkProgram(common + gl::kShader_mesh_vert, common + gl::kShader_mesh_frag, "shader", p.id); !err.empty()) return err;
     auto loc = [&](const char* n) { return glGetUniformLocation(p.id, n); };
     p.model = loc("uModel");
     p.drawable = loc("uDrawable");
@@ -206,28 +213,10 @@ std::string buildProgram(const std::string& key, const Features& ft, const Frame
 
 std::string buildDisplayProgram(sg::ToneMapping op, DisplayProgram& p) {
     const std::string prefix = "#version 330 core\n" + glslEnumDefines() + glslEnumDefine("TONE_MAPPING", "TONE_MAPPING_", op);
-    GLuint vs = 0, fs = 0;
-    std::string err = compileShader(GL_VERTEX_SHADER, prefix + kShader_display_vert, vs);
-    if (err.empty()) err = compileShader(GL_FRAGMENT_SHADER, prefix + kShader_tone_map_glsl + "\n" + kShader_display_frag, fs);
-    if (err.empty()) {
-        p.id = glCreateProgram();
-        glAttachShader(p.id, vs);
-        glAttachShader(p.id, fs);
-        glLinkProgram(p.id);
-        GLint ok = 0;
-        glGetProgramiv(p.id, GL_LINK_STATUS, &ok);
-        if (!ok) {
-            char log[2048] = {};
-            glGetProgramInfoLog(p.id, sizeof log, nullptr, log);
-            err = std::string("display shader link: ") + log;
-            std::replace(err.begin(), err.end(), '\n', ' ');
-            glDeleteProgram(p.id);
-            p.id = 0;
-        }
-    }
-    if (vs) glDeleteShader(vs);
-    if (fs) glDeleteShader(fs);
-    if (!err.empty()) return err;
+    if (std::string err =
+            linkProgram(prefix + kShader_display_vert, prefix + kShader_tone_map_glsl + "\n" + kShader_display_frag, "display shader", p.id);
+        !err.empty())
+        return err;
     p.frame = glGetUniformLocation(p.id, "uFrame");
     p.ssaa = glGetUniformLocation(p.id, "uSsaa");
     p.exposureScale = glGetUniformLocation(p.id, "uExposureScale");

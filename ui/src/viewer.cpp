@@ -18,7 +18,6 @@
 
 #include "assets/demo.h"
 #include "assets/image_io.h"
-#include "renderers/environment.h"
 #include "ui/aov_export.h"
 #include "ui/panels.h"
 #include "ui/render_slot.h"
@@ -764,17 +763,11 @@ private:
     }
 
     // A dropped .hdr lights the scene: the environment of the pbr model (switched to it), one undo
-    // step; a file that cannot be read leaves everything as it was and says why.
+    // step; a file that cannot be read leaves everything as it was and says why (setSettings).
     void useEnvironment(const std::string& path) {
         sg::RenderSettings s = m_st.doc.scene.settings;
         s.environment = path;
         s.reflection = sg::ReflectionModel::Pbr;
-        std::string why;
-        rnd::environmentFor(s, &why);
-        if (!why.empty()) {
-            m_st.ui.status = "Environment refused: " + why;
-            return;
-        }
         if (m_st.setSettings(s, "environment").empty()) m_st.ui.status = "Environment: " + path + " (pbr reflection model)";
     }
 

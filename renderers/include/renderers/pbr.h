@@ -41,6 +41,10 @@ sg::vec2 splitSum(float nv, float roughness);
 // The exact integral (by importance sampling with `samples` directions), for tests.
 sg::vec2 splitSumIntegral(float nv, float roughness, int samples);
 
+// Half vector i of n for GGX importance sampling (alpha^2 = a2), in the frame where n = +z:
+// stratified in the polar angle, Hammersley's radical inverse in the azimuth (Karis 2013).
+sg::vec3 ggxHalfVector(int i, int n, float a2);
+
 // The BRDF's parameters at one point, from the coefficients (the material with its maps) and rho.
 struct PbrPoint {
     sg::vec3 cdiffFactor{1.0f};   // c_diff = rho * cdiffFactor
