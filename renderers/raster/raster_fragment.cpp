@@ -57,8 +57,12 @@ __attribute__((noinline)) float prepareFragment(const TriCache& tc, const FrameC
             n = t.front ? perturbNormal(n, tw, ms.normalTexel, mat.normalScale) : -perturbNormal(-n, tw, ms.normalTexel, mat.normalScale);
         }
         const SurfaceCoefficients coeff = maps ? coefficientsAt(mat, ms) : coefficientsOf(mat);
-        if (fc.referenceShading || fc.pbr)
+        if (fc.referenceShading)
             sb.setColor(k, shade(coeff, SurfacePoint{pos, n, albedo}, f.camera.eye, f, nullptr, fc.environment));   // rnd::shade itself
+        else if (fc.pbr && coeff.unlit)
+            sb.setColor(k, albedo + coeff.emissive);
+        else if (fc.pbr)
+            sb.setPbr(k, pos, n, pbrPoint(coeff, albedo), albedo, coeff.occlusion, coeff.emissive);
         else
             sb.set(k, coeff, pos, n, albedo, f.ambientLight);
     }

@@ -27,10 +27,10 @@ struct TriCache : PlainTri {
     bool flat = false;
     ShadeTerms faceTerms;
     // Plain lit fragment (no vertex colours, textures or maps, not Gouraud, not reference
-    // shading): prepareFragment takes the short path with the material's coefficients below.
+    // shading): prepareFragment takes the short path with the material's constant block below.
     bool simple = false;
     SurfaceCoefficients coeff;
-    sg::vec3 simpleSpec, simpleBase;   // ShadeBatch::set's specular colour and ambient + emissive term (simple)
+    ShadeBatch::Constants block{};   // what ShadeBatch::set (or setPbr) would store (simple)
     // slot: the material's ShadeBatch constant block (simple; -1: not added yet)
 
     // The unit shading normal at barycentrics bo: the face normal (flat, or a mesh without
@@ -57,14 +57,18 @@ struct TriCache : PlainTri {
             gouraud = f.settings.shading == sg::ShadingModel::Gouraud && !d->gouraudA[0].empty();
             faceNormal = f.settings.shading == sg::ShadingModel::Flat || !d->hasNormals;
             flat = f.settings.shading == sg::ShadingModel::Flat && !mat->unlit;
-            simple =
-                !gouraud && !flat && !fc.referenceShading && !fc.pbr && !d->hasColors && !(d->texture && d->hasUV) && !(d->hasUV && d->hasMaps());
+            simple = !gouraud && !flat && !fc.referenceShading && !d->hasColors && !(d->texture && d->hasUV) && !(d->hasUV && d->hasMaps());
             if (simple) {
                 coeff = coefficientsOf(*mat);
                 simple = !coeff.unlit;
-                const sg::vec3 albedo = mat->baseColor;   // ShadeBatch::set() with this albedo
-                simpleSpec = coeff.specularTinted ? albedo : coeff.specularColor;
-                simpleBase = coeff.ka * albedo * f.ambientLight + coeff.emissive;
+                const sg::vec3 albedo = mat->baseColor;   // ShadeBatch::set() or setPbr() with this albedo
+                if (fc.pbr) {
+                    block = ShadeBatch::pbrConstants(pbrPoint(coeff, albedo), albedo, coeff.occlusion, coeff.emissive);
+                } else {
+                    const sg::vec3 spec = coeff.specularTinted ? albedo : coeff.specularColor;
+                    const sg::vec3 base = coeff.ka * albedo * f.ambientLight + coeff.emissive;
+                    block = {albedo.x, albedo.y, albedo.z, spec.x, spec.y, spec.z, coeff.kd, coeff.ks, coeff.shininess, base.x, base.y, base.z};
+                }
             }
         }
         cb = tri.clip >= 0 ? &ch.clipBary[size_t(tri.clip)] : nullptr;

@@ -163,7 +163,7 @@ struct FrameContext {
     int tilesX = 0, tilesY = 0;
     bool msaa = false;
     bool referenceShading = false;
-    bool pbr = false;                                // settings.reflection == pbr: every fragment by rnd::shade
+    bool pbr = false;                                // settings.reflection == pbr: ShadeBatch::setPbr and pbr_kernel.inl
     const EnvironmentLight* environment = nullptr;   // pbr's environment light (empty map: none)
     bool timing = false;                             // VIEWER_RASTER_TIMING=1: print stage times to stderr
     bool visibility = false;                         // fill target.drawable/primitive (one sample per pixel)

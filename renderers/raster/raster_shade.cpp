@@ -208,7 +208,7 @@ inline void writeVisibility(const FrameContext& fc, Framebuffer& target, size_t 
         if (run.tri != tc.id) {
             tc.load(run.tri, triById(chunks, run.tri), chunks[run.tri >> kChunkBits], fc);
             if (tc.simple && tc.slot < 0)   // once per material run: its constants for the kernel
-                tc.slot = buf.batch.addConstants(tc.mat->baseColor, tc.simpleSpec, tc.coeff.kd, tc.coeff.ks, tc.coeff.shininess, tc.simpleBase);
+                tc.slot = buf.batch.addConstants(tc.block);
         }
 #if defined(RASTER_HAVE_SSE2)
         if (tc.simple) {   // a vector of fragments per step (whole vectors: up to 7 slots past the run, rewritten later)
@@ -318,7 +318,7 @@ void shadeOpaque(const FrameContext& fc, Framebuffer& target, TileBuffers& buf, 
     buf.batch.pad();   // the vector stores may have run past nf
     int64_t tC = fc.timing ? nowNs() : 0;
     if (fc.timing) g_prepareNs += tC - tB;
-    shadeBatch(buf.batch, nf, *fc.frame);
+    shadeBatch(buf.batch, nf, *fc.frame, fc.environment);
     if (fc.timing) g_lightNs += nowNs() - tC;
     if (samples == 1 && fc.linear) {
         writeFragmentLinear(fc, buf, x0, y0, nf);

@@ -1,7 +1,8 @@
 // raster_shading.cpp - the CPU rasterizer's batched lighting (raster_shading.h): ShadeBatch's
 // sizing and padding, the sRGB byte encoder's tables (srgb_encoder.h), the run-time choice of
-// AVX2 or SSE2, and shadeBatch itself, whose body is shade_kernel.inl compiled once per
-// instruction set (a scalar loop over rnd::lightTerms where neither is available).
+// AVX2 or SSE2, and shadeBatch itself, whose body is shade_kernel.inl (Phong, Blinn-Phong) or
+// pbr_kernel.inl (pbr) compiled once per instruction set (a scalar loop over rnd::lightTerms or
+// the pbr terms where neither is available).
 #include "raster/raster_shading.h"
 #include "renderers/debug_switches.h"
 
@@ -78,9 +79,42 @@ bool useAvx2() {
 #endif
 }
 
+namespace {
+// What the pbr kernel reads of the environment, once per batch: the prefiltered levels, the
+// harmonics with the intensity in them, the rotation, the split-sum table.
+struct PbrKernelEnv {
+    static constexpr int kLevels = EnvironmentMap::kLevels;
+    struct Level {
+        const float* rgb = nullptr;
+        int width = 0, height = 0;
+    };
+    bool on = false;
+    Level levels[kLevels];
+    float sh[3][9] = {};
+    float intensity = 1.0f, cosRot = 1.0f, sinRot = 0.0f;
+    const float* splitSum = nullptr;
+
+    explicit PbrKernelEnv(const EnvironmentLight* env) {
+        if (!env || !env->map) return;
+        on = true;
+        for (int k = 0; k < kLevels; ++k) {
+            const EnvironmentMap::Level& l = env->map->level(k);
+            levels[k] = {l.rgb.data(), l.width, l.height};
+        }
+        for (int i = 0; i < 9; ++i)
+            for (int c = 0; c < 3; ++c) sh[c][i] = env->intensity * env->map->sh()[size_t(i)][c];
+        intensity = env->intensity;
+        cosRot = env->cosRot;
+        sinRot = env->sinRot;
+        splitSum = &splitSumTable()[0].x;
+    }
+};
+}   // namespace
+
 #if defined(RASTER_HAVE_SSE2)
 namespace kern_sse {
 using namespace simd_sse;
+#include "raster/pbr_kernel.inl"
 #include "raster/shade_kernel.inl"
 }   // namespace kern_sse
 
@@ -89,13 +123,26 @@ using namespace simd_sse;
 #pragma GCC target("avx2")
 namespace kern_avx2 {
 using namespace simd_avx2;
+#include "raster/pbr_kernel.inl"
 #include "raster/shade_kernel.inl"
 void shadeBatchAvx2(ShadeBatch& b, size_t n, const sg::FrameInput& f) { shadeKernel(b, n, f); }
+void shadePbrAvx2(ShadeBatch& b, size_t n, const sg::FrameInput& f, const PbrKernelEnv& env) { shadePbrKernel(b, n, f, env); }
 }   // namespace kern_avx2
 #pragma GCC pop_options
 #endif
 
-void shadeBatch(ShadeBatch& b, size_t n, const sg::FrameInput& f) {
+void shadeBatch(ShadeBatch& b, size_t n, const sg::FrameInput& f, const EnvironmentLight* env) {
+    if (f.settings.reflection == sg::ReflectionModel::Pbr) {
+        const PbrKernelEnv e(env);
+#if defined(RASTER_HAVE_AVX2)
+        if (useAvx2()) {
+            kern_avx2::shadePbrAvx2(b, n, f, e);
+            return;
+        }
+#endif
+        kern_sse::shadePbrKernel(b, n, f, e);
+        return;
+    }
 #if defined(RASTER_HAVE_AVX2)
     if (useAvx2()) {
         kern_avx2::shadeBatchAvx2(b, n, f);
@@ -107,10 +154,30 @@ void shadeBatch(ShadeBatch& b, size_t n, const sg::FrameInput& f) {
 
 #else
 
-void shadeBatch(ShadeBatch& b, size_t n, const sg::FrameInput& f) {
+void shadeBatch(ShadeBatch& b, size_t n, const sg::FrameInput& f, const EnvironmentLight* env) {
+    const bool pbr = f.settings.reflection == sg::ReflectionModel::Pbr;
     for (size_t i = 0; i < n; ++i) {
         if (b.mat[i] >= 0) b.expand(i);
         if (b.kd[i] == 0 && b.ks[i] == 0) continue;
+        if (pbr) {   // the layout of raster_shading.h: pbr.cpp's terms with c_diff as the albedo
+            PbrPoint q;
+            q.cdiffFactor = sg::vec3(1.0f);
+            q.f0 = {b.sr[i], b.sg[i], b.sb[i]};
+            q.f90 = b.kd[i];
+            q.roughness = b.ks[i];
+            q.alpha = q.roughness * q.roughness;
+            const sg::vec3 p(b.px[i], b.py[i], b.pz[i]), nn(b.nx[i], b.ny[i], b.nz[i]), cdiff(b.ar[i], b.ag[i], b.ab[i]);
+            sg::vec3 v = f.camera.eye - p;
+            const float len = glm::length(v);
+            v = len > 0 ? v / len : sg::vec3(0, 0, 1);
+            sg::vec3 c(b.cr[i], b.cg[i], b.cb[i]);
+            for (const auto& L : f.lights) c += pbrLightTerms(q, nn, v, samplePunctualLight(L, p)).apply(cdiff);
+            if (env && env->map) c += pbrEnvironmentTerms(q, nn, v, *env, b.shin[i]).apply(cdiff);
+            b.cr[i] = c.x;
+            b.cg[i] = c.y;
+            b.cb[i] = c.z;
+            continue;
+        }
         sg::Material m;
         m.kd = b.kd[i];
         m.ks = b.ks[i];

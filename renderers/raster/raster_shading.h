@@ -5,8 +5,16 @@
 // has it (chosen at run time; VIEWER_RASTER_SSE=1 forces SSE2; both give the same bits), with
 // pow(s, m) as exp2(m log2 s) from polynomials (relative error < 1e-5). tests/raster checks it
 // against rnd::shade.
+//
+// With the pbr reflection model the same batch carries glTF's BRDF parameters instead (setPbr,
+// pbr_kernel.inl: renderers/pbr.h's pbrLightTerms and pbrEnvironmentTerms per lane, the
+// environment's lookups included), in the same arrays under other names:
+//   ar ag ab = c_diff (albedo x (1 - metallic), or spec-gloss's factor)
+//   sr sg sb = F0          kd = F90          ks = roughness (>= 1e-3: the lane is lit)
+//   shin     = occlusion   cr cg cb = emissive in, the colour out
 #pragma once
 
+#include "renderers/pbr.h"
 #include "scenegraph/frame.h"
 
 #include <cstddef>
@@ -41,9 +49,10 @@ struct ShadeBatch {
     void resize(size_t n);
     // Sets the padding lanes again (after stores that ran past `size`).
     void pad();
-    // Adds a constant block (albedo, specular colour, kd, ks, shininess, ambient + emissive).
-    int32_t addConstants(const sg::vec3& albedo, const sg::vec3& spec, float kd_, float ks_, float shin_, const sg::vec3& base) {
-        mats.push_back({albedo.x, albedo.y, albedo.z, spec.x, spec.y, spec.z, kd_, ks_, shin_, base.x, base.y, base.z});
+    // Adds a constant block (albedo, specular colour, kd, ks, shininess, ambient + emissive; or
+    // pbrConstants).
+    int32_t addConstants(const Constants& c) {
+        mats.push_back(c);
         return int32_t(mats.size() - 1);
     }
     // Copies fragment i's constant block (mat[i] >= 0) into the per-fragment arrays.
@@ -92,6 +101,34 @@ struct ShadeBatch {
         cg[i] = c.y;
         cb[i] = c.z;
     }
+    // A pbr fragment (the layout above): the BRDF's parameters at the point, its occlusion and emission.
+    void setPbr(size_t i, const sg::vec3& p, const sg::vec3& n, const PbrPoint& q, const sg::vec3& albedo, float occlusion,
+                const sg::vec3& emissive) {
+        px[i] = p.x;
+        py[i] = p.y;
+        pz[i] = p.z;
+        nx[i] = n.x;
+        ny[i] = n.y;
+        nz[i] = n.z;
+        mat[i] = -1;
+        const Constants c = pbrConstants(q, albedo, occlusion, emissive);
+        ar[i] = c.ar;
+        ag[i] = c.ag;
+        ab[i] = c.ab;
+        sr[i] = c.sr;
+        sg[i] = c.sg;
+        sb[i] = c.sb;
+        kd[i] = c.kd;
+        ks[i] = c.ks;
+        shin[i] = c.shin;
+        cr[i] = c.cr;
+        cg[i] = c.cg;
+        cb[i] = c.cb;
+    }
+    static Constants pbrConstants(const PbrPoint& q, const sg::vec3& albedo, float occlusion, const sg::vec3& emissive) {
+        const sg::vec3 cdiff = albedo * q.cdiffFactor;
+        return {cdiff.x, cdiff.y, cdiff.z, q.f0.x, q.f0.y, q.f0.z, q.f90, q.roughness, occlusion, emissive.x, emissive.y, emissive.z};
+    }
     // A fragment whose colour is already final (unlit, Gouraud, reference shading).
     void setColor(size_t i, const sg::vec3& c) {
         px[i] = py[i] = pz[i] = 0;
@@ -107,7 +144,8 @@ struct ShadeBatch {
     }
 };
 
-// Adds the contribution of every light in f to cr/cg/cb for fragments [0, n).
-void shadeBatch(ShadeBatch& b, size_t n, const sg::FrameInput& f);
+// Adds the contribution of every light in f to cr/cg/cb for fragments [0, n); with the pbr
+// reflection model also the environment's (env: none when null or without a map).
+void shadeBatch(ShadeBatch& b, size_t n, const sg::FrameInput& f, const EnvironmentLight* env = nullptr);
 
 }   // namespace rnd::raster

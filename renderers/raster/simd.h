@@ -60,6 +60,7 @@ inline VI andI(VI a, VI b) { return _mm_and_si128(a, b); }
 inline VI orI(VI a, VI b) { return _mm_or_si128(a, b); }
 inline VI selI(VI mask, VI a, VI b) { return _mm_or_si128(_mm_and_si128(mask, a), _mm_andnot_si128(mask, b)); }
 inline VI cmpgtI(VI a, VI b) { return _mm_cmpgt_epi32(a, b); }
+inline VI cmpeqI(VI a, VI b) { return _mm_cmpeq_epi32(a, b); }
 inline VI set1I(int x) { return _mm_set1_epi32(x); }
 // Whether the kW values at p all equal v.
 inline bool allEqualI(const int32_t* p, int32_t v) {
@@ -79,6 +80,17 @@ inline VI gatherI(const int32_t* table, VI idx) {
     return _mm_setr_epi32(table[i[0]], table[i[1]], table[i[2]], table[i[3]]);
 }
 inline void storeI(int32_t* p, VI a) { _mm_storeu_si128(reinterpret_cast<__m128i*>(p), a); }
+inline V gatherF(const float* table, VI idx) {
+    alignas(16) int32_t i[4];
+    _mm_store_si128(reinterpret_cast<__m128i*>(i), idx);
+    return _mm_setr_ps(table[i[0]], table[i[1]], table[i[2]], table[i[3]]);
+}
+inline VI mulloI(VI a, VI b) {   // SSE2 has no 32-bit multiply-low: two 64-bit products
+    const __m128i even = _mm_mul_epu32(a, b), odd = _mm_mul_epu32(_mm_srli_epi64(a, 32), _mm_srli_epi64(b, 32));
+    return _mm_unpacklo_epi32(_mm_shuffle_epi32(even, _MM_SHUFFLE(0, 0, 2, 0)), _mm_shuffle_epi32(odd, _MM_SHUFFLE(0, 0, 2, 0)));
+}
+inline VI minI(VI a, VI b) { return selI(_mm_cmpgt_epi32(a, b), b, a); }
+inline VI maxI(VI a, VI b) { return selI(_mm_cmpgt_epi32(a, b), a, b); }
 }   // namespace simd_sse
 #endif
 
@@ -119,6 +131,7 @@ inline VI andI(VI a, VI b) { return _mm256_and_si256(a, b); }
 inline VI orI(VI a, VI b) { return _mm256_or_si256(a, b); }
 inline VI selI(VI mask, VI a, VI b) { return _mm256_blendv_epi8(b, a, mask); }
 inline VI cmpgtI(VI a, VI b) { return _mm256_cmpgt_epi32(a, b); }
+inline VI cmpeqI(VI a, VI b) { return _mm256_cmpeq_epi32(a, b); }
 inline VI set1I(int x) { return _mm256_set1_epi32(x); }
 inline bool allEqualI(const int32_t* p, int32_t v) {
     return _mm256_movemask_epi8(_mm256_cmpeq_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(p)), _mm256_set1_epi32(v))) == -1;
@@ -132,6 +145,10 @@ inline VI cvttI(V a) { return _mm256_cvttps_epi32(a); }
 // Table lookup per lane.
 inline VI gatherI(const int32_t* table, VI idx) { return _mm256_i32gather_epi32(table, idx, 4); }
 inline void storeI(int32_t* p, VI a) { _mm256_storeu_si256(reinterpret_cast<__m256i*>(p), a); }
+inline V gatherF(const float* table, VI idx) { return _mm256_i32gather_ps(table, idx, 4); }
+inline VI mulloI(VI a, VI b) { return _mm256_mullo_epi32(a, b); }
+inline VI minI(VI a, VI b) { return _mm256_min_epi32(a, b); }
+inline VI maxI(VI a, VI b) { return _mm256_max_epi32(a, b); }
 }   // namespace simd_avx2
 #pragma GCC pop_options
 #endif
