@@ -169,8 +169,16 @@ inline void shadePbrKernel(ShadeBatch& b, size_t n, const sg::FrameInput& f, con
         const V nv = vmax(ndv, zero);
         const V nv2Term = add(mul(mul(nv, nv), oneMinusA2), a2);   // the light-independent half of V
         const V gvRoot = vsqrt(nv2Term);
-        for (const sg::DrawLight& L : f.lights) {
+        for (size_t li = 0; li < f.lights.size(); ++li) {
+            const sg::DrawLight& L = f.lights[li];
             V lx, ly, lz, rr = set1(L.radiance.x), rg = set1(L.radiance.y), rb = set1(L.radiance.z);
+            if (b.visLights) {   // shadows: the fraction of the light that reaches each fragment
+                const V s = loadu(&b.vis[li * b.visStride + i]);
+                if (movemask(cmpgt(s, zero)) == 0) continue;
+                rr = mul(rr, s);
+                rg = mul(rg, s);
+                rb = mul(rb, s);
+            }
             if (L.type == sg::LightType::Directional) {
                 lx = set1(-L.direction.x);
                 ly = set1(-L.direction.y);

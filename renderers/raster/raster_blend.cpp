@@ -78,6 +78,7 @@ void compositeBlendFragments(const FrameContext& fc, Framebuffer& target, TileBu
         const int p = frags[k].pixel;
         buf.fogDist[k] = prepareFragment(tc, fc, x0 + p % tw, y0 + p / tw, buf.batch, k);
     }
+    fillShadowVisibility(fc, buf.batch, n);
     shadeBatch(buf.batch, n, *fc.frame, fc.environment);
     const auto& st = fc.frame->settings;
     const bool fog = st.fog != sg::FogMode::Off;

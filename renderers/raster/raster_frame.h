@@ -35,6 +35,7 @@
 #include "renderers/environment.h"
 #include "renderers/framebuffer.h"
 #include "renderers/shading.h"
+#include "renderers/shadow_map.h"
 #include "renderers/texture_sampler.h"
 #include "renderers/tone_map.h"
 #include "scenegraph/frame.h"
@@ -165,9 +166,11 @@ struct FrameContext {
     bool referenceShading = false;
     bool pbr = false;                                // settings.reflection == pbr: ShadeBatch::setPbr and pbr_kernel.inl
     const EnvironmentLight* environment = nullptr;   // pbr's environment light (empty map: none)
-    bool timing = false;                             // VIEWER_RASTER_TIMING=1: print stage times to stderr
-    bool visibility = false;                         // fill target.drawable/primitive (one sample per pixel)
-    bool overdraw = false;                           // count fragments per pixel into target.overdraw (one sample per pixel)
+    const ShadowPlan* shadowPlan = nullptr;          // the lights' shadow maps (empty plan: no shadows)
+    const ShadowMaps* shadowMaps = nullptr;
+    bool timing = false;       // VIEWER_RASTER_TIMING=1: print stage times to stderr
+    bool visibility = false;   // fill target.drawable/primitive (one sample per pixel)
+    bool overdraw = false;     // count fragments per pixel into target.overdraw (one sample per pixel)
     // The linear frame (width x height, rows top-down like the framebuffer) while the display
     // transform is not the identity: the tiles write each pixel's linear colour (after fog, the
     // MSAA resolve and blending) here and no colour bytes; nullptr: sRGB bytes as always.
@@ -262,6 +265,13 @@ inline int64_t nowNs() { return std::chrono::duration_cast<std::chrono::nanoseco
 
 // Step 2 (raster_vertex.cpp): transforms, outcodes and window coordinates of d's vertices
 // (Gouraud: the lighting terms of both sides too).
+// Shadows: the maps' answer (shadowVisibility) for the lit fragments [0, n) of a batch, per
+// light, into ShadeBatch::vis (raster_shadows.cpp); nothing without a shadow plan.
+void fillShadowVisibility(const FrameContext& fc, ShadeBatch& b, size_t n);
+// The depth maps of the plan from the frame's opaque and masked triangles (world positions of
+// the vertex stage).
+void renderShadowMaps(const ShadowPlan& plan, const std::vector<DrawItem>& draws, ShadowMaps& maps);
+
 void runVertexStage(DrawItem& d, const sg::FrameInput& f, int width, int height, bool gouraud, const EnvironmentLight* env);
 
 // Step 3 (raster_setup.cpp): clips, sets up and culls the chunk's triangles and bins them into

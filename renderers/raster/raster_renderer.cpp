@@ -46,6 +46,8 @@ public:
         c.progressive = true;
         c.wireframe = true;
         c.pointsAndLines = true;
+        c.shadows = true;   // shadow maps (renderers/shadow_map.h)
+        c.shadowMaps = true;
         c.visibility = true;   // the visibility buffer the tiles shade from
         c.overdraw = true;     // counted per tile when asked (countOverdraw)
         c.msaaSamples = {4};   // one fixed 4-sample pattern (raster_core.h)
@@ -53,6 +55,14 @@ public:
         c.ssaaRendersLarger = true;
         c.maxImageSize = 32768;
         return c;
+    }
+
+    // The pixel inspector's shadows: the last frame's maps at p.
+    std::vector<float> lightVisibility(const sg::FrameInput& f, const sg::vec3& p, const sg::vec3& ng) override {
+        if (m_shadowPlan.empty() || m_shadowPlan.viewCount.size() != f.lights.size()) return {};
+        std::vector<float> v(f.lights.size(), 1.0f);
+        for (size_t l = 0; l < v.size(); ++l) v[l] = shadowVisibility(m_shadowPlan, m_shadowMaps, f.lights[l], int(l), p, ng);
+        return v;
     }
 
 protected:
@@ -191,6 +201,9 @@ private:
         const EnvironmentLight environment = environmentFor(frame.settings, &envError);
         if (!envError.empty()) stats.config.notes.push_back("environment " + envError + " (lit without it)");
         tbb::parallel_for(size_t(0), draws.size(), [&](size_t i) { runVertexStage(draws[i], frame, width, height, gouraud, &environment); });
+        // Shadow maps (per-pixel shading only: flat and Gouraud sum the lights at the vertices).
+        m_shadowPlan = frame.settings.shading == sg::ShadingModel::Phong ? planShadows(frame, shadowCasterBounds(frame)) : ShadowPlan{};
+        renderShadowMaps(m_shadowPlan, draws, m_shadowMaps);
 
         auto tVert = std::chrono::steady_clock::now();
         // 3. triangles
@@ -204,6 +217,8 @@ private:
         fc.referenceShading = m_referenceShading;
         fc.pbr = frame.settings.reflection == sg::ReflectionModel::Pbr;
         fc.environment = &environment;
+        fc.shadowPlan = &m_shadowPlan;
+        fc.shadowMaps = &m_shadowMaps;
         fc.timing = m_timing;
         fc.visibility = visibility && !msaa;
         fc.overdraw = overdraw && !msaa;
@@ -256,6 +271,8 @@ private:
     std::vector<Chunk> m_chunks;
     std::vector<DrawItem> m_vertexBuffers;   // only their vertex-stage buffers (DrawItem::swapBuffers)
     LinearFrame m_linear;                    // the linear frame of step 6, kept between frames
+    ShadowPlan m_shadowPlan;                 // this frame's shadow maps (their memory kept between frames)
+    ShadowMaps m_shadowMaps;
     // VIEWER_RASTER_REFERENCE_SHADING=1: shade every fragment with rnd::shade (slow; used to
     // check the batched path).
     bool m_timing = debugSwitches().rasterTiming;

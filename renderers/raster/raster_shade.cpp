@@ -316,6 +316,7 @@ void shadeOpaque(const FrameContext& fc, Framebuffer& target, TileBuffers& buf, 
     buf.fogDist.resize(nf + ShadeBatch::kSlack);
     prepareFragments(fc, buf, x0, y0);
     buf.batch.pad();   // the vector stores may have run past nf
+    fillShadowVisibility(fc, buf.batch, nf);
     int64_t tC = fc.timing ? nowNs() : 0;
     if (fc.timing) g_prepareNs += tC - tB;
     shadeBatch(buf.batch, nf, *fc.frame, fc.environment);

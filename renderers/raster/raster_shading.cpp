@@ -26,6 +26,7 @@ void ShadeBatch::resize(size_t n) {
         if (v->size() < cap) v->resize(cap, 0.0f);
     if (mat.size() < cap) mat.resize(cap, -1);
     mats.clear();
+    visLights = visStride = 0;
     pad();
 }
 
@@ -171,7 +172,10 @@ void shadeBatch(ShadeBatch& b, size_t n, const sg::FrameInput& f, const Environm
             const float len = glm::length(v);
             v = len > 0 ? v / len : sg::vec3(0, 0, 1);
             sg::vec3 c(b.cr[i], b.cg[i], b.cb[i]);
-            for (const auto& L : f.lights) c += pbrLightTerms(q, nn, v, samplePunctualLight(L, p)).apply(cdiff);
+            for (size_t l = 0; l < f.lights.size(); ++l) {
+                const float w = b.visLights ? b.vis[l * b.visStride + i] : 1.0f;
+                c += w * pbrLightTerms(q, nn, v, samplePunctualLight(f.lights[l], p)).apply(cdiff);
+            }
             if (env && env->map) c += pbrEnvironmentTerms(q, nn, v, *env, b.shin[i]).apply(cdiff);
             b.cr[i] = c.x;
             b.cg[i] = c.y;
@@ -188,7 +192,10 @@ void shadeBatch(ShadeBatch& b, size_t n, const sg::FrameInput& f, const Environm
         float len = glm::length(v);
         v = len > 0 ? v / len : sg::vec3(0, 0, 1);
         sg::vec3 c(b.cr[i], b.cg[i], b.cb[i]);
-        for (const auto& L : f.lights) c += lightTerms(m, s.normal, v, sampleLight(L, s.position), f.settings.reflection).apply(s.albedo);
+        for (size_t l = 0; l < f.lights.size(); ++l) {
+            const float w = b.visLights ? b.vis[l * b.visStride + i] : 1.0f;
+            c += w * lightTerms(m, s.normal, v, sampleLight(f.lights[l], s.position), f.settings.reflection).apply(s.albedo);
+        }
         b.cr[i] = c.x;
         b.cg[i] = c.y;
         b.cb[i] = c.z;

@@ -42,11 +42,21 @@ struct ShadeBatch {
     std::vector<int32_t> mat;
     std::vector<Constants> mats;
     size_t size = 0;
+    // Shadows: the fraction of light l reaching fragment i is vis[l * visStride + i] (the
+    // kernels scale the light's radiance by it); no shadows when visLights is 0.
+    std::vector<float> vis;
+    size_t visStride = 0, visLights = 0;
+    // Sets visLights and visStride for the current size, every entry 1 (lit).
+    void resetVisibility(size_t lights) {
+        visLights = lights;
+        visStride = lights ? ((size + 7) & ~size_t(7)) + kSlack : 0;
+        vis.assign(visStride * lights, 1.0f);
+    }
 
     // Sets n fragments and empties mats. The arrays hold n rounded up to 8 (the padding lanes set
     // to harmless values, mat = -1) plus kSlack values that a vector store may write past the end.
     static constexpr size_t kSlack = 8;
-    void resize(size_t n);
+    void resize(size_t n);   // also drops the shadow visibility (resetVisibility)
     // Sets the padding lanes again (after stores that ran past `size`).
     void pad();
     // Adds a constant block (albedo, specular colour, kd, ks, shininess, ambient + emissive; or

@@ -86,8 +86,16 @@ inline void shadeKernel(ShadeBatch& b, size_t n, const sg::FrameInput& f) {
             }
             continue;
         }
-        for (const sg::DrawLight& L : f.lights) {
+        for (size_t li = 0; li < f.lights.size(); ++li) {
+            const sg::DrawLight& L = f.lights[li];
             V lx, ly, lz, rr = set1(L.radiance.x), rg = set1(L.radiance.y), rb = set1(L.radiance.z);
+            if (b.visLights) {   // shadows: the fraction of the light that reaches each fragment
+                const V s = loadu(&b.vis[li * b.visStride + i]);
+                if (movemask(cmpgt(s, zero)) == 0) continue;
+                rr = mul(rr, s);
+                rg = mul(rg, s);
+                rb = mul(rb, s);
+            }
             if (L.type == sg::LightType::Directional) {
                 lx = set1(-L.direction.x);
                 ly = set1(-L.direction.y);

@@ -50,6 +50,7 @@ bool notPbr(const RenderSettings& s) { return s.reflection != ReflectionModel::P
 bool pbrEnvironment(const RenderSettings& s) { return pbr(s) && s.environment != "none"; }
 bool fogLinear(const RenderSettings& s) { return s.fog == FogMode::Linear; }
 bool fogExponential(const RenderSettings& s) { return s.fog == FogMode::Exp || s.fog == FogMode::Exp2; }
+bool shadowsOn(const RenderSettings& s) { return s.shadows; }
 
 std::vector<Param<RenderSettings>> renderTable() {
     using S = RenderSettings;
@@ -132,9 +133,37 @@ std::vector<Param<RenderSettings>> renderTable() {
                                                  "Segments / marching-cubes resolution for implicit shapes, CSG, parametric surfaces and grids")
                              .range(4, 512),
                      }),
+        inSection<S>(
+            "Shadows",
+            {
+                field<&S::shadows>("shadows", "shadows", "Shadows", "Shadows of every light: shadow rays (ray caster) or shadow maps (rasterizers)")
+                    .needing(Feature::Shadows),
+                field<&S::shadowMapSize>("shadow.mapSize", "shadow-map-size", "Map size", "Texels per side of each shadow map")
+                    .range(64, 8192)
+                    .needing(Feature::ShadowMaps)
+                    .when(shadowsOn),
+                field<&S::shadowFilter>("shadow.filter", "shadow-filter", "Filter", "How a shadow-map lookup is filtered")
+                    .needing(Feature::ShadowMaps)
+                    .when(shadowsOn),
+                field<&S::shadowPcfSize>("shadow.pcfSize", "shadow-pcf-size", "PCF size", "k: the k x k texels PCF averages")
+                    .range(1, 15)
+                    .needing(Feature::ShadowMaps)
+                    .when([](const S& s) { return s.shadows && s.shadowFilter == ShadowFilter::Pcf; }),
+                field<&S::shadowDepthBias>("shadow.depthBias", "shadow-depth-bias", "Depth bias",
+                                           "Texels a receiver's depth is moved toward the light before the comparison (against acne)")
+                    .range(0.0, 64.0)
+                    .fmt("%.2f texels")
+                    .needing(Feature::ShadowMaps)
+                    .when(shadowsOn),
+                field<&S::shadowNormalBias>("shadow.normalBias", "shadow-normal-bias", "Normal bias",
+                                            "Texels a receiver is moved along its normal before the lookup (against acne)")
+                    .range(0.0, 64.0)
+                    .fmt("%.2f texels")
+                    .needing(Feature::ShadowMaps)
+                    .when(shadowsOn),
+            }),
         inSection<S>("Ray caster",
                      {
-                         field<&S::shadows>("shadows", "shadows", "Shadows", "Shadow rays toward every light").needing(Feature::Shadows),
                          field<&S::reflections>("reflections", "reflections", "Reflections", "Mirror reflections of reflective materials")
                              .needing(Feature::Reflections),
                          field<&S::maxBounces>("maxBounces", "bounces", "Max bounces", "Reflection depth limit")

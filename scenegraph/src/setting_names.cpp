@@ -73,6 +73,11 @@ constexpr NamedValue<ToneMapping> kToneMapping[] = {
      "Khronos PBR Neutral: base colours 0.08..0.8 kept (less 0.04), highlights compressed toward white without hue shifts"},
 };
 
+constexpr NamedValue<ShadowFilter> kShadowFilter[] = {
+    {ShadowFilter::None, "none", "None", "one texel's answer: hard, stair-stepped edges"},
+    {ShadowFilter::Pcf, "pcf", "PCF", "percentage-closer filtering: the mean answer of the k x k texels around the point"},
+};
+
 constexpr NamedValue<AlphaMode> kAlphaMode[] = {
     {AlphaMode::Opaque, "opaque", "Opaque", "alpha is ignored: the surface is fully opaque"},
     {AlphaMode::Mask, "mask", "Mask", "cut-out: drawn where alpha >= the cutoff, not drawn elsewhere"},
@@ -176,6 +181,11 @@ const NameTable<CullMode>& nameTable<CullMode>() {
     return t;
 }
 template <>
+const NameTable<ShadowFilter>& nameTable<ShadowFilter>() {
+    static const NameTable<ShadowFilter> t{kShadowFilter};
+    return t;
+}
+template <>
 const NameTable<ToneMapping>& nameTable<ToneMapping>() {
     static const NameTable<ToneMapping> t{kToneMapping};
     return t;
@@ -205,6 +215,7 @@ std::string_view toString(ReflectionModel m) { return nameOf(m); }
 std::string_view toString(FogMode m) { return nameOf(m); }
 std::string_view toString(CullMode m) { return nameOf(m); }
 std::string_view toString(ToneMapping m) { return nameOf(m); }
+std::string_view toString(ShadowFilter m) { return nameOf(m); }
 std::string_view toString(ProjectionType t) { return nameOf(t); }
 std::string_view toString(LightType t) { return nameOf(t); }
 bool parse(std::string_view s, ShadingModel& out) { return parseName(s, out); }

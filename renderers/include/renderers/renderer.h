@@ -44,6 +44,7 @@ struct Capabilities {
     bool progressive = false;         // render() reports progress per tile and can be cancelled
     bool exactImplicits = false;      // implicit shapes/CSG intersected analytically (vs tessellated)
     bool shadows = false;             // honours RenderSettings::shadows
+    bool shadowMaps = false;          // its shadows are shadow maps (RenderSettings::shadowMapSize ... honoured)
     bool reflections = false;         // honours RenderSettings::reflections
     bool wireframe = false;           // draws RenderSettings::wireframe
     bool pointsAndLines = false;      // draws meshes of PrimitiveMode::Points / Lines

@@ -104,6 +104,8 @@ const NameTable<CullMode>& nameTable<CullMode>();
 template <>
 const NameTable<ToneMapping>& nameTable<ToneMapping>();
 template <>
+const NameTable<ShadowFilter>& nameTable<ShadowFilter>();
+template <>
 const NameTable<AlphaMode>& nameTable<AlphaMode>();
 template <>
 const NameTable<WrapMode>& nameTable<WrapMode>();

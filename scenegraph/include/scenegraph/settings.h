@@ -22,6 +22,9 @@ enum class AAMode { None, MSAA, SSAA };
 enum class CullMode { Auto, On, Off };
 // The tone-mapping operator of the display transform (see RenderSettings::exposure).
 enum class ToneMapping { None, Aces, KhrNeutral };
+// How the rasterizers filter a shadow-map lookup (renderers/shadow_map.h): one texel's answer, or
+// the mean answer of the k x k texels around the point (percentage-closer filtering).
+enum class ShadowFilter { None, Pcf };
 
 // Whether a triangle of a material with this doubleSided flag loses its back face.
 inline bool cullsBackFaces(CullMode m, bool doubleSided) { return m == CullMode::On || (m == CullMode::Auto && !doubleSided); }
@@ -68,8 +71,18 @@ struct RenderSettings {
     ToneMapping toneMapping = ToneMapping::None;
     bool displayTransformIsIdentity() const { return exposure == 0.0f && toneMapping == ToneMapping::None; }
 
-    // Ray caster only.
+    // Shadows of every light: shadow rays in the ray caster, shadow maps in the rasterizers
+    // (docs/math.md, "Shadow maps"): one map of shadowMapSize^2 texels per light (six for a
+    // point light), biased by shadowDepthBias and shadowNormalBias texels, filtered by
+    // shadowFilter over shadowPcfSize^2 texels.
     bool shadows = true;
+    int shadowMapSize = 2048;
+    ShadowFilter shadowFilter = ShadowFilter::Pcf;
+    int shadowPcfSize = 3;
+    float shadowDepthBias = 1.0f;
+    float shadowNormalBias = 1.0f;
+
+    // Ray caster only.
     bool reflections = false;
     int maxBounces = 3;
 
@@ -94,6 +107,7 @@ std::string_view toString(ReflectionModel m);
 std::string_view toString(FogMode m);
 std::string_view toString(CullMode m);
 std::string_view toString(ToneMapping m);
+std::string_view toString(ShadowFilter m);
 bool parse(std::string_view s, ShadingModel& out);
 bool parse(std::string_view s, ReflectionModel& out);
 bool parse(std::string_view s, FogMode& out);

@@ -1,0 +1,312 @@
+// shadow_map.cpp - the rasterizers' shadow maps (shadow_map.h has the formulas): which maps a
+// frame's lights get, the CPU depth pass, and the lookup.
+#include "renderers/shadow_map.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+
+namespace rnd {
+
+using sg::Aabb;
+using sg::mat4;
+using sg::vec3;
+using sg::vec4;
+
+namespace {
+
+// An up vector not parallel to d.
+vec3 upFor(const vec3& d) { return std::abs(d.y) < 0.99f ? vec3(0, 1, 0) : vec3(1, 0, 0); }
+
+// The part of the casters the camera sees, in the light's eye space: the camera frustum between
+// the casters' nearest and farthest depths (clamped to the frustum), its 8 corners' bounds.
+Aabb visibleSliceInLight(const sg::FrameCamera& cam, const Aabb& casters, const mat4& lightView) {
+    Aabb out;
+    const Aabb ce = casters.transformed(cam.view);
+    if (ce.empty() || (ce.min.z >= 0.0f && cam.projection.type == sg::ProjectionType::Perspective)) return out;
+    auto ndcZ = [&](float dist) {
+        const vec4 c = cam.proj * vec4(0.0f, 0.0f, -dist, 1.0f);
+        return std::clamp(c.w != 0.0f ? c.z / c.w : 0.0f, -1.0f, 1.0f);
+    };
+    const float dNear = std::max(-ce.max.z, 0.0f), dFar = std::max(-ce.min.z, dNear);
+    const float zs[2] = {ndcZ(std::max(dNear, 1e-6f)), ndcZ(std::max(dFar, 1e-6f))};
+    const mat4 toLight = lightView * glm::inverse(cam.viewProj);
+    for (float z : zs)
+        for (float y : {-1.0f, 1.0f})
+            for (float x : {-1.0f, 1.0f}) {
+                const vec4 q = toLight * vec4(x, y, z, 1.0f);
+                if (q.w != 0.0f) out.extend(vec3(q) / q.w);
+            }
+    return out;
+}
+
+// The near and far distances of the casters from a perspective view's eye along its axis.
+void perspectiveRange(const Aabb& casters, const mat4& view, float& nearZ, float& farZ) {
+    const Aabb le = casters.transformed(view);
+    farZ = std::max(-le.min.z, 1e-4f) * 1.01f;
+    nearZ = std::clamp(-le.max.z * 0.99f, farZ * 1e-4f, farZ * 0.5f);
+}
+
+}   // namespace
+
+Aabb shadowCasterBounds(const sg::FrameInput& f) {
+    Aabb b;
+    for (const sg::DrawMesh& d : f.meshes)
+        if (d.mesh && d.mesh->mode == sg::PrimitiveMode::Triangles && !d.mesh->positions.empty()) b.extend(d.mesh->bounds().transformed(d.world));
+    for (const sg::DrawAnalytic& a : f.analytics)
+        if (!a.worldBounds.empty() && std::isfinite(a.worldBounds.min.x) && std::isfinite(a.worldBounds.max.x)) b.extend(a.worldBounds);
+    return b;
+}
+
+ShadowPlan planShadows(const sg::FrameInput& f, const Aabb& casters) {
+    ShadowPlan plan;
+    const sg::RenderSettings& s = f.settings;
+    if (!s.shadows || casters.empty() || f.lights.empty()) return plan;
+    plan.size = std::clamp(s.shadowMapSize, 1, 8192);
+    plan.filter = s.shadowFilter;
+    plan.pcf = s.shadowFilter == sg::ShadowFilter::Pcf ? std::clamp(s.shadowPcfSize, 1, 15) : 1;
+    plan.depthBias = s.shadowDepthBias;
+    plan.normalBias = s.shadowNormalBias;
+    const float N = float(plan.size);
+    // Texels kept beyond an edge so that the filter's taps there still read the map.
+    const float margin = float(plan.pcf + 2) / N;
+    const vec3 centre = casters.center();
+    const float radius = std::max(0.5f * glm::length(casters.extent()), 1e-6f);
+    for (const sg::DrawLight& L : f.lights) {
+        plan.firstView.push_back(int(plan.views.size()));
+        if (int(plan.views.size()) + (L.type == sg::LightType::Point ? 6 : 1) > kMaxShadowViews) {
+            plan.viewCount.push_back(0);
+            continue;
+        }
+        if (L.type == sg::LightType::Directional) {
+            const vec3 d = glm::normalize(L.direction);
+            const vec3 from = centre - 2.0f * radius * d;
+            ShadowView v;
+            v.view = glm::lookAt(from, from + d, upFor(d));
+            const Aabb all = casters.transformed(v.view);
+            Aabb fit = all;
+            const Aabb seen = visibleSliceInLight(f.camera, casters, v.view);
+            if (!seen.empty()) {   // x and y: the part in view, never more than the casters
+                fit.min.x = std::max(all.min.x, seen.min.x);
+                fit.max.x = std::min(all.max.x, seen.max.x);
+                fit.min.y = std::max(all.min.y, seen.min.y);
+                fit.max.y = std::min(all.max.y, seen.max.y);
+                if (fit.min.x > fit.max.x || fit.min.y > fit.max.y) fit = all;
+            }
+            // Square texels, the margin around, and the depth range of every caster.
+            const float half = 0.5f * std::max({fit.max.x - fit.min.x, fit.max.y - fit.min.y, 1e-6f * radius}) * (1.0f + 2.0f * margin);
+            const float cx = 0.5f * (fit.min.x + fit.max.x), cy = 0.5f * (fit.min.y + fit.max.y);
+            const float depth = std::max(all.max.z - all.min.z, 1e-6f * radius);
+            v.nearZ = -all.max.z - 0.01f * depth;
+            v.farZ = -all.min.z + 0.01f * depth;
+            v.viewProj = glm::ortho(cx - half, cx + half, cy - half, cy + half, v.nearZ, v.farZ) * v.view;
+            v.texelAtUnit = 2.0f * half / N;
+            plan.views.push_back(v);
+        } else if (L.type == sg::LightType::Spot) {
+            const vec3 d = glm::normalize(L.direction);
+            ShadowView v;
+            v.perspective = true;
+            v.view = glm::lookAt(L.position, L.position + d, upFor(d));
+            const float halfAngle = std::acos(std::clamp(L.cosOuter, -1.0f, 1.0f));
+            const float tanHalf = std::min(std::tan(std::min(halfAngle, sg::radians(85.0f))) * (1.0f + 2.0f * margin), std::tan(sg::radians(87.0f)));
+            perspectiveRange(casters, v.view, v.nearZ, v.farZ);
+            v.viewProj = glm::perspective(2.0f * std::atan(tanHalf), 1.0f, v.nearZ, v.farZ) * v.view;
+            v.texelAtUnit = 2.0f * tanHalf / N;
+            plan.views.push_back(v);
+        } else {   // point: six faces of 90 degrees plus the margin
+            static const vec3 dirs[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+            static const vec3 ups[6] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
+            const float tanHalf = 1.0f + 2.0f * margin;
+            for (int k = 0; k < 6; ++k) {
+                ShadowView v;
+                v.perspective = true;
+                v.view = glm::lookAt(L.position, L.position + dirs[k], ups[k]);
+                perspectiveRange(casters, v.view, v.nearZ, v.farZ);
+                v.viewProj = glm::perspective(2.0f * std::atan(tanHalf), 1.0f, v.nearZ, v.farZ) * v.view;
+                v.texelAtUnit = 2.0f * tanHalf / N;
+                plan.views.push_back(v);
+            }
+        }
+        plan.viewCount.push_back(int(plan.views.size()) - plan.firstView.back());
+    }
+    return plan;
+}
+
+int pointLightFace(const vec3& d) {
+    const float ax = std::abs(d.x), ay = std::abs(d.y), az = std::abs(d.z);
+    if (ax >= ay && ax >= az) return d.x > 0.0f ? 0 : 1;
+    if (ay >= az) return d.y > 0.0f ? 2 : 3;
+    return d.z > 0.0f ? 4 : 5;
+}
+
+namespace {
+
+// A triangle in the map's window coordinates (x, y in texels, z window depth).
+struct WinTri {
+    vec3 a, b, c;
+    int y0, y1;   // rows it may cover
+};
+
+constexpr int kBand = 64;   // rows per band of the parallel depth pass
+
+// Clips a clip-space polygon against the near plane (z >= -w) and appends its fan of window
+// triangles.
+void emitClipped(const vec4 (&in)[3], int size, std::vector<WinTri>& out) {
+    vec4 poly[4];
+    int n = 0;
+    for (int k = 0; k < 3; ++k) {
+        const vec4& p = in[k];
+        const vec4& q = in[(k + 1) % 3];
+        const float dp = p.z + p.w, dq = q.z + q.w;
+        if (dp >= 0.0f) poly[n++] = p;
+        if ((dp >= 0.0f) != (dq >= 0.0f)) {
+            const float t = dp / (dp - dq);
+            poly[n++] = p + t * (q - p);
+        }
+    }
+    if (n < 3) return;
+    const float s = float(size);
+    vec3 w[4];
+    for (int k = 0; k < n; ++k) {
+        if (!(poly[k].w > 0.0f)) return;
+        const vec3 ndc = vec3(poly[k]) / poly[k].w;
+        w[k] = vec3((ndc.x * 0.5f + 0.5f) * s, (ndc.y * 0.5f + 0.5f) * s, ndc.z * 0.5f + 0.5f);
+    }
+    for (int k = 1; k + 1 < n; ++k) {
+        WinTri t{w[0], w[k], w[k + 1], 0, 0};
+        const float ymin = std::min({t.a.y, t.b.y, t.c.y}), ymax = std::max({t.a.y, t.b.y, t.c.y});
+        const float xmin = std::min({t.a.x, t.b.x, t.c.x}), xmax = std::max({t.a.x, t.b.x, t.c.x});
+        if (!(ymax >= 0.0f && ymin < s && xmax >= 0.0f && xmin < s)) continue;   // off the map (or NaN)
+        t.y0 = std::max(0, int(std::floor(ymin - 0.5f)));
+        t.y1 = std::min(size - 1, int(std::ceil(ymax - 0.5f)));
+        if (t.y0 <= t.y1) out.push_back(t);
+    }
+}
+
+// Rasterizes t into rows [r0, r1] of the map: pixel centres, the top-left rule, depth less.
+void rasterizeRows(const WinTri& t, int size, int r0, int r1, float* map) {
+    vec3 a = t.a, b = t.b, c = t.c;
+    float area = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+    if (!(area != 0.0f)) return;
+    if (area < 0.0f) {   // both faces: counter-clockwise from here on
+        std::swap(b, c);
+        area = -area;
+    }
+    const float inv = 1.0f / area;
+    // Edge k: the one opposite vertex k; w_k(x, y) >= 0 inside. Top-left rule: a pixel centre on
+    // an edge belongs to the triangle when the edge is a top or a left edge.
+    const vec3 v[3] = {a, b, c};
+    float ex[3], ey[3], e0[3];
+    bool inclusive[3];
+    for (int k = 0; k < 3; ++k) {
+        const vec3& p = v[(k + 1) % 3];
+        const vec3& q = v[(k + 2) % 3];
+        ex[k] = p.y - q.y;   // d w / d x
+        ey[k] = q.x - p.x;   // d w / d y
+        e0[k] = p.x * q.y - p.y * q.x;
+        const bool top = ex[k] == 0.0f && ey[k] < 0.0f, left = ex[k] > 0.0f;
+        inclusive[k] = top || left;
+    }
+    const float xmin = std::min({a.x, b.x, c.x}), xmax = std::max({a.x, b.x, c.x});
+    const int x0 = std::max(0, int(std::floor(xmin - 0.5f))), x1 = std::min(size - 1, int(std::ceil(xmax - 0.5f)));
+    const int y0 = std::max(r0, t.y0), y1 = std::min(r1, t.y1);
+    for (int y = y0; y <= y1; ++y) {
+        const float py = float(y) + 0.5f;
+        float* row = map + size_t(y) * size_t(size);
+        for (int x = x0; x <= x1; ++x) {
+            const float px = float(x) + 0.5f;
+            float w[3];
+            bool in = true;
+            for (int k = 0; k < 3 && in; ++k) {
+                w[k] = ex[k] * px + ey[k] * py + e0[k];
+                in = w[k] > 0.0f || (w[k] == 0.0f && inclusive[k]);
+            }
+            if (!in) continue;
+            const float z = (w[0] * a.z + w[1] * b.z + w[2] * c.z) * inv;
+            if (z >= 0.0f && z <= 1.0f && z < row[x]) row[x] = z;
+        }
+    }
+}
+
+}   // namespace
+
+void renderShadowDepth(const ShadowView& v, int size, const std::vector<ShadowCaster>& casters, float* map) {
+    std::fill(map, map + size_t(size) * size_t(size), 1.0f);
+    // Window triangles, built in parallel blocks of each caster.
+    constexpr size_t kBlock = 4096;
+    struct Block {
+        const ShadowCaster* c;
+        size_t begin, end;
+    };
+    std::vector<Block> blocks;
+    for (const ShadowCaster& c : casters)
+        for (size_t b = 0; b < c.triangles; b += kBlock) blocks.push_back({&c, b, std::min(c.triangles, b + kBlock)});
+    std::vector<std::vector<WinTri>> built(blocks.size());
+    tbb::parallel_for(size_t(0), blocks.size(), [&](size_t bi) {
+        const Block& blk = blocks[bi];
+        const auto* base = static_cast<const unsigned char*>(blk.c->positions);
+        std::vector<WinTri>& out = built[bi];
+        for (size_t t = blk.begin; t < blk.end; ++t) {
+            vec4 clip[3];
+            bool valid = true;
+            for (int k = 0; k < 3 && valid; ++k) {
+                const size_t i = blk.c->idx ? blk.c->idx[3 * t + size_t(k)] : 3 * t + size_t(k);
+                valid = i < blk.c->vertices;
+                if (!valid) break;
+                float xyz[3];
+                std::memcpy(xyz, base + i * blk.c->stride, sizeof(xyz));
+                clip[k] = v.viewProj * vec4(xyz[0], xyz[1], xyz[2], 1.0f);
+            }
+            if (valid) emitClipped(clip, size, out);
+        }
+    });
+    // Bands of rows, each with the triangles that reach it, rasterized in parallel.
+    const int bands = (size + kBand - 1) / kBand;
+    std::vector<std::vector<const WinTri*>> perBand;
+    perBand.resize(size_t(bands));
+    for (const auto& list : built)
+        for (const WinTri& t : list)
+            for (int b = t.y0 / kBand; b <= t.y1 / kBand; ++b) perBand[size_t(b)].push_back(&t);
+    tbb::parallel_for(0, bands, [&](int b) {
+        const int r0 = b * kBand, r1 = std::min(size - 1, r0 + kBand - 1);
+        for (const WinTri* t : perBand[size_t(b)]) rasterizeRows(*t, size, r0, r1, map);
+    });
+}
+
+float shadowVisibility(const ShadowPlan& plan, const ShadowMaps& maps, const sg::DrawLight& L, int light, const vec3& p, const vec3& ng) {
+    if (light < 0 || size_t(light) >= plan.viewCount.size() || plan.viewCount[size_t(light)] == 0 || maps.size != plan.size) return 1.0f;
+    int vi = plan.firstView[size_t(light)];
+    if (L.type == sg::LightType::Point) vi += pointLightFace(p - L.position);
+    const ShadowView& v = plan.views[size_t(vi)];
+    const vec3 toLight = L.type == sg::LightType::Directional ? -L.direction : L.position - p;
+    const vec3 n = glm::dot(ng, toLight) < 0.0f ? -ng : ng;   // the side the light is on
+    // The texel's size at p, the normal offset, then the receiver's depth less the depth bias.
+    const float depthP = -(v.view[0][2] * p.x + v.view[1][2] * p.y + v.view[2][2] * p.z + v.view[3][2]);
+    const float t = v.perspective ? v.texelAtUnit * depthP : v.texelAtUnit;
+    const vec3 q = p + plan.normalBias * t * n;
+    const vec4 c = v.viewProj * vec4(q, 1.0f);
+    if (!(c.w > 0.0f)) return 1.0f;
+    const float u = (c.x / c.w) * 0.5f + 0.5f, w = (c.y / c.w) * 0.5f + 0.5f;
+    const float zq = -(v.view[0][2] * q.x + v.view[1][2] * q.y + v.view[2][2] * q.z + v.view[3][2]);
+    const float zb = zq - plan.depthBias * t;
+    // The biased depth as a window depth (linearDepth's inverse), compared with the texels'.
+    const float dRecv = v.perspective ? (v.farZ - v.nearZ * v.farZ / zb) / (v.farZ - v.nearZ) : (zb - v.nearZ) / (v.farZ - v.nearZ);
+    const int N = plan.size, k = plan.pcf;
+    const int i0 = int(std::floor(u * float(N) - 0.5f * float(k) + 0.5f)), j0 = int(std::floor(w * float(N) - 0.5f * float(k) + 0.5f));
+    const float* map = maps.map(vi);
+    int lit = 0;
+    for (int j = j0; j < j0 + k; ++j)
+        for (int i = i0; i < i0 + k; ++i) {
+            if (i < 0 || j < 0 || i >= N || j >= N) {
+                ++lit;
+                continue;
+            }
+            lit += dRecv <= map[size_t(j) * size_t(N) + size_t(i)] ? 1 : 0;
+        }
+    return float(lit) / float(k * k);
+}
+
+}   // namespace rnd

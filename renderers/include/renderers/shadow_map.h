@@ -1,0 +1,94 @@
+// shadow_map.h - shadow maps, the rasterizers' shadows: one description that the GL backend
+// (gl_shadows.cpp, shaders/shadow.glsl, mirroring shadowVisibility name for name) and the CPU
+// rasterizer (its own depth pass, renderShadowDepth below) both follow, so that their shadows
+// agree with each other and can be compared with the ray caster's exact shadow rays.
+// docs/math.md, "Shadow maps", has the formulas:
+//
+//   Which maps (planShadows): one per directional or spot light, six per point light.
+//     directional: orthographic along the light, fitted in x and y to the part of the scene the
+//       camera sees (the camera frustum between the scene's nearest and farthest depths,
+//       intersected with the scene's bounds), in depth to the whole scene (every caster);
+//     spot: perspective from the light along its axis, the outer cone plus a margin;
+//     point: perspective, 90 degrees, the six faces of a cube (+x, -x, +y, -y, +z, -z).
+//   Each map holds the window depth d in [0, 1] of the nearest surface (both faces drawn, cleared
+//   to 1) at texel centres ((i + 0.5)/N, (j + 0.5)/N), row 0 at v = 0 (GL's convention).
+//   Lookup of world point p with surface normal n (the shading normal, turned toward the light):
+//     t   = texel size in world units at p (orthographic: extent / N; perspective:
+//           2 tan(fov/2) / N times p's depth along the map's axis)
+//     p'  = p + normalBias t n                                   (normal offset)
+//     (u, v, z) = the map's projection of p',  z_lin its linear depth along the axis
+//     lit(texel) = z_lin - depthBias t <= linear(d(texel))       (depth bias)
+//     visibility = mean of lit over the k x k texels nearest (u, v) (k = 1 without PCF);
+//     texels outside the map are lit.
+#pragma once
+
+#include "scenegraph/frame.h"
+#include "scenegraph/math.h"
+
+#include <vector>
+
+namespace rnd {
+
+// One depth map: a view from the light.
+struct ShadowView {
+    sg::mat4 view{1.0f};       // world -> light eye (looking down -z)
+    sg::mat4 viewProj{1.0f};   // world -> light clip (window depth = 0.5 z/w + 0.5, as GL)
+    bool perspective = false;
+    float nearZ = 0.0f, farZ = 1.0f;   // the planes, as distances along the axis
+    float texelAtUnit = 0.0f;          // texel size in world units (perspective: at distance 1)
+
+    // The linear depth (distance along the axis) of window depth d.
+    float linearDepth(float d) const {
+        return perspective ? nearZ * farZ / (farZ - d * (farZ - nearZ)) : nearZ + d * (farZ - nearZ);
+    }
+};
+
+// At most this many maps per frame (GL's uniform arrays): lights whose maps would pass it, in
+// the frame's order, get none (lit everywhere) in both rasterizers.
+constexpr int kMaxShadowViews = 48;
+
+// Which maps a frame's lights get.
+struct ShadowPlan {
+    int size = 0;   // texels per side of every map
+    sg::ShadowFilter filter = sg::ShadowFilter::Pcf;
+    int pcf = 3;                                     // k of k x k (1 without PCF)
+    float depthBias = 1.0f, normalBias = 1.0f;       // in texels
+    std::vector<ShadowView> views;                   // all maps, light by light
+    std::vector<int> firstView, viewCount;           // per frame light (viewCount 0: no map, lit)
+    bool empty() const { return views.empty(); }
+};
+
+// The world bounds of everything in the frame that casts (meshes of triangles, analytic shapes).
+sg::Aabb shadowCasterBounds(const sg::FrameInput& f);
+// The plan for f's lights (empty when settings.shadows is off or nothing casts).
+ShadowPlan planShadows(const sg::FrameInput& f, const sg::Aabb& casters);
+
+// The depth maps, size x size floats each, view after view.
+struct ShadowMaps {
+    int size = 0;
+    std::vector<float> depth;
+    const float* map(int view) const { return depth.data() + size_t(view) * size_t(size) * size_t(size); }
+    float* map(int view) { return depth.data() + size_t(view) * size_t(size) * size_t(size); }
+};
+
+// World-space triangles that cast: the corners of triangle k are positions idx[3k], idx[3k + 1],
+// idx[3k + 2] (idx null: 3k, 3k + 1, 3k + 2), each position three floats, `stride` bytes apart.
+struct ShadowCaster {
+    const void* positions = nullptr;
+    size_t stride = 3 * sizeof(float);
+    const uint32_t* idx = nullptr;
+    size_t triangles = 0;
+    size_t vertices = 0;   // positions there are (a triangle with a corner past them is skipped)
+};
+// The CPU depth pass: clears one view's map (size x size) to 1 and rasterizes the casters into
+// it, both faces, depth test less, at pixel centres with the top-left rule (as GL's rasterizer).
+void renderShadowDepth(const ShadowView& v, int size, const std::vector<ShadowCaster>& casters, float* map);
+
+// The map of a point light's face for the direction from the light to p (views: first of six).
+int pointLightFace(const sg::vec3& fromLight);
+
+// Fraction of light `light` of the frame that reaches world point p (unit surface normal n, the
+// shading normal, either side), by the plan's maps: 1 lit, 0 shadowed, between at PCF edges.
+float shadowVisibility(const ShadowPlan& plan, const ShadowMaps& maps, const sg::DrawLight& L, int light, const sg::vec3& p, const sg::vec3& n);
+
+}   // namespace rnd

@@ -1,0 +1,222 @@
+// shadow_test.cpp - shadows in every backend: the rasterizers' shadow maps
+// (renderers/shadow_map.h) against the ray caster's exact shadow rays, and the maps' own pieces:
+//  - the lookup on a hand-made map: under an occluder 0, beside it 1, outside the map 1;
+//  - a lit plane facing the light, alone, has no shadowed pixel (no acne), in every backend;
+//  - a floating slab and a thin pole over a ground, lit by a sun or a spot light: each backend's
+//    shadowed pixels (darker with shadows on than off) overlap the ray caster's (IoU >= 0.9 at
+//    640 x 640), and the two rasterizers' overlap each other's (IoU >= 0.95);
+//  - the thin pole (a tenth of a unit, a few texels wide) still casts.
+#include "renderers/renderer.h"
+#include "renderers/shadow_map.h"
+#include "scenegraph/mesh.h"
+#include "scenegraph/transforms.h"
+#include "test_scenes.h"
+#include "test_support.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+
+namespace {
+
+using namespace test_scenes;
+using sg::vec3;
+
+constexpr int S = 640;
+
+sg::Material matte(const vec3& c) {
+    sg::Material m;
+    m.baseColor = c;
+    m.ka = 0.2f;
+    m.kd = 0.8f;
+    m.ks = 0.0f;
+    m.doubleSided = true;
+    return m;
+}
+
+enum class Caster { Sun, Spot, Point };
+
+// The ground (10 x 10 at y = 0), a slab floating at y = 1.5 and a thin pole, seen from above at
+// an angle; one light.
+sg::FrameInput slabAndPole(Caster light, bool withCasters = true) {
+    sg::Projection proj;
+    sg::FrameInput f = makeFrame(S, S, proj, vec3(0.0f, 9.0f, 8.0f), vec3(0.0f, 0.0f, 0.5f));
+    f.ambientLight = vec3(1.0f);
+    const sg::Mesh ground = quad(5.0f);   // z = 0 facing +z: turned to y = 0 facing +y
+    addMesh(f, ground, matte(vec3(0.8f)), glm::rotate(sg::mat4(1.0f), -sg::kPi / 2, vec3(1, 0, 0)));
+    if (withCasters) {
+        addMesh(f, sg::primitives::box(vec3(1.0f, 0.1f, 0.7f)), matte(vec3(0.8f, 0.3f, 0.2f)), glm::translate(sg::mat4(1.0f), vec3(-1.0f, 1.5f, 0.0f)));
+        addMesh(f, sg::primitives::box(vec3(0.05f, 1.25f, 0.05f)), matte(vec3(0.2f, 0.5f, 0.8f)), glm::translate(sg::mat4(1.0f), vec3(2.0f, 1.25f, 1.0f)));
+    }
+    switch (light) {
+    case Caster::Sun: f.lights.push_back(directional(glm::normalize(vec3(0.35f, -1.0f, -0.25f)), vec3(1.0f))); break;
+    case Caster::Spot: f.lights.push_back(spot(vec3(0.5f, 6.0f, 1.0f), glm::normalize(vec3(0.0f, -1.0f, -0.1f)), vec3(1.0f), 40.0f, 50.0f)); break;
+    case Caster::Point: f.lights.push_back(point(vec3(0.5f, 4.0f, 1.5f), vec3(1.0f), false)); break;
+    }
+    f.settings.shadows = true;
+    return f;
+}
+
+rnd::Framebuffer render(const std::string& backend, const sg::FrameInput& f, const std::string& name) {
+    std::string err;
+    auto r = rnd::makeRenderer(backend, &err);
+    EXPECT_TRUE(r) << err;
+    rnd::Framebuffer fb;
+    if (!r) return fb;
+    const rnd::RenderStats st = r->render(f, S, S, fb);
+    EXPECT_TRUE(st.ok) << backend << " " << name << ": " << st.error;
+    testing_support::writeImage(fb, "conformance", "shadow-" + backend + "-" + name);
+    return fb;
+}
+
+// Pixels darker with shadows on than off by more than a fifth of the lit value: shadowed.
+std::vector<uint8_t> shadowMask(const rnd::Framebuffer& on, const rnd::Framebuffer& off) {
+    std::vector<uint8_t> m(size_t(on.width) * size_t(on.height), 0);
+    for (int y = 0; y < on.height; ++y)
+        for (int x = 0; x < on.width; ++x) {
+            const int a = on.pixel(x, y)[0] + on.pixel(x, y)[1] + on.pixel(x, y)[2];
+            const int b = off.pixel(x, y)[0] + off.pixel(x, y)[1] + off.pixel(x, y)[2];
+            m[size_t(y) * size_t(on.width) + size_t(x)] = b > 30 && a < b - b / 5;
+        }
+    return m;
+}
+
+double iou(const std::vector<uint8_t>& a, const std::vector<uint8_t>& b) {
+    size_t inter = 0, uni = 0;
+    for (size_t i = 0; i < a.size(); ++i) {
+        inter += a[i] && b[i];
+        uni += a[i] || b[i];
+    }
+    return uni ? double(inter) / double(uni) : 1.0;
+}
+
+size_t count(const std::vector<uint8_t>& m) {
+    size_t n = 0;
+    for (uint8_t v : m) n += v;
+    return n;
+}
+
+const char* name(Caster c) { return c == Caster::Sun ? "sun" : c == Caster::Spot ? "spot" : "point"; }
+
+std::vector<uint8_t> maskOf(const std::string& backend, Caster light) {
+    sg::FrameInput f = slabAndPole(light);
+    const rnd::Framebuffer on = render(backend, f, std::string(name(light)) + "-on");
+    f.settings.shadows = false;
+    const rnd::Framebuffer off = render(backend, f, std::string(name(light)) + "-off");
+    return shadowMask(on, off);
+}
+
+// --- the lookup on a hand-made plan --------------------------------------------------------
+
+TEST(ShadowMapTest, LookupAnswersUnderBesideAndOutsideTheOccluder) {
+    // A sun straight down over a 4 x 4 ground; a 1 x 1 occluder at y = 1 over the origin.
+    sg::FrameInput f = makeFrame(64, 64, sg::Projection{}, vec3(0, 10, 0.01f), vec3(0));
+    f.lights.push_back(directional(vec3(0, -1, 0), vec3(1.0f)));
+    f.settings.shadowMapSize = 256;
+    f.settings.shadowFilter = sg::ShadowFilter::None;
+    const sg::Aabb casters{vec3(-2, 0, -2), vec3(2, 1, 2)};
+    const rnd::ShadowPlan plan = rnd::planShadows(f, casters);
+    ASSERT_EQ(plan.views.size(), 1u);
+    ASSERT_EQ(plan.viewCount, std::vector<int>{1});
+    const std::vector<vec3> pos = {{-0.5f, 1, -0.5f}, {0.5f, 1, -0.5f}, {0.5f, 1, 0.5f}, {-0.5f, 1, 0.5f}};
+    const std::vector<uint32_t> idx = {0, 1, 2, 0, 2, 3};
+    rnd::ShadowCaster c;
+    c.positions = pos.data();
+    c.stride = sizeof(vec3);
+    c.idx = idx.data();
+    c.triangles = 2;
+    c.vertices = 4;
+    rnd::ShadowMaps maps;
+    maps.size = plan.size;
+    maps.depth.resize(size_t(plan.size) * size_t(plan.size));
+    rnd::renderShadowDepth(plan.views[0], plan.size, {c}, maps.map(0));
+    const vec3 up(0, 1, 0);
+    EXPECT_EQ(rnd::shadowVisibility(plan, maps, f.lights[0], 0, vec3(0, 0, 0), up), 0.0f);
+    EXPECT_EQ(rnd::shadowVisibility(plan, maps, f.lights[0], 0, vec3(0.4f, 0, -0.4f), up), 0.0f);
+    EXPECT_EQ(rnd::shadowVisibility(plan, maps, f.lights[0], 0, vec3(1.5f, 0, 0), up), 1.0f);
+    EXPECT_EQ(rnd::shadowVisibility(plan, maps, f.lights[0], 0, vec3(0, 0, -1.5f), up), 1.0f);
+    EXPECT_EQ(rnd::shadowVisibility(plan, maps, f.lights[0], 0, vec3(0, 1, 0), up), 1.0f) << "the occluder itself is lit (acne)";
+    EXPECT_EQ(rnd::shadowVisibility(plan, maps, f.lights[0], 0, vec3(0, 1.5f, 0), up), 1.0f) << "above the occluder";
+    EXPECT_EQ(rnd::shadowVisibility(plan, maps, f.lights[0], 0, vec3(40, 0, 0), up), 1.0f) << "outside the map";
+    // PCF 3 x 3 across the occluder's edge: between 0 and 1.
+    f.settings.shadowFilter = sg::ShadowFilter::Pcf;
+    const rnd::ShadowPlan pcf = rnd::planShadows(f, casters);
+    ASSERT_EQ(pcf.pcf, 3);
+    const float edge = rnd::shadowVisibility(pcf, maps, f.lights[0], 0, vec3(0.5f, 0, 0), up);
+    EXPECT_GT(edge, 0.0f);
+    EXPECT_LT(edge, 1.0f);
+    // No shadows when they are off.
+    f.settings.shadows = false;
+    EXPECT_TRUE(rnd::planShadows(f, casters).empty());
+}
+
+TEST(ShadowMapTest, PointLightFacesCoverEveryDirection) {
+    EXPECT_EQ(rnd::pointLightFace(vec3(1, 0.2f, -0.3f)), 0);
+    EXPECT_EQ(rnd::pointLightFace(vec3(-1, 0.2f, -0.3f)), 1);
+    EXPECT_EQ(rnd::pointLightFace(vec3(0.1f, 2, -0.3f)), 2);
+    EXPECT_EQ(rnd::pointLightFace(vec3(0.1f, -2, -0.3f)), 3);
+    EXPECT_EQ(rnd::pointLightFace(vec3(0.1f, 0.2f, 3)), 4);
+    EXPECT_EQ(rnd::pointLightFace(vec3(0.1f, 0.2f, -3)), 5);
+    sg::FrameInput f = makeFrame(64, 64, sg::Projection{}, vec3(0, 10, 0.01f), vec3(0));
+    f.lights.push_back(point(vec3(0, 1, 0), vec3(1.0f), true));
+    const rnd::ShadowPlan plan = rnd::planShadows(f, sg::Aabb{vec3(-2, 0, -2), vec3(2, 3, 2)});
+    ASSERT_EQ(plan.views.size(), 6u);
+    // Every face's view projects its own axis direction to the map's centre.
+    const vec3 axes[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    for (int k = 0; k < 6; ++k) {
+        const sg::vec4 c = plan.views[size_t(k)].viewProj * sg::vec4(vec3(0, 1, 0) + axes[k], 1.0f);
+        EXPECT_NEAR(c.x / c.w, 0.0f, 1e-5f) << k;
+        EXPECT_NEAR(c.y / c.w, 0.0f, 1e-5f) << k;
+    }
+}
+
+// --- every backend -------------------------------------------------------------------------
+
+class Shadows : public ::testing::TestWithParam<std::string> {};
+
+// A lit ground facing the light and nothing above it: shadows on and off give the same image.
+TEST_P(Shadows, LitPlaneFacingTheLightHasNoAcne) {
+    for (Caster light : {Caster::Sun, Caster::Spot, Caster::Point}) {
+        sg::FrameInput f = slabAndPole(light, false);
+        const rnd::Framebuffer on = render(GetParam(), f, std::string("acne-") + name(light) + "-on");
+        f.settings.shadows = false;
+        const rnd::Framebuffer off = render(GetParam(), f, std::string("acne-") + name(light) + "-off");
+        EXPECT_EQ(count(shadowMask(on, off)), 0u) << name(light);
+    }
+}
+
+// The slab and the pole cast, with a sun, a spot and a point light; the pole's shadow, a few
+// texels wide, is there (its pixels beside the slab's shadow).
+TEST_P(Shadows, SlabAndThinPoleCast) {
+    for (Caster light : {Caster::Sun, Caster::Spot, Caster::Point}) {
+        const std::vector<uint8_t> m = maskOf(GetParam(), light);
+        EXPECT_GT(count(m), size_t(S * S / 200)) << name(light);
+        // The pole's shadow: in the right half of the image (the slab's is left of centre).
+        size_t right = 0;
+        for (int y = 0; y < S; ++y)
+            for (int x = S * 5 / 8; x < S; ++x) right += m[size_t(y) * S + size_t(x)];
+        EXPECT_GT(right, 200u) << name(light) << ": the thin pole casts no shadow";
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(EveryBackend, Shadows, ::testing::ValuesIn(rnd::rendererNames()), [](const auto& info) { return info.param; });
+
+// The shadow maps against the exact shadow rays, and the two rasterizers against each other.
+// (Needs every backend: the gl label.)
+TEST(ShadowAgreementGLTest, RasterizersMatchTheRayCasterAndEachOther) {
+    for (Caster light : {Caster::Sun, Caster::Spot, Caster::Point}) {
+        std::map<std::string, std::vector<uint8_t>> masks;
+        for (const std::string& b : rnd::rendererNames()) masks[b] = maskOf(b, light);
+        ASSERT_TRUE(masks.count("raycast") && masks.count("raster") && masks.count("gl"));
+        const double rasterRay = iou(masks["raster"], masks["raycast"]), glRay = iou(masks["gl"], masks["raycast"]);
+        const double glRaster = iou(masks["gl"], masks["raster"]);
+        std::printf("shadows %s: IoU raster~raycast %.4f gl~raycast %.4f gl~raster %.4f (%zu / %zu / %zu pixels)\n", name(light), rasterRay, glRay,
+                    glRaster, count(masks["raycast"]), count(masks["raster"]), count(masks["gl"]));
+        EXPECT_GE(rasterRay, 0.9) << name(light);
+        EXPECT_GE(glRay, 0.9) << name(light);
+        EXPECT_GE(glRaster, 0.95) << name(light);
+    }
+}
+
+}   // namespace
