@@ -23,6 +23,10 @@
 //   cold_ms     ours: the first frame of a new renderer (ours=) vs a warm one (ref=)
 //   pbr_ms      ours: the frame with the pbr model and the default environment (ours=) vs Phong (ref=;
 //               the goal: ratio <= 1.5)
+//   shadow_ms   ours: the frame lit by one sun with shadows (a 2048 map, PCF 3 x 3; ours=) vs the
+//               same frame without (ref=; the goal: ratio <= 1.5). The other rows are without
+//               shadows (the minimal GL program has none). Scene demo (the bundled demo, only
+//               when named in --scenes) gets this row alone.
 //   floor_shade the lighting kernel alone (raster_shading.h's shadeBatch on as many fragments as
 //               the scene covers, same lights; ours=) vs the whole raster frame (ref=)
 //   floor_shade_scaling  the same kernel on 1 thread (ours=) vs on --threads (ref=), ratio =
@@ -47,6 +51,7 @@
 // --gl-side ours|minimal only one of them runs, for a profiler to count one side's instructions
 // (valgrind --tool=callgrind bench_raster --gl-only --gl-side ours --frames N: the difference
 // between two frame counts is the cost of those frames).
+#include "assets/demo.h"
 #include "assets/scene_io.h"
 #include "min_gl.h"
 #include "raster/raster_shading.h"
@@ -431,6 +436,7 @@ int main(int argc, char** argv) {
         BenchScene b;
         if (bunnyScene(b)) scenes.push_back(std::move(b));
     }
+    if (!only.empty() && want("demo")) scenes.push_back({"demo", assets::makeDemoScene(), 0});
     for (const std::string& file : meshFiles) {
         BenchScene b;
         if (!fileScene(file, b)) return 1;
@@ -466,7 +472,34 @@ int main(int argc, char** argv) {
         b.scene.settings.fog = fog == "on" ? FogMode::Linear : FogMode::Off;
         b.scene.settings.fogStart = 2.0f;
         b.scene.settings.fogEnd = 60.0f;
+        b.scene.settings.shadows = false;
         FrameInput f = flatten(b.scene, float(w) / h);
+        const char* sceneName = b.name.c_str();
+        // Shadows: the scene lit by one sun (the first light's radiance) with and without them.
+        auto shadowRow = [&] {
+            FrameInput off = f;
+            sg::DrawLight sun;
+            sun.type = LightType::Directional;
+            sun.direction = glm::normalize(vec3(-0.4f, -1.0f, -0.3f));
+            sun.radiance = f.lights.empty() ? vec3(1.0f) : f.lights.front().radiance;
+            off.lights = {sun};
+            FrameInput on = off;
+            on.settings.shadows = true;
+            on.settings.shadowMapSize = 2048;
+            on.settings.shadowFilter = sg::ShadowFilter::Pcf;
+            on.settings.shadowPcfSize = 3;
+            rnd::Framebuffer fbS;
+            std::string es;
+            const Timing tOff = timeRenderer(*ours, off, w, h, frames, fbS, es), tOn = timeRenderer(*ours, on, w, h, frames, fbS, es);
+            if (!es.empty()) std::fprintf(stderr, "bench: raster shadows failed on %s: %s\n", sceneName, es.c_str());
+            std::printf("bench: scene=%s what=shadow_ms ours=%.2f ref=%.2f ratio=%.3f\n", sceneName, tOn.wallMs, tOff.wallMs,
+                        tOn.wallMs / tOff.wallMs);
+            std::fflush(stdout);
+        };
+        if (b.name == "demo") {   // analytic shapes: the minimal GL program does not draw them
+            if (!glOnly) shadowRow();
+            continue;
+        }
         rnd::Framebuffer fbO, fbG;
         std::string eo, eg;
         Timing r;
@@ -583,6 +616,7 @@ int main(int argc, char** argv) {
             if (!ep.empty()) std::fprintf(stderr, "bench: raster pbr failed on %s: %s\n", n, ep.c_str());
             std::printf("bench: scene=%s what=pbr_ms ours=%.2f ref=%.2f ratio=%.3f\n", n, p.wallMs, to, p.wallMs / to);
         }
+        shadowRow();
         std::printf("# %s: %zu triangles, %.0f covered pixels, %.2f%% of pixels within 8 of the minimal GL image, warm frame %s the first\n", n,
                     b.triangles, cov, closeToMinimal(fbO), fbCold.color == fbO.color ? "identical to" : "DIFFERS from");
         std::fflush(stdout);

@@ -144,9 +144,10 @@ int pointLightFace(const vec3& d) {
 
 namespace {
 
-// A triangle in the map's window coordinates (x, y in texels, z window depth).
+// A triangle in the map's window coordinates: x, y in texels, z = 1/w and w_ = d/w with d the
+// normalized linear depth (perspective-correct: d = w_ / z at a pixel; orthographic: w = 1).
 struct WinTri {
-    vec3 a, b, c;
+    vec4 a, b, c;
     int y0, y1;   // rows it may cover
 };
 
@@ -154,7 +155,7 @@ constexpr int kBand = 64;   // rows per band of the parallel depth pass
 
 // Clips a clip-space polygon against the near plane (z >= -w) and appends its fan of window
 // triangles.
-void emitClipped(const vec4 (&in)[3], int size, std::vector<WinTri>& out) {
+void emitClipped(const vec4 (&in)[3], const ShadowView& v, int size, std::vector<WinTri>& out) {
     vec4 poly[4];
     int n = 0;
     for (int k = 0; k < 3; ++k) {
@@ -168,12 +169,17 @@ void emitClipped(const vec4 (&in)[3], int size, std::vector<WinTri>& out) {
         }
     }
     if (n < 3) return;
-    const float s = float(size);
-    vec3 w[4];
+    const float s = float(size), range = v.farZ - v.nearZ;
+    vec4 w[4];
     for (int k = 0; k < n; ++k) {
         if (!(poly[k].w > 0.0f)) return;
-        const vec3 ndc = vec3(poly[k]) / poly[k].w;
-        w[k] = vec3((ndc.x * 0.5f + 0.5f) * s, (ndc.y * 0.5f + 0.5f) * s, ndc.z * 0.5f + 0.5f);
+        const float iw = 1.0f / poly[k].w;
+        const vec3 ndc = vec3(poly[k]) * iw;
+        // The stored depth: linear along the axis, 0 at near, 1 at far (perspective: w is the
+        // eye depth; orthographic: the window depth is already linear).
+        const float d = v.perspective ? (poly[k].w - v.nearZ) / range : ndc.z * 0.5f + 0.5f;
+        w[k] = v.perspective ? vec4((ndc.x * 0.5f + 0.5f) * s, (ndc.y * 0.5f + 0.5f) * s, iw, d * iw)
+                             : vec4((ndc.x * 0.5f + 0.5f) * s, (ndc.y * 0.5f + 0.5f) * s, 1.0f, d);
     }
     for (int k = 1; k + 1 < n; ++k) {
         WinTri t{w[0], w[k], w[k + 1], 0, 0};
@@ -188,26 +194,25 @@ void emitClipped(const vec4 (&in)[3], int size, std::vector<WinTri>& out) {
 
 // Rasterizes t into rows [r0, r1] of the map: pixel centres, the top-left rule, depth less.
 void rasterizeRows(const WinTri& t, int size, int r0, int r1, float* map) {
-    vec3 a = t.a, b = t.b, c = t.c;
+    vec4 a = t.a, b = t.b, c = t.c;
     float area = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
     if (!(area != 0.0f)) return;
     if (area < 0.0f) {   // both faces: counter-clockwise from here on
         std::swap(b, c);
         area = -area;
     }
-    const float inv = 1.0f / area;
     // Edge k: the one opposite vertex k; w_k(x, y) >= 0 inside. Top-left rule: a pixel centre on
     // an edge belongs to the triangle when the edge is a top or a left edge.
-    const vec3 v[3] = {a, b, c};
+    const vec4 v[3] = {a, b, c};
     float ex[3], ey[3], e0[3];
     bool inclusive[3];
     for (int k = 0; k < 3; ++k) {
-        const vec3& p = v[(k + 1) % 3];
-        const vec3& q = v[(k + 2) % 3];
+        const vec4& p = v[(k + 1) % 3];
+        const vec4& q = v[(k + 2) % 3];
         ex[k] = p.y - q.y;   // d w / d x
         ey[k] = q.x - p.x;   // d w / d y
         e0[k] = p.x * q.y - p.y * q.x;
-        const bool top = ex[k] == 0.0f && ey[k] < 0.0f, left = ex[k] > 0.0f;
+        const bool top = ex[k] == 0.0f && ey[k]<0.0f, left = ex[k]> 0.0f;
         inclusive[k] = top || left;
     }
     const float xmin = std::min({a.x, b.x, c.x}), xmax = std::max({a.x, b.x, c.x});
@@ -225,7 +230,8 @@ void rasterizeRows(const WinTri& t, int size, int r0, int r1, float* map) {
                 in = w[k] > 0.0f || (w[k] == 0.0f && inclusive[k]);
             }
             if (!in) continue;
-            const float z = (w[0] * a.z + w[1] * b.z + w[2] * c.z) * inv;
+            const float iw = w[0] * a.z + w[1] * b.z + w[2] * c.z, dw = w[0] * a.w + w[1] * b.w + w[2] * c.w;
+            const float z = iw != 0.0f ? dw / iw : 1.0f;   // (the barycentric normalisation cancels)
             if (z >= 0.0f && z <= 1.0f && z < row[x]) row[x] = z;
         }
     }
@@ -260,7 +266,7 @@ void renderShadowDepth(const ShadowView& v, int size, const std::vector<ShadowCa
                 std::memcpy(xyz, base + i * blk.c->stride, sizeof(xyz));
                 clip[k] = v.viewProj * vec4(xyz[0], xyz[1], xyz[2], 1.0f);
             }
-            if (valid) emitClipped(clip, size, out);
+            if (valid) emitClipped(clip, v, size, out);
         }
     });
     // Bands of rows, each with the triangles that reach it, rasterized in parallel.
@@ -292,10 +298,18 @@ float shadowVisibility(const ShadowPlan& plan, const ShadowMaps& maps, const sg:
     const float u = (c.x / c.w) * 0.5f + 0.5f, w = (c.y / c.w) * 0.5f + 0.5f;
     const float zq = -(v.view[0][2] * q.x + v.view[1][2] * q.y + v.view[2][2] * q.z + v.view[3][2]);
     const float zb = zq - plan.depthBias * t;
-    // The biased depth as a window depth (linearDepth's inverse), compared with the texels'.
-    const float dRecv = v.perspective ? (v.farZ - v.nearZ * v.farZ / zb) / (v.farZ - v.nearZ) : (zb - v.nearZ) / (v.farZ - v.nearZ);
+    // The biased depth as the maps store depth (linear, 0 at near, 1 at far); each tap compares
+    // the receiver's plane at the tap's texel centre (receiver-plane depth bias: a tilted receiver
+    // is deeper or shallower there than at q, by its slope in the light's frame, clamped at 4).
+    const float range = v.farZ - v.nearZ;
+    const float dRecv = (zb - v.nearZ) / range;
+    const vec3 nl(v.view[0][0] * n.x + v.view[1][0] * n.y + v.view[2][0] * n.z, v.view[0][1] * n.x + v.view[1][1] * n.y + v.view[2][1] * n.z,
+                  v.view[0][2] * n.x + v.view[1][2] * n.y + v.view[2][2] * n.z);
+    const float nz = std::max(nl.z, 0.25f * std::sqrt(nl.x * nl.x + nl.y * nl.y));                                      // the light's side: nl.z > 0
+    const float slopeX = nz > 0.0f ? nl.x / nz * t / range : 0.0f, slopeY = nz > 0.0f ? nl.y / nz * t / range : 0.0f;   // per texel
     const int N = plan.size, k = plan.pcf;
-    const int i0 = int(std::floor(u * float(N) - 0.5f * float(k) + 0.5f)), j0 = int(std::floor(w * float(N) - 0.5f * float(k) + 0.5f));
+    const float su = u * float(N), sv = w * float(N);
+    const int i0 = int(std::floor(su - 0.5f * float(k) + 0.5f)), j0 = int(std::floor(sv - 0.5f * float(k) + 0.5f));
     const float* map = maps.map(vi);
     int lit = 0;
     for (int j = j0; j < j0 + k; ++j)
@@ -304,7 +318,8 @@ float shadowVisibility(const ShadowPlan& plan, const ShadowMaps& maps, const sg:
                 ++lit;
                 continue;
             }
-            lit += dRecv <= map[size_t(j) * size_t(N) + size_t(i)] ? 1 : 0;
+            const float dTap = dRecv + slopeX * (float(i) + 0.5f - su) + slopeY * (float(j) + 0.5f - sv);
+            lit += dTap <= map[size_t(j) * size_t(N) + size_t(i)] ? 1 : 0;
         }
     return float(lit) / float(k * k);
 }

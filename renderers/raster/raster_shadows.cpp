@@ -2,6 +2,7 @@
 // over the vertex stage's world positions, and each fragment's visibility of each light for the
 // lighting kernels (ShadeBatch::vis).
 #include "raster/raster_frame.h"
+#include "renderers/shading.h"
 
 #include <tbb/parallel_for.h>
 
@@ -41,6 +42,9 @@ void fillShadowVisibility(const FrameContext& fc, ShadeBatch& b, size_t n) {
         for (size_t k = 0; k < n; ++k) {
             if (b.mat[k] < 0 && b.kd[k] == 0.0f && b.ks[k] == 0.0f) continue;   // a final colour: no lights
             const sg::vec3 p(b.px[k], b.py[k], b.pz[k]), nrm(b.nx[k], b.ny[k], b.nz[k]);
+            // Where the light adds nothing (facing away, outside a spot's cone) its visibility
+            // changes nothing: no lookup (as the ray caster traces no shadow ray there).
+            if (!lightReaches(lights[l], p, nrm, fc.frame->settings.reflection)) continue;
             out[k] = shadowVisibility(plan, *fc.shadowMaps, lights[l], int(l), p, nrm);
         }
     }

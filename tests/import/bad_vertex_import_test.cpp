@@ -25,7 +25,7 @@ fs::path dir() {
 
 assets::LoadResult loadText(const std::string& name, const std::string& text) {
     writeText(dir() / name, text);
-    return timedLoad(dir() / name, 5.0);
+    return timedLoad(dir() / name, kHangGuardSeconds);
 }
 
 // Every mesh is valid (finite positions, indices in range) and the file loaded with exactly

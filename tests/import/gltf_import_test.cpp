@@ -21,7 +21,7 @@ namespace {
 fs::path gltf(const std::string& rel) { return testing_support::testdataDir() / "gltf" / rel; }
 
 assets::LoadResult mustLoad(const fs::path& p) {
-    assets::LoadResult r = timedLoad(p, 5.0);
+    assets::LoadResult r = timedLoad(p, kHangGuardSeconds);
     EXPECT_TRUE(r.scene.has_value()) << r.error;
     return r;
 }
@@ -343,7 +343,7 @@ TEST(GltfImportTest, InvalidCorpusNeverCrashes) {
         ++files;
         SCOPED_TRACE(e.path().string());
         double dt = 0;
-        assets::LoadResult r = timedLoad(e.path(), 5.0, &dt);
+        assets::LoadResult r = timedLoad(e.path(), kHangGuardSeconds, &dt);
         if (dt > slowest) {
             slowest = dt;
             slowestName = e.path().filename().string();
@@ -383,13 +383,13 @@ TEST(GltfImportTest, KnownBadFilesRejected) {
         {"IncorrectVertexArrays/Cube.gltf", ""},
     };
     for (const Case& c : cases) {
-        assets::LoadResult r = timedLoad(dir / c.file, 5.0);
+        assets::LoadResult r = timedLoad(dir / c.file, kHangGuardSeconds);
         EXPECT_FALSE(r.scene) << c.file;
         EXPECT_NE(r.error.find(c.needle), std::string::npos) << r.error;
         std::printf("%s -> %s\n", c.file, r.error.c_str());
     }
     // Missing .bin: an error that says which file was missing.
-    assets::LoadResult mb = timedLoad(dir / "MissingBin/BoxTextured.gltf", 5.0);
+    assets::LoadResult mb = timedLoad(dir / "MissingBin/BoxTextured.gltf", kHangGuardSeconds);
     EXPECT_FALSE(mb.scene);
     std::printf("MissingBin -> %s\n", mb.error.c_str());
 }

@@ -112,7 +112,7 @@ struct Sandbox {
 
 assets::LoadResult quickLoad(const fs::path& p) {
     double dt = 0;
-    assets::LoadResult r = timedLoad(p, 5.0, &dt);
+    assets::LoadResult r = timedLoad(p, kHangGuardSeconds, &dt);
     EXPECT_LT(dt, 2.0) << p << " not refused quickly";
     if (!r.scene) {
         EXPECT_NE(r.error.find(p.filename().string()), std::string::npos) << r.error;

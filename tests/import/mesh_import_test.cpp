@@ -16,7 +16,7 @@ namespace {
 fs::path meshes(const std::string& rel) { return testing_support::testdataDir() / "meshes" / rel; }
 
 assets::LoadResult mustLoad(const fs::path& p) {
-    assets::LoadResult r = timedLoad(p, 5.0);
+    assets::LoadResult r = timedLoad(p, kHangGuardSeconds);
     EXPECT_TRUE(r.scene.has_value()) << r.error;
     return r;
 }
@@ -94,7 +94,7 @@ TEST(MeshImportTest, ManifestTriangleCounts) {
     };
     for (const auto& [rel, tris] : expected) {
         SCOPED_TRACE(rel);
-        assets::LoadResult r = timedLoad(meshes(rel), 5.0);
+        assets::LoadResult r = timedLoad(meshes(rel), kHangGuardSeconds);
         if (tris == -2) {
             if (!r.scene) { EXPECT_NE(r.error.find(fs::path(rel).filename().string()), std::string::npos); }
             continue;
@@ -199,7 +199,7 @@ TEST(MeshImportTest, InvalidMeshesGiveClearErrors) {
         std::string ext = e.path().extension().string();
         if (ext != ".obj" && ext != ".off" && ext != ".ply" && ext != ".stl") continue;
         SCOPED_TRACE(e.path().string());
-        assets::LoadResult r = timedLoad(e.path(), 5.0);
+        assets::LoadResult r = timedLoad(e.path(), kHangGuardSeconds);
         if (!r.scene) {
             EXPECT_NE(r.error.find(e.path().filename().string()), std::string::npos) << r.error;
             EXPECT_EQ(r.error.find('\n'), std::string::npos);

@@ -86,7 +86,7 @@ TEST(PolygonImportTest, UShapedFaceCoversTheU) {
     for (const auto& [name, text] : files) {
         SCOPED_TRACE(name);
         writeText(dir / name, text);
-        assets::LoadResult r = timedLoad(dir / name, 5.0);
+        assets::LoadResult r = timedLoad(dir / name, kHangGuardSeconds);
         ASSERT_TRUE(r.scene) << r.error;
         EXPECT_TRUE(r.warnings.empty()) << r.warnings.front();
         const Summary s = summarize(r);
@@ -98,7 +98,7 @@ TEST(PolygonImportTest, UShapedFaceCoversTheU) {
     }
     // Wound the other way: the same U, facing -z.
     writeText(dir / "u_cw.obj", uObj(true));
-    assets::LoadResult r = timedLoad(dir / "u_cw.obj", 5.0);
+    assets::LoadResult r = timedLoad(dir / "u_cw.obj", kHangGuardSeconds);
     ASSERT_TRUE(r.scene) << r.error;
     const Summary s = summarize(r);
     EXPECT_NEAR(s.area, kUArea, 1e-5);

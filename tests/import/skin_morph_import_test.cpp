@@ -301,7 +301,7 @@ TEST(SkinMorphImportTest, CesiumManWalks) {
     ASSERT_TRUE(testing_support::requireTestdata());
     for (const char* rel : {"CesiumMan/glTF/CesiumMan.gltf", "CesiumMan/glTF-Binary/CesiumMan.glb"}) {
         SCOPED_TRACE(rel);
-        assets::LoadResult r = timedLoad(sample(rel), 5.0);
+        assets::LoadResult r = timedLoad(sample(rel), kHangGuardSeconds);
         ASSERT_TRUE(r.scene) << r.error;
         expectNoDeformWarnings(r);
         sg::Scene& s = *r.scene;
@@ -335,7 +335,7 @@ TEST(SkinMorphImportTest, CesiumManWalks) {
 TEST(SkinMorphImportTest, MorphSampleModels) {
     ASSERT_TRUE(testing_support::requireTestdata());
     {
-        assets::LoadResult r = timedLoad(sample("AnimatedMorphCube/glTF/AnimatedMorphCube.gltf"), 5.0);
+        assets::LoadResult r = timedLoad(sample("AnimatedMorphCube/glTF/AnimatedMorphCube.gltf"), kHangGuardSeconds);
         ASSERT_TRUE(r.scene) << r.error;
         expectNoDeformWarnings(r);
         sg::Scene& s = *r.scene;
@@ -356,7 +356,7 @@ TEST(SkinMorphImportTest, MorphSampleModels) {
     }
     {
         // SimpleMorph: mesh weights (0.5, 0.5) and no node weights: posed from the start.
-        assets::LoadResult r = timedLoad(sample("SimpleMorph/glTF/SimpleMorph.gltf"), 5.0);
+        assets::LoadResult r = timedLoad(sample("SimpleMorph/glTF/SimpleMorph.gltf"), kHangGuardSeconds);
         ASSERT_TRUE(r.scene) << r.error;
         expectNoDeformWarnings(r);
         const sg::Scene& s = *r.scene;
@@ -369,7 +369,7 @@ TEST(SkinMorphImportTest, MorphSampleModels) {
     }
     {
         // MorphPrimitivesTest: two primitives (child nodes), one target each, mesh weight 0.5.
-        assets::LoadResult r = timedLoad(sample("MorphPrimitivesTest/glTF/MorphPrimitivesTest.gltf"), 5.0);
+        assets::LoadResult r = timedLoad(sample("MorphPrimitivesTest/glTF/MorphPrimitivesTest.gltf"), kHangGuardSeconds);
         ASSERT_TRUE(r.scene) << r.error;
         expectNoDeformWarnings(r);
         sg::FrameInput f = sg::flatten(*r.scene, 1.0f);

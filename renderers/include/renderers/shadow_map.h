@@ -10,14 +10,16 @@
 //       intersected with the scene's bounds), in depth to the whole scene (every caster);
 //     spot: perspective from the light along its axis, the outer cone plus a margin;
 //     point: perspective, 90 degrees, the six faces of a cube (+x, -x, +y, -y, +z, -z).
-//   Each map holds the window depth d in [0, 1] of the nearest surface (both faces drawn, cleared
-//   to 1) at texel centres ((i + 0.5)/N, (j + 0.5)/N), row 0 at v = 0 (GL's convention).
+//   Each map holds the depth d in [0, 1] of the nearest surface, linear along the map's axis
+//   (d = (z - near)/(far - near), z the eye depth; for a perspective map not the window depth,
+//   whose float precision near 1 would not do with a light inside the scene), both faces drawn,
+//   cleared to 1, at texel centres ((i + 0.5)/N, (j + 0.5)/N), row 0 at v = 0 (GL's convention).
 //   Lookup of world point p with surface normal n (the shading normal, turned toward the light):
 //     t   = texel size in world units at p (orthographic: extent / N; perspective:
 //           2 tan(fov/2) / N times p's depth along the map's axis)
 //     p'  = p + normalBias t n                                   (normal offset)
 //     (u, v, z) = the map's projection of p',  z_lin its linear depth along the axis
-//     lit(texel) = z_lin - depthBias t <= linear(d(texel))       (depth bias)
+//     lit(texel) = (z_lin - depthBias t - near)/(far - near) <= d(texel)   (depth bias)
 //     visibility = mean of lit over the k x k texels nearest (u, v) (k = 1 without PCF);
 //     texels outside the map are lit.
 #pragma once
@@ -32,15 +34,13 @@ namespace rnd {
 // One depth map: a view from the light.
 struct ShadowView {
     sg::mat4 view{1.0f};       // world -> light eye (looking down -z)
-    sg::mat4 viewProj{1.0f};   // world -> light clip (window depth = 0.5 z/w + 0.5, as GL)
+    sg::mat4 viewProj{1.0f};   // world -> light clip (x, y as GL; the depth stored is linear, below)
     bool perspective = false;
     float nearZ = 0.0f, farZ = 1.0f;   // the planes, as distances along the axis
     float texelAtUnit = 0.0f;          // texel size in world units (perspective: at distance 1)
 
-    // The linear depth (distance along the axis) of window depth d.
-    float linearDepth(float d) const {
-        return perspective ? nearZ * farZ / (farZ - d * (farZ - nearZ)) : nearZ + d * (farZ - nearZ);
-    }
+    // The depth along the axis of a stored map depth d.
+    float linearDepth(float d) const { return nearZ + d * (farZ - nearZ); }
 };
 
 // At most this many maps per frame (GL's uniform arrays): lights whose maps would pass it, in
@@ -51,10 +51,10 @@ constexpr int kMaxShadowViews = 48;
 struct ShadowPlan {
     int size = 0;   // texels per side of every map
     sg::ShadowFilter filter = sg::ShadowFilter::Pcf;
-    int pcf = 3;                                     // k of k x k (1 without PCF)
-    float depthBias = 1.0f, normalBias = 1.0f;       // in texels
-    std::vector<ShadowView> views;                   // all maps, light by light
-    std::vector<int> firstView, viewCount;           // per frame light (viewCount 0: no map, lit)
+    int pcf = 3;                                 // k of k x k (1 without PCF)
+    float depthBias = 1.0f, normalBias = 1.0f;   // in texels
+    std::vector<ShadowView> views;               // all maps, light by light
+    std::vector<int> firstView, viewCount;       // per frame light (viewCount 0: no map, lit)
     bool empty() const { return views.empty(); }
 };
 
