@@ -218,21 +218,55 @@ void rasterizeRows(const WinTri& t, int size, int r0, int r1, float* map) {
     const float xmin = std::min({a.x, b.x, c.x}), xmax = std::max({a.x, b.x, c.x});
     const int x0 = std::max(0, int(std::floor(xmin - 0.5f))), x1 = std::min(size - 1, int(std::ceil(xmax - 0.5f)));
     const int y0 = std::max(r0, t.y0), y1 = std::min(r1, t.y1);
+    // 1/w and d/w are affine in the pixel centre (sums of the edge functions' multiples).
+    float iwX = 0, iwY = 0, iw0 = 0, dwX = 0, dwY = 0, dw0 = 0;
+    for (int k = 0; k < 3; ++k) {
+        iwX += ex[k] * v[k].z;
+        iwY += ey[k] * v[k].z;
+        iw0 += e0[k] * v[k].z;
+        dwX += ex[k] * v[k].w;
+        dwY += ey[k] * v[k].w;
+        dw0 += e0[k] * v[k].w;
+    }
+    auto inside = [&](float px, float py) {
+        for (int k = 0; k < 3; ++k) {
+            const float w = ex[k] * px + ey[k] * py + e0[k];
+            if (!(w > 0.0f || (w == 0.0f && inclusive[k]))) return false;
+        }
+        return true;
+    };
     for (int y = y0; y <= y1; ++y) {
         const float py = float(y) + 0.5f;
+        // The row's span: each edge bounds x from one side; then the exact test at both ends
+        // (the top-left rule and rounding), every pixel between them inside (convex).
+        float lo = float(x0), hi = float(x1);
+        for (int k = 0; k < 3; ++k) {
+            const float c0 = ey[k] * py + e0[k];
+            if (ex[k] > 0.0f)
+                lo = std::max(lo, -c0 / ex[k] - 0.5f - 1.0f);
+            else if (ex[k] < 0.0f)
+                hi = std::min(hi, -c0 / ex[k] - 0.5f + 1.0f);
+        }
+        int xs = std::max(x0, int(std::floor(lo))), xe = std::min(x1, int(std::ceil(hi)));
+        while (xs <= xe && !inside(float(xs) + 0.5f, py)) ++xs;
+        while (xe >= xs && !inside(float(xe) + 0.5f, py)) --xe;
         float* row = map + size_t(y) * size_t(size);
-        for (int x = x0; x <= x1; ++x) {
-            const float px = float(x) + 0.5f;
-            float w[3];
-            bool in = true;
-            for (int k = 0; k < 3 && in; ++k) {
-                w[k] = ex[k] * px + ey[k] * py + e0[k];
-                in = w[k] > 0.0f || (w[k] == 0.0f && inclusive[k]);
+        const float iwRow = iwY * py + iw0, dwRow = dwY * py + dw0;
+        if (iwX == 0.0f && iwY == 0.0f) {   // orthographic: 1/w constant, no division per texel
+            const float inv = iwRow != 0.0f ? 1.0f / iwRow : 0.0f;
+            for (int x = xs; x <= xe; ++x) {
+                const float z = (dwX * (float(x) + 0.5f) + dwRow) * inv;
+                const bool ok = z >= 0.0f && z <= 1.0f;
+                row[x] = ok ? std::min(row[x], z) : row[x];
             }
-            if (!in) continue;
-            const float iw = w[0] * a.z + w[1] * b.z + w[2] * c.z, dw = w[0] * a.w + w[1] * b.w + w[2] * c.w;
+            continue;
+        }
+        for (int x = xs; x <= xe; ++x) {
+            const float px = float(x) + 0.5f;
+            const float iw = iwX * px + iwRow, dw = dwX * px + dwRow;
             const float z = iw != 0.0f ? dw / iw : 1.0f;   // (the barycentric normalisation cancels)
-            if (z >= 0.0f && z <= 1.0f && z < row[x]) row[x] = z;
+            const bool ok = z >= 0.0f && z <= 1.0f;
+            row[x] = ok ? std::min(row[x], z) : row[x];
         }
     }
 }

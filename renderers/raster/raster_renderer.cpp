@@ -203,7 +203,11 @@ private:
         tbb::parallel_for(size_t(0), draws.size(), [&](size_t i) { runVertexStage(draws[i], frame, width, height, gouraud, &environment); });
         // Shadow maps (per-pixel shading only: flat and Gouraud sum the lights at the vertices).
         m_shadowPlan = frame.settings.shading == sg::ShadingModel::Phong ? planShadows(frame, shadowCasterBounds(frame)) : ShadowPlan{};
+        const auto tShadow0 = std::chrono::steady_clock::now();
         renderShadowMaps(m_shadowPlan, draws, m_shadowMaps);
+        if (m_timing && !m_shadowPlan.empty())
+            std::fprintf(stderr, "raster timing: shadow maps %zu x %d^2 %.2f ms\n", m_shadowPlan.views.size(), m_shadowPlan.size,
+                         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - tShadow0).count());
 
         auto tVert = std::chrono::steady_clock::now();
         // 3. triangles
