@@ -9,6 +9,7 @@
 #include "raster/simd.h"
 #include "raster/srgb_encoder.h"
 #include "renderers/shading.h"
+#include "renderers/shadow_map.h"
 
 #include <algorithm>
 #include <cmath>
@@ -117,6 +118,7 @@ namespace kern_sse {
 using namespace simd_sse;
 #include "raster/pbr_kernel.inl"
 #include "raster/shade_kernel.inl"
+#include "raster/shadow_kernel.inl"
 }   // namespace kern_sse
 
 #if defined(RASTER_HAVE_AVX2)
@@ -126,8 +128,13 @@ namespace kern_avx2 {
 using namespace simd_avx2;
 #include "raster/pbr_kernel.inl"
 #include "raster/shade_kernel.inl"
+#include "raster/shadow_kernel.inl"
 void shadeBatchAvx2(ShadeBatch& b, size_t n, const sg::FrameInput& f) { shadeKernel(b, n, f); }
 void shadePbrAvx2(ShadeBatch& b, size_t n, const sg::FrameInput& f, const PbrKernelEnv& env) { shadePbrKernel(b, n, f, env); }
+void shadowLookupAvx2(const ShadowPlan& plan, const ShadowView& v, const float* map, const sg::vec3& lightVec, bool positional, const ShadeBatch& b,
+                      size_t i, float* out) {
+    shadowLookupV(plan, v, map, lightVec, positional, b, i, out);
+}
 }   // namespace kern_avx2
 #pragma GCC pop_options
 #endif
@@ -153,7 +160,28 @@ void shadeBatch(ShadeBatch& b, size_t n, const sg::FrameInput& f, const Environm
     kern_sse::shadeKernel(b, n, f);
 }
 
+size_t shadowLookupWidth() {
+#if defined(RASTER_HAVE_AVX2)
+    if (useAvx2()) return simd_avx2::kW;
+#endif
+    return simd_sse::kW;
+}
+
+void shadowLookupVector(const ShadowPlan& plan, const ShadowView& v, const float* map, const sg::vec3& lightVec, bool positional, const ShadeBatch& b,
+                        size_t i, float* out) {
+#if defined(RASTER_HAVE_AVX2)
+    if (useAvx2()) {
+        kern_avx2::shadowLookupAvx2(plan, v, map, lightVec, positional, b, i, out);
+        return;
+    }
+#endif
+    kern_sse::shadowLookupV(plan, v, map, lightVec, positional, b, i, out);
+}
+
 #else
+
+size_t shadowLookupWidth() { return 0; }
+void shadowLookupVector(const ShadowPlan&, const ShadowView&, const float*, const sg::vec3&, bool, const ShadeBatch&, size_t, float*) {}
 
 void shadeBatch(ShadeBatch& b, size_t n, const sg::FrameInput& f, const EnvironmentLight* env) {
     const bool pbr = f.settings.reflection == sg::ReflectionModel::Pbr;

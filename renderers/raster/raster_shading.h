@@ -15,6 +15,7 @@
 #pragma once
 
 #include "renderers/pbr.h"
+#include "renderers/shadow_map.h"
 #include "scenegraph/frame.h"
 
 #include <cstddef>
@@ -153,6 +154,13 @@ struct ShadeBatch {
         cb[i] = c.z;
     }
 };
+
+// rnd::shadowVisibility for fragments [i, i + shadowLookupWidth()) of b, all reading map `v`
+// of the plan (lightVec: the light's direction, or its position when positional), into out[i...]
+// (shadow_kernel.inl). Width 0: no vector kernel here (the caller uses the scalar function).
+size_t shadowLookupWidth();
+void shadowLookupVector(const ShadowPlan& plan, const ShadowView& v, const float* map, const sg::vec3& lightVec, bool positional, const ShadeBatch& b,
+                        size_t i, float* out);
 
 // Adds the contribution of every light in f to cr/cg/cb for fragments [0, n); with the pbr
 // reflection model also the environment's (env: none when null or without a map).

@@ -598,6 +598,69 @@ TEST(RasterShadingTest, BatchedPbrShadingMatchesRndShade) {
     }
 }
 
+// The vector shadow lookup (shadow_kernel.inl) against rnd::shadowVisibility: a map of random
+// triangles over a ground, points on and above the ground with random normals, for a sun and a
+// spot with PCF 3 x 3; both instruction sets in CI (raster_shading_sse2 forces SSE2). A tap whose
+// comparison is within a float's rounding of the texel's depth may go either way: at most a
+// few lanes in a thousand, by one tap.
+TEST(RasterShadingTest, VectorShadowLookupMatchesScalar) {
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> U(-1.0f, 1.0f), P(0.0f, 1.0f);
+    std::vector<vec3> tris;
+    for (int t = 0; t < 300; ++t) {
+        const vec3 c(3 * U(rng), 0.5f + 2 * P(rng), 3 * U(rng));
+        for (int k = 0; k < 3; ++k) tris.push_back(c + 0.4f * vec3(U(rng), U(rng), U(rng)));
+    }
+    for (LightType type : {LightType::Directional, LightType::Spot}) {
+        FrameInput f;
+        f.camera = cameraAt(vec3(0, 6, 8), vec3(0, 0, 0), Projection{}, 1.0f);
+        DrawLight L;
+        L.type = type;
+        L.position = vec3(0.5f, 7, 1);
+        L.direction = glm::normalize(vec3(0.2f, -1, -0.1f));
+        L.cosInner = std::cos(radians(40));
+        L.cosOuter = std::cos(radians(50));
+        f.lights = {L};
+        f.settings.shadowMapSize = 512;
+        const rnd::ShadowPlan plan = rnd::planShadows(f, sg::Aabb{vec3(-4, 0, -4), vec3(4, 3, 4)});
+        ASSERT_EQ(plan.views.size(), 1u);
+        rnd::ShadowMaps maps;
+        maps.size = plan.size;
+        maps.depth.resize(size_t(plan.size) * size_t(plan.size));
+        rnd::ShadowCaster c;
+        c.positions = tris.data();
+        c.stride = sizeof(vec3);
+        c.triangles = tris.size() / 3;
+        c.vertices = tris.size();
+        rnd::renderShadowDepth(plan.views[0], plan.size, {c}, maps.map(0));
+        const size_t n = 4000;
+        raster::ShadeBatch b;
+        b.resize(n);
+        for (size_t i = 0; i < n; ++i) {
+            const vec3 p(3.5f * U(rng), i % 4 == 0 ? 2.5f * P(rng) : 0.0f, 3.5f * U(rng));
+            const vec3 nrm = i % 3 == 0 ? glm::normalize(vec3(U(rng), U(rng), U(rng))) : vec3(0, 1, 0);
+            b.set(i, coefficientsOf(Material{}), p, nrm, vec3(1.0f), vec3(0.0f));
+        }
+        std::vector<float> out(n + 8, -1.0f);
+        const size_t W = raster::shadowLookupWidth();
+        ASSERT_GT(W, 0u);
+        for (size_t i = 0; i + W <= n; i += W)
+            raster::shadowLookupVector(plan, plan.views[0], maps.map(0), type == LightType::Directional ? L.direction : L.position,
+                                       type != LightType::Directional, b, i, out.data());
+        size_t differ = 0, shadowed = 0;
+        for (size_t i = 0; i < n; ++i) {
+            const float want = rnd::shadowVisibility(plan, maps, L, 0, vec3(b.px[i], b.py[i], b.pz[i]), vec3(b.nx[i], b.ny[i], b.nz[i]));
+            shadowed += want < 1.0f;
+            if (out[i] != want) {
+                ++differ;
+                EXPECT_NEAR(out[i], want, 1.0f / 9.0f + 1e-6f) << "fragment " << i;
+            }
+        }
+        EXPECT_GT(shadowed, n / 20) << "the test's triangles must shadow part of the ground";
+        EXPECT_LE(differ, n / 200) << differ << " lanes differ";
+    }
+}
+
 // ---------------------------------------------------------------------------------------
 // anti-aliasing, progress, cancellation, lines
 // ---------------------------------------------------------------------------------------
