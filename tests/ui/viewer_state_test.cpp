@@ -11,8 +11,10 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <fstream>
+#include <thread>
 
 using namespace ui;
 namespace fs = std::filesystem;
@@ -648,6 +650,53 @@ TEST(RenderSlotTest, ForgetDropsTheImageAndRendersInFlight) {
     slot.waitIdle();
     slot.poll();
     EXPECT_EQ(slot.image().width, 64);
+}
+
+// A new tessellation level rebuilds the shapes first (seconds at the highest levels): the
+// slot says so (SlotStatus::shapes) with a percentage that moves with the work done and gets
+// to the end, then renders the image as usual.
+TEST(RenderSlotTest, ATessellationRebuildShowsItsProgress) {
+    ViewerState st = demoState();
+    auto frame = std::make_shared<sg::FrameInput>(st.buildFrame(64.0f / 48.0f));
+    auto rebuilt = std::make_shared<sg::FrameInput>(*frame);
+    rebuilt->settings.tessellation = 160;
+    RenderSlot slot("raster");
+    slot.request(frame, 64, 48, 1, /*interacting=*/false);
+    slot.waitIdle();
+    slot.poll();
+    ASSERT_EQ(slot.status().error, "");
+    slot.request(rebuilt, 64, 48, 2, /*interacting=*/false);
+    std::vector<float> shapes;   // the progress shown while rebuilding, as the viewport polls it
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+    for (;;) {
+        slot.poll();
+        const SlotStatus s = slot.status();
+        if (s.rendering && s.shapes) shapes.push_back(s.progress);
+        if (!s.rendering && s.level == 1 && slot.imageFrame() == rebuilt) break;
+        ASSERT_LT(std::chrono::steady_clock::now(), deadline) << "no image";
+        std::this_thread::sleep_for(std::chrono::microseconds(200));
+    }
+    EXPECT_EQ(slot.status().error, "");
+    EXPECT_FALSE(slot.status().shapes);
+    ASSERT_FALSE(shapes.empty()) << "the rebuild was never shown";
+    int moves = 0;
+    for (size_t i = 1; i < shapes.size(); ++i) {
+        ASSERT_GE(shapes[i], shapes[i - 1]) << "sample " << i;
+        moves += shapes[i] > shapes[i - 1];
+    }
+    EXPECT_GT(moves, 10) << "the percentage moves with the work";
+    EXPECT_GT(shapes.back(), 0.9f) << "and gets to the end";
+    // The same level again: nothing to rebuild, no Shapes stage.
+    auto again = std::make_shared<sg::FrameInput>(*rebuilt);
+    slot.request(again, 64, 48, 3, /*interacting=*/false);
+    for (;;) {
+        slot.poll();
+        const SlotStatus s = slot.status();
+        ASSERT_FALSE(s.shapes);
+        if (!s.rendering && s.level == 1 && slot.imageFrame() == again) break;
+        ASSERT_LT(std::chrono::steady_clock::now(), deadline) << "no image";
+        std::this_thread::sleep_for(std::chrono::microseconds(200));
+    }
 }
 
 TEST(RenderSlotTest, UnknownBackendIsAnError) {

@@ -94,6 +94,7 @@ void RenderSlot::runJob(const Job& job) {
             m_control = &control;
             m_status.rendering = true;
             m_status.progress = 0.0f;
+            m_status.shapes = false;
         }
         rnd::Framebuffer fb;
         rnd::RenderStats st;
@@ -120,6 +121,7 @@ void RenderSlot::runJob(const Job& job) {
             std::lock_guard<std::mutex> lock(m_mutex);
             m_control = nullptr;
             m_status.rendering = !last && st.ok && !control.cancel;
+            m_status.shapes = false;
         }
         if (control.cancel || st.cancelled) return;
         if (st.ok && (fb.width != w || fb.height != h || fb.color.size() != size_t(w) * h * 4)) {
@@ -178,7 +180,10 @@ bool RenderSlot::poll() {
         }
     }
     std::lock_guard<std::mutex> lock(m_mutex);
-    if (m_control) m_status.progress = m_control->progress.load();
+    if (m_control) {
+        m_status.shapes = m_control->stage.load() == rnd::RenderStage::Shapes;
+        m_status.progress = m_control->progress.load();
+    }
     if (!m_haveNew) return false;
     m_haveNew = false;
     std::swap(m_shown, m_finished);

@@ -24,7 +24,8 @@ namespace ui {
 struct SlotStatus {
     std::string backend;
     bool rendering = false;   // a render is in flight
-    float progress = 0.0f;    // of the render in flight, 0..1
+    float progress = 0.0f;    // of the render in flight, 0..1 (of the shapes' rebuild while `shapes`)
+    bool shapes = false;      // the render in flight is tessellating shapes anew before its image
     int level = 1;            // resolution divisor of the image shown (1 = full)
     bool refining = false;    // a finer image follows: the one shown is a preview or a one-sample image
     rnd::RenderStats stats;   // of the image shown (or the last failure)
