@@ -268,7 +268,7 @@ public:
         const rnd::OverlayOptions& o = st.view.overlays;
         if (!o.any()) return 0;
         const uint64_t flags = uint64_t(o.grid) | uint64_t(o.axes) << 1 | uint64_t(o.lights) << 2 | uint64_t(o.cameras) << 3 |
-                               uint64_t(o.bounds) << 4 | uint64_t(o.selection) << 5;
+                               uint64_t(o.bounds) << 4 | uint64_t(o.selection) << 5 | uint64_t(o.gridOnTop) << 6;
         uint64_t sel = 0;
         for (sg::NodeId n : st.selection()) sel = sel * 1000003u + uint64_t(n) + 1;
         return flags ^ (st.doc.version << 8) ^ (sel << 40);
