@@ -166,13 +166,16 @@ json payloadJ(const sg::Payload& p) {
 }
 
 // Pretty printer: objects one key per line, arrays of plain values on one line, floats in
-// their shortest form that reads back to the same float (the scene stores floats).
+// their shortest form that reads back to the same float (the scene stores floats). "Reads
+// back" as the reader reads it: the JSON parser makes a double, the scene takes its float
+// (not strtof's direct rounding, which could differ for a decimal a hair from halfway between
+// two floats); 9 significant digits always do.
 void appendNumber(std::string& out, double d) {
     float f = float(d);
     char buf[32];
     for (int prec = 6; prec <= 9; ++prec) {
         std::snprintf(buf, sizeof buf, "%.*g", prec, double(f));
-        if (std::strtof(buf, nullptr) == f) break;
+        if (float(std::strtod(buf, nullptr)) == f) break;
     }
     std::string s = buf;
     if (s.find_first_of(".eEn") == std::string::npos) s += ".0";   // keep it a float in JSON terms

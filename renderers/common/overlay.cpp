@@ -213,14 +213,15 @@ float gridSpacing(float extent) {
     return float(10 * p);
 }
 
-void drawGrid(Painter& paint, const SceneExtent& e) {
+// Depth-tested unless `onTop`: surfaces in front hide it, a floor at y = 0 does not (kDepthBias).
+void drawGrid(Painter& paint, const SceneExtent& e, bool onTop) {
     const float x = std::max(e.box.extent().x, e.box.extent().z);
     const float s = gridSpacing(x > 1e-6f ? x : e.size);
     const long long i0 = std::llround(std::floor(e.box.min.x / s)), i1 = std::llround(std::ceil(e.box.max.x / s));
     const long long k0 = std::llround(std::floor(e.box.min.z / s)), k1 = std::llround(std::ceil(e.box.max.z / s));
     if (i1 - i0 > 200 || k1 - k0 > 200) return;
-    for (long long i = i0; i <= i1; ++i) paint.line(vec3(float(i) * s, 0, float(k0) * s), vec3(float(i) * s, 0, float(k1) * s), kGrid, true);
-    for (long long k = k0; k <= k1; ++k) paint.line(vec3(float(i0) * s, 0, float(k) * s), vec3(float(i1) * s, 0, float(k) * s), kGrid, true);
+    for (long long i = i0; i <= i1; ++i) paint.line(vec3(float(i) * s, 0, float(k0) * s), vec3(float(i) * s, 0, float(k1) * s), kGrid, !onTop);
+    for (long long k = k0; k <= k1; ++k) paint.line(vec3(float(i0) * s, 0, float(k) * s), vec3(float(i1) * s, 0, float(k) * s), kGrid, !onTop);
 }
 
 void drawAxes(Painter& paint, const SceneExtent& e) {
@@ -279,11 +280,15 @@ void drawSelection(Painter& paint, const sg::FrameInput& f, const std::vector<sg
 
 }   // namespace
 
-const char* overlayNameList() { return "grid, axes, lights, cameras, bounds, selection"; }
+const char* overlayNameList() { return "grid, axes, lights, cameras, bounds, selection, grid-on-top"; }
 
 bool parseOverlayList(const std::string& list, OverlayOptions& out, std::string& err) {
     std::stringstream in(list);
     for (std::string name; std::getline(in, name, ',');) {
+        if (name == "grid-on-top") {
+            out.grid = out.gridOnTop = true;
+            continue;
+        }
         bool* flag = name == "grid"        ? &out.grid
                      : name == "axes"      ? &out.axes
                      : name == "lights"    ? &out.lights
@@ -310,7 +315,7 @@ void drawOverlays(const sg::FrameInput& frame, const OverlayOptions& o, Framebuf
         return;
     Painter paint(frame, fb);
     const SceneExtent e = sceneExtent(frame);
-    if (o.grid) drawGrid(paint, e);
+    if (o.grid) drawGrid(paint, e, o.gridOnTop);
     if (o.bounds) {
         for (const auto& m : frame.meshes) paint.box(meshBounds(m), kBounds, true);
         for (const auto& a : frame.analytics) paint.box(a.worldBounds, kBounds, true);

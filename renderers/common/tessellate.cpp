@@ -11,6 +11,10 @@
 //      the Illinois variant of regula falsi on the exact function, gradient normals
 //   6. tessellate() dispatch and TessellationCache
 //
+// Progress: marching reports per z slice of the sampling and of the polygonization and per
+// block of vertices refined and given normals (the bulk of the work at high resolutions), and
+// stops between slices when cancelled (TessellationProgress).
+//
 // Orientation: every triangle is counter-clockwise seen from outside (its geometric normal
 // cross(p1-p0, p2-p0) points out of the solid), and vertex normals point outward.
 #include "renderers/tessellate.h"
@@ -21,6 +25,7 @@
 
 #include <array>
 #include <functional>
+#include <mutex>
 #include <unordered_map>
 
 namespace rnd {
@@ -36,6 +41,40 @@ using sg::vec3;
 using sg::vec4;
 
 // --- 1. helpers -------------------------------------------------------------------------
+
+// The share done of one tessellation, passed on to TessellationProgress: only increases, one
+// report at a time (the marching's parallel loops report from their worker threads).
+class Meter {
+public:
+    explicit Meter(const TessellationProgress* p) : m_p(p) {}
+    bool cancelled() const { return m_p && m_p->cancelled(); }
+    void at(float share) {
+        if (!m_p || !m_p->report) return;
+        std::lock_guard lock(m_mutex);
+        if (!(share > m_last)) return;
+        m_last = std::min(share, 1.0f);
+        m_p->report(m_last);
+    }
+
+private:
+    const TessellationProgress* m_p;
+    std::mutex m_mutex;
+    float m_last = 0.0f;
+};
+
+// Where each marching phase ends, as a share of a marched shape's work (the time they took on
+// the demo's quadric, CSG and metaballs at 256, averaged: sampling 0.15-0.5, polygonizing up
+// to 0.7-0.85, refining the vertices to 0.9, the normals the rest).
+constexpr float kSampled = 0.3f, kPolygonized = 0.75f, kRefined = 0.9f, kNormals = 0.99f;
+
+// Counts items done in a parallel loop and reports the share from..to they stand for.
+struct PhaseCounter {
+    Meter& meter;
+    float from, to;
+    size_t total;
+    std::atomic<size_t> done{0};
+    void add(size_t n) { meter.at(from + (to - from) * float(done += n) / float(std::max<size_t>(total, 1))); }
+};
 
 // -0.0f -> +0.0f so that equal positions also have equal bits.
 inline float clean(float v) { return v + 0.0f; }
@@ -455,7 +494,7 @@ const vec3 kCornerOffset[8] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {0, 0
 // Samples the field over `bounds` at `res` cells along the longest side, plus one cell of
 // margin on each side whose outermost layer is forced outside, so the surface closes inside
 // the grid.
-MarchGrid sampleGrid(const Field& field, const sg::Aabb& bounds, int res) {
+MarchGrid sampleGrid(const Field& field, const sg::Aabb& bounds, int res, Meter& meter) {
     MarchGrid g;
     res = std::clamp(res, 2, 256);
     vec3 ext = glm::max(bounds.extent(), vec3(1e-6f));
@@ -467,8 +506,10 @@ MarchGrid sampleGrid(const Field& field, const sg::Aabb& bounds, int res) {
     g.ny = size_t(dims.y);
     g.nz = size_t(dims.z);
     g.val.resize(g.nx * g.ny * g.nz);
+    std::atomic<size_t> slices{0};
     tbb::parallel_for(tbb::blocked_range<size_t>(0, g.nz), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t z = r.begin(); z < r.end(); ++z)
+        for (size_t z = r.begin(); z < r.end(); ++z) {
+            if (meter.cancelled()) return;
             for (size_t y = 0; y < g.ny; ++y)
                 for (size_t x = 0; x < g.nx; ++x) {
                     float v = field.value(g.pos(x, y, z));
@@ -477,6 +518,8 @@ MarchGrid sampleGrid(const Field& field, const sg::Aabb& bounds, int res) {
                     if (border && v < 0) v = 1e-6f;
                     g.val[g.index(x, y, z)] = v;
                 }
+            meter.at(kSampled * float(++slices) / float(g.nz));
+        }
     });
     return g;
 }
@@ -524,7 +567,7 @@ bool tetPolygon(const int (&tet)[4], int inside, EdgeVertex&& edge, MarchPoly& p
 // Marching tetrahedra over every cell of the grid. Vertices live on crossing edges and are
 // shared between the polygons using them: edgeEnds[i] = (inside corner, outside corner) of
 // vertex i, as grid indices.
-std::vector<MarchPoly> polygonize(const MarchGrid& g, std::vector<std::pair<size_t, size_t>>& edgeEnds) {
+std::vector<MarchPoly> polygonize(const MarchGrid& g, std::vector<std::pair<size_t, size_t>>& edgeEnds, Meter& meter) {
     const size_t nx = g.nx, ny = g.ny, nz = g.nz;
     // Key = lower corner index * 8 + offset bits.
     std::unordered_map<uint64_t, uint32_t> edgeVertex;
@@ -537,7 +580,8 @@ std::vector<MarchPoly> polygonize(const MarchGrid& g, std::vector<std::pair<size
     };
     std::vector<MarchPoly> polys;
     const size_t offs[8] = {0, 1, nx, nx + 1, nx * ny, nx * ny + 1, nx * ny + nx, nx * ny + nx + 1};
-    for (size_t z = 0; z + 1 < nz; ++z)
+    for (size_t z = 0; z + 1 < nz; ++z) {
+        if (meter.cancelled()) return {};
         for (size_t y = 0; y + 1 < ny; ++y)
             for (size_t x = 0; x + 1 < nx; ++x) {
                 size_t c0 = g.index(x, y, z);
@@ -553,6 +597,8 @@ std::vector<MarchPoly> polygonize(const MarchGrid& g, std::vector<std::pair<size
                 for (const auto& tet : kTets)
                     if (tetPolygon(tet, inside, edge, p)) polys.push_back(p);
             }
+        meter.at(kSampled + (kPolygonized - kSampled) * float(z + 1) / float(nz - 1));
+    }
     return polys;
 }
 
@@ -595,14 +641,16 @@ float surfaceCrossing(const Field& field, vec3 a, vec3 b, float fa, float fb) {
 }
 
 // The vertex positions: each crossing edge's point on the exact surface.
-std::vector<vec3> refineVertices(const Field& field, const MarchGrid& g, const std::vector<std::pair<size_t, size_t>>& edgeEnds) {
+std::vector<vec3> refineVertices(const Field& field, const MarchGrid& g, const std::vector<std::pair<size_t, size_t>>& edgeEnds, Meter& meter) {
     std::vector<vec3> positions(edgeEnds.size());
+    PhaseCounter counter{meter, kPolygonized, kRefined, edgeEnds.size()};
     tbb::parallel_for(tbb::blocked_range<size_t>(0, edgeEnds.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t e = r.begin(); e < r.end(); ++e) {
             auto [ia, ib] = edgeEnds[e];
             vec3 a = g.pos(ia), b = g.pos(ib);
             positions[e] = glm::mix(a, b, surfaceCrossing(field, a, b, g.val[ia], g.val[ib]));
         }
+        counter.add(r.size());
     });
     return positions;
 }
@@ -628,14 +676,16 @@ std::vector<std::array<uint32_t, 3>> triangulate(const std::vector<MarchPoly>& p
     return triangles;
 }
 
-// Sample, polygonize, refine the vertices onto the surface, triangulate.
-MarchResult march(const Field& field, sg::Aabb bounds, int res) {
+// Sample, polygonize, refine the vertices onto the surface, triangulate. Cancelled: empty.
+MarchResult march(const Field& field, sg::Aabb bounds, int res, Meter& meter) {
     MarchResult out;
     if (bounds.empty() || !sg::isFinite(bounds.min) || !sg::isFinite(bounds.max)) return out;
-    MarchGrid grid = sampleGrid(field, bounds, res);
+    MarchGrid grid = sampleGrid(field, bounds, res, meter);
+    if (meter.cancelled()) return out;
     std::vector<std::pair<size_t, size_t>> edgeEnds;   // per vertex: (inside corner, outside corner)
-    std::vector<MarchPoly> polys = polygonize(grid, edgeEnds);
-    out.positions = refineVertices(field, grid, edgeEnds);
+    std::vector<MarchPoly> polys = polygonize(grid, edgeEnds, meter);
+    if (meter.cancelled()) return out;
+    out.positions = refineVertices(field, grid, edgeEnds, meter);
     out.triangles = triangulate(polys, out.positions);
     return out;
 }
@@ -643,14 +693,16 @@ MarchResult march(const Field& field, sg::Aabb bounds, int res) {
 // Marches the field and builds the mesh. With `parts`, each triangle takes the part at its
 // centroid, and vertices shared by triangles of different parts are split so each side gets
 // its own part's normal (sharp CSG creases). Returns the per-triangle parts.
-std::vector<int> marchedMesh(const Field& field, const sg::Aabb& bounds, int res, bool parts, sg::Mesh& m) {
-    MarchResult r = march(field, bounds, res);
+std::vector<int> marchedMesh(const Field& field, const sg::Aabb& bounds, int res, bool parts, sg::Mesh& m, Meter& meter) {
+    MarchResult r = march(field, bounds, res, meter);
     size_t nv = r.positions.size();
     m.positions = std::move(r.positions);
     m.normals.resize(nv);
     std::vector<int> vertexPart(nv, 0);
+    PhaseCounter counter{meter, kRefined, kNormals, nv};
     tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, 256), [&](const tbb::blocked_range<size_t>& rr) {
         for (size_t i = rr.begin(); i < rr.end(); ++i) m.normals[i] = field.normal(m.positions[i], &vertexPart[i]);
+        counter.add(rr.size());
     });
     std::vector<int> triPart;
     if (parts) {
@@ -692,10 +744,26 @@ std::vector<int> marchedMesh(const Field& field, const sg::Aabb& bounds, int res
 
 // --- 6. dispatch and cache -----------------------------------------------------------------------
 
-Tessellation tessellate(const sg::DrawAnalytic& a, int resolution) {
+namespace {
+// Shapes tessellated by marching tetrahedra over a resolution^3 grid.
+bool marched(const sg::DrawAnalytic& a) {
+    return a.kind == sg::DrawAnalytic::Kind::Grid || a.kind == sg::DrawAnalytic::Kind::Csg ||
+           (a.kind == sg::DrawAnalytic::Kind::Implicit && a.implicit.type == sg::ImplicitType::Quadric);
+}
+}   // namespace
+
+double tessellationWork(const sg::DrawAnalytic& a, int resolution) {
+    const double r = std::clamp(resolution, 3, 1024);
+    if (!marched(a)) return r * r;
+    const double m = std::min(r, 256.0);   // sampleGrid's limit
+    return m * m * m;
+}
+
+Tessellation tessellate(const sg::DrawAnalytic& a, int resolution, const TessellationProgress* progress) {
     Tessellation t;
     auto mesh = std::make_shared<sg::Mesh>();
     resolution = std::clamp(resolution, 3, 1024);
+    Meter meter(progress);
     // Isolated so that a caller inside a TBB task (holding the cache lock) never picks up an
     // unrelated outer task while waiting here.
     tbb::this_task_arena::isolate([&] {
@@ -703,7 +771,7 @@ Tessellation tessellate(const sg::DrawAnalytic& a, int resolution) {
         case sg::DrawAnalytic::Kind::Implicit:
             if (a.implicit.type == sg::ImplicitType::Quadric) {
                 QuadricField f(a.implicit);
-                marchedMesh(f, a.implicit.quadricBounds, resolution, false, *mesh);
+                marchedMesh(f, a.implicit.quadricBounds, resolution, false, *mesh, meter);
                 mesh->name = "quadric";
             } else {
                 *mesh = implicitPrimitive(a.implicit, resolution);
@@ -714,7 +782,7 @@ Tessellation tessellate(const sg::DrawAnalytic& a, int resolution) {
             if (a.grid && a.grid->dims.x >= 2 && a.grid->dims.y >= 2 && a.grid->dims.z >= 2 &&
                 a.grid->values.size() == size_t(a.grid->dims.x) * a.grid->dims.y * a.grid->dims.z) {
                 GridField f(*a.grid);
-                marchedMesh(f, a.grid->bounds, resolution, false, *mesh);
+                marchedMesh(f, a.grid->bounds, resolution, false, *mesh, meter);
                 mesh->name = "density grid";
             }
             break;
@@ -722,7 +790,7 @@ Tessellation tessellate(const sg::DrawAnalytic& a, int resolution) {
             t.worldSpace = true;
             if (a.csg && a.csg->root >= 0 && size_t(a.csg->root) < a.csg->nodes.size()) {
                 CsgField f(*a.csg);
-                std::vector<int> parts = marchedMesh(f, csgBounds(*a.csg, a.csg->root), resolution, true, *mesh);
+                std::vector<int> parts = marchedMesh(f, csgBounds(*a.csg, a.csg->root), resolution, true, *mesh, meter);
                 mesh->name = "csg";
                 for (int leaf : f.leafNode) t.materials.push_back(a.csg->nodes[leaf].material);
                 t.triangleMaterial.resize(parts.size());
@@ -731,20 +799,32 @@ Tessellation tessellate(const sg::DrawAnalytic& a, int resolution) {
             break;
         }
     });
+    if (meter.cancelled()) return Tessellation{};   // no mesh: incomplete
     // Guarantee valid data for the backends even for unusual input.
     if (!mesh->validate().empty()) *mesh = sg::Mesh{};
     mesh->id = sg::newResourceId();
     t.mesh = std::move(mesh);
+    meter.at(1.0f);
     return t;
 }
 
-const Tessellation& TessellationCache::get(const sg::DrawAnalytic& a, int resolution) {
+const Tessellation& TessellationCache::get(const sg::DrawAnalytic& a, int resolution, const TessellationProgress* progress) {
+    static const Tessellation kNone;
     std::lock_guard lock(m_mutex);
-    uint64_t key = a.geometryKey * 1315423911u + uint64_t(resolution);
-    auto& e = m_entries[key];
-    if (!e.t.mesh) e.t = tessellate(a, resolution);
-    e.lastUsed = m_frame;
-    return e.t;
+    const uint64_t key = keyOf(a, resolution);
+    auto it = m_entries.find(key);
+    if (it == m_entries.end()) {
+        Tessellation t = tessellate(a, resolution, progress);
+        if (!t.mesh) return kNone;   // cancelled
+        it = m_entries.emplace(key, Entry{std::move(t), 0}).first;
+    }
+    it->second.lastUsed = m_frame;
+    return it->second.t;
+}
+
+bool TessellationCache::contains(const sg::DrawAnalytic& a, int resolution) const {
+    std::lock_guard lock(m_mutex);
+    return m_entries.count(keyOf(a, resolution)) > 0;
 }
 
 void TessellationCache::nextFrame(int maxAge) {

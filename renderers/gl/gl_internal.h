@@ -256,7 +256,8 @@ private:
     // gl_resources.cpp
     GpuMesh* meshFor(const sg::Mesh& mesh, const std::vector<uint16_t>* triangleMaterial);
     GpuTexture* textureFor(const sg::TexturePtr& t);
-    std::vector<DrawItem> collectDraws(const sg::FrameInput& frame, int tessellation);   // uploads what is new
+    // Uploads what is new; tessellates new shapes as control's Shapes stage (empty when cancelled).
+    std::vector<DrawItem> collectDraws(const sg::FrameInput& frame, int tessellation, RenderControl* control);
     void bindTextures(const DrawItem& it);
     void readBack(GLuint fbo, int w, int h, Framebuffer& out, bool withDepth = true);
     void evict();

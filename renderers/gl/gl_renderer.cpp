@@ -188,7 +188,6 @@ void GlRenderer::releaseAll() {
 }
 
 RenderStats GlRenderer::doRender(const FrameInput& frame, const RenderConfig& cfg, Framebuffer& target, RenderControl* control) {
-    (void)control;   // one GL frame: not progressive; render() checked cancellation before
     RenderStats stats;
     bool madeCurrent = false;
     std::string err = prepareContext(madeCurrent);
@@ -228,7 +227,15 @@ RenderStats GlRenderer::doRender(const FrameInput& frame, const RenderConfig& cf
 
     beginFrameState(s, m_target.fbo, rw, rh, samples);
     if (visibility) beginVisibility();
-    const std::vector<DrawItem> items = collectDraws(frame, cfg.tessellation);
+    // One GL frame is not progressive (render() checked cancellation before), but tessellating
+    // new shapes can take seconds: that part reports its progress and stops when cancelled.
+    const std::vector<DrawItem> items = collectDraws(frame, cfg.tessellation, control);
+    if (control && control->cancel.load()) {
+        if (visibility) glDrawBuffer(GL_COLOR_ATTACHMENT0);
+        stats.cancelled = true;
+        stats.error = "cancelled";
+        return stats;
+    }
     prepareEnvironment(frame, stats);   // pbr: textures on units 5 and 6
     // The programs of this frame (useProgram): its setup, and uniforms set once per program.
     beginFramePrograms(frame, ssaa, visibility);

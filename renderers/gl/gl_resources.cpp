@@ -345,9 +345,11 @@ void GlRenderer::bindTextures(const DrawItem& it) {
 // Draws for the frame from the shared draw list (renderers/draw_list.h), nearest first so
 // that llvmpipe's early depth test skips shading hidden fragments. Uploads happen here, only
 // for new or edited meshes and textures.
-std::vector<DrawItem> GlRenderer::collectDraws(const FrameInput& frame, int tessellation) {
+std::vector<DrawItem> GlRenderer::collectDraws(const FrameInput& frame, int tessellation, RenderControl* control) {
     std::vector<DrawItem> items;
-    for (const PreparedDraw& p : prepareDraws(frame, tessellation, m_tess)) {
+    const std::vector<PreparedDraw> prepared = prepareDraws(frame, tessellation, m_tess, control);
+    if (control && control->cancel.load()) return items;   // the caller gives up
+    for (const PreparedDraw& p : prepared) {
         DrawItem it;
         it.gpu = meshFor(*p.mesh, p.triangleMaterial);
         if (!it.gpu) continue;

@@ -176,7 +176,14 @@ private:
         const bool gouraud = frame.settings.shading == sg::ShadingModel::Gouraud;
 
         // 1. gather (the draw list shared with the GL backend)
-        const std::vector<PreparedDraw> prepared = prepareDraws(frame, tessRes, m_tess);
+        const std::vector<PreparedDraw> prepared = prepareDraws(frame, tessRes, m_tess, control);
+        if (control && control->cancel.load()) {   // while tessellating shapes anew
+            m_samplers.endFrame();
+            target.resize(width, height);
+            stats.cancelled = true;
+            stats.error = "cancelled";
+            return stats;
+        }
         std::vector<DrawItem> draws = gatherDraws(prepared, gouraud);
         m_samplers.endFrame();
         // Whatever way this frame ends, the vertex buffers go back for the next one.

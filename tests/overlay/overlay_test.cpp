@@ -109,6 +109,10 @@ TEST(OverlayParseTest, NamesAndErrors) {
     std::string err;
     ASSERT_TRUE(rnd::parseOverlayList("grid,axes,lights,bounds,selection,cameras", o, err)) << err;
     EXPECT_TRUE(o.grid && o.axes && o.lights && o.bounds && o.selection && o.cameras);
+    EXPECT_FALSE(o.gridOnTop) << "the grid is depth-tested unless asked";
+    rnd::OverlayOptions top;
+    ASSERT_TRUE(rnd::parseOverlayList("grid-on-top", top, err)) << err;
+    EXPECT_TRUE(top.grid && top.gridOnTop);
     for (std::string bad : {"", "grid,", "grid,,axes", "gird"}) {
         rnd::OverlayOptions p;
         EXPECT_FALSE(rnd::parseOverlayList(bad, p, err)) << bad;
@@ -170,6 +174,29 @@ TEST(OverlayDepthTest, OccludedLinesHiddenGizmosShown) {
     o.lights = true;
     rnd::drawOverlays(s.frame, o, s.fb);
     EXPECT_EQ(size_t(s.litPixels(0, 64)), midpointCirclePixels(32, 32, 6).size()) << "the radius-6 midpoint circle about the centre";
+}
+
+// The grid is hidden behind a surface like bounds and axes, and drawn over it with gridOnTop
+// (in its colour, and only the grid: the bounds stay hidden).
+TEST(OverlayDepthTest, GridOnTopShowsThroughSurfaces) {
+    Scene s;
+    s.addBox({-1, -2, -6}, {1, 2, -4});   // the grid (y = 0) crosses the view
+    std::fill(s.fb.depth.begin(), s.fb.depth.end(), 0.0f);
+    rnd::OverlayOptions o;
+    o.grid = o.bounds = true;
+    rnd::drawOverlays(s.frame, o, s.fb);
+    EXPECT_EQ(s.litPixels(0, 64), 0);
+    o.gridOnTop = true;
+    rnd::drawOverlays(s.frame, o, s.fb);
+    const int lit = s.litPixels(0, 64);
+    EXPECT_GT(lit, 10);
+    int gridColoured = 0;
+    for (int y = 0; y < 64; ++y)
+        for (int x = 0; x < 64; ++x) {
+            const uint8_t* p = s.fb.pixel(x, y);
+            gridColoured += p[0] == 20 && p[1] == 175 && p[2] == 190;
+        }
+    EXPECT_EQ(gridColoured, lit);
 }
 
 // The selection outlines only the selected node's drawables, through geometry.

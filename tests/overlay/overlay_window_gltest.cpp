@@ -1,6 +1,7 @@
 // overlay_window_gltest.cpp - View > Overlays in the real viewer window under Xvfb, driven by
 // the automation's `overlay LIST|none` (the menu's toggles): the shown image gains the
-// overlays and loses them again, and a bad name stops the script with a one-line error.
+// overlays and loses them again, the grid on top shows over the objects that hide it otherwise,
+// and a bad name stops the script with a one-line error.
 #include "assets/image_io.h"
 #include "test_support.h"
 #include "viewer_process.h"
@@ -35,6 +36,7 @@ TEST(OverlayWindowGLTest, MenuTogglesDrawAndRemoveOverlays) {
     const int rc = viewer_test::runViewer(dir,
                                           "wait\nbackend raster\nwait\nwindow-shot plain.png\n"
                                           "overlay grid,axes,bounds,lights\nframes 3\nwait\nwindow-shot on.png\n"
+                                          "overlay grid-on-top,axes,bounds,lights\nframes 3\nwait\nwindow-shot top.png\n"
                                           "overlay none\nframes 3\nwait\nwindow-shot off.png\n"
                                           "overlay gird\nquit\n");
     const std::string log = viewer_test::readLog(dir);
@@ -45,4 +47,8 @@ TEST(OverlayWindowGLTest, MenuTogglesDrawAndRemoveOverlays) {
     EXPECT_GT(on, 3000);
     EXPECT_GE(off, 0);
     EXPECT_LT(off, 500) << "only the status bar's frame rate may change";
+    // Grid on top: the grid lines the demo's objects hid come into view over them.
+    const long top = differingPixels(dir / "on.png", dir / "top.png");
+    std::printf("[overlay] window: %ld pixels changed with the grid on top\n", top);
+    EXPECT_GT(top, 700);
 }

@@ -2,16 +2,19 @@
 // edge shared by exactly two triangles, in opposite directions, after welding by position),
 // outward normals and counter-clockwise winding, vertices on the surface, volumes close to
 // the analytic ones, CSG faces carrying their leaf's material, parametric vertices equal to
-// evaluate(u, v), the sg::primitives winding, and the cache.
+// evaluate(u, v), the sg::primitives winding, the cache, and a rebuild's progress and cancel.
 // Set TESS_DUMP_DIR=/tmp/x to write every tested mesh as an .obj for inspection.
 #include "renderers/tessellate.h"
 
 #include "assets/demo.h"
+#include "renderers/draw_list.h"
 #include "scenegraph/transforms.h"
 
 #include <gtest/gtest.h>
 
 #include <array>
+#include <atomic>
+#include <chrono>
 #include <cstdlib>
 #include <fstream>
 #include <map>
@@ -580,4 +583,109 @@ TEST(TessellateTest, CacheReusesAndEvicts) {
     for (auto& th : threads) th.join();
     for (auto* p : got) EXPECT_EQ(p, got[0]);
     EXPECT_EQ(cache.size(), 1u);
+}
+
+// A rebuild at a high level takes seconds (marching is resolution^3): each shape reports the
+// share of its work done, strictly increasing and ending at 1, many times for the marched
+// ones (per slice of the sampling and of the polygonization), and the cached mesh is the one
+// made without a report.
+TEST(TessellateTest, RebuildReportsItsProgress) {
+    Scene s = assets::makeDemoScene();
+    FrameInput f = flatten(s, 1.0f);
+    constexpr int kLevel = 48;
+    int marchedShapes = 0;
+    for (const DrawAnalytic& a : f.analytics) {
+        SCOPED_TRACE(s.node(a.node).name);
+        std::vector<float> shares;
+        rnd::TessellationProgress progress;
+        progress.report = [&](float share) { shares.push_back(share); };
+        rnd::TessellationCache cache;
+        const Tessellation& t = cache.get(a, kLevel, &progress);
+        ASSERT_TRUE(t.mesh);
+        EXPECT_EQ(t.mesh->positions, rnd::tessellate(a, kLevel).mesh->positions);
+        ASSERT_FALSE(shares.empty());
+        for (size_t i = 1; i < shares.size(); ++i) ASSERT_GT(shares[i], shares[i - 1]) << "report " << i;
+        EXPECT_GT(shares.front(), 0.0f);
+        EXPECT_EQ(shares.back(), 1.0f);
+        const bool marched = rnd::tessellationWork(a, kLevel) > double(kLevel) * kLevel;
+        if (marched) {
+            ++marchedShapes;
+            EXPECT_GT(shares.size(), size_t(kLevel)) << "per slice";
+        }
+        EXPECT_TRUE(cache.contains(a, kLevel));
+        EXPECT_FALSE(cache.contains(a, kLevel + 1));
+    }
+    EXPECT_EQ(marchedShapes, 3) << "the demo's quadric, CSG and metaballs";
+}
+
+// A rebuild stopped part-way (a newer setting replaced it) returns no mesh and caches none;
+// the next request tessellates in full.
+TEST(TessellateTest, CancelledRebuildKeepsNothing) {
+    Scene s = assets::makeDemoScene();
+    FrameInput f = flatten(s, 1.0f);
+    const DrawAnalytic* csg = nullptr;
+    for (const DrawAnalytic& a : f.analytics)
+        if (a.kind == DrawAnalytic::Kind::Csg) csg = &a;
+    ASSERT_NE(csg, nullptr);
+    std::atomic<bool> cancel{false};
+    rnd::TessellationProgress progress;
+    progress.cancel = &cancel;
+    float last = 0.0f;
+    progress.report = [&](float share) {
+        last = share;
+        if (share > 0.2f) cancel = true;   // part-way through the sampling
+    };
+    rnd::TessellationCache cache;
+    EXPECT_FALSE(cache.get(*csg, 64, &progress).mesh);
+    EXPECT_LT(last, 0.85f) << "stopped before polygonizing it all";
+    EXPECT_FALSE(cache.contains(*csg, 64));
+    EXPECT_EQ(cache.size(), 0u);
+    EXPECT_FALSE(rnd::tessellate(*csg, 64, &progress).mesh) << "still cancelled";
+    const Tessellation& t = cache.get(*csg, 64);
+    ASSERT_TRUE(t.mesh);
+    EXPECT_GT(t.mesh->triangleCount(), 0u);
+}
+
+// prepareDraws tessellates the shapes missing from the cache as the render's Shapes stage,
+// its progress weighed over all of them, then hands the progress back to the image at 0; a
+// cancel part-way stops it with the rest left out of the cache.
+TEST(TessellateTest, PrepareDrawsReportsTheShapesStage) {
+    Scene s = assets::makeDemoScene();
+    FrameInput f = flatten(s, 1.0f);
+    rnd::TessellationCache cache;
+    rnd::RenderControl control;
+    std::atomic<bool> done{false};
+    std::vector<std::pair<rnd::RenderStage, float>> seen;
+    std::thread watch([&] {   // as the viewer's UI thread polls a render in flight
+        while (!done) {
+            seen.emplace_back(control.stage.load(), control.progress.load());
+            std::this_thread::sleep_for(std::chrono::microseconds(50));
+        }
+    });
+    const std::vector<rnd::PreparedDraw> draws = rnd::prepareDraws(f, 96, cache, &control);
+    done = true;
+    watch.join();
+    EXPECT_EQ(draws.size(), f.meshes.size() + f.analytics.size());
+    EXPECT_EQ(control.stage.load(), rnd::RenderStage::Image);
+    EXPECT_EQ(control.progress.load(), 0.0f);
+    float last = 0.0f;
+    int distinct = 0;
+    for (auto [stage, p] : seen) {
+        if (stage != rnd::RenderStage::Shapes) continue;
+        ASSERT_GE(p, last) << "the shapes' progress never goes back";
+        distinct += p > last;
+        last = p;
+    }
+    EXPECT_GT(distinct, 5) << seen.size() << " samples";
+    // Everything cached now: no Shapes stage, the progress left alone.
+    control.progress = 0.5f;
+    rnd::prepareDraws(f, 96, cache, &control);
+    EXPECT_EQ(control.stage.load(), rnd::RenderStage::Image);
+    EXPECT_EQ(control.progress.load(), 0.5f);
+    // Cancelled before it starts: nothing more is cached, the list stops short.
+    rnd::RenderControl cancelled;
+    cancelled.cancel = true;
+    const size_t before = cache.size();
+    EXPECT_LT(rnd::prepareDraws(f, 97, cache, &cancelled).size(), f.meshes.size() + f.analytics.size());
+    EXPECT_EQ(cache.size(), before);
 }

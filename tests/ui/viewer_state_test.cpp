@@ -11,8 +11,10 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <fstream>
+#include <thread>
 
 using namespace ui;
 namespace fs = std::filesystem;
@@ -648,6 +650,162 @@ TEST(RenderSlotTest, ForgetDropsTheImageAndRendersInFlight) {
     slot.waitIdle();
     slot.poll();
     EXPECT_EQ(slot.image().width, 64);
+}
+
+// A new tessellation level rebuilds the shapes first (seconds at the highest levels): the
+// slot says so (SlotStatus::shapes) with a percentage that moves with the work done and gets
+// to the end, then renders the image as usual.
+TEST(RenderSlotTest, ATessellationRebuildShowsItsProgress) {
+    ViewerState st = demoState();
+    auto frame = std::make_shared<sg::FrameInput>(st.buildFrame(64.0f / 48.0f));
+    auto rebuilt = std::make_shared<sg::FrameInput>(*frame);
+    rebuilt->settings.tessellation = 160;
+    RenderSlot slot("raster");
+    slot.request(frame, 64, 48, 1, /*interacting=*/false);
+    slot.waitIdle();
+    slot.poll();
+    ASSERT_EQ(slot.status().error, "");
+    slot.request(rebuilt, 64, 48, 2, /*interacting=*/false);
+    std::vector<float> shapes;   // the progress shown while rebuilding, as the viewport polls it
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+    for (;;) {
+        slot.poll();
+        const SlotStatus s = slot.status();
+        if (s.rendering && s.shapes) shapes.push_back(s.progress);
+        if (!s.rendering && s.level == 1 && slot.imageFrame() == rebuilt) break;
+        ASSERT_LT(std::chrono::steady_clock::now(), deadline) << "no image";
+        std::this_thread::sleep_for(std::chrono::microseconds(200));
+    }
+    EXPECT_EQ(slot.status().error, "");
+    EXPECT_FALSE(slot.status().shapes);
+    ASSERT_FALSE(shapes.empty()) << "the rebuild was never shown";
+    int moves = 0;
+    for (size_t i = 1; i < shapes.size(); ++i) {
+        ASSERT_GE(shapes[i], shapes[i - 1]) << "sample " << i;
+        moves += shapes[i] > shapes[i - 1];
+    }
+    EXPECT_GT(moves, 10) << "the percentage moves with the work";
+    EXPECT_GT(shapes.back(), 0.9f) << "and gets to the end";
+    // The same level again: nothing to rebuild, no Shapes stage.
+    auto again = std::make_shared<sg::FrameInput>(*rebuilt);
+    slot.request(again, 64, 48, 3, /*interacting=*/false);
+    for (;;) {
+        slot.poll();
+        const SlotStatus s = slot.status();
+        ASSERT_FALSE(s.shapes);
+        if (!s.rendering && s.level == 1 && slot.imageFrame() == again) break;
+        ASSERT_LT(std::chrono::steady_clock::now(), deadline) << "no image";
+        std::this_thread::sleep_for(std::chrono::microseconds(200));
+    }
+}
+
+// The steps of a job. While interacting: full resolution at one sample when the last such
+// frame fitted the budget (82 ms does not fit 50 ms: the preview stays), the preview when it did
+// not or nothing was measured yet. When still: what this key has shown already is not redone.
+TEST(RenderSlotTest, PlanSkipsThePreviewWhenAFullFrameFits) {
+    using Step = RenderSlot::Step;
+    RenderSlot::PlanInput in;
+    in.width = 640;
+    in.interacting = true;
+    in.budgetMs = 50;
+    in.fullMs = 30;
+    EXPECT_EQ(RenderSlot::planSteps(in), (std::vector<Step>{{1, true}})) << "fast: full resolution, no preview";
+    in.antialiased = true;
+    EXPECT_EQ(RenderSlot::planSteps(in), (std::vector<Step>{{1, true}})) << "one sample while interacting";
+    in.fullMs = 82;
+    EXPECT_EQ(RenderSlot::planSteps(in), (std::vector<Step>{{4, true}})) << "slow: the preview";
+    in.fullMs = 50;
+    EXPECT_EQ(RenderSlot::planSteps(in), (std::vector<Step>{{4, true}})) << "not under the budget";
+    in.fullMs = -1;
+    EXPECT_EQ(RenderSlot::planSteps(in), (std::vector<Step>{{4, true}})) << "not measured yet";
+    in.width = 24;   // too small for a preview
+    EXPECT_EQ(RenderSlot::planSteps(in), (std::vector<Step>{{1, true}, {1, false}}));
+    // Still: preview, one-sample image (anti-aliased, on a worker), the final image.
+    in = {};
+    in.width = 640;
+    in.fullMs = 10;
+    EXPECT_EQ(RenderSlot::planSteps(in), (std::vector<Step>{{4, true}, {1, false}}));
+    in.antialiased = true;
+    EXPECT_EQ(RenderSlot::planSteps(in), (std::vector<Step>{{4, true}, {1, true}, {1, false}}));
+    in.threaded = false;
+    EXPECT_EQ(RenderSlot::planSteps(in), (std::vector<Step>{{4, true}, {1, false}}));
+    in.threaded = true;
+    in.shownLevel = 4;   // the camera stopped on the view whose preview is shown
+    EXPECT_EQ(RenderSlot::planSteps(in), (std::vector<Step>{{1, true}, {1, false}}));
+    in.shownLevel = 1;   // its one-sample full-resolution image is shown
+    EXPECT_EQ(RenderSlot::planSteps(in), (std::vector<Step>{{1, false}}));
+    in.shownFinal = true;   // its final image is shown
+    EXPECT_EQ(RenderSlot::planSteps(in), (std::vector<Step>{}));
+}
+
+// What the plan takes for a full frame's cost: a frame measured while interacting as it is
+// (until kProbeAfter previews followed it); a still one (which may carry a scene's one-time
+// costs: 188 ms for a first frame whose previews take 1.5 ms) bounded by 16 previews.
+TEST(RenderSlotTest, LiveFrameEstimate) {
+    EXPECT_EQ(RenderSlot::liveFrameEstimate(188, false, 1.5, 4), 24.0);
+    EXPECT_EQ(RenderSlot::liveFrameEstimate(20, false, 1.5, 4), 20.0);
+    EXPECT_EQ(RenderSlot::liveFrameEstimate(60, true, 1.5, 4), 60.0) << "measured while interacting: as it is";
+    EXPECT_EQ(RenderSlot::liveFrameEstimate(143, true, 1.5, 4, RenderSlot::kProbeAfter - 1), 143.0);
+    EXPECT_EQ(RenderSlot::liveFrameEstimate(143, true, 1.5, 4, RenderSlot::kProbeAfter), 24.0) << "tried again after that many previews";
+    EXPECT_EQ(RenderSlot::liveFrameEstimate(-1, false, 2, 4), 32.0);
+    EXPECT_EQ(RenderSlot::liveFrameEstimate(30, false, -1, 4), 30.0);
+    EXPECT_LT(RenderSlot::liveFrameEstimate(-1, false, -1, 4), 0.0) << "unknown";
+}
+
+// The slot measures its full-resolution frames: while interacting it renders full resolution
+// when they fit liveBudgetMs and the preview when they do not; the full image rendered while
+// interacting is not rendered again when the interaction stops. An interacting frame pending
+// or in flight is let finish: needs() says no to the next interacting frame until it is done,
+// yes to a still one (which cancels it).
+TEST(RenderSlotTest, InteractingRendersFullResolutionWhenAFullFrameFits) {
+    ViewerState st = demoState();
+    auto frame = std::make_shared<sg::FrameInput>(st.buildFrame(64.0f / 48.0f));
+    RenderSlot slot("raster");
+    std::vector<int> levels;
+    slot.onPublish = [&](const rnd::Framebuffer&, const SlotStatus& s) { levels.push_back(s.level); };
+    EXPECT_LT(slot.fullFrameMs(), 0.0) << "nothing measured yet";
+    slot.request(frame, 64, 48, 1, /*interacting=*/false);
+    slot.waitIdle();
+    ASSERT_EQ(slot.status().error, "");
+    EXPECT_EQ(levels, (std::vector<int>{4, 1}));
+    const double full = slot.fullFrameMs();
+    EXPECT_GT(full, 0.0);
+    // Fits the budget: the next interacting frame (a camera step) is full resolution.
+    slot.liveBudgetMs = 1e9;
+    levels.clear();
+    slot.request(frame, 64, 48, 2, /*interacting=*/true);
+    slot.waitIdle();
+    slot.poll();
+    EXPECT_EQ(levels, (std::vector<int>{1}));
+    EXPECT_EQ(slot.image().width, 64);
+    EXPECT_FALSE(slot.status().refining);
+    EXPECT_TRUE(slot.image().hasVisibility()) << "picking works on it";
+    // Released on that view: nothing is rendered again.
+    levels.clear();
+    slot.request(frame, 64, 48, 2, /*interacting=*/false);
+    slot.waitIdle();
+    EXPECT_TRUE(levels.empty());
+    // Does not fit: the preview.
+    slot.liveBudgetMs = 0;
+    slot.request(frame, 64, 48, 3, /*interacting=*/true);
+    slot.waitIdle();
+    slot.poll();
+    EXPECT_EQ(levels, (std::vector<int>{4}));
+    EXPECT_EQ(slot.status().level, 4);
+    // A slow interacting frame (shapes rebuilt at a new level): the next camera step waits for
+    // it instead of cancelling it; stopping does not wait.
+    auto slow = std::make_shared<sg::FrameInput>(*frame);
+    slow->settings.tessellation = 150;
+    levels.clear();
+    slot.request(slow, 64, 48, 4, /*interacting=*/true);
+    EXPECT_FALSE(slot.needs(5, /*interacting=*/true)) << "the frame pending or in flight finishes first";
+    slot.request(slow, 64, 48, 5, /*interacting=*/true);   // ignored
+    EXPECT_TRUE(slot.needs(5, /*interacting=*/false)) << "a still frame replaces it";
+    slot.waitIdle();
+    EXPECT_EQ(levels, (std::vector<int>{4})) << "one frame, not cancelled";
+    EXPECT_TRUE(slot.needs(5, /*interacting=*/true)) << "done: the newest frame next";
+    slot.forget();   // another scene: its frames are measured afresh
+    EXPECT_LT(slot.fullFrameMs(), 0.0);
 }
 
 TEST(RenderSlotTest, UnknownBackendIsAnError) {

@@ -41,7 +41,8 @@
 //   backend NAME          single view with that backend
 //   view single|split|split3|difference   as the View menu
 //   diagnostic NAME       View > Diagnostic view: shaded, depth, normal, id, uv, triangles, overdraw, cost
-//   overlay LIST|none     View > Overlays: grid, axes, lights, cameras, bounds, selection
+//   overlay LIST|none     View > Overlays: grid, axes, lights, cameras, bounds, selection,
+//                         grid-on-top (the grid over every surface, "Grid on top")
 //   orbit DX DY | zoom STEPS | fit
 //   panels hide|show      View > Viewport only
 //   tab Inspector|Camera|Rendering|Compare

@@ -1,6 +1,7 @@
 // render_slot.cpp - coarse-to-fine, cancellable rendering for one viewport backend.
 #include "ui/render_slot.h"
 
+#include <algorithm>
 #include <chrono>
 
 namespace ui {
@@ -28,7 +29,43 @@ RenderSlot::~RenderSlot() {
 
 bool RenderSlot::needs(uint64_t key, bool interacting) const {
     if (!m_renderer) return false;
-    return !(key == m_lastKey && (interacting || !m_lastPreviewOnly));
+    if (key == m_lastKey && (interacting || !m_lastPreviewOnly)) return false;
+    if (interacting && m_threaded) {   // let the interacting frame pending or in flight finish
+        std::lock_guard<std::mutex> lock(m_mutex);
+        if ((m_pending && m_pending->interacting) || (m_busy && m_runningInteracting)) return false;
+    }
+    return true;
+}
+
+double RenderSlot::fullFrameMs() const {
+    std::lock_guard<std::mutex> lock(m_mutex);
+    return m_fullMs;
+}
+
+double RenderSlot::liveFrameEstimate(double fullMs, bool fullLive, double previewMs, int divisor, int previewsSince) {
+    if (fullMs >= 0 && fullLive && previewsSince < kProbeAfter) return fullMs;
+    const double bound = previewMs >= 0 ? previewMs * divisor * divisor : -1;
+    if (fullMs < 0) return bound;
+    return bound >= 0 ? std::min(fullMs, bound) : fullMs;
+}
+
+std::vector<RenderSlot::Step> RenderSlot::planSteps(const PlanInput& in) {
+    // A preview larger than ~1/16 of the pixels is pointless for tiny viewports.
+    bool preview = in.previewDivisor > 1 && in.width / in.previewDivisor >= 8;
+    if (in.interacting) {
+        if (in.fullMs >= 0 && in.fullMs < in.budgetMs) return {{1, true}};   // a full frame fits: no preview
+        if (preview) return {{in.previewDivisor, true}};
+    } else if (in.shownLevel == 1) {   // this very view at full resolution is on screen already
+        if (in.shownFinal) return {};
+        return {{1, false}};   // its one-sample image: only the anti-aliased one is left
+    } else if (in.shownLevel == in.previewDivisor) {
+        preview = false;   // the camera stopped: its preview is on screen already
+    }
+    std::vector<Step> steps;
+    if (preview) steps.push_back({in.previewDivisor, true});
+    if (in.threaded && in.antialiased) steps.push_back({1, true});
+    steps.push_back({1, false});
+    return steps;
 }
 
 void RenderSlot::request(std::shared_ptr<const sg::FrameInput> frame, int width, int height, uint64_t key, bool interacting,
@@ -38,7 +75,8 @@ void RenderSlot::request(std::shared_ptr<const sg::FrameInput> frame, int width,
     m_lastKey = key;
     m_lastPreviewOnly = interacting;
     std::lock_guard<std::mutex> lock(m_mutex);
-    m_pending = Job{std::move(frame), width, height, key, interacting, interacting, counters.overdraw, counters.traversalCost, m_generation};
+    m_pending =
+        Job{std::move(frame), width, height, key, interacting, interacting, counters.overdraw, counters.traversalCost, m_generation, liveBudgetMs};
     if (m_control) m_control->cancel = true;   // restart with the new frame
     m_cv.notify_all();
 }
@@ -53,6 +91,7 @@ void RenderSlot::publish(rnd::Framebuffer&& fb, const rnd::RenderStats& st, int 
         m_finishedFrame = job.frame;
         m_publishedKey = job.key;
         m_publishedLevel = level;
+        m_publishedFinal = !refining;
         m_status.level = level;
         m_status.refining = refining;
         m_haveNew = true;
@@ -60,28 +99,33 @@ void RenderSlot::publish(rnd::Framebuffer&& fb, const rnd::RenderStats& st, int 
     }
 }
 
-// The steps of a job: the preview (1/previewDivisor, one sample per pixel), then full
-// resolution. An anti-aliased frame on a worker thread gets a one-sample full-resolution step
-// before the anti-aliased one, so a sharp image shows in a fraction of the anti-aliased time
-// (SSAA 4x4 takes 16 times as long) and the viewport refines instead of waiting; the last step
-// keeps that step's visibility and counters instead of rendering a second pass for them.
+// The steps of a job (planSteps): the preview (1/previewDivisor, one sample per pixel), then
+// full resolution. An anti-aliased frame on a worker thread gets a one-sample full-resolution
+// step before the anti-aliased one, so a sharp image shows in a fraction of the anti-aliased
+// time (SSAA 4x4 takes 16 times as long) and the viewport refines instead of waiting; the last
+// step keeps that step's visibility and counters instead of rendering a second pass for them.
+// Every full-resolution one-sample step is timed: interacting jobs skip the preview while
+// such a frame fits liveBudgetMs.
 void RenderSlot::runJob(const Job& job) {
-    struct Step {
-        int divisor;
-        bool singleSample;
-    };
-    std::vector<Step> steps;
-    // A preview larger than ~1/16 of the pixels is pointless for tiny viewports.
-    bool preview = previewDivisor > 1 && job.width / previewDivisor >= 8;
-    if (preview && !job.previewOnly) {   // the camera stopped: its preview may be on screen already
+    const bool antialiased = job.frame->settings.aa != sg::AAMode::None;
+    PlanInput plan;
+    plan.width = job.width;
+    plan.interacting = job.previewOnly;   // a synchronous render (poll) plans as if still
+    plan.antialiased = antialiased;
+    plan.threaded = m_threaded;
+    plan.previewDivisor = previewDivisor;
+    plan.budgetMs = job.budgetMs;
+    {
         std::lock_guard<std::mutex> lock(m_mutex);
-        if (m_publishedKey == job.key && m_publishedLevel == previewDivisor) preview = false;
+        const bool fullHere = m_fullWidth == job.width && m_fullHeight == job.height;
+        const bool previewHere = m_previewWidth == job.width && m_previewHeight == job.height && m_previewLevel == previewDivisor;
+        plan.fullMs = liveFrameEstimate(fullHere ? m_fullMs : -1, m_fullLive, previewHere ? m_previewMs : -1, previewDivisor, m_previewsSinceFull);
+        if (m_publishedKey == job.key) {
+            plan.shownLevel = m_publishedLevel;
+            plan.shownFinal = m_publishedFinal;
+        }
     }
-    if (preview) steps.push_back({previewDivisor, true});
-    if (!preview || !job.previewOnly) {
-        if (m_threaded && job.frame->settings.aa != sg::AAMode::None) steps.push_back({1, true});
-        steps.push_back({1, false});
-    }
+    const std::vector<Step> steps = planSteps(plan);
     rnd::Framebuffer oneSample;   // the full-resolution one-sample step's image, for its visibility and counters
     for (size_t i = 0; i < steps.size(); ++i) {
         const int d = steps[i].divisor;
@@ -94,6 +138,7 @@ void RenderSlot::runJob(const Job& job) {
             m_control = &control;
             m_status.rendering = true;
             m_status.progress = 0.0f;
+            m_status.shapes = false;
         }
         rnd::Framebuffer fb;
         rnd::RenderStats st;
@@ -108,6 +153,7 @@ void RenderSlot::runJob(const Job& job) {
         // The diagnostic view's counters under the same rule (a second pass when anti-aliased).
         request.overdraw = m_caps.overdraw && job.overdraw && fullPass && !reuse;
         request.traversalCost = m_caps.traversalCost && job.traversalCost && fullPass && !reuse;
+        const auto start = std::chrono::steady_clock::now();
         try {
             std::lock_guard<std::mutex> rendering(m_renderMutex);
             m_renderedFrame = job.frame.get();
@@ -116,10 +162,27 @@ void RenderSlot::runJob(const Job& job) {
             st.ok = false;
             st.error = std::string("exception: ") + e.what();
         }
+        const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
         {
             std::lock_guard<std::mutex> lock(m_mutex);
             m_control = nullptr;
             m_status.rendering = !last && st.ok && !control.cancel;
+            m_status.shapes = false;
+            if (st.ok && !control.cancel && !st.cancelled) {   // what a frame costs while interacting
+                if (d == 1 && onePass) {
+                    m_fullMs = ms;
+                    m_fullWidth = w;
+                    m_fullHeight = h;
+                    m_fullLive = job.interacting;
+                    m_previewsSinceFull = 0;
+                } else if (d > 1) {
+                    m_previewsSinceFull += job.interacting;
+                    m_previewMs = ms;
+                    m_previewWidth = job.width;
+                    m_previewHeight = job.height;
+                    m_previewLevel = d;
+                }
+            }
         }
         if (control.cancel || st.cancelled) return;
         if (st.ok && (fb.width != w || fb.height != h || fb.color.size() != size_t(w) * h * 4)) {
@@ -136,7 +199,8 @@ void RenderSlot::runJob(const Job& job) {
             oneSample.costNodes = fb.costNodes;
             oneSample.costPrims = fb.costPrims;
         }
-        publish(std::move(fb), st, d, !last, job);
+        // A one-sample image of an anti-aliased frame (rendered while interacting too) is refined later.
+        publish(std::move(fb), st, d, !last || (d == 1 && steps[i].singleSample && antialiased), job);
         if (!st.ok) return;
     }
 }
@@ -151,6 +215,7 @@ void RenderSlot::workerLoop() {
             job = std::move(*m_pending);
             m_pending.reset();
             m_busy = true;
+            m_runningInteracting = job.interacting;
         }
         runJob(job);
         {
@@ -178,7 +243,10 @@ bool RenderSlot::poll() {
         }
     }
     std::lock_guard<std::mutex> lock(m_mutex);
-    if (m_control) m_status.progress = m_control->progress.load();
+    if (m_control) {
+        m_status.shapes = m_control->stage.load() == rnd::RenderStage::Shapes;
+        m_status.progress = m_control->progress.load();
+    }
     if (!m_haveNew) return false;
     m_haveNew = false;
     std::swap(m_shown, m_finished);
@@ -212,6 +280,10 @@ void RenderSlot::forget() {
     m_status.level = 1;
     m_lastKey = ~uint64_t(0);
     m_publishedKey = ~uint64_t(0);
+    m_publishedFinal = false;
+    m_fullMs = m_previewMs = -1;   // what frames of the old scene cost says nothing about the new one
+    m_fullLive = false;
+    m_previewsSinceFull = 0;
     if (!m_renderer) m_status.error = m_makeError.empty() ? "unknown backend " + m_backend : m_makeError;
 }
 

@@ -194,10 +194,16 @@ public:
         }
         int w = st.view.viewportWidth, h = st.view.viewportHeight;
         float aspect = float(w) / float(std::max(h, 1));
-        // A playing animation changes the scene every frame: previews only, like a camera drag
-        // (full resolution follows when it pauses).
-        bool interacting = (now - st.view.lastInteraction) < 0.25 || ImGui::GetIO().MouseDown[0] || ImGui::GetIO().MouseDown[1] ||
-                           ImGui::GetIO().MouseDown[2] || st.anim.playing;
+        // A playing animation changes the scene every frame: one quick image per frame, like a
+        // camera drag: the preview, or full resolution where a full frame fits the slot's budget
+        // (1/20 s while the camera moves, where the image must follow the hand; 1/10 s for
+        // playback alone, where a sharp image at 10 frames per second beats a blurred one); a
+        // frame in flight finishes and the newest time follows (RenderSlot::needs). The
+        // anti-aliased image follows when it pauses.
+        const bool cameraMoves =
+            (now - st.view.lastInteraction) < 0.25 || ImGui::GetIO().MouseDown[0] || ImGui::GetIO().MouseDown[1] || ImGui::GetIO().MouseDown[2];
+        const bool interacting = cameraMoves || st.anim.playing;
+        const double liveBudgetMs = cameraMoves ? 50.0 : 100.0;
         std::vector<std::string> names = visibleBackends(st);
         std::shared_ptr<sg::FrameInput> base;
         uint64_t key = (st.doc.version * 1000003u) ^ (st.view.version * 7919u) ^ (uint64_t(w) << 40) ^ (uint64_t(h) << 20);
@@ -210,6 +216,7 @@ public:
             uint64_t k = key ^ std::hash<std::string>{}(settings.aaName()) ^ (counters.overdraw ? 0x5bd1e995ull << 8 : 0) ^
                          (counters.traversalCost ? 0x27d4eb2full << 16 : 0);
             bool preview = interacting && v.slot->threaded();   // a synchronous render has no preview level
+            v.slot->liveBudgetMs = liveBudgetMs;
             if (!v.slot->needs(k, preview)) continue;
             if (!base) base = std::make_shared<sg::FrameInput>(st.buildFrame(aspect));   // flatten once per change
             auto frame = std::make_shared<sg::FrameInput>(*base);
@@ -268,7 +275,7 @@ public:
         const rnd::OverlayOptions& o = st.view.overlays;
         if (!o.any()) return 0;
         const uint64_t flags = uint64_t(o.grid) | uint64_t(o.axes) << 1 | uint64_t(o.lights) << 2 | uint64_t(o.cameras) << 3 |
-                               uint64_t(o.bounds) << 4 | uint64_t(o.selection) << 5;
+                               uint64_t(o.bounds) << 4 | uint64_t(o.selection) << 5 | uint64_t(o.gridOnTop) << 6;
         uint64_t sel = 0;
         for (sg::NodeId n : st.selection()) sel = sel * 1000003u + uint64_t(n) + 1;
         return flags ^ (st.doc.version << 8) ^ (sel << 40);

@@ -8,6 +8,7 @@
 // shapes exactly and does not use this.
 #pragma once
 
+#include "renderers/renderer.h"
 #include "renderers/tessellate.h"
 #include "scenegraph/frame.h"
 
@@ -35,7 +36,10 @@ struct PreparedDraw {
 
 // Meshes first (in frame.meshes order), then analytic shapes (in frame.analytics order).
 // Pointers refer into `frame` and `cache`: valid until either changes (cache.nextFrame()).
-std::vector<PreparedDraw> prepareDraws(const sg::FrameInput& frame, int tessellation, TessellationCache& cache);
+// control: shapes not in the cache at this level are tessellated as the render's Shapes stage
+// (control->progress counts their work, then the stage goes back to Image at 0); when
+// control->cancel is set meanwhile the list is incomplete and the caller must give up.
+std::vector<PreparedDraw> prepareDraws(const sg::FrameInput& frame, int tessellation, TessellationCache& cache, RenderControl* control = nullptr);
 // The meshes only (no tessellation); pointers refer into `frame`.
 std::vector<PreparedDraw> prepareMeshDraws(const sg::FrameInput& frame);
 

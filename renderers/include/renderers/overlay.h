@@ -6,8 +6,9 @@
 //            mapped to pixels, then Bresenham (all octants, both endpoints drawn);
 //   circles: the midpoint circle algorithm (8-way symmetry), radius in pixels.
 // Depth: grid, axes and bounds are hidden behind geometry (window z interpolated along the
-// line, drawn where z <= framebuffer depth + a small bias); light and camera gizmos and the
-// selection always show. Overlays write colour only, never depth or visibility.
+// line, drawn where z <= framebuffer depth + a small bias, so a line lying on a surface, the
+// grid on a floor, still shows); light and camera gizmos and the selection always show, and
+// so does the grid with gridOnTop. Overlays write colour only, never depth or visibility.
 #pragma once
 
 #include "renderers/framebuffer.h"
@@ -29,15 +30,17 @@ struct CameraGizmo {
 
 struct OverlayOptions {
     bool grid = false, axes = false, lights = false, cameras = false, bounds = false, selection = false;
+    bool gridOnTop = false;                  // the grid over every surface instead of depth-tested (with `grid`)
     std::vector<sg::NodeId> selected;        // selection: the drawables of these nodes (a node and its descendants)
     std::vector<CameraGizmo> cameraGizmos;   // cameras: the scene's cameras other than the viewing one
     bool any() const { return grid || axes || lights || cameras || bounds || selection; }
 };
 
-// "grid,axes,lights,cameras,bounds,selection" (any subset, comma separated) into `out`'s
-// flags. False with a one-line error naming the valid names for an unknown or empty name.
+// "grid,axes,lights,cameras,bounds,selection,grid-on-top" (any subset, comma separated) into
+// `out`'s flags; grid-on-top is the grid drawn over every surface (grid and gridOnTop). False
+// with a one-line error naming the valid names for an unknown or empty name.
 bool parseOverlayList(const std::string& list, OverlayOptions& out, std::string& err);
-const char* overlayNameList();   // "grid, axes, lights, cameras, bounds, selection"
+const char* overlayNameList();   // "grid, axes, lights, cameras, bounds, selection, grid-on-top"
 
 void drawOverlays(const sg::FrameInput& frame, const OverlayOptions& options, Framebuffer& fb);
 // Fills what the overlays need from the scene: `selected` becomes the `nodes` (a selection;

@@ -77,11 +77,19 @@ bool isSoftwareGLRenderer(std::string_view glRenderer);
 // Whether a backend with these capabilities draws what a parameter needs (params.h).
 bool hasFeature(const Capabilities& caps, sg::Feature feature);
 
+// What RenderControl::progress counts.
+enum class RenderStage : int {
+    Image,    // the image itself (tiles, rows)
+    Shapes,   // before it: analytic shapes tessellated anew (a new tessellation level or new
+              // shapes: seconds at the highest levels), weighed by tessellationWork()
+};
+
 // Shared between the caller and a render in progress (possibly on another thread).
 struct RenderControl {
     std::atomic<bool> cancel{false};
-    std::atomic<float> progress{0.0f};   // 0..1
-    std::function<void()> onTileDone;    // optional, called from worker threads
+    std::atomic<float> progress{0.0f};   // 0..1 of `stage`; starts again from 0 when the stage changes
+    std::atomic<RenderStage> stage{RenderStage::Image};
+    std::function<void()> onTileDone;   // optional, called from worker threads
 };
 
 // What the caller wants besides the colour image and depth.

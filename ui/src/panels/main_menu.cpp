@@ -143,6 +143,11 @@ void drawMainMenu(ViewerState& st) {
                                        {"Bounding boxes", &o.bounds},
                                        {"Selection bounds", &o.selection}})
                 ImGui::MenuItem(label, nullptr, flag);
+            ImGui::Separator();
+            // The grid is hidden behind surfaces (lines on a floor still show); this draws it over them.
+            ImGui::MenuItem("Grid on top", nullptr, &o.gridOnTop, o.grid);
+            if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
+                ImGui::SetTooltip("Draw the grid over every surface instead of behind them");
             ImGui::EndMenu();
         }
         ImGui::MenuItem("Stats overlay", nullptr, &st.ui.panels.showOverlay);

@@ -58,7 +58,10 @@ std::string slotStats(const SlotView& v) {
         for (const std::string& u : s.config.unsupported) extra += " " + u;
     }
     // The progress first, after the name: a long line is cut at the viewport's edge, never it.
-    const std::string progress = v.status.rendering ? std::to_string(int(v.status.progress * 100)) + "%  " : "";
+    // Tessellating shapes anew (a new tessellation level) comes before the image and can take
+    // seconds: said as such, with its own percentage.
+    const std::string percent = std::to_string(int(v.status.progress * 100)) + "%  ";
+    const std::string progress = !v.status.rendering ? "" : v.status.shapes ? "rebuilding shapes " + percent : percent;
     std::snprintf(buf, sizeof buf, "%-8s %s%7.1f ms  %6.1fk tris%s", v.status.backend.c_str(), progress.c_str(), s.milliseconds,
                   double(s.triangles) / 1000.0, extra.c_str());
     return buf;
