@@ -76,7 +76,7 @@ struct RenderSettings {
     // point light), biased by shadowDepthBias and shadowNormalBias texels, filtered by
     // shadowFilter over shadowPcfSize^2 texels.
     bool shadows = true;
-    int shadowMapSize = 2048;
+    int shadowMapSize = 1024;
     ShadowFilter shadowFilter = ShadowFilter::Pcf;
     int shadowPcfSize = 3;
     float shadowDepthBias = 1.0f;
