@@ -9,6 +9,10 @@
 //                     overdraw count target), the frame's draw list, read-back
 //   gl_passes.cpp     the draw passes: opaque (with the visibility attachment), blended,
 //                     wireframe, the overdraw view; frame state, MSAA resolve, the display pass
+//   gl_shadows.cpp    shadow maps (renderers/shadow_map.h, the CPU rasterizer's plan): the
+//                     depth pass into one texture array, the plan's uniform block for
+//                     shaders/shadow.glsl, the maps read back for the pixel inspector
+//   gl_environment.cpp pbr's environment light: its textures and the background pass
 //   gl_renderer.cpp   GlRenderer: context, capabilities, state guard, doRender
 //
 // Conventions (shared with the CPU backends, see renderers/shading.h): lighting in linear
@@ -30,6 +34,7 @@
 #include "renderers/environment.h"
 #include "renderers/framebuffer.h"
 #include "renderers/renderer.h"
+#include "renderers/shadow_map.h"
 #include "renderers/tessellate.h"
 #include "scenegraph/frame.h"
 
@@ -44,6 +49,7 @@
 namespace rnd::gl {
 
 extern const char* const kShader_lighting_glsl;
+extern const char* const kShader_shadow_glsl;
 extern const char* const kShader_pbr_glsl;
 extern const char* const kShader_mesh_vert;
 extern const char* const kShader_mesh_frag;
@@ -54,7 +60,9 @@ extern const char* const kShader_display_frag;
 constexpr int kMaxLights = 32;          // lights beyond this are ignored (uniform arrays)
 constexpr int kMaxUnrolledLights = 8;   // more lights: one generic program with a loop
 constexpr uint64_t kEvictAfterFrames = 120;
-constexpr size_t kMaxPrograms = 64;   // beyond this, programs not used by the last frame are deleted
+constexpr size_t kMaxPrograms = 64;    // beyond this, programs not used by the last frame are deleted
+constexpr int kShadowUnit = 7;         // texture unit of the shadow maps (shadow.glsl's uShadowMaps)
+constexpr GLuint kShadowBinding = 0;   // uniform buffer binding point of shadow.glsl's ShadowPlan
 
 // --- shader programs (gl_programs.cpp) -------------------------------------------------------
 
@@ -108,9 +116,9 @@ struct Program {
     GLint drawable = -1, primitiveBase = -1;   // visibility output (location 1)
 };
 
-// The frame setup part of a program's key: shading model, reflection model, fog mode and one
-// letter per light (see gl_programs.cpp).
-std::string programKey(const sg::FrameInput& f);
+// The frame setup part of a program's key: shading model, reflection model, fog mode, the
+// shadow maps' filter (none when `shadows` is empty) and one letter per light (see gl_programs.cpp).
+std::string programKey(const sg::FrameInput& f, const ShadowPlan& shadows);
 // Builds the program of frame setup `key` (programKey) with the draw's switches `ft` for frame
 // `f` into p (id and uniform locations). Returns "" or the compiler's or linker's message.
 std::string buildProgram(const std::string& key, const Features& ft, const sg::FrameInput& f, Program& p);
@@ -225,6 +233,9 @@ public:
     std::string_view name() const override { return "gl"; }
     Capabilities capabilities() const override;
     Device device() const override;
+    // The pixel inspector's shadows: the last frame's maps at p (read back from the GPU, the
+    // layers asked for, once per frame).
+    std::vector<float> lightVisibility(const sg::FrameInput& f, const sg::vec3& p, const sg::vec3& ng) override;
 
 protected:
     RenderStats doRender(const sg::FrameInput& frame, const RenderConfig& cfg, Framebuffer& target, RenderControl* control) override;
@@ -304,6 +315,23 @@ private:
     void drawEnvironmentBackground(const sg::FrameInput& frame, std::string& error);
     void releaseEnvironment();   // deletes the objects above (their context current)
     void forgetEnvironment();    // forgets them (their context is gone)
+    // Shadow maps (gl_shadows.cpp): this frame's plan (rnd::planShadows, per-pixel shading
+    // only), its maps as the layers of one DEPTH_COMPONENT32F array texture (kept between
+    // frames, reallocated when the size or the layer count changes), the FBO the depth pass
+    // draws each layer through, the plan's uniform buffer and the depth-only program.
+    ShadowPlan m_shadowPlan;
+    GLuint m_shadowTexture = 0, m_shadowFbo = 0, m_shadowUbo = 0, m_shadowProgram = 0;
+    GLint m_shadowModel = -1, m_shadowViewProj = -1, m_shadowDepth = -1;
+    int m_shadowTextureSize = 0, m_shadowTextureLayers = 0;
+    int m_maxTextureSize = 0, m_maxTextureLayers = 0;       // the driver's limits
+    std::unordered_map<int, ShadowMaps> m_shadowReadBack;   // layers read for lightVisibility this frame
+    // Plans and draws this frame's maps (frame setup: before beginFrameState) and binds them
+    // for the mesh programs; a map size the driver cannot make leaves the frame unshadowed,
+    // with a note in stats. Returns "" or the reason the depth pass failed.
+    std::string renderShadowMaps(const sg::FrameInput& frame, const std::vector<DrawItem>& items, RenderStats& stats);
+    const ShadowMaps* shadowLayer(int view);   // one layer of the last frame's maps, read back on first use
+    void releaseShadows();                     // deletes the objects above (their context current)
+    void forgetShadows();                      // forgets them (their context is gone)
     TessellationCache m_tess;
     std::vector<uint8_t> m_readRows;   // read-back rows to flip (without GL_MESA_pack_invert)
     uint64_t m_frame = 0, m_meshUploads = 0, m_textureUploads = 0;

@@ -1,9 +1,9 @@
 // gl_programs.cpp - the GL backend's shader programs (gl_internal.h): the GLSL of shaders/
 // (embedded at build time) specialised per frame setup - shading model, reflection model, fog
-// mode, light setup - and per draw's feature switches (textures, maps, alpha mode, the
-// wireframe, overdraw and visibility variants), compiled on first use and cached by key; the
-// uniforms a frame sets once per program (camera, lights, fog) and those a material sets; the
-// display pass's programs (exposure, tone mapping, SSAA box filter of linear frames).
+// mode, shadow maps, light setup - and per draw's feature switches (textures, maps, alpha
+// mode, the wireframe, overdraw and visibility variants), compiled on first use and cached by
+// key; the uniforms a frame sets once per program (camera, lights, fog) and those a material
+// sets; the display pass's programs (exposure, tone mapping, SSAA box filter of linear frames).
 #include "gl/gl_internal.h"
 
 #include "scenegraph/setting_names.h"
@@ -103,8 +103,8 @@ std::string glslEnumDefine(const char* name, const char* prefix, E value) {
 }
 
 std::string glslSources() {
-    return std::string(gl::kShader_pbr_glsl) + "\n" + gl::kShader_lighting_glsl + "\n" + gl::kShader_mesh_vert + "\n" + gl::kShader_mesh_frag + "\n" +
-           gl::kShader_tone_map_glsl + "\n" + gl::kShader_display_vert + "\n" + gl::kShader_display_frag;
+    return std::string(gl::kShader_pbr_glsl) + "\n" + gl::kShader_shadow_glsl + "\n" + gl::kShader_lighting_glsl + "\n" + gl::kShader_mesh_vert +
+           "\n" + gl::kShader_mesh_frag + "\n" + gl::kShader_tone_map_glsl + "\n" + gl::kShader_display_vert + "\n" + gl::kShader_display_frag;
 }
 
 namespace gl {
@@ -112,14 +112,18 @@ namespace gl {
 using namespace sg;
 
 // Programs are specialised per frame setup (see lighting.glsl): the key is the shading model,
-// the reflection model, the fog mode and one letter per light (p/P point, d directional, s/S
-// spot; upper case = inverse square), or '*' for the generic loop when there are many lights (a
-// 30-light unrolled program takes seconds to compile on llvmpipe).
-std::string programKey(const FrameInput& f) {
+// the reflection model, the fog mode, the shadow maps ('-' none, else 'A' + k - 1 for k x k
+// PCF; shadow.glsl), and one letter per light (p/P point, d directional, s/S spot; upper case =
+// inverse square), or '*' for the generic loop when there are many lights (a 30-light unrolled
+// program takes seconds to compile on llvmpipe).
+std::string programKey(const FrameInput& f, const ShadowPlan& shadows) {
     std::string key;
     key += char('0' + int(f.settings.shading));
     key += char('0' + int(f.settings.reflection));
     key += char('0' + int(f.settings.fog));
+    // Shadows in the per-pixel path only (the plan is empty otherwise).
+    const bool shadowed = !shadows.empty() && f.settings.shading == ShadingModel::Phong;
+    key += shadowed ? char('A' + std::clamp(shadows.pcf, 1, 15) - 1) : '-';
     size_t n = std::min<size_t>(f.lights.size(), kMaxLights);
     if (n > size_t(kMaxUnrolledLights)) return key + '*';
     for (size_t i = 0; i < n; ++i) {
@@ -133,7 +137,8 @@ std::string programKey(const FrameInput& f) {
 
 // Builds the program of frame setup `key` (programKey) with the draw's switches `ft` for frame `f`.
 std::string buildProgram(const std::string& key, const Features& ft, const FrameInput& f, Program& p) {
-    constexpr size_t kLights = 3;   // where the lights start in the key
+    constexpr size_t kLights = 4;   // where the lights start in the key
+    const int shadowPcf = key.size() > 3 && key[3] != '-' ? key[3] - 'A' + 1 : 0;
     std::string calls;
     if (key.size() > kLights && key[kLights] == '*')
         calls = "for (int i = 0; i < uNumLights; ++i) lightTerms(i, int(uLightPos[i].w + 0.5), uLightDir[i].w > 0.5, n, p, v, mul, add);";
@@ -145,6 +150,9 @@ std::string buildProgram(const std::string& key, const Features& ft, const Frame
     }
     auto flag = [](const char* name, bool on) { return std::string("#define ") + name + (on ? " 1\n" : " 0\n"); };
     const bool uv = ft.texture || ft.emissiveMap || ft.occlusionMap || ft.metalRoughMap || ft.normalMap;
+    // Shadow maps (shadow.glsl): on or off for the frame, the PCF kernel's size and the views' bound.
+    const std::string shadows = flag("SHADOWS", shadowPcf > 0) + "#define SHADOW_PCF " + std::to_string(std::max(shadowPcf, 1)) +
+                                "\n#define MAX_SHADOW_VIEWS " + std::to_string(kMaxShadowViews) + "\n";
     std::string prefix = "#version 330 core\n" + glslEnumDefines() + "#define SHADING " + key[0] + "\n#define REFLECTION " + key[1] +
                          "\n#define MAX_LIGHTS " + std::to_string(kMaxLights) + "\n#define LIGHT_CALLS " + calls + "\n" +
                          glslEnumDefine("FOG", "FOG_", f.settings.fog) + glslEnumDefine("ALPHA_MODE", "ALPHA_", ft.alphaMode) +
@@ -152,8 +160,8 @@ std::string buildProgram(const std::string& key, const Features& ft, const Frame
                          flag("HAS_METAL_ROUGH_MAP", ft.metalRoughMap) + flag("HAS_NORMAL_MAP", ft.normalMap) + flag("SPEC_GLOSS", ft.specGloss) +
                          flag("USES_UV", uv) + flag("USES_UV1", uv && ft.uv1) + flag("VERTEX_COLORS", ft.vertexColors) + flag("UNLIT", ft.unlit) +
                          flag("SOLID", ft.solid) + flag("OVERDRAW", ft.overdraw) + flag("VISIBILITY", ft.visibility) +
-                         flag("HAS_ENVIRONMENT", ft.environment) + flag("LINEAR_TARGET", ft.linearTarget);
-    std::string common = prefix + gl::kShader_pbr_glsl + "\n" + gl::kShader_lighting_glsl + "\n";
+                         flag("HAS_ENVIRONMENT", ft.environment) + flag("LINEAR_TARGET", ft.linearTarget) + shadows;
+    std::string common = prefix + gl::kShader_pbr_glsl + "\n" + gl::kShader_shadow_glsl + "\n" + gl::kShader_lighting_glsl + "\n";
     if (std::string err = linkProgram(common + gl::kShader_mesh_vert, common + gl::kShader_mesh_frag, "shader", p.id); !err.empty()) return err;
     auto loc = [&](const char* n) { return glGetUniformLocation(p.id, n); };
     p.model = loc("uModel");
@@ -208,6 +216,11 @@ std::string buildProgram(const std::string& key, const Features& ft, const Frame
     for (int k = 0; k < 4; ++k) glUniform1i(p.maps[k], 1 + k);
     glUniform1i(p.envMap, 5);
     glUniform1i(p.splitSum, 6);
+    if (shadowPcf > 0) {   // shadow.glsl: the maps and the plan's uniform block (gl_shadows.cpp)
+        glUniform1i(loc("uShadowMaps"), kShadowUnit);
+        const GLuint block = glGetUniformBlockIndex(p.id, "ShadowPlan");
+        if (block != GL_INVALID_INDEX) glUniformBlockBinding(p.id, block, kShadowBinding);
+    }
     return {};
 }
 
@@ -225,11 +238,11 @@ std::string buildDisplayProgram(sg::ToneMapping op, DisplayProgram& p) {
     return {};
 }
 
-// Starts the programs' frame: its input, setup key, SSAA factor and visibility output, for
-// useProgram; no program in use yet.
+// Starts the programs' frame: its input, setup key (with this frame's shadow plan, made
+// before), SSAA factor and visibility output, for useProgram; no program in use yet.
 void GlRenderer::beginFramePrograms(const FrameInput& frame, int ssaa, bool visibility) {
     m_frameInput = &frame;
-    m_frameKey = programKey(frame);
+    m_frameKey = programKey(frame, m_shadowPlan);
     m_ssaa = ssaa;
     m_visibility = visibility;
     m_current = nullptr;

@@ -1,8 +1,9 @@
 // gl_renderer.cpp - the OpenGL 3.3+ core rasterization backend ("gl"): the GlRenderer class
-// (gl_internal.h) with its context handling, capabilities and the frame (doRender), and the
-// state guard that restores the caller's GL state when we borrow its context. The programs,
-// GPU objects and draw passes a frame uses are in gl_programs.cpp, gl_resources.cpp and
-// gl_passes.cpp; gl_internal.h has the overview and the conventions.
+// (gl_internal.h) with its context handling, capabilities, the frame (doRender) and the pixel
+// inspector's shadows (lightVisibility), and the state guard that restores the caller's GL
+// state when we borrow its context. The programs, GPU objects, draw passes and shadow maps a
+// frame uses are in gl_programs.cpp, gl_resources.cpp, gl_passes.cpp and gl_shadows.cpp;
+// gl_internal.h has the overview and the conventions.
 #include "gl/gl_renderer.h"
 
 #include "gl/gl_context.h"
@@ -100,6 +101,8 @@ Capabilities GlRenderer::capabilities() const {
     c.affinity = ContextAffinity::CurrentGLContext;
     c.wireframe = true;
     c.pointsAndLines = true;
+    c.shadows = true;   // shadow maps (renderers/shadow_map.h, gl_shadows.cpp), as the CPU rasterizer's
+    c.shadowMaps = true;
     c.visibility = true;   // a second colour attachment, RG32UI (mesh.frag's fragId)
     c.overdraw = true;     // a second pass into an R32F target, additive (countOverdraw)
     // Constant for the life of the backend (callers may cache them): the driver's limits,
@@ -144,6 +147,8 @@ std::string GlRenderer::prepareContext(bool& madeCurrent) {
         glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &rb);
         glGetIntegerv(GL_MAX_VIEWPORT_DIMS, dims);
         m_maxSize = std::min({rb, dims[0], dims[1]});
+        glGetIntegerv(GL_MAX_TEXTURE_SIZE, &m_maxTextureSize);
+        glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &m_maxTextureLayers);
     }
     m_platform = (m_own && m_own->isCurrent()) ? m_own->platform() : "caller";
     return {};
@@ -160,6 +165,7 @@ void GlRenderer::forgetGLObjects() {
     m_meshes.clear();
     m_textures.clear();
     forgetEnvironment();
+    forgetShadows();
     m_loaded = false;
 }
 
@@ -181,6 +187,7 @@ void GlRenderer::releaseAll() {
         for (auto& [id, t] : m_textures)
             if (t.id) glDeleteTextures(1, &t.id);
         releaseEnvironment();
+        releaseShadows();
     }
     forgetGLObjects();
     if (madeCurrent) m_own->release();
@@ -225,17 +232,23 @@ RenderStats GlRenderer::doRender(const FrameInput& frame, const RenderConfig& cf
         return stats;
     }
 
-    beginFrameState(s, m_target.fbo, rw, rh, samples);
-    if (visibility) beginVisibility();
     // One GL frame is not progressive (render() checked cancellation before), but tessellating
     // new shapes can take seconds: that part reports its progress and stops when cancelled.
     const std::vector<DrawItem> items = collectDraws(frame, cfg.tessellation, control);
     if (control && control->cancel.load()) {
-        if (visibility) glDrawBuffer(GL_COLOR_ATTACHMENT0);
         stats.cancelled = true;
         stats.error = "cancelled";
         return stats;
     }
+    // Shadow maps into their own target first (their texture then on unit 7, the plan in a
+    // uniform buffer); the programs' key depends on the plan.
+    err = renderShadowMaps(frame, items, stats);
+    if (!err.empty()) {
+        stats.error = err;
+        return stats;
+    }
+    beginFrameState(s, m_target.fbo, rw, rh, samples);
+    if (visibility) beginVisibility();
     prepareEnvironment(frame, stats);   // pbr: textures on units 5 and 6
     // The programs of this frame (useProgram): its setup, and uniforms set once per program.
     beginFramePrograms(frame, ssaa, visibility);
@@ -275,6 +288,42 @@ RenderStats GlRenderer::doRender(const FrameInput& frame, const RenderConfig& cf
     }
     stats.ok = true;
     return stats;
+}
+
+std::vector<float> GlRenderer::lightVisibility(const FrameInput& f, const vec3& p, const vec3& ng) {
+    if (m_shadowPlan.empty() || m_shadowPlan.viewCount.size() != f.lights.size()) return {};
+    // The maps live in the GPU: their context current (ours, made current for the question, or
+    // the caller's), the caller's state kept.
+    bool madeCurrent = false;
+    const std::string err = prepareContext(madeCurrent);
+    struct ReleaseOnExit {
+        gl::GlContext* ctx;
+        ~ReleaseOnExit() {
+            if (ctx) ctx->release();
+        }
+    } releaseOnExit{madeCurrent ? m_own.get() : nullptr};
+    if (!err.empty() || m_shadowPlan.empty()) return {};   // (a different context forgets the maps)
+    StateGuard guard;
+    std::vector<float> v(f.lights.size(), 1.0f);
+    for (size_t l = 0; l < v.size(); ++l) {
+        if (m_shadowPlan.viewCount[l] == 0) continue;
+        // The light's map at p (a point light's face for p), as a plan of that one view: the same
+        // lookup as shadowVisibility over the whole plan, with one layer read back.
+        DrawLight L = f.lights[l];
+        int view = m_shadowPlan.firstView[l];
+        if (L.type == LightType::Point) {
+            view += pointLightFace(p - L.position);
+            L.type = LightType::Spot;   // one perspective view from the position, the face already chosen
+        }
+        const ShadowMaps* maps = shadowLayer(view);
+        if (!maps) return {};
+        ShadowPlan one = m_shadowPlan;
+        one.views = {m_shadowPlan.views[size_t(view)]};
+        one.firstView = {0};
+        one.viewCount = {1};
+        v[l] = shadowVisibility(one, *maps, L, 0, p, ng);
+    }
+    return v;
 }
 
 }   // namespace gl

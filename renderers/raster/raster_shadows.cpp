@@ -17,8 +17,7 @@ void renderShadowMaps(const ShadowPlan& plan, const std::vector<DrawItem>& draws
     }
     std::vector<ShadowCaster> casters;
     for (const DrawItem& d : draws) {
-        // Blended surfaces let light through (the ray caster: 1 - alpha); they cast nothing here.
-        if (d.material.alphaMode == sg::AlphaMode::Blend || d.wv.empty() || d.triCount == 0) continue;
+        if (!castsShadow(d.material) || d.wv.empty() || d.triCount == 0) continue;   // blended surfaces cast nothing (masked ones whole)
         ShadowCaster c;
         c.positions = &d.wv[0].pos;
         c.stride = sizeof(DrawItem::VertexOut);

@@ -15,6 +15,10 @@
 // code of the other light types; a loop over a uniform light count costs llvmpipe about 2x,
 // see bench/gl); for many lights a loop over uNumLights reading the type from the .w
 // components (one program for all, so it compiles once).
+//
+// Shadows (SHADOWS 1: shadow maps this frame, per-pixel shading only, as in the CPU
+// rasterizer): lightTerms multiplies each light's radiance by shadow.glsl's shadowVisibility at
+// p with the shading normal n; the ambient, emissive and environment terms are not shadowed.
 
 uniform int uNumLights;                // lights used by the loop form of LIGHT_CALLS
 uniform vec4 uLightPos[MAX_LIGHTS];    // xyz: world position; w: type (LIGHT_POINT ...)
@@ -119,10 +123,15 @@ void lightTerms(int i, int type, bool inverseSquare, vec3 n, vec3 p, vec3 v, ino
     vec3 l, radiance;
 #if REFLECTION == REFLECTION_PBR
     samplePunctualLight(i, type, inverseSquare, p, l, radiance);
-    pbrLightTerms(gPbr, n, v, l, radiance, mul, add);
-    return;
 #else
     sampleLight(i, type, inverseSquare, p, l, radiance);
+#endif
+#if SHADOWS
+    radiance *= shadowVisibility(i, type, uLightPos[i].xyz, uLightDir[i].xyz, p, n);   // shadow.glsl
+#endif
+#if REFLECTION == REFLECTION_PBR
+    pbrLightTerms(gPbr, n, v, l, radiance, mul, add);
+    return;
 #endif
     float nl = dot(n, l);
     if (nl <= 0.0) return;

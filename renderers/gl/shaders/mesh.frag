@@ -18,6 +18,9 @@
 //   VISIBILITY     1: also write fragId (the target has the visibility attachment)
 //   LINEAR_TARGET  1: the target is linear float (exposure or tone mapping follow): colour not
 //                  clamped at 1
+// The frame setup's switches (MAX_LIGHTS, LIGHT_CALLS, REFLECTION, SHADOWS, SHADOW_PCF) are
+// lighting.glsl's and shadow.glsl's: with shadow maps, the per-pixel path (SHADING_PHONG) gets
+// each light's visibility at the shading normal below.
 in vec3 vWorldPos;
 #if FOG != FOG_OFF
 in vec3 vEyePos;

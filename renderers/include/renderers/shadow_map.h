@@ -80,6 +80,14 @@ struct ShadowCaster {
     size_t triangles = 0;
     size_t vertices = 0;   // positions there are (a triangle with a corner past them is skipped)
 };
+// Whether a material's triangles go into the maps: blended surfaces do not (the ray caster lets
+// 1 - alpha through them; a depth map has no partial answer), nor cut-outs whose constant alpha is
+// already below the cutoff (never drawn); other cut-outs cast whole (no alpha test per texel).
+inline bool castsShadow(const sg::Material& m) {
+    if (m.alphaMode == sg::AlphaMode::Blend) return false;
+    return !(m.alphaMode == sg::AlphaMode::Mask && m.alpha < m.alphaCutoff);
+}
+
 // The CPU depth pass: clears one view's map (size x size) to 1 and rasterizes the casters into
 // it, both faces, depth test less, at pixel centres with the top-left rule (as GL's rasterizer).
 void renderShadowDepth(const ShadowView& v, int size, const std::vector<ShadowCaster>& casters, float* map);

@@ -1,0 +1,81 @@
+// shadow.glsl - the shadow-map lookup of renderers/common/shadow_map.cpp, name for name and
+// operation for operation (pointLightFace, shadowVisibility; keep the two in step;
+// renderers/shadow_map.h has the formulas). Included after pbr.glsl and before lighting.glsl,
+// whose lightTerms multiplies each light's radiance by shadowVisibility (both reflection
+// families; only the per-pixel path has SHADOWS 1).
+//
+// SHADOWS (0 or 1, part of the frame setup's key): this frame has shadow maps (rnd::planShadows
+// gave views) and the shading model is SHADING_PHONG; with 0 nothing here exists and lighting
+// costs what it did without shadows. SHADOW_PCF: k of the k x k filter (1 without PCF), a
+// constant so that the loops unroll. MAX_SHADOW_VIEWS: rnd::kMaxShadowViews.
+// The maps (gl_shadows.cpp): one layer per plan view of uShadowMaps (texture unit 7, depth
+// DEPTH_COMPONENT32F, nearest, no compare mode, read with texelFetch), row 0 at v = 0. The plan
+// in the uniform block ShadowPlan (binding point 0), std140, as gl_shadows.cpp fills it.
+
+#if SHADOWS
+uniform sampler2DArray uShadowMaps;
+
+layout(std140) uniform ShadowPlan {
+    mat4 uShadowViewProj[MAX_SHADOW_VIEWS];   // ShadowView::viewProj
+    vec4 uShadowAxis[MAX_SHADOW_VIEWS];       // the third row of ShadowView::view: -dot(axis, (p, 1)) = depth along the axis
+    vec4 uShadowRowX[MAX_SHADOW_VIEWS];       // its first and second rows
+    vec4 uShadowRowY[MAX_SHADOW_VIEWS];
+    vec4 uShadowView[MAX_SHADOW_VIEWS];       // x: perspective (1) or orthographic (0), y: nearZ, z: farZ, w: texelAtUnit
+    ivec4 uShadowLight[MAX_LIGHTS];           // x: first view, y: view count (0: no map, lit)
+    vec4 uShadowParams;                       // x: size N, y: depthBias, z: normalBias (texels)
+};
+
+// The map of a point light's face for the direction from the light to p (views: first of six).
+int pointLightFace(vec3 d) {
+    float ax = abs(d.x), ay = abs(d.y), az = abs(d.z);
+    if (ax >= ay && ax >= az) return d.x > 0.0 ? 0 : 1;
+    if (ay >= az) return d.y > 0.0 ? 2 : 3;
+    return d.z > 0.0 ? 4 : 5;
+}
+
+// Fraction of light `light` (its type, position and direction: the DrawLight of the C++) that
+// reaches world point p (unit surface normal ng, the shading normal, either side), by the
+// plan's maps: 1 lit, 0 shadowed, between at PCF edges.
+float shadowVisibility(int light, int type, vec3 lightPosition, vec3 lightDirection, vec3 p, vec3 ng) {
+    if (uShadowLight[light].y == 0) return 1.0;
+    int vi = uShadowLight[light].x;
+    if (type == LIGHT_POINT) vi += pointLightFace(p - lightPosition);
+    vec4 axis = uShadowAxis[vi], view = uShadowView[vi];
+    bool perspective = view.x > 0.5;
+    float nearZ = view.y, farZ = view.z, texelAtUnit = view.w;
+    vec3 toLight = type == LIGHT_DIRECTIONAL ? -lightDirection : lightPosition - p;
+    vec3 n = dot(ng, toLight) < 0.0 ? -ng : ng;   // the side the light is on
+    // The texel's size at p, the normal offset, then the receiver's depth less the depth bias.
+    float depthP = -(axis.x * p.x + axis.y * p.y + axis.z * p.z + axis.w);
+    float t = perspective ? texelAtUnit * depthP : texelAtUnit;
+    vec3 q = p + uShadowParams.z * t * n;
+    vec4 c = uShadowViewProj[vi] * vec4(q, 1.0);
+    if (!(c.w > 0.0)) return 1.0;
+    float u = (c.x / c.w) * 0.5 + 0.5, w = (c.y / c.w) * 0.5 + 0.5;
+    float zq = -(axis.x * q.x + axis.y * q.y + axis.z * q.z + axis.w);
+    float zb = zq - uShadowParams.y * t;
+    // The biased depth as the maps store depth (linear, 0 at near, 1 at far); each tap compares
+    // the receiver's plane at the tap's texel centre (receiver-plane depth bias, slope clamped at 4).
+    float range = farZ - nearZ;
+    float dRecv = (zb - nearZ) / range;
+    vec4 rx = uShadowRowX[vi], ry = uShadowRowY[vi];
+    vec3 nl = vec3(rx.x * n.x + rx.y * n.y + rx.z * n.z, ry.x * n.x + ry.y * n.y + ry.z * n.z, axis.x * n.x + axis.y * n.y + axis.z * n.z);
+    float nz = max(nl.z, 0.25 * sqrt(nl.x * nl.x + nl.y * nl.y));   // the light's side: nl.z > 0
+    float slopeX = nz > 0.0 ? nl.x / nz * t / range : 0.0, slopeY = nz > 0.0 ? nl.y / nz * t / range : 0.0;   // per texel
+    int N = int(uShadowParams.x + 0.5);
+    const int k = SHADOW_PCF;
+    float su = u * float(N), sv = w * float(N);
+    int i0 = int(floor(su - 0.5 * float(k) + 0.5)), j0 = int(floor(sv - 0.5 * float(k) + 0.5));
+    int lit = 0;
+    for (int dj = 0; dj < k; ++dj)   // j = j0 .. j0 + k - 1 (constant bounds: unrolled)
+        for (int di = 0; di < k; ++di) {
+            int i = i0 + di, j = j0 + dj;
+            // Texels outside the map are lit (the fetch is clamped to stay defined).
+            bool outside = i < 0 || j < 0 || i >= N || j >= N;
+            float d = texelFetch(uShadowMaps, ivec3(clamp(i, 0, N - 1), clamp(j, 0, N - 1), vi), 0).r;
+            float dTap = dRecv + slopeX * (float(i) + 0.5 - su) + slopeY * (float(j) + 0.5 - sv);
+            lit += outside || dTap <= d ? 1 : 0;
+        }
+    return float(lit) / float(k * k);
+}
+#endif
