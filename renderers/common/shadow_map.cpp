@@ -99,7 +99,9 @@ ShadowPlan planShadows(const sg::FrameInput& f, const Aabb& casters) {
             // Square texels, the margin around, and the depth range of every caster.
             const float half = 0.5f * std::max({fit.max.x - fit.min.x, fit.max.y - fit.min.y, 1e-6f * radius}) * (1.0f + 2.0f * margin);
             const float cx = 0.5f * (fit.min.x + fit.max.x), cy = 0.5f * (fit.min.y + fit.max.y);
-            const float depth = std::max(all.max.z - all.min.z, 1e-6f * radius);
+            // (At least a thousandth of the scene and clear of float rounding at this distance: a
+            // flat scene would otherwise get near == far.)
+            const float depth = std::max({all.max.z - all.min.z, 1e-3f * radius, 1e-4f * std::max(std::abs(all.min.z), std::abs(all.max.z))});
             v.nearZ = -all.max.z - 0.01f * depth;
             v.farZ = -all.min.z + 0.01f * depth;
             v.viewProj = glm::ortho(cx - half, cx + half, cy - half, cy + half, v.nearZ, v.farZ) * v.view;
@@ -336,10 +338,14 @@ float shadowVisibility(const ShadowPlan& plan, const ShadowMaps& maps, const sg:
     // the receiver's plane at the tap's texel centre (receiver-plane depth bias: a tilted receiver
     // is deeper or shallower there than at q, by its slope in the light's frame, clamped at 4).
     const float range = v.farZ - v.nearZ;
+    if (!(range > 0.0f)) return 1.0f;
     const float dRecv = (zb - v.nearZ) / range;
     const vec3 nl(v.view[0][0] * n.x + v.view[1][0] * n.y + v.view[2][0] * n.z, v.view[0][1] * n.x + v.view[1][1] * n.y + v.view[2][1] * n.z,
                   v.view[0][2] * n.x + v.view[1][2] * n.y + v.view[2][2] * n.z);
-    const float nz = std::max(nl.z, 0.25f * std::sqrt(nl.x * nl.x + nl.y * nl.y));                                      // the light's side: nl.z > 0
+    // The receiver's tilt against the ray to the light (a perspective map's rays leave its axis
+    // by up to 45 degrees at a cube face's edge), clamped at a slope of 4.
+    const float cosRay = v.perspective ? glm::dot(n, glm::normalize(toLight)) : nl.z;
+    const float nz = std::max(cosRay, 0.25f * std::sqrt(nl.x * nl.x + nl.y * nl.y));                                    // the light's side: > 0
     const float slopeX = nz > 0.0f ? nl.x / nz * t / range : 0.0f, slopeY = nz > 0.0f ? nl.y / nz * t / range : 0.0f;   // per texel
     const int N = plan.size, k = plan.pcf;
     const float su = u * float(N), sv = w * float(N);

@@ -43,12 +43,21 @@ inline void shadowLookupV(const ShadowPlan& plan, const ShadowView& v, const flo
     const V u = add(mul(mul(cx, icw), set1(0.5f)), set1(0.5f)), w = add(mul(mul(cy, icw), set1(0.5f)), set1(0.5f));
     const V zb = sub(depthOf(qx, qy, qz), mul(set1(plan.depthBias), t));
     const float range = v.farZ - v.nearZ;
+    if (!(range > 0.0f)) {   // no depth range (planShadows never makes one): lit
+        storeu(out + i, one);
+        return;
+    }
     const V dRecv = mul(sub(zb, set1(v.nearZ)), set1(1.0f / range));
     // receiver-plane slope per texel
     const V mx = add(add(mul(set1(vw[0][0]), nx), mul(set1(vw[1][0]), ny)), mul(set1(vw[2][0]), nz));
     const V my = add(add(mul(set1(vw[0][1]), nx), mul(set1(vw[1][1]), ny)), mul(set1(vw[2][1]), nz));
     const V mz = add(add(mul(set1(vw[0][2]), nx), mul(set1(vw[1][2]), ny)), mul(set1(vw[2][2]), nz));
-    const V mzc = vmax(mz, mul(set1(0.25f), vsqrt(add(mul(mx, mx), mul(my, my)))));
+    V cosRay = mz;
+    if (v.perspective) {   // against the ray to the light, not the map's axis
+        const V ll = vsqrt(add(add(mul(lx, lx), mul(ly, ly)), mul(lz, lz)));
+        cosRay = div(add(add(mul(nx, lx), mul(ny, ly)), mul(nz, lz)), sel(cmpgt(ll, zero), ll, one));
+    }
+    const V mzc = vmax(cosRay, mul(set1(0.25f), vsqrt(add(mul(mx, mx), mul(my, my)))));
     const V mpos = cmpgt(mzc, zero);
     const V scale = div(mul(t, set1(1.0f / range)), sel(mpos, mzc, one));
     const V slopeX = vand(mpos, mul(mx, scale)), slopeY = vand(mpos, mul(my, scale));

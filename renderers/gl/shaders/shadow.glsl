@@ -57,10 +57,14 @@ float shadowVisibility(int light, int type, vec3 lightPosition, vec3 lightDirect
     // The biased depth as the maps store depth (linear, 0 at near, 1 at far); each tap compares
     // the receiver's plane at the tap's texel centre (receiver-plane depth bias, slope clamped at 4).
     float range = farZ - nearZ;
+    if (!(range > 0.0)) return 1.0;
     float dRecv = (zb - nearZ) / range;
     vec4 rx = uShadowRowX[vi], ry = uShadowRowY[vi];
     vec3 nl = vec3(rx.x * n.x + rx.y * n.y + rx.z * n.z, ry.x * n.x + ry.y * n.y + ry.z * n.z, axis.x * n.x + axis.y * n.y + axis.z * n.z);
-    float nz = max(nl.z, 0.25 * sqrt(nl.x * nl.x + nl.y * nl.y));   // the light's side: nl.z > 0
+    // The receiver's tilt against the ray to the light (a perspective map's rays leave its axis
+    // by up to 45 degrees at a cube face's edge), clamped at a slope of 4.
+    float cosRay = perspective ? dot(n, normalize(toLight)) : nl.z;
+    float nz = max(cosRay, 0.25 * sqrt(nl.x * nl.x + nl.y * nl.y));   // the light's side: > 0
     float slopeX = nz > 0.0 ? nl.x / nz * t / range : 0.0, slopeY = nz > 0.0 ? nl.y / nz * t / range : 0.0;   // per texel
     int N = int(uShadowParams.x + 0.5);
     const int k = SHADOW_PCF;
