@@ -4,10 +4,13 @@
 
 #include <tbb/parallel_for.h>
 
+#include <sys/mman.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <new>
 
 namespace rnd {
 
@@ -51,6 +54,23 @@ void perspectiveRange(const Aabb& casters, const mat4& view, float& nearZ, float
 }
 
 }   // namespace
+
+PageBuffer::~PageBuffer() {
+    if (data_) munmap(data_, capacity_ * sizeof(float));
+}
+
+void PageBuffer::resize(size_t n) {
+    if (n > capacity_) {
+        if (data_) munmap(data_, capacity_ * sizeof(float));
+        data_ = nullptr;
+        size_ = capacity_ = 0;
+        void* p = mmap(nullptr, n * sizeof(float), PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+        if (p == MAP_FAILED) throw std::bad_alloc();
+        data_ = static_cast<float*>(p);
+        capacity_ = n;
+    }
+    size_ = n;
+}
 
 Aabb shadowCasterBounds(const sg::FrameInput& f) {
     Aabb b;
@@ -155,9 +175,9 @@ struct WinTri {
 
 constexpr int kBand = 64;   // rows per band of the parallel depth pass
 
-// Clips a clip-space polygon against the near plane (z >= -w) and appends its fan of window
-// triangles.
-void emitClipped(const vec4 (&in)[3], const ShadowView& v, int size, std::vector<WinTri>& out) {
+// Clips a clip-space polygon against the near plane (z >= -w) and writes its fan of window
+// triangles (at most two) to out; returns how many.
+int emitClipped(const vec4 (&in)[3], const ShadowView& v, int size, WinTri* out) {
     vec4 poly[4];
     int n = 0;
     for (int k = 0; k < 3; ++k) {
@@ -170,11 +190,11 @@ void emitClipped(const vec4 (&in)[3], const ShadowView& v, int size, std::vector
             poly[n++] = p + t * (q - p);
         }
     }
-    if (n < 3) return;
+    if (n < 3) return 0;
     const float s = float(size), range = v.farZ - v.nearZ;
     vec4 w[4];
     for (int k = 0; k < n; ++k) {
-        if (!(poly[k].w > 0.0f)) return;
+        if (!(poly[k].w > 0.0f)) return 0;
         const float iw = 1.0f / poly[k].w;
         const vec3 ndc = vec3(poly[k]) * iw;
         // The stored depth: linear along the axis, 0 at near, 1 at far (perspective: w is the
@@ -183,6 +203,7 @@ void emitClipped(const vec4 (&in)[3], const ShadowView& v, int size, std::vector
         w[k] = v.perspective ? vec4((ndc.x * 0.5f + 0.5f) * s, (ndc.y * 0.5f + 0.5f) * s, iw, d * iw)
                              : vec4((ndc.x * 0.5f + 0.5f) * s, (ndc.y * 0.5f + 0.5f) * s, 1.0f, d);
     }
+    int emitted = 0;
     for (int k = 1; k + 1 < n; ++k) {
         WinTri t{w[0], w[k], w[k + 1], 0, 0};
         const float ymin = std::min({t.a.y, t.b.y, t.c.y}), ymax = std::max({t.a.y, t.b.y, t.c.y});
@@ -190,8 +211,9 @@ void emitClipped(const vec4 (&in)[3], const ShadowView& v, int size, std::vector
         if (!(ymax >= 0.0f && ymin < s && xmax >= 0.0f && xmin < s)) continue;   // off the map (or NaN)
         t.y0 = std::max(0, int(std::floor(ymin - 0.5f)));
         t.y1 = std::min(size - 1, int(std::ceil(ymax - 0.5f)));
-        if (t.y0 <= t.y1) out.push_back(t);
+        if (t.y0 <= t.y1) out[emitted++] = t;
     }
+    return emitted;
 }
 
 // Rasterizes t into rows [r0, r1] of the map: pixel centres, the top-left rule, depth less.
@@ -277,20 +299,38 @@ void rasterizeRows(const WinTri& t, int size, int r0, int r1, float* map) {
 
 void renderShadowDepth(const ShadowView& v, int size, const std::vector<ShadowCaster>& casters, float* map) {
     std::fill(map, map + size_t(size) * size_t(size), 1.0f);
-    // Window triangles, built in parallel blocks of each caster.
+    // Window triangles, built in parallel blocks of each caster, each block into its own stretch
+    // of one buffer (a clipped triangle makes at most two). The buffers are the calling thread's,
+    // kept from call to call: allocating them per map, in the workers, fragmented the heap of
+    // a long session (resident memory kept growing).
     constexpr size_t kBlock = 4096;
     struct Block {
         const ShadowCaster* c;
         size_t begin, end;
     };
-    std::vector<Block> blocks;
+    struct Scratch {
+        std::vector<Block> blocks;
+        std::vector<WinTri> built;
+        std::vector<uint32_t> builtCount;
+        std::vector<std::vector<uint32_t>> perBand;
+    };
+    thread_local Scratch scratch;
+    // (Named here: inside the workers' lambdas a thread_local would be the worker's own.)
+    Scratch& sc = scratch;
+    auto& blocks = sc.blocks;
+    auto& built = sc.built;
+    auto& builtCount = sc.builtCount;
+    auto& perBand = sc.perBand;
+    blocks.clear();
     for (const ShadowCaster& c : casters)
         for (size_t b = 0; b < c.triangles; b += kBlock) blocks.push_back({&c, b, std::min(c.triangles, b + kBlock)});
-    std::vector<std::vector<WinTri>> built(blocks.size());
+    if (built.size() < blocks.size() * 2 * kBlock) built.resize(blocks.size() * 2 * kBlock);
+    builtCount.assign(blocks.size(), 0);
     tbb::parallel_for(size_t(0), blocks.size(), [&](size_t bi) {
         const Block& blk = blocks[bi];
         const auto* base = static_cast<const unsigned char*>(blk.c->positions);
-        std::vector<WinTri>& out = built[bi];
+        WinTri* out = &built[bi * 2 * kBlock];
+        uint32_t count = 0;
         for (size_t t = blk.begin; t < blk.end; ++t) {
             vec4 clip[3];
             bool valid = true;
@@ -302,19 +342,23 @@ void renderShadowDepth(const ShadowView& v, int size, const std::vector<ShadowCa
                 std::memcpy(xyz, base + i * blk.c->stride, sizeof(xyz));
                 clip[k] = v.viewProj * vec4(xyz[0], xyz[1], xyz[2], 1.0f);
             }
-            if (valid) emitClipped(clip, v, size, out);
+            if (valid) count += uint32_t(emitClipped(clip, v, size, out + count));
         }
+        builtCount[bi] = count;
     });
     // Bands of rows, each with the triangles that reach it, rasterized in parallel.
     const int bands = (size + kBand - 1) / kBand;
-    std::vector<std::vector<const WinTri*>> perBand;
-    perBand.resize(size_t(bands));
-    for (const auto& list : built)
-        for (const WinTri& t : list)
-            for (int b = t.y0 / kBand; b <= t.y1 / kBand; ++b) perBand[size_t(b)].push_back(&t);
+    if (perBand.size() < size_t(bands)) perBand.resize(size_t(bands));
+    for (auto& list : perBand) list.clear();
+    for (size_t bi = 0; bi < blocks.size(); ++bi)
+        for (uint32_t q = 0; q < builtCount[bi]; ++q) {
+            const uint32_t id = uint32_t(bi * 2 * kBlock + q);
+            const WinTri& t = built[id];
+            for (int b = t.y0 / kBand; b <= t.y1 / kBand; ++b) perBand[size_t(b)].push_back(id);
+        }
     tbb::parallel_for(0, bands, [&](int b) {
         const int r0 = b * kBand, r1 = std::min(size - 1, r0 + kBand - 1);
-        for (const WinTri* t : perBand[size_t(b)]) rasterizeRows(*t, size, r0, r1, map);
+        for (uint32_t id : perBand[size_t(b)]) rasterizeRows(built[id], size, r0, r1, map);
     });
 }
 

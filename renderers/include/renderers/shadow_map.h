@@ -27,6 +27,8 @@
 #include "scenegraph/frame.h"
 #include "scenegraph/math.h"
 
+#include <cstddef>
+#include <utility>
 #include <vector>
 
 namespace rnd {
@@ -63,10 +65,45 @@ sg::Aabb shadowCasterBounds(const sg::FrameInput& f);
 // The plan for f's lights (empty when settings.shadows is off or nothing casts).
 ShadowPlan planShadows(const sg::FrameInput& f, const sg::Aabb& casters);
 
+// Float storage straight from the operating system (mmap): the maps are tens of megabytes,
+// allocated as renderers come and go on different threads, and malloc kept such blocks in its
+// per-thread arenas (a long window session grew by hundreds of megabytes); these go back when
+// freed. resize() keeps the mapping when it is large enough and does not keep the contents.
+class PageBuffer {
+public:
+    PageBuffer() = default;
+    PageBuffer(const PageBuffer&) = delete;
+    PageBuffer& operator=(const PageBuffer&) = delete;
+    PageBuffer(PageBuffer&& o) noexcept { swap(o); }
+    PageBuffer& operator=(PageBuffer&& o) noexcept {
+        swap(o);
+        return *this;
+    }
+    ~PageBuffer();
+    void resize(size_t n);   // throws std::bad_alloc when the system has no memory for it
+    void clear() { size_ = 0; }
+    size_t size() const { return size_; }
+    float* data() { return data_; }
+    const float* data() const { return data_; }
+    float* begin() { return data_; }
+    float* end() { return data_ + size_; }
+    const float* begin() const { return data_; }
+    const float* end() const { return data_ + size_; }
+
+private:
+    void swap(PageBuffer& o) noexcept {
+        std::swap(data_, o.data_);
+        std::swap(size_, o.size_);
+        std::swap(capacity_, o.capacity_);
+    }
+    float* data_ = nullptr;
+    size_t size_ = 0, capacity_ = 0;
+};
+
 // The depth maps, size x size floats each, view after view.
 struct ShadowMaps {
     int size = 0;
-    std::vector<float> depth;
+    PageBuffer depth;
     const float* map(int view) const { return depth.data() + size_t(view) * size_t(size) * size_t(size); }
     float* map(int view) { return depth.data() + size_t(view) * size_t(size) * size_t(size); }
 };
