@@ -209,8 +209,9 @@ int emitClipped(const vec4 (&in)[3], const ShadowView& v, int size, WinTri* out)
         const float ymin = std::min({t.a.y, t.b.y, t.c.y}), ymax = std::max({t.a.y, t.b.y, t.c.y});
         const float xmin = std::min({t.a.x, t.b.x, t.c.x}), xmax = std::max({t.a.x, t.b.x, t.c.x});
         if (!(ymax >= 0.0f && ymin < s && xmax >= 0.0f && xmin < s)) continue;   // off the map (or NaN)
-        t.y0 = std::max(0, int(std::floor(ymin - 0.5f)));
-        t.y1 = std::min(size - 1, int(std::ceil(ymax - 0.5f)));
+        // (Clamped as floats first: a vertex far off the map would overflow the conversion.)
+        t.y0 = std::max(0, int(std::floor(std::max(ymin, -1.0f) - 0.5f)));
+        t.y1 = std::min(size - 1, int(std::ceil(std::min(ymax, s + 1.0f) - 0.5f)));
         if (t.y0 <= t.y1) out[emitted++] = t;
     }
     return emitted;
@@ -240,7 +241,8 @@ void rasterizeRows(const WinTri& t, int size, int r0, int r1, float* map) {
         inclusive[k] = top || left;
     }
     const float xmin = std::min({a.x, b.x, c.x}), xmax = std::max({a.x, b.x, c.x});
-    const int x0 = std::max(0, int(std::floor(xmin - 0.5f))), x1 = std::min(size - 1, int(std::ceil(xmax - 0.5f)));
+    const int x0 = std::max(0, int(std::floor(std::max(xmin, -1.0f) - 0.5f))),
+              x1 = std::min(size - 1, int(std::ceil(std::min(xmax, float(size) + 1.0f) - 0.5f)));
     const int y0 = std::max(r0, t.y0), y1 = std::min(r1, t.y1);
     // 1/w and d/w are affine in the pixel centre (sums of the edge functions' multiples).
     float iwX = 0, iwY = 0, iw0 = 0, dwX = 0, dwY = 0, dw0 = 0;
@@ -393,6 +395,7 @@ float shadowVisibility(const ShadowPlan& plan, const ShadowMaps& maps, const sg:
     const float slopeX = nz > 0.0f ? nl.x / nz * t / range : 0.0f, slopeY = nz > 0.0f ? nl.y / nz * t / range : 0.0f;   // per texel
     const int N = plan.size, k = plan.pcf;
     const float su = u * float(N), sv = w * float(N);
+    if (!(std::abs(su) < 1e8f && std::abs(sv) < 1e8f)) return 1.0f;   // far outside the map (or NaN): lit
     const int i0 = int(std::floor(su - 0.5f * float(k) + 0.5f)), j0 = int(std::floor(sv - 0.5f * float(k) + 0.5f));
     const float* map = maps.map(vi);
     int lit = 0;
