@@ -169,8 +169,9 @@ std::string renderNotes(const ViewportInput& view) {
         const rnd::RenderConfig& c = v.status.stats.config;
         std::string part;
         for (const std::string& n : c.notes) part += (part.empty() ? "" : "; ") + n;
-        std::string list;   // shadows/reflections are on by default and drawn only by the ray caster:
-                            // the stats overlay lists them, the status line would always show them
+        std::string list;   // shadows/reflections are on by default and not drawn by every backend
+                            // (reflections: the ray caster only): the stats overlay lists them, the
+                            // status line would always show them
         for (const std::string& u : c.unsupported)
             if (u != "shadows" && u != "reflections") list += (list.empty() ? "" : ", ") + u;
         if (!list.empty()) part += (part.empty() ? "" : "; ") + std::string("does not draw ") + list;
