@@ -67,8 +67,9 @@ struct ShadeBatch {
         return int32_t(mats.size() - 1);
     }
     // Copies fragment i's constant block (mat[i] >= 0) into the per-fragment arrays.
-    void expand(size_t i) {
-        const Constants& c = mats[size_t(mat[i])];
+    void expand(size_t i) { store(i, mats[size_t(mat[i])]); }
+    // Writes a constant block's values into fragment i's arrays.
+    void store(size_t i, const Constants& c) {
         ar[i] = c.ar;
         ag[i] = c.ag;
         ab[i] = c.ab;
@@ -122,19 +123,7 @@ struct ShadeBatch {
         ny[i] = n.y;
         nz[i] = n.z;
         mat[i] = -1;
-        const Constants c = pbrConstants(q, albedo, occlusion, emissive);
-        ar[i] = c.ar;
-        ag[i] = c.ag;
-        ab[i] = c.ab;
-        sr[i] = c.sr;
-        sg[i] = c.sg;
-        sb[i] = c.sb;
-        kd[i] = c.kd;
-        ks[i] = c.ks;
-        shin[i] = c.shin;
-        cr[i] = c.cr;
-        cg[i] = c.cg;
-        cb[i] = c.cb;
+        store(i, pbrConstants(q, albedo, occlusion, emissive));
     }
     static Constants pbrConstants(const PbrPoint& q, const sg::vec3& albedo, float occlusion, const sg::vec3& emissive) {
         const sg::vec3 cdiff = albedo * q.cdiffFactor;
