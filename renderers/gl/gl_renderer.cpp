@@ -292,17 +292,21 @@ RenderStats GlRenderer::doRender(const FrameInput& frame, const RenderConfig& cf
 
 std::vector<float> GlRenderer::lightVisibility(const FrameInput& f, const vec3& p, const vec3& ng) {
     if (m_shadowPlan.empty() || m_shadowPlan.viewCount.size() != f.lights.size()) return {};
-    // The maps live in the GPU: their context current (ours, made current for the question, or
-    // the caller's), the caller's state kept.
+    // The maps live in the GPU, in the context that rendered them: current here already (the
+    // caller's), or ours made current for the question. Never another one: prepareContext would
+    // take it for a new context and forget (leak) every object of the old one.
     bool madeCurrent = false;
-    const std::string err = prepareContext(madeCurrent);
+    if (!gl::anyContextCurrent()) {
+        if (!m_own || !m_own->makeCurrent(nullptr)) return {};
+        madeCurrent = true;
+    }
     struct ReleaseOnExit {
         gl::GlContext* ctx;
         ~ReleaseOnExit() {
             if (ctx) ctx->release();
         }
     } releaseOnExit{madeCurrent ? m_own.get() : nullptr};
-    if (!err.empty() || m_shadowPlan.empty()) return {};   // (a different context forgets the maps)
+    if (!m_loaded || gl::currentContextHandle() != m_objectsContext) return {};
     StateGuard guard;
     std::vector<float> v(f.lights.size(), 1.0f);
     for (size_t l = 0; l < v.size(); ++l) {

@@ -210,8 +210,19 @@ void RenderSlot::workerLoop() {
         Job job;
         {
             std::unique_lock<std::mutex> lock(m_mutex);
-            m_cv.wait(lock, [&] { return m_quit || m_pending.has_value(); });
+            m_cv.wait(lock, [&] { return m_quit || m_pending.has_value() || m_question; });
             if (m_quit) return;
+            if (Question* q = m_question) {   // between renders: the renderer's state is that of the last frame
+                m_question = nullptr;
+                lock.unlock();
+                std::vector<float> a = answer(*q);
+                lock.lock();
+                q->answer = std::move(a);
+                q->done = true;
+                lock.unlock();
+                m_cv.notify_all();
+                continue;
+            }
             job = std::move(*m_pending);
             m_pending.reset();
             m_busy = true;
@@ -255,13 +266,32 @@ bool RenderSlot::poll() {
     return true;
 }
 
+// The renderer answers for the frame it rendered last: only while that is the one shown.
+std::vector<float> RenderSlot::answer(const Question& q) {
+    std::lock_guard<std::mutex> rendering(m_renderMutex);
+    if (m_renderedFrame != q.frame.get()) return {};
+    return m_renderer->lightVisibility(*q.frame, q.p, q.ng);
+}
+
 std::vector<float> RenderSlot::lightVisibility(const sg::vec3& p, const sg::vec3& ng) {
     if (!m_renderer || !m_shownFrame) return {};
-    std::unique_lock<std::mutex> rendering(m_renderMutex, std::try_to_lock);
-    if (!rendering.owns_lock()) return {};
-    // The renderer answers for the frame it rendered last: only while that is the one shown.
-    if (m_renderedFrame != m_shownFrame.get()) return {};
-    return m_renderer->lightVisibility(*m_shownFrame, p, ng);
+    Question q;
+    q.frame = m_shownFrame;
+    q.p = p;
+    q.ng = ng;
+    if (!m_threaded) return answer(q);   // renders run here too (poll): none is in flight
+    // On the worker, where the renderer renders (and its GL context, if it has one, is made
+    // current); not while a render is in flight or waiting (asked again on a later frame).
+    std::unique_lock<std::mutex> lock(m_mutex);
+    if (m_busy || m_pending || m_quit || m_question) return {};
+    m_question = &q;
+    m_cv.notify_all();
+    if (!m_cv.wait_for(lock, std::chrono::milliseconds(500), [&] { return q.done || m_question != &q; })) {
+        m_question = nullptr;   // not taken (the worker is stuck elsewhere): no answer this time
+        return {};
+    }
+    m_cv.wait(lock, [&] { return q.done; });   // taken: the worker writes into q, which must outlive that
+    return std::move(q.answer);
 }
 
 void RenderSlot::forget() {

@@ -142,7 +142,17 @@ private:
         uint64_t generation = 0;                        // m_generation when requested: forget() outdates it
         double budgetMs = 50;                           // liveBudgetMs when requested
     };
+    // A question for the renderer between renders, answered on the worker (a GL renderer's maps
+    // live in the worker's context: asked from the UI thread, whose context is the window's, the
+    // answer would need the objects of another context).
+    struct Question {
+        std::shared_ptr<const sg::FrameInput> frame;
+        sg::vec3 p{0.0f}, ng{0.0f};
+        std::vector<float> answer;
+        bool done = false;   // guarded by m_mutex
+    };
     void workerLoop();
+    std::vector<float> answer(const Question& q);
     // Renders one job step by step (runJob in render_slot.cpp); publishes each finished step.
     void runJob(const Job& job);
     void publish(rnd::Framebuffer&& fb, const rnd::RenderStats& st, int level, bool refining, const Job& job);
@@ -161,6 +171,7 @@ private:
     std::optional<Job> m_pending;
     bool m_busy = false;
     bool m_quit = false;
+    Question* m_question = nullptr;            // asked by lightVisibility, taken by the worker (guarded by m_mutex)
     rnd::RenderControl* m_control = nullptr;   // of the render in flight (guarded by m_mutex)
     bool m_haveNew = false;
     uint64_t m_generation = 0;   // bumped by forget() (guarded by m_mutex)
