@@ -24,6 +24,8 @@ float visibility(float nl, float nv, float a2) {
 // The roughness the BRDF uses: at least 1e-3 (alpha 1e-6), where the GGX peak still fits a float.
 float usableRoughness(float r) { return std::clamp(r, 1e-3f, 1.0f); }
 
+}   // namespace
+
 float radicalInverse(uint32_t i) {
     i = (i << 16u) | (i >> 16u);
     i = ((i & 0x55555555u) << 1u) | ((i & 0xAAAAAAAAu) >> 1u);
@@ -32,7 +34,6 @@ float radicalInverse(uint32_t i) {
     i = ((i & 0x00FF00FFu) << 8u) | ((i & 0xFF00FF00u) >> 8u);
     return float(i) * 2.3283064365386963e-10f;
 }
-}   // namespace
 
 vec3 ggxHalfVector(int i, int n, float a2) {
     const float e1 = (float(i) + 0.5f) / float(n), e2 = radicalInverse(uint32_t(i));

@@ -10,6 +10,7 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <new>
 
 namespace rnd {
@@ -87,12 +88,13 @@ ShadowPlan planShadows(const sg::FrameInput& f, const Aabb& casters) {
     if (!s.shadows || casters.empty() || f.lights.empty()) return plan;
     plan.size = std::clamp(s.shadowMapSize, 1, 8192);
     plan.filter = s.shadowFilter;
-    plan.pcf = s.shadowFilter == sg::ShadowFilter::Pcf ? std::clamp(s.shadowPcfSize, 1, 15) : 1;
+    plan.pcf = s.shadowFilter != sg::ShadowFilter::None ? std::clamp(s.shadowPcfSize, 1, 15) : 1;
     plan.depthBias = s.shadowDepthBias;
     plan.normalBias = s.shadowNormalBias;
     const float N = float(plan.size);
-    // Texels kept beyond an edge so that the filter's taps there still read the map.
-    const float margin = float(plan.pcf + 2) / N;
+    // Texels kept beyond an edge so that the filter's taps there still read the map (PCSS's
+    // reach up to kPcssMaxRadius texels on each side).
+    const float margin = float((plan.filter == sg::ShadowFilter::Pcss ? 2 * kPcssMaxRadius : plan.pcf) + 2) / N;
     const vec3 centre = casters.center();
     const float radius = std::max(0.5f * glm::length(casters.extent()), 1e-6f);
     for (const sg::DrawLight& L : f.lights) {
@@ -364,6 +366,20 @@ void renderShadowDepth(const ShadowView& v, int size, const std::vector<ShadowCa
     });
 }
 
+float pcssJitter(int i, int j, int view, int axis) {
+    auto hash = [](uint32_t x) {
+        x ^= x >> 16;
+        x *= 0x7feb352dU;
+        x ^= x >> 15;
+        x *= 0x846ca68bU;
+        x ^= x >> 16;
+        return x;
+    };
+    uint32_t h = hash(uint32_t(i) * 73856093u ^ uint32_t(j) * 19349663u ^ uint32_t(view) * 83492791u);
+    if (axis) h = hash(h);
+    return float(h >> 8) * (1.0f / 16777216.0f);
+}
+
 float shadowVisibility(const ShadowPlan& plan, const ShadowMaps& maps, const sg::DrawLight& L, int light, const vec3& p, const vec3& ng) {
     if (light < 0 || size_t(light) >= plan.viewCount.size() || plan.viewCount[size_t(light)] == 0 || maps.size != plan.size) return 1.0f;
     int vi = plan.firstView[size_t(light)];
@@ -396,18 +412,56 @@ float shadowVisibility(const ShadowPlan& plan, const ShadowMaps& maps, const sg:
     const int N = plan.size, k = plan.pcf;
     const float su = u * float(N), sv = w * float(N);
     if (!(std::abs(su) < 1e8f && std::abs(sv) < 1e8f)) return 1.0f;   // far outside the map (or NaN): lit
-    const int i0 = int(std::floor(su - 0.5f * float(k) + 0.5f)), j0 = int(std::floor(sv - 0.5f * float(k) + 0.5f));
     const float* map = maps.map(vi);
+    // The receiver's depth at texel (i, j)'s centre, and that texel's depth (outside the map:
+    // infinite, lit).
+    auto receiver = [&](int i, int j) { return dRecv + slopeX * (float(i) + 0.5f - su) + slopeY * (float(j) + 0.5f - sv); };
+    auto stored = [&](int i, int j) {
+        return i < 0 || j < 0 || i >= N || j >= N ? std::numeric_limits<float>::infinity() : map[size_t(j) * size_t(N) + size_t(i)];
+    };
+    if (plan.filter == sg::ShadowFilter::Pcss) {
+        // PCSS (docs/math.md, "Soft shadows"): the source's size in the map's terms, lambda (a
+        // directional light: tan of its angular radius; a point or spot: its radius, over the
+        // blocker's depth for the penumbra and over the near plane's for the search), gives the
+        // blocker search's radius in texels, then the penumbra's from the blockers' mean depth.
+        const float zR = zq;
+        const float size = L.type == sg::LightType::Directional ? L.tanAngularRadius : L.radius;
+        auto reach = [&](float zB) {   // the penumbra's radius in texels for a blocker at depth zB
+            const float world = v.perspective ? size * (zR - zB) / std::max(zB, 1e-6f) : size * (zR - zB);
+            return world / t;
+        };
+        const float kf = float(k);
+        // The taps' grid shifted inside its cells by a hash of p's texel: a thin caster between
+        // taps turns into noise instead of streaks.
+        const float jx = pcssJitter(int(std::floor(su)), int(std::floor(sv)), vi, 0),
+                    jy = pcssJitter(int(std::floor(su)), int(std::floor(sv)), vi, 1);
+        const float rs = std::clamp(reach(v.nearZ), 0.5f * kf, float(kPcssMaxRadius));
+        float blockers = 0.0f, depthSum = 0.0f;
+        for (int b = 0; b < kPcssSearch * kPcssSearch; ++b) {
+            const float ox = ((float(b % kPcssSearch) + jx) / float(kPcssSearch) * 2.0f - 1.0f) * rs;
+            const float oy = ((float(b / kPcssSearch) + jy) / float(kPcssSearch) * 2.0f - 1.0f) * rs;
+            const int i = int(std::floor(su + ox)), j = int(std::floor(sv + oy));
+            const float d = stored(i, j);
+            if (d < receiver(i, j)) {
+                blockers += 1.0f;
+                depthSum += d;
+            }
+        }
+        if (blockers == 0.0f) return 1.0f;
+        const float zB = v.linearDepth(depthSum / blockers);
+        const float rf = std::clamp(reach(zB), 0.5f * kf, float(kPcssMaxRadius));
+        int lit = 0;
+        for (int b = 0; b < k * k; ++b) {
+            const float ox = ((float(b % k) + jx) / kf * 2.0f - 1.0f) * rf, oy = ((float(b / k) + jy) / kf * 2.0f - 1.0f) * rf;
+            const int i = int(std::floor(su + ox)), j = int(std::floor(sv + oy));
+            lit += receiver(i, j) <= stored(i, j) ? 1 : 0;
+        }
+        return float(lit) / float(k * k);
+    }
+    const int i0 = int(std::floor(su - 0.5f * float(k) + 0.5f)), j0 = int(std::floor(sv - 0.5f * float(k) + 0.5f));
     int lit = 0;
     for (int j = j0; j < j0 + k; ++j)
-        for (int i = i0; i < i0 + k; ++i) {
-            if (i < 0 || j < 0 || i >= N || j >= N) {
-                ++lit;
-                continue;
-            }
-            const float dTap = dRecv + slopeX * (float(i) + 0.5f - su) + slopeY * (float(j) + 0.5f - sv);
-            lit += dTap <= map[size_t(j) * size_t(N) + size_t(i)] ? 1 : 0;
-        }
+        for (int i = i0; i < i0 + k; ++i) lit += receiver(i, j) <= stored(i, j) ? 1 : 0;
     return float(lit) / float(k * k);
 }
 

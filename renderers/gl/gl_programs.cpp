@@ -113,7 +113,7 @@ using namespace sg;
 
 // Programs are specialised per frame setup (see lighting.glsl): the key is the shading model,
 // the reflection model, the fog mode, the shadow maps ('-' none, else 'A' + k - 1 for k x k
-// PCF; shadow.glsl), and one letter per light (p/P point, d directional, s/S spot; upper case =
+// PCF, 'a' + k - 1 for PCSS with k x k taps; shadow.glsl), and one letter per light (p/P point, d directional, s/S spot; upper case =
 // inverse square), or '*' for the generic loop when there are many lights (a 30-light unrolled
 // program takes seconds to compile on llvmpipe).
 std::string programKey(const FrameInput& f, const ShadowPlan& shadows) {
@@ -123,7 +123,7 @@ std::string programKey(const FrameInput& f, const ShadowPlan& shadows) {
     key += char('0' + int(f.settings.fog));
     // Shadows in the per-pixel path only (the plan is empty otherwise).
     const bool shadowed = !shadows.empty() && f.settings.shading == ShadingModel::Phong;
-    key += shadowed ? char('A' + std::clamp(shadows.pcf, 1, 15) - 1) : '-';
+    key += shadowed ? char((shadows.filter == ShadowFilter::Pcss ? 'a' : 'A') + std::clamp(shadows.pcf, 1, 15) - 1) : '-';
     size_t n = std::min<size_t>(f.lights.size(), kMaxLights);
     if (n > size_t(kMaxUnrolledLights)) return key + '*';
     for (size_t i = 0; i < n; ++i) {
@@ -138,7 +138,8 @@ std::string programKey(const FrameInput& f, const ShadowPlan& shadows) {
 // Builds the program of frame setup `key` (programKey) with the draw's switches `ft` for frame `f`.
 std::string buildProgram(const std::string& key, const Features& ft, const FrameInput& f, Program& p) {
     constexpr size_t kLights = 4;   // where the lights start in the key
-    const int shadowPcf = key.size() > 3 && key[3] != '-' ? key[3] - 'A' + 1 : 0;
+    const bool pcss = key.size() > 3 && key[3] >= 'a' && key[3] <= 'z';
+    const int shadowPcf = key.size() > 3 && key[3] != '-' ? key[3] - (pcss ? 'a' : 'A') + 1 : 0;
     std::string calls;
     if (key.size() > kLights && key[kLights] == '*')
         calls = "for (int i = 0; i < uNumLights; ++i) lightTerms(i, int(uLightPos[i].w + 0.5), uLightDir[i].w > 0.5, n, p, v, mul, add);";
@@ -150,9 +151,11 @@ std::string buildProgram(const std::string& key, const Features& ft, const Frame
     }
     auto flag = [](const char* name, bool on) { return std::string("#define ") + name + (on ? " 1\n" : " 0\n"); };
     const bool uv = ft.texture || ft.emissiveMap || ft.occlusionMap || ft.metalRoughMap || ft.normalMap;
-    // Shadow maps (shadow.glsl): on or off for the frame, the PCF kernel's size and the views' bound.
-    const std::string shadows = flag("SHADOWS", shadowPcf > 0) + "#define SHADOW_PCF " + std::to_string(std::max(shadowPcf, 1)) +
-                                "\n#define MAX_SHADOW_VIEWS " + std::to_string(kMaxShadowViews) + "\n";
+    // Shadow maps (shadow.glsl): on or off for the frame, the filter's taps, PCSS or plain PCF, and
+    // the bounds of the views and of PCSS.
+    const std::string shadows = flag("SHADOWS", shadowPcf > 0) + "#define SHADOW_PCF " + std::to_string(std::max(shadowPcf, 1)) + "\n" +
+                                flag("SHADOW_PCSS", pcss) + "#define MAX_SHADOW_VIEWS " + std::to_string(kMaxShadowViews) + "\n#define PCSS_SEARCH " +
+                                std::to_string(kPcssSearch) + "\n#define PCSS_MAX_RADIUS " + std::to_string(kPcssMaxRadius) + "\n";
     std::string prefix = "#version 330 core\n" + glslEnumDefines() + "#define SHADING " + key[0] + "\n#define REFLECTION " + key[1] +
                          "\n#define MAX_LIGHTS " + std::to_string(kMaxLights) + "\n#define LIGHT_CALLS " + calls + "\n" +
                          glslEnumDefine("FOG", "FOG_", f.settings.fog) + glslEnumDefine("ALPHA_MODE", "ALPHA_", ft.alphaMode) +
@@ -300,7 +303,7 @@ void GlRenderer::setFrameUniforms(const Program& p, const FrameInput& f, int ssa
         pos[i] = vec4(l.position, type);
         dir[i] = vec4(l.direction, l.inverseSquare ? 1.0f : 0.0f);
         rad[i] = vec4(l.radiance, 0.0f);
-        cone[i] = vec4(l.cosInner, l.cosOuter, l.range, 0.0f);
+        cone[i] = vec4(l.cosInner, l.cosOuter, l.range, l.type == LightType::Directional ? l.tanAngularRadius : l.radius);
     }
     glUniform1i(p.numLights, n);
     if (n > 0) {

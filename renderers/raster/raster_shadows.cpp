@@ -36,7 +36,7 @@ void fillShadowVisibility(const FrameContext& fc, ShadeBatch& b, size_t n) {
     const ShadowPlan& plan = *fc.shadowPlan;
     const auto& lights = fc.frame->lights;
     b.resetVisibility(lights.size());
-    const size_t W = shadowLookupWidth();
+    const size_t W = plan.filter == sg::ShadowFilter::Pcss ? 0 : shadowLookupWidth();   // PCSS: the scalar lookup
     for (size_t l = 0; l < lights.size(); ++l) {
         if (l >= plan.viewCount.size() || plan.viewCount[l] == 0) continue;
         const sg::DrawLight& L = lights[l];

@@ -23,6 +23,7 @@
 #include "renderers/environment.h"
 #include "renderers/pbr.h"
 #include "renderers/shading.h"
+#include "renderers/shadow_map.h"
 #include "renderers/texture_sampler.h"
 #include "renderers/tone_map.h"
 
@@ -36,6 +37,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdlib>
+#include <cstring>
 
 namespace rnd {
 
@@ -135,6 +137,15 @@ struct SurfaceRecord {
     uint32_t drawable = 0, primitive = kNoPrimitive;
 };
 
+uint32_t hash32(uint32_t x) {
+    x ^= x >> 16;
+    x *= 0x7feb352dU;
+    x ^= x >> 15;
+    x *= 0x846ca68bU;
+    x ^= x >> 16;
+    return x;
+}
+
 struct Tracer {
     const FrameInput& f;
     const rt::SceneAccel& accel;
@@ -232,6 +243,10 @@ struct Tracer {
             LightSample ls = sampleLight(f.lights[i], p);
             float side = glm::dot(ng, ls.toLight) >= 0 ? 1.0f : -1.0f;
             float eps = offsetScale(p);
+            if (f.lights[i].hasSize() && f.settings.shadowRays > 1) {
+                visible[i] = softVisibility(f.lights[i], p, side * ng, eps);
+                continue;
+            }
             rt::Ray sr;
             sr.org = p + side * eps * ng;
             sr.dir = ls.toLight;
@@ -241,6 +256,35 @@ struct Tracer {
             ++rays;
             visible[i] = transmittance(sr);
         }
+    }
+
+    // The fraction of a light with a size that reaches p (n: the geometric normal on the light's
+    // centre's side): settings.shadowRays rays to points of the source (softShadowRay), their
+    // transmittances averaged; a ray below p's surface counts as blocked (the surface hides that
+    // part of the source). The points are shifted by a hash of p: noise, not bands.
+    float softVisibility(const DrawLight& L, const vec3& p, const vec3& n, float eps) {
+        const int count = f.settings.shadowRays;
+        uint32_t seed = 0x2545f491u;
+        for (int a = 0; a < 3; ++a) {
+            uint32_t bits;
+            std::memcpy(&bits, &p[a], sizeof bits);
+            seed = hash32(seed ^ bits);
+        }
+        const vec2 rotation(float(seed >> 8) * (1.0f / 16777216.0f), float(hash32(seed) >> 8) * (1.0f / 16777216.0f));
+        float sum = 0.0f;
+        for (int k = 0; k < count; ++k) {
+            const ShadowRayTarget t = softShadowRay(L, p, k, count, rotation);
+            if (!(glm::dot(t.dir, n) > 0.0f)) continue;
+            rt::Ray sr;
+            sr.org = p + eps * n;
+            sr.dir = t.dir;
+            sr.tmin = 0.0f;
+            sr.tmax = std::isfinite(t.distance) ? t.distance * (1.0f - 1e-4f) - eps : std::numeric_limits<float>::infinity();
+            if (!(sr.tmax > 0)) continue;
+            ++rays;
+            sum += transmittance(sr);
+        }
+        return sum / float(count);
     }
 
     // A hit after shading: the point, its shading normal n and geometric normal ng (both on the
@@ -504,14 +548,6 @@ struct Tracer {
     }
 };
 
-uint32_t hash32(uint32_t x) {
-    x ^= x >> 16;
-    x *= 0x7feb352dU;
-    x ^= x >> 15;
-    x *= 0x846ca68bU;
-    x ^= x >> 16;
-    return x;
-}
 float rand01(uint32_t& s) {
     s = hash32(s + 0x9e3779b9u);
     return float(s >> 8) * (1.0f / 16777216.0f);

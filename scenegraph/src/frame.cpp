@@ -158,6 +158,8 @@ FrameInput flatten(const Scene& scene, float aspect, NodeId cameraNode) {
             l.cosInner = std::cos(radians(std::min(lp->spotInnerDeg, lp->spotOuterDeg)));
             l.cosOuter = std::cos(radians(lp->spotOuterDeg));
             l.range = lp->range;
+            l.radius = std::max(lp->radius, 0.0f);
+            l.tanAngularRadius = std::tan(radians(std::clamp(lp->angularRadiusDeg, 0.0f, 45.0f)));
             f.lights.push_back(l);
         } else if (!inCsg) {
             DrawAnalytic a;

@@ -148,7 +148,7 @@ std::vector<Param<RenderSettings>> renderTable() {
                 field<&S::shadowPcfSize>("shadow.pcfSize", "shadow-pcf-size", "PCF size", "k: the k x k texels PCF averages")
                     .range(1, 15)
                     .needing(Feature::ShadowMaps)
-                    .when([](const S& s) { return s.shadows && s.shadowFilter == ShadowFilter::Pcf; }),
+                    .when([](const S& s) { return s.shadows && s.shadowFilter != ShadowFilter::None; }),
                 field<&S::shadowDepthBias>("shadow.depthBias", "shadow-depth-bias", "Depth bias",
                                            "Texels a receiver's depth is moved toward the light before the comparison (against acne)")
                     .range(0.0, 64.0)
@@ -160,6 +160,11 @@ std::vector<Param<RenderSettings>> renderTable() {
                     .range(0.0, 64.0)
                     .fmt("%.2f texels")
                     .needing(Feature::ShadowMaps)
+                    .when(shadowsOn),
+                field<&S::shadowRays>("shadow.rays", "shadow-rays", "Shadow rays",
+                                      "Rays to each light that has a size (soft shadows; a point source takes one)")
+                    .range(1, 256)
+                    .needing(Feature::ShadowRays)
                     .when(shadowsOn),
             }),
         inSection<S>("Ray caster",
@@ -329,6 +334,15 @@ std::vector<Param<Light>> lightTable() {
                 .range(0.0, 1e9)
                 .dragged("%.3f")
                 .when([](const L& l) { return l.type != LightType::Directional; }),
+            field<&L::radius>("radius", "", "Radius", "Size of the source for soft shadows (world units; 0 = a point)")
+                .range(0.0, 1e6)
+                .dragged("%.3f")
+                .when([](const L& l) { return l.type != LightType::Directional; }),
+            field<&L::angularRadiusDeg>("angularRadius", "", "Angular radius",
+                                        "Size of the source for soft shadows (degrees; the sun is about 0.27; 0 = a point)")
+                .range(0.0, 45.0)
+                .dragged("%.2f")
+                .when([](const L& l) { return l.type == LightType::Directional; }),
         });
 }
 

@@ -76,6 +76,8 @@ constexpr NamedValue<ToneMapping> kToneMapping[] = {
 constexpr NamedValue<ShadowFilter> kShadowFilter[] = {
     {ShadowFilter::None, "none", "None", "one texel's answer: hard, stair-stepped edges"},
     {ShadowFilter::Pcf, "pcf", "PCF", "percentage-closer filtering: the mean answer of the k x k texels around the point"},
+    {ShadowFilter::Pcss, "pcss", "PCSS",
+     "percentage-closer soft shadows: PCF over the penumbra the light's size gives (blocker search, then k x k taps)"},
 };
 
 constexpr NamedValue<AlphaMode> kAlphaMode[] = {

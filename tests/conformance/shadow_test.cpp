@@ -5,7 +5,9 @@
 //  - a floating slab and a thin pole over a ground, lit by a sun or a spot light: each backend's
 //    shadowed pixels (darker with shadows on than off) overlap the ray caster's (IoU >= 0.9 at
 //    640 x 640), and the two rasterizers' overlap each other's (IoU >= 0.95);
-//  - the thin pole (a tenth of a unit, a few texels wide) still casts.
+//  - the thin pole (a tenth of a unit, a few texels wide) still casts;
+//  - soft shadows: a sun with an angular radius gives a penumbra as wide as the geometry says,
+//    in the ray caster (several rays per light) and in the rasterizers (PCSS); a point sun none.
 #include "renderers/renderer.h"
 #include "renderers/shadow_map.h"
 #include "scenegraph/mesh.h"
@@ -217,6 +219,92 @@ TEST_P(Shadows, SlabAndThinPoleCast) {
         for (int y = 0; y < S; ++y)
             for (int x = S * 5 / 8; x < S; ++x) right += m[size_t(y) * S + size_t(x)];
         EXPECT_GT(right, 200u) << name(light) << ": the thin pole casts no shadow";
+    }
+}
+
+// The visibility of a sun with angular radius `deg` along a ground line across the slab's
+// shadow's right edge (x from 0.54 - 1 to 0.54 + 1 at z = -0.36: the edge of the slab's upper
+// right corner, x = 1.55 * 0.35, cast along the sun's direction (0.35, -1, -0.25)).
+std::vector<float> edgeProfile(const std::string& backend, float deg, std::vector<float>& xs) {
+    sg::FrameInput f = slabAndPole(Caster::Sun);
+    f.lights[0].tanAngularRadius = std::tan(deg * sg::kPi / 180.0f);
+    f.settings.shadowFilter = sg::ShadowFilter::Pcss;
+    f.settings.shadowPcfSize = 5;
+    f.settings.shadowRays = 64;
+    std::string err;
+    auto r = rnd::makeRenderer(backend, &err);
+    EXPECT_TRUE(r) << err;
+    if (!r) return {};
+    rnd::Framebuffer fb;
+    EXPECT_TRUE(r->render(f, S, S, fb).ok);
+    testing_support::writeImage(fb, "conformance", "shadow-" + backend + "-soft-" + std::to_string(int(deg)));
+    std::vector<float> v;
+    xs.clear();
+    for (float x = 0.54f - 1.0f; x <= 0.54f + 1.0f; x += 0.02f) {
+        const std::vector<float> lv = r->lightVisibility(f, vec3(x, 0.0f, -0.36f), vec3(0.0f, 1.0f, 0.0f));
+        EXPECT_EQ(lv.size(), 1u) << backend;
+        xs.push_back(x);
+        v.push_back(lv.empty() ? -1.0f : lv[0]);
+    }
+    return v;
+}
+
+// Where a profile first rises past `level` (x; NaN: never).
+float crossing(const std::vector<float>& xs, const std::vector<float>& v, float level) {
+    for (size_t i = 0; i < v.size(); ++i)
+        if (v[i] >= level) return xs[i];
+    return std::nanf("");
+}
+
+// A sun of angular radius 8 degrees: the penumbra across the slab's straight edge spans
+// 1.55 (tan(alpha + 8) - tan(alpha - 8)) = 0.49 units on the ground (tan alpha = 0.35), centred
+// near x = 0.55. The visibility rises from 0 to 1 across it, in the ray caster by counting rays
+// and in the rasterizers by PCSS's estimate; with a point sun (radius 0) the edge is hard.
+TEST_P(Shadows, PenumbraFollowsTheLightsSize) {
+    std::vector<float> xs;
+    const std::vector<float> soft = edgeProfile(GetParam(), 8.0f, xs);
+    ASSERT_FALSE(soft.empty());
+    std::string profile;
+    for (size_t i = 0; i < soft.size(); i += 5) profile += " " + std::to_string(soft[i]).substr(0, 4);
+    const float lo = crossing(xs, soft, 0.1f), mid = crossing(xs, soft, 0.5f), hi = crossing(xs, soft, 0.9f);
+    std::printf("%s: soft edge 0.1 at %.2f, 0.5 at %.2f, 0.9 at %.2f:%s\n", GetParam().c_str(), lo, mid, hi, profile.c_str());
+    EXPECT_NEAR(mid, 0.55f, 0.1f) << profile;
+    EXPECT_GT(hi - lo, 0.2f) << "no penumbra:" << profile;
+    EXPECT_LT(hi - lo, 0.7f) << profile;
+    EXPECT_LT(soft.front(), 0.05f) << "inside the shadow" << profile;
+    EXPECT_GT(soft.back(), 0.95f) << "outside the shadow" << profile;
+    const std::vector<float> hard = edgeProfile(GetParam(), 0.0f, xs);
+    const float hlo = crossing(xs, hard, 0.1f), hhi = crossing(xs, hard, 0.9f);
+    EXPECT_LT(hhi - hlo, 0.1f) << "a point sun's edge is hard";
+    EXPECT_NEAR(crossing(xs, hard, 0.5f), 0.54f, 0.05f);
+}
+
+// The ray caster's shadow rays to a light with a size end on the source: a directional light's
+// within its angular radius of the light's direction, a sphere light's on the disc of its
+// radius facing the point; their mean is the centre (the samples are stratified).
+TEST(ShadowMapTest, SoftShadowRaysCoverTheSource) {
+    sg::DrawLight sun = directional(glm::normalize(vec3(0.3f, -1.0f, 0.2f)), vec3(1.0f));
+    sun.tanAngularRadius = std::tan(5.0f * sg::kPi / 180.0f);
+    sg::DrawLight bulb = point(vec3(1.0f, 4.0f, -2.0f), vec3(1.0f), false);
+    bulb.radius = 0.5f;
+    const vec3 p(0.2f, 0.0f, 0.1f);
+    for (int n : {1, 16, 64}) {
+        vec3 meanSun(0.0f), meanBulb(0.0f);
+        for (int k = 0; k < n; ++k) {
+            const rnd::ShadowRayTarget s = rnd::softShadowRay(sun, p, k, n, sg::vec2(0.37f, 0.81f));
+            EXPECT_GE(glm::dot(s.dir, -sun.direction), std::cos(5.0f * sg::kPi / 180.0f) - 1e-5f);
+            EXPECT_TRUE(std::isinf(s.distance));
+            meanSun += s.dir;
+            const rnd::ShadowRayTarget b = rnd::softShadowRay(bulb, p, k, n, sg::vec2(0.37f, 0.81f));
+            const vec3 target = p + b.dir * b.distance;
+            EXPECT_LE(glm::length(target - bulb.position), 0.5f + 1e-4f);
+            EXPECT_NEAR(glm::dot(target - bulb.position, glm::normalize(bulb.position - p)), 0.0f, 1e-4f) << "on the disc facing p";
+            meanBulb += target;
+        }
+        if (n >= 16) {
+            EXPECT_GT(glm::dot(glm::normalize(meanSun), -sun.direction), std::cos(1.0f * sg::kPi / 180.0f)) << n;
+            EXPECT_LT(glm::length(meanBulb / float(n) - bulb.position), 0.08f) << n;
+        }
     }
 }
 

@@ -22,8 +22,7 @@ struct Shown {
     std::shared_ptr<const sg::FrameInput> frame;
 };
 
-Shown renderStill(const std::string& backend, RenderSlot::Threading threading, const std::shared_ptr<const sg::FrameInput>& frame, int w,
-                  int h) {
+Shown renderStill(const std::string& backend, RenderSlot::Threading threading, const std::shared_ptr<const sg::FrameInput>& frame, int w, int h) {
     Shown s;
     s.frame = frame;
     s.slot = std::make_unique<RenderSlot>(backend, threading);

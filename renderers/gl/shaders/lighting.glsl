@@ -24,7 +24,7 @@ uniform int uNumLights;                // lights used by the loop form of LIGHT_
 uniform vec4 uLightPos[MAX_LIGHTS];    // xyz: world position; w: type (LIGHT_POINT ...)
 uniform vec4 uLightDir[MAX_LIGHTS];    // xyz: world direction the light travels; w: 1 = 1/r^2
 uniform vec4 uLightRad[MAX_LIGHTS];    // xyz: radiance (colour * intensity)
-uniform vec4 uLightCone[MAX_LIGHTS];   // x: cos inner, y: cos outer, z: range (pbr; 0 = none)
+uniform vec4 uLightCone[MAX_LIGHTS];   // x: cos inner, y: cos outer, z: range (pbr; 0 = none), w: size (PCSS)
 
 uniform vec3 uEye;          // camera position, world
 uniform vec3 uAmbient;      // L_ambient
@@ -127,7 +127,7 @@ void lightTerms(int i, int type, bool inverseSquare, vec3 n, vec3 p, vec3 v, ino
     sampleLight(i, type, inverseSquare, p, l, radiance);
 #endif
 #if SHADOWS
-    radiance *= shadowVisibility(i, type, uLightPos[i].xyz, uLightDir[i].xyz, p, n);   // shadow.glsl
+    radiance *= shadowVisibility(i, type, uLightPos[i].xyz, uLightDir[i].xyz, uLightCone[i].w, p, n);   // shadow.glsl
 #endif
 #if REFLECTION == REFLECTION_PBR
     pbrLightTerms(gPbr, n, v, l, radiance, mul, add);

@@ -7,7 +7,9 @@
 // SHADOWS (0 or 1, part of the frame setup's key): this frame has shadow maps (rnd::planShadows
 // gave views) and the shading model is SHADING_PHONG; with 0 nothing here exists and lighting
 // costs what it did without shadows. SHADOW_PCF: k of the k x k filter (1 without PCF), a
-// constant so that the loops unroll. MAX_SHADOW_VIEWS: rnd::kMaxShadowViews.
+// constant so that the loops unroll. SHADOW_PCSS: 1 for PCSS (the k x k taps spread over the
+// penumbra). MAX_SHADOW_VIEWS, PCSS_SEARCH, PCSS_MAX_RADIUS: rnd::kMaxShadowViews, kPcssSearch,
+// kPcssMaxRadius.
 // The maps (gl_shadows.cpp): one layer per plan view of uShadowMaps (texture unit 7, depth
 // DEPTH_COMPONENT32F, nearest, no compare mode, read with texelFetch), row 0 at v = 0. The plan
 // in the uniform block ShadowPlan (binding point 0), std140, as gl_shadows.cpp fills it.
@@ -33,10 +35,33 @@ int pointLightFace(vec3 d) {
     return d.z > 0.0 ? 4 : 5;
 }
 
+// The receiver's depth at texel (i, j)'s centre (its plane through the biased depth dRecv at
+// (su, sv), slopes per texel), and the depth stored there (outside the map: lit).
+float shadowReceiver(int i, int j, float dRecv, float su, float sv, float slopeX, float slopeY) {
+    return dRecv + slopeX * (float(i) + 0.5 - su) + slopeY * (float(j) + 0.5 - sv);
+}
+float shadowStored(int i, int j, int N, int vi) {
+    if (i < 0 || j < 0 || i >= N || j >= N) return 3.0e38;   // (+infinity in the C++)
+    return texelFetch(uShadowMaps, ivec3(i, j, vi), 0).r;
+}
+// PCSS's shift of its taps inside their grid cells (shadow_map.cpp's pcssJitter, bit for bit).
+uint pcssHash(uint x) {
+    x ^= x >> 16u;
+    x *= 0x7feb352du;
+    x ^= x >> 15u;
+    x *= 0x846ca68bu;
+    x ^= x >> 16u;
+    return x;
+}
+float pcssJitter(int i, int j, int view, int axis) {
+    uint h = pcssHash(uint(i) * 73856093u ^ uint(j) * 19349663u ^ uint(view) * 83492791u);
+    if (axis != 0) h = pcssHash(h);
+    return float(h >> 8u) * (1.0 / 16777216.0);
+}
 // Fraction of light `light` (its type, position and direction: the DrawLight of the C++) that
 // reaches world point p (unit surface normal ng, the shading normal, either side), by the
 // plan's maps: 1 lit, 0 shadowed, between at PCF edges.
-float shadowVisibility(int light, int type, vec3 lightPosition, vec3 lightDirection, vec3 p, vec3 ng) {
+float shadowVisibility(int light, int type, vec3 lightPosition, vec3 lightDirection, float lightSize, vec3 p, vec3 ng) {
     if (uShadowLight[light].y == 0) return 1.0;
     int vi = uShadowLight[light].x;
     if (type == LIGHT_POINT) vi += pointLightFace(p - lightPosition);
@@ -69,17 +94,44 @@ float shadowVisibility(int light, int type, vec3 lightPosition, vec3 lightDirect
     int N = int(uShadowParams.x + 0.5);
     const int k = SHADOW_PCF;
     float su = u * float(N), sv = w * float(N);
+#if SHADOW_PCSS
+    // PCSS (docs/math.md, "Soft shadows"): the blocker search, then k x k taps over the penumbra.
+    float zR = zq;
+    float kf = float(k);
+    int ci = int(floor(su)), cj = int(floor(sv));
+    float jx = pcssJitter(ci, cj, vi, 0), jy = pcssJitter(ci, cj, vi, 1);
+    float reachNear = (perspective ? lightSize * (zR - nearZ) / max(nearZ, 1e-6) : lightSize * (zR - nearZ)) / t;
+    float rs = clamp(reachNear, 0.5 * kf, float(PCSS_MAX_RADIUS));
+    float blockers = 0.0, depthSum = 0.0;
+    for (int b = 0; b < PCSS_SEARCH * PCSS_SEARCH; ++b) {
+        float ox = ((float(b % PCSS_SEARCH) + jx) / float(PCSS_SEARCH) * 2.0 - 1.0) * rs;
+        float oy = ((float(b / PCSS_SEARCH) + jy) / float(PCSS_SEARCH) * 2.0 - 1.0) * rs;
+        int i = int(floor(su + ox)), j = int(floor(sv + oy));
+        float d = shadowStored(i, j, N, vi);
+        if (d < shadowReceiver(i, j, dRecv, su, sv, slopeX, slopeY)) {
+            blockers += 1.0;
+            depthSum += d;
+        }
+    }
+    if (blockers == 0.0) return 1.0;
+    float zB = nearZ + depthSum / blockers * range;
+    float reachB = (perspective ? lightSize * (zR - zB) / max(zB, 1e-6) : lightSize * (zR - zB)) / t;
+    float rf = clamp(reachB, 0.5 * kf, float(PCSS_MAX_RADIUS));
+    int lit = 0;
+    for (int b = 0; b < k * k; ++b) {
+        float ox = ((float(b % k) + jx) / kf * 2.0 - 1.0) * rf, oy = ((float(b / k) + jy) / kf * 2.0 - 1.0) * rf;
+        int i = int(floor(su + ox)), j = int(floor(sv + oy));
+        lit += shadowReceiver(i, j, dRecv, su, sv, slopeX, slopeY) <= shadowStored(i, j, N, vi) ? 1 : 0;
+    }
+#else
     int i0 = int(floor(su - 0.5 * float(k) + 0.5)), j0 = int(floor(sv - 0.5 * float(k) + 0.5));
     int lit = 0;
     for (int dj = 0; dj < k; ++dj)   // j = j0 .. j0 + k - 1 (constant bounds: unrolled)
         for (int di = 0; di < k; ++di) {
             int i = i0 + di, j = j0 + dj;
-            // Texels outside the map are lit (the fetch is clamped to stay defined).
-            bool outside = i < 0 || j < 0 || i >= N || j >= N;
-            float d = texelFetch(uShadowMaps, ivec3(clamp(i, 0, N - 1), clamp(j, 0, N - 1), vi), 0).r;
-            float dTap = dRecv + slopeX * (float(i) + 0.5 - su) + slopeY * (float(j) + 0.5 - sv);
-            lit += outside || dTap <= d ? 1 : 0;
+            lit += shadowReceiver(i, j, dRecv, su, sv, slopeX, slopeY) <= shadowStored(i, j, N, vi) ? 1 : 0;
         }
+#endif
     return float(lit) / float(k * k);
 }
 #endif

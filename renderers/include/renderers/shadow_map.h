@@ -48,6 +48,10 @@ struct ShadowView {
 // At most this many maps per frame (GL's uniform arrays): lights whose maps would pass it, in
 // the frame's order, get none (lit everywhere) in both rasterizers.
 constexpr int kMaxShadowViews = 48;
+// PCSS (docs/math.md, "Soft shadows"): the blocker search reads kPcssSearch x kPcssSearch texels
+// spread over its radius; neither that radius nor the penumbra's exceeds kPcssMaxRadius texels.
+constexpr int kPcssSearch = 4;
+constexpr int kPcssMaxRadius = 24;
 
 // Which maps a frame's lights get.
 struct ShadowPlan {
@@ -135,5 +139,24 @@ int pointLightFace(const sg::vec3& fromLight);
 // Fraction of light `light` of the frame that reaches world point p (unit surface normal n, the
 // shading normal, either side), by the plan's maps: 1 lit, 0 shadowed, between at PCF edges.
 float shadowVisibility(const ShadowPlan& plan, const ShadowMaps& maps, const sg::DrawLight& L, int light, const sg::vec3& p, const sg::vec3& n);
+
+// PCSS's shift of its taps inside their grid cells, in [0, 1) (axis 0: x, 1: y), hashed from the
+// receiver's texel (i, j) of map `view` (shadow.glsl's pcssJitter, bit for bit).
+float pcssJitter(int i, int j, int view, int axis);
+
+// Soft shadows in the ray caster (docs/math.md, "Soft shadows"; soft_shadows.cpp): shadow ray k
+// of n from p toward a light that has a size (DrawLight::hasSize). The source is a disc facing p:
+// radius L.radius around the light's position (point, spot), or the directions within its angular
+// radius of the light's (directional). Its point is Hammersley point k of n, ((k + 0.5)/n,
+// radicalInverse(k)), shifted by `rotation` modulo 1 (one shift per shaded point: noise, not
+// bands), mapped to the unit disc by Shirley and Chiu's concentric map. distance: to that point
+// (infinite for a directional light).
+struct ShadowRayTarget {
+    sg::vec3 dir{0.0f, 0.0f, 1.0f};
+    float distance = 0.0f;
+};
+ShadowRayTarget softShadowRay(const sg::DrawLight& L, const sg::vec3& p, int k, int n, const sg::vec2& rotation);
+// The unit disc point of Shirley and Chiu's concentric map for (a, b) in [0, 1)^2.
+sg::vec2 concentricDisc(float a, float b);
 
 }   // namespace rnd

@@ -37,6 +37,10 @@ struct DrawLight {
     bool inverseSquare = false;               // 1/r^2 applies (already combined with settings.attenuation)
     float cosInner = 1.0f, cosOuter = 1.0f;   // spot cone
     float range = 0.0f;                       // Light::range (pbr only; 0 = none)
+    float radius = 0.0f;                      // point, spot: the source's radius (world)
+    float tanAngularRadius = 0.0f;            // directional: tan of the source's angular radius
+    // The source has a size: soft shadows.
+    bool hasSize() const { return type == LightType::Directional ? tanAngularRadius > 0.0f : radius > 0.0f; }
 };
 
 // CSG tree flattened into an array; leaves are implicit shapes in world space.

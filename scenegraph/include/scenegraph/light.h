@@ -21,6 +21,13 @@ struct Light {
     // KHR_lights_punctual's range (point and spot): the pbr model fades the light to zero at this
     // distance by (clamp(1 - (d/range)^4, 0, 1))^2 / d^2; 0 = no range (1/d^2 only).
     float range = 0.0f;
+    // The light's size, for soft shadows (docs/math.md, "Soft shadows"): point and spot lights are
+    // spheres of this radius (world units; 0 = a point), a directional light a disc of this
+    // angular radius (degrees; the sun is about 0.27). The ray caster samples the source with
+    // several shadow rays, the rasterizers' PCSS filter estimates the penumbra from it; the light
+    // itself is still evaluated from its centre.
+    float radius = 0.0f;
+    float angularRadiusDeg = 0.0f;
 
     bool operator==(const Light&) const = default;
 };

@@ -39,7 +39,7 @@ using ParamValue = std::variant<bool, int, float, vec3, std::string>;
 
 // A renderer feature a parameter needs to have any effect; renderers say which they have
 // (rnd::hasFeature), and the UI marks a parameter the shown backend ignores.
-enum class Feature : uint8_t { None, Shadows, ShadowMaps, Reflections, Wireframe };
+enum class Feature : uint8_t { None, Shadows, ShadowMaps, ShadowRays, Reflections, Wireframe };
 
 // One value of a Choice parameter (from the enum's name table, setting_names.h).
 struct ParamChoice {

@@ -24,7 +24,7 @@ enum class CullMode { Auto, On, Off };
 enum class ToneMapping { None, Aces, KhrNeutral };
 // How the rasterizers filter a shadow-map lookup (renderers/shadow_map.h): one texel's answer, or
 // the mean answer of the k x k texels around the point (percentage-closer filtering).
-enum class ShadowFilter { None, Pcf };
+enum class ShadowFilter { None, Pcf, Pcss };
 
 // Whether a triangle of a material with this doubleSided flag loses its back face.
 inline bool cullsBackFaces(CullMode m, bool doubleSided) { return m == CullMode::On || (m == CullMode::Auto && !doubleSided); }
@@ -74,13 +74,16 @@ struct RenderSettings {
     // Shadows of every light: shadow rays in the ray caster, shadow maps in the rasterizers
     // (docs/math.md, "Shadow maps"): one map of shadowMapSize^2 texels per light (six for a
     // point light), biased by shadowDepthBias and shadowNormalBias texels, filtered by
-    // shadowFilter over shadowPcfSize^2 texels.
+    // shadowFilter over shadowPcfSize^2 texels (PCSS: spread over the penumbra that the light's
+    // size gives, docs/math.md "Soft shadows"). The ray caster traces shadowRays rays to each
+    // light that has a size (Light::radius, angularRadiusDeg), one to a point source.
     bool shadows = true;
     int shadowMapSize = 1024;
     ShadowFilter shadowFilter = ShadowFilter::Pcf;
     int shadowPcfSize = 3;
     float shadowDepthBias = 1.0f;
     float shadowNormalBias = 1.0f;
+    int shadowRays = 16;
 
     // Ray caster only.
     bool reflections = false;
