@@ -19,7 +19,9 @@
 //   ms_best     raster vs the faster of the two submissions (per scene, by their medians): on
 //               some scenes (the bunny) the indexed draw is not the faster one on llvmpipe
 //   ref_fair    the two minimal programs: Order::Scene's ms (ours=) vs Order::Fair's (ref=); ratio =
-//               how much faster llvmpipe is when fed fairly. Their frames alternate (one each in turn)
+//               how much faster llvmpipe is when fed fairly
+// ms, ms_fair, ms_best, ref_fair, cpu_ms, cpu_ms_fair and scaling come from the same rounds: one
+// frame of ours on --threads, one on 1 thread, one of each minimal program, --frames times.
 //   ms_gl       wall ms per frame, raster vs our GL backend
 //   gl_ms       wall ms per frame, our GL backend vs the minimal GL program (goal: ratio <= 1.3)
 //   gl_cpu_ms   process CPU ms per frame, our GL backend vs the minimal GL program
@@ -86,7 +88,6 @@
 #include <optional>
 #include <sstream>
 #include <string>
-#include <tuple>
 #include <vector>
 
 #ifndef VIEWER_TESTDATA_DIR
@@ -294,27 +295,6 @@ Timing timeFrames(const std::function<bool()>& frame, int frames) {
         t.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     }
     return {median(t), median(c)};
-}
-
-// The two minimal GL programs' frames in turn (a warm-up frame each, then one frame of each
-// per round, the context switch outside the timed part), so that the machine's drift falls on
-// both; returns {a's, b's} medians.
-std::pair<Timing, Timing> timeMinimalPair(bench::MinimalGl& a, std::vector<uint8_t>& imageA, bench::MinimalGl& b, std::vector<uint8_t>& imageB,
-                                          int frames) {
-    a.render(imageA);
-    b.render(imageB);
-    std::vector<double> t[2], c[2];
-    for (int i = 0; i < frames; ++i)
-        for (int k = 0; k < 2; ++k) {
-            bench::MinimalGl& g = k ? b : a;
-            g.activate();
-            auto t0 = std::chrono::steady_clock::now();
-            const double c0 = cpuMs();
-            g.render(k ? imageB : imageA);
-            c[k].push_back(cpuMs() - c0);
-            t[k].push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-        }
-    return {{median(t[0]), median(c[0])}, {median(t[1]), median(c[1])}};
 }
 
 Timing timeRenderer(rnd::Renderer& r, const FrameInput& f, int w, int h, int frames, rnd::Framebuffer& fb, std::string& err) {
@@ -584,45 +564,62 @@ int main(int argc, char** argv) {
             if (fresh && fresh->render(f, w, h, fb).ok)
                 cold = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         }
+        // The minimal GL programs (both submissions), each in its own context.
+        bench::MinimalGl mgl, fair;
+        std::string em = noGl ? "skipped (--no-gl)" : mgl.setup(f, w, h);
+        if (em.empty()) em = fair.setup(f, w, h, bench::MinimalGl::Order::Fair);
+        const bool minimal = em.empty();
+        std::string fairInfo;
+        if (minimal) {
+            char buf[160];
+            std::snprintf(buf, sizeof buf, "minimal GL: %zu vertices unindexed, fair %zu vertices indexed in %zu draw(s)", mgl.vertices(),
+                          fair.vertices(), fair.draws());
+            fairInfo = buf;
+        } else if (!noGl) {
+            std::fprintf(stderr, "bench: minimal GL failed on %s: %s\n", b.name.c_str(), em.c_str());
+        }
+        // Rounds after a warm-up frame of each: ours on --threads, ours on 1 thread (when
+        // --threads > 1), the minimal program in the scene's order, the fair one; so that the
+        // machine's drift falls on all of them alike.
         Timing o, o1;
-        if (threads > 1) {
-            // Frames on --threads and on 1 thread alternate (both after a warm-up frame).
-            std::vector<double> tN, cN, t1;
-            auto frame = [&](std::vector<double>* cpu) {
+        {
+            std::vector<double> tN, cN, t1, tS, cS, tF, cF;
+            auto timed = [&](const std::function<void()>& fn, std::vector<double>& t, std::vector<double>* cpu) {
                 auto t0 = std::chrono::steady_clock::now();
                 const double c0 = cpuMs();
+                fn();
+                if (cpu) cpu->push_back(cpuMs() - c0);
+                t.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+            };
+            auto ourFrame = [&] {
                 rnd::RenderStats st = ours->render(f, w, h, fbO);
                 if (!st.ok) eo = st.error;
-                if (cpu) cpu->push_back(cpuMs() - c0);
-                return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
             };
-            frame(nullptr);
+            ourFrame();
+            if (minimal) {
+                mgl.render(rgba);
+                fair.render(rgbaFair);
+            }
             for (int i = 0; i < frames; ++i) {
-                tN.push_back(frame(&cN));
-                tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
-                t1.push_back(frame(nullptr));
+                timed(ourFrame, tN, &cN);
+                if (threads > 1) {
+                    tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+                    timed(ourFrame, t1, nullptr);
+                }
+                if (!minimal) continue;
+                mgl.activate();   // the context switch outside the timed frame
+                timed([&] { mgl.render(rgba); }, tS, &cS);
+                fair.activate();
+                timed([&] { fair.render(rgbaFair); }, tF, &cF);
             }
             o = {median(tN), median(cN)};
             o1 = {median(t1), NAN};
-        } else {
-            o = timeRenderer(*ours, f, w, h, frames, fbO, eo);
-        }
-        Timing g = glBackend ? timeRenderer(*glBackend, f, w, h, frames, fbG, eg) : Timing{};
-        std::string fairInfo;
-        {
-            bench::MinimalGl mgl, fair;
-            std::string em = noGl ? "skipped (--no-gl)" : mgl.setup(f, w, h);
-            if (em.empty()) em = fair.setup(f, w, h, bench::MinimalGl::Order::Fair);
-            if (em.empty()) {
-                std::tie(r, rf) = timeMinimalPair(mgl, rgba, fair, rgbaFair, frames);
-                char buf[160];
-                std::snprintf(buf, sizeof buf, "minimal GL: %zu vertices unindexed, fair %zu vertices indexed in %zu draw(s)", mgl.vertices(),
-                              fair.vertices(), fair.draws());
-                fairInfo = buf;
-            } else {
-                std::fprintf(stderr, "bench: minimal GL failed on %s: %s\n", b.name.c_str(), em.c_str());
+            if (minimal) {
+                r = {median(tS), median(cS)};
+                rf = {median(tF), median(cF)};
             }
         }
+        Timing g = glBackend ? timeRenderer(*glBackend, f, w, h, frames, fbG, eg) : Timing{};
         if (!eo.empty()) std::fprintf(stderr, "bench: raster failed on %s: %s\n", b.name.c_str(), eo.c_str());
         if (!eg.empty()) std::fprintf(stderr, "bench: gl failed on %s: %s\n", b.name.c_str(), eg.c_str());
         const double to = o.wallMs, tr = r.wallMs, cov = coveredPixels(fbO);
