@@ -5,8 +5,10 @@
 //
 //   cmake --build build/release -j2 --target bench_raycast_frame
 //   ./build/release/bench/raycast/bench_raycast_frame [--threads 2] [--frames 7] [--size 1280x720]
-//        [--scenes demo,bunny,igea,mesh1M] [--png DIR] [--testdata DIR]
+//        [--scenes demo,bunny,igea,mesh1M] [--png DIR] [--testdata DIR] [--ours-only N]
 //
+// --ours-only N: only N warm frames of ours per scene, nothing printed (for profilers:
+// perf record -g bench_raycast_frame --scenes bunny --ours-only 20).
 // Prints one line per scene and metric:
 //   bench: scene=<name> what=<metric> ours=<x> ref=<y> ratio=<ours/ref>
 // metrics (wall ms per frame, medians; the goal: frame_ms ratio <= 1.0):
@@ -154,7 +156,7 @@ void line(const std::string& scene, const char* what, double ours, double ref, d
 }   // namespace
 
 int main(int argc, char** argv) {
-    int threads = 2, frames = 7, w = 1280, h = 720;
+    int threads = 2, frames = 7, w = 1280, h = 720, oursOnly = 0;
     std::string only = "demo,bunny,igea,mesh1M", pngDir, testdata = VIEWER_TESTDATA_DIR;
     if (const char* env = std::getenv("VIEWER_TESTDATA")) testdata = env;
     for (int i = 1; i < argc; ++i) {
@@ -172,9 +174,13 @@ int main(int argc, char** argv) {
             pngDir = next();
         else if (a == "--testdata")
             testdata = next();
+        else if (a == "--ours-only")
+            oursOnly = std::max(1, std::atoi(next().c_str()));
         else {
-            std::fprintf(stderr, "usage: %s [--threads N] [--frames N] [--size WxH] [--scenes demo,bunny,igea,mesh1M] [--png DIR] [--testdata DIR]\n",
-                         argv[0]);
+            std::fprintf(
+                stderr,
+                "usage: %s [--threads N] [--frames N] [--size WxH] [--scenes demo,bunny,igea,mesh1M] [--png DIR] [--testdata DIR] [--ours-only N]\n",
+                argv[0]);
             return 2;
         }
     }
@@ -202,6 +208,10 @@ int main(int argc, char** argv) {
         if (!ours) {
             std::fprintf(stderr, "bench: %s\n", err.c_str());
             return 1;
+        }
+        if (oursOnly > 0) {
+            for (int i = 0; i <= oursOnly; ++i) ours->render(f, w, h, fb);
+            continue;
         }
         bool ok = true;
         const double coldOurs = timeMs([&] { ok = ours->render(f, w, h, fb).ok; });
