@@ -5,7 +5,7 @@
 //
 //   cmake --build build/release -j2 --target bench_raster
 //   ./build/release/bench/raster/bench_raster [--quick] [--threads 2] [--frames 15]
-//        [--size 1280x720] [--shading phong|gouraud|flat] [--fog on|off] [--scenes a,b,...]
+//        [--size 1280x720] [--shading phong|gouraud|flat] [--fog on|off] [--culling auto|on|off] [--scenes a,b,...]
 //        [--no-gl | --gl-only [--gl-side ours|minimal]] [--mesh FILE ...]
 //
 // Prints one line per scene and metric:
@@ -71,6 +71,7 @@
 #include "renderers/renderer.h"
 #include "scenegraph/frame.h"
 #include "scenegraph/scene.h"
+#include "scenegraph/setting_names.h"
 
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
@@ -386,6 +387,7 @@ int main(int argc, char** argv) {
     bool quick = false, noGl = false, glOnly = false;
     int threads = 2, frames = 15, w = 1280, h = 720;
     std::string shading = "phong", fog = "on", only, glSide = "both";
+    CullMode culling = CullMode::Auto;   // --culling: RenderSettings::culling of every scene (ours and the fair minimal program)
     std::vector<std::string> meshFiles;
     for (int i = 1; i < argc; ++i) {
         std::string a = argv[i];
@@ -408,7 +410,12 @@ int main(int argc, char** argv) {
             shading = next();
         else if (a == "--fog")
             fog = next();
-        else if (a == "--scenes")
+        else if (a == "--culling") {
+            if (!sg::parseName(next(), culling)) {
+                std::fprintf(stderr, "bench: --culling wants %s\n", sg::nameList<CullMode>().c_str());
+                return 2;
+            }
+        } else if (a == "--scenes")
             only = next();
         else if (a == "--mesh")
             meshFiles.push_back(next());
@@ -481,6 +488,7 @@ int main(int argc, char** argv) {
     }
     for (BenchScene& b : scenes) {
         parse(shading, b.scene.settings.shading);
+        b.scene.settings.culling = culling;
         b.scene.settings.fog = fog == "on" ? FogMode::Linear : FogMode::Off;
         b.scene.settings.fogStart = 2.0f;
         b.scene.settings.fogEnd = 60.0f;
