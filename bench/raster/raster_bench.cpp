@@ -57,6 +57,8 @@
 // bunny, named after the file (with --scenes NAME,... selecting the built-in ones: --scenes none
 // runs only the files).
 // LP_NUM_THREADS is set before any GL context is created; tbb is limited to the same count.
+// --culling auto|on|off: RenderSettings::culling of every scene (the scenes' materials are
+// double-sided, so with auto nothing is culled; on: ours and the fair minimal program cull back faces).
 // --quick: fewer frames and 960x540 (finishes well under a minute). --no-gl: raster only (for
 // profiling it, e.g. perf record ... bench_raster --no-gl --scenes mesh1M). --gl-only: our GL
 // backend and the minimal GL program only (gl_ms, gl_cpu_ms and the image check); with
