@@ -1,11 +1,15 @@
-// min_gl.cpp - the minimal GL reference of bench_raster (see min_gl.h).
+// min_gl.cpp - the minimal GL reference of bench_raster (see min_gl.h): the shader, the two
+// submissions (the scene's order unindexed; the fair one indexed, nearest first, culled as ours)
+// and the frame (clear, draw, glReadPixels).
 #include "min_gl.h"
 
 #include "gl/gl_context.h"
 
 #include <glad/gl.h>
 
+#include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 
 namespace bench {
 
@@ -84,14 +88,45 @@ GLuint compile(GLenum type, const std::string& src, std::string& err) {
     return s;
 }
 
+// Order::Fair sorts clusters of this many consecutive triangles of one mesh (not single
+// triangles: neighbours share vertices, which llvmpipe's vertex cache reuses within a draw);
+// BENCH_GL_CLUSTER overrides it.
+size_t clusterSize() {
+    const char* e = std::getenv("BENCH_GL_CLUSTER");
+    return e ? std::max<size_t>(1, size_t(std::atol(e))) : 64;
+}
+
+// Appends vertex v of draw d (world position, world normal, base colour, ks) to `data`.
+void pushVertex(std::vector<float>& data, const sg::DrawMesh& d, uint32_t v) {
+    const sg::Mesh& mesh = *d.mesh;
+    const sg::vec3 p = sg::vec3(d.world * sg::vec4(mesh.positions[v], 1.0f));
+    const sg::vec3 n = mesh.normals.size() == mesh.positions.size() ? glm::normalize(d.normal * mesh.normals[v]) : sg::vec3(0, 1, 0);
+    data.insert(data.end(), {p.x, p.y, p.z, n.x, n.y, n.z, d.material.baseColor.x, d.material.baseColor.y, d.material.baseColor.z, d.material.ks});
+}
+
 }   // namespace
+
+// One glDrawElements of the fair submission: `count` indices from `first`, culling back faces or not.
+struct DrawRun {
+    size_t first = 0, count = 0;
+    bool cull = false;
+};
 
 struct MinimalGl::State {
     std::unique_ptr<rnd::gl::GlContext> ctx;
     GLuint prog = 0, vao = 0, vbo = 0, fbo = 0, rbColor = 0, rbDepth = 0;
+    GLuint ibo = 0;
     int width = 0, height = 0;
     sg::vec3 background{0.0f};
+    MinimalGl::Order order = MinimalGl::Order::Scene;
+    std::vector<DrawRun> runs;   // Order::Fair
 };
+
+void MinimalGl::activate() {
+    if (m && m->ctx && !m->ctx->isCurrent()) m->ctx->makeCurrent();
+}
+
+size_t MinimalGl::draws() const { return !m ? 0 : m->order == Order::Scene ? 1 : m->runs.size(); }
 
 MinimalGl::MinimalGl() = default;
 
@@ -99,6 +134,7 @@ MinimalGl::~MinimalGl() {
     if (!m || !m->ctx || !m->ctx->makeCurrent()) return;
     glDeleteProgram(m->prog);
     glDeleteBuffers(1, &m->vbo);
+    glDeleteBuffers(1, &m->ibo);
     glDeleteVertexArrays(1, &m->vao);
     glDeleteFramebuffers(1, &m->fbo);
     glDeleteRenderbuffers(1, &m->rbColor);
@@ -106,7 +142,7 @@ MinimalGl::~MinimalGl() {
     m->ctx->release();
 }
 
-std::string MinimalGl::setup(const sg::FrameInput& f, int width, int height) {
+std::string MinimalGl::setup(const sg::FrameInput& f, int width, int height, Order order) {
     m = std::make_unique<State>();
     std::string err;
     m->ctx = rnd::gl::createHeadlessContext("", &err);
@@ -116,19 +152,61 @@ std::string MinimalGl::setup(const sg::FrameInput& f, int width, int height) {
     m->width = width;
     m->height = height;
     m->background = f.settings.background;
+    m->order = order;
 
     // Interleaved world-space vertices: position, normal, colour (rgb base colour, a ks).
     std::vector<float> data;
-    for (const sg::DrawMesh& d : f.meshes) {
-        if (!d.mesh || d.mesh->mode != sg::PrimitiveMode::Triangles) continue;
-        const sg::Mesh& mesh = *d.mesh;
-        const bool normals = mesh.normals.size() == mesh.positions.size();
-        for (uint32_t i : mesh.indices) {
-            sg::vec3 p = sg::vec3(d.world * sg::vec4(mesh.positions[i], 1.0f));
-            sg::vec3 n = normals ? glm::normalize(d.normal * mesh.normals[i]) : sg::vec3(0, 1, 0);
-            data.insert(data.end(),
-                        {p.x, p.y, p.z, n.x, n.y, n.z, d.material.baseColor.x, d.material.baseColor.y, d.material.baseColor.z, d.material.ks});
+    std::vector<uint32_t> indices;   // Order::Fair
+    if (order == Order::Scene) {
+        for (const sg::DrawMesh& d : f.meshes) {
+            if (!d.mesh || d.mesh->mode != sg::PrimitiveMode::Triangles) continue;
+            for (uint32_t i : d.mesh->indices) pushVertex(data, d, i);
         }
+        m_triangles = data.size() / 30;
+    } else {
+        // Each mesh's vertices once; its triangles in clusters of kCluster, each cluster with
+        // its distance from the eye (to the nearest point of its bounds) and whether our
+        // rasterizer culls its back faces. Mirrored draws swap two corners, so that front
+        // faces wind counter-clockwise in world space for every draw.
+        struct Cluster {
+            float distance;
+            bool cull;
+            size_t first, count;   // into `tris`
+        };
+        std::vector<uint32_t> tris;
+        std::vector<Cluster> clusters;
+        for (const sg::DrawMesh& d : f.meshes) {
+            if (!d.mesh || d.mesh->mode != sg::PrimitiveMode::Triangles) continue;
+            const sg::Mesh& mesh = *d.mesh;
+            const uint32_t base = uint32_t(data.size() / 10);
+            for (uint32_t v = 0; v < uint32_t(mesh.positions.size()); ++v) pushVertex(data, d, v);
+            const bool cull = sg::cullsBackFaces(f.settings.culling, d.material.doubleSided);
+            const size_t nt = mesh.indices.size() / 3;
+            const size_t kCluster = clusterSize();
+            for (size_t t0 = 0; t0 < nt; t0 += kCluster) {
+                Cluster c{0.0f, cull, tris.size(), 0};
+                sg::Aabb box;
+                for (size_t t = t0; t < std::min(t0 + kCluster, nt); ++t) {
+                    uint32_t v[3] = {mesh.indices[3 * t], mesh.indices[3 * t + 1], mesh.indices[3 * t + 2]};
+                    if (d.mirrored) std::swap(v[1], v[2]);
+                    for (uint32_t k : v) {
+                        tris.push_back(base + k);
+                        const float* p = &data[size_t(base + k) * 10];
+                        box.extend(sg::vec3(p[0], p[1], p[2]));
+                    }
+                }
+                c.count = tris.size() - c.first;
+                c.distance = glm::length(f.camera.eye - glm::clamp(f.camera.eye, box.min, box.max));
+                clusters.push_back(c);
+            }
+        }
+        std::stable_sort(clusters.begin(), clusters.end(), [](const Cluster& a, const Cluster& b) { return a.distance < b.distance; });
+        for (const Cluster& c : clusters) {
+            if (m->runs.empty() || m->runs.back().cull != c.cull) m->runs.push_back({indices.size(), 0, c.cull});
+            indices.insert(indices.end(), tris.begin() + std::ptrdiff_t(c.first), tris.begin() + std::ptrdiff_t(c.first + c.count));
+            m->runs.back().count += c.count;
+        }
+        m_triangles = indices.size() / 3;
     }
     m_vertices = data.size() / 10;
 
@@ -179,6 +257,11 @@ std::string MinimalGl::setup(const sg::FrameInput& f, int width, int height) {
     glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(3 * sizeof(float)));
     glVertexAttribPointer(2, 4, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(6 * sizeof(float)));
     for (GLuint a = 0; a < 3; ++a) glEnableVertexAttribArray(a);
+    if (order == Order::Fair) {
+        glGenBuffers(1, &m->ibo);
+        glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, m->ibo);
+        glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(indices.size() * sizeof(uint32_t)), indices.data(), GL_STATIC_DRAW);
+    }
 
     glGenRenderbuffers(1, &m->rbColor);
     glBindRenderbuffer(GL_RENDERBUFFER, m->rbColor);
@@ -195,6 +278,8 @@ std::string MinimalGl::setup(const sg::FrameInput& f, int width, int height) {
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
     glDisable(GL_CULL_FACE);
+    glCullFace(GL_BACK);
+    glFrontFace(GL_CCW);
     glViewport(0, 0, width, height);
     glClearColor(m->background.x, m->background.y, m->background.z, 1.0f);
     if (glGetError() != GL_NO_ERROR) return "GL error during setup";
@@ -202,9 +287,19 @@ std::string MinimalGl::setup(const sg::FrameInput& f, int width, int height) {
 }
 
 void MinimalGl::render(std::vector<uint8_t>& rgba) {
+    activate();
     rgba.resize(size_t(m->width) * m->height * 4);
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-    glDrawArrays(GL_TRIANGLES, 0, GLsizei(m_vertices));
+    if (m->order == Order::Scene)
+        glDrawArrays(GL_TRIANGLES, 0, GLsizei(m_vertices));
+    else
+        for (const DrawRun& r : m->runs) {
+            if (r.cull)
+                glEnable(GL_CULL_FACE);
+            else
+                glDisable(GL_CULL_FACE);
+            glDrawElements(GL_TRIANGLES, GLsizei(r.count), GL_UNSIGNED_INT, reinterpret_cast<const void*>(r.first * sizeof(uint32_t)));
+        }
     glReadPixels(0, 0, m->width, m->height, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
 }
 

@@ -1,0 +1,269 @@
+// raycast_frame_bench.cpp - our ray caster's whole frame (the "raycast" backend through
+// rnd::Renderer::render, shadows on) against the minimal Embree renderer of min_embree.h on the
+// same scene, camera, size and thread count: what a user waits for, against what Embree alone
+// makes of the same image.
+//
+//   cmake --build build/release -j2 --target bench_raycast_frame
+//   ./build/release/bench/raycast/bench_raycast_frame [--threads 2] [--frames 7] [--size 1280x720]
+//        [--scenes demo,bunny,igea,mesh1M] [--png DIR] [--testdata DIR] [--ours-only N]
+//
+// --ours-only N: only N warm frames of ours per scene, nothing printed (for profilers:
+// perf record -g bench_raycast_frame --scenes bunny --ours-only 20).
+// Prints one line per scene and metric:
+//   bench: scene=<name> what=<metric> ours=<x> ref=<y> ratio=<ours/ref>
+// metrics (wall ms per frame, medians; the goal: frame_ms ratio <= 1.0):
+//   frame_ms                 warm frames (our BVHs kept between frames, Embree's scene built
+//                            once): ours against the faster of min_embree on Embree's default ISA
+//                            and on "isa=avx2", frame by frame (ratio: the median of the rounds')
+//   frame_ms_vs_default_isa  the same against the default ISA alone
+//   frame_ms_vs_avx2         against isa=avx2 alone
+//   cold_ms                  the first frame of a new renderer (ours: its BVH builds included)
+//                            against min_embree's setup (world-space copy, tessellation, Embree
+//                            build) plus its first frame, default ISA
+// Rounds alternate: one frame of ours, one of each min_embree, --frames times after a warm-up
+// frame each, so that the machine's drift falls on all three. A "#" line per scene gives the
+// image agreement (mean absolute difference per channel, % of pixels within 8 of ours); --png
+// DIR writes both images (DIR/<scene>_ours.png, DIR/<scene>_min_embree.png).
+// Scenes: demo (the bundled demo: analytic shapes, which min_embree draws as the rasterizers'
+// tessellation; textured floor and crates, which it samples at level 0), bunny and igea (mesh
+// files from the test data on a ground plane with a point light, framed like bench_raster's
+// bunny), mesh1M (bench_raster's mesh1M: 22 x 22 uv-spheres and a ground plane merged into one
+// mesh, 988k triangles). TBB is limited to --threads, Embree's devices get threads=N.
+#include "assets/demo.h"
+#include "assets/image_io.h"
+#include "assets/scene_io.h"
+#include "min_embree.h"
+#include "renderers/renderer.h"
+#include "scenegraph/frame.h"
+#include "scenegraph/scene.h"
+
+#include <tbb/global_control.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <functional>
+#include <string>
+#include <vector>
+
+#ifndef VIEWER_TESTDATA_DIR
+#define VIEWER_TESTDATA_DIR "../shared/testdata"
+#endif
+
+using namespace sg;
+
+namespace {
+
+struct BenchScene {
+    std::string name;
+    Scene scene;
+};
+
+// A mesh on a ground plane, scaled to a 2-unit diagonal, seen from the front with a point light
+// (bench_raster's bunny framing).
+BenchScene meshScene(const std::string& name, std::shared_ptr<Mesh> m) {
+    BenchScene b;
+    b.name = name;
+    Scene& s = b.scene;
+    Aabb bb = m->bounds();
+    auto ground = std::make_shared<Mesh>(primitives::plane(1.0f, 32));
+    s.meshes = {m, ground};
+    Material mb;
+    mb.baseColor = vec3(0.75f, 0.7f, 0.6f);
+    s.materials = {mb};
+    NodeId n = s.addNode(name, s.root(), MeshInstance{0, 0});
+    float scale = 2.0f / glm::length(bb.extent());
+    s.setLocal(n, LocalTransform::fromTRS(-bb.center() * scale + vec3(0, 0.5f * bb.extent().y * scale, 0), quat(1, 0, 0, 0), vec3(scale)));
+    s.addNode("ground", s.root(), MeshInstance{1, 0});
+    Camera cam;
+    cam.projection.zNear = 0.05f;
+    cam.projection.zFar = 20.0f;
+    NodeId c = s.addNode("camera", s.root(), cam);
+    s.lookAt(c, vec3(0.0f, 0.9f, 2.0f), vec3(0.0f, 0.45f, 0.0f));
+    s.activeCamera = c;
+    NodeId key = s.addNode("key", s.root(), Light{LightType::Point, vec3(1.0f), 1.0f, false});
+    s.setLocal(key, LocalTransform::fromTRS(vec3(1, 3, 2)));
+    return b;
+}
+
+bool fileScene(const std::string& name, const std::string& path, BenchScene& b) {
+    assets::LoadResult r = assets::loadScene(path);
+    if (!r.scene || r.scene->meshes.empty() || !r.scene->meshes.front()) {
+        std::fprintf(stderr, "bench: %s: %s\n", path.c_str(), r.scene ? "no mesh" : r.error.c_str());
+        return false;
+    }
+    b = meshScene(name, r.scene->meshes.front());
+    return true;
+}
+
+// bench_raster's mesh1M: grid x grid uv-spheres of `seg` slices and a ground plane of
+// groundSub^2 quads merged into one mesh, one point light, the camera looking down at the grid.
+BenchScene singleMesh(const std::string& name, int grid, int seg, int groundSub) {
+    BenchScene b;
+    b.name = name;
+    Scene& s = b.scene;
+    const float extent = float(grid);
+    auto m = std::make_shared<Mesh>(primitives::plane(extent, groundSub));
+    m->uv0.clear();
+    const Mesh sphere = primitives::uvSphere(0.4f, seg, seg / 2);
+    for (int i = 0; i < grid; ++i)
+        for (int j = 0; j < grid; ++j) {
+            const vec3 at(i - (grid - 1) * 0.5f, 0.4f, j - (grid - 1) * 0.5f);
+            const uint32_t base = uint32_t(m->positions.size());
+            for (size_t v = 0; v < sphere.positions.size(); ++v) {
+                m->positions.push_back(sphere.positions[v] + at);
+                m->normals.push_back(sphere.normals[v]);
+            }
+            for (uint32_t idx : sphere.indices) m->indices.push_back(base + idx);
+        }
+    s.meshes = {m};
+    Material mat;
+    mat.baseColor = vec3(0.8f, 0.3f, 0.2f);
+    mat.ks = 0.5f;
+    s.materials = {mat};
+    s.addNode("mesh", s.root(), MeshInstance{0, 0});
+    Camera cam;
+    cam.projection.fovyDeg = 50.0f;
+    cam.projection.zNear = 0.1f;
+    cam.projection.zFar = 4.0f * extent + 20.0f;
+    NodeId c = s.addNode("camera", s.root(), cam);
+    s.lookAt(c, vec3(0.0f, 0.55f * extent + 1.0f, 0.75f * extent + 1.5f), vec3(0.0f));
+    s.activeCamera = c;
+    NodeId key = s.addNode("key", s.root(), Light{LightType::Point, vec3(1.0f), 1.0f, false});
+    s.setLocal(key, LocalTransform::fromTRS(vec3(extent * 0.3f, extent, extent * 0.5f)));
+    s.settings.ambientLight = vec3(0.3f);
+    return b;
+}
+
+double median(std::vector<double> v) {
+    if (v.empty()) return NAN;
+    std::sort(v.begin(), v.end());
+    return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+}
+
+double timeMs(const std::function<void()>& fn) {
+    const auto t0 = std::chrono::steady_clock::now();
+    fn();
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+void line(const std::string& scene, const char* what, double ours, double ref, double ratio) {
+    std::printf("bench: scene=%s what=%s ours=%.2f ref=%.2f ratio=%.3f\n", scene.c_str(), what, ours, ref, ratio);
+}
+
+}   // namespace
+
+int main(int argc, char** argv) {
+    int threads = 2, frames = 7, w = 1280, h = 720, oursOnly = 0;
+    std::string only = "demo,bunny,igea,mesh1M", pngDir, testdata = VIEWER_TESTDATA_DIR;
+    if (const char* env = std::getenv("VIEWER_TESTDATA")) testdata = env;
+    for (int i = 1; i < argc; ++i) {
+        const std::string a = argv[i];
+        auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
+        if (a == "--threads")
+            threads = std::max(1, std::atoi(next().c_str()));
+        else if (a == "--frames")
+            frames = std::max(1, std::atoi(next().c_str()));
+        else if (a == "--size")
+            std::sscanf(next().c_str(), "%dx%d", &w, &h);
+        else if (a == "--scenes")
+            only = next();
+        else if (a == "--png")
+            pngDir = next();
+        else if (a == "--testdata")
+            testdata = next();
+        else if (a == "--ours-only")
+            oursOnly = std::max(1, std::atoi(next().c_str()));
+        else {
+            std::fprintf(
+                stderr,
+                "usage: %s [--threads N] [--frames N] [--size WxH] [--scenes demo,bunny,igea,mesh1M] [--png DIR] [--testdata DIR] [--ours-only N]\n",
+                argv[0]);
+            return 2;
+        }
+    }
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
+    const std::string threadsCfg = "threads=" + std::to_string(threads);
+    auto want = [&](const std::string& n) { return ("," + only + ",").find("," + n + ",") != std::string::npos; };
+    std::vector<BenchScene> scenes;
+    if (want("demo")) scenes.push_back({"demo", assets::makeDemoScene()});
+    const std::string models = testdata + "/meshes/common-3d-test-models/";
+    BenchScene b;
+    if (want("bunny") && fileScene("bunny", models + "stanford-bunny/stanford-bunny.obj", b)) scenes.push_back(std::move(b));
+    if (want("igea") && fileScene("igea", models + "igea/igea.ply", b)) scenes.push_back(std::move(b));
+    if (want("mesh1M")) scenes.push_back(singleMesh("mesh1M", 22, 46, 64));
+
+    std::printf("# raycast frame vs min_embree (Embree 3, 4x4 packets): %dx%d, %d threads, shadows on, median of %d rounds\n", w, h, threads, frames);
+    for (BenchScene& sc : scenes) {
+        sc.scene.settings.shadows = true;
+        const FrameInput f = flatten(sc.scene, float(w) / float(h));
+        const char* n = sc.name.c_str();
+        std::string err;
+        // Cold: a new renderer's first frame against min_embree's setup and first frame.
+        rnd::Framebuffer fb;
+        std::vector<uint8_t> img, imgA;
+        auto ours = rnd::makeRenderer("raycast", &err);
+        if (!ours) {
+            std::fprintf(stderr, "bench: %s\n", err.c_str());
+            return 1;
+        }
+        if (oursOnly > 0) {
+            for (int i = 0; i <= oursOnly; ++i) ours->render(f, w, h, fb);
+            continue;
+        }
+        bool ok = true;
+        const double coldOurs = timeMs([&] { ok = ours->render(f, w, h, fb).ok; });
+        bench::MinimalEmbree ref, refA;
+        const double coldRef = timeMs([&] {
+            err = ref.setup(f, f.settings.tessellation, threadsCfg);
+            if (err.empty()) ref.render(f, w, h, img);
+        });
+        if (!err.empty() || !ok || !(err = refA.setup(f, f.settings.tessellation, threadsCfg + ",isa=avx2")).empty()) {
+            std::fprintf(stderr, "bench: scene %s failed: %s\n", n, ok ? err.c_str() : "our render failed");
+            return 1;
+        }
+        refA.render(f, w, h, imgA);
+        // Warm frames, in rounds.
+        std::vector<double> to, td, ta, q, qd, qa;
+        for (int i = 0; i < frames; ++i) {
+            to.push_back(timeMs([&] { ours->render(f, w, h, fb); }));
+            td.push_back(timeMs([&] { ref.render(f, w, h, img); }));
+            ta.push_back(timeMs([&] { refA.render(f, w, h, imgA); }));
+            q.push_back(to.back() / std::min(td.back(), ta.back()));
+            qd.push_back(to.back() / td.back());
+            qa.push_back(to.back() / ta.back());
+        }
+        std::vector<double> best(td.size());
+        for (size_t i = 0; i < td.size(); ++i) best[i] = std::min(td[i], ta[i]);
+        line(sc.name, "frame_ms", median(to), median(best), median(q));
+        line(sc.name, "frame_ms_vs_default_isa", median(to), median(td), median(qd));
+        line(sc.name, "frame_ms_vs_avx2", median(to), median(ta), median(qa));
+        line(sc.name, "cold_ms", coldOurs, coldRef, coldOurs / coldRef);
+        // Image agreement.
+        double sum = 0;
+        size_t close = 0;
+        for (size_t p = 0; p + 3 < img.size() && img.size() == fb.color.size(); p += 4) {
+            int worst = 0;
+            for (int k = 0; k < 3; ++k) {
+                const int d = std::abs(int(img[p + k]) - int(fb.color[p + k]));
+                sum += d;
+                worst = std::max(worst, d);
+            }
+            close += worst <= 8;
+        }
+        const double px = double(w) * h;
+        std::printf(
+            "# %s: %zu triangles in min_embree (ours: %zu + analytic shapes), mean |ours - min_embree| %.2f / 255 per channel, %.2f%% of pixels "
+            "within 8%s\n",
+            n, ref.triangles(), f.triangleCount(), sum / (3.0 * px), 100.0 * double(close) / px, img == imgA ? "" : " (the two ISAs' images differ)");
+        if (!pngDir.empty()) {
+            const std::string e1 = assets::writePng(pngDir + "/" + sc.name + "_ours.png", w, h, fb.color.data(), true);
+            const std::string e2 = assets::writePng(pngDir + "/" + sc.name + "_min_embree.png", w, h, img.data(), true);
+            if (!e1.empty() || !e2.empty()) std::fprintf(stderr, "bench: png: %s %s\n", e1.c_str(), e2.c_str());
+        }
+        std::fflush(stdout);
+    }
+    return 0;
+}
