@@ -753,6 +753,67 @@ TEST(RasterShadingTest, VectorShadowDepthMatchesScalar) {
     compare(grid, 256, {g, c}, "texel-centre grid and random triangles");
 }
 
+// A renderer keeps its shadow maps when a frame's plan and casters are the last frame's; every
+// frame of a sequence (the same frame again, a caster moved, a mesh edited in place, the camera
+// moved, a blended caster, shadows off and on) matches a new renderer's image exactly.
+TEST(RasterShadowTest, KeptMapsMatchNewlyDrawnOnes) {
+    Material m;
+    m.baseColor = vec3(0.7f);
+    m.ka = 0.2f;
+    m.kd = 0.8f;
+    m.ks = 0.0f;
+    m.doubleSided = true;
+    auto ground = quadMesh({-4, 0, 4}, {4, 0, 4}, {4, 0, -4}, {-4, 0, -4});
+    auto box = std::make_shared<Mesh>(primitives::box(vec3(0.6f, 0.3f, 0.5f)));
+    FrameInput f0;
+    f0.meshes.push_back(drawOf(ground, m));
+    f0.meshes.push_back(drawOf(box, m, glm::translate(mat4(1.0f), vec3(-0.5f, 1.2f, 0.0f))));
+    DrawLight sun;
+    sun.type = LightType::Directional;
+    sun.direction = glm::normalize(vec3(0.3f, -1.0f, -0.2f));
+    sun.radiance = vec3(1.0f);
+    f0.lights = {sun};
+    f0.ambientLight = vec3(0.5f);
+    f0.settings.shadows = true;
+    f0.settings.shadowMapSize = 512;
+    Projection p;
+    f0.camera = cameraAt(vec3(0, 6, 7), vec3(0, 0, 0), p, 1.0f);
+    FrameInput moved = f0;
+    moved.meshes[1] = drawOf(box, m, glm::translate(mat4(1.0f), vec3(0.7f, 1.2f, 0.3f)));
+    FrameInput camera = f0;
+    camera.camera = cameraAt(vec3(1, 5, 7), vec3(0, 0, 0), p, 1.0f);
+    FrameInput blended = f0;
+    blended.meshes[1].material.alphaMode = AlphaMode::Blend;
+    blended.meshes[1].material.alpha = 0.5f;
+    FrameInput off = f0;
+    off.settings.shadows = false;
+    auto edited = std::make_shared<Mesh>(*box);
+    FrameInput editedFrame = f0;
+    editedFrame.meshes[1] = drawOf(edited, m, f0.meshes[1].world);
+    auto r = makeRenderer("raster");
+    ASSERT_TRUE(r);
+    auto check = [&](const FrameInput& f, const char* what) -> Framebuffer {
+        Framebuffer kept;
+        RenderStats st = r->render(f, 96, 96, kept);
+        EXPECT_TRUE(st.ok) << st.error;
+        const Framebuffer fresh = renderRaster(f, 96, 96);
+        EXPECT_TRUE(kept.color == fresh.color) << what;
+        return kept;
+    };
+    const Framebuffer a = check(f0, "first frame");
+    check(f0, "the same frame again");
+    const Framebuffer b = check(moved, "a caster moved");
+    EXPECT_FALSE(a.color == b.color) << "the moved caster's shadow must move";
+    check(moved, "the moved caster again");
+    check(editedFrame, "the same mesh in another object");
+    for (vec3& q : edited->positions) q.y *= 2.0f;   // edited in place: the same mesh object
+    check(editedFrame, "the mesh edited in place");
+    check(camera, "the camera moved");
+    check(blended, "the caster blended (casts nothing)");
+    check(off, "shadows off");
+    check(f0, "shadows on again");
+}
+
 // ---------------------------------------------------------------------------------------
 // anti-aliasing, progress, cancellation, lines
 // ---------------------------------------------------------------------------------------
