@@ -18,6 +18,7 @@ DebugSwitches debugSwitches() {
     d.rasterTiming = is("VIEWER_RASTER_TIMING", '1');
     d.rasterReferenceShading = is("VIEWER_RASTER_REFERENCE_SHADING", '1');
     d.rasterForceSse = is("VIEWER_RASTER_SSE", '1');
+    d.rasterShadowReuse = !is("VIEWER_RASTER_SHADOW_REUSE", '0');
     d.raycastForceSse = is("VIEWER_RAYCAST_SSE", '1');
     d.raycastPackets = !is("VIEWER_RAYCAST_PACKETS", '0');
     return d;

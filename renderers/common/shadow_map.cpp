@@ -2,6 +2,9 @@
 // frame's lights get, the CPU depth pass, and the lookup.
 #include "renderers/shadow_map.h"
 
+#include "raster/simd.h"
+#include "renderers/debug_switches.h"
+
 #include <tbb/parallel_for.h>
 
 #include <sys/mman.h>
@@ -219,71 +222,95 @@ int emitClipped(const vec4 (&in)[3], const ShadowView& v, int size, WinTri* out)
     return emitted;
 }
 
-// Rasterizes t into rows [r0, r1] of the map: pixel centres, the top-left rule, depth less.
-void rasterizeRows(const WinTri& t, int size, int r0, int r1, float* map) {
+// A window triangle's rasterizer constants, worked out once (not per band): edge k is the one
+// opposite vertex k (counter-clockwise, so w_k(x, y) = ex x + ey y + e0 >= 0 inside); 1/w and d/w
+// are affine in the pixel centre (sums of the edge functions' multiples); x0..x1, y0..y1 the
+// texels it may cover.
+struct TriSetup {
+    float ex[3], ey[3], e0[3];
+    float iwX, iwY, iw0, dwX, dwY, dw0;
+    int x0, x1, y0, y1;
+    bool inclusive[3];   // the top-left rule: a pixel centre on a top or a left edge is inside
+    bool ortho;          // 1/w constant (orthographic): no division per texel
+};
+
+// t's constants; false when it has no area (or NaN corners) or covers no column.
+bool setupTri(const WinTri& t, int size, TriSetup& s) {
     vec4 a = t.a, b = t.b, c = t.c;
     float area = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
-    if (!(area != 0.0f)) return;
+    if (!(area != 0.0f)) return false;
     if (area < 0.0f) {   // both faces: counter-clockwise from here on
         std::swap(b, c);
         area = -area;
     }
-    // Edge k: the one opposite vertex k; w_k(x, y) >= 0 inside. Top-left rule: a pixel centre on
-    // an edge belongs to the triangle when the edge is a top or a left edge.
     const vec4 v[3] = {a, b, c};
-    float ex[3], ey[3], e0[3];
-    bool inclusive[3];
     for (int k = 0; k < 3; ++k) {
         const vec4& p = v[(k + 1) % 3];
         const vec4& q = v[(k + 2) % 3];
-        ex[k] = p.y - q.y;   // d w / d x
-        ey[k] = q.x - p.x;   // d w / d y
-        e0[k] = p.x * q.y - p.y * q.x;
-        const bool top = ex[k] == 0.0f && ey[k]<0.0f, left = ex[k]> 0.0f;
-        inclusive[k] = top || left;
+        s.ex[k] = p.y - q.y;   // d w / d x
+        s.ey[k] = q.x - p.x;   // d w / d y
+        s.e0[k] = p.x * q.y - p.y * q.x;
+        const bool top = s.ex[k] == 0.0f && s.ey[k]<0.0f, left = s.ex[k]> 0.0f;
+        s.inclusive[k] = top || left;
     }
     const float xmin = std::min({a.x, b.x, c.x}), xmax = std::max({a.x, b.x, c.x});
-    const int x0 = std::max(0, int(std::floor(std::max(xmin, -1.0f) - 0.5f))),
-              x1 = std::min(size - 1, int(std::ceil(std::min(xmax, float(size) + 1.0f) - 0.5f)));
-    const int y0 = std::max(r0, t.y0), y1 = std::min(r1, t.y1);
-    // 1/w and d/w are affine in the pixel centre (sums of the edge functions' multiples).
-    float iwX = 0, iwY = 0, iw0 = 0, dwX = 0, dwY = 0, dw0 = 0;
+    s.x0 = std::max(0, int(std::floor(std::max(xmin, -1.0f) - 0.5f)));
+    s.x1 = std::min(size - 1, int(std::ceil(std::min(xmax, float(size) + 1.0f) - 0.5f)));
+    s.y0 = t.y0;
+    s.y1 = t.y1;
+    s.iwX = s.iwY = s.iw0 = s.dwX = s.dwY = s.dw0 = 0.0f;
     for (int k = 0; k < 3; ++k) {
-        iwX += ex[k] * v[k].z;
-        iwY += ey[k] * v[k].z;
-        iw0 += e0[k] * v[k].z;
-        dwX += ex[k] * v[k].w;
-        dwY += ey[k] * v[k].w;
-        dw0 += e0[k] * v[k].w;
+        s.iwX += s.ex[k] * v[k].z;
+        s.iwY += s.ey[k] * v[k].z;
+        s.iw0 += s.e0[k] * v[k].z;
+        s.dwX += s.ex[k] * v[k].w;
+        s.dwY += s.ey[k] * v[k].w;
+        s.dw0 += s.e0[k] * v[k].w;
     }
+    s.ortho = s.iwX == 0.0f && s.iwY == 0.0f;
+    return s.x0 <= s.x1;
+}
+
+// Row y's candidate span [xs, xe] (pixel centre py): each edge bounds x from one side, a texel
+// beyond its crossing; the exact test then decides each texel of it (the texels inside form one
+// run: every edge function, rounding included, is monotonic along the row).
+inline void rowSpan(const TriSetup& s, float py, int& xs, int& xe) {
+    float lo = float(s.x0), hi = float(s.x1);
+    for (int k = 0; k < 3; ++k) {
+        const float c0 = s.ey[k] * py + s.e0[k];
+        if (s.ex[k] > 0.0f)
+            lo = std::max(lo, -c0 / s.ex[k] - 0.5f - 1.0f);
+        else if (s.ex[k] < 0.0f)
+            hi = std::min(hi, -c0 / s.ex[k] - 0.5f + 1.0f);
+    }
+    xs = std::max(s.x0, int(std::floor(lo)));
+    xe = std::min(s.x1, int(std::ceil(hi)));
+}
+
+// The scalar reference: rasterizes s into rows [r0, r1] of the map (pixel centres, the top-left
+// rule, depth less, depths outside [0, 1] dropped).
+void rasterizeRows(const TriSetup& s, int size, int r0, int r1, float* map) {
     auto inside = [&](float px, float py) {
         for (int k = 0; k < 3; ++k) {
-            const float w = ex[k] * px + ey[k] * py + e0[k];
-            if (!(w > 0.0f || (w == 0.0f && inclusive[k]))) return false;
+            const float w = s.ex[k] * px + s.ey[k] * py + s.e0[k];
+            if (!(w > 0.0f || (w == 0.0f && s.inclusive[k]))) return false;
         }
         return true;
     };
+    const int y0 = std::max(r0, s.y0), y1 = std::min(r1, s.y1);
     for (int y = y0; y <= y1; ++y) {
         const float py = float(y) + 0.5f;
-        // The row's span: each edge bounds x from one side; then the exact test at both ends
-        // (the top-left rule and rounding), every pixel between them inside (convex).
-        float lo = float(x0), hi = float(x1);
-        for (int k = 0; k < 3; ++k) {
-            const float c0 = ey[k] * py + e0[k];
-            if (ex[k] > 0.0f)
-                lo = std::max(lo, -c0 / ex[k] - 0.5f - 1.0f);
-            else if (ex[k] < 0.0f)
-                hi = std::min(hi, -c0 / ex[k] - 0.5f + 1.0f);
-        }
-        int xs = std::max(x0, int(std::floor(lo))), xe = std::min(x1, int(std::ceil(hi)));
+        int xs, xe;
+        rowSpan(s, py, xs, xe);
+        // The run's ends by the exact test; every texel between them is inside (convex).
         while (xs <= xe && !inside(float(xs) + 0.5f, py)) ++xs;
         while (xe >= xs && !inside(float(xe) + 0.5f, py)) --xe;
         float* row = map + size_t(y) * size_t(size);
-        const float iwRow = iwY * py + iw0, dwRow = dwY * py + dw0;
-        if (iwX == 0.0f && iwY == 0.0f) {   // orthographic: 1/w constant, no division per texel
+        const float iwRow = s.iwY * py + s.iw0, dwRow = s.dwY * py + s.dw0;
+        if (s.ortho) {
             const float inv = iwRow != 0.0f ? 1.0f / iwRow : 0.0f;
             for (int x = xs; x <= xe; ++x) {
-                const float z = (dwX * (float(x) + 0.5f) + dwRow) * inv;
+                const float z = (s.dwX * (float(x) + 0.5f) + dwRow) * inv;
                 const bool ok = z >= 0.0f && z <= 1.0f;
                 row[x] = ok ? std::min(row[x], z) : row[x];
             }
@@ -291,7 +318,7 @@ void rasterizeRows(const WinTri& t, int size, int r0, int r1, float* map) {
         }
         for (int x = xs; x <= xe; ++x) {
             const float px = float(x) + 0.5f;
-            const float iw = iwX * px + iwRow, dw = dwX * px + dwRow;
+            const float iw = s.iwX * px + iwRow, dw = s.dwX * px + dwRow;
             const float z = iw != 0.0f ? dw / iw : 1.0f;   // (the barycentric normalisation cancels)
             const bool ok = z >= 0.0f && z <= 1.0f;
             row[x] = ok ? std::min(row[x], z) : row[x];
@@ -301,12 +328,63 @@ void rasterizeRows(const WinTri& t, int size, int r0, int r1, float* map) {
 
 }   // namespace
 
-void renderShadowDepth(const ShadowView& v, int size, const std::vector<ShadowCaster>& casters, float* map) {
-    std::fill(map, map + size_t(size) * size_t(size), 1.0f);
-    // Window triangles, built in parallel blocks of each caster, each block into its own stretch
-    // of one buffer (a clipped triangle makes at most two). The buffers are the calling thread's,
-    // kept from call to call: allocating them per map, in the workers, fragmented the heap of
-    // a long session (resident memory kept growing).
+// The same rows a vector of texels at a time (shadow_depth_kernel.inl), once per instruction set.
+#if defined(RASTER_HAVE_SSE2)
+namespace depth_sse {
+using namespace raster::simd_sse;
+#include "common/shadow_depth_kernel.inl"
+}   // namespace depth_sse
+#if defined(RASTER_HAVE_AVX2)
+#pragma GCC push_options
+#pragma GCC target("avx2")
+namespace depth_avx2 {
+using namespace raster::simd_avx2;
+#include "common/shadow_depth_kernel.inl"
+}   // namespace depth_avx2
+#pragma GCC pop_options
+#endif
+#endif
+
+namespace {
+
+using RowsFn = void (*)(const TriSetup&, int, int, int, float*);
+
+// The kernel the CPU runs: AVX2 where it has it (and VIEWER_RASTER_SSE is not 1), else SSE2.
+RowsFn vectorRows(const char** name) {
+#if defined(RASTER_HAVE_SSE2)
+#if defined(RASTER_HAVE_AVX2)
+    static const bool avx2 = [] {
+        if (debugSwitches().rasterForceSse) return false;
+        __builtin_cpu_init();
+        return bool(__builtin_cpu_supports("avx2"));
+    }();
+    if (avx2) {
+        if (name) *name = "avx2";
+        return depth_avx2::rasterizeRowsV;
+    }
+#endif
+    if (name) *name = "sse2";
+    return depth_sse::rasterizeRowsV;
+#else
+    if (name) *name = "scalar";
+    return rasterizeRows;
+#endif
+}
+
+}   // namespace
+
+const char* shadowDepthKernelName(ShadowDepthKernel kernel) {
+    const char* name = "scalar";
+    if (kernel == ShadowDepthKernel::Auto) vectorRows(&name);
+    return name;
+}
+
+void renderShadowDepth(const ShadowView& v, int size, const std::vector<ShadowCaster>& casters, float* map, ShadowDepthKernel kernel) {
+    const RowsFn rows = kernel == ShadowDepthKernel::Scalar ? rasterizeRows : vectorRows(nullptr);
+    // Window triangles and their rasterizer constants, built in parallel blocks of each caster,
+    // each block into its own stretch of one buffer (a clipped triangle makes at most two). The
+    // buffers are the calling thread's, kept from call to call: allocating them per map, in the
+    // workers, fragmented the heap of a long session (resident memory kept growing).
     constexpr size_t kBlock = 4096;
     struct Block {
         const ShadowCaster* c;
@@ -314,7 +392,7 @@ void renderShadowDepth(const ShadowView& v, int size, const std::vector<ShadowCa
     };
     struct Scratch {
         std::vector<Block> blocks;
-        std::vector<WinTri> built;
+        std::vector<TriSetup> built;
         std::vector<uint32_t> builtCount;
         std::vector<std::vector<uint32_t>> perBand;
     };
@@ -333,7 +411,7 @@ void renderShadowDepth(const ShadowView& v, int size, const std::vector<ShadowCa
     tbb::parallel_for(size_t(0), blocks.size(), [&](size_t bi) {
         const Block& blk = blocks[bi];
         const auto* base = static_cast<const unsigned char*>(blk.c->positions);
-        WinTri* out = &built[bi * 2 * kBlock];
+        TriSetup* out = &built[bi * 2 * kBlock];
         uint32_t count = 0;
         for (size_t t = blk.begin; t < blk.end; ++t) {
             vec4 clip[3];
@@ -346,23 +424,28 @@ void renderShadowDepth(const ShadowView& v, int size, const std::vector<ShadowCa
                 std::memcpy(xyz, base + i * blk.c->stride, sizeof(xyz));
                 clip[k] = v.viewProj * vec4(xyz[0], xyz[1], xyz[2], 1.0f);
             }
-            if (valid) count += uint32_t(emitClipped(clip, v, size, out + count));
+            if (!valid) continue;
+            WinTri w[2];
+            const int n = emitClipped(clip, v, size, w);
+            for (int q = 0; q < n; ++q) count += setupTri(w[q], size, out[count]) ? 1u : 0u;
         }
         builtCount[bi] = count;
     });
-    // Bands of rows, each with the triangles that reach it, rasterized in parallel.
+    // Bands of rows, each with the triangles that reach it, cleared to 1 and rasterized in
+    // parallel (a band's rows stay in the cache between the two).
     const int bands = (size + kBand - 1) / kBand;
     if (perBand.size() < size_t(bands)) perBand.resize(size_t(bands));
     for (auto& list : perBand) list.clear();
     for (size_t bi = 0; bi < blocks.size(); ++bi)
         for (uint32_t q = 0; q < builtCount[bi]; ++q) {
             const uint32_t id = uint32_t(bi * 2 * kBlock + q);
-            const WinTri& t = built[id];
+            const TriSetup& t = built[id];
             for (int b = t.y0 / kBand; b <= t.y1 / kBand; ++b) perBand[size_t(b)].push_back(id);
         }
     tbb::parallel_for(0, bands, [&](int b) {
         const int r0 = b * kBand, r1 = std::min(size - 1, r0 + kBand - 1);
-        for (uint32_t id : perBand[size_t(b)]) rasterizeRows(built[id], size, r0, r1, map);
+        std::fill(map + size_t(r0) * size_t(size), map + size_t(r1 + 1) * size_t(size), 1.0f);
+        for (uint32_t id : perBand[size_t(b)]) rows(built[id], size, r0, r1, map);
     });
 }
 

@@ -268,9 +268,26 @@ inline int64_t nowNs() { return std::chrono::duration_cast<std::chrono::nanoseco
 // Shadows: the maps' answer (shadowVisibility) for the lit fragments [0, n) of a batch, per
 // light, into ShadeBatch::vis (raster_shadows.cpp); nothing without a shadow plan.
 void fillShadowVisibility(const FrameContext& fc, ShadeBatch& b, size_t n);
+// What a renderer's shadow maps were last drawn from: the maps' views and size, and a copy of
+// every caster's world positions and triangles. A frame whose plan and casters equal it bit for
+// bit (a still camera: a directional light's maps follow the camera) keeps the maps as they are.
+struct ShadowMapsSource {
+    bool valid = false;
+    int size = 0;
+    std::vector<ShadowView> views;
+    std::vector<float> positions;    // xyz per vertex, caster after caster
+    std::vector<uint32_t> indices;   // per caster with indices, caster after caster
+    std::vector<uint64_t> shape;     // per caster: vertices, triangles, whether indexed
+    void clear() {                   // (the copies' memory too: they are as large as the casters' meshes)
+        *this = ShadowMapsSource{};
+    }
+};
+
 // The depth maps of the plan from the frame's opaque and masked triangles (world positions of
-// the vertex stage).
-void renderShadowMaps(const ShadowPlan& plan, const std::vector<DrawItem>& draws, ShadowMaps& maps);
+// the vertex stage). source (optional): what the maps were last drawn from; when this frame's
+// plan and casters are the same the maps are left as they are (and it is updated otherwise).
+// Returns whether the maps were drawn.
+bool renderShadowMaps(const ShadowPlan& plan, const std::vector<DrawItem>& draws, ShadowMaps& maps, ShadowMapsSource* source = nullptr);
 
 void runVertexStage(DrawItem& d, const sg::FrameInput& f, int width, int height, bool gouraud, const EnvironmentLight* env);
 

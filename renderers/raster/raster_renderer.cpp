@@ -211,10 +211,10 @@ private:
         // Shadow maps (per-pixel shading only: flat and Gouraud sum the lights at the vertices).
         m_shadowPlan = frame.settings.shading == sg::ShadingModel::Phong ? planShadows(frame, shadowCasterBounds(frame)) : ShadowPlan{};
         const auto tShadow0 = std::chrono::steady_clock::now();
-        renderShadowMaps(m_shadowPlan, draws, m_shadowMaps);
+        const bool drawn = renderShadowMaps(m_shadowPlan, draws, m_shadowMaps, m_shadowReuse ? &m_shadowSource : nullptr);
         if (m_timing && !m_shadowPlan.empty())
-            std::fprintf(stderr, "raster timing: shadow maps %zu x %d^2 %.2f ms\n", m_shadowPlan.views.size(), m_shadowPlan.size,
-                         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - tShadow0).count());
+            std::fprintf(stderr, "raster timing: shadow maps %zu x %d^2 %s %.2f ms\n", m_shadowPlan.views.size(), m_shadowPlan.size,
+                         drawn ? "drawn" : "kept", std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - tShadow0).count());
 
         auto tVert = std::chrono::steady_clock::now();
         // 3. triangles
@@ -284,10 +284,12 @@ private:
     LinearFrame m_linear;                    // the linear frame of step 6, kept between frames
     ShadowPlan m_shadowPlan;                 // this frame's shadow maps (their memory kept between frames)
     ShadowMaps m_shadowMaps;
+    ShadowMapsSource m_shadowSource;   // what they were drawn from (kept when a frame's are the same)
     // VIEWER_RASTER_REFERENCE_SHADING=1: shade every fragment with rnd::shade (slow; used to
     // check the batched path).
     bool m_timing = debugSwitches().rasterTiming;
     bool m_referenceShading = debugSwitches().rasterReferenceShading;
+    bool m_shadowReuse = debugSwitches().rasterShadowReuse;   // VIEWER_RASTER_SHADOW_REUSE=0: draw the maps every frame
 };
 
 }   // namespace

@@ -5,15 +5,85 @@
 #include "raster/raster_shading.h"
 #include "renderers/shading.h"
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+
+#include <atomic>
+#include <cstring>
 
 namespace rnd::raster {
 
-void renderShadowMaps(const ShadowPlan& plan, const std::vector<DrawItem>& draws, ShadowMaps& maps) {
+namespace {
+
+bool sameView(const ShadowView& a, const ShadowView& b) {
+    return std::memcmp(&a.view, &b.view, sizeof(a.view)) == 0 && std::memcmp(&a.viewProj, &b.viewProj, sizeof(a.viewProj)) == 0 &&
+           a.perspective == b.perspective && std::memcmp(&a.nearZ, &b.nearZ, sizeof(float)) == 0 && std::memcmp(&a.farZ, &b.farZ, sizeof(float)) == 0;
+}
+
+// Whether the casters are the ones src holds, bit for bit.
+bool sameCasters(const std::vector<ShadowCaster>& casters, const ShadowMapsSource& src) {
+    size_t vertices = 0, indices = 0;
+    for (const ShadowCaster& c : casters) {
+        vertices += c.vertices;
+        indices += c.idx ? 3 * c.triangles : 0;
+    }
+    if (src.shape.size() != 3 * casters.size() || src.positions.size() != 3 * vertices || src.indices.size() != indices) return false;
+    for (size_t i = 0; i < casters.size(); ++i)
+        if (src.shape[3 * i] != casters[i].vertices || src.shape[3 * i + 1] != casters[i].triangles ||
+            src.shape[3 * i + 2] != (casters[i].idx != nullptr))
+            return false;
+    std::atomic<bool> differ{false};
+    size_t vBase = 0, iBase = 0;
+    for (const ShadowCaster& c : casters) {   // the positions in parallel blocks
+        const auto* base = static_cast<const unsigned char*>(c.positions);
+        const float* copy = src.positions.data() + 3 * vBase;
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, c.vertices, 16384), [&](const tbb::blocked_range<size_t>& r) {
+            if (differ.load(std::memory_order_relaxed)) return;
+            for (size_t v = r.begin(); v < r.end(); ++v)
+                if (std::memcmp(base + v * c.stride, copy + 3 * v, 3 * sizeof(float)) != 0) {
+                    differ = true;
+                    return;
+                }
+        });
+        if (differ || (c.idx && std::memcmp(c.idx, src.indices.data() + iBase, 3 * c.triangles * sizeof(uint32_t)) != 0)) return false;
+        vBase += c.vertices;
+        iBase += c.idx ? 3 * c.triangles : 0;
+    }
+    return true;
+}
+
+// src's copy of the casters.
+void copyCasters(const std::vector<ShadowCaster>& casters, ShadowMapsSource& src) {
+    size_t vertices = 0, indices = 0;
+    for (const ShadowCaster& c : casters) {
+        vertices += c.vertices;
+        indices += c.idx ? 3 * c.triangles : 0;
+    }
+    src.shape.clear();
+    src.positions.resize(3 * vertices);
+    src.indices.resize(indices);
+    size_t vBase = 0, iBase = 0;
+    for (const ShadowCaster& c : casters) {
+        src.shape.insert(src.shape.end(), {uint64_t(c.vertices), uint64_t(c.triangles), uint64_t(c.idx != nullptr)});
+        const auto* base = static_cast<const unsigned char*>(c.positions);
+        float* copy = src.positions.data() + 3 * vBase;
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, c.vertices, 16384), [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t v = r.begin(); v < r.end(); ++v) std::memcpy(copy + 3 * v, base + v * c.stride, 3 * sizeof(float));
+        });
+        if (c.idx) std::memcpy(src.indices.data() + iBase, c.idx, 3 * c.triangles * sizeof(uint32_t));
+        vBase += c.vertices;
+        iBase += c.idx ? 3 * c.triangles : 0;
+    }
+}
+
+}   // namespace
+
+bool renderShadowMaps(const ShadowPlan& plan, const std::vector<DrawItem>& draws, ShadowMaps& maps, ShadowMapsSource* source) {
     maps.size = plan.size;
     if (plan.empty()) {
         maps.depth.clear();
-        return;
+        if (source) source->clear();
+        return false;
     }
     std::vector<ShadowCaster> casters;
     for (const DrawItem& d : draws) {
@@ -27,8 +97,23 @@ void renderShadowMaps(const ShadowPlan& plan, const std::vector<DrawItem>& draws
         casters.push_back(c);
     }
     const size_t texels = size_t(plan.size) * size_t(plan.size);
+    // The maps as they are when they were drawn from this very plan and these casters.
+    if (source) {
+        bool same = source->valid && source->size == plan.size && source->views.size() == plan.views.size() &&
+                    maps.depth.size() == texels * plan.views.size();
+        for (size_t v = 0; same && v < plan.views.size(); ++v) same = sameView(source->views[v], plan.views[v]);
+        if (same && sameCasters(casters, *source)) return false;
+        source->valid = false;   // (until the maps below are whole)
+    }
     maps.depth.resize(texels * plan.views.size());
     for (size_t v = 0; v < plan.views.size(); ++v) renderShadowDepth(plan.views[v], plan.size, casters, maps.map(int(v)));
+    if (source) {
+        source->size = plan.size;
+        source->views = plan.views;
+        copyCasters(casters, *source);
+        source->valid = true;
+    }
+    return true;
 }
 
 void fillShadowVisibility(const FrameContext& fc, ShadeBatch& b, size_t n) {

@@ -8,6 +8,7 @@
 #include "renderers/pbr.h"
 #include "renderers/renderer.h"
 #include "renderers/shading.h"
+#include "renderers/shadow_map.h"
 #include "renderers/texture_sampler.h"
 #include "scenegraph/frame.h"
 #include "scenegraph/transforms.h"
@@ -16,6 +17,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <memory>
 #include <random>
@@ -659,6 +661,157 @@ TEST(RasterShadingTest, VectorShadowLookupMatchesScalar) {
         EXPECT_GT(shadowed, n / 20) << "the test's triangles must shadow part of the ground";
         EXPECT_LE(differ, n / 200) << differ << " lanes differ";
     }
+}
+
+// The shadow depth pass's vector kernel (shadow_depth_kernel.inl) against its scalar reference,
+// bit for bit: random triangles of every size (below a texel, slivers, larger than the map,
+// crossing the near plane of a perspective map) for a sun, a spot and a point light's faces, and
+// triangles whose corners and edges lie on texel centres (the top-left rule decides those) in a
+// map whose window coordinates are the world's. Both instruction sets in CI (raster_shading_sse2
+// forces SSE2).
+TEST(RasterShadingTest, VectorShadowDepthMatchesScalar) {
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> U(-1.0f, 1.0f), P(0.0f, 1.0f);
+    std::vector<vec3> tris;
+    for (int t = 0; t < 3000; ++t) {
+        const float scale = t % 5 == 0 ? 0.003f : t % 5 == 1 ? 0.05f : t % 5 == 2 ? 0.4f : t % 5 == 3 ? 2.0f : 9.0f;
+        const vec3 c(4 * U(rng), 1.5f + 1.5f * U(rng), 4 * U(rng));
+        if (t % 7 == 0) {   // a sliver: two corners close, one far
+            const vec3 d = scale * vec3(U(rng), U(rng), U(rng));
+            tris.push_back(c);
+            tris.push_back(c + d);
+            tris.push_back(c + d + 1e-3f * vec3(U(rng), U(rng), U(rng)));
+            continue;
+        }
+        for (int k = 0; k < 3; ++k) tris.push_back(c + scale * vec3(U(rng), U(rng), U(rng)));
+    }
+    rnd::ShadowCaster c;
+    c.positions = tris.data();
+    c.stride = sizeof(vec3);
+    c.triangles = tris.size() / 3;
+    c.vertices = tris.size();
+    std::vector<rnd::ShadowView> views;
+    for (LightType type : {LightType::Directional, LightType::Spot, LightType::Point}) {
+        FrameInput f;
+        f.camera = cameraAt(vec3(0, 6, 8), vec3(0, 0, 0), Projection{}, 1.0f);
+        DrawLight L;
+        L.type = type;
+        L.position = vec3(0.5f, type == LightType::Point ? 1.5f : 7.0f, 1);
+        L.direction = glm::normalize(vec3(0.2f, -1, -0.1f));
+        L.cosInner = std::cos(radians(40));
+        L.cosOuter = std::cos(radians(50));
+        f.lights = {L};
+        f.settings.shadows = true;
+        f.settings.shadowMapSize = 203;   // bands and vectors that do not divide it
+        const rnd::ShadowPlan plan = rnd::planShadows(f, sg::Aabb{vec3(-4, 0, -4), vec3(4, 3, 4)});
+        ASSERT_FALSE(plan.empty());
+        views.insert(views.end(), plan.views.begin(), plan.views.end());
+    }
+    auto compare = [&](const rnd::ShadowView& v, int size, const std::vector<rnd::ShadowCaster>& casters, const char* what) {
+        std::vector<float> want(size_t(size) * size_t(size), -1.0f), got(want.size(), -2.0f);
+        rnd::renderShadowDepth(v, size, casters, want.data(), rnd::ShadowDepthKernel::Scalar);
+        rnd::renderShadowDepth(v, size, casters, got.data(), rnd::ShadowDepthKernel::Auto);
+        size_t differ = 0, covered = 0;
+        for (size_t i = 0; i < want.size(); ++i) {
+            covered += want[i] < 1.0f;
+            differ += std::memcmp(&want[i], &got[i], sizeof(float)) != 0;
+        }
+        EXPECT_EQ(differ, 0u) << what << ": " << differ << " texels differ (" << rnd::shadowDepthKernelName(rnd::ShadowDepthKernel::Auto) << ")";
+        EXPECT_GT(covered, want.size() / 50) << what << ": the triangles must cover part of the map";
+    };
+    for (size_t i = 0; i < views.size(); ++i) compare(views[i], 203, {c}, views[i].perspective ? "perspective view" : "orthographic view");
+    // Window coordinates = world x, y exactly (a power-of-two map): corners on texel centres and
+    // edges through them, both windings, depths inside and outside [0, 1].
+    rnd::ShadowView grid;
+    grid.view = sg::mat4(1.0f);
+    grid.viewProj = glm::ortho(0.0f, 256.0f, 0.0f, 256.0f, -1.0f, 1.0f);
+    std::vector<vec3> snapped;
+    std::uniform_int_distribution<int> I(-8, 520), S(1, 24);
+    for (int t = 0; t < 4000; ++t) {
+        const float x = 0.5f * float(I(rng)), y = 0.5f * float(I(rng));
+        const float s = 0.5f * float(S(rng)) * (t % 3 == 0 ? 8.0f : 1.0f);
+        const float z0 = 1.2f * U(rng), z1 = 1.2f * U(rng), z2 = 1.2f * U(rng);
+        const int shape = t % 4;
+        const vec3 a(x, y, z0);
+        const vec3 b = shape == 0 ? vec3(x + s, y, z1) : shape == 1 ? vec3(x, y + s, z1) : vec3(x + s, y + 0.5f * float(S(rng)), z1);
+        const vec3 d = shape == 2 ? vec3(x - 0.5f * float(S(rng)), y + s, z2) : vec3(x + 0.5f * float(S(rng)), y + s, z2);
+        snapped.push_back(a);
+        if (t % 2 == 0) {
+            snapped.push_back(b);
+            snapped.push_back(d);
+        } else {
+            snapped.push_back(d);
+            snapped.push_back(b);
+        }
+    }
+    rnd::ShadowCaster g;
+    g.positions = snapped.data();
+    g.stride = sizeof(vec3);
+    g.triangles = snapped.size() / 3;
+    g.vertices = snapped.size();
+    compare(grid, 256, {g}, "texel-centre grid");
+    compare(grid, 256, {g, c}, "texel-centre grid and random triangles");
+}
+
+// A renderer keeps its shadow maps when a frame's plan and casters are the last frame's; every
+// frame of a sequence (the same frame again, a caster moved, a mesh edited in place, the camera
+// moved, a blended caster, shadows off and on) matches a new renderer's image exactly.
+TEST(RasterShadowTest, KeptMapsMatchNewlyDrawnOnes) {
+    Material m;
+    m.baseColor = vec3(0.7f);
+    m.ka = 0.2f;
+    m.kd = 0.8f;
+    m.ks = 0.0f;
+    m.doubleSided = true;
+    auto ground = quadMesh({-4, 0, 4}, {4, 0, 4}, {4, 0, -4}, {-4, 0, -4});
+    auto box = std::make_shared<Mesh>(primitives::box(vec3(0.6f, 0.3f, 0.5f)));
+    FrameInput f0;
+    f0.meshes.push_back(drawOf(ground, m));
+    f0.meshes.push_back(drawOf(box, m, glm::translate(mat4(1.0f), vec3(-0.5f, 1.2f, 0.0f))));
+    DrawLight sun;
+    sun.type = LightType::Directional;
+    sun.direction = glm::normalize(vec3(0.3f, -1.0f, -0.2f));
+    sun.radiance = vec3(1.0f);
+    f0.lights = {sun};
+    f0.ambientLight = vec3(0.5f);
+    f0.settings.shadows = true;
+    f0.settings.shadowMapSize = 512;
+    Projection p;
+    f0.camera = cameraAt(vec3(0, 6, 7), vec3(0, 0, 0), p, 1.0f);
+    FrameInput moved = f0;
+    moved.meshes[1] = drawOf(box, m, glm::translate(mat4(1.0f), vec3(0.7f, 1.2f, 0.3f)));
+    FrameInput camera = f0;
+    camera.camera = cameraAt(vec3(1, 5, 7), vec3(0, 0, 0), p, 1.0f);
+    FrameInput blended = f0;
+    blended.meshes[1].material.alphaMode = AlphaMode::Blend;
+    blended.meshes[1].material.alpha = 0.5f;
+    FrameInput off = f0;
+    off.settings.shadows = false;
+    auto edited = std::make_shared<Mesh>(*box);
+    FrameInput editedFrame = f0;
+    editedFrame.meshes[1] = drawOf(edited, m, f0.meshes[1].world);
+    auto r = makeRenderer("raster");
+    ASSERT_TRUE(r);
+    auto check = [&](const FrameInput& f, const char* what) -> Framebuffer {
+        Framebuffer kept;
+        RenderStats st = r->render(f, 96, 96, kept);
+        EXPECT_TRUE(st.ok) << st.error;
+        const Framebuffer fresh = renderRaster(f, 96, 96);
+        EXPECT_TRUE(kept.color == fresh.color) << what;
+        return kept;
+    };
+    const Framebuffer a = check(f0, "first frame");
+    check(f0, "the same frame again");
+    const Framebuffer b = check(moved, "a caster moved");
+    EXPECT_FALSE(a.color == b.color) << "the moved caster's shadow must move";
+    check(moved, "the moved caster again");
+    check(editedFrame, "the same mesh in another object");
+    for (vec3& q : edited->positions) q.y *= 2.0f;   // edited in place: the same mesh object
+    check(editedFrame, "the mesh edited in place");
+    check(camera, "the camera moved");
+    check(blended, "the caster blended (casts nothing)");
+    check(off, "shadows off");
+    check(f0, "shadows on again");
 }
 
 // ---------------------------------------------------------------------------------------

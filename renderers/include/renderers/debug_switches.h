@@ -9,6 +9,9 @@
 //   VIEWER_RASTER_REFERENCE_SHADING=1     the CPU rasterizer shades every fragment with rnd::shade
 //                                         (slow; checks the batched path)
 //   VIEWER_RASTER_SSE=1                   the CPU rasterizer's SSE2 kernels even where AVX2 runs
+//                                         (its shadow depth pass's too)
+//   VIEWER_RASTER_SHADOW_REUSE=0          the CPU rasterizer draws its shadow maps every frame,
+//                                         also when the plan and the casters are the last frame's
 //   VIEWER_RAYCAST_SSE=1                  the ray caster's BVH4/SSE traversal even where AVX2 runs
 //   VIEWER_RAYCAST_PACKETS=0              the ray caster traces camera rays one by one (no packets)
 #pragma once
@@ -22,6 +25,7 @@ struct DebugSwitches {
     bool rasterTiming = false;
     bool rasterReferenceShading = false;
     bool rasterForceSse = false;
+    bool rasterShadowReuse = true;
     bool raycastForceSse = false;
     bool raycastPackets = true;
 };

@@ -129,9 +129,15 @@ inline bool castsShadow(const sg::Material& m) {
     return !(m.alphaMode == sg::AlphaMode::Mask && m.alpha < m.alphaCutoff);
 }
 
+// The CPU depth pass's kernels: Auto, the vector one the CPU offers (AVX2, or SSE2 where it has
+// no AVX2 or VIEWER_RASTER_SSE=1), and Scalar, the reference it is held to bit for bit (tests).
+enum class ShadowDepthKernel { Auto, Scalar };
+const char* shadowDepthKernelName(ShadowDepthKernel kernel);   // "avx2", "sse2" or "scalar"
+
 // The CPU depth pass: clears one view's map (size x size) to 1 and rasterizes the casters into
 // it, both faces, depth test less, at pixel centres with the top-left rule (as GL's rasterizer).
-void renderShadowDepth(const ShadowView& v, int size, const std::vector<ShadowCaster>& casters, float* map);
+void renderShadowDepth(const ShadowView& v, int size, const std::vector<ShadowCaster>& casters, float* map,
+                       ShadowDepthKernel kernel = ShadowDepthKernel::Auto);
 
 // The map of a point light's face for the direction from the light to p (views: first of six).
 int pointLightFace(const sg::vec3& fromLight);
