@@ -145,7 +145,8 @@ std::vector<Param<RenderSettings>> renderTable() {
                 field<&S::shadowFilter>("shadow.filter", "shadow-filter", "Filter", "How a shadow-map lookup is filtered")
                     .needing(Feature::ShadowMaps)
                     .when(shadowsOn),
-                field<&S::shadowPcfSize>("shadow.pcfSize", "shadow-pcf-size", "PCF size", "k: the k x k texels PCF averages")
+                field<&S::shadowPcfSize>("shadow.pcfSize", "shadow-pcf-size", "Filter taps",
+                                         "k: PCF averages the k x k texels around the point; PCSS spreads k x k taps over the penumbra")
                     .range(1, 15)
                     .needing(Feature::ShadowMaps)
                     .when([](const S& s) { return s.shadows && s.shadowFilter != ShadowFilter::None; }),
