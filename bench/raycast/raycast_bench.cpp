@@ -264,10 +264,15 @@ struct Embree {
             q.time[i] = 0;
         }
     }
-    void intersect16(const Ray* r, int n, TriHit* h) const {
+    // A context for rays of one tile (RTC_INTERSECT_CONTEXT_FLAG_COHERENT).
+    static RTCIntersectContext coherentContext() {
         RTCIntersectContext ctx;
         rtcInitIntersectContext(&ctx);
         ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+        return ctx;
+    }
+    void intersect16(const Ray* r, int n, TriHit* h) const {
+        RTCIntersectContext ctx = coherentContext();
         alignas(64) int valid[16];
         RTCRayHit16 rh;
         load16(r, n, rh.ray, valid);
@@ -286,9 +291,7 @@ struct Embree {
                 h[i] = TriHit();
     }
     void occluded16(const Ray* r, int n, uint8_t* occ) const {
-        RTCIntersectContext ctx;
-        rtcInitIntersectContext(&ctx);
-        ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+        RTCIntersectContext ctx = coherentContext();
         alignas(64) int valid[16];
         RTCRay16 q;
         load16(r, n, q, valid);

@@ -32,6 +32,7 @@
 #include "assets/demo.h"
 #include "assets/image_io.h"
 #include "assets/scene_io.h"
+#include "bench_scenes.h"
 #include "min_embree.h"
 #include "renderers/renderer.h"
 #include "scenegraph/frame.h"
@@ -56,86 +57,9 @@ using namespace sg;
 
 namespace {
 
-struct BenchScene {
-    std::string name;
-    Scene scene;
-};
-
-// A mesh on a ground plane, scaled to a 2-unit diagonal, seen from the front with a point light
-// (bench_raster's bunny framing).
-BenchScene meshScene(const std::string& name, std::shared_ptr<Mesh> m) {
-    BenchScene b;
-    b.name = name;
-    Scene& s = b.scene;
-    Aabb bb = m->bounds();
-    auto ground = std::make_shared<Mesh>(primitives::plane(1.0f, 32));
-    s.meshes = {m, ground};
-    Material mb;
-    mb.baseColor = vec3(0.75f, 0.7f, 0.6f);
-    s.materials = {mb};
-    NodeId n = s.addNode(name, s.root(), MeshInstance{0, 0});
-    float scale = 2.0f / glm::length(bb.extent());
-    s.setLocal(n, LocalTransform::fromTRS(-bb.center() * scale + vec3(0, 0.5f * bb.extent().y * scale, 0), quat(1, 0, 0, 0), vec3(scale)));
-    s.addNode("ground", s.root(), MeshInstance{1, 0});
-    Camera cam;
-    cam.projection.zNear = 0.05f;
-    cam.projection.zFar = 20.0f;
-    NodeId c = s.addNode("camera", s.root(), cam);
-    s.lookAt(c, vec3(0.0f, 0.9f, 2.0f), vec3(0.0f, 0.45f, 0.0f));
-    s.activeCamera = c;
-    NodeId key = s.addNode("key", s.root(), Light{LightType::Point, vec3(1.0f), 1.0f, false});
-    s.setLocal(key, LocalTransform::fromTRS(vec3(1, 3, 2)));
-    return b;
-}
-
-bool fileScene(const std::string& name, const std::string& path, BenchScene& b) {
-    assets::LoadResult r = assets::loadScene(path);
-    if (!r.scene || r.scene->meshes.empty() || !r.scene->meshes.front()) {
-        std::fprintf(stderr, "bench: %s: %s\n", path.c_str(), r.scene ? "no mesh" : r.error.c_str());
-        return false;
-    }
-    b = meshScene(name, r.scene->meshes.front());
-    return true;
-}
-
-// bench_raster's mesh1M: grid x grid uv-spheres of `seg` slices and a ground plane of
-// groundSub^2 quads merged into one mesh, one point light, the camera looking down at the grid.
-BenchScene singleMesh(const std::string& name, int grid, int seg, int groundSub) {
-    BenchScene b;
-    b.name = name;
-    Scene& s = b.scene;
-    const float extent = float(grid);
-    auto m = std::make_shared<Mesh>(primitives::plane(extent, groundSub));
-    m->uv0.clear();
-    const Mesh sphere = primitives::uvSphere(0.4f, seg, seg / 2);
-    for (int i = 0; i < grid; ++i)
-        for (int j = 0; j < grid; ++j) {
-            const vec3 at(i - (grid - 1) * 0.5f, 0.4f, j - (grid - 1) * 0.5f);
-            const uint32_t base = uint32_t(m->positions.size());
-            for (size_t v = 0; v < sphere.positions.size(); ++v) {
-                m->positions.push_back(sphere.positions[v] + at);
-                m->normals.push_back(sphere.normals[v]);
-            }
-            for (uint32_t idx : sphere.indices) m->indices.push_back(base + idx);
-        }
-    s.meshes = {m};
-    Material mat;
-    mat.baseColor = vec3(0.8f, 0.3f, 0.2f);
-    mat.ks = 0.5f;
-    s.materials = {mat};
-    s.addNode("mesh", s.root(), MeshInstance{0, 0});
-    Camera cam;
-    cam.projection.fovyDeg = 50.0f;
-    cam.projection.zNear = 0.1f;
-    cam.projection.zFar = 4.0f * extent + 20.0f;
-    NodeId c = s.addNode("camera", s.root(), cam);
-    s.lookAt(c, vec3(0.0f, 0.55f * extent + 1.0f, 0.75f * extent + 1.5f), vec3(0.0f));
-    s.activeCamera = c;
-    NodeId key = s.addNode("key", s.root(), Light{LightType::Point, vec3(1.0f), 1.0f, false});
-    s.setLocal(key, LocalTransform::fromTRS(vec3(extent * 0.3f, extent, extent * 0.5f)));
-    s.settings.ambientLight = vec3(0.3f);
-    return b;
-}
+using bench::BenchScene;
+using bench::fileScene;
+using bench::singleMesh;
 
 double median(std::vector<double> v) {
     if (v.empty()) return NAN;
@@ -191,8 +115,8 @@ int main(int argc, char** argv) {
     if (want("demo")) scenes.push_back({"demo", assets::makeDemoScene()});
     const std::string models = testdata + "/meshes/common-3d-test-models/";
     BenchScene b;
-    if (want("bunny") && fileScene("bunny", models + "stanford-bunny/stanford-bunny.obj", b)) scenes.push_back(std::move(b));
-    if (want("igea") && fileScene("igea", models + "igea/igea.ply", b)) scenes.push_back(std::move(b));
+    if (want("bunny") && fileScene(models + "stanford-bunny/stanford-bunny.obj", b, "bunny")) scenes.push_back(std::move(b));
+    if (want("igea") && fileScene(models + "igea/igea.ply", b, "igea")) scenes.push_back(std::move(b));
     if (want("mesh1M")) scenes.push_back(singleMesh("mesh1M", 22, 46, 64));
 
     std::printf("# raycast frame vs min_embree (Embree 3, 4x4 packets): %dx%d, %d threads, shadows on, median of %d rounds\n", w, h, threads, frames);

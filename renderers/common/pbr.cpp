@@ -1,6 +1,7 @@
 // pbr.cpp - glTF's BRDF, the split-sum table, punctual lights in KHR_lights_punctual's units and
 // the environment's terms (pbr.h has the formulas).
 #include "renderers/pbr.h"
+#include "renderers/sampling.h"
 
 #include <algorithm>
 #include <cmath>

@@ -120,7 +120,7 @@ bool hasFeature(const Capabilities& caps, sg::Feature feature) {
     case sg::Feature::None: return true;
     case sg::Feature::Shadows: return caps.shadows;
     case sg::Feature::ShadowMaps: return caps.shadowMaps;
-    case sg::Feature::ShadowRays: return caps.shadows && !caps.shadowMaps;
+    case sg::Feature::ShadowRays: return caps.shadowRays;
     case sg::Feature::Reflections: return caps.reflections;
     case sg::Feature::Wireframe: return caps.wireframe;
     }

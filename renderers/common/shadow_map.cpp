@@ -2,6 +2,8 @@
 // frame's lights get, the CPU depth pass, and the lookup.
 #include "renderers/shadow_map.h"
 
+#include "renderers/sampling.h"
+
 #include "raster/simd.h"
 #include "renderers/debug_switches.h"
 
@@ -450,17 +452,9 @@ void renderShadowDepth(const ShadowView& v, int size, const std::vector<ShadowCa
 }
 
 float pcssJitter(int i, int j, int view, int axis) {
-    auto hash = [](uint32_t x) {
-        x ^= x >> 16;
-        x *= 0x7feb352dU;
-        x ^= x >> 15;
-        x *= 0x846ca68bU;
-        x ^= x >> 16;
-        return x;
-    };
-    uint32_t h = hash(uint32_t(i) * 73856093u ^ uint32_t(j) * 19349663u ^ uint32_t(view) * 83492791u);
-    if (axis) h = hash(h);
-    return float(h >> 8) * (1.0f / 16777216.0f);
+    uint32_t h = hash32(uint32_t(i) * 73856093u ^ uint32_t(j) * 19349663u ^ uint32_t(view) * 83492791u);
+    if (axis) h = hash32(h);
+    return unitFloat(h);
 }
 
 float shadowVisibility(const ShadowPlan& plan, const ShadowMaps& maps, const sg::DrawLight& L, int light, const vec3& p, const vec3& ng) {

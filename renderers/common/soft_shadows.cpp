@@ -1,6 +1,6 @@
 // soft_shadows.cpp - softShadowRay(): the ray caster's shadow rays to a light with a size
 // (shadow_map.h; docs/math.md, "Soft shadows").
-#include "renderers/pbr.h"
+#include "renderers/sampling.h"
 #include "renderers/shadow_map.h"
 
 #include <cmath>

@@ -22,6 +22,7 @@
 #include "renderers/draw_list.h"
 #include "renderers/environment.h"
 #include "renderers/pbr.h"
+#include "renderers/sampling.h"
 #include "renderers/shading.h"
 #include "renderers/shadow_map.h"
 #include "renderers/texture_sampler.h"
@@ -136,15 +137,6 @@ struct SurfaceRecord {
     vec3 p{std::numeric_limits<float>::quiet_NaN()};
     uint32_t drawable = 0, primitive = kNoPrimitive;
 };
-
-uint32_t hash32(uint32_t x) {
-    x ^= x >> 16;
-    x *= 0x7feb352dU;
-    x ^= x >> 15;
-    x *= 0x846ca68bU;
-    x ^= x >> 16;
-    return x;
-}
 
 struct Tracer {
     const FrameInput& f;
@@ -270,7 +262,7 @@ struct Tracer {
             std::memcpy(&bits, &p[a], sizeof bits);
             seed = hash32(seed ^ bits);
         }
-        const vec2 rotation(float(seed >> 8) * (1.0f / 16777216.0f), float(hash32(seed) >> 8) * (1.0f / 16777216.0f));
+        const vec2 rotation(unitFloat(seed), unitFloat(hash32(seed)));
         float sum = 0.0f;
         for (int k = 0; k < count; ++k) {
             const ShadowRayTarget t = softShadowRay(L, p, k, count, rotation);
@@ -550,7 +542,7 @@ struct Tracer {
 
 float rand01(uint32_t& s) {
     s = hash32(s + 0x9e3779b9u);
-    return float(s >> 8) * (1.0f / 16777216.0f);
+    return unitFloat(s);
 }
 
 // --- a frame's tiles ----------------------------------------------------------------------------
@@ -664,6 +656,7 @@ public:
         c.progressive = true;
         c.exactImplicits = true;
         c.shadows = true;
+        c.shadowRays = true;   // soft ones: settings.shadowRays rays to a light with a size
         c.reflections = true;
         c.wireframe = true;        // the CPU backends' overlay (common/line_overlay.h), after the rays
         c.pointsAndLines = true;   // the same pixel footprint as the rasterizers

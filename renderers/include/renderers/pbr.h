@@ -41,9 +41,6 @@ sg::vec2 splitSum(float nv, float roughness);
 // The exact integral (by importance sampling with `samples` directions), for tests.
 sg::vec2 splitSumIntegral(float nv, float roughness, int samples);
 
-// Van der Corput's radical inverse in base 2 of i, in [0, 1) (Hammersley points: ((i + 0.5)/n, it)).
-float radicalInverse(uint32_t i);
-
 // Half vector i of n for GGX importance sampling (alpha^2 = a2), in the frame where n = +z:
 // stratified in the polar angle, Hammersley's radical inverse in the azimuth (Karis 2013).
 sg::vec3 ggxHalfVector(int i, int n, float a2);

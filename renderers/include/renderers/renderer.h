@@ -45,6 +45,7 @@ struct Capabilities {
     bool exactImplicits = false;      // implicit shapes/CSG intersected analytically (vs tessellated)
     bool shadows = false;             // honours RenderSettings::shadows
     bool shadowMaps = false;          // its shadows are shadow maps (RenderSettings::shadowMapSize ... honoured)
+    bool shadowRays = false;          // its shadows are shadow rays (RenderSettings::shadowRays honoured)
     bool reflections = false;         // honours RenderSettings::reflections
     bool wireframe = false;           // draws RenderSettings::wireframe
     bool pointsAndLines = false;      // draws meshes of PrimitiveMode::Points / Lines

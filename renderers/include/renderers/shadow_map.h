@@ -162,7 +162,5 @@ struct ShadowRayTarget {
     float distance = 0.0f;
 };
 ShadowRayTarget softShadowRay(const sg::DrawLight& L, const sg::vec3& p, int k, int n, const sg::vec2& rotation);
-// The unit disc point of Shirley and Chiu's concentric map for (a, b) in [0, 1)^2.
-sg::vec2 concentricDisc(float a, float b);
 
 }   // namespace rnd
