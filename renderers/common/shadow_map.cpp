@@ -337,13 +337,12 @@ using namespace raster::simd_sse;
 #include "common/shadow_depth_kernel.inl"
 }   // namespace depth_sse
 #if defined(RASTER_HAVE_AVX2)
-#pragma GCC push_options
-#pragma GCC target("avx2")
+VIEWER_ISA_REGION_BEGIN("avx2")
 namespace depth_avx2 {
 using namespace raster::simd_avx2;
 #include "common/shadow_depth_kernel.inl"
 }   // namespace depth_avx2
-#pragma GCC pop_options
+VIEWER_ISA_REGION_END
 #endif
 #endif
 

@@ -122,8 +122,7 @@ using namespace simd_sse;
 }   // namespace kern_sse
 
 #if defined(RASTER_HAVE_AVX2)
-#pragma GCC push_options
-#pragma GCC target("avx2")
+VIEWER_ISA_REGION_BEGIN("avx2")
 namespace kern_avx2 {
 using namespace simd_avx2;
 #include "raster/pbr_kernel.inl"
@@ -136,7 +135,7 @@ void shadowLookupAvx2(const ShadowPlan& plan, const ShadowView& v, const float* 
     shadowLookupV(plan, v, map, lightVec, positional, b, i, out);
 }
 }   // namespace kern_avx2
-#pragma GCC pop_options
+VIEWER_ISA_REGION_END
 #endif
 
 void shadeBatch(ShadeBatch& b, size_t n, const sg::FrameInput& f, const EnvironmentLight* env) {

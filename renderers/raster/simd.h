@@ -9,6 +9,8 @@
 // bits. VIEWER_RASTER_SSE=1 forces the SSE2 kernels (the tests compare the two).
 #pragma once
 
+#include "renderers/isa_region.h"
+
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #define RASTER_HAVE_SSE2 1
@@ -95,8 +97,7 @@ inline VI maxI(VI a, VI b) { return selI(_mm_cmpgt_epi32(a, b), a, b); }
 #endif
 
 #if defined(RASTER_HAVE_AVX2)
-#pragma GCC push_options
-#pragma GCC target("avx2")
+VIEWER_ISA_REGION_BEGIN("avx2")
 namespace simd_avx2 {
 using V = __m256;
 using VI = __m256i;
@@ -150,7 +151,7 @@ inline VI mulloI(VI a, VI b) { return _mm256_mullo_epi32(a, b); }
 inline VI minI(VI a, VI b) { return _mm256_min_epi32(a, b); }
 inline VI maxI(VI a, VI b) { return _mm256_max_epi32(a, b); }
 }   // namespace simd_avx2
-#pragma GCC pop_options
+VIEWER_ISA_REGION_END
 #endif
 
 }   // namespace rnd::raster

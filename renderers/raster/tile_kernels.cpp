@@ -15,8 +15,7 @@ using namespace simd_sse;
 }   // namespace tile_sse
 
 #if defined(RASTER_HAVE_AVX2)
-#pragma GCC push_options
-#pragma GCC target("avx2")
+VIEWER_ISA_REGION_BEGIN("avx2")
 namespace tile_avx2 {
 using namespace simd_avx2;
 #include "raster/tile_kernels.inl"
@@ -33,7 +32,7 @@ void writeFragmentsAvx2(const float* cr, const float* cg, const float* cb, const
     writeFragmentsKernel(cr, cg, cb, fogDist, fragPixel, n, fog, srgb, color);
 }
 }   // namespace tile_avx2
-#pragma GCC pop_options
+VIEWER_ISA_REGION_END
 #endif
 
 void rasterizeOpaque(const TriCoverage& s, const TriPlanes& pl, uint32_t id, int tx0, int ty0, int x0, int y0, int x1, int y1, float* depth,

@@ -3,6 +3,7 @@
 // and the brute-force reference the tests compare against.
 #include "raycast/bvh.h"
 #include "renderers/debug_switches.h"
+#include "renderers/isa_region.h"
 
 #include <immintrin.h>
 
@@ -25,14 +26,13 @@ namespace kern_sse {
 #undef RT_FMA
 }   // namespace kern_sse
 
-#pragma GCC push_options
-#pragma GCC target("avx2,fma")
+VIEWER_ISA_REGION_BEGIN("avx2,fma")
 namespace kern_avx2 {
 #define RT_FMA 1
 #include "raycast/tri_kernel.inl"
 #undef RT_FMA
 }   // namespace kern_avx2
-#pragma GCC pop_options
+VIEWER_ISA_REGION_END
 
 namespace {
 const bool kUseAvx2 = [] {
