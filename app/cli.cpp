@@ -13,6 +13,7 @@
 #include "renderers/inspect.h"
 #include "renderers/overlay.h"
 #include "renderers/renderer.h"
+#include "renderers/shadow_map_view.h"
 #include "scenegraph/camera_model.h"
 #include "scenegraph/instances.h"
 #include "scenegraph/params.h"
@@ -332,10 +333,12 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a, Command command) {
         cmd.add_option("--cameras", a.cameras, "Render one frame per line of this JSON-lines file of cameras: OUT_0000.png, OUT_0001.png, ...");
         cmd.add_option("--turntable", a.turntable, "Render N frames around the camera's pivot: OUT_0000.png, ...");
         cmd.add_option("--shard", a.shard, "Render only frames k with k mod N == I (I/N), for a scheduler's array jobs");
-        cmd.add_option("--view", a.view,
-                       "What OUT.png shows: shaded (default), depth, normal, id, uv, triangles (density), overdraw (fragments per pixel; "
-                       "rasterizers) or cost (BVH nodes + triangles tested per primary ray; ray caster); the diagnostic views are "
-                       "made from the backend's own visibility and counters, and the legend is printed")
+        cmd.add_option(
+               "--view", a.view,
+               "What OUT.png shows: shaded (default), depth, normal, id, uv, triangles (density), overdraw (fragments per pixel; "
+               "rasterizers), cost (BVH nodes + triangles tested per primary ray; ray caster) or shadow-map (the map of the light --select "
+               "names, else the first, against the ray caster's shadow rays: red acne, blue peter-panning; rasterizers); the diagnostic views are "
+               "made from the backend's own visibility and counters, and the legend is printed")
             ->capture_default_str();
     }
     cmd.add_option("--size", a.size,
@@ -353,7 +356,7 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a, Command command) {
     if (command == Command::Inspect) return;
     cmd.add_option("--overlay", a.overlay,
                    std::string("Draw overlays on the image, the same pixels in every backend: a comma-separated list of ") + rnd::overlayNameList());
-    cmd.add_option("--select", a.select, "The node (by name) that --overlay selection outlines");
+    cmd.add_option("--select", a.select, "The node (by name) that --overlay selection outlines, and the light whose map --view shadow-map shows");
 }
 
 std::vector<std::string> aovKinds(const RenderArgs& a) { return ui::parseAovList(a.aov); }
@@ -382,7 +385,14 @@ std::string renderJob(const RenderArgs& a, const CameraJob& job, const sg::Scene
     rnd::requestFor(view, request);
     Shot shot = renderWith(a.backend, frame, w, h, request);
     if (!shot.stats.ok) return shot.stats.error;   // starts with the backend's name
-    rnd::DiagnosticImage shown = rnd::diagnosticImage(view, frame, shot.image);
+    rnd::DiagnosticImage shown;
+    if (view == rnd::DiagnosticView::ShadowMap) {   // the backend's maps against the ray caster's shadow rays
+        const int light = rnd::shadowMapViewLight(frame, a.select.empty() ? sg::kNoNode : scene.findByName(a.select));
+        const std::unique_ptr<rnd::Renderer> exact = rnd::makeExactShadowBackend();
+        shown = rnd::shadowMapView(frame, shot.image, light, *shot.renderer, exact.get());
+    } else {
+        shown = rnd::diagnosticImage(view, frame, shot.image);
+    }
     shown.image.depth = shot.image.depth;   // overlays are hidden behind the rendered surfaces
     rnd::drawOverlays(frame, overlays, shown.image);
     err = assets::writePng(job.out, shown.image.width, shown.image.height, shown.image.color.data(), a.overwrite);

@@ -2,6 +2,7 @@
 #include "renderers/diagnostic.h"
 
 #include "renderers/inspect.h"
+#include "renderers/shadow_map_view.h"
 #include "scenegraph/camera_model.h"
 #include "scenegraph/instances.h"
 
@@ -17,14 +18,15 @@ namespace {
 using sg::vec3;
 using sg::vec4;
 
-constexpr std::array<std::pair<DiagnosticView, std::string_view>, 8> kNames = {{{DiagnosticView::Shaded, "shaded"},
+constexpr std::array<std::pair<DiagnosticView, std::string_view>, 9> kNames = {{{DiagnosticView::Shaded, "shaded"},
                                                                                 {DiagnosticView::Depth, "depth"},
                                                                                 {DiagnosticView::Normal, "normal"},
                                                                                 {DiagnosticView::Id, "id"},
                                                                                 {DiagnosticView::Uv, "uv"},
                                                                                 {DiagnosticView::Triangles, "triangles"},
                                                                                 {DiagnosticView::Overdraw, "overdraw"},
-                                                                                {DiagnosticView::Cost, "cost"}}};
+                                                                                {DiagnosticView::Cost, "cost"},
+                                                                                {DiagnosticView::ShadowMap, "shadow-map"}}};
 
 void put(Framebuffer& fb, size_t k, float r, float g, float b) {
     uint8_t* p = &fb.color[4 * k];
@@ -101,6 +103,7 @@ bool diagnosticViewSupported(DiagnosticView view, const Capabilities& caps) {
     case DiagnosticView::Shaded: return true;
     case DiagnosticView::Overdraw: return caps.overdraw;
     case DiagnosticView::Cost: return caps.traversalCost;
+    case DiagnosticView::ShadowMap: return caps.shadowMaps && caps.visibility;
     default: return caps.visibility;
     }
 }
@@ -132,6 +135,8 @@ DiagnosticImage diagnosticImage(DiagnosticView view, const sg::FrameInput& f, co
         out.legend = view == DiagnosticView::Shaded ? "" : std::string(nameOf(view)) + ": " + missing + " for this image yet";
         return out;
     }
+    if (view == DiagnosticView::ShadowMap)   // without the backends' answers: the map's texels and the inset
+        return shadowMapViewImage(f, fb, shadowMapViewPoints(f, fb, shadowMapViewLight(f)), {}, {});
     const int w = fb.width, h = fb.height;
     const size_t n = size_t(w) * h;
     out.image.resize(w, h);
@@ -237,7 +242,8 @@ DiagnosticImage diagnosticImage(DiagnosticView view, const sg::FrameInput& f, co
                      format("; mean %.1f nodes, %.1f triangles per pixel", double(nodes) / double(n), double(prims) / double(n));
         break;
     }
-    case DiagnosticView::Shaded: break;
+    case DiagnosticView::Shaded:
+    case DiagnosticView::ShadowMap: break;
     }
     return out;
 }

@@ -41,6 +41,15 @@ std::unique_ptr<Renderer> makeRenderer(std::string_view name, std::string* error
     return nullptr;
 }
 
+std::unique_ptr<Renderer> makeExactShadowBackend() {
+    for (const BackendInfo& b : kBackends) {
+        std::unique_ptr<Renderer> r = b.make();
+        const Capabilities caps = r->capabilities();
+        if (caps.shadowRays && caps.affinity == ContextAffinity::AnyThread) return r;
+    }
+    return nullptr;
+}
+
 BackendChoice defaultRenderBackend() {
     const std::unique_ptr<Renderer> gl = makeRenderer("gl");
     const Device d = gl->device();

@@ -115,6 +115,18 @@ RenderStats Renderer::render(const sg::FrameInput& frame, int width, int height,
 
 std::vector<float> Renderer::lightVisibility(const sg::FrameInput&, const sg::vec3&, const sg::vec3&) { return {}; }
 
+std::vector<float> Renderer::lightVisibilityMany(const sg::FrameInput& frame, int light, const std::vector<sg::vec3>& p,
+                                                 const std::vector<sg::vec3>& ng) {
+    if (light < 0 || size_t(light) >= frame.lights.size() || p.size() != ng.size()) return {};
+    std::vector<float> out(p.size(), 1.0f);
+    for (size_t i = 0; i < p.size(); ++i) {
+        const std::vector<float> v = lightVisibility(frame, p[i], ng[i]);
+        if (v.size() != frame.lights.size()) return {};
+        out[i] = v[size_t(light)];
+    }
+    return out;
+}
+
 bool hasFeature(const Capabilities& caps, sg::Feature feature) {
     switch (feature) {
     case sg::Feature::None: return true;

@@ -41,6 +41,7 @@
 #include <glad/gl.h>
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <unordered_map>
@@ -236,6 +237,8 @@ public:
     // The pixel inspector's shadows: the last frame's maps at p (read back from the GPU, the
     // layers asked for, once per frame).
     std::vector<float> lightVisibility(const sg::FrameInput& f, const sg::vec3& p, const sg::vec3& ng) override;
+    std::vector<float> lightVisibilityMany(const sg::FrameInput& f, int light, const std::vector<sg::vec3>& p,
+                                           const std::vector<sg::vec3>& ng) override;
 
 protected:
     RenderStats doRender(const sg::FrameInput& frame, const RenderConfig& cfg, Framebuffer& target, RenderControl* control) override;
@@ -323,7 +326,12 @@ private:
     GLuint m_shadowTexture = 0, m_shadowFbo = 0, m_shadowUbo = 0, m_shadowProgram = 0;
     GLint m_shadowModel = -1, m_shadowViewProj = -1, m_shadowDepth = -1;
     int m_shadowTextureSize = 0, m_shadowTextureLayers = 0;
-    int m_maxTextureSize = 0, m_maxTextureLayers = 0;       // the driver's limits
+    int m_maxTextureSize = 0, m_maxTextureLayers = 0;   // the driver's limits
+    // lightVisibility's: runs `ask` with the maps' context current (false: no maps to ask), and the
+    // answer for light l at one point from the layer it needs.
+    bool inMapsContext(const sg::FrameInput& f, const std::function<bool()>& ask);
+    bool visibilityAt(const sg::FrameInput& f, size_t l, const sg::vec3& p, const sg::vec3& ng, float& out);
+    ShadowPlan m_onePlan;                                   // visibilityAt's plan of one view
     std::unordered_map<int, ShadowMaps> m_shadowReadBack;   // layers read for lightVisibility this frame
     // Plans and draws this frame's maps (frame setup: before beginFrameState) and binds them
     // for the mesh programs; a map size the driver cannot make leaves the frame unshadowed,

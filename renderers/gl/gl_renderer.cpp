@@ -290,14 +290,14 @@ RenderStats GlRenderer::doRender(const FrameInput& frame, const RenderConfig& cf
     return stats;
 }
 
-std::vector<float> GlRenderer::lightVisibility(const FrameInput& f, const vec3& p, const vec3& ng) {
-    if (m_shadowPlan.empty() || m_shadowPlan.viewCount.size() != f.lights.size()) return {};
+bool GlRenderer::inMapsContext(const FrameInput& f, const std::function<bool()>& ask) {
+    if (m_shadowPlan.empty() || m_shadowPlan.viewCount.size() != f.lights.size()) return false;
     // The maps live in the GPU, in the context that rendered them: current here already (the
     // caller's), or ours made current for the question. Never another one: prepareContext would
     // take it for a new context and forget (leak) every object of the old one.
     bool madeCurrent = false;
     if (!gl::anyContextCurrent()) {
-        if (!m_own || !m_own->makeCurrent(nullptr)) return {};
+        if (!m_own || !m_own->makeCurrent(nullptr)) return false;
         madeCurrent = true;
     }
     struct ReleaseOnExit {
@@ -306,28 +306,56 @@ std::vector<float> GlRenderer::lightVisibility(const FrameInput& f, const vec3& 
             if (ctx) ctx->release();
         }
     } releaseOnExit{madeCurrent ? m_own.get() : nullptr};
-    if (!m_loaded || gl::currentContextHandle() != m_objectsContext) return {};
+    if (!m_loaded || gl::currentContextHandle() != m_objectsContext) return false;
     StateGuard guard;
-    std::vector<float> v(f.lights.size(), 1.0f);
-    for (size_t l = 0; l < v.size(); ++l) {
-        if (m_shadowPlan.viewCount[l] == 0) continue;
-        // The light's map at p (a point light's face for p), as a plan of that one view: the same
-        // lookup as shadowVisibility over the whole plan, with one layer read back.
-        DrawLight L = f.lights[l];
-        int view = m_shadowPlan.firstView[l];
-        if (L.type == LightType::Point) {
-            view += pointLightFace(p - L.position);
-            L.type = LightType::Spot;   // one perspective view from the position, the face already chosen
-        }
-        const ShadowMaps* maps = shadowLayer(view);
-        if (!maps) return {};
-        ShadowPlan one = m_shadowPlan;
-        one.views = {m_shadowPlan.views[size_t(view)]};
-        one.firstView = {0};
-        one.viewCount = {1};
-        v[l] = shadowVisibility(one, *maps, L, 0, p, ng);
+    return ask();
+}
+
+bool GlRenderer::visibilityAt(const FrameInput& f, size_t l, const vec3& p, const vec3& ng, float& out) {
+    out = 1.0f;
+    if (m_shadowPlan.viewCount[l] == 0) return true;
+    // The light's map at p (a point light's face for p), as a plan of that one view: the same
+    // lookup as shadowVisibility over the whole plan, with one layer read back.
+    DrawLight L = f.lights[l];
+    int view = m_shadowPlan.firstView[l];
+    if (L.type == LightType::Point) {
+        view += pointLightFace(p - L.position);
+        L.type = LightType::Spot;   // one perspective view from the position, the face already chosen
     }
-    return v;
+    const ShadowMaps* maps = shadowLayer(view);
+    if (!maps) return false;
+    ShadowPlan& one = m_onePlan;   // (kept: no allocation per point)
+    one.size = m_shadowPlan.size;
+    one.filter = m_shadowPlan.filter;
+    one.pcf = m_shadowPlan.pcf;
+    one.depthBias = m_shadowPlan.depthBias;
+    one.normalBias = m_shadowPlan.normalBias;
+    one.views.assign(1, m_shadowPlan.views[size_t(view)]);
+    one.firstView.assign(1, 0);
+    one.viewCount.assign(1, 1);
+    out = shadowVisibility(one, *maps, L, 0, p, ng);
+    return true;
+}
+
+std::vector<float> GlRenderer::lightVisibility(const FrameInput& f, const vec3& p, const vec3& ng) {
+    std::vector<float> v(f.lights.size(), 1.0f);
+    const bool ok = inMapsContext(f, [&] {
+        for (size_t l = 0; l < v.size(); ++l)
+            if (!visibilityAt(f, l, p, ng, v[l])) return false;
+        return true;
+    });
+    return ok ? v : std::vector<float>{};
+}
+
+std::vector<float> GlRenderer::lightVisibilityMany(const FrameInput& f, int light, const std::vector<vec3>& p, const std::vector<vec3>& ng) {
+    if (light < 0 || size_t(light) >= f.lights.size() || p.size() != ng.size()) return {};
+    std::vector<float> v(p.size(), 1.0f);
+    const bool ok = inMapsContext(f, [&] {
+        for (size_t i = 0; i < p.size(); ++i)
+            if (!visibilityAt(f, size_t(light), p[i], ng[i], v[i])) return false;
+        return true;
+    });
+    return ok ? v : std::vector<float>{};
 }
 
 }   // namespace gl

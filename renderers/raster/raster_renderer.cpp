@@ -64,6 +64,18 @@ public:
         for (size_t l = 0; l < v.size(); ++l) v[l] = shadowVisibility(m_shadowPlan, m_shadowMaps, f.lights[l], int(l), p, ng);
         return v;
     }
+    std::vector<float> lightVisibilityMany(const sg::FrameInput& f, int light, const std::vector<sg::vec3>& p,
+                                           const std::vector<sg::vec3>& ng) override {
+        if (m_shadowPlan.empty() || m_shadowPlan.viewCount.size() != f.lights.size() || light < 0 || size_t(light) >= f.lights.size() ||
+            p.size() != ng.size())
+            return {};
+        std::vector<float> out(p.size(), 1.0f);
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, p.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t i = r.begin(); i < r.end(); ++i)
+                out[i] = shadowVisibility(m_shadowPlan, m_shadowMaps, f.lights[size_t(light)], light, p[i], ng[i]);
+        });
+        return out;
+    }
 
 protected:
     RenderStats doRender(const sg::FrameInput& frame, const RenderConfig& cfg, Framebuffer& target, RenderControl* control) override {

@@ -722,6 +722,21 @@ public:
         if (!v.empty()) tr.lightVisibility(p, ng, v.data());
         return v;
     }
+    std::vector<float> lightVisibilityMany(const FrameInput& f, int light, const std::vector<vec3>& p, const std::vector<vec3>& ng) override {
+        if (!f.settings.shadows || m_textures.size() != f.meshes.size() || light < 0 || size_t(light) >= f.lights.size() || p.size() != ng.size())
+            return {};
+        std::vector<float> out(p.size(), 1.0f);
+        const bool translucent = anyTranslucent(f);
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, p.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
+            Tracer tr{f, m_accel, m_textures, m_maps, 0, translucent};
+            std::vector<float> v(f.lights.size(), 1.0f);
+            for (size_t i = r.begin(); i < r.end(); ++i) {
+                tr.lightVisibility(p[i], ng[i], v.data());
+                out[i] = v[size_t(light)];
+            }
+        });
+        return out;
+    }
 
 private:
     // Samplers (mip chains) per texture, cached by id + version; one pointer per mesh (m_textures,

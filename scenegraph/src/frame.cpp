@@ -149,6 +149,7 @@ FrameInput flatten(const Scene& scene, float aspect, NodeId cameraNode) {
             if (drawMeshOf(scene, id, *mi, w, d)) f.meshes.push_back(std::move(d));
         } else if (auto* lp = std::get_if<Light>(&n.payload)) {
             DrawLight l;
+            l.node = id;
             l.type = lp->type;
             l.position = vec3(w[3]);
             vec3 dir = vec3(w * vec4(0, 0, -1, 0));

@@ -8,8 +8,10 @@
 //  - the thin pole (a tenth of a unit, a few texels wide) still casts;
 //  - soft shadows: a sun with an angular radius gives a penumbra as wide as the geometry says,
 //    in the ray caster (several rays per light) and in the rasterizers (PCSS); a point sun none.
+#include "renderers/diagnostic.h"
 #include "renderers/renderer.h"
 #include "renderers/shadow_map.h"
+#include "renderers/shadow_map_view.h"
 #include "scenegraph/mesh.h"
 #include "scenegraph/transforms.h"
 #include "test_scenes.h"
@@ -306,6 +308,66 @@ TEST(ShadowMapTest, SoftShadowRaysCoverTheSource) {
             EXPECT_LT(glm::length(meanBulb / float(n) - bulb.position), 0.08f) << n;
         }
     }
+}
+
+// The shadow-map view (renderers/shadow_map_view.h) of the slab and pole under a sun: with the
+// default biases the map and the shadow rays disagree only along the shadows' edges; without
+// bias the lit ground shadows itself (acne: the map alone shadows, red); with a bias of many
+// texels the shadows come loose from their casters (the map alone lets light through, blue);
+// a map 8 times finer has 8 times the texels per pixel. A backend without maps cannot make it.
+rnd::ShadowMapViewCounts shadowMapCounts(const std::string& backend, sg::FrameInput f, const std::string& tag) {
+    rnd::ShadowMapViewCounts c;
+    std::string err;
+    auto r = rnd::makeRenderer(backend, &err);
+    EXPECT_TRUE(r) << err;
+    if (!r) return c;
+    rnd::Framebuffer fb;
+    rnd::RenderRequest req;
+    rnd::requestFor(rnd::DiagnosticView::ShadowMap, req);
+    EXPECT_TRUE(r->render(f, S, S, fb, nullptr, req).ok);
+    const std::unique_ptr<rnd::Renderer> exact = rnd::makeExactShadowBackend();
+    EXPECT_TRUE(exact) << "no backend with shadow rays";
+    const int light = rnd::shadowMapViewLight(f);
+    EXPECT_EQ(light, 0);
+    const rnd::DiagnosticImage view = rnd::shadowMapView(f, fb, light, *r, exact.get(), &c);
+    testing_support::writeImage(view.image, "conformance", "shadow-map-view-" + backend + "-" + tag);
+    std::printf("%s %s: %s\n", backend.c_str(), tag.c_str(), view.legend.c_str());
+    return c;
+}
+
+TEST_P(Shadows, ShadowMapViewShowsAcnePeterPanningAndTexels) {
+    sg::FrameInput f = slabAndPole(Caster::Sun);
+    const bool maps = rnd::diagnosticViewSupported(rnd::DiagnosticView::ShadowMap, rnd::makeRenderer(GetParam())->capabilities());
+    EXPECT_EQ(maps, rnd::makeRenderer(GetParam())->capabilities().shadowMaps);
+    if (!maps) return;   // (checked: the ray caster has no maps to show)
+    f.settings.shadowFilter = sg::ShadowFilter::None;
+    const rnd::ShadowMapViewCounts good = shadowMapCounts(GetParam(), f, "default");
+    ASSERT_GT(good.facing, size_t(S * S / 4));
+    const double goodWrong = double(good.mapOnlyShadow + good.mapOnlyLight) / double(good.facing);
+    EXPECT_LT(goodWrong, 0.01) << "the map and the rays disagree beyond the shadows' edges";
+    EXPECT_GT(good.shadowedByMap, size_t(S * S / 200)) << "the slab and the pole cast";
+
+    sg::FrameInput noBias = f;
+    noBias.settings.shadowDepthBias = 0.0f;
+    noBias.settings.shadowNormalBias = 0.0f;
+    const rnd::ShadowMapViewCounts acne = shadowMapCounts(GetParam(), noBias, "no-bias");
+    EXPECT_GT(double(acne.mapOnlyShadow) / double(acne.facing), 0.02) << "no bias: the ground shadows itself";
+    EXPECT_GT(acne.mapOnlyShadow, 10 * std::max<size_t>(good.mapOnlyShadow, 1));
+
+    sg::FrameInput loose = f;
+    loose.settings.shadowDepthBias = 40.0f;
+    loose.settings.shadowNormalBias = 40.0f;
+    const rnd::ShadowMapViewCounts leak = shadowMapCounts(GetParam(), loose, "large-bias");
+    EXPECT_GT(leak.mapOnlyLight, 4 * std::max<size_t>(good.mapOnlyLight, 50)) << "a large bias lets light under the casters";
+
+    sg::FrameInput coarse = f;
+    coarse.settings.shadowMapSize = 256;
+    sg::FrameInput fine = f;
+    fine.settings.shadowMapSize = 2048;
+    const float dCoarse = shadowMapCounts(GetParam(), coarse, "256").texelsPerPixel;
+    const float dFine = shadowMapCounts(GetParam(), fine, "2048").texelsPerPixel;
+    EXPECT_GT(dCoarse, 0.0f);
+    EXPECT_NEAR(dFine / dCoarse, 8.0f, 0.5f);
 }
 
 INSTANTIATE_TEST_SUITE_P(EveryBackend, Shadows, ::testing::ValuesIn(rnd::rendererNames()), [](const auto& info) { return info.param; });

@@ -223,7 +223,7 @@ TEST(OverlayRobustnessTest, BadInputIsIgnored) {
     rnd::drawOverlays(s.frame, o, empty);
     Scene huge;   // coordinates that overflow to infinity in clip space
     huge.addBox({-1e38f, -1e38f, -1e38f}, {1e38f, 1e38f, 3e38f});
-    huge.frame.lights.push_back(sg::DrawLight{sg::LightType::Point, {1e38f, 0, -3e38f}});
+    huge.frame.lights.push_back(sg::DrawLight{sg::kNoNode, sg::LightType::Point, {1e38f, 0, -3e38f}});
     rnd::drawOverlays(huge.frame, o, huge.fb);
     s.frame.camera.viewProj[0][0] = std::numeric_limits<float>::quiet_NaN();
     rnd::drawOverlays(s.frame, o, s.fb);

@@ -40,7 +40,7 @@
 // The view
 //   backend NAME          single view with that backend
 //   view single|split|split3|difference   as the View menu
-//   diagnostic NAME       View > Diagnostic view: shaded, depth, normal, id, uv, triangles, overdraw, cost
+//   diagnostic NAME       View > Diagnostic view: shaded, depth, normal, id, uv, triangles, overdraw, cost, shadow-map
 //   overlay LIST|none     View > Overlays: grid, axes, lights, cameras, bounds, selection,
 //                         grid-on-top (the grid over every surface, "Grid on top")
 //   orbit DX DY | zoom STEPS | fit

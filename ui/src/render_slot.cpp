@@ -270,6 +270,7 @@ bool RenderSlot::poll() {
 std::vector<float> RenderSlot::answer(const Question& q) {
     std::lock_guard<std::mutex> rendering(m_renderMutex);
     if (m_renderedFrame != q.frame.get()) return {};
+    if (q.light >= 0) return m_renderer->lightVisibilityMany(*q.frame, q.light, *q.ps, *q.ngs);
     return m_renderer->lightVisibility(*q.frame, q.p, q.ng);
 }
 
@@ -279,16 +280,31 @@ std::vector<float> RenderSlot::lightVisibility(const sg::vec3& p, const sg::vec3
     q.frame = m_shownFrame;
     q.p = p;
     q.ng = ng;
+    return ask(q).value_or(std::vector<float>{});
+}
+
+std::optional<std::vector<float>> RenderSlot::lightVisibilityMany(int light, const std::vector<sg::vec3>& p, const std::vector<sg::vec3>& ng) {
+    if (!m_renderer || !m_shownFrame) return {};
+    Question q;
+    q.frame = m_shownFrame;
+    q.light = light;
+    q.ps = &p;
+    q.ngs = &ng;
+    return ask(q);
+}
+
+std::optional<std::vector<float>> RenderSlot::ask(Question& q) {
     if (!m_threaded) return answer(q);   // renders run here too (poll): none is in flight
     // On the worker, where the renderer renders (and its GL context, if it has one, is made
     // current); not while a render is in flight or waiting (asked again on a later frame).
     std::unique_lock<std::mutex> lock(m_mutex);
-    if (m_busy || m_pending || m_quit || m_question) return {};
+    if (m_quit) return std::vector<float>{};
+    if (m_busy || m_pending || m_question) return std::nullopt;
     m_question = &q;
     m_cv.notify_all();
     if (!m_cv.wait_for(lock, std::chrono::milliseconds(500), [&] { return q.done || m_question != &q; })) {
         m_question = nullptr;   // not taken (the worker is stuck elsewhere): no answer this time
-        return {};
+        return std::nullopt;
     }
     m_cv.wait(lock, [&] { return q.done; });   // taken: the worker writes into q, which must outlive that
     return std::move(q.answer);

@@ -18,6 +18,7 @@
 
 #include "assets/demo.h"
 #include "assets/image_io.h"
+#include "renderers/shadow_map_view.h"
 #include "ui/aov_export.h"
 #include "ui/panels.h"
 #include "ui/render_slot.h"
@@ -134,6 +135,7 @@ struct BackendView {
     rnd::DiagnosticView diagnostic = rnd::DiagnosticView::Shaded;   // what the texture shows
     std::string legend;                                             // of that diagnostic view
     uint64_t overlays = 0;                                          // overlayKey() when uploaded
+    bool retryDiagnostic = false;                                   // the view waits for the backend's answers
 };
 
 // A screenshot in progress (CPU backends render it on a thread; GL right away).
@@ -149,6 +151,10 @@ public:
     ViewerState st;
     GLFWwindow* window = nullptr;
     std::map<std::string, BackendView> views;
+    // The shadow-map view's exact shadows, and the frame they were made for.
+    std::unique_ptr<rnd::Renderer> exact;
+    rnd::Framebuffer exactImage;
+    std::shared_ptr<const sg::FrameInput> exactFrame;
     Texture diffTexture;
     uint64_t diffKey = ~uint64_t(0);
     std::vector<PendingShot> shots;
@@ -233,7 +239,7 @@ public:
         const bool fresh = v.slot->poll();
         const std::vector<sg::NodeId> sel = st.selection();
         const uint64_t overlays = overlayKey();
-        if (!fresh && sel == v.outlined && st.view.diagnostic == v.diagnostic && overlays == v.overlays &&
+        if (!fresh && !v.retryDiagnostic && sel == v.outlined && st.view.diagnostic == v.diagnostic && overlays == v.overlays &&
             (sel.empty() || v.outlinedVersion == st.doc.version))
             return;
         v.overlays = overlays;
@@ -260,7 +266,8 @@ public:
                                    : view + ": the " + v.slot->backend() + " backend cannot make this view (showing the shaded image)";
             return;
         }
-        rnd::DiagnosticImage shown = rnd::diagnosticImage(v.diagnostic, *v.slot->imageFrame(), img);
+        rnd::DiagnosticImage shown =
+            v.diagnostic == rnd::DiagnosticView::ShadowMap ? shadowMapView(v) : rnd::diagnosticImage(v.diagnostic, *v.slot->imageFrame(), img);
         v.legend = shown.legend;
         shown.image.drawable = img.drawable;   // outlineNodes reads the visibility
         shown.image.primitive = img.primitive;
@@ -268,6 +275,39 @@ public:
         shown.image.depth = img.depth;
         drawViewOverlays(shown.image, *v.slot->imageFrame());
         v.texture.upload(shown.image);
+    }
+
+    // The selected light's node (the first selected node; the view takes it when it is a light).
+    sg::NodeId selectedLight() const {
+        const std::vector<sg::NodeId> sel = st.selection();
+        return sel.empty() ? sg::kNoNode : sel.front();
+    }
+    // The shadow-map view of v's image: its backend's maps (asked on its worker, between renders)
+    // against the shadow rays of a reference kept for the window (its image rendered again, here,
+    // when the frame changes: a diagnostic view's price; the BVHs are kept).
+    rnd::DiagnosticImage shadowMapView(BackendView& v) {
+        const std::shared_ptr<const sg::FrameInput>& frame = v.slot->imageFrame();
+        const rnd::ShadowMapViewPoints pts = rnd::shadowMapViewPoints(*frame, v.slot->image(), rnd::shadowMapViewLight(*frame, selectedLight()));
+        std::vector<float> map, rays;
+        v.retryDiagnostic = false;
+        if (pts.light >= 0 && !pts.pixel.empty()) {
+            std::optional<std::vector<float>> asked = v.slot->lightVisibilityMany(pts.light, pts.position, pts.normal);
+            if (!asked) {   // asked again once the render in flight is done
+                v.retryDiagnostic = true;
+                rnd::DiagnosticImage waiting = rnd::shadowMapViewImage(*frame, v.slot->image(), pts, {}, {});
+                waiting.legend = "shadow-map: waiting for the backend between renders";
+                return waiting;
+            }
+            map = std::move(*asked);
+            const rnd::Framebuffer& img = v.slot->image();
+            if (exactFrame != frame || exactImage.width != img.width || exactImage.height != img.height) {
+                exactFrame.reset();
+                if (!exact) exact = rnd::makeExactShadowBackend();
+                if (exact && rnd::renderShadowReference(*exact, *frame, img.width, img.height, exactImage)) exactFrame = frame;
+            }
+            if (exactFrame) rays = rnd::referenceVisibility(*frame, img, *exact, exactImage, pts.light);
+        }
+        return rnd::shadowMapViewImage(*frame, v.slot->image(), pts, map, rays);
     }
 
     // View > Overlays: which are on (0 = none) and what they depend on, to redraw on a change.
@@ -391,14 +431,17 @@ public:
             }
             // A view this backend cannot make: its shaded image, as the viewport shows it.
             const rnd::DiagnosticView shotView = rnd::diagnosticViewSupported(view, r->capabilities()) ? view : rnd::DiagnosticView::Shaded;
-            auto job = [n, r, frame, w, h, path, exports, instances, shotView, overlays, visibility]() -> std::string {
+            const int shadowLight = shotView == rnd::DiagnosticView::ShadowMap ? rnd::shadowMapViewLight(*frame, selectedLight()) : -1;
+            auto job = [n, r, frame, w, h, path, exports, instances, shotView, overlays, visibility, shadowLight]() -> std::string {
                 rnd::Framebuffer fb;
                 rnd::RenderRequest request;
                 request.visibility = visibility && r->capabilities().visibility;
                 rnd::requestFor(shotView, request);
                 rnd::RenderStats s = r->render(*frame, w, h, fb, nullptr, request);
                 if (!s.ok) return s.error.empty() ? n + ": render failed" : s.error;
-                rnd::DiagnosticImage shown = rnd::diagnosticImage(shotView, *frame, fb);
+                rnd::DiagnosticImage shown = shotView == rnd::DiagnosticView::ShadowMap   // the maps against the ray caster's shadow rays
+                                                 ? rnd::shadowMapView(*frame, fb, shadowLight, *r, rnd::makeExactShadowBackend().get())
+                                                 : rnd::diagnosticImage(shotView, *frame, fb);
                 shown.image.depth = fb.depth;   // overlays are hidden behind the rendered surfaces
                 rnd::drawOverlays(*frame, overlays, shown.image);
                 std::string e = assets::writePng(path, shown.image.width, shown.image.height, shown.image.color.data(), /*overwrite=*/false);

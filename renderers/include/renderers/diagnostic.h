@@ -21,6 +21,11 @@
 //              through every cut-out or blended layer it passes, not shadow or reflection
 //              rays. Heat map of nodes + primitives, log scale from 1 (blue) to the image's
 //              largest (red); the legend gives the range and the means of both
+//   shadow-map (rasterizers, Capabilities::shadowMaps) the selected light's shadow map against the
+//              ray caster's shadow rays: where the map alone shadows (acne) or alone lets light
+//              through (peter-panning, leaks), its texels on screen, and what the light sees
+//              (renderers/shadow_map_view.h; diagnosticImage alone shows the texels only: the
+//              comparison needs both backends' answers, shadowMapView)
 // Background pixels are black (overdraw and cost: a background pixel shows its own count).
 #pragma once
 
@@ -34,7 +39,7 @@
 
 namespace rnd {
 
-enum class DiagnosticView { Shaded, Depth, Normal, Id, Uv, Triangles, Overdraw, Cost };
+enum class DiagnosticView { Shaded, Depth, Normal, Id, Uv, Triangles, Overdraw, Cost, ShadowMap };
 
 std::vector<std::string_view> diagnosticViewNames();   // "shaded", "depth", ...
 bool parseDiagnosticView(std::string_view name, DiagnosticView& out);

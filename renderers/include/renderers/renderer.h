@@ -146,6 +146,11 @@ public:
     // be the one of the last successful render(). Empty when the backend draws no shadows for
     // it (every light reaches every point).
     virtual std::vector<float> lightVisibility(const sg::FrameInput& frame, const sg::vec3& p, const sg::vec3& ng);
+    // The same for many points and one light (the shadow-map view): the fraction of
+    // frame.lights[light] reaching each p[i] (normal ng[i]); empty when the backend draws no
+    // shadows for it. The default asks lightVisibility point by point.
+    virtual std::vector<float> lightVisibilityMany(const sg::FrameInput& frame, int light, const std::vector<sg::vec3>& p,
+                                                   const std::vector<sg::vec3>& ng);
 
 protected:
     // The backend's part: render `frame` with `config` (size, AA, tessellation already resolved
@@ -170,6 +175,10 @@ std::string rendererNameList(std::string_view last = "or");
 // Makes a backend by name; on an unknown name returns null and sets *error to a message that
 // lists the valid names.
 std::unique_ptr<Renderer> makeRenderer(std::string_view name, std::string* error = nullptr);
+
+// The shadow-map view's reference: the first backend with exact shadow rays
+// (Capabilities::shadowRays) that runs on any thread; null when there is none.
+std::unique_ptr<Renderer> makeExactShadowBackend();
 
 // The backend `viewer render` uses when none is named: "gl", unless its device() here is
 // software emulation of a GPU (Mesa llvmpipe without a GPU) or unusable; then the CPU

@@ -30,6 +30,7 @@ struct DrawMesh {
 };
 
 struct DrawLight {
+    NodeId node = kNoNode;   // the light's node (what the window's selection names)
     LightType type = LightType::Point;
     vec3 position{0.0f};                      // world (point, spot)
     vec3 direction{0, 0, -1};                 // world, unit: direction light travels (directional, spot)

@@ -79,6 +79,9 @@ public:
     // The backend's shadows at a point of imageFrame() (rnd::Renderer::lightVisibility); empty
     // when it has none, or while a render is in flight (asked again on a later frame).
     std::vector<float> lightVisibility(const sg::vec3& p, const sg::vec3& ng);
+    // The same for one light at many points (rnd::Renderer::lightVisibilityMany: the shadow-map
+    // view); nullopt while a render is in flight or waiting (ask again later).
+    std::optional<std::vector<float>> lightVisibilityMany(int light, const std::vector<sg::vec3>& p, const std::vector<sg::vec3>& ng);
     uint64_t imageSerial() const { return m_serial; }   // bumped whenever image() changes
     SlotStatus status() const;
     // Blocks until nothing is pending (tests, screenshots at exit).
@@ -148,11 +151,15 @@ private:
     struct Question {
         std::shared_ptr<const sg::FrameInput> frame;
         sg::vec3 p{0.0f}, ng{0.0f};
+        int light = -1;                              // >= 0: the visibility of that light at many points
+        const std::vector<sg::vec3>* ps = nullptr;   // (lightVisibilityMany's, outliving the question)
+        const std::vector<sg::vec3>* ngs = nullptr;
         std::vector<float> answer;
         bool done = false;   // guarded by m_mutex
     };
     void workerLoop();
     std::vector<float> answer(const Question& q);
+    std::optional<std::vector<float>> ask(Question& q);   // answered here or handed to the worker (nullopt: busy)
     // Renders one job step by step (runJob in render_slot.cpp); publishes each finished step.
     void runJob(const Job& job);
     void publish(rnd::Framebuffer&& fb, const rnd::RenderStats& st, int level, bool refining, const Job& job);
