@@ -289,6 +289,7 @@ TEST(ViewerAutomationGLTest, ViewCommandDoesWhatTheViewMenuDoes) {
 // capabilities): overdraw with the rasterizer, cost with the ray caster, and a click on a
 // greyed-out entry changes nothing. In the three-way split each backend's legend says what its
 // image shows: the counts where it has them, and that it cannot make the view where it has not.
+// The same for the shadow-map view (the rasterizers'), whose legends compare with the rays.
 TEST(ViewerAutomationGLTest, OverdrawAndCostViewsFollowTheCapabilities) {
     if (!viewer_test::haveXvfb()) GTEST_FAIL() << "xvfb-run is missing (apt-get install xvfb): window tests cannot run";
     fs::path dir = sceneFolder("automation_diagnostic");
@@ -297,11 +298,12 @@ TEST(ViewerAutomationGLTest, OverdrawAndCostViewsFollowTheCapabilities) {
         "backend raycast\nframes 2\nclick menu/view\nclick view/diagnostic\nclick diagnostic/cost\nprint view\n"
         "diagnostic overdraw\nview split3\nframes 3\nwait\nframes 5\nwait\nframes 5\nprint compare\nprint legend\n"
         "diagnostic cost\nframes 3\nwait\nframes 5\nwait\nframes 5\nprint legend\n"
+        "set shadows on\ndiagnostic shadow-map\nframes 3\nwait\nframes 5\nwait\nframes 5\nprint legend\n"
         "view single\nbackend raycast\ndiagnostic shaded\nframes 2\nclick menu/view\nclick view/diagnostic\nclick diagnostic/overdraw\nprint "
         "view\nquit\n";
     ScriptRun r = runScript(dir, script);
     ASSERT_EQ(r.rc, 0) << dump(r);
-    ASSERT_EQ(r.out.size(), 10u) << dump(r);
+    ASSERT_EQ(r.out.size(), 13u) << dump(r);
     EXPECT_EQ(r.out[0], "view single overdraw");
     EXPECT_EQ(r.out[1], "view single cost");
     EXPECT_EQ(r.out[2].rfind("compare split3 ", 0), 0u) << r.out[2];
@@ -315,7 +317,7 @@ TEST(ViewerAutomationGLTest, OverdrawAndCostViewsFollowTheCapabilities) {
         }
         return m;
     };
-    std::map<std::string, std::string> od = legends(3), cost = legends(6);
+    std::map<std::string, std::string> od = legends(3), cost = legends(6), maps = legends(9);
     ASSERT_EQ(od.size(), 3u) << dump(r);
     ASSERT_EQ(cost.size(), 3u) << dump(r);
     EXPECT_EQ(od["gl"].rfind("overdraw (fragments per pixel", 0), 0u) << od["gl"];
@@ -324,7 +326,19 @@ TEST(ViewerAutomationGLTest, OverdrawAndCostViewsFollowTheCapabilities) {
     EXPECT_EQ(cost["gl"], "cost: the gl backend cannot make this view (showing the shaded image)");
     EXPECT_EQ(cost["raster"], "cost: the raster backend cannot make this view (showing the shaded image)");
     EXPECT_EQ(cost["raycast"].rfind("cost (BVH nodes visited + triangles tested", 0), 0u) << cost["raycast"];
-    EXPECT_EQ(r.out[9], "view single shaded") << "overdraw is greyed out for the ray caster alone";
+    // The shadow-map view: the rasterizers' maps against the ray caster's rays, which agree on the
+    // demo but for a few edge pixels; the ray caster has no map to show.
+    for (const char* b : {"gl", "raster"}) {
+        const std::string& m = maps[b];
+        EXPECT_EQ(m.rfind("shadow-map: light 0 (", 0), 0u) << b << ": " << m;
+        const size_t red = m.find("(red: acne, edge spill) "), blue = m.find("(blue: leak, peter-panning) ");
+        ASSERT_NE(red, std::string::npos) << b << ": no comparison: " << m;
+        ASSERT_NE(blue, std::string::npos) << m;
+        EXPECT_LT(std::stod(m.substr(red + 24)), 1.0) << m;
+        EXPECT_LT(std::stod(m.substr(blue + 28)), 1.0) << m;
+    }
+    EXPECT_EQ(maps["raycast"], "shadow-map: the raycast backend cannot make this view (showing the shaded image)");
+    EXPECT_EQ(r.out[12], "view single shaded") << "overdraw is greyed out for the ray caster alone";
 }
 
 TEST(ViewerAutomationGLTest, BadCommandsFailTheScript) {
