@@ -1,5 +1,5 @@
 // diagnostic_counters_test.cpp - the per-pixel counters behind the overdraw and cost diagnostic
-// views (RenderRequest::overdraw / traversalCost, Framebuffer::overdraw / costNodes /
+// views (RenderRequest::aovs' Overdraw / TraversalCost, Framebuffer::overdraw / costNodes /
 // costPrims, renderers/diagnostic.h): counts worked out by hand on crafted scenes (three
 // overlapping quads under an orthographic camera; a lone triangle), GL and raster agreeing on
 // the demo, anti-aliased images getting the one-sample counts, the primary ray's cost growing
@@ -24,10 +24,10 @@ using sg::vec3;
 constexpr int W = 160, H = 120;   // orthographic half height 1.5: a pixel is 0.025 scene units
 
 // Backends whose capabilities have the counter (never decided by name).
-std::vector<std::string> backendsWith(bool rnd::Capabilities::*flag) {
+std::vector<std::string> backendsWith(rnd::Aov aov) {
     std::vector<std::string> v;
     for (const std::string& b : rnd::rendererNames())
-        if (auto r = rnd::makeRenderer(b); r && r->capabilities().*flag) v.push_back(b);
+        if (auto r = rnd::makeRenderer(b); r && r->capabilities().aovs.has(aov)) v.push_back(b);
     return v;
 }
 
@@ -37,8 +37,7 @@ rnd::Framebuffer renderCounted(const std::string& backend, const sg::FrameInput&
     rnd::Framebuffer fb;
     if (!r) return fb;
     rnd::RenderRequest req;
-    req.overdraw = overdraw;
-    req.traversalCost = cost;
+    req.aovs.set(rnd::Aov::Overdraw, overdraw).set(rnd::Aov::TraversalCost, cost);
     const rnd::RenderStats st = r->render(f, w, h, fb, nullptr, req);
     EXPECT_TRUE(st.ok) << backend << ": " << st.error;
     return fb;
@@ -84,7 +83,7 @@ class Overdraw : public ::testing::TestWithParam<std::string> {};
 TEST_P(Overdraw, ThreeOverlappingQuadsCountedByHand) {
     const sg::FrameInput f = threeQuads();
     const rnd::Framebuffer fb = renderCounted(GetParam(), f, W, H, true, false);
-    ASSERT_TRUE(fb.hasOverdraw());
+    ASSERT_TRUE(fb.has(rnd::Aov::Overdraw));
     int exact = 0, interiorWrong = 0, seen[4] = {0, 0, 0, 0};
     for (int y = 0; y < H; ++y)
         for (int x = 0; x < W; ++x) {
@@ -127,31 +126,30 @@ TEST_P(Overdraw, AntiAliasedAndCulledCountsAreTheOneSampleOnes) {
     f.settings.aa = sg::AAMode::MSAA;
     f.settings.aaRate = 4;
     const rnd::Framebuffer msaa = renderCounted(GetParam(), f, W, H, true, false);
-    ASSERT_TRUE(msaa.hasOverdraw());
+    ASSERT_TRUE(msaa.has(rnd::Aov::Overdraw));
     EXPECT_EQ(msaa.overdraw, plain.overdraw);
     f.settings.aa = sg::AAMode::None;
     f.settings.culling = sg::CullMode::On;
     f.meshes[2].world = glm::translate(mat4(1.0f), vec3(0.0f, 0.25f, 1.0f)) * glm::rotate(mat4(1.0f), glm::radians(180.0f), vec3(0, 1, 0));
     f.meshes[2].normal = sg::normalMatrix(f.meshes[2].world);
     const rnd::Framebuffer culled = renderCounted(GetParam(), f, W, H, true, false);
-    ASSERT_TRUE(culled.hasOverdraw());
+    ASSERT_TRUE(culled.has(rnd::Aov::Overdraw));
     EXPECT_EQ(culled.overdraw[size_t(40) * W + 80], 2u) << "C turned away and culled: A and B only";
 }
 
-INSTANTIATE_TEST_SUITE_P(Rasterizers, Overdraw, ::testing::ValuesIn(backendsWith(&rnd::Capabilities::overdraw)),
-                         [](const auto& info) { return info.param; });
+INSTANTIATE_TEST_SUITE_P(Rasterizers, Overdraw, ::testing::ValuesIn(backendsWith(rnd::Aov::Overdraw)), [](const auto& info) { return info.param; });
 
 // GL and raster count the same fragments on the demo (meshes, tessellated analytic shapes, a
 // blended surface, points and lines): equal counts on >= 99% of the pixels.
 TEST(OverdrawAgreement, GlAndRasterAgreeOnTheDemo) {
-    const std::vector<std::string> both = backendsWith(&rnd::Capabilities::overdraw);
+    const std::vector<std::string> both = backendsWith(rnd::Aov::Overdraw);
     ASSERT_EQ(both.size(), 2u) << "gl and raster count fragments";
     sg::Scene scene = assets::makeDemoScene();
     constexpr int DW = 192, DH = 170;
     const sg::FrameInput f = sg::flatten(scene, float(DW) / float(DH));
     const rnd::Framebuffer a = renderCounted(both[0], f, DW, DH, true, false);
     const rnd::Framebuffer b = renderCounted(both[1], f, DW, DH, true, false);
-    ASSERT_TRUE(a.hasOverdraw() && b.hasOverdraw());
+    ASSERT_TRUE(a.has(rnd::Aov::Overdraw) && b.has(rnd::Aov::Overdraw));
     size_t same = 0, covered = 0, layered = 0;
     for (size_t k = 0; k < a.overdraw.size(); ++k) {
         same += a.overdraw[k] == b.overdraw[k];
@@ -167,7 +165,7 @@ TEST(OverdrawAgreement, GlAndRasterAgreeOnTheDemo) {
 // visits 1 node (the top-level root) and tests no triangle; one that enters the instance's box
 // visits the top-level root and the mesh BVH's root and tests the one triangle.
 TEST(TraversalCost, LoneTriangleCountedByHand) {
-    const std::vector<std::string> counting = backendsWith(&rnd::Capabilities::traversalCost);
+    const std::vector<std::string> counting = backendsWith(rnd::Aov::TraversalCost);
     ASSERT_FALSE(counting.empty());
     sg::Projection p;
     p.fovyDeg = 45.0f;
@@ -180,7 +178,7 @@ TEST(TraversalCost, LoneTriangleCountedByHand) {
     for (const std::string& b : counting) {
         SCOPED_TRACE(b);
         const rnd::Framebuffer fb = renderCounted(b, f, W, H, false, true);
-        ASSERT_TRUE(fb.hasTraversalCost());
+        ASSERT_TRUE(fb.has(rnd::Aov::TraversalCost));
         int misses = 0, entered = 0;
         for (size_t k = 0; k < fb.costNodes.size(); ++k) {
             const uint32_t n = fb.costNodes[k], t = fb.costPrims[k];
@@ -228,11 +226,11 @@ TEST(TraversalCost, LayersCountShadowRaysDoNot) {
         }
     addMesh(f, grid, unlit(vec3(0.7f)));
     f.lights.push_back(directional(vec3(-0.3f, -0.4f, -1.0f), vec3(0.9f)));
-    const std::vector<std::string> counting = backendsWith(&rnd::Capabilities::traversalCost);
+    const std::vector<std::string> counting = backendsWith(rnd::Aov::TraversalCost);
     ASSERT_FALSE(counting.empty());
     const std::string b = counting.front();
     const rnd::Framebuffer base = renderCounted(b, f, W, H, false, true);
-    ASSERT_TRUE(base.hasTraversalCost());
+    ASSERT_TRUE(base.has(rnd::Aov::TraversalCost));
     const size_t centre = size_t(H / 2) * W + W / 2;
     EXPECT_GE(base.costPrims[centre], 1u);
     EXPECT_LT(base.costPrims[centre], 200u) << "of 3200 triangles: the BVH culls";
@@ -257,7 +255,7 @@ TEST(TraversalCost, LayersCountShadowRaysDoNot) {
     veil.alpha = 0.5f;
     addMesh(layered, quad(0.5f), veil, glm::translate(mat4(1.0f), vec3(0.0f, 0.0f, 1.0f)));
     const rnd::Framebuffer more = renderCounted(b, layered, W, H, false, true);
-    ASSERT_TRUE(more.hasTraversalCost());
+    ASSERT_TRUE(more.has(rnd::Aov::TraversalCost));
     EXPECT_GE(more.costPrims[centre], base.costPrims[centre] + 2) << "the veil's two triangles, then the grid behind it";
     EXPECT_GT(more.costNodes[centre], base.costNodes[centre]);
     uint64_t sumBase = 0, sumMore = 0;
@@ -277,17 +275,17 @@ TEST(DiagnosticCounters, UnsupportedRequestsFailClearly) {
         auto r = rnd::makeRenderer(b, nullptr);
         ASSERT_TRUE(r);
         const rnd::Capabilities caps = r->capabilities();
-        EXPECT_EQ(rnd::diagnosticViewSupported(rnd::DiagnosticView::Overdraw, caps), caps.overdraw);
-        EXPECT_EQ(rnd::diagnosticViewSupported(rnd::DiagnosticView::Cost, caps), caps.traversalCost);
+        EXPECT_EQ(rnd::diagnosticViewSupported(rnd::DiagnosticView::Overdraw, caps), caps.aovs.has(rnd::Aov::Overdraw));
+        EXPECT_EQ(rnd::diagnosticViewSupported(rnd::DiagnosticView::Cost, caps), caps.aovs.has(rnd::Aov::TraversalCost));
         rnd::Framebuffer fb;
         const rnd::RenderStats plain = r->render(f, W, H, fb);
         ASSERT_TRUE(plain.ok) << plain.error;
         EXPECT_TRUE(fb.overdraw.empty() && fb.costNodes.empty() && fb.costPrims.empty()) << "counted without being asked";
         for (bool overdraw : {true, false}) {
             rnd::RenderRequest req;
-            req.overdraw = overdraw;
-            req.traversalCost = !overdraw;
-            const bool can = overdraw ? caps.overdraw : caps.traversalCost;
+            const rnd::Aov counter = overdraw ? rnd::Aov::Overdraw : rnd::Aov::TraversalCost;
+            req.aovs.add(counter);
+            const bool can = caps.aovs.has(counter);
             const rnd::RenderStats st = r->render(f, W, H, fb, nullptr, req);
             EXPECT_EQ(st.ok, can) << st.error;
             if (can) continue;

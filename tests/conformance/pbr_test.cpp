@@ -256,7 +256,7 @@ TEST_P(Pbr, FlatShadingGivesEachTriangleOneColour) {
         ASSERT_TRUE(r) << err;
         rnd::Framebuffer fb;
         rnd::RenderRequest req;
-        req.visibility = true;
+        req.aovs.add(rnd::Aov::Visibility);
         ASSERT_TRUE(r->render(f, 64, 64, fb, nullptr, req).ok);
         testing_support::writeImage(fb, "conformance", "flat-" + GetParam() + "-" + std::string(sg::nameOf(reflection)));
         std::map<uint32_t, std::pair<std::array<int, 3>, std::array<int, 3>>> range;   // primitive -> min, max per channel

@@ -1,5 +1,5 @@
 // visibility_test.cpp - the visibility every backend fills on request (Framebuffer::drawable /
-// primitive, RenderRequest::visibility) and what is reconstructed from it (renderers/inspect.h):
+// primitive, RenderRequest::aovs' Aov::Visibility) and what is reconstructed from it (renderers/inspect.h):
 // known answers at pixels where hand-placed surfaces project, the three backends agreeing,
 // anti-aliased images getting the one-sample visibility, blended layers never taking a pixel,
 // and the inspector's terms adding up to the pixel's colour.
@@ -84,7 +84,7 @@ rnd::Framebuffer renderVisible(const std::string& backend, const sg::FrameInput&
     EXPECT_TRUE(r);
     rnd::Framebuffer fb;
     rnd::RenderRequest req;
-    req.visibility = true;
+    req.aovs.add(rnd::Aov::Visibility);
     rnd::RenderStats st = r->render(f, W, H, fb, nullptr, req);
     EXPECT_TRUE(st.ok) << st.error;
     return fb;
@@ -95,7 +95,7 @@ class Visibility : public ::testing::TestWithParam<std::string> {};
 TEST_P(Visibility, KnownSurfacesAtKnownPixels) {
     const sg::FrameInput f = scene();
     const rnd::Framebuffer fb = renderVisible(GetParam(), f);
-    ASSERT_TRUE(fb.hasVisibility());
+    ASSERT_TRUE(fb.has(rnd::Aov::Visibility));
     auto at = [&](const vec3& p) {
         auto [x, y] = pixelOf(f, p);
         const size_t k = size_t(y) * W + x;
@@ -117,7 +117,7 @@ TEST_P(Visibility, AntiAliasedImagesGetTheOneSampleVisibility) {
         f.settings.aa = aa;
         f.settings.aaRate = rate;
         const rnd::Framebuffer fb = renderVisible(GetParam(), f);
-        ASSERT_TRUE(fb.hasVisibility());
+        ASSERT_TRUE(fb.has(rnd::Aov::Visibility));
         EXPECT_EQ(fb.drawable, plain.drawable) << GetParam() << " " << f.settings.aaName();
         EXPECT_EQ(fb.primitive, plain.primitive) << GetParam() << " " << f.settings.aaName();
         EXPECT_NE(fb.color, plain.color) << GetParam() << ": the colour image is anti-aliased";
@@ -198,7 +198,7 @@ TEST(VisibilityDemo, TermsAddUpToThePixelsOfTheDemo) {
         ASSERT_TRUE(r);
         rnd::Framebuffer fb;
         rnd::RenderRequest req;
-        req.visibility = true;
+        req.aovs.add(rnd::Aov::Visibility);
         ASSERT_TRUE(r->render(f, DW, DH, fb, nullptr, req).ok);
         int hit = 0, close = 0;
         for (int y = 1; y < DH - 1; y += 3)

@@ -184,11 +184,11 @@ TEST(GlShaderVariantsGLTest, VisibilityWireframeAndOverdrawPasses) {
     f.settings.wireframe = true;
     auto gl = rnd::makeGlRenderer();
     rnd::RenderRequest request;
-    request.visibility = true;
-    request.overdraw = true;
+    request.aovs.add(rnd::Aov::Visibility);
+    request.aovs.add(rnd::Aov::Overdraw);
     const rnd::Framebuffer fb = render(*gl, f, cols, rows, request);
-    ASSERT_TRUE(fb.hasVisibility());
-    ASSERT_TRUE(fb.hasOverdraw());
+    ASSERT_TRUE(fb.has(rnd::Aov::Visibility));
+    ASSERT_TRUE(fb.has(rnd::Aov::Overdraw));
     for (size_t i = 0; i < combos.size(); ++i) {
         const int x = int(i) % cols * kCell + kCell / 2, y = int(i) / cols * kCell + kCell / 2;
         const size_t at = size_t(y) * fb.width + x;

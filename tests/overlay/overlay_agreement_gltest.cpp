@@ -109,10 +109,10 @@ TEST(OverlayGridDepthGLTest, SurfacesHideTheGridUnlessItIsOnTop) {
         ASSERT_TRUE(r) << err;
         rnd::Framebuffer base;
         rnd::RenderRequest visibility;
-        visibility.visibility = true;
+        visibility.aovs.add(rnd::Aov::Visibility);
         const rnd::RenderStats st = r->render(f, kW, kH, base, nullptr, visibility);
         ASSERT_TRUE(st.ok) << st.error;
-        ASSERT_TRUE(base.hasVisibility());
+        ASSERT_TRUE(base.has(rnd::Aov::Visibility));
         rnd::OverlayOptions o;
         o.grid = true;
         rnd::Framebuffer tested = base, onTop = base;

@@ -734,7 +734,7 @@ TEST(RaycastTest, ShadowRaysOnlyWhereALightCanAddSomething) {
         auto r = makeRenderer("raycast");
         Framebuffer fb;
         RenderRequest req;
-        req.visibility = true;
+        req.aovs.add(rnd::Aov::Visibility);
         const RenderStats st = r->render(f, w, h, fb, nullptr, req);
         ASSERT_TRUE(st.ok) << st.error;
         size_t hits = 0, reachedBySpot = 0, checked = 0, close = 0, shadowed = 0;
