@@ -5,6 +5,7 @@
 // seen, and each pixel's depth equals the depth of the ray through its centre hitting the
 // quad's plane.
 #include "assets/aov_io.h"
+#include "render_support.h"
 #include "renderers/renderer.h"
 #include "scenegraph/camera_model.h"
 #include "test_scenes.h"
@@ -78,11 +79,8 @@ class AovDepth : public ::testing::TestWithParam<std::string> {};
 // background 0; a world point's projection K [R|t] X lands on a pixel whose depth is X's z.
 TEST_P(AovDepth, DepthAlongTheOpticalAxisMatchesTheRayPlaneIntersection) {
     const sg::FrameInput f = planeFrame();
-    std::string err;
-    auto r = rnd::makeRenderer(GetParam(), &err);
-    ASSERT_TRUE(r) << err;
     rnd::Framebuffer fb;
-    ASSERT_TRUE(r->render(f, W, H, fb).ok);
+    ASSERT_TRUE(testing_support::renderBackend(GetParam(), f, W, H, fb));
     const std::vector<float> depth = sg::opticalDepthMap(f.camera, W, H, fb.depth);
     const sg::CameraModel m = sg::cameraModelOf(f.camera, W, H);
     int seen = 0, empty = 0;
@@ -113,10 +111,8 @@ TEST(AovDepthAgreement, BackendsAgreeOnDepth) {
     const sg::FrameInput f = planeFrame();
     std::vector<std::vector<float>> maps;
     for (const std::string& b : rnd::rendererNames()) {
-        auto r = rnd::makeRenderer(b, nullptr);
-        ASSERT_TRUE(r);
         rnd::Framebuffer fb;
-        ASSERT_TRUE(r->render(f, W, H, fb).ok);
+        ASSERT_TRUE(testing_support::renderBackend(b, f, W, H, fb));
         maps.push_back(sg::opticalDepthMap(f.camera, W, H, fb.depth));
     }
     for (size_t a = 0; a < maps.size(); ++a)

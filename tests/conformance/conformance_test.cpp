@@ -42,6 +42,7 @@
 // PNGs to build/<preset>/test-output/conformance/. When the GL backend cannot get a context
 // its instances fail with the reason (RenderStats::error); nothing is skipped silently.
 #include "conformance_formulas.h"
+#include "render_support.h"
 #include "renderers/renderer.h"
 #include "scenegraph/frame.h"
 #include "test_scenes.h"
@@ -64,16 +65,7 @@ namespace {
 const char* kSuite = "conformance";
 
 // Renders with a fresh backend; fails the test with the backend's reason when it cannot.
-::testing::AssertionResult renderWith(const std::string& backend, const FrameInput& f, int w, int h, rnd::Framebuffer& out) {
-    std::string err;
-    auto r = rnd::makeRenderer(backend, &err);
-    if (!r) return ::testing::AssertionFailure() << "makeRenderer(\"" << backend << "\"): " << err;
-    rnd::RenderStats st = r->render(f, w, h, out);
-    if (!st.ok) return ::testing::AssertionFailure() << backend << " could not render: " << st.error;
-    if (out.width != w || out.height != h)
-        return ::testing::AssertionFailure() << backend << " rendered " << out.width << "x" << out.height << ", asked for " << w << "x" << h;
-    return ::testing::AssertionSuccess();
-}
+using testing_support::renderBackend;
 
 rnd::Framebuffer blankImage(int w, int h, const vec3& background) {
     rnd::Framebuffer fb;
@@ -108,7 +100,7 @@ void checkLitSphere(const std::string& backend, ShadingModel shading, Reflection
     const bool phong = shading == ShadingModel::Phong;
     const FrameInput f = test_scenes::litSphereFrame(W, H, shading, refl, light, phong ? 256 : 24);
     rnd::Framebuffer actual;
-    ASSERT_TRUE(renderWith(backend, f, W, H, actual));
+    ASSERT_TRUE(renderBackend(backend, f, W, H, actual));
 
     const DrawMesh& dm = f.meshes[0];
     const Material& m = dm.material;
@@ -194,7 +186,7 @@ void checkFog(const std::string& backend, FogMode mode, const std::string& scene
     const int W = 160, H = 120;
     const FrameInput f = test_scenes::fogPlaneFrame(W, H, mode);
     rnd::Framebuffer actual;
-    ASSERT_TRUE(renderWith(backend, f, W, H, actual));
+    ASSERT_TRUE(renderBackend(backend, f, W, H, actual));
     const vec3 colour = f.meshes[0].material.baseColor;
     const float planeY = f.meshes[0].world[3][1];
     rnd::Framebuffer expected = blankImage(W, H, f.settings.background);
@@ -229,7 +221,7 @@ void checkTexture(const std::string& backend, bool tilted, const std::string& sc
     const int W = 161, H = 161;
     const FrameInput f = test_scenes::texturedQuadFrame(W, H, tilted);
     rnd::Framebuffer actual;
-    ASSERT_TRUE(renderWith(backend, f, W, H, actual));
+    ASSERT_TRUE(renderBackend(backend, f, W, H, actual));
     const Texture& tex = *f.meshes[0].texture;
     const mat4& world = f.meshes[0].world;
     // quad(1): position (-1 + 2u, -1 + 2v, 0); texture row 0 is v = 1 (top).
@@ -290,7 +282,7 @@ void checkProjection(const std::string& backend, const Projection& proj, const s
     const FrameInput f = test_scenes::projectedBoxFrame(W, H, proj);
     ASSERT_NEAR(glm::length(f.camera.eye - eye), 0.0f, 1e-5f);
     rnd::Framebuffer actual;
-    ASSERT_TRUE(renderWith(backend, f, W, H, actual));
+    ASSERT_TRUE(renderBackend(backend, f, W, H, actual));
     const DrawMesh& dm = f.meshes[0];
     std::vector<vec2> corners;
     for (int i = 0; i < 8; ++i) {
@@ -365,7 +357,7 @@ void checkAntiAliasing(const std::string& backend, AAMode aa, int rate, const st
             GTEST_SKIP() << backend << " does not offer " << f.settings.aaName() << " (Capabilities)";
     }
     rnd::Framebuffer actual;
-    ASSERT_TRUE(renderWith(backend, f, W, H, actual));
+    ASSERT_TRUE(renderBackend(backend, f, W, H, actual));
     std::vector<vec2> quadCorners;
     const DrawMesh& dm = f.meshes[0];
     for (const vec3& p : dm.mesh->positions) quadCorners.push_back(toWindow(f.camera.viewProj, vec3(dm.world * vec4(p, 1.0f)), W, H));
@@ -437,7 +429,7 @@ bool offersAA(const std::string& backend, AAMode aa, int rate) {
     if (aa == AAMode::None) return true;
     std::string err;
     auto r = rnd::makeRenderer(backend, &err);
-    if (!r) return true;   // renderWith reports it
+    if (!r) return true;   // renderBackend reports it
     const rnd::Capabilities caps = r->capabilities();
     const std::vector<int>& offered = aa == AAMode::MSAA ? caps.msaaSamples : caps.ssaaFactors;
     return std::find(offered.begin(), offered.end(), rate) != offered.end();
@@ -462,7 +454,7 @@ void checkToneMapped(const std::string& backend, ToneMapping op, float ev, AAMod
     if (aa != AAMode::None) f.settings.aaRate = rate;
     if (!offersAA(backend, aa, rate)) GTEST_SKIP() << backend << " does not offer " << f.settings.aaName() << " (Capabilities)";
     rnd::Framebuffer actual;
-    ASSERT_TRUE(renderWith(backend, f, W, H, actual));
+    ASSERT_TRUE(renderBackend(backend, f, W, H, actual));
 
     const auto surface = toBytes(displayReference(m.baseColor + m.emissive, ev, op));
     const auto background = toBytes(displayReference(f.settings.background, ev, op));
@@ -485,7 +477,7 @@ void checkExposedEdge(const std::string& backend, AAMode aa, int rate, const std
     f.settings.exposure = 2.0f;
     if (!offersAA(backend, aa, rate)) GTEST_SKIP() << backend << " does not offer " << f.settings.aaName() << " (Capabilities)";
     rnd::Framebuffer actual;
-    ASSERT_TRUE(renderWith(backend, f, W, H, actual));
+    ASSERT_TRUE(renderBackend(backend, f, W, H, actual));
     std::vector<vec2> quadCorners;
     const DrawMesh& dm = f.meshes[0];
     for (const vec3& p : dm.mesh->positions) quadCorners.push_back(toWindow(f.camera.viewProj, vec3(dm.world * vec4(p, 1.0f)), W, H));

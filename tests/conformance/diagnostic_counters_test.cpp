@@ -6,6 +6,7 @@
 // with the layers it passes and not with its shadow rays, and backends without the capability
 // refusing the request with an error that says which view.
 #include "assets/demo.h"
+#include "render_support.h"
 #include "renderers/diagnostic.h"
 #include "renderers/renderer.h"
 #include "test_scenes.h"
@@ -31,16 +32,11 @@ std::vector<std::string> backendsWith(rnd::Aov aov) {
     return v;
 }
 
+// With the counters asked for (RenderRequest::aovs).
 rnd::Framebuffer renderCounted(const std::string& backend, const sg::FrameInput& f, int w, int h, bool overdraw, bool cost) {
-    auto r = rnd::makeRenderer(backend, nullptr);
-    EXPECT_TRUE(r);
-    rnd::Framebuffer fb;
-    if (!r) return fb;
     rnd::RenderRequest req;
     req.aovs.set(rnd::Aov::Overdraw, overdraw).set(rnd::Aov::TraversalCost, cost);
-    const rnd::RenderStats st = r->render(f, w, h, fb, nullptr, req);
-    EXPECT_TRUE(st.ok) << backend << ": " << st.error;
-    return fb;
+    return testing_support::BackendImages{w, h}(backend, f, {"counted", req});
 }
 
 // Three opaque quads facing an orthographic camera at three depths, every edge on a pixel

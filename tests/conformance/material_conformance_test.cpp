@@ -11,6 +11,7 @@
 //  - shadows (backends that cast them) pass through cut-out texels.
 // Quads are unlit so that the expected colour is exact; one lit case checks the flipped normal.
 #include "assets/scene_io.h"
+#include "render_support.h"
 #include "renderers/renderer.h"
 #include "renderers/shading.h"
 #include "scenegraph/setting_names.h"
@@ -39,17 +40,7 @@ sg::FrameInput orthoFrame() {
     return f;
 }
 
-rnd::Framebuffer render(const std::string& backend, const sg::FrameInput& f, const std::string& name) {
-    std::string err;
-    auto r = rnd::makeRenderer(backend, &err);
-    EXPECT_TRUE(r) << err;
-    rnd::Framebuffer fb;
-    if (!r) return fb;
-    rnd::RenderStats st = r->render(f, W, H, fb);
-    EXPECT_TRUE(st.ok) << backend << " " << name << ": " << st.error;
-    testing_support::writeImage(fb, "conformance", "material-" + backend + "-" + name);
-    return fb;
-}
+const testing_support::BackendImages render{W, H, "conformance", "material"};
 
 // Expected 8-bit sRGB of a linear colour.
 std::array<int, 3> bytes(const vec3& linear) { return {rnd::toByteSRGB(linear.x), rnd::toByteSRGB(linear.y), rnd::toByteSRGB(linear.z)}; }

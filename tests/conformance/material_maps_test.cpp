@@ -11,6 +11,7 @@
 // right halves of the image sampling one texel each, so every expected colour is exact.
 #include "assets/image_io.h"
 #include "assets/scene_io.h"
+#include "render_support.h"
 #include "renderers/renderer.h"
 #include "renderers/shading.h"
 #include "scenegraph/setting_names.h"
@@ -60,17 +61,7 @@ sg::FrameInput mapsFrame(const sg::Material& m, const sg::MaterialMaps& maps, sg
     return f;
 }
 
-rnd::Framebuffer render(const std::string& backend, const sg::FrameInput& f, const std::string& name) {
-    std::string err;
-    auto r = rnd::makeRenderer(backend, &err);
-    EXPECT_TRUE(r) << err;
-    rnd::Framebuffer fb;
-    if (!r) return fb;
-    rnd::RenderStats st = r->render(f, W, H, fb);
-    EXPECT_TRUE(st.ok) << backend << " " << name << ": " << st.error;
-    testing_support::writeImage(fb, "conformance", "maps-" + backend + "-" + name);
-    return fb;
-}
+const testing_support::BackendImages render{W, H, "conformance", "maps"};
 
 ::testing::AssertionResult pixelIs(const rnd::Framebuffer& fb, int x, const vec3& linear, int tol = 2) {
     const uint8_t* p = fb.pixel(x, H / 2);

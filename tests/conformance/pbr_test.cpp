@@ -8,6 +8,7 @@
 //    irradiance and prefiltered levels; KHR_lights_punctual's spot and range windows;
 //  - with environment none there is no ambient term: an unlit-by-lights pbr scene is black.
 #include "renderers/pbr.h"
+#include "render_support.h"
 #include "renderers/environment.h"
 #include "renderers/renderer.h"
 #include "renderers/shading.h"
@@ -50,16 +51,11 @@ vec3 appendixB(const vec3& baseColor, float metallic, float roughness, const vec
     return f * lux * nl;
 }
 
+// Every render here also holds that no note says the environment was replaced.
 rnd::Framebuffer render(const std::string& backend, const sg::FrameInput& f, const std::string& name) {
-    std::string err;
-    auto r = rnd::makeRenderer(backend, &err);
-    EXPECT_TRUE(r) << err;
-    rnd::Framebuffer fb;
-    if (!r) return fb;
-    rnd::RenderStats st = r->render(f, W, H, fb);
-    EXPECT_TRUE(st.ok) << backend << " " << name << ": " << st.error;
+    rnd::RenderStats st;
+    rnd::Framebuffer fb = testing_support::BackendImages{W, H, "conformance", "pbr"}(backend, f, {name, {}, &st});
     for (const std::string& n : st.config.notes) EXPECT_EQ(n.find("environment"), std::string::npos) << n;
-    testing_support::writeImage(fb, "conformance", "pbr-" + backend + "-" + name);
     return fb;
 }
 
@@ -251,13 +247,8 @@ TEST_P(Pbr, FlatShadingGivesEachTriangleOneColour) {
         m.roughness = 0.3f;
         m.metallic = 0.5f;
         addMesh(f, sg::primitives::uvSphere(1.0f, 12, 6), m);
-        std::string err;
-        auto r = rnd::makeRenderer(GetParam(), &err);
-        ASSERT_TRUE(r) << err;
         rnd::Framebuffer fb;
-        rnd::RenderRequest req;
-        req.aovs.add(rnd::Aov::Visibility);
-        ASSERT_TRUE(r->render(f, 64, 64, fb, nullptr, req).ok);
+        ASSERT_TRUE(testing_support::renderBackend(GetParam(), f, 64, 64, fb, {"flat", {.aovs = {rnd::Aov::Visibility}}}));
         testing_support::writeImage(fb, "conformance", "flat-" + GetParam() + "-" + std::string(sg::nameOf(reflection)));
         std::map<uint32_t, std::pair<std::array<int, 3>, std::array<int, 3>>> range;   // primitive -> min, max per channel
         for (int y = 0; y < 64; ++y)
@@ -297,9 +288,8 @@ TEST(PbrRaycast, SmoothSurfacesReflectTheScene) {
         // A red panel to the right, facing the sphere (seen in it, off screen itself).
         addMesh(f, quad(3.0f), unlit(vec3(1.0f, 0.0f, 0.0f)),
                 glm::translate(sg::mat4(1.0f), vec3(3.0f, 0, 0)) * glm::rotate(sg::mat4(1.0f), -1.5707963f, vec3(0, 1, 0)));
-        auto r = rnd::makeRenderer("raycast");
         rnd::Framebuffer fb;
-        EXPECT_TRUE(r->render(f, 64, 64, fb).ok);
+        EXPECT_TRUE(testing_support::renderBackend("raycast", f, 64, 64, fb, {"reflections"}));
         testing_support::writeImage(fb, "conformance",
                                     std::string("pbr-reflect-") + (reflections ? "on" : "off") + "-r" + std::to_string(int(roughness * 10)));
         // The sphere's right rim: its mirror direction points at the panel.

@@ -6,6 +6,7 @@
 // checks that the pose moved pixels (the image differs from the file's rest pose). Images go
 // to build/<preset>/test-output/posed-agreement/. Needs ../shared/testdata.
 #include "assets/scene_io.h"
+#include "render_support.h"
 #include "renderers/renderer.h"
 #include "scenegraph/frame.h"
 #include "test_support.h"
@@ -47,11 +48,7 @@ TEST_P(PosedAgreement, ThreeBackendsAgree) {
     ASSERT_FALSE(frame.meshes.empty());
     std::map<std::string, rnd::Framebuffer> img;
     for (const char* b : {"gl", "raster", "raycast"}) {
-        std::string err;
-        auto r = rnd::makeRenderer(b, &err);
-        ASSERT_TRUE(r) << err;
-        rnd::RenderStats st = r->render(frame, kW, kH, img[b]);
-        ASSERT_TRUE(st.ok) << b << ": " << st.error;
+        ASSERT_TRUE(testing_support::renderBackend(b, frame, kW, kH, img[b], {c.name}));
         testing_support::writeImage(img[b], "posed-agreement", std::string(c.name) + "-" + b);
     }
     const testing_support::ImageTolerance glRaster = testing_support::agreementTolerance(testing_support::Agreement::SameMethod);
@@ -62,7 +59,7 @@ TEST_P(PosedAgreement, ThreeBackendsAgree) {
 
     // The pose shows: the raster image differs from the rest pose's in a good share of pixels.
     rnd::Framebuffer rest;
-    ASSERT_TRUE(rnd::makeRenderer("raster")->render(posedFrame(c, -1.0f), kW, kH, rest).ok);
+    ASSERT_TRUE(testing_support::renderBackend("raster", posedFrame(c, -1.0f), kW, kH, rest, {"rest pose"}));
     rnd::ImageDiff d = rnd::compareImages(img["raster"], rest, 8);
     EXPECT_LT(d.fractionWithin, 0.99) << c.name << ": the posed image looks like the rest pose (" << d.describe() << ")";
 }

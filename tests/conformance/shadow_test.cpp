@@ -8,6 +8,7 @@
 //  - the thin pole (a tenth of a unit, a few texels wide) still casts;
 //  - soft shadows: a sun with an angular radius gives a penumbra as wide as the geometry says,
 //    in the ray caster (several rays per light) and in the rasterizers (PCSS); a point sun none.
+#include "render_support.h"
 #include "renderers/renderer.h"
 #include "renderers/shadow_map.h"
 #include "scenegraph/mesh.h"
@@ -62,17 +63,7 @@ sg::FrameInput slabAndPole(Caster light, bool withCasters = true) {
     return f;
 }
 
-rnd::Framebuffer render(const std::string& backend, const sg::FrameInput& f, const std::string& name) {
-    std::string err;
-    auto r = rnd::makeRenderer(backend, &err);
-    EXPECT_TRUE(r) << err;
-    rnd::Framebuffer fb;
-    if (!r) return fb;
-    const rnd::RenderStats st = r->render(f, S, S, fb);
-    EXPECT_TRUE(st.ok) << backend << " " << name << ": " << st.error;
-    testing_support::writeImage(fb, "conformance", "shadow-" + backend + "-" + name);
-    return fb;
-}
+const testing_support::BackendImages render{S, S, "conformance", "shadow"};
 
 // Pixels darker with shadows on than off by more than a fifth of the lit value: shadowed.
 std::vector<uint8_t> shadowMask(const rnd::Framebuffer& on, const rnd::Framebuffer& off) {

@@ -6,6 +6,7 @@
 // and from both formats.
 #include "assets/image_io.h"
 #include "assets/scene_io.h"
+#include "render_support.h"
 #include "renderers/renderer.h"
 #include "test_support.h"
 
@@ -84,12 +85,8 @@ void checkQuadrants(const std::string& backend, const fs::path& file) {
     const int W = 40, H = 40;
     sg::FrameInput f = sg::flatten(scene, 1.0f, c);
     for (sg::DrawMesh& d : f.meshes) d.material.unlit = true;   // the texel colour itself
-    std::string err;
-    auto renderer = rnd::makeRenderer(backend, &err);
-    ASSERT_TRUE(renderer) << err;
     rnd::Framebuffer fb;
-    rnd::RenderStats st = renderer->render(f, W, H, fb);
-    ASSERT_TRUE(st.ok) << st.error;
+    ASSERT_TRUE(testing_support::renderBackend(backend, f, W, H, fb));
     struct Probe {
         int x, y;
         uint8_t r, g, b;

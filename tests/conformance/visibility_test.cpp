@@ -4,6 +4,7 @@
 // anti-aliased images getting the one-sample visibility, blended layers never taking a pixel,
 // and the inspector's terms adding up to the pixel's colour.
 #include "assets/demo.h"
+#include "render_support.h"
 #include "renderers/diagnostic.h"
 #include "renderers/inspect.h"
 #include "renderers/renderer.h"
@@ -79,15 +80,9 @@ std::pair<int, int> pixelOf(const sg::FrameInput& f, const vec3& p) {
     return {int((c.x * 0.5f + 0.5f) * W), int((0.5f - c.y * 0.5f) * H)};
 }
 
+// With the visibility (RenderRequest::aovs).
 rnd::Framebuffer renderVisible(const std::string& backend, const sg::FrameInput& f) {
-    auto r = rnd::makeRenderer(backend, nullptr);
-    EXPECT_TRUE(r);
-    rnd::Framebuffer fb;
-    rnd::RenderRequest req;
-    req.aovs.add(rnd::Aov::Visibility);
-    rnd::RenderStats st = r->render(f, W, H, fb, nullptr, req);
-    EXPECT_TRUE(st.ok) << st.error;
-    return fb;
+    return testing_support::BackendImages{W, H}(backend, f, {"visibility", {.aovs = {rnd::Aov::Visibility}}});
 }
 
 class Visibility : public ::testing::TestWithParam<std::string> {};
@@ -194,7 +189,7 @@ TEST(VisibilityDemo, TermsAddUpToThePixelsOfTheDemo) {
     const sg::FrameInput f = sg::flatten(scene, float(DW) / float(DH));
     const sg::InstanceTable ids = sg::instanceTable(f);
     for (const std::string& b : rnd::rendererNames()) {
-        auto r = rnd::makeRenderer(b, nullptr);
+        auto r = rnd::makeRenderer(b, nullptr);   // kept: its lightVisibility() answers for this render
         ASSERT_TRUE(r);
         rnd::Framebuffer fb;
         rnd::RenderRequest req;
