@@ -1,4 +1,4 @@
-// overlay_window_gltest.cpp - View > Overlays in the real viewer window under Xvfb, driven by
+// overlay_window_gl_test.cpp - View > Overlays in the real viewer window under Xvfb, driven by
 // the automation's `overlay LIST|none` (the menu's toggles): the shown image gains the
 // overlays and loses them again, the grid on top shows over the objects that hide it otherwise,
 // and a bad name stops the script with a one-line error.

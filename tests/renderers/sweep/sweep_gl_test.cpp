@@ -1,4 +1,4 @@
-// sweep_test.cpp - every model in shared/testdata (glTF, OBJ, PLY, OFF, STL; not the invalid
+// sweep_gl_test.cpp - every model in shared/testdata (glTF, OBJ, PLY, OFF, STL; not the invalid
 // ones) rendered by gl, raster and raycast at 320x180 with shadows off and AA off, compared
 // pairwise:
 //   gl ~ raster:      mean |difference| <= 1/255 and >= 99.5% of pixels within 3/255;

@@ -1,4 +1,4 @@
-// cli_default_backend_test.cpp - the backend `viewer render` uses when none is named, through
+// cli_default_backend_gl_test.cpp - the backend `viewer render` uses when none is named, through
 // the real executable: gl, or the CPU rasterizer with a one-line note where OpenGL is software
 // only (rnd::defaultRenderBackend); `--backend gl` renders with GL whatever GL is. The output
 // line "OUT: WxH, NAME backend, ..." says which backend rendered.

@@ -1,6 +1,6 @@
 // gl_sample_baseline_test.cpp - GL renders (240x180) of sample models whose correct look is
 // known, held against tests/baselines/gl/sample_<name>.png (thresholds of
-// gl_baseline_test.cpp). Agreement between the backends is the sweep's job (tests/sweep);
+// gl_baseline_test.cpp). Agreement between the backends is the sweep's job (tests/renderers/sweep);
 // these hold the picture itself, since all three backends were once wrong together (upside-
 // down textures). They render with the pbr model in the default environment. Each baseline was
 // looked at by eye:

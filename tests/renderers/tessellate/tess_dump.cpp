@@ -1,7 +1,7 @@
 // tess_dump.cpp - debug tool: tessellates the demo scene's analytic drawables and writes
 // OUTDIR/<node>.obj and OUTDIR/<node>.png (orthographic z-buffer preview, Lambert shading
 // from interpolated vertex normals; back-facing triangles are drawn red).
-//   build/release/tests/tessellate/tess_dump /tmp/tess 64
+//   build/release/tests/renderers/tessellate/tess_dump /tmp/tess 64
 #include "renderers/tessellate.h"
 
 #include "assets/demo.h"

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # package_test.sh STEP BUILD_DIR SOURCE_DIR [BACKEND]: the steps of the Debian package test
-# (tests/package/CMakeLists.txt says what each checks). Environment from CTest: CPACK_COMMAND,
+# (tests/packaging/CMakeLists.txt says what each checks). Environment from CTest: CPACK_COMMAND,
 # VIEWER_VERSION (the CMake project version), VIEWER_SANITIZE (1 in sanitizer builds).
 # Never skips: a missing tool or file is a failure, reported as one line on stderr.
 set -euo pipefail

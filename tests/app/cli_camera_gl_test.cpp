@@ -1,4 +1,4 @@
-// cli_camera_test.cpp - cameras of `viewer render` through the real executable: a sidecar's
+// cli_camera_gl_test.cpp - cameras of `viewer render` through the real executable: a sidecar's
 // camera (--camera-json) reproduces its image bit for bit in every backend, for perspective,
 // off-centre (--intrinsics) and oblique cameras; --intrinsics gives back its own K; a camera
 // list (--cameras) and a turntable (--turntable) write numbered frames that shards (--shard)

@@ -1,5 +1,5 @@
 // regression_test.cpp - every input a fuzzer ever crashed or hung on stays here
-// (tests/import/regressions) and must load into valid meshes or fail with a one-line error
+// (tests/assets/import/regressions) and must load into valid meshes or fail with a one-line error
 // naming the file, within seconds.
 #include "assets/image_io.h"
 #include "assets/scene_io.h"
@@ -12,7 +12,7 @@
 namespace fs = std::filesystem;
 
 TEST(FuzzRegressionTest, CrashInputsLoadValidMeshesOrFailClearly) {
-    fs::path dir = fs::path(VIEWER_SOURCE_DIR) / "tests/import/regressions";
+    fs::path dir = fs::path(VIEWER_SOURCE_DIR) / "tests/assets/import/regressions";
     int files = 0;
     for (const auto& e : fs::directory_iterator(dir)) {
         if (!e.is_regular_file()) continue;

@@ -1,4 +1,4 @@
-// raster_agreement_gltest.cpp - the CPU rasterizer against the GL backend (Mesa llvmpipe) on
+// raster_agreement_gl_test.cpp - the CPU rasterizer against the GL backend (Mesa llvmpipe) on
 // reference scenes covering each shading model, each projection, fog on/off, textures
 // (nearest, bilinear, trilinear with mipmaps; repeat/clamp/mirror), AA off. Passes when the
 // mean absolute difference is <= 1/255 per channel and >= 99.5% of pixels are within 3/255;

@@ -1,4 +1,4 @@
-// overlay_agreement_gltest.cpp - the demo scene rendered by every backend (gl, raster,
+// overlay_agreement_gl_test.cpp - the demo scene rendered by every backend (gl, raster,
 // raycast), the overlays drawn on each image, and only the overlay pixels compared: the
 // gizmos that always show (lights, cameras, selection) must cover exactly the same pixels in
 // the same colours; the depth-tested ones (grid, axes, bounds) may differ only where the

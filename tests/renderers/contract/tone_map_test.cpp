@@ -1,7 +1,7 @@
 // tone_map_test.cpp - the display transform's scalar implementation (renderers/tone_map.h), the
 // one every CPU backend calls and the GL shader mirrors: each operator at known inputs (0, 0.18,
 // 1, 10, a large value, grey and coloured) against the published formulas evaluated
-// independently in double precision (tests/conformance/conformance_formulas.h), a few values
+// independently in double precision (tests/renderers/conformance/conformance_formulas.h), a few values
 // the specifications state outright, the curves' range and order, and exposure: +1 EV doubles
 // the linear output, and exposure 0 with no operator returns the colour bit for bit.
 #include "renderers/tone_map.h"

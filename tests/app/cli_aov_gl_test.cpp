@@ -1,4 +1,4 @@
-// cli_aov_test.cpp - the synthetic-data export and the pixel inspector through the real
+// cli_aov_gl_test.cpp - the synthetic-data export and the pixel inspector through the real
 // executable: `viewer render demo --aov depth,normal,id` writes a 16-bit id image whose ids the
 // sidecar names, a normal image of unit normals on exactly the covered pixels, the same ids in
 // every backend; `viewer inspect demo --at X,Y` prints per backend a provenance whose terms add

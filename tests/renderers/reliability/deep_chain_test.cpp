@@ -7,7 +7,7 @@
 // The chain's links alternate translations of +1 and -1 along y (exact in float), with one
 // link halfway down moving +1 along x, so the red unlit quad at the leaf shows up exactly at
 // x = +1 only when every level was composed. Built twice: deep_chain_tests (CPU backends,
-// label unit) and deep_chain_gltests (DEEP_CHAIN_GL: the GL backend, label gl).
+// label unit) and deep_chain_gl_tests (DEEP_CHAIN_GL: the GL backend, label gl).
 #include "assets/scene_io.h"
 #include "renderers/renderer.h"
 #include "scenegraph/frame.h"
