@@ -359,14 +359,18 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a, Command command) {
     cmd.add_option("--select", a.select, "The node (by name) that --overlay selection outlines, and the light whose map --view shadow-map shows");
 }
 
-std::vector<std::string> aovKinds(const RenderArgs& a) { return ui::parseAovList(a.aov); }
+// --aov's list; checkAovs() has held it to the known kinds before anything renders.
+std::vector<rnd::Aov> aovKinds(const RenderArgs& a) {
+    std::vector<rnd::Aov> kinds;
+    (void)ui::parseAovList(a.aov, kinds);
+    return kinds;
+}
 
 // --aov: the extra files next to `out` (P.png -> P.depth.pfm, P.normal.png, P.id.png, P.json).
 // Checked before rendering: known kinds only, and no existing file replaced without --overwrite.
 std::string checkAovs(const RenderArgs& a, const fs::path& out) {
-    const std::vector<std::string> kinds = aovKinds(a);
-    for (const std::string& k : kinds)
-        if (!ui::aovSuffix(k)) return "--aov: unknown kind '" + k + "' (known: depth, normal, id)";
+    std::vector<rnd::Aov> kinds;
+    if (std::string e = ui::parseAovList(a.aov, kinds); !e.empty()) return "--aov: " + e;
     std::error_code ec;
     for (const fs::path& f : ui::aovFiles(out, kinds))
         if (!a.overwrite && fs::exists(fs::symlink_status(f, ec))) return f.string() + ": file exists (use --overwrite to replace it)";
@@ -381,7 +385,7 @@ std::string renderJob(const RenderArgs& a, const CameraJob& job, const sg::Scene
     std::string err = applyCameraJob(a, job, frame);
     if (!err.empty()) return (job.index >= 0 ? job.out.string() + ": " : std::string()) + err;
     rnd::RenderRequest request;
-    request.visibility = ui::aovsNeedVisibility(aovKinds(a));
+    request.aovs = ui::aovSetOf(aovKinds(a));   // the normal and id images: the visibility
     rnd::requestFor(view, request);
     Shot shot = renderWith(a.backend, frame, w, h, request);
     if (!shot.stats.ok) return shot.stats.error;   // starts with the backend's name
@@ -397,8 +401,8 @@ std::string renderJob(const RenderArgs& a, const CameraJob& job, const sg::Scene
     rnd::drawOverlays(frame, overlays, shown.image);
     err = assets::writePng(job.out, shown.image.width, shown.image.height, shown.image.color.data(), a.overwrite);
     if (!err.empty()) return err;
-    const std::vector<std::string> kinds = aovKinds(a);
-    const bool ids = std::find(kinds.begin(), kinds.end(), "id") != kinds.end();   // the id -> node table only when it is written
+    const std::vector<rnd::Aov> kinds = aovKinds(a);
+    const bool ids = std::find(kinds.begin(), kinds.end(), rnd::Aov::Id) != kinds.end();   // the id -> node table only when it is written
     if (!(err = ui::writeAovs(job.out, kinds, a.backend, ids ? ui::aovInstances(scene, frame) : std::vector<assets::AovInstance>{}, frame, shot.image,
                               a.overwrite))
              .empty())
@@ -609,7 +613,7 @@ int runInspect(const RenderArgs& a) {
     int failures = 0;
     for (const std::string& b : backends) {
         rnd::RenderRequest visibility;
-        visibility.visibility = true;
+        visibility.aovs.add(rnd::Aov::Visibility);
         Shot s = renderWith(b, frame, w, h, visibility);
         if (!s.stats.ok) {
             out["backends"][b] = {{"error", s.stats.error}};

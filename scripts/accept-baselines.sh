@@ -9,6 +9,6 @@ preset="${1:-release}"
 cd "$root"
 if [ ! -f "build/$preset/CMakeCache.txt" ]; then cmake --preset "$preset" >/dev/null; fi
 cmake --build "build/$preset" -j2 --target gl_tests
-VIEWER_ACCEPT_BASELINES=1 "build/$preset/tests/gl/gl_tests" --gtest_filter='*BaselineGLTest*' | grep '^\[baseline\]' || true
+VIEWER_ACCEPT_BASELINES=1 "build/$preset/tests/renderers/gl/gl_tests" --gtest_filter='*BaselineGLTest*' | grep '^\[baseline\]' || true
 echo "accept-baselines: changed files (git status):"
 git status --short -- tests/baselines/gl

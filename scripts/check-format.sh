@@ -8,7 +8,7 @@ if [ -z "$cf" ]; then
   echo "check-format: clang-format not found (apt-get install clang-format)" >&2
   exit 1
 fi
-mapfile -t files < <(git ls-files '*.cpp' '*.h' '*.inl' | grep -v '^tests/import/regressions/')
+mapfile -t files < <(git ls-files '*.cpp' '*.h' '*.inl' | grep -v '^tests/assets/import/regressions/')
 if [ "${1:-}" = "--fix" ]; then
   "$cf" -i "${files[@]}"
   exit 0

@@ -9,13 +9,13 @@
 # the unit tests' job) so each target runs many more of them. libFuzzer's -timeout is wall
 # time and the runs are niced, so each timeout input is run again on its own with a 20 s CPU
 # limit: only one that is still too slow counts as a hang; the others move to slow_TARGET.
-# Results: build/fuzz/tests/fuzz/campaign/TARGET.result, and a Markdown table in
-# build/fuzz/tests/fuzz/campaign/summary.md: docs/fuzzing.md quotes it between its
+# Results: build/fuzz/tests/assets/fuzz/campaign/TARGET.result, and a Markdown table in
+# build/fuzz/tests/assets/fuzz/campaign/summary.md: docs/fuzzing.md quotes it between its
 # campaign:begin/end markers (copied there by hand; this script never edits tracked files).
 # Build first:  scripts/setup.sh fuzz   (or cmake --preset fuzz && cmake --build build/fuzz --target fuzz_all)
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-bindir="${FUZZ_BINDIR:-$root/build/fuzz/tests/fuzz}"
+bindir="${FUZZ_BINDIR:-$root/build/fuzz/tests/assets/fuzz}"
 data="${VIEWER_TESTDATA_DIR:-$root/../shared/testdata}"
 out="$bindir/campaign"
 ticks=$(getconf CLK_TCK)

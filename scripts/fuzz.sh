@@ -9,14 +9,14 @@
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 t="$1"; secs="${2:-60}"
-bindir="${3:-$root/build/fuzz/tests/fuzz}"
+bindir="${3:-$root/build/fuzz/tests/assets/fuzz}"
 data="${4:-$root/../shared/testdata}"
 exe="$bindir/fuzz_$t"
 [ -x "$exe" ] || { echo "fuzz.sh: $exe not built (cmake --preset fuzz && cmake --build build/fuzz)" >&2; exit 1; }
 corpus="$bindir/corpus_$t"; seeds="$bindir/seeds_$t"; artifacts="$bindir/artifacts_$t"
 mkdir -p "$corpus" "$seeds" "$artifacts"
 case "$t" in
-  scene_json) cp "$root"/tests/fuzz/seeds/*.json "$seeds/" ;;
+  scene_json) cp "$root"/tests/assets/fuzz/seeds/*.json "$seeds/" ;;
   gltf) pat='*.gltf' ;; glb) pat='*.glb' ;; obj) pat='*.obj' ;; ply) pat='*.ply' ;;
   off) pat='*.off' ;; stl) pat='*.[sS][tT][lL]' ;; image) pat='*.png' ;;
 esac

@@ -98,30 +98,26 @@ std::string_view nameOf(DiagnosticView v) {
     return "shaded";
 }
 
-bool diagnosticViewSupported(DiagnosticView view, const Capabilities& caps) {
+AovSet aovsFor(DiagnosticView view) {
     switch (view) {
-    case DiagnosticView::Shaded: return true;
-    case DiagnosticView::Overdraw: return caps.overdraw;
-    case DiagnosticView::Cost: return caps.traversalCost;
-    case DiagnosticView::ShadowMap: return caps.shadowMaps && caps.visibility;
-    default: return caps.visibility;
+    case DiagnosticView::Shaded: return {};
+    case DiagnosticView::Overdraw: return {Aov::Overdraw};
+    case DiagnosticView::Cost: return {Aov::TraversalCost};
+    default: return {Aov::Visibility};
     }
 }
 
-void requestFor(DiagnosticView view, RenderRequest& request) {
-    switch (view) {
-    case DiagnosticView::Shaded: break;
-    case DiagnosticView::Overdraw: request.overdraw = true; break;
-    case DiagnosticView::Cost: request.traversalCost = true; break;
-    default: request.visibility = true; break;
-    }
+bool diagnosticViewSupported(DiagnosticView view, const Capabilities& caps) {
+    if (view == DiagnosticView::ShadowMap && !caps.shadowMaps) return false;   // (and the visibility its points come from)
+    return caps.aovs.hasAll(aovsFor(view));
 }
+
+void requestFor(DiagnosticView view, RenderRequest& request) { request.aovs.add(aovsFor(view)); }
 
 DiagnosticImage diagnosticImage(DiagnosticView view, const sg::FrameInput& f, const Framebuffer& fb) {
     DiagnosticImage out;
-    const bool counts = view == DiagnosticView::Overdraw ? fb.hasOverdraw()
-                        : view == DiagnosticView::Cost   ? fb.hasTraversalCost()
-                                                         : fb.hasVisibility();
+    bool counts = true;
+    for (Aov a : aovsFor(view).list()) counts = counts && fb.has(a);
     if (view == DiagnosticView::Shaded || !counts) {
         out.image = fb;
         out.image.drawable.clear();

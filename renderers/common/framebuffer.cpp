@@ -41,16 +41,35 @@ void Framebuffer::resizeForOverwrite(int w, int h) {
     costPrims.clear();
 }
 
-void Framebuffer::resizeVisibility() {
-    drawable.assign(size_t(width) * height, 0u);
-    primitive.assign(size_t(width) * height, kNoPrimitive);
+void Framebuffer::allocate(Aov aov) {
+    const size_t n = size_t(width) * height;
+    switch (aov) {
+    case Aov::Depth: depth.assign(n, 1.0f); break;
+    case Aov::Visibility:
+    case Aov::Normal:
+    case Aov::Id:
+        drawable.assign(n, 0u);
+        primitive.assign(n, kNoPrimitive);
+        break;
+    case Aov::Overdraw: overdraw.assign(n, 0u); break;
+    case Aov::TraversalCost:
+        costNodes.assign(n, 0u);
+        costPrims.assign(n, 0u);
+        break;
+    }
 }
 
-void Framebuffer::resizeOverdraw() { overdraw.assign(size_t(width) * height, 0u); }
-
-void Framebuffer::resizeTraversalCost() {
-    costNodes.assign(size_t(width) * height, 0u);
-    costPrims.assign(size_t(width) * height, 0u);
+bool Framebuffer::has(Aov aov) const {
+    const size_t n = size_t(width) * height;
+    switch (aov) {
+    case Aov::Depth: return depth.size() == n && !depth.empty();
+    case Aov::Visibility:
+    case Aov::Normal:
+    case Aov::Id: return drawable.size() == n && primitive.size() == n && !drawable.empty();
+    case Aov::Overdraw: return overdraw.size() == n && !overdraw.empty();
+    case Aov::TraversalCost: return costNodes.size() == n && costPrims.size() == n && !costNodes.empty();
+    }
+    return false;
 }
 
 void Framebuffer::takeVisibilityAndCounters(Framebuffer&& src) {

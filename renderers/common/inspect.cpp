@@ -173,7 +173,7 @@ void analyticSurface(const sg::FrameInput& f, const sg::DrawAnalytic& a, const P
 
 SurfaceAt surfaceAt(const sg::FrameInput& f, const sg::InstanceTable& ids, const Framebuffer& fb, int x, int y) {
     SurfaceAt s;
-    if (!fb.hasVisibility() || x < 0 || y < 0 || x >= fb.width || y >= fb.height) return s;
+    if (!fb.has(Aov::Visibility) || x < 0 || y < 0 || x >= fb.width || y >= fb.height) return s;
     const size_t k = size_t(y) * fb.width + x;
     s.drawable = fb.drawable[k];
     s.primitive = fb.primitive[k];
@@ -288,7 +288,7 @@ PixelTerms pixelTerms(const sg::FrameInput& f, const SurfaceAt& s, const std::ve
 
 std::vector<vec3> normalImage(const sg::FrameInput& f, const sg::InstanceTable& ids, const Framebuffer& fb) {
     std::vector<vec3> out(size_t(fb.width) * fb.height, vec3(0.0f));
-    if (!fb.hasVisibility()) return out;
+    if (!fb.has(Aov::Visibility)) return out;
     for (int y = 0; y < fb.height; ++y)
         for (int x = 0; x < fb.width; ++x)
             if (fb.drawable[size_t(y) * fb.width + x]) out[size_t(y) * fb.width + x] = surfaceAt(f, ids, fb, x, y).normal;

@@ -39,7 +39,7 @@ void writeLinePixel(LineTarget& t, int i, int j, float z, const vec3& linear, fl
     float& dst = fb.depth[at];
     if (!(z < dst + bias)) return;   // LESS (wireframe: LEQUAL with a small offset)
     dst = std::min(dst, z);
-    if (from.drawable && fb.hasVisibility()) {
+    if (from.drawable && fb.has(Aov::Visibility)) {
         fb.drawable[at] = from.drawable;
         fb.primitive[at] = from.primitive;
     }

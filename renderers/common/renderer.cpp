@@ -9,14 +9,38 @@ namespace rnd {
 namespace {
 
 // The one-sample configuration the second pass of an anti-aliased image renders with: the
-// visibility and the per-pixel counters that were asked for.
-RenderConfig onePixelPass(RenderConfig c, const RenderRequest& r) {
+// AOVs that were asked for.
+RenderConfig onePixelPass(RenderConfig c, AovSet aovs) {
     c.aa = sg::AAMode::None;
     c.msaaSamples = c.ssaaFactor = c.samplesPerPixel = 1;
-    c.visibility = r.visibility;
-    c.overdraw = r.overdraw;
-    c.traversalCost = r.traversalCost;
+    c.aovs = aovs;
     return c;
+}
+
+// Why a backend without `aov` in its capabilities cannot render a request for it.
+const char* cannotFill(Aov aov) {
+    switch (aov) {
+    case Aov::Depth: return "cannot write depth";
+    case Aov::Visibility:
+    case Aov::Normal:
+    case Aov::Id: return "cannot tell which surface each pixel shows (no visibility buffer)";
+    case Aov::Overdraw: return "cannot count fragments per pixel (the overdraw view)";
+    case Aov::TraversalCost: return "cannot count BVH nodes and triangles per ray (the cost view)";
+    }
+    return "cannot fill an AOV";
+}
+
+// Why a render that was asked for `aov` fails when the backend did not fill it.
+const char* didNotFill(Aov aov) {
+    switch (aov) {
+    case Aov::Depth: return "the backend did not fill the depth buffer";
+    case Aov::Visibility:
+    case Aov::Normal:
+    case Aov::Id: return "the backend did not fill the visibility buffer";
+    case Aov::Overdraw: return "the backend did not fill the overdraw counters";
+    case Aov::TraversalCost: return "the backend did not fill the traversal cost counters";
+    }
+    return "the backend did not fill an AOV";
 }
 
 }   // namespace
@@ -42,27 +66,22 @@ RenderStats Renderer::render(const sg::FrameInput& frame, int width, int height,
         return finish(stats);
     }
     const Capabilities caps = capabilities();
-    if (request.visibility && !caps.visibility) {
-        stats.error = "cannot tell which surface each pixel shows (no visibility buffer)";
-        return finish(stats);
-    }
-    if (request.overdraw && !caps.overdraw) {
-        stats.error = "cannot count fragments per pixel (the overdraw view)";
-        return finish(stats);
-    }
-    if (request.traversalCost && !caps.traversalCost) {
-        stats.error = "cannot count BVH nodes and triangles per ray (the cost view)";
-        return finish(stats);
-    }
+    // Normal and Id are made from the visibility; depth comes with every pass, the others at
+    // one sample per pixel.
+    const AovSet asked = renderedAovs(request.aovs);
+    for (Aov a : asked.list())
+        if (!caps.aovs.has(a)) {
+            stats.error = cannotFill(a);
+            return finish(stats);
+        }
+    const AovSet oneSample = asked.without(Aov::Depth);
     if (request.singleSample && config.samplesPerPixel > 1) {
         config.aa = sg::AAMode::None;
         config.msaaSamples = config.ssaaFactor = config.samplesPerPixel = 1;
         config.aaUsed = "none";
     }
     const bool onePixel = config.samplesPerPixel == 1;
-    config.visibility = request.visibility && onePixel;
-    config.overdraw = request.overdraw && onePixel;
-    config.traversalCost = request.traversalCost && onePixel;
+    config.aovs = onePixel ? oneSample : AovSet{};
     stats.config = config;
     if (control && control->cancel.load()) {
         stats.cancelled = true;
@@ -75,11 +94,11 @@ RenderStats Renderer::render(const sg::FrameInput& frame, int width, int height,
         for (std::string& n : done.config.notes) stats.config.notes.push_back(std::move(n));
         done.config = std::move(stats.config);
         stats = std::move(done);
-        if (stats.ok && !onePixel && (request.visibility || request.overdraw || request.traversalCost)) {
+        if (stats.ok && !onePixel && !oneSample.empty()) {
             // Anti-aliased: the visibility and the counters come from a one-sample pass at the
             // pixel centres.
             Framebuffer vis;
-            RenderStats v = doRender(frame, onePixelPass(config, request), vis, control);
+            RenderStats v = doRender(frame, onePixelPass(config, oneSample), vis, control);
             if (!v.ok) {
                 stats.ok = false;
                 stats.cancelled = v.cancelled;
@@ -90,18 +109,11 @@ RenderStats Renderer::render(const sg::FrameInput& frame, int width, int height,
                 stats.rays += v.rays;
             }
         }
-        if (stats.ok && request.visibility && !target.hasVisibility()) {
-            stats.ok = false;
-            stats.error = "the backend did not fill the visibility buffer";
-        }
-        if (stats.ok && request.overdraw && !target.hasOverdraw()) {
-            stats.ok = false;
-            stats.error = "the backend did not fill the overdraw counters";
-        }
-        if (stats.ok && request.traversalCost && !target.hasTraversalCost()) {
-            stats.ok = false;
-            stats.error = "the backend did not fill the traversal cost counters";
-        }
+        for (Aov a : oneSample.list())
+            if (stats.ok && !target.has(a)) {
+                stats.ok = false;
+                stats.error = didNotFill(a);
+            }
     } catch (const std::bad_alloc&) {
         stats.ok = false;
         stats.error = "out of memory at " + std::to_string(width) + "x" + std::to_string(height);

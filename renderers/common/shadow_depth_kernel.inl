@@ -2,7 +2,7 @@
 // vector of texels at a time: the same candidate span per row (rowSpan), then every texel of it
 // tested and written at once, by the same IEEE operations in the same order as the scalar loop
 // (no FMA in either instruction set), so the maps are bit for bit the scalar reference's.
-// shadow_map.cpp includes it once per instruction set (raster/simd.h's names); tests/raster holds
+// shadow_map.cpp includes it once per instruction set (raster/simd.h's names); tests/renderers/raster holds
 // it to the scalar reference.
 // NOLINTBEGIN
 

@@ -147,7 +147,7 @@ int shadowMapViewLight(const sg::FrameInput& f, sg::NodeId selected) {
 ShadowMapViewPoints shadowMapViewPoints(const sg::FrameInput& f, const Framebuffer& fb, int light) {
     ShadowMapViewPoints pts;
     pts.light = light;
-    if (light < 0 || size_t(light) >= f.lights.size() || !fb.hasVisibility()) return pts;
+    if (light < 0 || size_t(light) >= f.lights.size() || !fb.has(Aov::Visibility)) return pts;
     const sg::InstanceTable ids = sg::instanceTable(f);
     for (int y = 0; y < fb.height; ++y)
         for (int x = 0; x < fb.width; ++x) {
@@ -283,7 +283,7 @@ DiagnosticImage shadowMapViewImage(const sg::FrameInput& f, const Framebuffer& f
 }
 
 std::vector<float> referenceVisibility(const sg::FrameInput& f, const Framebuffer& fb, Renderer& exact, const Framebuffer& exactImage, int light) {
-    if (exactImage.width != fb.width || exactImage.height != fb.height || !fb.hasVisibility()) return {};
+    if (exactImage.width != fb.width || exactImage.height != fb.height || !fb.has(Aov::Visibility)) return {};
     const ShadowMapViewPoints own = shadowMapViewPoints(f, exactImage, light);
     std::vector<float> perPixel(size_t(fb.width) * size_t(fb.height), std::nanf(""));
     if (own.pixel.empty()) return perPixel;
@@ -298,8 +298,8 @@ std::vector<float> referenceVisibility(const sg::FrameInput& f, const Framebuffe
 
 bool renderShadowReference(Renderer& exact, const sg::FrameInput& f, int width, int height, Framebuffer& image) {
     RenderRequest request;
-    request.visibility = true;
-    return exact.render(f, width, height, image, nullptr, request).ok && image.hasVisibility();
+    request.aovs.add(Aov::Visibility);
+    return exact.render(f, width, height, image, nullptr, request).ok && image.has(Aov::Visibility);
 }
 
 DiagnosticImage shadowMapView(const sg::FrameInput& f, const Framebuffer& fb, int light, Renderer& backend, Renderer* exact,

@@ -149,7 +149,7 @@ void GlRenderer::drawWireframePass(const std::vector<DrawItem>& items, const Ren
     glDisable(GL_POLYGON_OFFSET_LINE);
 }
 
-// The overdraw view (RenderConfig::overdraw, one sample per pixel): the frame's draws again
+// The overdraw view (Aov::Overdraw, one sample per pixel): the frame's draws again
 // (surfaces of every alpha mode, lines, points, the wireframe; culled as in the frame) into
 // m_overdraw with the depth test off and additive blending, with mesh.frag's OVERDRAW variant
 // writing 1.0 for every fragment (it never discards), so each pixel holds the fragments
@@ -185,7 +185,7 @@ std::string GlRenderer::countOverdraw(const std::vector<DrawItem>& items, const 
     glReadBuffer(GL_COLOR_ATTACHMENT0);
     glPixelStorei(GL_PACK_ALIGNMENT, 4);
     glReadPixels(0, 0, w, h, GL_RED, GL_FLOAT, counts.data());
-    target.resizeOverdraw();
+    target.allocate(Aov::Overdraw);
     for (int y = 0; y < h; ++y) {
         const float* src = &counts[size_t(h - 1 - y) * w];
         for (int x = 0; x < w; ++x) target.overdraw[size_t(y) * w + x] = uint32_t(std::lround(std::max(src[x], 0.0f)));

@@ -103,8 +103,8 @@ Capabilities GlRenderer::capabilities() const {
     c.pointsAndLines = true;
     c.shadows = true;   // shadow maps (renderers/shadow_map.h, gl_shadows.cpp), as the CPU rasterizer's
     c.shadowMaps = true;
-    c.visibility = true;   // a second colour attachment, RG32UI (mesh.frag's fragId)
-    c.overdraw = true;     // a second pass into an R32F target, additive (countOverdraw)
+    c.aovs.add(Aov::Visibility);   // a second colour attachment, RG32UI (mesh.frag's fragId)
+    c.aovs.add(Aov::Overdraw);     // a second pass into an R32F target, additive (countOverdraw)
     // Constant for the life of the backend (callers may cache them): the driver's limits,
     // read once per process (gl::glLimits), whether or not this instance has rendered.
     const gl::GlLimits limits = gl::glLimits();
@@ -222,7 +222,7 @@ RenderStats GlRenderer::doRender(const FrameInput& frame, const RenderConfig& cf
         stats.error = "render size " + std::to_string(rw) + "x" + std::to_string(rh) + " exceeds the driver's limit of " + std::to_string(m_maxSize);
         return stats;
     }
-    const bool visibility = cfg.visibility && samples <= 1 && ssaa == 1;   // render() asks only for one-sample frames
+    const bool visibility = cfg.aovs.has(Aov::Visibility) && samples <= 1 && ssaa == 1;   // render() asks only for one-sample frames
     // Exposure or tone mapping: linear float targets, and the display pass at the end.
     m_linear = !s.displayTransformIsIdentity();
     err = m_target.ensure(rw, rh, samples > 1 ? samples : 0, visibility, m_linear);
@@ -270,7 +270,7 @@ RenderStats GlRenderer::doRender(const FrameInput& frame, const RenderConfig& cf
         stats.error = err;
         return stats;
     }
-    if (cfg.overdraw && samples <= 1 && ssaa == 1) {   // render() asks only for one-sample frames
+    if (cfg.aovs.has(Aov::Overdraw) && samples <= 1 && ssaa == 1) {   // render() asks only for one-sample frames
         err = countOverdraw(items, s, rw, rh, target);
         if (!err.empty()) {
             stats.error = err;

@@ -192,7 +192,7 @@ std::string RenderTarget::ensure(int w, int h, int s, bool withIds, bool linear)
     height = h;
     samples = s;
     hdr = linear;
-    if (withIds) {   // single-sampled only (RenderConfig::visibility)
+    if (withIds) {   // single-sampled only (RenderConfig::aovs' Visibility)
         glGenRenderbuffers(1, &ids);
         glBindRenderbuffer(GL_RENDERBUFFER, ids);
         glRenderbufferStorage(GL_RENDERBUFFER, GL_RG32UI, w, h);
@@ -411,7 +411,7 @@ void GlRenderer::readBack(GLuint fbo, int w, int h, Framebuffer& out, bool withD
 
 // Reads the visibility attachment (drawable, primitive) of `fbo` into `out` (already sized).
 void readVisibility(GLuint fbo, int w, int h, Framebuffer& out) {
-    out.resizeVisibility();
+    out.allocate(Aov::Visibility);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
     glReadBuffer(GL_COLOR_ATTACHMENT1);
     glPixelStorei(GL_PACK_ALIGNMENT, 4);

@@ -5,7 +5,7 @@
 // (environment.cpp: equirectUv's polynomial atan2 and acos, the bilinear sample of two
 // prefiltered levels, the spherical harmonics, the split-sum table) done a vector at a time.
 // The ShadeBatch layout for pbr is in raster_shading.h. The order of operations is not the
-// scalar code's, so results differ from rnd::shade in the last bits; tests/raster holds them
+// scalar code's, so results differ from rnd::shade in the last bits; tests/renderers/raster holds them
 // to it.
 // NOLINTBEGIN
 

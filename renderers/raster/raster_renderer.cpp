@@ -48,9 +48,9 @@ public:
         c.pointsAndLines = true;
         c.shadows = true;   // shadow maps (renderers/shadow_map.h)
         c.shadowMaps = true;
-        c.visibility = true;   // the visibility buffer the tiles shade from
-        c.overdraw = true;     // counted per tile when asked (countOverdraw)
-        c.msaaSamples = {4};   // one fixed 4-sample pattern (raster_core.h)
+        c.aovs.add(Aov::Visibility);   // the visibility buffer the tiles shade from
+        c.aovs.add(Aov::Overdraw);     // counted per tile when asked (countOverdraw)
+        c.msaaSamples = {4};           // one fixed 4-sample pattern (raster_core.h)
         c.ssaaFactors = {2, 3, 4};
         c.ssaaRendersLarger = true;
         c.maxImageSize = 32768;
@@ -89,8 +89,8 @@ protected:
             stats = renderSingle(frame, cfg.width * r, cfg.height * r, cfg.tessellation, hi, false, control, r, false, false, linear);
             if (stats.ok) target = downsample(hi, r);   // depth (and the colour, unless the linear frame replaces it)
         } else {
-            stats = renderSingle(frame, cfg.width, cfg.height, cfg.tessellation, target, cfg.msaaSamples > 1, control, 1, cfg.visibility,
-                                 cfg.overdraw, linear);
+            stats = renderSingle(frame, cfg.width, cfg.height, cfg.tessellation, target, cfg.msaaSamples > 1, control, 1,
+                                 cfg.aovs.has(Aov::Visibility), cfg.aovs.has(Aov::Overdraw), linear);
         }
         if (stats.ok && linear) encodeLinearFrame(linear->pixels(0), r, display, target);
         return stats;
@@ -183,8 +183,8 @@ private:
         // The tiles write every pixel's colour and depth (background where nothing is drawn), so
         // the buffers are not cleared first: a serial pass over ~7 MB at 1280x720.
         target.resizeForOverwrite(width, height);
-        if (visibility) target.resizeVisibility();
-        if (overdraw && !msaa) target.resizeOverdraw();
+        if (visibility) target.allocate(Aov::Visibility);
+        if (overdraw && !msaa) target.allocate(Aov::Overdraw);
         const bool gouraud = frame.settings.shading == sg::ShadingModel::Gouraud;
 
         // 1. gather (the draw list shared with the GL backend)

@@ -3,7 +3,7 @@
 // Blinn-Phong, specular times max(n.l, 0), 1/d^2 attenuation, smoothstep spot cones, ambient
 // and emissive) computed 4 fragments per instruction with SSE2, or 8 with AVX2 where the CPU
 // has it (chosen at run time; VIEWER_RASTER_SSE=1 forces SSE2; both give the same bits), with
-// pow(s, m) as exp2(m log2 s) from polynomials (relative error < 1e-5). tests/raster checks it
+// pow(s, m) as exp2(m log2 s) from polynomials (relative error < 1e-5). tests/renderers/raster checks it
 // against rnd::shade.
 //
 // With the pbr reflection model the same batch carries glTF's BRDF parameters instead (setPbr,

@@ -108,7 +108,7 @@ void rasterizeMasked(const Tri& t, uint32_t id, uint32_t local, const Chunk& ch,
     });
 }
 
-// The overdraw view (RenderConfig::overdraw, one sample per pixel): every fragment the tile's
+// The overdraw view (Aov::Overdraw, one sample per pixel): every fragment the tile's
 // triangles rasterize, whatever their alpha mode and before any depth or alpha test, adds one
 // to its pixel's counter. A pass of its own, so that frames that do not ask pay nothing.
 void countOverdraw(int tile, const FrameContext& fc, Framebuffer& target, int x0, int y0, int x1, int y1) {

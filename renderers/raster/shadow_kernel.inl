@@ -2,7 +2,7 @@
 // fragments at once, every lane reading the same map (a directional or spot light, or a point
 // light's face when all lanes pick it): the same steps per lane (normal offset, depth bias,
 // receiver-plane bias per tap, k x k taps, texels outside the map lit). raster_shadows.cpp
-// includes it once per instruction set, like shade_kernel.inl; tests/raster holds it to the
+// includes it once per instruction set, like shade_kernel.inl; tests/renderers/raster holds it to the
 // scalar function.
 // NOLINTBEGIN
 

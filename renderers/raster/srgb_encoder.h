@@ -7,7 +7,7 @@
 // and x >= next[b], the smallest float whose byte is b + 1, adds one; a bucket is narrower than
 // the gap between two thresholds, so one comparison finishes it. Values below 2^-13 (and NaN)
 // encode to 0, values >= 1 to 255. The byte is rnd::toByteSRGB's for every float (the ray
-// caster's and the GL backend's reference), which tests/raster checks exhaustively on [2^-14, 1].
+// caster's and the GL backend's reference), which tests/renderers/raster checks exhaustively on [2^-14, 1].
 #pragma once
 
 #include <cstdint>

@@ -8,7 +8,7 @@
 //     kernel (raster_shading.h).
 // Both give the bits of the scalar code they replace (raster_core.h's forEachCoveredPixel with
 // the renderer's depth test; prepareSimple in raster_shade.cpp): the same IEEE operations in
-// the same order per lane. tests/raster checks them against it.
+// the same order per lane. tests/renderers/raster checks them against it.
 #pragma once
 
 #include "raster/raster_core.h"

@@ -629,7 +629,7 @@ void shadePixel(const FrameJob& job, Tracer& tr, int x, int row, int x0, int y0,
                 target.costPrims[size_t(row) * w + x] = count.prims;
             }
             if (!std::isnan(hp.p.x)) depth = std::min(depth, std::clamp(job.cam.depth(hp.p), 0.0f, 1.0f));
-            if (job.cfg.visibility) {   // one centre ray per pixel (RenderConfig::visibility)
+            if (job.cfg.aovs.has(Aov::Visibility)) {   // one centre ray per pixel (RenderConfig::aovs)
                 target.drawable[size_t(row) * w + x] = hp.drawable;
                 target.primitive[size_t(row) * w + x] = hp.primitive;
             }
@@ -658,10 +658,10 @@ public:
         c.shadows = true;
         c.shadowRays = true;   // soft ones: settings.shadowRays rays to a light with a size
         c.reflections = true;
-        c.wireframe = true;        // the CPU backends' overlay (common/line_overlay.h), after the rays
-        c.pointsAndLines = true;   // the same pixel footprint as the rasterizers
-        c.visibility = true;       // what each primary ray keeps
-        c.traversalCost = true;    // counted per primary ray when asked (Tracer::cost)
+        c.wireframe = true;               // the CPU backends' overlay (common/line_overlay.h), after the rays
+        c.pointsAndLines = true;          // the same pixel footprint as the rasterizers
+        c.aovs.add(Aov::Visibility);      // what each primary ray keeps
+        c.aovs.add(Aov::TraversalCost);   // counted per primary ray when asked (Tracer::cost)
         // MSAA n and SSAA f are both taken as stratified jittered rays per pixel: n rays
         // (2 -> 2x1, 4 -> 2x2, 8 -> 4x2 strata) and f x f rays; each ray is shaded.
         c.msaaSamples = {2, 4, 8};
@@ -679,9 +679,9 @@ protected:
         const vec3 background = display(f.settings.background);
         const uint8_t bg[4] = {toByteSRGB(background.x), toByteSRGB(background.y), toByteSRGB(background.z), 255};
         target.clear(bg, 1.0f);
-        if (cfg.visibility) target.resizeVisibility();
-        const bool countCost = cfg.traversalCost && cfg.samplesPerPixel == 1;   // render() asks only for one-sample frames
-        if (countCost) target.resizeTraversalCost();
+        if (cfg.aovs.has(Aov::Visibility)) target.allocate(Aov::Visibility);
+        const bool countCost = cfg.aovs.has(Aov::TraversalCost) && cfg.samplesPerPixel == 1;   // render() asks only for one-sample frames
+        if (countCost) target.allocate(Aov::TraversalCost);
         rt::CameraRays cam(f.camera, w, h);
         if (!cam.valid() || !isFinite(f.camera.eye)) {
             stats.error = "camera matrices are not invertible";

@@ -45,7 +45,7 @@ sg::FrameInput triangleAgreementFrame(const sg::Projection& proj, int w, int h);
 // A 64x64 checker of 4-texel squares (250/255 and 10/255 grey), trilinear, repeating.
 std::shared_ptr<sg::Texture> minificationChecker();
 
-// --- Reference scenes of the BackendConformance suite (tests/conformance). Every parameter a
+// --- Reference scenes of the BackendConformance suite (tests/renderers/conformance). Every parameter a
 // check needs (material, light, camera, settings) is read back from the returned frame.
 
 // A sphere of radius 1 at the origin (uvSphere with `slices` x slices/2), camera at (0, 0, 3.2)

@@ -47,8 +47,8 @@ TEST(RenderSlotGLTest, WorkerGlAnswersShadowsWithItsOwnMapsEveryTime) {
     Shown raster = renderStill("raster", RenderSlot::Threading::Auto, frame, 160, 120);
     ASSERT_EQ(gl.slot->status().error, "");
     ASSERT_EQ(raster.slot->status().error, "");
-    ASSERT_TRUE(gl.slot->image().hasVisibility());
-    ASSERT_TRUE(raster.slot->image().hasVisibility());
+    ASSERT_TRUE(gl.slot->image().has(rnd::Aov::Visibility));
+    ASSERT_TRUE(raster.slot->image().has(rnd::Aov::Visibility));
     ASSERT_FALSE(frame->lights.empty());
 
     // This thread has a context of its own current, as the window's UI thread has the window's.

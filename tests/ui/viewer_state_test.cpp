@@ -414,7 +414,7 @@ TEST(ViewerStateTest, ScreenshotNamesWithExportsNeverOverwriteAnExportFile) {
     fs::path dir = testing_support::outputDir("ui") / "shots_exports";
     fs::remove_all(dir);
     fs::create_directories(dir);
-    const std::vector<std::string> exports = {"depth", "id"};
+    const std::vector<rnd::Aov> exports = {rnd::Aov::Depth, rnd::Aov::Id};
     EXPECT_EQ(screenshotPath(dir, "gl", "screenshot", exports).filename(), "screenshot-gl.png");
     ASSERT_EQ(assets::writeFileAtomic(dir / "screenshot-gl.depth.pfm", "x", false), "");
     EXPECT_EQ(screenshotPath(dir, "gl").filename(), "screenshot-gl.png") << "without exports only the PNG counts";
@@ -424,7 +424,7 @@ TEST(ViewerStateTest, ScreenshotNamesWithExportsNeverOverwriteAnExportFile) {
     ScreenshotDialogState dialog;
     EXPECT_TRUE(screenshotExports(dialog).empty());
     dialog.exportId = dialog.exportDepth = true;
-    EXPECT_EQ(screenshotExports(dialog), (std::vector<std::string>{"depth", "id"}));
+    EXPECT_EQ(screenshotExports(dialog), (std::vector<rnd::Aov>{rnd::Aov::Depth, rnd::Aov::Id}));
 }
 
 // The screenshot dialog's size option says the size it writes; the status line names
@@ -451,7 +451,7 @@ TEST(ViewerStateTest, ScreenshotSummaryNamesEveryFileAndFailure) {
     EXPECT_EQ(screenshotSummary({{"gl", dir / "screenshot-gl.png", "no context"}}), "Screenshot failed: gl failed: no context");
     EXPECT_EQ(screenshotSummary({{"gl", dir / "screenshot-gl.png", "gl: no context"}}), "Screenshot failed: gl failed: no context")
         << "the backend named once";
-    EXPECT_EQ(screenshotSummary({{"gl", dir / "screenshot-gl.png", "", {"depth", "id"}}}),
+    EXPECT_EQ(screenshotSummary({{"gl", dir / "screenshot-gl.png", "", {rnd::Aov::Depth, rnd::Aov::Id}}}),
               "Saved screenshot-gl.png in /home/me/shots; with depth, id and the camera .json");
 }
 
@@ -565,7 +565,7 @@ TEST(RenderSlotTest, AntiAliasedFramesRefineThroughAOneSampleImage) {
         RenderSlot slot("raster");
         std::vector<Step> steps;
         slot.onPublish = [&](const rnd::Framebuffer& fb, const SlotStatus& s) {
-            steps.push_back({s.level, s.refining, s.stats.config.samplesPerPixel, fb.hasVisibility()});
+            steps.push_back({s.level, s.refining, s.stats.config.samplesPerPixel, fb.has(rnd::Aov::Visibility)});
         };
         slot.request(frame, 64, 48, 1, /*interacting=*/false);
         slot.waitIdle();
@@ -588,7 +588,7 @@ TEST(RenderSlotTest, AntiAliasedFramesRefineThroughAOneSampleImage) {
         auto direct = rnd::makeRenderer("raster");
         rnd::Framebuffer want;
         rnd::RenderRequest vis;
-        vis.visibility = true;
+        vis.aovs.add(rnd::Aov::Visibility);
         ASSERT_TRUE(direct->render(g, 64, 48, want, nullptr, vis).ok);
         EXPECT_EQ(slot.image().color, want.color);
         EXPECT_EQ(slot.image().drawable, want.drawable);
@@ -779,7 +779,7 @@ TEST(RenderSlotTest, InteractingRendersFullResolutionWhenAFullFrameFits) {
     EXPECT_EQ(levels, (std::vector<int>{1}));
     EXPECT_EQ(slot.image().width, 64);
     EXPECT_FALSE(slot.status().refining);
-    EXPECT_TRUE(slot.image().hasVisibility()) << "picking works on it";
+    EXPECT_TRUE(slot.image().has(rnd::Aov::Visibility)) << "picking works on it";
     // Released on that view: nothing is rendered again.
     levels.clear();
     slot.request(frame, 64, 48, 2, /*interacting=*/false);

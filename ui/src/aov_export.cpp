@@ -40,31 +40,49 @@ std::string writeIdImage(const fs::path& p, const sg::InstanceTable& ids, const 
 
 fs::path withoutExtension(fs::path p) { return p.replace_extension(); }
 
+// "depth, normal, id": the names of the AOVs the export writes.
+std::string exportedNames() {
+    std::string known;
+    for (rnd::Aov a : rnd::kAllAovs)
+        if (aovSuffix(a)) known += (known.empty() ? "" : ", ") + std::string(rnd::nameOf(a));
+    return known;
+}
+
 }   // namespace
 
-const char* aovSuffix(std::string_view kind) {
-    if (kind == "depth") return ".depth.pfm";
-    if (kind == "normal") return ".normal.png";
-    if (kind == "id") return ".id.png";
-    return nullptr;
+const char* aovSuffix(rnd::Aov aov) {
+    switch (aov) {
+    case rnd::Aov::Depth: return ".depth.pfm";
+    case rnd::Aov::Normal: return ".normal.png";
+    case rnd::Aov::Id: return ".id.png";
+    default: return nullptr;
+    }
 }
 
-std::vector<std::string> parseAovList(const std::string& list) {
-    std::vector<std::string> kinds;
+std::string parseAovList(const std::string& list, std::vector<rnd::Aov>& out) {
+    out.clear();
     std::stringstream in(list);
-    for (std::string k; std::getline(in, k, ',');)
-        if (!k.empty() && std::find(kinds.begin(), kinds.end(), k) == kinds.end()) kinds.push_back(k);
-    return kinds;
+    for (std::string k; std::getline(in, k, ',');) {
+        if (k.empty()) continue;
+        rnd::Aov a{};
+        if (!rnd::parseAov(k, a) || !aovSuffix(a)) { return "unknown kind '" + k + "' (known: " + exportedNames() + ")"; }
+        if (std::find(out.begin(), out.end(), a) == out.end()) out.push_back(a);
+    }
+    return {};
 }
 
-bool aovsNeedVisibility(const std::vector<std::string>& kinds) {
-    return std::any_of(kinds.begin(), kinds.end(), [](const std::string& k) { return k == "normal" || k == "id"; });
+rnd::AovSet aovSetOf(const std::vector<rnd::Aov>& kinds) {
+    rnd::AovSet s;
+    for (rnd::Aov a : kinds) s.add(a);
+    return s;
 }
 
-std::vector<fs::path> aovFiles(const fs::path& png, const std::vector<std::string>& kinds) {
+bool aovsNeedVisibility(const std::vector<rnd::Aov>& kinds) { return rnd::renderedAovs(aovSetOf(kinds)).has(rnd::Aov::Visibility); }
+
+std::vector<fs::path> aovFiles(const fs::path& png, const std::vector<rnd::Aov>& kinds) {
     const std::string base = withoutExtension(png).string();
     std::vector<fs::path> files;
-    for (const std::string& k : kinds)
+    for (rnd::Aov k : kinds)
         if (const char* s = aovSuffix(k)) files.push_back(base + s);
     if (!files.empty()) files.push_back(base + ".json");
     return files;
@@ -80,11 +98,12 @@ std::vector<assets::AovInstance> aovInstances(const sg::Scene& scene, const sg::
     return out;
 }
 
-std::string writeAovs(const fs::path& png, const std::vector<std::string>& kinds, const std::string& backend,
+std::string writeAovs(const fs::path& png, const std::vector<rnd::Aov>& kinds, const std::string& backend,
                       const std::vector<assets::AovInstance>& instances, const sg::FrameInput& frame, const rnd::Framebuffer& img, bool overwrite) {
     if (kinds.empty()) return {};
     const std::string base = withoutExtension(png).string();
-    if (aovsNeedVisibility(kinds) && !img.hasVisibility()) return base + ": the " + backend + " render has no visibility for the normal / id export";
+    if (aovsNeedVisibility(kinds) && !img.has(rnd::Aov::Visibility))
+        return base + ": the " + backend + " render has no visibility for the normal / id export";
     const sg::InstanceTable ids = sg::instanceTable(frame);
     assets::AovSidecar side;
     side.width = img.width;
@@ -92,20 +111,20 @@ std::string writeAovs(const fs::path& png, const std::vector<std::string>& kinds
     side.backend = backend;
     side.projection = std::string(sg::nameOf(frame.camera.projection.type));
     side.camera = sg::cameraModelOf(frame.camera, img.width, img.height);
-    for (const std::string& k : kinds) {
+    for (rnd::Aov k : kinds) {
         const char* suffix = aovSuffix(k);
-        if (!suffix) return base + ": unknown export '" + k + "' (known: depth, normal, id)";
+        if (!suffix) return base + ": " + std::string(rnd::nameOf(k)) + " is not exported (known: " + exportedNames() + ")";
         const fs::path p = base + suffix;
         std::string e;
-        if (k == "depth")
+        if (k == rnd::Aov::Depth)
             e = assets::writePfm(p, img.width, img.height, sg::opticalDepthMap(frame.camera, img.width, img.height, img.depth), overwrite);
-        else if (k == "normal")
+        else if (k == rnd::Aov::Normal)
             e = writeNormalImage(p, frame, ids, img, overwrite);
         else
             e = writeIdImage(p, ids, img, overwrite);
         if (!e.empty()) return e;
         side.files.push_back(p.filename().string());
-        side.hasIds = side.hasIds || k == "id";
+        side.hasIds = side.hasIds || k == rnd::Aov::Id;
     }
     if (side.hasIds) side.ids = instances;
     return assets::writeAovSidecar(base + ".json", side, overwrite);

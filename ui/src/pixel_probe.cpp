@@ -37,7 +37,7 @@ ProbeResult probeAt(const ViewerState& st, const ProbeImage& im, float u, float 
     if (!im.image || !im.frame || !pixelOf(*im.image, u, v, r.x, r.y)) return r;
     const uint8_t* px = im.image->pixel(r.x, r.y);
     std::copy(px, px + 3, r.rgb);
-    if (!im.image->hasVisibility()) return r;
+    if (!im.image->has(rnd::Aov::Visibility)) return r;
     r.valid = true;
     const sg::InstanceTable ids = sg::instanceTable(*im.frame);
     r.surface = rnd::surfaceAt(*im.frame, ids, *im.image, r.x, r.y);
@@ -60,13 +60,13 @@ ProbeResult probeAt(const ViewerState& st, const ProbeImage& im, float u, float 
 
 sg::NodeId pickAt(const ProbeImage& im, float u, float v) {
     int x = 0, y = 0;
-    if (!im.image || !im.frame || !im.image->hasVisibility() || !pixelOf(*im.image, u, v, x, y)) return sg::kNoNode;
+    if (!im.image || !im.frame || !im.image->has(rnd::Aov::Visibility) || !pixelOf(*im.image, u, v, x, y)) return sg::kNoNode;
     const uint32_t d = im.image->drawable[size_t(y) * im.image->width + x];
     return d ? sg::instanceTable(*im.frame).nodeOf(d) : sg::kNoNode;
 }
 
 void outlineNodes(rnd::Framebuffer& fb, const sg::FrameInput& frame, const sg::Scene& scene, const std::vector<sg::NodeId>& nodes) {
-    if (!fb.hasVisibility() || nodes.empty()) return;
+    if (!fb.has(rnd::Aov::Visibility) || nodes.empty()) return;
     const sg::InstanceTable ids = sg::instanceTable(frame);
     std::vector<uint8_t> drawableSelected(ids.ofDrawable.size(), 0);
     for (size_t k = 1; k < ids.ofDrawable.size(); ++k)

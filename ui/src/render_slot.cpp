@@ -75,8 +75,7 @@ void RenderSlot::request(std::shared_ptr<const sg::FrameInput> frame, int width,
     m_lastKey = key;
     m_lastPreviewOnly = interacting;
     std::lock_guard<std::mutex> lock(m_mutex);
-    m_pending =
-        Job{std::move(frame), width, height, key, interacting, interacting, counters.overdraw, counters.traversalCost, m_generation, liveBudgetMs};
+    m_pending = Job{std::move(frame), width, height, key, interacting, interacting, counters.aovs, m_generation, liveBudgetMs};
     if (m_control) m_control->cancel = true;   // restart with the new frame
     m_cv.notify_all();
 }
@@ -149,10 +148,9 @@ void RenderSlot::runJob(const Job& job) {
         const bool onePass = steps[i].singleSample || job.frame->settings.aa == sg::AAMode::None;
         const bool fullPass = d == 1 && (!job.interacting || onePass);
         const bool reuse = d == 1 && !steps[i].singleSample && oneSample.width == w && oneSample.height == h;
-        request.visibility = m_caps.visibility && fullPass && !reuse;
         // The diagnostic view's counters under the same rule (a second pass when anti-aliased).
-        request.overdraw = m_caps.overdraw && job.overdraw && fullPass && !reuse;
-        request.traversalCost = m_caps.traversalCost && job.traversalCost && fullPass && !reuse;
+        if (fullPass && !reuse)
+            for (rnd::Aov a : rnd::AovSet(job.aovs).add(rnd::Aov::Visibility).list()) request.aovs.set(a, m_caps.aovs.has(a));
         const auto start = std::chrono::steady_clock::now();
         try {
             std::lock_guard<std::mutex> rendering(m_renderMutex);

@@ -142,7 +142,7 @@ struct BackendView {
 struct PendingShot {
     std::string backend;
     fs::path path;
-    std::vector<std::string> exports;
+    std::vector<rnd::Aov> exports;
     std::future<std::string> result;   // "" or error
 };
 
@@ -219,8 +219,8 @@ public:
             // The counters of the diagnostic view shown, where this backend has them.
             rnd::RenderRequest counters;
             if (rnd::diagnosticViewSupported(st.view.diagnostic, v.slot->capabilities())) rnd::requestFor(st.view.diagnostic, counters);
-            uint64_t k = key ^ std::hash<std::string>{}(settings.aaName()) ^ (counters.overdraw ? 0x5bd1e995ull << 8 : 0) ^
-                         (counters.traversalCost ? 0x27d4eb2full << 16 : 0);
+            uint64_t k = key ^ std::hash<std::string>{}(settings.aaName()) ^ (counters.aovs.has(rnd::Aov::Overdraw) ? 0x5bd1e995ull << 8 : 0) ^
+                         (counters.aovs.has(rnd::Aov::TraversalCost) ? 0x27d4eb2full << 16 : 0);
             bool preview = interacting && v.slot->threaded();   // a synchronous render has no preview level
             v.slot->liveBudgetMs = liveBudgetMs;
             if (!v.slot->needs(k, preview)) continue;
@@ -247,10 +247,11 @@ public:
         v.outlinedVersion = st.doc.version;
         v.diagnostic = st.view.diagnostic;
         const rnd::Framebuffer& img = v.slot->image();
-        // What the view is made from: the counters for overdraw and cost, else the visibility.
-        const bool visible = v.slot->imageFrame() && (v.diagnostic == rnd::DiagnosticView::Overdraw ? img.hasOverdraw()
-                                                      : v.diagnostic == rnd::DiagnosticView::Cost   ? img.hasTraversalCost()
-                                                                                                    : img.hasVisibility());
+        // What the view is made from: the counters for overdraw and cost, else the visibility
+        // (the shaded image's selection outline too).
+        const rnd::AovSet made = v.diagnostic == rnd::DiagnosticView::Shaded ? rnd::AovSet{rnd::Aov::Visibility} : rnd::aovsFor(v.diagnostic);
+        bool visible = v.slot->imageFrame() != nullptr;
+        for (rnd::Aov a : made.list()) visible = visible && img.has(a);
         const bool supported = rnd::diagnosticViewSupported(v.diagnostic, v.slot->capabilities());
         if ((sel.empty() && v.diagnostic == rnd::DiagnosticView::Shaded) || !visible || !supported) {
             if (overlays && v.slot->imageFrame()) {
@@ -403,8 +404,8 @@ public:
         }
         float aspect = float(w) / float(h);
         auto base = std::make_shared<sg::FrameInput>(st.buildFrame(aspect));
-        const std::vector<std::string> exports = screenshotExports(dialog);
-        const bool ids = std::find(exports.begin(), exports.end(), "id") != exports.end();
+        const std::vector<rnd::Aov> exports = screenshotExports(dialog);
+        const bool ids = std::find(exports.begin(), exports.end(), rnd::Aov::Id) != exports.end();
         // Everything read from the document is taken here, on the UI thread; the jobs see copies.
         auto instances =
             std::make_shared<const std::vector<assets::AovInstance>>(ids ? aovInstances(st.doc.scene, *base) : std::vector<assets::AovInstance>{});
@@ -435,7 +436,7 @@ public:
             auto job = [n, r, frame, w, h, path, exports, instances, shotView, overlays, visibility, shadowLight]() -> std::string {
                 rnd::Framebuffer fb;
                 rnd::RenderRequest request;
-                request.visibility = visibility && r->capabilities().visibility;
+                request.aovs.set(rnd::Aov::Visibility, visibility && r->capabilities().aovs.has(rnd::Aov::Visibility));
                 rnd::requestFor(shotView, request);
                 rnd::RenderStats s = r->render(*frame, w, h, fb, nullptr, request);
                 if (!s.ok) return s.error.empty() ? n + ": render failed" : s.error;

@@ -405,7 +405,7 @@ std::string saveWindowRect(const fs::path& dir, const WindowRect& r) {
     return assets::writeFileAtomic(dir / "window.txt", text, /*overwrite=*/true);
 }
 
-fs::path screenshotPath(const fs::path& dir, const std::string& backend, const std::string& stem, const std::vector<std::string>& exports) {
+fs::path screenshotPath(const fs::path& dir, const std::string& backend, const std::string& stem, const std::vector<rnd::Aov>& exports) {
     std::error_code ec;
     auto taken = [&](const fs::path& png) {
         if (fs::exists(fs::symlink_status(png, ec))) return true;
@@ -419,11 +419,11 @@ fs::path screenshotPath(const fs::path& dir, const std::string& backend, const s
     return p;
 }
 
-std::vector<std::string> screenshotExports(const ScreenshotDialogState& dialog) {
-    std::vector<std::string> kinds;
-    if (dialog.exportDepth) kinds.push_back("depth");
-    if (dialog.exportNormal) kinds.push_back("normal");
-    if (dialog.exportId) kinds.push_back("id");
+std::vector<rnd::Aov> screenshotExports(const ScreenshotDialogState& dialog) {
+    std::vector<rnd::Aov> kinds;
+    if (dialog.exportDepth) kinds.push_back(rnd::Aov::Depth);
+    if (dialog.exportNormal) kinds.push_back(rnd::Aov::Normal);
+    if (dialog.exportId) kinds.push_back(rnd::Aov::Id);
     return kinds;
 }
 
@@ -447,7 +447,7 @@ std::string screenshotSummary(const std::vector<ScreenshotResult>& results) {
     std::string exports;
     for (const ScreenshotResult& r : results)
         if (r.error.empty() && !r.exports.empty()) {
-            for (const std::string& k : r.exports) exports += (exports.empty() ? "" : ", ") + k;
+            for (rnd::Aov k : r.exports) exports += (exports.empty() ? "" : ", ") + std::string(rnd::nameOf(k));
             break;   // one batch, one set of choices
         }
     if (!exports.empty()) line += "; with " + exports + " and the camera .json";

@@ -68,7 +68,7 @@ layout(location = 0) out vec4 fragColor;
 #if VISIBILITY
 uniform uint uDrawable;        // Framebuffer::drawable of this draw
 uniform uint uPrimitiveBase;   // the draw call's first primitive in its mesh (0xffffffff: analytic)
-// Visibility (rnd::RenderConfig::visibility): drawable, and the primitive index within its mesh.
+// Visibility (Aov::Visibility in rnd::RenderConfig::aovs): drawable, and the primitive index within its mesh.
 layout(location = 1) out uvec2 fragId;
 #endif
 

@@ -8,13 +8,13 @@
 //   triangles  triangle density: how many of the seen triangle fit in a pixel (1 / its
 //              projected area in pixels), log heat map: blue 0.001, cyan 0.006, green 0.03,
 //              yellow 0.18, red >= 1 (one triangle or more per pixel); grey: analytic shapes
-//   overdraw   (rasterizers, Capabilities::overdraw) fragments rasterized per pixel before the
+//   overdraw   (rasterizers, Aov::Overdraw) fragments rasterized per pixel before the
 //              depth test, at one sample per pixel: every covered pixel centre of every drawn
 //              triangle (opaque, masked and blended alike, after back-face culling; the
 //              fragments of clipped triangles once), line, point and wireframe edge counts one,
 //              whether it is then hidden, cut out or blended. Heat map: 1 blue, 2 cyan,
 //              3-4 green, 5-7 yellow, 8+ red; black: no fragment
-//   cost       (ray caster, Capabilities::traversalCost) the work of the pixel's primary ray
+//   cost       (ray caster, Aov::TraversalCost) the work of the pixel's primary ray
 //              through the centre: BVH nodes visited (the top level over instances and the
 //              meshes' BVHs; a node counts when its child boxes are tested) plus primitives
 //              tested (triangles of the leaves it opens; an analytic shape counts one),
@@ -50,7 +50,10 @@ struct DiagnosticImage {
     std::string legend;   // one line: what the colours mean ("depth 2.10 (white) .. 14.30 (dark)")
 };
 
-// Whether a backend with `caps` can make the view (overdraw and cost need their counters).
+// The AOVs (aov.h) the view is made from: none for shaded, the counters for overdraw and
+// cost, the visibility for the others.
+AovSet aovsFor(DiagnosticView view);
+// Whether a backend with `caps` can make the view (it fills aovsFor(view)).
 bool diagnosticViewSupported(DiagnosticView view, const Capabilities& caps);
 // What the render behind the view must ask for (adds to `request`; visibility for all but
 // shaded, overdraw and cost; the counters for those two).

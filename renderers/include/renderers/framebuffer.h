@@ -1,8 +1,10 @@
 // framebuffer.h - what every backend renders into: RGBA8 colour + float depth, any size, and on
-// request the visibility of each pixel (which drawable and which of its primitives it shows)
-// and per-pixel counters for the overdraw and cost diagnostic views.
+// request the other AOVs (aov.h): the visibility of each pixel (which drawable and which of its
+// primitives it shows) and per-pixel counters for the overdraw and cost diagnostic views.
 // Rows are stored top to bottom (row 0 is the top of the image, as in PNG files).
 #pragma once
+
+#include "renderers/aov.h"
 
 #include <cstdint>
 #include <string>
@@ -34,12 +36,11 @@ struct Framebuffer {
     // As resize(), but colour and depth keep whatever they held (unspecified values): for a
     // backend that writes every pixel next, so a frame of the same size costs no fill.
     void resizeForOverwrite(int w, int h);
-    void resizeVisibility();      // visibility at the current size, all empty
-    void resizeOverdraw();        // overdraw counters at the current size, all 0
-    void resizeTraversalCost();   // costNodes/costPrims at the current size, all 0
-    bool hasVisibility() const { return drawable.size() == size_t(width) * height && primitive.size() == drawable.size() && !drawable.empty(); }
-    bool hasOverdraw() const { return overdraw.size() == size_t(width) * height && !overdraw.empty(); }
-    bool hasTraversalCost() const { return costNodes.size() == size_t(width) * height && costPrims.size() == costNodes.size() && !costNodes.empty(); }
+    // The buffers of `aov` at the current size: the visibility all empty (Normal and Id: the
+    // visibility they are made from), the counters all 0, the depth all 1.
+    void allocate(Aov aov);
+    // Whether the image holds `aov` at its size (Normal and Id: the visibility they are made from).
+    bool has(Aov aov) const;
     // Takes the visibility and the counters of `src` (an image of the same pixel centres: the
     // one-sample pass of an anti-aliased image), leaving colour and depth as they are.
     void takeVisibilityAndCounters(Framebuffer&& src);

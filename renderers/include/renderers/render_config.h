@@ -10,6 +10,7 @@
 // notes.
 #pragma once
 
+#include "renderers/aov.h"
 #include "scenegraph/frame.h"
 
 #include <string>
@@ -26,15 +27,13 @@ struct RenderConfig {
     int ssaaFactor = 1;                 // SSAA: factor x factor samples per pixel (1 = off)
     int samplesPerPixel = 1;            // samples (or rays) per pixel actually taken
     int tessellation = 64;              // grid resolution / segments of analytic shapes
-    // Fill the target's visibility (Framebuffer::drawable/primitive). render() asks for it
-    // only with one sample per pixel at the pixel centre (it renders the visibility in a
-    // second pass when the image is anti-aliased), so backends write the one surface they
-    // see through each pixel centre.
-    bool visibility = false;
-    // Count per pixel, under the same one-sample rule as the visibility: fragments rasterized
-    // (Framebuffer::overdraw) and the primary ray's BVH work (Framebuffer::costNodes/costPrims).
-    bool overdraw = false;
-    bool traversalCost = false;
+    // The AOVs (aov.h) besides colour and depth to fill in this pass: the visibility
+    // (Framebuffer::drawable/primitive), fragments rasterized per pixel (Framebuffer::overdraw)
+    // and the primary ray's BVH work (Framebuffer::costNodes/costPrims). render() asks for them
+    // only with one sample per pixel at the pixel centre (it renders them in a second pass when
+    // the image is anti-aliased), so backends write the one surface they see through each
+    // pixel centre and count at one sample per pixel.
+    AovSet aovs;
     std::string aaAsked = "none";   // RenderSettings::aaName() as asked
     std::string aaUsed = "none";    // the same spelling for what is used
     // Settings the backend does not honour as asked, one line each ("msaa8 -> msaa4: raster

@@ -41,18 +41,17 @@ enum class ContextAffinity {
 // What a backend can do. The UI and the command line decide from these, never from names.
 struct Capabilities {
     ContextAffinity affinity = ContextAffinity::AnyThread;
-    bool progressive = false;         // render() reports progress per tile and can be cancelled
-    bool exactImplicits = false;      // implicit shapes/CSG intersected analytically (vs tessellated)
-    bool shadows = false;             // honours RenderSettings::shadows
-    bool shadowMaps = false;          // its shadows are shadow maps (RenderSettings::shadowMapSize ... honoured)
-    bool shadowRays = false;          // its shadows are shadow rays (RenderSettings::shadowRays honoured)
-    bool reflections = false;         // honours RenderSettings::reflections
-    bool wireframe = false;           // draws RenderSettings::wireframe
-    bool pointsAndLines = false;      // draws meshes of PrimitiveMode::Points / Lines
-    bool depth = true;                // fills Framebuffer::depth (window depth in [0,1])
-    bool visibility = false;          // fills Framebuffer::drawable/primitive when asked (RenderRequest)
-    bool overdraw = false;            // fills Framebuffer::overdraw when asked (fragments per pixel)
-    bool traversalCost = false;       // fills Framebuffer::costNodes/costPrims when asked (BVH work per primary ray)
+    bool progressive = false;      // render() reports progress per tile and can be cancelled
+    bool exactImplicits = false;   // implicit shapes/CSG intersected analytically (vs tessellated)
+    bool shadows = false;          // honours RenderSettings::shadows
+    bool shadowMaps = false;       // its shadows are shadow maps (RenderSettings::shadowMapSize ... honoured)
+    bool shadowRays = false;       // its shadows are shadow rays (RenderSettings::shadowRays honoured)
+    bool reflections = false;      // honours RenderSettings::reflections
+    bool wireframe = false;        // draws RenderSettings::wireframe
+    bool pointsAndLines = false;   // draws meshes of PrimitiveMode::Points / Lines
+    // The AOVs (aov.h) it fills: Depth always; Visibility, Overdraw and TraversalCost when a
+    // RenderRequest asks for them (Normal and Id are made from the Visibility, never listed).
+    AovSet aovs = {Aov::Depth};
     std::vector<int> msaaSamples;     // MSAA sample counts taken as asked, ascending ({} = no MSAA)
     std::vector<int> ssaaFactors;     // SSAA factors taken as asked, ascending ({} = no SSAA)
     bool ssaaRendersLarger = false;   // SSAA renders a factor x larger image (counts against maxImageSize)
@@ -95,19 +94,16 @@ struct RenderControl {
 
 // What the caller wants besides the colour image and depth.
 struct RenderRequest {
-    // Framebuffer::drawable/primitive: what each pixel centre shows (picking, the pixel
-    // inspector, id/normal export). With anti-aliasing, render() renders them in a second,
-    // one-sample pass, so they never mix surfaces; a backend without Capabilities::visibility
-    // fails the render with an error saying so.
-    bool visibility = false;
-    // Framebuffer::overdraw (Capabilities::overdraw) and Framebuffer::costNodes/costPrims
-    // (Capabilities::traversalCost): per-pixel counters of the diagnostic views "overdraw" and
-    // "cost" (renderers/diagnostic.h), counted at one sample per pixel like the visibility (in
-    // the same second pass when the image is anti-aliased). Backends count only when asked,
-    // so a render that does not ask pays nothing for them; a backend without the capability
-    // fails the render with an error saying so.
-    bool overdraw = false;
-    bool traversalCost = false;
+    // The AOVs (aov.h) wanted besides the colour image and depth (which every render fills):
+    //   Visibility (Framebuffer::drawable/primitive): what each pixel centre shows (picking,
+    //     the pixel inspector, id/normal export); Normal and Id ask for it, as they are made from it.
+    //   Overdraw (Framebuffer::overdraw) and TraversalCost (Framebuffer::costNodes/costPrims):
+    //     per-pixel counters of the diagnostic views "overdraw" and "cost" (renderers/diagnostic.h).
+    // All of them are made at one sample per pixel: with anti-aliasing, render() renders them
+    // in a second, one-sample pass, so they never mix surfaces. Backends fill them only when
+    // asked, so a render that does not ask pays nothing for them; a backend without one in
+    // Capabilities::aovs fails the render with an error saying so.
+    AovSet aovs;
     // One sample per pixel at the pixel centres whatever the settings' anti-aliasing asks
     // (stats.config says aa "none"): the first full-resolution image of a caller that refines
     // progressively (ui::RenderSlot), the anti-aliased render following it. The visibility and

@@ -10,6 +10,7 @@
 #pragma once
 
 #include "assets/aov_io.h"
+#include "renderers/aov.h"
 #include "renderers/framebuffer.h"
 #include "scenegraph/frame.h"
 #include "scenegraph/scene.h"
@@ -21,15 +22,21 @@
 
 namespace ui {
 
-// ".depth.pfm", ".normal.png", ".id.png" for "depth", "normal", "id"; nullptr for anything else.
-const char* aovSuffix(std::string_view kind);
-// "depth,normal" -> {"depth", "normal"} (order kept, duplicates and empty items dropped).
-std::vector<std::string> parseAovList(const std::string& list);
-// The normal and id images need the render's visibility (RenderRequest::visibility); depth does not.
-bool aovsNeedVisibility(const std::vector<std::string>& kinds);
+// The AOVs (renderers/aov.h) the export writes, by their names in rnd::nameOf(Aov): depth,
+// normal and id. ".depth.pfm", ".normal.png", ".id.png" for those; nullptr for the others.
+const char* aovSuffix(rnd::Aov aov);
+// "depth,normal" -> {Depth, Normal} (order kept, duplicates and empty items dropped) into
+// `out`. "" or, for a name that is not an exported AOV, "unknown kind 'x' (known: depth,
+// normal, id)".
+std::string parseAovList(const std::string& list, std::vector<rnd::Aov>& out);
+// The AOVs of the list as a set (RenderRequest::aovs: the normal and id images ask for the
+// render's visibility, depth for nothing more).
+rnd::AovSet aovSetOf(const std::vector<rnd::Aov>& kinds);
+// The normal and id images need the render's visibility (RenderRequest::aovs); depth does not.
+bool aovsNeedVisibility(const std::vector<rnd::Aov>& kinds);
 // The files the export of `kinds` writes next to `png` (the sidecar last); none for no kinds.
-// Unknown kinds are left out (check them with aovSuffix first).
-std::vector<std::filesystem::path> aovFiles(const std::filesystem::path& png, const std::vector<std::string>& kinds);
+// AOVs without a file are left out.
+std::vector<std::filesystem::path> aovFiles(const std::filesystem::path& png, const std::vector<rnd::Aov>& kinds);
 
 // The id -> node table of the id export for `frame` (flattened from `scene`): id k is
 // sg::instanceTable(frame)'s instance k. Made where the scene may be read (the UI thread).
@@ -38,7 +45,7 @@ std::vector<assets::AovInstance> aovInstances(const sg::Scene& scene, const sg::
 // Writes the export of `kinds` for the image `img` (rendered from `frame` by `backend`, with
 // visibility when aovsNeedVisibility) next to `png`; `instances` from aovInstances. An existing
 // file is replaced only with `overwrite`. "" or a one-line error naming the file.
-std::string writeAovs(const std::filesystem::path& png, const std::vector<std::string>& kinds, const std::string& backend,
+std::string writeAovs(const std::filesystem::path& png, const std::vector<rnd::Aov>& kinds, const std::string& backend,
                       const std::vector<assets::AovInstance>& instances, const sg::FrameInput& frame, const rnd::Framebuffer& img, bool overwrite);
 
 }   // namespace ui

@@ -64,8 +64,9 @@ void handleShortcuts(ViewerState& st);
 
 // Backends shown by the current view mode (the slots the window must render).
 std::vector<std::string> visibleBackends(const ViewerState& st);
-// What a backend can do (made once per name and kept; empty for an unknown name). The menus
-// decide from these, never from names.
+// What a backend can do (asked once per name and kept: Capabilities are constant for the life
+// of a backend, GL's driver limits included, which it reads once per process whether or not it
+// has rendered; empty for an unknown name). The menus decide from these, never from names.
 const rnd::Capabilities& backendCapabilities(const std::string& backend);
 
 }   // namespace ui

@@ -58,9 +58,9 @@ public:
     // rendering (needs()).
     // On a worker thread an anti-aliased frame refines in steps: the preview and a full-
     // resolution image at one sample per pixel come first, then the anti-aliased image.
-    // counters: the per-pixel counters the full-resolution image should carry (RenderRequest's
-    // overdraw / traversalCost, for the diagnostic view shown; asked only where the backend has
-    // them, and included in what `key` identifies).
+    // counters: the AOVs the full-resolution image should carry besides the visibility
+    // (RenderRequest::aovs: the counters Overdraw / TraversalCost of the diagnostic view shown;
+    // asked only where the backend has them, and included in what `key` identifies).
     void request(std::shared_ptr<const sg::FrameInput> frame, int width, int height, uint64_t key, bool interacting,
                  const rnd::RenderRequest& counters = {});
     // True when request() with this key would start work (so callers can skip building frames):
@@ -140,10 +140,10 @@ private:
         int width = 0, height = 0;
         uint64_t key = 0;
         bool previewOnly = false;
-        bool interacting = false;                       // no visibility while the camera moves (anti-aliased)
-        bool overdraw = false, traversalCost = false;   // counters asked for (with the visibility)
-        uint64_t generation = 0;                        // m_generation when requested: forget() outdates it
-        double budgetMs = 50;                           // liveBudgetMs when requested
+        bool interacting = false;   // no visibility while the camera moves (anti-aliased)
+        rnd::AovSet aovs;           // AOVs asked for (with the visibility)
+        uint64_t generation = 0;    // m_generation when requested: forget() outdates it
+        double budgetMs = 50;       // liveBudgetMs when requested
     };
     // A question for the renderer between renders, answered on the worker (a GL renderer's maps
     // live in the worker's context: asked from the UI thread, whose context is the window's, the

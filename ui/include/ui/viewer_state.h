@@ -411,16 +411,16 @@ std::string saveUiScale(const std::filesystem::path& configDir, float scale);
 // dir/"<stem>-<backend>.png" or, when taken, the first free "-N" variant: free for the PNG and
 // for every export file of `exports` next to it (ui/aov_export.h), so nothing is overwritten.
 std::filesystem::path screenshotPath(const std::filesystem::path& dir, const std::string& backend, const std::string& stem = "screenshot",
-                                     const std::vector<std::string>& exports = {});
-// The export kinds ("depth", "normal", "id") the screenshot dialog's boxes ask for.
-std::vector<std::string> screenshotExports(const ScreenshotDialogState& dialog);
+                                     const std::vector<rnd::Aov>& exports = {});
+// The AOVs exported (Depth, Normal, Id: ui/aov_export.h) the screenshot dialog's boxes ask for.
+std::vector<rnd::Aov> screenshotExports(const ScreenshotDialogState& dialog);
 
 // One backend's screenshot, finished: the file written, or why not.
 struct ScreenshotResult {
     std::string backend;
-    std::filesystem::path path;              // absolute
-    std::string error;                       // "" when written
-    std::vector<std::string> exports = {};   // the export kinds written next to it ("depth", "normal", "id")
+    std::filesystem::path path;           // absolute
+    std::string error;                    // "" when written
+    std::vector<rnd::Aov> exports = {};   // the AOVs exported next to it (Depth, Normal, Id)
 };
 // The status line for a finished batch: every file written, the folder once (absolute), the
 // exports next to them ("; with depth, normal, id and the camera .json"), then each failure ("Saved 2 screenshots in /home/me/shots: screenshot-gl.png, screenshot-raster.png",

@@ -77,7 +77,7 @@ const rnd::Capabilities& backendCapabilities(const std::string& backend) {
     auto it = known.find(backend);
     if (it == known.end()) {
         rnd::Capabilities c;
-        if (auto r = rnd::makeRenderer(backend)) c = r->capabilities();   // a GL backend makes no context until it renders
+        if (auto r = rnd::makeRenderer(backend)) c = r->capabilities();   // the same as any instance's, rendered or not
         it = known.emplace(backend, std::move(c)).first;
     }
     return it->second;

@@ -332,7 +332,7 @@ void pickAndProbe(ViewerState& st, const ViewportInput& view, ImVec2 a, ImVec2 a
     }
     if (probe.pickPending && (probe.pickViewVersion != st.view.version || probe.pickDocVersion != st.doc.version)) probe.pickPending = false;
     if (probe.pickPending)
-        if (const SlotView* s = slotUnder(st, view, probe.u); s && s->probe.image && s->probe.image->hasVisibility()) {
+        if (const SlotView* s = slotUnder(st, view, probe.u); s && s->probe.image && s->probe.image->has(rnd::Aov::Visibility)) {
             const sg::NodeId picked = pickAt(s->probe, probe.u, probe.v);
             if (probe.pickAdds)
                 st.toggleSelected(picked);   // Ctrl+click: adds or takes out; on empty space nothing changes
