@@ -17,6 +17,13 @@ if(VIEWER_SANITIZE)
   target_compile_options(viewer_options INTERFACE -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
   target_link_options(viewer_options INTERFACE -fsanitize=address,undefined)
 endif()
+if(VIEWER_TSAN)
+  # ThreadSanitizer (the tsan preset). It only means something with a TBB built with it too
+  # (scripts/build-tbb-tsan.sh; the preset points TBB_DIR there): Debian's libtbb is not
+  # instrumented, so TSan cannot see its synchronisation and reports races inside its scheduler.
+  target_compile_options(viewer_options INTERFACE -fsanitize=thread -fno-omit-frame-pointer)
+  target_link_options(viewer_options INTERFACE -fsanitize=thread)
+endif()
 if(VIEWER_FUZZ)
   # Coverage instrumentation for libFuzzer on all our code; the fuzz targets add -fsanitize=fuzzer.
   target_compile_options(viewer_options INTERFACE -fsanitize=fuzzer-no-link,address,undefined -fno-omit-frame-pointer -gline-tables-only)

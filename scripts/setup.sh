@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Shared by ./run and ./test: install missing Debian packages, configure, build.
 # Usage: scripts/setup.sh [preset]   (default: release); scripts/setup.sh --packages-only installs and stops
+# (tsan also builds TBB with ThreadSanitizer: scripts/build-tbb-tsan.sh)
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 preset="${1:-release}"
@@ -43,6 +44,8 @@ fi
 [ "$preset" = "--packages-only" ] && exit 0
 
 cd "$root"
+# The tsan preset links a TBB built with ThreadSanitizer (cached under build/tbb-tsan/).
+if [ "$preset" = tsan ]; then scripts/build-tbb-tsan.sh; fi
 builddir="build/$preset"
 if [ ! -f "$builddir/CMakeCache.txt" ]; then
   cmake --preset "$preset" >/dev/null
@@ -50,6 +53,8 @@ fi
 jobs="$(nproc 2>/dev/null || echo 2)"
 if [ "$preset" = fuzz ]; then
   cmake --build "$builddir" -j "$jobs" --target fuzz_all
+elif [ "$preset" = tsan ]; then
+  cmake --build "$builddir" -j "$jobs" --target tsan_all
 else
   cmake --build "$builddir" -j "$jobs"
 fi

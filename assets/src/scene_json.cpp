@@ -4,6 +4,8 @@
 //
 // Format (version 1). Every array of numbers is plain JSON numbers; matrices are 16 numbers in
 // column-major order (as GLM stores them); quaternions are [x, y, z, w]; colours linear RGB.
+// Floats are written in the fewest digits that read back to the same bits (up to +-3.40282347e+38);
+// a NaN or an infinity has no JSON spelling, and a scene holding one is not saved.
 //   {
 //     "format": "sceneviewer", "version": 1, "name": "...",
 //     "activeCamera": <node index or null>,

@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <sstream>
 
 namespace fs = std::filesystem;
@@ -92,11 +93,19 @@ private:
         auto it = obj.find(key);
         return it == obj.end() || it->is_null() ? nullptr : &*it;
     }
+    // The float a number of the file stands for, as the writer meant it: every finite float,
+    // up to the largest (3.40282347e+38, which reads as a double a hair above FLT_MAX and
+    // rounds to it), comes back; a number that would round to infinity is refused.
+    float toFloat(double d, const std::string& path) {
+        constexpr double kRoundsToInfinity = 0x1.ffffffp+127;   // halfway from FLT_MAX to 2^128
+        if (!std::isfinite(d) || std::abs(d) >= kRoundsToInfinity) fail(path, "number is not finite as a float (beyond +-3.40282347e+38)");
+        constexpr float kMax = std::numeric_limits<float>::max();
+        if (std::abs(d) > double(kMax)) return d > 0 ? kMax : -kMax;   // what rounding gives, without an out-of-range conversion
+        return float(d);
+    }
     float number(const json& v, const std::string& path) {
         if (!v.is_number()) fail(path, "expected a number");
-        double d = v.get<double>();
-        if (!std::isfinite(d) || std::abs(d) > 3.0e38) fail(path, "number is not finite");
-        return float(d);
+        return toFloat(v.get<double>(), path);
     }
     int integer(const json& v, const std::string& path, long long lo, long long hi) {
         if (!v.is_number_integer()) fail(path, "expected an integer");
@@ -208,12 +217,11 @@ private:
             for (int c = 0; c < N; ++c) {
                 const json& x = (*v)[i * N + c];
                 if (!x.is_number()) fail(path + "/" + std::to_string(i * N + c), "expected a number");
-                double d = x.get<double>();
-                if (!std::isfinite(d) || std::abs(d) > 3.0e38) fail(path + "/" + std::to_string(i * N + c), "number is not finite");
+                const float f = toFloat(x.get<double>(), path + "/" + std::to_string(i * N + c));
                 if constexpr (N == 1)
-                    dst[i] = float(d);
+                    dst[i] = f;
                 else
-                    dst[i][c] = float(d);
+                    dst[i][c] = f;
             }
     }
 

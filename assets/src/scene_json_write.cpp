@@ -229,9 +229,25 @@ void pretty(std::string& out, const json& j, int indent) {
     }
 }
 
-}   // namespace
+// The JSON pointer of the first number that is not finite ("" when there is none), and which.
+std::string findNonFinite(const json& j, const std::string& path, std::string& what) {
+    if (j.is_number_float()) {
+        const double d = j.get<double>();
+        if (std::isfinite(d)) return {};
+        what = std::isnan(d) ? "NaN" : d > 0 ? "+infinity" : "-infinity";
+        return path.empty() ? "/" : path;
+    }
+    if (j.is_object()) {
+        for (auto it = j.begin(); it != j.end(); ++it)
+            if (std::string at = findNonFinite(it.value(), path + "/" + it.key(), what); !at.empty()) return at;
+    } else if (j.is_array()) {
+        for (size_t i = 0; i < j.size(); ++i)
+            if (std::string at = findNonFinite(j[i], path + "/" + std::to_string(i), what); !at.empty()) return at;
+    }
+    return {};
+}
 
-std::string serializeSceneJson(const sg::Scene& s) {
+json sceneJson(const sg::Scene& s) {
     json j;
     j["format"] = "sceneviewer";
     j["version"] = 1;
@@ -308,13 +324,32 @@ std::string serializeSceneJson(const sg::Scene& s) {
         }
     }
     j["activeCamera"] = s.valid(s.activeCamera) ? json(indexOf[s.activeCamera]) : json(nullptr);
+    return j;
+}
+
+}   // namespace
+
+// A NaN or an infinity is refused, not written: JSON has no spelling for it (what printf gives,
+// "nan", makes a file nobody can open), and writing null to read back as a default would
+// replace the user's value with another one without a word, in a file that then looks fine.
+// Refused, the save changes nothing on disk and the error names the value, so it can be fixed.
+std::string serializeSceneJson(const sg::Scene& s, std::string* error) {
+    const json j = sceneJson(s);
+    std::string what;
+    if (std::string at = findNonFinite(j, "", what); !at.empty()) {
+        if (error) *error = at + ": " + what + " cannot be saved (a scene file holds finite numbers only)";
+        return {};
+    }
     std::string out;
     pretty(out, j, 0);
     return out + "\n";
 }
 
 std::string saveSceneJson(const sg::Scene& scene, const fs::path& path, bool overwrite) {
-    return writeFileAtomic(path, serializeSceneJson(scene), overwrite);
+    std::string error;
+    std::string text = serializeSceneJson(scene, &error);
+    if (!error.empty()) return path.string() + ": " + error;
+    return writeFileAtomic(path, text, overwrite);
 }
 
 }   // namespace assets

@@ -1,6 +1,7 @@
 // scene_roundtrip_test.cpp - save, then reopen, gives the same scene to the bit: awkward floats
-// (0.1, 1/3, 1e-7, denormals, integers around 2^24, -0, random bit patterns) read back exactly,
-// and the demo and glTF samples (imported, saved as our scene file, reopened) render the same
+// (0.1, 1/3, 1e-7, denormals, integers around 2^24, -0, the largest floats, random bit patterns)
+// read back exactly, a NaN or an infinity is refused on saving (and the file left alone), and
+// the demo and glTF samples (imported, saved as our scene file, reopened) render the same
 // image with the CPU rasterizer, colour and depth byte for byte.
 #include "assets/demo.h"
 #include "assets/scene_io.h"
@@ -15,6 +16,10 @@
 #include <cfloat>
 #include <cmath>
 #include <cstring>
+#include <fstream>
+#include <functional>
+#include <limits>
+#include <optional>
 #include <random>
 
 namespace fs = std::filesystem;
@@ -51,15 +56,21 @@ std::vector<float> awkwardFloats() {
                             1e-45f,
                             1e30f,
                             2.9e38f,
+                            3.0e38f,
+                            std::nextafter(3.0e38f, FLT_MAX),
+                            -3.1e38f,
+                            FLT_MAX,   // written as 3.40282347e+38, which reads as a double above FLT_MAX
+                            -FLT_MAX,
+                            std::nextafter(FLT_MAX, 0.0f),
                             -0.0f,
                             0.0f,
                             FLT_EPSILON,
                             1.0f + FLT_EPSILON};
-    // Random bit patterns over the whole range the scene file takes (finite, |x| <= 3e38).
+    // Random bit patterns: every finite float (all exponents, denormals included).
     std::mt19937 rng(20240611);
     while (v.size() < 30000) {
         const float f = std::bit_cast<float>(uint32_t(rng()));
-        if (std::isfinite(f) && std::fabs(f) <= 3.0e38f) v.push_back(f);
+        if (std::isfinite(f)) v.push_back(f);
     }
     while (v.size() % 3) v.push_back(0.5f);
     return v;
@@ -117,6 +128,75 @@ TEST(SceneRoundTripTest, AwkwardFloatsReadBackBitForBit) {
     EXPECT_EQ(sg::sceneDifference(s, *r.scene), "");
     // And saving what was read gives the same text: nothing drifts.
     EXPECT_EQ(assets::serializeSceneJson(*r.scene), assets::serializeSceneJson(s));
+}
+
+// The reader takes every spelling of the largest float (the writer's 3.40282347e+38 reads as a
+// double a hair above FLT_MAX), and refuses a number that would round to infinity as a float.
+TEST(SceneRoundTripTest, LargestFloatReadsBackAndBeyondItIsRefused) {
+    auto translationX = [](const std::string& x, std::string& error) {
+        const assets::LoadResult r =
+            assets::parseSceneJson(R"({"nodes": [{}, {"parent": 0, "transform": {"translation": [)" + x + ", 0, 0]}}]}", "big.json");
+        error = r.error;
+        return r.scene ? std::optional<float>(r.scene->node(1).local.translation.x) : std::nullopt;
+    };
+    std::string error;
+    for (const char* text : {"3.40282347e+38", "3.4028235e38", "340282346638528859811704183484516925440.0", "3.4028235677973e38"}) {
+        for (const std::string sign : {"", "-"}) {
+            const std::optional<float> x = translationX(sign + text, error);
+            ASSERT_TRUE(x) << sign << text << ": " << error;
+            EXPECT_EQ(std::bit_cast<uint32_t>(*x), std::bit_cast<uint32_t>(sign.empty() ? FLT_MAX : -FLT_MAX)) << sign << text;
+        }
+    }
+    // 2^128 - 2^103, halfway between FLT_MAX and 2^128, rounds (to even) to infinity.
+    for (const char* text : {"3.4028235677973366e38", "-3.4028235677973366e38", "3.5e38", "-1e39", "1e300"}) {
+        EXPECT_FALSE(translationX(text, error)) << text;
+        EXPECT_NE(error.find("big.json: /nodes/1/transform/translation/0"), std::string::npos) << error;
+        EXPECT_NE(error.find("not finite"), std::string::npos) << error;
+    }
+}
+
+// NaN and infinity have no JSON spelling (printf's "nan" made files nobody could open). A save
+// is refused, naming the value by its JSON path, and the file on disk is left as it was; no file
+// is made where there was none.
+TEST(SceneRoundTripTest, NonFiniteNumbersAreRefusedAndLeaveTheFileAlone) {
+    struct Case {
+        const char* name;
+        std::function<void(sg::Scene&)> spoil;
+        const char* path;
+        const char* what;
+    };
+    const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+    const std::vector<Case> cases = {
+        {"translation_nan", [&](sg::Scene& s) { s.setLocal(s.findByName("crate"), sg::LocalTransform::fromTRS(sg::vec3(0, nan, 0))); },
+         "/transform/translation/1", "NaN"},
+        {"fog_inf", [&](sg::Scene& s) { s.settings.fogDensity = inf; }, "/settings/fog/density", "+infinity"},
+        {"position_minus_inf", [&](sg::Scene& s) { s.meshes.at(0)->positions.at(0).z = -inf; }, "/meshes/0/positions/2", "-infinity"},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.name);
+        sg::Scene s = assets::makeDemoScene();
+        ASSERT_FALSE(s.meshes.empty());
+        ASSERT_NE(s.findByName("crate"), sg::kNoNode);
+        c.spoil(s);
+        std::string error;
+        EXPECT_EQ(assets::serializeSceneJson(s, &error), "");
+        EXPECT_NE(error.find(c.path), std::string::npos) << error;
+        EXPECT_NE(error.find(c.what), std::string::npos) << error;
+
+        const fs::path dir = testing_support::outputDir("scene_roundtrip") / c.name;
+        fs::remove_all(dir);
+        fs::create_directories(dir);
+        const fs::path file = dir / "scene.json";
+        std::ofstream(file, std::ios::binary) << "the previous save";
+        const std::string err = assets::saveSceneJson(s, file, true);
+        EXPECT_NE(err.find(file.string()), std::string::npos) << err;
+        EXPECT_NE(err.find(c.path), std::string::npos) << err;
+        EXPECT_NE(err.find("cannot be saved"), std::string::npos) << err;
+        std::ifstream in(file, std::ios::binary);
+        EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), "the previous save");
+        EXPECT_NE(assets::saveSceneJson(s, dir / "new.json", false), "");
+        EXPECT_FALSE(fs::exists(dir / "new.json"));
+    }
 }
 
 // A scene saved as our file and reopened renders the same image, byte for byte.

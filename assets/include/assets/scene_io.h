@@ -41,9 +41,13 @@ LoadResult loadScene(const std::filesystem::path& path, const LoadOptions& optio
 LoadResult loadSceneJson(const std::filesystem::path& path);
 LoadResult parseSceneJson(std::string_view text, const std::filesystem::path& pathForErrors);
 // Serialises the scene. Every mesh is written inline (also one that was loaded from a file
-// reference) and every texture as an embedded PNG; file references are only read.
-std::string serializeSceneJson(const sg::Scene& scene);
-// Writes atomically; refuses to replace an existing file unless overwrite. "" on success.
+// reference) and every texture as an embedded PNG; file references are only read. Every float
+// is written so that it reads back bit for bit (-0.0, denormals and the largest float included).
+// A scene holding a NaN or an infinity is not serialised: "" comes back and *error (when given)
+// names the first such value by its JSON path.
+std::string serializeSceneJson(const sg::Scene& scene, std::string* error = nullptr);
+// Writes atomically; refuses to replace an existing file unless overwrite, and refuses a scene
+// with a NaN or an infinity (the file is not touched). "" on success.
 std::string saveSceneJson(const sg::Scene& scene, const std::filesystem::path& path, bool overwrite);
 
 // Which extensions loadScene understands (lower case, with dot).
