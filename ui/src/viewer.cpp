@@ -15,10 +15,10 @@
 #include "ui/viewer.h"
 
 #include "automation.h"
+#include "shadow_map_window.h"
 
 #include "assets/demo.h"
 #include "assets/image_io.h"
-#include "renderers/shadow_map_view.h"
 #include "ui/aov_export.h"
 #include "ui/panels.h"
 #include "ui/render_slot.h"
@@ -151,10 +151,7 @@ public:
     ViewerState st;
     GLFWwindow* window = nullptr;
     std::map<std::string, BackendView> views;
-    // The shadow-map view's exact shadows, and the frame they were made for.
-    std::unique_ptr<rnd::Renderer> exact;
-    rnd::Framebuffer exactImage;
-    std::shared_ptr<const sg::FrameInput> exactFrame;
+    ShadowMapWindowView shadowMapView;   // the shadow-map view's reference (exact shadows)
     Texture diffTexture;
     uint64_t diffKey = ~uint64_t(0);
     std::vector<PendingShot> shots;
@@ -267,8 +264,9 @@ public:
                                    : view + ": the " + v.slot->backend() + " backend cannot make this view (showing the shaded image)";
             return;
         }
-        rnd::DiagnosticImage shown =
-            v.diagnostic == rnd::DiagnosticView::ShadowMap ? shadowMapView(v) : rnd::diagnosticImage(v.diagnostic, *v.slot->imageFrame(), img);
+        rnd::DiagnosticImage shown = v.diagnostic == rnd::DiagnosticView::ShadowMap
+                                         ? shadowMapView.make(*v.slot, shadowMapSelection(sel), v.retryDiagnostic)
+                                         : rnd::diagnosticImage(v.diagnostic, *v.slot->imageFrame(), img);
         v.legend = shown.legend;
         shown.image.drawable = img.drawable;   // outlineNodes reads the visibility
         shown.image.primitive = img.primitive;
@@ -276,39 +274,6 @@ public:
         shown.image.depth = img.depth;
         drawViewOverlays(shown.image, *v.slot->imageFrame());
         v.texture.upload(shown.image);
-    }
-
-    // The selected light's node (the first selected node; the view takes it when it is a light).
-    sg::NodeId selectedLight() const {
-        const std::vector<sg::NodeId> sel = st.selection();
-        return sel.empty() ? sg::kNoNode : sel.front();
-    }
-    // The shadow-map view of v's image: its backend's maps (asked on its worker, between renders)
-    // against the shadow rays of a reference kept for the window (its image rendered again, here,
-    // when the frame changes: a diagnostic view's price; the BVHs are kept).
-    rnd::DiagnosticImage shadowMapView(BackendView& v) {
-        const std::shared_ptr<const sg::FrameInput>& frame = v.slot->imageFrame();
-        const rnd::ShadowMapViewPoints pts = rnd::shadowMapViewPoints(*frame, v.slot->image(), rnd::shadowMapViewLight(*frame, selectedLight()));
-        std::vector<float> map, rays;
-        v.retryDiagnostic = false;
-        if (pts.light >= 0 && !pts.pixel.empty()) {
-            std::optional<std::vector<float>> asked = v.slot->lightVisibilityMany(pts.light, pts.position, pts.normal);
-            if (!asked) {   // asked again once the render in flight is done
-                v.retryDiagnostic = true;
-                rnd::DiagnosticImage waiting = rnd::shadowMapViewImage(*frame, v.slot->image(), pts, {}, {});
-                waiting.legend = "shadow-map: waiting for the backend between renders";
-                return waiting;
-            }
-            map = std::move(*asked);
-            const rnd::Framebuffer& img = v.slot->image();
-            if (exactFrame != frame || exactImage.width != img.width || exactImage.height != img.height) {
-                exactFrame.reset();
-                if (!exact) exact = rnd::makeExactShadowBackend();
-                if (exact && rnd::renderShadowReference(*exact, *frame, img.width, img.height, exactImage)) exactFrame = frame;
-            }
-            if (exactFrame) rays = rnd::referenceVisibility(*frame, img, *exact, exactImage, pts.light);
-        }
-        return rnd::shadowMapViewImage(*frame, v.slot->image(), pts, map, rays);
     }
 
     // View > Overlays: which are on (0 = none) and what they depend on, to redraw on a change.
@@ -432,7 +397,8 @@ public:
             }
             // A view this backend cannot make: its shaded image, as the viewport shows it.
             const rnd::DiagnosticView shotView = rnd::diagnosticViewSupported(view, r->capabilities()) ? view : rnd::DiagnosticView::Shaded;
-            const int shadowLight = shotView == rnd::DiagnosticView::ShadowMap ? rnd::shadowMapViewLight(*frame, selectedLight()) : -1;
+            const int shadowLight =
+                shotView == rnd::DiagnosticView::ShadowMap ? rnd::shadowMapViewLight(*frame, shadowMapSelection(st.selection())) : -1;
             auto job = [n, r, frame, w, h, path, exports, instances, shotView, overlays, visibility, shadowLight]() -> std::string {
                 rnd::Framebuffer fb;
                 rnd::RenderRequest request;
