@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
-# scripts/compare-builds.sh OLD_VIEWER NEW_VIEWER [BACKEND]: renders a fixed set of scenes and
-# settings with two builds of the viewer (default backend: raster) and compares the images and
-# the --aov files byte for byte. For changes that must not change a pixel (a faster loop, a
+# scripts/compare-builds.sh OLD_VIEWER NEW_VIEWER [BACKEND [EXTRA...]]: renders a fixed set of
+# scenes and settings with two builds of the viewer (default backend: raster; EXTRA options are
+# added to every case, e.g. --shadows on) and compares the images and the --aov files byte for byte. For changes that must not change a pixel (a faster loop, a
 # refactor). Prints one line per case and a summary; exit 1 when any case differs.
 # Needs the shared test data (VIEWER_TESTDATA, default ../shared/testdata).
 set -uo pipefail
 old="$1" new="$2" backend="${3:-raster}"
+shift $(($# < 3 ? $# : 3))
+extra=("$@")
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 data="${VIEWER_TESTDATA:-$root/../shared/testdata}"
 out="$(mktemp -d)"
@@ -54,7 +56,7 @@ for c in "${cases[@]}"; do
     bin="$old"; [ "$side" = new ] && bin="$new"
     mkdir -p "$out/$side"
     # shellcheck disable=SC2086
-    "$bin" render $args --backend "$backend" --size 640x360 --out "$out/$side/$name.png" >/dev/null 2>"$out/$name.$side.err" || failed="$failed $side"
+    "$bin" render $args --backend "$backend" "${extra[@]}" --size 640x360 --out "$out/$side/$name.png" >/dev/null 2>"$out/$name.$side.err" || failed="$failed $side"
   done
   if [ -n "$failed" ]; then
     # Both builds refusing with the same message (a view this backend cannot make) is no difference.

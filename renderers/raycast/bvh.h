@@ -58,6 +58,16 @@ using HugeVector = std::vector<T, HugePageAllocator<T>>;
 // Most rays in one packet (TriangleBvh::intersectPacket / occludedPacket).
 inline constexpr int kMaxPacket = 64;
 
+// Scratch space for one packet's rays or hits, left uninitialised: the packet functions write
+// and read only the active lanes, and filling kMaxPacket default values per packet showed in
+// the frame's profile. T must be an implicit-lifetime type (an aggregate such as Ray).
+template <class T, int N = kMaxPacket>
+struct PacketScratch {
+    alignas(T) unsigned char bytes[sizeof(T) * N];
+    T* data() { return reinterpret_cast<T*>(bytes); }
+    T& operator[](int i) { return data()[i]; }
+};
+
 // A ray segment org + t*dir, t in [tmin, tmax]. dir need not be unit length. TriangleBvh
 // treats a negative (or NaN) tmin as 0: its box test relies on tmin >= 0 (see traceTriangles8).
 struct Ray {

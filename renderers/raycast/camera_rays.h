@@ -11,6 +11,7 @@
 #include "raycast/bvh.h"
 #include "scenegraph/frame.h"
 
+#include <cmath>
 #include <limits>
 
 namespace rnd::rt {
@@ -22,7 +23,14 @@ public:
           m_inv(glm::inverse(glm::dmat4(cam.proj) * glm::dmat4(cam.view))),
           m_forward(-glm::dvec3(cam.viewInverse[2])),
           m_w(double(width)),
-          m_h(double(height)) {}
+          m_h(double(height)) {
+        // m_inv * (x, y, z, 1) is (m0 x + m1 y) + (m2 z + m3) in glm's own order of operations;
+        // the (z, 1) halves are the same for every pixel, so they are made once (bit for bit
+        // what the full product gives).
+        m_zw[0] = m_inv[2] * glm::dvec4(-1.0) + m_inv[3] * glm::dvec4(1.0);
+        m_zw[1] = m_inv[2] * glm::dvec4(1.0) + m_inv[3] * glm::dvec4(1.0);
+        m_zw[2] = m_inv[2] * glm::dvec4(0.0) + m_inv[3] * glm::dvec4(1.0);
+    }
 
     // Ray through window position (wx, wy); framebuffer row = height - 1 - floor(wy).
     // When the far plane lies at or beyond infinity in the float projection (far/near so large
@@ -30,7 +38,8 @@ public:
     // runs from the near plane through NDC z = 0 with no far end (tmax = FLT_MAX).
     Ray ray(float wx, float wy) const {
         const double x = 2.0 * double(wx) / m_w - 1.0, y = 2.0 * double(wy) / m_h - 1.0;
-        const glm::dvec4 a = m_inv * glm::dvec4(x, y, -1.0, 1.0), b = m_inv * glm::dvec4(x, y, 1.0, 1.0);
+        const glm::dvec4 xy = m_inv[0] * glm::dvec4(x) + m_inv[1] * glm::dvec4(y);
+        const glm::dvec4 a = xy + m_zw[0], b = xy + m_zw[1];   // the points at NDC z = -1 and z = +1
         const glm::dvec3 org = glm::dvec3(a) / a.w;
         Ray r;
         r.org = sg::vec3(org);
@@ -38,12 +47,12 @@ public:
         r.tmax = 1.0f;
         const glm::dvec3 far = glm::dvec3(b) / b.w;
         r.dir = sg::vec3(far - org);
-        if (!sg::isFinite(r.dir) || glm::dot(far - org, m_forward) <= 0.0) {   // no far end: at infinity or "beyond" (behind the eye)
-            const glm::dvec4 c = m_inv * glm::dvec4(x, y, 0.0, 1.0);
+        if (!finite(r.dir) || glm::dot(far - org, m_forward) <= 0.0) {   // no far end: at infinity or "beyond" (behind the eye)
+            const glm::dvec4 c = xy + m_zw[2];
             r.dir = sg::vec3(glm::dvec3(c) / c.w - org);
             r.tmax = std::numeric_limits<float>::max();
         }
-        if (!sg::isFinite(r.org) || !sg::isFinite(r.dir)) r.tmax = -1.0f;   // meets nothing
+        if (!finite(r.org) || !finite(r.dir)) r.tmax = -1.0f;   // meets nothing
         return r;
     }
     // Window depth (0.5 * ndc_z + 0.5) of a world point, as the rasterizers write it.
@@ -59,8 +68,11 @@ public:
     bool valid() const { return sg::isFinite(sg::mat4(m_inv)); }
 
 private:
+    static bool finite(const sg::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
     sg::mat4 m_viewProj;
     glm::dmat4 m_inv;
+    glm::dvec4 m_zw[3];     // m_inv's (z, 1) half at NDC z = -1, +1 and 0 (see the constructor)
     glm::dvec3 m_forward;   // the view direction (world)
     double m_w, m_h;
 };

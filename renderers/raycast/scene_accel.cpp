@@ -4,6 +4,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cmath>
 #include <memory>
 
 namespace rnd::rt {
@@ -11,7 +12,7 @@ namespace rnd::rt {
 using namespace sg;
 
 namespace {
-constexpr size_t kPacketMinTriangles = 8192;   // meshes traced as packets by intersectPacket
+constexpr size_t kPacketMinTriangles = 256;   // meshes traced as packets by intersectPacket / occludedPacket
 }   // namespace
 
 int SceneAccel::update(const FrameInput& f) {
@@ -57,14 +58,18 @@ int SceneAccel::update(const FrameInput& f) {
         inst.isMesh = true;
         inst.index = i;
         inst.bvh = &it->second.bvh;
-        // Packets pay where a ray's own traversal is more than a few nodes. Measured on the demo
-        // (960x850, medians of 5): with its floor (1152 triangles) and torus (3072) as packets
-        // the frame took 5% longer (541 against 515 ms): finding the instances and tracing them
-        // without the other instances' hits as bounds cost more than sharing saved.
+        // Packets pay where a ray's own traversal is more than a few nodes. Since the rays that
+        // also reach other instances test them from a list instead of a second top-level
+        // traversal, the demo's floor (1152 triangles) and torus (3072) and the bunny's ground
+        // pay too (frame / min_embree, 1280x720, 3 alternated runs: demo 5.0-5.8 against 6.2-6.5
+        // at a threshold of 8192, bunny 3.3-3.5 against 3.4-4.1); boxes of a few triangles
+        // stay single rays.
         inst.packets = d.mesh->triangleCount() >= kPacketMinTriangles;
         m_anyPacketMesh |= inst.packets;
         inst.invWorld = glm::inverse(d.world);
         Aabb wb = it->second.bvh.bounds().transformed(d.world);
+        inst.boxMin = wb.min;
+        inst.boxMax = wb.max;
         m_instances.push_back(inst);
         bmin.push_back(wb.min);
         bmax.push_back(wb.max);
@@ -97,6 +102,8 @@ int SceneAccel::update(const FrameInput& f) {
         }
         if (wb.empty()) continue;
         vec3 pad = 1e-4f * (glm::abs(wb.min) + glm::abs(wb.max)) + vec3(1e-6f);
+        inst.boxMin = wb.min - pad;
+        inst.boxMax = wb.max + pad;
         m_instances.push_back(inst);
         bmin.push_back(wb.min - pad);
         bmax.push_back(wb.max + pad);
@@ -112,6 +119,20 @@ int SceneAccel::update(const FrameInput& f) {
 }
 
 namespace {
+// Where ray r (inv = 1 / r.dir) enters the box [lo, hi]: the largest of the three slabs' near
+// distances. A NaN (0 * inf: the origin on a slab plane of an axis the ray runs along) never
+// raises it, so the answer errs toward entering early, never late; +inf: the ray never enters.
+float slabEntry(const vec3& lo, const vec3& hi, const Ray& r, const vec3& inv) {
+    float entry = -std::numeric_limits<float>::infinity();
+    for (int a = 0; a < 3; ++a) {
+        const float t0 = (lo[a] - r.org[a]) * inv[a], t1 = (hi[a] - r.org[a]) * inv[a];
+        if (std::isnan(t0) || std::isnan(t1)) continue;
+        const float near = t0 < t1 ? t0 : t1;
+        if (near > entry) entry = near;
+    }
+    return entry;
+}
+
 // The world ray in the instance's object space (the direction not normalised, so t is shared).
 Ray localRay(const mat4& invWorld, const Ray& wr, float tmax) {
     Ray lr;
@@ -132,6 +153,8 @@ void setMeshHit(SceneHit& hit, const TriHit& th, uint32_t instance) {
     hit.b2 = th.b2;
 }
 }   // namespace
+
+float SceneAccel::boxEntry(const Instance& inst, const Ray& r, const vec3& inv) const { return slabEntry(inst.boxMin, inst.boxMax, r, inv); }
 
 bool SceneAccel::intersectInstance(const Instance& inst, const Ray& wr, float tmax, SceneHit& hit, bool cull, TraversalCount* count) const {
     const Ray lr = localRay(inst.invWorld, wr, tmax);
@@ -248,15 +271,27 @@ uint64_t SceneAccel::intersectPacket(const Ray* rays, int n, uint64_t active, Sc
     Touched touched[kMaxMeshes];
     int k = 0;
     bool overflow = false;
-    uint64_t others = 0;   // rays that reach an instance not traced as a packet (phase 2 needs their traversal)
+    uint64_t others = 0;   // rays that reach an instance not traced as a packet
+    // The instances not traced as packets that each ray reaches, in the order its traversal meets
+    // them (phase 2 tests them without a second traversal); rays that reach more than kListed
+    // are in listFull and traverse again.
+    constexpr int kListed = 6;
+    uint32_t listed[kMaxPacket][kListed];
+    uint8_t listedN[kMaxPacket];
+    uint64_t listFull = 0;
     for (uint64_t m = active; m && !overflow; m &= m - 1) {
         const int i = __builtin_ctzll(m);
         float tmax = rays[i].tmax;
+        listedN[i] = 0;
         m_tlas.traverse<false>(rays[i], tmax, [&](uint32_t first, uint32_t count, float&) {
             for (uint32_t c = 0; c < count; ++c) {
                 const uint32_t j = prims[first + c];
                 if (!m_instances[j].packets) {
                     others |= uint64_t(1) << i;
+                    if (listedN[i] < kListed)
+                        listed[i][listedN[i]++] = j;
+                    else
+                        listFull |= uint64_t(1) << i;
                     continue;
                 }
                 int s = 0;
@@ -288,7 +323,7 @@ uint64_t SceneAccel::intersectPacket(const Ray* rays, int n, uint64_t active, Sc
     for (int i = 0; i < n; ++i) bound[i] = rays[i].tmax;
     for (int s = 0; s < k; ++s) {
         const Instance& inst = m_instances[touched[s].instance];
-        Ray lr[kMaxPacket];
+        PacketScratch<Ray> lr;
         for (uint64_t m = touched[s].rays; m; m &= m - 1) {
             const int i = __builtin_ctzll(m);
             lr[i].org = vec3(inst.invWorld * vec4(rays[i].org, 1.0f));   // as intersectInstance
@@ -297,7 +332,7 @@ uint64_t SceneAccel::intersectPacket(const Ray* rays, int n, uint64_t active, Sc
             lr[i].tmax = bound[i];
         }
         const bool cull = sg::cullsBackFaces(culling, m_frame->meshes[inst.index].material.doubleSided);
-        touched[s].found = inst.bvh->intersectPacket(lr, n, touched[s].rays, meshHits + s * kMaxPacket, cull);
+        touched[s].found = inst.bvh->intersectPacket(lr.data(), n, touched[s].rays, meshHits + s * kMaxPacket, cull);
         for (uint64_t m = touched[s].found; m; m &= m - 1) {
             const int i = __builtin_ctzll(m);
             bound[i] = std::min(bound[i], meshHits[s * kMaxPacket + i].t);
@@ -326,7 +361,37 @@ uint64_t SceneAccel::intersectPacket(const Ray* rays, int n, uint64_t active, Sc
         h.b2 = th.b2;
         found |= uint64_t(1) << i;
     }
-    for (uint64_t m = active & others; m; m &= m - 1) {
+    // Rays that reach a few other instances: the closest kept mesh hit, then each listed instance
+    // that may hold a closer hit (its box entered before the closest so far), as closestHit
+    // would test it. Only between hits at exactly the same distance can the one kept differ.
+    for (uint64_t m = active & others & ~listFull; m; m &= m - 1) {
+        const int i = __builtin_ctzll(m);
+        const Ray& r = rays[i];
+        float tm = r.tmax;
+        bool any = false;
+        for (int s = 0; s < k; ++s)
+            if (((touched[s].found >> i) & 1) && meshHits[s * kMaxPacket + i].t < tm) {
+                const TriHit& th = meshHits[s * kMaxPacket + i];
+                tm = th.t;
+                SceneHit h;
+                setMeshHit(h, th, m_instances[touched[s].instance].index);
+                hits[i] = h;
+                any = true;
+            }
+        const vec3 inv = 1.0f / r.dir;
+        for (int c = 0; c < listedN[i]; ++c) {
+            const Instance& inst = m_instances[listed[i][c]];
+            if (boxEntry(inst, r, inv) > tm * (1.0f + 1e-5f)) continue;   // no hit before tm in there
+            SceneHit h;
+            const bool cull = inst.isMesh && sg::cullsBackFaces(culling, m_frame->meshes[inst.index].material.doubleSided);
+            if (!intersectInstance(inst, r, tm, h, cull) || !(h.t < tm)) continue;
+            tm = h.t;
+            hits[i] = h;
+            any = true;
+        }
+        if (any) found |= uint64_t(1) << i;
+    }
+    for (uint64_t m = active & others & listFull; m; m &= m - 1) {
         const int i = __builtin_ctzll(m);
         const Ray& r = rays[i];
         float tmax = r.tmax;
@@ -358,6 +423,76 @@ uint64_t SceneAccel::intersectPacket(const Ray* rays, int n, uint64_t active, Sc
         if (any) found |= uint64_t(1) << i;
     }
     return found;
+}
+
+uint64_t SceneAccel::occludedPacket(const Ray* rays, int n, uint64_t active) const {
+    n = std::clamp(n, 0, kMaxPacket);
+    if (n < kMaxPacket) active &= (uint64_t(1) << n) - 1;
+    if (m_tlas.empty() || !active) return 0;
+    uint64_t blocked = 0;
+    if (!m_anyPacketMesh) {   // no mesh to share: one ray at a time
+        for (uint64_t m = active; m; m &= m - 1) {
+            const int i = __builtin_ctzll(m);
+            if (occluded(rays[i])) blocked |= uint64_t(1) << i;
+        }
+        return blocked;
+    }
+    const std::vector<uint32_t>& prims = m_tlas.primIndex();
+    constexpr int kMaxMeshes = 16;
+    struct Touched {
+        uint32_t instance;
+        uint64_t rays;
+    };
+    Touched touched[kMaxMeshes];
+    int k = 0;
+    // Phase 1: each ray's top-level traversal (as occluded()); the big meshes are set aside for
+    // phase 2 (tested right away once kMaxMeshes are set aside), the rest tested here.
+    for (uint64_t m = active; m; m &= m - 1) {
+        const int i = __builtin_ctzll(m);
+        const Ray& r = rays[i];
+        float tmax = r.tmax;
+        m_tlas.traverse<true>(r, tmax, [&](uint32_t first, uint32_t count, float&) {
+            for (uint32_t c = 0; c < count; ++c) {
+                const uint32_t j = prims[first + c];
+                const Instance& inst = m_instances[j];
+                if (inst.packets) {
+                    int s = 0;
+                    while (s < k && touched[s].instance != j) ++s;
+                    if (s == k && k < kMaxMeshes) touched[k++] = {j, 0};
+                    if (s < k) {
+                        touched[s].rays |= uint64_t(1) << i;
+                        continue;
+                    }
+                }
+                bool hit;
+                if (inst.isMesh || inst.param) {
+                    const Ray lr = localRay(inst.invWorld, r, r.tmax);
+                    hit = inst.isMesh ? inst.bvh->occluded(lr) : inst.param->occluded(lr);
+                } else {
+                    SceneHit h;
+                    hit = intersectInstance(inst, r, r.tmax, h);
+                }
+                if (hit) {
+                    blocked |= uint64_t(1) << i;
+                    return true;
+                }
+            }
+            return false;
+        });
+    }
+    // Phase 2: each big mesh once, for the rays that reach it and are not blocked yet.
+    PacketScratch<Ray> lr;
+    for (int s = 0; s < k; ++s) {
+        const uint64_t todo = touched[s].rays & ~blocked;
+        if (!todo) continue;
+        const Instance& inst = m_instances[touched[s].instance];
+        for (uint64_t m = todo; m; m &= m - 1) {
+            const int i = __builtin_ctzll(m);
+            lr[i] = localRay(inst.invWorld, rays[i], rays[i].tmax);
+        }
+        blocked |= inst.bvh->occludedPacket(lr.data(), n, todo);
+    }
+    return blocked;
 }
 
 bool SceneAccel::occluded(const Ray& r) const {

@@ -52,6 +52,12 @@ public:
     // the rays in each instance's object space), analytic shapes one ray at a time. Returns the
     // mask of rays that hit (hits[i] is written only for them).
     uint64_t intersectPacket(const Ray* worldRays, int n, uint64_t active, SceneHit* hits, sg::CullMode culling = sg::CullMode::Off) const;
+    // Any hits of a packet of world rays (the shadow rays of a pixel tile toward one light): for
+    // each active ray exactly what occluded(rays[i]) gives; returns the mask of blocked rays.
+    // Each ray finds the instances its own top-level traversal reaches; instances not traced as
+    // packets are tested right there (a hit ends the ray), the big meshes once per packet for the
+    // rays that reach them and are not blocked yet (TriangleBvh::occludedPacket).
+    uint64_t occludedPacket(const Ray* worldRays, int n, uint64_t active) const;
 
     size_t cachedMeshes() const { return m_meshes.size(); }
     uint64_t buildsTotal() const { return m_buildsTotal; }
@@ -77,12 +83,15 @@ private:
         const ParametricAccel* param = nullptr;
         const GridAccel* grid = nullptr;
         sg::mat4 invWorld{1.0f};
+        sg::vec3 boxMin{0.0f}, boxMax{0.0f};   // its box in the top level (world)
     };
 
     // intersect() without and with counting (Count: the cost view), so rays that are not
     // counted run the traversal without the counters.
     template <bool Count>
     bool closestHit(const Ray& r, SceneHit& hit, sg::CullMode culling, TraversalCount* cost) const;
+    // Where a world ray (inv: 1 / its direction) enters the instance's box (+inf: never).
+    float boxEntry(const Instance& inst, const Ray& r, const sg::vec3& inv) const;
     bool intersectInstance(const Instance& inst, const Ray& r, float tmax, SceneHit& hit, bool cull = false, TraversalCount* count = nullptr) const;
 
     const sg::FrameInput* m_frame = nullptr;

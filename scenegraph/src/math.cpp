@@ -15,8 +15,6 @@ Aabb Aabb::transformed(const mat4& m) const {
     return out;
 }
 
-bool isFinite(const vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
-
 bool isFinite(const mat4& m) {
     for (int c = 0; c < 4; ++c)
         for (int r = 0; r < 4; ++r)

@@ -14,6 +14,8 @@
 //                                         also when the plan and the casters are the last frame's
 //   VIEWER_RAYCAST_SSE=1                  the ray caster's BVH4/SSE traversal even where AVX2 runs
 //   VIEWER_RAYCAST_PACKETS=0              the ray caster traces camera rays one by one (no packets)
+//   VIEWER_RAYCAST_SHADOW_PACKETS=0       the ray caster traces shadow rays one by one (camera rays
+//                                         still in packets)
 #pragma once
 
 #include <string>
@@ -28,6 +30,7 @@ struct DebugSwitches {
     bool rasterShadowReuse = true;
     bool raycastForceSse = false;
     bool raycastPackets = true;
+    bool raycastShadowPackets = true;
 };
 
 // The switches as the environment sets them now (a few getenv calls: backends ask when they

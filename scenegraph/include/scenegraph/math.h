@@ -50,7 +50,8 @@ struct Aabb {
     bool operator==(const Aabb&) const = default;
 };
 
-bool isFinite(const vec3& v);
+// Inline: the ray caster asks per ray and per pixel.
+inline bool isFinite(const vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 bool isFinite(const mat4& m);
 
 // Inverse transpose of the upper 3x3: transforms normals so they stay perpendicular

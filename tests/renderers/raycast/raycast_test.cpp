@@ -852,7 +852,7 @@ TEST(RaycastTest, SceneAccelPacketsEqualSingleRays) {
         SceneAccel acc;
         acc.update(f);
         const CameraRays cam(f.camera, 96, 96);
-        int hits = 0, ties = 0;
+        int hits = 0, ties = 0, occludedHits = 0, occludedMisses = 0;
         for (int ty = 0; ty < 96 + 16; ty += 4)
             for (int tx = 0; tx < 96; tx += 8) {
                 Ray rays[32];
@@ -868,6 +868,22 @@ TEST(RaycastTest, SceneAccelPacketsEqualSingleRays) {
                 const uint64_t active = (tx / 8 + ty / 4) % 3 ? ~uint64_t(0) : 0xF0F0F0F0F0ull;   // some inactive lanes
                 SceneHit ph[32];
                 const uint64_t found = acc.intersectPacket(rays, n, active, ph, culling);
+                // Any hits: the same rays, and the same rays cut at a third of their length (some
+                // then stop short of what they hit), packet against one by one.
+                Ray cut[32];
+                for (int i = 0; i < n; ++i) {
+                    cut[i] = rays[i];
+                    cut[i].tmax = rays[i].tmax / 3.0f;
+                }
+                for (const Ray* set : {static_cast<const Ray*>(rays), static_cast<const Ray*>(cut)}) {
+                    const uint64_t blocked = acc.occludedPacket(set, n, active);
+                    for (int i = 0; i < n; ++i) {
+                        const bool on = (active >> i) & 1;
+                        ASSERT_EQ(bool((blocked >> i) & 1), on && acc.occluded(set[i])) << "ray " << i << " tile " << tx << "," << ty;
+                        occludedHits += on && acc.occluded(set[i]);
+                        occludedMisses += on && !acc.occluded(set[i]);
+                    }
+                }
                 for (int i = 0; i < n; ++i) {
                     SceneHit a;
                     const bool ha = acc.intersect(rays[i], a, culling);
@@ -891,6 +907,63 @@ TEST(RaycastTest, SceneAccelPacketsEqualSingleRays) {
             }
         EXPECT_GT(hits, 3000);
         EXPECT_LE(ties, 3);
+        EXPECT_GT(occludedHits, 3000);
+        EXPECT_GT(occludedMisses, 1000);
+    }
+}
+
+// The renderer's shadow rays traced as packets (after the tile's camera packets) give the image
+// they give one by one, byte for byte: shading models, a big mesh (packets) beside small ones
+// and analytic shapes, a point light, a spot, a sun, and a light with a size (soft: one by one).
+TEST(RaycastTest, ShadowPacketsGiveTheSameImageAsSingleShadowRays) {
+    const int w = 160, h = 120;
+    FrameInput f = triangleScene(w, h);
+    DrawMesh big;
+    big.mesh = std::make_shared<Mesh>(primitives::uvSphere(0.6f, 128, 64));   // 16k triangles: traced as packets
+    big.world = glm::translate(mat4(1.0f), vec3(-1.2f, 0.7f, 0.3f));
+    big.normal = normalMatrix(big.world);
+    f.meshes.push_back(big);
+    DrawLight spot;
+    spot.type = LightType::Spot;
+    spot.position = vec3(-1.5f, 4, 0.5f);
+    spot.direction = glm::normalize(vec3(0.5f, -1, 0));
+    spot.cosInner = std::cos(glm::radians(20.0f));
+    spot.cosOuter = std::cos(glm::radians(30.0f));
+    f.lights.push_back(spot);
+    spot.position = vec3(2.0f, 3.0f, 2.0f);   // a second spot with a size: soft, its rays one by one
+    spot.direction = glm::normalize(vec3(-0.5f, -1, -0.5f));
+    spot.radius = 0.3f;
+    f.lights.push_back(spot);
+    f.settings.shadowRays = 4;
+    DrawLight sun;
+    sun.type = LightType::Directional;
+    sun.direction = glm::normalize(vec3(0.3f, -1.0f, -0.4f));
+    f.lights.push_back(sun);
+    f.settings.shadows = true;
+    auto render = [&](const char* packets) {
+        setenv("VIEWER_RAYCAST_SHADOW_PACKETS", packets, 1);
+        auto r = makeRenderer("raycast");
+        Framebuffer fb;
+        const RenderStats st = r->render(f, w, h, fb, nullptr, RenderRequest{});
+        unsetenv("VIEWER_RAYCAST_SHADOW_PACKETS");
+        EXPECT_TRUE(st.ok) << st.error;
+        return fb;
+    };
+    for (ShadingModel model : {ShadingModel::Phong, ShadingModel::Flat, ShadingModel::Gouraud}) {
+        SCOPED_TRACE(std::string(toString(model)));
+        f.settings.shading = model;
+        const Framebuffer one = render("0"), packets = render("1");
+        ASSERT_EQ(one.color.size(), packets.color.size());
+        EXPECT_TRUE(one.color == packets.color);
+        EXPECT_TRUE(one.depth == packets.depth);
+        f.settings.shadows = false;
+        const Framebuffer unshadowed = render("1");
+        f.settings.shadows = true;
+        size_t darker = 0;   // shadows are in the picture
+        for (size_t i = 0; i + 3 < one.color.size(); i += 4)
+            darker +=
+                one.color[i] + one.color[i + 1] + one.color[i + 2] + 6 < unshadowed.color[i] + unshadowed.color[i + 1] + unshadowed.color[i + 2];
+        EXPECT_GT(darker, size_t(w * h / 50));
     }
 }
 
