@@ -437,4 +437,51 @@ TEST(ShadowAgreementGLTest, FlatAndGouraudRasterizersMatchTheRayCasterAndEachOth
         }
 }
 
+// Gouraud carries the shadowed lights' terms apart in GL's vertex outputs, for at most two
+// lights (rnd::kGouraudShadowedLights, the first with maps); a third is summed unshadowed, in
+// both rasterizers alike, where flat shading still shadows it. Two dim spots on a far corner of
+// the ground come first, the sun third: under Gouraud the slab and the pole cast nothing. With
+// nine lights (GL's loop over the lights, not calls per light) the sun comes first and casts.
+TEST(ShadowAgreementGLTest, GouraudShadowsTheFirstTwoLightsWithMapsInBothRasterizers) {
+    const vec3 corner(-4.0f, 0.0f, 4.0f);
+    auto cornerSpot = [&] { return spot(corner + vec3(0.0f, 2.0f, 0.0f), vec3(0.0f, -1.0f, 0.0f), vec3(0.2f), 20.0f, 30.0f); };
+    struct Case {
+        const char* tag;
+        std::vector<sg::DrawLight> lights;
+        sg::ShadingModel shading;
+        bool sunCasts;
+    };
+    const sg::DrawLight sun = slabAndPole(Caster::Sun).lights[0];
+    std::vector<sg::DrawLight> many = {sun, cornerSpot()};
+    for (int k = 0; k < 7; ++k) many.push_back(directional(glm::normalize(vec3(0.1f * float(k - 3), -1.0f, 0.2f)), vec3(0.01f)));
+    const Case cases[] = {{"third-gouraud", {cornerSpot(), cornerSpot(), sun}, sg::ShadingModel::Gouraud, false},
+                          {"third-flat", {cornerSpot(), cornerSpot(), sun}, sg::ShadingModel::Flat, true},
+                          {"nine-gouraud", many, sg::ShadingModel::Gouraud, true}};
+    for (const Case& c : cases) {
+        std::map<std::string, std::vector<uint8_t>> masks;
+        std::map<std::string, rnd::Framebuffer> images;
+        for (const std::string b : {"raster", "gl"}) {
+            sg::FrameInput f = slabAndPole(Caster::Sun, true, c.shading);
+            f.lights = c.lights;
+            const rnd::Framebuffer on = render(b, f, std::string("lights-") + c.tag + "-on");
+            f.settings.shadows = false;
+            masks[b] = shadowMask(on, render(b, f, std::string("lights-") + c.tag + "-off"));
+            images[b] = on;
+        }
+        std::printf("shadows %s: %zu / %zu pixels (raster / gl), IoU %.4f\n", c.tag, count(masks["raster"]), count(masks["gl"]),
+                    iou(masks["gl"], masks["raster"]));
+        for (const std::string b : {"raster", "gl"}) {
+            if (c.sunCasts)
+                EXPECT_GT(count(masks[b]), size_t(S * S / 200)) << c.tag << " " << b << ": the sun casts nothing";
+            else
+                EXPECT_EQ(count(masks[b]), 0u) << c.tag << " " << b << ": the third light with a map is shadowed under Gouraud";
+        }
+        EXPECT_GE(iou(masks["gl"], masks["raster"]), 0.95) << c.tag;
+        EXPECT_TRUE(testing_support::imagesClose(images["gl"], images["raster"],
+                                                 testing_support::agreementTolerance(testing_support::Agreement::SameMethod), "conformance",
+                                                 std::string("shadow-gl-raster-lights-") + c.tag))
+            << c.tag;
+    }
+}
+
 }   // namespace
