@@ -209,6 +209,16 @@ ShadeTerms shadeTerms(const SurfaceCoefficients& m, const vec3& p, const vec3& n
     return t;
 }
 
+ShadeTerms lightShareTerms(const SurfaceCoefficients& m, const vec3& p, const vec3& n, const vec3& eye, const FrameInput& f, size_t light,
+                           const ShadeExtras& x) {
+    if (m.unlit || light >= f.lights.size()) return {};
+    vec3 v = eye - p;
+    float len = glm::length(v);
+    v = len > 0 ? v / len : vec3(0, 0, 1);
+    if (f.settings.reflection == ReflectionModel::Pbr) return pbrLightTerms(pbrPoint(m, x.albedo), n, v, samplePunctualLight(f.lights[light], p));
+    return lightTerms(m, n, v, sampleLight(f.lights[light], p), f.settings.reflection);
+}
+
 vec3 shade(const SurfaceCoefficients& m, const SurfacePoint& s, const vec3& eye, const FrameInput& f, const float* visible,
            const EnvironmentLight* environment) {
     return shadeTerms(m, s.position, s.normal, eye, f, visible, {s.albedo, environment}).apply(s.albedo);

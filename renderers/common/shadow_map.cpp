@@ -456,6 +456,13 @@ float pcssJitter(int i, int j, int view, int axis) {
     return unitFloat(h);
 }
 
+std::vector<int> gouraudShadowedLights(const ShadowPlan& plan, size_t maxLights) {
+    std::vector<int> out;
+    for (size_t l = 0; l < plan.viewCount.size() && l < maxLights && out.size() < size_t(kGouraudShadowedLights); ++l)
+        if (plan.viewCount[l] > 0) out.push_back(int(l));
+    return out;
+}
+
 float shadowVisibility(const ShadowPlan& plan, const ShadowMaps& maps, const sg::DrawLight& L, int light, const vec3& p, const vec3& ng) {
     if (light < 0 || size_t(light) >= plan.viewCount.size() || plan.viewCount[size_t(light)] == 0 || maps.size != plan.size) return 1.0f;
     int vi = plan.firstView[size_t(light)];

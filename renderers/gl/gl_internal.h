@@ -318,8 +318,8 @@ private:
     void drawEnvironmentBackground(const sg::FrameInput& frame, std::string& error);
     void releaseEnvironment();   // deletes the objects above (their context current)
     void forgetEnvironment();    // forgets them (their context is gone)
-    // Shadow maps (gl_shadows.cpp): this frame's plan (rnd::planShadows, per-pixel shading
-    // only), its maps as the layers of one DEPTH_COMPONENT32F array texture (kept between
+    // Shadow maps (gl_shadows.cpp): this frame's plan (rnd::planShadows, every shading
+    // model), its maps as the layers of one DEPTH_COMPONENT32F array texture (kept between
     // frames, reallocated when the size or the layer count changes), the FBO the depth pass
     // draws each layer through, the plan's uniform buffer and the depth-only program.
     ShadowPlan m_shadowPlan;

@@ -115,22 +115,30 @@ using namespace sg;
 // the reflection model, the fog mode, the shadow maps ('-' none, else 'A' + k - 1 for k x k
 // PCF, 'a' + k - 1 for PCSS with k x k taps; shadow.glsl), and one letter per light (p/P point, d directional, s/S spot; upper case =
 // inverse square), or '*' for the generic loop when there are many lights (a 30-light unrolled
-// program takes seconds to compile on llvmpipe).
+// program takes seconds to compile on llvmpipe); Gouraud shading with maps then adds '/' and
+// one character per light it shadows ('0' + index: gouraudShadowedLights, their terms kept
+// apart in the vertex outputs).
 std::string programKey(const FrameInput& f, const ShadowPlan& shadows) {
     std::string key;
     key += char('0' + int(f.settings.shading));
     key += char('0' + int(f.settings.reflection));
     key += char('0' + int(f.settings.fog));
-    // Shadows in the per-pixel path only (the plan is empty otherwise).
-    const bool shadowed = !shadows.empty() && f.settings.shading == ShadingModel::Phong;
-    key += shadowed ? char((shadows.filter == ShadowFilter::Pcss ? 'a' : 'A') + std::clamp(shadows.pcf, 1, 15) - 1) : '-';
+    key += !shadows.empty() ? char((shadows.filter == ShadowFilter::Pcss ? 'a' : 'A') + std::clamp(shadows.pcf, 1, 15) - 1) : '-';
     size_t n = std::min<size_t>(f.lights.size(), kMaxLights);
-    if (n > size_t(kMaxUnrolledLights)) return key + '*';
-    for (size_t i = 0; i < n; ++i) {
-        const DrawLight& l = f.lights[i];
-        char c = l.type == LightType::Point ? 'p' : l.type == LightType::Directional ? 'd' : 's';
-        if (l.inverseSquare && c != 'd') c = char(c - 'a' + 'A');
-        key += c;
+    if (n > size_t(kMaxUnrolledLights)) {
+        key += '*';
+    } else {
+        for (size_t i = 0; i < n; ++i) {
+            const DrawLight& l = f.lights[i];
+            char c = l.type == LightType::Point ? 'p' : l.type == LightType::Directional ? 'd' : 's';
+            if (l.inverseSquare && c != 'd') c = char(c - 'a' + 'A');
+            key += c;
+        }
+    }
+    if (f.settings.shading == ShadingModel::Gouraud && !shadows.empty()) {
+        const std::vector<int> apart = gouraudShadowedLights(shadows, n);
+        if (!apart.empty()) key += '/';
+        for (int l : apart) key += char('0' + l);
     }
     return key;
 }
@@ -140,14 +148,32 @@ std::string buildProgram(const std::string& key, const Features& ft, const Frame
     constexpr size_t kLights = 4;   // where the lights start in the key
     const bool pcss = key.size() > 3 && key[3] >= 'a' && key[3] <= 'z';
     const int shadowPcf = key.size() > 3 && key[3] != '-' ? key[3] - (pcss ? 'a' : 'A') + 1 : 0;
+    const size_t slash = std::min(key.find('/'), key.size());
+    std::vector<int> apart;   // Gouraud's shadowed lights (programKey), whose terms lightTerms keeps in gLightMul/Add[j]
+    for (size_t i = slash + 1; i < key.size(); ++i) apart.push_back(key[i] - '0');
+    static_assert(kGouraudShadowedLights == 2, "mesh.vert and mesh.frag name two slots (SHADOW_SLOT_LIGHT0, SHADOW_SLOT_LIGHT1)");
     std::string calls;
-    if (key.size() > kLights && key[kLights] == '*')
-        calls = "for (int i = 0; i < uNumLights; ++i) lightTerms(i, int(uLightPos[i].w + 0.5), uLightDir[i].w > 0.5, n, p, v, mul, add);";
-    for (size_t i = kLights; i < key.size() && key[kLights] != '*'; ++i) {
+    if (key.size() > kLights && key[kLights] == '*') {
+        const std::string call = "lightTerms(i, int(uLightPos[i].w + 0.5), uLightDir[i].w > 0.5, n, p, v, ";
+        if (apart.empty()) {
+            calls = "for (int i = 0; i < uNumLights; ++i) " + call + "mul, add);";
+        } else {   // a branch per kept light: an inout argument must be an l-value
+            calls = "for (int i = 0; i < uNumLights; ++i) {";
+            for (size_t j = 0; j < apart.size(); ++j)
+                calls += " if (i == " + std::to_string(apart[j]) + ") " + call + "gLightMul[" + std::to_string(j) + "], gLightAdd[" +
+                         std::to_string(j) + "]); else";
+            calls += " " + call + "mul, add); }";
+        }
+    }
+    for (size_t i = kLights; i < slash && key[kLights] != '*'; ++i) {
         char c = char(key[i] | 0x20);
         const char* type = c == 'p' ? "LIGHT_POINT" : c == 'd' ? "LIGHT_DIRECTIONAL" : "LIGHT_SPOT";
         bool invSq = key[i] >= 'A' && key[i] <= 'Z';
-        calls += "lightTerms(" + std::to_string(i - kLights) + ", " + type + ", " + (invSq ? "true" : "false") + ", n, p, v, mul, add); ";
+        const int light = int(i - kLights);
+        std::string out = "mul, add";
+        for (size_t j = 0; j < apart.size(); ++j)
+            if (apart[j] == light) out = "gLightMul[" + std::to_string(j) + "], gLightAdd[" + std::to_string(j) + "]";
+        calls += "lightTerms(" + std::to_string(light) + ", " + type + ", " + (invSq ? "true" : "false") + ", n, p, v, " + out + "); ";
     }
     auto flag = [](const char* name, bool on) { return std::string("#define ") + name + (on ? " 1\n" : " 0\n"); };
     const bool uv = ft.texture || ft.emissiveMap || ft.occlusionMap || ft.metalRoughMap || ft.normalMap;
@@ -155,7 +181,10 @@ std::string buildProgram(const std::string& key, const Features& ft, const Frame
     // the bounds of the views and of PCSS.
     const std::string shadows = flag("SHADOWS", shadowPcf > 0) + "#define SHADOW_PCF " + std::to_string(std::max(shadowPcf, 1)) + "\n" +
                                 flag("SHADOW_PCSS", pcss) + "#define MAX_SHADOW_VIEWS " + std::to_string(kMaxShadowViews) + "\n#define PCSS_SEARCH " +
-                                std::to_string(kPcssSearch) + "\n#define PCSS_MAX_RADIUS " + std::to_string(kPcssMaxRadius) + "\n";
+                                std::to_string(kPcssSearch) + "\n#define PCSS_MAX_RADIUS " + std::to_string(kPcssMaxRadius) +
+                                "\n#define SHADOW_SLOTS " + std::to_string(apart.size()) + "\n#define SHADOW_SLOT_LIGHT0 " +
+                                std::to_string(apart.size() > 0 ? apart[0] : -1) + "\n#define SHADOW_SLOT_LIGHT1 " +
+                                std::to_string(apart.size() > 1 ? apart[1] : -1) + "\n";
     std::string prefix = "#version 330 core\n" + glslEnumDefines() + "#define SHADING " + key[0] + "\n#define REFLECTION " + key[1] +
                          "\n#define MAX_LIGHTS " + std::to_string(kMaxLights) + "\n#define LIGHT_CALLS " + calls + "\n" +
                          glslEnumDefine("FOG", "FOG_", f.settings.fog) + glslEnumDefine("ALPHA_MODE", "ALPHA_", ft.alphaMode) +

@@ -1,5 +1,5 @@
 // gl_shadows.cpp - the GL backend's shadow maps (renderers/shadow_map.h), so that its shadows
-// agree with the CPU rasterizer's: the same plan (rnd::planShadows, per-pixel shading only),
+// agree with the CPU rasterizer's: the same plan (rnd::planShadows, every shading model),
 // one depth map per plan view drawn by the GPU the way renderShadowDepth draws it on the CPU
 // (every opaque or masked triangle mesh, both faces, depth test less, cleared to 1; blended
 // surfaces, lines and points cast nothing), and the lookup in shaders/shadow.glsl, which
@@ -59,9 +59,9 @@ static_assert(sizeof(ShadowBlock) == size_t(kMaxShadowViews) * (64 + 16 + 16 + 1
 
 std::string GlRenderer::renderShadowMaps(const FrameInput& frame, const std::vector<DrawItem>& items, RenderStats& stats) {
     m_shadowReadBack.clear();
-    // Shadow maps for per-pixel shading only: flat and Gouraud sum the lights at the vertices (as
-    // the CPU rasterizer).
-    m_shadowPlan = frame.settings.shading == ShadingModel::Phong ? planShadows(frame, shadowCasterBounds(frame)) : ShadowPlan{};
+    // Shadow maps for every shading model (flat and Gouraud scale the lights with maps by each
+    // fragment's visibility, as the CPU rasterizer).
+    m_shadowPlan = planShadows(frame, shadowCasterBounds(frame));
     if (m_shadowPlan.empty()) return {};
     const int N = m_shadowPlan.size, layers = int(m_shadowPlan.views.size());
     if (N > m_maxTextureSize || N > m_maxSize || layers > m_maxTextureLayers) {

@@ -11,6 +11,29 @@ namespace rnd::raster {
 using sg::vec3;
 using sg::vec4;
 
+namespace {
+
+// Gouraud with shadow maps: each shadowed light's terms interpolated from the vertices on their
+// own, scaled by the fragment's visibility (no lookup where the light adds nothing).
+void addShadowedGouraud(const TriCache& tc, const FrameContext& fc, const vec3& bo, const vec3& pos, int side, ShadeTerms& terms) {
+    const DrawItem& d = *tc.d;
+    const size_t ns = fc.gouraudShadowed.size();
+    const size_t v0 = tc.v[0] * ns, v1 = tc.v[1] * ns, v2 = tc.v[2] * ns;
+    const std::vector<vec3>& A = d.shadowedA[side];
+    const std::vector<vec3>& B = d.shadowedB[side];
+    for (size_t j = 0; j < ns; ++j) {
+        const vec3 mul = bo[0] * A[v0 + j] + bo[1] * A[v1 + j] + bo[2] * A[v2 + j];
+        const vec3 add = bo[0] * B[v0 + j] + bo[1] * B[v1 + j] + bo[2] * B[v2 + j];
+        if (mul == vec3(0.0f) && add == vec3(0.0f)) continue;
+        const int l = fc.gouraudShadowed[j];
+        const float vis = shadowVisibility(*fc.shadowPlan, *fc.shadowMaps, fc.frame->lights[size_t(l)], l, pos, tc.ng);
+        terms.mul += vis * mul;
+        terms.add += vis * add;
+    }
+}
+
+}   // namespace
+
 __attribute__((noinline)) float prepareFragment(const TriCache& tc, const FrameContext& fc, int i, int j, ShadeBatch& sb, size_t k) {
     const Tri& t = *tc.t;
     const DrawItem& d = *tc.d;
@@ -40,6 +63,11 @@ __attribute__((noinline)) float prepareFragment(const TriCache& tc, const FrameC
 
     if (tc.flat) {   // one evaluation per triangle (TriCache::faceTerms); occlusion and emission per pixel
         ShadeTerms terms = tc.faceTerms;
+        for (const auto& [l, lt] : tc.faceLights) {   // the lights with maps, scaled by the fragment's visibility
+            const float vis = shadowVisibility(*fc.shadowPlan, *fc.shadowMaps, f.lights[size_t(l)], l, pos, tc.ng);
+            terms.mul += vis * lt.mul;
+            terms.add += vis * lt.add;
+        }
         if (maps) applyMapsToTerms(terms, mat, ms, f.ambientLight, f.settings.reflection);
         sb.setColor(k, terms.apply(albedo));
     } else if (tc.gouraud) {
@@ -47,6 +75,7 @@ __attribute__((noinline)) float prepareFragment(const TriCache& tc, const FrameC
         ShadeTerms terms;
         terms.mul = bo[0] * d.gouraudA[side][v[0]] + bo[1] * d.gouraudA[side][v[1]] + bo[2] * d.gouraudA[side][v[2]];
         terms.add = bo[0] * d.gouraudB[side][v[0]] + bo[1] * d.gouraudB[side][v[1]] + bo[2] * d.gouraudB[side][v[2]];
+        if (tc.gouraudShadowed) addShadowedGouraud(tc, fc, bo, pos, side, terms);
         if (maps) applyMapsToTerms(terms, mat, ms, f.ambientLight, f.settings.reflection);
         sb.setColor(k, terms.apply(albedo));
     } else {

@@ -26,6 +26,13 @@ struct TriCache : PlainTri {
     // normal (faceTerms); the albedo (texture, vertex colours) still applies per pixel.
     bool flat = false;
     ShadeTerms faceTerms;
+    // With shadow maps (FrameContext::mappedLights): flat's faceTerms leave out the lights with
+    // maps, whose own terms at the first vertex are here (those that reach it), and Gouraud's
+    // draw keeps its shadowed lights apart (DrawItem::shadowedA/B); the fragments scale them by
+    // their visibility, looked up with the face normal ng.
+    std::vector<std::pair<int, ShadeTerms>> faceLights;
+    bool gouraudShadowed = false;
+    sg::vec3 ng{0.0f};
     // Plain lit fragment (no vertex colours, textures or maps, not Gouraud, not reference
     // shading): prepareFragment takes the short path with the material's constant block below.
     bool simple = false;
@@ -55,6 +62,7 @@ struct TriCache : PlainTri {
             mat = nm;
             slot = -1;
             gouraud = f.settings.shading == sg::ShadingModel::Gouraud && !d->gouraudA[0].empty();
+            gouraudShadowed = gouraud && !fc.gouraudShadowed.empty() && !d->shadowedA[0].empty();
             faceNormal = f.settings.shading == sg::ShadingModel::Flat || !d->hasNormals;
             flat = f.settings.shading == sg::ShadingModel::Flat && !mat->unlit;
             simple = !gouraud && !flat && !fc.referenceShading && !d->hasColors && !(d->texture && d->hasUV) && !(d->hasUV && d->hasMaps());
@@ -96,8 +104,30 @@ struct TriCache : PlainTri {
         }
         if (flat) {   // the first vertex: GL's provoking vertex (glProvokingVertex(GL_FIRST_VERTEX_CONVENTION))
             const sg::vec3 albedo0 = d->hasColors ? mat->baseColor * sg::vec3(d->mesh->colors[d->meshIndex(v[0])]) : mat->baseColor;
-            faceTerms = shadeTerms(*mat, p[0], n[0], f.camera.eye, f, nullptr, {albedo0, fc.environment});
+            if (fc.mappedLights.empty())
+                faceTerms = shadeTerms(*mat, p[0], n[0], f.camera.eye, f, nullptr, {albedo0, fc.environment});
+            else
+                loadFlatShadowed(fc, albedo0);
         }
+        if (gouraudShadowed) {   // the face normal, either side (the lookup turns it toward the light)
+            const sg::vec3 nn = glm::cross(p[1] - p[0], p[2] - p[0]);
+            const float len = glm::length(nn);
+            ng = len > 0 ? nn / len : sg::vec3(0, 0, 1);
+        }
+    }
+
+    // Flat shading with shadow maps: faceTerms without the lights with maps, and their own terms.
+    void loadFlatShadowed(const FrameContext& fc, const sg::vec3& albedo0) {
+        const sg::FrameInput& f = *fc.frame;
+        const SurfaceCoefficients c = coefficientsOf(*mat);
+        const ShadeExtras x{albedo0, fc.environment};
+        faceTerms = shadeTerms(c, p[0], n[0], f.camera.eye, f, fc.unmapped.data(), x);
+        faceLights.clear();
+        for (int l : fc.mappedLights) {
+            const ShadeTerms t = lightShareTerms(c, p[0], n[0], f.camera.eye, f, size_t(l), x);
+            if (t.mul != sg::vec3(0.0f) || t.add != sg::vec3(0.0f)) faceLights.emplace_back(l, t);
+        }
+        ng = n[0];
     }
 };
 

@@ -95,6 +95,9 @@ struct DrawItem {
     std::vector<VertexOut> wv;
     std::vector<sg::vec4> wtan;                       // world tangent (xyz, handedness; mirrored draws flip it), when hasTangents
     std::vector<sg::vec3> gouraudA[2], gouraudB[2];   // front/back: colour = A * albedo + B
+    // Gouraud with shadow maps: A and B above leave out the lights of FrameContext::gouraudShadowed,
+    // whose own terms are here, vertex v's of light j at v * count + j (empty: none).
+    std::vector<sg::vec3> shadowedA[2], shadowedB[2];
 
     // Exchanges the vertex stage's buffers with `o` (the renderer keeps them between frames,
     // so a frame neither allocates nor zero-fills them: large meshes page-faulted on them).
@@ -107,6 +110,8 @@ struct DrawItem {
         for (int s = 0; s < 2; ++s) {
             gouraudA[s].swap(o.gouraudA[s]);
             gouraudB[s].swap(o.gouraudB[s]);
+            shadowedA[s].swap(o.shadowedA[s]);
+            shadowedB[s].swap(o.shadowedB[s]);
         }
     }
 
@@ -168,6 +173,13 @@ struct FrameContext {
     const EnvironmentLight* environment = nullptr;   // pbr's environment light (empty map: none)
     const ShadowPlan* shadowPlan = nullptr;          // the lights' shadow maps (empty plan: no shadows)
     const ShadowMaps* shadowMaps = nullptr;
+    // Flat and Gouraud shading with shadow maps (docs/math.md, "Shadow maps"): the lights with a
+    // map (flat: each scaled by the fragment's visibility), per light 0 for those and 1 for the
+    // rest (shadeTerms' visibility for the unshadowed sum; empty without maps), and the lights
+    // Gouraud shadows (gouraudShadowedLights; the vertex stage's DrawItem::shadowedA/B).
+    std::vector<int> mappedLights;
+    std::vector<float> unmapped;
+    std::vector<int> gouraudShadowed;
     bool timing = false;       // VIEWER_RASTER_TIMING=1: print stage times to stderr
     bool visibility = false;   // fill target.drawable/primitive (one sample per pixel)
     bool overdraw = false;     // count fragments per pixel into target.overdraw (one sample per pixel)
@@ -289,7 +301,10 @@ struct ShadowMapsSource {
 // Returns whether the maps were drawn.
 bool renderShadowMaps(const ShadowPlan& plan, const std::vector<DrawItem>& draws, ShadowMaps& maps, ShadowMapsSource* source = nullptr);
 
-void runVertexStage(DrawItem& d, const sg::FrameInput& f, int width, int height, bool gouraud, const EnvironmentLight* env);
+// shadowed: Gouraud's lights with per-fragment visibility (FrameContext::gouraudShadowed), kept
+// apart in DrawItem::shadowedA/B.
+void runVertexStage(DrawItem& d, const sg::FrameInput& f, int width, int height, bool gouraud, const EnvironmentLight* env,
+                    const std::vector<int>& shadowed);
 
 // Step 3 (raster_setup.cpp): clips, sets up and culls the chunk's triangles and bins them into
 // the tiles (ch.tileStart / ch.items, submission order within each tile).

@@ -219,9 +219,12 @@ private:
         std::string envError;
         const EnvironmentLight environment = environmentFor(frame.settings, &envError);
         if (!envError.empty()) stats.config.notes.push_back("environment " + envError + " (lit without it)");
-        tbb::parallel_for(size_t(0), draws.size(), [&](size_t i) { runVertexStage(draws[i], frame, width, height, gouraud, &environment); });
-        // Shadow maps (per-pixel shading only: flat and Gouraud sum the lights at the vertices).
-        m_shadowPlan = frame.settings.shading == sg::ShadingModel::Phong ? planShadows(frame, shadowCasterBounds(frame)) : ShadowPlan{};
+        // Shadow maps (every shading model: flat and Gouraud scale the lights with maps by each
+        // fragment's visibility, Gouraud keeping its shadowed lights apart at the vertices).
+        m_shadowPlan = planShadows(frame, shadowCasterBounds(frame));
+        const std::vector<int> gouraudShadowed = gouraud ? gouraudShadowedLights(m_shadowPlan) : std::vector<int>{};
+        tbb::parallel_for(size_t(0), draws.size(),
+                          [&](size_t i) { runVertexStage(draws[i], frame, width, height, gouraud, &environment, gouraudShadowed); });
         const auto tShadow0 = std::chrono::steady_clock::now();
         const bool drawn = renderShadowMaps(m_shadowPlan, draws, m_shadowMaps, m_shadowReuse ? &m_shadowSource : nullptr);
         if (m_timing && !m_shadowPlan.empty())
@@ -242,6 +245,15 @@ private:
         fc.environment = &environment;
         fc.shadowPlan = &m_shadowPlan;
         fc.shadowMaps = &m_shadowMaps;
+        if (!m_shadowPlan.empty() && frame.settings.shading != sg::ShadingModel::Phong) {
+            fc.unmapped.assign(frame.lights.size(), 1.0f);
+            for (size_t l = 0; l < m_shadowPlan.viewCount.size() && l < frame.lights.size(); ++l)
+                if (m_shadowPlan.viewCount[l] > 0) {
+                    fc.mappedLights.push_back(int(l));
+                    fc.unmapped[l] = 0.0f;
+                }
+            fc.gouraudShadowed = gouraudShadowed;
+        }
         fc.timing = m_timing;
         fc.visibility = visibility && !msaa;
         fc.overdraw = overdraw && !msaa;

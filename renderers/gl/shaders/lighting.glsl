@@ -16,9 +16,13 @@
 // see bench/gl); for many lights a loop over uNumLights reading the type from the .w
 // components (one program for all, so it compiles once).
 //
-// Shadows (SHADOWS 1: shadow maps this frame, per-pixel shading only, as in the CPU
-// rasterizer): lightTerms multiplies each light's radiance by shadow.glsl's shadowVisibility at
-// p with the shading normal n; the ambient, emissive and environment terms are not shadowed.
+// Shadows (SHADOWS 1: shadow maps this frame, as in the CPU rasterizer; docs/math.md, "Shadow
+// maps"): per-pixel shading: lightTerms multiplies each light's radiance by shadow.glsl's
+// shadowVisibility at p with the shading normal n; flat: the same at the fragment's own point
+// gShadowPos (the model is evaluated at the first vertex) with the face normal; Gouraud (in the
+// vertex shader): no lookup here, the generated light calls put the SHADOW_SLOTS shadowed
+// lights' terms into gLightMul/gLightAdd[j] instead of mul/add, and mesh.frag scales them by the
+// fragment's visibility. The ambient, emissive and environment terms are not shadowed.
 
 uniform int uNumLights;                // lights used by the loop form of LIGHT_CALLS
 uniform vec4 uLightPos[MAX_LIGHTS];    // xyz: world position; w: type (LIGHT_POINT ...)
@@ -117,6 +121,15 @@ void samplePunctualLight(int i, int type, bool inverseSquare, vec3 p, out vec3 t
 #if REFLECTION == REFLECTION_PBR
 PbrPoint gPbr;   // pbrPoint(gAlbedo), set by shadeTerms for the light calls
 #endif
+#if SHADOWS && SHADING == SHADING_FLAT
+vec3 gShadowPos;   // flat: where the maps are read (the fragment's point), set before shadeTerms
+#define SHADOW_POS(p) gShadowPos
+#else
+#define SHADOW_POS(p) p
+#endif
+#if SHADOW_SLOTS > 0
+vec3 gLightMul[SHADOW_SLOTS], gLightAdd[SHADOW_SLOTS];   // Gouraud: the shadowed lights' own terms (shadeTerms zeroes them)
+#endif
 
 // lightTerms() of shading.h for light i, added to mul and add; v = unit vector to the eye.
 void lightTerms(int i, int type, bool inverseSquare, vec3 n, vec3 p, vec3 v, inout vec3 mul, inout vec3 add) {
@@ -126,8 +139,8 @@ void lightTerms(int i, int type, bool inverseSquare, vec3 n, vec3 p, vec3 v, ino
 #else
     sampleLight(i, type, inverseSquare, p, l, radiance);
 #endif
-#if SHADOWS
-    radiance *= shadowVisibility(i, type, uLightPos[i].xyz, uLightDir[i].xyz, uLightCone[i].w, p, n);   // shadow.glsl
+#if SHADOWS && SHADING != SHADING_GOURAUD
+    radiance *= shadowVisibility(i, type, uLightPos[i].xyz, uLightDir[i].xyz, uLightCone[i].w, SHADOW_POS(p), n);   // shadow.glsl
 #endif
 #if REFLECTION == REFLECTION_PBR
     pbrLightTerms(gPbr, n, v, l, radiance, mul, add);
@@ -157,6 +170,9 @@ void lightTerms(int i, int type, bool inverseSquare, vec3 n, vec3 p, vec3 v, ino
 // The two albedo-linear terms of shade() at world position p with unit normal n (already
 // facing the viewer for two-sided surfaces).
 void shadeTerms(vec3 n, vec3 p, out vec3 mul, out vec3 add) {
+#if SHADOW_SLOTS > 0
+    for (int j = 0; j < SHADOW_SLOTS; ++j) gLightMul[j] = gLightAdd[j] = vec3(0.0);
+#endif
     vec3 v = uEye - p;
     float len = length(v);
     v = len > 0.0 ? v / len : vec3(0.0, 0.0, 1.0);

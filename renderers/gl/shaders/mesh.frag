@@ -18,9 +18,12 @@
 //   VISIBILITY     1: also write fragId (the target has the visibility attachment)
 //   LINEAR_TARGET  1: the target is linear float (exposure or tone mapping follow): colour not
 //                  clamped at 1
-// The frame setup's switches (MAX_LIGHTS, LIGHT_CALLS, REFLECTION, SHADOWS, SHADOW_PCF) are
-// lighting.glsl's and shadow.glsl's: with shadow maps, the per-pixel path (SHADING_PHONG) gets
-// each light's visibility at the shading normal below.
+// The frame setup's switches (MAX_LIGHTS, LIGHT_CALLS, REFLECTION, SHADOWS, SHADOW_PCF,
+// SHADOW_SLOTS) are lighting.glsl's and shadow.glsl's: with shadow maps, the per-pixel path
+// (SHADING_PHONG) gets each light's visibility at the shading normal, flat at the fragment's
+// point with the face normal, and Gouraud scales its SHADOW_SLOTS shadowed lights' interpolated
+// terms by the visibility at the fragment's point with the face normal (lights beyond those stay
+// in the vertices' unshadowed sum; docs/math.md, "Shadow maps").
 in vec3 vWorldPos;
 #if FOG != FOG_OFF
 in vec3 vEyePos;
@@ -47,6 +50,9 @@ in vec3 vMulFront;
 in vec3 vAddFront;
 in vec3 vMulBack;
 in vec3 vAddBack;
+#if SHADOW_SLOTS > 0
+in vec4 vShadowed[3 * SHADOW_SLOTS];   // mesh.vert: per shadowed light front mul, front add, back mul, back add
+#endif
 #endif
 
 uniform sampler2D uTexture;
@@ -197,6 +203,9 @@ void main() {
     vec3 n = normalize(cross(dFdx(vWorldPos), dFdy(vWorldPos)));
     coefficientsOfMaterial();
     gAlbedo = vFlatAlbedo;
+#if SHADOWS
+    gShadowPos = vWorldPos;   // each light scaled by the visibility at the fragment's own point
+#endif
     shadeTerms(n, vFlatPos, mul, add);
 #if HAS_OCCLUSION_MAP && REFLECTION != REFLECTION_PBR
     mul -= uKa * uOcclusionStrength * (1.0 - ao) * uAmbient;
@@ -209,6 +218,20 @@ void main() {
     // still apply exactly here (applyMapsToTerms): both terms are additive.
     mul = gl_FrontFacing ? vMulFront : vMulBack;
     add = gl_FrontFacing ? vAddFront : vAddBack;
+#if SHADOW_SLOTS > 0
+    // The shadowed lights' terms, interpolated on their own, scaled by the visibility here (the
+    // face normal for the lookup's offsets, either side: the lookup turns it toward the light).
+    vec3 ng = normalize(cross(dFdx(vWorldPos), dFdy(vWorldPos)));
+    for (int j = 0; j < SHADOW_SLOTS; ++j) {
+        int l = j == 0 ? SHADOW_SLOT_LIGHT0 : SHADOW_SLOT_LIGHT1;
+        vec4 a = vShadowed[3 * j], b = vShadowed[3 * j + 1], c3 = vShadowed[3 * j + 2];
+        vec3 lm = gl_FrontFacing ? a.xyz : vec3(b.zw, c3.x);
+        vec3 la = gl_FrontFacing ? vec3(a.w, b.xy) : c3.yzw;
+        float vis = shadowVisibility(l, int(uLightPos[l].w + 0.5), uLightPos[l].xyz, uLightDir[l].xyz, uLightCone[l].w, vWorldPos, ng);
+        mul += vis * lm;
+        add += vis * la;
+    }
+#endif
 #if HAS_OCCLUSION_MAP && REFLECTION != REFLECTION_PBR
     mul -= uKa * uOcclusionStrength * (1.0 - ao) * uAmbient;
 #endif

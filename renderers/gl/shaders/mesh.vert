@@ -1,5 +1,6 @@
 // mesh.vert - world-space transform for all shading models; Gouraud lights the vertices here
-// (front and back side, chosen per fragment by gl_FrontFacing). The renderer prepends
+// (front and back side, chosen per fragment by gl_FrontFacing; with shadow maps the shadowed
+// lights' terms apart, for mesh.frag to scale by the fragment's visibility). The renderer prepends
 // "#version 330 core", SHADING (SHADING_FLAT, SHADING_GOURAUD or SHADING_PHONG), MAX_LIGHTS, the
 // draw's feature switches (see mesh.frag) and lighting.glsl. Outputs the fragment shader of the
 // same features does not read are not written (each one costs llvmpipe setup per triangle and
@@ -43,6 +44,11 @@ out vec3 vMulFront;
 out vec3 vAddFront;
 out vec3 vMulBack;
 out vec3 vAddBack;
+#if SHADOW_SLOTS > 0
+// The shadowed lights' own terms (lighting.glsl's gLightMul/gLightAdd), 12 floats a light packed
+// in three vec4: front mul, front add, back mul, back add (mesh.frag's shadowedTerms).
+out vec4 vShadowed[3 * SHADOW_SLOTS];
+#endif
 #endif
 
 void main() {
@@ -84,6 +90,20 @@ void main() {
     float len = length(vNormal);
     vec3 n = len > 0.0 ? vNormal / len : vec3(0.0, 0.0, 1.0);
     shadeTerms(n, world.xyz, vMulFront, vAddFront);
+#if SHADOW_SLOTS > 0
+    vec3 frontMul[SHADOW_SLOTS], frontAdd[SHADOW_SLOTS];
+    for (int j = 0; j < SHADOW_SLOTS; ++j) {
+        frontMul[j] = gLightMul[j];
+        frontAdd[j] = gLightAdd[j];
+    }
+#endif
     shadeTerms(-n, world.xyz, vMulBack, vAddBack);   // two-sided: seen from the back
+#if SHADOW_SLOTS > 0
+    for (int j = 0; j < SHADOW_SLOTS; ++j) {
+        vShadowed[3 * j] = vec4(frontMul[j], frontAdd[j].x);
+        vShadowed[3 * j + 1] = vec4(frontAdd[j].yz, gLightMul[j].xy);
+        vShadowed[3 * j + 2] = vec4(gLightMul[j].z, gLightAdd[j]);
+    }
+#endif
 #endif
 }

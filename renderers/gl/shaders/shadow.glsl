@@ -2,11 +2,10 @@
 // operation for operation (pointLightFace, shadowVisibility; keep the two in step;
 // renderers/shadow_map.h has the formulas). Included after pbr.glsl and before lighting.glsl,
 // whose lightTerms multiplies each light's radiance by shadowVisibility (both reflection
-// families; only the per-pixel path has SHADOWS 1).
+// families; per-pixel and flat shading), and read by mesh.frag for Gouraud's shadowed lights.
 //
 // SHADOWS (0 or 1, part of the frame setup's key): this frame has shadow maps (rnd::planShadows
-// gave views) and the shading model is SHADING_PHONG; with 0 nothing here exists and lighting
-// costs what it did without shadows. SHADOW_PCF: k of the k x k filter (1 without PCF), a
+// gave views); with 0 nothing here exists and lighting costs what it did without shadows. SHADOW_PCF: k of the k x k filter (1 without PCF), a
 // constant so that the loops unroll. SHADOW_PCSS: 1 for PCSS (the k x k taps spread over the
 // penumbra). MAX_SHADOW_VIEWS, PCSS_SEARCH, PCSS_MAX_RADIUS: rnd::kMaxShadowViews, kPcssSearch,
 // kPcssMaxRadius.
@@ -59,7 +58,8 @@ float pcssJitter(int i, int j, int view, int axis) {
     return float(h >> 8u) * (1.0 / 16777216.0);
 }
 // Fraction of light `light` (its type, position and direction: the DrawLight of the C++) that
-// reaches world point p (unit surface normal ng, the shading normal, either side), by the
+// reaches world point p (unit surface normal ng: the shading normal, or flat's and Gouraud's
+// face normal; either side), by the
 // plan's maps: 1 lit, 0 shadowed, between at PCF edges.
 float shadowVisibility(int light, int type, vec3 lightPosition, vec3 lightDirection, float lightSize, vec3 p, vec3 ng) {
     if (uShadowLight[light].y == 0) return 1.0;

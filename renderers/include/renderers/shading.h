@@ -143,6 +143,11 @@ inline ShadeTerms shadeTerms(const sg::Material& m, const sg::vec3& p, const sg:
     return shadeTerms(coefficientsOf(m), p, n, eye, f, lightVisible, extras);
 }
 
+// Light `light`'s own share of shadeTerms (what it adds there with visibility 1; zero for unlit
+// surfaces): Gouraud and flat shading keep the shadowed lights apart from the rest.
+ShadeTerms lightShareTerms(const SurfaceCoefficients& m, const sg::vec3& p, const sg::vec3& n, const sg::vec3& eye, const sg::FrameInput& f,
+                           size_t light, const ShadeExtras& extras = {});
+
 // The full model: shadeTerms(..., {s.albedo, environment}).apply(s.albedo).
 sg::vec3 shade(const SurfaceCoefficients& m, const SurfacePoint& s, const sg::vec3& eye, const sg::FrameInput& f, const float* lightVisible = nullptr,
                const EnvironmentLight* environment = nullptr);

@@ -14,7 +14,8 @@
 //   (d = (z - near)/(far - near), z the eye depth; for a perspective map not the window depth,
 //   whose float precision near 1 would not do with a light inside the scene), both faces drawn,
 //   cleared to 1, at texel centres ((i + 0.5)/N, (j + 0.5)/N), row 0 at v = 0 (GL's convention).
-//   Lookup of world point p with surface normal n (the shading normal, turned toward the light):
+//   Lookup of world point p with surface normal n (the shading normal, or under flat and Gouraud
+//   shading the face normal; turned toward the light):
 //     t   = texel size in world units at p (orthographic: extent / N; perspective:
 //           2 tan(fov/2) / N times p's depth along the map's axis)
 //     p'  = p + normalBias t n                                   (normal offset)
@@ -63,6 +64,17 @@ struct ShadowPlan {
     std::vector<int> firstView, viewCount;       // per frame light (viewCount 0: no map, lit)
     bool empty() const { return views.empty(); }
 };
+
+// Gouraud shading with shadow maps (docs/math.md, "Shadow maps"): each light's terms are
+// interpolated from the vertices on their own and scaled by the pixel's visibility, which GL
+// carries in vertex outputs (12 floats a light: both sides' two terms; GL 3.3 guarantees 60
+// varying components, 26 of which Gouraud may already use). So at most this many lights, the
+// first ones with maps in the frame's order, are shadowed under Gouraud shading; further lights
+// are summed at the vertices unshadowed (lit), in both rasterizers. Flat shading has no bound.
+constexpr int kGouraudShadowedLights = 2;
+// The lights Gouraud shading shadows under `plan`: the first kGouraudShadowedLights of those with
+// a map, below `maxLights`.
+std::vector<int> gouraudShadowedLights(const ShadowPlan& plan, size_t maxLights = size_t(-1));
 
 // The world bounds of everything in the frame that casts (meshes of triangles, analytic shapes).
 sg::Aabb shadowCasterBounds(const sg::FrameInput& f);

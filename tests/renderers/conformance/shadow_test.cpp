@@ -1,10 +1,13 @@
 // shadow_test.cpp - shadows in every backend: the rasterizers' shadow maps
 // (renderers/shadow_map.h) against the ray caster's exact shadow rays, and the maps' own pieces:
 //  - the lookup on a hand-made map: under an occluder 0, beside it 1, outside the map 1;
-//  - a lit plane facing the light, alone, has no shadowed pixel (no acne), in every backend;
+//  - a lit plane facing the light, alone, has no shadowed pixel (no acne), in every backend and
+//    under every shading model;
 //  - a floating slab and a thin pole over a ground, lit by a sun or a spot light: each backend's
 //    shadowed pixels (darker with shadows on than off) overlap the ray caster's (IoU >= 0.9 at
-//    640 x 640), and the two rasterizers' overlap each other's (IoU >= 0.95);
+//    640 x 640), and the two rasterizers' overlap each other's (IoU >= 0.95); the same under flat
+//    and Gouraud shading (the lights evaluated per triangle or per vertex, each scaled by the
+//    pixel's own visibility), where the two rasterizers' images also agree pixel for pixel;
 //  - the thin pole (a tenth of a unit, a few texels wide) still casts;
 //  - soft shadows: a sun with an angular radius gives a penumbra as wide as the geometry says,
 //    in the ray caster (several rays per light) and in the rasterizers (PCSS); a point sun none.
@@ -43,13 +46,19 @@ sg::Material matte(const vec3& c) {
 enum class Caster { Sun, Spot, Point };
 
 // The ground (10 x 10 at y = 0), a slab floating at y = 1.5 and a thin pole, seen from above at
-// an angle; one light.
-sg::FrameInput slabAndPole(Caster light, bool withCasters = true) {
+// an angle; one light. Under flat and Gouraud shading the ground is a 32 x 32 grid (the lights
+// are evaluated at its vertices: one quad's corners lie outside the spot's cone).
+sg::FrameInput slabAndPole(Caster light, bool withCasters = true, sg::ShadingModel shading = sg::ShadingModel::Phong) {
     sg::Projection proj;
     sg::FrameInput f = makeFrame(S, S, proj, vec3(0.0f, 9.0f, 8.0f), vec3(0.0f, 0.0f, 0.5f));
     f.ambientLight = vec3(1.0f);
-    const sg::Mesh ground = quad(5.0f);   // z = 0 facing +z: turned to y = 0 facing +y
-    addMesh(f, ground, matte(vec3(0.8f)), glm::rotate(sg::mat4(1.0f), -sg::kPi / 2, vec3(1, 0, 0)));
+    f.settings.shading = shading;
+    if (shading == sg::ShadingModel::Phong) {
+        const sg::Mesh ground = quad(5.0f);   // z = 0 facing +z: turned to y = 0 facing +y
+        addMesh(f, ground, matte(vec3(0.8f)), glm::rotate(sg::mat4(1.0f), -sg::kPi / 2, vec3(1, 0, 0)));
+    } else {
+        addMesh(f, sg::primitives::plane(5.0f, 32), matte(vec3(0.8f)));
+    }
     if (withCasters) {
         addMesh(f, sg::primitives::box(vec3(1.0f, 0.1f, 0.7f)), matte(vec3(0.8f, 0.3f, 0.2f)),
                 glm::translate(sg::mat4(1.0f), vec3(-1.0f, 1.5f, 0.0f)));
@@ -95,13 +104,18 @@ size_t count(const std::vector<uint8_t>& m) {
 }
 
 const char* name(Caster c) { return c == Caster::Sun ? "sun" : c == Caster::Spot ? "spot" : "point"; }
+const char* name(sg::ShadingModel s) { return s == sg::ShadingModel::Flat ? "flat" : s == sg::ShadingModel::Gouraud ? "gouraud" : "phong"; }
 
-std::vector<uint8_t> maskOf(const std::string& backend, Caster light) {
-    sg::FrameInput f = slabAndPole(light);
-    const rnd::Framebuffer on = render(backend, f, std::string(name(light)) + "-on");
+// The shadowed pixels of `backend`'s image; `on`: the image with shadows (when given).
+std::vector<uint8_t> maskOf(const std::string& backend, Caster light, sg::ShadingModel shading = sg::ShadingModel::Phong,
+                            rnd::Framebuffer* on = nullptr) {
+    sg::FrameInput f = slabAndPole(light, true, shading);
+    const std::string tag = std::string(name(light)) + (shading == sg::ShadingModel::Phong ? "" : std::string("-") + name(shading));
+    const rnd::Framebuffer withShadows = render(backend, f, tag + "-on");
     f.settings.shadows = false;
-    const rnd::Framebuffer off = render(backend, f, std::string(name(light)) + "-off");
-    return shadowMask(on, off);
+    const rnd::Framebuffer off = render(backend, f, tag + "-off");
+    if (on) *on = withShadows;
+    return shadowMask(withShadows, off);
 }
 
 // --- the lookup on a hand-made plan --------------------------------------------------------
@@ -172,15 +186,18 @@ TEST(ShadowMapTest, PointLightFacesCoverEveryDirection) {
 
 class Shadows : public ::testing::TestWithParam<std::string> {};
 
-// A lit ground facing the light and nothing above it: shadows on and off give the same image.
+// A lit ground facing the light and nothing above it: shadows on and off give the same image,
+// under per-pixel, flat and Gouraud shading.
 TEST_P(Shadows, LitPlaneFacingTheLightHasNoAcne) {
-    for (Caster light : {Caster::Sun, Caster::Spot, Caster::Point}) {
-        sg::FrameInput f = slabAndPole(light, false);
-        const rnd::Framebuffer on = render(GetParam(), f, std::string("acne-") + name(light) + "-on");
-        f.settings.shadows = false;
-        const rnd::Framebuffer off = render(GetParam(), f, std::string("acne-") + name(light) + "-off");
-        EXPECT_EQ(count(shadowMask(on, off)), 0u) << name(light);
-    }
+    for (sg::ShadingModel shading : {sg::ShadingModel::Phong, sg::ShadingModel::Flat, sg::ShadingModel::Gouraud})
+        for (Caster light : {Caster::Sun, Caster::Spot, Caster::Point}) {
+            sg::FrameInput f = slabAndPole(light, false, shading);
+            const std::string tag = std::string("acne-") + name(light) + "-" + name(shading);
+            const rnd::Framebuffer on = render(GetParam(), f, tag + "-on");
+            f.settings.shadows = false;
+            const rnd::Framebuffer off = render(GetParam(), f, tag + "-off");
+            EXPECT_EQ(count(shadowMask(on, off)), 0u) << name(light) << " " << name(shading);
+        }
 }
 
 // A lone tessellated sphere over nothing: its lit side shadows nothing of itself (a receiver
@@ -213,6 +230,24 @@ TEST_P(Shadows, SlabAndThinPoleCast) {
             for (int x = S * 5 / 8; x < S; ++x) right += m[size_t(y) * S + size_t(x)];
         EXPECT_GT(right, 200u) << name(light) << ": the thin pole casts no shadow";
     }
+}
+
+// Flat and Gouraud shading: the lights evaluated at the triangle's first vertex or at its three
+// vertices, each scaled by the visibility at the pixel's own point (the ray caster's shadow ray
+// from the hit, the rasterizers' map lookup there); the shadowed pixels overlap the ray
+// caster's as under per-pixel shading.
+TEST_P(Shadows, FlatAndGouraudShadowLikeTheRays) {
+    for (sg::ShadingModel shading : {sg::ShadingModel::Flat, sg::ShadingModel::Gouraud})
+        for (Caster light : {Caster::Sun, Caster::Spot}) {
+            const std::vector<uint8_t> m = maskOf(GetParam(), light, shading);
+            EXPECT_GT(count(m), size_t(S * S / 200)) << name(light) << " " << name(shading) << ": nothing shadowed";
+            if (GetParam() == "raycast") continue;
+            const std::vector<uint8_t> rays = maskOf("raycast", light, shading);
+            const double overlap = iou(m, rays);
+            std::printf("shadows %s %s: IoU %s~raycast %.4f (%zu / %zu pixels)\n", name(shading), name(light), GetParam().c_str(), overlap, count(m),
+                        count(rays));
+            EXPECT_GE(overlap, 0.9) << name(light) << " " << name(shading);
+        }
 }
 
 // The visibility of a sun with angular radius `deg` along a ground line across the slab's
@@ -377,6 +412,75 @@ TEST(ShadowAgreementGLTest, RasterizersMatchTheRayCasterAndEachOther) {
         EXPECT_GE(rasterRay, 0.9) << name(light);
         EXPECT_GE(glRay, 0.9) << name(light);
         EXPECT_GE(glRaster, 0.95) << name(light);
+    }
+}
+
+// Flat and Gouraud shading: both rasterizers against the ray caster and each other, the
+// shadowed pixels and the whole images (the same formulas, the same maps).
+TEST(ShadowAgreementGLTest, FlatAndGouraudRasterizersMatchTheRayCasterAndEachOther) {
+    for (sg::ShadingModel shading : {sg::ShadingModel::Flat, sg::ShadingModel::Gouraud})
+        for (Caster light : {Caster::Sun, Caster::Spot}) {
+            rnd::Framebuffer glOn, rasterOn;
+            const std::vector<uint8_t> rays = maskOf("raycast", light, shading);
+            const std::vector<uint8_t> raster = maskOf("raster", light, shading, &rasterOn);
+            const std::vector<uint8_t> gl = maskOf("gl", light, shading, &glOn);
+            const double rasterRay = iou(raster, rays), glRay = iou(gl, rays), glRaster = iou(gl, raster);
+            std::printf("shadows %s %s: IoU raster~raycast %.4f gl~raycast %.4f gl~raster %.4f (%zu / %zu / %zu pixels)\n", name(shading),
+                        name(light), rasterRay, glRay, glRaster, count(rays), count(raster), count(gl));
+            const std::string what = std::string(name(shading)) + " " + name(light);
+            EXPECT_GE(rasterRay, 0.9) << what;
+            EXPECT_GE(glRay, 0.9) << what;
+            EXPECT_GE(glRaster, 0.95) << what;
+            EXPECT_TRUE(testing_support::imagesClose(glOn, rasterOn, testing_support::agreementTolerance(testing_support::Agreement::SameMethod),
+                                                     "conformance", std::string("shadow-gl-raster-") + name(shading) + "-" + name(light)))
+                << what;
+        }
+}
+
+// Gouraud carries the shadowed lights' terms apart in GL's vertex outputs, for at most two
+// lights (rnd::kGouraudShadowedLights, the first with maps); a third is summed unshadowed, in
+// both rasterizers alike, where flat shading still shadows it. Two dim spots on a far corner of
+// the ground come first, the sun third: under Gouraud the slab and the pole cast nothing. With
+// nine lights (GL's loop over the lights, not calls per light) the sun comes first and casts.
+TEST(ShadowAgreementGLTest, GouraudShadowsTheFirstTwoLightsWithMapsInBothRasterizers) {
+    const vec3 corner(-4.0f, 0.0f, 4.0f);
+    auto cornerSpot = [&] { return spot(corner + vec3(0.0f, 2.0f, 0.0f), vec3(0.0f, -1.0f, 0.0f), vec3(0.2f), 20.0f, 30.0f); };
+    struct Case {
+        const char* tag;
+        std::vector<sg::DrawLight> lights;
+        sg::ShadingModel shading;
+        bool sunCasts;
+    };
+    const sg::DrawLight sun = slabAndPole(Caster::Sun).lights[0];
+    std::vector<sg::DrawLight> many = {sun, cornerSpot()};
+    for (int k = 0; k < 7; ++k) many.push_back(directional(glm::normalize(vec3(0.1f * float(k - 3), -1.0f, 0.2f)), vec3(0.01f)));
+    const Case cases[] = {{"third-gouraud", {cornerSpot(), cornerSpot(), sun}, sg::ShadingModel::Gouraud, false},
+                          {"third-flat", {cornerSpot(), cornerSpot(), sun}, sg::ShadingModel::Flat, true},
+                          {"nine-gouraud", many, sg::ShadingModel::Gouraud, true}};
+    for (const Case& c : cases) {
+        std::map<std::string, std::vector<uint8_t>> masks;
+        std::map<std::string, rnd::Framebuffer> images;
+        for (const std::string b : {"raster", "gl"}) {
+            sg::FrameInput f = slabAndPole(Caster::Sun, true, c.shading);
+            f.lights = c.lights;
+            const rnd::Framebuffer on = render(b, f, std::string("lights-") + c.tag + "-on");
+            f.settings.shadows = false;
+            masks[b] = shadowMask(on, render(b, f, std::string("lights-") + c.tag + "-off"));
+            images[b] = on;
+        }
+        std::printf("shadows %s: %zu / %zu pixels (raster / gl), IoU %.4f\n", c.tag, count(masks["raster"]), count(masks["gl"]),
+                    iou(masks["gl"], masks["raster"]));
+        for (const std::string b : {"raster", "gl"}) {
+            if (c.sunCasts)
+                EXPECT_GT(count(masks[b]), size_t(S * S / 200)) << c.tag << " " << b << ": the sun casts nothing";
+            else
+                EXPECT_EQ(count(masks[b]), 0u) << c.tag << " " << b << ": the third light with a map is shadowed under Gouraud";
+        }
+        EXPECT_GE(iou(masks["gl"], masks["raster"]), 0.95) << c.tag;
+        EXPECT_TRUE(testing_support::imagesClose(images["gl"], images["raster"],
+                                                 testing_support::agreementTolerance(testing_support::Agreement::SameMethod), "conformance",
+                                                 std::string("shadow-gl-raster-lights-") + c.tag))
+            << c.tag;
     }
 }
 
