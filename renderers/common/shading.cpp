@@ -6,6 +6,7 @@
 #include "renderers/shading.h"
 
 #include "renderers/pbr.h"
+#include "renderers/srgb_encoder.h"
 #include "renderers/texture_sampler.h"
 
 #include <algorithm>
@@ -297,6 +298,30 @@ vec3 srgbBytesToLinear(const uint8_t* rgb) {
         return t;
     }();
     return vec3(table[rgb[0]], table[rgb[1]], table[rgb[2]]);
+}
+
+SrgbEncoder::SrgbEncoder() {
+    // rnd::toByteSRGB's own thresholds, so that this encoder gives its byte for every float.
+    // (decodeSRGB((b + 0.5) / 255) differs from them in the last bit on 225 floats of [2^-14, 1].)
+    for (int b = 0; b < 256; ++b) next[b] = srgbByteThreshold(b + 1);   // next[255] = 2: never reached
+    for (int i = 0; i < kBuckets; ++i) {
+        const float first = std::ldexp(1.0f + float(i % 256) / 256.0f, kMinExp + i / 256);
+        table[i] = toByteSRGB(first);
+        const uint32_t start = 0x39000000u + (uint32_t(i) << 15), end = start + 0x8000u;
+        uint32_t thr;
+        std::memcpy(&thr, &next[table[i]], 4);
+        if (thr <= start)   // the whole bucket is above the threshold: operator() adds one everywhere
+            packed[i] = uint32_t(table[i] + 1) << 16 | 0x8000u;
+        else if (thr < end)
+            packed[i] = uint32_t(table[i]) << 16 | (thr - start);
+        else
+            packed[i] = uint32_t(table[i]) << 16 | 0x8000u;
+    }
+}
+
+const SrgbEncoder& srgbEncoder() {
+    static const SrgbEncoder e;
+    return e;
 }
 
 }   // namespace rnd

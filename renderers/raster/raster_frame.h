@@ -30,12 +30,12 @@
 
 #include "raster/raster_core.h"
 #include "raster/raster_shading.h"
-#include "raster/srgb_encoder.h"
 #include "raster/tile_kernels.h"
 #include "renderers/environment.h"
 #include "renderers/framebuffer.h"
 #include "renderers/shading.h"
 #include "renderers/shadow_map.h"
+#include "renderers/srgb_encoder.h"
 #include "renderers/texture_sampler.h"
 #include "renderers/tone_map.h"
 #include "scenegraph/frame.h"

@@ -1,13 +1,11 @@
 // raster_shading.cpp - the CPU rasterizer's batched lighting (raster_shading.h): ShadeBatch's
-// sizing and padding, the sRGB byte encoder's tables (srgb_encoder.h), the run-time choice of
-// AVX2 or SSE2, and shadeBatch itself, whose body is shade_kernel.inl (Phong, Blinn-Phong) or
+// sizing and padding, the run-time choice of AVX2 or SSE2, and shadeBatch itself, whose body is shade_kernel.inl (Phong, Blinn-Phong) or
 // pbr_kernel.inl (pbr) compiled once per instruction set (a scalar loop over rnd::lightTerms or
 // the pbr terms where neither is available).
 #include "raster/raster_shading.h"
 #include "renderers/debug_switches.h"
 
 #include "raster/simd.h"
-#include "raster/srgb_encoder.h"
 #include "renderers/shading.h"
 #include "renderers/shadow_map.h"
 
@@ -42,30 +40,6 @@ void ShadeBatch::pad() {
         shin[i] = 1;
         mat[i] = -1;
     }
-}
-
-SrgbEncoder::SrgbEncoder() {
-    // rnd::toByteSRGB's own thresholds, so that this encoder gives its byte for every float.
-    // (decodeSRGB((b + 0.5) / 255) differs from them in the last bit on 225 floats of [2^-14, 1].)
-    for (int b = 0; b < 256; ++b) next[b] = srgbByteThreshold(b + 1);   // next[255] = 2: never reached
-    for (int i = 0; i < kBuckets; ++i) {
-        const float first = std::ldexp(1.0f + float(i % 256) / 256.0f, kMinExp + i / 256);
-        table[i] = toByteSRGB(first);
-        const uint32_t start = 0x39000000u + (uint32_t(i) << 15), end = start + 0x8000u;
-        uint32_t thr;
-        std::memcpy(&thr, &next[table[i]], 4);
-        if (thr <= start)   // the whole bucket is above the threshold: operator() adds one everywhere
-            packed[i] = uint32_t(table[i] + 1) << 16 | 0x8000u;
-        else if (thr < end)
-            packed[i] = uint32_t(table[i]) << 16 | (thr - start);
-        else
-            packed[i] = uint32_t(table[i]) << 16 | 0x8000u;
-    }
-}
-
-const SrgbEncoder& srgbEncoder() {
-    static const SrgbEncoder e;
-    return e;
 }
 
 bool useAvx2() {

@@ -13,7 +13,7 @@
 
 #include "raster/raster_core.h"
 #include "raster/raster_shading.h"
-#include "raster/srgb_encoder.h"
+#include "renderers/srgb_encoder.h"
 
 #include <array>
 #include <cstddef>

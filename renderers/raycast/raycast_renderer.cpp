@@ -21,6 +21,7 @@
 #include "renderers/sampling.h"
 #include "renderers/shading.h"
 #include "renderers/shadow_map.h"
+#include "renderers/srgb_encoder.h"
 #include "renderers/texture_sampler.h"
 #include "renderers/tone_map.h"
 
@@ -60,11 +61,12 @@ struct FrameJob {
     const RenderConfig& cfg;
     const rt::CameraRays& cam;
     int w, h;
-    int sx, sy;                         // strata per pixel (see RaycastRenderer::capabilities)
-    bool packets;                       // the tile's camera rays are traced first, in packets
-    bool shadowPackets;                 // and then their hits' shadow rays (Tracer::presetShadows)
-    bool countCost;                     // the cost view: one centre ray per pixel, counted
-    DisplayTransform display;           // exposure and tone mapping of each pixel's mean colour
+    int sx, sy;                 // strata per pixel (see RaycastRenderer::capabilities)
+    bool packets;               // the tile's camera rays are traced first, in packets
+    bool shadowPackets;         // and then their hits' shadow rays (Tracer::presetShadows)
+    bool countCost;             // the cost view: one centre ray per pixel, counted
+    DisplayTransform display;   // exposure and tone mapping of each pixel's mean colour
+    const SrgbEncoder& srgb = srgbEncoder();
     static constexpr int kTile = 32;    // pixels per tile side
     static constexpr int kPacket = 4;   // pixels per packet side (4x4: the benchmark's best, docs/benchmarks.md)
     static_assert(kPacket * kPacket <= rt::kMaxPacket);
@@ -171,9 +173,9 @@ void shadePixel(const FrameJob& job, Tracer& tr, int x, int row, int x0, int y0,
     sum = job.display(sum);                    // after the resolve, as every backend (tone_map.h)
     if (!isFinite(sum)) sum = vec3(1, 0, 1);   // never feed NaN to the byte conversion
     uint8_t* px = target.pixel(x, row);
-    px[0] = toByteSRGB(sum.x);
-    px[1] = toByteSRGB(sum.y);
-    px[2] = toByteSRGB(sum.z);
+    px[0] = job.srgb(sum.x);   // toByteSRGB's byte, with one table lookup
+    px[1] = job.srgb(sum.y);
+    px[2] = job.srgb(sum.z);
     px[3] = 255;
     target.depth[size_t(row) * w + x] = depth;
 }

@@ -7,8 +7,8 @@
 #include "raster/tile_kernels.h"
 #include "raster/raster_core.h"
 #include "raster/simd.h"
-#include "raster/srgb_encoder.h"
 #include "renderers/shading.h"
+#include "renderers/srgb_encoder.h"
 
 #include <gtest/gtest.h>
 
@@ -21,6 +21,8 @@
 #include <vector>
 
 using namespace rnd::raster;
+using rnd::SrgbEncoder;
+using rnd::srgbEncoder;
 using sg::vec3;
 
 namespace {

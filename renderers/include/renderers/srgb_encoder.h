@@ -1,6 +1,6 @@
-// srgb_encoder.h - the CPU rasterizer's exact linear -> 8-bit sRGB encoder without pow: the
-// byte every fragment's colour channel ends as (the scalar operator(), and the tables the vector
-// output kernel in tile_kernels.inl reads).
+// srgb_encoder.h - the CPU backends' exact linear -> 8-bit sRGB encoder without pow: the byte
+// every fragment's or ray-cast pixel's colour channel ends as (the scalar operator(), and the
+// tables the rasterizer's vector output kernel in raster/tile_kernels.inl reads).
 //
 // Floats in [2^-13, 1) fall into buckets by exponent and the top 8 mantissa bits (13 * 256
 // buckets, index (bits(x) - bits(2^-13)) >> 15). table[i] is the byte of bucket i's first float
@@ -13,7 +13,7 @@
 #include <cstdint>
 #include <cstring>
 
-namespace rnd::raster {
+namespace rnd {
 
 struct SrgbEncoder {
     static constexpr int kMinExp = -13;
@@ -40,4 +40,4 @@ struct SrgbEncoder {
 // The one encoder (built on first use).
 const SrgbEncoder& srgbEncoder();
 
-}   // namespace rnd::raster
+}   // namespace rnd
