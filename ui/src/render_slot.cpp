@@ -86,7 +86,11 @@ void RenderSlot::publish(rnd::Framebuffer&& fb, const rnd::RenderStats& st, int 
     m_status.stats = st;
     m_status.error = st.ok ? std::string() : (st.error.empty() ? "render failed" : st.error);
     if (st.ok) {
-        m_finished = std::move(fb);
+        std::swap(m_finished, fb);   // fb: the image this one replaces, kept to render into again
+        if (fb.width > 0) {
+            if (m_spares.size() >= 4) m_spares.erase(m_spares.begin());
+            m_spares.push_back(std::move(fb));
+        }
         m_finishedFrame = job.frame;
         m_publishedKey = job.key;
         m_publishedLevel = level;
@@ -96,6 +100,23 @@ void RenderSlot::publish(rnd::Framebuffer&& fb, const rnd::RenderStats& st, int 
         m_haveNew = true;
         if (onPublish) onPublish(m_finished, m_status);
     }
+}
+
+rnd::Framebuffer RenderSlot::takeSpare(int width, int height) {
+    std::lock_guard<std::mutex> lock(m_mutex);
+    // After a poll m_finished holds the image shown before it (poll swaps): nobody reads it again.
+    if (!m_haveNew && m_finished.width == width && m_finished.height == height) {
+        rnd::Framebuffer fb = std::move(m_finished);
+        m_finished = {};
+        return fb;
+    }
+    for (size_t i = m_spares.size(); i-- > 0;)
+        if (m_spares[i].width == width && m_spares[i].height == height) {
+            rnd::Framebuffer fb = std::move(m_spares[i]);
+            m_spares.erase(m_spares.begin() + std::ptrdiff_t(i));
+            return fb;   // its old pixels stay until the renderer writes every one (Renderer::render)
+        }
+    return {};
 }
 
 // The steps of a job (planSteps): the preview (1/previewDivisor, one sample per pixel), then
@@ -139,7 +160,7 @@ void RenderSlot::runJob(const Job& job) {
             m_status.progress = 0.0f;
             m_status.shapes = false;
         }
-        rnd::Framebuffer fb;
+        rnd::Framebuffer fb = takeSpare(w, h);
         rnd::RenderStats st;
         rnd::RenderRequest request;
         request.singleSample = steps[i].singleSample;
@@ -315,6 +336,7 @@ void RenderSlot::forget() {
     if (m_control) m_control->cancel = true;
     m_haveNew = false;
     m_finished = {};
+    m_spares.clear();
     m_shown = {};
     m_finishedFrame.reset();
     m_shownFrame.reset();
