@@ -19,6 +19,7 @@ DebugSwitches debugSwitches() {
     d.rasterReferenceShading = is("VIEWER_RASTER_REFERENCE_SHADING", '1');
     d.rasterForceSse = is("VIEWER_RASTER_SSE", '1');
     d.rasterShadowReuse = !is("VIEWER_RASTER_SHADOW_REUSE", '0');
+    d.glShadowReuse = !is("VIEWER_GL_SHADOW_REUSE", '0');
     d.raycastForceSse = is("VIEWER_RAYCAST_SSE", '1');
     d.raycastPackets = !is("VIEWER_RAYCAST_PACKETS", '0');
     d.raycastShadowPackets = !is("VIEWER_RAYCAST_SHADOW_PACKETS", '0');

@@ -548,4 +548,9 @@ float shadowVisibility(const ShadowPlan& plan, const ShadowMaps& maps, const sg:
     return float(lit) / float(k * k);
 }
 
+bool sameShadowView(const ShadowView& a, const ShadowView& b) {
+    return std::memcmp(&a.view, &b.view, sizeof(a.view)) == 0 && std::memcmp(&a.viewProj, &b.viewProj, sizeof(a.viewProj)) == 0 &&
+           a.perspective == b.perspective && std::memcmp(&a.nearZ, &b.nearZ, sizeof(float)) == 0 && std::memcmp(&a.farZ, &b.farZ, sizeof(float)) == 0;
+}
+
 }   // namespace rnd

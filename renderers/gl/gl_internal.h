@@ -31,6 +31,7 @@
 
 #include "gl/gl_context.h"
 #include "gl/gl_renderer.h"
+#include "renderers/debug_switches.h"
 #include "renderers/environment.h"
 #include "renderers/framebuffer.h"
 #include "renderers/renderer.h"
@@ -145,6 +146,7 @@ struct IndexRange {
 };
 
 struct GpuMesh {
+    uint64_t id = 0;   // sg::Mesh::id
     uint64_t version = 0;
     GLuint vao = 0, vbo = 0, ebo = 0;
     GLuint tbo = 0;    // tangents (attribute 4), only for meshes that have them
@@ -326,6 +328,20 @@ private:
     GLuint m_shadowTexture = 0, m_shadowFbo = 0, m_shadowUbo = 0, m_shadowProgram = 0;
     GLint m_shadowModel = -1, m_shadowViewProj = -1, m_shadowDepth = -1;
     int m_shadowTextureSize = 0, m_shadowTextureLayers = 0;
+    // What the maps in m_shadowTexture were drawn from: the plan's views and one key per drawn
+    // range (sorted: the draw order changes with the camera, the depths do not). A frame with the
+    // same views and keys keeps them (a still camera; a moving one where the maps do not follow
+    // it); m_shadowDrawn false: nothing kept. VIEWER_GL_SHADOW_REUSE=0 draws them every frame.
+    struct ShadowCasterKey {
+        uint64_t mesh, version;
+        sg::mat4 world;
+        uint32_t first, count;
+    };
+    std::vector<ShadowView> m_shadowDrawnViews;
+    std::vector<ShadowCasterKey> m_shadowDrawnCasters;
+    bool m_shadowDrawn = false;
+    bool m_shadowReuse = debugSwitches().glShadowReuse;   // VIEWER_GL_SHADOW_REUSE=0: draw the maps every frame
+    std::string drawShadowLayers(const std::vector<DrawItem>& items, const std::vector<bool>& draw);
     int m_maxTextureSize = 0, m_maxTextureLayers = 0;   // the driver's limits
     // lightVisibility's: runs `ask` with the maps' context current (false: no maps to ask), and the
     // answer for light l at one point from the layer it needs.

@@ -276,6 +276,7 @@ std::string CountTarget::ensure(int w, int h) {
 
 GpuMesh* GlRenderer::meshFor(const Mesh& mesh, const std::vector<uint16_t>* triangleMaterial) {
     GpuMesh& g = m_meshes[mesh.id];
+    g.id = mesh.id;
     if (g.version != mesh.version || (!g.vao && g.valid)) {
         uploadMesh(g, mesh, triangleMaterial);
         ++m_meshUploads;

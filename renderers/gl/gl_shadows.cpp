@@ -57,6 +57,66 @@ static_assert(sizeof(ShadowBlock) == size_t(kMaxShadowViews) * (64 + 16 + 16 + 1
 
 }   // namespace
 
+// Draws the layers of m_shadowPlan that `draw` marks into m_shadowTexture.
+std::string GlRenderer::drawShadowLayers(const std::vector<DrawItem>& items, const std::vector<bool>& draw) {
+    const int N = m_shadowPlan.size, layers = int(m_shadowPlan.views.size());
+    if (!m_shadowFbo) glGenFramebuffers(1, &m_shadowFbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, m_shadowFbo);
+    glDrawBuffer(GL_NONE);
+    glReadBuffer(GL_NONE);
+
+    // renderShadowDepth's state: both faces, depth test less, cleared to 1, single sample.
+    glViewport(0, 0, N, N);
+    glDisable(GL_SCISSOR_TEST);
+    glDisable(GL_STENCIL_TEST);
+    glDisable(GL_BLEND);
+    glDisable(GL_CULL_FACE);
+    glDisable(GL_POLYGON_OFFSET_FILL);
+    glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+    glClearDepth(1.0);
+    glUseProgram(m_shadowProgram);
+    m_current = nullptr;   // useProgram must bind a mesh program again
+    bool checked = false;
+    for (int layer = 0; layer < layers; ++layer) {
+        if (!draw[size_t(layer)]) continue;
+        glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, m_shadowTexture, 0, layer);
+        if (!checked) {
+            checked = true;
+            const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+            if (status != GL_FRAMEBUFFER_COMPLETE) {
+                char buf[128];
+                std::snprintf(buf, sizeof buf, "shadow map framebuffer %dx%d is incomplete (status 0x%x)", N, N, status);
+                m_shadowPlan = ShadowPlan{};
+                return buf;
+            }
+        }
+        glClear(GL_DEPTH_BUFFER_BIT);
+        const ShadowView& sv = m_shadowPlan.views[size_t(layer)];
+        glUniformMatrix4fv(m_shadowViewProj, 1, GL_FALSE, &sv.viewProj[0][0]);
+        glUniform3f(m_shadowDepth, sv.perspective ? 1.0f : 0.0f, sv.nearZ, sv.farZ);
+        for (const DrawItem& it : items) {
+            if (it.gpu->primitive != GL_TRIANGLES) continue;   // points and lines cast nothing
+            bool bound = false;
+            for (const IndexRange& r : it.gpu->ranges) {
+                const Material* m = it.material;
+                if (it.rangeMaterials && r.material >= 0 && size_t(r.material) < it.rangeMaterials->size()) m = &(*it.rangeMaterials)[r.material];
+                if (!castsShadow(*m)) continue;   // blended surfaces cast nothing (masked ones whole)
+                if (!bound) {
+                    glUniformMatrix4fv(m_shadowModel, 1, GL_FALSE, &(*it.world)[0][0]);
+                    glBindVertexArray(it.gpu->vao);
+                    bound = true;
+                }
+                glDrawElements(GL_TRIANGLES, r.count, GL_UNSIGNED_INT, reinterpret_cast<const void*>(size_t(r.first) * sizeof(uint32_t)));
+            }
+        }
+    }
+    glBindVertexArray(0);
+    return {};
+}
+
 std::string GlRenderer::renderShadowMaps(const FrameInput& frame, const std::vector<DrawItem>& items, RenderStats& stats) {
     m_shadowReadBack.clear();
     // Shadow maps for every shading model (flat and Gouraud scale the lights with maps by each
@@ -90,61 +150,44 @@ std::string GlRenderer::renderShadowMaps(const FrameInput& frame, const std::vec
         glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
         glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
         m_shadowTextureSize = N;
+        m_shadowDrawn = false;   // new storage: nothing kept
         m_shadowTextureLayers = layers;
     }
     glBindTexture(GL_TEXTURE_2D_ARRAY, 0);   // not sampled while drawn into
     glActiveTexture(GL_TEXTURE0);
-    if (!m_shadowFbo) glGenFramebuffers(1, &m_shadowFbo);
-    glBindFramebuffer(GL_FRAMEBUFFER, m_shadowFbo);
-    glDrawBuffer(GL_NONE);
-    glReadBuffer(GL_NONE);
-
-    // renderShadowDepth's state: both faces, depth test less, cleared to 1, single sample.
-    glViewport(0, 0, N, N);
-    glDisable(GL_SCISSOR_TEST);
-    glDisable(GL_STENCIL_TEST);
-    glDisable(GL_BLEND);
-    glDisable(GL_CULL_FACE);
-    glDisable(GL_POLYGON_OFFSET_FILL);
-    glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LESS);
-    glDepthMask(GL_TRUE);
-    glClearDepth(1.0);
-    glUseProgram(m_shadowProgram);
-    m_current = nullptr;   // useProgram must bind a mesh program again
-    for (int layer = 0; layer < layers; ++layer) {
-        glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, m_shadowTexture, 0, layer);
-        if (layer == 0) {
-            const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
-            if (status != GL_FRAMEBUFFER_COMPLETE) {
-                char buf[128];
-                std::snprintf(buf, sizeof buf, "shadow map framebuffer %dx%d is incomplete (status 0x%x)", N, N, status);
-                m_shadowPlan = ShadowPlan{};
-                return buf;
-            }
-        }
-        glClear(GL_DEPTH_BUFFER_BIT);
-        const ShadowView& sv = m_shadowPlan.views[size_t(layer)];
-        glUniformMatrix4fv(m_shadowViewProj, 1, GL_FALSE, &sv.viewProj[0][0]);
-        glUniform3f(m_shadowDepth, sv.perspective ? 1.0f : 0.0f, sv.nearZ, sv.farZ);
-        for (const DrawItem& it : items) {
-            if (it.gpu->primitive != GL_TRIANGLES) continue;   // points and lines cast nothing
-            bool bound = false;
-            for (const IndexRange& r : it.gpu->ranges) {
-                const Material* m = it.material;
-                if (it.rangeMaterials && r.material >= 0 && size_t(r.material) < it.rangeMaterials->size()) m = &(*it.rangeMaterials)[r.material];
-                if (!castsShadow(*m)) continue;   // blended surfaces cast nothing (masked ones whole)
-                if (!bound) {
-                    glUniformMatrix4fv(m_shadowModel, 1, GL_FALSE, &(*it.world)[0][0]);
-                    glBindVertexArray(it.gpu->vao);
-                    bound = true;
-                }
-                glDrawElements(GL_TRIANGLES, r.count, GL_UNSIGNED_INT, reinterpret_cast<const void*>(size_t(r.first) * sizeof(uint32_t)));
-            }
+    // The casters as keys; the maps stay when they were drawn from these very views and keys.
+    std::vector<ShadowCasterKey> casters;
+    for (const DrawItem& it : items) {
+        if (it.gpu->primitive != GL_TRIANGLES) continue;   // points and lines cast nothing
+        for (const IndexRange& r : it.gpu->ranges) {
+            const Material* m = it.material;
+            if (it.rangeMaterials && r.material >= 0 && size_t(r.material) < it.rangeMaterials->size()) m = &(*it.rangeMaterials)[r.material];
+            if (castsShadow(*m)) casters.push_back({it.gpu->id, it.gpu->version, *it.world, uint32_t(r.first), uint32_t(r.count)});
         }
     }
-    glBindVertexArray(0);
+    static_assert(sizeof(ShadowCasterKey) == 8 + 8 + 64 + 4 + 4, "no padding: keys compare as bytes");
+    auto less = [](const ShadowCasterKey& a, const ShadowCasterKey& b) { return std::memcmp(&a, &b, sizeof a) < 0; };
+    std::sort(casters.begin(), casters.end(), less);
+    // Each layer stays when the casters and its own view are the ones it was drawn from (a
+    // moving camera refits a sun's map; a point light's faces and a spot's map stay).
+    const bool sameCasters =
+        m_shadowReuse && m_shadowDrawn && m_shadowDrawnViews.size() == m_shadowPlan.views.size() && m_shadowDrawnCasters.size() == casters.size() &&
+        (casters.empty() || std::memcmp(casters.data(), m_shadowDrawnCasters.data(), casters.size() * sizeof(ShadowCasterKey)) == 0);
+    std::vector<bool> draw(size_t(layers), true);
+    int drawn = 0;
+    for (int v = 0; v < layers; ++v) {
+        draw[size_t(v)] = !(sameCasters && sameShadowView(m_shadowDrawnViews[size_t(v)], m_shadowPlan.views[size_t(v)]));
+        drawn += draw[size_t(v)];
+    }
+    if (drawn > 0) {
+        m_shadowDrawn = false;   // (until the layers are whole)
+        const std::string err = drawShadowLayers(items, draw);
+        if (!err.empty()) return err;
+        m_shadowDrawnViews = m_shadowPlan.views;
+        m_shadowDrawnCasters = std::move(casters);
+        m_shadowDrawn = true;
+    }
+    stats.shadowMapsDrawn = drawn;
 
     // The plan for shadow.glsl, and the maps on their unit for the frame's draws.
     ShadowBlock b{};
@@ -215,6 +258,9 @@ void GlRenderer::forgetShadows() {
     m_shadowTextureSize = m_shadowTextureLayers = 0;
     m_shadowPlan = ShadowPlan{};
     m_shadowReadBack.clear();
+    m_shadowDrawn = false;
+    m_shadowDrawnViews.clear();
+    m_shadowDrawnCasters.clear();
 }
 
 }   // namespace rnd::gl

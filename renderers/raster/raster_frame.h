@@ -281,8 +281,9 @@ inline int64_t nowNs() { return std::chrono::duration_cast<std::chrono::nanoseco
 // light, into ShadeBatch::vis (raster_shadows.cpp); nothing without a shadow plan.
 void fillShadowVisibility(const FrameContext& fc, ShadeBatch& b, size_t n);
 // What a renderer's shadow maps were last drawn from: the maps' views and size, and a copy of
-// every caster's world positions and triangles. A frame whose plan and casters equal it bit for
-// bit (a still camera: a directional light's maps follow the camera) keeps the maps as they are.
+// every caster's world positions and triangles. A frame whose casters equal it bit for bit
+// keeps each map whose view is the same too (a still camera keeps them all; a moving one
+// refits a directional light's maps and keeps the spot and point lights').
 struct ShadowMapsSource {
     bool valid = false;
     int size = 0;
@@ -297,9 +298,9 @@ struct ShadowMapsSource {
 
 // The depth maps of the plan from the frame's opaque and masked triangles (world positions of
 // the vertex stage). source (optional): what the maps were last drawn from; when this frame's
-// plan and casters are the same the maps are left as they are (and it is updated otherwise).
-// Returns whether the maps were drawn.
-bool renderShadowMaps(const ShadowPlan& plan, const std::vector<DrawItem>& draws, ShadowMaps& maps, ShadowMapsSource* source = nullptr);
+// casters and a map's view are the same that map is left as it is (and source is updated when
+// any is drawn). Returns how many maps were drawn.
+int renderShadowMaps(const ShadowPlan& plan, const std::vector<DrawItem>& draws, ShadowMaps& maps, ShadowMapsSource* source = nullptr);
 
 // shadowed: Gouraud's lights with per-fragment visibility (FrameContext::gouraudShadowed), kept
 // apart in DrawItem::shadowedA/B.

@@ -226,10 +226,11 @@ private:
         tbb::parallel_for(size_t(0), draws.size(),
                           [&](size_t i) { runVertexStage(draws[i], frame, width, height, gouraud, &environment, gouraudShadowed); });
         const auto tShadow0 = std::chrono::steady_clock::now();
-        const bool drawn = renderShadowMaps(m_shadowPlan, draws, m_shadowMaps, m_shadowReuse ? &m_shadowSource : nullptr);
+        const int drawn = renderShadowMaps(m_shadowPlan, draws, m_shadowMaps, m_shadowReuse ? &m_shadowSource : nullptr);
+        stats.shadowMapsDrawn = drawn;
         if (m_timing && !m_shadowPlan.empty())
-            std::fprintf(stderr, "raster timing: shadow maps %zu x %d^2 %s %.2f ms\n", m_shadowPlan.views.size(), m_shadowPlan.size,
-                         drawn ? "drawn" : "kept", std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - tShadow0).count());
+            std::fprintf(stderr, "raster timing: shadow maps %d of %zu x %d^2 drawn %.2f ms\n", drawn, m_shadowPlan.views.size(), m_shadowPlan.size,
+                         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - tShadow0).count());
 
         auto tVert = std::chrono::steady_clock::now();
         // 3. triangles

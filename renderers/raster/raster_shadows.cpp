@@ -15,11 +15,6 @@ namespace rnd::raster {
 
 namespace {
 
-bool sameView(const ShadowView& a, const ShadowView& b) {
-    return std::memcmp(&a.view, &b.view, sizeof(a.view)) == 0 && std::memcmp(&a.viewProj, &b.viewProj, sizeof(a.viewProj)) == 0 &&
-           a.perspective == b.perspective && std::memcmp(&a.nearZ, &b.nearZ, sizeof(float)) == 0 && std::memcmp(&a.farZ, &b.farZ, sizeof(float)) == 0;
-}
-
 // Whether the casters are the ones src holds, bit for bit.
 bool sameCasters(const std::vector<ShadowCaster>& casters, const ShadowMapsSource& src) {
     size_t vertices = 0, indices = 0;
@@ -78,12 +73,12 @@ void copyCasters(const std::vector<ShadowCaster>& casters, ShadowMapsSource& src
 
 }   // namespace
 
-bool renderShadowMaps(const ShadowPlan& plan, const std::vector<DrawItem>& draws, ShadowMaps& maps, ShadowMapsSource* source) {
+int renderShadowMaps(const ShadowPlan& plan, const std::vector<DrawItem>& draws, ShadowMaps& maps, ShadowMapsSource* source) {
     maps.size = plan.size;
     if (plan.empty()) {
         maps.depth.clear();
         if (source) source->clear();
-        return false;
+        return 0;
     }
     std::vector<ShadowCaster> casters;
     for (const DrawItem& d : draws) {
@@ -97,23 +92,33 @@ bool renderShadowMaps(const ShadowPlan& plan, const std::vector<DrawItem>& draws
         casters.push_back(c);
     }
     const size_t texels = size_t(plan.size) * size_t(plan.size);
-    // The maps as they are when they were drawn from this very plan and these casters.
+    // A map as it is when it was drawn from this very view and these casters.
+    std::vector<bool> draw(plan.views.size(), true);
     if (source) {
-        bool same = source->valid && source->size == plan.size && source->views.size() == plan.views.size() &&
-                    maps.depth.size() == texels * plan.views.size();
-        for (size_t v = 0; same && v < plan.views.size(); ++v) same = sameView(source->views[v], plan.views[v]);
-        if (same && sameCasters(casters, *source)) return false;
+        const bool same = source->valid && source->size == plan.size && source->views.size() == plan.views.size() &&
+                          maps.depth.size() == texels * plan.views.size() && sameCasters(casters, *source);
+        int drawn = 0;
+        for (size_t v = 0; v < plan.views.size(); ++v) {
+            draw[v] = !(same && sameShadowView(source->views[v], plan.views[v]));
+            drawn += draw[v];
+        }
+        if (drawn == 0) return 0;
         source->valid = false;   // (until the maps below are whole)
     }
     maps.depth.resize(texels * plan.views.size());
-    for (size_t v = 0; v < plan.views.size(); ++v) renderShadowDepth(plan.views[v], plan.size, casters, maps.map(int(v)));
+    int drawn = 0;
+    for (size_t v = 0; v < plan.views.size(); ++v)
+        if (draw[v]) {
+            renderShadowDepth(plan.views[v], plan.size, casters, maps.map(int(v)));
+            ++drawn;
+        }
     if (source) {
         source->size = plan.size;
         source->views = plan.views;
         copyCasters(casters, *source);
         source->valid = true;
     }
-    return true;
+    return drawn;
 }
 
 void fillShadowVisibility(const FrameContext& fc, ShadeBatch& b, size_t n) {

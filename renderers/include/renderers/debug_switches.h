@@ -12,6 +12,8 @@
 //                                         (its shadow depth pass's too)
 //   VIEWER_RASTER_SHADOW_REUSE=0          the CPU rasterizer draws its shadow maps every frame,
 //                                         also when the plan and the casters are the last frame's
+//   VIEWER_GL_SHADOW_REUSE=0              the GL backend draws its shadow maps every frame (as
+//                                         VIEWER_RASTER_SHADOW_REUSE=0)
 //   VIEWER_RAYCAST_SSE=1                  the ray caster's BVH4/SSE traversal even where AVX2 runs
 //   VIEWER_RAYCAST_PACKETS=0              the ray caster traces camera rays one by one (no packets)
 //   VIEWER_RAYCAST_SHADOW_PACKETS=0       the ray caster traces shadow rays one by one (camera rays
@@ -28,6 +30,7 @@ struct DebugSwitches {
     bool rasterReferenceShading = false;
     bool rasterForceSse = false;
     bool rasterShadowReuse = true;
+    bool glShadowReuse = true;
     bool raycastForceSse = false;
     bool raycastPackets = true;
     bool raycastShadowPackets = true;

@@ -118,6 +118,7 @@ struct RenderStats {
     double milliseconds = 0;   // the whole render() call
     uint64_t triangles = 0;    // triangles submitted
     uint64_t rays = 0;         // rays traced (ray caster)
+    int shadowMapsDrawn = 0;   // shadow maps drawn (rasterizers; 0 where the last frame's were kept)
     RenderConfig config;       // what was asked and what was used, with notes
 };
 

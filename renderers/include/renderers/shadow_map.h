@@ -46,6 +46,9 @@ struct ShadowView {
     float linearDepth(float d) const { return nearZ + d * (farZ - nearZ); }
 };
 
+// Whether two views are the same bit for bit (a map drawn from one is the other's).
+bool sameShadowView(const ShadowView& a, const ShadowView& b);
+
 // At most this many maps per frame (GL's uniform arrays): lights whose maps would pass it, in
 // the frame's order, get none (lit everywhere) in both rasterizers.
 constexpr int kMaxShadowViews = 48;

@@ -485,3 +485,57 @@ TEST(ShadowAgreementGLTest, GouraudShadowsTheFirstTwoLightsWithMapsInBothRasteri
 }
 
 }   // namespace
+
+// Both rasterizers keep their shadow maps while a frame's plan and casters are the last
+// frame's, and draw them again when either changes; every frame of a sequence matches a new
+// renderer's image of it. A spot light's map does not follow the camera (a camera move keeps
+// it); a sun's map is fitted to the view (a camera move draws it again).
+TEST(ShadowAgreementGLTest, KeptMapsMatchNewlyDrawnOnesInBothRasterizers) {
+    constexpr int W = 160;
+    for (const char* backend : {"raster", "gl"})
+        for (Caster light : {Caster::Spot, Caster::Sun}) {
+            SCOPED_TRACE(std::string(backend) + " " + name(light));
+            sg::FrameInput f = slabAndPole(light);
+            auto slab = std::make_shared<sg::Mesh>(f.meshes[1].mesh ? *f.meshes[1].mesh : sg::Mesh{});
+            f.meshes[1].mesh = slab;
+            auto r = rnd::makeRenderer(backend);
+            ASSERT_TRUE(r);
+            auto step = [&](const sg::FrameInput& frame, bool drawn, const char* what) {
+                rnd::Framebuffer kept, fresh;
+                const rnd::RenderStats st = r->render(frame, W, W, kept);
+                EXPECT_TRUE(st.ok) << what << ": " << st.error;
+                EXPECT_EQ(st.shadowMapsDrawn > 0, drawn) << what << ": " << st.shadowMapsDrawn << " maps drawn";
+                EXPECT_TRUE(rnd::makeRenderer(backend)->render(frame, W, W, fresh).ok);
+                EXPECT_TRUE(kept.color == fresh.color) << what;
+                return kept;
+            };
+            const rnd::Framebuffer first = step(f, true, "first frame");
+            step(f, false, "the same frame again");
+            sg::FrameInput turned = f;
+            turned.camera = makeFrame(S, S, sg::Projection{}, vec3(1.0f, 8.0f, 8.5f), vec3(0.0f, 0.0f, 0.5f)).camera;
+            step(turned, light == Caster::Sun, "the camera moved");
+            sg::FrameInput moved = turned;
+            moved.meshes[1].world = glm::translate(sg::mat4(1.0f), vec3(-0.6f, 1.5f, 0.4f));
+            const rnd::Framebuffer m = step(moved, true, "a caster moved");
+            step(moved, false, "the moved caster again");
+            for (vec3& q : slab->positions) q.y *= 2.0f;   // the mesh edited in place (a new version)
+            slab->touch();
+            step(moved, true, "the caster's mesh edited");
+            EXPECT_FALSE(first.color == m.color);
+        }
+    // A sun and a spot: a camera move draws the sun's map again and keeps the spot's.
+    for (const char* backend : {"raster", "gl"}) {
+        SCOPED_TRACE(backend);
+        sg::FrameInput f = slabAndPole(Caster::Sun);
+        f.lights.push_back(slabAndPole(Caster::Spot).lights[0]);
+        sg::FrameInput turned = f;
+        turned.camera = makeFrame(S, S, sg::Projection{}, vec3(1.0f, 8.0f, 8.5f), vec3(0.0f, 0.0f, 0.5f)).camera;
+        auto r = rnd::makeRenderer(backend);
+        ASSERT_TRUE(r);
+        rnd::Framebuffer a, b, fresh;
+        EXPECT_EQ(r->render(f, W, W, a).shadowMapsDrawn, 2);
+        EXPECT_EQ(r->render(turned, W, W, b).shadowMapsDrawn, 1);
+        EXPECT_TRUE(rnd::makeRenderer(backend)->render(turned, W, W, fresh).ok);
+        EXPECT_TRUE(b.color == fresh.color);
+    }
+}
