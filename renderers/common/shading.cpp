@@ -170,6 +170,22 @@ bool lightReaches(const DrawLight& light, const vec3& p, const vec3& n, Reflecti
     return glm::dot(n, l.toLight) > 0.0f && l.radiance != vec3(0.0f);
 }
 
+namespace {
+// The unit vector from p toward the eye (+z where they meet).
+vec3 toViewer(const vec3& eye, const vec3& p) {
+    vec3 v = eye - p;
+    const float len = glm::length(v);
+    return len > 0 ? v / len : vec3(0, 0, 1);
+}
+
+// Light i's own terms at p (v: toViewer); pt: pbrPoint under the pbr model, null otherwise.
+ShadeTerms oneLightTerms(const SurfaceCoefficients& m, const PbrPoint* pt, const vec3& p, const vec3& n, const vec3& v, const FrameInput& f,
+                         size_t i) {
+    if (pt) return pbrLightTerms(*pt, n, v, samplePunctualLight(f.lights[i], p));
+    return lightTerms(m, n, v, sampleLight(f.lights[i], p), f.settings.reflection);
+}
+}   // namespace
+
 ShadeTerms shadeTerms(const SurfaceCoefficients& m, const vec3& p, const vec3& n, const vec3& eye, const FrameInput& f, const float* visible,
                       const ShadeExtras& x) {
     ShadeTerms t;
@@ -178,34 +194,27 @@ ShadeTerms shadeTerms(const SurfaceCoefficients& m, const vec3& p, const vec3& n
         t.add = m.emissive;
         return t;
     }
-    vec3 v = eye - p;
-    float len = glm::length(v);
-    v = len > 0 ? v / len : vec3(0, 0, 1);
-    if (f.settings.reflection == ReflectionModel::Pbr) {   // renderers/pbr.h
-        const PbrPoint pt = pbrPoint(m, x.albedo);
+    const vec3 v = toViewer(eye, p);
+    const bool pbr = f.settings.reflection == ReflectionModel::Pbr;   // renderers/pbr.h
+    PbrPoint pt;
+    if (pbr) {
+        pt = pbrPoint(m, x.albedo);
         t.add = m.emissive;
-        for (size_t i = 0; i < f.lights.size(); ++i) {
-            if (visible && visible[i] <= 0.0f) continue;
-            ShadeTerms li = pbrLightTerms(pt, n, v, samplePunctualLight(f.lights[i], p));
-            float w = visible ? visible[i] : 1.0f;
-            t.mul += w * li.mul;
-            t.add += w * li.add;
-        }
-        if (x.environment && x.environment->map) {
-            ShadeTerms e = pbrEnvironmentTerms(pt, n, v, *x.environment, m.occlusion);
-            t.mul += e.mul;
-            t.add += e.add;
-        }
-        return t;
+    } else {
+        t.mul = m.ka * f.ambientLight;
+        t.add = m.emissive;
     }
-    t.mul = m.ka * f.ambientLight;
-    t.add = m.emissive;
     for (size_t i = 0; i < f.lights.size(); ++i) {
         if (visible && visible[i] <= 0.0f) continue;
-        ShadeTerms li = lightTerms(m, n, v, sampleLight(f.lights[i], p), f.settings.reflection);
-        float w = visible ? visible[i] : 1.0f;
+        const ShadeTerms li = oneLightTerms(m, pbr ? &pt : nullptr, p, n, v, f, i);
+        const float w = visible ? visible[i] : 1.0f;
         t.mul += w * li.mul;
         t.add += w * li.add;
+    }
+    if (pbr && x.environment && x.environment->map) {
+        const ShadeTerms e = pbrEnvironmentTerms(pt, n, v, *x.environment, m.occlusion);
+        t.mul += e.mul;
+        t.add += e.add;
     }
     return t;
 }
@@ -213,11 +222,10 @@ ShadeTerms shadeTerms(const SurfaceCoefficients& m, const vec3& p, const vec3& n
 ShadeTerms lightShareTerms(const SurfaceCoefficients& m, const vec3& p, const vec3& n, const vec3& eye, const FrameInput& f, size_t light,
                            const ShadeExtras& x) {
     if (m.unlit || light >= f.lights.size()) return {};
-    vec3 v = eye - p;
-    float len = glm::length(v);
-    v = len > 0 ? v / len : vec3(0, 0, 1);
-    if (f.settings.reflection == ReflectionModel::Pbr) return pbrLightTerms(pbrPoint(m, x.albedo), n, v, samplePunctualLight(f.lights[light], p));
-    return lightTerms(m, n, v, sampleLight(f.lights[light], p), f.settings.reflection);
+    const bool pbr = f.settings.reflection == ReflectionModel::Pbr;
+    PbrPoint pt;
+    if (pbr) pt = pbrPoint(m, x.albedo);
+    return oneLightTerms(m, pbr ? &pt : nullptr, p, n, toViewer(eye, p), f, light);
 }
 
 vec3 shade(const SurfaceCoefficients& m, const SurfacePoint& s, const vec3& eye, const FrameInput& f, const float* visible,

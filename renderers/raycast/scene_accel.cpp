@@ -133,6 +133,17 @@ float slabEntry(const vec3& lo, const vec3& hi, const Ray& r, const vec3& inv) {
     return entry;
 }
 
+// The mask of the rays of `active` for which hit(i) is true (the packets' one-ray-at-a-time paths).
+template <class Hit>
+uint64_t eachRay(uint64_t active, Hit&& hit) {
+    uint64_t mask = 0;
+    for (uint64_t m = active; m; m &= m - 1) {
+        const int i = __builtin_ctzll(m);
+        if (hit(i)) mask |= uint64_t(1) << i;
+    }
+    return mask;
+}
+
 // The world ray in the instance's object space (the direction not normalised, so t is shared).
 Ray localRay(const mat4& invWorld, const Ray& wr, float tmax) {
     Ray lr;
@@ -250,14 +261,9 @@ uint64_t SceneAccel::intersectPacket(const Ray* rays, int n, uint64_t active, Sc
     n = std::clamp(n, 0, kMaxPacket);
     if (n < kMaxPacket) active &= (uint64_t(1) << n) - 1;
     if (m_tlas.empty() || !active) return 0;
+    auto oneByOne = [&](int i) { return intersect(rays[i], hits[i], culling); };
+    if (!m_anyPacketMesh) return eachRay(active, oneByOne);   // no mesh to share
     uint64_t found = 0;
-    if (!m_anyPacketMesh) {   // no mesh to share: one ray at a time
-        for (uint64_t m = active; m; m &= m - 1) {
-            const int i = __builtin_ctzll(m);
-            if (intersect(rays[i], hits[i], culling)) found |= uint64_t(1) << i;
-        }
-        return found;
-    }
     const std::vector<uint32_t>& prims = m_tlas.primIndex();
     // Phase 1: the big mesh instances (Instance::packets) whose world boxes the rays reach (each ray's own top-level
     // traversal, not cut short by hits), in the order the rays meet them, and which rays reach
@@ -308,13 +314,7 @@ uint64_t SceneAccel::intersectPacket(const Ray* rays, int n, uint64_t active, Sc
             return false;
         });
     }
-    if (overflow) {   // too many meshes under one packet: one ray at a time
-        for (uint64_t m = active; m; m &= m - 1) {
-            const int i = __builtin_ctzll(m);
-            if (intersect(rays[i], hits[i], culling)) found |= uint64_t(1) << i;
-        }
-        return found;
-    }
+    if (overflow) return eachRay(active, oneByOne);   // too many meshes under one packet
     // Hits per touched mesh and ray, read only where found (constructed only for the k used).
     alignas(TriHit) unsigned char hitBytes[sizeof(TriHit) * kMaxMeshes * kMaxPacket];
     TriHit* const meshHits = reinterpret_cast<TriHit*>(hitBytes);
@@ -429,14 +429,8 @@ uint64_t SceneAccel::occludedPacket(const Ray* rays, int n, uint64_t active) con
     n = std::clamp(n, 0, kMaxPacket);
     if (n < kMaxPacket) active &= (uint64_t(1) << n) - 1;
     if (m_tlas.empty() || !active) return 0;
+    if (!m_anyPacketMesh) return eachRay(active, [&](int i) { return occluded(rays[i]); });   // no mesh to share
     uint64_t blocked = 0;
-    if (!m_anyPacketMesh) {   // no mesh to share: one ray at a time
-        for (uint64_t m = active; m; m &= m - 1) {
-            const int i = __builtin_ctzll(m);
-            if (occluded(rays[i])) blocked |= uint64_t(1) << i;
-        }
-        return blocked;
-    }
     const std::vector<uint32_t>& prims = m_tlas.primIndex();
     constexpr int kMaxMeshes = 16;
     struct Touched {
@@ -464,15 +458,7 @@ uint64_t SceneAccel::occludedPacket(const Ray* rays, int n, uint64_t active) con
                         continue;
                     }
                 }
-                bool hit;
-                if (inst.isMesh || inst.param) {
-                    const Ray lr = localRay(inst.invWorld, r, r.tmax);
-                    hit = inst.isMesh ? inst.bvh->occluded(lr) : inst.param->occluded(lr);
-                } else {
-                    SceneHit h;
-                    hit = intersectInstance(inst, r, r.tmax, h);
-                }
-                if (hit) {
+                if (instanceOccluded(inst, r)) {
                     blocked |= uint64_t(1) << i;
                     return true;
                 }
@@ -495,6 +481,15 @@ uint64_t SceneAccel::occludedPacket(const Ray* rays, int n, uint64_t active) con
     return blocked;
 }
 
+bool SceneAccel::instanceOccluded(const Instance& inst, const Ray& r) const {
+    if (inst.isMesh || inst.param) {   // any-hit tests; a parametric surface's stops at its first sub-patch hit
+        const Ray lr = localRay(inst.invWorld, r, r.tmax);
+        return inst.isMesh ? inst.bvh->occluded(lr) : inst.param->occluded(lr);
+    }
+    SceneHit h;
+    return intersectInstance(inst, r, r.tmax, h);
+}
+
 bool SceneAccel::occluded(const Ray& r) const {
     if (m_tlas.empty()) return false;
     float tmax = r.tmax;
@@ -502,19 +497,9 @@ bool SceneAccel::occluded(const Ray& r) const {
     const std::vector<uint32_t>& prims = m_tlas.primIndex();
     m_tlas.traverse<true>(r, tmax, [&](uint32_t first, uint32_t count, float&) {
         for (uint32_t k = 0; k < count; ++k) {
-            const Instance& inst = m_instances[prims[first + k]];
-            if (inst.isMesh || inst.param) {   // any-hit tests; a parametric surface's stops at its first sub-patch hit
-                const Ray lr = localRay(inst.invWorld, r, r.tmax);
-                if (inst.isMesh ? inst.bvh->occluded(lr) : inst.param->occluded(lr)) {
-                    any = true;
-                    return true;
-                }
-            } else {
-                SceneHit h;
-                if (intersectInstance(inst, r, r.tmax, h)) {
-                    any = true;
-                    return true;
-                }
+            if (instanceOccluded(m_instances[prims[first + k]], r)) {
+                any = true;
+                return true;
             }
         }
         return false;

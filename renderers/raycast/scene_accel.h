@@ -90,6 +90,8 @@ private:
     // counted run the traversal without the counters.
     template <bool Count>
     bool closestHit(const Ray& r, SceneHit& hit, sg::CullMode culling, TraversalCount* cost) const;
+    // Any hit of a world ray in one instance in (tmin, tmax).
+    bool instanceOccluded(const Instance& inst, const Ray& r) const;
     // Where a world ray (inv: 1 / its direction) enters the instance's box (+inf: never).
     float boxEntry(const Instance& inst, const Ray& r, const sg::vec3& inv) const;
     bool intersectInstance(const Instance& inst, const Ray& r, float tmax, SceneHit& hit, bool cull = false, TraversalCount* count = nullptr) const;

@@ -46,7 +46,7 @@ out vec3 vMulBack;
 out vec3 vAddBack;
 #if SHADOW_SLOTS > 0
 // The shadowed lights' own terms (lighting.glsl's gLightMul/gLightAdd), 12 floats a light packed
-// in three vec4: front mul, front add, back mul, back add (mesh.frag's shadowedTerms).
+// in three vec4: front mul, front add, back mul, back add (mesh.frag unpacks them).
 out vec4 vShadowed[3 * SHADOW_SLOTS];
 #endif
 #endif
