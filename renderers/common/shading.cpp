@@ -166,8 +166,7 @@ ShadeTerms lightTerms(const SurfaceCoefficients& m, const vec3& n, const vec3& v
 }
 
 bool lightReaches(const DrawLight& light, const vec3& p, const vec3& n, ReflectionModel model) {
-    const LightSample l = model == ReflectionModel::Pbr ? samplePunctualLight(light, p) : sampleLight(light, p);
-    return glm::dot(n, l.toLight) > 0.0f && l.radiance != vec3(0.0f);
+    return sampleReaches(model == ReflectionModel::Pbr ? samplePunctualLight(light, p) : sampleLight(light, p), n);
 }
 
 namespace {

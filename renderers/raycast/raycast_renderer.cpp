@@ -103,6 +103,7 @@ void traceCameraPackets(const FrameJob& job, const rt::SceneAccel& accel, int x0
                     tileRays[size_t(row - y0) * tile + size_t(x - x0)] = pr[n];
                     Tracer::FirstHit& fh = tileHits[size_t(row - y0) * tile + size_t(x - x0)];
                     fh.found = (found >> n) & 1;
+                    fh.framed = false;
                     if (fh.found) fh.hit = ph[n];
                 }
         }

@@ -315,10 +315,10 @@ uint64_t SceneAccel::intersectPacket(const Ray* rays, int n, uint64_t active, Sc
         });
     }
     if (overflow) return eachRay(active, oneByOne);   // too many meshes under one packet
-    // Hits per touched mesh and ray, read only where found (constructed only for the k used).
-    alignas(TriHit) unsigned char hitBytes[sizeof(TriHit) * kMaxMeshes * kMaxPacket];
-    TriHit* const meshHits = reinterpret_cast<TriHit*>(hitBytes);
-    std::uninitialized_default_construct_n(meshHits, size_t(k) * kMaxPacket);
+    // Hits per touched mesh and ray, written by the packet trace where found and read only there
+    // (default values for k x kMaxPacket of them showed in the frame's profile).
+    PacketScratch<TriHit, kMaxMeshes * kMaxPacket> hitScratch;
+    TriHit* const meshHits = hitScratch.data();
     float bound[kMaxPacket];
     for (int i = 0; i < n; ++i) bound[i] = rays[i].tmax;
     for (int s = 0; s < k; ++s) {

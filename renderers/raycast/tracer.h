@@ -114,6 +114,33 @@ inline bool uvWithFootprint(const PixelFootprint* footprint, const vec3 P[3], co
 
 // --- Tracer --------------------------------------------------------------------------------------
 
+// A triangle hit's world vertices P, point p (interpolated), outward geometric normal gn and
+// that normal on the ray's side ng (back: the ray sees the triangle's back).
+struct MeshHitFrame {
+    vec3 P[3], p, gn, ng;
+    bool back = false;
+};
+inline MeshHitFrame meshHitFrame(const DrawMesh& dm, const rt::SceneHit& h, const rt::Ray& r) {
+    const Mesh& mesh = *dm.mesh;
+    const uint32_t i0 = mesh.indices[3 * h.prim], i1 = mesh.indices[3 * h.prim + 1], i2 = mesh.indices[3 * h.prim + 2];
+    const float w0 = 1.0f - h.b1 - h.b2, w1 = h.b1, w2 = h.b2;
+    MeshHitFrame fr;
+    fr.P[0] = vec3(dm.world * vec4(mesh.positions[i0], 1.0f));
+    fr.P[1] = vec3(dm.world * vec4(mesh.positions[i1], 1.0f));
+    fr.P[2] = vec3(dm.world * vec4(mesh.positions[i2], 1.0f));
+    fr.p = w0 * fr.P[0] + w1 * fr.P[1] + w2 * fr.P[2];
+    // Outward geometric normal: the CCW side, the CW side for mirrored instances
+    // (as GL's glFrontFace(GL_CW) for them).
+    vec3 gn = glm::cross(fr.P[1] - fr.P[0], fr.P[2] - fr.P[0]);
+    const float gl = glm::length(gn);
+    gn = gl > 0 ? gn / gl : vec3(0, 1, 0);
+    if (dm.mirrored) gn = -gn;
+    fr.gn = gn;
+    fr.back = glm::dot(gn, r.dir) > 0;   // seen from its back: flip (two-sided)
+    fr.ng = fr.back ? -gn : gn;
+    return fr;
+}
+
 // The surface a primary ray keeps (see Tracer::trace): where, and what (Framebuffer's
 // visibility). p is NaN while the ray has met nothing that writes depth.
 struct SurfaceRecord {
@@ -133,11 +160,17 @@ struct Tracer {
     rt::TraversalCount* cost = nullptr;
     // The primary ray's first hit when it was already traced (a tile's camera rays go through
     // SceneAccel::intersectPacket): used once, by the next firstSurface call, instead of tracing.
+    // A mesh hit's frame (meshHitFrame) is kept with it once made: the shadow packets ask for
+    // it first, the shading again (one vertex fetch and transform per hit instead of two).
     struct FirstHit {
         bool found = false;
         rt::SceneHit hit;
+        mutable bool framed = false;
+        mutable MeshHitFrame frame;
     };
     const FirstHit* firstHit = nullptr;
+    // The FirstHit that the last firstSurface call returned as the surface (null when it traced).
+    const FirstHit* surfaceFrom = nullptr;
     // The shadow rays of a primary hit when they were already traced (a tile's packets, see
     // presetShadows): for the surface point p with geometric normal ng, bit i of `known` says
     // light i's visibility is known, bit i of `lit` gives it (1 or 0: opaque scenes, hard shadows).
@@ -249,8 +282,8 @@ struct Tracer {
 
     // The hard shadow ray toward light L from p (geometric normal ng): it starts eps off the
     // surface on the light's side and stops just short of the light (tmax <= 0: no ray).
-    static rt::Ray shadowRay(const DrawLight& L, const vec3& p, const vec3& ng) {
-        const LightSample ls = sampleLight(L, p);
+    static rt::Ray shadowRay(const DrawLight& L, const vec3& p, const vec3& ng) { return shadowRay(sampleLight(L, p), p, ng); }
+    static rt::Ray shadowRay(const LightSample& ls, const vec3& p, const vec3& ng) {
         const float side = glm::dot(ng, ls.toLight) >= 0 ? 1.0f : -1.0f;
         const float eps = offsetScale(p);
         rt::Ray sr;
@@ -264,12 +297,13 @@ struct Tracer {
     // Where a primary hit's shading will ask for shadows: the point p and the geometric normal ng
     // on the ray's side, computed as shadeMeshHit / shadeAnalyticHit do (meshHitFrame). False for
     // hits that ask for none (unlit materials).
-    bool shadowPoint(const rt::SceneHit& h, const rt::Ray& r, vec3& p, vec3& ng) const {
+    bool shadowPoint(const FirstHit& fh, const rt::Ray& r, vec3& p, vec3& ng) const {
+        const rt::SceneHit& h = fh.hit;
         if (materialOf(h).unlit) return false;
         if (h.kind == rt::SceneHit::Kind::Mesh) {
-            vec3 P[3], gn;
-            bool back;
-            meshHitFrame(f.meshes[h.instance], h, r, P, p, gn, back, ng);
+            const MeshHitFrame& fr = frameOf(fh, r);
+            p = fr.p;
+            ng = fr.ng;
             return true;
         }
         p = r.org + h.t * r.dir;
@@ -291,17 +325,19 @@ struct Tracer {
         for (int k = 0; k < n; ++k) {
             out[k] = presets[k];
             out[k]->known = out[k]->lit = 0;
-            if (hits[k]->found && shadowPoint(hits[k]->hit, *camRays[k], out[k]->p, out[k]->ng)) pending |= uint64_t(1) << k;
+            if (hits[k]->found && shadowPoint(*hits[k], *camRays[k], out[k]->p, out[k]->ng)) pending |= uint64_t(1) << k;
         }
         const size_t lights = std::min<size_t>(f.lights.size(), 64);
+        const bool pbr = f.settings.reflection == ReflectionModel::Pbr;
         for (size_t i = 0; i < lights && pending; ++i) {
             const DrawLight& L = f.lights[i];
             if (softLight(L)) continue;
             uint64_t active = 0;
             for (uint64_t m = pending; m; m &= m - 1) {
                 const int k = __builtin_ctzll(m);
-                if (!lightReaches(L, out[k]->p, out[k]->ng, f.settings.reflection)) continue;
-                sr[k] = shadowRay(L, out[k]->p, out[k]->ng);
+                const LightSample ls = sampleLight(L, out[k]->p);   // lightReaches' own sample, but under pbr
+                if (!(pbr ? lightReaches(L, out[k]->p, out[k]->ng, f.settings.reflection) : sampleReaches(ls, out[k]->ng))) continue;
+                sr[k] = shadowRay(ls, out[k]->p, out[k]->ng);
                 out[k]->known |= uint64_t(1) << i;
                 if (sr[k].tmax > 0)
                     active |= uint64_t(1) << k;
@@ -362,11 +398,13 @@ struct Tracer {
     // count: where the traversal cost is added (primary rays of the cost view), or null.
     bool firstSurface(rt::Ray& r, rt::SceneHit& h, float& alpha, int& layer, const PixelFootprint* footprint, rt::TraversalCount* count = nullptr) {
         for (;;) {
+            surfaceFrom = nullptr;
             if (firstHit) {
                 const FirstHit* pre = firstHit;
                 firstHit = nullptr;
                 if (!pre->found) return false;
                 h = pre->hit;
+                surfaceFrom = pre;
             } else if (!accel.intersect(r, h, f.settings.culling, count)) {
                 return false;
             }
@@ -396,29 +434,20 @@ struct Tracer {
         return back ? -perturbNormal(-n, tw, ms.normalTexel, scale) : perturbNormal(n, tw, ms.normalTexel, scale);
     }
 
-    // Shades a triangle hit: interpolated position (s.p), normals, vertex colours, texture
-    // (filtered with the footprint), then the shading model with shadow rays into vis.
-    // A triangle hit's world vertices P, point p (interpolated), outward geometric normal gn and
-    // that normal on the ray's side ng (back: the ray sees the triangle's back).
-    static void meshHitFrame(const DrawMesh& dm, const rt::SceneHit& h, const rt::Ray& r, vec3 P[3], vec3& p, vec3& gn, bool& back, vec3& ng) {
-        const Mesh& mesh = *dm.mesh;
-        const uint32_t i0 = mesh.indices[3 * h.prim], i1 = mesh.indices[3 * h.prim + 1], i2 = mesh.indices[3 * h.prim + 2];
-        const float w0 = 1.0f - h.b1 - h.b2, w1 = h.b1, w2 = h.b2;
-        P[0] = vec3(dm.world * vec4(mesh.positions[i0], 1.0f));
-        P[1] = vec3(dm.world * vec4(mesh.positions[i1], 1.0f));
-        P[2] = vec3(dm.world * vec4(mesh.positions[i2], 1.0f));
-        p = w0 * P[0] + w1 * P[1] + w2 * P[2];
-        // Outward geometric normal: the CCW side, the CW side for mirrored instances
-        // (as GL's glFrontFace(GL_CW) for them).
-        gn = glm::cross(P[1] - P[0], P[2] - P[0]);
-        const float gl = glm::length(gn);
-        gn = gl > 0 ? gn / gl : vec3(0, 1, 0);
-        if (dm.mirrored) gn = -gn;
-        back = glm::dot(gn, r.dir) > 0;   // seen from its back: flip (two-sided)
-        ng = back ? -gn : gn;
+    // The frame of fh's mesh hit along r, made on the first call and kept with the hit.
+    const MeshHitFrame& frameOf(const FirstHit& fh, const rt::Ray& r) const {
+        if (!fh.framed) {
+            fh.frame = meshHitFrame(f.meshes[fh.hit.instance], fh.hit, r);
+            fh.framed = true;
+        }
+        return fh.frame;
     }
 
-    void shadeMeshHit(const rt::SceneHit& h, const rt::Ray& r, const vec3& eye, const PixelFootprint* footprint, float* vis, ShadedHit& s) {
+    // Shades a triangle hit: interpolated position (s.p), normals, vertex colours, texture
+    // (filtered with the footprint), then the shading model with shadow rays into vis. known:
+    // the hit's frame when it was already made (frameOf), else null.
+    void shadeMeshHit(const rt::SceneHit& h, const rt::Ray& r, const vec3& eye, const PixelFootprint* footprint, float* vis, ShadedHit& s,
+                      const MeshHitFrame* known = nullptr) {
         vec3 &p = s.p, &n = s.n, &ng = s.ng, &color = s.color;
         const Material*& mat = s.mat;
         const DrawMesh& dm = f.meshes[h.instance];
@@ -426,9 +455,12 @@ struct Tracer {
         mat = &dm.material;
         const uint32_t i0 = mesh.indices[3 * h.prim], i1 = mesh.indices[3 * h.prim + 1], i2 = mesh.indices[3 * h.prim + 2];
         const float w0 = 1.0f - h.b1 - h.b2, w1 = h.b1, w2 = h.b2;
-        vec3 P[3], gn;
-        bool back;
-        meshHitFrame(dm, h, r, P, p, gn, back, ng);
+        const MeshHitFrame fr = known ? *known : meshHitFrame(dm, h, r);
+        const vec3(&P)[3] = fr.P;
+        const vec3& gn = fr.gn;
+        const bool back = fr.back;
+        p = fr.p;
+        ng = fr.ng;
         const bool hasN = mesh.normals.size() == mesh.positions.size();
         const bool hasC = mesh.colors.size() == mesh.positions.size();
         const bool hasUV = mesh.uv0.size() == mesh.positions.size();
@@ -591,7 +623,7 @@ struct Tracer {
         ShadedHit s;
         s.p = r.org + h.t * r.dir;
         if (h.kind == rt::SceneHit::Kind::Mesh)
-            shadeMeshHit(h, r, eye, footprint, vis, s);
+            shadeMeshHit(h, r, eye, footprint, vis, s, surfaceFrom && surfaceFrom->framed ? &surfaceFrom->frame : nullptr);
         else
             shadeAnalyticHit(h, r, eye, vis, s);
         if (ownHit) {
@@ -606,7 +638,7 @@ struct Tracer {
             color = glm::mix(color, reflection(s, dirN, bounce, footprint), std::clamp(s.mat->reflectivity, 0.0f, 1.0f));
         else if (f.settings.reflections && f.settings.reflection == ReflectionModel::Pbr && s.lit && bounce < f.settings.maxBounces)
             color += tracedSpecular(s, dirN, bounce, footprint);
-        if (bounce == 0) color = applyFog(f.settings, color, glm::length(vec3(f.camera.view * vec4(s.p, 1.0f))));
+        if (bounce == 0 && f.settings.fog != FogMode::Off) color = applyFog(f.settings, color, glm::length(vec3(f.camera.view * vec4(s.p, 1.0f))));
         if (blended && (alpha < 1.0f || hitPos) && layer + 1 < kMaxLayers) {
             rt::Ray behind = r;
             behind.tmin = h.t;

@@ -125,6 +125,9 @@ ShadeTerms lightTerms(const SurfaceCoefficients& m, const sg::vec3& n, const sg:
 // when n.l <= 0 or no radiance arrives (outside a spot's cone or range), and then the light's
 // visibility changes nothing (the ray caster skips its shadow ray).
 bool lightReaches(const sg::DrawLight& light, const sg::vec3& p, const sg::vec3& n, sg::ReflectionModel model = sg::ReflectionModel::Phong);
+// The same test on a sample already made (sampleLight for Phong and Blinn-Phong,
+// samplePunctualLight for pbr).
+inline bool sampleReaches(const LightSample& l, const sg::vec3& n) { return glm::dot(n, l.toLight) > 0.0f && l.radiance != sg::vec3(0.0f); }
 
 // What the pbr model needs beyond Phong's inputs: the albedo rho (F0 of metals depends on it;
 // Gouraud passes the vertex's) and the environment light (null or empty: none).
