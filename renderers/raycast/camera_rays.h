@@ -36,9 +36,25 @@ public:
     // When the far plane lies at or beyond infinity in the float projection (far/near so large
     // that -(f + n) / (f - n) rounds to -1 or past it, as the rasterizers also see it), the ray
     // runs from the near plane through NDC z = 0 with no far end (tmax = FLT_MAX).
-    Ray ray(float wx, float wy) const {
-        const double x = 2.0 * double(wx) / m_w - 1.0, y = 2.0 * double(wy) / m_h - 1.0;
-        const glm::dvec4 xy = m_inv[0] * glm::dvec4(x) + m_inv[1] * glm::dvec4(y);
+    Ray ray(float wx, float wy) const { return rayThrough(column(wx) + row(wy)); }
+    // The rays through a grid of window positions, row by row: out[j * nx + i] is ray(wx[i],
+    // wy[j]) bit for bit, each column's and row's share of the unprojection made once.
+    void grid(const float* wx, int nx, const float* wy, int ny, Ray* out) const {
+        constexpr int kMax = 8;
+        glm::dvec4 cols[kMax];
+        for (int i = 0; i < nx && i < kMax; ++i) cols[i] = column(wx[i]);
+        for (int j = 0; j < ny; ++j) {
+            const glm::dvec4 r = row(wy[j]);
+            for (int i = 0; i < nx; ++i) out[j * nx + i] = rayThrough((i < kMax ? cols[i] : column(wx[i])) + r);
+        }
+    }
+
+private:
+    // m_inv * (x, y, z, 1) = (m0 x + m1 y) + (m2 z + m3): the x and y terms of window position (wx, wy).
+    glm::dvec4 column(float wx) const { return m_inv[0] * glm::dvec4(2.0 * double(wx) / m_w - 1.0); }
+    glm::dvec4 row(float wy) const { return m_inv[1] * glm::dvec4(2.0 * double(wy) / m_h - 1.0); }
+    // The ray whose (x, y) share of the unprojection is xy.
+    Ray rayThrough(const glm::dvec4& xy) const {
         const glm::dvec4 a = xy + m_zw[0], b = xy + m_zw[1];   // the points at NDC z = -1 and z = +1
         const glm::dvec3 org = glm::dvec3(a) / a.w;
         Ray r;
@@ -55,6 +71,8 @@ public:
         if (!finite(r.org) || !finite(r.dir)) r.tmax = -1.0f;   // meets nothing
         return r;
     }
+
+public:
     // Window depth (0.5 * ndc_z + 0.5) of a world point, as the rasterizers write it.
     float depth(const sg::vec3& p) const {
         sg::vec4 c = m_viewProj * sg::vec4(p, 1.0f);

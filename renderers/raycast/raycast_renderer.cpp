@@ -93,9 +93,12 @@ void traceCameraPackets(const FrameJob& job, const rt::SceneAccel& accel, int x0
         for (int px = x0; px < x1; px += kPacket) {
             rt::PacketScratch<rt::Ray, kPacket * kPacket> pr;
             rt::PacketScratch<rt::SceneHit, kPacket * kPacket> ph;
-            int n = 0;
-            for (int row = py; row < std::min(py + kPacket, y1); ++row)
-                for (int x = px; x < std::min(px + kPacket, x1); ++x) pr[n++] = job.cam.ray(float(x) + 0.5f, float(job.h - 1 - row) + 0.5f);
+            const int nx = std::min(px + kPacket, x1) - px, ny = std::min(py + kPacket, y1) - py;
+            float wx[kPacket], wy[kPacket];
+            for (int i = 0; i < nx; ++i) wx[i] = float(px + i) + 0.5f;
+            for (int j = 0; j < ny; ++j) wy[j] = float(job.h - 1 - (py + j)) + 0.5f;
+            job.cam.grid(wx, nx, wy, ny, pr.data());
+            int n = nx * ny;
             const uint64_t found = accel.intersectPacket(pr.data(), n, ~uint64_t(0), ph.data(), job.f.settings.culling);
             n = 0;
             for (int row = py; row < std::min(py + kPacket, y1); ++row)
@@ -226,6 +229,7 @@ protected:
         // FTZ/DAZ: denormals in the traversal cost a lot and change nothing visible.
         const unsigned csr = _mm_getcsr();
         m_accel.update(f);
+        m_world = debugSwitches().raycastWorldVertices ? &m_worldVertices.update(f) : nullptr;
         stats.triangles = f.triangleCount();
         prepareSamplers(f);
         std::string envError;
@@ -255,7 +259,7 @@ protected:
 public:
     std::vector<float> lightVisibility(const FrameInput& f, const vec3& p, const vec3& ng) override {
         if (!f.settings.shadows || m_textures.size() != f.meshes.size()) return {};
-        Tracer tr{f, m_accel, m_textures, m_maps, 0, anyTranslucent(f)};
+        Tracer tr{f, m_accel, m_textures, m_maps, nullptr, 0, anyTranslucent(f)};
         std::vector<float> v(f.lights.size(), 1.0f);
         if (!v.empty()) tr.lightVisibility(p, ng, v.data());
         return v;
@@ -266,7 +270,7 @@ public:
         std::vector<float> out(p.size(), 1.0f);
         const bool translucent = anyTranslucent(f);
         tbb::parallel_for(tbb::blocked_range<size_t>(0, p.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
-            Tracer tr{f, m_accel, m_textures, m_maps, 0, translucent};
+            Tracer tr{f, m_accel, m_textures, m_maps, nullptr, 0, translucent};
             std::vector<float> v(f.lights.size(), 1.0f);
             for (size_t i = r.begin(); i < r.end(); ++i) {
                 tr.lightVisibility(p[i], ng[i], v.data());
@@ -317,7 +321,7 @@ private:
                     cancelled = true;
                     break;
                 }
-                Tracer tr{f, m_accel, m_textures, m_maps, 0, anyAlpha};
+                Tracer tr{f, m_accel, m_textures, m_maps, m_world, 0, anyAlpha};
                 tr.env = &m_environment;
                 const int x0 = (ti % tx) * tile, y0 = (ti / tx) * tile;   // y0: framebuffer row (top-down)
                 const int x1 = std::min(x0 + tile, job.w), y1 = std::min(y0 + tile, job.h);
@@ -355,6 +359,8 @@ private:
     }
 
     rt::SceneAccel m_accel;
+    rt::WorldVertexCache m_worldVertices;
+    const std::vector<const rt::WorldVertices*>* m_world = nullptr;   // this frame's (null: switched off)
     SamplerCache m_samplers;
     // The last frame's samplers per mesh (kept for lightVisibility).
     std::vector<const SampledTexture*> m_textures;

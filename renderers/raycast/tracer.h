@@ -13,6 +13,7 @@
 
 #include "raycast/camera_rays.h"
 #include "raycast/scene_accel.h"
+#include "raycast/world_vertices.h"
 #include "renderers/environment.h"
 #include "renderers/pbr.h"
 #include "renderers/sampling.h"
@@ -120,14 +121,21 @@ struct MeshHitFrame {
     vec3 P[3], p, gn, ng;
     bool back = false;
 };
-inline MeshHitFrame meshHitFrame(const DrawMesh& dm, const rt::SceneHit& h, const rt::Ray& r) {
+// wv: the instance's world vertices (the same values, made once), or null.
+inline MeshHitFrame meshHitFrame(const DrawMesh& dm, const rt::SceneHit& h, const rt::Ray& r, const rt::WorldVertices* wv) {
     const Mesh& mesh = *dm.mesh;
     const uint32_t i0 = mesh.indices[3 * h.prim], i1 = mesh.indices[3 * h.prim + 1], i2 = mesh.indices[3 * h.prim + 2];
     const float w0 = 1.0f - h.b1 - h.b2, w1 = h.b1, w2 = h.b2;
     MeshHitFrame fr;
-    fr.P[0] = vec3(dm.world * vec4(mesh.positions[i0], 1.0f));
-    fr.P[1] = vec3(dm.world * vec4(mesh.positions[i1], 1.0f));
-    fr.P[2] = vec3(dm.world * vec4(mesh.positions[i2], 1.0f));
+    if (wv) {
+        fr.P[0] = wv->positions[i0];
+        fr.P[1] = wv->positions[i1];
+        fr.P[2] = wv->positions[i2];
+    } else {
+        fr.P[0] = vec3(dm.world * vec4(mesh.positions[i0], 1.0f));
+        fr.P[1] = vec3(dm.world * vec4(mesh.positions[i1], 1.0f));
+        fr.P[2] = vec3(dm.world * vec4(mesh.positions[i2], 1.0f));
+    }
     fr.p = w0 * fr.P[0] + w1 * fr.P[1] + w2 * fr.P[2];
     // Outward geometric normal: the CCW side, the CW side for mirrored instances
     // (as GL's glFrontFace(GL_CW) for them).
@@ -153,6 +161,9 @@ struct Tracer {
     const rt::SceneAccel& accel;
     const std::vector<const SampledTexture*>& textures;   // per f.meshes entry, null if none
     const std::vector<MapSamplers>& maps;                 // per f.meshes entry: emissive, occlusion, metallic-roughness, normal
+    // Per f.meshes entry, its vertices in world space (WorldVertexCache), null where not made;
+    // null: none at all.
+    const std::vector<const rt::WorldVertices*>* world = nullptr;
     uint64_t rays = 0;
     bool anyAlpha = false;   // some material is masked or blended (anyTranslucent())
     // The cost view (RenderConfig::traversalCost): the BVH work of the primary ray (bounce 0,
@@ -255,13 +266,15 @@ struct Tracer {
         for (size_t i = 0; i < f.lights.size(); ++i) {
             visible[i] = 1.0f;
             if (!f.settings.shadows) continue;
+            const bool isKnown = i < 64 && ((known >> i) & 1);
+            if (isKnown && ((pre->lit >> i) & 1)) continue;   // lit: 1, whether the light reaches the points or not
             if (points > 0) {
                 bool reaches = false;
                 for (int k = 0; k < points && !reaches; ++k) reaches = lightReaches(f.lights[i], q[k], n[k], f.settings.reflection);
                 if (!reaches) continue;
             }
-            if (i < 64 && ((known >> i) & 1)) {
-                visible[i] = float((pre->lit >> i) & 1);
+            if (isKnown) {   // blocked
+                visible[i] = 0.0f;
                 continue;
             }
             if (softLight(f.lights[i])) {
@@ -434,10 +447,12 @@ struct Tracer {
         return back ? -perturbNormal(-n, tw, ms.normalTexel, scale) : perturbNormal(n, tw, ms.normalTexel, scale);
     }
 
+    const rt::WorldVertices* worldOf(uint32_t mesh) const { return world ? (*world)[mesh] : nullptr; }
+
     // The frame of fh's mesh hit along r, made on the first call and kept with the hit.
     const MeshHitFrame& frameOf(const FirstHit& fh, const rt::Ray& r) const {
         if (!fh.framed) {
-            fh.frame = meshHitFrame(f.meshes[fh.hit.instance], fh.hit, r);
+            fh.frame = meshHitFrame(f.meshes[fh.hit.instance], fh.hit, r, worldOf(fh.hit.instance));
             fh.framed = true;
         }
         return fh.frame;
@@ -455,7 +470,8 @@ struct Tracer {
         mat = &dm.material;
         const uint32_t i0 = mesh.indices[3 * h.prim], i1 = mesh.indices[3 * h.prim + 1], i2 = mesh.indices[3 * h.prim + 2];
         const float w0 = 1.0f - h.b1 - h.b2, w1 = h.b1, w2 = h.b2;
-        const MeshHitFrame fr = known ? *known : meshHitFrame(dm, h, r);
+        const rt::WorldVertices* wv = worldOf(h.instance);
+        const MeshHitFrame fr = known ? *known : meshHitFrame(dm, h, r, wv);
         const vec3(&P)[3] = fr.P;
         const vec3& gn = fr.gn;
         const bool back = fr.back;
@@ -492,11 +508,17 @@ struct Tracer {
             }
         }
         vec3 Nv[3];
+        const bool worldN = hasN && wv && !wv->normals.empty();
         for (int k = 0; k < 3; ++k) {
             uint32_t idx = k == 0 ? i0 : k == 1 ? i1 : i2;
-            vec3 nn = hasN ? dm.normal * mesh.normals[idx] : gn;
-            float l = glm::length(nn);
-            Nv[k] = l > 1e-20f ? nn / l : gn;
+            if (worldN) {   // the same values, made once (zero: the face normal)
+                const vec3& c = wv->normals[idx];
+                Nv[k] = c.x == 0.0f && c.y == 0.0f && c.z == 0.0f ? gn : c;
+            } else {
+                vec3 nn = hasN ? dm.normal * mesh.normals[idx] : gn;
+                float l = glm::length(nn);
+                Nv[k] = l > 1e-20f ? nn / l : gn;
+            }
             if (back) Nv[k] = -Nv[k];
         }
         const ShadingModel model = f.settings.shading;
@@ -611,7 +633,6 @@ struct Tracer {
         const bool blended = materialOf(h).alphaMode == AlphaMode::Blend;
         if (blended) alpha = std::clamp(alpha, 0.0f, 1.0f);
         SurfaceRecord* const ownHit = blended ? nullptr : hitPos;
-        vec3 dirN = glm::normalize(r.dir);
         float visible[64];
         std::vector<float> visHeap;
         float* vis = visible;
@@ -635,9 +656,9 @@ struct Tracer {
         vec3 color = s.color;
 
         if (f.settings.reflections && s.mat->reflectivity > 0.0f && bounce < f.settings.maxBounces)
-            color = glm::mix(color, reflection(s, dirN, bounce, footprint), std::clamp(s.mat->reflectivity, 0.0f, 1.0f));
+            color = glm::mix(color, reflection(s, glm::normalize(r.dir), bounce, footprint), std::clamp(s.mat->reflectivity, 0.0f, 1.0f));
         else if (f.settings.reflections && f.settings.reflection == ReflectionModel::Pbr && s.lit && bounce < f.settings.maxBounces)
-            color += tracedSpecular(s, dirN, bounce, footprint);
+            color += tracedSpecular(s, glm::normalize(r.dir), bounce, footprint);
         if (bounce == 0 && f.settings.fog != FogMode::Off) color = applyFog(f.settings, color, glm::length(vec3(f.camera.view * vec4(s.p, 1.0f))));
         if (blended && (alpha < 1.0f || hitPos) && layer + 1 < kMaxLayers) {
             rt::Ray behind = r;

@@ -967,6 +967,69 @@ TEST(RaycastTest, ShadowPacketsGiveTheSameImageAsSingleShadowRays) {
     }
 }
 
+// The ray caster keeps its meshes' vertices in world space across frames (WorldVertexCache):
+// the same values the shading would compute per hit, so the image is the same bit for bit,
+// under a rotated, non-uniformly scaled and a mirrored instance, a degenerate vertex normal and
+// a mesh without normals; and a kept copy follows edits of the mesh and of its instance's matrix.
+TEST(RaycastTest, WorldVertexCopiesGiveTheSameImageAndFollowEdits) {
+    const int w = 160, h = 120;
+    FrameInput f = triangleScene(w, h);
+    auto sphere = std::make_shared<Mesh>(primitives::uvSphere(0.6f, 64, 32));   // 4k triangles: copied
+    sphere->normals[100] = vec3(0.0f);                                          // the face normal there
+    DrawMesh big;
+    big.mesh = sphere;
+    big.world = glm::translate(mat4(1.0f), vec3(-1.2f, 0.7f, 0.3f)) * glm::rotate(mat4(1.0f), 0.7f, glm::normalize(vec3(1, 2, 3))) *
+                glm::scale(mat4(1.0f), vec3(1.3f, 0.6f, 0.9f));
+    big.normal = normalMatrix(big.world);
+    f.meshes.push_back(big);
+    DrawMesh mirrored = big;   // the same mesh, mirrored: a second copy
+    mirrored.world = glm::translate(mat4(1.0f), vec3(1.3f, 0.8f, 0.0f)) * glm::scale(mat4(1.0f), vec3(-1.0f, 1.0f, 1.0f));
+    mirrored.normal = normalMatrix(mirrored.world);
+    mirrored.mirrored = true;
+    f.meshes.push_back(mirrored);
+    auto bare = std::make_shared<Mesh>(primitives::uvSphere(0.3f, 32, 16));   // no vertex normals: positions only
+    bare->normals.clear();
+    DrawMesh noNormals;
+    noNormals.mesh = bare;
+    noNormals.world = glm::translate(mat4(1.0f), vec3(0.2f, 0.4f, 1.5f));
+    noNormals.normal = normalMatrix(noNormals.world);
+    f.meshes.push_back(noNormals);
+    f.settings.shadows = true;
+    auto render = [&](Renderer& r, const char* copies) {
+        setenv("VIEWER_RAYCAST_WORLD_VERTICES", copies, 1);
+        Framebuffer fb;
+        const RenderStats st = r.render(f, w, h, fb, nullptr, RenderRequest{});
+        unsetenv("VIEWER_RAYCAST_WORLD_VERTICES");
+        EXPECT_TRUE(st.ok) << st.error;
+        return fb;
+    };
+    auto kept = makeRenderer("raycast");   // keeps its copies from frame to frame
+    auto expectSame = [&](const char* what) -> Framebuffer {
+        SCOPED_TRACE(what);
+        auto fresh = makeRenderer("raycast");
+        const Framebuffer perHit = render(*fresh, "0"), copied = render(*kept, "1");
+        EXPECT_EQ(perHit.color.size(), copied.color.size());
+        EXPECT_TRUE(perHit.color == copied.color);
+        EXPECT_TRUE(perHit.depth == copied.depth);
+        return copied;
+    };
+    for (ShadingModel model : {ShadingModel::Phong, ShadingModel::Gouraud, ShadingModel::Flat}) {
+        SCOPED_TRACE(std::string(toString(model)));
+        f.settings.shading = model;
+        expectSame("first frame");
+        expectSame("kept copies");
+    }
+    f.settings.shading = ShadingModel::Phong;
+    const Framebuffer before = expectSame("before the edits");
+    for (vec3& p : sphere->positions) p *= 0.8f;   // the mesh edited in place
+    sphere->touch();
+    const Framebuffer edited = expectSame("mesh edited");
+    f.meshes[3].world = glm::translate(f.meshes[3].world, vec3(0.0f, 0.3f, 0.0f));   // an instance moved
+    f.meshes[3].normal = normalMatrix(f.meshes[3].world);
+    expectSame("instance moved");
+    EXPECT_FALSE(before.color == edited.color);   // the edit shows
+}
+
 TEST(RaycastTest, AntiAliasingAndShadingModelsRun) {
     const int w = 64, h = 48;
     FrameInput f = triangleScene(w, h);

@@ -1,0 +1,58 @@
+// world_vertices.h - the ray caster's world-space copies of its meshes' vertices, kept across
+// frames. Shading a triangle hit reads its three vertices in world space: the positions through
+// the instance's world matrix and the normals through its normal matrix, normalized. Made per
+// hit, that is three matrix products and three square roots and divisions per pixel; a camera
+// that orbits a still scene asks for the same values frame after frame. The copies hold exactly
+// what the per-hit code computes (the same operations on the same inputs), so images do not
+// change by a bit.
+#pragma once
+
+#include "scenegraph/frame.h"
+
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+namespace rnd::rt {
+
+// One instance's vertices in world space.
+struct WorldVertices {
+    // vec3(world * vec4(p, 1)) for each position p.
+    std::vector<sg::vec3> positions;
+    // normal * n / |normal * n| for each vertex normal n, or exactly (0, 0, 0) where that length
+    // is not above 1e-20 (the shading then takes the face normal). Empty when the mesh has no
+    // normals per vertex.
+    std::vector<sg::vec3> normals;
+};
+
+class WorldVertexCache {
+public:
+    // Meshes below this many triangles are not copied: few pixels read each of their vertices.
+    static constexpr size_t kMinTriangles = 256;
+    // At most this many vertices are kept over all instances (24 bytes each with normals).
+    static constexpr size_t kMaxVertices = size_t(1) << 21;
+
+    // The copies for this frame, one per f.meshes entry (null: none, the shading transforms the
+    // vertices itself). Made in parallel where missing; an instance's copy is kept while its mesh
+    // (id, version) and matrices are the same bit for bit, and dropped after 8 frames unused. Not
+    // thread-safe; the returned pointers stay valid until the next update.
+    const std::vector<const WorldVertices*>& update(const sg::FrameInput& f);
+    size_t cachedVertices() const { return m_vertices; }
+
+private:
+    struct Entry {
+        sg::MeshPtr mesh;
+        uint64_t version = 0;   // 0: to be made again
+        size_t count = 0;       // vertices held (what m_vertices counts)
+        sg::mat4 world{1.0f};
+        sg::mat3 normal{1.0f};
+        WorldVertices v;
+        uint64_t lastFrame = 0;
+    };
+    std::unordered_multimap<uint64_t, Entry> m_entries;   // by a hash of mesh id and matrices
+    std::vector<const WorldVertices*> m_perMesh;
+    uint64_t m_frame = 0;
+    size_t m_vertices = 0;
+};
+
+}   // namespace rnd::rt
