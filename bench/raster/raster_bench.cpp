@@ -60,7 +60,9 @@
 // --culling auto|on|off: RenderSettings::culling of every scene (the scenes' materials are
 // double-sided, so with auto nothing is culled; on: ours and the fair minimal program cull back faces).
 // --quick: fewer frames and 960x540 (finishes well under a minute). --no-gl: raster only (for
-// profiling it, e.g. perf record ... bench_raster --no-gl --scenes mesh1M). --gl-only: our GL
+// profiling it, e.g. perf record ... bench_raster --no-gl --scenes mesh1M). --ours-only N: only
+// N warm frames of ours per scene (after a cold one), nothing printed: a profile of the frame alone
+// (perf record -g bench_raster --no-gl --ours-only 100 --scenes mesh10k). --gl-only: our GL
 // backend and the minimal GL program only (gl_ms, gl_cpu_ms and the image check); with
 // --gl-side ours|minimal only one of them runs, for a profiler to count one side's instructions
 // (valgrind --tool=callgrind bench_raster --gl-only --gl-side ours --frames N: the difference
@@ -301,7 +303,7 @@ double coveredPixels(const rnd::Framebuffer& fb) {
 
 int main(int argc, char** argv) {
     bool quick = false, noGl = false, glOnly = false;
-    int threads = 2, frames = 15, w = 1280, h = 720;
+    int threads = 2, frames = 15, w = 1280, h = 720, oursOnly = 0;
     std::string shading = "phong", fog = "on", only, glSide = "both";
     CullMode culling = CullMode::Auto;   // --culling: RenderSettings::culling of every scene (ours and the fair minimal program)
     std::vector<std::string> meshFiles;
@@ -320,6 +322,8 @@ int main(int argc, char** argv) {
             threads = std::max(1, std::atoi(next().c_str()));
         else if (a == "--frames")
             frames = std::max(1, std::atoi(next().c_str()));
+        else if (a == "--ours-only")
+            oursOnly = std::max(1, std::atoi(next().c_str()));
         else if (a == "--size")
             std::sscanf(next().c_str(), "%dx%d", &w, &h);
         else if (a == "--shading")
@@ -384,7 +388,7 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "bench: --gl-only without a GL backend: %s\n", err.c_str());
         return 1;
     }
-    if (!glOnly) {
+    if (!glOnly && oursOnly == 0) {
         const double bw1 = copyBandwidth(1), bwN = copyBandwidth(threads);
         std::printf("bench: scene=all what=floor_bw ours=%.2f ref=%.2f ratio=%.3f\n", bw1, bwN, bwN / bw1);
         const auto [cpu1, cpuN] = computeScaling(threads);
@@ -411,6 +415,11 @@ int main(int argc, char** argv) {
         b.scene.settings.shadows = false;
         FrameInput f = flatten(b.scene, float(w) / h);
         const char* sceneName = b.name.c_str();
+        if (oursOnly > 0) {   // a profiler's run: only our frames (one cold, then warm ones)
+            rnd::Framebuffer fb;
+            for (int i = 0; i <= oursOnly; ++i) ours->render(f, w, h, fb);
+            continue;
+        }
         // Shadows: the scene lit by one sun (the first light's radiance) with and without them.
         auto shadowRow = [&] {
             FrameInput off = f;

@@ -7,9 +7,16 @@
 // touches get the background straight away.
 #include "raster/raster_fragment.h"
 #include "raster/raster_frame.h"
+#include "raster/simd.h"
 
 #include <algorithm>
 #include <cstring>
+
+// rasterizeIntoTile's vector path is compiled only where simd.h says SSE2 is there: without the
+// include above it silently fell back to the scalar block walk (a file split lost it once).
+#if defined(__SSE2__) && !defined(RASTER_HAVE_SSE2)
+#error "raster/simd.h must define RASTER_HAVE_SSE2 here"
+#endif
 
 namespace rnd::raster {
 
