@@ -32,7 +32,10 @@
 //   scaling     ours: ms on 1 thread (ours=) vs on --threads (ref=); ratio = the speed-up; the
 //               frames of the two alternate (one on 1 thread, one on --threads, ...), so a
 //               change in the machine's load falls on both
-//   cold_ms     ours: the first frame of a new renderer (ours=) vs a warm one (ref=)
+//   cold_ms     ours: the first frame of a new renderer (ours=) vs a warm one (ref=), into a new image
+//   cold_reused_ms  the same into an image of the right size that it already had (as the window's
+//               RenderSlot gives a renderer after a backend switch): the renderer's own cold cost
+//               without the first touch of the image's pages
 //   pbr_ms      ours: the frame with the pbr model and the default environment (ours=) vs Phong (ref=;
 //               the goal: ratio <= 1.5)
 //   shadow_ms   ours: the frame lit by one sun with shadows (a 2048 map, PCF 3 x 3; ours=) vs the
@@ -497,6 +500,13 @@ int main(int argc, char** argv) {
             if (fresh && fresh->render(f, w, h, fb).ok)
                 cold = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         }
+        double coldReused = NAN;
+        {
+            auto fresh = rnd::makeRenderer("raster", &err);
+            auto t0 = std::chrono::steady_clock::now();
+            if (fresh && fresh->render(f, w, h, fbCold).ok)
+                coldReused = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        }
         // The minimal GL programs (both submissions), each in its own context.
         bench::MinimalGl mgl, fair;
         std::string em = noGl ? "skipped (--no-gl)" : mgl.setup(f, w, h);
@@ -574,6 +584,7 @@ int main(int argc, char** argv) {
             std::printf("bench: scene=%s what=floor_shade_scaling ours=%.2f ref=%.2f ratio=%.3f\n", n, shade1, shadeN, shade1 / shadeN);
         }
         std::printf("bench: scene=%s what=cold_ms ours=%.2f ref=%.2f ratio=%.3f\n", n, cold, to, cold / to);
+        std::printf("bench: scene=%s what=cold_reused_ms ours=%.2f ref=%.2f ratio=%.3f\n", n, coldReused, to, coldReused / to);
         {
             // The pbr model lit by the default environment (image-based light) vs the same frame in Phong.
             FrameInput fp = f;
