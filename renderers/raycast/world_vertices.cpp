@@ -59,10 +59,11 @@ const std::vector<const WorldVertices*>& WorldVertexCache::update(const FrameInp
             if (e.mesh == d.mesh && sameBits(&e.world, &d.world, sizeof d.world) && sameBits(&e.normal, &d.normal, sizeof d.normal)) found = &e;
         }
         const size_t n = d.mesh->positions.size();
-        if (found && found->version != d.mesh->version) {   // the mesh was edited: made again
+        if (found && (found->version != d.mesh->version || found->count != n)) {   // the mesh was edited: made again
             m_vertices -= found->count;
             found->count = 0;
             found->version = 0;
+            found->v = {};
         }
         if (!found || found->version == 0) {
             if (m_vertices + n > kMaxVertices) {   // over the budget: shaded from the mesh itself
