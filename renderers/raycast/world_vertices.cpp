@@ -53,35 +53,39 @@ const std::vector<const WorldVertices*>& WorldVertexCache::update(const FrameInp
         uint64_t key = mix(0xcbf29ce484222325ull, &d.mesh->id, sizeof d.mesh->id);
         key = mix(key, &d.world, sizeof d.world);
         key = mix(key, &d.normal, sizeof d.normal);
-        Entry* found = nullptr;
-        for (auto [it, end] = m_entries.equal_range(key); it != end && !found; ++it) {
-            Entry& e = it->second;
-            if (e.mesh == d.mesh && sameBits(&e.world, &d.world, sizeof d.world) && sameBits(&e.normal, &d.normal, sizeof d.normal)) found = &e;
+        Entry* e = nullptr;
+        for (auto [it, end] = m_entries.equal_range(key); it != end && !e; ++it) {
+            Entry& c = it->second;
+            if (c.mesh == d.mesh && sameBits(&c.world, &d.world, sizeof d.world) && sameBits(&c.normal, &d.normal, sizeof d.normal)) e = &c;
         }
         const size_t n = d.mesh->positions.size();
-        if (found && (found->version != d.mesh->version || found->count != n)) {   // the mesh was edited: made again
-            m_vertices -= found->count;
-            found->count = 0;
-            found->version = 0;
-            found->v = {};
+        const bool seenBefore = e != nullptr;
+        const uint64_t last = e ? e->lastFrame : 0;
+        if (!e) {   // first seen: remembered, not copied yet
+            e = &m_entries.emplace(key, Entry{})->second;
+            e->mesh = d.mesh;
+            e->world = d.world;
+            e->normal = d.normal;
         }
-        if (!found || found->version == 0) {
-            if (m_vertices + n > kMaxVertices) {   // over the budget: shaded from the mesh itself
-                if (found) found->lastFrame = 0;   // (an edited one is dropped below)
-                continue;
-            }
-            Entry& e = found ? *found : m_entries.emplace(key, Entry{})->second;
-            e.mesh = d.mesh;
-            e.version = d.mesh->version;
-            e.world = d.world;
-            e.normal = d.normal;
-            e.count = n;
+        e->lastFrame = m_frame;
+        if (e->made && (e->version != d.mesh->version || e->count != n)) {   // the mesh was edited: dropped
+            m_vertices -= e->count;
+            e->count = 0;
+            e->made = false;
+            e->v = {};
+        }
+        if (!e->made) {
+            // Copied only when seen unchanged in the frame before too: an instance being dragged or
+            // a mesh being edited changes every frame, and would pay a copy per frame for nothing.
+            const bool steady = seenBefore && last + 1 == m_frame && e->version == d.mesh->version;
+            e->version = d.mesh->version;
+            if (!steady || m_vertices + n > kMaxVertices) continue;   // shaded from the mesh itself
+            e->made = true;
+            e->count = n;
             m_vertices += n;
-            missing.emplace_back(&d, &e);
-            found = &e;
+            missing.emplace_back(&d, e);
         }
-        found->lastFrame = m_frame;
-        m_perMesh[i] = &found->v;
+        m_perMesh[i] = &e->v;
     }
     for (auto& [d, e] : missing) fill(*d, e->v);   // each fills in parallel
     for (auto it = m_entries.begin(); it != m_entries.end();) {

@@ -33,8 +33,10 @@ public:
     static constexpr size_t kMaxVertices = size_t(1) << 21;
 
     // The copies for this frame, one per f.meshes entry (null: none, the shading transforms the
-    // vertices itself). Made in parallel where missing; an instance's copy is kept while its mesh
-    // (id, version) and matrices are the same bit for bit, and dropped after 8 frames unused. Not
+    // vertices itself). An instance is copied (in parallel) when its mesh (id, version) and
+    // matrices are the same bit for bit as in the frame before: a still scene seen by a moving
+    // camera from its second frame on, never an instance dragged or a mesh edited frame after
+    // frame. A copy is kept while they stay the same and dropped after 8 frames unused. Not
     // thread-safe; the returned pointers stay valid until the next update.
     const std::vector<const WorldVertices*>& update(const sg::FrameInput& f);
     size_t cachedVertices() const { return m_vertices; }
@@ -42,7 +44,8 @@ public:
 private:
     struct Entry {
         sg::MeshPtr mesh;
-        uint64_t version = 0;   // 0: to be made again
+        uint64_t version = 0;   // the mesh's version when last seen (made: the one copied)
+        bool made = false;      // v holds the copy
         size_t count = 0;       // vertices held (what m_vertices counts)
         sg::mat4 world{1.0f};
         sg::mat3 normal{1.0f};
