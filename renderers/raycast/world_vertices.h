@@ -39,7 +39,6 @@ public:
     // frame. A copy is kept while they stay the same and dropped after 8 frames unused. Not
     // thread-safe; the returned pointers stay valid until the next update.
     const std::vector<const WorldVertices*>& update(const sg::FrameInput& f);
-    size_t cachedVertices() const { return m_vertices; }
 
 private:
     struct Entry {
