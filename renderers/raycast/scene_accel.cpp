@@ -67,6 +67,7 @@ int SceneAccel::update(const FrameInput& f) {
         inst.packets = d.mesh->triangleCount() >= kPacketMinTriangles;
         m_anyPacketMesh |= inst.packets;
         inst.invWorld = glm::inverse(d.world);
+        inst.invLinear = mat3(inst.invWorld);
         Aabb wb = it->second.bvh.bounds().transformed(d.world);
         inst.boxMin = wb.min;
         inst.boxMax = wb.max;
@@ -81,6 +82,7 @@ int SceneAccel::update(const FrameInput& f) {
         inst.isMesh = false;
         inst.index = i;
         inst.invWorld = a.invWorld;
+        inst.invLinear = mat3(inst.invWorld);
         if (a.kind != DrawAnalytic::Kind::Csg && !isInvertible(a.world)) continue;
         if (a.kind == DrawAnalytic::Kind::Parametric || a.kind == DrawAnalytic::Kind::Grid) {
             AnalyticEntry& e = m_analytics[a.geometryKey];
@@ -145,10 +147,10 @@ uint64_t eachRay(uint64_t active, Hit&& hit) {
 }
 
 // The world ray in the instance's object space (the direction not normalised, so t is shared).
-Ray localRay(const mat4& invWorld, const Ray& wr, float tmax) {
+Ray localRay(const mat4& invWorld, const mat3& invLinear, const Ray& wr, float tmax) {
     Ray lr;
     lr.org = vec3(invWorld * vec4(wr.org, 1.0f));
-    lr.dir = mat3(invWorld) * wr.dir;
+    lr.dir = invLinear * wr.dir;
     lr.tmin = wr.tmin;
     lr.tmax = tmax;
     return lr;
@@ -168,7 +170,7 @@ void setMeshHit(SceneHit& hit, const TriHit& th, uint32_t instance) {
 float SceneAccel::boxEntry(const Instance& inst, const Ray& r, const vec3& inv) const { return slabEntry(inst.boxMin, inst.boxMax, r, inv); }
 
 bool SceneAccel::intersectInstance(const Instance& inst, const Ray& wr, float tmax, SceneHit& hit, bool cull, TraversalCount* count) const {
-    const Ray lr = localRay(inst.invWorld, wr, tmax);
+    const Ray lr = localRay(inst.invWorld, inst.invLinear, wr, tmax);
     if (inst.isMesh) {
         TriHit th;
         if (!inst.bvh->intersect(lr, th, cull, count)) return false;
@@ -327,7 +329,7 @@ uint64_t SceneAccel::intersectPacket(const Ray* rays, int n, uint64_t active, Sc
         for (uint64_t m = touched[s].rays; m; m &= m - 1) {
             const int i = __builtin_ctzll(m);
             lr[i].org = vec3(inst.invWorld * vec4(rays[i].org, 1.0f));   // as intersectInstance
-            lr[i].dir = mat3(inst.invWorld) * rays[i].dir;
+            lr[i].dir = inst.invLinear * rays[i].dir;
             lr[i].tmin = rays[i].tmin;
             lr[i].tmax = bound[i];
         }
@@ -474,7 +476,7 @@ uint64_t SceneAccel::occludedPacket(const Ray* rays, int n, uint64_t active) con
         const Instance& inst = m_instances[touched[s].instance];
         for (uint64_t m = todo; m; m &= m - 1) {
             const int i = __builtin_ctzll(m);
-            lr[i] = localRay(inst.invWorld, rays[i], rays[i].tmax);
+            lr[i] = localRay(inst.invWorld, inst.invLinear, rays[i], rays[i].tmax);
         }
         blocked |= inst.bvh->occludedPacket(lr.data(), n, todo);
     }
@@ -483,7 +485,7 @@ uint64_t SceneAccel::occludedPacket(const Ray* rays, int n, uint64_t active) con
 
 bool SceneAccel::instanceOccluded(const Instance& inst, const Ray& r) const {
     if (inst.isMesh || inst.param) {   // any-hit tests; a parametric surface's stops at its first sub-patch hit
-        const Ray lr = localRay(inst.invWorld, r, r.tmax);
+        const Ray lr = localRay(inst.invWorld, inst.invLinear, r, r.tmax);
         return inst.isMesh ? inst.bvh->occluded(lr) : inst.param->occluded(lr);
     }
     SceneHit h;

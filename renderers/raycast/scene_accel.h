@@ -83,6 +83,7 @@ private:
         const ParametricAccel* param = nullptr;
         const GridAccel* grid = nullptr;
         sg::mat4 invWorld{1.0f};
+        sg::mat3 invLinear{1.0f};              // mat3(invWorld): what turns directions into object space
         sg::vec3 boxMin{0.0f}, boxMax{0.0f};   // its box in the top level (world)
     };
 
