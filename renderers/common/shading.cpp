@@ -196,13 +196,11 @@ ShadeTerms shadeTerms(const SurfaceCoefficients& m, const vec3& p, const vec3& n
     const vec3 v = toViewer(eye, p);
     const bool pbr = f.settings.reflection == ReflectionModel::Pbr;   // renderers/pbr.h
     PbrPoint pt;
-    if (pbr) {
-        pt = pbrPoint(m, x.albedo);
-        t.add = m.emissive;
-    } else {
+    if (pbr)
+        pt = pbrPoint(m, x.albedo);   // ambient light: the environment's terms below
+    else
         t.mul = m.ka * f.ambientLight;
-        t.add = m.emissive;
-    }
+    t.add = m.emissive;
     for (size_t i = 0; i < f.lights.size(); ++i) {
         if (visible && visible[i] <= 0.0f) continue;
         const ShadeTerms li = oneLightTerms(m, pbr ? &pt : nullptr, p, n, v, f, i);

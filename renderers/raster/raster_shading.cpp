@@ -1,7 +1,7 @@
 // raster_shading.cpp - the CPU rasterizer's batched lighting (raster_shading.h): ShadeBatch's
-// sizing and padding, the run-time choice of AVX2 or SSE2, and shadeBatch itself, whose body is shade_kernel.inl (Phong, Blinn-Phong) or
-// pbr_kernel.inl (pbr) compiled once per instruction set (a scalar loop over rnd::lightTerms or
-// the pbr terms where neither is available).
+// sizing and padding, the run-time choice of AVX2 or SSE2, and shadeBatch itself, whose body is
+// shade_kernel.inl (Phong, Blinn-Phong) or pbr_kernel.inl (pbr) compiled once per instruction
+// set (a scalar loop over rnd::lightTerms or the pbr terms where neither is available).
 #include "raster/raster_shading.h"
 #include "renderers/debug_switches.h"
 
