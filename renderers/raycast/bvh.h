@@ -165,6 +165,15 @@ public:
     // so the uncounted traversal is unchanged).
     template <bool AnyHit = false, bool Count = false, class LeafFn>
     void traverse(const Ray& ray, float& tmax, LeafFn&& leaf, uint32_t* visited = nullptr) const;
+    // The leaves that the rays[i] with bit i of `active` set reach (each ray's tmax as given,
+    // never shortened), the tree walked once for all of them: leaf(first, count, rays) gets each
+    // leaf reached once, with the mask of the rays that reach it; returns true to stop. A ray
+    // reaches a leaf where traverse() with the same tmax would test it (the same box test,
+    // node by node), or where traverse() skips it only because its entry distance lies between
+    // tmax and the grown far end (a ray can then not hit anything in it before tmax). Leaves
+    // come nearest first for the packet's first ray.
+    template <class LeafFn>
+    void traversePacket(const Ray* rays, uint64_t active, LeafFn&& leaf) const;
 
 private:
     std::vector<Node4> m_nodes;   // m_nodes[0] is the root (a leaf root is wrapped in a node)

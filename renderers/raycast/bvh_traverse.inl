@@ -6,6 +6,7 @@
 
 #include <xmmintrin.h>
 #include <cstddef>
+#include <new>
 
 namespace rnd::rt {
 
@@ -36,17 +37,41 @@ inline RayPre::RayPre(const Ray& r, const float* boxAbsMax) {
     nearZ = (neg >> 2) & 1;
 }
 
+// One ray's box test of a Bvh4 node's four children, as Bvh4::traverse and traversePacket do it:
+// t = (b - org) * rdir per slab, entry tn = max(near slabs, tmin), exit = min(far slabs, tmax)
+// grown by kGrow (rays grazing a box edge are not lost to rounding); a child is reached where
+// tn <= exit.
+struct Bvh4RayTest {
+    __m128 ox, oy, oz, rx, ry, rz, tminV;
+    int nx, ny, nz, fx, fy, fz;
+    static constexpr float kGrow = 1.0f + 4.0f * std::numeric_limits<float>::epsilon();
+    explicit Bvh4RayTest(const Ray& ray) {
+        const RayPre pre(ray, nullptr);   // only org and rdir: this test is (b - org) * rdir
+        ox = _mm_set1_ps(pre.org[0]), oy = _mm_set1_ps(pre.org[1]), oz = _mm_set1_ps(pre.org[2]);
+        rx = _mm_set1_ps(pre.rdir[0]), ry = _mm_set1_ps(pre.rdir[1]), rz = _mm_set1_ps(pre.rdir[2]);
+        nx = pre.nearX, ny = 2 + pre.nearY, nz = 4 + pre.nearZ;
+        fx = 1 - pre.nearX, fy = 3 - pre.nearY, fz = 5 - pre.nearZ;
+        tminV = _mm_set1_ps(ray.tmin);
+    }
+    // The mask of children reached with the far end at tmax; their entry distances in tn.
+    int children(const Node4& n, float tmax, __m128& tn) const {
+        const __m128 t0x = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(n.b[nx]), ox), rx);
+        const __m128 t1x = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(n.b[fx]), ox), rx);
+        const __m128 t0y = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(n.b[ny]), oy), ry);
+        const __m128 t1y = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(n.b[fy]), oy), ry);
+        const __m128 t0z = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(n.b[nz]), oz), rz);
+        const __m128 t1z = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(n.b[fz]), oz), rz);
+        tn = _mm_max_ps(_mm_max_ps(t0x, t0y), _mm_max_ps(t0z, tminV));
+        __m128 tf = _mm_min_ps(_mm_min_ps(t1x, t1y), _mm_min_ps(t1z, _mm_set1_ps(tmax)));
+        tf = _mm_mul_ps(tf, _mm_set1_ps(kGrow));
+        return _mm_movemask_ps(_mm_cmple_ps(tn, tf));
+    }
+};
+
 template <bool AnyHit, bool Count, class LeafFn>
 void Bvh4::traverse(const Ray& ray, float& tmax, LeafFn&& leaf, uint32_t* visited) const {
     if (m_nodes.empty()) return;
-    const RayPre pre(ray, nullptr);   // only org and rdir: this test is (b - org) * rdir
-    const __m128 ox = _mm_set1_ps(pre.org[0]), oy = _mm_set1_ps(pre.org[1]), oz = _mm_set1_ps(pre.org[2]);
-    const __m128 rx = _mm_set1_ps(pre.rdir[0]), ry = _mm_set1_ps(pre.rdir[1]), rz = _mm_set1_ps(pre.rdir[2]);
-    const int nx = pre.nearX, ny = 2 + pre.nearY, nz = 4 + pre.nearZ;
-    const int fx = 1 - pre.nearX, fy = 3 - pre.nearY, fz = 5 - pre.nearZ;
-    const __m128 tminV = _mm_set1_ps(ray.tmin);
-    // Slightly enlarged far distance so rays grazing a box edge are not lost to rounding.
-    const float kGrow = 1.0f + 4.0f * std::numeric_limits<float>::epsilon();
+    const Bvh4RayTest test(ray);
 
     struct Entry {
         uint32_t ref;
@@ -59,16 +84,8 @@ void Bvh4::traverse(const Ray& ray, float& tmax, LeafFn&& leaf, uint32_t* visite
         if (!(cur & Node4::kLeafBit)) {
             if constexpr (Count) ++*visited;
             const Node4& n = m_nodes[cur];
-            __m128 t0x = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(n.b[nx]), ox), rx);
-            __m128 t1x = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(n.b[fx]), ox), rx);
-            __m128 t0y = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(n.b[ny]), oy), ry);
-            __m128 t1y = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(n.b[fy]), oy), ry);
-            __m128 t0z = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(n.b[nz]), oz), rz);
-            __m128 t1z = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(n.b[fz]), oz), rz);
-            __m128 tn = _mm_max_ps(_mm_max_ps(t0x, t0y), _mm_max_ps(t0z, tminV));
-            __m128 tf = _mm_min_ps(_mm_min_ps(t1x, t1y), _mm_min_ps(t1z, _mm_set1_ps(tmax)));
-            tf = _mm_mul_ps(tf, _mm_set1_ps(kGrow));
-            int mask = _mm_movemask_ps(_mm_cmple_ps(tn, tf));
+            __m128 tn;
+            int mask = test.children(n, tmax, tn);
             if (mask != 0) {
                 alignas(16) float d[4];
                 _mm_store_ps(d, tn);
@@ -135,6 +152,69 @@ void Bvh4::traverse(const Ray& ray, float& tmax, LeafFn&& leaf, uint32_t* visite
                 break;
             }
         }
+    }
+}
+
+template <class LeafFn>
+void Bvh4::traversePacket(const Ray* rays, uint64_t active, LeafFn&& leaf) const {
+    if (m_nodes.empty() || !active) return;
+    struct alignas(16) Tests {
+        alignas(Bvh4RayTest) unsigned char bytes[sizeof(Bvh4RayTest) * kMaxPacket];
+        Bvh4RayTest& operator[](int i) { return reinterpret_cast<Bvh4RayTest*>(bytes)[i]; }
+    } test;   // the active rays' only (left uninitialised, like PacketScratch)
+    for (uint64_t m = active; m; m &= m - 1) {
+        const int i = __builtin_ctzll(m);
+        ::new (static_cast<void*>(&test[i])) Bvh4RayTest(rays[i]);
+    }
+    struct Entry {
+        uint32_t ref;
+        uint64_t rays;
+    };
+    Entry stack[256];
+    int sp = 0;
+    uint32_t cur = 0;   // root: node 0
+    uint64_t curRays = active;
+    for (;;) {
+        if (!(cur & Node4::kLeafBit)) {
+            const Node4& n = m_nodes[cur];
+            uint64_t reach[4] = {0, 0, 0, 0};
+            alignas(16) float lead[4];   // entry distances for the packet's first ray here
+            const int first = __builtin_ctzll(curRays);
+            for (uint64_t m = curRays; m; m &= m - 1) {
+                const int i = __builtin_ctzll(m);
+                __m128 tn;
+                int mask = test[i].children(n, rays[i].tmax, tn);
+                if (i == first) _mm_store_ps(lead, tn);
+                for (; mask; mask &= mask - 1) reach[__builtin_ctz(unsigned(mask))] |= uint64_t(1) << i;
+            }
+            // Children reached, nearest (for the first ray) visited first.
+            Entry e[4];
+            float key[4];
+            int k = 0;
+            for (int c = 0; c < 4; ++c)
+                if (reach[c]) {
+                    key[k] = (reach[c] >> first) & 1 ? lead[c] : std::numeric_limits<float>::infinity();
+                    e[k++] = {n.child[c], reach[c]};
+                }
+            for (int i = 1; i < k; ++i)   // insertion sort, descending key (far first on the stack)
+                for (int j = i; j > 0 && key[j - 1] < key[j]; --j) {
+                    std::swap(key[j - 1], key[j]);
+                    std::swap(e[j - 1], e[j]);
+                }
+            if (k > 0) {
+                for (int i = 0; i < k - 1; ++i) stack[sp++] = e[i];
+                cur = e[k - 1].ref;
+                curRays = e[k - 1].rays;
+                continue;
+            }
+        } else {
+            const uint32_t first = (cur & ~Node4::kLeafBit) >> 3, count = cur & 7u;
+            if (leaf(first, count, curRays)) return;
+        }
+        if (sp == 0) return;
+        --sp;
+        cur = stack[sp].ref;
+        curRays = stack[sp].rays;
     }
 }
 

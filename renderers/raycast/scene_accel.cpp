@@ -66,8 +66,7 @@ int SceneAccel::update(const FrameInput& f) {
         // stay single rays.
         inst.packets = d.mesh->triangleCount() >= kPacketMinTriangles;
         m_anyPacketMesh |= inst.packets;
-        inst.invWorld = glm::inverse(d.world);
-        inst.invLinear = mat3(inst.invWorld);
+        inst.toObject = RayTransform(glm::inverse(d.world));
         Aabb wb = it->second.bvh.bounds().transformed(d.world);
         inst.boxMin = wb.min;
         inst.boxMax = wb.max;
@@ -81,8 +80,7 @@ int SceneAccel::update(const FrameInput& f) {
         Instance inst;
         inst.isMesh = false;
         inst.index = i;
-        inst.invWorld = a.invWorld;
-        inst.invLinear = mat3(inst.invWorld);
+        inst.toObject = RayTransform(a.invWorld);
         if (a.kind != DrawAnalytic::Kind::Csg && !isInvertible(a.world)) continue;
         if (a.kind == DrawAnalytic::Kind::Parametric || a.kind == DrawAnalytic::Kind::Grid) {
             AnalyticEntry& e = m_analytics[a.geometryKey];
@@ -146,16 +144,6 @@ uint64_t eachRay(uint64_t active, Hit&& hit) {
     return mask;
 }
 
-// The world ray in the instance's object space (the direction not normalised, so t is shared).
-Ray localRay(const mat4& invWorld, const mat3& invLinear, const Ray& wr, float tmax) {
-    Ray lr;
-    lr.org = vec3(invWorld * vec4(wr.org, 1.0f));
-    lr.dir = invLinear * wr.dir;
-    lr.tmin = wr.tmin;
-    lr.tmax = tmax;
-    return lr;
-}
-
 // A triangle hit of mesh draw `instance` as a scene hit.
 void setMeshHit(SceneHit& hit, const TriHit& th, uint32_t instance) {
     hit.kind = SceneHit::Kind::Mesh;
@@ -170,7 +158,7 @@ void setMeshHit(SceneHit& hit, const TriHit& th, uint32_t instance) {
 float SceneAccel::boxEntry(const Instance& inst, const Ray& r, const vec3& inv) const { return slabEntry(inst.boxMin, inst.boxMax, r, inv); }
 
 bool SceneAccel::intersectInstance(const Instance& inst, const Ray& wr, float tmax, SceneHit& hit, bool cull, TraversalCount* count) const {
-    const Ray lr = localRay(inst.invWorld, inst.invLinear, wr, tmax);
+    const Ray lr = inst.toObject.apply(wr, tmax);
     if (inst.isMesh) {
         TriHit th;
         if (!inst.bvh->intersect(lr, th, cull, count)) return false;
@@ -267,10 +255,11 @@ uint64_t SceneAccel::intersectPacket(const Ray* rays, int n, uint64_t active, Sc
     if (!m_anyPacketMesh) return eachRay(active, oneByOne);   // no mesh to share
     uint64_t found = 0;
     const std::vector<uint32_t>& prims = m_tlas.primIndex();
-    // Phase 1: the big mesh instances (Instance::packets) whose world boxes the rays reach (each ray's own top-level
-    // traversal, not cut short by hits), in the order the rays meet them, and which rays reach
-    // each; each is traced once as a packet, every ray limited to the closest mesh hit found so
-    // far, and its hits are kept per ray.
+    // Phase 1: the big mesh instances (Instance::packets) whose world boxes the rays reach (the
+    // top level walked once for the packet, each ray tested at each node as its own traversal
+    // tests it, not cut short by hits), nearest first for the packet's first ray, and which rays
+    // reach each; each is traced once as a packet, every ray limited to the closest mesh hit
+    // found so far, and its hits are kept per ray.
     constexpr int kMaxMeshes = 16;
     struct Touched {
         uint32_t instance;
@@ -280,42 +269,36 @@ uint64_t SceneAccel::intersectPacket(const Ray* rays, int n, uint64_t active, Sc
     int k = 0;
     bool overflow = false;
     uint64_t others = 0;   // rays that reach an instance not traced as a packet
-    // The instances not traced as packets that each ray reaches, in the order its traversal meets
+    // The instances not traced as packets that each ray reaches, in the order the walk meets
     // them (phase 2 tests them without a second traversal); rays that reach more than kListed
     // are in listFull and traverse again.
     constexpr int kListed = 6;
     uint32_t listed[kMaxPacket][kListed];
     uint8_t listedN[kMaxPacket];
     uint64_t listFull = 0;
-    for (uint64_t m = active; m && !overflow; m &= m - 1) {
-        const int i = __builtin_ctzll(m);
-        float tmax = rays[i].tmax;
-        listedN[i] = 0;
-        m_tlas.traverse<false>(rays[i], tmax, [&](uint32_t first, uint32_t count, float&) {
-            for (uint32_t c = 0; c < count; ++c) {
-                const uint32_t j = prims[first + c];
-                if (!m_instances[j].packets) {
-                    others |= uint64_t(1) << i;
+    for (uint64_t m = active; m; m &= m - 1) listedN[__builtin_ctzll(m)] = 0;
+    m_tlas.traversePacket(rays, active, [&](uint32_t first, uint32_t count, uint64_t reach) {
+        for (uint32_t c = 0; c < count; ++c) {
+            const uint32_t j = prims[first + c];
+            if (!m_instances[j].packets) {
+                others |= reach;
+                for (uint64_t m = reach; m; m &= m - 1) {
+                    const int i = __builtin_ctzll(m);
                     if (listedN[i] < kListed)
                         listed[i][listedN[i]++] = j;
                     else
                         listFull |= uint64_t(1) << i;
-                    continue;
                 }
-                int s = 0;
-                while (s < k && touched[s].instance != j) ++s;
-                if (s == k) {
-                    if (k == kMaxMeshes) {
-                        overflow = true;
-                        return true;
-                    }
-                    touched[k++] = {j, 0, 0};
-                }
-                touched[s].rays |= uint64_t(1) << i;
+                continue;
             }
-            return false;
-        });
-    }
+            if (k == kMaxMeshes) {   // instances are unique in the top level: each leaf's are new
+                overflow = true;
+                return true;
+            }
+            touched[k++] = {j, reach, 0};
+        }
+        return false;
+    });
     if (overflow) return eachRay(active, oneByOne);   // too many meshes under one packet
     // Hits per touched mesh and ray, written by the packet trace where found and read only there
     // (default values for k x kMaxPacket of them showed in the frame's profile).
@@ -328,10 +311,7 @@ uint64_t SceneAccel::intersectPacket(const Ray* rays, int n, uint64_t active, Sc
         PacketScratch<Ray> lr;
         for (uint64_t m = touched[s].rays; m; m &= m - 1) {
             const int i = __builtin_ctzll(m);
-            lr[i].org = vec3(inst.invWorld * vec4(rays[i].org, 1.0f));   // as intersectInstance
-            lr[i].dir = inst.invLinear * rays[i].dir;
-            lr[i].tmin = rays[i].tmin;
-            lr[i].tmax = bound[i];
+            lr[i] = inst.toObject.apply(rays[i], bound[i]);   // as intersectInstance
         }
         const bool cull = sg::cullsBackFaces(culling, m_frame->meshes[inst.index].material.doubleSided);
         touched[s].found = inst.bvh->intersectPacket(lr.data(), n, touched[s].rays, meshHits + s * kMaxPacket, cull);
@@ -441,33 +421,24 @@ uint64_t SceneAccel::occludedPacket(const Ray* rays, int n, uint64_t active) con
     };
     Touched touched[kMaxMeshes];
     int k = 0;
-    // Phase 1: each ray's top-level traversal (as occluded()); the big meshes are set aside for
-    // phase 2 (tested right away once kMaxMeshes are set aside), the rest tested here.
-    for (uint64_t m = active; m; m &= m - 1) {
-        const int i = __builtin_ctzll(m);
-        const Ray& r = rays[i];
-        float tmax = r.tmax;
-        m_tlas.traverse<true>(r, tmax, [&](uint32_t first, uint32_t count, float&) {
-            for (uint32_t c = 0; c < count; ++c) {
-                const uint32_t j = prims[first + c];
-                const Instance& inst = m_instances[j];
-                if (inst.packets) {
-                    int s = 0;
-                    while (s < k && touched[s].instance != j) ++s;
-                    if (s == k && k < kMaxMeshes) touched[k++] = {j, 0};
-                    if (s < k) {
-                        touched[s].rays |= uint64_t(1) << i;
-                        continue;
-                    }
-                }
-                if (instanceOccluded(inst, r)) {
-                    blocked |= uint64_t(1) << i;
-                    return true;
-                }
+    // Phase 1: the top level walked once for the packet (each ray tested at each node as
+    // occluded() tests it); the big meshes are set aside for phase 2 (tested right away once
+    // kMaxMeshes are set aside), the rest tested here for the rays not blocked yet.
+    m_tlas.traversePacket(rays, active, [&](uint32_t first, uint32_t count, uint64_t reach) {
+        for (uint32_t c = 0; c < count; ++c) {
+            const uint32_t j = prims[first + c];
+            const Instance& inst = m_instances[j];
+            if (inst.packets && k < kMaxMeshes) {   // instances are unique in the top level
+                touched[k++] = {j, reach};
+                continue;
             }
-            return false;
-        });
-    }
+            for (uint64_t m = reach & ~blocked; m; m &= m - 1) {
+                const int i = __builtin_ctzll(m);
+                if (instanceOccluded(inst, rays[i])) blocked |= uint64_t(1) << i;
+            }
+        }
+        return (active & ~blocked) == 0;
+    });
     // Phase 2: each big mesh once, for the rays that reach it and are not blocked yet.
     PacketScratch<Ray> lr;
     for (int s = 0; s < k; ++s) {
@@ -476,7 +447,7 @@ uint64_t SceneAccel::occludedPacket(const Ray* rays, int n, uint64_t active) con
         const Instance& inst = m_instances[touched[s].instance];
         for (uint64_t m = todo; m; m &= m - 1) {
             const int i = __builtin_ctzll(m);
-            lr[i] = localRay(inst.invWorld, inst.invLinear, rays[i], rays[i].tmax);
+            lr[i] = inst.toObject.apply(rays[i], rays[i].tmax);
         }
         blocked |= inst.bvh->occludedPacket(lr.data(), n, todo);
     }
@@ -485,7 +456,7 @@ uint64_t SceneAccel::occludedPacket(const Ray* rays, int n, uint64_t active) con
 
 bool SceneAccel::instanceOccluded(const Instance& inst, const Ray& r) const {
     if (inst.isMesh || inst.param) {   // any-hit tests; a parametric surface's stops at its first sub-patch hit
-        const Ray lr = localRay(inst.invWorld, inst.invLinear, r, r.tmax);
+        const Ray lr = inst.toObject.apply(r, r.tmax);
         return inst.isMesh ? inst.bvh->occluded(lr) : inst.param->occluded(lr);
     }
     SceneHit h;

@@ -11,6 +11,7 @@
 #include "raycast/bvh.h"
 #include "scenegraph/frame.h"
 
+#include <cstddef>
 #include <memory>
 #include <mutex>
 #include <unordered_map>
@@ -30,6 +31,38 @@ struct SceneHit {
     sg::vec3 normal{0, 1, 0};
     int csgLeaf = -1;
     float u = 0, v = 0;
+};
+
+// A world -> object space transform for rays: org' = M (org, 1), dir' = mat3(M) dir, the
+// direction not normalised (so t is shared between the spaces). Bit for bit glm's
+// mat4 * vec4(org, 1) and mat3 * dir: per lane (c0 x + c1 y) + (c2 z + c3) and
+// (c0 x + c1 y) + c2 z, the same IEEE products and sums, made four lanes at a time.
+struct RayTransform {
+    alignas(16) float col[4][4];   // M's columns
+    alignas(16) float lin[3][4];   // mat3(M)'s columns, lane 3 zero
+    RayTransform() : RayTransform(sg::mat4(1.0f)) {}
+    explicit RayTransform(const sg::mat4& m) {
+        for (int c = 0; c < 4; ++c)
+            for (int r = 0; r < 4; ++r) col[c][r] = m[c][r];
+        for (int c = 0; c < 3; ++c)
+            for (int r = 0; r < 4; ++r) lin[c][r] = r < 3 ? m[c][r] : 0.0f;
+    }
+    // r in object space, its segment ending at tmax.
+    Ray apply(const Ray& r, float tmax) const {
+        static_assert(sizeof(Ray) == 32 && offsetof(Ray, dir) == 16, "Ray: org, tmin, dir, tmax packed");
+        const __m128 o =
+            _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_load_ps(col[0]), _mm_set1_ps(r.org.x)), _mm_mul_ps(_mm_load_ps(col[1]), _mm_set1_ps(r.org.y))),
+                       _mm_add_ps(_mm_mul_ps(_mm_load_ps(col[2]), _mm_set1_ps(r.org.z)), _mm_load_ps(col[3])));
+        const __m128 d =
+            _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_load_ps(lin[0]), _mm_set1_ps(r.dir.x)), _mm_mul_ps(_mm_load_ps(lin[1]), _mm_set1_ps(r.dir.y))),
+                       _mm_mul_ps(_mm_load_ps(lin[2]), _mm_set1_ps(r.dir.z)));
+        Ray out;
+        _mm_storeu_ps(&out.org.x, o);   // lane 3 lands in tmin, set next
+        _mm_storeu_ps(&out.dir.x, d);   // lane 3 lands in tmax, set next
+        out.tmin = r.tmin;
+        out.tmax = tmax;
+        return out;
+    }
 };
 
 class SceneAccel {
@@ -82,8 +115,7 @@ private:
         bool packets = false;   // a mesh big enough to trace as packets (intersectPacket)
         const ParametricAccel* param = nullptr;
         const GridAccel* grid = nullptr;
-        sg::mat4 invWorld{1.0f};
-        sg::mat3 invLinear{1.0f};              // mat3(invWorld): what turns directions into object space
+        RayTransform toObject;                 // the inverse world matrix, for rays
         sg::vec3 boxMin{0.0f}, boxMax{0.0f};   // its box in the top level (world)
     };
 

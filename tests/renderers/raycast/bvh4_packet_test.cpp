@@ -1,0 +1,117 @@
+// Bvh4::traversePacket (the top level's walk for a packet of rays) against Bvh4::traverse, ray
+// by ray: every leaf a ray's own traversal tests is reached, and no leaf beyond what that
+// traversal tests with a far end a hair further out.
+#include "raycast/bvh.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+#include <set>
+#include <utility>
+#include <vector>
+
+using namespace rnd::rt;
+using sg::vec3;
+
+namespace {
+
+using LeafSet = std::set<std::pair<uint32_t, uint32_t>>;   // (first, count) of each leaf
+
+template <bool AnyHit>
+LeafSet visits(const Bvh4& bvh, const Ray& r) {
+    LeafSet out;
+    float tmax = r.tmax;
+    bvh.traverse<AnyHit>(r, tmax, [&](uint32_t first, uint32_t count, float&) {
+        out.insert({first, count});
+        return false;
+    });
+    return out;
+}
+
+}   // namespace
+
+TEST(RaycastTest, Bvh4PacketWalkReachesWhatEachRayTraversalTests) {
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> u(-10.0f, 10.0f), size(0.05f, 2.0f), unit(-1.0f, 1.0f);
+    // Boxes of instances in a scene: spread, overlapping, some flat (a ground plane).
+    std::vector<vec3> lo, hi;
+    for (int i = 0; i < 300; ++i) {
+        const vec3 c(u(rng), u(rng), u(rng)), e(size(rng), i % 17 == 0 ? 0.0f : size(rng), size(rng));
+        lo.push_back(c - e);
+        hi.push_back(c + e);
+    }
+    Bvh4::BuildOptions o;
+    o.maxLeafSize = 2;   // as SceneAccel's top level
+    o.parallel = false;
+    Bvh4 bvh;
+    bvh.build(lo.data(), hi.data(), lo.size(), o);
+    ASSERT_GT(bvh.depth(), 2);
+
+    size_t reachedPairs = 0, extraPairs = 0;
+    for (int p = 0; p < 200; ++p) {
+        // A packet: rays from one eye (camera rays) or from points nearby (shadow rays), short
+        // and infinite segments, and some inactive lanes.
+        Ray rays[kMaxPacket];
+        const int n = 1 + p % kMaxPacket;
+        const vec3 eye(u(rng), u(rng), u(rng)), toward(unit(rng), unit(rng), unit(rng));
+        for (int i = 0; i < n; ++i) {
+            rays[i].org = p % 2 ? eye : eye + 0.3f * vec3(unit(rng), unit(rng), unit(rng));
+            rays[i].dir = toward + 0.4f * vec3(unit(rng), unit(rng), unit(rng));
+            if (i % 7 == 3) rays[i].dir.y = 0.0f;   // along a slab
+            rays[i].tmin = 0.0f;
+            rays[i].tmax = i % 3 == 0 ? std::numeric_limits<float>::infinity() : 1.0f + 30.0f * std::abs(unit(rng));
+        }
+        const uint64_t active = (p % 5 == 0 ? 0xAAAAAAAAAAAAAAAAull : ~uint64_t(0)) & (n == 64 ? ~uint64_t(0) : (uint64_t(1) << n) - 1);
+        std::vector<LeafSet> reached(static_cast<size_t>(n));
+        bvh.traversePacket(rays, active, [&](uint32_t first, uint32_t count, uint64_t reach) {
+            EXPECT_EQ(reach & ~active, 0u) << "an inactive ray reached a leaf";
+            for (uint64_t m = reach; m; m &= m - 1) EXPECT_TRUE(reached[size_t(__builtin_ctzll(m))].insert({first, count}).second) << "a leaf twice";
+            return false;
+        });
+        for (int i = 0; i < n; ++i) {
+            if (!((active >> i) & 1)) continue;
+            Ray further = rays[i];
+            further.tmax *= 1.0f + 1e-5f;
+            for (const LeafSet& own : {visits<false>(bvh, rays[i]), visits<true>(bvh, rays[i])})
+                for (const auto& leaf : own) EXPECT_TRUE(reached[size_t(i)].count(leaf)) << "packet " << p << " ray " << i << " missed a leaf";
+            const LeafSet bound = visits<false>(bvh, further);
+            for (const auto& leaf : reached[size_t(i)]) EXPECT_TRUE(bound.count(leaf)) << "packet " << p << " ray " << i << " reached a leaf too far";
+            reachedPairs += reached[size_t(i)].size();
+            extraPairs += reached[size_t(i)].size() - visits<false>(bvh, rays[i]).size();
+        }
+    }
+    EXPECT_GT(reachedPairs, 2000u);   // the rays do reach leaves
+    EXPECT_LE(extraPairs, reachedPairs / 100);
+}
+
+// Stopping: the walk ends as soon as the leaf function says so.
+TEST(RaycastTest, Bvh4PacketWalkStopsWhenAsked) {
+    std::vector<vec3> lo, hi;
+    for (int i = 0; i < 50; ++i) {
+        lo.push_back(vec3(float(i), 0, 0));
+        hi.push_back(vec3(float(i) + 0.5f, 1, 1));
+    }
+    Bvh4 bvh;
+    bvh.build(lo.data(), hi.data(), lo.size());
+    Ray rays[2];
+    for (Ray& r : rays) {
+        r.org = vec3(-1, 0.5f, 0.5f);
+        r.dir = vec3(1, 0, 0);
+    }
+    int calls = 0;
+    bvh.traversePacket(rays, 3, [&](uint32_t, uint32_t, uint64_t reach) {
+        EXPECT_EQ(reach, 3u);
+        return ++calls == 2;
+    });
+    EXPECT_EQ(calls, 2);
+    int all = 0;
+    bvh.traversePacket(rays, 3, [&](uint32_t, uint32_t count, uint64_t) {
+        all += int(count);
+        return false;
+    });
+    EXPECT_EQ(all, 50);
+    bvh.traversePacket(rays, 0, [&](uint32_t, uint32_t, uint64_t) {
+        ADD_FAILURE() << "no active ray";
+        return false;
+    });
+}
