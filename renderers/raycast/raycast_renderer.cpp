@@ -173,7 +173,7 @@ void shadePixel(const FrameJob& job, Tracer& tr, int x, int row, int x0, int y0,
             }
             sum += c;
         }
-    sum /= float(sx * sy);
+    if (sx * sy > 1) sum /= float(sx * sy);    // (x / 1 is x: one sample skips three divisions)
     sum = job.display(sum);                    // after the resolve, as every backend (tone_map.h)
     if (!isFinite(sum)) sum = vec3(1, 0, 1);   // never feed NaN to the byte conversion
     uint8_t* px = target.pixel(x, row);
