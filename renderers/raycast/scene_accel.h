@@ -87,9 +87,10 @@ public:
     uint64_t intersectPacket(const Ray* worldRays, int n, uint64_t active, SceneHit* hits, sg::CullMode culling = sg::CullMode::Off) const;
     // Any hits of a packet of world rays (the shadow rays of a pixel tile toward one light): for
     // each active ray exactly what occluded(rays[i]) gives; returns the mask of blocked rays.
-    // Each ray finds the instances its own top-level traversal reaches; instances not traced as
-    // packets are tested right there (a hit ends the ray), the big meshes once per packet for the
-    // rays that reach them and are not blocked yet (TriangleBvh::occludedPacket).
+    // The top level is walked once for the packet (Bvh4::traversePacket: each ray reaches the
+    // instances its own traversal would); instances not traced as packets are tested right there
+    // for the rays not blocked yet, the big meshes once per packet for the rays that reach them
+    // and are not blocked yet (TriangleBvh::occludedPacket).
     uint64_t occludedPacket(const Ray* worldRays, int n, uint64_t active) const;
 
     size_t cachedMeshes() const { return m_meshes.size(); }
