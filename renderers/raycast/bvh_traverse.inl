@@ -158,10 +158,7 @@ void Bvh4::traverse(const Ray& ray, float& tmax, LeafFn&& leaf, uint32_t* visite
 template <class LeafFn>
 void Bvh4::traversePacket(const Ray* rays, uint64_t active, LeafFn&& leaf) const {
     if (m_nodes.empty() || !active) return;
-    struct alignas(16) Tests {
-        alignas(Bvh4RayTest) unsigned char bytes[sizeof(Bvh4RayTest) * kMaxPacket];
-        Bvh4RayTest& operator[](int i) { return reinterpret_cast<Bvh4RayTest*>(bytes)[i]; }
-    } test;   // the active rays' only (left uninitialised, like PacketScratch)
+    PacketScratch<Bvh4RayTest> test;   // the active rays' only
     for (uint64_t m = active; m; m &= m - 1) {
         const int i = __builtin_ctzll(m);
         ::new (static_cast<void*>(&test[i])) Bvh4RayTest(rays[i]);
