@@ -11,6 +11,8 @@
 #include "raycast/bvh.h"
 #include "scenegraph/frame.h"
 
+#include <emmintrin.h>
+
 #include <cmath>
 #include <limits>
 
@@ -45,7 +47,7 @@ public:
         for (int i = 0; i < nx && i < kMax; ++i) cols[i] = column(wx[i]);
         for (int j = 0; j < ny; ++j) {
             const glm::dvec4 r = row(wy[j]);
-            for (int i = 0; i < nx; ++i) out[j * nx + i] = rayThrough((i < kMax ? cols[i] : column(wx[i])) + r);
+            for (int i = 0; i < nx; ++i) out[j * nx + i] = rayThroughPairs(i < kMax ? cols[i] : column(wx[i]), r);
         }
     }
 
@@ -69,6 +71,38 @@ private:
             r.tmax = std::numeric_limits<float>::max();
         }
         if (!finite(r.org) || !finite(r.dir)) r.tmax = -1.0f;   // meets nothing
+        return r;
+    }
+
+    // rayThrough(col + row) with SSE2's double pairs: the same IEEE operations on the same values
+    // (glm's dvec4 sum and divisions, the double difference rounded to float), two at a time,
+    // for rays with a far end; the others (rare: see ray()) go through rayThrough itself.
+    Ray rayThroughPairs(const glm::dvec4& col, const glm::dvec4& row) const {
+        const __m128d xy01 = _mm_add_pd(_mm_loadu_pd(&col.x), _mm_loadu_pd(&row.x));
+        const __m128d xy23 = _mm_add_pd(_mm_loadu_pd(&col.z), _mm_loadu_pd(&row.z));
+        const __m128d a01 = _mm_add_pd(xy01, _mm_loadu_pd(&m_zw[0].x)), a23 = _mm_add_pd(xy23, _mm_loadu_pd(&m_zw[0].z));
+        const __m128d b01 = _mm_add_pd(xy01, _mm_loadu_pd(&m_zw[1].x)), b23 = _mm_add_pd(xy23, _mm_loadu_pd(&m_zw[1].z));
+        const __m128d org01 = _mm_div_pd(a01, _mm_unpackhi_pd(a23, a23));                      // (a.x, a.y) / a.w
+        const __m128d far01 = _mm_div_pd(b01, _mm_unpackhi_pd(b23, b23));                      // (b.x, b.y) / b.w
+        const __m128d zz = _mm_div_pd(_mm_unpacklo_pd(a23, b23), _mm_unpackhi_pd(a23, b23));   // (a.z / a.w, b.z / b.w)
+        const __m128d d01 = _mm_sub_pd(far01, org01);
+        const __m128d dz = _mm_sub_sd(_mm_unpackhi_pd(zz, zz), zz);
+        // glm::dot(far - org, m_forward): (x fx + y fy) + z fz
+        const __m128d p01 = _mm_mul_pd(d01, _mm_loadu_pd(&m_forward.x));
+        const double dot = (_mm_cvtsd_f64(p01) + _mm_cvtsd_f64(_mm_unpackhi_pd(p01, p01))) + _mm_cvtsd_f64(dz) * m_forward.z;
+        const __m128 orgF = _mm_movelh_ps(_mm_cvtpd_ps(org01), _mm_cvtpd_ps(zz));   // org.x, org.y, org.z, (far.z)
+        const __m128 dirF = _mm_movelh_ps(_mm_cvtpd_ps(d01), _mm_cvtpd_ps(dz));     // dir.x, dir.y, dir.z, 0
+        // v - v is NaN exactly where v is infinite or NaN (lanes 0-2 of each).
+        const int notFinite = _mm_movemask_ps(_mm_cmpunord_ps(_mm_sub_ps(orgF, orgF), _mm_sub_ps(dirF, dirF))) & 7;
+        if (notFinite || !(dot > 0.0)) return rayThrough(col + row);
+        alignas(16) float o[4], d[4];
+        _mm_store_ps(o, orgF);
+        _mm_store_ps(d, dirF);
+        Ray r;
+        r.org = sg::vec3(o[0], o[1], o[2]);
+        r.tmin = 0.0f;
+        r.dir = sg::vec3(d[0], d[1], d[2]);
+        r.tmax = 1.0f;
         return r;
     }
 
