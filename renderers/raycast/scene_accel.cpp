@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <memory>
 
 namespace rnd::rt {
@@ -276,7 +277,7 @@ uint64_t SceneAccel::intersectPacket(const Ray* rays, int n, uint64_t active, Sc
     uint32_t listed[kMaxPacket][kListed];
     uint8_t listedN[kMaxPacket];
     uint64_t listFull = 0;
-    for (uint64_t m = active; m; m &= m - 1) listedN[__builtin_ctzll(m)] = 0;
+    std::memset(listedN, 0, sizeof listedN);
     m_tlas.traversePacket(rays, active, [&](uint32_t first, uint32_t count, uint64_t reach) {
         for (uint32_t c = 0; c < count; ++c) {
             const uint32_t j = prims[first + c];
@@ -326,12 +327,13 @@ uint64_t SceneAccel::intersectPacket(const Ray* rays, int n, uint64_t active, Sc
     // at or below the bound is still to come, so a hit in between would not be kept either.
     // Rays that reach packet meshes only: their closest hit is the closest kept one (the first
     // found of equal ones, as closestHit keeps the first it visits).
-    for (uint64_t m = active & ~others; m; m &= m - 1) {
+    uint64_t foundAny = 0;
+    for (int s = 0; s < k; ++s) foundAny |= touched[s].found;
+    for (uint64_t m = active & ~others & foundAny; m; m &= m - 1) {
         const int i = __builtin_ctzll(m);
         int best = -1;
         for (int s = 0; s < k; ++s)
             if (((touched[s].found >> i) & 1) && (best < 0 || meshHits[s * kMaxPacket + i].t < meshHits[best * kMaxPacket + i].t)) best = s;
-        if (best < 0) continue;
         const TriHit& th = meshHits[best * kMaxPacket + i];
         SceneHit& h = hits[i];
         h = SceneHit{};
