@@ -26,6 +26,7 @@
 #include "renderers/tone_map.h"
 
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <pmmintrin.h>
@@ -153,7 +154,8 @@ void shadePixel(const FrameJob& job, Tracer& tr, int x, int row, int x0, int y0,
                 oy = (float(j) + rand01(seed)) / float(sy);
             }
             // (the packet's ray: the same call with ox = oy = 0.5)
-            const rt::Ray r = job.packets ? tileRays[size_t(row - y0) * tile + size_t(x - x0)] : job.cam.ray(float(x) + ox, float(wy) + oy);
+            rt::Ray own;
+            const rt::Ray& r = job.packets ? tileRays[size_t(row - y0) * tile + size_t(x - x0)] : (own = job.cam.ray(float(x) + ox, float(wy) + oy));
             SurfaceRecord hp;
             const PixelFootprint fp{&job.cam, float(x) + ox, float(wy) + oy};
             rt::TraversalCount count;
@@ -282,13 +284,15 @@ public:
 
 private:
     // Samplers (mip chains) per texture, cached by id + version; one pointer per mesh (m_textures,
-    // m_maps: the material maps).
+    // m_maps: the material maps); and each mesh's material coefficients (m_coefficients).
     void prepareSamplers(const FrameInput& f) {
         m_samplers.beginFrame();
         m_textures.assign(f.meshes.size(), nullptr);
         m_maps.assign(f.meshes.size(), {});
+        m_coefficients.resize(f.meshes.size());
         for (size_t i = 0; i < f.meshes.size(); ++i) {
             m_textures[i] = m_samplers.get(f.meshes[i].texture);
+            m_coefficients[i] = coefficientsOf(f.meshes[i].material);
             const sg::DrawMesh& dm = f.meshes[i];
             const sg::MaterialMaps& fm = dm.maps;
             const bool hasUv1 = dm.mesh && dm.mesh->uv1.size() == dm.mesh->positions.size();
@@ -311,9 +315,11 @@ private:
         if (control) control->progress = 0.0f;
 
         tbb::parallel_for(tbb::blocked_range<int>(0, ntiles, 1), [&](const tbb::blocked_range<int>& range) {
-            std::vector<Tracer::FirstHit> tileHits(job.packets ? size_t(tile) * tile : 0);
-            std::vector<rt::Ray> tileRays(tileHits.size());
-            std::vector<Tracer::PresetVisibility> tilePresets(job.shadowPackets ? tileHits.size() : 0);
+            TileBuffers& buffers = m_tileBuffers.local();   // made once per thread (every entry is written before it is read)
+            buffers.reserve(job);
+            std::vector<Tracer::FirstHit>& tileHits = buffers.hits;
+            std::vector<rt::Ray>& tileRays = buffers.rays;
+            std::vector<Tracer::PresetVisibility>& tilePresets = buffers.presets;
             const unsigned old = _mm_getcsr();
             _mm_setcsr(old | 0x8040);   // FTZ | DAZ in this worker
             for (int ti = range.begin(); ti != range.end(); ++ti) {
@@ -323,6 +329,7 @@ private:
                 }
                 Tracer tr{f, m_accel, m_textures, m_maps, m_world, 0, anyAlpha};
                 tr.env = &m_environment;
+                tr.meshCoefficients = &m_coefficients;
                 const int x0 = (ti % tx) * tile, y0 = (ti / tx) * tile;   // y0: framebuffer row (top-down)
                 const int x1 = std::min(x0 + tile, job.w), y1 = std::min(y0 + tile, job.h);
                 if (job.packets) traceCameraPackets(job, m_accel, x0, y0, x1, y1, tileRays, tileHits);
@@ -358,6 +365,24 @@ private:
         if (!draws.empty()) drawPointsLinesWireframe(draws, f, target, 2.0f);
     }
 
+    // A tile's camera rays, their first hits and their shadow presets (traceCameraPackets,
+    // presetTileShadows), per thread: kept between ranges and frames rather than made and
+    // value-initialized for each range.
+    struct TileBuffers {
+        std::vector<Tracer::FirstHit> hits;
+        std::vector<rt::Ray> rays;
+        std::vector<Tracer::PresetVisibility> presets;
+        void reserve(const FrameJob& job) {
+            constexpr size_t n = size_t(FrameJob::kTile) * FrameJob::kTile;
+            if (job.packets && hits.size() < n) {
+                hits.resize(n);
+                rays.resize(n);
+            }
+            if (job.shadowPackets && presets.size() < n) presets.resize(n);
+        }
+    };
+    tbb::enumerable_thread_specific<TileBuffers> m_tileBuffers;
+
     rt::SceneAccel m_accel;
     rt::WorldVertexCache m_worldVertices;
     const std::vector<const rt::WorldVertices*>* m_world = nullptr;   // this frame's (null: switched off)
@@ -365,8 +390,9 @@ private:
     // The last frame's samplers per mesh (kept for lightVisibility).
     std::vector<const SampledTexture*> m_textures;
     std::vector<MapSamplers> m_maps;
-    EnvironmentLight m_environment;   // this frame's (environmentFor)
-    TessellationCache m_tess;         // wireframe of analytic shapes only
+    std::vector<SurfaceCoefficients> m_coefficients;   // this frame's coefficientsOf per mesh (Tracer::meshCoefficients)
+    EnvironmentLight m_environment;                    // this frame's (environmentFor)
+    TessellationCache m_tess;                          // wireframe of analytic shapes only
 };
 
 }   // namespace

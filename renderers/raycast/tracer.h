@@ -194,6 +194,11 @@ struct Tracer {
     // The pbr model's environment light (null or empty map: none): it lights surfaces and is what
     // rays that leave the scene see (reflection rays always, camera rays when it is the background).
     const EnvironmentLight* env = nullptr;
+    // Per f.meshes entry, coefficientsOf(its material), made once per frame (null: made per hit).
+    const std::vector<SurfaceCoefficients>* meshCoefficients = nullptr;
+    SurfaceCoefficients coefficientsOfMesh(uint32_t mesh) const {
+        return meshCoefficients ? (*meshCoefficients)[mesh] : coefficientsOf(f.meshes[mesh].material);
+    }
 
     vec3 missed(const rt::Ray& r, int bounce) const {
         if (env && env->map && (bounce > 0 || env->background)) return env->backgroundRadiance(glm::normalize(r.dir));
@@ -531,8 +536,9 @@ struct Tracer {
             lightVisibility(p, ng, vis, P, Nv, 3);
             const float wk[3] = {w0, w1, w2};
             ShadeTerms t;
+            const SurfaceCoefficients coeff = coefficientsOfMesh(h.instance);
             for (int k = 0; k < 3; ++k) {
-                ShadeTerms tk = shadeTerms(*mat, P[k], Nv[k], eye, f, vis, {albedoV[k], env});
+                ShadeTerms tk = shadeTerms(coeff, P[k], Nv[k], eye, f, vis, {albedoV[k], env});
                 t.mul += wk[k] * tk.mul;
                 t.add += wk[k] * tk.add;
             }
@@ -545,7 +551,7 @@ struct Tracer {
             // rasterizers, whose provoking vertex it is); the hit's shadow rays scale the lights.
             n = ng;
             lightVisibility(p, ng, vis, &P[0], &ng, 1);
-            ShadeTerms t = shadeTerms(*mat, P[0], ng, eye, f, vis, {albedoV[0], env});
+            ShadeTerms t = shadeTerms(coefficientsOfMesh(h.instance), P[0], ng, eye, f, vis, {albedoV[0], env});
             if (hasMaps) applyMapsToTerms(t, *mat, ms, f.ambientLight, f.settings.reflection);
             color = t.apply(albedo);
         } else {
@@ -558,7 +564,7 @@ struct Tracer {
                 if (ms.hasNormal && mesh.tangents.size() == mesh.positions.size()) n = mappedNormal(dm, i0, i1, i2, w0, w1, w2, n, back, ms);
             }
             if (!mat->unlit) lightVisibility(p, ng, vis, &p, &n, 1);
-            const SurfaceCoefficients coeff = hasMaps ? coefficientsAt(*mat, ms) : coefficientsOf(*mat);
+            const SurfaceCoefficients coeff = hasMaps ? coefficientsAt(*mat, ms) : coefficientsOfMesh(h.instance);
             color = shade(coeff, SurfacePoint{p, n, albedo}, eye, f, mat->unlit ? nullptr : vis, env);
             s.lit = !mat->unlit;
             s.coeff = coeff;
