@@ -43,11 +43,20 @@ public:
     // wy[j]) bit for bit, each column's and row's share of the unprojection made once.
     void grid(const float* wx, int nx, const float* wy, int ny, Ray* out) const {
         constexpr int kMax = 8;
-        glm::dvec4 cols[kMax];
-        for (int i = 0; i < nx && i < kMax; ++i) cols[i] = column(wx[i]);
+        __m128d cols[kMax][2];   // column(wx[i]) as (x, y) and (z, w) pairs (no zeroing: glm's vectors clear themselves)
+        auto pairs = [](const glm::dvec4& v, __m128d* out) {
+            out[0] = _mm_loadu_pd(&v.x);
+            out[1] = _mm_loadu_pd(&v.z);
+        };
+        for (int i = 0; i < nx && i < kMax; ++i) pairs(column(wx[i]), cols[i]);
         for (int j = 0; j < ny; ++j) {
-            const glm::dvec4 r = row(wy[j]);
-            for (int i = 0; i < nx; ++i) out[j * nx + i] = rayThroughPairs(i < kMax ? cols[i] : column(wx[i]), r);
+            __m128d r[2];
+            pairs(row(wy[j]), r);
+            for (int i = 0; i < nx; ++i) {
+                __m128d wide[2];
+                if (i >= kMax) pairs(column(wx[i]), wide);
+                out[j * nx + i] = rayThroughPairs(i < kMax ? cols[i] : wide, r);
+            }
         }
     }
 
@@ -74,12 +83,11 @@ private:
         return r;
     }
 
-    // rayThrough(col + row) with SSE2's double pairs: the same IEEE operations on the same values
+    // rayThrough(col + row) (each as its (x, y) and (z, w) pairs) with SSE2's double pairs: the same IEEE operations on the same values
     // (glm's dvec4 sum and divisions, the double difference rounded to float), two at a time,
     // for rays with a far end; the others (rare: see ray()) go through rayThrough itself.
-    Ray rayThroughPairs(const glm::dvec4& col, const glm::dvec4& row) const {
-        const __m128d xy01 = _mm_add_pd(_mm_loadu_pd(&col.x), _mm_loadu_pd(&row.x));
-        const __m128d xy23 = _mm_add_pd(_mm_loadu_pd(&col.z), _mm_loadu_pd(&row.z));
+    Ray rayThroughPairs(const __m128d* col, const __m128d* row) const {
+        const __m128d xy01 = _mm_add_pd(col[0], row[0]), xy23 = _mm_add_pd(col[1], row[1]);   // glm's col + row
         const __m128d a01 = _mm_add_pd(xy01, _mm_loadu_pd(&m_zw[0].x)), a23 = _mm_add_pd(xy23, _mm_loadu_pd(&m_zw[0].z));
         const __m128d b01 = _mm_add_pd(xy01, _mm_loadu_pd(&m_zw[1].x)), b23 = _mm_add_pd(xy23, _mm_loadu_pd(&m_zw[1].z));
         const __m128d org01 = _mm_div_pd(a01, _mm_unpackhi_pd(a23, a23));                      // (a.x, a.y) / a.w
@@ -94,7 +102,12 @@ private:
         const __m128 dirF = _mm_movelh_ps(_mm_cvtpd_ps(d01), _mm_cvtpd_ps(dz));     // dir.x, dir.y, dir.z, 0
         // v - v is NaN exactly where v is infinite or NaN (lanes 0-2 of each).
         const int notFinite = _mm_movemask_ps(_mm_cmpunord_ps(_mm_sub_ps(orgF, orgF), _mm_sub_ps(dirF, dirF))) & 7;
-        if (notFinite || !(dot > 0.0)) return rayThrough(col + row);
+        if (notFinite || !(dot > 0.0)) {
+            glm::dvec4 xy;
+            _mm_storeu_pd(&xy.x, xy01);
+            _mm_storeu_pd(&xy.z, xy23);
+            return rayThrough(xy);
+        }
         alignas(16) float o[4], d[4];
         _mm_store_ps(o, orgF);
         _mm_store_ps(d, dirF);

@@ -67,6 +67,10 @@ struct FrameJob {
     bool shadowPackets;         // and then their hits' shadow rays (Tracer::presetShadows)
     bool countCost;             // the cost view: one centre ray per pixel, counted
     DisplayTransform display;   // exposure and tone mapping of each pixel's mean colour
+    // Where a packet's camera ray met nothing and what it sees there is the plain background
+    // (no environment map behind the scene): the pixel's bytes, made once (see missPixel).
+    bool constantMiss = false;
+    uint8_t missRgba[4] = {0, 0, 0, 255};
     const SrgbEncoder& srgb = srgbEncoder();
     static constexpr int kTile = 32;    // pixels per tile side
     static constexpr int kPacket = 4;   // pixels per packet side (4x4: the benchmark's best, docs/benchmarks.md)
@@ -135,6 +139,21 @@ void presetTileShadows(Tracer& tr, int x0, int y0, int x1, int y1, const std::ve
         }
 }
 
+// The bytes shadePixel gives a pixel whose one camera ray meets nothing when Tracer::missed
+// returns the settings' background: that colour summed, through the display transform, checked
+// and encoded, as shadePixel does it.
+void setConstantMiss(FrameJob& job) {
+    vec3 sum(0.0f);
+    sum += job.f.settings.background;
+    sum = job.display(sum);
+    if (!isFinite(sum)) sum = vec3(1, 0, 1);
+    job.missRgba[0] = job.srgb(sum.x);
+    job.missRgba[1] = job.srgb(sum.y);
+    job.missRgba[2] = job.srgb(sum.z);
+    job.missRgba[3] = 255;
+    job.constantMiss = true;
+}
+
 // Pixel (x, row) of the tile with corner (x0, y0): its sx x sy stratified rays traced and
 // shaded, the mean colour through the display transform as sRGB bytes, the nearest depth, and (centre ray) the visibility and
 // the traversal cost when asked.
@@ -142,10 +161,22 @@ void shadePixel(const FrameJob& job, Tracer& tr, int x, int row, int x0, int y0,
                 const std::vector<Tracer::FirstHit>& tileHits, const std::vector<Tracer::PresetVisibility>& tilePresets, Framebuffer& target) {
     constexpr int tile = FrameJob::kTile;
     const int w = job.w, h = job.h, sx = job.sx, sy = job.sy;
+    if (job.constantMiss && !tileHits[size_t(row - y0) * tile + size_t(x - x0)].found) {
+        // What trace gives for the packet's missed ray (one ray, no depth, no surface), without
+        // the per-pixel work: the same bytes (setConstantMiss), depth and visibility.
+        ++tr.rays;
+        std::memcpy(target.pixel(x, row), job.missRgba, 4);
+        target.depth[size_t(row) * w + x] = 1.0f;
+        if (job.cfg.aovs.has(Aov::Visibility)) {
+            target.drawable[size_t(row) * w + x] = 0;
+            target.primitive[size_t(row) * w + x] = kNoPrimitive;
+        }
+        return;
+    }
     const int wy = h - 1 - row;   // GL window y of this row
     vec3 sum(0.0f);
     float depth = 1.0f;
-    uint32_t seed = hash32(uint32_t(x) * 73856093u ^ uint32_t(wy) * 19349663u);
+    uint32_t seed = sx * sy > 1 ? hash32(uint32_t(x) * 73856093u ^ uint32_t(wy) * 19349663u) : 0u;   // (jitter only)
     for (int j = 0; j < sy; ++j)
         for (int i = 0; i < sx; ++i) {
             float ox = 0.5f, oy = 0.5f;
@@ -246,7 +277,8 @@ protected:
         // Their shadow rays in packets too where every shadow ray is a plain any-hit ray (no
         // cut-outs or blended layers to pass through).
         const bool shadowPackets = packets && debugSwitches().raycastShadowPackets && f.settings.shadows && !f.lights.empty() && !anyTranslucent(f);
-        const FrameJob job{f, cfg, cam, w, h, sx, sy, packets, shadowPackets, countCost, display};
+        FrameJob job{f, cfg, cam, w, h, sx, sy, packets, shadowPackets, countCost, display};
+        if (packets && !(m_environment.map && m_environment.background)) setConstantMiss(job);   // as Tracer::missed
         uint64_t rays = 0;
         stats.cancelled = !renderTiles(job, target, control, rays);
         _mm_setcsr(csr);

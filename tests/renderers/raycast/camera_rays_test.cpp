@@ -65,8 +65,8 @@ TEST(CameraRaysTest, GridGivesEachRayBitForBit) {
                         const Ray& got = out[size_t(j * nx + i)];
                         ++rays;
                         fallbacks += one.tmax != 1.0f;
-                        EXPECT_TRUE(sameBits(got, one)) << name << " at (" << wx[size_t(i)] << ", " << wy[size_t(j)] << "): grid " << describe(got)
-                                                        << ", ray " << describe(one);
+                        EXPECT_TRUE(sameBits(got, one))
+                            << name << " at (" << wx[size_t(i)] << ", " << wy[size_t(j)] << "): grid " << describe(got) << ", ray " << describe(one);
                     }
             }
         }

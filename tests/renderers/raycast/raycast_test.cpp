@@ -967,6 +967,68 @@ TEST(RaycastTest, ShadowPacketsGiveTheSameImageAsSingleShadowRays) {
     }
 }
 
+// Camera rays traced as packets give the image, depth, visibility and (without shadows) ray count
+// that they give one by one, with and without shadows, pixels that meet nothing included (those take a shortcut when what they see is
+// the plain background colour): with the display transform off and on, a background with a
+// negative zero, and the environment drawn behind the scene (no shortcut).
+TEST(RaycastTest, CameraPacketsGiveTheSameImageAsSingleRays) {
+    const int w = 160, h = 120;
+    FrameInput f = triangleScene(w, h);
+    DrawMesh big;
+    big.mesh = std::make_shared<Mesh>(primitives::uvSphere(0.6f, 128, 64));   // 16k triangles: traced as packets
+    big.world = glm::translate(mat4(1.0f), vec3(-1.2f, 0.7f, 0.3f));
+    big.normal = normalMatrix(big.world);
+    f.meshes.push_back(big);
+    auto render = [&](const char* packets, uint64_t& rays) {
+        setenv("VIEWER_RAYCAST_PACKETS", packets, 1);
+        auto r = makeRenderer("raycast");
+        Framebuffer fb;
+        RenderRequest req;
+        req.aovs.add(Aov::Visibility);
+        const RenderStats st = r->render(f, w, h, fb, nullptr, req);
+        unsetenv("VIEWER_RAYCAST_PACKETS");
+        EXPECT_TRUE(st.ok) << st.error;
+        rays = st.rays;
+        return fb;
+    };
+    struct Case {
+        const char* name;
+        float exposure;
+        ToneMapping op;
+        vec3 background;
+        ReflectionModel model;
+        bool environmentBehind;
+    };
+    const Case cases[] = {
+        {"plain", 0.0f, ToneMapping::None, vec3(0.08f, 0.09f, 0.11f), ReflectionModel::Phong, false},
+        {"exposed, tone-mapped", 1.5f, ToneMapping::Aces, vec3(0.6f, -0.0f, 0.3f), ReflectionModel::Phong, false},
+        {"environment behind", 0.0f, ToneMapping::None, vec3(0.08f, 0.09f, 0.11f), ReflectionModel::Pbr, true},
+    };
+    for (const Case& c : cases)
+        for (bool shadows : {false, true}) {
+            SCOPED_TRACE(std::string(c.name) + (shadows ? ", shadows" : ""));
+            f.settings.shadows = shadows;
+            f.settings.exposure = c.exposure;
+            f.settings.toneMapping = c.op;
+            f.settings.background = c.background;
+            f.settings.reflection = c.model;
+            f.settings.environmentBackground = c.environmentBehind;
+            uint64_t raysOne = 0, raysPackets = 0;
+            const Framebuffer one = render("0", raysOne), packets = render("1", raysPackets);
+            ASSERT_EQ(one.color.size(), packets.color.size());
+            EXPECT_TRUE(one.color == packets.color);
+            EXPECT_TRUE(one.depth == packets.depth);
+            EXPECT_TRUE(one.drawable == packets.drawable);
+            EXPECT_TRUE(one.primitive == packets.primitive);
+            if (!shadows) {   // (shadow packets count their rays by their own rule)
+                EXPECT_EQ(raysOne, raysPackets);
+            }
+            size_t empty = 0;   // pixels that meet nothing are in the picture
+            for (float d : packets.depth) empty += d == 1.0f;
+            EXPECT_GT(empty, size_t(w * h / 10));
+        }
+}
+
 // The ray caster keeps its meshes' vertices in world space across frames (WorldVertexCache):
 // the same values the shading would compute per hit, so the image is the same bit for bit,
 // under a rotated, non-uniformly scaled and a mirrored instance, a degenerate vertex normal and
