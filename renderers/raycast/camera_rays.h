@@ -13,6 +13,7 @@
 
 #include <emmintrin.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -42,22 +43,33 @@ public:
     // The rays through a grid of window positions, row by row: out[j * nx + i] is ray(wx[i],
     // wy[j]) bit for bit, each column's and row's share of the unprojection made once.
     void grid(const float* wx, int nx, const float* wy, int ny, Ray* out) const {
-        constexpr int kMax = 8;
+        constexpr int kMax = 8, kBatch = 16;
         __m128d cols[kMax][2];   // column(wx[i]) as (x, y) and (z, w) pairs (no zeroing: glm's vectors clear themselves)
-        auto pairs = [](const glm::dvec4& v, __m128d* out) {
-            out[0] = _mm_loadu_pd(&v.x);
-            out[1] = _mm_loadu_pd(&v.z);
+        auto pairs = [](const glm::dvec4& v, __m128d* p) {
+            p[0] = _mm_loadu_pd(&v.x);
+            p[1] = _mm_loadu_pd(&v.z);
         };
         for (int i = 0; i < nx && i < kMax; ++i) pairs(column(wx[i]), cols[i]);
+        // Up to kBatch rays at a time: first every ray's divisions (independent of each other,
+        // so they overlap in the divider), then what follows from them.
+        Unprojected u[kBatch];
+        int pending = 0, done = 0;
+        auto flush = [&] {
+            for (int k = 0; k < pending; ++k) finish(u[k], out[done + k]);
+            done += pending;
+            pending = 0;
+        };
         for (int j = 0; j < ny; ++j) {
             __m128d r[2];
             pairs(row(wy[j]), r);
             for (int i = 0; i < nx; ++i) {
                 __m128d wide[2];
                 if (i >= kMax) pairs(column(wx[i]), wide);
-                out[j * nx + i] = rayThroughPairs(i < kMax ? cols[i] : wide, r);
+                u[pending++] = unproject(i < kMax ? cols[i] : wide, r);
+                if (pending == kBatch) flush();
             }
         }
+        flush();
     }
 
 private:
@@ -83,40 +95,46 @@ private:
         return r;
     }
 
-    // rayThrough(col + row) (each as its (x, y) and (z, w) pairs) with SSE2's double pairs: the same IEEE operations on the same values
-    // (glm's dvec4 sum and divisions, the double difference rounded to float), two at a time,
-    // for rays with a far end; the others (rare: see ray()) go through rayThrough itself.
-    Ray rayThroughPairs(const __m128d* col, const __m128d* row) const {
-        const __m128d xy01 = _mm_add_pd(col[0], row[0]), xy23 = _mm_add_pd(col[1], row[1]);   // glm's col + row
-        const __m128d a01 = _mm_add_pd(xy01, _mm_loadu_pd(&m_zw[0].x)), a23 = _mm_add_pd(xy23, _mm_loadu_pd(&m_zw[0].z));
-        const __m128d b01 = _mm_add_pd(xy01, _mm_loadu_pd(&m_zw[1].x)), b23 = _mm_add_pd(xy23, _mm_loadu_pd(&m_zw[1].z));
-        const __m128d org01 = _mm_div_pd(a01, _mm_unpackhi_pd(a23, a23));                      // (a.x, a.y) / a.w
-        const __m128d far01 = _mm_div_pd(b01, _mm_unpackhi_pd(b23, b23));                      // (b.x, b.y) / b.w
-        const __m128d zz = _mm_div_pd(_mm_unpacklo_pd(a23, b23), _mm_unpackhi_pd(a23, b23));   // (a.z / a.w, b.z / b.w)
-        const __m128d d01 = _mm_sub_pd(far01, org01);
-        const __m128d dz = _mm_sub_sd(_mm_unpackhi_pd(zz, zz), zz);
+    // rayThrough(col + row) (each as its (x, y) and (z, w) pairs) with SSE2's double pairs: the
+    // same IEEE operations on the same values (glm's dvec4 sum and divisions, the double
+    // difference rounded to float), two at a time, for rays with a far end; the others (rare:
+    // see ray()) go through rayThrough itself. In two steps: unproject (the sums and the
+    // divisions), then finish.
+    struct Unprojected {
+        __m128d xy01, xy23, org01, far01, zz;   // col + row; (org.x, org.y), (far.x, far.y), (org.z, far.z)
+    };
+    Unprojected unproject(const __m128d* col, const __m128d* row) const {
+        Unprojected u;
+        u.xy01 = _mm_add_pd(col[0], row[0]);   // glm's col + row
+        u.xy23 = _mm_add_pd(col[1], row[1]);
+        const __m128d a01 = _mm_add_pd(u.xy01, _mm_loadu_pd(&m_zw[0].x)), a23 = _mm_add_pd(u.xy23, _mm_loadu_pd(&m_zw[0].z));
+        const __m128d b01 = _mm_add_pd(u.xy01, _mm_loadu_pd(&m_zw[1].x)), b23 = _mm_add_pd(u.xy23, _mm_loadu_pd(&m_zw[1].z));
+        u.org01 = _mm_div_pd(a01, _mm_unpackhi_pd(a23, a23));                      // (a.x, a.y) / a.w
+        u.far01 = _mm_div_pd(b01, _mm_unpackhi_pd(b23, b23));                      // (b.x, b.y) / b.w
+        u.zz = _mm_div_pd(_mm_unpacklo_pd(a23, b23), _mm_unpackhi_pd(a23, b23));   // (a.z / a.w, b.z / b.w)
+        return u;
+    }
+    void finish(const Unprojected& u, Ray& out) const {
+        static_assert(sizeof(Ray) == 32 && offsetof(Ray, dir) == 16, "Ray: org, tmin, dir, tmax packed");
+        const __m128d d01 = _mm_sub_pd(u.far01, u.org01);
+        const __m128d dz = _mm_sub_sd(_mm_unpackhi_pd(u.zz, u.zz), u.zz);
         // glm::dot(far - org, m_forward): (x fx + y fy) + z fz
         const __m128d p01 = _mm_mul_pd(d01, _mm_loadu_pd(&m_forward.x));
         const double dot = (_mm_cvtsd_f64(p01) + _mm_cvtsd_f64(_mm_unpackhi_pd(p01, p01))) + _mm_cvtsd_f64(dz) * m_forward.z;
-        const __m128 orgF = _mm_movelh_ps(_mm_cvtpd_ps(org01), _mm_cvtpd_ps(zz));   // org.x, org.y, org.z, (far.z)
-        const __m128 dirF = _mm_movelh_ps(_mm_cvtpd_ps(d01), _mm_cvtpd_ps(dz));     // dir.x, dir.y, dir.z, 0
+        // (org.x, org.y, org.z, tmin = 0) and (dir.x, dir.y, dir.z, tmax = 1), each double rounded to float
+        const __m128 orgF = _mm_movelh_ps(_mm_cvtpd_ps(u.org01), _mm_cvtpd_ps(_mm_move_sd(_mm_setzero_pd(), u.zz)));
+        const __m128 dirF = _mm_movelh_ps(_mm_cvtpd_ps(d01), _mm_cvtpd_ps(_mm_unpacklo_pd(dz, _mm_set1_pd(1.0))));
         // v - v is NaN exactly where v is infinite or NaN (lanes 0-2 of each).
         const int notFinite = _mm_movemask_ps(_mm_cmpunord_ps(_mm_sub_ps(orgF, orgF), _mm_sub_ps(dirF, dirF))) & 7;
         if (notFinite || !(dot > 0.0)) {
             glm::dvec4 xy;
-            _mm_storeu_pd(&xy.x, xy01);
-            _mm_storeu_pd(&xy.z, xy23);
-            return rayThrough(xy);
+            _mm_storeu_pd(&xy.x, u.xy01);
+            _mm_storeu_pd(&xy.z, u.xy23);
+            out = rayThrough(xy);
+            return;
         }
-        alignas(16) float o[4], d[4];
-        _mm_store_ps(o, orgF);
-        _mm_store_ps(d, dirF);
-        Ray r;
-        r.org = sg::vec3(o[0], o[1], o[2]);
-        r.tmin = 0.0f;
-        r.dir = sg::vec3(d[0], d[1], d[2]);
-        r.tmax = 1.0f;
-        return r;
+        _mm_storeu_ps(&out.org.x, orgF);
+        _mm_storeu_ps(&out.dir.x, dirF);
     }
 
 public:
