@@ -90,10 +90,16 @@ void strataOf(const RenderConfig& cfg, int& sx, int& sy) {
 
 // One sample per pixel: the camera rays of tile [x0, x1) x [y0, y1) (rows top-down) traced
 // kPacket x kPacket pixels at a time (SceneAccel::intersectPacket: the same hits as one by one),
-// into tileRays and tileHits (kTile per row).
+// into tileRays and tileHits (kTile per row); bit x - x0 of rowFound[row - y0] tells whether
+// pixel (x, row)'s ray met something (tileHits' `found`, kept compact: the loops over the tile
+// read it for every pixel).
 void traceCameraPackets(const FrameJob& job, const rt::SceneAccel& accel, int x0, int y0, int x1, int y1, std::vector<rt::Ray>& tileRays,
-                        std::vector<Tracer::FirstHit>& tileHits) {
+                        std::vector<Tracer::FirstHit>& tileHits, uint32_t* rowFound) {
     constexpr int kPacket = FrameJob::kPacket, tile = FrameJob::kTile;
+    static_assert(tile <= 32, "one 32-bit mask per tile row");
+    std::fill(rowFound, rowFound + (y1 - y0), 0u);
+    rt::Ray* const rays = tileRays.data();
+    Tracer::FirstHit* const hits = tileHits.data();
     for (int py = y0; py < y1; py += kPacket)
         for (int px = x0; px < x1; px += kPacket) {
             rt::PacketScratch<rt::Ray, kPacket * kPacket> pr;
@@ -105,25 +111,32 @@ void traceCameraPackets(const FrameJob& job, const rt::SceneAccel& accel, int x0
             job.cam.grid(wx, nx, wy, ny, pr.data());
             int n = nx * ny;
             const uint64_t found = accel.intersectPacket(pr.data(), n, ~uint64_t(0), ph.data(), job.f.settings.culling);
-            n = 0;
-            for (int row = py; row < std::min(py + kPacket, y1); ++row)
-                for (int x = px; x < std::min(px + kPacket, x1); ++x, ++n) {
-                    tileRays[size_t(row - y0) * tile + size_t(x - x0)] = pr[n];
-                    Tracer::FirstHit& fh = tileHits[size_t(row - y0) * tile + size_t(x - x0)];
+            for (int j = 0; j < ny; ++j) {
+                const size_t at = size_t(py + j - y0) * tile + size_t(px - x0);
+                for (int i = 0; i < nx; ++i) {
+                    n = j * nx + i;
+                    rays[at + size_t(i)] = pr[n];
+                    Tracer::FirstHit& fh = hits[at + size_t(i)];
                     fh.found = (found >> n) & 1;
                     fh.framed = false;
                     if (fh.found) fh.hit = ph[n];
                 }
+                rowFound[py + j - y0] |= uint32_t((found >> (j * nx)) & ((1u << nx) - 1)) << (px - x0);
+            }
         }
 }
 
 // The shadow rays of the tile's primary hits (traceCameraPackets), kPacket x kPacket pixels at a
-// time (Tracer::presetShadows), into tilePresets (kTile per row).
+// time (Tracer::presetShadows), into tilePresets (kTile per row). Packets without a hit are left
+// out: only a hit's shading reads its preset.
 void presetTileShadows(Tracer& tr, int x0, int y0, int x1, int y1, const std::vector<rt::Ray>& tileRays,
-                       const std::vector<Tracer::FirstHit>& tileHits, std::vector<Tracer::PresetVisibility>& tilePresets) {
+                       const std::vector<Tracer::FirstHit>& tileHits, const uint32_t* rowFound, std::vector<Tracer::PresetVisibility>& tilePresets) {
     constexpr int kPacket = FrameJob::kPacket, tile = FrameJob::kTile;
     for (int py = y0; py < y1; py += kPacket)
         for (int px = x0; px < x1; px += kPacket) {
+            uint32_t any = 0;
+            for (int row = py; row < std::min(py + kPacket, y1); ++row) any |= rowFound[row - y0] >> (px - x0);
+            if (!(any & ((1u << kPacket) - 1))) continue;
             const rt::Ray* pr[kPacket * kPacket];
             const Tracer::FirstHit* ph[kPacket * kPacket];
             Tracer::PresetVisibility* pv[kPacket * kPacket];
@@ -154,6 +167,24 @@ void setConstantMiss(FrameJob& job) {
     job.constantMiss = true;
 }
 
+// The pixels x0 + i of `row` in [x0, x1) whose bit i of `found` is clear (their packet ray met
+// nothing), when that gives the plain background (job.constantMiss): what shadePixel gives them
+// (one ray, the bytes of setConstantMiss, depth 1, no surface) without the per-pixel work.
+void fillMisses(const FrameJob& job, Tracer& tr, int row, int x0, int x1, uint32_t found, Framebuffer& target) {
+    const size_t at = size_t(row) * size_t(job.w);
+    const bool visibility = job.cfg.aovs.has(Aov::Visibility);
+    for (int x = x0; x < x1; ++x) {
+        if ((found >> (x - x0)) & 1) continue;
+        ++tr.rays;
+        std::memcpy(target.pixel(x, row), job.missRgba, 4);
+        target.depth[at + size_t(x)] = 1.0f;
+        if (visibility) {
+            target.drawable[at + size_t(x)] = 0;
+            target.primitive[at + size_t(x)] = kNoPrimitive;
+        }
+    }
+}
+
 // Pixel (x, row) of the tile with corner (x0, y0): its sx x sy stratified rays traced and
 // shaded, the mean colour through the display transform as sRGB bytes, the nearest depth, and (centre ray) the visibility and
 // the traversal cost when asked.
@@ -161,18 +192,6 @@ void shadePixel(const FrameJob& job, Tracer& tr, int x, int row, int x0, int y0,
                 const std::vector<Tracer::FirstHit>& tileHits, const std::vector<Tracer::PresetVisibility>& tilePresets, Framebuffer& target) {
     constexpr int tile = FrameJob::kTile;
     const int w = job.w, h = job.h, sx = job.sx, sy = job.sy;
-    if (job.constantMiss && !tileHits[size_t(row - y0) * tile + size_t(x - x0)].found) {
-        // What trace gives for the packet's missed ray (one ray, no depth, no surface), without
-        // the per-pixel work: the same bytes (setConstantMiss), depth and visibility.
-        ++tr.rays;
-        std::memcpy(target.pixel(x, row), job.missRgba, 4);
-        target.depth[size_t(row) * w + x] = 1.0f;
-        if (job.cfg.aovs.has(Aov::Visibility)) {
-            target.drawable[size_t(row) * w + x] = 0;
-            target.primitive[size_t(row) * w + x] = kNoPrimitive;
-        }
-        return;
-    }
     const int wy = h - 1 - row;   // GL window y of this row
     vec3 sum(0.0f);
     float depth = 1.0f;
@@ -364,10 +383,19 @@ private:
                 tr.meshCoefficients = &m_coefficients;
                 const int x0 = (ti % tx) * tile, y0 = (ti / tx) * tile;   // y0: framebuffer row (top-down)
                 const int x1 = std::min(x0 + tile, job.w), y1 = std::min(y0 + tile, job.h);
-                if (job.packets) traceCameraPackets(job, m_accel, x0, y0, x1, y1, tileRays, tileHits);
-                if (job.shadowPackets) presetTileShadows(tr, x0, y0, x1, y1, tileRays, tileHits, tilePresets);
-                for (int row = y0; row < y1; ++row)
-                    for (int x = x0; x < x1; ++x) shadePixel(job, tr, x, row, x0, y0, tileRays, tileHits, tilePresets, target);
+                uint32_t* const rowFound = buffers.rowFound;
+                if (job.packets) traceCameraPackets(job, m_accel, x0, y0, x1, y1, tileRays, tileHits, rowFound);
+                if (job.shadowPackets) presetTileShadows(tr, x0, y0, x1, y1, tileRays, tileHits, rowFound, tilePresets);
+                for (int row = y0; row < y1; ++row) {
+                    if (!job.constantMiss) {
+                        for (int x = x0; x < x1; ++x) shadePixel(job, tr, x, row, x0, y0, tileRays, tileHits, tilePresets, target);
+                        continue;
+                    }
+                    const uint32_t found = rowFound[row - y0];
+                    fillMisses(job, tr, row, x0, x1, found, target);
+                    for (uint32_t m = found; m; m &= m - 1)
+                        shadePixel(job, tr, x0 + __builtin_ctz(m), row, x0, y0, tileRays, tileHits, tilePresets, target);
+                }
                 rayCount += tr.rays;
                 int d = ++done;
                 if (control) {
@@ -404,6 +432,7 @@ private:
         std::vector<Tracer::FirstHit> hits;
         std::vector<rt::Ray> rays;
         std::vector<Tracer::PresetVisibility> presets;
+        uint32_t rowFound[FrameJob::kTile];   // per tile row, which pixels' rays met something
         void reserve(const FrameJob& job) {
             constexpr size_t n = size_t(FrameJob::kTile) * FrameJob::kTile;
             if (job.packets && hits.size() < n) {
