@@ -23,6 +23,7 @@ DebugSwitches debugSwitches() {
     d.raycastForceSse = is("VIEWER_RAYCAST_SSE", '1');
     d.raycastPackets = !is("VIEWER_RAYCAST_PACKETS", '0');
     d.raycastShadowPackets = !is("VIEWER_RAYCAST_SHADOW_PACKETS", '0');
+    d.raycastPacketCull = !is("VIEWER_RAYCAST_PACKET_CULL", '0');
     d.raycastWorldVertices = !is("VIEWER_RAYCAST_WORLD_VERTICES", '0');
     return d;
 }

@@ -24,6 +24,7 @@ public:
     CameraRays(const sg::FrameCamera& cam, int width, int height)
         : m_viewProj(cam.proj * cam.view),
           m_inv(glm::inverse(glm::dmat4(cam.proj) * glm::dmat4(cam.view))),
+          m_viewProjD(glm::dmat4(cam.proj) * glm::dmat4(cam.view)),
           m_forward(-glm::dvec3(cam.viewInverse[2])),
           m_w(double(width)),
           m_h(double(height)) {
@@ -33,6 +34,49 @@ public:
         m_zw[0] = m_inv[2] * glm::dvec4(-1.0) + m_inv[3] * glm::dvec4(1.0);
         m_zw[1] = m_inv[2] * glm::dvec4(1.0) + m_inv[3] * glm::dvec4(1.0);
         m_zw[2] = m_inv[2] * glm::dvec4(0.0) + m_inv[3] * glm::dvec4(1.0);
+        // The largest coordinate of a ray origin: the near points form a convex quadrilateral
+        // (or, unprojected with a w of changing sign, no bound at all: infinity).
+        for (int corner = 0; corner < 4; ++corner) {
+            const glm::dvec4 a = column(corner & 1 ? float(width) : 0.0f) + row(corner & 2 ? float(height) : 0.0f) + m_zw[0];
+            const double s = a.w > 0.0 ? std::max({std::abs(a.x), std::abs(a.y), std::abs(a.z)}) / a.w : std::numeric_limits<double>::infinity();
+            m_originScale = std::max(m_originScale, s);
+        }
+    }
+
+    // The window rectangle (GL window coordinates x0, y0, x1, y1) that holds the window position
+    // of every camera ray that can meet a point of the box [lo, hi], or false where there is no
+    // such bound (part of the box lies at or behind the eye's plane, or nothing is finite).
+    // The ray of window position q is the line of points that project to q, so a point of the
+    // box met by the exact ray of q projects to q, inside the hull of the projected corners. A
+    // traced ray is that ray rounded to float; it passes within 1e-6 x (its origin's and the
+    // point's largest coordinate) of it; moved into an instance's space and its hit seen from
+    // world space, that grows by up to the instance's spread (|L|_F |L^-1|_F, 3 for rotations
+    // with a uniform scale). So the box is grown by 1e-4 x max(1, spread / 10) x those first
+    // (slab and triangle tests round far less), and the rectangle by a pixel (the double
+    // projection's own rounding is far below).
+    bool windowBounds(const sg::vec3& lo, const sg::vec3& hi, float spread, float rect[4]) const {
+        const glm::dvec3 bmin(lo), bmax(hi);
+        const double boxScale =
+            std::max({std::abs(bmin.x), std::abs(bmin.y), std::abs(bmin.z), std::abs(bmax.x), std::abs(bmax.y), std::abs(bmax.z)});
+        const double eps = 1e-4 * std::max(1.0, double(spread) / 10.0) * (m_originScale + boxScale);
+        if (!std::isfinite(eps)) return false;
+        double x0 = std::numeric_limits<double>::infinity(), y0 = x0, x1 = -x0, y1 = -x0;
+        for (int corner = 0; corner < 8; ++corner) {
+            const glm::dvec3 p(corner & 1 ? bmax.x + eps : bmin.x - eps, corner & 2 ? bmax.y + eps : bmin.y - eps,
+                               corner & 4 ? bmax.z + eps : bmin.z - eps);
+            const glm::dvec4 c = m_viewProjD * glm::dvec4(p, 1.0);
+            if (!(c.w > 0.0)) return false;
+            const double wx = (0.5 * c.x / c.w + 0.5) * m_w, wy = (0.5 * c.y / c.w + 0.5) * m_h;
+            x0 = std::min(x0, wx), x1 = std::max(x1, wx), y0 = std::min(y0, wy), y1 = std::max(y1, wy);
+        }
+        if (!(std::isfinite(x0) && std::isfinite(x1) && std::isfinite(y0) && std::isfinite(y1))) return false;
+        // Clamped to a little beyond the image: a float holds those bounds exactly enough.
+        const double lim = 2.0 * (m_w + m_h) + 2.0;
+        rect[0] = float(std::clamp(x0 - 1.0, -lim, lim));
+        rect[1] = float(std::clamp(y0 - 1.0, -lim, lim));
+        rect[2] = float(std::clamp(x1 + 1.0, -lim, lim));
+        rect[3] = float(std::clamp(y1 + 1.0, -lim, lim));
+        return true;
     }
 
     // Ray through window position (wx, wy); framebuffer row = height - 1 - floor(wy).
@@ -155,9 +199,11 @@ private:
 
     sg::mat4 m_viewProj;
     glm::dmat4 m_inv;
-    glm::dvec4 m_zw[3];     // m_inv's (z, 1) half at NDC z = -1, +1 and 0 (see the constructor)
-    glm::dvec3 m_forward;   // the view direction (world)
+    glm::dmat4 m_viewProjD;   // proj * view in double (windowBounds)
+    glm::dvec4 m_zw[3];       // m_inv's (z, 1) half at NDC z = -1, +1 and 0 (see the constructor)
+    glm::dvec3 m_forward;     // the view direction (world)
     double m_w, m_h;
+    double m_originScale = 0.0;   // the largest coordinate of a camera ray's origin (windowBounds)
 };
 
 }   // namespace rnd::rt

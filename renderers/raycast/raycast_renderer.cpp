@@ -33,6 +33,7 @@
 #include <xmmintrin.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cstdlib>
@@ -71,6 +72,10 @@ struct FrameJob {
     // (no environment map behind the scene): the pixel's bytes, made once (see missPixel).
     bool constantMiss = false;
     uint8_t missRgba[4] = {0, 0, 0, 255};
+    // With constantMiss, a packet none of whose pixel centres lies in one of these window
+    // rectangles (CameraRays::windowBounds of SceneAccel::hitBoxes) is not traced: its rays would
+    // meet nothing, and such pixels need no ray (fillMisses). Empty: every packet is traced.
+    std::vector<std::array<float, 4>> hitRects;
     const SrgbEncoder& srgb = srgbEncoder();
     static constexpr int kTile = 32;    // pixels per tile side
     static constexpr int kPacket = 4;   // pixels per packet side (4x4: the benchmark's best, docs/benchmarks.md)
@@ -108,6 +113,12 @@ void traceCameraPackets(const FrameJob& job, const rt::SceneAccel& accel, int x0
             float wx[kPacket], wy[kPacket];
             for (int i = 0; i < nx; ++i) wx[i] = float(px + i) + 0.5f;
             for (int j = 0; j < ny; ++j) wy[j] = float(job.h - 1 - (py + j)) + 0.5f;
+            if (!job.hitRects.empty()) {   // rowFound keeps 0 for the packet's pixels: misses, as traced
+                bool any = false;
+                for (const std::array<float, 4>& r : job.hitRects)
+                    any = any || (wx[nx - 1] >= r[0] && wx[0] <= r[2] && wy[0] >= r[1] && wy[ny - 1] <= r[3]);   // (wy falls row by row)
+                if (!any) continue;
+            }
             job.cam.grid(wx, nx, wy, ny, pr.data());
             int n = nx * ny;
             const uint64_t found = accel.intersectPacket(pr.data(), n, ~uint64_t(0), ph.data(), job.f.settings.culling);
@@ -298,6 +309,16 @@ protected:
         const bool shadowPackets = packets && debugSwitches().raycastShadowPackets && f.settings.shadows && !f.lights.empty() && !anyTranslucent(f);
         FrameJob job{f, cfg, cam, w, h, sx, sy, packets, shadowPackets, countCost, display};
         if (packets && !(m_environment.map && m_environment.background)) setConstantMiss(job);   // as Tracer::missed
+        if (job.constantMiss && debugSwitches().raycastPacketCull) {
+            for (const rt::SceneAccel::Box& b : m_accel.hitBoxes()) {
+                std::array<float, 4> r;
+                if (!cam.windowBounds(b.lo, b.hi, b.spread, r.data())) {   // no bound for this box: trace every packet
+                    job.hitRects.clear();
+                    break;
+                }
+                job.hitRects.push_back(r);
+            }
+        }
         uint64_t rays = 0;
         stats.cancelled = !renderTiles(job, target, control, rays);
         _mm_setcsr(csr);

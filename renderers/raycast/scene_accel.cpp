@@ -16,6 +16,19 @@ namespace {
 constexpr size_t kPacketMinTriangles = 256;   // meshes traced as packets by intersectPacket / occludedPacket
 }   // namespace
 
+namespace {
+// |L|_F |L^-1|_F of an instance's linear part (3 for a rotation with a uniform scale; infinite
+// when singular): how much the rounding of a ray moved into the instance's space can grow when
+// its hit is seen from world space.
+float spreadOf(const sg::mat3& l) {
+    auto frob = [](const sg::mat3& m) { return std::sqrt(glm::dot(m[0], m[0]) + glm::dot(m[1], m[1]) + glm::dot(m[2], m[2])); };
+    const float d = glm::determinant(l);
+    if (!(std::abs(d) > 0.0f) || !std::isfinite(d)) return std::numeric_limits<float>::infinity();
+    const float s = frob(l) * frob(glm::inverse(l));
+    return std::isfinite(s) ? s : std::numeric_limits<float>::infinity();
+}
+}   // namespace
+
 int SceneAccel::update(const FrameInput& f) {
     m_frame = &f;
     ++m_frameCounter;
@@ -23,6 +36,7 @@ int SceneAccel::update(const FrameInput& f) {
     m_instances.clear();
     m_anyPacketMesh = false;
     std::vector<vec3> bmin, bmax;
+    std::vector<float> spread;   // per box, hitBoxes' Box::spread
 
     // Mesh BVHs: (id, version) keyed, built in parallel when several are missing.
     std::vector<MeshEntry*> toBuild;
@@ -74,6 +88,7 @@ int SceneAccel::update(const FrameInput& f) {
         m_instances.push_back(inst);
         bmin.push_back(wb.min);
         bmax.push_back(wb.max);
+        spread.push_back(spreadOf(sg::mat3(d.world)));
     }
 
     for (uint32_t i = 0; i < f.analytics.size(); ++i) {
@@ -108,6 +123,7 @@ int SceneAccel::update(const FrameInput& f) {
         m_instances.push_back(inst);
         bmin.push_back(wb.min - pad);
         bmax.push_back(wb.max + pad);
+        spread.push_back(spreadOf(sg::mat3(a.world)));
     }
     for (auto it = m_analytics.begin(); it != m_analytics.end();)
         it = m_frameCounter - it->second.lastFrame > 8 ? m_analytics.erase(it) : std::next(it);
@@ -116,6 +132,19 @@ int SceneAccel::update(const FrameInput& f) {
     o.maxLeafSize = 2;
     o.parallel = false;
     m_tlas.build(bmin.data(), bmax.data(), bmin.size(), o);
+    constexpr size_t kMaxHitBoxes = 16;
+    m_hitBoxes.clear();
+    if (bmin.size() <= kMaxHitBoxes) {
+        for (size_t i = 0; i < bmin.size(); ++i) m_hitBoxes.push_back({bmin[i], bmax[i], spread[i]});
+    } else {
+        Box all{bmin[0], bmax[0], spread[0]};
+        for (size_t i = 1; i < bmin.size(); ++i) {
+            all.lo = glm::min(all.lo, bmin[i]);
+            all.hi = glm::max(all.hi, bmax[i]);
+            all.spread = std::max(all.spread, spread[i]);
+        }
+        m_hitBoxes.push_back(all);
+    }
     return built;
 }
 

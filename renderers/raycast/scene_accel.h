@@ -93,6 +93,15 @@ public:
     // and are not blocked yet (TriangleBvh::occludedPacket).
     uint64_t occludedPacket(const Ray* worldRays, int n, uint64_t active) const;
 
+    // Boxes that hold every hit a ray can have: each instance's box in the top level, or one
+    // around them all where there are many (the ray caster's packet culling). spread: the
+    // largest |L|_F |L^-1|_F of their instances' linear parts (see CameraRays::windowBounds).
+    struct Box {
+        sg::vec3 lo, hi;
+        float spread = 3.0f;
+    };
+    const std::vector<Box>& hitBoxes() const { return m_hitBoxes; }
+
     size_t cachedMeshes() const { return m_meshes.size(); }
     uint64_t buildsTotal() const { return m_buildsTotal; }
 
@@ -135,6 +144,7 @@ private:
     std::unordered_map<uint64_t, AnalyticEntry> m_analytics;   // by geometryKey
     std::vector<Instance> m_instances;
     bool m_anyPacketMesh = false;   // some instance has packets set
+    std::vector<Box> m_hitBoxes;    // see hitBoxes()
     Bvh4 m_tlas;
     uint64_t m_frameCounter = 0;
     uint64_t m_buildsTotal = 0;

@@ -18,6 +18,8 @@
 //   VIEWER_RAYCAST_PACKETS=0              the ray caster traces camera rays one by one (no packets)
 //   VIEWER_RAYCAST_SHADOW_PACKETS=0       the ray caster traces shadow rays one by one (camera rays
 //                                         still in packets)
+//   VIEWER_RAYCAST_PACKET_CULL=0          the ray caster traces every camera packet, also those
+//                                         whose region misses every box of the scene
 //   VIEWER_RAYCAST_WORLD_VERTICES=0       the ray caster transforms a hit's vertices per hit
 //                                         instead of keeping world-space copies (WorldVertexCache)
 #pragma once
@@ -36,6 +38,7 @@ struct DebugSwitches {
     bool raycastForceSse = false;
     bool raycastPackets = true;
     bool raycastShadowPackets = true;
+    bool raycastPacketCull = true;
     bool raycastWorldVertices = true;
 };
 

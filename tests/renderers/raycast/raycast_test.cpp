@@ -968,9 +968,12 @@ TEST(RaycastTest, ShadowPacketsGiveTheSameImageAsSingleShadowRays) {
 }
 
 // Camera rays traced as packets give the image, depth, visibility and (without shadows) ray count
-// that they give one by one, with and without shadows, pixels that meet nothing included (those take a shortcut when what they see is
-// the plain background colour): with the display transform off and on, a background with a
-// negative zero, and the environment drawn behind the scene (no shortcut).
+// that they give one by one, with and without shadows, pixels that meet nothing included (those
+// take a shortcut when what they see is the plain background colour, and packets whose pixels
+// lie outside every box's window rectangle are not traced): with the display transform off and
+// on, a background with a negative zero, the environment drawn behind the scene (no shortcut),
+// an orthographic and an oblique camera, and the whole scene far from the origin under a
+// squashed instance.
 TEST(RaycastTest, CameraPacketsGiveTheSameImageAsSingleRays) {
     const int w = 160, h = 120;
     FrameInput f = triangleScene(w, h);
@@ -998,15 +1001,36 @@ TEST(RaycastTest, CameraPacketsGiveTheSameImageAsSingleRays) {
         vec3 background;
         ReflectionModel model;
         bool environmentBehind;
+        int view;   // 0: the scene's camera; 1: orthographic; 2: cabinet; 3: everything moved far off and squashed
     };
     const Case cases[] = {
-        {"plain", 0.0f, ToneMapping::None, vec3(0.08f, 0.09f, 0.11f), ReflectionModel::Phong, false},
-        {"exposed, tone-mapped", 1.5f, ToneMapping::Aces, vec3(0.6f, -0.0f, 0.3f), ReflectionModel::Phong, false},
-        {"environment behind", 0.0f, ToneMapping::None, vec3(0.08f, 0.09f, 0.11f), ReflectionModel::Pbr, true},
+        {"plain", 0.0f, ToneMapping::None, vec3(0.08f, 0.09f, 0.11f), ReflectionModel::Phong, false, 0},
+        {"exposed, tone-mapped", 1.5f, ToneMapping::Aces, vec3(0.6f, -0.0f, 0.3f), ReflectionModel::Phong, false, 0},
+        {"environment behind", 0.0f, ToneMapping::None, vec3(0.08f, 0.09f, 0.11f), ReflectionModel::Pbr, true, 0},
+        {"orthographic", 0.0f, ToneMapping::None, vec3(0.08f, 0.09f, 0.11f), ReflectionModel::Phong, false, 1},
+        {"cabinet", 0.0f, ToneMapping::None, vec3(0.08f, 0.09f, 0.11f), ReflectionModel::Phong, false, 2},
+        {"far off, squashed", 0.0f, ToneMapping::None, vec3(0.08f, 0.09f, 0.11f), ReflectionModel::Phong, false, 3},
     };
+    const FrameInput scene = f;
     for (const Case& c : cases)
         for (bool shadows : {false, true}) {
             SCOPED_TRACE(std::string(c.name) + (shadows ? ", shadows" : ""));
+            f = scene;
+            const mat4 camWorld = glm::inverse(glm::lookAt(vec3(0, 3, 6), vec3(0, 0.5f, 0), vec3(0, 1, 0)));
+            if (c.view == 1 || c.view == 2) {
+                Projection p = c.view == 1 ? Projection{} : Projection::cabinet();
+                p.type = c.view == 1 ? ProjectionType::Orthographic : p.type;
+                p.orthoHalfHeight = 4.0f;   // the scene with room around it
+                f.camera = makeFrameCamera(camWorld, p, float(w) / h, 6.0f);
+            } else if (c.view == 3) {
+                const mat4 away = glm::translate(mat4(1.0f), vec3(4000.0f, -3000.0f, 2500.0f));
+                for (DrawMesh& d : f.meshes) {
+                    d.world = away * d.world * glm::scale(mat4(1.0f), vec3(1.0f, 0.05f, 1.0f));
+                    d.normal = normalMatrix(d.world);
+                }
+                for (DrawLight& l : f.lights) l.position = vec3(away * vec4(l.position, 1.0f));
+                f.camera = makeFrameCamera(away * camWorld, Projection{}, float(w) / h, 6.0f);
+            }
             f.settings.shadows = shadows;
             f.settings.exposure = c.exposure;
             f.settings.toneMapping = c.op;
