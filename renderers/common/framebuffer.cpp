@@ -13,6 +13,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <limits>
 
 namespace rnd {
@@ -81,7 +82,11 @@ void Framebuffer::takeVisibilityAndCounters(Framebuffer&& src) {
 }
 
 void Framebuffer::clear(const uint8_t rgba[4], float d) {
-    for (size_t i = 0; i < color.size(); i += 4) std::copy(rgba, rgba + 4, &color[i]);
+    uint32_t pixel;   // one 4-byte store per pixel (the compiler makes wide stores of the loop)
+    std::memcpy(&pixel, rgba, 4);
+    uint8_t* const out = color.data();
+    const size_t n = color.size() / 4;
+    for (size_t i = 0; i < n; ++i) std::memcpy(out + 4 * i, &pixel, 4);
     std::fill(depth.begin(), depth.end(), d);
 }
 

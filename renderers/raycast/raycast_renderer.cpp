@@ -69,7 +69,7 @@ struct FrameJob {
     bool countCost;             // the cost view: one centre ray per pixel, counted
     DisplayTransform display;   // exposure and tone mapping of each pixel's mean colour
     // Where a packet's camera ray met nothing and what it sees there is the plain background
-    // (no environment map behind the scene): the pixel's bytes, made once (see missPixel).
+    // (no environment map behind the scene): the pixel's bytes, made once (setConstantMiss, fillMisses).
     bool constantMiss = false;
     uint8_t missRgba[4] = {0, 0, 0, 255};
     // With constantMiss, a packet none of whose pixel centres lies in one of these window

@@ -912,17 +912,25 @@ TEST(RaycastTest, SceneAccelPacketsEqualSingleRays) {
     }
 }
 
+namespace {
+// triangleScene with a sphere of 16k triangles beside its small meshes: a mesh traced as packets.
+FrameInput triangleSceneWithBigSphere(int w, int h) {
+    FrameInput f = triangleScene(w, h);
+    DrawMesh big;
+    big.mesh = std::make_shared<Mesh>(primitives::uvSphere(0.6f, 128, 64));
+    big.world = glm::translate(mat4(1.0f), vec3(-1.2f, 0.7f, 0.3f));
+    big.normal = normalMatrix(big.world);
+    f.meshes.push_back(big);
+    return f;
+}
+}   // namespace
+
 // The renderer's shadow rays traced as packets (after the tile's camera packets) give the image
 // they give one by one, byte for byte: shading models, a big mesh (packets) beside small ones
 // and analytic shapes, a point light, a spot, a sun, and a light with a size (soft: one by one).
 TEST(RaycastTest, ShadowPacketsGiveTheSameImageAsSingleShadowRays) {
     const int w = 160, h = 120;
-    FrameInput f = triangleScene(w, h);
-    DrawMesh big;
-    big.mesh = std::make_shared<Mesh>(primitives::uvSphere(0.6f, 128, 64));   // 16k triangles: traced as packets
-    big.world = glm::translate(mat4(1.0f), vec3(-1.2f, 0.7f, 0.3f));
-    big.normal = normalMatrix(big.world);
-    f.meshes.push_back(big);
+    FrameInput f = triangleSceneWithBigSphere(w, h);
     DrawLight spot;
     spot.type = LightType::Spot;
     spot.position = vec3(-1.5f, 4, 0.5f);
@@ -976,12 +984,7 @@ TEST(RaycastTest, ShadowPacketsGiveTheSameImageAsSingleShadowRays) {
 // squashed instance.
 TEST(RaycastTest, CameraPacketsGiveTheSameImageAsSingleRays) {
     const int w = 160, h = 120;
-    FrameInput f = triangleScene(w, h);
-    DrawMesh big;
-    big.mesh = std::make_shared<Mesh>(primitives::uvSphere(0.6f, 128, 64));   // 16k triangles: traced as packets
-    big.world = glm::translate(mat4(1.0f), vec3(-1.2f, 0.7f, 0.3f));
-    big.normal = normalMatrix(big.world);
-    f.meshes.push_back(big);
+    FrameInput f = triangleSceneWithBigSphere(w, h);
     auto render = [&](const char* packets, uint64_t& rays) {
         setenv("VIEWER_RAYCAST_PACKETS", packets, 1);
         auto r = makeRenderer("raycast");
