@@ -541,6 +541,20 @@ void TriangleBvh::build(const vec3* pos, const uint32_t* idx, size_t triCount, c
     for (int a = 0; a < 3; ++a) m_absMax[a] = m_packets.empty() ? 0.0f : std::max(std::abs(m_bounds.min[a]), std::abs(m_bounds.max[a]));
 }
 
+std::vector<sg::Aabb> TriangleBvh::rootChildBoxes() const {
+    std::vector<sg::Aabb> out;
+    auto collect = [&](const auto& root, int width) {
+        for (int c = 0; c < width; ++c)
+            if (root.child[c] != NodeBits::kEmpty)
+                out.push_back({vec3(root.b[0][c], root.b[2][c], root.b[4][c]), vec3(root.b[1][c], root.b[3][c], root.b[5][c])});
+    };
+    if (!m_nodes8.empty())
+        collect(m_nodes8[0], 8);
+    else if (!m_nodes4.empty())
+        collect(m_nodes4[0], 4);
+    return out;
+}
+
 namespace {
 // refScale: what an inner child reference is in units of nodes (BVH8: byte offsets).
 template <int W>

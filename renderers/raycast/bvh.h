@@ -231,6 +231,9 @@ public:
 
     bool empty() const { return m_packets.empty(); }
     const sg::Aabb& bounds() const { return m_bounds; }
+    // The boxes of the root's children, in the mesh's frame: every point of every triangle lies
+    // in one of them (a tighter bound than bounds(), for the ray caster's packet culling).
+    std::vector<sg::Aabb> rootChildBoxes() const;
     size_t memoryBytes() const {
         return m_nodes4.size() * sizeof(Node4) + m_nodes8.size() * sizeof(Node8) + m_packets.size() * sizeof(TriPacket4) + m_prims.size() * 4;
     }

@@ -37,6 +37,7 @@ int SceneAccel::update(const FrameInput& f) {
     m_anyPacketMesh = false;
     std::vector<vec3> bmin, bmax;
     std::vector<float> spread;   // per box, hitBoxes' Box::spread
+    std::vector<Box> tight;      // hitBoxes with each mesh's root child boxes instead of its box
 
     // Mesh BVHs: (id, version) keyed, built in parallel when several are missing.
     std::vector<MeshEntry*> toBuild;
@@ -89,6 +90,10 @@ int SceneAccel::update(const FrameInput& f) {
         bmin.push_back(wb.min);
         bmax.push_back(wb.max);
         spread.push_back(spreadOf(sg::mat3(d.world)));
+        for (const Aabb& child : it->second.bvh.rootChildBoxes()) {
+            const Aabb cw = child.transformed(d.world);
+            tight.push_back({cw.min, cw.max, spread.back()});
+        }
     }
 
     for (uint32_t i = 0; i < f.analytics.size(); ++i) {
@@ -124,6 +129,7 @@ int SceneAccel::update(const FrameInput& f) {
         bmin.push_back(wb.min - pad);
         bmax.push_back(wb.max + pad);
         spread.push_back(spreadOf(sg::mat3(a.world)));
+        tight.push_back({bmin.back(), bmax.back(), spread.back()});
     }
     for (auto it = m_analytics.begin(); it != m_analytics.end();)
         it = m_frameCounter - it->second.lastFrame > 8 ? m_analytics.erase(it) : std::next(it);
@@ -132,9 +138,11 @@ int SceneAccel::update(const FrameInput& f) {
     o.maxLeafSize = 2;
     o.parallel = false;
     m_tlas.build(bmin.data(), bmax.data(), bmin.size(), o);
-    constexpr size_t kMaxHitBoxes = 16;
+    constexpr size_t kMaxHitBoxes = 16, kMaxTightBoxes = 32;
     m_hitBoxes.clear();
-    if (bmin.size() <= kMaxHitBoxes) {
+    if (bmin.size() <= kMaxHitBoxes && tight.size() <= kMaxTightBoxes) {
+        m_hitBoxes = std::move(tight);
+    } else if (bmin.size() <= kMaxHitBoxes) {
         for (size_t i = 0; i < bmin.size(); ++i) m_hitBoxes.push_back({bmin[i], bmax[i], spread[i]});
     } else {
         Box all{bmin[0], bmax[0], spread[0]};

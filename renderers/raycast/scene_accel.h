@@ -93,9 +93,11 @@ public:
     // and are not blocked yet (TriangleBvh::occludedPacket).
     uint64_t occludedPacket(const Ray* worldRays, int n, uint64_t active) const;
 
-    // Boxes that hold every hit a ray can have: each instance's box in the top level, or one
-    // around them all where there are many (the ray caster's packet culling). spread: the
-    // largest |L|_F |L^-1|_F of their instances' linear parts (see CameraRays::windowBounds).
+    // Boxes that hold every hit a ray can have (the ray caster's packet culling): with up to 16
+    // instances, each mesh's root child boxes in world space (TriangleBvh::rootChildBoxes; the
+    // instances' boxes where that makes more than 32) and each analytic shape's box; with more,
+    // one box around them all. spread: the largest |L|_F |L^-1|_F of their instances' linear
+    // parts (see CameraRays::windowBounds).
     struct Box {
         sg::vec3 lo, hi;
         float spread = 3.0f;

@@ -2,7 +2,8 @@
 // doubles at a time) against CameraRays::ray, bit for bit, for every projection, far planes at
 // infinity, window positions inside and far outside the image, and grids wider than the
 // columns it keeps; CameraRays::windowBounds (the window rectangle that holds every camera ray
-// that can meet a box) against the rays' own box tests, boxes grazed by rays included.
+// that can meet a box) against the rays' own box tests, boxes grazed by rays included; and
+// TriangleBvh::rootChildBoxes, the tighter boxes the culling uses, holding every triangle.
 #include "raycast/camera_rays.h"
 #include "raycast/bvh.h"
 
@@ -165,4 +166,41 @@ TEST(CameraRaysTest, WindowBoundsHoldEveryRayThatMeetsTheBox) {
     EXPECT_GT(outside, 100000);
     EXPECT_GT(grazes, 100);
     EXPECT_GT(unbounded, 0);
+}
+
+// Every triangle of a mesh lies wholly in one of its BVH's root child boxes (the packet
+// culling's boxes for a mesh), for meshes of a few triangles (one leaf) to many, and a soup of
+// random triangles of every size.
+TEST(CameraRaysTest, RootChildBoxesHoldEveryTriangle) {
+    std::mt19937 rng(31);
+    std::uniform_real_distribution<float> U(-10.0f, 10.0f), E(0.001f, 3.0f);
+    for (int triangles : {1, 3, 40, 700, 20000}) {
+        std::vector<vec3> pos;
+        std::vector<uint32_t> idx;
+        for (int t = 0; t < triangles; ++t) {
+            const vec3 c(U(rng), U(rng), U(rng));
+            const float e = E(rng);
+            for (int k = 0; k < 3; ++k) {
+                idx.push_back(uint32_t(pos.size()));
+                pos.push_back(c + e * vec3(U(rng), U(rng), U(rng)) / 10.0f);
+            }
+        }
+        TriangleBvh bvh;
+        bvh.build(pos.data(), idx.data(), size_t(triangles));
+        const std::vector<Aabb> boxes = bvh.rootChildBoxes();
+        ASSERT_FALSE(boxes.empty()) << triangles;
+        EXPECT_LE(boxes.size(), size_t(bvh.width()));
+        for (int t = 0; t < triangles; ++t) {
+            bool held = false;
+            for (const Aabb& b : boxes) {
+                bool all = true;
+                for (int k = 0; k < 3; ++k) {
+                    const vec3& p = pos[idx[size_t(3 * t + k)]];
+                    all = all && glm::all(glm::greaterThanEqual(p, b.min)) && glm::all(glm::lessThanEqual(p, b.max));
+                }
+                held = held || all;
+            }
+            EXPECT_TRUE(held) << triangles << " triangles: triangle " << t << " is in no root child box";
+        }
+    }
 }
