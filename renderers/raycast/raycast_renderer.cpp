@@ -163,18 +163,24 @@ void presetTileShadows(Tracer& tr, int x0, int y0, int x1, int y1, const std::ve
         }
 }
 
+// A pixel's bytes from its mean linear colour: the display transform after the resolve, as every
+// backend (tone_map.h), then the sRGB bytes (toByteSRGB's, with one table lookup each); NaN is
+// never fed to the byte conversion.
+void encodePixel(const FrameJob& job, vec3 mean, uint8_t* px) {
+    mean = job.display(mean);
+    if (!isFinite(mean)) mean = vec3(1, 0, 1);
+    px[0] = job.srgb(mean.x);
+    px[1] = job.srgb(mean.y);
+    px[2] = job.srgb(mean.z);
+    px[3] = 255;
+}
+
 // The bytes shadePixel gives a pixel whose one camera ray meets nothing when Tracer::missed
-// returns the settings' background: that colour summed, through the display transform, checked
-// and encoded, as shadePixel does it.
+// returns the settings' background: that colour summed as shadePixel sums it, then encodePixel.
 void setConstantMiss(FrameJob& job) {
     vec3 sum(0.0f);
     sum += job.f.settings.background;
-    sum = job.display(sum);
-    if (!isFinite(sum)) sum = vec3(1, 0, 1);
-    job.missRgba[0] = job.srgb(sum.x);
-    job.missRgba[1] = job.srgb(sum.y);
-    job.missRgba[2] = job.srgb(sum.z);
-    job.missRgba[3] = 255;
+    encodePixel(job, sum, job.missRgba);
     job.constantMiss = true;
 }
 
@@ -236,14 +242,8 @@ void shadePixel(const FrameJob& job, Tracer& tr, int x, int row, int x0, int y0,
             }
             sum += c;
         }
-    if (sx * sy > 1) sum /= float(sx * sy);    // (x / 1 is x: one sample skips three divisions)
-    sum = job.display(sum);                    // after the resolve, as every backend (tone_map.h)
-    if (!isFinite(sum)) sum = vec3(1, 0, 1);   // never feed NaN to the byte conversion
-    uint8_t* px = target.pixel(x, row);
-    px[0] = job.srgb(sum.x);   // toByteSRGB's byte, with one table lookup
-    px[1] = job.srgb(sum.y);
-    px[2] = job.srgb(sum.z);
-    px[3] = 255;
+    if (sx * sy > 1) sum /= float(sx * sy);   // (x / 1 is x: one sample skips three divisions)
+    encodePixel(job, sum, target.pixel(x, row));
     target.depth[size_t(row) * w + x] = depth;
 }
 

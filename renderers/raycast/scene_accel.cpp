@@ -14,9 +14,7 @@ using namespace sg;
 
 namespace {
 constexpr size_t kPacketMinTriangles = 256;   // meshes traced as packets by intersectPacket / occludedPacket
-}   // namespace
 
-namespace {
 // |L|_F |L^-1|_F of an instance's linear part (3 for a rotation with a uniform scale; infinite
 // when singular): how much the rounding of a ray moved into the instance's space can grow when
 // its hit is seen from world space.
