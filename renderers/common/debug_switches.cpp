@@ -25,6 +25,7 @@ DebugSwitches debugSwitches() {
     d.raycastShadowPackets = !is("VIEWER_RAYCAST_SHADOW_PACKETS", '0');
     d.raycastPacketCull = !is("VIEWER_RAYCAST_PACKET_CULL", '0');
     d.raycastWorldVertices = !is("VIEWER_RAYCAST_WORLD_VERTICES", '0');
+    d.raycastLanes = !is("VIEWER_RAYCAST_LANES", '0');
     return d;
 }
 

@@ -76,6 +76,9 @@ struct FrameJob {
     // rectangles (CameraRays::windowBounds of SceneAccel::hitBoxes) is not traced: its rays would
     // meet nothing, and such pixels need no ray (fillMisses). Empty: every packet is traced.
     std::vector<std::array<float, 4>> hitRects;
+    // Per f.meshes entry, whether its packet hits are shaded four at a time (lane_shading.h;
+    // RaycastRenderer::laneMeshes); empty: every hit through Tracer::trace.
+    std::vector<uint8_t> laneMesh;
     const SrgbEncoder& srgb = srgbEncoder();
     static constexpr int kTile = 32;    // pixels per tile side
     static constexpr int kPacket = 4;   // pixels per packet side (4x4: the benchmark's best, docs/benchmarks.md)
@@ -202,6 +205,17 @@ void fillMisses(const FrameJob& job, Tracer& tr, int row, int x0, int x1, uint32
     }
 }
 
+// What a pixel keeps of its surface hp (one of its rays'): the nearest depth (window z) into
+// `depth`, and its drawable and primitive when the visibility is asked (one centre ray per pixel,
+// RenderConfig::aovs).
+void keepSurface(const FrameJob& job, const SurfaceRecord& hp, int x, int row, float& depth, Framebuffer& target) {
+    if (!std::isnan(hp.p.x)) depth = std::min(depth, std::clamp(job.cam.depth(hp.p), 0.0f, 1.0f));
+    if (job.cfg.aovs.has(Aov::Visibility)) {
+        target.drawable[size_t(row) * size_t(job.w) + size_t(x)] = hp.drawable;
+        target.primitive[size_t(row) * size_t(job.w) + size_t(x)] = hp.primitive;
+    }
+}
+
 // Pixel (x, row) of the tile with corner (x0, y0): its sx x sy stratified rays traced and
 // shaded, the mean colour through the display transform as sRGB bytes, the nearest depth, and (centre ray) the visibility and
 // the traversal cost when asked.
@@ -235,16 +249,64 @@ void shadePixel(const FrameJob& job, Tracer& tr, int x, int row, int x0, int y0,
                 target.costNodes[size_t(row) * w + x] = count.nodes;
                 target.costPrims[size_t(row) * w + x] = count.prims;
             }
-            if (!std::isnan(hp.p.x)) depth = std::min(depth, std::clamp(job.cam.depth(hp.p), 0.0f, 1.0f));
-            if (job.cfg.aovs.has(Aov::Visibility)) {   // one centre ray per pixel (RenderConfig::aovs)
-                target.drawable[size_t(row) * w + x] = hp.drawable;
-                target.primitive[size_t(row) * w + x] = hp.primitive;
-            }
+            keepSurface(job, hp, x, row, depth, target);
             sum += c;
         }
     if (sx * sy > 1) sum /= float(sx * sy);   // (x / 1 is x: one sample skips three divisions)
     encodePixel(job, sum, target.pixel(x, row));
     target.depth[size_t(row) * w + x] = depth;
+}
+
+// The pixels x0 + i of `row` (tile corner (x0, y0)) whose bit i of `pixels` is set, when the
+// tile's camera rays went in packets: hits of the meshes in job.laneMesh four at a time
+// (raycast::shadeLanes, then what Tracer::trace and shadePixel do after the shading: fog, depth,
+// visibility, bytes), every other pixel and every lane shadeLanes leaves through shadePixel.
+void shadePixels(const FrameJob& job, Tracer& tr, int row, int x0, int y0, uint32_t pixels, const std::vector<rt::Ray>& tileRays,
+                 const std::vector<Tracer::FirstHit>& tileHits, const std::vector<Tracer::PresetVisibility>& tilePresets, Framebuffer& target) {
+    constexpr int tile = FrameJob::kTile;
+    if (job.laneMesh.empty()) {
+        for (uint32_t m = pixels; m; m &= m - 1) shadePixel(job, tr, x0 + __builtin_ctz(m), row, x0, y0, tileRays, tileHits, tilePresets, target);
+        return;
+    }
+    raycast::LaneBatch b;
+    size_t at[raycast::LaneBatch::kLanes];
+    auto flush = [&] {
+        float rgb[3][raycast::LaneBatch::kLanes];
+        const unsigned shaded = raycast::shadeLanes(b, job.f, rgb);
+        for (int l = 0; l < b.count; ++l) {
+            const int x = x0 + int(at[l] % tile);
+            if (!((shaded >> l) & 1)) {
+                shadePixel(job, tr, x, row, x0, y0, tileRays, tileHits, tilePresets, target);
+                continue;
+            }
+            const rt::SceneHit& h = tileHits[at[l]].hit;
+            SurfaceRecord hp;
+            hp.p = tileHits[at[l]].frame.p;
+            hp.drawable = h.instance + 1;
+            hp.primitive = h.prim;
+            ++tr.rays;   // (trace's)
+            float depth = 1.0f;
+            keepSurface(job, hp, x, row, depth, target);
+            vec3 sum(0.0f);
+            sum += tr.fogged(vec3(rgb[0][l], rgb[1][l], rgb[2][l]), hp.p);
+            encodePixel(job, sum, target.pixel(x, row));
+            target.depth[size_t(row) * size_t(job.w) + size_t(x)] = depth;
+        }
+        b.count = 0;
+    };
+    for (uint32_t m = pixels; m; m &= m - 1) {
+        const int x = x0 + __builtin_ctz(m);
+        const size_t i = size_t(row - y0) * tile + size_t(x - x0);
+        const Tracer::FirstHit& fh = tileHits[i];
+        if (!(fh.found && fh.hit.kind == rt::SceneHit::Kind::Mesh && job.laneMesh[fh.hit.instance])) {
+            shadePixel(job, tr, x, row, x0, y0, tileRays, tileHits, tilePresets, target);
+            continue;
+        }
+        tr.laneInputs(fh, tileRays[i], job.shadowPackets ? &tilePresets[i] : nullptr, b, b.count);
+        at[b.count++] = i;
+        if (b.count == raycast::LaneBatch::kLanes) flush();
+    }
+    if (b.count) flush();
 }
 
 // --- RaycastRenderer --------------------------------------------------------------------------------
@@ -319,6 +381,7 @@ protected:
                 job.hitRects.push_back(r);
             }
         }
+        if (packets && debugSwitches().raycastLanes && raycast::laneShadingApplies(f, shadowPackets)) job.laneMesh = laneMeshes(f);
         uint64_t rays = 0;
         stats.cancelled = !renderTiles(job, target, control, rays);
         _mm_setcsr(csr);
@@ -374,6 +437,21 @@ private:
         m_samplers.endFrame();
     }
 
+    // Per f.meshes entry, whether Tracer::trace would shade its hits as raycast::shadeLanes does
+    // (given laneShadingApplies): an opaque, lit material without textures or maps, and no
+    // mirror reflection.
+    std::vector<uint8_t> laneMeshes(const FrameInput& f) const {
+        std::vector<uint8_t> lanes(f.meshes.size(), 0);
+        for (size_t i = 0; i < f.meshes.size(); ++i) {
+            const sg::DrawMesh& dm = f.meshes[i];
+            const sg::Material& m = dm.material;
+            const bool hasUV = dm.mesh && dm.mesh->uv0.size() == dm.mesh->positions.size();
+            const bool reflects = f.settings.reflections && m.reflectivity > 0.0f && f.settings.maxBounces > 0;
+            lanes[i] = dm.mesh && m.alphaMode == sg::AlphaMode::Opaque && !m.unlit && !reflects && !(hasUV && (m_textures[i] || m_maps[i].any()));
+        }
+        return lanes;
+    }
+
     // The frame's 32x32 tiles, in parallel (FTZ/DAZ in each worker), with progress and
     // cancellation; adds the rays traced to `rays`. Returns false when cancelled.
     bool renderTiles(const FrameJob& job, Framebuffer& target, RenderControl* control, uint64_t& rays) {
@@ -407,15 +485,15 @@ private:
                 uint32_t* const rowFound = buffers.rowFound;
                 if (job.packets) traceCameraPackets(job, m_accel, x0, y0, x1, y1, tileRays, tileHits, rowFound);
                 if (job.shadowPackets) presetTileShadows(tr, x0, y0, x1, y1, tileRays, tileHits, rowFound, tilePresets);
+                const uint32_t allPixels = uint32_t((uint64_t(1) << (x1 - x0)) - 1);
                 for (int row = y0; row < y1; ++row) {
-                    if (!job.constantMiss) {
+                    if (!job.packets) {
                         for (int x = x0; x < x1; ++x) shadePixel(job, tr, x, row, x0, y0, tileRays, tileHits, tilePresets, target);
                         continue;
                     }
-                    const uint32_t found = rowFound[row - y0];
-                    fillMisses(job, tr, row, x0, x1, found, target);
-                    for (uint32_t m = found; m; m &= m - 1)
-                        shadePixel(job, tr, x0 + __builtin_ctz(m), row, x0, y0, tileRays, tileHits, tilePresets, target);
+                    const uint32_t found = job.constantMiss ? rowFound[row - y0] : allPixels;
+                    if (job.constantMiss) fillMisses(job, tr, row, x0, x1, found, target);
+                    shadePixels(job, tr, row, x0, y0, found, tileRays, tileHits, tilePresets, target);
                 }
                 rayCount += tr.rays;
                 int d = ++done;

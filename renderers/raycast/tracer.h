@@ -12,6 +12,7 @@
 #pragma once
 
 #include "raycast/camera_rays.h"
+#include "raycast/lane_shading.h"
 #include "raycast/scene_accel.h"
 #include "raycast/world_vertices.h"
 #include "renderers/environment.h"
@@ -463,6 +464,39 @@ struct Tracer {
         return fh.frame;
     }
 
+    // The albedo at the vertices i0, i1, i2: the material's base colour times the vertex colours.
+    static void vertexAlbedos(const Material& mat, const Mesh& mesh, uint32_t i0, uint32_t i1, uint32_t i2, vec3 albedoV[3]) {
+        for (int k = 0; k < 3; ++k) albedoV[k] = mat.baseColor;
+        if (mesh.colors.size() == mesh.positions.size()) {
+            albedoV[0] *= vec3(mesh.colors[i0]);
+            albedoV[1] *= vec3(mesh.colors[i1]);
+            albedoV[2] *= vec3(mesh.colors[i2]);
+        }
+    }
+
+    // The unit world normals at the vertices i0, i1, i2 of the hit with frame fr, on the ray's
+    // side (flipped on a back face): the face normal where the mesh has none or one is too short
+    // to normalize. wv: the instance's world vertices, or null.
+    static void vertexNormals(const DrawMesh& dm, const rt::WorldVertices* wv, uint32_t i0, uint32_t i1, uint32_t i2, const MeshHitFrame& fr,
+                              vec3 Nv[3]) {
+        const Mesh& mesh = *dm.mesh;
+        const vec3& gn = fr.gn;
+        const bool hasN = mesh.normals.size() == mesh.positions.size();
+        const bool worldN = hasN && wv && !wv->normals.empty();
+        for (int k = 0; k < 3; ++k) {
+            uint32_t idx = k == 0 ? i0 : k == 1 ? i1 : i2;
+            if (worldN) {   // the same values, made once (zero: the face normal)
+                const vec3& c = wv->normals[idx];
+                Nv[k] = c.x == 0.0f && c.y == 0.0f && c.z == 0.0f ? gn : c;
+            } else {
+                vec3 nn = hasN ? dm.normal * mesh.normals[idx] : gn;
+                float l = glm::length(nn);
+                Nv[k] = l > 1e-20f ? nn / l : gn;
+            }
+            if (fr.back) Nv[k] = -Nv[k];
+        }
+    }
+
     // Shades a triangle hit: interpolated position (s.p), normals, vertex colours, texture
     // (filtered with the footprint), then the shading model with shadow rays into vis. known:
     // the hit's frame when it was already made (frameOf), else null.
@@ -478,20 +512,13 @@ struct Tracer {
         const rt::WorldVertices* wv = worldOf(h.instance);
         const MeshHitFrame fr = known ? *known : meshHitFrame(dm, h, r, wv);
         const vec3(&P)[3] = fr.P;
-        const vec3& gn = fr.gn;
         const bool back = fr.back;
         p = fr.p;
         ng = fr.ng;
         const bool hasN = mesh.normals.size() == mesh.positions.size();
-        const bool hasC = mesh.colors.size() == mesh.positions.size();
         const bool hasUV = mesh.uv0.size() == mesh.positions.size();
         vec3 albedoV[3];
-        for (int k = 0; k < 3; ++k) albedoV[k] = mat->baseColor;
-        if (hasC) {
-            albedoV[0] *= vec3(mesh.colors[i0]);
-            albedoV[1] *= vec3(mesh.colors[i1]);
-            albedoV[2] *= vec3(mesh.colors[i2]);
-        }
+        vertexAlbedos(*mat, mesh, i0, i1, i2, albedoV);
         vec3 texColor(1.0f);
         const MapSamplers& mm = maps[h.instance];
         const bool hasMaps = hasUV && mm.any();
@@ -513,19 +540,7 @@ struct Tracer {
             }
         }
         vec3 Nv[3];
-        const bool worldN = hasN && wv && !wv->normals.empty();
-        for (int k = 0; k < 3; ++k) {
-            uint32_t idx = k == 0 ? i0 : k == 1 ? i1 : i2;
-            if (worldN) {   // the same values, made once (zero: the face normal)
-                const vec3& c = wv->normals[idx];
-                Nv[k] = c.x == 0.0f && c.y == 0.0f && c.z == 0.0f ? gn : c;
-            } else {
-                vec3 nn = hasN ? dm.normal * mesh.normals[idx] : gn;
-                float l = glm::length(nn);
-                Nv[k] = l > 1e-20f ? nn / l : gn;
-            }
-            if (back) Nv[k] = -Nv[k];
-        }
+        vertexNormals(dm, wv, i0, i1, i2, fr, Nv);
         const ShadingModel model = f.settings.shading;
         vec3 albedo = (w0 * albedoV[0] + w1 * albedoV[1] + w2 * albedoV[2]) * texColor;
         if (model == ShadingModel::Gouraud && !mat->unlit) {
@@ -622,6 +637,42 @@ struct Tracer {
         return trace(rr, p, bounce + 1, nullptr, rf.carried ? &rf : nullptr);
     }
 
+    // A primary ray's colour fogged by the eye distance of its hit at p.
+    vec3 fogged(const vec3& color, const vec3& p) const {
+        if (f.settings.fog == FogMode::Off) return color;
+        return applyFog(f.settings, color, glm::length(vec3(f.camera.view * vec4(p, 1.0f))));
+    }
+
+    // Lane l of b (lane_shading.h) from the mesh hit fh along r: its frame, vertex normals and
+    // albedos, the mesh's coefficients (meshCoefficients must be set), and the light bits of its
+    // shadow packets' preset where that preset is this hit's (null: none).
+    void laneInputs(const FirstHit& fh, const rt::Ray& r, const PresetVisibility* pre, LaneBatch& b, int l) const {
+        const rt::SceneHit& h = fh.hit;
+        const DrawMesh& dm = f.meshes[h.instance];
+        const Mesh& mesh = *dm.mesh;
+        const uint32_t i0 = mesh.indices[3 * h.prim], i1 = mesh.indices[3 * h.prim + 1], i2 = mesh.indices[3 * h.prim + 2];
+        const MeshHitFrame& fr = frameOf(fh, r);
+        const bool smooth = mesh.normals.size() == mesh.positions.size();
+        vec3 Nv[3], albedoV[3];
+        if (smooth) vertexNormals(dm, worldOf(h.instance), i0, i1, i2, fr, Nv);
+        vertexAlbedos(dm.material, mesh, i0, i1, i2, albedoV);
+        const float w[3] = {1.0f - h.b1 - h.b2, h.b1, h.b2};
+        for (int a = 0; a < 3; ++a) {
+            b.p[a][l] = fr.p[a];
+            b.ng[a][l] = fr.ng[a];
+            b.w[a][l] = w[a];
+            for (int k = 0; k < 3; ++k) {
+                b.vn[k][a][l] = smooth ? Nv[k][a] : fr.ng[a];
+                b.va[k][a][l] = albedoV[k][a];
+            }
+        }
+        b.smooth[l] = smooth;
+        b.coeff[l] = &(*meshCoefficients)[h.instance];
+        const bool same = pre && sameBits(pre->p, fr.p) && sameBits(pre->ng, fr.ng);
+        b.known[l] = same ? pre->known : 0;
+        b.lit[l] = same ? pre->lit : 0;
+    }
+
     // Radiance along the ray (linear), depth of the first hit (window z via the camera) when
     // depthOut is given; eye = where the viewer is for this ray (camera eye or bounce origin).
     // footprint: the ray's differentials (texture mip selection); null: textures at level 0.
@@ -665,7 +716,7 @@ struct Tracer {
             color = glm::mix(color, reflection(s, glm::normalize(r.dir), bounce, footprint), std::clamp(s.mat->reflectivity, 0.0f, 1.0f));
         else if (f.settings.reflections && f.settings.reflection == ReflectionModel::Pbr && s.lit && bounce < f.settings.maxBounces)
             color += tracedSpecular(s, glm::normalize(r.dir), bounce, footprint);
-        if (bounce == 0 && f.settings.fog != FogMode::Off) color = applyFog(f.settings, color, glm::length(vec3(f.camera.view * vec4(s.p, 1.0f))));
+        if (bounce == 0) color = fogged(color, s.p);
         if (blended && (alpha < 1.0f || hitPos) && layer + 1 < kMaxLayers) {
             rt::Ray behind = r;
             behind.tmin = h.t;

@@ -22,6 +22,8 @@
 //                                         whose region misses every box of the scene
 //   VIEWER_RAYCAST_WORLD_VERTICES=0       the ray caster transforms a hit's vertices per hit
 //                                         instead of keeping world-space copies (WorldVertexCache)
+//   VIEWER_RAYCAST_LANES=0                the ray caster shades every hit one by one (Tracer::trace)
+//                                         instead of four plain Phong hits at a time (lane_shading.h)
 #pragma once
 
 #include <string>
@@ -40,6 +42,7 @@ struct DebugSwitches {
     bool raycastShadowPackets = true;
     bool raycastPacketCull = true;
     bool raycastWorldVertices = true;
+    bool raycastLanes = true;
 };
 
 // The switches as the environment sets them now (a few getenv calls: backends ask when they

@@ -1,0 +1,48 @@
+// lane_shading.h - the ray caster's smooth Phong / Blinn-Phong shading of four mesh hits at once
+// (SSE2 lanes), for the commonest primary hit: an opaque, lit, untextured triangle seen in a
+// frame without pbr, reflections or lights with a size under shadows. Every lane performs the
+// IEEE operations of Tracer::shadeMeshHit and rnd::shadeTerms in their order (no FMA, no
+// reciprocal for a division, libm's powf per lane), so a pixel shaded here has the bytes of one
+// shaded by Tracer::trace; RaycastTest checks that byte for byte, and VIEWER_RAYCAST_LANES=0
+// turns the lanes off.
+//
+// What the lanes do not compute comes in per lane, made by Tracer's own functions: the hit's frame
+// (meshHitFrame), the vertex normals and albedos, and the hard shadows of the tile's shadow packets.
+#pragma once
+
+#include "renderers/shading.h"
+#include "scenegraph/frame.h"
+
+#include <cstdint>
+
+namespace rnd::raycast {
+
+struct LaneBatch {
+    static constexpr int kLanes = 4;
+    int count = 0;   // lanes filled, from 0
+    // Per lane: the hit point p and geometric normal ng toward the ray (meshHitFrame), the
+    // barycentric weights w, the three vertex normals facing the ray (smooth: a vertex normal
+    // per vertex; otherwise the shading normal is ng) and vertex albedos, the coefficients.
+    alignas(16) float p[3][kLanes], ng[3][kLanes];
+    alignas(16) float w[3][kLanes];
+    alignas(16) float vn[3][3][kLanes];   // [vertex][axis][lane]
+    alignas(16) float va[3][3][kLanes];   // [vertex][channel][lane]
+    bool smooth[kLanes] = {};
+    const SurfaceCoefficients* coeff[kLanes] = {};
+    // With shadows: the light bits of the tile's shadow packets (Tracer::PresetVisibility) for
+    // this p and ng: known (traced) and lit.
+    uint64_t known[kLanes] = {}, lit[kLanes] = {};
+};
+
+// Whether a frame's hits may be shaded in lanes at all (the per-mesh conditions are the caller's):
+// smooth shading, Phong or Blinn-Phong, at most 64 lights, and under shadows every light's shadow
+// ray a hard one from the shadow packets (shadowPackets).
+bool laneShadingApplies(const sg::FrameInput& f, bool shadowPackets);
+
+// Shades lanes [0, b.count): their linear colours (rnd::shade's) into rgb[channel][lane]. Returns
+// the lanes it shaded as bits; a lane it leaves (a light that reaches the shading normal but not
+// the geometric one, so that no packet traced its shadow ray) is for Tracer::trace. The lanes
+// past b.count are filled with lane 0's inputs first.
+unsigned shadeLanes(LaneBatch& b, const sg::FrameInput& f, float rgb[3][LaneBatch::kLanes]);
+
+}   // namespace rnd::raycast

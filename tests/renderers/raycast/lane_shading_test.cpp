@@ -1,0 +1,153 @@
+// lane_shading_test.cpp - raycast::shadeLanes (four mesh hits shaded at once in SSE2) against
+// the scalar shading it stands for, bit for bit: the interpolated albedo and normal of
+// Tracer::shadeMeshHit, the visibility rule of Tracer::lightVisibility with the shadow packets'
+// bits, and rnd::shade. Random hits, materials and lights (point with and without 1/r^2, spots
+// with soft and hard cones, suns, a black light), Phong and Blinn-Phong, with and without
+// shadows, partly filled batches, points on a light and on the eye, normals too short to
+// normalize and hits without vertex normals.
+#include "raycast/lane_shading.h"
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <random>
+#include <string>
+#include <vector>
+
+using namespace sg;
+using rnd::SurfaceCoefficients;
+using rnd::raycast::LaneBatch;
+
+namespace {
+
+struct Expected {
+    bool shaded = false;
+    vec3 color{0.0f};
+};
+
+// What Tracer::trace gives lane l of b (the scalar functions the lanes stand for).
+Expected scalarLane(const LaneBatch& b, int l, const FrameInput& f) {
+    const float w0 = b.w[0][l], w1 = b.w[1][l], w2 = b.w[2][l];
+    auto at = [&](const float (&a)[3][LaneBatch::kLanes]) { return vec3(a[0][l], a[1][l], a[2][l]); };
+    const vec3 p = at(b.p), ng = at(b.ng);
+    const vec3 albedo = (w0 * at(b.va[0]) + w1 * at(b.va[1]) + w2 * at(b.va[2])) * vec3(1.0f);
+    vec3 n = ng;
+    if (b.smooth[l]) {
+        n = w0 * at(b.vn[0]) + w1 * at(b.vn[1]) + w2 * at(b.vn[2]);
+        const float len = glm::length(n);
+        n = len > 1e-20f ? n / len : ng;
+    }
+    std::vector<float> vis(f.lights.size(), 1.0f);
+    Expected e;
+    for (size_t i = 0; i < f.lights.size() && f.settings.shadows; ++i) {
+        const bool known = (b.known[l] >> i) & 1, lit = (b.lit[l] >> i) & 1;
+        if (known && lit) continue;
+        if (!rnd::sampleReaches(rnd::sampleLight(f.lights[i], p), n)) continue;
+        if (!known) return e;   // a shadow ray no packet traced: the lane is trace()'s
+        vis[i] = 0.0f;
+    }
+    e.shaded = true;
+    e.color = rnd::shade(*b.coeff[l], rnd::SurfacePoint{p, n, albedo}, f.camera.eye, f, vis.data());
+    return e;
+}
+
+vec3 unitVector(std::mt19937& rng) {
+    std::normal_distribution<float> g;
+    for (;;) {
+        const vec3 v(g(rng), g(rng), g(rng));
+        if (glm::length(v) > 1e-3f) return glm::normalize(v);
+    }
+}
+
+std::string bits(const vec3& v) {
+    char s[128];
+    std::snprintf(s, sizeof s, "(%a %a %a)", double(v.x), double(v.y), double(v.z));
+    return s;
+}
+
+}   // namespace
+
+TEST(LaneShadingTest, LanesGiveTheScalarShadingBitForBit) {
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f), s(-4.0f, 4.0f);
+    std::vector<SurfaceCoefficients> coeffs(4);
+    coeffs[0].specularTinted = true;
+    coeffs[1].emissive = vec3(0.2f, 0.0f, 0.1f);
+    coeffs[1].specularColor = vec3(1.0f, 0.5f, 0.25f);
+    coeffs[1].shininess = 180.0f;
+    coeffs[2].ks = 0.0f;
+    coeffs[2].shininess = 1.0f;
+    coeffs[3].ka = 0.7f;
+    coeffs[3].kd = 0.05f;
+    coeffs[3].ks = 1.0f;
+    coeffs[3].shininess = 3.5f;
+
+    size_t shaded = 0, leftToTrace = 0, dark = 0;
+    for (int trial = 0; trial < 3000; ++trial) {
+        FrameInput f;
+        f.settings.reflection = trial % 2 ? ReflectionModel::BlinnPhong : ReflectionModel::Phong;
+        f.settings.shadows = trial % 3 != 0;
+        f.ambientLight = vec3(u(rng), u(rng), u(rng)) * 0.3f;
+        f.camera.eye = vec3(s(rng), s(rng), s(rng)) * 2.0f;
+        const int lights = 1 + int(rng() % 6);
+        for (int i = 0; i < lights; ++i) {
+            DrawLight L;
+            L.type = LightType(rng() % 3);
+            L.position = vec3(s(rng), s(rng), s(rng));
+            L.direction = unitVector(rng);
+            L.radiance = rng() % 9 == 0 ? vec3(0.0f) : vec3(u(rng), u(rng), u(rng)) * 3.0f;
+            L.inverseSquare = rng() % 2;
+            L.cosOuter = std::cos(0.2f + u(rng));
+            L.cosInner = rng() % 4 == 0 ? L.cosOuter : std::cos(0.1f + 0.1f * u(rng));   // equal cones: a hard edge
+            f.lights.push_back(L);
+        }
+        LaneBatch b;
+        b.count = 1 + int(rng() % LaneBatch::kLanes);
+        for (int l = 0; l < b.count; ++l) {
+            vec3 p(s(rng), s(rng), s(rng));
+            if (rng() % 40 == 0) p = f.lights[0].position;   // on a light: toward it (0, 1, 0)
+            if (rng() % 40 == 0) p = f.camera.eye;           // on the eye: toward it (0, 0, 1)
+            const vec3 ng = unitVector(rng);
+            float b1 = u(rng), b2 = u(rng);
+            if (b1 + b2 > 1.0f) b1 = 1.0f - b1, b2 = 1.0f - b2;
+            const float w[3] = {1.0f - b1 - b2, b1, b2};
+            vec3 vn[3];
+            for (vec3& v : vn) v = glm::normalize(ng + 0.4f * unitVector(rng));
+            if (rng() % 30 == 0)
+                for (vec3& v : vn) v *= 1e-22f;   // too short to normalize: ng
+            b.smooth[l] = rng() % 8 != 0;
+            for (int a = 0; a < 3; ++a) {
+                b.p[a][l] = p[a];
+                b.ng[a][l] = ng[a];
+                b.w[a][l] = w[a];
+                for (int k = 0; k < 3; ++k) {
+                    b.vn[k][a][l] = vn[k][a];
+                    b.va[k][a][l] = u(rng);
+                }
+            }
+            b.coeff[l] = &coeffs[rng() % coeffs.size()];
+            b.known[l] = rng() % 5 == 0 ? 0 : (uint64_t(rng()) & ((uint64_t(1) << lights) - 1));
+            b.lit[l] = uint64_t(rng()) & b.known[l];
+        }
+        const LaneBatch in = b;
+        float rgb[3][LaneBatch::kLanes];
+        const unsigned got = rnd::raycast::shadeLanes(b, f, rgb);
+        EXPECT_EQ(got >> b.count, 0u) << "trial " << trial;
+        for (int l = 0; l < in.count; ++l) {
+            const Expected e = scalarLane(in, l, f);
+            ASSERT_EQ(bool((got >> l) & 1), e.shaded) << "trial " << trial << " lane " << l;
+            if (!e.shaded) {
+                ++leftToTrace;
+                continue;
+            }
+            ++shaded;
+            const vec3 c(rgb[0][l], rgb[1][l], rgb[2][l]);
+            dark += e.color == vec3(0.0f);
+            ASSERT_EQ(std::memcmp(&c, &e.color, sizeof c), 0) << "trial " << trial << " lane " << l << ": " << bits(c) << " vs " << bits(e.color);
+        }
+    }
+    // Both outcomes occur, and most shaded lanes are lit (not zero against zero).
+    EXPECT_GT(shaded, size_t(3000));
+    EXPECT_GT(leftToTrace, size_t(100));
+    EXPECT_LT(dark, shaded / 4);
+}
