@@ -187,6 +187,19 @@ public:
         sg::vec4 c = m_viewProj * sg::vec4(p, 1.0f);
         return 0.5f * (c.z / c.w) + 0.5f;
     }
+    // depth() of the four points (x[l], y[l], z[l]) into out[l], in SSE2 lanes: the same
+    // operations in the same order (glm's mat4 * vec4 is (m0 x + m1 y) + (m2 z + m3 1), of which
+    // only the z and w rows are needed).
+    void depth4(const float* x, const float* y, const float* z, float* out) const {
+        const __m128 X = _mm_loadu_ps(x), Y = _mm_loadu_ps(y), Z = _mm_loadu_ps(z), one = _mm_set1_ps(1.0f);
+        auto row = [&](int r) {
+            const __m128 a = _mm_add_ps(_mm_mul_ps(_mm_set1_ps(m_viewProj[0][r]), X), _mm_mul_ps(_mm_set1_ps(m_viewProj[1][r]), Y));
+            const __m128 b = _mm_add_ps(_mm_mul_ps(_mm_set1_ps(m_viewProj[2][r]), Z), _mm_mul_ps(_mm_set1_ps(m_viewProj[3][r]), one));
+            return _mm_add_ps(a, b);
+        };
+        const __m128 half = _mm_set1_ps(0.5f);
+        _mm_storeu_ps(out, _mm_add_ps(_mm_mul_ps(half, _mm_div_ps(row(2), row(3))), half));
+    }
     // Window position (x, y) of a world point.
     sg::vec2 project(const sg::vec3& p) const {
         sg::vec4 c = m_viewProj * sg::vec4(p, 1.0f);

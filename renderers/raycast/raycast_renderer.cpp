@@ -270,27 +270,33 @@ void shadePixels(const FrameJob& job, Tracer& tr, int row, int x0, int y0, uint3
     }
     raycast::LaneBatch b;
     size_t at[raycast::LaneBatch::kLanes];
+    const bool visibility = job.cfg.aovs.has(Aov::Visibility);
+    const size_t rowAt = size_t(row) * size_t(job.w);
     auto flush = [&] {
-        float rgb[3][raycast::LaneBatch::kLanes];
+        float rgb[3][raycast::LaneBatch::kLanes], windowZ[raycast::LaneBatch::kLanes];
         const unsigned shaded = raycast::shadeLanes(b, job.f, rgb);
+        job.cam.depth4(b.p[0], b.p[1], b.p[2], windowZ);   // (b.p: the hit points; shadeLanes filled every lane)
         for (int l = 0; l < b.count; ++l) {
             const int x = x0 + int(at[l] % tile);
             if (!((shaded >> l) & 1)) {
                 shadePixel(job, tr, x, row, x0, y0, tileRays, tileHits, tilePresets, target);
                 continue;
             }
+            // What trace() and shadePixel do after the shading: count the ray, keep the surface
+            // (keepSurface: depth, visibility), fog, bytes.
             const rt::SceneHit& h = tileHits[at[l]].hit;
-            SurfaceRecord hp;
-            hp.p = tileHits[at[l]].frame.p;
-            hp.drawable = h.instance + 1;
-            hp.primitive = h.prim;
-            ++tr.rays;   // (trace's)
+            const vec3 p(b.p[0][l], b.p[1][l], b.p[2][l]);
+            ++tr.rays;
             float depth = 1.0f;
-            keepSurface(job, hp, x, row, depth, target);
+            if (!std::isnan(p.x)) depth = std::min(depth, std::clamp(windowZ[l], 0.0f, 1.0f));
+            if (visibility) {
+                target.drawable[rowAt + size_t(x)] = h.instance + 1;
+                target.primitive[rowAt + size_t(x)] = h.prim;
+            }
             vec3 sum(0.0f);
-            sum += tr.fogged(vec3(rgb[0][l], rgb[1][l], rgb[2][l]), hp.p);
+            sum += tr.fogged(vec3(rgb[0][l], rgb[1][l], rgb[2][l]), p);
             encodePixel(job, sum, target.pixel(x, row));
-            target.depth[size_t(row) * size_t(job.w) + size_t(x)] = depth;
+            target.depth[rowAt + size_t(x)] = depth;
         }
         b.count = 0;
     };
