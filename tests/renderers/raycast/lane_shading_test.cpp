@@ -28,7 +28,7 @@ struct Expected {
 // What Tracer::trace gives lane l of b (the scalar functions the lanes stand for).
 Expected scalarLane(const LaneBatch& b, int l, const FrameInput& f) {
     const float w0 = b.w[0][l], w1 = b.w[1][l], w2 = b.w[2][l];
-    auto at = [&](const float (&a)[3][LaneBatch::kLanes]) { return vec3(a[0][l], a[1][l], a[2][l]); };
+    auto at = [&](const float(&a)[3][LaneBatch::kLanes]) { return vec3(a[0][l], a[1][l], a[2][l]); };
     const vec3 p = at(b.p), ng = at(b.ng);
     const vec3 albedo = (w0 * at(b.va[0]) + w1 * at(b.va[1]) + w2 * at(b.va[2])) * vec3(1.0f);
     vec3 n = ng;
