@@ -11,6 +11,7 @@
 #include <emmintrin.h>
 
 #include <cmath>
+#include <limits>
 
 namespace rnd::raycast {
 
@@ -46,6 +47,47 @@ V3 mul(V s, const V3& a) { return {mul(s, a.x), mul(s, a.y), mul(s, a.z)}; }
 V3 div(const V3& a, V s) { return {div(a.x, s), div(a.y, s), div(a.z, s)}; }
 V3 sel(V mask, const V3& a, const V3& b) { return {sel(mask, a.x, b.x), sel(mask, a.y, b.y), sel(mask, a.z, b.z)}; }
 V dot(const V3& a, const V3& b) { return add(add(mul(a.x, b.x), mul(a.y, b.y)), mul(a.z, b.z)); }
+
+// -a (glm's unary minus: the sign bits flipped).
+V3 neg(const V3& a) {
+    const V signBit = set1(-0.0f);
+    return {_mm_xor_ps(a.x, signBit), _mm_xor_ps(a.y, signBit), _mm_xor_ps(a.z, signBit)};
+}
+
+// sampleLight(L, p) in lanes: the unit vector toward the light, the distance (infinite for a
+// sun) and the radiance arriving (1/r^2, the spot's smoothstep between its cones).
+struct LightLanes {
+    V3 toL, rad;
+    V dist;
+    LightLanes(const DrawLight& L, const V3& p) {
+        const V zero = _mm_setzero_ps(), one = set1(1.0f);
+        rad = splat(L.radiance);
+        if (L.type == LightType::Directional) {
+            toL = splat(-L.direction);
+            dist = set1(std::numeric_limits<float>::infinity());
+            return;
+        }
+        const V3 d = sub(splat(L.position), p);
+        const V dist2 = dot(d, d);
+        dist = _mm_sqrt_ps(dist2);
+        toL = sel(_mm_cmpgt_ps(dist, zero), div(d, dist), splat(vec3(0, 1, 0)));
+        if (L.inverseSquare) rad = div(rad, _mm_max_ps(set1(1e-8f), dist2));   // radiance / max(dist2, 1e-8)
+        if (L.type == LightType::Spot) {
+            const V c = dot(neg(toL), splat(L.direction));   // dot(-toLight, direction)
+            V t = L.cosInner > L.cosOuter ? div(sub(c, set1(L.cosOuter)), set1(L.cosInner - L.cosOuter))
+                                          : _mm_and_ps(_mm_cmpge_ps(c, set1(L.cosOuter)), one);
+            t = sel(_mm_cmplt_ps(t, zero), zero, sel(_mm_cmplt_ps(one, t), one, t));   // std::clamp(t, 0, 1)
+            const V k = mul(mul(t, t), sub(set1(3.0f), mul(set1(2.0f), t)));
+            rad = V3{mul(rad.x, k), mul(rad.y, k), mul(rad.z, k)};
+        }
+    }
+};
+
+// Whether radiance rad is not (0, 0, 0) (vec3's !=: NaN counts as not equal).
+V nonZero(const V3& rad) {
+    const V zero = _mm_setzero_ps();
+    return _mm_or_ps(_mm_or_ps(_mm_cmpneq_ps(rad.x, zero), _mm_cmpneq_ps(rad.y, zero)), _mm_cmpneq_ps(rad.z, zero));
+}
 
 // Lanes count..kL-1 take lane 0's inputs (their results are not used).
 void pad(LaneBatch& b) {
@@ -117,24 +159,8 @@ unsigned shadeLanes(LaneBatch& b, const FrameInput& f, float rgb[3][kL]) {
     unsigned fallback = 0;
     for (size_t i = 0; i < f.lights.size(); ++i) {
         const DrawLight& L = f.lights[i];
-        // sampleLight(L, p)
-        V3 toL, rad = splat(L.radiance);
-        if (L.type == LightType::Directional) {
-            toL = splat(-L.direction);
-        } else {
-            const V3 d = sub(splat(L.position), p);
-            const V dist2 = dot(d, d), dist = _mm_sqrt_ps(dist2);
-            toL = sel(_mm_cmpgt_ps(dist, zero), div(d, dist), splat(vec3(0, 1, 0)));
-            if (L.inverseSquare) rad = div(rad, _mm_max_ps(set1(1e-8f), dist2));   // radiance / max(dist2, 1e-8)
-            if (L.type == LightType::Spot) {
-                const V c = dot(V3{sub(zero, toL.x), sub(zero, toL.y), sub(zero, toL.z)}, splat(L.direction));   // dot(-toLight, direction)
-                V t = L.cosInner > L.cosOuter ? div(sub(c, set1(L.cosOuter)), set1(L.cosInner - L.cosOuter))
-                                              : _mm_and_ps(_mm_cmpge_ps(c, set1(L.cosOuter)), one);
-                t = sel(_mm_cmplt_ps(t, zero), zero, sel(_mm_cmplt_ps(one, t), one, t));   // std::clamp(t, 0, 1)
-                const V k = mul(mul(t, t), sub(set1(3.0f), mul(set1(2.0f), t)));
-                rad = V3{mul(rad.x, k), mul(rad.y, k), mul(rad.z, k)};
-            }
-        }
+        const LightLanes ls(L, p);
+        const V3 &toL = ls.toL, &rad = ls.rad;
         const V nl = dot(n, toL);
         // Tracer::lightVisibility: 1 without shadows; with them, the packets' answer where they
         // traced the light, 1 where it does not reach the shading normal (sampleReaches: its terms
@@ -146,8 +172,7 @@ unsigned shadeLanes(LaneBatch& b, const FrameInput& f, float rgb[3][kL]) {
                 known |= unsigned((b.known[l] >> i) & 1) << l;
                 lit |= unsigned((b.lit[l] >> i) & 1) << l;
             }
-            const V radNonZero = _mm_or_ps(_mm_or_ps(_mm_cmpneq_ps(rad.x, zero), _mm_cmpneq_ps(rad.y, zero)), _mm_cmpneq_ps(rad.z, zero));
-            const unsigned reaches = bitsOf(_mm_and_ps(_mm_cmpgt_ps(nl, zero), radNonZero));
+            const unsigned reaches = bitsOf(_mm_and_ps(_mm_cmpgt_ps(nl, zero), nonZero(rad)));
             fallback |= ~known & reaches;
             visible = _mm_and_ps(maskOf(~(known & ~lit & reaches)), one);   // 0 where traced and blocked
         }
@@ -185,6 +210,67 @@ unsigned shadeLanes(LaneBatch& b, const FrameInput& f, float rgb[3][kL]) {
     _mm_store_ps(rgb[1], color.y);
     _mm_store_ps(rgb[2], color.z);
     return valid & ~fallback;
+}
+
+void hitFrames(FrameLanes& b) {
+    for (int l = b.count; l < kL; ++l) {   // (unused lanes: lane 0's inputs)
+        for (int a = 0; a < 3; ++a) {
+            for (int k = 0; k < 3; ++k) b.P[k][a][l] = b.P[k][a][0];
+            b.dir[a][l] = b.dir[a][0];
+        }
+        b.b1[l] = b.b1[0], b.b2[l] = b.b2[0];
+    }
+    const V zero = _mm_setzero_ps();
+    const V3 P0 = load3(b.P[0]), P1 = load3(b.P[1]), P2 = load3(b.P[2]);
+    const V b1 = load(b.b1), b2 = load(b.b2);
+    const V w0 = sub(sub(set1(1.0f), b1), b2);   // 1 - b1 - b2
+    const V3 p = add(add(mul(w0, P0), mul(b1, P1)), mul(b2, P2));
+    // glm::cross(e1, e2) = (e1.y e2.z - e2.y e1.z, e1.z e2.x - e2.z e1.x, e1.x e2.y - e2.x e1.y)
+    const V3 e1 = sub(P1, P0), e2 = sub(P2, P0);
+    V3 gn{sub(mul(e1.y, e2.z), mul(e2.y, e1.z)), sub(mul(e1.z, e2.x), mul(e2.z, e1.x)), sub(mul(e1.x, e2.y), mul(e2.x, e1.y))};
+    const V gl = _mm_sqrt_ps(dot(gn, gn));
+    gn = sel(_mm_cmpgt_ps(gl, zero), div(gn, gl), splat(vec3(0, 1, 0)));
+    gn = sel(maskOf(b.mirrored), neg(gn), gn);
+    const V back = _mm_cmpgt_ps(dot(gn, load3(b.dir)), zero);
+    const V3 ng = sel(back, neg(gn), gn);
+    for (int a = 0; a < 3; ++a) {
+        const V* const pv[3] = {&p.x, &p.y, &p.z};
+        const V* const gv[3] = {&gn.x, &gn.y, &gn.z};
+        const V* const nv[3] = {&ng.x, &ng.y, &ng.z};
+        _mm_store_ps(b.p[a], *pv[a]);
+        _mm_store_ps(b.gn[a], *gv[a]);
+        _mm_store_ps(b.ng[a], *nv[a]);
+    }
+    b.back = bitsOf(back) & ((1u << b.count) - 1);
+}
+
+void shadowRays(ShadowLanes& b, const DrawLight& L) {
+    for (int l = b.count; l < kL; ++l)
+        for (int a = 0; a < 3; ++a) b.p[a][l] = b.p[a][0], b.ng[a][l] = b.ng[a][0];
+    const V zero = _mm_setzero_ps();
+    const V3 p = load3(b.p), ng = load3(b.ng);
+    const LightLanes ls(L, p);
+    const V ngl = dot(ng, ls.toL);
+    b.reaches = bitsOf(_mm_and_ps(_mm_cmpgt_ps(ngl, zero), nonZero(ls.rad))) & ((1u << b.count) - 1);   // sampleReaches(ls, ng)
+    if (!b.reaches) return;
+    // Tracer::shadowRay: side = ng.l >= 0 ? 1 : -1; eps = offsetScale(p) =
+    // 1e-4 (1 + std::max(|x|, std::max(|y|, |z|))) (std::max(a, b) = b > a ? b : a);
+    // org = p + (side eps) ng; tmax = distance (1 - 1e-4) - eps where the distance is finite.
+    const V side = sel(_mm_cmpge_ps(ngl, zero), set1(1.0f), set1(-1.0f));
+    const V absMask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+    const V ax = _mm_and_ps(p.x, absMask), ay = _mm_and_ps(p.y, absMask), az = _mm_and_ps(p.z, absMask);
+    const V eps = mul(set1(1e-4f), add(set1(1.0f), _mm_max_ps(_mm_max_ps(az, ay), ax)));
+    const V3 org = add(p, mul(mul(side, eps), ng));
+    const V finite = _mm_cmpeq_ps(sub(ls.dist, ls.dist), zero);
+    const V tmax = sel(finite, sub(mul(ls.dist, set1(1.0f - 1e-4f)), eps), set1(std::numeric_limits<float>::infinity()));
+    __m128 o[4] = {org.x, org.y, org.z, zero}, d[4] = {ls.toL.x, ls.toL.y, ls.toL.z, tmax};
+    _MM_TRANSPOSE4_PS(o[0], o[1], o[2], o[3]);   // (org, tmin = 0) per lane
+    _MM_TRANSPOSE4_PS(d[0], d[1], d[2], d[3]);   // (dir, tmax) per lane
+    static_assert(sizeof(rt::Ray) == 32 && offsetof(rt::Ray, dir) == 16, "Ray: org, tmin, dir, tmax packed");
+    for (int l = 0; l < kL; ++l) {
+        _mm_storeu_ps(&b.rays[l].org.x, o[l]);
+        _mm_storeu_ps(&b.rays[l].dir.x, d[l]);
+    }
 }
 
 }   // namespace rnd::raycast

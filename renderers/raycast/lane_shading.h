@@ -10,6 +10,7 @@
 // (meshHitFrame), the vertex normals and albedos, and the hard shadows of the tile's shadow packets.
 #pragma once
 
+#include "raycast/bvh.h"
 #include "renderers/shading.h"
 #include "scenegraph/frame.h"
 
@@ -44,5 +45,32 @@ bool laneShadingApplies(const sg::FrameInput& f, bool shadowPackets);
 // the geometric one, so that no packet traced its shadow ray) is for Tracer::trace. The lanes
 // past b.count are filled with lane 0's inputs first.
 unsigned shadeLanes(LaneBatch& b, const sg::FrameInput& f, float rgb[3][LaneBatch::kLanes]);
+
+// The frames of up to four triangle hits (tracer.h's meshHitFrame in lanes): in, each hit's
+// world vertices, barycentrics b1 b2 and ray direction, and whether its instance is mirrored;
+// out, the point p, the outward geometric normal gn, that normal on the ray's side ng, and
+// whether the ray sees the back.
+struct FrameLanes {
+    static constexpr int kLanes = 4;
+    int count = 0;
+    alignas(16) float P[3][3][kLanes];   // [vertex][axis][lane]
+    alignas(16) float b1[kLanes], b2[kLanes], dir[3][kLanes];
+    unsigned mirrored = 0;   // bit l: lane l
+    alignas(16) float p[3][kLanes], gn[3][kLanes], ng[3][kLanes];
+    unsigned back = 0;   // bit l: lane l
+};
+void hitFrames(FrameLanes& b);
+
+// Tracer::shadowRay toward light L (sampleLight's sample) from up to four points p with
+// geometric normals ng, where the light reaches ng's side (sampleReaches, the Phong models'
+// rule): out, those lanes as bits (reaches) and their rays.
+struct ShadowLanes {
+    static constexpr int kLanes = 4;
+    int count = 0;
+    alignas(16) float p[3][kLanes], ng[3][kLanes];
+    unsigned reaches = 0;
+    rt::PacketScratch<rt::Ray, kLanes> rays;   // (uninitialized: written where reached)
+};
+void shadowRays(ShadowLanes& b, const sg::DrawLight& L);
 
 }   // namespace rnd::raycast

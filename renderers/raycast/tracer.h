@@ -16,6 +16,7 @@
 #include "raycast/scene_accel.h"
 #include "raycast/world_vertices.h"
 #include "renderers/environment.h"
+#include "renderers/framebuffer.h"
 #include "renderers/pbr.h"
 #include "renderers/sampling.h"
 #include "renderers/shading.h"
@@ -341,6 +342,7 @@ struct Tracer {
         PresetVisibility* out[rt::kMaxPacket];
         uint64_t pending = 0;
         n = std::min(n, rt::kMaxPacket);
+        frameMeshHits(camRays, hits, n);
         for (int k = 0; k < n; ++k) {
             out[k] = presets[k];
             out[k]->known = out[k]->lit = 0;
@@ -348,14 +350,45 @@ struct Tracer {
         }
         const size_t lights = std::min<size_t>(f.lights.size(), 64);
         const bool pbr = f.settings.reflection == ReflectionModel::Pbr;
+        // The Phong models' lights in lanes (shadowRays), the points four at a time, set up once.
+        constexpr int kLanes = ShadowLanes::kLanes;
+        ShadowLanes groups[rt::kMaxPacket / kLanes];
+        int laneHit[rt::kMaxPacket];
+        int nGroups = 0;
+        if (!pbr) {
+            int g = -1;
+            for (uint64_t m = pending; m; m &= m - 1) {
+                const int k = __builtin_ctzll(m);
+                if (g < 0 || groups[g].count == kLanes) groups[++g].count = 0;
+                const int l = groups[g].count++;
+                laneHit[g * kLanes + l] = k;
+                for (int a = 0; a < 3; ++a) {
+                    groups[g].p[a][l] = out[k]->p[a];
+                    groups[g].ng[a][l] = out[k]->ng[a];
+                }
+            }
+            nGroups = g + 1;
+        }
         for (size_t i = 0; i < lights && pending; ++i) {
             const DrawLight& L = f.lights[i];
             if (softLight(L)) continue;
             uint64_t active = 0;
-            for (uint64_t m = pending; m; m &= m - 1) {
+            for (int g = 0; g < nGroups; ++g) {
+                shadowRays(groups[g], L);
+                for (unsigned m = groups[g].reaches; m; m &= m - 1) {
+                    const int l = __builtin_ctz(m), k = laneHit[g * kLanes + l];
+                    sr[k] = groups[g].rays[l];
+                    out[k]->known |= uint64_t(1) << i;
+                    if (sr[k].tmax > 0)
+                        active |= uint64_t(1) << k;
+                    else
+                        out[k]->lit |= uint64_t(1) << i;
+                }
+            }
+            for (uint64_t m = pbr ? pending : 0; m; m &= m - 1) {
                 const int k = __builtin_ctzll(m);
-                const LightSample ls = sampleLight(L, out[k]->p);   // lightReaches' own sample, but under pbr
-                if (!(pbr ? lightReaches(L, out[k]->p, out[k]->ng, f.settings.reflection) : sampleReaches(ls, out[k]->ng))) continue;
+                const LightSample ls = sampleLight(L, out[k]->p);
+                if (!lightReaches(L, out[k]->p, out[k]->ng, f.settings.reflection)) continue;   // (pbr's sample)
                 sr[k] = shadowRay(ls, out[k]->p, out[k]->ng);
                 out[k]->known |= uint64_t(1) << i;
                 if (sr[k].tmax > 0)
@@ -368,6 +401,49 @@ struct Tracer {
             const uint64_t blocked = accel.occludedPacket(sr.data(), n, active);
             for (uint64_t m = active & ~blocked; m; m &= m - 1) out[__builtin_ctzll(m)]->lit |= uint64_t(1) << i;
         }
+    }
+
+    // The frames of the mesh hits among hits[0, n) along camRays (frameOf), four at a time
+    // (hitFrames: meshHitFrame's values in lanes).
+    void frameMeshHits(const rt::Ray* const* camRays, const FirstHit* const* hits, int n) const {
+        FrameLanes b;
+        const FirstHit* lane[FrameLanes::kLanes];
+        auto flush = [&] {
+            hitFrames(b);
+            for (int l = 0; l < b.count; ++l) {
+                MeshHitFrame& fr = lane[l]->frame;
+                for (int a = 0; a < 3; ++a) {
+                    for (int k = 0; k < 3; ++k) fr.P[k][a] = b.P[k][a][l];
+                    fr.p[a] = b.p[a][l];
+                    fr.gn[a] = b.gn[a][l];
+                    fr.ng[a] = b.ng[a][l];
+                }
+                fr.back = (b.back >> l) & 1;
+                lane[l]->framed = true;
+            }
+            b.count = 0;
+        };
+        for (int k = 0; k < n; ++k) {
+            const FirstHit& fh = *hits[k];
+            if (!fh.found || fh.framed || fh.hit.kind != rt::SceneHit::Kind::Mesh) continue;
+            const rt::SceneHit& h = fh.hit;
+            const DrawMesh& dm = f.meshes[h.instance];
+            const Mesh& mesh = *dm.mesh;
+            const rt::WorldVertices* wv = worldOf(h.instance);
+            const int l = b.count++;
+            for (int v = 0; v < 3; ++v) {   // meshHitFrame's vertices
+                const uint32_t idx = mesh.indices[3 * h.prim + uint32_t(v)];
+                const vec3 P = wv ? wv->positions[idx] : vec3(dm.world * vec4(mesh.positions[idx], 1.0f));
+                for (int a = 0; a < 3; ++a) b.P[v][a][l] = P[a];
+            }
+            for (int a = 0; a < 3; ++a) b.dir[a][l] = camRays[k]->dir[a];
+            b.b1[l] = h.b1;
+            b.b2[l] = h.b2;
+            b.mirrored = (b.mirrored & ~(1u << l)) | (unsigned(dm.mirrored) << l);
+            lane[l] = &fh;
+            if (b.count == FrameLanes::kLanes) flush();
+        }
+        if (b.count) flush();
     }
 
     // The fraction of a light with a size that reaches p (n: the geometric normal on the light's

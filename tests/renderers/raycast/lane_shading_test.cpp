@@ -4,8 +4,11 @@
 // bits, and rnd::shade. Random hits, materials and lights (point with and without 1/r^2, spots
 // with soft and hard cones, suns, a black light), Phong and Blinn-Phong, with and without
 // shadows, partly filled batches, points on a light and on the eye, normals too short to
-// normalize and hits without vertex normals.
+// normalize and hits without vertex normals. Also raycast::hitFrames against meshHitFrame and
+// raycast::shadowRays against Tracer::shadowRay and sampleReaches, bit for bit.
 #include "raycast/lane_shading.h"
+#include "raycast/tracer.h"
+#include "raycast/world_vertices.h"
 
 #include <gtest/gtest.h>
 
@@ -150,4 +153,84 @@ TEST(LaneShadingTest, LanesGiveTheScalarShadingBitForBit) {
     EXPECT_GT(shaded, size_t(3000));
     EXPECT_GT(leftToTrace, size_t(100));
     EXPECT_LT(dark, shaded / 4);
+}
+
+TEST(LaneShadingTest, FramesAndShadowRaysInLanesAreTheScalarOnesBitForBit) {
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f), s(-50.0f, 50.0f);
+    size_t reached = 0, missed = 0, backs = 0;
+    for (int trial = 0; trial < 2000; ++trial) {
+        // Frames: four triangles (one degenerate now and then), mirrored or not, seen from either side.
+        rnd::raycast::FrameLanes fl;
+        fl.count = 1 + int(rng() % 4);
+        DrawMesh dm[4];
+        rnd::rt::WorldVertices wv[4];
+        rnd::rt::SceneHit h[4];
+        rnd::rt::Ray r[4];
+        for (int l = 0; l < fl.count; ++l) {
+            auto mesh = std::make_shared<Mesh>();
+            for (int v = 0; v < 3; ++v) mesh->positions.push_back(vec3(s(rng), s(rng), s(rng)));
+            if (trial % 25 == 0) mesh->positions[2] = mesh->positions[1];   // no area: the normal is (0, 1, 0)
+            mesh->indices = {0, 1, 2};
+            dm[l].mesh = mesh;
+            dm[l].mirrored = rng() % 3 == 0;
+            wv[l].positions = mesh->positions;
+            h[l].kind = rnd::rt::SceneHit::Kind::Mesh;
+            h[l].b1 = u(rng), h[l].b2 = u(rng) * (1.0f - h[l].b1);
+            r[l].dir = unitVector(rng) * (0.5f + u(rng));
+            for (int v = 0; v < 3; ++v)
+                for (int a = 0; a < 3; ++a) fl.P[v][a][l] = mesh->positions[size_t(v)][a];
+            fl.b1[l] = h[l].b1, fl.b2[l] = h[l].b2;
+            for (int a = 0; a < 3; ++a) fl.dir[a][l] = r[l].dir[a];
+            fl.mirrored |= unsigned(dm[l].mirrored) << l;
+        }
+        rnd::raycast::hitFrames(fl);
+        for (int l = 0; l < fl.count; ++l) {
+            const rnd::raycast::MeshHitFrame fr = rnd::raycast::meshHitFrame(dm[l], h[l], r[l], &wv[l]);
+            const vec3 p(fl.p[0][l], fl.p[1][l], fl.p[2][l]), gn(fl.gn[0][l], fl.gn[1][l], fl.gn[2][l]), ng(fl.ng[0][l], fl.ng[1][l], fl.ng[2][l]);
+            ASSERT_EQ(std::memcmp(&p, &fr.p, sizeof p), 0) << "trial " << trial << " lane " << l << ": " << bits(p) << " vs " << bits(fr.p);
+            ASSERT_EQ(std::memcmp(&gn, &fr.gn, sizeof gn), 0) << "trial " << trial << " lane " << l;
+            ASSERT_EQ(std::memcmp(&ng, &fr.ng, sizeof ng), 0) << "trial " << trial << " lane " << l;
+            ASSERT_EQ(bool((fl.back >> l) & 1), fr.back) << "trial " << trial << " lane " << l;
+            backs += fr.back;
+        }
+
+        // Shadow rays toward one light from four points, far from the origin now and then.
+        DrawLight L;
+        L.type = LightType(rng() % 3);
+        L.position = vec3(s(rng), s(rng), s(rng));
+        L.direction = unitVector(rng);
+        L.radiance = rng() % 9 == 0 ? vec3(0.0f) : vec3(1.0f);
+        L.inverseSquare = rng() % 2;
+        L.cosOuter = std::cos(0.3f + u(rng));
+        L.cosInner = rng() % 4 == 0 ? L.cosOuter : std::cos(0.1f + 0.1f * u(rng));
+        rnd::raycast::ShadowLanes sl;
+        sl.count = 1 + int(rng() % 4);
+        vec3 p[4], ng[4];
+        for (int l = 0; l < sl.count; ++l) {
+            p[l] = vec3(s(rng), s(rng), s(rng)) * (rng() % 5 == 0 ? 1000.0f : 1.0f);
+            if (rng() % 30 == 0) p[l] = L.position;   // on the light: a zero distance
+            ng[l] = unitVector(rng);
+            for (int a = 0; a < 3; ++a) sl.p[a][l] = p[l][a], sl.ng[a][l] = ng[l][a];
+        }
+        rnd::raycast::shadowRays(sl, L);
+        EXPECT_EQ(sl.reaches >> sl.count, 0u);
+        for (int l = 0; l < sl.count; ++l) {
+            const rnd::LightSample ls = rnd::sampleLight(L, p[l]);
+            const bool reaches = rnd::sampleReaches(ls, ng[l]);
+            ASSERT_EQ(bool((sl.reaches >> l) & 1), reaches) << "trial " << trial << " lane " << l;
+            if (!reaches) {
+                ++missed;
+                continue;
+            }
+            ++reached;
+            const rnd::rt::Ray want = rnd::raycast::Tracer::shadowRay(ls, p[l], ng[l]);
+            ASSERT_EQ(std::memcmp(&sl.rays[l], &want, sizeof want), 0)
+                << "trial " << trial << " lane " << l << ": org " << bits(sl.rays[l].org) << " vs " << bits(want.org) << ", tmax " << sl.rays[l].tmax
+                << " vs " << want.tmax;
+        }
+    }
+    EXPECT_GT(reached, size_t(1000));
+    EXPECT_GT(missed, size_t(500));
+    EXPECT_GT(backs, size_t(500));
 }
