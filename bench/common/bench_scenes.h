@@ -1,6 +1,7 @@
 // bench_scenes.h - scenes more than one benchmark draws, built the same way everywhere so that
 // their figures compare: the mesh scenes (one mesh on a ground plane, framed like the bunny),
-// the single-mesh sphere grids (mesh10k / mesh100k / mesh1M) and the grid scenes' camera and key.
+// the single-mesh sphere grids (mesh10k / mesh100k / mesh1M), the instanced ones (spheres...)
+// and the grid scenes' camera and key.
 #pragma once
 
 #include "scenegraph/mesh.h"
@@ -24,6 +25,11 @@ void addGridCameraAndKey(sg::Scene& s, float extent);
 // One mesh (a single draw): grid x grid uv-spheres of `seg` slices (seg/2 stacks) and a ground
 // plane of `groundSub` x `groundSub` quads, merged, one material, one point light.
 BenchScene singleMesh(const std::string& name, int grid, int seg, int groundSub);
+
+// Instances: grid x grid instances of one uv-sphere mesh of `seg` slices (seg/2 stacks) on a
+// ground plane, a point key light and a sun (spheres10k / spheres100k / spheres1M; small `seg`:
+// many tiny instances).
+BenchScene sphereGrid(const std::string& name, int grid, int seg);
 
 // One mesh on a ground plane, scaled to a 2-unit diagonal, seen from the front with a point light
 // (the bunny's framing).

@@ -144,35 +144,7 @@ using bench::BenchScene;
 using bench::fileScene;
 using bench::meshScene;
 using bench::singleMesh;
-
-// grid x grid spheres with `seg` slices (seg/2 stacks) on a ground plane.
-BenchScene sphereGrid(const std::string& name, int grid, int seg) {
-    BenchScene b;
-    b.name = name;
-    Scene& s = b.scene;
-    float spacing = 1.0f, extent = grid * spacing;
-    auto ground = std::make_shared<Mesh>(primitives::plane(extent, 64));
-    auto sphere = std::make_shared<Mesh>(primitives::uvSphere(0.4f * spacing, seg, seg / 2));
-    s.meshes = {ground, sphere};
-    Material mg;
-    mg.baseColor = vec3(0.5f, 0.5f, 0.45f);
-    Material ms;
-    ms.baseColor = vec3(0.8f, 0.3f, 0.2f);
-    ms.ks = 0.5f;
-    s.materials = {mg, ms};
-    s.addNode("ground", s.root(), MeshInstance{0, 0});
-    for (int i = 0; i < grid; ++i)
-        for (int j = 0; j < grid; ++j) {
-            NodeId n = s.addNode("sphere", s.root(), MeshInstance{1, 1});
-            s.setLocal(n, LocalTransform::fromTRS(vec3((i - (grid - 1) * 0.5f) * spacing, 0.4f * spacing, (j - (grid - 1) * 0.5f) * spacing)));
-        }
-    b.triangles = ground->triangleCount() + size_t(grid) * grid * sphere->triangleCount();
-    addGridCameraAndKey(s, extent);
-    NodeId sun = s.addNode("sun", s.root(), Light{LightType::Directional, vec3(0.6f, 0.7f, 0.9f), 0.4f, false});
-    s.lookAt(sun, vec3(-1, 2, 1), vec3(0));
-    s.settings.ambientLight = vec3(0.3f);
-    return b;
-}
+using bench::sphereGrid;
 
 bool bunnyScene(BenchScene& b) {
     auto m = std::make_shared<Mesh>();

@@ -28,7 +28,9 @@
 // tessellation; textured floor and crates, which it samples at level 0), bunny and igea (mesh
 // files from the test data on a ground plane with a point light, framed like bench_raster's
 // bunny), mesh1M (bench_raster's mesh1M: 22 x 22 uv-spheres and a ground plane merged into one
-// mesh, 988k triangles). TBB is limited to --threads, Embree's devices get threads=N.
+// mesh, 988k triangles); and by name only: spheres1M (bench_raster's: 32 x 32 instances of one
+// 1k-triangle sphere) and tiny (48 x 48 instances of a 36-triangle sphere: many small instances
+// under each packet). TBB is limited to --threads, Embree's devices get threads=N.
 #include "assets/demo.h"
 #include "assets/image_io.h"
 #include "assets/scene_io.h"
@@ -118,6 +120,8 @@ int main(int argc, char** argv) {
     if (want("bunny") && fileScene(models + "stanford-bunny/stanford-bunny.obj", b, "bunny")) scenes.push_back(std::move(b));
     if (want("igea") && fileScene(models + "igea/igea.ply", b, "igea")) scenes.push_back(std::move(b));
     if (want("mesh1M")) scenes.push_back(singleMesh("mesh1M", 22, 46, 64));
+    if (want("spheres1M")) scenes.push_back(bench::sphereGrid("spheres1M", 32, 32));   // 1024 instances of 1k triangles
+    if (want("tiny")) scenes.push_back(bench::sphereGrid("tiny", 48, 6));              // 2304 instances of 36 triangles
 
     std::printf("# raycast frame vs min_embree (Embree 3, 4x4 packets): %dx%d, %d threads, shadows on, median of %d rounds\n", w, h, threads, frames);
     for (BenchScene& sc : scenes) {

@@ -88,9 +88,9 @@ public:
     // Any hits of a packet of world rays (the shadow rays of a pixel tile toward one light): for
     // each active ray exactly what occluded(rays[i]) gives; returns the mask of blocked rays.
     // The top level is walked once for the packet (Bvh4::traversePacket: each ray reaches the
-    // instances its own traversal would); instances not traced as packets are tested right there
-    // for the rays not blocked yet, the big meshes once per packet for the rays that reach them
-    // and are not blocked yet (TriangleBvh::occludedPacket).
+    // instances its own traversal would); analytic shapes are tested right there for the rays not
+    // blocked yet, meshes (of any size) once per packet for the rays that reach them and are not
+    // blocked yet (TriangleBvh::occludedPacket).
     uint64_t occludedPacket(const Ray* worldRays, int n, uint64_t active) const;
 
     // Boxes that hold every hit a ray can have (the ray caster's packet culling): with up to 16
@@ -124,7 +124,8 @@ private:
         bool isMesh = true;
         uint32_t index = 0;   // into frame meshes / analytics
         const TriangleBvh* bvh = nullptr;
-        bool packets = false;   // a mesh big enough to trace as packets (intersectPacket)
+        bool packets = false;          // a mesh big enough to trace as packets (intersectPacket)
+        bool occludePackets = false;   // a mesh traced as packets by occludedPacket (any size)
         const ParametricAccel* param = nullptr;
         const GridAccel* grid = nullptr;
         RayTransform toObject;                 // the inverse world matrix, for rays
@@ -145,8 +146,9 @@ private:
     std::unordered_map<uint64_t, MeshEntry> m_meshes;          // by Mesh::id
     std::unordered_map<uint64_t, AnalyticEntry> m_analytics;   // by geometryKey
     std::vector<Instance> m_instances;
-    bool m_anyPacketMesh = false;   // some instance has packets set
-    std::vector<Box> m_hitBoxes;    // see hitBoxes()
+    bool m_anyPacketMesh = false;          // some instance has packets set
+    bool m_anyOccludePacketMesh = false;   // some instance has occludePackets set
+    std::vector<Box> m_hitBoxes;           // see hitBoxes()
     Bvh4 m_tlas;
     uint64_t m_frameCounter = 0;
     uint64_t m_buildsTotal = 0;
