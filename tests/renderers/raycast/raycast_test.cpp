@@ -915,6 +915,41 @@ TEST(RaycastTest, SceneAccelPacketsEqualSingleRays) {
 
 namespace {
 // triangleScene with a sphere of 16k triangles beside its small meshes: a mesh traced as packets.
+// A spot (cones of 20 and 30 degrees) over the left of triangleSceneWithBigSphere's spheres.
+DrawLight spotOverTheSphere() {
+    DrawLight spot;
+    spot.type = LightType::Spot;
+    spot.position = vec3(-1.5f, 4, 0.5f);
+    spot.direction = glm::normalize(vec3(0.5f, -1, 0));
+    spot.cosInner = std::cos(glm::radians(20.0f));
+    spot.cosOuter = std::cos(glm::radians(30.0f));
+    return spot;
+}
+
+// f rendered by the ray caster with the environment variable `name` (a debug switch) set to
+// value, the visibility asked for; rays: the rays it counted.
+Framebuffer renderWithSwitch(const FrameInput& f, int w, int h, const char* name, const char* value, uint64_t& rays) {
+    setenv(name, value, 1);
+    auto r = makeRenderer("raycast");
+    Framebuffer fb;
+    RenderRequest req;
+    req.aovs.add(Aov::Visibility);
+    const RenderStats st = r->render(f, w, h, fb, nullptr, req);
+    unsetenv(name);
+    EXPECT_TRUE(st.ok) << st.error;
+    rays = st.rays;
+    return fb;
+}
+
+// The same bytes, depth, drawables and primitives.
+void expectSameImage(const Framebuffer& a, const Framebuffer& b) {
+    ASSERT_EQ(a.color.size(), b.color.size());
+    EXPECT_TRUE(a.color == b.color);
+    EXPECT_TRUE(a.depth == b.depth);
+    EXPECT_TRUE(a.drawable == b.drawable);
+    EXPECT_TRUE(a.primitive == b.primitive);
+}
+
 FrameInput triangleSceneWithBigSphere(int w, int h) {
     FrameInput f = triangleScene(w, h);
     DrawMesh big;
@@ -932,12 +967,7 @@ FrameInput triangleSceneWithBigSphere(int w, int h) {
 TEST(RaycastTest, ShadowPacketsGiveTheSameImageAsSingleShadowRays) {
     const int w = 160, h = 120;
     FrameInput f = triangleSceneWithBigSphere(w, h);
-    DrawLight spot;
-    spot.type = LightType::Spot;
-    spot.position = vec3(-1.5f, 4, 0.5f);
-    spot.direction = glm::normalize(vec3(0.5f, -1, 0));
-    spot.cosInner = std::cos(glm::radians(20.0f));
-    spot.cosOuter = std::cos(glm::radians(30.0f));
+    DrawLight spot = spotOverTheSphere();
     f.lights.push_back(spot);
     spot.position = vec3(2.0f, 3.0f, 2.0f);   // a second spot with a size: soft, its rays one by one
     spot.direction = glm::normalize(vec3(-0.5f, -1, -0.5f));
@@ -986,18 +1016,7 @@ TEST(RaycastTest, ShadowPacketsGiveTheSameImageAsSingleShadowRays) {
 TEST(RaycastTest, CameraPacketsGiveTheSameImageAsSingleRays) {
     const int w = 160, h = 120;
     FrameInput f = triangleSceneWithBigSphere(w, h);
-    auto render = [&](const char* packets, uint64_t& rays) {
-        setenv("VIEWER_RAYCAST_PACKETS", packets, 1);
-        auto r = makeRenderer("raycast");
-        Framebuffer fb;
-        RenderRequest req;
-        req.aovs.add(Aov::Visibility);
-        const RenderStats st = r->render(f, w, h, fb, nullptr, req);
-        unsetenv("VIEWER_RAYCAST_PACKETS");
-        EXPECT_TRUE(st.ok) << st.error;
-        rays = st.rays;
-        return fb;
-    };
+    auto render = [&](const char* packets, uint64_t& rays) { return renderWithSwitch(f, w, h, "VIEWER_RAYCAST_PACKETS", packets, rays); };
     struct Case {
         const char* name;
         float exposure;
@@ -1043,11 +1062,7 @@ TEST(RaycastTest, CameraPacketsGiveTheSameImageAsSingleRays) {
             f.settings.environmentBackground = c.environmentBehind;
             uint64_t raysOne = 0, raysPackets = 0;
             const Framebuffer one = render("0", raysOne), packets = render("1", raysPackets);
-            ASSERT_EQ(one.color.size(), packets.color.size());
-            EXPECT_TRUE(one.color == packets.color);
-            EXPECT_TRUE(one.depth == packets.depth);
-            EXPECT_TRUE(one.drawable == packets.drawable);
-            EXPECT_TRUE(one.primitive == packets.primitive);
+            expectSameImage(one, packets);
             if (!shadows) {   // (shadow packets count their rays by their own rule)
                 EXPECT_EQ(raysOne, raysPackets);
             }
@@ -1097,13 +1112,7 @@ TEST(RaycastTest, LaneShadingGivesTheSameImageAsTrace) {
     f.meshes.push_back(textured);
     f.lights[0].inverseSquare = true;
     f.lights[0].radiance = vec3(30.0f);
-    DrawLight spot;
-    spot.type = LightType::Spot;
-    spot.position = vec3(-1.5f, 4, 0.5f);
-    spot.direction = glm::normalize(vec3(0.5f, -1, 0));
-    spot.cosInner = std::cos(glm::radians(20.0f));
-    spot.cosOuter = std::cos(glm::radians(30.0f));
-    f.lights.push_back(spot);
+    f.lights.push_back(spotOverTheSphere());
     DrawLight sun;
     sun.type = LightType::Directional;
     sun.direction = glm::normalize(vec3(0.3f, -1.0f, -0.4f));
@@ -1113,18 +1122,7 @@ TEST(RaycastTest, LaneShadingGivesTheSameImageAsTrace) {
     low.position = vec3(-4.0f, 0.8f, 2.0f);
     low.radiance = vec3(0.3f, 0.4f, 0.9f);
     f.lights.push_back(low);
-    auto render = [&](const char* lanes, uint64_t& rays) {
-        setenv("VIEWER_RAYCAST_LANES", lanes, 1);
-        auto r = makeRenderer("raycast");
-        Framebuffer fb;
-        RenderRequest req;
-        req.aovs.add(Aov::Visibility);
-        const RenderStats st = r->render(f, w, h, fb, nullptr, req);
-        unsetenv("VIEWER_RAYCAST_LANES");
-        EXPECT_TRUE(st.ok) << st.error;
-        rays = st.rays;
-        return fb;
-    };
+    auto render = [&](const char* lanes, uint64_t& rays) { return renderWithSwitch(f, w, h, "VIEWER_RAYCAST_LANES", lanes, rays); };
     for (ReflectionModel model : {ReflectionModel::Phong, ReflectionModel::BlinnPhong})
         for (bool shadows : {false, true})
             for (FogMode fog : {FogMode::Off, FogMode::Exp2}) {
@@ -1135,11 +1133,7 @@ TEST(RaycastTest, LaneShadingGivesTheSameImageAsTrace) {
                 f.settings.fogDensity = 0.08f;
                 uint64_t raysOne = 0, raysLanes = 0;
                 const Framebuffer one = render("0", raysOne), lanes = render("1", raysLanes);
-                ASSERT_EQ(one.color.size(), lanes.color.size());
-                EXPECT_TRUE(one.color == lanes.color);
-                EXPECT_TRUE(one.depth == lanes.depth);
-                EXPECT_TRUE(one.drawable == lanes.drawable);
-                EXPECT_TRUE(one.primitive == lanes.primitive);
+                expectSameImage(one, lanes);
                 EXPECT_EQ(raysOne, raysLanes);
                 std::set<uint32_t> seen(lanes.drawable.begin(), lanes.drawable.end());   // every mesh is in the picture
                 for (uint32_t d = 1; d <= f.meshes.size(); ++d) EXPECT_TRUE(seen.count(d)) << "mesh " << d - 1;
