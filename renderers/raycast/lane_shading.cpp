@@ -96,6 +96,7 @@ void pad(LaneBatch& b) {
             b.p[a][l] = b.p[a][0];
             b.ng[a][l] = b.ng[a][0];
             b.w[a][l] = b.w[a][0];
+            b.tex[a][l] = b.tex[a][0];
             for (int k = 0; k < 3; ++k) {
                 b.vn[k][a][l] = b.vn[k][a][0];
                 b.va[k][a][l] = b.va[k][a][0];
@@ -136,10 +137,10 @@ unsigned shadeLanes(LaneBatch& b, const FrameInput& f, float rgb[3][kL]) {
     }
     const V tinted = maskOf(tintedBits);
 
-    // shadeMeshHit: albedo = (w0 albedoV[0] + w1 albedoV[1] + w2 albedoV[2]) * texColor (1: no texture),
+    // shadeMeshHit: albedo = (w0 albedoV[0] + w1 albedoV[1] + w2 albedoV[2]) * texColor,
     // n = normalize(w0 Nv[0] + w1 Nv[1] + w2 Nv[2]) where it is longer than 1e-20, else ng; ng without vertex normals.
     const V w0 = load(b.w[0]), w1 = load(b.w[1]), w2 = load(b.w[2]);
-    const V3 albedo = mul(add(add(mul(w0, load3(b.va[0])), mul(w1, load3(b.va[1]))), mul(w2, load3(b.va[2]))), splat(vec3(1.0f)));
+    const V3 albedo = mul(add(add(mul(w0, load3(b.va[0])), mul(w1, load3(b.va[1]))), mul(w2, load3(b.va[2]))), load3(b.tex));
     const V3 p = load3(b.p), ng = load3(b.ng);
     V3 n = add(add(mul(w0, load3(b.vn[0])), mul(w1, load3(b.vn[1]))), mul(w2, load3(b.vn[2])));
     const V nLen = _mm_sqrt_ps(dot(n, n));

@@ -1,6 +1,7 @@
 // lane_shading.h - the ray caster's smooth Phong / Blinn-Phong shading of four mesh hits at once
 // (SSE2 lanes), for the commonest primary hit: an opaque, lit, untextured triangle seen in a
-// frame without pbr, reflections or lights with a size under shadows. Every lane performs the
+// frame without pbr, reflections or lights with a size under shadows (a colour texture, sampled
+// per lane by the caller, is fine; the other material maps are not). Every lane performs the
 // IEEE operations of Tracer::shadeMeshHit and rnd::shadeTerms in their order (no FMA, no
 // reciprocal for a division, libm's powf per lane), so a pixel shaded here has the bytes of one
 // shaded by Tracer::trace; RaycastTest checks that byte for byte, and VIEWER_RAYCAST_LANES=0
@@ -22,12 +23,13 @@ struct LaneBatch {
     static constexpr int kLanes = 4;
     int count = 0;   // lanes filled, from 0
     // Per lane: the hit point p and geometric normal ng toward the ray (meshHitFrame), the
-    // barycentric weights w, the three vertex normals facing the ray (smooth: a vertex normal
+    // barycentric weights w, the texel tex, the three vertex normals facing the ray (smooth: a vertex normal
     // per vertex; otherwise the shading normal is ng) and vertex albedos, the coefficients.
     alignas(16) float p[3][kLanes], ng[3][kLanes];
     alignas(16) float w[3][kLanes];
     alignas(16) float vn[3][3][kLanes];   // [vertex][axis][lane]
     alignas(16) float va[3][3][kLanes];   // [vertex][channel][lane]
+    alignas(16) float tex[3][kLanes];     // the colour texture's texel (1 without one)
     bool smooth[kLanes] = {};
     const SurfaceCoefficients* coeff[kLanes] = {};
     // With shadows: the light bits of the tile's shadow packets (Tracer::PresetVisibility) for

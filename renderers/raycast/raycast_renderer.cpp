@@ -308,7 +308,8 @@ void shadePixels(const FrameJob& job, Tracer& tr, int row, int x0, int y0, uint3
             shadePixel(job, tr, x, row, x0, y0, tileRays, tileHits, tilePresets, target);
             continue;
         }
-        tr.laneInputs(fh, tileRays[i], job.shadowPackets ? &tilePresets[i] : nullptr, b, b.count);
+        const PixelFootprint fp{&job.cam, float(x) + 0.5f, float(job.h - 1 - row) + 0.5f};   // (shadePixel's)
+        tr.laneInputs(fh, tileRays[i], job.shadowPackets ? &tilePresets[i] : nullptr, &fp, b, b.count);
         at[b.count++] = i;
         if (b.count == raycast::LaneBatch::kLanes) flush();
     }
@@ -444,8 +445,8 @@ private:
     }
 
     // Per f.meshes entry, whether Tracer::trace would shade its hits as raycast::shadeLanes does
-    // (given laneShadingApplies): an opaque, lit material without textures or maps, and no
-    // mirror reflection.
+    // (given laneShadingApplies): an opaque, lit material without maps other than the colour
+    // texture, and no mirror reflection.
     std::vector<uint8_t> laneMeshes(const FrameInput& f) const {
         std::vector<uint8_t> lanes(f.meshes.size(), 0);
         for (size_t i = 0; i < f.meshes.size(); ++i) {
@@ -453,7 +454,7 @@ private:
             const sg::Material& m = dm.material;
             const bool hasUV = dm.mesh && dm.mesh->uv0.size() == dm.mesh->positions.size();
             const bool reflects = f.settings.reflections && m.reflectivity > 0.0f && f.settings.maxBounces > 0;
-            lanes[i] = dm.mesh && m.alphaMode == sg::AlphaMode::Opaque && !m.unlit && !reflects && !(hasUV && (m_textures[i] || m_maps[i].any()));
+            lanes[i] = dm.mesh && m.alphaMode == sg::AlphaMode::Opaque && !m.unlit && !reflects && !(hasUV && m_maps[i].any());
         }
         return lanes;
     }

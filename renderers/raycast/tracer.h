@@ -573,6 +573,12 @@ struct Tracer {
         }
     }
 
+    // A colour texture's texel at uv: filtered with its derivatives where the ray carries a
+    // footprint, level 0 otherwise.
+    static vec3 texel(const SampledTexture& tex, const UvFootprint& uv, bool footprinted) {
+        return footprinted ? tex.sample(uv.uv, uv.ddx, uv.ddy) : tex.sampleLevel(uv.uv, 0, tex.filter() != FilterMode::Nearest);
+    }
+
     // Shades a triangle hit: interpolated position (s.p), normals, vertex colours, texture
     // (filtered with the footprint), then the shading model with shadow rays into vis. known:
     // the hit's frame when it was already made (frameOf), else null.
@@ -604,9 +610,7 @@ struct Tracer {
             const float w[3] = {w0, w1, w2};
             UvFootprint uvs[2];   // without a footprint the derivatives stay 0: level 0
             const bool footprinted = uvWithFootprint(footprint, P, UV, w, uvs[0].uv, uvs[0].ddx, uvs[0].ddy);
-            if (tex)
-                texColor = footprinted ? tex->sample(uvs[0].uv, uvs[0].ddx, uvs[0].ddy)
-                                       : tex->sampleLevel(uvs[0].uv, 0, tex->filter() != FilterMode::Nearest);
+            if (tex) texColor = texel(*tex, uvs[0], footprinted);
             if (hasMaps) {
                 if (mm.uv1) {
                     const vec2 UV1[3] = {mesh.uv1[i0], mesh.uv1[i1], mesh.uv1[i2]};
@@ -720,9 +724,10 @@ struct Tracer {
     }
 
     // Lane l of b (lane_shading.h) from the mesh hit fh along r: its frame, vertex normals and
-    // albedos, the mesh's coefficients (meshCoefficients must be set), and the light bits of its
-    // shadow packets' preset where that preset is this hit's (null: none).
-    void laneInputs(const FirstHit& fh, const rt::Ray& r, const PresetVisibility* pre, LaneBatch& b, int l) const {
+    // albedos, the colour texture's texel (filtered with the ray's footprint), the mesh's
+    // coefficients (meshCoefficients must be set), and the light bits of its shadow packets'
+    // preset where that preset is this hit's (null: none).
+    void laneInputs(const FirstHit& fh, const rt::Ray& r, const PresetVisibility* pre, const PixelFootprint* footprint, LaneBatch& b, int l) const {
         const rt::SceneHit& h = fh.hit;
         const DrawMesh& dm = f.meshes[h.instance];
         const Mesh& mesh = *dm.mesh;
@@ -733,10 +738,18 @@ struct Tracer {
         if (smooth) vertexNormals(dm, worldOf(h.instance), i0, i1, i2, fr, Nv);
         vertexAlbedos(dm.material, mesh, i0, i1, i2, albedoV);
         const float w[3] = {1.0f - h.b1 - h.b2, h.b1, h.b2};
+        vec3 texColor(1.0f);   // (shadeMeshHit's)
+        if (const SampledTexture* tex = textures[h.instance]; tex && mesh.uv0.size() == mesh.positions.size()) {
+            const vec2 UV[3] = {mesh.uv0[i0], mesh.uv0[i1], mesh.uv0[i2]};
+            UvFootprint uv;
+            const bool footprinted = uvWithFootprint(footprint, fr.P, UV, w, uv.uv, uv.ddx, uv.ddy);
+            texColor = texel(*tex, uv, footprinted);
+        }
         for (int a = 0; a < 3; ++a) {
             b.p[a][l] = fr.p[a];
             b.ng[a][l] = fr.ng[a];
             b.w[a][l] = w[a];
+            b.tex[a][l] = texColor[a];
             for (int k = 0; k < 3; ++k) {
                 b.vn[k][a][l] = smooth ? Nv[k][a] : fr.ng[a];
                 b.va[k][a][l] = albedoV[k][a];

@@ -3,7 +3,7 @@
 // Tracer::shadeMeshHit, the visibility rule of Tracer::lightVisibility with the shadow packets'
 // bits, and rnd::shade. Random hits, materials and lights (point with and without 1/r^2, spots
 // with soft and hard cones, suns, a black light), Phong and Blinn-Phong, with and without
-// shadows, partly filled batches, points on a light and on the eye, normals too short to
+// shadows, textured and untextured hits, partly filled batches, points on a light and on the eye, normals too short to
 // normalize and hits without vertex normals. Also raycast::hitFrames against meshHitFrame and
 // raycast::shadowRays against Tracer::shadowRay and sampleReaches, bit for bit.
 #include "raycast/lane_shading.h"
@@ -33,7 +33,7 @@ Expected scalarLane(const LaneBatch& b, int l, const FrameInput& f) {
     const float w0 = b.w[0][l], w1 = b.w[1][l], w2 = b.w[2][l];
     auto at = [&](const float(&a)[3][LaneBatch::kLanes]) { return vec3(a[0][l], a[1][l], a[2][l]); };
     const vec3 p = at(b.p), ng = at(b.ng);
-    const vec3 albedo = (w0 * at(b.va[0]) + w1 * at(b.va[1]) + w2 * at(b.va[2])) * vec3(1.0f);
+    const vec3 albedo = (w0 * at(b.va[0]) + w1 * at(b.va[1]) + w2 * at(b.va[2])) * at(b.tex);
     vec3 n = ng;
     if (b.smooth[l]) {
         n = w0 * at(b.vn[0]) + w1 * at(b.vn[1]) + w2 * at(b.vn[2]);
@@ -119,7 +119,9 @@ TEST(LaneShadingTest, LanesGiveTheScalarShadingBitForBit) {
             if (rng() % 30 == 0)
                 for (vec3& v : vn) v *= 1e-22f;   // too short to normalize: ng
             b.smooth[l] = rng() % 8 != 0;
+            const bool textured = rng() % 2;
             for (int a = 0; a < 3; ++a) {
+                b.tex[a][l] = textured ? u(rng) : 1.0f;
                 b.p[a][l] = p[a];
                 b.ng[a][l] = ng[a];
                 b.w[a][l] = w[a];

@@ -1077,8 +1077,9 @@ TEST(RaycastTest, CameraPacketsGiveTheSameImageAsSingleRays) {
 // Tracer::trace gives it one by one: Phong and Blinn-Phong, with and without shadows and fog,
 // a point light with and without 1/r^2, a spot and a sun; tinted and coloured specular, an
 // emissive material, vertex colours on a mesh without normals, a mirrored instance, a plane
-// seen from its back, a small mesh (no world-space copy), and a textured mesh (never in lanes)
-// beside them. Each light reaches hits whose shading normal faces it while their face does not
+// seen from its back, a small mesh (no world-space copy), a textured mesh (its texel sampled with
+// the pixel's footprint, as trace() does), and one with an emissive map (never in lanes) beside
+// them. Each light reaches hits whose shading normal faces it while their face does not
 // (the lanes leave those to trace()).
 TEST(RaycastTest, LaneShadingGivesTheSameImageAsTrace) {
     const int w = 160, h = 120;
@@ -1106,10 +1107,18 @@ TEST(RaycastTest, LaneShadingGivesTheSameImageAsTrace) {
     textured.world = glm::translate(mat4(1.0f), vec3(-1.8f, 0.02f, 1.2f));
     textured.normal = normalMatrix(textured.world);
     auto tex = std::make_shared<Texture>();
-    tex->width = tex->height = 2;
-    tex->rgba = {255, 0, 0, 255, 0, 255, 0, 255, 0, 0, 255, 255, 255, 255, 0, 255};
+    tex->width = tex->height = 64;   // a fine checker: minified, so the footprint picks the level
+    for (int y = 0; y < 64; ++y)
+        for (int x = 0; x < 64; ++x)
+            for (uint8_t c : {uint8_t((x ^ y) & 1 ? 230 : 20), uint8_t(x * 4), uint8_t(y * 4), uint8_t(255)}) tex->rgba.push_back(c);
     textured.texture = tex;
     f.meshes.push_back(textured);
+    DrawMesh mapped = textured;
+    mapped.world = glm::translate(mat4(1.0f), vec3(1.9f, 0.02f, 1.6f)) * glm::scale(mat4(1.0f), vec3(0.6f));
+    mapped.normal = normalMatrix(mapped.world);
+    mapped.maps.emissive = tex;
+    mapped.material.emissive = vec3(0.3f);
+    f.meshes.push_back(mapped);
     f.lights[0].inverseSquare = true;
     f.lights[0].radiance = vec3(30.0f);
     f.lights.push_back(spotOverTheSphere());
