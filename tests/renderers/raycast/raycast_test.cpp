@@ -1079,8 +1079,9 @@ TEST(RaycastTest, CameraPacketsGiveTheSameImageAsSingleRays) {
 // emissive material, vertex colours on a mesh without normals, a mirrored instance, a plane
 // seen from its back, a small mesh (no world-space copy), a textured mesh (its texel sampled with
 // the pixel's footprint, as trace() does), and one with an emissive map (never in lanes) beside
-// them. Each light reaches hits whose shading normal faces it while their face does not
-// (the lanes leave those to trace()).
+// them; analytic shapes (never in lanes: their shading is a small share of a frame, measured no
+// faster in lanes) beside them: an implicit sphere, an unlit one and a CSG difference. Each light reaches hits whose shading normal faces it while their face does not (the
+// lanes leave those to trace()).
 TEST(RaycastTest, LaneShadingGivesTheSameImageAsTrace) {
     const int w = 160, h = 120;
     FrameInput f = triangleSceneWithBigSphere(w, h);
@@ -1119,6 +1120,33 @@ TEST(RaycastTest, LaneShadingGivesTheSameImageAsTrace) {
     mapped.maps.emissive = tex;
     mapped.material.emissive = vec3(0.3f);
     f.meshes.push_back(mapped);
+    // Analytic shapes: an implicit sphere, an unlit one, a box with a sphere cut out of it (its
+    // two leaves' materials).
+    DrawAnalytic ball;
+    ball.kind = DrawAnalytic::Kind::Implicit;
+    ball.implicit.type = ImplicitType::Sphere;
+    ball.implicit.radius = 0.35f;
+    ball.material.baseColor = vec3(0.2f, 0.7f, 0.3f);
+    ball.material.shininess = 12.0f;
+    ball.world = glm::translate(mat4(1.0f), vec3(0.6f, 0.35f, 1.9f));
+    ball.invWorld = glm::inverse(ball.world);
+    ball.normal = normalMatrix(ball.world);
+    ball.worldBounds = ball.implicit.localBounds().transformed(ball.world);
+    f.analytics.push_back(ball);
+    DrawAnalytic unlit = ball;
+    unlit.material.unlit = true;
+    unlit.world = glm::translate(mat4(1.0f), vec3(-0.5f, 0.35f, 2.2f));
+    unlit.invWorld = glm::inverse(unlit.world);
+    unlit.normal = normalMatrix(unlit.world);
+    unlit.worldBounds = unlit.implicit.localBounds().transformed(unlit.world);
+    f.analytics.push_back(unlit);
+    f.analytics.push_back(csgFrame(CsgOp::Difference).analytics[0]);
+    for (CsgTree::Node& node : std::const_pointer_cast<CsgTree>(f.analytics.back().csg)->nodes) {   // smaller, off to the right
+        node.world = glm::translate(mat4(1.0f), vec3(2.3f, 0.4f, -0.8f)) * glm::scale(mat4(1.0f), vec3(0.4f)) * node.world;
+        node.invWorld = glm::inverse(node.world);
+        node.normal = normalMatrix(node.world);
+    }
+    f.analytics.back().worldBounds = {vec3(1.8f, -0.1f, -1.3f), vec3(3.0f, 0.9f, -0.3f)};
     f.lights[0].inverseSquare = true;
     f.lights[0].radiance = vec3(30.0f);
     f.lights.push_back(spotOverTheSphere());
@@ -1144,8 +1172,8 @@ TEST(RaycastTest, LaneShadingGivesTheSameImageAsTrace) {
                 const Framebuffer one = render("0", raysOne), lanes = render("1", raysLanes);
                 expectSameImage(one, lanes);
                 EXPECT_EQ(raysOne, raysLanes);
-                std::set<uint32_t> seen(lanes.drawable.begin(), lanes.drawable.end());   // every mesh is in the picture
-                for (uint32_t d = 1; d <= f.meshes.size(); ++d) EXPECT_TRUE(seen.count(d)) << "mesh " << d - 1;
+                std::set<uint32_t> seen(lanes.drawable.begin(), lanes.drawable.end());   // every drawable is in the picture
+                for (uint32_t d = 1; d <= f.meshes.size() + f.analytics.size(); ++d) EXPECT_TRUE(seen.count(d)) << "drawable " << d;
             }
 }
 
