@@ -308,8 +308,8 @@ void shadePixels(const FrameJob& job, Tracer& tr, int row, int x0, int y0, uint3
             shadePixel(job, tr, x, row, x0, y0, tileRays, tileHits, tilePresets, target);
             continue;
         }
-        const PixelFootprint fp{&job.cam, float(x) + 0.5f, float(job.h - 1 - row) + 0.5f};   // (shadePixel's)
-        tr.laneInputs(fh, tileRays[i], job.shadowPackets ? &tilePresets[i] : nullptr, &fp, b, b.count);
+        const vec2 window(float(x) + 0.5f, float(job.h - 1 - row) + 0.5f);   // (shadePixel's footprint)
+        tr.laneInputs(fh, tileRays[i], job.shadowPackets ? &tilePresets[i] : nullptr, job.cam, window, b, b.count);
         at[b.count++] = i;
         if (b.count == raycast::LaneBatch::kLanes) flush();
     }

@@ -724,10 +724,12 @@ struct Tracer {
     }
 
     // Lane l of b (lane_shading.h) from the mesh hit fh along r: its frame, vertex normals and
-    // albedos, the colour texture's texel (filtered with the ray's footprint), the mesh's
+    // albedos, the colour texture's texel (filtered with the footprint of the camera ray through
+    // window position `window`), the mesh's
     // coefficients (meshCoefficients must be set), and the light bits of its shadow packets'
     // preset where that preset is this hit's (null: none).
-    void laneInputs(const FirstHit& fh, const rt::Ray& r, const PresetVisibility* pre, const PixelFootprint* footprint, LaneBatch& b, int l) const {
+    void laneInputs(const FirstHit& fh, const rt::Ray& r, const PresetVisibility* pre, const rt::CameraRays& cam, const vec2& window, LaneBatch& b,
+                    int l) const {
         const rt::SceneHit& h = fh.hit;
         const DrawMesh& dm = f.meshes[h.instance];
         const Mesh& mesh = *dm.mesh;
@@ -742,7 +744,8 @@ struct Tracer {
         if (const SampledTexture* tex = textures[h.instance]; tex && mesh.uv0.size() == mesh.positions.size()) {
             const vec2 UV[3] = {mesh.uv0[i0], mesh.uv0[i1], mesh.uv0[i2]};
             UvFootprint uv;
-            const bool footprinted = uvWithFootprint(footprint, fr.P, UV, w, uv.uv, uv.ddx, uv.ddy);
+            const PixelFootprint footprint{&cam, window.x, window.y};
+            const bool footprinted = uvWithFootprint(&footprint, fr.P, UV, w, uv.uv, uv.ddx, uv.ddy);
             texColor = texel(*tex, uv, footprinted);
         }
         for (int a = 0; a < 3; ++a) {
