@@ -96,7 +96,6 @@ void pad(LaneBatch& b) {
             b.p[a][l] = b.p[a][0];
             b.ng[a][l] = b.ng[a][0];
             b.w[a][l] = b.w[a][0];
-            b.tex[a][l] = b.tex[a][0];
             for (int k = 0; k < 3; ++k) {
                 b.vn[k][a][l] = b.vn[k][a][0];
                 b.va[k][a][l] = b.va[k][a][0];
@@ -140,7 +139,13 @@ unsigned shadeLanes(LaneBatch& b, const FrameInput& f, float rgb[3][kL]) {
     // shadeMeshHit: albedo = (w0 albedoV[0] + w1 albedoV[1] + w2 albedoV[2]) * texColor,
     // n = normalize(w0 Nv[0] + w1 Nv[1] + w2 Nv[2]) where it is longer than 1e-20, else ng; ng without vertex normals.
     const V w0 = load(b.w[0]), w1 = load(b.w[1]), w2 = load(b.w[2]);
-    const V3 albedo = mul(add(add(mul(w0, load3(b.va[0])), mul(w1, load3(b.va[1]))), mul(w2, load3(b.va[2]))), load3(b.tex));
+    V3 albedo = add(add(mul(w0, load3(b.va[0])), mul(w1, load3(b.va[1]))), mul(w2, load3(b.va[2])));
+    if (const unsigned textured = b.textured & valid) {   // (x * 1 is x bit for bit: the others multiply by 1, or not at all)
+        for (int l = 0; l < kL; ++l)
+            if (!((textured >> l) & 1))
+                for (int a = 0; a < 3; ++a) b.tex[a][l] = 1.0f;
+        albedo = mul(albedo, load3(b.tex));
+    }
     const V3 p = load3(b.p), ng = load3(b.ng);
     V3 n = add(add(mul(w0, load3(b.vn[0])), mul(w1, load3(b.vn[1]))), mul(w2, load3(b.vn[2])));
     const V nLen = _mm_sqrt_ps(dot(n, n));

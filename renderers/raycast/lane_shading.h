@@ -29,7 +29,8 @@ struct LaneBatch {
     alignas(16) float w[3][kLanes];
     alignas(16) float vn[3][3][kLanes];   // [vertex][axis][lane]
     alignas(16) float va[3][3][kLanes];   // [vertex][channel][lane]
-    alignas(16) float tex[3][kLanes];     // the colour texture's texel (1 without one)
+    alignas(16) float tex[3][kLanes];     // the colour texture's texel, in the lanes of `textured`
+    unsigned textured = 0;                // bit l: lane l has a texel (the others' texColor is 1)
     bool smooth[kLanes] = {};
     const SurfaceCoefficients* coeff[kLanes] = {};
     // With shadows: the light bits of the tile's shadow packets (Tracer::PresetVisibility) for

@@ -77,7 +77,8 @@ struct FrameJob {
     // meet nothing, and such pixels need no ray (fillMisses). Empty: every packet is traced.
     std::vector<std::array<float, 4>> hitRects;
     // Per f.meshes entry, whether its packet hits are shaded four at a time (lane_shading.h;
-    // RaycastRenderer::laneMeshes); empty: every hit through Tracer::trace.
+    // RaycastRenderer::laneMeshes: 0 no, 1 yes, 2 yes with a colour texture); empty: every hit
+    // through Tracer::trace.
     std::vector<uint8_t> laneMesh;
     const SrgbEncoder& srgb = srgbEncoder();
     static constexpr int kTile = 32;    // pixels per tile side
@@ -304,12 +305,13 @@ void shadePixels(const FrameJob& job, Tracer& tr, int row, int x0, int y0, uint3
         const int x = x0 + __builtin_ctz(m);
         const size_t i = size_t(row - y0) * tile + size_t(x - x0);
         const Tracer::FirstHit& fh = tileHits[i];
-        if (!(fh.found && fh.hit.kind == rt::SceneHit::Kind::Mesh && job.laneMesh[fh.hit.instance])) {
+        const uint8_t lane = fh.found && fh.hit.kind == rt::SceneHit::Kind::Mesh ? job.laneMesh[fh.hit.instance] : uint8_t(0);
+        if (!lane) {
             shadePixel(job, tr, x, row, x0, y0, tileRays, tileHits, tilePresets, target);
             continue;
         }
         const vec2 window(float(x) + 0.5f, float(job.h - 1 - row) + 0.5f);   // (shadePixel's footprint)
-        tr.laneInputs(fh, tileRays[i], job.shadowPackets ? &tilePresets[i] : nullptr, job.cam, window, b, b.count);
+        tr.laneInputs(fh, tileRays[i], job.shadowPackets ? &tilePresets[i] : nullptr, lane == 2 ? &job.cam : nullptr, window, b, b.count);
         at[b.count++] = i;
         if (b.count == raycast::LaneBatch::kLanes) flush();
     }
@@ -446,7 +448,7 @@ private:
 
     // Per f.meshes entry, whether Tracer::trace would shade its hits as raycast::shadeLanes does
     // (given laneShadingApplies): an opaque, lit material without maps other than the colour
-    // texture, and no mirror reflection.
+    // texture, and no mirror reflection; 2 where that texture is sampled (texture and uvs), else 1.
     std::vector<uint8_t> laneMeshes(const FrameInput& f) const {
         std::vector<uint8_t> lanes(f.meshes.size(), 0);
         for (size_t i = 0; i < f.meshes.size(); ++i) {
@@ -454,7 +456,8 @@ private:
             const sg::Material& m = dm.material;
             const bool hasUV = dm.mesh && dm.mesh->uv0.size() == dm.mesh->positions.size();
             const bool reflects = f.settings.reflections && m.reflectivity > 0.0f && f.settings.maxBounces > 0;
-            lanes[i] = dm.mesh && m.alphaMode == sg::AlphaMode::Opaque && !m.unlit && !reflects && !(hasUV && m_maps[i].any());
+            if (dm.mesh && m.alphaMode == sg::AlphaMode::Opaque && !m.unlit && !reflects && !(hasUV && m_maps[i].any()))
+                lanes[i] = hasUV && m_textures[i] ? 2 : 1;
         }
         return lanes;
     }

@@ -723,13 +723,23 @@ struct Tracer {
         return applyFog(f.settings, color, glm::length(vec3(f.camera.view * vec4(p, 1.0f))));
     }
 
+    // laneInputs' texel (out of line: the untextured lanes' loop stays small).
+    [[gnu::noinline]] static vec3 laneTexel(const SampledTexture& tex, const Mesh& mesh, uint32_t i0, uint32_t i1, uint32_t i2,
+                                            const MeshHitFrame& fr, const float w[3], const rt::CameraRays& cam, const vec2& window) {
+        const vec2 UV[3] = {mesh.uv0[i0], mesh.uv0[i1], mesh.uv0[i2]};
+        UvFootprint uv;
+        const PixelFootprint footprint{&cam, window.x, window.y};
+        const bool footprinted = uvWithFootprint(&footprint, fr.P, UV, w, uv.uv, uv.ddx, uv.ddy);
+        return texel(tex, uv, footprinted);
+    }
+
     // Lane l of b (lane_shading.h) from the mesh hit fh along r: its frame, vertex normals and
-    // albedos, the colour texture's texel (filtered with the footprint of the camera ray through
-    // window position `window`), the mesh's
+    // albedos, the colour texture's texel where the mesh has one and uvs (texturedCam set: filtered
+    // with the footprint of that camera's ray through window position `window`), the mesh's
     // coefficients (meshCoefficients must be set), and the light bits of its shadow packets'
     // preset where that preset is this hit's (null: none).
-    void laneInputs(const FirstHit& fh, const rt::Ray& r, const PresetVisibility* pre, const rt::CameraRays& cam, const vec2& window, LaneBatch& b,
-                    int l) const {
+    void laneInputs(const FirstHit& fh, const rt::Ray& r, const PresetVisibility* pre, const rt::CameraRays* texturedCam, const vec2& window,
+                    LaneBatch& b, int l) const {
         const rt::SceneHit& h = fh.hit;
         const DrawMesh& dm = f.meshes[h.instance];
         const Mesh& mesh = *dm.mesh;
@@ -740,19 +750,16 @@ struct Tracer {
         if (smooth) vertexNormals(dm, worldOf(h.instance), i0, i1, i2, fr, Nv);
         vertexAlbedos(dm.material, mesh, i0, i1, i2, albedoV);
         const float w[3] = {1.0f - h.b1 - h.b2, h.b1, h.b2};
-        vec3 texColor(1.0f);   // (shadeMeshHit's)
-        if (const SampledTexture* tex = textures[h.instance]; tex && mesh.uv0.size() == mesh.positions.size()) {
-            const vec2 UV[3] = {mesh.uv0[i0], mesh.uv0[i1], mesh.uv0[i2]};
-            UvFootprint uv;
-            const PixelFootprint footprint{&cam, window.x, window.y};
-            const bool footprinted = uvWithFootprint(&footprint, fr.P, UV, w, uv.uv, uv.ddx, uv.ddy);
-            texColor = texel(*tex, uv, footprinted);
+        b.textured &= ~(1u << l);
+        if (texturedCam) {
+            const vec3 texColor = laneTexel(*textures[h.instance], mesh, i0, i1, i2, fr, w, *texturedCam, window);
+            for (int a = 0; a < 3; ++a) b.tex[a][l] = texColor[a];
+            b.textured |= 1u << l;
         }
         for (int a = 0; a < 3; ++a) {
             b.p[a][l] = fr.p[a];
             b.ng[a][l] = fr.ng[a];
             b.w[a][l] = w[a];
-            b.tex[a][l] = texColor[a];
             for (int k = 0; k < 3; ++k) {
                 b.vn[k][a][l] = smooth ? Nv[k][a] : fr.ng[a];
                 b.va[k][a][l] = albedoV[k][a];

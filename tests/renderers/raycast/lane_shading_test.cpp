@@ -33,7 +33,7 @@ Expected scalarLane(const LaneBatch& b, int l, const FrameInput& f) {
     const float w0 = b.w[0][l], w1 = b.w[1][l], w2 = b.w[2][l];
     auto at = [&](const float(&a)[3][LaneBatch::kLanes]) { return vec3(a[0][l], a[1][l], a[2][l]); };
     const vec3 p = at(b.p), ng = at(b.ng);
-    const vec3 albedo = (w0 * at(b.va[0]) + w1 * at(b.va[1]) + w2 * at(b.va[2])) * at(b.tex);
+    const vec3 albedo = (w0 * at(b.va[0]) + w1 * at(b.va[1]) + w2 * at(b.va[2])) * ((b.textured >> l) & 1 ? at(b.tex) : vec3(1.0f));
     vec3 n = ng;
     if (b.smooth[l]) {
         n = w0 * at(b.vn[0]) + w1 * at(b.vn[1]) + w2 * at(b.vn[2]);
@@ -120,8 +120,9 @@ TEST(LaneShadingTest, LanesGiveTheScalarShadingBitForBit) {
                 for (vec3& v : vn) v *= 1e-22f;   // too short to normalize: ng
             b.smooth[l] = rng() % 8 != 0;
             const bool textured = rng() % 2;
+            b.textured = (b.textured & ~(1u << l)) | (unsigned(textured) << l);
             for (int a = 0; a < 3; ++a) {
-                b.tex[a][l] = textured ? u(rng) : 1.0f;
+                b.tex[a][l] = textured ? u(rng) : 1e30f;   // (not read without the bit)
                 b.p[a][l] = p[a];
                 b.ng[a][l] = ng[a];
                 b.w[a][l] = w[a];
