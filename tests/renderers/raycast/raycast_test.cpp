@@ -216,6 +216,19 @@ TEST(RaycastTest, PolyRootsQuartic) {
 // --- CSG ---------------------------------------------------------------------------------------
 
 namespace {
+// An implicit sphere of radius r centred at c.
+DrawAnalytic implicitSphere(float r, const vec3& c) {
+    DrawAnalytic s;
+    s.kind = DrawAnalytic::Kind::Implicit;
+    s.implicit.type = ImplicitType::Sphere;
+    s.implicit.radius = r;
+    s.world = glm::translate(mat4(1.0f), c);
+    s.invWorld = glm::inverse(s.world);
+    s.normal = normalMatrix(s.world);
+    s.worldBounds = s.implicit.localBounds().transformed(s.world);
+    return s;
+}
+
 FrameInput csgFrame(CsgOp op) {
     auto tree = std::make_shared<CsgTree>();
     CsgTree::Node a, b, root;
@@ -840,15 +853,7 @@ TEST(RaycastTest, SceneAccelPacketsEqualSingleRays) {
     mirrored.mirrored = true;
     mirrored.material.doubleSided = false;
     f.meshes.push_back(mirrored);
-    DrawAnalytic s;
-    s.kind = DrawAnalytic::Kind::Implicit;
-    s.implicit.type = ImplicitType::Sphere;
-    s.implicit.radius = 0.4f;
-    s.world = glm::translate(mat4(1.0f), vec3(0.3f, 1.2f, 1.5f));
-    s.invWorld = glm::inverse(s.world);
-    s.normal = normalMatrix(s.world);
-    s.worldBounds = s.implicit.localBounds().transformed(s.world);
-    f.analytics.push_back(s);
+    f.analytics.push_back(implicitSphere(0.4f, vec3(0.3f, 1.2f, 1.5f)));
     for (const CullMode culling : {CullMode::Off, CullMode::On, CullMode::Auto}) {
         SceneAccel acc;
         acc.update(f);
@@ -1122,23 +1127,13 @@ TEST(RaycastTest, LaneShadingGivesTheSameImageAsTrace) {
     f.meshes.push_back(mapped);
     // Analytic shapes: an implicit sphere, an unlit one, a box with a sphere cut out of it (its
     // two leaves' materials).
-    DrawAnalytic ball;
-    ball.kind = DrawAnalytic::Kind::Implicit;
-    ball.implicit.type = ImplicitType::Sphere;
-    ball.implicit.radius = 0.35f;
+    DrawAnalytic ball = implicitSphere(0.35f, vec3(0.6f, 0.35f, 1.9f));
     ball.material.baseColor = vec3(0.2f, 0.7f, 0.3f);
     ball.material.shininess = 12.0f;
-    ball.world = glm::translate(mat4(1.0f), vec3(0.6f, 0.35f, 1.9f));
-    ball.invWorld = glm::inverse(ball.world);
-    ball.normal = normalMatrix(ball.world);
-    ball.worldBounds = ball.implicit.localBounds().transformed(ball.world);
     f.analytics.push_back(ball);
-    DrawAnalytic unlit = ball;
+    DrawAnalytic unlit = implicitSphere(0.35f, vec3(-0.5f, 0.35f, 2.2f));
+    unlit.material = ball.material;
     unlit.material.unlit = true;
-    unlit.world = glm::translate(mat4(1.0f), vec3(-0.5f, 0.35f, 2.2f));
-    unlit.invWorld = glm::inverse(unlit.world);
-    unlit.normal = normalMatrix(unlit.world);
-    unlit.worldBounds = unlit.implicit.localBounds().transformed(unlit.world);
     f.analytics.push_back(unlit);
     f.analytics.push_back(csgFrame(CsgOp::Difference).analytics[0]);
     for (CsgTree::Node& node : std::const_pointer_cast<CsgTree>(f.analytics.back().csg)->nodes) {   // smaller, off to the right
