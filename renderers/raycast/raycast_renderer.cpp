@@ -206,11 +206,11 @@ void fillMisses(const FrameJob& job, Tracer& tr, int row, int x0, int x1, uint32
     }
 }
 
-// What a pixel keeps of its surface hp (one of its rays'): the nearest depth (window z) into
-// `depth`, and its drawable and primitive when the visibility is asked (one centre ray per pixel,
-// RenderConfig::aovs).
-void keepSurface(const FrameJob& job, const SurfaceRecord& hp, int x, int row, float& depth, Framebuffer& target) {
-    if (!std::isnan(hp.p.x)) depth = std::min(depth, std::clamp(job.cam.depth(hp.p), 0.0f, 1.0f));
+// What a pixel keeps of its surface hp (one of its rays'): the nearest depth into `depth` (windowZ:
+// job.cam.depth(hp.p), read only where hp.p is a point), and its drawable and primitive when the
+// visibility is asked (one centre ray per pixel, RenderConfig::aovs).
+void keepSurface(const FrameJob& job, const SurfaceRecord& hp, float windowZ, int x, int row, float& depth, Framebuffer& target) {
+    if (!std::isnan(hp.p.x)) depth = std::min(depth, std::clamp(windowZ, 0.0f, 1.0f));
     if (job.cfg.aovs.has(Aov::Visibility)) {
         target.drawable[size_t(row) * size_t(job.w) + size_t(x)] = hp.drawable;
         target.primitive[size_t(row) * size_t(job.w) + size_t(x)] = hp.primitive;
@@ -250,7 +250,7 @@ void shadePixel(const FrameJob& job, Tracer& tr, int x, int row, int x0, int y0,
                 target.costNodes[size_t(row) * w + x] = count.nodes;
                 target.costPrims[size_t(row) * w + x] = count.prims;
             }
-            keepSurface(job, hp, x, row, depth, target);
+            keepSurface(job, hp, std::isnan(hp.p.x) ? 1.0f : job.cam.depth(hp.p), x, row, depth, target);
             sum += c;
         }
     if (sx * sy > 1) sum /= float(sx * sy);   // (x / 1 is x: one sample skips three divisions)
@@ -271,8 +271,6 @@ void shadePixels(const FrameJob& job, Tracer& tr, int row, int x0, int y0, uint3
     }
     raycast::LaneBatch b;
     size_t at[raycast::LaneBatch::kLanes];
-    const bool visibility = job.cfg.aovs.has(Aov::Visibility);
-    const size_t rowAt = size_t(row) * size_t(job.w);
     auto flush = [&] {
         float rgb[3][raycast::LaneBatch::kLanes], windowZ[raycast::LaneBatch::kLanes];
         const unsigned shaded = raycast::shadeLanes(b, job.f, rgb);
@@ -286,18 +284,17 @@ void shadePixels(const FrameJob& job, Tracer& tr, int row, int x0, int y0, uint3
             // What trace() and shadePixel do after the shading: count the ray, keep the surface
             // (keepSurface: depth, visibility), fog, bytes.
             const rt::SceneHit& h = tileHits[at[l]].hit;
-            const vec3 p(b.p[0][l], b.p[1][l], b.p[2][l]);
+            SurfaceRecord hp;
+            hp.p = vec3(b.p[0][l], b.p[1][l], b.p[2][l]);
+            hp.drawable = h.instance + 1;
+            hp.primitive = h.prim;
             ++tr.rays;
             float depth = 1.0f;
-            if (!std::isnan(p.x)) depth = std::min(depth, std::clamp(windowZ[l], 0.0f, 1.0f));
-            if (visibility) {
-                target.drawable[rowAt + size_t(x)] = h.instance + 1;
-                target.primitive[rowAt + size_t(x)] = h.prim;
-            }
+            keepSurface(job, hp, windowZ[l], x, row, depth, target);
             vec3 sum(0.0f);
-            sum += tr.fogged(vec3(rgb[0][l], rgb[1][l], rgb[2][l]), p);
+            sum += tr.fogged(vec3(rgb[0][l], rgb[1][l], rgb[2][l]), hp.p);
             encodePixel(job, sum, target.pixel(x, row));
-            target.depth[rowAt + size_t(x)] = depth;
+            target.depth[size_t(row) * size_t(job.w) + size_t(x)] = depth;
         }
         b.count = 0;
     };

@@ -33,7 +33,7 @@ int SceneAccel::update(const FrameInput& f) {
     int built = 0;
     m_instances.clear();
     m_anyPacketMesh = false;
-    m_anyOccludePacketMesh = false;
+    m_anyMesh = false;
     std::vector<vec3> bmin, bmax;
     std::vector<float> spread;   // per box, hitBoxes' Box::spread
     std::vector<Box> tight;      // hitBoxes with each mesh's root child boxes instead of its box
@@ -81,16 +81,16 @@ int SceneAccel::update(const FrameInput& f) {
         // stay single rays.
         inst.packets = d.mesh->triangleCount() >= kPacketMinTriangles;
         m_anyPacketMesh |= inst.packets;
-        // Shadow packets take every mesh: whether a ray is blocked does not depend on the order
-        // the instances are visited in, and a packet sets a mesh up once where single rays each
-        // transform, set up and walk it (the demo spent 8% of a frame in its small meshes' single
-        // shadow rays; frame / min_embree, 3 alternated runs: demo 3.59-3.64 -> 3.47-3.50, 48 x 48
-        // instances of 36 triangles 1.73 -> 1.68-1.70). Closest hits keep the threshold (with
-        // it at 1: demo 3.43, tiny instances 1.58): between instances met at exactly the same
-        // distance the one kept follows the visit order, which for a packet is its first ray's,
-        // and one pixel of bench_raycast_frame's "tiny" (a sphere's pole on the ground) changed.
-        inst.occludePackets = true;
-        m_anyOccludePacketMesh = true;
+        // Shadow packets take every mesh (occludedPacket): whether a ray is blocked does not
+        // depend on the order the instances are visited in, and a packet sets a mesh up once
+        // where single rays each transform, set up and walk it (the demo spent 8% of a frame in
+        // its small meshes' single shadow rays; frame / min_embree, 3 alternated runs: demo
+        // 3.59-3.64 -> 3.47-3.50, 48 x 48 instances of 36 triangles 1.73 -> 1.68-1.70). Closest
+        // hits keep the threshold (with it at 1: demo 3.43, tiny instances 1.58): between
+        // instances met at exactly the same distance the one kept follows the visit order, which
+        // for a packet is its first ray's, and one pixel of bench_raycast_frame's "tiny" (a
+        // sphere's pole on the ground) changed.
+        m_anyMesh = true;
         inst.toObject = RayTransform(glm::inverse(d.world));
         Aabb wb = it->second.bvh.bounds().transformed(d.world);
         inst.boxMin = wb.min;
@@ -459,7 +459,7 @@ uint64_t SceneAccel::occludedPacket(const Ray* rays, int n, uint64_t active) con
     n = std::clamp(n, 0, kMaxPacket);
     if (n < kMaxPacket) active &= (uint64_t(1) << n) - 1;
     if (m_tlas.empty() || !active) return 0;
-    if (!m_anyOccludePacketMesh) return eachRay(active, [&](int i) { return occluded(rays[i]); });   // no mesh to share
+    if (!m_anyMesh) return eachRay(active, [&](int i) { return occluded(rays[i]); });   // no mesh to share
     uint64_t blocked = 0;
     const std::vector<uint32_t>& prims = m_tlas.primIndex();
     constexpr int kMaxMeshes = 16;
@@ -476,7 +476,7 @@ uint64_t SceneAccel::occludedPacket(const Ray* rays, int n, uint64_t active) con
         for (uint32_t c = 0; c < count; ++c) {
             const uint32_t j = prims[first + c];
             const Instance& inst = m_instances[j];
-            if (inst.occludePackets && k < kMaxMeshes) {   // instances are unique in the top level
+            if (inst.isMesh && k < kMaxMeshes) {   // instances are unique in the top level
                 touched[k++] = {j, reach};
                 continue;
             }

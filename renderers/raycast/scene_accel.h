@@ -124,8 +124,7 @@ private:
         bool isMesh = true;
         uint32_t index = 0;   // into frame meshes / analytics
         const TriangleBvh* bvh = nullptr;
-        bool packets = false;          // a mesh big enough to trace as packets (intersectPacket)
-        bool occludePackets = false;   // a mesh traced as packets by occludedPacket (any size)
+        bool packets = false;   // a mesh big enough to trace as packets (intersectPacket; occludedPacket takes every mesh)
         const ParametricAccel* param = nullptr;
         const GridAccel* grid = nullptr;
         RayTransform toObject;                 // the inverse world matrix, for rays
@@ -146,9 +145,9 @@ private:
     std::unordered_map<uint64_t, MeshEntry> m_meshes;          // by Mesh::id
     std::unordered_map<uint64_t, AnalyticEntry> m_analytics;   // by geometryKey
     std::vector<Instance> m_instances;
-    bool m_anyPacketMesh = false;          // some instance has packets set
-    bool m_anyOccludePacketMesh = false;   // some instance has occludePackets set
-    std::vector<Box> m_hitBoxes;           // see hitBoxes()
+    bool m_anyPacketMesh = false;   // some instance has packets set
+    bool m_anyMesh = false;         // some instance is a mesh
+    std::vector<Box> m_hitBoxes;    // see hitBoxes()
     Bvh4 m_tlas;
     uint64_t m_frameCounter = 0;
     uint64_t m_buildsTotal = 0;
