@@ -5,6 +5,8 @@
 // (sub-patch boxes + Newton), GridAccel (block min/max + marching + bisection).
 #include "raycast/analytic.h"
 
+#include <emmintrin.h>
+
 #include <algorithm>
 #include <cmath>
 
@@ -316,26 +318,28 @@ int polyRoots(const double* c, int deg, double lo, double hi, double* roots) {
 
 namespace {
 
+// One end of a span: its distance, and which list, span and end it is (a plain struct: the
+// array of them is not initialized before it is filled).
 struct Event {
-    Bound b;
-    bool fromB;
-    bool enter;
+    float t;
+    uint8_t fromB, enter, span;
 };
 
 // Boolean of two sorted span lists by sweeping their ends (CSG: combine the intervals).
 // Difference: ends contributed by the cutter B get their normal flipped.
 void combine(const SpanList& A, const SpanList& B, CsgOp op, SpanList& out) {
+    static_assert(SpanList::kCapacity <= 256, "Event::span is one byte");
     Event ev[2 * 2 * SpanList::kCapacity];
     int ne = 0;
     for (int i = 0; i < A.n; ++i) {
-        ev[ne++] = {A.s[i].in, false, true};
-        ev[ne++] = {A.s[i].out, false, false};
+        ev[ne++] = {A.s[i].in.t, 0, 1, uint8_t(i)};
+        ev[ne++] = {A.s[i].out.t, 0, 0, uint8_t(i)};
     }
     for (int i = 0; i < B.n; ++i) {
-        ev[ne++] = {B.s[i].in, true, true};
-        ev[ne++] = {B.s[i].out, true, false};
+        ev[ne++] = {B.s[i].in.t, 1, 1, uint8_t(i)};
+        ev[ne++] = {B.s[i].out.t, 1, 0, uint8_t(i)};
     }
-    std::sort(ev, ev + ne, [](const Event& x, const Event& y) { return x.b.t < y.b.t; });
+    std::sort(ev, ev + ne, [](const Event& x, const Event& y) { return x.t < y.t; });
     bool inA = false, inB = false, inR = false;
     Bound start;
     out.n = 0;
@@ -344,7 +348,8 @@ void combine(const SpanList& A, const SpanList& B, CsgOp op, SpanList& out) {
         (e.fromB ? inB : inA) = e.enter;
         bool r = op == CsgOp::Union ? (inA || inB) : op == CsgOp::Intersection ? (inA && inB) : (inA && !inB);
         if (r == inR) continue;
-        Bound b = e.b;
+        const Span& from = (e.fromB ? B : A).s[e.span];
+        Bound b = e.enter ? from.in : from.out;
         if (op == CsgOp::Difference && e.fromB) b.flip ^= 1;
         if (r)
             start = b;
@@ -383,6 +388,12 @@ void csgSpans(const CsgTree& tree, const Ray& worldRay, SpanList& out) { csgRec(
 // --- parametric -----------------------------------------------------------------------------------
 
 ParametricAccel::ParametricAccel(const ParametricSurface& s) : m_surface(s) {
+    for (int k = 0; k < 16; ++k) {
+        m_control[k][0] = s.control[k].x;
+        m_control[k][1] = s.control[k].y;
+        m_control[k][2] = s.control[k].z;
+        m_control[k][3] = 0.0f;
+    }
     if (s.type == ParametricType::Torus) {
         m_nu = 32;
         m_nv = 16;
@@ -408,6 +419,49 @@ ParametricAccel::ParametricAccel(const ParametricSurface& s) : m_surface(s) {
     o.maxLeafSize = 1;
     o.parallel = false;
     m_bvh.build(m_boxMin.data(), m_boxMax.data(), m_boxMin.size(), o);
+    // Newton's starts in each sub-patch: its centre first; the two others are tried only when
+    // that one fails (it converges from the centre for nearly all rays that hit the sub-patch).
+    // The surface there does not depend on the ray, so it is evaluated here once.
+    const float starts[kNewtonStarts][2] = {{0.5f, 0.5f}, {0.25f, 0.25f}, {0.75f, 0.75f}};
+    m_starts.resize(m_boxMin.size() * kNewtonStarts);
+    m_scale.resize(m_boxMin.size());
+    for (int j = 0; j < m_nv; ++j)
+        for (int i = 0; i < m_nu; ++i) {
+            const size_t patch = size_t(j) * m_nu + i;
+            m_scale[patch] = glm::length(m_boxMax[patch] - m_boxMin[patch]);
+            float u0 = float(i) / m_nu, u1 = float(i + 1) / m_nu, v0 = float(j) / m_nv, v1 = float(j + 1) / m_nv;
+            for (int k = 0; k < kNewtonStarts; ++k) {
+                NewtonStart& st = m_starts[patch * kNewtonStarts + k];
+                st.u = u0 + starts[k][0] * (u1 - u0);
+                st.v = v0 + starts[k][1] * (v1 - v0);
+                st.P = evaluate(st.u, st.v, st.Pu, st.Pv);
+            }
+        }
+}
+
+vec3 ParametricAccel::evaluate(float u, float v, vec3& Pu, vec3& Pv) const {
+    if (m_surface.type != ParametricType::BezierPatch) return m_surface.evaluate(u, v, Pu, Pv);
+    // ParametricSurface::evaluate's sums term by term in its order: each term's weight is one
+    // float product (bu * bv, dbu * bv, bu * dbv), then weight * control and the add, per
+    // component. The lanes do the same IEEE operations, so the bits are the same.
+    float bu[4], dbu[4], bv[4], dbv[4];
+    cubicBernstein(u, bu, dbu);
+    cubicBernstein(v, bv, dbv);
+    __m128 p = _mm_setzero_ps(), pu = p, pv = p;
+    for (int j = 0; j < 4; ++j)
+        for (int i = 0; i < 4; ++i) {
+            const __m128 c = _mm_load_ps(m_control[j * 4 + i]);
+            p = _mm_add_ps(p, _mm_mul_ps(_mm_set1_ps(bu[i] * bv[j]), c));
+            pu = _mm_add_ps(pu, _mm_mul_ps(_mm_set1_ps(dbu[i] * bv[j]), c));
+            pv = _mm_add_ps(pv, _mm_mul_ps(_mm_set1_ps(bu[i] * dbv[j]), c));
+        }
+    alignas(16) float o[3][4];
+    _mm_store_ps(o[0], p);
+    _mm_store_ps(o[1], pu);
+    _mm_store_ps(o[2], pv);
+    Pu = vec3(o[1][0], o[1][1], o[1][2]);
+    Pv = vec3(o[2][0], o[2][1], o[2][2]);
+    return vec3(o[0][0], o[0][1], o[0][2]);
 }
 
 template <bool AnyHit>
@@ -424,22 +478,21 @@ bool ParametricAccel::trace(const Ray& r, float& tOut, float& uOut, float& vOut)
             float u0 = float(i) / m_nu, u1 = float(i + 1) / m_nu, v0 = float(j) / m_nv, v1 = float(j + 1) / m_nv;
             float bt0, bt1;
             if (!boxInterval(r, m_boxMin[patch], m_boxMax[patch], bt0, bt1)) continue;
-            float scale = glm::length(m_boxMax[patch] - m_boxMin[patch]);
-            // Newton on F(t, u, v) = o + t d - P(u, v) = 0 from a few starts in the patch.
-            // Newton from the patch centre first; the two other starts only when it fails
-            // (it converges from the centre for nearly all rays that hit this sub-patch).
-            const float starts[3][2] = {{0.5f, 0.5f}, {0.25f, 0.25f}, {0.75f, 0.75f}};
+            const float scale = m_scale[patch];
+            // Newton on F(t, u, v) = o + t d - P(u, v) = 0 from a few starts in the patch
+            // (kNewtonStarts; the surface at each was evaluated once, in the constructor).
             bool patchHit = false;
-            for (const auto& st : starts) {
+            for (int k = 0; k < kNewtonStarts; ++k) {
                 if (patchHit) break;
-                float u = u0 + st[0] * (u1 - u0), v = v0 + st[1] * (v1 - v0);
-                vec3 Pu, Pv;
-                vec3 P = m_surface.evaluate(u, v, Pu, Pv);
+                const NewtonStart& st = m_starts[size_t(patch) * kNewtonStarts + k];
+                float u = st.u, v = st.v;
+                vec3 Pu = st.Pu, Pv = st.Pv;
+                vec3 P = st.P;
                 float t = glm::dot(P - r.org, r.dir) / dd;
                 bool ok = false;
                 float prevErr = std::numeric_limits<float>::infinity();
                 for (int it = 0; it < 16; ++it) {
-                    if (it > 0) P = m_surface.evaluate(u, v, Pu, Pv);
+                    if (it > 0) P = evaluate(u, v, Pu, Pv);
                     vec3 F = r.org + t * r.dir - P;
                     const float err = glm::length(F);
                     if (err < 1e-6f * (scale + 1.0f)) {

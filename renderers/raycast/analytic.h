@@ -10,6 +10,7 @@
 #include "raycast/bvh.h"
 #include "scenegraph/frame.h"
 
+#include <algorithm>
 #include <memory>
 #include <vector>
 
@@ -31,10 +32,21 @@ struct Span {
 };
 
 // Small fixed-capacity interval list (a torus gives 2, a quadric 2 after clipping, CSG more).
+// Only s[0, n) is ever read: the storage past n stays uninitialized, and copies take the first n
+// (one is made per ray and shape, and filling all 32 spans cost more than most intersections).
 struct SpanList {
     static constexpr int kCapacity = 32;
-    Span s[kCapacity];
+    union {
+        Span s[kCapacity];
+    };
     int n = 0;
+    SpanList() {}
+    SpanList(const SpanList& o) : n(o.n) { std::copy_n(o.s, o.n, s); }
+    SpanList& operator=(const SpanList& o) {
+        n = o.n;
+        std::copy_n(o.s, o.n, s);
+        return *this;
+    }
     void push(const Span& x) {
         if (n < kCapacity) s[n++] = x;
     }
@@ -76,11 +88,22 @@ public:
         return trace<true>(localRay, t, u, v);
     }
     const sg::ParametricSurface& surface() const { return m_surface; }
+    // surface().evaluate(u, v, Pu, Pv), bit for bit; a Bezier patch's x, y and z in one SSE
+    // register (Newton's method evaluates the patch several times per ray and sub-patch).
+    sg::vec3 evaluate(float u, float v, sg::vec3& Pu, sg::vec3& Pv) const;
 
 private:
     template <bool AnyHit>
     bool trace(const Ray& localRay, float& t, float& u, float& v) const;
     sg::ParametricSurface m_surface;
+    alignas(16) float m_control[16][4];   // the patch's control points, x y z 0
+    struct NewtonStart {
+        float u, v;
+        sg::vec3 P, Pu, Pv;   // evaluate(u, v, Pu, Pv)
+    };
+    static constexpr int kNewtonStarts = 3;
+    std::vector<NewtonStart> m_starts;   // kNewtonStarts per sub-patch
+    std::vector<float> m_scale;          // per sub-patch: its box's diagonal
     int m_nu = 8, m_nv = 8;
     std::vector<sg::vec3> m_boxMin, m_boxMax;
     Bvh4 m_bvh;

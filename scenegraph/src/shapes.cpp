@@ -110,20 +110,6 @@ vec3 ImplicitShape::normal(const vec3& p) const {
 
 // --- parametric ---------------------------------------------------------------------------
 
-namespace {
-void bernstein(float t, float b[4], float db[4]) {
-    float s = 1 - t;
-    b[0] = s * s * s;
-    b[1] = 3 * t * s * s;
-    b[2] = 3 * t * t * s;
-    b[3] = t * t * t;
-    db[0] = -3 * s * s;
-    db[1] = 3 * s * s - 6 * t * s;
-    db[2] = 6 * t * s - 3 * t * t;
-    db[3] = 3 * t * t;
-}
-}   // namespace
-
 vec3 ParametricSurface::evaluate(float u, float v) const {
     if (type == ParametricType::Torus) {
         float a = 2 * kPi * u, b = 2 * kPi * v;
@@ -131,8 +117,8 @@ vec3 ParametricSurface::evaluate(float u, float v) const {
         return majorRadius * dir + minorRadius * (std::cos(b) * dir + vec3(0, std::sin(b), 0));
     }
     float bu[4], dbu[4], bv[4], dbv[4];
-    bernstein(u, bu, dbu);
-    bernstein(v, bv, dbv);
+    cubicBernstein(u, bu, dbu);
+    cubicBernstein(v, bv, dbv);
     vec3 p(0.0f);
     for (int j = 0; j < 4; ++j)
         for (int i = 0; i < 4; ++i) p += bu[i] * bv[j] * control[j * 4 + i];
@@ -148,8 +134,8 @@ void ParametricSurface::partials(float u, float v, vec3& dPdu, vec3& dPdv) const
         return;
     }
     float bu[4], dbu[4], bv[4], dbv[4];
-    bernstein(u, bu, dbu);
-    bernstein(v, bv, dbv);
+    cubicBernstein(u, bu, dbu);
+    cubicBernstein(v, bv, dbv);
     dPdu = dPdv = vec3(0.0f);
     for (int j = 0; j < 4; ++j)
         for (int i = 0; i < 4; ++i) {
@@ -168,8 +154,8 @@ vec3 ParametricSurface::evaluate(float u, float v, vec3& dPdu, vec3& dPdv) const
         return majorRadius * dir + minorRadius * (cb * dir + vec3(0, sb, 0));
     }
     float bu[4], dbu[4], bv[4], dbv[4];
-    bernstein(u, bu, dbu);
-    bernstein(v, bv, dbv);
+    cubicBernstein(u, bu, dbu);
+    cubicBernstein(v, bv, dbv);
     vec3 p(0.0f);
     dPdu = dPdv = vec3(0.0f);
     for (int j = 0; j < 4; ++j)

@@ -63,6 +63,20 @@ struct ParametricSurface {
     static ParametricSurface defaultPatch();   // a gentle hill over [-1,1]^2
 };
 
+// The cubic Bernstein basis at t, b[i] = C(3, i) t^i (1 - t)^(3 - i), and its derivative db[i],
+// exactly as ParametricSurface evaluates them (shared, so a faster evaluator gives the same bits).
+inline void cubicBernstein(float t, float b[4], float db[4]) {
+    float s = 1 - t;
+    b[0] = s * s * s;
+    b[1] = 3 * t * s * s;
+    b[2] = 3 * t * t * s;
+    b[3] = t * t * t;
+    db[0] = -3 * s * s;
+    db[1] = 3 * s * s - 6 * t * s;
+    db[2] = 6 * t * s - 3 * t * t;
+    db[3] = 3 * t * t;
+}
+
 // Scalar density on a regular grid filling `bounds`; the surface is value == isoValue and
 // "inside" is value > isoValue. Samples are at the cell corners: dims.x * dims.y * dims.z values,
 // x fastest.

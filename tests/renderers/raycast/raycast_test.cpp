@@ -14,6 +14,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <random>
 #include <set>
 
@@ -329,6 +330,32 @@ TEST(RaycastTest, ParametricBezierAndTorus) {
     EXPECT_FALSE(ta.intersect(mkRay({0, 5, 0}, {0, -1, 0}), t, u, v));   // the hole
     ASSERT_TRUE(ta.intersect(mkRay({0, 5, 1}, {0, -1, 0}), t, u, v));
     EXPECT_NEAR(t, 4.7f, 1e-3f);
+}
+
+// Newton's method evaluates the patch through ParametricAccel's SSE evaluator; it must give
+// ParametricSurface's bits, or the ray caster's hits would move with the build.
+TEST(RaycastTest, PatchEvaluatorGivesTheSurfacesBitsExactly) {
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> C(-5.0f, 5.0f), U(-0.3f, 1.3f);
+    auto sameBits = [](vec3 a, vec3 b) { return std::memcmp(&a, &b, sizeof a) == 0; };
+    for (int shape = 0; shape < 40; ++shape) {
+        ParametricSurface s = ParametricSurface::defaultPatch();
+        if (shape > 0)
+            for (vec3& c : s.control) c = vec3(C(rng), C(rng), C(rng)) * std::pow(10.0f, float(shape % 7 - 3));
+        if (shape == 1) s.control[5] = vec3(-0.0f, 0.0f, 1e-38f);   // signed zeros, a denormal product
+        ParametricAccel acc(s);
+        for (int k = 0; k < 200; ++k) {
+            float u = k == 0 ? 0.0f : k == 1 ? 1.0f : U(rng), v = k == 0 ? 1.0f : k == 1 ? -0.0f : U(rng);
+            vec3 pu, pv, qu, qv;
+            vec3 p = s.evaluate(u, v, pu, pv), q = acc.evaluate(u, v, qu, qv);
+            ASSERT_TRUE(sameBits(p, q) && sameBits(pu, qu) && sameBits(pv, qv)) << shape << " " << u << " " << v;
+        }
+    }
+    ParametricSurface tor;
+    tor.type = ParametricType::Torus;
+    ParametricAccel ta(tor);
+    vec3 pu, pv, qu, qv;
+    EXPECT_TRUE(sameBits(tor.evaluate(0.3f, 0.7f, pu, pv), ta.evaluate(0.3f, 0.7f, qu, qv)) && sameBits(pu, qu) && sameBits(pv, qv));
 }
 
 TEST(RaycastTest, DensityGridSphereRadius) {
