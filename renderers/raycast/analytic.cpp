@@ -439,22 +439,56 @@ ParametricAccel::ParametricAccel(const ParametricSurface& s) : m_surface(s) {
         }
 }
 
+namespace {
+
+// cubicBernstein's b[0..3] and db[0..3] in two registers, with its operations lane by lane:
+// b = (s s, 3t s, 3t t, t t) * (s, s, s, t) and db = (-3s s, 3s s, 6t s, 3t t) minus
+// (0, 6t s, 3t t, 0) (x - 0 is x, -0 included).
+void bernstein4(float t, __m128& b, __m128& db) {
+    const float s = 1 - t;
+    const __m128 sssT = _mm_setr_ps(s, s, s, t);
+    b = _mm_mul_ps(_mm_mul_ps(_mm_setr_ps(s, 3 * t, 3 * t, t), _mm_setr_ps(s, s, t, t)), sssT);
+    const __m128 a = _mm_mul_ps(_mm_setr_ps(-3 * s, 3 * s, 6 * t, 3 * t), sssT);
+    const __m128 sub = _mm_and_ps(_mm_shuffle_ps(a, a, _MM_SHUFFLE(3, 3, 2, 2)),   // (a2, a2, a3, a3)
+                                  _mm_castsi128_ps(_mm_setr_epi32(0, -1, -1, 0)));
+    db = _mm_sub_ps(a, sub);
+}
+
+template <int I>
+__m128 lane(__m128 v) {
+    return _mm_shuffle_ps(v, v, _MM_SHUFFLE(I, I, I, I));
+}
+
+}   // namespace
+
 vec3 ParametricAccel::evaluate(float u, float v, vec3& Pu, vec3& Pv) const {
     if (m_surface.type != ParametricType::BezierPatch) return m_surface.evaluate(u, v, Pu, Pv);
     // ParametricSurface::evaluate's sums term by term in its order: each term's weight is one
     // float product (bu * bv, dbu * bv, bu * dbv), then weight * control and the add, per
-    // component. The lanes do the same IEEE operations, so the bits are the same.
-    float bu[4], dbu[4], bv[4], dbv[4];
-    cubicBernstein(u, bu, dbu);
-    cubicBernstein(v, bv, dbv);
+    // component. The lanes do the same IEEE operations, so the bits are the same: a row's four
+    // weights are one product of registers, each term's is broadcast from its lane.
+    __m128 bu, dbu, bv, dbv;
+    bernstein4(u, bu, dbu);
+    bernstein4(v, bv, dbv);
+    alignas(16) float bvs[4], dbvs[4];
+    _mm_store_ps(bvs, bv);
+    _mm_store_ps(dbvs, dbv);
     __m128 p = _mm_setzero_ps(), pu = p, pv = p;
-    for (int j = 0; j < 4; ++j)
-        for (int i = 0; i < 4; ++i) {
-            const __m128 c = _mm_load_ps(m_control[j * 4 + i]);
-            p = _mm_add_ps(p, _mm_mul_ps(_mm_set1_ps(bu[i] * bv[j]), c));
-            pu = _mm_add_ps(pu, _mm_mul_ps(_mm_set1_ps(dbu[i] * bv[j]), c));
-            pv = _mm_add_ps(pv, _mm_mul_ps(_mm_set1_ps(bu[i] * dbv[j]), c));
-        }
+    auto term = [&](const float* control, __m128 wp, __m128 wu, __m128 wv) {
+        const __m128 c = _mm_load_ps(control);
+        p = _mm_add_ps(p, _mm_mul_ps(wp, c));
+        pu = _mm_add_ps(pu, _mm_mul_ps(wu, c));
+        pv = _mm_add_ps(pv, _mm_mul_ps(wv, c));
+    };
+    for (int j = 0; j < 4; ++j) {
+        const __m128 wp = _mm_mul_ps(bu, _mm_set1_ps(bvs[j])), wu = _mm_mul_ps(dbu, _mm_set1_ps(bvs[j]));
+        const __m128 wv = _mm_mul_ps(bu, _mm_set1_ps(dbvs[j]));
+        const float(*row)[4] = m_control + j * 4;
+        term(row[0], lane<0>(wp), lane<0>(wu), lane<0>(wv));
+        term(row[1], lane<1>(wp), lane<1>(wu), lane<1>(wv));
+        term(row[2], lane<2>(wp), lane<2>(wu), lane<2>(wv));
+        term(row[3], lane<3>(wp), lane<3>(wu), lane<3>(wv));
+    }
     alignas(16) float o[3][4];
     _mm_store_ps(o[0], p);
     _mm_store_ps(o[1], pu);
