@@ -580,6 +580,11 @@ GridAccel::GridAccel(std::shared_ptr<const DensityGrid> g) : m_grid(std::move(g)
     if (!m_valid) return;
     ivec3 cells = d.dims - 1;
     m_cell = d.bounds.extent() / vec3(cells);
+    for (int a = 0; a < 3; ++a) {
+        m_corner4[a] = d.bounds.min[a];
+        m_cell4[a] = m_cell[a];
+        m_lastCell4[a] = float(d.dims[a] - 2);
+    }
     m_blocks = (cells + kBlock - 1) / kBlock;
     size_t nb = size_t(m_blocks.x) * m_blocks.y * m_blocks.z;
     m_blockMin.assign(nb, std::numeric_limits<float>::infinity());
@@ -602,10 +607,19 @@ GridAccel::GridAccel(std::shared_ptr<const DensityGrid> g) : m_grid(std::move(g)
 }
 
 bool GridAccel::blockMayCross(const vec3& p) const {
+    // The cell of p, (p - corner) / cell clamped to [0, dims - 2] (before float -> int), all
+    // three axes in one register. glm::clamp is min(max(x, 0), hi) with glm's max(x, y) =
+    // x < y ? y : x and min(x, y) = y < x ? y : x, which are _mm_max_ps(0, x) and
+    // _mm_min_ps(hi, x) lane by lane (a NaN x kept, -0 kept); a NaN lane then sends every axis
+    // to cell 0, as the scalar isFinite test did (the clamp leaves no infinity).
+    const __m128 x = _mm_setr_ps(p.x, p.y, p.z, 0.0f);
+    __m128 g = _mm_div_ps(_mm_sub_ps(x, _mm_load_ps(m_corner4)), _mm_load_ps(m_cell4));
+    g = _mm_min_ps(_mm_load_ps(m_lastCell4), _mm_max_ps(_mm_setzero_ps(), g));
+    if (_mm_movemask_ps(_mm_cmpunord_ps(g, g)) & 7) g = _mm_setzero_ps();
+    alignas(16) int cell[4];
+    _mm_store_si128(reinterpret_cast<__m128i*>(cell), _mm_cvttps_epi32(g));
     const DensityGrid& d = *m_grid;
-    vec3 g = glm::clamp((p - d.bounds.min) / m_cell, vec3(0.0f), vec3(d.dims - 2));   // clamp before float->int
-    if (!isFinite(g)) g = vec3(0.0f);
-    ivec3 c = ivec3(g) / kBlock;
+    ivec3 c = ivec3(cell[0], cell[1], cell[2]) / kBlock;
     c = glm::clamp(c, ivec3(0), m_blocks - 1);
     size_t i = (size_t(c.z) * m_blocks.y + c.y) * m_blocks.x + c.x;
     return m_blockMin[i] <= d.isoValue && m_blockMax[i] >= d.isoValue;
@@ -636,15 +650,20 @@ bool GridAccel::intersect(const Ray& r, float& tOut) const {
         }
         float fb = f(tb);
         if ((fa > 0) != (fb > 0)) {
-            // Bisection on the bracket (secant would be faster; bisection cannot fail).
+            // Bisection on the bracket (secant would be faster; bisection cannot fail). A step
+            // depends only on a, b and fA's sign; once one leaves all three as they were (a and
+            // b adjacent floats, m one of them), every later step repeats it, so stop there.
             float a = ta, b = tb, fA = fa;
             for (int it = 0; it < 30; ++it) {
-                float m = 0.5f * (a + b), fm = f(m);
+                const float m = 0.5f * (a + b), fm = f(m);
+                const float a0 = a, b0 = b;
+                const bool sign0 = fA > 0;
                 if ((fm > 0) == (fA > 0)) {
                     a = m;
                     fA = fm;
                 } else
                     b = m;
+                if (a == a0 && b == b0 && (fA > 0) == sign0) break;
             }
             tOut = 0.5f * (a + b);
             if (tOut <= r.tmin) tOut = b;

@@ -128,6 +128,9 @@ private:
     sg::ivec3 m_blocks{0};
     std::vector<float> m_blockMin, m_blockMax;
     sg::vec3 m_cell{1.0f};
+    // blockMayCross's operands, x y z and a harmless fourth lane: the grid's corner, its cell
+    // size and the highest cell index (dims - 2).
+    alignas(16) float m_corner4[4] = {0, 0, 0, 0}, m_cell4[4] = {1, 1, 1, 1}, m_lastCell4[4] = {0, 0, 0, 0};
     bool blockMayCross(const sg::vec3& p) const;
 };
 
