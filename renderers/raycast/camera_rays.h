@@ -84,15 +84,24 @@ public:
     // that -(f + n) / (f - n) rounds to -1 or past it, as the rasterizers also see it), the ray
     // runs from the near plane through NDC z = 0 with no far end (tmax = FLT_MAX).
     Ray ray(float wx, float wy) const { return rayThrough(column(wx) + row(wy)); }
+    // ray(wx + 1, wy) and ray(wx, wy + 1) bit for bit (a pixel's neighbours, for texture
+    // footprints), through the grid's SSE2 steps with both rays' divisions together.
+    void neighbours(float wx, float wy, Ray& right, Ray& up) const {
+        __m128d c0[2], c1[2], r0[2], r1[2];
+        toPairs(column(wx + 1.0f), c0);
+        toPairs(row(wy), r0);
+        toPairs(column(wx), c1);
+        toPairs(row(wy + 1.0f), r1);
+        const Unprojected a = unproject(c0, r0), b = unproject(c1, r1);
+        finish(a, right);
+        finish(b, up);
+    }
     // The rays through a grid of window positions, row by row: out[j * nx + i] is ray(wx[i],
     // wy[j]) bit for bit, each column's and row's share of the unprojection made once.
     void grid(const float* wx, int nx, const float* wy, int ny, Ray* out) const {
         constexpr int kMax = 8, kBatch = 16;
         __m128d cols[kMax][2];   // column(wx[i]) as (x, y) and (z, w) pairs (no zeroing: glm's vectors clear themselves)
-        auto pairs = [](const glm::dvec4& v, __m128d* p) {
-            p[0] = _mm_loadu_pd(&v.x);
-            p[1] = _mm_loadu_pd(&v.z);
-        };
+        const auto pairs = toPairs;
         for (int i = 0; i < nx && i < kMax; ++i) pairs(column(wx[i]), cols[i]);
         // Up to kBatch rays at a time: first every ray's divisions (independent of each other,
         // so they overlap in the divider), then what follows from them.
@@ -117,6 +126,10 @@ public:
     }
 
 private:
+    static void toPairs(const glm::dvec4& v, __m128d* p) {   // (x, y) and (z, w)
+        p[0] = _mm_loadu_pd(&v.x);
+        p[1] = _mm_loadu_pd(&v.z);
+    }
     // m_inv * (x, y, z, 1) = (m0 x + m1 y) + (m2 z + m3): the x and y terms of window position (wx, wy).
     glm::dvec4 column(float wx) const { return m_inv[0] * glm::dvec4(2.0 * double(wx) / m_w - 1.0); }
     glm::dvec4 row(float wy) const { return m_inv[1] * glm::dvec4(2.0 * double(wy) / m_h - 1.0); }

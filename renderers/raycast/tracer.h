@@ -50,8 +50,7 @@ struct PixelFootprint {
             return true;
         }
         if (!cam) return false;
-        x = cam->ray(wx + 1.0f, wy);
-        y = cam->ray(wx, wy + 1.0f);
+        cam->neighbours(wx, wy, x, y);
         return true;
     }
 };

@@ -1,7 +1,7 @@
 // camera_rays_test.cpp - CameraRays::grid (a packet's camera rays, the unprojection done two
-// doubles at a time) against CameraRays::ray, bit for bit, for every projection, far planes at
-// infinity, window positions inside and far outside the image, and grids wider than the
-// columns it keeps; CameraRays::windowBounds (the window rectangle that holds every camera ray
+// doubles at a time) and CameraRays::neighbours (a pixel's neighbours) against CameraRays::ray,
+// bit for bit, for every projection, far planes at infinity, window positions inside and far
+// outside the image, and grids wider than the columns it keeps; CameraRays::windowBounds (the window rectangle that holds every camera ray
 // that can meet a box) against the rays' own box tests, boxes grazed by rays included; and
 // TriangleBvh::rootChildBoxes, the tighter boxes the culling uses, holding every triangle.
 #include "raycast/camera_rays.h"
@@ -70,6 +70,11 @@ TEST(CameraRaysTest, GridGivesEachRayBitForBit) {
                         fallbacks += one.tmax != 1.0f;
                         EXPECT_TRUE(sameBits(got, one))
                             << name << " at (" << wx[size_t(i)] << ", " << wy[size_t(j)] << "): grid " << describe(got) << ", ray " << describe(one);
+                        Ray right, up;   // a texture footprint's neighbours
+                        cr.neighbours(wx[size_t(i)], wy[size_t(j)], right, up);
+                        EXPECT_TRUE(sameBits(right, cr.ray(wx[size_t(i)] + 1.0f, wy[size_t(j)])) &&
+                                    sameBits(up, cr.ray(wx[size_t(i)], wy[size_t(j)] + 1.0f)))
+                            << name << ": the neighbours of (" << wx[size_t(i)] << ", " << wy[size_t(j)] << ")";
                     }
             }
         }
