@@ -47,9 +47,10 @@ const std::vector<const WorldVertices*>& WorldVertexCache::update(const FrameInp
     ++m_frame;
     m_perMesh.assign(f.meshes.size(), nullptr);
     std::vector<std::pair<const DrawMesh*, Entry*>> missing;
+    const size_t minTriangles = f.meshes.size() <= kMaxSmallInstances ? 1 : kSmallMesh;
     for (size_t i = 0; i < f.meshes.size(); ++i) {
         const DrawMesh& d = f.meshes[i];
-        if (!d.mesh || d.mesh->mode != PrimitiveMode::Triangles || d.mesh->triangleCount() < kMinTriangles) continue;
+        if (!d.mesh || d.mesh->mode != PrimitiveMode::Triangles || d.mesh->triangleCount() < minTriangles) continue;
         uint64_t key = mix(0xcbf29ce484222325ull, &d.mesh->id, sizeof d.mesh->id);
         key = mix(key, &d.world, sizeof d.world);
         key = mix(key, &d.normal, sizeof d.normal);

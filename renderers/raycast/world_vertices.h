@@ -27,8 +27,11 @@ struct WorldVertices {
 
 class WorldVertexCache {
 public:
-    // Meshes below this many triangles are not copied: few pixels read each of their vertices.
-    static constexpr size_t kMinTriangles = 256;
+    // Meshes below kSmallMesh triangles are copied only in frames of at most kMaxSmallInstances
+    // mesh instances: a wall of 12 triangles may fill much of a view (each of its pixels would
+    // transform and normalize three vertices), but a frame of a million small instances would
+    // pay a hash and an entry per instance and frame for copies the vertex budget cannot hold.
+    static constexpr size_t kSmallMesh = 256, kMaxSmallInstances = 4096;
     // At most this many vertices are kept over all instances (24 bytes each with normals).
     static constexpr size_t kMaxVertices = size_t(1) << 21;
 

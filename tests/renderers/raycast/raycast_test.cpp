@@ -1109,7 +1109,7 @@ TEST(RaycastTest, CameraPacketsGiveTheSameImageAsSingleRays) {
 // Tracer::trace gives it one by one: Phong and Blinn-Phong, with and without shadows and fog,
 // a point light with and without 1/r^2, a spot and a sun; tinted and coloured specular, an
 // emissive material, vertex colours on a mesh without normals, a mirrored instance, a plane
-// seen from its back, a small mesh (no world-space copy), a textured mesh (its texel sampled with
+// seen from its back, a small mesh, a textured mesh (its texel sampled with
 // the pixel's footprint, as trace() does), and one with an emissive map (never in lanes) beside
 // them; analytic shapes (never in lanes: their shading is a small share of a frame, measured no
 // faster in lanes) beside them: an implicit sphere, an unlit one and a CSG difference. Each light reaches hits whose shading normal faces it while their face does not (the
