@@ -101,8 +101,7 @@ public:
     void grid(const float* wx, int nx, const float* wy, int ny, Ray* out) const {
         constexpr int kMax = 8, kBatch = 16;
         __m128d cols[kMax][2];   // column(wx[i]) as (x, y) and (z, w) pairs (no zeroing: glm's vectors clear themselves)
-        const auto pairs = toPairs;
-        for (int i = 0; i < nx && i < kMax; ++i) pairs(column(wx[i]), cols[i]);
+        for (int i = 0; i < nx && i < kMax; ++i) toPairs(column(wx[i]), cols[i]);
         // Up to kBatch rays at a time: first every ray's divisions (independent of each other,
         // so they overlap in the divider), then what follows from them.
         Unprojected u[kBatch];
@@ -114,10 +113,10 @@ public:
         };
         for (int j = 0; j < ny; ++j) {
             __m128d r[2];
-            pairs(row(wy[j]), r);
+            toPairs(row(wy[j]), r);
             for (int i = 0; i < nx; ++i) {
                 __m128d wide[2];
-                if (i >= kMax) pairs(column(wx[i]), wide);
+                if (i >= kMax) toPairs(column(wx[i]), wide);
                 u[pending++] = unproject(i < kMax ? cols[i] : wide, r);
                 if (pending == kBatch) flush();
             }
