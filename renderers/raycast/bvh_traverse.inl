@@ -122,6 +122,75 @@ struct Bvh4PacketTest {
         }
     }
 
+    // The packet as a whole, for mayReach: per axis the bounds of its rays' origins and
+    // reciprocal directions and the direction signs they share, its smallest tmin and largest
+    // tmax, each in every lane (made by setWhole on the first node below the root: a packet
+    // that meets only the root's leaves never needs them). `whole` is false where the rays do
+    // not share their signs or some value is not finite (a NaN can drop out of SSE's min and
+    // max, in a ray's own test too, so no bound would hold for it); then every child is tested
+    // group by group.
+    bool whole = false;
+    int wholeSigns = 0;
+    __m128 olo[3], ohi[3], rlo[3], rhi[3], tminLo, tmaxHi;
+
+    void setWhole(uint64_t active) {
+        const __m128 inf = _mm_set1_ps(std::numeric_limits<float>::infinity()), absMask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+        __m128 lo[3] = {inf, inf, inf}, hi[3], rl[3] = {inf, inf, inf}, rh[3], tl = inf, th = _mm_sub_ps(_mm_setzero_ps(), inf);
+        for (int a = 0; a < 3; ++a) hi[a] = rh[a] = th;
+        __m128 bad = _mm_setzero_ps();
+        int signs = -1;
+        for (int k = 0; k < kGroups; ++k) {
+            if (!((active >> (4 * k)) & 15u)) continue;
+            const Group& q = g[k];
+            if (q.signs < 0 || (signs >= 0 && q.signs != signs)) return;
+            signs = q.signs;
+            const __m128 o[3] = {q.ox, q.oy, q.oz}, r[3] = {q.rx, q.ry, q.rz};
+            for (int a = 0; a < 3; ++a) {
+                lo[a] = _mm_min_ps(lo[a], o[a]), hi[a] = _mm_max_ps(hi[a], o[a]);
+                rl[a] = _mm_min_ps(rl[a], r[a]), rh[a] = _mm_max_ps(rh[a], r[a]);
+                // Origins within 1e30 and reciprocals of at least 1e-30 (never NaN, and no
+                // 0 x inf in the products below).
+                bad = _mm_or_ps(bad, _mm_or_ps(_mm_cmpnle_ps(_mm_and_ps(o[a], absMask), _mm_set1_ps(1e30f)),
+                                               _mm_cmpnge_ps(_mm_and_ps(r[a], absMask), _mm_set1_ps(1e-30f))));
+            }
+            tl = _mm_min_ps(tl, q.tmin), th = _mm_max_ps(th, q.tmax);
+            bad = _mm_or_ps(bad, _mm_or_ps(_mm_cmpunord_ps(q.tmin, q.tmin), _mm_cmpunord_ps(q.tmax, q.tmax)));
+        }
+        if (signs < 0 || _mm_movemask_ps(bad)) return;
+        auto all = [](__m128 v, bool max) {   // the lanes' min or max, in every lane
+            const __m128 s = _mm_shuffle_ps(v, v, _MM_SHUFFLE(2, 3, 0, 1));
+            v = max ? _mm_max_ps(v, s) : _mm_min_ps(v, s);
+            const __m128 t = _mm_shuffle_ps(v, v, _MM_SHUFFLE(1, 0, 3, 2));
+            return max ? _mm_max_ps(v, t) : _mm_min_ps(v, t);
+        };
+        for (int a = 0; a < 3; ++a) {
+            olo[a] = all(lo[a], false), ohi[a] = all(hi[a], true);
+            rlo[a] = all(rl[a], false), rhi[a] = all(rh[a], true);
+        }
+        tminLo = all(tl, false), tmaxHi = all(th, true);
+        wholeSigns = signs;
+        whole = true;
+    }
+
+    // The children of n that some ray of the packet may reach (bit c), with interval arithmetic
+    // over the packet's bounds (whole must be set): for a ray with origin o in [olo, ohi] and
+    // reciprocal r in [rlo, rhi] (one sign), its computed slab distance fl(fl(b - o) r) lies
+    // within the bounds of the extreme corners, since rounding is monotonic (a near plane's
+    // lowest at the farthest origin, a far plane's highest at the nearest); so a child whose
+    // highest exit lies below its lowest entry is reached by no ray's own test.
+    int mayReach(const Node4& n) const {
+        __m128 tn = tminLo, tf = tmaxHi;
+        for (int a = 0; a < 3; ++a) {
+            const bool neg = (wholeSigns >> a) & 1;
+            const __m128 xn = _mm_sub_ps(_mm_load_ps(n.b[2 * a + (neg ? 1 : 0)]), neg ? olo[a] : ohi[a]);
+            const __m128 xf = _mm_sub_ps(_mm_load_ps(n.b[2 * a + (neg ? 0 : 1)]), neg ? ohi[a] : olo[a]);
+            tn = _mm_max_ps(tn, _mm_min_ps(_mm_mul_ps(xn, rlo[a]), _mm_mul_ps(xn, rhi[a])));
+            tf = _mm_min_ps(tf, _mm_max_ps(_mm_mul_ps(xf, rlo[a]), _mm_mul_ps(xf, rhi[a])));
+        }
+        tf = _mm_mul_ps(tf, _mm_set1_ps(Bvh4RayTest::kGrow));
+        return _mm_movemask_ps(_mm_cmple_ps(tn, tf));
+    }
+
     // The lanes of group k that reach child c of n (bit l: ray 4k + l); the entry distances in tn.
     int reaches(const Node4& n, int c, int k, __m128& tn) const {
         const Group& q = g[k];
@@ -242,7 +311,8 @@ void Bvh4::traverse(const Ray& ray, float& tmax, LeafFn&& leaf, uint32_t* visite
 template <class LeafFn>
 void Bvh4::traversePacket(const Ray* rays, uint64_t active, LeafFn&& leaf) const {
     if (m_nodes.empty() || !active) return;
-    const Bvh4PacketTest test(rays, active);
+    Bvh4PacketTest test(rays, active);
+    bool wholeSet = false;
     struct Entry {
         uint32_t ref;
         uint64_t rays;
@@ -257,8 +327,16 @@ void Bvh4::traversePacket(const Ray* rays, uint64_t active, LeafFn&& leaf) const
             uint64_t reach[4] = {0, 0, 0, 0};
             alignas(16) float lead[4];   // entry distances for the packet's first ray here
             const int first = __builtin_ctzll(curRays);
+            // Below the root (whose children most packets reach), children that no ray can reach
+            // are found for the whole packet at once first.
+            int may = 15;
+            if (cur != 0) {
+                if (!wholeSet) test.setWhole(active);
+                wholeSet = true;
+                if (test.whole) may = test.mayReach(n);
+            }
             for (int c = 0; c < 4; ++c) {
-                if (n.child[c] == Node4::kEmpty) continue;   // (empty bounds: never reached)
+                if (!((may >> c) & 1) || n.child[c] == Node4::kEmpty) continue;   // (empty bounds: never reached)
                 for (uint64_t groups = curRays; groups;) {
                     const int k = __builtin_ctzll(groups) >> 2;
                     groups &= ~(uint64_t(15) << (4 * k));

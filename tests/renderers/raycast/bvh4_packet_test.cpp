@@ -115,3 +115,76 @@ TEST(RaycastTest, Bvh4PacketWalkStopsWhenAsked) {
         return false;
     });
 }
+
+// Bvh4PacketTest::mayReach, the whole packet's interval test below the root: a child it rules
+// out is reached by no ray's own test (the per-group test, lane by lane), for coherent packets
+// of camera and shadow rays against random boxes (flat, tiny, huge, behind the rays), and it
+// rules out children that none reaches. Packets it cannot bound (mixed direction signs, NaN,
+// origins beyond 1e30) are left to the per-group tests.
+TEST(RaycastTest, Bvh4PacketIntervalNeverRulesOutAReachedChild) {
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u(-20.0f, 20.0f), unit(-1.0f, 1.0f), size(0.0f, 3.0f);
+    std::uniform_int_distribution<int> pick(0, 9);
+    size_t reachedChildren = 0, ruledOut = 0, unbounded = 0;
+    for (int p = 0; p < 4000; ++p) {
+        Ray rays[kMaxPacket];
+        const int n = 1 + p % 16;
+        const vec3 eye(u(rng), u(rng), u(rng));
+        vec3 toward(unit(rng), unit(rng), unit(rng));
+        const float spread = p % 3 == 0 ? 0.02f : 0.2f;
+        for (int i = 0; i < n; ++i) {
+            Ray& r = rays[i];
+            r.org = p % 2 ? eye : eye + 0.5f * vec3(unit(rng), unit(rng), unit(rng));   // one eye, or shadow rays' points
+            r.dir = toward + spread * vec3(unit(rng), unit(rng), unit(rng));
+            r.tmin = p % 4 == 0 ? 0.5f : 0.0f;
+            r.tmax = i % 3 == 0 ? std::numeric_limits<float>::infinity() : 1.0f + 40.0f * std::abs(unit(rng));
+            switch (p % 97 == 5 ? pick(rng) : -1) {   // now and then a hostile lane
+            case 0: r.dir.x = std::numeric_limits<float>::quiet_NaN(); break;
+            case 1: r.org.y = 3e30f; break;
+            case 2: r.tmax = std::numeric_limits<float>::quiet_NaN(); break;
+            case 3: r.dir = vec3(0.0f, 0.0f, 1e-35f); break;
+            case 4: r.tmax = -1.0f; break;   // a camera ray that meets nothing
+            default: break;
+            }
+        }
+        const uint64_t active = (p % 5 == 0 ? 0x5555ull : ~uint64_t(0)) & ((uint64_t(1) << n) - 1);
+        if (!active) continue;
+        Bvh4PacketTest test(rays, active);
+        test.setWhole(active);
+        if (!test.whole) {
+            ++unbounded;
+            continue;
+        }
+        Node4 node;
+        for (int c = 0; c < 4; ++c) {
+            const vec3 centre = eye + (p % 7 == 0 ? -1.0f : 1.0f) * u(rng) * toward + vec3(u(rng), u(rng), u(rng)) * 0.3f;
+            vec3 e(size(rng), size(rng), size(rng));
+            if (c == 1) e.y = 0.0f;       // flat (a ground plane)
+            if (p % 11 == 0) e *= 1e4f;   // huge
+            for (int a = 0; a < 3; ++a) {
+                node.b[2 * a][c] = centre[a] - e[a];
+                node.b[2 * a + 1][c] = centre[a] + e[a];
+            }
+            node.child[c] = uint32_t(c);
+        }
+        const int may = test.mayReach(node);
+        for (int c = 0; c < 4; ++c) {
+            uint64_t reach = 0;
+            for (int k = 0; k < Bvh4PacketTest::kGroups; ++k) {
+                if (!((active >> (4 * k)) & 15u)) continue;
+                __m128 tn;
+                reach |= uint64_t(test.reaches(node, c, k, tn)) << (4 * k);
+            }
+            reach &= active;
+            if (reach) {
+                ++reachedChildren;
+                EXPECT_TRUE((may >> c) & 1) << "packet " << p << " child " << c << ": rays 0x" << std::hex << reach << " reach it";
+            } else if (!((may >> c) & 1)) {
+                ++ruledOut;
+            }
+        }
+    }
+    EXPECT_GT(reachedChildren, 1000u);
+    EXPECT_GT(ruledOut, 2000u);   // the test does rule children out
+    EXPECT_GT(unbounded, 10u);    // and declines packets it cannot bound
+}
