@@ -33,10 +33,15 @@ struct MinimalEmbree::State {
     RTCDevice device = nullptr;
     RTCScene scene = nullptr;
     std::vector<Geom> geoms;
+    // Instanced: one object-space scene per mesh (shared by its instances), each draw an instance
+    // of it in `scene`; a hit's draw is then its instance ID, not its geometry ID.
+    bool instanced = false;
+    std::vector<std::pair<const Mesh*, RTCScene>> meshScenes;
     rnd::TessellationCache tess;
     float decode[256];      // sRGB byte -> linear
     uint8_t encode[4097];   // linear [0, 1] in steps of 1/4096 -> sRGB byte
     ~State() {
+        for (auto& ms : meshScenes) rtcReleaseScene(ms.second);
         if (scene) rtcReleaseScene(scene);
         if (device) rtcReleaseDevice(device);
     }
@@ -50,8 +55,9 @@ size_t MinimalEmbree::triangles() const {
     return n;
 }
 
-std::string MinimalEmbree::setup(const FrameInput& f, int tessellation, const std::string& config) {
+std::string MinimalEmbree::setup(const FrameInput& f, int tessellation, const std::string& config, bool instanced) {
     m = std::make_unique<State>();
+    m->instanced = instanced;
     for (int i = 0; i < 256; ++i) m->decode[i] = rnd::decodeSRGB(float(i) / 255.0f);
     for (int i = 0; i <= 4096; ++i) m->encode[i] = uint8_t(rnd::encodeSRGB(float(i) / 4096.0f) * 255.0f + 0.5f);
     m->device = rtcNewDevice(config.c_str());
@@ -78,10 +84,33 @@ std::string MinimalEmbree::setup(const FrameInput& f, int tessellation, const st
         g.mat = d.material;
         g.triMat = d.triangleMaterial;
         g.mats = d.materials;
-        RTCGeometry eg = rtcNewGeometry(m->device, RTC_GEOMETRY_TYPE_TRIANGLE);
-        std::memcpy(rtcSetNewGeometryBuffer(eg, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 12, g.p.size()), g.p.data(), g.p.size() * 12);
-        std::memcpy(rtcSetNewGeometryBuffer(eg, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 12, g.idx.size() / 3), g.idx.data(), g.idx.size() * 4);
-        rtcCommitGeometry(eg);
+        auto triangles = [&](const std::vector<vec3>& p, const std::vector<uint32_t>& idx) {
+            RTCGeometry eg = rtcNewGeometry(m->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+            std::memcpy(rtcSetNewGeometryBuffer(eg, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 12, p.size()), p.data(), p.size() * 12);
+            std::memcpy(rtcSetNewGeometryBuffer(eg, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 12, idx.size() / 3), idx.data(), idx.size() * 4);
+            rtcCommitGeometry(eg);
+            return eg;
+        };
+        RTCGeometry eg;
+        if (instanced) {   // the mesh's own scene (made once per mesh), placed by the draw's world matrix
+            RTCScene ms = nullptr;
+            for (const auto& e : m->meshScenes)
+                if (e.first == &mesh) ms = e.second;
+            if (!ms) {
+                ms = rtcNewScene(m->device);
+                RTCGeometry mg = triangles(mesh.positions, mesh.indices);
+                rtcAttachGeometryByID(ms, mg, 0);
+                rtcReleaseGeometry(mg);
+                rtcCommitScene(ms);
+                m->meshScenes.emplace_back(&mesh, ms);
+            }
+            eg = rtcNewGeometry(m->device, RTC_GEOMETRY_TYPE_INSTANCE);
+            rtcSetGeometryInstancedScene(eg, ms);
+            rtcSetGeometryTransform(eg, 0, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, &(*d.world)[0][0]);
+            rtcCommitGeometry(eg);
+        } else {
+            eg = triangles(g.p, g.idx);
+        }
         rtcAttachGeometryByID(m->scene, eg, unsigned(m->geoms.size()));
         rtcReleaseGeometry(eg);
         m->geoms.push_back(std::move(g));
@@ -126,7 +155,7 @@ void MinimalEmbree::render(const FrameInput& f, int W, int H, std::vector<uint8_
                         rh.ray.org_x[i] = o.x, rh.ray.org_y[i] = o.y, rh.ray.org_z[i] = o.z;
                         rh.ray.dir_x[i] = d.x, rh.ray.dir_y[i] = d.y, rh.ray.dir_z[i] = d.z;
                         rh.ray.tnear[i] = 0.0f, rh.ray.tfar[i] = 1.0f, rh.ray.mask[i] = ~0u, rh.ray.flags[i] = 0, rh.ray.time[i] = 0;
-                        rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+                        rh.hit.geomID[i] = rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
                     }
                     rtcIntersect16(valid, m->scene, &ctx, &rh);
                     // Per lane: position, shading normal, geometric normal (both toward the ray), material, albedo.
@@ -136,7 +165,7 @@ void MinimalEmbree::render(const FrameInput& f, int W, int H, std::vector<uint8_
                     for (int i = 0; i < 16; ++i) {
                         hit[i] = valid[i] && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
                         if (!hit[i]) continue;
-                        const State::Geom& g = m->geoms[rh.hit.geomID[i]];
+                        const State::Geom& g = m->geoms[m->instanced ? rh.hit.instID[0][i] : rh.hit.geomID[i]];
                         const uint32_t t = rh.hit.primID[i], i0 = g.idx[3 * t], i1 = g.idx[3 * t + 1], i2 = g.idx[3 * t + 2];
                         const float u = rh.hit.u[i], v = rh.hit.v[i], w = 1.0f - u - v;
                         P[i] = w * g.p[i0] + u * g.p[i1] + v * g.p[i2];

@@ -1,6 +1,6 @@
 // min_embree.h - the minimal Embree 3 renderer that bench_raycast_frame holds our ray caster's
 // whole frame to: the frame's triangles (meshes, and analytic shapes as their tessellation) in
-// world space in one Embree scene; camera rays as 4x4 packets (rtcIntersect16, coherent
+// world space in one Embree scene (or, for comparison, instanced: two levels as ours); camera rays as 4x4 packets (rtcIntersect16, coherent
 // context), one shadow ray per light a packet at a time (rtcOccluded16), the Phong / Blinn-Phong
 // model of renderers/common/shading.cpp for plain materials (ka, kd, ks, shininess, specular
 // colour, base colour texture at level 0, nearest), fog, sRGB bytes; 16x16-pixel tiles over
@@ -23,8 +23,11 @@ public:
     MinimalEmbree& operator=(const MinimalEmbree&) = delete;
     // Builds the Embree scene of the frame's triangles (analytic shapes tessellated at
     // `tessellation`, as the rasterizers draw them) on a device with `config` (e.g. "isa=avx2").
-    // Returns "" or why it failed.
-    std::string setup(const sg::FrameInput& f, int tessellation, const std::string& config = "");
+    // instanced: two levels, as our ray caster keeps them (each mesh's triangles once, in its
+    // object space, in a scene of their own; each draw an Embree instance of it with its world
+    // matrix) instead of every draw's triangles copied into world space. The shading reads the
+    // same world-space copies either way. Returns "" or why it failed.
+    std::string setup(const sg::FrameInput& f, int tessellation, const std::string& config = "", bool instanced = false);
     // One frame of f's camera and lights: RGBA8, rows top to bottom (as rnd::Framebuffer::color).
     void render(const sg::FrameInput& f, int width, int height, std::vector<uint8_t>& rgba) const;
     size_t triangles() const;

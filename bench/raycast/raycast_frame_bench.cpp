@@ -17,6 +17,9 @@
 //                            and on "isa=avx2", frame by frame (ratio: the median of the rounds')
 //   frame_ms_vs_default_isa  the same against the default ISA alone
 //   frame_ms_vs_avx2         against isa=avx2 alone
+//   frame_ms_vs_instanced    against min_embree with two levels as ours (each mesh once in its
+//                            own space, each draw an Embree instance; default ISA): not the
+//                            goal's reference, what instancing costs Embree itself
 //   cold_ms                  the first frame of a new renderer (ours: its BVH builds included)
 //                            against min_embree's setup (world-space copy, tessellation, Embree
 //                            build) plus its first frame, default ISA
@@ -153,21 +156,32 @@ int main(int argc, char** argv) {
             return 1;
         }
         refA.render(f, w, h, imgA);
+        // Two levels, as ours (default ISA): not the reference, what instancing costs Embree.
+        bench::MinimalEmbree refI;
+        std::vector<uint8_t> imgI;
+        if (!(err = refI.setup(f, f.settings.tessellation, threadsCfg, true)).empty()) {
+            std::fprintf(stderr, "bench: scene %s failed (instanced): %s\n", n, err.c_str());
+            return 1;
+        }
+        refI.render(f, w, h, imgI);
         // Warm frames, in rounds.
-        std::vector<double> to, td, ta, q, qd, qa;
+        std::vector<double> to, td, ta, ti, q, qd, qa, qi;
         for (int i = 0; i < frames; ++i) {
             to.push_back(timeMs([&] { ours->render(f, w, h, fb); }));
             td.push_back(timeMs([&] { ref.render(f, w, h, img); }));
             ta.push_back(timeMs([&] { refA.render(f, w, h, imgA); }));
+            ti.push_back(timeMs([&] { refI.render(f, w, h, imgI); }));
             q.push_back(to.back() / std::min(td.back(), ta.back()));
             qd.push_back(to.back() / td.back());
             qa.push_back(to.back() / ta.back());
+            qi.push_back(to.back() / ti.back());
         }
         std::vector<double> best(td.size());
         for (size_t i = 0; i < td.size(); ++i) best[i] = std::min(td[i], ta[i]);
         line(sc.name, "frame_ms", median(to), median(best), median(q));
         line(sc.name, "frame_ms_vs_default_isa", median(to), median(td), median(qd));
         line(sc.name, "frame_ms_vs_avx2", median(to), median(ta), median(qa));
+        line(sc.name, "frame_ms_vs_instanced", median(to), median(ti), median(qi));
         line(sc.name, "cold_ms", coldOurs, coldRef, coldOurs / coldRef);
         // Image agreement.
         double sum = 0;
@@ -186,6 +200,10 @@ int main(int argc, char** argv) {
             "# %s: %zu triangles in min_embree (ours: %zu + analytic shapes), mean |ours - min_embree| %.2f / 255 per channel, %.2f%% of pixels "
             "within 8%s\n",
             n, ref.triangles(), f.triangleCount(), sum / (3.0 * px), 100.0 * double(close) / px, img == imgA ? "" : " (the two ISAs' images differ)");
+        double sumI = 0;
+        for (size_t p = 0; p < img.size() && img.size() == imgI.size(); ++p)
+            if (p % 4 != 3) sumI += std::abs(int(img[p]) - int(imgI[p]));
+        std::printf("# %s: min_embree instanced against flat: mean difference %.3f / 255 per channel\n", n, sumI / (3.0 * px));
         if (!pngDir.empty()) {
             const std::string e1 = assets::writePng(pngDir + "/" + sc.name + "_ours.png", w, h, fb.color.data(), true);
             const std::string e2 = assets::writePng(pngDir + "/" + sc.name + "_min_embree.png", w, h, img.data(), true);
