@@ -134,10 +134,12 @@ struct Bvh4PacketTest {
     __m128 olo[3], ohi[3], rlo[3], rhi[3], tminLo, tmaxHi;
 
     void setWhole(uint64_t active) {
-        const __m128 inf = _mm_set1_ps(std::numeric_limits<float>::infinity()), absMask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+        const __m128 inf = _mm_set1_ps(std::numeric_limits<float>::infinity());
         __m128 lo[3] = {inf, inf, inf}, hi[3], rl[3] = {inf, inf, inf}, rh[3], tl = inf, th = _mm_sub_ps(_mm_setzero_ps(), inf);
         for (int a = 0; a < 3; ++a) hi[a] = rh[a] = th;
-        __m128 bad = _mm_setzero_ps();
+        // Sums of every origin and reciprocal: NaN where any is NaN or infinite (SSE's min and
+        // max may drop a NaN, an add never does); the limits are checked on the bounds below.
+        __m128 sum = _mm_setzero_ps(), nanT = _mm_setzero_ps();
         int signs = -1;
         for (int k = 0; k < kGroups; ++k) {
             if (!((active >> (4 * k)) & 15u)) continue;
@@ -148,25 +150,30 @@ struct Bvh4PacketTest {
             for (int a = 0; a < 3; ++a) {
                 lo[a] = _mm_min_ps(lo[a], o[a]), hi[a] = _mm_max_ps(hi[a], o[a]);
                 rl[a] = _mm_min_ps(rl[a], r[a]), rh[a] = _mm_max_ps(rh[a], r[a]);
-                // Origins within 1e30 and reciprocals of at least 1e-30 (never NaN, and no
-                // 0 x inf in the products below).
-                bad = _mm_or_ps(bad, _mm_or_ps(_mm_cmpnle_ps(_mm_and_ps(o[a], absMask), _mm_set1_ps(1e30f)),
-                                               _mm_cmpnge_ps(_mm_and_ps(r[a], absMask), _mm_set1_ps(1e-30f))));
+                sum = _mm_add_ps(sum, _mm_add_ps(o[a], r[a]));
             }
             tl = _mm_min_ps(tl, q.tmin), th = _mm_max_ps(th, q.tmax);
-            bad = _mm_or_ps(bad, _mm_or_ps(_mm_cmpunord_ps(q.tmin, q.tmin), _mm_cmpunord_ps(q.tmax, q.tmax)));
+            nanT = _mm_or_ps(nanT, _mm_cmpunord_ps(q.tmin, q.tmax));
         }
-        if (signs < 0 || _mm_movemask_ps(bad)) return;
+        if (signs < 0 || _mm_movemask_ps(_mm_or_ps(nanT, _mm_cmpunord_ps(sum, sum)))) return;
         auto all = [](__m128 v, bool max) {   // the lanes' min or max, in every lane
             const __m128 s = _mm_shuffle_ps(v, v, _MM_SHUFFLE(2, 3, 0, 1));
             v = max ? _mm_max_ps(v, s) : _mm_min_ps(v, s);
             const __m128 t = _mm_shuffle_ps(v, v, _MM_SHUFFLE(1, 0, 3, 2));
             return max ? _mm_max_ps(v, t) : _mm_min_ps(v, t);
         };
+        // Origins within 1e30 and reciprocals of at least 1e-30 (of one sign per axis): no
+        // overflow to NaN in the sums above and no 0 x inf in mayReach's products.
+        __m128 outside = _mm_setzero_ps();
         for (int a = 0; a < 3; ++a) {
-            olo[a] = all(lo[a], false), ohi[a] = all(hi[a], true);
-            rlo[a] = all(rl[a], false), rhi[a] = all(rh[a], true);
+            lo[a] = all(lo[a], false), hi[a] = all(hi[a], true);
+            rl[a] = all(rl[a], false), rh[a] = all(rh[a], true);
+            const __m128 rMin = (signs >> a) & 1 ? _mm_sub_ps(_mm_setzero_ps(), rh[a]) : rl[a];   // the smallest |r|
+            outside = _mm_or_ps(outside, _mm_or_ps(_mm_cmplt_ps(lo[a], _mm_set1_ps(-1e30f)), _mm_cmpgt_ps(hi[a], _mm_set1_ps(1e30f))));
+            outside = _mm_or_ps(outside, _mm_cmplt_ps(rMin, _mm_set1_ps(1e-30f)));
         }
+        if (_mm_movemask_ps(outside)) return;
+        for (int a = 0; a < 3; ++a) olo[a] = lo[a], ohi[a] = hi[a], rlo[a] = rl[a], rhi[a] = rh[a];
         tminLo = all(tl, false), tmaxHi = all(th, true);
         wholeSigns = signs;
         whole = true;
