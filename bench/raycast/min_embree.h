@@ -1,10 +1,11 @@
 // min_embree.h - the minimal Embree 3 renderer that bench_raycast_frame holds our ray caster's
 // whole frame to: the frame's triangles (meshes, and analytic shapes as their tessellation) in
-// world space in one Embree scene (or, for comparison, instanced: two levels as ours); camera rays as 4x4 packets (rtcIntersect16, coherent
-// context), one shadow ray per light a packet at a time (rtcOccluded16), the Phong / Blinn-Phong
-// model of renderers/common/shading.cpp for plain materials (ka, kd, ks, shininess, specular
-// colour, base colour texture at level 0, nearest), fog, sRGB bytes; 16x16-pixel tiles over
-// oneTBB. No reflections, alpha, pbr or material maps: scenes that use them are not its work.
+// world space in one Embree scene (or, for comparison, instanced: two levels as ours); camera
+// rays as 4x4 packets (rtcIntersect16, coherent context), one shadow ray per light a packet at a
+// time (rtcOccluded16), the Phong / Blinn-Phong model of renderers/common/shading.cpp for plain
+// materials (ka, kd, ks, shininess, specular colour, base colour texture at level 0, nearest),
+// fog, sRGB bytes; 16x16-pixel tiles over oneTBB. No reflections, alpha, pbr or material maps:
+// scenes that use them are not its work.
 #pragma once
 
 #include "scenegraph/frame.h"
