@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <unordered_map>
 
 namespace bench {
 
@@ -36,7 +37,7 @@ struct MinimalEmbree::State {
     // Instanced: one object-space scene per mesh (shared by its instances), each draw an instance
     // of it in `scene`; a hit's draw is then its instance ID, not its geometry ID.
     bool instanced = false;
-    std::vector<std::pair<const Mesh*, RTCScene>> meshScenes;
+    std::unordered_map<const Mesh*, RTCScene> meshScenes;
     rnd::TessellationCache tess;
     float decode[256];      // sRGB byte -> linear
     uint8_t encode[4097];   // linear [0, 1] in steps of 1/4096 -> sRGB byte
@@ -93,16 +94,13 @@ std::string MinimalEmbree::setup(const FrameInput& f, int tessellation, const st
         };
         RTCGeometry eg;
         if (instanced) {   // the mesh's own scene (made once per mesh), placed by the draw's world matrix
-            RTCScene ms = nullptr;
-            for (const auto& e : m->meshScenes)
-                if (e.first == &mesh) ms = e.second;
+            RTCScene& ms = m->meshScenes[&mesh];
             if (!ms) {
                 ms = rtcNewScene(m->device);
                 RTCGeometry mg = triangles(mesh.positions, mesh.indices);
                 rtcAttachGeometryByID(ms, mg, 0);
                 rtcReleaseGeometry(mg);
                 rtcCommitScene(ms);
-                m->meshScenes.emplace_back(&mesh, ms);
             }
             eg = rtcNewGeometry(m->device, RTC_GEOMETRY_TYPE_INSTANCE);
             rtcSetGeometryInstancedScene(eg, ms);
