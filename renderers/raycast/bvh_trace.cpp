@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <type_traits>
 
 namespace rnd::rt {
 
@@ -66,12 +67,17 @@ bool TriangleBvh::occluded(const Ray& ray) const {
                     : kern_sse::traceTriangles<true>(m_nodes4.data(), m_packets.data(), m_prims.data(), m_absMax, ray, nullptr, false);
 }
 
-uint64_t TriangleBvh::intersectPacket(const Ray* rays, int n, uint64_t active, TriHit* hits, bool cullBack) const {
+uint64_t TriangleBvh::intersectPacket(const Ray* rays, int n, uint64_t active, TriHit* hits, bool cullBack, uint64_t* ties) const {
+    if (ties) *ties = 0;
     n = std::clamp(n, 0, kMaxPacket);
     if (n < kMaxPacket) active &= (uint64_t(1) << n) - 1;
     if (m_packets.empty() || !active) return 0;
-    if (!m_nodes8.empty())
+    if (!m_nodes8.empty()) {
+        if (ties)
+            return kern_avx2::tracePacket8<false, true>(m_nodes8.data(), m_packets.data(), m_prims.data(), m_absMax, rays, n, active, hits, cullBack,
+                                                        ties);
         return kern_avx2::tracePacket8<false>(m_nodes8.data(), m_packets.data(), m_prims.data(), m_absMax, rays, n, active, hits, cullBack);
+    }
     uint64_t found = 0;   // BVH4 (SSE, or a tree too big for BVH8): one ray at a time
     for (uint64_t m = active; m; m &= m - 1) {
         const int i = __builtin_ctzll(m);

@@ -13,7 +13,8 @@ namespace rnd::rt {
 using namespace sg;
 
 namespace {
-constexpr size_t kPacketMinTriangles = 256;   // meshes traced as packets by intersectPacket / occludedPacket
+// Meshes below this size have their camera packets' ties reported and traced alone (see update).
+constexpr size_t kTiesBelowTriangles = 256;
 
 // |L|_F |L^-1|_F of an instance's linear part (3 for a rotation with a uniform scale; infinite
 // when singular): how much the rounding of a ray moved into the instance's space can grow when
@@ -73,23 +74,20 @@ int SceneAccel::update(const FrameInput& f) {
         inst.isMesh = true;
         inst.index = i;
         inst.bvh = &it->second.bvh;
-        // Packets pay where a ray's own traversal is more than a few nodes. Since the rays that
-        // also reach other instances test them from a list instead of a second top-level
-        // traversal, the demo's floor (1152 triangles) and torus (3072) and the bunny's ground
-        // pay too (frame / min_embree, 1280x720, 3 alternated runs: demo 5.0-5.8 against 6.2-6.5
-        // at a threshold of 8192, bunny 3.3-3.5 against 3.4-4.1); boxes of a few triangles
-        // stay single rays.
-        inst.packets = d.mesh->triangleCount() >= kPacketMinTriangles;
+        // Every mesh is traced as packets, closest hits (intersectPacket) and shadow rays
+        // (occludedPacket) alike: a packet sets a mesh up once where single rays each transform,
+        // set up and walk it. Where a ray meets two hits (of one mesh or of two) at exactly or
+        // nearly the same distance, the one kept follows the visit order, which for a packet is
+        // not the ray's own. Small meshes (walls, crates, the instances of a sphere grid; before
+        // the tie rule single rays, so that their pixels stay the single rays') have such rays
+        // reported and traced alone; big meshes keep the packet's first found, as they always
+        // have, sparing them the ~2% the reports cost (bench_raycast_frame, 3 alternated runs:
+        // bunny 1.30 -> 1.33, igea 1.22 -> 1.24 with them; tiny instances 1.57 -> 1.48 and the
+        // demo 2.56 -> 2.54 from small meshes in packets). Where the kernel cannot report ties
+        // (the SSE / BVH4 path), small meshes stay single rays.
+        inst.ties = d.mesh->triangleCount() < kTiesBelowTriangles;
+        inst.packets = !inst.ties || it->second.bvh.width() == 8;
         m_anyPacketMesh |= inst.packets;
-        // Shadow packets take every mesh (occludedPacket): whether a ray is blocked does not
-        // depend on the order the instances are visited in, and a packet sets a mesh up once
-        // where single rays each transform, set up and walk it (the demo spent 8% of a frame in
-        // its small meshes' single shadow rays; frame / min_embree, 3 alternated runs: demo
-        // 3.59-3.64 -> 3.47-3.50, 48 x 48 instances of 36 triangles 1.73 -> 1.68-1.70). Closest
-        // hits keep the threshold (with it at 1: demo 3.43, tiny instances 1.58): between
-        // instances met at exactly the same distance the one kept follows the visit order, which
-        // for a packet is its first ray's, and one pixel of bench_raycast_frame's "tiny" (a
-        // sphere's pole on the ground) changed.
         m_anyMesh = true;
         inst.toObject = RayTransform(glm::inverse(d.world));
         Aabb wb = it->second.bvh.bounds().transformed(d.world);
@@ -353,6 +351,11 @@ uint64_t SceneAccel::intersectPacket(const Ray* rays, int n, uint64_t active, Sc
     TriHit* const meshHits = hitScratch.data();
     float bound[kMaxPacket];
     for (int i = 0; i < n; ++i) bound[i] = rays[i].tmax;
+    // Rays whose hit could depend on the order in which meshes and leaves are visited, as the
+    // small meshes report them (hits at exactly or nearly the same distance,
+    // TriangleBvh::intersectPacket's ties; a mesh traced after another sees the other's hit as
+    // its tmax): closestHit keeps the one its own walk meets first, so they are traced alone.
+    uint64_t tied = 0;
     for (int s = 0; s < k; ++s) {
         const Instance& inst = m_instances[touched[s].instance];
         PacketScratch<Ray> lr;
@@ -361,12 +364,15 @@ uint64_t SceneAccel::intersectPacket(const Ray* rays, int n, uint64_t active, Sc
             lr[i] = inst.toObject.apply(rays[i], bound[i]);   // as intersectInstance
         }
         const bool cull = sg::cullsBackFaces(culling, m_frame->meshes[inst.index].material.doubleSided);
-        touched[s].found = inst.bvh->intersectPacket(lr.data(), n, touched[s].rays, meshHits + s * kMaxPacket, cull);
+        uint64_t meshTies = 0;
+        touched[s].found = inst.bvh->intersectPacket(lr.data(), n, touched[s].rays, meshHits + s * kMaxPacket, cull, inst.ties ? &meshTies : nullptr);
+        tied |= meshTies;
         for (uint64_t m = touched[s].found; m; m &= m - 1) {
             const int i = __builtin_ctzll(m);
             bound[i] = std::min(bound[i], meshHits[s * kMaxPacket + i].t);
         }
     }
+    tied &= active;
     // Phase 2: each ray's closestHit, with a mesh instance's hit looked up instead of traced. The
     // kept hit is the instance's closest below the bound it was traced with; closestHit asks for
     // its closest below tm, the closest hit so far. Where tm exceeds that bound, a mesh hit
@@ -375,7 +381,7 @@ uint64_t SceneAccel::intersectPacket(const Ray* rays, int n, uint64_t active, Sc
     // found of equal ones, as closestHit keeps the first it visits).
     uint64_t foundAny = 0;
     for (int s = 0; s < k; ++s) foundAny |= touched[s].found;
-    for (uint64_t m = active & ~others & foundAny; m; m &= m - 1) {
+    for (uint64_t m = active & ~others & foundAny & ~tied; m; m &= m - 1) {
         const int i = __builtin_ctzll(m);
         int best = -1;
         for (int s = 0; s < k; ++s)
@@ -393,8 +399,10 @@ uint64_t SceneAccel::intersectPacket(const Ray* rays, int n, uint64_t active, Sc
     }
     // Rays that reach a few other instances: the closest kept mesh hit, then each listed instance
     // that may hold a closer hit (its box entered before the closest so far), as closestHit
-    // would test it. Only between hits at exactly the same distance can the one kept differ.
-    for (uint64_t m = active & others & ~listFull; m; m &= m - 1) {
+    // would test it. Only between hits at exactly the same distance can the one kept differ
+    // from closestHit's (of two big meshes, or a mesh's and an analytic shape's; ties that a
+    // small mesh saw went to `tied`).
+    for (uint64_t m = active & others & ~listFull & ~tied; m; m &= m - 1) {
         const int i = __builtin_ctzll(m);
         const Ray& r = rays[i];
         float tm = r.tmax;
@@ -421,7 +429,7 @@ uint64_t SceneAccel::intersectPacket(const Ray* rays, int n, uint64_t active, Sc
         }
         if (any) found |= uint64_t(1) << i;
     }
-    for (uint64_t m = active & others & listFull; m; m &= m - 1) {
+    for (uint64_t m = active & others & listFull & ~tied; m; m &= m - 1) {
         const int i = __builtin_ctzll(m);
         const Ray& r = rays[i];
         float tmax = r.tmax;
@@ -452,7 +460,7 @@ uint64_t SceneAccel::intersectPacket(const Ray* rays, int n, uint64_t active, Sc
         });
         if (any) found |= uint64_t(1) << i;
     }
-    return found;
+    return found | eachRay(tied, oneByOne);
 }
 
 uint64_t SceneAccel::occludedPacket(const Ray* rays, int n, uint64_t active) const {

@@ -82,8 +82,11 @@ public:
     // Closest hits of a packet of coherent world rays (camera rays of a pixel tile): rays[0, n)
     // (n <= kMaxPacket) with bit i of `active` set; for each, exactly what intersect(rays[i],
     // hits[i], culling) gives. Mesh instances are traced as packets (TriangleBvh::intersectPacket,
-    // the rays in each instance's object space), analytic shapes one ray at a time. Returns the
-    // mask of rays that hit (hits[i] is written only for them).
+    // the rays in each instance's object space), analytic shapes one ray at a time. Between hits
+    // at exactly the same distance the one kept can follow the packet's visit order instead of
+    // the ray's own; rays that a small mesh's packet sees at such a tie are traced alone, so
+    // small meshes' pixels are exactly the single rays' (see update). Returns the mask of rays
+    // that hit (hits[i] is written only for them).
     uint64_t intersectPacket(const Ray* worldRays, int n, uint64_t active, SceneHit* hits, sg::CullMode culling = sg::CullMode::Off) const;
     // Any hits of a packet of world rays (the shadow rays of a pixel tile toward one light): for
     // each active ray exactly what occluded(rays[i]) gives; returns the mask of blocked rays.
@@ -124,7 +127,8 @@ private:
         bool isMesh = true;
         uint32_t index = 0;   // into frame meshes / analytics
         const TriangleBvh* bvh = nullptr;
-        bool packets = false;   // a mesh big enough to trace as packets (intersectPacket; occludedPacket takes every mesh)
+        bool packets = false;   // a mesh traced as packets by intersectPacket (occludedPacket takes every mesh)
+        bool ties = false;      // a small mesh: intersectPacket has its ties reported (see update)
         const ParametricAccel* param = nullptr;
         const GridAccel* grid = nullptr;
         RayTransform toObject;                 // the inverse world matrix, for rays

@@ -64,8 +64,12 @@ inline int intersectPacket(const TriPacket4& p, const __m128 o[3], const __m128 
 // intersectPacket on two packets at once (AVX: lanes 0-3 from a, 4-7 from b). Same
 // arithmetic lane by lane, so the same hits. Returns the 8-bit hit mask.
 inline __m256 loadPair(const float* x, const float* y) { return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(x)), _mm_load_ps(y), 1); }
+// Ties (see closestLaneTies): also *near, the lanes that hit below tmaxW (>= tmax) on the same
+// tests. The undivided test then runs with tmaxW (lanes below it are rare beyond those below
+// tmax: the common miss costs what it did), and the hit lanes are picked from them after.
+template <bool Ties = false>
 inline int intersectPacketPair(const TriPacket4& a, const TriPacket4& b, const __m256 o[3], const __m256 d[3], __m256 tmin, __m256 tmax, __m256& tOut,
-                               __m256& uOut, __m256& vOut, bool cullBack) {
+                               __m256& uOut, __m256& vOut, bool cullBack, __m256 tmaxW = __m256(), int* near = nullptr) {
     const auto ld = loadPair;
     const __m256 nx = ld(a.n[0], b.n[0]), ny = ld(a.n[1], b.n[1]), nz = ld(a.n[2], b.n[2]);
     const __m256 sx = _mm256_sub_ps(o[0], ld(a.v0[0], b.v0[0]));
@@ -91,6 +95,20 @@ inline int intersectPacketPair(const TriPacket4& a, const TriPacket4& b, const _
     ok = _mm256_and_ps(ok, _mm256_cmp_ps(V, zero, _CMP_GE_OQ));
     ok = _mm256_and_ps(ok, _mm256_cmp_ps(_mm256_add_ps(U, V), absDet, _CMP_LE_OQ));
     ok = _mm256_and_ps(ok, _mm256_cmp_ps(T, _mm256_mul_ps(absDet, tmin), _CMP_GT_OQ));
+    if constexpr (Ties) {
+        *near = 0;
+        const int wide = _mm256_movemask_ps(_mm256_and_ps(ok, _mm256_cmp_ps(T, _mm256_mul_ps(absDet, tmaxW), _CMP_LT_OQ)));
+        if (!wide) return 0;
+        const __m256 inv = _mm256_div_ps(_mm256_set1_ps(1.0f), absDet);
+        tOut = _mm256_mul_ps(T, inv);
+        uOut = _mm256_mul_ps(U, inv);
+        vOut = _mm256_mul_ps(V, inv);
+        const __m256 above = _mm256_cmp_ps(tOut, tmin, _CMP_GT_OQ);
+        *near = wide & _mm256_movemask_ps(_mm256_and_ps(_mm256_cmp_ps(tOut, tmaxW, _CMP_LT_OQ), above));
+        // The hits: exactly the lanes of the test below with tmax (undivided, then divided).
+        return wide & _mm256_movemask_ps(_mm256_and_ps(
+                          _mm256_and_ps(_mm256_cmp_ps(T, _mm256_mul_ps(absDet, tmax), _CMP_LT_OQ), _mm256_cmp_ps(tOut, tmax, _CMP_LT_OQ)), above));
+    }
     ok = _mm256_and_ps(ok, _mm256_cmp_ps(T, _mm256_mul_ps(absDet, tmax), _CMP_LT_OQ));
     int mask = _mm256_movemask_ps(ok);
     if (mask) {
@@ -121,6 +139,40 @@ inline bool closestLane(int mask, const float* ta, const float* ua, const float*
         }
     }
     return found;
+}
+
+// closestLane for a packet's ray, which also sees where the hit kept could depend on the order
+// in which leaves are visited (the packet's is not the ray's own). `near`: the lanes that hit
+// below widenTmax(tmax) (those below tmax included; intersectPacketPair). Order can matter only
+// where another hit lies within widenTmax of the one kept: equal distances, or one a few units
+// in the last place away, where the undivided test can take or leave it depending on the
+// running tmax. So after the pair, where the running tmax before it or another near lane lies
+// within widenTmax of the running tmax, tieT = the running tmax and `bit` is set in `seen`. A
+// later closer hit makes it moot: the caller compares tieT with the final tmax. (With the
+// packet's boxes tested against widenTmax too, every hit within it is seen; docs/math.md.)
+inline bool closestLaneTies(int mask, int near, const float* ta, const float* ua, const float* va, const uint32_t* ids, float& tmax, TriHit* hit,
+                            float& tieT, uint64_t& seen, uint64_t bit) {
+    const float before = tmax;
+    int kept = -1;
+    for (int m = mask; m; m &= m - 1) {
+        const int k = __builtin_ctz(m);
+        if (ta[k] < tmax) {
+            tmax = ta[k];
+            hit->t = ta[k];
+            hit->prim = ids[k];
+            hit->b1 = ua[k];
+            hit->b2 = va[k];
+            kept = k;
+        }
+    }
+    const float w = widenTmax(tmax);
+    bool order = kept >= 0 && before <= w;
+    for (int m = kept >= 0 ? near & ~(1 << kept) : near; m && !order; m &= m - 1) order = ta[__builtin_ctz(m)] <= w;
+    if (order) {
+        tieT = tmax;
+        seen |= bit;
+    }
+    return kept >= 0;
 }
 
 // Child ordering keys: the entry distance's bit pattern above the child reference. Distances
@@ -316,9 +368,11 @@ inline __m256 loadPlane(const char* base, uint32_t ref) { return _mm256_load_ps(
 // The same traversal over 8-wide nodes: one AVX compare per node for 8 boxes (BVH8: fewer,
 // wider levels); leaf packets tested two at a time (8 lanes). start: the node to begin at (byte
 // offset; tracePacket8 continues a ray alone in a subtree).
-template <bool AnyHit, bool Count = false>
+// Ties (closest hit only): where the hit kept could depend on the visit order (closestLaneTies),
+// *tieT = the running tmax (the caller sets it below 0 first).
+template <bool AnyHit, bool Count = false, bool Ties = false>
 inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const uint32_t* prims, const float* absMax, const Ray& ray, TriHit* hit,
-                            bool cullBack, TraversalCount* count = nullptr, uint32_t start = 0) {
+                            bool cullBack, TraversalCount* count = nullptr, uint32_t start = 0, float* tieT = nullptr) {
     const RayPre pre(ray, absMax);
     const __m256 rx = _mm256_set1_ps(pre.rdir[0]), ry = _mm256_set1_ps(pre.rdir[1]), rz = _mm256_set1_ps(pre.rdir[2]);
     const __m256 orx = _mm256_set1_ps(pre.orgRdirNear[0]), ory = _mm256_set1_ps(pre.orgRdirNear[1]), orz = _mm256_set1_ps(pre.orgRdirNear[2]);
@@ -335,7 +389,9 @@ inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const
     const __m256 orxf = _mm256_set1_ps(pre.orgRdirFar[0]), oryf = _mm256_set1_ps(pre.orgRdirFar[1]), orzf = _mm256_set1_ps(pre.orgRdirFar[2]);
     float tmax = ray.tmax;
     __m256 tmax8 = _mm256_set1_ps(tmax);
+    __m256 tmaxW8 = Ties ? _mm256_set1_ps(widenTmax(tmax)) : tmax8;   // (Ties) the near lanes' bound
     bool found = false;
+    uint64_t tieSeen = 0;   // (Ties) unused: the caller reads *tieT
 
     // Inner children are byte offsets into nodes, and each of the six planes this ray reads
     // gets its own base pointer: a plane's address is base + ref, so no arithmetic sits
@@ -365,7 +421,7 @@ inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const
             const __m256i tn = _mm256_max_epi32(_mm256_max_epi32(_mm256_castps_si256(t0x), _mm256_castps_si256(t0y)),
                                                 _mm256_max_epi32(_mm256_castps_si256(t0z), tmin8i));
             const __m256i tf = _mm256_min_epi32(_mm256_min_epi32(_mm256_castps_si256(t1x), _mm256_castps_si256(t1y)),
-                                                _mm256_min_epi32(_mm256_castps_si256(t1z), _mm256_castps_si256(tmax8)));
+                                                _mm256_min_epi32(_mm256_castps_si256(t1z), _mm256_castps_si256(Ties ? tmaxW8 : tmax8)));
             // movemask of 8 lanes sets bits 0-7 only: ^ 0xFF is the complement (one op).
             unsigned mask = unsigned(_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpgt_epi32(tn, tf)))) ^ 0xFFu;
             if (mask != 0) {
@@ -398,21 +454,27 @@ inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const
                 const bool two = p + 1 < end;
                 if constexpr (Count) count->prims += filledLanes(prims + 4 * (p - packets), two ? 8 : 4);
                 __m256 t, u, v;
-                int mask = intersectPacketPair(p[0], p[two ? 1 : 0], o8, d8, tmin8, tmax8, t, u, v, cullBack) & (two ? 0xFF : 0x0F);
-                if (!mask) continue;
+                const int lanes = two ? 0xFF : 0x0F;
+                int near = 0;
+                const int mask = intersectPacketPair<Ties>(p[0], p[two ? 1 : 0], o8, d8, tmin8, tmax8, t, u, v, cullBack, tmaxW8, &near) & lanes;
+                if (!(Ties ? (mask | (near & lanes)) : mask)) continue;
                 if constexpr (AnyHit) return true;
                 alignas(32) float ta[8], ua[8], va[8];
                 _mm256_store_ps(ta, t);
                 _mm256_store_ps(ua, u);
                 _mm256_store_ps(va, v);
-                found |= closestLane(mask, ta, ua, va, prims + 4 * (p - packets), tmax, hit);
+                if constexpr (Ties)
+                    found |= closestLaneTies(mask, near & lanes, ta, ua, va, prims + 4 * (p - packets), tmax, hit, *tieT, tieSeen, 1);
+                else
+                    found |= closestLane(mask, ta, ua, va, prims + 4 * (p - packets), tmax, hit);
                 tmax8 = _mm256_set1_ps(tmax);
+                if constexpr (Ties) tmaxW8 = _mm256_set1_ps(widenTmax(tmax));
             }
         }
         for (;;) {
             if (sp == 0) return found;
             const StackEntry& e = stack[--sp];
-            if (AnyHit || e.t <= tmax) {
+            if (AnyHit || e.t <= (Ties ? widenTmax(tmax) : tmax)) {
                 cur = e.ref;
                 break;
             }
@@ -429,7 +491,11 @@ inline bool traceTriangles8(const Node8* nodes, const TriPacket4* packets, const
 // box test with the ray's current tmax, then the leaf's triangles exactly as traceTriangles8
 // tests them (the same packet-pair kernel, the ray broadcast), so every hit is bit for bit the
 // single-ray hit. Only the order in which leaves are visited can differ from the single ray's,
-// which matters only for exact ties of t between triangles (the first found is kept, as there).
+// which matters only for exact ties of t between triangles (the first found is kept, as there):
+// a ray that meets a triangle at exactly its running tmax is reported (tracePacket8's `ties`).
+// Every triangle at the ray's final distance is met: its leaf's box is entered at or before
+// that distance (the boxes' rounding margins, see RayPre), so the packet tests it whatever the
+// order, and a ray with one triangle at its final distance has the single ray's hit.
 //
 // Interval test, conservative for every ray of the packet: the slab distance of plane b for ray i
 // is (b - o_i) * rdir_i. With the origins in [olo, ohi] and rdir in [rlo, rhi] per axis (one
@@ -449,6 +515,14 @@ struct PacketRays {
     alignas(32) float of[3][kMaxPacket];   // orgRdirFar
     alignas(32) float tmin[kMaxPacket];    // max(tmin, 0)
     alignas(32) float tmax[kMaxPacket];    // shrinks as closer hits are found
+};
+
+// Ties (tracePacket8): the rays where the hit kept could depend on the visit order
+// (closestLaneTies), and the running tmax of the last such pair test (read only for the rays in
+// seen).
+struct PacketTies {
+    uint64_t seen = 0;
+    float tie[kMaxPacket];
 };
 
 // Packet stack entry: node or leaf reference, the packet's entry distance, and where its box is
@@ -471,7 +545,10 @@ inline __m256 packetUpper(__m256 b, __m256 r0, __m256 r1, __m256 o) {
 inline __m256 bcast(const float* p) { return _mm256_broadcast_ss(p); }
 
 // The leaf's box (slot of parent) against the rays in group g: mask of rays whose own box test
-// (the single-ray test with their current tmax) passes.
+// (the single-ray test with their current tmax) passes. Wide (closest hit): with each tmax 32
+// units in the last place further (widenTmax; beyond the largest float the test just passes
+// more boxes), so that every hit near the ray's current one is seen (closestLaneTies).
+template <bool Wide = false>
 inline unsigned leafRayMask(const Node8& parent, uint32_t slot, int nx, int ny, int nz, const PacketRays& pr, int g) {
     const int fx = 1 - nx, fy = 5 - ny, fz = 9 - nz;   // ny = 2 + s, fy = 3 - s; nz = 4 + s, fz = 5 - s
     const int o = 8 * g;
@@ -483,8 +560,10 @@ inline unsigned leafRayMask(const Node8& parent, uint32_t slot, int nx, int ny, 
     const __m256 t1z = _mm256_fmsub_ps(bcast(&parent.b[fz][slot]), _mm256_load_ps(pr.rd[2] + o), _mm256_load_ps(pr.of[2] + o));
     const __m256i tn = _mm256_max_epi32(_mm256_max_epi32(_mm256_castps_si256(t0x), _mm256_castps_si256(t0y)),
                                         _mm256_max_epi32(_mm256_castps_si256(t0z), _mm256_load_si256(reinterpret_cast<const __m256i*>(pr.tmin + o))));
-    const __m256i tf = _mm256_min_epi32(_mm256_min_epi32(_mm256_castps_si256(t1x), _mm256_castps_si256(t1y)),
-                                        _mm256_min_epi32(_mm256_castps_si256(t1z), _mm256_load_si256(reinterpret_cast<const __m256i*>(pr.tmax + o))));
+    __m256i tmax = _mm256_load_si256(reinterpret_cast<const __m256i*>(pr.tmax + o));
+    if constexpr (Wide) tmax = _mm256_add_epi32(tmax, _mm256_set1_epi32(32));   // inactive lanes (-1) stay negative
+    const __m256i tf =
+        _mm256_min_epi32(_mm256_min_epi32(_mm256_castps_si256(t1x), _mm256_castps_si256(t1y)), _mm256_min_epi32(_mm256_castps_si256(t1z), tmax));
     return unsigned(_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpgt_epi32(tn, tf)))) ^ 0xFFu;
 }
 
@@ -507,6 +586,7 @@ struct PacketScene {
     const Ray* rays;
     TriHit* hits;
     bool cullBack;
+    PacketTies* ties;   // null unless ties are asked for
 };
 
 // What gatherPacket learns of the rays: those in the packet (pm) and those traced alone
@@ -580,13 +660,23 @@ struct PacketGather {
 }
 
 // Traces the rays of mask m one by one from the root (traceTriangles8); returns those that hit.
-template <bool AnyHit>
-[[gnu::always_inline]] inline uint64_t traceAlone(const PacketScene& sc, uint64_t m) {
+// Ties: adds to *ties the rays whose hit lay among near ones (closestLaneTies): a ray's own order
+// inside this mesh, but the caller may have made its tmax another mesh's hit.
+template <bool AnyHit, bool Ties = false>
+[[gnu::always_inline]] inline uint64_t traceAlone(const PacketScene& sc, uint64_t m, uint64_t* ties) {
     uint64_t found = 0;
     for (; m; m &= m - 1) {
         const int i = __builtin_ctzll(m);
-        if (traceTriangles8<AnyHit>(sc.nodes, sc.packets, sc.prims, sc.absMax, sc.rays[i], AnyHit ? nullptr : &sc.hits[i], sc.cullBack))
-            found |= uint64_t(1) << i;
+        if constexpr (!Ties) {
+            if (traceTriangles8<AnyHit>(sc.nodes, sc.packets, sc.prims, sc.absMax, sc.rays[i], AnyHit ? nullptr : &sc.hits[i], sc.cullBack))
+                found |= uint64_t(1) << i;
+        } else {
+            float tieT = -1.0f;
+            const bool hit = traceTriangles8<false, false, true>(sc.nodes, sc.packets, sc.prims, sc.absMax, sc.rays[i], &sc.hits[i], sc.cullBack,
+                                                                 nullptr, 0, &tieT);
+            if (hit) found |= uint64_t(1) << i;
+            if (tieT >= 0.0f && tieT == (hit ? sc.hits[i].t : sc.rays[i].tmax)) *ties |= uint64_t(1) << i;
+        }
     }
     return found;
 }
@@ -646,15 +736,15 @@ struct PacketFrustum {
 // it (their own box tests, current tmax). Two or more: returns true, the packet goes on. None
 // or one: returns false, and the one goes on alone (traceTriangles8 from here: the packet's
 // interval test has nothing left to share); its hit updates found and pm (AnyHit: it leaves the
-// packet) or its tmax and the packet's (tmaxP, tmax8).
-template <bool AnyHit>
+// packet) or its tmax and the packet's (tmaxP, tmax8). Ties: see tracePacket8.
+template <bool AnyHit, bool Ties = false>
 [[gnu::always_inline]] inline bool packetEnters(const PacketScene& sc, const PacketFrustum& fr, PacketRays& pr, uint32_t cur, uint32_t curParent,
                                                 uint32_t curSlot, unsigned groups, uint64_t& pm, uint64_t& found, float& tmaxP, __m256& tmax8) {
     uint64_t am = 0;
     const Node8& parent = *reinterpret_cast<const Node8*>(reinterpret_cast<const char*>(sc.nodes) + curParent);
     for (unsigned gm = groups; gm; gm &= gm - 1) {
         const int g = __builtin_ctz(gm);
-        am |= uint64_t(leafRayMask(parent, curSlot, fr.nx, fr.ny, fr.nz, pr, g)) << (8 * g);
+        am |= uint64_t(leafRayMask<Ties>(parent, curSlot, fr.nx, fr.ny, fr.nz, pr, g)) << (8 * g);
     }
     am &= pm;
     if (__builtin_popcountll(am) > 1) return true;
@@ -662,13 +752,20 @@ template <bool AnyHit>
         const int i = __builtin_ctzll(am);
         Ray r = sc.rays[i];
         r.tmax = pr.tmax[i];
-        if (traceTriangles8<AnyHit>(sc.nodes, sc.packets, sc.prims, sc.absMax, r, AnyHit ? nullptr : &sc.hits[i], sc.cullBack, nullptr, cur)) {
+        float tieT = -1.0f;
+        const bool hit = traceTriangles8<AnyHit, false, Ties>(sc.nodes, sc.packets, sc.prims, sc.absMax, r, AnyHit ? nullptr : &sc.hits[i],
+                                                              sc.cullBack, nullptr, cur, &tieT);
+        if (Ties && tieT >= 0.0f) {
+            sc.ties->tie[i] = tieT;
+            sc.ties->seen |= uint64_t(1) << i;
+        }
+        if (hit) {
             found |= uint64_t(1) << i;
             if constexpr (AnyHit) {
                 pm &= ~(uint64_t(1) << i);
             } else {
                 pr.tmax[i] = sc.hits[i].t;
-                tmaxP = packetTmax(pr, groups);
+                tmaxP = Ties ? widenTmax(packetTmax(pr, groups)) : packetTmax(pr, groups);   // Ties: boxes up to the widened tmax (leafRayMask)
                 tmax8 = _mm256_set1_ps(tmaxP);
             }
         }
@@ -727,29 +824,46 @@ template <bool AnyHit>
 
 // Packet ray i against the triangles of a leaf [first, end), exactly as traceTriangles8 tests
 // them (the same packet-pair kernel, the ray broadcast). Returns whether it hit (AnyHit) or found
-// a closer hit (then pr.tmax[i] and hits[i] hold it).
-template <bool AnyHit>
+// a closer hit (then pr.tmax[i] and hits[i] hold it). Ties: see tracePacket8.
+template <bool AnyHit, bool Ties = false>
 [[gnu::always_inline]] inline bool intersectLeafRay(const PacketScene& sc, const TriPacket4* first, const TriPacket4* end, PacketRays& pr, int i) {
     const Ray& r = sc.rays[i];
     const __m256 o8[3] = {_mm256_set1_ps(r.org.x), _mm256_set1_ps(r.org.y), _mm256_set1_ps(r.org.z)};
     const __m256 d8[3] = {_mm256_set1_ps(r.dir.x), _mm256_set1_ps(r.dir.y), _mm256_set1_ps(r.dir.z)};
     const __m256 rtmin = _mm256_set1_ps(pr.tmin[i]);
     __m256 rtmax = _mm256_set1_ps(pr.tmax[i]);
+    __m256 rtmaxW = Ties ? _mm256_set1_ps(widenTmax(pr.tmax[i])) : rtmax;   // the near lanes' bound (closestLaneTies)
     bool hit = false;
     for (const TriPacket4* p = first; p < end; p += 2) {
         const bool two = p + 1 < end;
         __m256 t, u, v;
-        const int hm = intersectPacketPair(p[0], p[two ? 1 : 0], o8, d8, rtmin, rtmax, t, u, v, sc.cullBack) & (two ? 0xFF : 0x0F);
-        if (!hm) continue;
+        const int lanes = two ? 0xFF : 0x0F;
         if constexpr (AnyHit) {
-            return true;
-        } else {
+            if (intersectPacketPair(p[0], p[two ? 1 : 0], o8, d8, rtmin, rtmax, t, u, v, sc.cullBack) & lanes) return true;
+        } else if constexpr (!Ties) {
+            const int hm = intersectPacketPair(p[0], p[two ? 1 : 0], o8, d8, rtmin, rtmax, t, u, v, sc.cullBack) & lanes;
+            if (!hm) continue;
             alignas(32) float ta[8], ua[8], va[8];
             _mm256_store_ps(ta, t);
             _mm256_store_ps(ua, u);
             _mm256_store_ps(va, v);
             if (closestLane(hm, ta, ua, va, sc.prims + 4 * (p - sc.packets), pr.tmax[i], &sc.hits[i])) hit = true;
             rtmax = _mm256_set1_ps(pr.tmax[i]);
+        } else {
+            int near = 0;
+            const int hm = intersectPacketPair<true>(p[0], p[two ? 1 : 0], o8, d8, rtmin, rtmax, t, u, v, sc.cullBack, rtmaxW, &near) & lanes;
+            near &= lanes;
+            if (!(hm | near)) continue;
+            alignas(32) float ta[8], ua[8], va[8];
+            _mm256_store_ps(ta, t);
+            _mm256_store_ps(ua, u);
+            _mm256_store_ps(va, v);
+            if (closestLaneTies(hm, near, ta, ua, va, sc.prims + 4 * (p - sc.packets), pr.tmax[i], &sc.hits[i], sc.ties->tie[i], sc.ties->seen,
+                                uint64_t(1) << i)) {
+                hit = true;
+                rtmax = _mm256_set1_ps(pr.tmax[i]);
+                rtmaxW = _mm256_set1_ps(widenTmax(pr.tmax[i]));
+            }
         }
     }
     return hit;
@@ -757,8 +871,8 @@ template <bool AnyHit>
 
 // Leaf cur (its box: slot curSlot of curParent): each packet ray whose own box test passes there
 // tests the leaf's triangles on its own. Hits update found; AnyHit: the ray leaves the packet
-// (pm, groups); closest hit: the packet's tmax shrinks with the rays'.
-template <bool AnyHit>
+// (pm, groups); closest hit: the packet's tmax shrinks with the rays'. Ties: see tracePacket8.
+template <bool AnyHit, bool Ties = false>
 [[gnu::always_inline]] inline void intersectLeafRays(const PacketScene& sc, const PacketFrustum& fr, PacketRays& pr, uint32_t cur, uint32_t curParent,
                                                      uint32_t curSlot, unsigned& groups, uint64_t& pm, uint64_t& found, float& tmaxP, __m256& tmax8) {
     const Node8& parent = *reinterpret_cast<const Node8*>(reinterpret_cast<const char*>(sc.nodes) + curParent);
@@ -767,11 +881,11 @@ template <bool AnyHit>
     bool shrunk = false;
     for (unsigned gm = groups; gm; gm &= gm - 1) {
         const int g = __builtin_ctz(gm);
-        unsigned rm = leafRayMask(parent, curSlot, fr.nx, fr.ny, fr.nz, pr, g) & unsigned(pm >> (8 * g)) & 0xFFu;
+        unsigned rm = leafRayMask<Ties>(parent, curSlot, fr.nx, fr.ny, fr.nz, pr, g) & unsigned(pm >> (8 * g)) & 0xFFu;
         while (rm) {
             const int i = 8 * g + __builtin_ctz(rm);
             rm &= rm - 1;
-            if (intersectLeafRay<AnyHit>(sc, first, end, pr, i)) {
+            if (intersectLeafRay<AnyHit, Ties>(sc, first, end, pr, i)) {
                 found |= uint64_t(1) << i;
                 if constexpr (AnyHit)
                     pm &= ~(uint64_t(1) << i);
@@ -784,7 +898,7 @@ template <bool AnyHit>
     }
     if constexpr (!AnyHit) {
         if (shrunk) {
-            tmaxP = packetTmax(pr, groups);
+            tmaxP = Ties ? widenTmax(packetTmax(pr, groups)) : packetTmax(pr, groups);
             tmax8 = _mm256_set1_ps(tmaxP);
         }
     }
@@ -811,20 +925,34 @@ template <bool AnyHit>
 // traceTriangles8 writes for that ray. Rays that do not fit the packet (other direction signs
 // than the first, non-finite data, an empty [tmin, tmax]) are traced one by one. Returns the
 // mask of rays that hit. The phases above are force-inlined: this is one loop, as it was written.
-template <bool AnyHit>
+// Only the order in which leaves are visited can differ from a ray's own, which matters where
+// hits lie at exactly (or within a few units in the last place of) the same distance: there the
+// packet keeps the first it finds. Ties (closest hit): *ties gets the rays where that could be
+// so (closestLaneTies; the packet then also tests boxes up to widenTmax), for the caller to
+// trace alone; their hits[i] are left as the packet found them.
+template <bool AnyHit, bool Ties = false>
 inline uint64_t tracePacket8(const Node8* nodes, const TriPacket4* packets, const uint32_t* prims, const float* absMax, const Ray* rays, int n,
-                             uint64_t active, TriHit* hits, bool cullBack) {
+                             uint64_t active, TriHit* hits, bool cullBack, uint64_t* ties = nullptr) {
+    static_assert(!(AnyHit && Ties), "ties are for closest hits");
+    if constexpr (Ties) *ties = 0;
     if (n < kMaxPacket) active &= (uint64_t(1) << n) - 1;
-    const PacketScene sc{nodes, packets, prims, absMax, rays, hits, cullBack};
+    std::conditional_t<Ties, PacketTies, char> tieState;   // (a char, unused, without ties)
+    PacketTies* tiesP = nullptr;
+    if constexpr (Ties) tiesP = &tieState;
+    const PacketScene sc{nodes, packets, prims, absMax, rays, hits, cullBack, tiesP};
     PacketRays pr;
     const PacketGather pg = gatherPacket(rays, n, active, absMax, pr);
-    uint64_t found = traceAlone<AnyHit>(sc, pg.single);
-    if (!pg.pm) return found;
-    if (__builtin_popcountll(pg.pm) == 1) return found | traceAlone<AnyHit>(sc, pg.pm);   // nothing to share
+    uint64_t tiesAlone = 0;
+    uint64_t found = traceAlone<AnyHit, Ties>(sc, pg.single, &tiesAlone);
+    if (__builtin_popcountll(pg.pm) <= 1) {   // nothing to share
+        found |= traceAlone<AnyHit, Ties>(sc, pg.pm, &tiesAlone);
+        if constexpr (Ties) *ties = tiesAlone;
+        return found;
+    }
     uint64_t pm = pg.pm;
     unsigned groups = packetGroups(pm, (n + 7) / 8);
     const PacketFrustum fr = makePacketFrustum(pg, absMax, nodes);
-    float tmaxP = pg.tmaxP;
+    float tmaxP = Ties ? widenTmax(pg.tmaxP) : pg.tmaxP;   // Ties: see leafRayMask
     __m256 tmax8 = _mm256_set1_ps(tmaxP);
 
     const char* const nodeBytes = reinterpret_cast<const char*>(nodes);
@@ -833,18 +961,26 @@ inline uint64_t tracePacket8(const Node8* nodes, const TriPacket4* packets, cons
     uint32_t cur = 0, curParent = 0, curSlot = 0;
     for (;;) {
         const bool inner = !(cur & Node8::kLeafBit);
-        if (inner && cur != 0 && !packetEnters<AnyHit>(sc, fr, pr, cur, curParent, curSlot, groups, pm, found, tmaxP, tmax8)) {
+        if (inner && cur != 0 && !packetEnters<AnyHit, Ties>(sc, fr, pr, cur, curParent, curSlot, groups, pm, found, tmaxP, tmax8)) {
             if constexpr (AnyHit)
                 if (!pm) return found;
         } else if (inner) {
             if (descendPacket(fr, nodeBytes, tmax8, stack, sp, cur, curParent, curSlot)) continue;
         } else {
-            intersectLeafRays<AnyHit>(sc, fr, pr, cur, curParent, curSlot, groups, pm, found, tmaxP, tmax8);
+            intersectLeafRays<AnyHit, Ties>(sc, fr, pr, cur, curParent, curSlot, groups, pm, found, tmaxP, tmax8);
             if constexpr (AnyHit)
                 if (!pm) return found;
         }
-        if (!popPacketEntry<AnyHit>(stack, sp, tmaxP, cur, curParent, curSlot)) return found;
+        if (!popPacketEntry<AnyHit>(stack, sp, tmaxP, cur, curParent, curSlot)) break;
     }
+    if constexpr (Ties) {
+        *ties = tiesAlone;
+        for (uint64_t m = tieState.seen; m; m &= m - 1) {   // a tie at a distance the ray's hit then went below does not count
+            const int i = __builtin_ctzll(m);
+            if (tieState.tie[i] == pr.tmax[i]) *ties |= uint64_t(1) << i;
+        }
+    }
+    return found;
 }
 #endif
 

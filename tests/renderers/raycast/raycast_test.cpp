@@ -590,6 +590,12 @@ TEST(RaycastTest, BvhPacketsEqualSingleRays) {
             for (TriHit& h : ph) h.t = -7.0f;   // inactive lanes and misses: untouched
             const uint64_t found = bvh.intersectPacket(rays.data(), n, active, ph.data());
             const uint64_t occ = bvh.occludedPacket(rays.data(), n, active);
+            // With ties reported: the same hits, and every ray whose triangle differs from the
+            // single ray's among them.
+            std::vector<TriHit> pt(static_cast<size_t>(n));
+            uint64_t tied = 0;
+            EXPECT_EQ(bvh.intersectPacket(rays.data(), n, active, pt.data(), false, &tied), found) << "packet " << p;
+            EXPECT_EQ(tied & ~active, 0u);
             for (int i = 0; i < n; ++i) {
                 const bool on = (active >> i) & 1;
                 TriHit a;
@@ -608,6 +614,8 @@ TEST(RaycastTest, BvhPacketsEqualSingleRays) {
                 ASSERT_TRUE((found >> i) & 1) << "packet " << p << " ray " << i;
                 EXPECT_EQ(bool((occ >> i) & 1), bvh.occluded(rays[size_t(i)])) << "packet " << p << " ray " << i;
                 EXPECT_EQ(b.t, a.t) << "packet " << p << " ray " << i;
+                EXPECT_EQ(pt[size_t(i)].t, a.t) << "packet " << p << " ray " << i;
+                if (pt[size_t(i)].prim != a.prim) { EXPECT_TRUE((tied >> i) & 1) << "packet " << p << " ray " << i << ": a tie not reported"; }
                 if (b.prim != a.prim) {   // exact ties between two triangles may keep either
                     ++ties;
                     continue;
