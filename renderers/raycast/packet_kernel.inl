@@ -1,0 +1,505 @@
+// packet_kernel.inl - the packet traversal of TriangleBvh (BVH8, AVX2): up to kMaxPacket
+// coherent rays walk the tree together. Included by tri_kernel.inl inside its AVX2+FMA part
+// (namespace kern_avx2), after the single-ray kernel it builds on (traceTriangles8,
+// intersectPacketPair, closestLane / closestLaneTies).
+
+// --- packets of coherent rays (BVH8, AVX2) ----------------------------------------------------
+//
+// Up to kMaxPacket rays whose directions share their signs (camera rays of a pixel tile, shadow
+// rays of neighbouring pixels to one light) traverse the tree together: an inner node tests its
+// 8 child boxes once against the whole packet with interval arithmetic (one box test for all
+// rays, about twice a single ray's work), and only at a leaf is each ray tested on its own: its
+// box test with the ray's current tmax, then the leaf's triangles exactly as traceTriangles8
+// tests them (the same packet-pair kernel, the ray broadcast), so every hit is bit for bit the
+// single-ray hit. Only the order in which leaves are visited can differ from the single ray's,
+// which matters only for exact ties of t between triangles (the first found is kept, as there):
+// a ray that meets a triangle at exactly its running tmax is reported (tracePacket8's `ties`).
+// Every triangle at the ray's final distance is met: its leaf's box is entered at or before
+// that distance (the boxes' rounding margins, see RayPre), so the packet tests it whatever the
+// order, and a ray with one triangle at its final distance has the single ray's hit.
+//
+// Interval test, conservative for every ray of the packet: the slab distance of plane b for ray i
+// is (b - o_i) * rdir_i. With the origins in [olo, ohi] and rdir in [rlo, rhi] per axis (one
+// sign), for rdir > 0 it is at least min((b - ohi) * rlo, (b - ohi) * rhi) and at most
+// max((b - olo) * rlo, (b - olo) * rhi) (mirrored for rdir < 0): a frustum for camera rays (one
+// origin), a swept box for rays from several origins. The origin bounds are widened by
+// d = 2^-19 (max |o| + max |b|) per axis (oNear / oFar below), so the packet's interval contains
+// each ray's own computed interval (RayPre's margin is 2^-20 (|o| + max |b|) |rdir|, the
+// rounding of either computation a few 2^-24 (|b| + |o|) |rdir|): the packet enters at least
+// every box some ray's own test enters.
+
+// A packet's per-ray data, SoA in groups of 8 rays (one AVX register per group). Rays outside
+// the packet get tmax = -1 (a negative integer: their box tests always fail).
+struct PacketRays {
+    alignas(32) float rd[3][kMaxPacket];   // reciprocal directions (RayPre, nudged zeros)
+    alignas(32) float on[3][kMaxPacket];   // orgRdirNear
+    alignas(32) float of[3][kMaxPacket];   // orgRdirFar
+    alignas(32) float tmin[kMaxPacket];    // max(tmin, 0)
+    alignas(32) float tmax[kMaxPacket];    // shrinks as closer hits are found
+};
+
+// Ties (tracePacket8): the rays where the hit kept could depend on the visit order
+// (closestLaneTies), and the running tmax of the last such pair test (read only for the rays in
+// seen).
+struct PacketTies {
+    uint64_t seen = 0;
+    float tie[kMaxPacket];
+};
+
+// Packet stack entry: node or leaf reference, the packet's entry distance, and where its box is
+// (parent node byte offset and child slot: the leaf's per-ray box test reads it from there).
+struct PacketEntry {
+    uint32_t ref;
+    float t;
+    uint32_t parent, slot;
+};
+
+// The interval bounds of a slab distance (b - o) * rdir over rdir in [r0, r1] (see above).
+inline __m256 packetLower(__m256 b, __m256 r0, __m256 r1, __m256 o) {
+    const __m256 x = _mm256_sub_ps(b, o);
+    return _mm256_min_ps(_mm256_mul_ps(x, r0), _mm256_mul_ps(x, r1));
+}
+inline __m256 packetUpper(__m256 b, __m256 r0, __m256 r1, __m256 o) {
+    const __m256 x = _mm256_sub_ps(b, o);
+    return _mm256_max_ps(_mm256_mul_ps(x, r0), _mm256_mul_ps(x, r1));
+}
+inline __m256 bcast(const float* p) { return _mm256_broadcast_ss(p); }
+
+// The leaf's box (slot of parent) against the rays in group g: mask of rays whose own box test
+// (the single-ray test with their current tmax) passes. Wide (closest hit): with each tmax 32
+// units in the last place further (widenTmax; beyond the largest float the test just passes
+// more boxes), so that every hit near the ray's current one is seen (closestLaneTies).
+template <bool Wide = false>
+inline unsigned leafRayMask(const Node8& parent, uint32_t slot, int nx, int ny, int nz, const PacketRays& pr, int g) {
+    const int fx = 1 - nx, fy = 5 - ny, fz = 9 - nz;   // ny = 2 + s, fy = 3 - s; nz = 4 + s, fz = 5 - s
+    const int o = 8 * g;
+    const __m256 t0x = _mm256_fmsub_ps(bcast(&parent.b[nx][slot]), _mm256_load_ps(pr.rd[0] + o), _mm256_load_ps(pr.on[0] + o));
+    const __m256 t1x = _mm256_fmsub_ps(bcast(&parent.b[fx][slot]), _mm256_load_ps(pr.rd[0] + o), _mm256_load_ps(pr.of[0] + o));
+    const __m256 t0y = _mm256_fmsub_ps(bcast(&parent.b[ny][slot]), _mm256_load_ps(pr.rd[1] + o), _mm256_load_ps(pr.on[1] + o));
+    const __m256 t1y = _mm256_fmsub_ps(bcast(&parent.b[fy][slot]), _mm256_load_ps(pr.rd[1] + o), _mm256_load_ps(pr.of[1] + o));
+    const __m256 t0z = _mm256_fmsub_ps(bcast(&parent.b[nz][slot]), _mm256_load_ps(pr.rd[2] + o), _mm256_load_ps(pr.on[2] + o));
+    const __m256 t1z = _mm256_fmsub_ps(bcast(&parent.b[fz][slot]), _mm256_load_ps(pr.rd[2] + o), _mm256_load_ps(pr.of[2] + o));
+    const __m256i tn = _mm256_max_epi32(_mm256_max_epi32(_mm256_castps_si256(t0x), _mm256_castps_si256(t0y)),
+                                        _mm256_max_epi32(_mm256_castps_si256(t0z), _mm256_load_si256(reinterpret_cast<const __m256i*>(pr.tmin + o))));
+    __m256i tmax = _mm256_load_si256(reinterpret_cast<const __m256i*>(pr.tmax + o));
+    if constexpr (Wide) tmax = _mm256_add_epi32(tmax, _mm256_set1_epi32(32));   // inactive lanes (-1) stay negative
+    const __m256i tf =
+        _mm256_min_epi32(_mm256_min_epi32(_mm256_castps_si256(t1x), _mm256_castps_si256(t1y)), _mm256_min_epi32(_mm256_castps_si256(t1z), tmax));
+    return unsigned(_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpgt_epi32(tn, tf)))) ^ 0xFFu;
+}
+
+// Max of pr.tmax over the groups in `groups` (bit g: group g has packet rays).
+inline float packetTmax(const PacketRays& pr, unsigned groups) {
+    __m256 m = _mm256_set1_ps(-std::numeric_limits<float>::infinity());
+    for (unsigned gm = groups; gm; gm &= gm - 1) m = _mm256_max_ps(m, _mm256_load_ps(pr.tmax + 8 * __builtin_ctz(gm)));
+    __m128 h = _mm_max_ps(_mm256_castps256_ps128(m), _mm256_extractf128_ps(m, 1));
+    h = _mm_max_ps(h, _mm_movehl_ps(h, h));
+    h = _mm_max_ss(h, _mm_shuffle_ps(h, h, 1));
+    return _mm_cvtss_f32(h);
+}
+
+// The fixed inputs of one tracePacket8 call, shared by its phases below.
+struct PacketScene {
+    const Node8* nodes;
+    const TriPacket4* packets;
+    const uint32_t* prims;
+    const float* absMax;
+    const Ray* rays;
+    TriHit* hits;
+    bool cullBack;
+    PacketTies* ties;   // null unless ties are asked for
+};
+
+// What gatherPacket learns of the rays: those in the packet (pm) and those traced alone
+// (single), the packet's direction signs (bit k: axis k negative; -1 before the first ray), the
+// bounds of its reciprocal directions (rlo, rhi) and origins (olo, ohi) per axis, and its
+// smallest tmin and largest tmax.
+struct PacketGather {
+    uint64_t pm = 0, single = 0;
+    int sign = -1;
+    __m128 rlo, rhi, olo, ohi;
+    float tminP, tmaxP;
+};
+
+// Sorts the active rays into the packet (the first ray's direction signs, finite data, a
+// non-empty [tmin, tmax]; their RayPre values into pr) and the rest; every other slot of pr is
+// set to never enter a box.
+[[gnu::always_inline]] inline PacketGather gatherPacket(const Ray* rays, int n, uint64_t active, const float* absMax, PacketRays& pr) {
+    PacketGather g;
+    g.rlo = _mm_set1_ps(std::numeric_limits<float>::infinity());
+    g.rhi = _mm_set1_ps(-std::numeric_limits<float>::infinity());
+    g.olo = g.rlo;
+    g.ohi = g.rhi;
+    g.tminP = std::numeric_limits<float>::infinity();
+    g.tmaxP = -std::numeric_limits<float>::infinity();
+    const int groupsN = (n + 7) / 8;
+    for (int i = 0; i < 8 * groupsN; ++i) {
+        const bool in = (active >> i) & 1;
+        bool fits = false;
+        if (in) {
+            const Ray& r = rays[i];
+            const RayPre pre(r, absMax);
+            const float tmin = r.tmin > 0.0f ? r.tmin : 0.0f;
+            const __m128 rd = _mm_load_ps(pre.rdir), on = _mm_load_ps(pre.orgRdirNear), of = _mm_load_ps(pre.orgRdirFar);
+            // Finite: x - x == 0 (lanes 0-2).
+            const __m128 z = _mm_add_ps(_mm_add_ps(_mm_sub_ps(rd, rd), _mm_sub_ps(on, on)),
+                                        _mm_add_ps(_mm_sub_ps(of, of), _mm_sub_ps(_mm_load_ps(pre.org), _mm_load_ps(pre.org))));
+            const int s = pre.nearX | (pre.nearY << 1) | (pre.nearZ << 2);
+            if ((_mm_movemask_ps(_mm_cmpeq_ps(z, _mm_setzero_ps())) & 7) == 7 && sg::isFinite(r.dir) && r.tmax > tmin &&
+                (g.sign < 0 || s == g.sign)) {
+                g.sign = s;
+                fits = true;
+                g.pm |= uint64_t(1) << i;
+                alignas(16) float a[4], b[4], c[4];
+                _mm_store_ps(a, rd);
+                _mm_store_ps(b, on);
+                _mm_store_ps(c, of);
+                for (int k = 0; k < 3; ++k) {
+                    pr.rd[k][i] = a[k];
+                    pr.on[k][i] = b[k];
+                    pr.of[k][i] = c[k];
+                }
+                pr.tmin[i] = tmin;
+                pr.tmax[i] = r.tmax;
+                g.rlo = _mm_min_ps(g.rlo, rd);
+                g.rhi = _mm_max_ps(g.rhi, rd);
+                g.olo = _mm_min_ps(g.olo, _mm_load_ps(pre.org));
+                g.ohi = _mm_max_ps(g.ohi, _mm_load_ps(pre.org));
+                g.tminP = std::min(g.tminP, tmin);
+                g.tmaxP = std::max(g.tmaxP, r.tmax);
+            } else {
+                g.single |= uint64_t(1) << i;
+            }
+        }
+        if (!fits) {   // never enters a box
+            for (int k = 0; k < 3; ++k) pr.rd[k][i] = 1.0f, pr.on[k][i] = 0.0f, pr.of[k][i] = 0.0f;
+            pr.tmin[i] = 0.0f;
+            pr.tmax[i] = -1.0f;
+        }
+    }
+    return g;
+}
+
+// Traces the rays of mask m one by one from the root (traceTriangles8); returns those that hit.
+// Ties: adds to *ties the rays whose hit lay among near ones (closestLaneTies): a ray's own order
+// inside this mesh, but the caller may have made its tmax another mesh's hit.
+template <bool AnyHit, bool Ties = false>
+[[gnu::always_inline]] inline uint64_t traceAlone(const PacketScene& sc, uint64_t m, uint64_t* ties) {
+    uint64_t found = 0;
+    for (; m; m &= m - 1) {
+        const int i = __builtin_ctzll(m);
+        if constexpr (!Ties) {
+            if (traceTriangles8<AnyHit>(sc.nodes, sc.packets, sc.prims, sc.absMax, sc.rays[i], AnyHit ? nullptr : &sc.hits[i], sc.cullBack))
+                found |= uint64_t(1) << i;
+        } else {
+            float tieT = -1.0f;
+            const bool hit = traceTriangles8<false, false, true>(sc.nodes, sc.packets, sc.prims, sc.absMax, sc.rays[i], &sc.hits[i], sc.cullBack,
+                                                                 nullptr, 0, &tieT);
+            if (hit) found |= uint64_t(1) << i;
+            if (tieT >= 0.0f && tieT == (hit ? sc.hits[i].t : sc.rays[i].tmax)) *ties |= uint64_t(1) << i;
+        }
+    }
+    return found;
+}
+
+// The packet's interval test, per axis (see above): the bounds of the reciprocal directions
+// (rl*, rh*) and the widened origin bounds (entry on*, exit of*) broadcast, its smallest tmin,
+// and the near planes (nx, ny, nz: rows of Node8::b) with a base pointer per plane.
+struct PacketFrustum {
+    int nx, ny, nz;
+    __m256 rlx, rly, rlz, rhx, rhy, rhz;
+    __m256 onx, ony, onz, ofx, ofy, ofz;
+    __m256i tmin8i;
+    const char *pnx, *pfx, *pny, *pfy, *pnz, *pfz;
+};
+
+[[gnu::always_inline]] inline PacketFrustum makePacketFrustum(const PacketGather& g, const float* absMax, const Node8* nodes) {
+    PacketFrustum f;
+    const int sign = g.sign;
+    const int nearX = sign & 1, nearY = (sign >> 1) & 1, nearZ = (sign >> 2) & 1;
+    f.nx = nearX;
+    f.ny = 2 + nearY;
+    f.nz = 4 + nearZ;
+    const int fx = 1 - nearX, fy = 3 - nearY, fz = 5 - nearZ;
+    alignas(16) float lo[4], hi[4], oL[4], oH[4];
+    _mm_store_ps(lo, g.rlo);
+    _mm_store_ps(hi, g.rhi);
+    _mm_store_ps(oL, g.olo);
+    _mm_store_ps(oH, g.ohi);
+    float oNear[3], oFar[3];   // widened origin bounds (see above): entry uses oNear, exit oFar
+    for (int k = 0; k < 3; ++k) {
+        const float d = 0x1p-19f * (std::max(std::abs(oL[k]), std::abs(oH[k])) + absMax[k]);
+        const bool neg = (sign >> k) & 1;
+        oNear[k] = neg ? oL[k] - d : oH[k] + d;
+        oFar[k] = neg ? oH[k] + d : oL[k] - d;
+    }
+    f.rlx = _mm256_set1_ps(lo[0]), f.rly = _mm256_set1_ps(lo[1]), f.rlz = _mm256_set1_ps(lo[2]);
+    f.rhx = _mm256_set1_ps(hi[0]), f.rhy = _mm256_set1_ps(hi[1]), f.rhz = _mm256_set1_ps(hi[2]);
+    f.onx = _mm256_set1_ps(oNear[0]), f.ony = _mm256_set1_ps(oNear[1]), f.onz = _mm256_set1_ps(oNear[2]);
+    f.ofx = _mm256_set1_ps(oFar[0]), f.ofy = _mm256_set1_ps(oFar[1]), f.ofz = _mm256_set1_ps(oFar[2]);
+    f.tmin8i = _mm256_castps_si256(_mm256_set1_ps(g.tminP));
+
+    const char* const nodeBytes = reinterpret_cast<const char*>(nodes);
+    f.pnx = planeBase(nodeBytes, f.nx), f.pfx = planeBase(nodeBytes, fx), f.pny = planeBase(nodeBytes, f.ny);
+    f.pfy = planeBase(nodeBytes, fy), f.pnz = planeBase(nodeBytes, f.nz), f.pfz = planeBase(nodeBytes, fz);
+    return f;
+}
+
+// Bit g: group g of 8 rays has packet rays (pm), for the groupsN groups.
+[[gnu::always_inline]] inline unsigned packetGroups(uint64_t pm, int groupsN) {
+    unsigned groups = 0;
+    for (int g = 0; g < groupsN; ++g)
+        if ((pm >> (8 * g)) & 0xFF) groups |= 1u << g;
+    return groups;
+}
+
+// At inner node cur (not the root), entered from slot curSlot of curParent: the rays that enter
+// it (their own box tests, current tmax). Two or more: returns true, the packet goes on. None
+// or one: returns false, and the one goes on alone (traceTriangles8 from here: the packet's
+// interval test has nothing left to share); its hit updates found and pm (AnyHit: it leaves the
+// packet) or its tmax and the packet's (tmaxP, tmax8). Ties: see tracePacket8.
+template <bool AnyHit, bool Ties = false>
+[[gnu::always_inline]] inline bool packetEnters(const PacketScene& sc, const PacketFrustum& fr, PacketRays& pr, uint32_t cur, uint32_t curParent,
+                                                uint32_t curSlot, unsigned groups, uint64_t& pm, uint64_t& found, float& tmaxP, __m256& tmax8) {
+    uint64_t am = 0;
+    const Node8& parent = *reinterpret_cast<const Node8*>(reinterpret_cast<const char*>(sc.nodes) + curParent);
+    for (unsigned gm = groups; gm; gm &= gm - 1) {
+        const int g = __builtin_ctz(gm);
+        am |= uint64_t(leafRayMask<Ties>(parent, curSlot, fr.nx, fr.ny, fr.nz, pr, g)) << (8 * g);
+    }
+    am &= pm;
+    if (__builtin_popcountll(am) > 1) return true;
+    if (am) {
+        const int i = __builtin_ctzll(am);
+        Ray r = sc.rays[i];
+        r.tmax = pr.tmax[i];
+        float tieT = -1.0f;
+        const bool hit = traceTriangles8<AnyHit, false, Ties>(sc.nodes, sc.packets, sc.prims, sc.absMax, r, AnyHit ? nullptr : &sc.hits[i],
+                                                              sc.cullBack, nullptr, cur, &tieT);
+        if (Ties && tieT >= 0.0f) {
+            sc.ties->tie[i] = tieT;
+            sc.ties->seen |= uint64_t(1) << i;
+        }
+        if (hit) {
+            found |= uint64_t(1) << i;
+            if constexpr (AnyHit) {
+                pm &= ~(uint64_t(1) << i);
+            } else {
+                pr.tmax[i] = sc.hits[i].t;
+                tmaxP = Ties ? widenTmax(packetTmax(pr, groups)) : packetTmax(pr, groups);   // Ties: boxes up to the widened tmax (leafRayMask)
+                tmax8 = _mm256_set1_ps(tmaxP);
+            }
+        }
+    }
+    return false;
+}
+
+// Inner node cur: the packet's interval test against its 8 child boxes. The children it enters,
+// front to back by the packet's entry distance: the nearest becomes cur (with its parent and
+// slot), the others go on the stack. False when it enters none.
+[[gnu::always_inline]] inline bool descendPacket(const PacketFrustum& fr, const char* nodeBytes, __m256 tmax8, PacketEntry* stack, int& sp,
+                                                 uint32_t& cur, uint32_t& curParent, uint32_t& curSlot) {
+    const Node8& nd = *reinterpret_cast<const Node8*>(nodeBytes + cur);
+    const __m256 t0x = packetLower(loadPlane(fr.pnx, cur), fr.rlx, fr.rhx, fr.onx), t1x = packetUpper(loadPlane(fr.pfx, cur), fr.rlx, fr.rhx, fr.ofx);
+    const __m256 t0y = packetLower(loadPlane(fr.pny, cur), fr.rly, fr.rhy, fr.ony), t1y = packetUpper(loadPlane(fr.pfy, cur), fr.rly, fr.rhy, fr.ofy);
+    const __m256 t0z = packetLower(loadPlane(fr.pnz, cur), fr.rlz, fr.rhz, fr.onz), t1z = packetUpper(loadPlane(fr.pfz, cur), fr.rlz, fr.rhz, fr.ofz);
+    const __m256i tn =
+        _mm256_max_epi32(_mm256_max_epi32(_mm256_castps_si256(t0x), _mm256_castps_si256(t0y)), _mm256_max_epi32(_mm256_castps_si256(t0z), fr.tmin8i));
+    const __m256i tf = _mm256_min_epi32(_mm256_min_epi32(_mm256_castps_si256(t1x), _mm256_castps_si256(t1y)),
+                                        _mm256_min_epi32(_mm256_castps_si256(t1z), _mm256_castps_si256(tmax8)));
+    unsigned mask = unsigned(_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpgt_epi32(tn, tf)))) ^ 0xFFu;
+    if (mask == 0) return false;
+    alignas(32) float dist[8];
+    _mm256_store_si256(reinterpret_cast<__m256i*>(dist), tn);
+    const unsigned c0 = unsigned(__builtin_ctz(mask));
+    mask &= mask - 1;
+    if (mask == 0) {
+        curParent = cur;
+        curSlot = c0;
+        cur = nd.child[c0];
+        return true;
+    }
+    // Front to back by the packet's entry distance: keys (distance, slot), far first.
+    uint64_t key[8];
+    int k = 0;
+    key[k++] = sortKey(dist[c0], c0);
+    do {
+        const int c = __builtin_ctz(mask);
+        mask &= mask - 1;
+        key[k++] = sortKey(dist[c], uint32_t(c));
+    } while (mask);
+    if (k == 2) {
+        if (key[0] < key[1]) std::swap(key[0], key[1]);
+    } else {
+        sortFarFirst(key, k);
+    }
+    for (int i = 0; i < k - 1; ++i) {
+        const uint32_t s = uint32_t(key[i]);
+        stack[sp++] = {nd.child[s], keyDistance(key[i]), cur, s};
+    }
+    curParent = cur;
+    curSlot = uint32_t(key[k - 1]);
+    cur = nd.child[curSlot];
+    return true;
+}
+
+// Packet ray i against the triangles of a leaf [first, end), exactly as traceTriangles8 tests
+// them (the same packet-pair kernel, the ray broadcast). Returns whether it hit (AnyHit) or found
+// a closer hit (then pr.tmax[i] and hits[i] hold it). Ties: see tracePacket8.
+template <bool AnyHit, bool Ties = false>
+[[gnu::always_inline]] inline bool intersectLeafRay(const PacketScene& sc, const TriPacket4* first, const TriPacket4* end, PacketRays& pr, int i) {
+    const Ray& r = sc.rays[i];
+    const __m256 o8[3] = {_mm256_set1_ps(r.org.x), _mm256_set1_ps(r.org.y), _mm256_set1_ps(r.org.z)};
+    const __m256 d8[3] = {_mm256_set1_ps(r.dir.x), _mm256_set1_ps(r.dir.y), _mm256_set1_ps(r.dir.z)};
+    const __m256 rtmin = _mm256_set1_ps(pr.tmin[i]);
+    __m256 rtmax = _mm256_set1_ps(pr.tmax[i]);
+    __m256 rtmaxW = Ties ? _mm256_set1_ps(widenTmax(pr.tmax[i])) : rtmax;   // the near lanes' bound (closestLaneTies)
+    bool hit = false;
+    for (const TriPacket4* p = first; p < end; p += 2) {
+        const bool two = p + 1 < end;
+        __m256 t, u, v;
+        const int lanes = two ? 0xFF : 0x0F;
+        if constexpr (AnyHit) {
+            if (intersectPacketPair(p[0], p[two ? 1 : 0], o8, d8, rtmin, rtmax, t, u, v, sc.cullBack) & lanes) return true;
+        } else if constexpr (!Ties) {
+            const int hm = intersectPacketPair(p[0], p[two ? 1 : 0], o8, d8, rtmin, rtmax, t, u, v, sc.cullBack) & lanes;
+            if (!hm) continue;
+            alignas(32) float ta[8], ua[8], va[8];
+            _mm256_store_ps(ta, t);
+            _mm256_store_ps(ua, u);
+            _mm256_store_ps(va, v);
+            if (closestLane(hm, ta, ua, va, sc.prims + 4 * (p - sc.packets), pr.tmax[i], &sc.hits[i])) hit = true;
+            rtmax = _mm256_set1_ps(pr.tmax[i]);
+        } else {
+            int near = 0;
+            const int hm = intersectPacketPair<true>(p[0], p[two ? 1 : 0], o8, d8, rtmin, rtmax, t, u, v, sc.cullBack, rtmaxW, &near) & lanes;
+            near &= lanes;
+            if (!(hm | near)) continue;
+            alignas(32) float ta[8], ua[8], va[8];
+            _mm256_store_ps(ta, t);
+            _mm256_store_ps(ua, u);
+            _mm256_store_ps(va, v);
+            if (closestLaneTies(hm, near, ta, ua, va, sc.prims + 4 * (p - sc.packets), pr.tmax[i], &sc.hits[i], sc.ties->tie[i], sc.ties->seen,
+                                uint64_t(1) << i)) {
+                hit = true;
+                rtmax = _mm256_set1_ps(pr.tmax[i]);
+                rtmaxW = _mm256_set1_ps(widenTmax(pr.tmax[i]));
+            }
+        }
+    }
+    return hit;
+}
+
+// Leaf cur (its box: slot curSlot of curParent): each packet ray whose own box test passes there
+// tests the leaf's triangles on its own. Hits update found; AnyHit: the ray leaves the packet
+// (pm, groups); closest hit: the packet's tmax shrinks with the rays'. Ties: see tracePacket8.
+template <bool AnyHit, bool Ties = false>
+[[gnu::always_inline]] inline void intersectLeafRays(const PacketScene& sc, const PacketFrustum& fr, PacketRays& pr, uint32_t cur, uint32_t curParent,
+                                                     uint32_t curSlot, unsigned& groups, uint64_t& pm, uint64_t& found, float& tmaxP, __m256& tmax8) {
+    const Node8& parent = *reinterpret_cast<const Node8*>(reinterpret_cast<const char*>(sc.nodes) + curParent);
+    const TriPacket4* first = sc.packets + ((cur & ~Node8::kLeafBit) >> 3);
+    const TriPacket4* end = first + (cur & 7u);
+    bool shrunk = false;
+    for (unsigned gm = groups; gm; gm &= gm - 1) {
+        const int g = __builtin_ctz(gm);
+        unsigned rm = leafRayMask<Ties>(parent, curSlot, fr.nx, fr.ny, fr.nz, pr, g) & unsigned(pm >> (8 * g)) & 0xFFu;
+        while (rm) {
+            const int i = 8 * g + __builtin_ctz(rm);
+            rm &= rm - 1;
+            if (intersectLeafRay<AnyHit, Ties>(sc, first, end, pr, i)) {
+                found |= uint64_t(1) << i;
+                if constexpr (AnyHit)
+                    pm &= ~(uint64_t(1) << i);
+                else
+                    shrunk = true;
+            }
+        }
+        if constexpr (AnyHit)
+            if (!((pm >> (8 * g)) & 0xFF)) groups &= ~(1u << g);
+    }
+    if constexpr (!AnyHit) {
+        if (shrunk) {
+            tmaxP = Ties ? widenTmax(packetTmax(pr, groups)) : packetTmax(pr, groups);
+            tmax8 = _mm256_set1_ps(tmaxP);
+        }
+    }
+}
+
+// The next stack entry that can still hold a closer hit (any entry, for AnyHit) becomes cur, with
+// its parent and slot; false when none is left.
+template <bool AnyHit>
+[[gnu::always_inline]] inline bool popPacketEntry(const PacketEntry* stack, int& sp, float tmaxP, uint32_t& cur, uint32_t& curParent,
+                                                  uint32_t& curSlot) {
+    for (;;) {
+        if (sp == 0) return false;
+        const PacketEntry& e = stack[--sp];
+        if (AnyHit || e.t <= tmaxP) {
+            cur = e.ref;
+            curParent = e.parent;
+            curSlot = e.slot;
+            return true;
+        }
+    }
+}
+
+// Traces rays[i] for the bits i of `active` (n <= kMaxPacket); hits[i] gets exactly what
+// traceTriangles8 writes for that ray. Rays that do not fit the packet (other direction signs
+// than the first, non-finite data, an empty [tmin, tmax]) are traced one by one. Returns the
+// mask of rays that hit. The phases above are force-inlined: this is one loop, as it was written.
+// Only the order in which leaves are visited can differ from a ray's own, which matters where
+// hits lie at exactly (or within a few units in the last place of) the same distance: there the
+// packet keeps the first it finds. Ties (closest hit): *ties gets the rays where that could be
+// so (closestLaneTies; the packet then also tests boxes up to widenTmax), for the caller to
+// trace alone; their hits[i] are left as the packet found them.
+template <bool AnyHit, bool Ties = false>
+inline uint64_t tracePacket8(const Node8* nodes, const TriPacket4* packets, const uint32_t* prims, const float* absMax, const Ray* rays, int n,
+                             uint64_t active, TriHit* hits, bool cullBack, uint64_t* ties = nullptr) {
+    static_assert(!(AnyHit && Ties), "ties are for closest hits");
+    if constexpr (Ties) *ties = 0;
+    if (n < kMaxPacket) active &= (uint64_t(1) << n) - 1;
+    std::conditional_t<Ties, PacketTies, char> tieState;   // (a char, unused, without ties)
+    PacketTies* tiesP = nullptr;
+    if constexpr (Ties) tiesP = &tieState;
+    const PacketScene sc{nodes, packets, prims, absMax, rays, hits, cullBack, tiesP};
+    PacketRays pr;
+    const PacketGather pg = gatherPacket(rays, n, active, absMax, pr);
+    uint64_t tiesAlone = 0;
+    uint64_t found = traceAlone<AnyHit, Ties>(sc, pg.single, &tiesAlone);
+    if (__builtin_popcountll(pg.pm) <= 1) {   // nothing to share
+        found |= traceAlone<AnyHit, Ties>(sc, pg.pm, &tiesAlone);
+        if constexpr (Ties) *ties = tiesAlone;
+        return found;
+    }
+    uint64_t pm = pg.pm;
+    unsigned groups = packetGroups(pm, (n + 7) / 8);
+    const PacketFrustum fr = makePacketFrustum(pg, absMax, nodes);
+    float tmaxP = Ties ? widenTmax(pg.tmaxP) : pg.tmaxP;   // Ties: see leafRayMask
+    __m256 tmax8 = _mm256_set1_ps(tmaxP);
+
+    const char* const nodeBytes = reinterpret_cast<const char*>(nodes);
+    PacketEntry stack[512];
+    int sp = 0;
+    uint32_t cur = 0, curParent = 0, curSlot = 0;
+    for (;;) {
+        const bool inner = !(cur & Node8::kLeafBit);
+        if (inner && cur != 0 && !packetEnters<AnyHit, Ties>(sc, fr, pr, cur, curParent, curSlot, groups, pm, found, tmaxP, tmax8)) {
+            if constexpr (AnyHit)
+                if (!pm) return found;
+        } else if (inner) {
+            if (descendPacket(fr, nodeBytes, tmax8, stack, sp, cur, curParent, curSlot)) continue;
+        } else {
+            intersectLeafRays<AnyHit, Ties>(sc, fr, pr, cur, curParent, curSlot, groups, pm, found, tmaxP, tmax8);
+            if constexpr (AnyHit)
+                if (!pm) return found;
+        }
+        if (!popPacketEntry<AnyHit>(stack, sp, tmaxP, cur, curParent, curSlot)) break;
+    }
+    if constexpr (Ties) {
+        *ties = tiesAlone;
+        for (uint64_t m = tieState.seen; m; m &= m - 1) {   // a tie at a distance the ray's hit then went below does not count
+            const int i = __builtin_ctzll(m);
+            if (tieState.tie[i] == pr.tmax[i]) *ties |= uint64_t(1) << i;
+        }
+    }
+    return found;
+}
