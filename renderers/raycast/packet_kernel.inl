@@ -12,11 +12,8 @@
 // box test with the ray's current tmax, then the leaf's triangles exactly as traceTriangles8
 // tests them (the same packet-pair kernel, the ray broadcast), so every hit is bit for bit the
 // single-ray hit. Only the order in which leaves are visited can differ from the single ray's,
-// which matters only for exact ties of t between triangles (the first found is kept, as there):
-// a ray that meets a triangle at exactly its running tmax is reported (tracePacket8's `ties`).
-// Every triangle at the ray's final distance is met: its leaf's box is entered at or before
-// that distance (the boxes' rounding margins, see RayPre), so the packet tests it whatever the
-// order, and a ray with one triangle at its final distance has the single ray's hit.
+// which matters only where hits lie at exactly or nearly the same distance (the first found is
+// kept, as there); with ties asked for, such rays are reported (tracePacket8).
 //
 // Interval test, conservative for every ray of the packet: the slab distance of plane b for ray i
 // is (b - o_i) * rdir_i. With the origins in [olo, ohi] and rdir in [rlo, rhi] per axis (one
