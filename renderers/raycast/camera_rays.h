@@ -133,18 +133,21 @@ private:
     glm::dvec4 column(float wx) const { return m_inv[0] * glm::dvec4(2.0 * double(wx) / m_w - 1.0); }
     glm::dvec4 row(float wy) const { return m_inv[1] * glm::dvec4(2.0 * double(wy) / m_h - 1.0); }
     // The ray whose (x, y) share of the unprojection is xy.
+    // A point's homogeneous divide is a product with the reciprocal of its w (one division per
+    // point, not three: the grid's rays were bound by the divider).
+    static glm::dvec3 divide(const glm::dvec4& v) { return glm::dvec3(v) * (1.0 / v.w); }
     Ray rayThrough(const glm::dvec4& xy) const {
         const glm::dvec4 a = xy + m_zw[0], b = xy + m_zw[1];   // the points at NDC z = -1 and z = +1
-        const glm::dvec3 org = glm::dvec3(a) / a.w;
+        const glm::dvec3 org = divide(a);
         Ray r;
         r.org = sg::vec3(org);
         r.tmin = 0.0f;
         r.tmax = 1.0f;
-        const glm::dvec3 far = glm::dvec3(b) / b.w;
+        const glm::dvec3 far = divide(b);
         r.dir = sg::vec3(far - org);
         if (!finite(r.dir) || glm::dot(far - org, m_forward) <= 0.0) {   // no far end: at infinity or "beyond" (behind the eye)
             const glm::dvec4 c = xy + m_zw[2];
-            r.dir = sg::vec3(glm::dvec3(c) / c.w - org);
+            r.dir = sg::vec3(divide(c) - org);
             r.tmax = std::numeric_limits<float>::max();
         }
         if (!finite(r.org) || !finite(r.dir)) r.tmax = -1.0f;   // meets nothing
@@ -152,7 +155,7 @@ private:
     }
 
     // rayThrough(col + row) (each as its (x, y) and (z, w) pairs) with SSE2's double pairs: the
-    // same IEEE operations on the same values (glm's dvec4 sum and divisions, the double
+    // same IEEE operations on the same values (glm's dvec4 sum, divide()'s reciprocals and products, the double
     // difference rounded to float), two at a time, for rays with a far end; the others (rare:
     // see ray()) go through rayThrough itself. In two steps: unproject (the sums and the
     // divisions), then finish.
@@ -165,9 +168,10 @@ private:
         u.xy23 = _mm_add_pd(col[1], row[1]);
         const __m128d a01 = _mm_add_pd(u.xy01, _mm_loadu_pd(&m_zw[0].x)), a23 = _mm_add_pd(u.xy23, _mm_loadu_pd(&m_zw[0].z));
         const __m128d b01 = _mm_add_pd(u.xy01, _mm_loadu_pd(&m_zw[1].x)), b23 = _mm_add_pd(u.xy23, _mm_loadu_pd(&m_zw[1].z));
-        u.org01 = _mm_div_pd(a01, _mm_unpackhi_pd(a23, a23));                      // (a.x, a.y) / a.w
-        u.far01 = _mm_div_pd(b01, _mm_unpackhi_pd(b23, b23));                      // (b.x, b.y) / b.w
-        u.zz = _mm_div_pd(_mm_unpacklo_pd(a23, b23), _mm_unpackhi_pd(a23, b23));   // (a.z / a.w, b.z / b.w)
+        const __m128d rw = _mm_div_pd(_mm_set1_pd(1.0), _mm_unpackhi_pd(a23, b23));   // (1 / a.w, 1 / b.w)
+        u.org01 = _mm_mul_pd(a01, _mm_unpacklo_pd(rw, rw));                          // (a.x, a.y) (1 / a.w)
+        u.far01 = _mm_mul_pd(b01, _mm_unpackhi_pd(rw, rw));                          // (b.x, b.y) (1 / b.w)
+        u.zz = _mm_mul_pd(_mm_unpacklo_pd(a23, b23), rw);                            // (a.z (1 / a.w), b.z (1 / b.w))
         return u;
     }
     void finish(const Unprojected& u, Ray& out) const {
