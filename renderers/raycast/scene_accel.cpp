@@ -362,7 +362,7 @@ uint64_t SceneAccel::intersectPacket(const Ray* rays, int n, uint64_t active, Sc
         PacketScratch<Ray> lr;
         for (uint64_t m = touched[s].rays; m; m &= m - 1) {
             const int i = __builtin_ctzll(m);
-            lr[i] = inst.toObject.apply(rays[i], bound[i]);   // as intersectInstance
+            inst.toObject.applyTo(rays[i], bound[i], lr[i]);   // as intersectInstance
         }
         const bool cull = sg::cullsBackFaces(culling, m_frame->meshes[inst.index].material.doubleSided);
         uint64_t meshTies = 0;
@@ -504,7 +504,7 @@ uint64_t SceneAccel::occludedPacket(const Ray* rays, int n, uint64_t active) con
         const Instance& inst = m_instances[touched[s].instance];
         for (uint64_t m = todo; m; m &= m - 1) {
             const int i = __builtin_ctzll(m);
-            lr[i] = inst.toObject.apply(rays[i], rays[i].tmax);
+            inst.toObject.applyTo(rays[i], rays[i].tmax, lr[i]);
         }
         blocked |= inst.bvh->occludedPacket(lr.data(), n, todo);
     }
