@@ -118,62 +118,127 @@ struct PacketGather {
     float tminP, tmaxP;
 };
 
+// Lane l of group g: bit l of m.
+inline __m256 laneMask8(unsigned m) {
+    const __m256i bits = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+    return _mm256_castsi256_ps(_mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32(int(m)), bits), bits));
+}
+// The smallest (largest) of v's 8 lanes.
+inline float laneMin8(__m256 v) {
+    __m128 h = _mm_min_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps(v, 1));
+    h = _mm_min_ps(h, _mm_movehl_ps(h, h));
+    return _mm_cvtss_f32(_mm_min_ss(h, _mm_shuffle_ps(h, h, 1)));
+}
+inline float laneMax8(__m256 v) {
+    __m128 h = _mm_max_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps(v, 1));
+    h = _mm_max_ps(h, _mm_movehl_ps(h, h));
+    return _mm_cvtss_f32(_mm_max_ss(h, _mm_shuffle_ps(h, h, 1)));
+}
+
 // Sorts the active rays into the packet (the first ray's direction signs, finite data, a
 // non-empty [tmin, tmax]; their RayPre values into pr) and the rest; every other slot of pr is
-// set to never enter a box.
+// set to never enter a box. Eight rays at a time: RayPre's operations (the nudge of a tiny
+// direction component, 1 / d, o * rdir and the margin 2^-20 (|o| + max |b|) |rdir|) in the same
+// order on each lane, so pr holds bit for bit what RayPre gives each ray. The packet's bounds
+// are the same values whatever the order they are taken in, up to the sign of a zero origin
+// coordinate, which makePacketFrustum's widening (d > 0 for any mesh with a box) removes.
 [[gnu::always_inline]] inline PacketGather gatherPacket(const Ray* rays, int n, uint64_t active, const float* absMax, PacketRays& pr) {
+    static_assert(sizeof(Ray) == 32 && offsetof(Ray, tmin) == 12 && offsetof(Ray, dir) == 16 && offsetof(Ray, tmax) == 28,
+                  "Ray: org, tmin, dir, tmax packed");
     PacketGather g;
-    g.rlo = _mm_set1_ps(std::numeric_limits<float>::infinity());
-    g.rhi = _mm_set1_ps(-std::numeric_limits<float>::infinity());
-    g.olo = g.rlo;
-    g.ohi = g.rhi;
-    g.tminP = std::numeric_limits<float>::infinity();
-    g.tmaxP = -std::numeric_limits<float>::infinity();
+    const __m256 inf = _mm256_set1_ps(std::numeric_limits<float>::infinity()), ninf = _mm256_set1_ps(-std::numeric_limits<float>::infinity());
+    const __m256 signBit = _mm256_set1_ps(-0.0f), zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f);
+    __m256 rlo[3] = {inf, inf, inf}, rhi[3] = {ninf, ninf, ninf}, olo[3] = {inf, inf, inf}, ohi[3] = {ninf, ninf, ninf};
+    __m256 tminLo = inf, tmaxHi = ninf;
     const int groupsN = (n + 7) / 8;
-    for (int i = 0; i < 8 * groupsN; ++i) {
-        const bool in = (active >> i) & 1;
-        bool fits = false;
-        if (in) {
-            const Ray& r = rays[i];
-            const RayPre pre(r, absMax);
-            const float tmin = r.tmin > 0.0f ? r.tmin : 0.0f;
-            const __m128 rd = _mm_load_ps(pre.rdir), on = _mm_load_ps(pre.orgRdirNear), of = _mm_load_ps(pre.orgRdirFar);
-            // Finite: x - x == 0 (lanes 0-2).
-            const __m128 z = _mm_add_ps(_mm_add_ps(_mm_sub_ps(rd, rd), _mm_sub_ps(on, on)),
-                                        _mm_add_ps(_mm_sub_ps(of, of), _mm_sub_ps(_mm_load_ps(pre.org), _mm_load_ps(pre.org))));
-            const int s = pre.nearX | (pre.nearY << 1) | (pre.nearZ << 2);
-            if ((_mm_movemask_ps(_mm_cmpeq_ps(z, _mm_setzero_ps())) & 7) == 7 && sg::isFinite(r.dir) && r.tmax > tmin &&
-                (g.sign < 0 || s == g.sign)) {
-                g.sign = s;
-                fits = true;
-                g.pm |= uint64_t(1) << i;
-                alignas(16) float a[4], b[4], c[4];
-                _mm_store_ps(a, rd);
-                _mm_store_ps(b, on);
-                _mm_store_ps(c, of);
-                for (int k = 0; k < 3; ++k) {
-                    pr.rd[k][i] = a[k];
-                    pr.on[k][i] = b[k];
-                    pr.of[k][i] = c[k];
-                }
-                pr.tmin[i] = tmin;
-                pr.tmax[i] = r.tmax;
-                g.rlo = _mm_min_ps(g.rlo, rd);
-                g.rhi = _mm_max_ps(g.rhi, rd);
-                g.olo = _mm_min_ps(g.olo, _mm_load_ps(pre.org));
-                g.ohi = _mm_max_ps(g.ohi, _mm_load_ps(pre.org));
-                g.tminP = std::min(g.tminP, tmin);
-                g.tmaxP = std::max(g.tmaxP, r.tmax);
-            } else {
-                g.single |= uint64_t(1) << i;
+    for (int k = 0; k < groupsN; ++k) {
+        const unsigned lanes = unsigned(active >> (8 * k)) & 0xFFu;
+        const int o8 = 8 * k;
+        if (!lanes) {   // never enters a box
+            for (int a = 0; a < 3; ++a) {
+                _mm256_store_ps(pr.rd[a] + o8, one);
+                _mm256_store_ps(pr.on[a] + o8, zero);
+                _mm256_store_ps(pr.of[a] + o8, zero);
             }
+            _mm256_store_ps(pr.tmin + o8, zero);
+            _mm256_store_ps(pr.tmax + o8, _mm256_set1_ps(-1.0f));
+            continue;
         }
-        if (!fits) {   // never enters a box
-            for (int k = 0; k < 3; ++k) pr.rd[k][i] = 1.0f, pr.on[k][i] = 0.0f, pr.of[k][i] = 0.0f;
-            pr.tmin[i] = 0.0f;
-            pr.tmax[i] = -1.0f;
+        // The group's rays as (org, tmin) and (dir, tmax) rows, lanes l and l + 4 in one register
+        // (an inactive lane repeats an active ray: only active slots of `rays` are read).
+        const int firstLane = __builtin_ctz(lanes);
+        auto ray = [&](int l) -> const Ray& { return rays[o8 + (((lanes >> l) & 1) ? l : firstLane)]; };
+        __m256 ov[4], dv[4];
+        for (int l = 0; l < 4; ++l) {
+            const Ray &lo = ray(l), &hi = ray(l + 4);
+            ov[l] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(&lo.org.x)), _mm_loadu_ps(&hi.org.x), 1);
+            dv[l] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(&lo.dir.x)), _mm_loadu_ps(&hi.dir.x), 1);
         }
+        auto transpose = [](const __m256* v, __m256* out) {   // rows -> x, y, z, w of the 8 rays
+            const __m256 t0 = _mm256_unpacklo_ps(v[0], v[1]), t1 = _mm256_unpackhi_ps(v[0], v[1]);
+            const __m256 t2 = _mm256_unpacklo_ps(v[2], v[3]), t3 = _mm256_unpackhi_ps(v[2], v[3]);
+            out[0] = _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(1, 0, 1, 0));
+            out[1] = _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(3, 2, 3, 2));
+            out[2] = _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(1, 0, 1, 0));
+            out[3] = _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(3, 2, 3, 2));
+        };
+        __m256 org[4], dir[4];   // x, y, z and tmin / tmax
+        transpose(ov, org);
+        transpose(dv, dir);
+        __m256 rd[3], on[3], of[3];
+        __m256 bad = zero;   // lanes with a value that is not finite (x - x is NaN there)
+        unsigned neg[3];
+        for (int a = 0; a < 3; ++a) {
+            __m256 d = dir[a];
+            bad = _mm256_or_ps(bad, _mm256_cmp_ps(_mm256_sub_ps(d, d), zero, _CMP_NEQ_UQ));   // sg::isFinite(r.dir)
+            const __m256 tiny = _mm256_cmp_ps(_mm256_andnot_ps(signBit, d), _mm256_set1_ps(1e-30f), _CMP_LT_OS);
+            d = _mm256_or_ps(_mm256_andnot_ps(tiny, d), _mm256_and_ps(tiny, _mm256_or_ps(_mm256_and_ps(d, signBit), _mm256_set1_ps(1e-30f))));
+            rd[a] = _mm256_div_ps(one, d);
+            const __m256 ord = _mm256_mul_ps(org[a], rd[a]);
+            const __m256 absB = _mm256_set1_ps(absMax ? absMax[a] : 0.0f);
+            const __m256 e = _mm256_mul_ps(_mm256_mul_ps(_mm256_add_ps(_mm256_andnot_ps(signBit, org[a]), absB), _mm256_andnot_ps(signBit, rd[a])),
+                                           _mm256_set1_ps(0x1p-20f));
+            on[a] = _mm256_add_ps(ord, e);
+            of[a] = _mm256_sub_ps(ord, e);
+            const __m256 z = _mm256_add_ps(_mm256_add_ps(_mm256_sub_ps(rd[a], rd[a]), _mm256_sub_ps(on[a], on[a])),
+                                           _mm256_add_ps(_mm256_sub_ps(of[a], of[a]), _mm256_sub_ps(org[a], org[a])));
+            bad = _mm256_or_ps(bad, _mm256_cmp_ps(z, zero, _CMP_NEQ_UQ));
+            neg[a] = unsigned(_mm256_movemask_ps(d));
+        }
+        const __m256 tmin = _mm256_max_ps(org[3], zero);   // r.tmin > 0 ? r.tmin : 0
+        const __m256 tmax = dir[3];
+        const unsigned nonEmpty = unsigned(_mm256_movemask_ps(_mm256_cmp_ps(tmax, tmin, _CMP_GT_OQ)));
+        const unsigned ok = lanes & ~unsigned(_mm256_movemask_ps(bad)) & nonEmpty;
+        if (g.sign < 0 && ok) {   // the first ray that fits sets the packet's signs
+            const int l = __builtin_ctz(ok);
+            g.sign = int((neg[0] >> l) & 1) | int(((neg[1] >> l) & 1) << 1) | int(((neg[2] >> l) & 1) << 2);
+        }
+        unsigned same = 0xFFu;
+        for (int a = 0; a < 3; ++a) same &= (g.sign >> a) & 1 ? neg[a] : ~neg[a];
+        const unsigned fits = ok & same;
+        g.pm |= uint64_t(fits) << o8;
+        g.single |= uint64_t(lanes & ~fits) << o8;
+        const __m256 fitV = laneMask8(fits);
+        for (int a = 0; a < 3; ++a) {
+            _mm256_store_ps(pr.rd[a] + o8, _mm256_blendv_ps(one, rd[a], fitV));
+            _mm256_store_ps(pr.on[a] + o8, _mm256_blendv_ps(zero, on[a], fitV));
+            _mm256_store_ps(pr.of[a] + o8, _mm256_blendv_ps(zero, of[a], fitV));
+            rlo[a] = _mm256_min_ps(rlo[a], _mm256_blendv_ps(inf, rd[a], fitV));
+            rhi[a] = _mm256_max_ps(rhi[a], _mm256_blendv_ps(ninf, rd[a], fitV));
+            olo[a] = _mm256_min_ps(olo[a], _mm256_blendv_ps(inf, org[a], fitV));
+            ohi[a] = _mm256_max_ps(ohi[a], _mm256_blendv_ps(ninf, org[a], fitV));
+        }
+        _mm256_store_ps(pr.tmin + o8, _mm256_blendv_ps(zero, tmin, fitV));
+        _mm256_store_ps(pr.tmax + o8, _mm256_blendv_ps(_mm256_set1_ps(-1.0f), tmax, fitV));
+        tminLo = _mm256_min_ps(tminLo, _mm256_blendv_ps(inf, tmin, fitV));
+        tmaxHi = _mm256_max_ps(tmaxHi, _mm256_blendv_ps(ninf, tmax, fitV));
     }
+    g.rlo = _mm_setr_ps(laneMin8(rlo[0]), laneMin8(rlo[1]), laneMin8(rlo[2]), 0.0f);
+    g.rhi = _mm_setr_ps(laneMax8(rhi[0]), laneMax8(rhi[1]), laneMax8(rhi[2]), 0.0f);
+    g.olo = _mm_setr_ps(laneMin8(olo[0]), laneMin8(olo[1]), laneMin8(olo[2]), 0.0f);
+    g.ohi = _mm_setr_ps(laneMax8(ohi[0]), laneMax8(ohi[1]), laneMax8(ohi[2]), 0.0f);
+    g.tminP = laneMin8(tminLo);
+    g.tmaxP = laneMax8(tmaxHi);
     return g;
 }
 
