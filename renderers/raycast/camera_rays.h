@@ -169,9 +169,9 @@ private:
         const __m128d a01 = _mm_add_pd(u.xy01, _mm_loadu_pd(&m_zw[0].x)), a23 = _mm_add_pd(u.xy23, _mm_loadu_pd(&m_zw[0].z));
         const __m128d b01 = _mm_add_pd(u.xy01, _mm_loadu_pd(&m_zw[1].x)), b23 = _mm_add_pd(u.xy23, _mm_loadu_pd(&m_zw[1].z));
         const __m128d rw = _mm_div_pd(_mm_set1_pd(1.0), _mm_unpackhi_pd(a23, b23));   // (1 / a.w, 1 / b.w)
-        u.org01 = _mm_mul_pd(a01, _mm_unpacklo_pd(rw, rw));                          // (a.x, a.y) (1 / a.w)
-        u.far01 = _mm_mul_pd(b01, _mm_unpackhi_pd(rw, rw));                          // (b.x, b.y) (1 / b.w)
-        u.zz = _mm_mul_pd(_mm_unpacklo_pd(a23, b23), rw);                            // (a.z (1 / a.w), b.z (1 / b.w))
+        u.org01 = _mm_mul_pd(a01, _mm_unpacklo_pd(rw, rw));                           // (a.x, a.y) (1 / a.w)
+        u.far01 = _mm_mul_pd(b01, _mm_unpackhi_pd(rw, rw));                           // (b.x, b.y) (1 / b.w)
+        u.zz = _mm_mul_pd(_mm_unpacklo_pd(a23, b23), rw);                             // (a.z (1 / a.w), b.z (1 / b.w))
         return u;
     }
     void finish(const Unprojected& u, Ray& out) const {

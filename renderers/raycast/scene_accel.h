@@ -75,7 +75,7 @@ private:
     // (v0, v1, v2, s)
     static __m128 withLane3(__m128 v, float s) {
         const __m128 hi = _mm_shuffle_ps(v, _mm_set_ss(s), _MM_SHUFFLE(0, 0, 2, 2));   // (v2, v2, s, s)
-        return _mm_shuffle_ps(v, hi, _MM_SHUFFLE(2, 0, 1, 0));                          // (v0, v1, v2, s)
+        return _mm_shuffle_ps(v, hi, _MM_SHUFFLE(2, 0, 1, 0));                         // (v0, v1, v2, s)
     }
 };
 
