@@ -15,6 +15,8 @@
 
 #include "scenegraph/math.h"
 
+#include <xmmintrin.h>
+
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
@@ -77,6 +79,52 @@ struct Ray {
     float tmin = 0.0f;
     sg::vec3 dir{0, 0, -1};
     float tmax = std::numeric_limits<float>::infinity();
+};
+
+// A world -> object space transform for rays: org' = M (org, 1), dir' = mat3(M) dir, the
+// direction not normalised (so t is shared between the spaces). Bit for bit glm's
+// mat4 * vec4(org, 1) and mat3 * dir: per lane (c0 x + c1 y) + (c2 z + c3) and
+// (c0 x + c1 y) + c2 z, the same IEEE products and sums, made four lanes at a time.
+struct RayTransform {
+    alignas(16) float col[4][4];   // M's columns
+    alignas(16) float lin[3][4];   // mat3(M)'s columns, lane 3 zero
+    RayTransform() : RayTransform(sg::mat4(1.0f)) {}
+    explicit RayTransform(const sg::mat4& m) {
+        for (int c = 0; c < 4; ++c)
+            for (int r = 0; r < 4; ++r) col[c][r] = m[c][r];
+        for (int c = 0; c < 3; ++c)
+            for (int r = 0; r < 4; ++r) lin[c][r] = r < 3 ? m[c][r] : 0.0f;
+    }
+    // r in object space, its segment ending at tmax.
+    Ray apply(const Ray& r, float tmax) const {
+        Ray out;
+        applyTo(r, tmax, out);
+        return out;
+    }
+    // apply(r, tmax) written into out as two 16-byte stores (org and tmin, dir and tmax): no
+    // member-wise copy of a returned Ray (glm's vectors copy element by element), and a later
+    // 16-byte load of either half is forwarded from one store.
+    void applyTo(const Ray& r, float tmax, Ray& out) const {
+        static_assert(sizeof(Ray) == 32 && offsetof(Ray, tmin) == 12 && offsetof(Ray, dir) == 16 && offsetof(Ray, tmax) == 28,
+                      "Ray: org, tmin, dir, tmax packed");
+        __m128 o =
+            _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_load_ps(col[0]), _mm_set1_ps(r.org.x)), _mm_mul_ps(_mm_load_ps(col[1]), _mm_set1_ps(r.org.y))),
+                       _mm_add_ps(_mm_mul_ps(_mm_load_ps(col[2]), _mm_set1_ps(r.org.z)), _mm_load_ps(col[3])));
+        __m128 d =
+            _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_load_ps(lin[0]), _mm_set1_ps(r.dir.x)), _mm_mul_ps(_mm_load_ps(lin[1]), _mm_set1_ps(r.dir.y))),
+                       _mm_mul_ps(_mm_load_ps(lin[2]), _mm_set1_ps(r.dir.z)));
+        o = withLane3(o, r.tmin);
+        d = withLane3(d, tmax);
+        _mm_storeu_ps(&out.org.x, o);
+        _mm_storeu_ps(&out.dir.x, d);
+    }
+
+private:
+    // (v0, v1, v2, s)
+    static __m128 withLane3(__m128 v, float s) {
+        const __m128 hi = _mm_shuffle_ps(v, _mm_set_ss(s), _MM_SHUFFLE(0, 0, 2, 2));   // (v2, v2, s, s)
+        return _mm_shuffle_ps(v, hi, _MM_SHUFFLE(2, 0, 1, 0));                         // (v0, v1, v2, s)
+    }
 };
 
 // tmax widened by 32 units in the last place (about 2^-18 of it; +inf at and beyond the
@@ -246,8 +294,11 @@ public:
     // miss was decided within that of their tmax (another mesh's hit, for a caller tracing
     // several), for the caller to trace alone; about 2.5% more instructions in a frame of one big mesh. (BVH4
     // traces each ray alone, so only such tmax ties could differ there: none are reported.)
-    uint64_t intersectPacket(const Ray* rays, int n, uint64_t active, TriHit* hits, bool cullBack = false, uint64_t* ties = nullptr) const;
-    uint64_t occludedPacket(const Ray* rays, int n, uint64_t active) const;
+    // move: the rays are world rays, each traced as move->apply(rays[i], tmax ? tmax[i] :
+    // rays[i].tmax) (bit for bit; the kernel moves them eight at a time as it gathers them).
+    uint64_t intersectPacket(const Ray* rays, int n, uint64_t active, TriHit* hits, bool cullBack = false, uint64_t* ties = nullptr,
+                             const RayTransform* move = nullptr, const float* tmax = nullptr) const;
+    uint64_t occludedPacket(const Ray* rays, int n, uint64_t active, const RayTransform* move = nullptr) const;
 
     bool empty() const { return m_packets.empty(); }
     const sg::Aabb& bounds() const { return m_bounds; }

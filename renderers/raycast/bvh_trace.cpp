@@ -67,7 +67,8 @@ bool TriangleBvh::occluded(const Ray& ray) const {
                     : kern_sse::traceTriangles<true>(m_nodes4.data(), m_packets.data(), m_prims.data(), m_absMax, ray, nullptr, false);
 }
 
-uint64_t TriangleBvh::intersectPacket(const Ray* rays, int n, uint64_t active, TriHit* hits, bool cullBack, uint64_t* ties) const {
+uint64_t TriangleBvh::intersectPacket(const Ray* rays, int n, uint64_t active, TriHit* hits, bool cullBack, uint64_t* ties, const RayTransform* move,
+                                      const float* tmax) const {
     if (ties) *ties = 0;
     n = std::clamp(n, 0, kMaxPacket);
     if (n < kMaxPacket) active &= (uint64_t(1) << n) - 1;
@@ -75,27 +76,28 @@ uint64_t TriangleBvh::intersectPacket(const Ray* rays, int n, uint64_t active, T
     if (!m_nodes8.empty()) {
         if (ties)
             return kern_avx2::tracePacket8<false, true>(m_nodes8.data(), m_packets.data(), m_prims.data(), m_absMax, rays, n, active, hits, cullBack,
-                                                        ties);
-        return kern_avx2::tracePacket8<false>(m_nodes8.data(), m_packets.data(), m_prims.data(), m_absMax, rays, n, active, hits, cullBack);
+                                                        ties, move, tmax);
+        return kern_avx2::tracePacket8<false>(m_nodes8.data(), m_packets.data(), m_prims.data(), m_absMax, rays, n, active, hits, cullBack, nullptr,
+                                              move, tmax);
     }
     uint64_t found = 0;   // BVH4 (SSE, or a tree too big for BVH8): one ray at a time
     for (uint64_t m = active; m; m &= m - 1) {
         const int i = __builtin_ctzll(m);
-        if (intersect(rays[i], hits[i], cullBack)) found |= uint64_t(1) << i;
+        if (intersect(move ? move->apply(rays[i], tmax ? tmax[i] : rays[i].tmax) : rays[i], hits[i], cullBack)) found |= uint64_t(1) << i;
     }
     return found;
 }
-
-uint64_t TriangleBvh::occludedPacket(const Ray* rays, int n, uint64_t active) const {
+uint64_t TriangleBvh::occludedPacket(const Ray* rays, int n, uint64_t active, const RayTransform* move) const {
     n = std::clamp(n, 0, kMaxPacket);
     if (n < kMaxPacket) active &= (uint64_t(1) << n) - 1;
     if (m_packets.empty() || !active) return 0;
     if (!m_nodes8.empty())
-        return kern_avx2::tracePacket8<true>(m_nodes8.data(), m_packets.data(), m_prims.data(), m_absMax, rays, n, active, nullptr, false);
+        return kern_avx2::tracePacket8<true>(m_nodes8.data(), m_packets.data(), m_prims.data(), m_absMax, rays, n, active, nullptr, false, nullptr,
+                                             move, nullptr);
     uint64_t found = 0;
     for (uint64_t m = active; m; m &= m - 1) {
         const int i = __builtin_ctzll(m);
-        if (occluded(rays[i])) found |= uint64_t(1) << i;
+        if (occluded(move ? move->apply(rays[i], rays[i].tmax) : rays[i])) found |= uint64_t(1) << i;
     }
     return found;
 }

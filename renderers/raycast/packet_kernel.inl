@@ -135,6 +135,14 @@ inline float laneMax8(__m256 v) {
     return _mm_cvtss_f32(_mm_max_ss(h, _mm_shuffle_ps(h, h, 1)));
 }
 
+// a * b as a value of its own: the empty asm keeps GCC from fusing the product into the sum that
+// follows (this region has FMA; code that must give the same bits, compiled without it, has none).
+inline __m256 unfusedProduct(__m256 a, __m256 b) {
+    __m256 p = _mm256_mul_ps(a, b);
+    asm("" : "+x"(p));
+    return p;
+}
+
 // Sorts the active rays into the packet (the first ray's direction signs, finite data, a
 // non-empty [tmin, tmax]; their RayPre values into pr) and the rest; every other slot of pr is
 // set to never enter a box. Eight rays at a time: RayPre's operations (the nudge of a tiny
@@ -142,7 +150,11 @@ inline float laneMax8(__m256 v) {
 // order on each lane, so pr holds bit for bit what RayPre gives each ray. The packet's bounds
 // are the same values whatever the order they are taken in, up to the sign of a zero origin
 // coordinate, which makePacketFrustum's widening (d > 0 for any mesh with a box) removes.
-[[gnu::always_inline]] inline PacketGather gatherPacket(const Ray* rays, int n, uint64_t active, const float* absMax, PacketRays& pr) {
+// move (with tmaxIn: the rays' tmax, null: their own): the rays are world rays, moved into the
+// mesh's space first, as RayTransform::applyTo moves them (per lane (c0 x + c1 y) + (c2 z + c3)
+// and (c0 x + c1 y) + c2 z, no product fused into a sum), and written to moved[i] for the leaves.
+[[gnu::always_inline]] inline PacketGather gatherPacket(const Ray* rays, int n, uint64_t active, const float* absMax, PacketRays& pr,
+                                                        const RayTransform* move = nullptr, const float* tmaxIn = nullptr, Ray* moved = nullptr) {
     static_assert(sizeof(Ray) == 32 && offsetof(Ray, tmin) == 12 && offsetof(Ray, dir) == 16 && offsetof(Ray, tmax) == 28,
                   "Ray: org, tmin, dir, tmax packed");
     PacketGather g;
@@ -185,6 +197,32 @@ inline float laneMax8(__m256 v) {
         __m256 org[4], dir[4];   // x, y, z and tmin / tmax
         transpose(ov, org);
         transpose(dv, dir);
+        if (move) {
+            __m256 mo[3], md[3];
+            for (int r = 0; r < 3; ++r) {
+                const float(*c)[4] = move->col;
+                const float(*d)[4] = move->lin;
+                mo[r] = _mm256_add_ps(_mm256_add_ps(unfusedProduct(_mm256_set1_ps(c[0][r]), org[0]), unfusedProduct(_mm256_set1_ps(c[1][r]), org[1])),
+                                      _mm256_add_ps(unfusedProduct(_mm256_set1_ps(c[2][r]), org[2]), _mm256_set1_ps(c[3][r])));
+                md[r] = _mm256_add_ps(_mm256_add_ps(unfusedProduct(_mm256_set1_ps(d[0][r]), dir[0]), unfusedProduct(_mm256_set1_ps(d[1][r]), dir[1])),
+                                      unfusedProduct(_mm256_set1_ps(d[2][r]), dir[2]));
+            }
+            for (int r = 0; r < 3; ++r) org[r] = mo[r], dir[r] = md[r];
+            if (tmaxIn) {
+                alignas(32) float t[8];
+                for (int l = 0; l < 8; ++l) t[l] = tmaxIn[o8 + (((lanes >> l) & 1) ? l : firstLane)];
+                dir[3] = _mm256_load_ps(t);
+            }
+            __m256 ro[4], rw[4];   // back to rows: lane l's ray in the low half of ro[l], lane l + 4's in the high half
+            transpose(org, ro);
+            transpose(dir, rw);
+            for (int l = 0; l < 4; ++l) {
+                _mm_storeu_ps(&moved[o8 + l].org.x, _mm256_castps256_ps128(ro[l]));
+                _mm_storeu_ps(&moved[o8 + l].dir.x, _mm256_castps256_ps128(rw[l]));
+                _mm_storeu_ps(&moved[o8 + l + 4].org.x, _mm256_extractf128_ps(ro[l], 1));
+                _mm_storeu_ps(&moved[o8 + l + 4].dir.x, _mm256_extractf128_ps(rw[l], 1));
+            }
+        }
         __m256 rd[3], on[3], of[3];
         __m256 bad = zero;   // lanes with a value that is not finite (x - x is NaN there)
         unsigned neg[3];
@@ -515,16 +553,18 @@ template <bool AnyHit>
 // trace alone; their hits[i] are left as the packet found them.
 template <bool AnyHit, bool Ties = false>
 inline uint64_t tracePacket8(const Node8* nodes, const TriPacket4* packets, const uint32_t* prims, const float* absMax, const Ray* rays, int n,
-                             uint64_t active, TriHit* hits, bool cullBack, uint64_t* ties = nullptr) {
+                             uint64_t active, TriHit* hits, bool cullBack, uint64_t* ties = nullptr, const RayTransform* move = nullptr,
+                             const float* tmaxIn = nullptr) {
     static_assert(!(AnyHit && Ties), "ties are for closest hits");
     if constexpr (Ties) *ties = 0;
     if (n < kMaxPacket) active &= (uint64_t(1) << n) - 1;
     std::conditional_t<Ties, PacketTies, char> tieState;   // (a char, unused, without ties)
     PacketTies* tiesP = nullptr;
     if constexpr (Ties) tiesP = &tieState;
-    const PacketScene sc{nodes, packets, prims, absMax, rays, hits, cullBack, tiesP};
     PacketRays pr;
-    const PacketGather pg = gatherPacket(rays, n, active, absMax, pr);
+    PacketScratch<Ray> moved;   // with move: the rays in the mesh's space (gatherPacket writes the active groups)
+    const PacketGather pg = gatherPacket(rays, n, active, absMax, pr, move, tmaxIn, moved.data());
+    const PacketScene sc{nodes, packets, prims, absMax, move ? moved.data() : rays, hits, cullBack, tiesP};
     uint64_t tiesAlone = 0;
     uint64_t found = traceAlone<AnyHit, Ties>(sc, pg.single, &tiesAlone);
     if (__builtin_popcountll(pg.pm) <= 1) {   // nothing to share

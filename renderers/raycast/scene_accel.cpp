@@ -359,14 +359,11 @@ uint64_t SceneAccel::intersectPacket(const Ray* rays, int n, uint64_t active, Sc
     uint64_t tied = 0;
     for (int s = 0; s < k; ++s) {
         const Instance& inst = m_instances[touched[s].instance];
-        PacketScratch<Ray> lr;
-        for (uint64_t m = touched[s].rays; m; m &= m - 1) {
-            const int i = __builtin_ctzll(m);
-            inst.toObject.applyTo(rays[i], bound[i], lr[i]);   // as intersectInstance
-        }
         const bool cull = sg::cullsBackFaces(culling, m_frame->meshes[inst.index].material.doubleSided);
         uint64_t meshTies = 0;
-        touched[s].found = inst.bvh->intersectPacket(lr.data(), n, touched[s].rays, meshHits + s * kMaxPacket, cull, inst.ties ? &meshTies : nullptr);
+        // Each ray moved into the mesh's space with its segment ending at bound[i], as intersectInstance.
+        touched[s].found = inst.bvh->intersectPacket(rays, n, touched[s].rays, meshHits + s * kMaxPacket, cull, inst.ties ? &meshTies : nullptr,
+                                                     &inst.toObject, bound);
         tied |= meshTies;
         for (uint64_t m = touched[s].found; m; m &= m - 1) {
             const int i = __builtin_ctzll(m);
@@ -496,17 +493,13 @@ uint64_t SceneAccel::occludedPacket(const Ray* rays, int n, uint64_t active) con
         }
         return (active & ~blocked) == 0;
     });
-    // Phase 2: each big mesh once, for the rays that reach it and are not blocked yet.
-    PacketScratch<Ray> lr;
+    // Phase 2: each big mesh once, for the rays that reach it and are not blocked yet (moved
+    // into its space by the packet kernel).
     for (int s = 0; s < k; ++s) {
         const uint64_t todo = touched[s].rays & ~blocked;
         if (!todo) continue;
         const Instance& inst = m_instances[touched[s].instance];
-        for (uint64_t m = todo; m; m &= m - 1) {
-            const int i = __builtin_ctzll(m);
-            inst.toObject.applyTo(rays[i], rays[i].tmax, lr[i]);
-        }
-        blocked |= inst.bvh->occludedPacket(lr.data(), n, todo);
+        blocked |= inst.bvh->occludedPacket(rays, n, todo, &inst.toObject);
     }
     return blocked;
 }

@@ -33,52 +33,6 @@ struct SceneHit {
     float u = 0, v = 0;
 };
 
-// A world -> object space transform for rays: org' = M (org, 1), dir' = mat3(M) dir, the
-// direction not normalised (so t is shared between the spaces). Bit for bit glm's
-// mat4 * vec4(org, 1) and mat3 * dir: per lane (c0 x + c1 y) + (c2 z + c3) and
-// (c0 x + c1 y) + c2 z, the same IEEE products and sums, made four lanes at a time.
-struct RayTransform {
-    alignas(16) float col[4][4];   // M's columns
-    alignas(16) float lin[3][4];   // mat3(M)'s columns, lane 3 zero
-    RayTransform() : RayTransform(sg::mat4(1.0f)) {}
-    explicit RayTransform(const sg::mat4& m) {
-        for (int c = 0; c < 4; ++c)
-            for (int r = 0; r < 4; ++r) col[c][r] = m[c][r];
-        for (int c = 0; c < 3; ++c)
-            for (int r = 0; r < 4; ++r) lin[c][r] = r < 3 ? m[c][r] : 0.0f;
-    }
-    // r in object space, its segment ending at tmax.
-    Ray apply(const Ray& r, float tmax) const {
-        Ray out;
-        applyTo(r, tmax, out);
-        return out;
-    }
-    // apply(r, tmax) written into out as two 16-byte stores (org and tmin, dir and tmax): no
-    // member-wise copy of a returned Ray (glm's vectors copy element by element), and a later
-    // 16-byte load of either half is forwarded from one store.
-    void applyTo(const Ray& r, float tmax, Ray& out) const {
-        static_assert(sizeof(Ray) == 32 && offsetof(Ray, tmin) == 12 && offsetof(Ray, dir) == 16 && offsetof(Ray, tmax) == 28,
-                      "Ray: org, tmin, dir, tmax packed");
-        __m128 o =
-            _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_load_ps(col[0]), _mm_set1_ps(r.org.x)), _mm_mul_ps(_mm_load_ps(col[1]), _mm_set1_ps(r.org.y))),
-                       _mm_add_ps(_mm_mul_ps(_mm_load_ps(col[2]), _mm_set1_ps(r.org.z)), _mm_load_ps(col[3])));
-        __m128 d =
-            _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_load_ps(lin[0]), _mm_set1_ps(r.dir.x)), _mm_mul_ps(_mm_load_ps(lin[1]), _mm_set1_ps(r.dir.y))),
-                       _mm_mul_ps(_mm_load_ps(lin[2]), _mm_set1_ps(r.dir.z)));
-        o = withLane3(o, r.tmin);
-        d = withLane3(d, tmax);
-        _mm_storeu_ps(&out.org.x, o);
-        _mm_storeu_ps(&out.dir.x, d);
-    }
-
-private:
-    // (v0, v1, v2, s)
-    static __m128 withLane3(__m128 v, float s) {
-        const __m128 hi = _mm_shuffle_ps(v, _mm_set_ss(s), _MM_SHUFFLE(0, 0, 2, 2));   // (v2, v2, s, s)
-        return _mm_shuffle_ps(v, hi, _MM_SHUFFLE(2, 0, 1, 0));                         // (v0, v1, v2, s)
-    }
-};
-
 class SceneAccel {
 public:
     // Builds/fetches BLASes for this frame and rebuilds the TLAS. Not thread-safe; call before

@@ -523,7 +523,8 @@ TEST(RaycastTest, BvhKeepsGrazingRaysOnFlatFarGeometry) {
 }
 
 // Packets (intersectPacket / occludedPacket) give exactly the single-ray results for every active
-// ray and leave inactive lanes alone: camera-like packets (one origin, zero direction components
+// ray and leave inactive lanes alone (also given as world rays with the instance's move and a
+// tmax per ray): camera-like packets (one origin, zero direction components
 // included), shadow-like packets (many origins, one target), origins inside the boxes, tmin/tmax
 // limits, rays that cannot join the packet (other direction signs, non-finite, empty segment), on
 // BVH8 (or BVH4 with the SSE kernel) and on a tree forced to BVH4.
@@ -590,6 +591,27 @@ TEST(RaycastTest, BvhPacketsEqualSingleRays) {
             for (TriHit& h : ph) h.t = -7.0f;   // inactive lanes and misses: untouched
             const uint64_t found = bvh.intersectPacket(rays.data(), n, active, ph.data());
             const uint64_t occ = bvh.occludedPacket(rays.data(), n, active);
+            // The same rays as world rays of an instance (rotated, scaled unevenly, moved), each
+            // with a tmax of its own: the kernel moves them itself, as RayTransform::apply does.
+            {
+                const RayTransform move(
+                    glm::translate(glm::rotate(glm::scale(mat4(1.0f), vec3(1.3f, 0.7f, 1.1f)), 0.4f, glm::normalize(vec3(0.3f, 1.0f, 0.2f))),
+                                   vec3(0.2f, -0.3f, 0.1f)));
+                std::vector<float> bound(static_cast<size_t>(n));
+                for (int i = 0; i < n; ++i) bound[size_t(i)] = i % 3 ? rays[size_t(i)].tmax : 0.7f * rays[size_t(i)].tmax;
+                std::vector<TriHit> mh(static_cast<size_t>(n));
+                const uint64_t movedFound = bvh.intersectPacket(rays.data(), n, active, mh.data(), false, nullptr, &move, bound.data());
+                const uint64_t movedOcc = bvh.occludedPacket(rays.data(), n, active, &move);
+                for (int i = 0; i < n; ++i) {
+                    const bool on = (active >> i) & 1;
+                    TriHit a;
+                    const bool ha = on && bvh.intersect(move.apply(rays[size_t(i)], bound[size_t(i)]), a);
+                    ASSERT_EQ(bool((movedFound >> i) & 1), ha) << "moved packet " << p << " ray " << i;
+                    if (ha) { EXPECT_EQ(mh[size_t(i)].t, a.t) << "moved packet " << p << " ray " << i; }
+                    EXPECT_EQ(bool((movedOcc >> i) & 1), on && bvh.occluded(move.apply(rays[size_t(i)], rays[size_t(i)].tmax)))
+                        << "moved packet " << p << " ray " << i;
+                }
+            }
             // With ties reported: the same hits, and every ray whose triangle differs from the
             // single ray's among them.
             std::vector<TriHit> pt(static_cast<size_t>(n));
