@@ -87,6 +87,7 @@ uint64_t TriangleBvh::intersectPacket(const Ray* rays, int n, uint64_t active, T
     }
     return found;
 }
+
 uint64_t TriangleBvh::occludedPacket(const Ray* rays, int n, uint64_t active, const RayTransform* move) const {
     n = std::clamp(n, 0, kMaxPacket);
     if (n < kMaxPacket) active &= (uint64_t(1) << n) - 1;
