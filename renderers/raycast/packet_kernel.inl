@@ -118,7 +118,7 @@ struct PacketGather {
     float tminP, tmaxP;
 };
 
-// Lane l of group g: bit l of m.
+// All ones in lane l where bit l of m is set.
 inline __m256 laneMask8(unsigned m) {
     const __m256i bits = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
     return _mm256_castsi256_ps(_mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32(int(m)), bits), bits));
@@ -147,7 +147,8 @@ inline __m256 unfusedProduct(__m256 a, __m256 b) {
 // non-empty [tmin, tmax]; their RayPre values into pr) and the rest; every other slot of pr is
 // set to never enter a box. Eight rays at a time: RayPre's operations (the nudge of a tiny
 // direction component, 1 / d, o * rdir and the margin 2^-20 (|o| + max |b|) |rdir|) in the same
-// order on each lane, so pr holds bit for bit what RayPre gives each ray. The packet's bounds
+// order on each lane, so pr holds bit for bit what RayPre gives each ray (where the compiler
+// fuses the margin's product with 2^-20 into a sum, that product is exact, so the bits agree). The packet's bounds
 // are the same values whatever the order they are taken in, up to the sign of a zero origin
 // coordinate, which makePacketFrustum's widening (d > 0 for any mesh with a box) removes.
 // move (with tmaxIn: the rays' tmax, null: their own): the rays are world rays, moved into the
