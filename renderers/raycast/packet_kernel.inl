@@ -85,14 +85,23 @@ inline unsigned leafRayMask(const Node8& parent, uint32_t slot, int nx, int ny, 
     return unsigned(_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpgt_epi32(tn, tf)))) ^ 0xFFu;
 }
 
+// The smallest (largest) of v's 8 lanes.
+inline float laneMin8(__m256 v) {
+    __m128 h = _mm_min_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps(v, 1));
+    h = _mm_min_ps(h, _mm_movehl_ps(h, h));
+    return _mm_cvtss_f32(_mm_min_ss(h, _mm_shuffle_ps(h, h, 1)));
+}
+inline float laneMax8(__m256 v) {
+    __m128 h = _mm_max_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps(v, 1));
+    h = _mm_max_ps(h, _mm_movehl_ps(h, h));
+    return _mm_cvtss_f32(_mm_max_ss(h, _mm_shuffle_ps(h, h, 1)));
+}
+
 // Max of pr.tmax over the groups in `groups` (bit g: group g has packet rays).
 inline float packetTmax(const PacketRays& pr, unsigned groups) {
     __m256 m = _mm256_set1_ps(-std::numeric_limits<float>::infinity());
     for (unsigned gm = groups; gm; gm &= gm - 1) m = _mm256_max_ps(m, _mm256_load_ps(pr.tmax + 8 * __builtin_ctz(gm)));
-    __m128 h = _mm_max_ps(_mm256_castps256_ps128(m), _mm256_extractf128_ps(m, 1));
-    h = _mm_max_ps(h, _mm_movehl_ps(h, h));
-    h = _mm_max_ss(h, _mm_shuffle_ps(h, h, 1));
-    return _mm_cvtss_f32(h);
+    return laneMax8(m);
 }
 
 // The fixed inputs of one tracePacket8 call, shared by its phases below.
@@ -122,17 +131,6 @@ struct PacketGather {
 inline __m256 laneMask8(unsigned m) {
     const __m256i bits = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
     return _mm256_castsi256_ps(_mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32(int(m)), bits), bits));
-}
-// The smallest (largest) of v's 8 lanes.
-inline float laneMin8(__m256 v) {
-    __m128 h = _mm_min_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps(v, 1));
-    h = _mm_min_ps(h, _mm_movehl_ps(h, h));
-    return _mm_cvtss_f32(_mm_min_ss(h, _mm_shuffle_ps(h, h, 1)));
-}
-inline float laneMax8(__m256 v) {
-    __m128 h = _mm_max_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps(v, 1));
-    h = _mm_max_ps(h, _mm_movehl_ps(h, h));
-    return _mm_cvtss_f32(_mm_max_ss(h, _mm_shuffle_ps(h, h, 1)));
 }
 
 // a * b as a value of its own: the empty asm keeps GCC from fusing the product into the sum that
