@@ -5,7 +5,7 @@
 //
 //   cmake --build build/release -j2 --target bench_raycast_frame
 //   ./build/release/bench/raycast/bench_raycast_frame [--threads 2] [--frames 7] [--size 1280x720]
-//        [--scenes demo,bunny,igea,mesh1M] [--png DIR] [--testdata DIR] [--ours-only N]
+//        [--scenes demo,bunny,igea,mesh1M] [--png DIR] [--testdata DIR] [--ours-only N] [--avx2-only]
 //
 // --ours-only N: only N warm frames of ours per scene, nothing printed (for profilers:
 // perf record -g bench_raycast_frame --scenes bunny --ours-only 20).
@@ -34,6 +34,9 @@
 // mesh, 988k triangles); and by name only: spheres1M (bench_raster's: 32 x 32 instances of one
 // 1k-triangle sphere) and tiny (48 x 48 instances of a 36-triangle sphere: many small instances
 // under each packet). TBB is limited to --threads, Embree's devices get threads=N.
+// A min_embree call that has not returned after 120 s ends the run with a message (exit code 3):
+// Embree 3.13's AVX-512 packet kernels never return from some rtcOccluded16 calls on AMD Zen 5;
+// --avx2-only then runs min_embree on isa=avx2 alone (frame_ms_vs_default_isa is not printed).
 #include "assets/demo.h"
 #include "assets/image_io.h"
 #include "assets/scene_io.h"
@@ -46,12 +49,14 @@
 #include <tbb/global_control.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #ifndef VIEWER_TESTDATA_DIR
@@ -82,10 +87,53 @@ void line(const std::string& scene, const char* what, double ours, double ref, d
     std::printf("bench: scene=%s what=%s ours=%.2f ref=%.2f ratio=%.3f\n", scene.c_str(), what, ours, ref, ratio);
 }
 
+// Ends the process with a message when a guarded call has run longer than its limit: a library
+// call that never returns cannot be stopped from inside, and a benchmark that hangs says nothing.
+class Watchdog {
+public:
+    Watchdog()
+        : m_thread([this] {
+              while (!m_stop) {
+                  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+                  const int64_t due = m_due;
+                  if (due != 0 && now() > due) {
+                      std::fflush(stdout);
+                      std::fprintf(stderr,
+                                   "bench: %s did not return within %d s; on a CPU where Embree's default ISA hangs, rerun with --avx2-only\n",
+                                   m_what.load(), m_limitS.load());
+                      std::_Exit(3);
+                  }
+              }
+          }) {}
+    ~Watchdog() {
+        m_stop = true;
+        m_thread.join();
+    }
+    // fn(), ended by the watchdog after `limitS` seconds; `what` names it in the message.
+    void guard(const char* what, int limitS, const std::function<void()>& fn) {
+        m_what = what;
+        m_limitS = limitS;
+        m_due = now() + int64_t(limitS) * 1000;
+        fn();
+        m_due = 0;
+    }
+
+private:
+    static int64_t now() {
+        return std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
+    }
+    std::atomic<bool> m_stop{false};
+    std::atomic<int64_t> m_due{0};
+    std::atomic<const char*> m_what{""};
+    std::atomic<int> m_limitS{0};
+    std::thread m_thread;
+};
+
 }   // namespace
 
 int main(int argc, char** argv) {
     int threads = 2, frames = 7, w = 1280, h = 720, oursOnly = 0;
+    bool avx2Only = false;
     std::string only = "demo,bunny,igea,mesh1M", pngDir, testdata = VIEWER_TESTDATA_DIR;
     if (const char* env = std::getenv("VIEWER_TESTDATA")) testdata = env;
     for (int i = 1; i < argc; ++i) {
@@ -105,11 +153,13 @@ int main(int argc, char** argv) {
             testdata = next();
         else if (a == "--ours-only")
             oursOnly = std::max(1, std::atoi(next().c_str()));
+        else if (a == "--avx2-only")
+            avx2Only = true;
         else {
-            std::fprintf(
-                stderr,
-                "usage: %s [--threads N] [--frames N] [--size WxH] [--scenes demo,bunny,igea,mesh1M] [--png DIR] [--testdata DIR] [--ours-only N]\n",
-                argv[0]);
+            std::fprintf(stderr,
+                         "usage: %s [--threads N] [--frames N] [--size WxH] [--scenes demo,bunny,igea,mesh1M] [--png DIR] [--testdata DIR] "
+                         "[--ours-only N] [--avx2-only]\n",
+                         argv[0]);
             return 2;
         }
     }
@@ -127,6 +177,12 @@ int main(int argc, char** argv) {
     if (want("tiny")) scenes.push_back(bench::sphereGrid("tiny", 48, 6));              // 2304 instances of 36 triangles
 
     std::printf("# raycast frame vs min_embree (Embree 3, 4x4 packets): %dx%d, %d threads, shadows on, median of %d rounds\n", w, h, threads, frames);
+    if (avx2Only) std::printf("# --avx2-only: min_embree on isa=avx2 alone (Embree's default ISA left out)\n");
+    // The reference's devices: Embree's default ISA (isa=avx2 with --avx2-only) and isa=avx2.
+    const std::string defaultCfg = avx2Only ? threadsCfg + ",isa=avx2" : threadsCfg;
+    const char* defaultName = avx2Only ? "min_embree (isa=avx2)" : "min_embree on Embree's default ISA";
+    constexpr int kLimitS = 120;   // per min_embree call: a cold 1M-triangle frame takes a few seconds
+    Watchdog watchdog;
     for (BenchScene& sc : scenes) {
         sc.scene.settings.shadows = true;
         const FrameInput f = flatten(sc.scene, float(w) / float(h));
@@ -148,29 +204,31 @@ int main(int argc, char** argv) {
         const double coldOurs = timeMs([&] { ok = ours->render(f, w, h, fb).ok; });
         bench::MinimalEmbree ref, refA;
         const double coldRef = timeMs([&] {
-            err = ref.setup(f, f.settings.tessellation, threadsCfg);
-            if (err.empty()) ref.render(f, w, h, img);
+            watchdog.guard(defaultName, kLimitS, [&] {
+                err = ref.setup(f, f.settings.tessellation, defaultCfg);
+                if (err.empty()) ref.render(f, w, h, img);
+            });
         });
         if (!err.empty() || !ok || !(err = refA.setup(f, f.settings.tessellation, threadsCfg + ",isa=avx2")).empty()) {
             std::fprintf(stderr, "bench: scene %s failed: %s\n", n, ok ? err.c_str() : "our render failed");
             return 1;
         }
-        refA.render(f, w, h, imgA);
+        watchdog.guard("min_embree (isa=avx2)", kLimitS, [&] { refA.render(f, w, h, imgA); });
         // Two levels, as ours (default ISA): not the reference, what instancing costs Embree.
         bench::MinimalEmbree refI;
         std::vector<uint8_t> imgI;
-        if (!(err = refI.setup(f, f.settings.tessellation, threadsCfg, true)).empty()) {
+        if (!(err = refI.setup(f, f.settings.tessellation, defaultCfg, true)).empty()) {
             std::fprintf(stderr, "bench: scene %s failed (instanced): %s\n", n, err.c_str());
             return 1;
         }
-        refI.render(f, w, h, imgI);
+        watchdog.guard(defaultName, kLimitS, [&] { refI.render(f, w, h, imgI); });
         // Warm frames, in rounds.
         std::vector<double> to, td, ta, ti, q, qd, qa, qi;
         for (int i = 0; i < frames; ++i) {
             to.push_back(timeMs([&] { ours->render(f, w, h, fb); }));
-            td.push_back(timeMs([&] { ref.render(f, w, h, img); }));
-            ta.push_back(timeMs([&] { refA.render(f, w, h, imgA); }));
-            ti.push_back(timeMs([&] { refI.render(f, w, h, imgI); }));
+            watchdog.guard(defaultName, kLimitS, [&] { td.push_back(timeMs([&] { ref.render(f, w, h, img); })); });
+            watchdog.guard("min_embree (isa=avx2)", kLimitS, [&] { ta.push_back(timeMs([&] { refA.render(f, w, h, imgA); })); });
+            watchdog.guard(defaultName, kLimitS, [&] { ti.push_back(timeMs([&] { refI.render(f, w, h, imgI); })); });
             q.push_back(to.back() / std::min(td.back(), ta.back()));
             qd.push_back(to.back() / td.back());
             qa.push_back(to.back() / ta.back());
@@ -179,7 +237,7 @@ int main(int argc, char** argv) {
         std::vector<double> best(td.size());
         for (size_t i = 0; i < td.size(); ++i) best[i] = std::min(td[i], ta[i]);
         line(sc.name, "frame_ms", median(to), median(best), median(q));
-        line(sc.name, "frame_ms_vs_default_isa", median(to), median(td), median(qd));
+        if (!avx2Only) line(sc.name, "frame_ms_vs_default_isa", median(to), median(td), median(qd));
         line(sc.name, "frame_ms_vs_avx2", median(to), median(ta), median(qa));
         line(sc.name, "frame_ms_vs_instanced", median(to), median(ti), median(qi));
         line(sc.name, "cold_ms", coldOurs, coldRef, coldOurs / coldRef);
