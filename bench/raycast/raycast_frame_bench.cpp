@@ -55,6 +55,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -181,8 +182,9 @@ int main(int argc, char** argv) {
     // The reference's devices: Embree's default ISA (isa=avx2 with --avx2-only) and isa=avx2.
     const std::string defaultCfg = avx2Only ? threadsCfg + ",isa=avx2" : threadsCfg;
     const char* defaultName = avx2Only ? "min_embree (isa=avx2)" : "min_embree on Embree's default ISA";
-    constexpr int kLimitS = 120;   // per min_embree call: a cold 1M-triangle frame takes a few seconds
-    Watchdog watchdog;
+    constexpr int kLimitS = 120;        // per min_embree call: a cold 1M-triangle frame takes a few seconds
+    std::optional<Watchdog> watchdog;   // (not with --ours-only: no min_embree call to watch)
+    if (oursOnly == 0) watchdog.emplace();
     for (BenchScene& sc : scenes) {
         sc.scene.settings.shadows = true;
         const FrameInput f = flatten(sc.scene, float(w) / float(h));
@@ -204,7 +206,7 @@ int main(int argc, char** argv) {
         const double coldOurs = timeMs([&] { ok = ours->render(f, w, h, fb).ok; });
         bench::MinimalEmbree ref, refA;
         const double coldRef = timeMs([&] {
-            watchdog.guard(defaultName, kLimitS, [&] {
+            watchdog->guard(defaultName, kLimitS, [&] {
                 err = ref.setup(f, f.settings.tessellation, defaultCfg);
                 if (err.empty()) ref.render(f, w, h, img);
             });
@@ -213,7 +215,7 @@ int main(int argc, char** argv) {
             std::fprintf(stderr, "bench: scene %s failed: %s\n", n, ok ? err.c_str() : "our render failed");
             return 1;
         }
-        watchdog.guard("min_embree (isa=avx2)", kLimitS, [&] { refA.render(f, w, h, imgA); });
+        watchdog->guard("min_embree (isa=avx2)", kLimitS, [&] { refA.render(f, w, h, imgA); });
         // Two levels, as ours (default ISA): not the reference, what instancing costs Embree.
         bench::MinimalEmbree refI;
         std::vector<uint8_t> imgI;
@@ -221,14 +223,14 @@ int main(int argc, char** argv) {
             std::fprintf(stderr, "bench: scene %s failed (instanced): %s\n", n, err.c_str());
             return 1;
         }
-        watchdog.guard(defaultName, kLimitS, [&] { refI.render(f, w, h, imgI); });
+        watchdog->guard(defaultName, kLimitS, [&] { refI.render(f, w, h, imgI); });
         // Warm frames, in rounds.
         std::vector<double> to, td, ta, ti, q, qd, qa, qi;
         for (int i = 0; i < frames; ++i) {
             to.push_back(timeMs([&] { ours->render(f, w, h, fb); }));
-            watchdog.guard(defaultName, kLimitS, [&] { td.push_back(timeMs([&] { ref.render(f, w, h, img); })); });
-            watchdog.guard("min_embree (isa=avx2)", kLimitS, [&] { ta.push_back(timeMs([&] { refA.render(f, w, h, imgA); })); });
-            watchdog.guard(defaultName, kLimitS, [&] { ti.push_back(timeMs([&] { refI.render(f, w, h, imgI); })); });
+            watchdog->guard(defaultName, kLimitS, [&] { td.push_back(timeMs([&] { ref.render(f, w, h, img); })); });
+            watchdog->guard("min_embree (isa=avx2)", kLimitS, [&] { ta.push_back(timeMs([&] { refA.render(f, w, h, imgA); })); });
+            watchdog->guard(defaultName, kLimitS, [&] { ti.push_back(timeMs([&] { refI.render(f, w, h, imgI); })); });
             q.push_back(to.back() / std::min(td.back(), ta.back()));
             qd.push_back(to.back() / td.back());
             qa.push_back(to.back() / ta.back());
