@@ -216,7 +216,7 @@ int main(int argc, char** argv) {
             return 1;
         }
         watchdog->guard("min_embree (isa=avx2)", kLimitS, [&] { refA.render(f, w, h, imgA); });
-        // Two levels, as ours (default ISA): not the reference, what instancing costs Embree.
+        // Two levels, as ours (the default ISA; isa=avx2 with --avx2-only): not the reference, what instancing costs Embree.
         bench::MinimalEmbree refI;
         std::vector<uint8_t> imgI;
         if (!(err = refI.setup(f, f.settings.tessellation, defaultCfg, true)).empty()) {
