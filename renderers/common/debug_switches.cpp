@@ -21,6 +21,7 @@ DebugSwitches debugSwitches() {
     d.rasterShadowReuse = !is("VIEWER_RASTER_SHADOW_REUSE", '0');
     d.glShadowReuse = !is("VIEWER_GL_SHADOW_REUSE", '0');
     d.raycastForceSse = is("VIEWER_RAYCAST_SSE", '1');
+    d.raycastForceAvx2 = is("VIEWER_RAYCAST_AVX2", '1');
     d.raycastPackets = !is("VIEWER_RAYCAST_PACKETS", '0');
     d.raycastShadowPackets = !is("VIEWER_RAYCAST_SHADOW_PACKETS", '0');
     d.raycastPacketCull = !is("VIEWER_RAYCAST_PACKET_CULL", '0');

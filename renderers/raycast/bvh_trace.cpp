@@ -1,6 +1,6 @@
-// bvh_trace.cpp - tracing rays through a TriangleBvh: the SSE (BVH4) and AVX2+FMA (BVH8)
-// builds of tri_kernel.inl, chosen once at run time, the entry points that dispatch to them,
-// and the brute-force reference the tests compare against.
+// bvh_trace.cpp - tracing rays through a TriangleBvh: the SSE (BVH4), AVX2+FMA (BVH8) and
+// AVX-512 (its packet leaves) builds of tri_kernel.inl, chosen once at run time, the entry
+// points that dispatch to them, and the brute-force reference the tests compare against.
 #include "raycast/bvh.h"
 #include "renderers/debug_switches.h"
 #include "renderers/isa_region.h"
@@ -21,6 +21,7 @@ void setLane(TriPacket4& p, int k, const vec3& p0, const vec3& p1, const vec3& p
 
 // --- kernels: SSE and AVX2+FMA builds of tri_kernel.inl, chosen once at run time ------------
 
+#define RT_AVX512 0
 namespace kern_sse {
 #define RT_FMA 0
 #include "raycast/tri_kernel.inl"
@@ -34,6 +35,20 @@ namespace kern_avx2 {
 #undef RT_FMA
 }   // namespace kern_avx2
 VIEWER_ISA_REGION_END
+#undef RT_AVX512
+
+// The packet kernel on AVX-512: at a leaf, a triangle against 16 rays or two rays against 8
+// triangles per test (packet_kernel_avx512.inl), lane by lane the AVX2 kernel's operations, so
+// the same hits. Only the packets use it; single rays stay on the AVX2 kernel.
+VIEWER_ISA_REGION_BEGIN("avx512f,avx512dq,avx2,fma")
+namespace kern_avx512 {
+#define RT_FMA 1
+#define RT_AVX512 1
+#include "raycast/tri_kernel.inl"
+#undef RT_AVX512
+#undef RT_FMA
+}   // namespace kern_avx512
+VIEWER_ISA_REGION_END
 
 namespace {
 const bool kUseAvx2 = [] {
@@ -41,9 +56,13 @@ const bool kUseAvx2 = [] {
     __builtin_cpu_init();
     return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
 }();
+const bool kUseAvx512 = [] {
+    if (!kUseAvx2 || rnd::debugSwitches().raycastForceAvx2) return false;
+    return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq");
+}();
 }   // namespace
 
-const char* kernelName() { return kUseAvx2 ? "avx2+fma bvh8" : "sse bvh4"; }
+const char* kernelName() { return kUseAvx512 ? "avx2+fma bvh8, avx-512 packet leaves" : kUseAvx2 ? "avx2+fma bvh8" : "sse bvh4"; }
 int kernelWidth() { return kUseAvx2 ? 8 : 4; }
 
 bool TriangleBvh::intersect(const Ray& ray, TriHit& hit, bool cullBack, TraversalCount* count) const {
@@ -74,9 +93,15 @@ uint64_t TriangleBvh::intersectPacket(const Ray* rays, int n, uint64_t active, T
     if (n < kMaxPacket) active &= (uint64_t(1) << n) - 1;
     if (m_packets.empty() || !active) return 0;
     if (!m_nodes8.empty()) {
+        if (ties && kUseAvx512)
+            return kern_avx512::tracePacket8<false, true>(m_nodes8.data(), m_packets.data(), m_prims.data(), m_absMax, rays, n, active, hits,
+                                                          cullBack, ties, move, tmax);
         if (ties)
             return kern_avx2::tracePacket8<false, true>(m_nodes8.data(), m_packets.data(), m_prims.data(), m_absMax, rays, n, active, hits, cullBack,
                                                         ties, move, tmax);
+        if (kUseAvx512)
+            return kern_avx512::tracePacket8<false>(m_nodes8.data(), m_packets.data(), m_prims.data(), m_absMax, rays, n, active, hits, cullBack,
+                                                    nullptr, move, tmax);
         return kern_avx2::tracePacket8<false>(m_nodes8.data(), m_packets.data(), m_prims.data(), m_absMax, rays, n, active, hits, cullBack, nullptr,
                                               move, tmax);
     }
@@ -92,6 +117,9 @@ uint64_t TriangleBvh::occludedPacket(const Ray* rays, int n, uint64_t active, co
     n = std::clamp(n, 0, kMaxPacket);
     if (n < kMaxPacket) active &= (uint64_t(1) << n) - 1;
     if (m_packets.empty() || !active) return 0;
+    if (!m_nodes8.empty() && kUseAvx512)
+        return kern_avx512::tracePacket8<true>(m_nodes8.data(), m_packets.data(), m_prims.data(), m_absMax, rays, n, active, nullptr, false, nullptr,
+                                               move, nullptr);
     if (!m_nodes8.empty())
         return kern_avx2::tracePacket8<true>(m_nodes8.data(), m_packets.data(), m_prims.data(), m_absMax, rays, n, active, nullptr, false, nullptr,
                                              move, nullptr);

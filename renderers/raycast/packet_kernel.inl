@@ -27,12 +27,16 @@
 
 // A packet's per-ray data, SoA in groups of 8 rays (one AVX register per group). Rays outside
 // the packet get tmax = -1 (a negative integer: their box tests always fail).
+// (Aligned to 64 bytes for the AVX-512 build's 16-ray loads.)
 struct PacketRays {
-    alignas(32) float rd[3][kMaxPacket];   // reciprocal directions (RayPre, nudged zeros)
-    alignas(32) float on[3][kMaxPacket];   // orgRdirNear
-    alignas(32) float of[3][kMaxPacket];   // orgRdirFar
-    alignas(32) float tmin[kMaxPacket];    // max(tmin, 0)
-    alignas(32) float tmax[kMaxPacket];    // shrinks as closer hits are found
+    alignas(64) float rd[3][kMaxPacket];   // reciprocal directions (RayPre, nudged zeros)
+    alignas(64) float on[3][kMaxPacket];   // orgRdirNear
+    alignas(64) float of[3][kMaxPacket];   // orgRdirFar
+    alignas(64) float tmin[kMaxPacket];    // max(tmin, 0)
+    alignas(64) float tmax[kMaxPacket];    // shrinks as closer hits are found
+#if RT_AVX512
+    alignas(64) float org[3][kMaxPacket], dir[3][kMaxPacket];   // the rays (in the mesh's space), for 16 rays per leaf test
+#endif
 };
 
 // Ties (tracePacket8): the rays where the hit kept could depend on the visit order
@@ -173,6 +177,12 @@ inline __m256 unfusedProduct(__m256 a, __m256 b) {
             }
             _mm256_store_ps(pr.tmin + o8, zero);
             _mm256_store_ps(pr.tmax + o8, _mm256_set1_ps(-1.0f));
+#if RT_AVX512
+            for (int a = 0; a < 3; ++a) {
+                _mm256_store_ps(pr.org[a] + o8, zero);
+                _mm256_store_ps(pr.dir[a] + o8, zero);
+            }
+#endif
             continue;
         }
         // The group's rays as (org, tmin) and (dir, tmax) rows, lanes l and l + 4 in one register
@@ -222,6 +232,12 @@ inline __m256 unfusedProduct(__m256 a, __m256 b) {
                 _mm_storeu_ps(&moved[o8 + l + 4].dir.x, _mm256_extractf128_ps(rw[l], 1));
             }
         }
+#if RT_AVX512
+        for (int a = 0; a < 3; ++a) {
+            _mm256_store_ps(pr.org[a] + o8, org[a]);
+            _mm256_store_ps(pr.dir[a] + o8, dir[a]);
+        }
+#endif
         __m256 rd[3], on[3], of[3];
         __m256 bad = zero;   // lanes with a value that is not finite (x - x is NaN there)
         unsigned neg[3];
@@ -489,8 +505,12 @@ template <bool AnyHit, bool Ties = false>
     return hit;
 }
 
+#if RT_AVX512
+#include "raycast/packet_kernel_avx512.inl"
+#endif
+
 // Leaf cur (its box: slot curSlot of curParent): each packet ray whose own box test passes there
-// tests the leaf's triangles on its own. Hits update found; AnyHit: the ray leaves the packet
+// tests the leaf's triangles on its own (with AVX-512 two such rays share each test). Hits update found; AnyHit: the ray leaves the packet
 // (pm, groups); closest hit: the packet's tmax shrinks with the rays'. Ties: see tracePacket8.
 template <bool AnyHit, bool Ties = false>
 [[gnu::always_inline]] inline void intersectLeafRays(const PacketScene& sc, const PacketFrustum& fr, PacketRays& pr, uint32_t cur, uint32_t curParent,
@@ -498,29 +518,48 @@ template <bool AnyHit, bool Ties = false>
     const Node8& parent = *reinterpret_cast<const Node8*>(reinterpret_cast<const char*>(sc.nodes) + curParent);
     const TriPacket4* first = sc.packets + ((cur & ~Node8::kLeafBit) >> 3);
     const TriPacket4* end = first + (cur & 7u);
-    bool shrunk = false;
+    uint64_t lm = 0;   // the rays whose own box test passes (it reads only the ray's own tmax: all first)
+#if RT_AVX512
+    for (int h = 0; h < kMaxPacket / 16; ++h)   // 16 rays per test
+        if ((groups >> (2 * h)) & 3u) lm |= uint64_t(leafRayMask16<Ties>(parent, curSlot, fr.nx, fr.ny, fr.nz, pr, h)) << (16 * h);
+#else
     for (unsigned gm = groups; gm; gm &= gm - 1) {
         const int g = __builtin_ctz(gm);
-        unsigned rm = leafRayMask<Ties>(parent, curSlot, fr.nx, fr.ny, fr.nz, pr, g) & unsigned(pm >> (8 * g)) & 0xFFu;
-        while (rm) {
-            const int i = 8 * g + __builtin_ctz(rm);
-            rm &= rm - 1;
-            if (intersectLeafRay<AnyHit, Ties>(sc, first, end, pr, i)) {
-                found |= uint64_t(1) << i;
-                if constexpr (AnyHit)
-                    pm &= ~(uint64_t(1) << i);
-                else
-                    shrunk = true;
-            }
-        }
-        if constexpr (AnyHit)
-            if (!((pm >> (8 * g)) & 0xFF)) groups &= ~(1u << g);
+        lm |= uint64_t(leafRayMask<Ties>(parent, curSlot, fr.nx, fr.ny, fr.nz, pr, g)) << (8 * g);
     }
-    if constexpr (!AnyHit) {
-        if (shrunk) {
-            tmaxP = Ties ? widenTmax(packetTmax(pr, groups)) : packetTmax(pr, groups);
-            tmax8 = _mm256_set1_ps(tmaxP);
+#endif
+    lm &= pm;
+    uint64_t hit = 0;
+#if RT_AVX512
+    for (int h = 0; h < kMaxPacket / 16; ++h) {   // many rays: each triangle against 16 rays (packet_kernel_avx512.inl)
+        const unsigned b = unsigned(lm >> (16 * h)) & 0xFFFFu;
+        if (__builtin_popcount(b) < kRaysPerTriangleTest) continue;
+        hit |= uint64_t(intersectLeafRays16<AnyHit, Ties>(sc, first, end, pr, h, b)) << (16 * h);
+        lm &= ~(uint64_t(b) << (16 * h));
+    }
+#endif
+    while (lm) {
+        const int i = __builtin_ctzll(lm);
+        lm &= lm - 1;
+#if RT_AVX512
+        if (lm) {   // two rays per test (packet_kernel_avx512.inl); a last odd one alone
+            const int j = __builtin_ctzll(lm);
+            lm &= lm - 1;
+            const unsigned r = intersectLeafRayPair<AnyHit, Ties>(sc, first, end, pr, i, j);
+            hit |= (uint64_t(r & 1u) << i) | (uint64_t(r >> 1) << j);
+            continue;
         }
+#endif
+        if (intersectLeafRay<AnyHit, Ties>(sc, first, end, pr, i)) hit |= uint64_t(1) << i;
+    }
+    found |= hit;
+    if constexpr (AnyHit) {
+        pm &= ~hit;
+        for (unsigned gm = groups; gm; gm &= gm - 1)
+            if (!((pm >> (8 * __builtin_ctz(gm))) & 0xFF)) groups &= ~(1u << __builtin_ctz(gm));
+    } else if (hit) {
+        tmaxP = Ties ? widenTmax(packetTmax(pr, groups)) : packetTmax(pr, groups);
+        tmax8 = _mm256_set1_ps(tmaxP);
     }
 }
 

@@ -15,6 +15,8 @@
 //   VIEWER_GL_SHADOW_REUSE=0              the GL backend draws its shadow maps every frame (as
 //                                         VIEWER_RASTER_SHADOW_REUSE=0)
 //   VIEWER_RAYCAST_SSE=1                  the ray caster's BVH4/SSE traversal even where AVX2 runs
+//   VIEWER_RAYCAST_AVX2=1                 the ray caster's AVX2 packet kernel even where AVX-512
+//                                         runs (one ray per leaf test instead of two)
 //   VIEWER_RAYCAST_PACKETS=0              the ray caster traces camera rays one by one (no packets)
 //   VIEWER_RAYCAST_SHADOW_PACKETS=0       the ray caster traces shadow rays one by one (camera rays
 //                                         still in packets)
@@ -38,6 +40,7 @@ struct DebugSwitches {
     bool rasterShadowReuse = true;
     bool glShadowReuse = true;
     bool raycastForceSse = false;
+    bool raycastForceAvx2 = false;
     bool raycastPackets = true;
     bool raycastShadowPackets = true;
     bool raycastPacketCull = true;
