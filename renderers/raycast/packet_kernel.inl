@@ -510,8 +510,9 @@ template <bool AnyHit, bool Ties = false>
 #endif
 
 // Leaf cur (its box: slot curSlot of curParent): each packet ray whose own box test passes there
-// tests the leaf's triangles on its own (with AVX-512 two such rays share each test). Hits update found; AnyHit: the ray leaves the packet
-// (pm, groups); closest hit: the packet's tmax shrinks with the rays'. Ties: see tracePacket8.
+// tests the leaf's triangles on its own (with AVX-512, two or more of a block of 16 test each
+// triangle together). Hits update found; AnyHit: the ray leaves the packet (pm, groups); closest
+// hit: the packet's tmax shrinks with the rays'. Ties: see tracePacket8.
 template <bool AnyHit, bool Ties = false>
 [[gnu::always_inline]] inline void intersectLeafRays(const PacketScene& sc, const PacketFrustum& fr, PacketRays& pr, uint32_t cur, uint32_t curParent,
                                                      uint32_t curSlot, unsigned& groups, uint64_t& pm, uint64_t& found, float& tmaxP, __m256& tmax8) {
@@ -531,25 +532,15 @@ template <bool AnyHit, bool Ties = false>
     lm &= pm;
     uint64_t hit = 0;
 #if RT_AVX512
-    for (int h = 0; h < kMaxPacket / 16; ++h) {   // many rays: each triangle against 16 rays (packet_kernel_avx512.inl)
+    for (int h = 0; h < kMaxPacket / 16; ++h) {   // two or more of a block of 16 (packet_kernel_avx512.inl)
         const unsigned b = unsigned(lm >> (16 * h)) & 0xFFFFu;
-        if (__builtin_popcount(b) < kRaysPerTriangleTest) continue;
+        if (!(b & (b - 1))) continue;   // none or one
         hit |= uint64_t(intersectLeafRays16<AnyHit, Ties>(sc, first, end, pr, h, b)) << (16 * h);
         lm &= ~(uint64_t(b) << (16 * h));
     }
 #endif
-    while (lm) {
+    for (; lm; lm &= lm - 1) {
         const int i = __builtin_ctzll(lm);
-        lm &= lm - 1;
-#if RT_AVX512
-        if (lm) {   // two rays per test (packet_kernel_avx512.inl); a last odd one alone
-            const int j = __builtin_ctzll(lm);
-            lm &= lm - 1;
-            const unsigned r = intersectLeafRayPair<AnyHit, Ties>(sc, first, end, pr, i, j);
-            hit |= (uint64_t(r & 1u) << i) | (uint64_t(r >> 1) << j);
-            continue;
-        }
-#endif
         if (intersectLeafRay<AnyHit, Ties>(sc, first, end, pr, i)) hit |= uint64_t(1) << i;
     }
     found |= hit;

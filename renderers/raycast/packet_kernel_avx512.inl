@@ -3,22 +3,17 @@
 // RT_AVX512 1) only; the traversal above the leaves is the AVX2 one.
 //
 // The AVX2 packet kernel tests each ray that reaches a leaf on its own, 8 triangles (two
-// TriPacket4) per 8-lane test. Here, where many of a block of 16 rays reach the leaf, each
-// triangle is tested against all 16 at once (intersectLeafRays16, as Embree's coherent packets
-// do); where few do, two rays share a test of 8 triangles, lanes [a: ray i | a: ray j | b: ray i |
-// b: ray j], four each (intersectLeafRayPair). Either way every lane runs exactly the operations
-// of intersectPacketPair's lane for that ray and triangle (intersect16), and each ray's hits of a
+// TriPacket4) per 8-lane test. Here, where two or more of a block of 16 rays reach the leaf,
+// each triangle is tested against all 16 at once (intersectLeafRays16, as Embree's coherent
+// packets do; a lone ray still takes the AVX2 test). Every lane runs exactly the operations of
+// intersectPacketPair's lane for that ray and triangle (intersect16), and each ray's hits of a
 // pair of packets are taken as closestLane takes them (the tmax from before the pair for the
 // tests, lane order, strict less-than), so every hit is bit for bit the AVX2 kernel's and the
-// single ray's.
+// single ray's. (Measured on Zen 5: the same speed from 1 to 8 rays per block as the threshold;
+// two rays per 16-lane test of 8 triangles, where few rays reach a leaf, was no faster.)
 
-// A TriPacket4 field of a and b as [a a b b] (four lanes each). (The masked forms: GCC 12's
-// unmasked _mm512_broadcast_f32x4 and _mm512_permutexvar_ps warn of an uninitialised operand.)
-inline __m512 loadPairTwice(const float* a, const float* b) {
-    return _mm512_mask_broadcast_f32x4(_mm512_maskz_broadcast_f32x4(0x00FF, _mm_load_ps(a)), 0xFF00, _mm_load_ps(b));
-}
-
-// Lane-wise max / min of 32-bit integers (the all-lanes masked forms: see loadPairTwice).
+// Lane-wise max / min of 32-bit integers. (The masked forms with all lanes set: GCC 12's
+// unmasked _mm512_max_epi32 and _mm512_min_epi32 warn of an uninitialised operand.)
 inline __m512i max16i(__m512i a, __m512i b) { return _mm512_maskz_max_epi32(0xFFFF, a, b); }
 inline __m512i min16i(__m512i a, __m512i b) { return _mm512_maskz_min_epi32(0xFFFF, a, b); }
 
@@ -42,16 +37,12 @@ inline unsigned leafRayMask16(const Node8& parent, uint32_t slot, int nx, int ny
     return unsigned(_mm512_cmple_epi32_mask(tn, tf));
 }
 
-// x in the lanes of ray i, y in those of ray j (intersectLeafRayPair).
-inline __m512 twoRays(float x, float y) { return _mm512_mask_blend_ps(0xF0F0, _mm512_set1_ps(x), _mm512_set1_ps(y)); }
-
-// A triangle field per lane: a TriPacket4 pair's lanes for two rays (loadPairTwice), or one
-// triangle for 16 rays (broadcast).
+// One triangle's fields, broadcast to the 16 lanes.
 struct Tri16 {
     __m512 n[3], v0[3], e1[3], e2[3];
 };
 
-// intersectPacketPair's test on 16 lanes (a ray and a triangle each): the same arithmetic lane
+// intersectPacketPair's test on 16 lanes (a ray each): the same arithmetic lane
 // by lane. Returns the 16-bit hit mask. Ties: also *near, as intersectPacketPair<true> gives it.
 template <bool Ties = false>
 [[gnu::always_inline]] inline unsigned intersect16(const Tri16& q, const __m512 o[3], const __m512 d[3], __m512 tmin, __m512 tmax, __m512& tOut,
@@ -103,82 +94,6 @@ template <bool Ties = false>
     return ok;
 }
 
-// intersectPacketPair for two rays (lanes above); the 16-bit hit mask in that lane layout.
-template <bool Ties = false>
-[[gnu::always_inline]] inline unsigned intersectPacketPair2(const TriPacket4& a, const TriPacket4& b, const __m512 o[3], const __m512 d[3],
-                                                            __m512 tmin, __m512 tmax, __m512& tOut, __m512& uOut, __m512& vOut, bool cullBack,
-                                                            __m512 tmaxW = __m512(), unsigned* near = nullptr) {
-    Tri16 q;
-    for (int k = 0; k < 3; ++k) {
-        q.n[k] = loadPairTwice(a.n[k], b.n[k]);
-        q.v0[k] = loadPairTwice(a.v0[k], b.v0[k]);
-        q.e1[k] = loadPairTwice(a.e1[k], b.e1[k]);
-        q.e2[k] = loadPairTwice(a.e2[k], b.e2[k]);
-    }
-    return intersect16<Ties>(q, o, d, tmin, tmax, tOut, uOut, vOut, cullBack, tmaxW, near);
-}
-
-// Ray i's (ray j's) 8 lanes, in intersectPacketPair's order, of a 16-lane mask.
-inline unsigned firstRayLanes(unsigned m) { return (m & 0xFu) | ((m >> 4) & 0xF0u); }
-inline unsigned secondRayLanes(unsigned m) { return ((m >> 4) & 0xFu) | ((m >> 8) & 0xF0u); }
-
-// Packet rays i and j against the triangles of a leaf [first, end) (intersectLeafRay for two
-// rays). Returns bit 0: ray i hit (AnyHit) or found a closer hit (then pr.tmax[i] and hits[i]
-// hold it); bit 1: the same for ray j.
-template <bool AnyHit, bool Ties = false>
-[[gnu::always_inline]] inline unsigned intersectLeafRayPair(const PacketScene& sc, const TriPacket4* first, const TriPacket4* end, PacketRays& pr, int i,
-                                                            int j) {
-    const Ray &ri = sc.rays[i], &rj = sc.rays[j];
-    const __m512 o[3] = {twoRays(ri.org.x, rj.org.x), twoRays(ri.org.y, rj.org.y), twoRays(ri.org.z, rj.org.z)};
-    const __m512 d[3] = {twoRays(ri.dir.x, rj.dir.x), twoRays(ri.dir.y, rj.dir.y), twoRays(ri.dir.z, rj.dir.z)};
-    const __m512 tmin = twoRays(pr.tmin[i], pr.tmin[j]);
-    __m512 tmax = twoRays(pr.tmax[i], pr.tmax[j]);
-    __m512 tmaxW = Ties ? twoRays(widenTmax(pr.tmax[i]), widenTmax(pr.tmax[j])) : tmax;   // the near lanes' bound (closestLaneTies)
-    unsigned res = 0;
-    unsigned live = 0xFFFFu;   // AnyHit: the lanes of the rays not yet blocked
-    for (const TriPacket4* p = first; p < end; p += 2) {
-        const bool two = p + 1 < end;
-        const unsigned lanes = two ? live : live & 0x00FFu;
-        __m512 t, u, v;
-        unsigned near = 0;
-        const unsigned hm = intersectPacketPair2<Ties>(p[0], p[two ? 1 : 0], o, d, tmin, tmax, t, u, v, sc.cullBack, tmaxW, &near) & lanes;
-        near &= lanes;
-        if (!(Ties ? hm | near : hm)) continue;
-        if constexpr (AnyHit) {
-            if (hm & 0x0F0Fu) res |= 1u, live &= 0xF0F0u;
-            if (hm & 0xF0F0u) res |= 2u, live &= 0x0F0Fu;
-            if (!live) return res;
-        } else {
-            // Each ray's 8 lanes in a row of its own, in the order closestLane reads them.
-            const __m512i order = _mm512_setr_epi32(0, 1, 2, 3, 8, 9, 10, 11, 4, 5, 6, 7, 12, 13, 14, 15);
-            alignas(64) float ta[16], ua[16], va[16];
-            _mm512_store_ps(ta, _mm512_maskz_permutexvar_ps(0xFFFF, order, t));
-            _mm512_store_ps(ua, _mm512_maskz_permutexvar_ps(0xFFFF, order, u));
-            _mm512_store_ps(va, _mm512_maskz_permutexvar_ps(0xFFFF, order, v));
-            const uint32_t* ids = sc.prims + 4 * (p - sc.packets);
-            if constexpr (Ties) {
-                const unsigned mi = firstRayLanes(hm), ni = firstRayLanes(near), mj = secondRayLanes(hm), nj = secondRayLanes(near);
-                if ((mi | ni) && closestLaneTies(int(mi), int(ni), ta, ua, va, ids, pr.tmax[i], &sc.hits[i], sc.ties->tie[i], sc.ties->seen,
-                                                 uint64_t(1) << i))
-                    res |= 1u;
-                if ((mj | nj) && closestLaneTies(int(mj), int(nj), ta + 8, ua + 8, va + 8, ids, pr.tmax[j], &sc.hits[j], sc.ties->tie[j],
-                                                 sc.ties->seen, uint64_t(1) << j))
-                    res |= 2u;
-                tmaxW = twoRays(widenTmax(pr.tmax[i]), widenTmax(pr.tmax[j]));
-            } else {
-                if (const unsigned mi = firstRayLanes(hm); mi && closestLane(int(mi), ta, ua, va, ids, pr.tmax[i], &sc.hits[i])) res |= 1u;
-                if (const unsigned mj = secondRayLanes(hm); mj && closestLane(int(mj), ta + 8, ua + 8, va + 8, ids, pr.tmax[j], &sc.hits[j])) res |= 2u;
-            }
-            tmax = twoRays(pr.tmax[i], pr.tmax[j]);
-        }
-    }
-    return res;
-}
-
-// From this many rays of a block of 16 at a leaf on, each triangle is tested against the block
-// at once (intersectLeafRays16) instead of two rays against 8 triangles per test.
-inline constexpr int kRaysPerTriangleTest = 8;
-
 // widenTmax on 16 lanes.
 inline __m512 widenTmax16(__m512 t) {
     const __m512i b = _mm512_castps_si512(t), inf = _mm512_set1_epi32(0x7F800000);
@@ -210,9 +125,9 @@ template <bool AnyHit, bool Ties = false>
     for (const TriPacket4* p = first; p < end; p += 2) {
         const int count = p + 1 < end ? 8 : 4;
         const uint32_t* ids = sc.prims + 4 * (p - sc.packets);
-        __m512 run = tmax;      // the running tmax; the tests use tmax, the one from before the pair
-        unsigned kept = 0;      // (Ties) rays with a hit kept in this pair
-        __m512 nearT[8];        // (Ties) the pair's near lanes: distances and masks
+        __m512 run = tmax;   // the running tmax; the tests use tmax, the one from before the pair
+        unsigned kept = 0;   // (Ties) rays with a hit kept in this pair
+        __m512 nearT[8];     // (Ties) the pair's near lanes: distances and masks
         unsigned nearM[8];
         int nears = 0;
         for (int k = 0; k < count; ++k) {
