@@ -368,6 +368,28 @@ struct PacketFrustum {
     return groups;
 }
 
+#if RT_AVX512
+#include "raycast/packet_kernel_avx512.inl"
+#endif
+
+// The box of slot `slot` of parent (a node's or a leaf's) against the rays of the groups in
+// `groups`: bit i for ray i whose own box test passes (leafRayMask; 16 rays per test on AVX-512).
+template <bool Wide>
+[[gnu::always_inline]] inline uint64_t raysEntering(const Node8& parent, uint32_t slot, const PacketFrustum& fr, const PacketRays& pr,
+                                                    unsigned groups) {
+    uint64_t m = 0;
+#if RT_AVX512
+    for (int h = 0; h < kMaxPacket / 16; ++h)
+        if ((groups >> (2 * h)) & 3u) m |= uint64_t(leafRayMask16<Wide>(parent, slot, fr.nx, fr.ny, fr.nz, pr, h)) << (16 * h);
+#else
+    for (unsigned gm = groups; gm; gm &= gm - 1) {
+        const int g = __builtin_ctz(gm);
+        m |= uint64_t(leafRayMask<Wide>(parent, slot, fr.nx, fr.ny, fr.nz, pr, g)) << (8 * g);
+    }
+#endif
+    return m;
+}
+
 // At inner node cur (not the root), entered from slot curSlot of curParent: the rays that enter
 // it (their own box tests, current tmax). Two or more: returns true, the packet goes on. None
 // or one: returns false, and the one goes on alone (traceTriangles8 from here: the packet's
@@ -376,13 +398,8 @@ struct PacketFrustum {
 template <bool AnyHit, bool Ties = false>
 [[gnu::always_inline]] inline bool packetEnters(const PacketScene& sc, const PacketFrustum& fr, PacketRays& pr, uint32_t cur, uint32_t curParent,
                                                 uint32_t curSlot, unsigned groups, uint64_t& pm, uint64_t& found, float& tmaxP, __m256& tmax8) {
-    uint64_t am = 0;
     const Node8& parent = *reinterpret_cast<const Node8*>(reinterpret_cast<const char*>(sc.nodes) + curParent);
-    for (unsigned gm = groups; gm; gm &= gm - 1) {
-        const int g = __builtin_ctz(gm);
-        am |= uint64_t(leafRayMask<Ties>(parent, curSlot, fr.nx, fr.ny, fr.nz, pr, g)) << (8 * g);
-    }
-    am &= pm;
+    uint64_t am = raysEntering<Ties>(parent, curSlot, fr, pr, groups) & pm;
     if (__builtin_popcountll(am) > 1) return true;
     if (am) {
         const int i = __builtin_ctzll(am);
@@ -505,10 +522,6 @@ template <bool AnyHit, bool Ties = false>
     return hit;
 }
 
-#if RT_AVX512
-#include "raycast/packet_kernel_avx512.inl"
-#endif
-
 // Leaf cur (its box: slot curSlot of curParent): each packet ray whose own box test passes there
 // tests the leaf's triangles on its own (with AVX-512, two or more of a block of 16 test each
 // triangle together). Hits update found; AnyHit: the ray leaves the packet (pm, groups); closest
@@ -519,17 +532,8 @@ template <bool AnyHit, bool Ties = false>
     const Node8& parent = *reinterpret_cast<const Node8*>(reinterpret_cast<const char*>(sc.nodes) + curParent);
     const TriPacket4* first = sc.packets + ((cur & ~Node8::kLeafBit) >> 3);
     const TriPacket4* end = first + (cur & 7u);
-    uint64_t lm = 0;   // the rays whose own box test passes (it reads only the ray's own tmax: all first)
-#if RT_AVX512
-    for (int h = 0; h < kMaxPacket / 16; ++h)   // 16 rays per test
-        if ((groups >> (2 * h)) & 3u) lm |= uint64_t(leafRayMask16<Ties>(parent, curSlot, fr.nx, fr.ny, fr.nz, pr, h)) << (16 * h);
-#else
-    for (unsigned gm = groups; gm; gm &= gm - 1) {
-        const int g = __builtin_ctz(gm);
-        lm |= uint64_t(leafRayMask<Ties>(parent, curSlot, fr.nx, fr.ny, fr.nz, pr, g)) << (8 * g);
-    }
-#endif
-    lm &= pm;
+    // The rays whose own box test passes (it reads only the ray's own tmax: all of them first).
+    uint64_t lm = raysEntering<Ties>(parent, curSlot, fr, pr, groups) & pm;
     uint64_t hit = 0;
 #if RT_AVX512
     for (int h = 0; h < kMaxPacket / 16; ++h) {   // two or more of a block of 16 (packet_kernel_avx512.inl)
