@@ -37,9 +37,10 @@ namespace kern_avx2 {
 VIEWER_ISA_REGION_END
 #undef RT_AVX512
 
-// The packet kernel on AVX-512: at a leaf, a triangle against 16 rays or two rays against 8
-// triangles per test (packet_kernel_avx512.inl), lane by lane the AVX2 kernel's operations, so
-// the same hits. Only the packets use it; single rays stay on the AVX2 kernel.
+// The packet kernel on AVX-512: at a leaf, each triangle against a block of 16 rays per test,
+// and the rays' own box tests 16 at a time (packet_kernel_avx512.inl), lane by lane the AVX2
+// kernel's operations, so the same hits. Only the packets use it; single rays stay on the AVX2
+// kernel.
 VIEWER_ISA_REGION_BEGIN("avx512f,avx512dq,avx2,fma")
 namespace kern_avx512 {
 #define RT_FMA 1

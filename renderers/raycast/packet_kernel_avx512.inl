@@ -1,6 +1,7 @@
-// packet_kernel_avx512.inl - the leaf step of the packet traversal on AVX-512 (16 lanes).
-// Included by packet_kernel.inl in the AVX-512 build of the kernels (namespace kern_avx512,
-// RT_AVX512 1) only; the traversal above the leaves is the AVX2 one.
+// packet_kernel_avx512.inl - the 16-lane steps of the packet traversal on AVX-512: the leaf's
+// triangle tests and the rays' own box tests (at leaves and inner nodes). Included by
+// packet_kernel.inl in the AVX-512 build of the kernels (namespace kern_avx512, RT_AVX512 1)
+// only; the rest of the traversal (the packet's interval node test, the stack) is the AVX2 one.
 //
 // The AVX2 packet kernel tests each ray that reaches a leaf on its own, 8 triangles (two
 // TriPacket4) per 8-lane test. Here, where two or more of a block of 16 rays reach the leaf,

@@ -16,7 +16,7 @@
 //                                         VIEWER_RASTER_SHADOW_REUSE=0)
 //   VIEWER_RAYCAST_SSE=1                  the ray caster's BVH4/SSE traversal even where AVX2 runs
 //   VIEWER_RAYCAST_AVX2=1                 the ray caster's AVX2 packet kernel even where AVX-512
-//                                         runs (one ray per leaf test instead of two)
+//                                         runs (each ray alone at a leaf, not 16 per triangle test)
 //   VIEWER_RAYCAST_PACKETS=0              the ray caster traces camera rays one by one (no packets)
 //   VIEWER_RAYCAST_SHADOW_PACKETS=0       the ray caster traces shadow rays one by one (camera rays
 //                                         still in packets)
