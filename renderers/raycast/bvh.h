@@ -234,9 +234,11 @@ public:
     // reaches a leaf where traverse() with the same tmax would test it (the same box test,
     // node by node), or where traverse() skips it only because its entry distance lies between
     // tmax and the grown far end (a ray can then not hit anything in it before tmax). Leaves
-    // come nearest first for the packet's first ray.
+    // come nearest first for the packet's first ray. live (optional): the rays still wanted,
+    // which the leaf function may clear as it goes (an occlusion query's blocked rays); nodes
+    // are then walked for those alone, and skipped where none is left.
     template <class LeafFn>
-    void traversePacket(const Ray* rays, uint64_t active, LeafFn&& leaf) const;
+    void traversePacket(const Ray* rays, uint64_t active, LeafFn&& leaf, const uint64_t* live = nullptr) const;
 
 private:
     std::vector<Node4> m_nodes;   // m_nodes[0] is the root (a leaf root is wrapped in a node)

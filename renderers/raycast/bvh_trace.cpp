@@ -1,6 +1,7 @@
 // bvh_trace.cpp - tracing rays through a TriangleBvh: the SSE (BVH4), AVX2+FMA (BVH8) and
 // AVX-512 (its packet leaves) builds of tri_kernel.inl, chosen once at run time, the entry
-// points that dispatch to them, and the brute-force reference the tests compare against.
+// points that dispatch to them, the top level's packet node test 8 or 16 rays wide (bvh4Reach),
+// and the brute-force reference the tests compare against.
 #include "raycast/bvh.h"
 #include "renderers/debug_switches.h"
 #include "renderers/isa_region.h"
@@ -130,6 +131,93 @@ uint64_t TriangleBvh::occludedPacket(const Ray* rays, int n, uint64_t active, co
         if (occluded(move ? move->apply(rays[i], rays[i].tmax) : rays[i])) found |= uint64_t(1) << i;
     }
     return found;
+}
+
+// --- the top level's node test for a packet, 8 or 16 lanes at a time -------------------------
+
+// Bvh4PacketTest::reachChildren4's operations per lane (the same IEEE operations, in the same
+// order, with the same NaN rules: max / min return the second operand where either is NaN, and
+// <= is false with a NaN), on blocks of W lanes: with every active lane of a block sharing its
+// direction signs a child's near and far planes are chosen once, otherwise per lane by the
+// sign of the lane's reciprocal (its direction's; BLEND(a, b, r): b where r's sign bit is set,
+// else a). A macro, not a function of vectors: GCC warns
+// of the ABI of vector arguments between the ISA regions.
+#define VIEWER_BVH4_REACH(V, W, SET1, LOAD, SUB, MUL, MAX, MIN, BLEND, LE_MASK, STORE, SIGNS)           \
+    for (int blk = 0; blk < kMaxPacket / W; ++blk) {                                                    \
+        const int at = W * blk;                                                                         \
+        if (!((rays >> at) & ((uint64_t(1) << W) - 1))) continue;                                       \
+        const V ox = LOAD(&t.o[0][at]), oy = LOAD(&t.o[1][at]), oz = LOAD(&t.o[2][at]);                 \
+        const V rx = LOAD(&t.r[0][at]), ry = LOAD(&t.r[1][at]), rz = LOAD(&t.r[2][at]);                 \
+        const V tmin = LOAD(&t.tmin[at]), tmax = LOAD(&t.tmax[at]);                                     \
+        const int signs = SIGNS[blk];                                                                   \
+        for (int c = 0; c < 4; ++c) {                                                                   \
+            if (!((may >> c) & 1) || n.child[c] == Node4::kEmpty) continue;                             \
+            V t0x, t1x, t0y, t1y, t0z, t1z;                                                             \
+            if (signs >= 0) {                                                                           \
+                const int nx = signs & 1, ny = 2 + ((signs >> 1) & 1), nz = 4 + ((signs >> 2) & 1);     \
+                t0x = MUL(SUB(SET1(n.b[nx][c]), ox), rx);                                               \
+                t1x = MUL(SUB(SET1(n.b[1 - (nx & 1)][c]), ox), rx);                                     \
+                t0y = MUL(SUB(SET1(n.b[ny][c]), oy), ry);                                               \
+                t1y = MUL(SUB(SET1(n.b[5 - ny][c]), oy), ry);                                           \
+                t0z = MUL(SUB(SET1(n.b[nz][c]), oz), rz);                                               \
+                t1z = MUL(SUB(SET1(n.b[9 - nz][c]), oz), rz);                                           \
+            } else {                                                                                    \
+                const V lx = MUL(SUB(SET1(n.b[0][c]), ox), rx), hx = MUL(SUB(SET1(n.b[1][c]), ox), rx); \
+                const V ly = MUL(SUB(SET1(n.b[2][c]), oy), ry), hy = MUL(SUB(SET1(n.b[3][c]), oy), ry); \
+                const V lz = MUL(SUB(SET1(n.b[4][c]), oz), rz), hz = MUL(SUB(SET1(n.b[5][c]), oz), rz); \
+                t0x = BLEND(lx, hx, rx), t1x = BLEND(hx, lx, rx);                                       \
+                t0y = BLEND(ly, hy, ry), t1y = BLEND(hy, ly, ry);                                       \
+                t0z = BLEND(lz, hz, rz), t1z = BLEND(hz, lz, rz);                                       \
+            }                                                                                           \
+            const V tn = MAX(MAX(t0x, t0y), MAX(t0z, tmin));                                            \
+            const V tf = MUL(MIN(MIN(t1x, t1y), MIN(t1z, tmax)), SET1(Bvh4RayTest::kGrow));             \
+            reach[c] |= uint64_t(LE_MASK(tn, tf)) << at;                                                \
+            if (first >= at && first < at + W) {                                                        \
+                alignas(64) float d[W];                                                                 \
+                STORE(d, tn);                                                                           \
+                lead[c] = d[first - at];                                                                \
+            }                                                                                           \
+        }                                                                                               \
+    }                                                                                                   \
+    for (int c = 0; c < 4; ++c) reach[c] &= rays;
+
+VIEWER_ISA_REGION_BEGIN("avx2")
+namespace {
+#define VIEWER_LE8(a, b) _mm256_movemask_ps(_mm256_cmp_ps(a, b, _CMP_LE_OS))
+void reachChildren8(const Bvh4PacketTest& t, const Node4& n, uint64_t rays, int may, uint64_t reach[4], float lead[4], int first) {
+    VIEWER_BVH4_REACH(__m256, 8, _mm256_set1_ps, _mm256_load_ps, _mm256_sub_ps, _mm256_mul_ps, _mm256_max_ps, _mm256_min_ps, _mm256_blendv_ps,
+                      VIEWER_LE8, _mm256_store_ps, t.signs8)
+}
+#undef VIEWER_LE8
+}   // namespace
+VIEWER_ISA_REGION_END
+
+VIEWER_ISA_REGION_BEGIN("avx512f,avx512dq,avx2")
+namespace {
+#define VIEWER_BLEND16(a, b, r) _mm512_mask_blend_ps(_mm512_movepi32_mask(_mm512_castps_si512(r)), a, b)
+#define VIEWER_LE16(a, b) _mm512_cmp_ps_mask(a, b, _CMP_LE_OS)
+// (GCC 12's unmasked _mm512_max_ps / _mm512_min_ps warn of an uninitialised operand.)
+#define VIEWER_MAX16(a, b) _mm512_maskz_max_ps(0xFFFF, a, b)
+#define VIEWER_MIN16(a, b) _mm512_maskz_min_ps(0xFFFF, a, b)
+void reachChildren16(const Bvh4PacketTest& t, const Node4& n, uint64_t rays, int may, uint64_t reach[4], float lead[4], int first) {
+    VIEWER_BVH4_REACH(__m512, 16, _mm512_set1_ps, _mm512_load_ps, _mm512_sub_ps, _mm512_mul_ps, VIEWER_MAX16, VIEWER_MIN16, VIEWER_BLEND16,
+                      VIEWER_LE16, _mm512_store_ps, t.signs16)
+}
+#undef VIEWER_BLEND16
+#undef VIEWER_LE16
+#undef VIEWER_MAX16
+#undef VIEWER_MIN16
+}   // namespace
+VIEWER_ISA_REGION_END
+#undef VIEWER_BVH4_REACH
+
+void bvh4Reach(const Bvh4PacketTest& test, const Node4& n, uint64_t rays, int may, uint64_t reach[4], float lead[4], int first) {
+    if (kUseAvx512)
+        reachChildren16(test, n, rays, may, reach, lead, first);
+    else if (kUseAvx2)
+        reachChildren8(test, n, rays, may, reach, lead, first);
+    else
+        test.reachChildren4(n, rays, may, reach, lead, first);
 }
 
 // --- brute force ------------------------------------------------------------------------------

@@ -69,56 +69,85 @@ struct Bvh4RayTest {
     }
 };
 
-// Bvh4RayTest for a packet's rays four at a time (ray 4g + l in lane l of group g): each lane
-// makes the operations Bvh4RayTest makes for its ray, in the same order, so a child is reached
-// by exactly the rays that reach it one by one. A node's child is tested against a group of rays
-// (not a ray against the four children): setting the rays up, skipping empty children and
-// making the reach masks then cost a quarter as much. Where a group's active rays share their
-// direction signs (coherent packets, nearly always), a child's near and far bounds are chosen once
-// for the group; otherwise per lane.
+// Bvh4RayTest for a packet's rays, lane i holding ray i: each lane makes the operations
+// Bvh4RayTest makes for its ray, in the same order, so a child is reached by exactly the rays
+// that reach it one by one. A node's child is tested against a group of rays (not a ray against
+// the four children): setting the rays up, skipping empty children and making the reach masks
+// then cost a fraction as much. The rays are kept lane by lane in arrays, so a test can take
+// four (SSE, `reaches`), eight (AVX2) or sixteen (AVX-512) of them at once (bvh4Reach picks the
+// widest the CPU has). Where a group's active rays share their direction signs (coherent
+// packets, nearly always), a child's near and far bounds are chosen once for the group;
+// otherwise per lane.
 struct Bvh4PacketTest {
     static constexpr int kGroups = kMaxPacket / 4;
-    struct Group {
-        __m128 ox, oy, oz, rx, ry, rz, tmin, tmax;
-        __m128 negX, negY, negZ;   // lanes whose (nudged) direction is negative on that axis
-        int signs;                 // bit a: negative on axis a, where every active lane agrees; -1 otherwise
-    };
-    Group g[kGroups];
+    // Per lane: origin, reciprocal of the (nudged) direction, tmin, tmax. Lanes of inactive rays
+    // within a block of 16 that holds an active one repeat an active ray (so every lane a wide
+    // test reads is set); a lane's direction is negative on an axis where its reciprocal's sign
+    // bit is set (1 / v keeps v's sign, infinities and NaN included).
+    alignas(64) float o[3][kMaxPacket];
+    alignas(64) float r[3][kMaxPacket];
+    alignas(64) float tmin[kMaxPacket];
+    alignas(64) float tmax[kMaxPacket];
+    // Bit a: negative on axis a, where every active lane of the group agrees; -1 otherwise. Per
+    // group of 4, 8 and 16 lanes.
+    int8_t signs4[kGroups], signs8[kMaxPacket / 8], signs16[kMaxPacket / 16];
 
     Bvh4PacketTest(const Ray* rays, uint64_t active) {
         static_assert(sizeof(Ray) == 32 && offsetof(Ray, dir) == 16, "Ray: org, tmin, dir, tmax packed");
         const __m128 signBit = _mm_set1_ps(-0.0f);
         for (int k = 0; k < kGroups; ++k) {
             const unsigned lanes = unsigned(active >> (4 * k)) & 15u;
+            signs4[k] = 0;
             if (!lanes) continue;
             const int firstLane = __builtin_ctz(lanes);
-            __m128 o[4], d[4];
+            __m128 ov[4], d[4];
             for (int l = 0; l < 4; ++l) {   // inactive lanes repeat an active ray
-                const Ray& r = rays[4 * k + (((lanes >> l) & 1) ? l : firstLane)];
-                o[l] = _mm_loadu_ps(&r.org.x);
-                d[l] = _mm_loadu_ps(&r.dir.x);
+                const Ray& ray = rays[4 * k + (((lanes >> l) & 1) ? l : firstLane)];
+                ov[l] = _mm_loadu_ps(&ray.org.x);
+                d[l] = _mm_loadu_ps(&ray.dir.x);
             }
-            _MM_TRANSPOSE4_PS(o[0], o[1], o[2], o[3]);   // ox, oy, oz, tmin
-            _MM_TRANSPOSE4_PS(d[0], d[1], d[2], d[3]);   // dx, dy, dz, tmax
-            Group& q = g[k];
-            q.ox = o[0], q.oy = o[1], q.oz = o[2], q.tmin = o[3], q.tmax = d[3];
-            __m128* const r[3] = {&q.rx, &q.ry, &q.rz};
-            __m128* const neg[3] = {&q.negX, &q.negY, &q.negZ};
-            q.signs = 0;
+            _MM_TRANSPOSE4_PS(ov[0], ov[1], ov[2], ov[3]);   // ox, oy, oz, tmin
+            _MM_TRANSPOSE4_PS(d[0], d[1], d[2], d[3]);       // dx, dy, dz, tmax
+            for (int a = 0; a < 3; ++a) _mm_store_ps(&o[a][4 * k], ov[a]);
+            _mm_store_ps(&tmin[4 * k], ov[3]);
+            _mm_store_ps(&tmax[4 * k], d[3]);
+            int signs = 0;
             bool mixed = false;
             for (int a = 0; a < 3; ++a) {   // RayPre's nudge of a zero component, then 1 / d
                 __m128 v = d[a];
                 const __m128 tiny = _mm_cmplt_ps(_mm_andnot_ps(signBit, v), _mm_set1_ps(1e-30f));
                 v = _mm_or_ps(_mm_andnot_ps(tiny, v), _mm_and_ps(tiny, _mm_or_ps(_mm_and_ps(v, signBit), _mm_set1_ps(1e-30f))));
-                *r[a] = _mm_div_ps(_mm_set1_ps(1.0f), v);
-                *neg[a] = _mm_castsi128_ps(_mm_srai_epi32(_mm_castps_si128(v), 31));
+                _mm_store_ps(&r[a][4 * k], _mm_div_ps(_mm_set1_ps(1.0f), v));
                 const unsigned n = unsigned(_mm_movemask_ps(v)) & lanes;
                 if (n == lanes)
-                    q.signs |= 1 << a;
+                    signs |= 1 << a;
                 else if (n != 0)
                     mixed = true;
             }
-            if (mixed) q.signs = -1;
+            signs4[k] = int8_t(mixed ? -1 : signs);
+        }
+        // The wider groups' signs, and their inactive groups of four filled from an active one.
+        auto merge = [&](int from, int count) {
+            int s = -2;   // none active yet
+            for (int k = from; k < from + count; ++k) {
+                if (!((active >> (4 * k)) & 15u)) continue;
+                s = s == -2 ? signs4[k] : s == signs4[k] ? s : -1;
+            }
+            return int8_t(s == -2 ? 0 : s);
+        };
+        for (int b = 0; b < kMaxPacket / 8; ++b) signs8[b] = merge(2 * b, 2);
+        for (int b = 0; b < kMaxPacket / 16; ++b) {
+            signs16[b] = merge(4 * b, 4);
+            const unsigned lanes = unsigned(active >> (16 * b)) & 0xFFFFu;
+            if (!lanes || lanes == 0xFFFFu) continue;
+            const int from = 16 * b + __builtin_ctz(lanes);   // an active lane
+            for (int k = 4 * b; k < 4 * b + 4; ++k) {
+                if ((active >> (4 * k)) & 15u) continue;
+                for (int l = 4 * k; l < 4 * k + 4; ++l) {
+                    for (int a = 0; a < 3; ++a) o[a][l] = o[a][from], r[a][l] = r[a][from];
+                    tmin[l] = tmin[from], tmax[l] = tmax[from];
+                }
+            }
         }
     }
 
@@ -143,17 +172,17 @@ struct Bvh4PacketTest {
         int signs = -1;
         for (int k = 0; k < kGroups; ++k) {
             if (!((active >> (4 * k)) & 15u)) continue;
-            const Group& q = g[k];
-            if (q.signs < 0 || (signs >= 0 && q.signs != signs)) return;
-            signs = q.signs;
-            const __m128 o[3] = {q.ox, q.oy, q.oz}, r[3] = {q.rx, q.ry, q.rz};
+            if (signs4[k] < 0 || (signs >= 0 && signs4[k] != signs)) return;
+            signs = signs4[k];
             for (int a = 0; a < 3; ++a) {
-                lo[a] = _mm_min_ps(lo[a], o[a]), hi[a] = _mm_max_ps(hi[a], o[a]);
-                rl[a] = _mm_min_ps(rl[a], r[a]), rh[a] = _mm_max_ps(rh[a], r[a]);
-                sum = _mm_add_ps(sum, _mm_add_ps(o[a], r[a]));
+                const __m128 ov = _mm_load_ps(&o[a][4 * k]), rv = _mm_load_ps(&r[a][4 * k]);
+                lo[a] = _mm_min_ps(lo[a], ov), hi[a] = _mm_max_ps(hi[a], ov);
+                rl[a] = _mm_min_ps(rl[a], rv), rh[a] = _mm_max_ps(rh[a], rv);
+                sum = _mm_add_ps(sum, _mm_add_ps(ov, rv));
             }
-            tl = _mm_min_ps(tl, q.tmin), th = _mm_max_ps(th, q.tmax);
-            nanT = _mm_or_ps(nanT, _mm_cmpunord_ps(q.tmin, q.tmax));
+            const __m128 qmin = _mm_load_ps(&tmin[4 * k]), qmax = _mm_load_ps(&tmax[4 * k]);
+            tl = _mm_min_ps(tl, qmin), th = _mm_max_ps(th, qmax);
+            nanT = _mm_or_ps(nanT, _mm_cmpunord_ps(qmin, qmax));
         }
         if (signs < 0 || _mm_movemask_ps(_mm_or_ps(nanT, _mm_cmpunord_ps(sum, sum)))) return;
         auto all = [](__m128 v, bool max) {   // the lanes' min or max, in every lane
@@ -200,33 +229,61 @@ struct Bvh4PacketTest {
 
     // The lanes of group k that reach child c of n (bit l: ray 4k + l); the entry distances in tn.
     int reaches(const Node4& n, int c, int k, __m128& tn) const {
-        const Group& q = g[k];
+        const __m128 ox = _mm_load_ps(&o[0][4 * k]), oy = _mm_load_ps(&o[1][4 * k]), oz = _mm_load_ps(&o[2][4 * k]);
+        const __m128 rx = _mm_load_ps(&r[0][4 * k]), ry = _mm_load_ps(&r[1][4 * k]), rz = _mm_load_ps(&r[2][4 * k]);
         __m128 t0x, t1x, t0y, t1y, t0z, t1z;
-        if (q.signs >= 0) {
-            const int nx = q.signs & 1, ny = 2 + ((q.signs >> 1) & 1), nz = 4 + ((q.signs >> 2) & 1);
-            t0x = _mm_mul_ps(_mm_sub_ps(_mm_set1_ps(n.b[nx][c]), q.ox), q.rx);
-            t1x = _mm_mul_ps(_mm_sub_ps(_mm_set1_ps(n.b[1 - (nx & 1)][c]), q.ox), q.rx);
-            t0y = _mm_mul_ps(_mm_sub_ps(_mm_set1_ps(n.b[ny][c]), q.oy), q.ry);
-            t1y = _mm_mul_ps(_mm_sub_ps(_mm_set1_ps(n.b[5 - ny][c]), q.oy), q.ry);
-            t0z = _mm_mul_ps(_mm_sub_ps(_mm_set1_ps(n.b[nz][c]), q.oz), q.rz);
-            t1z = _mm_mul_ps(_mm_sub_ps(_mm_set1_ps(n.b[9 - nz][c]), q.oz), q.rz);
+        const int signs = signs4[k];
+        if (signs >= 0) {
+            const int nx = signs & 1, ny = 2 + ((signs >> 1) & 1), nz = 4 + ((signs >> 2) & 1);
+            t0x = _mm_mul_ps(_mm_sub_ps(_mm_set1_ps(n.b[nx][c]), ox), rx);
+            t1x = _mm_mul_ps(_mm_sub_ps(_mm_set1_ps(n.b[1 - (nx & 1)][c]), ox), rx);
+            t0y = _mm_mul_ps(_mm_sub_ps(_mm_set1_ps(n.b[ny][c]), oy), ry);
+            t1y = _mm_mul_ps(_mm_sub_ps(_mm_set1_ps(n.b[5 - ny][c]), oy), ry);
+            t0z = _mm_mul_ps(_mm_sub_ps(_mm_set1_ps(n.b[nz][c]), oz), rz);
+            t1z = _mm_mul_ps(_mm_sub_ps(_mm_set1_ps(n.b[9 - nz][c]), oz), rz);
         } else {
-            auto slab = [&](int axis, __m128 o, __m128 r, __m128 neg, __m128& near, __m128& far) {
-                const __m128 lo = _mm_mul_ps(_mm_sub_ps(_mm_set1_ps(n.b[2 * axis][c]), o), r);
-                const __m128 hi = _mm_mul_ps(_mm_sub_ps(_mm_set1_ps(n.b[2 * axis + 1][c]), o), r);
+            auto slab = [&](int axis, __m128 ov, __m128 rv, __m128& near, __m128& far) {
+                const __m128 neg = _mm_castsi128_ps(_mm_srai_epi32(_mm_castps_si128(rv), 31));
+                const __m128 lo = _mm_mul_ps(_mm_sub_ps(_mm_set1_ps(n.b[2 * axis][c]), ov), rv);
+                const __m128 hi = _mm_mul_ps(_mm_sub_ps(_mm_set1_ps(n.b[2 * axis + 1][c]), ov), rv);
                 near = _mm_or_ps(_mm_and_ps(neg, hi), _mm_andnot_ps(neg, lo));
                 far = _mm_or_ps(_mm_and_ps(neg, lo), _mm_andnot_ps(neg, hi));
             };
-            slab(0, q.ox, q.rx, q.negX, t0x, t1x);
-            slab(1, q.oy, q.ry, q.negY, t0y, t1y);
-            slab(2, q.oz, q.rz, q.negZ, t0z, t1z);
+            slab(0, ox, rx, t0x, t1x);
+            slab(1, oy, ry, t0y, t1y);
+            slab(2, oz, rz, t0z, t1z);
         }
-        tn = _mm_max_ps(_mm_max_ps(t0x, t0y), _mm_max_ps(t0z, q.tmin));
-        __m128 tf = _mm_min_ps(_mm_min_ps(t1x, t1y), _mm_min_ps(t1z, q.tmax));
+        tn = _mm_max_ps(_mm_max_ps(t0x, t0y), _mm_max_ps(t0z, _mm_load_ps(&tmin[4 * k])));
+        __m128 tf = _mm_min_ps(_mm_min_ps(t1x, t1y), _mm_min_ps(t1z, _mm_load_ps(&tmax[4 * k])));
         tf = _mm_mul_ps(tf, _mm_set1_ps(Bvh4RayTest::kGrow));
         return _mm_movemask_ps(_mm_cmple_ps(tn, tf));
     }
+
+    // reach[c]: the rays of `rays` that reach child c of n, for each c in `may` that is not
+    // empty (the others keep 0); lead[c]: ray `first`'s entry distance there (set where that ray
+    // reaches c). Four lanes per test.
+    void reachChildren4(const Node4& n, uint64_t rays, int may, uint64_t reach[4], float lead[4], int first) const {
+        for (int c = 0; c < 4; ++c) {
+            if (!((may >> c) & 1) || n.child[c] == Node4::kEmpty) continue;   // (empty bounds: never reached)
+            for (uint64_t groups = rays; groups;) {
+                const int k = __builtin_ctzll(groups) >> 2;
+                groups &= ~(uint64_t(15) << (4 * k));
+                __m128 tn;
+                reach[c] |= uint64_t(reaches(n, c, k, tn)) << (4 * k);
+                if (k == first >> 2) {
+                    alignas(16) float t[4];
+                    _mm_store_ps(t, tn);
+                    lead[c] = t[first & 3];
+                }
+            }
+            reach[c] &= rays;
+        }
+    }
 };
+
+// Bvh4PacketTest::reachChildren4 with the widest test this CPU has: 16 lanes per test with
+// AVX-512, 8 with AVX2, else 4 (bvh4_packet.cpp); lane by lane the same operations.
+void bvh4Reach(const Bvh4PacketTest& test, const Node4& n, uint64_t rays, int may, uint64_t reach[4], float lead[4], int first);
 
 template <bool AnyHit, bool Count, class LeafFn>
 void Bvh4::traverse(const Ray& ray, float& tmax, LeafFn&& leaf, uint32_t* visited) const {
@@ -316,7 +373,7 @@ void Bvh4::traverse(const Ray& ray, float& tmax, LeafFn&& leaf, uint32_t* visite
 }
 
 template <class LeafFn>
-void Bvh4::traversePacket(const Ray* rays, uint64_t active, LeafFn&& leaf) const {
+void Bvh4::traversePacket(const Ray* rays, uint64_t active, LeafFn&& leaf, const uint64_t* live) const {
     if (m_nodes.empty() || !active) return;
     Bvh4PacketTest test(rays, active);
     bool wholeSet = false;
@@ -329,7 +386,9 @@ void Bvh4::traversePacket(const Ray* rays, uint64_t active, LeafFn&& leaf) const
     uint32_t cur = 0;   // root: node 0
     uint64_t curRays = active;
     for (;;) {
-        if (!(cur & Node4::kLeafBit)) {
+        if (live) curRays &= *live;
+        if (!curRays) {   // every ray of this entry is done
+        } else if (!(cur & Node4::kLeafBit)) {
             const Node4& n = m_nodes[cur];
             uint64_t reach[4] = {0, 0, 0, 0};
             alignas(16) float lead[4];   // entry distances for the packet's first ray here
@@ -342,21 +401,7 @@ void Bvh4::traversePacket(const Ray* rays, uint64_t active, LeafFn&& leaf) const
                 wholeSet = true;
                 if (test.whole) may = test.mayReach(n);
             }
-            for (int c = 0; c < 4; ++c) {
-                if (!((may >> c) & 1) || n.child[c] == Node4::kEmpty) continue;   // (empty bounds: never reached)
-                for (uint64_t groups = curRays; groups;) {
-                    const int k = __builtin_ctzll(groups) >> 2;
-                    groups &= ~(uint64_t(15) << (4 * k));
-                    __m128 tn;
-                    reach[c] |= uint64_t(test.reaches(n, c, k, tn)) << (4 * k);
-                    if (k == first >> 2) {
-                        alignas(16) float t[4];
-                        _mm_store_ps(t, tn);
-                        lead[c] = t[first & 3];
-                    }
-                }
-                reach[c] &= curRays;
-            }
+            bvh4Reach(test, n, curRays, may, reach, lead, first);
             // Children reached, nearest (for the first ray) visited first.
             Entry e[4];
             float key[4];

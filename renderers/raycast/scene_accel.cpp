@@ -466,41 +466,33 @@ uint64_t SceneAccel::occludedPacket(const Ray* rays, int n, uint64_t active) con
     if (n < kMaxPacket) active &= (uint64_t(1) << n) - 1;
     if (m_tlas.empty() || !active) return 0;
     if (!m_anyMesh) return eachRay(active, [&](int i) { return occluded(rays[i]); });   // no mesh to share
-    uint64_t blocked = 0;
+    uint64_t blocked = 0, open = active;                                                // open: the rays not blocked yet
     const std::vector<uint32_t>& prims = m_tlas.primIndex();
-    constexpr int kMaxMeshes = 16;
-    struct Touched {
-        uint32_t instance;
-        uint64_t rays;
-    };
-    Touched touched[kMaxMeshes];
-    int k = 0;
-    // Phase 1: the top level walked once for the packet (each ray tested at each node as
-    // occluded() tests it); the big meshes are set aside for phase 2 (tested right away once
-    // kMaxMeshes are set aside), the rest tested here for the rays not blocked yet.
-    m_tlas.traversePacket(rays, active, [&](uint32_t first, uint32_t count, uint64_t reach) {
-        for (uint32_t c = 0; c < count; ++c) {
-            const uint32_t j = prims[first + c];
-            const Instance& inst = m_instances[j];
-            if (inst.isMesh && k < kMaxMeshes) {   // instances are unique in the top level
-                touched[k++] = {j, reach};
-                continue;
+    // The top level walked once for the packet (each ray tested at each node as occluded()
+    // tests it), nearest first for its first ray; each instance met is tested for the rays that
+    // reach it and are not blocked yet (a mesh as a packet, moved into its space by the packet
+    // kernel), and blocked rays leave the walk. Which rays are blocked does not depend on the
+    // order the instances are tested in.
+    m_tlas.traversePacket(
+        rays, active,
+        [&](uint32_t first, uint32_t count, uint64_t reach) {
+            for (uint32_t c = 0; c < count; ++c) {
+                const uint64_t todo = reach & open;
+                if (!todo) break;
+                const Instance& inst = m_instances[prims[first + c]];
+                if (inst.isMesh) {
+                    blocked |= inst.bvh->occludedPacket(rays, n, todo, &inst.toObject);
+                } else {
+                    for (uint64_t m = todo; m; m &= m - 1) {
+                        const int i = __builtin_ctzll(m);
+                        if (instanceOccluded(inst, rays[i])) blocked |= uint64_t(1) << i;
+                    }
+                }
+                open = active & ~blocked;
             }
-            for (uint64_t m = reach & ~blocked; m; m &= m - 1) {
-                const int i = __builtin_ctzll(m);
-                if (instanceOccluded(inst, rays[i])) blocked |= uint64_t(1) << i;
-            }
-        }
-        return (active & ~blocked) == 0;
-    });
-    // Phase 2: each big mesh once, for the rays that reach it and are not blocked yet (moved
-    // into its space by the packet kernel).
-    for (int s = 0; s < k; ++s) {
-        const uint64_t todo = touched[s].rays & ~blocked;
-        if (!todo) continue;
-        const Instance& inst = m_instances[touched[s].instance];
-        blocked |= inst.bvh->occludedPacket(rays, n, todo, &inst.toObject);
-    }
+            return open == 0;
+        },
+        &open);
     return blocked;
 }
 

@@ -59,9 +59,9 @@ public:
     // Any hits of a packet of world rays (the shadow rays of a pixel tile toward one light): for
     // each active ray exactly what occluded(rays[i]) gives; returns the mask of blocked rays.
     // The top level is walked once for the packet (Bvh4::traversePacket: each ray reaches the
-    // instances its own traversal would); analytic shapes are tested right there for the rays not
-    // blocked yet, meshes (of any size) once per packet for the rays that reach them and are not
-    // blocked yet (TriangleBvh::occludedPacket).
+    // instances its own traversal would); each instance is tested as the walk meets it, for the
+    // rays that reach it and are not blocked yet (a mesh of any size as a packet,
+    // TriangleBvh::occludedPacket), and blocked rays leave the walk.
     uint64_t occludedPacket(const Ray* worldRays, int n, uint64_t active) const;
 
     // Boxes that hold every hit a ray can have (the ray caster's packet culling): with up to 16

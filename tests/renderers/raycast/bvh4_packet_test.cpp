@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <random>
 #include <set>
 #include <utility>
@@ -187,4 +188,73 @@ TEST(RaycastTest, Bvh4PacketIntervalNeverRulesOutAReachedChild) {
     EXPECT_GT(reachedChildren, 1000u);
     EXPECT_GT(ruledOut, 2000u);   // the test does rule children out
     EXPECT_GT(unbounded, 10u);    // and declines packets it cannot bound
+}
+
+// bvh4Reach (8 or 16 lanes per test where the CPU has AVX2 or AVX-512; CTest runs this test a
+// second time with VIEWER_RAYCAST_AVX2=1) against the four-lane test, child by child: the same
+// rays reach each child and the first ray's entry distance is the same bit for bit, for packets
+// of up to 64 rays with gaps, mixed direction signs, rays along a slab, NaN and infinite lanes.
+TEST(RaycastTest, Bvh4PacketWideTestsEqualFourLanes) {
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> u(-20.0f, 20.0f), unit(-1.0f, 1.0f), size(0.0f, 3.0f);
+    std::uniform_int_distribution<int> pick(0, 11);
+    size_t reached = 0, missed = 0;
+    for (int p = 0; p < 3000; ++p) {
+        Ray rays[kMaxPacket];
+        const int n = 1 + (p * 7) % kMaxPacket;
+        const vec3 eye(u(rng), u(rng), u(rng)), toward(unit(rng), unit(rng), unit(rng));
+        const float spread = p % 3 == 0 ? 0.05f : p % 3 == 1 ? 0.4f : 2.0f;   // the last: mixed signs
+        for (int i = 0; i < n; ++i) {
+            Ray& r = rays[i];
+            r.org = p % 2 ? eye : eye + 0.5f * vec3(unit(rng), unit(rng), unit(rng));
+            r.dir = toward + spread * vec3(unit(rng), unit(rng), unit(rng));
+            r.tmin = p % 4 == 0 ? 0.5f : 0.0f;
+            r.tmax = i % 3 == 0 ? std::numeric_limits<float>::infinity() : 1.0f + 40.0f * std::abs(unit(rng));
+            switch (p % 13 == 5 ? pick(rng) : -1) {
+            case 0: r.dir.x = std::numeric_limits<float>::quiet_NaN(); break;
+            case 1: r.org.y = 3e30f; break;
+            case 2: r.tmax = std::numeric_limits<float>::quiet_NaN(); break;
+            case 3: r.dir = vec3(0.0f, 0.0f, 1e-35f); break;
+            case 4: r.tmax = -1.0f; break;
+            case 5: r.dir.y = 0.0f; break;    // along a slab
+            case 6: r.dir.z = -0.0f; break;   // a negative zero
+            case 7: r.dir.x = std::numeric_limits<float>::infinity(); break;
+            default: break;
+            }
+        }
+        uint64_t active = n == 64 ? ~uint64_t(0) : (uint64_t(1) << n) - 1;
+        if (p % 5 == 0) active &= 0x5555555555555555ull;
+        if (p % 7 == 0) active &= 0xF0F0F0F00000FFFFull;
+        if (!active) continue;
+        const Bvh4PacketTest test(rays, active);
+        // The walk asks for a subset of the packet's rays at nodes below the root.
+        const uint64_t subset = p % 4 == 3 ? active & (0x0123456789ABCDEFull * uint64_t(p + 1)) : active;
+        if (!subset) continue;
+        Node4 node;
+        for (int c = 0; c < 4; ++c) {
+            const vec3 centre = eye + u(rng) * toward + vec3(u(rng), u(rng), u(rng)) * 0.3f;
+            vec3 e(size(rng), size(rng), size(rng));
+            if (c == 1) e.y = 0.0f;
+            for (int a = 0; a < 3; ++a) {
+                node.b[2 * a][c] = centre[a] - e[a];
+                node.b[2 * a + 1][c] = centre[a] + e[a];
+            }
+            node.child[c] = c == 3 && p % 6 == 0 ? Node4::kEmpty : uint32_t(c);
+        }
+        const int may = p % 8 == 0 ? 5 : 15;
+        const int first = __builtin_ctzll(subset);
+        uint64_t want[4] = {0, 0, 0, 0}, got[4] = {0, 0, 0, 0};
+        float wantLead[4] = {-1, -1, -1, -1}, gotLead[4] = {-2, -2, -2, -2};
+        test.reachChildren4(node, subset, may, want, wantLead, first);
+        bvh4Reach(test, node, subset, may, got, gotLead, first);
+        for (int c = 0; c < 4; ++c) {
+            EXPECT_EQ(got[c], want[c]) << "packet " << p << " child " << c << " (" << kernelName() << ")";
+            EXPECT_EQ(got[c] & ~subset, 0u);
+            if ((want[c] >> first) & 1) { EXPECT_EQ(std::memcmp(&gotLead[c], &wantLead[c], sizeof(float)), 0) << "packet " << p << " child " << c; }
+            reached += size_t(__builtin_popcountll(want[c]));
+            missed += size_t(__builtin_popcountll(subset & ~want[c]));
+        }
+    }
+    EXPECT_GT(reached, 5000u);   // both outcomes are exercised
+    EXPECT_GT(missed, 10000u);
 }
