@@ -89,65 +89,52 @@ struct Bvh4PacketTest {
     alignas(64) float tmin[kMaxPacket];
     alignas(64) float tmax[kMaxPacket];
     // Bit a: negative on axis a, where every active lane of the group agrees; -1 otherwise. Per
-    // group of 4, 8 and 16 lanes.
+    // group of 4, 8 and 16 lanes (read only for groups with an active ray).
     int8_t signs4[kGroups], signs8[kMaxPacket / 8], signs16[kMaxPacket / 16];
 
     Bvh4PacketTest(const Ray* rays, uint64_t active) {
         static_assert(sizeof(Ray) == 32 && offsetof(Ray, dir) == 16, "Ray: org, tmin, dir, tmax packed");
         const __m128 signBit = _mm_set1_ps(-0.0f);
-        for (int k = 0; k < kGroups; ++k) {
-            const unsigned lanes = unsigned(active >> (4 * k)) & 15u;
-            signs4[k] = 0;
-            if (!lanes) continue;
-            const int firstLane = __builtin_ctz(lanes);
-            __m128 ov[4], d[4];
-            for (int l = 0; l < 4; ++l) {   // inactive lanes repeat an active ray
-                const Ray& ray = rays[4 * k + (((lanes >> l) & 1) ? l : firstLane)];
-                ov[l] = _mm_loadu_ps(&ray.org.x);
-                d[l] = _mm_loadu_ps(&ray.dir.x);
-            }
-            _MM_TRANSPOSE4_PS(ov[0], ov[1], ov[2], ov[3]);   // ox, oy, oz, tmin
-            _MM_TRANSPOSE4_PS(d[0], d[1], d[2], d[3]);       // dx, dy, dz, tmax
-            for (int a = 0; a < 3; ++a) _mm_store_ps(&o[a][4 * k], ov[a]);
-            _mm_store_ps(&tmin[4 * k], ov[3]);
-            _mm_store_ps(&tmax[4 * k], d[3]);
-            int signs = 0;
-            bool mixed = false;
-            for (int a = 0; a < 3; ++a) {   // RayPre's nudge of a zero component, then 1 / d
-                __m128 v = d[a];
-                const __m128 tiny = _mm_cmplt_ps(_mm_andnot_ps(signBit, v), _mm_set1_ps(1e-30f));
-                v = _mm_or_ps(_mm_andnot_ps(tiny, v), _mm_and_ps(tiny, _mm_or_ps(_mm_and_ps(v, signBit), _mm_set1_ps(1e-30f))));
-                _mm_store_ps(&r[a][4 * k], _mm_div_ps(_mm_set1_ps(1.0f), v));
-                const unsigned n = unsigned(_mm_movemask_ps(v)) & lanes;
-                if (n == lanes)
-                    signs |= 1 << a;
-                else if (n != 0)
-                    mixed = true;
-            }
-            signs4[k] = int8_t(mixed ? -1 : signs);
-        }
-        // The wider groups' signs, and their inactive groups of four filled from an active one.
-        auto merge = [&](int from, int count) {
-            int s = -2;   // none active yet
-            for (int k = from; k < from + count; ++k) {
-                if (!((active >> (4 * k)) & 15u)) continue;
-                s = s == -2 ? signs4[k] : s == signs4[k] ? s : -1;
-            }
-            return int8_t(s == -2 ? 0 : s);
-        };
-        for (int b = 0; b < kMaxPacket / 8; ++b) signs8[b] = merge(2 * b, 2);
-        for (int b = 0; b < kMaxPacket / 16; ++b) {
-            signs16[b] = merge(4 * b, 4);
-            const unsigned lanes = unsigned(active >> (16 * b)) & 0xFFFFu;
-            if (!lanes || lanes == 0xFFFFu) continue;
-            const int from = 16 * b + __builtin_ctz(lanes);   // an active lane
+        for (uint64_t blocks = active; blocks;) {   // the blocks of 16 lanes that hold an active ray
+            const int b = __builtin_ctzll(blocks) >> 4;
+            blocks &= ~(uint64_t(0xFFFF) << (16 * b));
+            const unsigned lanes16 = unsigned(active >> (16 * b)) & 0xFFFFu;
+            const int from = 16 * b + __builtin_ctz(lanes16);   // an active ray, for groups without one
+            int merged[3] = {-2, -2, -2};                       // the two groups of 8, then 16 (-2: none active yet)
             for (int k = 4 * b; k < 4 * b + 4; ++k) {
-                if ((active >> (4 * k)) & 15u) continue;
-                for (int l = 4 * k; l < 4 * k + 4; ++l) {
-                    for (int a = 0; a < 3; ++a) o[a][l] = o[a][from], r[a][l] = r[a][from];
-                    tmin[l] = tmin[from], tmax[l] = tmax[from];
+                const unsigned lanes = unsigned(active >> (4 * k)) & 15u;
+                const int firstLane = lanes ? 4 * k + __builtin_ctz(lanes) : from;
+                __m128 ov[4], d[4];
+                for (int l = 0; l < 4; ++l) {   // inactive lanes repeat an active ray
+                    const Ray& ray = rays[((lanes >> l) & 1) ? 4 * k + l : firstLane];
+                    ov[l] = _mm_loadu_ps(&ray.org.x);
+                    d[l] = _mm_loadu_ps(&ray.dir.x);
                 }
+                _MM_TRANSPOSE4_PS(ov[0], ov[1], ov[2], ov[3]);   // ox, oy, oz, tmin
+                _MM_TRANSPOSE4_PS(d[0], d[1], d[2], d[3]);       // dx, dy, dz, tmax
+                for (int a = 0; a < 3; ++a) _mm_store_ps(&o[a][4 * k], ov[a]);
+                _mm_store_ps(&tmin[4 * k], ov[3]);
+                _mm_store_ps(&tmax[4 * k], d[3]);
+                int signs = 0;
+                bool mixed = false;
+                for (int a = 0; a < 3; ++a) {   // RayPre's nudge of a zero component, then 1 / d
+                    __m128 v = d[a];
+                    const __m128 tiny = _mm_cmplt_ps(_mm_andnot_ps(signBit, v), _mm_set1_ps(1e-30f));
+                    v = _mm_or_ps(_mm_andnot_ps(tiny, v), _mm_and_ps(tiny, _mm_or_ps(_mm_and_ps(v, signBit), _mm_set1_ps(1e-30f))));
+                    _mm_store_ps(&r[a][4 * k], _mm_div_ps(_mm_set1_ps(1.0f), v));
+                    const unsigned n = unsigned(_mm_movemask_ps(v)) & lanes;
+                    if (n == lanes)
+                        signs |= 1 << a;
+                    else if (n != 0)
+                        mixed = true;
+                }
+                signs4[k] = int8_t(mixed ? -1 : signs);
+                if (!lanes) continue;   // (its lanes are copies: no say in the wider groups' signs)
+                for (int* m : {&merged[(k >> 1) & 1], &merged[2]}) *m = *m == -2 ? signs4[k] : *m == signs4[k] ? *m : -1;
             }
+            signs8[2 * b] = int8_t(merged[0] == -2 ? 0 : merged[0]);
+            signs8[2 * b + 1] = int8_t(merged[1] == -2 ? 0 : merged[1]);
+            signs16[b] = int8_t(merged[2]);
         }
     }
 
