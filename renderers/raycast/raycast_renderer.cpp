@@ -126,6 +126,12 @@ void traceCameraPackets(const FrameJob& job, const rt::SceneAccel& accel, int x0
             job.cam.grid(wx, nx, wy, ny, pr.data());
             int n = nx * ny;
             const uint64_t found = accel.intersectPacket(pr.data(), n, ~uint64_t(0), ph.data(), job.f.settings.culling);
+            // The hit triangles' vertex indices, fetched now for the frames (Tracer::frameMeshHits) a
+            // few packets later.
+            for (uint64_t m = found; m; m &= m - 1) {
+                const rt::SceneHit& h = ph[__builtin_ctzll(m)];
+                if (h.kind == rt::SceneHit::Kind::Mesh) __builtin_prefetch(&job.f.meshes[h.instance].mesh->indices[3 * size_t(h.prim)]);
+            }
             for (int j = 0; j < ny; ++j) {
                 const size_t at = size_t(py + j - y0) * tile + size_t(px - x0);
                 for (int i = 0; i < nx; ++i) {
