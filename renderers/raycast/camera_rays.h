@@ -100,6 +100,16 @@ public:
     // wy[j]) bit for bit, each column's and row's share of the unprojection made once.
     void grid(const float* wx, int nx, const float* wy, int ny, Ray* out) const {
         constexpr int kMax = 8, kBatch = 16;
+        if (nx == 4 && ny <= kMaxRows && rowsOfFourAvailable()) {   // a packet's rows, four rays per vector
+            glm::dvec4 cols[4], rows[kMaxRows], slow[4 * kMaxRows];
+            for (int i = 0; i < 4; ++i) cols[i] = column(wx[i]);
+            for (int j = 0; j < ny; ++j) rows[j] = row(wy[j]);
+            for (uint32_t m = rowsOfFour(cols, rows, ny, out, slow); m; m &= m - 1) {
+                const int k = __builtin_ctz(m);
+                out[k] = rayThrough(slow[k]);
+            }
+            return;
+        }
         __m128d cols[kMax][2];   // column(wx[i]) as (x, y) and (z, w) pairs (no zeroing: glm's vectors clear themselves)
         for (int i = 0; i < nx && i < kMax; ++i) toPairs(column(wx[i]), cols[i]);
         // Up to kBatch rays at a time: first every ray's divisions (independent of each other,
@@ -125,6 +135,12 @@ public:
     }
 
 private:
+    // grid's rows of four rays with AVX2 (camera_rays.cpp), where the CPU has it: ray 4j + i
+    // through column cols[i] and row rows[j], j < ny <= kMaxRows, into out; returns bit 4j + i
+    // for the rays with no far end or something not finite (they take rayThrough(slow[4j + i])).
+    static constexpr int kMaxRows = 8;
+    static bool rowsOfFourAvailable();
+    uint32_t rowsOfFour(const glm::dvec4 cols[4], const glm::dvec4* rows, int ny, Ray* out, glm::dvec4* slow) const;
     static void toPairs(const glm::dvec4& v, __m128d* p) {   // (x, y) and (z, w)
         p[0] = _mm_loadu_pd(&v.x);
         p[1] = _mm_loadu_pd(&v.z);

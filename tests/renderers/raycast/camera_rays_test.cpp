@@ -1,5 +1,5 @@
 // camera_rays_test.cpp - CameraRays::grid (a packet's camera rays, the unprojection done two
-// doubles at a time) and CameraRays::neighbours (a pixel's neighbours) against CameraRays::ray,
+// doubles at a time, or a row of four rays per vector with AVX2) and CameraRays::neighbours (a pixel's neighbours) against CameraRays::ray,
 // bit for bit, for every projection, far planes at infinity, window positions inside and far
 // outside the image, and grids wider than the columns it keeps; CameraRays::windowBounds (the window rectangle that holds every camera ray
 // that can meet a box) against the rays' own box tests, boxes grazed by rays included; and
@@ -55,7 +55,9 @@ TEST(CameraRaysTest, GridGivesEachRayBitForBit) {
             const FrameCamera cam = makeFrameCamera(camWorld, proj, float(w) / h, 5.0f);
             const CameraRays cr(cam, w, h);
             for (int trial = 0; trial < 40; ++trial) {
-                const int nx = 1 + trial % 11, ny = 1 + trial % 5;   // up to 11 columns: more than grid keeps
+                // Up to 11 columns (more than grid keeps); often 4, a packet's rows (four rays per
+                // vector where the CPU has AVX2).
+                const int nx = trial % 3 == 0 ? 4 : 1 + trial % 11, ny = 1 + trial % 5;
                 std::uniform_real_distribution<float>& d = trial % 4 == 3 ? outside : inside;
                 std::vector<float> wx(static_cast<size_t>(nx)), wy(static_cast<size_t>(ny));
                 for (float& x : wx) x = trial % 2 ? std::floor(d(rng) * w) + 0.5f : d(rng) * w;
