@@ -33,8 +33,8 @@ uint32_t CameraRays::rowsOfFour(const glm::dvec4 cols[4], const glm::dvec4* rows
         __m256d xy[4], a[4], b[4];
         for (int k = 0; k < 4; ++k) {
             xy[k] = _mm256_add_pd(c[k], _mm256_set1_pd(rows[j][k]));   // glm's col + row
-            a[k] = _mm256_add_pd(xy[k], _mm256_set1_pd(m_zw[0][k]));    // the point at NDC z = -1
-            b[k] = _mm256_add_pd(xy[k], _mm256_set1_pd(m_zw[1][k]));    // and at z = +1
+            a[k] = _mm256_add_pd(xy[k], _mm256_set1_pd(m_zw[0][k]));   // the point at NDC z = -1
+            b[k] = _mm256_add_pd(xy[k], _mm256_set1_pd(m_zw[1][k]));   // and at z = +1
         }
         const __m256d ra = _mm256_div_pd(one, a[3]), rb = _mm256_div_pd(one, b[3]);
         __m256d d[3], org[3];
@@ -43,8 +43,9 @@ uint32_t CameraRays::rowsOfFour(const glm::dvec4 cols[4], const glm::dvec4* rows
             d[k] = _mm256_sub_pd(_mm256_mul_pd(b[k], rb), org[k]);   // far - org
         }
         // glm::dot(far - org, m_forward) = (x fx + y fy) + z fz
-        const __m256d dot = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(d[0], _mm256_set1_pd(m_forward.x)), _mm256_mul_pd(d[1], _mm256_set1_pd(m_forward.y))),
-                                          _mm256_mul_pd(d[2], _mm256_set1_pd(m_forward.z)));
+        const __m256d dot =
+            _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(d[0], _mm256_set1_pd(m_forward.x)), _mm256_mul_pd(d[1], _mm256_set1_pd(m_forward.y))),
+                          _mm256_mul_pd(d[2], _mm256_set1_pd(m_forward.z)));
         __m128 o[4] = {_mm256_cvtpd_ps(org[0]), _mm256_cvtpd_ps(org[1]), _mm256_cvtpd_ps(org[2]), _mm_setzero_ps()};
         __m128 v[4] = {_mm256_cvtpd_ps(d[0]), _mm256_cvtpd_ps(d[1]), _mm256_cvtpd_ps(d[2]), _mm_set1_ps(1.0f)};
         // Lanes with a component that is not finite (v - v is NaN) or no far end ahead go the slow way.

@@ -96,24 +96,38 @@ public:
         finish(a, right);
         finish(b, up);
     }
+    // The x and y shares of a window position's unprojection (m_inv's first two columns times its
+    // NDC x and y; ray(wx, wy) goes through column(wx) + row(wy)): a grid's inputs, which a
+    // tile makes once per column and row of pixels.
+    glm::dvec4 column(float wx) const { return m_inv[0] * glm::dvec4(2.0 * double(wx) / m_w - 1.0); }
+    glm::dvec4 row(float wy) const { return m_inv[1] * glm::dvec4(2.0 * double(wy) / m_h - 1.0); }
     // The rays through a grid of window positions, row by row: out[j * nx + i] is ray(wx[i],
     // wy[j]) bit for bit, each column's and row's share of the unprojection made once.
     void grid(const float* wx, int nx, const float* wy, int ny, Ray* out) const {
-        constexpr int kMax = 8, kBatch = 16;
+        constexpr int kMax = 16;
+        glm::dvec4 cols[kMax], rows[kMax];
+        if (nx > kMax || ny > kMax) {   // (wider than any packet: row by row)
+            for (int j = 0; j < ny; ++j)
+                for (int i = 0; i < nx; ++i) out[j * nx + i] = ray(wx[i], wy[j]);
+            return;
+        }
+        for (int i = 0; i < nx; ++i) cols[i] = column(wx[i]);
+        for (int j = 0; j < ny; ++j) rows[j] = row(wy[j]);
+        gridOf(cols, nx, rows, ny, out);
+    }
+    // grid() with the shares given: out[j * nx + i] is the ray through cols[i] + rows[j].
+    void gridOf(const glm::dvec4* cols, int nx, const glm::dvec4* rows, int ny, Ray* out) const {
         if (nx == 4 && ny <= kMaxRows && rowsOfFourAvailable()) {   // a packet's rows, four rays per vector
-            glm::dvec4 cols[4], rows[kMaxRows], slow[4 * kMaxRows];
-            for (int i = 0; i < 4; ++i) cols[i] = column(wx[i]);
-            for (int j = 0; j < ny; ++j) rows[j] = row(wy[j]);
+            glm::dvec4 slow[4 * kMaxRows];
             for (uint32_t m = rowsOfFour(cols, rows, ny, out, slow); m; m &= m - 1) {
                 const int k = __builtin_ctz(m);
                 out[k] = rayThrough(slow[k]);
             }
             return;
         }
-        __m128d cols[kMax][2];   // column(wx[i]) as (x, y) and (z, w) pairs (no zeroing: glm's vectors clear themselves)
-        for (int i = 0; i < nx && i < kMax; ++i) toPairs(column(wx[i]), cols[i]);
         // Up to kBatch rays at a time: first every ray's divisions (independent of each other,
         // so they overlap in the divider), then what follows from them.
+        constexpr int kBatch = 16;
         Unprojected u[kBatch];
         int pending = 0, done = 0;
         auto flush = [&] {
@@ -123,11 +137,11 @@ public:
         };
         for (int j = 0; j < ny; ++j) {
             __m128d r[2];
-            toPairs(row(wy[j]), r);
+            toPairs(rows[j], r);
             for (int i = 0; i < nx; ++i) {
-                __m128d wide[2];
-                if (i >= kMax) toPairs(column(wx[i]), wide);
-                u[pending++] = unproject(i < kMax ? cols[i] : wide, r);
+                __m128d c[2];   // (no zeroing: glm's vectors clear themselves)
+                toPairs(cols[i], c);
+                u[pending++] = unproject(c, r);
                 if (pending == kBatch) flush();
             }
         }
@@ -145,9 +159,6 @@ private:
         p[0] = _mm_loadu_pd(&v.x);
         p[1] = _mm_loadu_pd(&v.z);
     }
-    // m_inv * (x, y, z, 1) = (m0 x + m1 y) + (m2 z + m3): the x and y terms of window position (wx, wy).
-    glm::dvec4 column(float wx) const { return m_inv[0] * glm::dvec4(2.0 * double(wx) / m_w - 1.0); }
-    glm::dvec4 row(float wy) const { return m_inv[1] * glm::dvec4(2.0 * double(wy) / m_h - 1.0); }
     // The ray whose (x, y) share of the unprojection is xy.
     // A point's homogeneous divide is a product with the reciprocal of its w (one division per
     // point, not three: the grid's rays were bound by the divider).

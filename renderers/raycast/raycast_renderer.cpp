@@ -97,16 +97,19 @@ void strataOf(const RenderConfig& cfg, int& sx, int& sy) {
     }
 }
 
-// One sample per pixel: the camera rays of tile [x0, x1) x [y0, y1) (rows top-down) traced
+// One sample per pixel: the camera rays of tile [x0, x1) x [y0, y1) (rows top-down; colShares[x -
+// x0]: CameraRays::column at pixel column x) traced
 // kPacket x kPacket pixels at a time (SceneAccel::intersectPacket: the same hits as one by one),
 // into tileRays and tileHits (kTile per row); bit x - x0 of rowFound[row - y0] tells whether
 // pixel (x, row)'s ray met something (tileHits' `found`, kept compact: the loops over the tile
 // read it for every pixel).
-void traceCameraPackets(const FrameJob& job, const rt::SceneAccel& accel, int x0, int y0, int x1, int y1, std::vector<rt::Ray>& tileRays,
-                        std::vector<Tracer::FirstHit>& tileHits, uint32_t* rowFound) {
+void traceCameraPackets(const FrameJob& job, const rt::SceneAccel& accel, int x0, int y0, int x1, int y1, const glm::dvec4* colShares,
+                        std::vector<rt::Ray>& tileRays, std::vector<Tracer::FirstHit>& tileHits, uint32_t* rowFound) {
     constexpr int kPacket = FrameJob::kPacket, tile = FrameJob::kTile;
     static_assert(tile <= 32, "one 32-bit mask per tile row");
     std::fill(rowFound, rowFound + (y1 - y0), 0u);
+    glm::dvec4 rowShares[tile];   // CameraRays::row of each row, made once for all the packets
+    for (int row = y0; row < y1; ++row) rowShares[row - y0] = job.cam.row(float(job.h - 1 - row) + 0.5f);
     rt::Ray* const rays = tileRays.data();
     Tracer::FirstHit* const hits = tileHits.data();
     for (int py = y0; py < y1; py += kPacket)
@@ -123,7 +126,7 @@ void traceCameraPackets(const FrameJob& job, const rt::SceneAccel& accel, int x0
                     any = any || (wx[nx - 1] >= r[0] && wx[0] <= r[2] && wy[0] >= r[1] && wy[ny - 1] <= r[3]);   // (wy falls row by row)
                 if (!any) continue;
             }
-            job.cam.grid(wx, nx, wy, ny, pr.data());
+            job.cam.gridOf(colShares + (px - x0), nx, rowShares + (py - y0), ny, pr.data());   // (at wx, wy)
             int n = nx * ny;
             const uint64_t found = accel.intersectPacket(pr.data(), n, ~uint64_t(0), ph.data(), job.f.settings.culling);
             // The hit triangles' vertex indices, fetched now for the frames (Tracer::frameMeshHits) a
@@ -504,9 +507,11 @@ private:
                 // With packets, one row of packets at a time through all three steps (camera rays,
                 // their shadow rays, the shading): its hits (kTile x kPacket of them) stay in the
                 // first level cache between the steps, where a whole tile's would not.
+                if (job.packets)
+                    for (int x = x0; x < x1; ++x) buffers.colShares[x - x0] = job.cam.column(float(x) + 0.5f);
                 for (int sy = y0; job.packets && sy < y1; sy += FrameJob::kPacket) {
                     const int sy1 = std::min(sy + FrameJob::kPacket, y1);
-                    traceCameraPackets(job, m_accel, x0, sy, x1, sy1, tileRays, tileHits, rowFound);
+                    traceCameraPackets(job, m_accel, x0, sy, x1, sy1, buffers.colShares, tileRays, tileHits, rowFound);
                     if (job.shadowPackets) presetTileShadows(tr, x0, sy, x1, sy1, tileRays, tileHits, rowFound, tilePresets);
                     for (int row = sy; row < sy1; ++row) {
                         const uint32_t found = job.constantMiss ? rowFound[row - sy] : allPixels;
@@ -550,7 +555,8 @@ private:
         std::vector<Tracer::FirstHit> hits;
         std::vector<rt::Ray> rays;
         std::vector<Tracer::PresetVisibility> presets;
-        uint32_t rowFound[FrameJob::kTile];   // per tile row, which pixels' rays met something
+        uint32_t rowFound[FrameJob::kTile];      // per tile row, which pixels' rays met something
+        glm::dvec4 colShares[FrameJob::kTile];   // CameraRays::column per tile column (traceCameraPackets)
         void reserve(const FrameJob& job) {
             constexpr size_t n = size_t(FrameJob::kTile) * FrameJob::kTile;
             if (job.packets && hits.size() < n) {
