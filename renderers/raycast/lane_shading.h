@@ -1,5 +1,5 @@
-// lane_shading.h - the ray caster's smooth Phong / Blinn-Phong shading of four mesh hits at once
-// (SSE2 lanes), for the commonest primary hit: an opaque, lit, untextured triangle seen in a
+// lane_shading.h - the ray caster's smooth Phong / Blinn-Phong shading of eight mesh hits at once
+// (AVX2 lanes, or SSE2's four twice), for the commonest primary hit: an opaque, lit, untextured triangle seen in a
 // frame without pbr, reflections or lights with a size under shadows (a colour texture, sampled
 // per lane by the caller, is fine; the other material maps are not). Every lane performs the
 // IEEE operations of Tracer::shadeMeshHit and rnd::shadeTerms in their order (no FMA, no
@@ -20,16 +20,16 @@
 namespace rnd::raycast {
 
 struct LaneBatch {
-    static constexpr int kLanes = 4;
+    static constexpr int kLanes = 8;
     int count = 0;   // lanes filled, from 0
     // Per lane: the hit point p and geometric normal ng toward the ray (meshHitFrame), the
     // barycentric weights w, the texel tex, the three vertex normals facing the ray (smooth: a vertex normal
     // per vertex; otherwise the shading normal is ng) and vertex albedos, the coefficients.
-    alignas(16) float p[3][kLanes], ng[3][kLanes];
-    alignas(16) float w[3][kLanes];
-    alignas(16) float vn[3][3][kLanes];   // [vertex][axis][lane]
-    alignas(16) float va[3][3][kLanes];   // [vertex][channel][lane]
-    alignas(16) float tex[3][kLanes];     // the colour texture's texel, in the lanes of `textured`
+    alignas(32) float p[3][kLanes], ng[3][kLanes];
+    alignas(32) float w[3][kLanes];
+    alignas(32) float vn[3][3][kLanes];   // [vertex][axis][lane]
+    alignas(32) float va[3][3][kLanes];   // [vertex][channel][lane]
+    alignas(32) float tex[3][kLanes];     // the colour texture's texel, in the lanes of `textured`
     unsigned textured = 0;                // bit l: lane l has a texel (the others' texColor is 1)
     bool smooth[kLanes] = {};
     const SurfaceCoefficients* coeff[kLanes] = {};
@@ -49,28 +49,28 @@ bool laneShadingApplies(const sg::FrameInput& f, bool shadowPackets);
 // past b.count are filled with lane 0's inputs first.
 unsigned shadeLanes(LaneBatch& b, const sg::FrameInput& f, float rgb[3][LaneBatch::kLanes]);
 
-// The frames of up to four triangle hits (tracer.h's meshHitFrame in lanes): in, each hit's
+// The frames of up to eight triangle hits (tracer.h's meshHitFrame in lanes): in, each hit's
 // world vertices, barycentrics b1 b2 and ray direction, and whether its instance is mirrored;
 // out, the point p, the outward geometric normal gn, that normal on the ray's side ng, and
 // whether the ray sees the back.
 struct FrameLanes {
-    static constexpr int kLanes = 4;
+    static constexpr int kLanes = 8;
     int count = 0;
-    alignas(16) float P[3][3][kLanes];   // [vertex][axis][lane]
-    alignas(16) float b1[kLanes], b2[kLanes], dir[3][kLanes];
+    alignas(32) float P[3][3][kLanes];   // [vertex][axis][lane]
+    alignas(32) float b1[kLanes], b2[kLanes], dir[3][kLanes];
     unsigned mirrored = 0;   // bit l: lane l
-    alignas(16) float p[3][kLanes], gn[3][kLanes], ng[3][kLanes];
+    alignas(32) float p[3][kLanes], gn[3][kLanes], ng[3][kLanes];
     unsigned back = 0;   // bit l: lane l
 };
 void hitFrames(FrameLanes& b);
 
-// Tracer::shadowRay toward light L (sampleLight's sample) from up to four points p with
+// Tracer::shadowRay toward light L (sampleLight's sample) from up to eight points p with
 // geometric normals ng, where the light reaches ng's side (sampleReaches, the Phong models'
 // rule): out, those lanes as bits (reaches) and their rays.
 struct ShadowLanes {
-    static constexpr int kLanes = 4;
+    static constexpr int kLanes = 8;
     int count = 0;
-    alignas(16) float p[3][kLanes], ng[3][kLanes];
+    alignas(32) float p[3][kLanes], ng[3][kLanes];
     unsigned reaches = 0;
     rt::PacketScratch<rt::Ray, kLanes> rays;   // (uninitialized: written where reached)
 };

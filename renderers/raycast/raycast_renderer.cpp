@@ -268,7 +268,7 @@ void shadePixel(const FrameJob& job, Tracer& tr, int x, int row, int x0, int y0,
 }
 
 // The pixels x0 + i of `row` (tile corner (x0, y0)) whose bit i of `pixels` is set, when the
-// tile's camera rays went in packets: hits of the meshes in job.laneMesh four at a time
+// tile's camera rays went in packets: hits of the meshes in job.laneMesh eight at a time
 // (raycast::shadeLanes, then what Tracer::trace and shadePixel do after the shading: fog, depth,
 // visibility, bytes), every other pixel and every lane shadeLanes leaves through shadePixel.
 void shadePixels(const FrameJob& job, Tracer& tr, int row, int x0, int y0, uint32_t pixels, const std::vector<rt::Ray>& tileRays,
@@ -283,7 +283,8 @@ void shadePixels(const FrameJob& job, Tracer& tr, int row, int x0, int y0, uint3
     auto flush = [&] {
         float rgb[3][raycast::LaneBatch::kLanes], windowZ[raycast::LaneBatch::kLanes];
         const unsigned shaded = raycast::shadeLanes(b, job.f, rgb);
-        job.cam.depth4(b.p[0], b.p[1], b.p[2], windowZ);   // (b.p: the hit points; shadeLanes filled every lane)
+        for (int q = 0; q < b.count; q += 4)   // (b.p: the hit points; shadeLanes filled every lane)
+            job.cam.depth4(b.p[0] + q, b.p[1] + q, b.p[2] + q, windowZ + q);
         for (int l = 0; l < b.count; ++l) {
             const int x = x0 + int(at[l] % tile);
             if (!((shaded >> l) & 1)) {

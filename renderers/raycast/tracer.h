@@ -552,8 +552,8 @@ struct Tracer {
     // The unit world normals at the vertices i0, i1, i2 of the hit with frame fr, on the ray's
     // side (flipped on a back face): the face normal where the mesh has none or one is too short
     // to normalize. wv: the instance's world vertices, or null.
-    static void vertexNormals(const DrawMesh& dm, const rt::WorldVertices* wv, uint32_t i0, uint32_t i1, uint32_t i2, const MeshHitFrame& fr,
-                              vec3 Nv[3]) {
+    [[gnu::always_inline]] static void vertexNormals(const DrawMesh& dm, const rt::WorldVertices* wv, uint32_t i0, uint32_t i1, uint32_t i2,
+                                                     const MeshHitFrame& fr, vec3 Nv[3]) {
         const Mesh& mesh = *dm.mesh;
         const vec3& gn = fr.gn;
         const bool hasN = mesh.normals.size() == mesh.positions.size();
@@ -737,8 +737,8 @@ struct Tracer {
     // with the footprint of that camera's ray through window position `window`), the mesh's
     // coefficients (meshCoefficients must be set), and the light bits of its shadow packets'
     // preset where that preset is this hit's (null: none).
-    void laneInputs(const FirstHit& fh, const rt::Ray& r, const PresetVisibility* pre, const rt::CameraRays* texturedCam, const vec2& window,
-                    LaneBatch& b, int l) const {
+    [[gnu::always_inline]] void laneInputs(const FirstHit& fh, const rt::Ray& r, const PresetVisibility* pre, const rt::CameraRays* texturedCam,
+                                           const vec2& window, LaneBatch& b, int l) const {
         const rt::SceneHit& h = fh.hit;
         const DrawMesh& dm = f.meshes[h.instance];
         const Mesh& mesh = *dm.mesh;

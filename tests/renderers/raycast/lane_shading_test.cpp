@@ -1,4 +1,4 @@
-// lane_shading_test.cpp - raycast::shadeLanes (four mesh hits shaded at once in SSE2) against
+// lane_shading_test.cpp - raycast::shadeLanes (eight mesh hits shaded at once: AVX2, or SSE2 twice) against
 // the scalar shading it stands for, bit for bit: the interpolated albedo and normal of
 // Tracer::shadeMeshHit, the visibility rule of Tracer::lightVisibility with the shadow packets'
 // bits, and rnd::shade. Random hits, materials and lights (point with and without 1/r^2, spots
@@ -163,13 +163,14 @@ TEST(LaneShadingTest, FramesAndShadowRaysInLanesAreTheScalarOnesBitForBit) {
     std::uniform_real_distribution<float> u(0.0f, 1.0f), s(-50.0f, 50.0f);
     size_t reached = 0, missed = 0, backs = 0;
     for (int trial = 0; trial < 2000; ++trial) {
-        // Frames: four triangles (one degenerate now and then), mirrored or not, seen from either side.
+        // Frames: up to eight triangles (one degenerate now and then), mirrored or not, seen from either side.
+        constexpr int kL = rnd::raycast::FrameLanes::kLanes;
         rnd::raycast::FrameLanes fl;
-        fl.count = 1 + int(rng() % 4);
-        DrawMesh dm[4];
-        rnd::rt::WorldVertices wv[4];
-        rnd::rt::SceneHit h[4];
-        rnd::rt::Ray r[4];
+        fl.count = 1 + int(rng() % kL);
+        DrawMesh dm[kL];
+        rnd::rt::WorldVertices wv[kL];
+        rnd::rt::SceneHit h[kL];
+        rnd::rt::Ray r[kL];
         for (int l = 0; l < fl.count; ++l) {
             auto mesh = std::make_shared<Mesh>();
             for (int v = 0; v < 3; ++v) mesh->positions.push_back(vec3(s(rng), s(rng), s(rng)));
@@ -198,7 +199,7 @@ TEST(LaneShadingTest, FramesAndShadowRaysInLanesAreTheScalarOnesBitForBit) {
             backs += fr.back;
         }
 
-        // Shadow rays toward one light from four points, far from the origin now and then.
+        // Shadow rays toward one light from up to eight points, far from the origin now and then.
         DrawLight L;
         L.type = LightType(rng() % 3);
         L.position = vec3(s(rng), s(rng), s(rng));
@@ -208,8 +209,8 @@ TEST(LaneShadingTest, FramesAndShadowRaysInLanesAreTheScalarOnesBitForBit) {
         L.cosOuter = std::cos(0.3f + u(rng));
         L.cosInner = rng() % 4 == 0 ? L.cosOuter : std::cos(0.1f + 0.1f * u(rng));
         rnd::raycast::ShadowLanes sl;
-        sl.count = 1 + int(rng() % 4);
-        vec3 p[4], ng[4];
+        sl.count = 1 + int(rng() % rnd::raycast::ShadowLanes::kLanes);
+        vec3 p[rnd::raycast::ShadowLanes::kLanes], ng[rnd::raycast::ShadowLanes::kLanes];
         for (int l = 0; l < sl.count; ++l) {
             p[l] = vec3(s(rng), s(rng), s(rng)) * (rng() % 5 == 0 ? 1000.0f : 1.0f);
             if (rng() % 30 == 0) p[l] = L.position;   // on the light: a zero distance
