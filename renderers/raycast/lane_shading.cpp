@@ -6,6 +6,7 @@
 #include "raycast/lane_shading.h"
 #include "renderers/debug_switches.h"
 #include "renderers/isa_region.h"
+#include "renderers/srgb_encoder.h"
 
 #include <immintrin.h>
 
@@ -86,6 +87,30 @@ inline unsigned bitsOf(V mask) { return unsigned(_mm256_movemask_ps(mask)); }
 #define LANE_W 8
 #include "raycast/lane_kernel.inl"
 #undef LANE_W
+
+// SrgbEncoder::operator() per lane, branch-free with one gathered table word: values clamped to
+// [2^-13, the largest float below 1] (those encode to 0 and 255 as smaller values, NaN and values
+// >= 1 do), the bucket's packed word gives its byte and the float bits where it steps up (floats
+// >= 0 order like their bits).
+inline __m256i encodeSrgb(V x, const SrgbEncoder& t) {
+    x = _mm256_min_ps(_mm256_max_ps(x, set1(0x1p-13f)), set1(0x1.fffffep-1f));
+    const __m256i bits = _mm256_castps_si256(x);
+    const __m256i word = _mm256_i32gather_epi32(reinterpret_cast<const int*>(t.packed),
+                                                _mm256_srli_epi32(_mm256_sub_epi32(bits, _mm256_set1_epi32(0x39000000)), 15), 4);
+    const __m256i step = _mm256_add_epi32(_mm256_and_si256(bits, _mm256_set1_epi32(~0x7FFF)), _mm256_and_si256(word, _mm256_set1_epi32(0xFFFF)));
+    return _mm256_sub_epi32(_mm256_srli_epi32(word, 16), _mm256_cmpgt_epi32(bits, _mm256_sub_epi32(step, _mm256_set1_epi32(1))));
+}
+
+void encodeRun(const float rgb[3][kL], uint32_t out[kL]) {
+    const SrgbEncoder& t = srgbEncoder();
+    const V r = load(rgb[0]), g = load(rgb[1]), b = load(rgb[2]);
+    // isFinite (x - x is NaN exactly for an infinity or a NaN) of all three channels
+    const V finite = cmpeq(add(add(sub(r, r), sub(g, g)), sub(b, b)), setzero());
+    const __m256i word = _mm256_or_si256(_mm256_or_si256(encodeSrgb(r, t), _mm256_slli_epi32(encodeSrgb(g, t), 8)),
+                                         _mm256_or_si256(_mm256_slli_epi32(encodeSrgb(b, t), 16), _mm256_set1_epi32(int(0xFF000000u))));
+    const __m256i magenta = _mm256_set1_epi32(int(0xFFFF00FFu));   // bytes 255, 0, 255, 255
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(out), _mm256_blendv_epi8(magenta, word, _mm256_castps_si256(finite)));
+}
 }   // namespace avx2
 VIEWER_ISA_REGION_END
 
@@ -133,6 +158,17 @@ unsigned shadeLanes(LaneBatch& b, const FrameInput& f, float rgb[3][kL]) {
     unsigned shaded = sse::shadeRun(b, f, rgb, 0);
     if (b.count > 4) shaded |= sse::shadeRun(b, f, rgb, 4);
     return shaded;
+}
+
+void encodeLanes(const float rgb[3][kL], int count, uint32_t out[kL]) {
+    if (kUseAvx2) return avx2::encodeRun(rgb, out);
+    const SrgbEncoder& t = srgbEncoder();
+    for (int l = 0; l < count; ++l) {
+        vec3 c(rgb[0][l], rgb[1][l], rgb[2][l]);
+        if (!isFinite(c)) c = vec3(1, 0, 1);
+        const uint8_t px[4] = {t(c.x), t(c.y), t(c.z), 255};
+        std::memcpy(&out[l], px, 4);
+    }
 }
 
 void hitFrames(FrameLanes& b) {

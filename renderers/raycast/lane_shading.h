@@ -16,6 +16,7 @@
 #include "scenegraph/frame.h"
 
 #include <cstdint>
+#include <cstring>
 
 namespace rnd::raycast {
 
@@ -48,6 +49,12 @@ bool laneShadingApplies(const sg::FrameInput& f, bool shadowPackets);
 // the geometric one, so that no packet traced its shadow ray) is for Tracer::trace. The lanes
 // past b.count are filled with lane 0's inputs first.
 unsigned shadeLanes(LaneBatch& b, const sg::FrameInput& f, float rgb[3][LaneBatch::kLanes]);
+
+// The bytes encodePixel (raycast_renderer.cpp) gives lanes [0, count) of linear colours
+// rgb[channel][lane] under an identity display transform, as RGBA words: toByteSRGB of each
+// channel (SrgbEncoder's table; AVX2's gathers where the CPU has them), alpha 255, and magenta
+// (255, 0, 255) where a channel is not finite.
+void encodeLanes(const float rgb[3][LaneBatch::kLanes], int count, uint32_t out[LaneBatch::kLanes]);
 
 // The frames of up to eight triangle hits (tracer.h's meshHitFrame in lanes): in, each hit's
 // world vertices, barycentrics b1 b2 and ray direction, and whether its instance is mirrored;

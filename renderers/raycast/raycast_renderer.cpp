@@ -285,6 +285,9 @@ void shadePixels(const FrameJob& job, Tracer& tr, int row, int x0, int y0, uint3
         const unsigned shaded = raycast::shadeLanes(b, job.f, rgb);
         for (int q = 0; q < b.count; q += 4)   // (b.p: the hit points; shadeLanes filled every lane)
             job.cam.depth4(b.p[0] + q, b.p[1] + q, b.p[2] + q, windowZ + q);
+        // With an identity display transform the bytes of all lanes are made at once (encodeLanes).
+        const bool plainBytes = job.display.identity;
+        alignas(32) float sums[3][raycast::LaneBatch::kLanes] = {};
         for (int l = 0; l < b.count; ++l) {
             const int x = x0 + int(at[l] % tile);
             if (!((shaded >> l) & 1)) {
@@ -303,8 +306,19 @@ void shadePixels(const FrameJob& job, Tracer& tr, int row, int x0, int y0, uint3
             keepSurface(job, hp, windowZ[l], x, row, depth, target);
             vec3 sum(0.0f);
             sum += tr.fogged(vec3(rgb[0][l], rgb[1][l], rgb[2][l]), hp.p);
-            encodePixel(job, sum, target.pixel(x, row));
+            if (plainBytes)
+                for (int a = 0; a < 3; ++a) sums[a][l] = sum[a];
+            else
+                encodePixel(job, sum, target.pixel(x, row));
             target.depth[size_t(row) * size_t(job.w) + size_t(x)] = depth;
+        }
+        if (plainBytes) {
+            uint32_t words[raycast::LaneBatch::kLanes];
+            raycast::encodeLanes(sums, b.count, words);
+            for (unsigned m = shaded; m; m &= m - 1) {
+                const int l = __builtin_ctz(m);
+                std::memcpy(target.pixel(x0 + int(at[l] % tile), row), &words[l], 4);
+            }
         }
         b.count = 0;
     };

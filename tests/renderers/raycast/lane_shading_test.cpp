@@ -5,14 +5,17 @@
 // with soft and hard cones, suns, a black light), Phong and Blinn-Phong, with and without
 // shadows, textured and untextured hits, partly filled batches, points on a light and on the eye, normals too short to
 // normalize and hits without vertex normals. Also raycast::hitFrames against meshHitFrame and
-// raycast::shadowRays against Tracer::shadowRay and sampleReaches, bit for bit.
+// raycast::shadowRays against Tracer::shadowRay and sampleReaches, bit for bit, and
+// raycast::encodeLanes against the scalar sRGB bytes.
 #include "raycast/lane_shading.h"
 #include "raycast/tracer.h"
 #include "raycast/world_vertices.h"
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -237,4 +240,55 @@ TEST(LaneShadingTest, FramesAndShadowRaysInLanesAreTheScalarOnesBitForBit) {
     EXPECT_GT(reached, size_t(1000));
     EXPECT_GT(missed, size_t(500));
     EXPECT_GT(backs, size_t(500));
+}
+
+// raycast::encodeLanes against the scalar bytes (toByteSRGB per channel, magenta where a channel
+// is not finite, alpha 255), for colours around every byte's threshold, outside [0, 1], -0,
+// denormals, NaN and infinities, in batches of every length.
+TEST(LaneShadingTest, EncodedLanesAreTheScalarBytes) {
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<float> u(-0.2f, 1.2f);
+    std::uniform_int_distribution<int> byte(1, 255);
+    const float special[] = {0.0f,
+                             -0.0f,
+                             1e-40f,
+                             0x1p-13f,
+                             1.0f,
+                             0x1.fffffep-1f,
+                             7.5f,
+                             -3.0f,
+                             std::numeric_limits<float>::quiet_NaN(),
+                             std::numeric_limits<float>::infinity(),
+                             -std::numeric_limits<float>::infinity()};
+    size_t magenta = 0;
+    for (int trial = 0; trial < 20000; ++trial) {
+        constexpr int kL = LaneBatch::kLanes;
+        alignas(32) float rgb[3][kL];
+        const int count = 1 + trial % kL;
+        for (int a = 0; a < 3; ++a)
+            for (int l = 0; l < kL; ++l) {
+                float x = u(rng);
+                switch (rng() % 8) {
+                case 0: x = special[rng() % (sizeof special / sizeof special[0])]; break;
+                case 1: x = std::nextafter(rnd::srgbByteThreshold(byte(rng)), rng() % 2 ? 2.0f : -1.0f); break;   // a hair off a threshold
+                case 2: x = rnd::srgbByteThreshold(byte(rng)); break;
+                default: break;
+                }
+                rgb[a][l] = x;
+            }
+        uint32_t words[kL];
+        rnd::raycast::encodeLanes(rgb, count, words);
+        for (int l = 0; l < count; ++l) {
+            vec3 c(rgb[0][l], rgb[1][l], rgb[2][l]);
+            const bool finite = isFinite(c);
+            magenta += !finite;
+            if (!finite) c = vec3(1, 0, 1);
+            const uint8_t want[4] = {rnd::toByteSRGB(c.x), rnd::toByteSRGB(c.y), rnd::toByteSRGB(c.z), 255};
+            uint8_t got[4];
+            std::memcpy(got, &words[l], 4);
+            ASSERT_EQ(std::memcmp(got, want, 4), 0) << "trial " << trial << " lane " << l << ": " << bits(vec3(rgb[0][l], rgb[1][l], rgb[2][l]))
+                                                    << " -> " << int(got[0]) << " " << int(got[1]) << " " << int(got[2]) << " " << int(got[3]);
+        }
+    }
+    EXPECT_GT(magenta, 100u);
 }
