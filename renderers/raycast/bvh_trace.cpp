@@ -142,7 +142,7 @@ uint64_t TriangleBvh::occludedPacket(const Ray* rays, int n, uint64_t active, co
 // sign of the lane's reciprocal (its direction's; BLEND(a, b, r): b where r's sign bit is set,
 // else a). A macro, not a function of vectors: GCC warns
 // of the ABI of vector arguments between the ISA regions.
-#define VIEWER_BVH4_REACH(V, W, SET1, LOAD, SUB, MUL, MAX, MIN, BLEND, LE_MASK, STORE, SIGNS)           \
+#define VIEWER_BVH4_REACH(V, W, SET1, LOAD, SUB, MUL, MAX, MIN, BLEND, LE_MASK, LANE, SIGNS)            \
     for (int blk = 0; blk < kMaxPacket / W; ++blk) {                                                    \
         const int at = W * blk;                                                                         \
         if (!((rays >> at) & ((uint64_t(1) << W) - 1))) continue;                                       \
@@ -171,24 +171,21 @@ uint64_t TriangleBvh::occludedPacket(const Ray* rays, int n, uint64_t active, co
             }                                                                                           \
             const V tn = MAX(MAX(t0x, t0y), MAX(t0z, tmin));                                            \
             const V tf = MUL(MIN(MIN(t1x, t1y), MIN(t1z, tmax)), SET1(Bvh4RayTest::kGrow));             \
-            reach[c] |= uint64_t(LE_MASK(tn, tf)) << at;                                                \
-            if (first >= at && first < at + W) {                                                        \
-                alignas(64) float d[W];                                                                 \
-                STORE(d, tn);                                                                           \
-                lead[c] = d[first - at];                                                                \
-            }                                                                                           \
+            reach[c] |= (uint64_t(LE_MASK(tn, tf)) << at) & rays;                                       \
+            if (first >= at && first < at + W) lead[c] = LANE(tn, first - at);                          \
         }                                                                                               \
-    }                                                                                                   \
-    for (int c = 0; c < 4; ++c) reach[c] &= rays;
+    }
 
 VIEWER_ISA_REGION_BEGIN("avx2")
 namespace {
 #define VIEWER_LE8(a, b) _mm256_movemask_ps(_mm256_cmp_ps(a, b, _CMP_LE_OS))
+#define VIEWER_LANE8(v, i) _mm256_cvtss_f32(_mm256_permutevar8x32_ps(v, _mm256_set1_epi32(i)))
 void reachChildren8(const Bvh4PacketTest& t, const Node4& n, uint64_t rays, int may, uint64_t reach[4], float lead[4], int first) {
     VIEWER_BVH4_REACH(__m256, 8, _mm256_set1_ps, _mm256_load_ps, _mm256_sub_ps, _mm256_mul_ps, _mm256_max_ps, _mm256_min_ps, _mm256_blendv_ps,
-                      VIEWER_LE8, _mm256_store_ps, t.signs8)
+                      VIEWER_LE8, VIEWER_LANE8, t.signs8)
 }
 #undef VIEWER_LE8
+#undef VIEWER_LANE8
 }   // namespace
 VIEWER_ISA_REGION_END
 
@@ -199,14 +196,16 @@ namespace {
 // (GCC 12's unmasked _mm512_max_ps / _mm512_min_ps warn of an uninitialised operand.)
 #define VIEWER_MAX16(a, b) _mm512_maskz_max_ps(0xFFFF, a, b)
 #define VIEWER_MIN16(a, b) _mm512_maskz_min_ps(0xFFFF, a, b)
+#define VIEWER_LANE16(v, i) _mm512_cvtss_f32(_mm512_maskz_permutexvar_ps(0xFFFF, _mm512_set1_epi32(i), v))
 void reachChildren16(const Bvh4PacketTest& t, const Node4& n, uint64_t rays, int may, uint64_t reach[4], float lead[4], int first) {
     VIEWER_BVH4_REACH(__m512, 16, _mm512_set1_ps, _mm512_load_ps, _mm512_sub_ps, _mm512_mul_ps, VIEWER_MAX16, VIEWER_MIN16, VIEWER_BLEND16,
-                      VIEWER_LE16, _mm512_store_ps, t.signs16)
+                      VIEWER_LE16, VIEWER_LANE16, t.signs16)
 }
 #undef VIEWER_BLEND16
 #undef VIEWER_LE16
 #undef VIEWER_MAX16
 #undef VIEWER_MIN16
+#undef VIEWER_LANE16
 }   // namespace
 VIEWER_ISA_REGION_END
 #undef VIEWER_BVH4_REACH
