@@ -2,7 +2,9 @@
 // lanes) and once for AVX2 (namespace simd_avx2, 8 lanes, compiled for AVX2 only inside its own
 // target region; callers choose it at run time with useAvx2()). Kernels are written over these
 // names (V, VI, kW, set1, add, ...) in .inl files that a .cpp includes once per namespace
-// (raster_shading.cpp: the lighting kernel; tile_kernels.cpp: coverage and fragment preparation).
+// (raster_shading.cpp: the lighting kernel; tile_kernels.cpp: coverage and fragment preparation;
+// also common/shadow_map.cpp's depth pass and the ray caster's lanes, raycast/lane_kernel.inl,
+// which choose the set by their own CPU check).
 //
 // Every lane performs the same IEEE operation as the scalar code it replaces, and there is no FMA
 // in either set (the AVX2 region enables avx2 only), so SSE2, AVX2 and scalar code give the same
@@ -48,6 +50,9 @@ inline V cmpgt(V a, V b) { return _mm_cmpgt_ps(a, b); }
 inline V cmpge(V a, V b) { return _mm_cmpge_ps(a, b); }
 inline V cmplt(V a, V b) { return _mm_cmplt_ps(a, b); }
 inline V cmpneq(V a, V b) { return _mm_cmpneq_ps(a, b); }
+inline V cmpnle(V a, V b) { return _mm_cmpnle_ps(a, b); }   // !(a <= b): true with a NaN
+inline V cmpeq(V a, V b) { return _mm_cmpeq_ps(a, b); }
+inline V vxor(V a, V b) { return _mm_xor_ps(a, b); }
 inline int movemask(V a) { return _mm_movemask_ps(a); }
 inline V zeroV() { return _mm_setzero_ps(); }
 inline V loadu(const float* p) { return _mm_loadu_ps(p); }
@@ -69,6 +74,7 @@ inline bool allEqualI(const int32_t* p, int32_t v) {
     return _mm_movemask_epi8(_mm_cmpeq_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(p)), _mm_set1_epi32(v))) == 0xFFFF;
 }
 inline VI laneIndex() { return _mm_setr_epi32(0, 1, 2, 3); }
+inline VI laneBit() { return _mm_setr_epi32(1, 2, 4, 8); }   // 1 << laneIndex()
 inline VI loaduI(const void* p) { return _mm_loadu_si128(static_cast<const __m128i*>(p)); }
 inline void storeuI(void* p, VI a) { _mm_storeu_si128(static_cast<__m128i*>(p), a); }
 // kW 16-bit values zero-extended to 32-bit lanes.
@@ -118,6 +124,9 @@ inline V cmpgt(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_GT_OS); }
 inline V cmpge(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_GE_OS); }
 inline V cmplt(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_LT_OS); }
 inline V cmpneq(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_NEQ_UQ); }
+inline V cmpnle(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_NLE_US); }   // SSE's predicates, as above
+inline V cmpeq(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_EQ_OQ); }
+inline V vxor(V a, V b) { return _mm256_xor_ps(a, b); }
 inline int movemask(V a) { return _mm256_movemask_ps(a); }
 inline V zeroV() { return _mm256_setzero_ps(); }
 inline V loadu(const float* p) { return _mm256_loadu_ps(p); }
@@ -138,6 +147,7 @@ inline bool allEqualI(const int32_t* p, int32_t v) {
     return _mm256_movemask_epi8(_mm256_cmpeq_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(p)), _mm256_set1_epi32(v))) == -1;
 }
 inline VI laneIndex() { return _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7); }
+inline VI laneBit() { return _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128); }
 inline VI loaduI(const void* p) { return _mm256_loadu_si256(static_cast<const __m256i*>(p)); }
 inline void storeuI(void* p, VI a) { _mm256_storeu_si256(static_cast<__m256i*>(p), a); }
 inline VI loadU16(const uint16_t* p) { return _mm256_cvtepu16_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(p))); }

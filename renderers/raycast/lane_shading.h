@@ -16,7 +16,6 @@
 #include "scenegraph/frame.h"
 
 #include <cstdint>
-#include <cstring>
 
 namespace rnd::raycast {
 
@@ -52,7 +51,7 @@ unsigned shadeLanes(LaneBatch& b, const sg::FrameInput& f, float rgb[3][LaneBatc
 
 // The bytes encodePixel (raycast_renderer.cpp) gives lanes [0, count) of linear colours
 // rgb[channel][lane] under an identity display transform, as RGBA words: toByteSRGB of each
-// channel (SrgbEncoder's table; AVX2's gathers where the CPU has them), alpha 255, and magenta
+// channel (SrgbEncoder's packed table, one gathered word per channel), alpha 255, and magenta
 // (255, 0, 255) where a channel is not finite.
 void encodeLanes(const float rgb[3][LaneBatch::kLanes], int count, uint32_t out[LaneBatch::kLanes]);
 
