@@ -112,6 +112,18 @@ void traceCameraPackets(const FrameJob& job, const rt::SceneAccel& accel, int x0
     for (int row = y0; row < y1; ++row) rowShares[row - y0] = job.cam.row(float(job.h - 1 - row) + 0.5f);
     rt::Ray* const rays = tileRays.data();
     Tracer::FirstHit* const hits = tileHits.data();
+    // The window rectangles that overlap these rows' pixel centres: a packet lies inside them,
+    // so a rectangle that misses the rows misses each of its packets too (the same comparisons).
+    constexpr int kNear = 64;
+    const std::array<float, 4>* nearRects[kNear];
+    int nNear = 0;
+    const bool culled = !job.hitRects.empty() && job.hitRects.size() <= size_t(kNear);
+    if (culled) {
+        const float wxLo = float(x0) + 0.5f, wxHi = float(x1 - 1) + 0.5f;
+        const float wyHi = float(job.h - 1 - y0) + 0.5f, wyLo = float(job.h - 1 - (y1 - 1)) + 0.5f;
+        for (const std::array<float, 4>& r : job.hitRects)
+            if (wxHi >= r[0] && wxLo <= r[2] && wyHi >= r[1] && wyLo <= r[3]) nearRects[nNear++] = &r;
+    }
     for (int py = y0; py < y1; py += kPacket)
         for (int px = x0; px < x1; px += kPacket) {
             rt::PacketScratch<rt::Ray, kPacket * kPacket> pr;
@@ -122,8 +134,15 @@ void traceCameraPackets(const FrameJob& job, const rt::SceneAccel& accel, int x0
             for (int j = 0; j < ny; ++j) wy[j] = float(job.h - 1 - (py + j)) + 0.5f;
             if (!job.hitRects.empty()) {   // rowFound keeps 0 for the packet's pixels: misses, as traced
                 bool any = false;
-                for (const std::array<float, 4>& r : job.hitRects)
-                    any = any || (wx[nx - 1] >= r[0] && wx[0] <= r[2] && wy[0] >= r[1] && wy[ny - 1] <= r[3]);   // (wy falls row by row)
+                if (culled) {
+                    for (int k = 0; k < nNear && !any; ++k) {
+                        const std::array<float, 4>& r = *nearRects[k];
+                        any = wx[nx - 1] >= r[0] && wx[0] <= r[2] && wy[0] >= r[1] && wy[ny - 1] <= r[3];   // (wy falls row by row)
+                    }
+                } else {
+                    for (const std::array<float, 4>& r : job.hitRects)
+                        any = any || (wx[nx - 1] >= r[0] && wx[0] <= r[2] && wy[0] >= r[1] && wy[ny - 1] <= r[3]);
+                }
                 if (!any) continue;
             }
             job.cam.gridOf(colShares + (px - x0), nx, rowShares + (py - y0), ny, pr.data());   // (at wx, wy)
@@ -367,7 +386,7 @@ protected:
     RenderStats doRender(const FrameInput& f, const RenderConfig& cfg, Framebuffer& target, RenderControl* control) override {
         RenderStats stats;
         const int w = cfg.width, h = cfg.height;
-        target.resize(w, h);
+        target.resizeForOverwrite(w, h);   // (clear() below fills colour and depth)
         const DisplayTransform display(f.settings);
         const vec3 background = display(f.settings.background);
         const uint8_t bg[4] = {toByteSRGB(background.x), toByteSRGB(background.y), toByteSRGB(background.z), 255};
