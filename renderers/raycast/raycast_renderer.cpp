@@ -76,7 +76,7 @@ struct FrameJob {
     // rectangles (CameraRays::windowBounds of SceneAccel::hitBoxes) is not traced: its rays would
     // meet nothing, and such pixels need no ray (fillMisses). Empty: every packet is traced.
     std::vector<std::array<float, 4>> hitRects;
-    // Per f.meshes entry, whether its packet hits are shaded four at a time (lane_shading.h;
+    // Per f.meshes entry, whether its packet hits are shaded eight at a time (lane_shading.h;
     // RaycastRenderer::laneMeshes: 0 no, 1 yes, 2 yes with a colour texture); empty: every hit
     // through Tracer::trace.
     std::vector<uint8_t> laneMesh;

@@ -349,7 +349,7 @@ struct Tracer {
         }
         const size_t lights = std::min<size_t>(f.lights.size(), 64);
         const bool pbr = f.settings.reflection == ReflectionModel::Pbr;
-        // The Phong models' lights in lanes (shadowRays), the points four at a time, set up once.
+        // The Phong models' lights in lanes (shadowRays), the points eight at a time, set up once.
         constexpr int kLanes = ShadowLanes::kLanes;
         ShadowLanes groups[rt::kMaxPacket / kLanes];
         int laneHit[rt::kMaxPacket];
@@ -402,7 +402,7 @@ struct Tracer {
         }
     }
 
-    // The frames of the mesh hits among hits[0, n) along camRays (frameOf), four at a time
+    // The frames of the mesh hits among hits[0, n) along camRays (frameOf), eight at a time
     // (hitFrames: meshHitFrame's values in lanes).
     void frameMeshHits(const rt::Ray* const* camRays, const FirstHit* const* hits, int n) const {
         FrameLanes b;

@@ -1134,7 +1134,7 @@ TEST(RaycastTest, CameraPacketsGiveTheSameImageAsSingleRays) {
         }
 }
 
-// Plain Phong hits of the tile's camera packets are shaded four at a time in SSE2 lanes
+// Plain Phong hits of the tile's camera packets are shaded eight at a time in lanes (AVX2, or SSE2 twice)
 // (lane_shading.h); every pixel keeps the bytes, depth, visibility and ray count that
 // Tracer::trace gives it one by one: Phong and Blinn-Phong, with and without shadows and fog,
 // a point light with and without 1/r^2, a spot and a sun; tinted and coloured specular, an
