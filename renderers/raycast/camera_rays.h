@@ -118,8 +118,8 @@ public:
     // grid() with the shares given: out[j * nx + i] is the ray through cols[i] + rows[j].
     void gridOf(const glm::dvec4* cols, int nx, const glm::dvec4* rows, int ny, Ray* out) const {
         if (nx == 4 && ny <= kMaxRows && rowsOfFourAvailable()) {   // a packet's rows, four rays per vector
-            glm::dvec4 slow[4 * kMaxRows];
-            for (uint32_t m = rowsOfFour(cols, rows, ny, out, slow); m; m &= m - 1) {
+            PacketScratch<glm::dvec4, 4 * kMaxRows> slow;           // (written where read: glm would zero it)
+            for (uint32_t m = rowsOfFour(cols, rows, ny, out, slow.data()); m; m &= m - 1) {
                 const int k = __builtin_ctz(m);
                 out[k] = rayThrough(slow[k]);
             }

@@ -108,7 +108,7 @@ void traceCameraPackets(const FrameJob& job, const rt::SceneAccel& accel, int x0
     constexpr int kPacket = FrameJob::kPacket, tile = FrameJob::kTile;
     static_assert(tile <= 32, "one 32-bit mask per tile row");
     std::fill(rowFound, rowFound + (y1 - y0), 0u);
-    glm::dvec4 rowShares[tile];   // CameraRays::row of each row, made once for all the packets
+    rt::PacketScratch<glm::dvec4, tile> rowShares;   // CameraRays::row of each row, made once for all the packets
     for (int row = y0; row < y1; ++row) rowShares[row - y0] = job.cam.row(float(job.h - 1 - row) + 0.5f);
     rt::Ray* const rays = tileRays.data();
     Tracer::FirstHit* const hits = tileHits.data();
@@ -145,7 +145,7 @@ void traceCameraPackets(const FrameJob& job, const rt::SceneAccel& accel, int x0
                 }
                 if (!any) continue;
             }
-            job.cam.gridOf(colShares + (px - x0), nx, rowShares + (py - y0), ny, pr.data());   // (at wx, wy)
+            job.cam.gridOf(colShares + (px - x0), nx, rowShares.data() + (py - y0), ny, pr.data());   // (at wx, wy)
             int n = nx * ny;
             const uint64_t found = accel.intersectPacket(pr.data(), n, ~uint64_t(0), ph.data(), job.f.settings.culling);
             // The hit triangles' vertex indices, fetched now for the frames (Tracer::frameMeshHits) a
