@@ -335,6 +335,10 @@ private:
 // Which triangle kernel runs: "avx2+fma" (picked at run time when the CPU has it) or "sse"
 // (forced with VIEWER_RAYCAST_SSE=1).
 const char* kernelName();
+// Whether the ray caster's AVX2 builds run (its kernels, the camera rays' rows of four, the
+// shading lanes): the CPU has AVX2 and FMA and VIEWER_RAYCAST_SSE is not 1. Read once; safe to
+// call from other files' static initializers.
+bool useAvx2();
 
 // Brute-force reference (tests): closest hit over all triangles with the same test.
 bool intersectBruteForce(const sg::vec3* positions, const uint32_t* indices, size_t triangleCount, const Ray& ray, TriHit& hit);

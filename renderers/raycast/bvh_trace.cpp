@@ -52,12 +52,17 @@ namespace kern_avx512 {
 }   // namespace kern_avx512
 VIEWER_ISA_REGION_END
 
+bool useAvx2() {
+    static const bool use = [] {
+        if (rnd::debugSwitches().raycastForceSse) return false;   // force the SSE path
+        __builtin_cpu_init();
+        return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+    }();
+    return use;
+}
+
 namespace {
-const bool kUseAvx2 = [] {
-    if (rnd::debugSwitches().raycastForceSse) return false;   // force the SSE path
-    __builtin_cpu_init();
-    return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-}();
+const bool kUseAvx2 = useAvx2();
 const bool kUseAvx512 = [] {
     if (!kUseAvx2 || rnd::debugSwitches().raycastForceAvx2) return false;
     return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq");
@@ -140,8 +145,8 @@ uint64_t TriangleBvh::occludedPacket(const Ray* rays, int n, uint64_t active, co
 // <= is false with a NaN), on blocks of W lanes: with every active lane of a block sharing its
 // direction signs a child's near and far planes are chosen once, otherwise per lane by the
 // sign of the lane's reciprocal (its direction's; BLEND(a, b, r): b where r's sign bit is set,
-// else a). A macro, not a function of vectors: GCC warns
-// of the ABI of vector arguments between the ISA regions.
+// else a). A macro, not a function of vectors: GCC warns of the ABI of vector arguments between
+// the ISA regions.
 #define VIEWER_BVH4_REACH(V, W, SET1, LOAD, SUB, MUL, MAX, MIN, BLEND, LE_MASK, LANE, SIGNS)            \
     for (int blk = 0; blk < kMaxPacket / W; ++blk) {                                                    \
         const int at = W * blk;                                                                         \

@@ -269,7 +269,7 @@ struct Bvh4PacketTest {
 };
 
 // Bvh4PacketTest::reachChildren4 with the widest test this CPU has: 16 lanes per test with
-// AVX-512, 8 with AVX2, else 4 (bvh4_packet.cpp); lane by lane the same operations.
+// AVX-512, 8 with AVX2, else 4 (bvh_trace.cpp); lane by lane the same operations.
 void bvh4Reach(const Bvh4PacketTest& test, const Node4& n, uint64_t rays, int may, uint64_t reach[4], float lead[4], int first);
 
 template <bool AnyHit, bool Count, class LeafFn>

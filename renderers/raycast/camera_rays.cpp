@@ -1,25 +1,15 @@
-// camera_rays.cpp - CameraRays::grid's rows of four rays with AVX2 (chosen at run time): the
+// camera_rays.cpp - CameraRays::grid's rows of four rays with AVX2 (where rt::useAvx2()): the
 // four rays of a row in the lanes of 4-double vectors, each lane making the IEEE operations of
 // CameraRays::unproject and finish for its ray in their order (sums, reciprocals of w, products,
 // the difference, the dot product with the view direction, the rounding to float), so the rays
 // are those of CameraRays::ray bit for bit. No FMA: the region is compiled for AVX2 alone, and
 // the project builds with -ffp-contract=off.
 #include "raycast/camera_rays.h"
-#include "renderers/debug_switches.h"
 #include "renderers/isa_region.h"
 
 #include <immintrin.h>
 
 namespace rnd::rt {
-
-bool CameraRays::rowsOfFourAvailable() {
-    static const bool available = [] {
-        if (rnd::debugSwitches().raycastForceSse) return false;
-        __builtin_cpu_init();
-        return bool(__builtin_cpu_supports("avx2"));
-    }();
-    return available;
-}
 
 VIEWER_ISA_REGION_BEGIN("avx2")
 uint32_t CameraRays::rowsOfFour(const glm::dvec4 cols[4], const glm::dvec4* rows, int ny, Ray* out, glm::dvec4* slow) const {

@@ -117,8 +117,8 @@ public:
     }
     // grid() with the shares given: out[j * nx + i] is the ray through cols[i] + rows[j].
     void gridOf(const glm::dvec4* cols, int nx, const glm::dvec4* rows, int ny, Ray* out) const {
-        if (nx == 4 && ny <= kMaxRows && rowsOfFourAvailable()) {   // a packet's rows, four rays per vector
-            PacketScratch<glm::dvec4, 4 * kMaxRows> slow;           // (written where read: glm would zero it)
+        if (nx == 4 && ny <= kMaxRows && useAvx2()) {       // a packet's rows, four rays per vector
+            PacketScratch<glm::dvec4, 4 * kMaxRows> slow;   // (written where read: glm would zero it)
             for (uint32_t m = rowsOfFour(cols, rows, ny, out, slow.data()); m; m &= m - 1) {
                 const int k = __builtin_ctz(m);
                 out[k] = rayThrough(slow[k]);
@@ -153,7 +153,6 @@ private:
     // through column cols[i] and row rows[j], j < ny <= kMaxRows, into out; returns bit 4j + i
     // for the rays with no far end or something not finite (they take rayThrough(slow[4j + i])).
     static constexpr int kMaxRows = 8;
-    static bool rowsOfFourAvailable();
     uint32_t rowsOfFour(const glm::dvec4 cols[4], const glm::dvec4* rows, int ny, Ray* out, glm::dvec4* slow) const;
     static void toPairs(const glm::dvec4& v, __m128d* p) {   // (x, y) and (z, w)
         p[0] = _mm_loadu_pd(&v.x);

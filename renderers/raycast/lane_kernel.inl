@@ -15,16 +15,14 @@
 
 constexpr int kLaneW = int(kW);
 
-inline V load(const float* p) { return loadu(p); }
 inline V vabs(V a) { return vand(a, castF(set1I(0x7fffffff))); }
 inline V negate(V a) { return vxor(a, set1(-0.0f)); }                                                    // glm's unary minus: the sign bit flipped
 inline V maskOf(unsigned bits) { return castF(cmpeqI(andI(set1I(int(bits)), laneBit()), laneBit())); }   // lane l all ones where bit l is set
-inline unsigned bitsOf(V mask) { return unsigned(movemask(mask)); }
 
 struct V3 {
     V x, y, z;
 };
-inline V3 load3(const float (&a)[3][kL], int off) { return {load(a[0] + off), load(a[1] + off), load(a[2] + off)}; }
+inline V3 load3(const float (&a)[3][kL], int off) { return {loadu(a[0] + off), loadu(a[1] + off), loadu(a[2] + off)}; }
 inline V3 splat(const vec3& v) { return {set1(v.x), set1(v.y), set1(v.z)}; }
 inline V3 add3(const V3& a, const V3& b) { return {add(a.x, b.x), add(a.y, b.y), add(a.z, b.z)}; }
 inline V3 sub3(const V3& a, const V3& b) { return {sub(a.x, b.x), sub(a.y, b.y), sub(a.z, b.z)}; }
@@ -89,13 +87,13 @@ unsigned shadeRun(const LaneBatch& b, const FrameInput& f, float rgb[3][kL], int
 
     // shadeMeshHit: albedo = (w0 albedoV[0] + w1 albedoV[1] + w2 albedoV[2]) * texColor,
     // n = normalize(w0 Nv[0] + w1 Nv[1] + w2 Nv[2]) where it is longer than 1e-20, else ng; ng without vertex normals.
-    const V w0 = load(b.w[0] + off), w1 = load(b.w[1] + off), w2 = load(b.w[2] + off);
+    const V w0 = loadu(b.w[0] + off), w1 = loadu(b.w[1] + off), w2 = loadu(b.w[2] + off);
     V3 albedo = add3(add3(scale3(w0, load3(b.va[0], off)), scale3(w1, load3(b.va[1], off))), scale3(w2, load3(b.va[2], off)));
     if (const unsigned textured = (b.textured >> off) & valid) {   // (x * 1 is x bit for bit: the others multiply by 1, or not at all)
         alignas(32) float tex[3][kLaneW];
         for (int a = 0; a < 3; ++a)
             for (int l = 0; l < kLaneW; ++l) tex[a][l] = (textured >> l) & 1 ? b.tex[a][off + l] : 1.0f;
-        albedo = mul3(albedo, V3{load(tex[0]), load(tex[1]), load(tex[2])});
+        albedo = mul3(albedo, V3{loadu(tex[0]), loadu(tex[1]), loadu(tex[2])});
     }
     const V3 p = load3(b.p, off), ng = load3(b.ng, off);
     V3 n = add3(add3(scale3(w0, load3(b.vn[0], off)), scale3(w1, load3(b.vn[1], off))), scale3(w2, load3(b.vn[2], off)));
@@ -107,9 +105,9 @@ unsigned shadeRun(const LaneBatch& b, const FrameInput& f, float rgb[3][kL], int
     const V vLen = vsqrt(dot(v, v));
     v = sel3(cmpgt(vLen, zero), div3(v, vLen), splat(vec3(0, 0, 1)));
     const V3 ambient = splat(f.ambientLight);
-    V3 tMul = scale3(load(ka), ambient), tAdd = V3{load(em[0]), load(em[1]), load(em[2])};
-    const V3 specColor{load(sc[0]), load(sc[1]), load(sc[2])};
-    const V kdV = load(kd), ksV = load(ks);
+    V3 tMul = scale3(loadu(ka), ambient), tAdd = V3{loadu(em[0]), loadu(em[1]), loadu(em[2])};
+    const V3 specColor{loadu(sc[0]), loadu(sc[1]), loadu(sc[2])};
+    const V kdV = loadu(kd), ksV = loadu(ks);
     const bool blinn = f.settings.reflection == ReflectionModel::BlinnPhong;
 
     unsigned fallback = 0;
@@ -128,7 +126,7 @@ unsigned shadeRun(const LaneBatch& b, const FrameInput& f, float rgb[3][kL], int
                 known |= unsigned((b.known[off + l] >> i) & 1) << l;
                 lit |= unsigned((b.lit[off + l] >> i) & 1) << l;
             }
-            const unsigned reaches = bitsOf(vand(cmpgt(nl, zero), nonZero(rad)));
+            const unsigned reaches = unsigned(movemask(vand(cmpgt(nl, zero), nonZero(rad))));
             fallback |= ~known & reaches;
             visible = vand(maskOf(~(known & ~lit & reaches)), one);   // 0 where traced and blocked
         }
@@ -146,9 +144,9 @@ unsigned shadeRun(const LaneBatch& b, const FrameInput& f, float rgb[3][kL], int
         const V front = cmpnle(nl, zero), active = cmpnle(visible, zero);
         alignas(32) float s[kLaneW];
         storeu(s, spec);
-        const unsigned powered = bitsOf(vand(vand(front, active), cmpgt(spec, zero))) & valid;
+        const unsigned powered = unsigned(movemask(vand(vand(front, active), cmpgt(spec, zero)))) & valid;
         for (int l = 0; l < kLaneW; ++l) s[l] = (powered >> l) & 1 ? std::pow(s[l], shin[l]) : 0.0f;
-        spec = load(s);
+        spec = loadu(s);
         const V3 ln = scale3(nl, rad);   // radiance * nl
         const V ksSpec = mul(ksV, spec);
         V3 liMul = scale3(kdV, ln);
@@ -172,7 +170,7 @@ unsigned shadeRun(const LaneBatch& b, const FrameInput& f, float rgb[3][kL], int
 void framesRun(FrameLanes& b, int off) {
     const V zero = zeroV();
     const V3 P0 = load3(b.P[0], off), P1 = load3(b.P[1], off), P2 = load3(b.P[2], off);
-    const V b1 = load(b.b1 + off), b2 = load(b.b2 + off);
+    const V b1 = loadu(b.b1 + off), b2 = loadu(b.b2 + off);
     const V w0 = sub(sub(set1(1.0f), b1), b2);   // 1 - b1 - b2
     const V3 p = add3(add3(scale3(w0, P0), scale3(b1, P1)), scale3(b2, P2));
     // glm::cross(e1, e2) = (e1.y e2.z - e2.y e1.z, e1.z e2.x - e2.z e1.x, e1.x e2.y - e2.x e1.y)
@@ -186,7 +184,7 @@ void framesRun(FrameLanes& b, int off) {
     storeu(b.p[0] + off, p.x), storeu(b.p[1] + off, p.y), storeu(b.p[2] + off, p.z);
     storeu(b.gn[0] + off, gn.x), storeu(b.gn[1] + off, gn.y), storeu(b.gn[2] + off, gn.z);
     storeu(b.ng[0] + off, ng.x), storeu(b.ng[1] + off, ng.y), storeu(b.ng[2] + off, ng.z);
-    b.back |= (bitsOf(back) << off) & ((1u << b.count) - 1);
+    b.back |= (unsigned(movemask(back)) << off) & ((1u << b.count) - 1);
 }
 
 // shadowRays for lanes [off, off + kLaneW) (padded): their bits into b.reaches, their rays into b.rays.
@@ -195,7 +193,7 @@ void shadowRun(ShadowLanes& b, const DrawLight& L, int off) {
     const V3 p = load3(b.p, off), ng = load3(b.ng, off);
     const LightLanes ls(L, p);
     const V ngl = dot(ng, ls.toL);
-    const unsigned reaches = (bitsOf(vand(cmpgt(ngl, zero), nonZero(ls.rad))) << off) & ((1u << b.count) - 1);   // sampleReaches(ls, ng)
+    const unsigned reaches = (unsigned(movemask(vand(cmpgt(ngl, zero), nonZero(ls.rad)))) << off) & ((1u << b.count) - 1);   // sampleReaches(ls, ng)
     b.reaches |= reaches;
     if (!reaches) return;
     // Tracer::shadowRay: side = ng.l >= 0 ? 1 : -1; eps = offsetScale(p) =
@@ -227,7 +225,7 @@ void shadowRun(ShadowLanes& b, const DrawLight& L, int off) {
 // magenta (bytes 255, 0, 255, 255) where a channel is not finite (x - x is NaN exactly there).
 void encodeRun(const float rgb[3][kL], uint32_t out[kL], int off) {
     const SrgbEncoder& t = srgbEncoder();
-    const V r = load(rgb[0] + off), g = load(rgb[1] + off), b = load(rgb[2] + off);
+    const V r = loadu(rgb[0] + off), g = loadu(rgb[1] + off), b = loadu(rgb[2] + off);
     const V finite = cmpeq(add(add(sub(r, r), sub(g, g)), sub(b, b)), zeroV());
     const VI word = orI(orI(encodeSrgb(r, t), slliI(encodeSrgb(g, t), 8)), orI(slliI(encodeSrgb(b, t), 16), set1I(int(0xFF000000u))));
     storeuI(out + off, selI(castI(finite), word, set1I(int(0xFFFF00FFu))));

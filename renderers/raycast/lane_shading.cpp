@@ -6,7 +6,6 @@
 // the same operations as the scalar functions (see there).
 #include "raycast/lane_shading.h"
 #include "raster/simd.h"
-#include "renderers/debug_switches.h"
 #include "renderers/isa_region.h"
 #include "renderers/srgb_encoder.h"
 
@@ -36,11 +35,7 @@ using namespace raster::simd_avx2;
 }   // namespace avx2
 VIEWER_ISA_REGION_END
 
-const bool kUseAvx2 = [] {
-    if (rnd::debugSwitches().raycastForceSse) return false;
-    __builtin_cpu_init();
-    return bool(__builtin_cpu_supports("avx2"));
-}();
+const bool kUseAvx2 = rt::useAvx2();
 
 // Lanes count..kL-1 take lane 0's inputs (their results are not used).
 void pad(LaneBatch& b) {

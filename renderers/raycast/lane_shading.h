@@ -1,8 +1,8 @@
 // lane_shading.h - the ray caster's smooth Phong / Blinn-Phong shading of eight mesh hits at once
-// (AVX2 lanes, or SSE2's four twice), for the commonest primary hit: an opaque, lit, untextured triangle seen in a
-// frame without pbr, reflections or lights with a size under shadows (a colour texture, sampled
-// per lane by the caller, is fine; the other material maps are not). Every lane performs the
-// IEEE operations of Tracer::shadeMeshHit and rnd::shadeTerms in their order (no FMA, no
+// (AVX2 lanes, or SSE2's four twice), for the commonest primary hit: an opaque, lit, untextured
+// triangle seen in a frame without pbr, reflections or lights with a size under shadows (a
+// colour texture, sampled per lane by the caller, is fine; the other material maps are not).
+// Every lane performs the IEEE operations of Tracer::shadeMeshHit and rnd::shadeTerms in their order (no FMA, no
 // reciprocal for a division, libm's powf per lane), so a pixel shaded here has the bytes of one
 // shaded by Tracer::trace; RaycastTest checks that byte for byte, and VIEWER_RAYCAST_LANES=0
 // turns the lanes off.

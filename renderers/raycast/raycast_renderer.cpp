@@ -112,18 +112,21 @@ void traceCameraPackets(const FrameJob& job, const rt::SceneAccel& accel, int x0
     for (int row = y0; row < y1; ++row) rowShares[row - y0] = job.cam.row(float(job.h - 1 - row) + 0.5f);
     rt::Ray* const rays = tileRays.data();
     Tracer::FirstHit* const hits = tileHits.data();
-    // The window rectangles that overlap these rows' pixel centres: a packet lies inside them,
-    // so a rectangle that misses the rows misses each of its packets too (the same comparisons).
-    constexpr int kNear = 64;
+    // Whether window rectangle r overlaps the pixel centres [xLo, xHi] x [yLo, yHi].
+    auto overlaps = [](const std::array<float, 4>& r, float xLo, float xHi, float yLo, float yHi) {
+        return xHi >= r[0] && xLo <= r[2] && yHi >= r[1] && yLo <= r[3];
+    };
+    // The rectangles that overlap these rows' pixel centres: a packet lies inside the rows, so a
+    // rectangle that misses them misses each of its packets too (the same comparisons).
+    // SceneAccel::hitBoxes holds at most 32 boxes; were there more, every packet is traced.
+    constexpr int kNear = 32;
+    const bool cull = !job.hitRects.empty() && job.hitRects.size() <= size_t(kNear);
     const std::array<float, 4>* nearRects[kNear];
     int nNear = 0;
-    const bool culled = !job.hitRects.empty() && job.hitRects.size() <= size_t(kNear);
-    if (culled) {
-        const float wxLo = float(x0) + 0.5f, wxHi = float(x1 - 1) + 0.5f;
-        const float wyHi = float(job.h - 1 - y0) + 0.5f, wyLo = float(job.h - 1 - (y1 - 1)) + 0.5f;
+    if (cull)
         for (const std::array<float, 4>& r : job.hitRects)
-            if (wxHi >= r[0] && wxLo <= r[2] && wyHi >= r[1] && wyLo <= r[3]) nearRects[nNear++] = &r;
-    }
+            if (overlaps(r, float(x0) + 0.5f, float(x1 - 1) + 0.5f, float(job.h - 1 - (y1 - 1)) + 0.5f, float(job.h - 1 - y0) + 0.5f))
+                nearRects[nNear++] = &r;
     for (int py = y0; py < y1; py += kPacket)
         for (int px = x0; px < x1; px += kPacket) {
             rt::PacketScratch<rt::Ray, kPacket * kPacket> pr;
@@ -132,17 +135,10 @@ void traceCameraPackets(const FrameJob& job, const rt::SceneAccel& accel, int x0
             float wx[kPacket], wy[kPacket];
             for (int i = 0; i < nx; ++i) wx[i] = float(px + i) + 0.5f;
             for (int j = 0; j < ny; ++j) wy[j] = float(job.h - 1 - (py + j)) + 0.5f;
-            if (!job.hitRects.empty()) {   // rowFound keeps 0 for the packet's pixels: misses, as traced
+            if (cull) {   // rowFound keeps 0 for the packet's pixels: misses, as traced
                 bool any = false;
-                if (culled) {
-                    for (int k = 0; k < nNear && !any; ++k) {
-                        const std::array<float, 4>& r = *nearRects[k];
-                        any = wx[nx - 1] >= r[0] && wx[0] <= r[2] && wy[0] >= r[1] && wy[ny - 1] <= r[3];   // (wy falls row by row)
-                    }
-                } else {
-                    for (const std::array<float, 4>& r : job.hitRects)
-                        any = any || (wx[nx - 1] >= r[0] && wx[0] <= r[2] && wy[0] >= r[1] && wy[ny - 1] <= r[3]);
-                }
+                for (int k = 0; k < nNear && !any; ++k)
+                    any = overlaps(*nearRects[k], wx[0], wx[nx - 1], wy[ny - 1], wy[0]);   // (wy falls row by row)
                 if (!any) continue;
             }
             job.cam.gridOf(colShares + (px - x0), nx, rowShares.data() + (py - y0), ny, pr.data());   // (at wx, wy)
