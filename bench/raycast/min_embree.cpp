@@ -5,6 +5,7 @@
 
 #include "renderers/draw_list.h"
 #include "renderers/shading.h"
+#include "renderers/texture_sampler.h"
 
 #include <embree3/rtcore.h>
 #include <tbb/blocked_range.h>
@@ -30,6 +31,7 @@ struct MinimalEmbree::State {
         const std::vector<uint16_t>* triMat = nullptr;   // per-triangle materials (CSG)
         const std::vector<Material>* mats = nullptr;
         const Texture* tex = nullptr;
+        const rnd::SampledTexture* sampler = nullptr;   // tex's mip levels (filtered lookups)
     };
     RTCDevice device = nullptr;
     RTCScene scene = nullptr;
@@ -39,6 +41,8 @@ struct MinimalEmbree::State {
     bool instanced = false;
     std::unordered_map<const Mesh*, RTCScene> meshScenes;
     rnd::TessellationCache tess;
+    bool nearest = false;   // textures at level 0, nearest texel (the reference before filtered lookups)
+    std::unordered_map<const Texture*, std::unique_ptr<rnd::SampledTexture>> samplers;
     float decode[256];      // sRGB byte -> linear
     uint8_t encode[4097];   // linear [0, 1] in steps of 1/4096 -> sRGB byte
     ~State() {
@@ -56,9 +60,10 @@ size_t MinimalEmbree::triangles() const {
     return n;
 }
 
-std::string MinimalEmbree::setup(const FrameInput& f, int tessellation, const std::string& config, bool instanced) {
+std::string MinimalEmbree::setup(const FrameInput& f, int tessellation, const std::string& config, bool instanced, bool nearestTextures) {
     m = std::make_unique<State>();
     m->instanced = instanced;
+    m->nearest = nearestTextures;
     for (int i = 0; i < 256; ++i) m->decode[i] = rnd::decodeSRGB(float(i) / 255.0f);
     for (int i = 0; i <= 4096; ++i) m->encode[i] = uint8_t(rnd::encodeSRGB(float(i) / 4096.0f) * 255.0f + 0.5f);
     m->device = rtcNewDevice(config.c_str());
@@ -78,6 +83,9 @@ std::string MinimalEmbree::setup(const FrameInput& f, int tessellation, const st
         if (d.texture && mesh.uv0.size() == mesh.positions.size()) {
             g.uv = mesh.uv0;
             g.tex = d.texture.get();
+            std::unique_ptr<rnd::SampledTexture>& st = m->samplers[g.tex];
+            if (!st) st = std::make_unique<rnd::SampledTexture>(*g.tex);
+            g.sampler = st.get();
         }
         g.idx = mesh.indices;
         if (d.mirrored)   // front faces counter-clockwise in world space for every draw
@@ -116,6 +124,27 @@ std::string MinimalEmbree::setup(const FrameInput& f, int tessellation, const st
     rtcCommitScene(m->scene);
     return rtcGetDeviceError(m->device) == RTC_ERROR_NONE ? "" : "Embree error during setup";
 }
+
+namespace {
+
+// uv where the camera ray through window position (wx, wy) meets the plane of triangle P (its
+// barycentrics there, inside the triangle or not): a neighbouring pixel's uv, for the footprint.
+bool uvOnPlane(const vec3& o0, const vec3& ox, const vec3& oy, const vec3& f0, const vec3& fx, const vec3& fy, float wx, float wy, const vec3 P[3],
+               const vec2 uv[3], vec2& out) {
+    const vec3 o = o0 + wx * ox + wy * oy, d = f0 + wx * fx + wy * fy - o;
+    const vec3 e1 = P[1] - P[0], e2 = P[2] - P[0], n = glm::cross(e1, e2);
+    const float den = glm::dot(d, n);
+    if (!(std::abs(den) > 1e-30f)) return false;
+    const vec3 q = o + (glm::dot(P[0] - o, n) / den) * d - P[0];
+    const float d00 = glm::dot(e1, e1), d01 = glm::dot(e1, e2), d11 = glm::dot(e2, e2);
+    const float d20 = glm::dot(q, e1), d21 = glm::dot(q, e2), det = d00 * d11 - d01 * d01;
+    if (!(std::abs(det) > 0)) return false;
+    const float b1 = (d11 * d20 - d01 * d21) / det, b2 = (d00 * d21 - d01 * d20) / det;
+    out = (1.0f - b1 - b2) * uv[0] + b1 * uv[1] + b2 * uv[2];
+    return std::isfinite(out.x) && std::isfinite(out.y);
+}
+
+}   // namespace
 
 void MinimalEmbree::render(const FrameInput& f, int W, int H, std::vector<uint8_t>& rgba) const {
     rgba.resize(size_t(W) * H * 4);
@@ -179,7 +208,17 @@ void MinimalEmbree::render(const FrameInput& f, int W, int H, std::vector<uint8_
                         }
                         mat[i] = g.triMat ? &(*g.mats)[(*g.triMat)[t]] : g.mat;
                         albedo[i] = mat[i]->baseColor;
-                        if (g.tex) {   // level 0, nearest, repeat; file row r is GL row h - 1 - r
+                        if (g.tex && !m->nearest) {   // filtered as ours: the uv footprint of the neighbouring pixels' rays
+                            const vec2 uv = w * g.uv[i0] + u * g.uv[i1] + v * g.uv[i2];
+                            const float wx = float(px + (i & 3)) + 0.5f, wy = float(H - 1 - (py + (i >> 2))) + 0.5f;
+                            vec2 uvX, uvY;
+                            const vec3 tri[3] = {g.p[i0], g.p[i1], g.p[i2]};
+                            const vec2 triUv[3] = {g.uv[i0], g.uv[i1], g.uv[i2]};
+                            const bool footprint = uvOnPlane(o0, ox, oy, f0, fx, fy, wx + 1.0f, wy, tri, triUv, uvX) &&
+                                                   uvOnPlane(o0, ox, oy, f0, fx, fy, wx, wy + 1.0f, tri, triUv, uvY);
+                            albedo[i] *= footprint ? g.sampler->sample(uv, uvX - uv, uvY - uv)
+                                                   : g.sampler->sampleLevel(uv, 0, g.sampler->filter() != FilterMode::Nearest);
+                        } else if (g.tex) {   // level 0, nearest, repeat; file row r is GL row h - 1 - r
                             const vec2 uv = w * g.uv[i0] + u * g.uv[i1] + v * g.uv[i2];
                             const int tw = g.tex->width, th = g.tex->height;
                             const int tx = ((int(std::floor(uv.x * tw)) % tw) + tw) % tw, ty = ((int(std::floor(uv.y * th)) % th) + th) % th;

@@ -6,7 +6,10 @@
 //   cmake --build build/release -j2 --target bench_raycast_frame
 //   ./build/release/bench/raycast/bench_raycast_frame [--threads 2] [--frames 7] [--size 1280x720]
 //        [--scenes demo,bunny,igea,mesh1M] [--png DIR] [--testdata DIR] [--ours-only N] [--avx2-only]
+//        [--nearest-textures]
 //
+// --nearest-textures: min_embree samples colour textures at level 0, nearest texel (the
+// reference as first written), not filtered with the pixel's footprint as ours (the default).
 // --ours-only N: only N warm frames of ours per scene, nothing printed (for profilers:
 // perf record -g bench_raycast_frame --scenes bunny --ours-only 20).
 // Prints one line per scene and metric:
@@ -28,7 +31,9 @@
 // image agreement (mean absolute difference per channel, % of pixels within 8 of ours); --png
 // DIR writes both images (DIR/<scene>_ours.png, DIR/<scene>_min_embree.png).
 // Scenes: demo (the bundled demo: analytic shapes, which min_embree draws as the rasterizers'
-// tessellation; textured floor and crates, which it samples at level 0), bunny and igea (mesh
+// tessellation; textured floor and crates), demo_tessellated (by name only: the demo with its
+// analytic shapes given to both renderers as those triangles, so that what is left between them
+// is the triangle scene's work), bunny and igea (mesh
 // files from the test data on a ground plane with a point light, framed like bench_raster's
 // bunny), mesh1M (bench_raster's mesh1M: 22 x 22 uv-spheres and a ground plane merged into one
 // mesh, 988k triangles); and by name only: spheres1M (bench_raster's: 32 x 32 instances of one
@@ -42,6 +47,7 @@
 #include "assets/scene_io.h"
 #include "bench_scenes.h"
 #include "min_embree.h"
+#include "renderers/draw_list.h"
 #include "renderers/renderer.h"
 #include "scenegraph/frame.h"
 #include "scenegraph/scene.h"
@@ -130,11 +136,50 @@ private:
     std::thread m_thread;
 };
 
+// f with its analytic shapes replaced by their tessellation at the frame's level (the triangles
+// min_embree draws for them), as meshes in world space: a shape whose faces take several
+// materials (CSG) becomes one mesh per material. The same triangles on both sides, so what is
+// left between the two renderers is the triangle scene's work (demo_tessellated).
+FrameInput tessellated(const FrameInput& f) {
+    FrameInput t = f;
+    t.analytics.clear();
+    rnd::TessellationCache cache;
+    for (const rnd::PreparedDraw& d : rnd::prepareDraws(f, f.settings.tessellation, cache)) {
+        if (!d.analytic) continue;
+        DrawMesh dm;
+        dm.node = d.node;
+        dm.texture = d.texture;
+        dm.maps = d.maps;
+        dm.world = *d.world;
+        dm.normal = d.normal;
+        dm.mirrored = d.mirrored;
+        if (!d.triangleMaterial) {
+            dm.mesh = d.mesh;
+            dm.material = *d.material;
+            t.meshes.push_back(dm);
+            continue;
+        }
+        for (size_t m = 0; m < d.materials->size(); ++m) {
+            auto part = std::make_shared<Mesh>(*d.mesh);
+            part->id = newResourceId();
+            part->indices.clear();
+            for (size_t tri = 0; tri < d.triangleMaterial->size(); ++tri)
+                if ((*d.triangleMaterial)[tri] == m)
+                    part->indices.insert(part->indices.end(), &d.mesh->indices[3 * tri], &d.mesh->indices[3 * tri + 3]);
+            if (part->indices.empty()) continue;
+            dm.mesh = part;
+            dm.material = (*d.materials)[m];
+            t.meshes.push_back(dm);
+        }
+    }
+    return t;
+}
+
 }   // namespace
 
 int main(int argc, char** argv) {
     int threads = 2, frames = 7, w = 1280, h = 720, oursOnly = 0;
-    bool avx2Only = false;
+    bool avx2Only = false, nearestTextures = false;
     std::string only = "demo,bunny,igea,mesh1M", pngDir, testdata = VIEWER_TESTDATA_DIR;
     if (const char* env = std::getenv("VIEWER_TESTDATA")) testdata = env;
     for (int i = 1; i < argc; ++i) {
@@ -156,10 +201,12 @@ int main(int argc, char** argv) {
             oursOnly = std::max(1, std::atoi(next().c_str()));
         else if (a == "--avx2-only")
             avx2Only = true;
+        else if (a == "--nearest-textures")
+            nearestTextures = true;
         else {
             std::fprintf(stderr,
                          "usage: %s [--threads N] [--frames N] [--size WxH] [--scenes demo,bunny,igea,mesh1M] [--png DIR] [--testdata DIR] "
-                         "[--ours-only N] [--avx2-only]\n",
+                         "[--ours-only N] [--avx2-only] [--nearest-textures]\n",
                          argv[0]);
             return 2;
         }
@@ -169,6 +216,7 @@ int main(int argc, char** argv) {
     auto want = [&](const std::string& n) { return ("," + only + ",").find("," + n + ",") != std::string::npos; };
     std::vector<BenchScene> scenes;
     if (want("demo")) scenes.push_back({"demo", assets::makeDemoScene()});
+    if (want("demo_tessellated")) scenes.push_back({"demo_tessellated", assets::makeDemoScene()});
     const std::string models = testdata + "/meshes/common-3d-test-models/";
     BenchScene b;
     if (want("bunny") && fileScene(models + "stanford-bunny/stanford-bunny.obj", b, "bunny")) scenes.push_back(std::move(b));
@@ -187,7 +235,8 @@ int main(int argc, char** argv) {
     if (oursOnly == 0) watchdog.emplace();
     for (BenchScene& sc : scenes) {
         sc.scene.settings.shadows = true;
-        const FrameInput f = flatten(sc.scene, float(w) / float(h));
+        const FrameInput f =
+            sc.name == "demo_tessellated" ? tessellated(flatten(sc.scene, float(w) / float(h))) : flatten(sc.scene, float(w) / float(h));
         const char* n = sc.name.c_str();
         std::string err;
         // Cold: a new renderer's first frame against min_embree's setup and first frame.
@@ -207,11 +256,11 @@ int main(int argc, char** argv) {
         bench::MinimalEmbree ref, refA;
         const double coldRef = timeMs([&] {
             watchdog->guard(defaultName, kLimitS, [&] {
-                err = ref.setup(f, f.settings.tessellation, defaultCfg);
+                err = ref.setup(f, f.settings.tessellation, defaultCfg, false, nearestTextures);
                 if (err.empty()) ref.render(f, w, h, img);
             });
         });
-        if (!err.empty() || !ok || !(err = refA.setup(f, f.settings.tessellation, threadsCfg + ",isa=avx2")).empty()) {
+        if (!err.empty() || !ok || !(err = refA.setup(f, f.settings.tessellation, threadsCfg + ",isa=avx2", false, nearestTextures)).empty()) {
             std::fprintf(stderr, "bench: scene %s failed: %s\n", n, ok ? err.c_str() : "our render failed");
             return 1;
         }
@@ -219,7 +268,7 @@ int main(int argc, char** argv) {
         // Two levels, as ours (the default ISA; isa=avx2 with --avx2-only): not the reference, what instancing costs Embree.
         bench::MinimalEmbree refI;
         std::vector<uint8_t> imgI;
-        if (!(err = refI.setup(f, f.settings.tessellation, defaultCfg, true)).empty()) {
+        if (!(err = refI.setup(f, f.settings.tessellation, defaultCfg, true, nearestTextures)).empty()) {
             std::fprintf(stderr, "bench: scene %s failed (instanced): %s\n", n, err.c_str());
             return 1;
         }
