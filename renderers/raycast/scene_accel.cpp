@@ -142,8 +142,12 @@ int SceneAccel::update(const FrameInput& f) {
     for (auto it = m_analytics.begin(); it != m_analytics.end();)
         it = m_frameCounter - it->second.lastFrame > 8 ? m_analytics.erase(it) : std::next(it);
 
+    // One instance per leaf: the rays a leaf's box passes are then exactly those that reach its
+    // instance's box, so a packet calls an instance's kernel (rays moved into its space, the
+    // packet set up) only for rays that can meet it. With two per leaf, every packet reaching
+    // the ground under the bunny also set the bunny's kernel up for nothing.
     Bvh4::BuildOptions o;
-    o.maxLeafSize = 2;
+    o.maxLeafSize = 1;
     o.parallel = false;
     m_tlas.build(bmin.data(), bmax.data(), bmin.size(), o);
     constexpr size_t kMaxHitBoxes = 16, kMaxTightBoxes = 32;
