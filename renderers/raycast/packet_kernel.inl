@@ -145,6 +145,178 @@ inline __m256 unfusedProduct(__m256 a, __m256 b) {
     return p;
 }
 
+// Rows of 8 floats (lanes l and l + 4 in the halves of v[l]) -> x, y, z, w of the 8 rows.
+inline void transposeRows8(const __m256* v, __m256* out) {
+    const __m256 t0 = _mm256_unpacklo_ps(v[0], v[1]), t1 = _mm256_unpackhi_ps(v[0], v[1]);
+    const __m256 t2 = _mm256_unpacklo_ps(v[2], v[3]), t3 = _mm256_unpackhi_ps(v[2], v[3]);
+    out[0] = _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(1, 0, 1, 0));
+    out[1] = _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(3, 2, 3, 2));
+    out[2] = _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(1, 0, 1, 0));
+    out[3] = _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(3, 2, 3, 2));
+}
+
+#if RT_AVX512
+// a * b on 16 lanes as a value of its own (see unfusedProduct).
+inline __m512 unfusedProduct16(__m512 a, __m512 b) {
+    __m512 p = _mm512_mul_ps(a, b);
+    asm("" : "+v"(p));
+    return p;
+}
+
+// Lane-wise min / max, and the smallest / largest of 16 lanes. (The masked forms with all lanes
+// set: GCC 12's unmasked ones warn of an uninitialised operand.)
+inline __m512 min16(__m512 a, __m512 b) { return _mm512_maskz_min_ps(0xFFFF, a, b); }
+inline __m512 max16(__m512 a, __m512 b) { return _mm512_maskz_max_ps(0xFFFF, a, b); }
+inline float laneMin16(__m512 v) {
+    return laneMin8(_mm256_min_ps(_mm512_maskz_extractf32x8_ps(0xFF, v, 0), _mm512_maskz_extractf32x8_ps(0xFF, v, 1)));
+}
+inline float laneMax16(__m512 v) {
+    return laneMax8(_mm256_max_ps(_mm512_maskz_extractf32x8_ps(0xFF, v, 0), _mm512_maskz_extractf32x8_ps(0xFF, v, 1)));
+}
+
+// gatherPacket (below) sixteen rays at a time on AVX-512: lane by lane the same operations as
+// its groups of eight (the rays loaded and transposed eight at a time, then everything else in
+// 16 lanes), so pr and the bounds get the same values. An inactive lane repeats the block's
+// first active ray (the eight-ray groups repeat their own first; those lanes are never read as
+// rays), and moved is written for each group of eight that holds an active ray, as there.
+inline PacketGather gatherPacket16(const Ray* rays, int n, uint64_t active, const float* absMax, PacketRays& pr, const RayTransform* move,
+                                   const float* tmaxIn, Ray* moved) {
+    PacketGather g;
+    const __m512 inf = _mm512_set1_ps(std::numeric_limits<float>::infinity()), ninf = _mm512_set1_ps(-std::numeric_limits<float>::infinity());
+    const __m512 signBit = _mm512_set1_ps(-0.0f), zero = _mm512_setzero_ps(), one = _mm512_set1_ps(1.0f);
+    __m512 rlo[3] = {inf, inf, inf}, rhi[3] = {ninf, ninf, ninf}, olo[3] = {inf, inf, inf}, ohi[3] = {ninf, ninf, ninf};
+    __m512 tminLo = inf, tmaxHi = ninf;
+    const int blocksN = (n + 15) / 16;
+    for (int b = 0; b < blocksN; ++b) {
+        const unsigned lanes = unsigned(active >> (16 * b)) & 0xFFFFu;
+        const int o16 = 16 * b;
+        if (!lanes) {   // never enters a box
+            for (int a = 0; a < 3; ++a) {
+                _mm512_store_ps(pr.rd[a] + o16, one);
+                _mm512_store_ps(pr.on[a] + o16, zero);
+                _mm512_store_ps(pr.of[a] + o16, zero);
+                _mm512_store_ps(pr.org[a] + o16, zero);
+                _mm512_store_ps(pr.dir[a] + o16, zero);
+            }
+            _mm512_store_ps(pr.tmin + o16, zero);
+            _mm512_store_ps(pr.tmax + o16, _mm512_set1_ps(-1.0f));
+            continue;
+        }
+        const int firstLane = __builtin_ctz(lanes);
+        auto ray = [&](int l) -> const Ray& { return rays[o16 + (((lanes >> l) & 1) ? l : firstLane)]; };
+        __m512 org[4], dir[4];   // x, y, z and tmin / tmax of the 16 rays
+        for (int h = 0; h < 2; ++h) {
+            __m256 ov[4], dv[4], o8[4], d8[4];
+            for (int l = 0; l < 4; ++l) {
+                const Ray &lo = ray(8 * h + l), &hi = ray(8 * h + l + 4);
+                ov[l] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(&lo.org.x)), _mm_loadu_ps(&hi.org.x), 1);
+                dv[l] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(&lo.dir.x)), _mm_loadu_ps(&hi.dir.x), 1);
+            }
+            transposeRows8(ov, o8);
+            transposeRows8(dv, d8);
+            for (int a = 0; a < 4; ++a) {
+                org[a] = h == 0 ? _mm512_castps256_ps512(o8[a]) : _mm512_insertf32x8(org[a], o8[a], 1);
+                dir[a] = h == 0 ? _mm512_castps256_ps512(d8[a]) : _mm512_insertf32x8(dir[a], d8[a], 1);
+            }
+        }
+        if (move) {
+            __m512 mo[3], md[3];
+            for (int r = 0; r < 3; ++r) {
+                const float(*c)[4] = move->col;
+                const float(*d)[4] = move->lin;
+                mo[r] =
+                    _mm512_add_ps(_mm512_add_ps(unfusedProduct16(_mm512_set1_ps(c[0][r]), org[0]), unfusedProduct16(_mm512_set1_ps(c[1][r]), org[1])),
+                                  _mm512_add_ps(unfusedProduct16(_mm512_set1_ps(c[2][r]), org[2]), _mm512_set1_ps(c[3][r])));
+                md[r] =
+                    _mm512_add_ps(_mm512_add_ps(unfusedProduct16(_mm512_set1_ps(d[0][r]), dir[0]), unfusedProduct16(_mm512_set1_ps(d[1][r]), dir[1])),
+                                  unfusedProduct16(_mm512_set1_ps(d[2][r]), dir[2]));
+            }
+            for (int r = 0; r < 3; ++r) org[r] = mo[r], dir[r] = md[r];
+            if (tmaxIn) {
+                alignas(64) float t[16];
+                for (int l = 0; l < 16; ++l) t[l] = tmaxIn[o16 + (((lanes >> l) & 1) ? l : firstLane)];
+                dir[3] = _mm512_load_ps(t);
+            }
+            for (int h = 0; h < 2; ++h) {   // back to rows, for the leaves' single rays
+                if (!((lanes >> (8 * h)) & 0xFFu)) continue;
+                __m256 og[4], dg[4], ro[4], rw[4];
+                for (int a = 0; a < 4; ++a) {
+                    og[a] = _mm512_maskz_extractf32x8_ps(0xFF, org[a], h);
+                    dg[a] = _mm512_maskz_extractf32x8_ps(0xFF, dir[a], h);
+                }
+                transposeRows8(og, ro);
+                transposeRows8(dg, rw);
+                const int o8 = o16 + 8 * h;
+                for (int l = 0; l < 4; ++l) {
+                    _mm_storeu_ps(&moved[o8 + l].org.x, _mm256_castps256_ps128(ro[l]));
+                    _mm_storeu_ps(&moved[o8 + l].dir.x, _mm256_castps256_ps128(rw[l]));
+                    _mm_storeu_ps(&moved[o8 + l + 4].org.x, _mm256_extractf128_ps(ro[l], 1));
+                    _mm_storeu_ps(&moved[o8 + l + 4].dir.x, _mm256_extractf128_ps(rw[l], 1));
+                }
+            }
+        }
+        for (int a = 0; a < 3; ++a) {
+            _mm512_store_ps(pr.org[a] + o16, org[a]);
+            _mm512_store_ps(pr.dir[a] + o16, dir[a]);
+        }
+        __m512 rd[3], on[3], of[3];
+        __mmask16 bad = 0;   // lanes with a value that is not finite (x - x is NaN there)
+        unsigned neg[3];
+        for (int a = 0; a < 3; ++a) {
+            __m512 d = dir[a];
+            bad |= _mm512_cmp_ps_mask(_mm512_sub_ps(d, d), zero, _CMP_NEQ_UQ);
+            const __mmask16 tiny = _mm512_cmp_ps_mask(_mm512_andnot_ps(signBit, d), _mm512_set1_ps(1e-30f), _CMP_LT_OS);
+            d = _mm512_mask_mov_ps(d, tiny, _mm512_or_ps(_mm512_and_ps(d, signBit), _mm512_set1_ps(1e-30f)));
+            rd[a] = _mm512_div_ps(one, d);
+            const __m512 ord = unfusedProduct16(org[a], rd[a]);
+            const __m512 absB = _mm512_set1_ps(absMax ? absMax[a] : 0.0f);
+            const __m512 e = unfusedProduct16(_mm512_mul_ps(_mm512_add_ps(_mm512_andnot_ps(signBit, org[a]), absB), _mm512_andnot_ps(signBit, rd[a])),
+                                              _mm512_set1_ps(0x1p-20f));
+            on[a] = _mm512_add_ps(ord, e);
+            of[a] = _mm512_sub_ps(ord, e);
+            const __m512 z = _mm512_add_ps(_mm512_add_ps(_mm512_sub_ps(rd[a], rd[a]), _mm512_sub_ps(on[a], on[a])),
+                                           _mm512_add_ps(_mm512_sub_ps(of[a], of[a]), _mm512_sub_ps(org[a], org[a])));
+            bad |= _mm512_cmp_ps_mask(z, zero, _CMP_NEQ_UQ);
+            neg[a] = unsigned(_mm512_movepi32_mask(_mm512_castps_si512(d)));
+        }
+        const __m512 tmin = max16(org[3], zero);   // r.tmin > 0 ? r.tmin : 0
+        const __m512 tmax = dir[3];
+        const unsigned nonEmpty = unsigned(_mm512_cmp_ps_mask(tmax, tmin, _CMP_GT_OQ));
+        const unsigned ok = lanes & ~unsigned(bad) & nonEmpty;
+        if (g.sign < 0 && ok) {   // the first ray that fits sets the packet's signs
+            const int l = __builtin_ctz(ok);
+            g.sign = int((neg[0] >> l) & 1) | int(((neg[1] >> l) & 1) << 1) | int(((neg[2] >> l) & 1) << 2);
+        }
+        unsigned same = 0xFFFFu;
+        for (int a = 0; a < 3; ++a) same &= (g.sign >> a) & 1 ? neg[a] : ~neg[a];
+        const unsigned fits = ok & same & 0xFFFFu;
+        g.pm |= uint64_t(fits) << o16;
+        g.single |= uint64_t(lanes & ~fits) << o16;
+        const __mmask16 fit = __mmask16(fits);
+        for (int a = 0; a < 3; ++a) {
+            _mm512_store_ps(pr.rd[a] + o16, _mm512_mask_blend_ps(fit, one, rd[a]));
+            _mm512_store_ps(pr.on[a] + o16, _mm512_mask_blend_ps(fit, zero, on[a]));
+            _mm512_store_ps(pr.of[a] + o16, _mm512_mask_blend_ps(fit, zero, of[a]));
+            rlo[a] = min16(rlo[a], _mm512_mask_blend_ps(fit, inf, rd[a]));
+            rhi[a] = max16(rhi[a], _mm512_mask_blend_ps(fit, ninf, rd[a]));
+            olo[a] = min16(olo[a], _mm512_mask_blend_ps(fit, inf, org[a]));
+            ohi[a] = max16(ohi[a], _mm512_mask_blend_ps(fit, ninf, org[a]));
+        }
+        _mm512_store_ps(pr.tmin + o16, _mm512_mask_blend_ps(fit, zero, tmin));
+        _mm512_store_ps(pr.tmax + o16, _mm512_mask_blend_ps(fit, _mm512_set1_ps(-1.0f), tmax));
+        tminLo = min16(tminLo, _mm512_mask_blend_ps(fit, inf, tmin));
+        tmaxHi = max16(tmaxHi, _mm512_mask_blend_ps(fit, ninf, tmax));
+    }
+    g.rlo = _mm_setr_ps(laneMin16(rlo[0]), laneMin16(rlo[1]), laneMin16(rlo[2]), 0.0f);
+    g.rhi = _mm_setr_ps(laneMax16(rhi[0]), laneMax16(rhi[1]), laneMax16(rhi[2]), 0.0f);
+    g.olo = _mm_setr_ps(laneMin16(olo[0]), laneMin16(olo[1]), laneMin16(olo[2]), 0.0f);
+    g.ohi = _mm_setr_ps(laneMax16(ohi[0]), laneMax16(ohi[1]), laneMax16(ohi[2]), 0.0f);
+    g.tminP = laneMin16(tminLo);
+    g.tmaxP = laneMax16(tmaxHi);
+    return g;
+}
+#endif
+
 // Sorts the active rays into the packet (the first ray's direction signs, finite data, a
 // non-empty [tmin, tmax]; their RayPre values into pr) and the rest; every other slot of pr is
 // set to never enter a box. Eight rays at a time: RayPre's operations (the nudge of a tiny
@@ -160,6 +332,9 @@ inline __m256 unfusedProduct(__m256 a, __m256 b) {
                                                         const RayTransform* move = nullptr, const float* tmaxIn = nullptr, Ray* moved = nullptr) {
     static_assert(sizeof(Ray) == 32 && offsetof(Ray, tmin) == 12 && offsetof(Ray, dir) == 16 && offsetof(Ray, tmax) == 28,
                   "Ray: org, tmin, dir, tmax packed");
+#if RT_AVX512
+    return gatherPacket16(rays, n, active, absMax, pr, move, tmaxIn, moved);
+#endif
     PacketGather g;
     const __m256 inf = _mm256_set1_ps(std::numeric_limits<float>::infinity()), ninf = _mm256_set1_ps(-std::numeric_limits<float>::infinity());
     const __m256 signBit = _mm256_set1_ps(-0.0f), zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f);
@@ -195,17 +370,9 @@ inline __m256 unfusedProduct(__m256 a, __m256 b) {
             ov[l] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(&lo.org.x)), _mm_loadu_ps(&hi.org.x), 1);
             dv[l] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(&lo.dir.x)), _mm_loadu_ps(&hi.dir.x), 1);
         }
-        auto transpose = [](const __m256* v, __m256* out) {   // rows -> x, y, z, w of the 8 rays
-            const __m256 t0 = _mm256_unpacklo_ps(v[0], v[1]), t1 = _mm256_unpackhi_ps(v[0], v[1]);
-            const __m256 t2 = _mm256_unpacklo_ps(v[2], v[3]), t3 = _mm256_unpackhi_ps(v[2], v[3]);
-            out[0] = _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(1, 0, 1, 0));
-            out[1] = _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(3, 2, 3, 2));
-            out[2] = _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(1, 0, 1, 0));
-            out[3] = _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(3, 2, 3, 2));
-        };
         __m256 org[4], dir[4];   // x, y, z and tmin / tmax
-        transpose(ov, org);
-        transpose(dv, dir);
+        transposeRows8(ov, org);
+        transposeRows8(dv, dir);
         if (move) {
             __m256 mo[3], md[3];
             for (int r = 0; r < 3; ++r) {
@@ -223,8 +390,8 @@ inline __m256 unfusedProduct(__m256 a, __m256 b) {
                 dir[3] = _mm256_load_ps(t);
             }
             __m256 ro[4], rw[4];   // back to rows: lane l's ray in the low half of ro[l], lane l + 4's in the high half
-            transpose(org, ro);
-            transpose(dir, rw);
+            transposeRows8(org, ro);
+            transposeRows8(dir, rw);
             for (int l = 0; l < 4; ++l) {
                 _mm_storeu_ps(&moved[o8 + l].org.x, _mm256_castps256_ps128(ro[l]));
                 _mm_storeu_ps(&moved[o8 + l].dir.x, _mm256_castps256_ps128(rw[l]));
