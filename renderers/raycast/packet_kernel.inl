@@ -114,10 +114,30 @@ struct PacketScene {
     const TriPacket4* packets;
     const uint32_t* prims;
     const float* absMax;
-    const Ray* rays;
+    const Ray* rays;   // the rays in the mesh's space (null where moved is set)
     TriHit* hits;
     bool cullBack;
     PacketTies* ties;   // null unless ties are asked for
+    // AVX-512 with a move: the moved rays are read from the packet's lanes (pr's org and dir,
+    // which gatherPacket16 stores for every ray of a block it sets up) and the world rays' tmin
+    // and tmax (or tmaxIn), the values the rows of moved rays would hold.
+    const PacketRays* moved = nullptr;
+    const Ray* world = nullptr;
+    const float* tmaxIn = nullptr;
+    // Ray i in the mesh's space.
+    Ray ray(int i) const {
+#if RT_AVX512
+        if (moved) {
+            Ray r;
+            r.org = sg::vec3(moved->org[0][i], moved->org[1][i], moved->org[2][i]);
+            r.dir = sg::vec3(moved->dir[0][i], moved->dir[1][i], moved->dir[2][i]);
+            r.tmin = world[i].tmin;
+            r.tmax = tmaxIn ? tmaxIn[i] : world[i].tmax;
+            return r;
+        }
+#endif
+        return rays[i];
+    }
 };
 
 // What gatherPacket learns of the rays: those in the packet (pm) and those traced alone
@@ -178,9 +198,10 @@ inline float laneMax16(__m512 v) {
 // its groups of eight (the rays loaded and transposed eight at a time, then everything else in
 // 16 lanes), so pr and the bounds get the same values. An inactive lane repeats the block's
 // first active ray (the eight-ray groups repeat their own first; those lanes are never read as
-// rays), and moved is written for each group of eight that holds an active ray, as there.
+// rays). The moved rays are not written back as rows: tracePacket8 reads them from pr.org and
+// pr.dir (PacketScene::ray), which hold every ray of a block set up here.
 inline PacketGather gatherPacket16(const Ray* rays, int n, uint64_t active, const float* absMax, PacketRays& pr, const RayTransform* move,
-                                   const float* tmaxIn, Ray* moved) {
+                                   const float* tmaxIn) {
     PacketGather g;
     const __m512 inf = _mm512_set1_ps(std::numeric_limits<float>::infinity()), ninf = _mm512_set1_ps(-std::numeric_limits<float>::infinity());
     const __m512 signBit = _mm512_set1_ps(-0.0f), zero = _mm512_setzero_ps(), one = _mm512_set1_ps(1.0f);
@@ -236,23 +257,6 @@ inline PacketGather gatherPacket16(const Ray* rays, int n, uint64_t active, cons
                 alignas(64) float t[16];
                 for (int l = 0; l < 16; ++l) t[l] = tmaxIn[o16 + (((lanes >> l) & 1) ? l : firstLane)];
                 dir[3] = _mm512_load_ps(t);
-            }
-            for (int h = 0; h < 2; ++h) {   // back to rows, for the leaves' single rays
-                if (!((lanes >> (8 * h)) & 0xFFu)) continue;
-                __m256 og[4], dg[4], ro[4], rw[4];
-                for (int a = 0; a < 4; ++a) {
-                    og[a] = _mm512_maskz_extractf32x8_ps(0xFF, org[a], h);
-                    dg[a] = _mm512_maskz_extractf32x8_ps(0xFF, dir[a], h);
-                }
-                transposeRows8(og, ro);
-                transposeRows8(dg, rw);
-                const int o8 = o16 + 8 * h;
-                for (int l = 0; l < 4; ++l) {
-                    _mm_storeu_ps(&moved[o8 + l].org.x, _mm256_castps256_ps128(ro[l]));
-                    _mm_storeu_ps(&moved[o8 + l].dir.x, _mm256_castps256_ps128(rw[l]));
-                    _mm_storeu_ps(&moved[o8 + l + 4].org.x, _mm256_extractf128_ps(ro[l], 1));
-                    _mm_storeu_ps(&moved[o8 + l + 4].dir.x, _mm256_extractf128_ps(rw[l], 1));
-                }
             }
         }
         for (int a = 0; a < 3; ++a) {
@@ -327,13 +331,15 @@ inline PacketGather gatherPacket16(const Ray* rays, int n, uint64_t active, cons
 // coordinate, which makePacketFrustum's widening (d > 0 for any mesh with a box) removes.
 // move (with tmaxIn: the rays' tmax, null: their own): the rays are world rays, moved into the
 // mesh's space first, as RayTransform::applyTo moves them (per lane (c0 x + c1 y) + (c2 z + c3)
-// and (c0 x + c1 y) + c2 z, no product fused into a sum), and written to moved[i] for the leaves.
+// and (c0 x + c1 y) + c2 z, no product fused into a sum), and written to moved[i] for the leaves
+// (on AVX-512, gatherPacket16, they stay in pr's lanes instead).
 [[gnu::always_inline]] inline PacketGather gatherPacket(const Ray* rays, int n, uint64_t active, const float* absMax, PacketRays& pr,
                                                         const RayTransform* move = nullptr, const float* tmaxIn = nullptr, Ray* moved = nullptr) {
     static_assert(sizeof(Ray) == 32 && offsetof(Ray, tmin) == 12 && offsetof(Ray, dir) == 16 && offsetof(Ray, tmax) == 28,
                   "Ray: org, tmin, dir, tmax packed");
 #if RT_AVX512
-    return gatherPacket16(rays, n, active, absMax, pr, move, tmaxIn, moved);
+    (void)moved;
+    return gatherPacket16(rays, n, active, absMax, pr, move, tmaxIn);
 #endif
     PacketGather g;
     const __m256 inf = _mm256_set1_ps(std::numeric_limits<float>::infinity()), ninf = _mm256_set1_ps(-std::numeric_limits<float>::infinity());
@@ -471,14 +477,15 @@ template <bool AnyHit, bool Ties = false>
     for (; m; m &= m - 1) {
         const int i = __builtin_ctzll(m);
         if constexpr (!Ties) {
-            if (traceTriangles8<AnyHit>(sc.nodes, sc.packets, sc.prims, sc.absMax, sc.rays[i], AnyHit ? nullptr : &sc.hits[i], sc.cullBack))
+            if (traceTriangles8<AnyHit>(sc.nodes, sc.packets, sc.prims, sc.absMax, sc.ray(i), AnyHit ? nullptr : &sc.hits[i], sc.cullBack))
                 found |= uint64_t(1) << i;
         } else {
             float tieT = -1.0f;
-            const bool hit = traceTriangles8<false, false, true>(sc.nodes, sc.packets, sc.prims, sc.absMax, sc.rays[i], &sc.hits[i], sc.cullBack,
-                                                                 nullptr, 0, &tieT);
+            const Ray r = sc.ray(i);
+            const bool hit =
+                traceTriangles8<false, false, true>(sc.nodes, sc.packets, sc.prims, sc.absMax, r, &sc.hits[i], sc.cullBack, nullptr, 0, &tieT);
             if (hit) found |= uint64_t(1) << i;
-            if (tieT >= 0.0f && tieT == (hit ? sc.hits[i].t : sc.rays[i].tmax)) *ties |= uint64_t(1) << i;
+            if (tieT >= 0.0f && tieT == (hit ? sc.hits[i].t : r.tmax)) *ties |= uint64_t(1) << i;
         }
     }
     return found;
@@ -570,7 +577,7 @@ template <bool AnyHit, bool Ties = false>
     if (__builtin_popcountll(am) > 1) return true;
     if (am) {
         const int i = __builtin_ctzll(am);
-        Ray r = sc.rays[i];
+        Ray r = sc.ray(i);
         r.tmax = pr.tmax[i];
         float tieT = -1.0f;
         const bool hit = traceTriangles8<AnyHit, false, Ties>(sc.nodes, sc.packets, sc.prims, sc.absMax, r, AnyHit ? nullptr : &sc.hits[i],
@@ -647,7 +654,7 @@ template <bool AnyHit, bool Ties = false>
 // a closer hit (then pr.tmax[i] and hits[i] hold it). Ties: see tracePacket8.
 template <bool AnyHit, bool Ties = false>
 [[gnu::always_inline]] inline bool intersectLeafRay(const PacketScene& sc, const TriPacket4* first, const TriPacket4* end, PacketRays& pr, int i) {
-    const Ray& r = sc.rays[i];
+    const Ray r = sc.ray(i);
     const __m256 o8[3] = {_mm256_set1_ps(r.org.x), _mm256_set1_ps(r.org.y), _mm256_set1_ps(r.org.z)};
     const __m256 d8[3] = {_mm256_set1_ps(r.dir.x), _mm256_set1_ps(r.dir.y), _mm256_set1_ps(r.dir.z)};
     const __m256 rtmin = _mm256_set1_ps(pr.tmin[i]);
@@ -762,9 +769,20 @@ inline uint64_t tracePacket8(const Node8* nodes, const TriPacket4* packets, cons
     PacketTies* tiesP = nullptr;
     if constexpr (Ties) tiesP = &tieState;
     PacketRays pr;
+#if RT_AVX512
+    // With move: the rays in the mesh's space are read from pr (PacketScene::ray).
+    const PacketGather pg = gatherPacket(rays, n, active, absMax, pr, move, tmaxIn, nullptr);
+    PacketScene sc{nodes, packets, prims, absMax, move ? nullptr : rays, hits, cullBack, tiesP};
+    if (move) {
+        sc.moved = &pr;
+        sc.world = rays;
+        sc.tmaxIn = tmaxIn;
+    }
+#else
     PacketScratch<Ray> moved;   // with move: the rays in the mesh's space (gatherPacket writes the active groups)
     const PacketGather pg = gatherPacket(rays, n, active, absMax, pr, move, tmaxIn, moved.data());
     const PacketScene sc{nodes, packets, prims, absMax, move ? moved.data() : rays, hits, cullBack, tiesP};
+#endif
     uint64_t tiesAlone = 0;
     uint64_t found = traceAlone<AnyHit, Ties>(sc, pg.single, &tiesAlone);
     if (__builtin_popcountll(pg.pm) <= 1) {   // nothing to share
