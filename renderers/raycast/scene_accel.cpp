@@ -73,6 +73,7 @@ int SceneAccel::update(const FrameInput& f) {
         Instance inst;
         inst.isMesh = true;
         inst.index = i;
+        inst.doubleSided = d.material.doubleSided;
         inst.bvh = &it->second.bvh;
         // Every mesh is traced as packets, closest hits (intersectPacket) and shadow rays
         // (occludedPacket) alike: a packet sets a mesh up once where single rays each transform,
@@ -279,7 +280,7 @@ bool SceneAccel::closestHit(const Ray& r, SceneHit& hit, sg::CullMode culling, T
         for (uint32_t k = 0; k < count; ++k) {
             SceneHit h;
             const Instance& inst = m_instances[prims[first + k]];
-            const bool cull = inst.isMesh && sg::cullsBackFaces(culling, m_frame->meshes[inst.index].material.doubleSided);
+            const bool cull = inst.isMesh && sg::cullsBackFaces(culling, inst.doubleSided);
             if (intersectInstance(inst, r, tm, h, cull, cost) && h.t < tm) {
                 tm = h.t;
                 hit = h;
@@ -363,7 +364,7 @@ uint64_t SceneAccel::intersectPacket(const Ray* rays, int n, uint64_t active, Sc
     uint64_t tied = 0;
     for (int s = 0; s < k; ++s) {
         const Instance& inst = m_instances[touched[s].instance];
-        const bool cull = sg::cullsBackFaces(culling, m_frame->meshes[inst.index].material.doubleSided);
+        const bool cull = sg::cullsBackFaces(culling, inst.doubleSided);
         uint64_t meshTies = 0;
         // Each ray moved into the mesh's space with its segment ending at bound[i], as intersectInstance.
         touched[s].found = inst.bvh->intersectPacket(rays, n, touched[s].rays, meshHits + s * kMaxPacket, cull, inst.ties ? &meshTies : nullptr,
@@ -423,7 +424,7 @@ uint64_t SceneAccel::intersectPacket(const Ray* rays, int n, uint64_t active, Sc
             const Instance& inst = m_instances[listed[i][c]];
             if (boxEntry(inst, r, inv) > tm * (1.0f + 1e-5f)) continue;   // no hit before tm in there
             SceneHit h;
-            const bool cull = inst.isMesh && sg::cullsBackFaces(culling, m_frame->meshes[inst.index].material.doubleSided);
+            const bool cull = inst.isMesh && sg::cullsBackFaces(culling, inst.doubleSided);
             if (!intersectInstance(inst, r, tm, h, cull) || !(h.t < tm)) continue;
             tm = h.t;
             hits[i] = h;
@@ -449,7 +450,7 @@ uint64_t SceneAccel::intersectPacket(const Ray* rays, int n, uint64_t active, Sc
                     if (!(th.t < tm)) continue;
                     setMeshHit(h, th, inst.index);
                 } else {   // as closestHit
-                    const bool cull = inst.isMesh && sg::cullsBackFaces(culling, m_frame->meshes[inst.index].material.doubleSided);
+                    const bool cull = inst.isMesh && sg::cullsBackFaces(culling, inst.doubleSided);
                     if (!intersectInstance(inst, r, tm, h, cull)) continue;
                 }
                 if (h.t < tm) {

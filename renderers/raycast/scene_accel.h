@@ -95,8 +95,9 @@ private:
         bool isMesh = true;
         uint32_t index = 0;   // into frame meshes / analytics
         const TriangleBvh* bvh = nullptr;
-        bool packets = false;   // a mesh traced as packets by intersectPacket (occludedPacket takes every mesh)
-        bool ties = false;      // a small mesh: intersectPacket has its ties reported (see update)
+        bool packets = false;       // a mesh traced as packets by intersectPacket (occludedPacket takes every mesh)
+        bool ties = false;          // a small mesh: intersectPacket has its ties reported (see update)
+        bool doubleSided = false;   // a mesh's material.doubleSided (culling), kept here: the draw's record is cold
         const ParametricAccel* param = nullptr;
         const GridAccel* grid = nullptr;
         RayTransform toObject;                 // the inverse world matrix, for rays
