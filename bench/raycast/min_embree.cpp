@@ -127,21 +127,12 @@ std::string MinimalEmbree::setup(const FrameInput& f, int tessellation, const st
 
 namespace {
 
-// uv where the camera ray through window position (wx, wy) meets the plane of triangle P (its
-// barycentrics there, inside the triangle or not): a neighbouring pixel's uv, for the footprint.
+// uv where the camera ray through window position (wx, wy) meets the plane of triangle P: a
+// neighbouring pixel's uv, for the footprint (the rays as render() makes them).
 bool uvOnPlane(const vec3& o0, const vec3& ox, const vec3& oy, const vec3& f0, const vec3& fx, const vec3& fy, float wx, float wy, const vec3 P[3],
                const vec2 uv[3], vec2& out) {
     const vec3 o = o0 + wx * ox + wy * oy, d = f0 + wx * fx + wy * fy - o;
-    const vec3 e1 = P[1] - P[0], e2 = P[2] - P[0], n = glm::cross(e1, e2);
-    const float den = glm::dot(d, n);
-    if (!(std::abs(den) > 1e-30f)) return false;
-    const vec3 q = o + (glm::dot(P[0] - o, n) / den) * d - P[0];
-    const float d00 = glm::dot(e1, e1), d01 = glm::dot(e1, e2), d11 = glm::dot(e2, e2);
-    const float d20 = glm::dot(q, e1), d21 = glm::dot(q, e2), det = d00 * d11 - d01 * d01;
-    if (!(std::abs(det) > 0)) return false;
-    const float b1 = (d11 * d20 - d01 * d21) / det, b2 = (d00 * d21 - d01 * d20) / det;
-    out = (1.0f - b1 - b2) * uv[0] + b1 * uv[1] + b2 * uv[2];
-    return std::isfinite(out.x) && std::isfinite(out.y);
+    return rnd::uvOnTrianglePlane(o, d, P, uv, out);
 }
 
 }   // namespace

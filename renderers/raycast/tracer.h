@@ -74,18 +74,7 @@ inline bool reflectNeighbour(const rt::Ray& a, const vec3& p, const vec3& ng, co
 
 // uv at the point where ray r meets the plane of triangle P (barycentrics of that point, even
 // outside the triangle: derivatives only need the plane). False for rays along the plane.
-inline bool uvOnPlane(const rt::Ray& r, const vec3 P[3], const vec2 uv[3], vec2& out) {
-    const vec3 e1 = P[1] - P[0], e2 = P[2] - P[0], n = glm::cross(e1, e2);
-    const float denom = glm::dot(r.dir, n);
-    if (!(std::abs(denom) > 1e-30f)) return false;
-    const vec3 q = r.org + (glm::dot(P[0] - r.org, n) / denom) * r.dir - P[0];
-    const float d00 = glm::dot(e1, e1), d01 = glm::dot(e1, e2), d11 = glm::dot(e2, e2);
-    const float d20 = glm::dot(q, e1), d21 = glm::dot(q, e2), det = d00 * d11 - d01 * d01;
-    if (!(std::abs(det) > 0)) return false;
-    const float b1 = (d11 * d20 - d01 * d21) / det, b2 = (d00 * d21 - d01 * d20) / det;
-    out = (1.0f - b1 - b2) * uv[0] + b1 * uv[1] + b2 * uv[2];
-    return std::isfinite(out.x) && std::isfinite(out.y);
-}
+inline bool uvOnPlane(const rt::Ray& r, const vec3 P[3], const vec2 uv[3], vec2& out) { return uvOnTrianglePlane(r.org, r.dir, P, uv, out); }
 
 // Whether any material of the frame is masked or blended (shadow rays then test alpha).
 inline bool anyTranslucent(const FrameInput& f) {

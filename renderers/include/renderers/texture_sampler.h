@@ -9,6 +9,7 @@
 
 #include "scenegraph/mesh.h"
 
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <unordered_map>
@@ -46,6 +47,23 @@ private:
     sg::FilterMode m_filter;
     bool m_srgb = true;
 };
+
+// uv where the ray org + t dir meets the plane of triangle P with uvs uv: the barycentrics of
+// that point, inside the triangle or not (a neighbouring pixel's uv, whose difference from the
+// pixel's own gives sample()'s derivatives). False for rays along the plane and for degenerate
+// triangles.
+inline bool uvOnTrianglePlane(const sg::vec3& org, const sg::vec3& dir, const sg::vec3 P[3], const sg::vec2 uv[3], sg::vec2& out) {
+    const sg::vec3 e1 = P[1] - P[0], e2 = P[2] - P[0], n = glm::cross(e1, e2);
+    const float denom = glm::dot(dir, n);
+    if (!(std::abs(denom) > 1e-30f)) return false;
+    const sg::vec3 q = org + (glm::dot(P[0] - org, n) / denom) * dir - P[0];
+    const float d00 = glm::dot(e1, e1), d01 = glm::dot(e1, e2), d11 = glm::dot(e2, e2);
+    const float d20 = glm::dot(q, e1), d21 = glm::dot(q, e2), det = d00 * d11 - d01 * d01;
+    if (!(std::abs(det) > 0)) return false;
+    const float b1 = (d11 * d20 - d01 * d21) / det, b2 = (d00 * d21 - d01 * d20) / det;
+    out = (1.0f - b1 - b2) * uv[0] + b1 * uv[1] + b2 * uv[2];
+    return std::isfinite(out.x) && std::isfinite(out.y);
+}
 
 // Samplers (mip chains) per texture, rebuilt when a texture's version or its filter/wrap modes
 // change (a copy of a texture keeps its id), shared by the
