@@ -41,10 +41,10 @@ struct MinimalEmbree::State {
     bool instanced = false;
     std::unordered_map<const Mesh*, RTCScene> meshScenes;
     rnd::TessellationCache tess;
-    bool nearest = false;   // textures at level 0, nearest texel (the reference before filtered lookups)
-    std::unordered_map<const Texture*, std::unique_ptr<rnd::SampledTexture>> samplers;
-    float decode[256];      // sRGB byte -> linear
-    uint8_t encode[4097];   // linear [0, 1] in steps of 1/4096 -> sRGB byte
+    bool nearest = false;         // textures at level 0, nearest texel (the reference before filtered lookups)
+    rnd::SamplerCache samplers;   // the mip chains, as the CPU backends keep them
+    float decode[256];            // sRGB byte -> linear
+    uint8_t encode[4097];         // linear [0, 1] in steps of 1/4096 -> sRGB byte
     ~State() {
         for (auto& ms : meshScenes) rtcReleaseScene(ms.second);
         if (scene) rtcReleaseScene(scene);
@@ -80,12 +80,9 @@ std::string MinimalEmbree::setup(const FrameInput& f, int tessellation, const st
                 const float l = glm::length(w);
                 g.n.push_back(l > 1e-20f ? w / l : vec3(0.0f));
             }
-        if (d.texture && mesh.uv0.size() == mesh.positions.size()) {
+        if (d.texture && mesh.uv0.size() == mesh.positions.size() && (g.sampler = m->samplers.get(d.texture))) {   // (null: an unusable texture)
             g.uv = mesh.uv0;
             g.tex = d.texture.get();
-            std::unique_ptr<rnd::SampledTexture>& st = m->samplers[g.tex];
-            if (!st) st = std::make_unique<rnd::SampledTexture>(*g.tex);
-            g.sampler = st.get();
         }
         g.idx = mesh.indices;
         if (d.mirrored)   // front faces counter-clockwise in world space for every draw

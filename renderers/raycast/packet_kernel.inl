@@ -359,16 +359,12 @@ inline PacketGather gatherPacket16(const Ray* rays, int n, uint64_t active, cons
 // coordinate, which makePacketFrustum's widening (d > 0 for any mesh with a box) removes.
 // move (with tmaxIn: the rays' tmax, null: their own): the rays are world rays, moved into the
 // mesh's space first, as RayTransform::applyTo moves them (per lane (c0 x + c1 y) + (c2 z + c3)
-// and (c0 x + c1 y) + c2 z, no product fused into a sum), and written to moved[i] for the leaves
-// (on AVX-512, gatherPacket16, they stay in pr's lanes instead).
+// and (c0 x + c1 y) + c2 z, no product fused into a sum), and written to moved[i] for the leaves.
+// (The AVX-512 build's tracePacket8 takes gatherPacket16 instead.)
 [[gnu::always_inline]] inline PacketGather gatherPacket(const Ray* rays, int n, uint64_t active, const float* absMax, PacketRays& pr,
                                                         const RayTransform* move = nullptr, const float* tmaxIn = nullptr, Ray* moved = nullptr) {
     static_assert(sizeof(Ray) == 32 && offsetof(Ray, tmin) == 12 && offsetof(Ray, dir) == 16 && offsetof(Ray, tmax) == 28,
                   "Ray: org, tmin, dir, tmax packed");
-#if RT_AVX512
-    (void)moved;
-    return gatherPacket16(rays, n, active, absMax, pr, move, tmaxIn);
-#endif
     PacketGather g;
     const __m256 inf = _mm256_set1_ps(std::numeric_limits<float>::infinity()), ninf = _mm256_set1_ps(-std::numeric_limits<float>::infinity());
     const __m256 signBit = _mm256_set1_ps(-0.0f), zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f);
@@ -799,7 +795,7 @@ inline uint64_t tracePacket8(const Node8* nodes, const TriPacket4* packets, cons
     PacketRays pr;
 #if RT_AVX512
     // With move: the rays in the mesh's space are read from pr (PacketScene::ray).
-    const PacketGather pg = gatherPacket(rays, n, active, absMax, pr, move, tmaxIn, nullptr);
+    const PacketGather pg = gatherPacket16(rays, n, active, absMax, pr, move, tmaxIn);
     PacketScene sc{nodes, packets, prims, absMax, move ? nullptr : rays, hits, cullBack, tiesP};
     if (move) {
         sc.moved = &pr;
