@@ -102,12 +102,14 @@ void strataOf(const RenderConfig& cfg, int& sx, int& sy) {
 // kPacket x kPacket pixels at a time (SceneAccel::intersectPacket: the same hits as one by one),
 // into tileRays and tileHits (kTile per row); bit x - x0 of rowFound[row - y0] tells whether
 // pixel (x, row)'s ray met something (tileHits' `found`, kept compact: the loops over the tile
-// read it for every pixel).
+// read it for every pixel), the same bit of rowTraced[row - y0] whether its packet was traced
+// (tileRays holds its ray; packets that no hit rectangle overlaps are not).
 void traceCameraPackets(const FrameJob& job, const rt::SceneAccel& accel, int x0, int y0, int x1, int y1, const glm::dvec4* colShares,
-                        std::vector<rt::Ray>& tileRays, std::vector<Tracer::FirstHit>& tileHits, uint32_t* rowFound) {
+                        std::vector<rt::Ray>& tileRays, std::vector<Tracer::FirstHit>& tileHits, uint32_t* rowFound, uint32_t* rowTraced) {
     constexpr int kPacket = FrameJob::kPacket, tile = FrameJob::kTile;
     static_assert(tile <= 32, "one 32-bit mask per tile row");
     std::fill(rowFound, rowFound + (y1 - y0), 0u);
+    std::fill(rowTraced, rowTraced + (y1 - y0), 0u);
     rt::PacketScratch<glm::dvec4, tile> rowShares;   // CameraRays::row of each row, made once for all the packets
     for (int row = y0; row < y1; ++row) rowShares[row - y0] = job.cam.row(float(job.h - 1 - row) + 0.5f);
     rt::Ray* const rays = tileRays.data();
@@ -161,6 +163,7 @@ void traceCameraPackets(const FrameJob& job, const rt::SceneAccel& accel, int x0
                     if (fh.found) fh.hit = ph[n];
                 }
                 rowFound[py + j - y0] |= uint32_t((found >> (j * nx)) & ((1u << nx) - 1)) << (px - x0);
+                rowTraced[py + j - y0] |= ((1u << nx) - 1) << (px - x0);
             }
         }
 }
@@ -241,11 +244,41 @@ void keepSurface(const FrameJob& job, const SurfaceRecord& hp, float windowZ, in
     }
 }
 
+// The camera rays of a strip of packets (rows [y0, y0 + kPacket) of a tile from column x0),
+// which are also its pixels' neighbouring rays for texture footprints: CameraRays::neighbours
+// gives ray(wx + 1, wy) and ray(wx, wy + 1), the grid's rays of the pixels to the right and
+// above bit for bit. The strip's own rays (kTile per row) where bit x - x0 of traced[row - y0]
+// is set, and the row above the strip (the strip before's last) in above[x - x0] where bit
+// x - x0 of aboveTraced is.
+struct StripRays {
+    const rt::Ray* rays = nullptr;
+    const uint32_t* traced = nullptr;
+    const rt::Ray* above = nullptr;
+    uint32_t aboveTraced = 0;
+    int x0 = 0, y0 = 0;
+    // Pixel (x, row)'s footprint (its centre ray's), with the neighbours' rays where made.
+    void footprint(const FrameJob& job, int x, int row, PixelFootprint& fp) const {
+        constexpr int tile = FrameJob::kTile;
+        fp.cam = &job.cam;
+        fp.wx = float(x) + 0.5f;
+        fp.wy = float(job.h - 1 - row) + 0.5f;
+        fp.carried = false;
+        const int i = x - x0, j = row - y0;
+        fp.madeX = i + 1 < tile && ((traced[j] >> (i + 1)) & 1) ? &rays[size_t(j) * tile + size_t(i + 1)] : nullptr;
+        fp.madeY = nullptr;
+        if (j > 0 && ((traced[j - 1] >> i) & 1))   // (window y + 1 is the row above: rows run top-down)
+            fp.madeY = &rays[size_t(j - 1) * tile + size_t(i)];
+        else if (j == 0 && ((aboveTraced >> i) & 1))
+            fp.madeY = &above[i];
+    }
+};
+
 // Pixel (x, row) of the tile with corner (x0, y0): its sx x sy stratified rays traced and
 // shaded, the mean colour through the display transform as sRGB bytes, the nearest depth, and (centre ray) the visibility and
-// the traversal cost when asked.
+// the traversal cost when asked. made: the strip's rays (with packets; null without).
 void shadePixel(const FrameJob& job, Tracer& tr, int x, int row, int x0, int y0, const std::vector<rt::Ray>& tileRays,
-                const std::vector<Tracer::FirstHit>& tileHits, const std::vector<Tracer::PresetVisibility>& tilePresets, Framebuffer& target) {
+                const std::vector<Tracer::FirstHit>& tileHits, const std::vector<Tracer::PresetVisibility>& tilePresets, const StripRays* made,
+                Framebuffer& target) {
     constexpr int tile = FrameJob::kTile;
     const int w = job.w, h = job.h, sx = job.sx, sy = job.sy;
     const int wy = h - 1 - row;   // GL window y of this row
@@ -263,7 +296,8 @@ void shadePixel(const FrameJob& job, Tracer& tr, int x, int row, int x0, int y0,
             rt::Ray own;
             const rt::Ray& r = job.packets ? tileRays[size_t(row - y0) * tile + size_t(x - x0)] : (own = job.cam.ray(float(x) + ox, float(wy) + oy));
             SurfaceRecord hp;
-            const PixelFootprint fp{&job.cam, float(x) + ox, float(wy) + oy};
+            PixelFootprint fp{&job.cam, float(x) + ox, float(wy) + oy};
+            if (made) made->footprint(job, x, row, fp);   // (the same window position: one centre ray)
             rt::TraversalCount count;
             if (job.countCost) tr.cost = &count;
             if (job.packets) tr.firstHit = &tileHits[size_t(row - y0) * tile + size_t(x - x0)];
@@ -287,14 +321,17 @@ void shadePixel(const FrameJob& job, Tracer& tr, int x, int row, int x0, int y0,
 // (raycast::shadeLanes, then what Tracer::trace and shadePixel do after the shading: fog, depth,
 // visibility, bytes), every other pixel and every lane shadeLanes leaves through shadePixel.
 void shadePixels(const FrameJob& job, Tracer& tr, int row, int x0, int y0, uint32_t pixels, const std::vector<rt::Ray>& tileRays,
-                 const std::vector<Tracer::FirstHit>& tileHits, const std::vector<Tracer::PresetVisibility>& tilePresets, Framebuffer& target) {
+                 const std::vector<Tracer::FirstHit>& tileHits, const std::vector<Tracer::PresetVisibility>& tilePresets, const StripRays& made,
+                 Framebuffer& target) {
     constexpr int tile = FrameJob::kTile;
     if (job.laneMesh.empty()) {
-        for (uint32_t m = pixels; m; m &= m - 1) shadePixel(job, tr, x0 + __builtin_ctz(m), row, x0, y0, tileRays, tileHits, tilePresets, target);
+        for (uint32_t m = pixels; m; m &= m - 1)
+            shadePixel(job, tr, x0 + __builtin_ctz(m), row, x0, y0, tileRays, tileHits, tilePresets, &made, target);
         return;
     }
     raycast::LaneBatch b;
     size_t at[raycast::LaneBatch::kLanes];
+    PixelFootprint fp;   // a textured lane's
     auto flush = [&] {
         float rgb[3][raycast::LaneBatch::kLanes], windowZ[raycast::LaneBatch::kLanes];
         const unsigned shaded = raycast::shadeLanes(b, job.f, rgb);
@@ -306,7 +343,7 @@ void shadePixels(const FrameJob& job, Tracer& tr, int row, int x0, int y0, uint3
         for (int l = 0; l < b.count; ++l) {
             const int x = x0 + int(at[l] % tile);
             if (!((shaded >> l) & 1)) {
-                shadePixel(job, tr, x, row, x0, y0, tileRays, tileHits, tilePresets, target);
+                shadePixel(job, tr, x, row, x0, y0, tileRays, tileHits, tilePresets, &made, target);
                 continue;
             }
             // What trace() and shadePixel do after the shading: count the ray, keep the surface
@@ -343,11 +380,11 @@ void shadePixels(const FrameJob& job, Tracer& tr, int row, int x0, int y0, uint3
         const Tracer::FirstHit& fh = tileHits[i];
         const uint8_t lane = fh.found && fh.hit.kind == rt::SceneHit::Kind::Mesh ? job.laneMesh[fh.hit.instance] : uint8_t(0);
         if (!lane) {
-            shadePixel(job, tr, x, row, x0, y0, tileRays, tileHits, tilePresets, target);
+            shadePixel(job, tr, x, row, x0, y0, tileRays, tileHits, tilePresets, &made, target);
             continue;
         }
-        const vec2 window(float(x) + 0.5f, float(job.h - 1 - row) + 0.5f);   // (shadePixel's footprint)
-        tr.laneInputs(fh, tileRays[i], job.shadowPackets ? &tilePresets[i] : nullptr, lane == 2 ? &job.cam : nullptr, window, b, b.count);
+        if (lane == 2) made.footprint(job, x, row, fp);   // (shadePixel's)
+        tr.laneInputs(fh, tileRays[i], job.shadowPackets ? &tilePresets[i] : nullptr, lane == 2 ? &fp : nullptr, b, b.count);
         at[b.count++] = i;
         if (b.count == raycast::LaneBatch::kLanes) flush();
     }
@@ -532,21 +569,30 @@ private:
                 const uint32_t allPixels = uint32_t((uint64_t(1) << (x1 - x0)) - 1);
                 if (!job.packets) {
                     for (int row = y0; row < y1; ++row)
-                        for (int x = x0; x < x1; ++x) shadePixel(job, tr, x, row, x0, y0, tileRays, tileHits, tilePresets, target);
+                        for (int x = x0; x < x1; ++x) shadePixel(job, tr, x, row, x0, y0, tileRays, tileHits, tilePresets, nullptr, target);
                 }
                 // With packets, one row of packets at a time through all three steps (camera rays,
                 // their shadow rays, the shading): its hits (kTile x kPacket of them) stay in the
                 // first level cache between the steps, where a whole tile's would not.
                 if (job.packets)
                     for (int x = x0; x < x1; ++x) buffers.colShares[x - x0] = job.cam.column(float(x) + 0.5f);
+                StripRays made{tileRays.data(), buffers.rowTraced, buffers.above, 0, x0, y0};
                 for (int sy = y0; job.packets && sy < y1; sy += FrameJob::kPacket) {
                     const int sy1 = std::min(sy + FrameJob::kPacket, y1);
-                    traceCameraPackets(job, m_accel, x0, sy, x1, sy1, buffers.colShares, tileRays, tileHits, rowFound);
+                    traceCameraPackets(job, m_accel, x0, sy, x1, sy1, buffers.colShares, tileRays, tileHits, rowFound, buffers.rowTraced);
                     if (job.shadowPackets) presetTileShadows(tr, x0, sy, x1, sy1, tileRays, tileHits, rowFound, tilePresets);
+                    made.y0 = sy;
                     for (int row = sy; row < sy1; ++row) {
                         const uint32_t found = job.constantMiss ? rowFound[row - sy] : allPixels;
                         if (job.constantMiss) fillMisses(job, tr, row, x0, x1, found, target);
-                        shadePixels(job, tr, row, x0, sy, found, tileRays, tileHits, tilePresets, target);
+                        shadePixels(job, tr, row, x0, sy, found, tileRays, tileHits, tilePresets, made, target);
+                    }
+                    // The strip's last row is the next one's row above (the next strip overwrites tileRays).
+                    const int last = sy1 - 1 - sy;
+                    made.aboveTraced = buffers.rowTraced[last];
+                    for (uint32_t m = made.aboveTraced; m; m &= m - 1) {
+                        const int i = __builtin_ctz(m);
+                        buffers.above[i] = tileRays[size_t(last) * tile + size_t(i)];
                     }
                 }
                 rayCount += tr.rays;
@@ -586,6 +632,8 @@ private:
         std::vector<rt::Ray> rays;
         std::vector<Tracer::PresetVisibility> presets;
         uint32_t rowFound[FrameJob::kTile];      // per tile row, which pixels' rays met something
+        uint32_t rowTraced[FrameJob::kTile];     // and which were traced (traceCameraPackets)
+        rt::Ray above[FrameJob::kTile];          // the camera rays of the row above a strip (StripRays)
         glm::dvec4 colShares[FrameJob::kTile];   // CameraRays::column per tile column (traceCameraPackets)
         void reserve(const FrameJob& job) {
             constexpr size_t n = size_t(FrameJob::kTile) * FrameJob::kTile;

@@ -37,12 +37,16 @@ using namespace sg;
 // The rays through the neighbouring pixels (one to the right, one up) that go with a ray: its
 // ray differentials, from which a textured hit gets its uv derivatives and so its mip level.
 // Camera rays keep only their window position (the neighbours are made when a texture needs
-// them); reflected rays carry their neighbours, reflected at the same mirror.
+// them, unless both were made already: madeX, madeY, the camera rays of those pixels, which
+// are cam->neighbours' rays bit for bit); reflected rays carry their neighbours, reflected at
+// the same mirror.
 struct PixelFootprint {
     const rt::CameraRays* cam = nullptr;
     float wx = 0, wy = 0;
     bool carried = false;
     rt::Ray rx, ry;
+    const rt::Ray* madeX = nullptr;   // cam's ray through (wx + 1, wy), or null
+    const rt::Ray* madeY = nullptr;   // and through (wx, wy + 1)
     bool neighbours(rt::Ray& x, rt::Ray& y) const {
         if (carried) {
             x = rx;
@@ -50,6 +54,11 @@ struct PixelFootprint {
             return true;
         }
         if (!cam) return false;
+        if (madeX && madeY) {
+            x = *madeX;
+            y = *madeY;
+            return true;
+        }
         cam->neighbours(wx, wy, x, y);
         return true;
     }
@@ -713,21 +722,20 @@ struct Tracer {
 
     // laneInputs' texel (out of line: the untextured lanes' loop stays small).
     [[gnu::noinline]] static vec3 laneTexel(const SampledTexture& tex, const Mesh& mesh, uint32_t i0, uint32_t i1, uint32_t i2,
-                                            const MeshHitFrame& fr, const float w[3], const rt::CameraRays& cam, const vec2& window) {
+                                            const MeshHitFrame& fr, const float w[3], const PixelFootprint& footprint) {
         const vec2 UV[3] = {mesh.uv0[i0], mesh.uv0[i1], mesh.uv0[i2]};
         UvFootprint uv;
-        const PixelFootprint footprint{&cam, window.x, window.y};
         const bool footprinted = uvWithFootprint(&footprint, fr.P, UV, w, uv.uv, uv.ddx, uv.ddy);
         return texel(tex, uv, footprinted);
     }
 
     // Lane l of b (lane_shading.h) from the mesh hit fh along r: its frame, vertex normals and
-    // albedos, the colour texture's texel where the mesh has one and uvs (texturedCam set: filtered
-    // with the footprint of that camera's ray through window position `window`), the mesh's
-    // coefficients (meshCoefficients must be set), and the light bits of its shadow packets'
-    // preset where that preset is this hit's (null: none).
-    [[gnu::always_inline]] void laneInputs(const FirstHit& fh, const rt::Ray& r, const PresetVisibility* pre, const rt::CameraRays* texturedCam,
-                                           const vec2& window, LaneBatch& b, int l) const {
+    // albedos, the colour texture's texel where the mesh has one and uvs (textured set: filtered
+    // with that camera ray's footprint), the mesh's coefficients (meshCoefficients must be set),
+    // and the light bits of its shadow packets' preset where that preset is this hit's (null:
+    // none).
+    [[gnu::always_inline]] void laneInputs(const FirstHit& fh, const rt::Ray& r, const PresetVisibility* pre, const PixelFootprint* textured,
+                                           LaneBatch& b, int l) const {
         const rt::SceneHit& h = fh.hit;
         const DrawMesh& dm = f.meshes[h.instance];
         const Mesh& mesh = *dm.mesh;
@@ -739,8 +747,8 @@ struct Tracer {
         vertexAlbedos(dm.material, mesh, i0, i1, i2, albedoV);
         const float w[3] = {1.0f - h.b1 - h.b2, h.b1, h.b2};
         b.textured &= ~(1u << l);
-        if (texturedCam) {
-            const vec3 texColor = laneTexel(*textures[h.instance], mesh, i0, i1, i2, fr, w, *texturedCam, window);
+        if (textured) {
+            const vec3 texColor = laneTexel(*textures[h.instance], mesh, i0, i1, i2, fr, w, *textured);
             for (int a = 0; a < 3; ++a) b.tex[a][l] = texColor[a];
             b.textured |= 1u << l;
         }

@@ -10,6 +10,7 @@
 #include "renderers/renderer.h"
 #include "renderers/shading.h"
 #include "scenegraph/frame.h"
+#include "test_scenes.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>
@@ -1132,6 +1133,53 @@ TEST(RaycastTest, CameraPacketsGiveTheSameImageAsSingleRays) {
             for (float d : packets.depth) empty += d == 1.0f;
             EXPECT_GT(empty, size_t(w * h / 10));
         }
+}
+
+// A textured hit's mip level comes from its footprint: the rays through the pixels to its right
+// and above. With camera packets those are the neighbours' own packet rays (a strip of packets'
+// own, and the row above a strip kept from the strip before); at a tile's right edge, at the
+// image's edges and beside packets that were not traced (they meet no box) they are made as for
+// a single ray. The same bytes as one by one: a minified checker on the ground (its level changes
+// across the image) and on a card in the air, with empty packets around it, shaded in lanes
+// (Phong), through trace() (pbr) and flat, at sizes that are not multiples of the 32-pixel tile.
+// Against level 0 only, the images differ (so the footprints are what this compares).
+TEST(RaycastTest, PacketFootprintsGiveTheSameTexelsAsSingleRays) {
+    for (const auto& [w, h] : {std::pair{150, 100}, std::pair{97, 203}}) {
+        SCOPED_TRACE(std::to_string(w) + "x" + std::to_string(h));
+        FrameInput f = triangleScene(w, h);
+        auto ground = std::make_shared<Mesh>(*f.meshes[1].mesh);
+        for (vec2& uv : ground->uv0) uv *= 16.0f;
+        f.meshes[1].mesh = ground;
+        f.meshes[1].texture = test_scenes::minificationChecker();
+        f.meshes[1].material.baseColor = vec3(1.0f);
+        DrawMesh card = f.meshes[1];   // tilted toward the camera, above the sphere's right
+        card.world =
+            glm::translate(mat4(1.0f), vec3(1.7f, 2.6f, 0.5f)) * glm::rotate(mat4(1.0f), 1.1f, vec3(1, 0, 0)) * glm::scale(mat4(1.0f), vec3(0.2f));
+        card.normal = normalMatrix(card.world);
+        f.meshes.push_back(card);
+        for (ReflectionModel model : {ReflectionModel::Phong, ReflectionModel::Pbr})
+            for (ShadingModel shading : {ShadingModel::Phong, ShadingModel::Flat}) {
+                SCOPED_TRACE(std::string(toString(model)) + ", " + std::string(toString(shading)));
+                f.settings.reflection = model;
+                f.settings.shading = shading;
+                uint64_t rays = 0;
+                const Framebuffer one = renderWithSwitch(f, w, h, "VIEWER_RAYCAST_PACKETS", "0", rays);
+                const Framebuffer packets = renderWithSwitch(f, w, h, "VIEWER_RAYCAST_PACKETS", "1", rays);
+                expectSameImage(one, packets);
+                std::set<uint32_t> seen(packets.drawable.begin(), packets.drawable.end());   // the card is in the picture
+                EXPECT_TRUE(seen.count(uint32_t(f.meshes.size()))) << "the card";
+            }
+        FrameInput level0 = f;   // the same checker sampled at level 0 (bilinear, no mip levels)
+        auto flat = std::make_shared<Texture>(*f.meshes[1].texture);
+        flat->filter = FilterMode::Bilinear;
+        level0.meshes[1].texture = level0.meshes.back().texture = flat;
+        uint64_t rays = 0;
+        const Framebuffer mipmapped = renderWithSwitch(f, w, h, "VIEWER_RAYCAST_PACKETS", "1", rays);
+        const Framebuffer unfiltered = renderWithSwitch(level0, w, h, "VIEWER_RAYCAST_PACKETS", "1", rays);
+        size_t differ = 0;
+        for (size_t i = 0; i < mipmapped.color.size(); i += 4) differ += std::memcmp(&mipmapped.color[i], &unfiltered.color[i], 3) != 0;
+        EXPECT_GT(differ, size_t(w * h / 20)) << "the checker is not minified enough for the footprint to matter";
+    }
 }
 
 // Plain Phong hits of the tile's camera packets are shaded eight at a time in lanes (AVX2, or SSE2 twice)
