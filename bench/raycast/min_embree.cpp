@@ -124,12 +124,12 @@ std::string MinimalEmbree::setup(const FrameInput& f, int tessellation, const st
 
 namespace {
 
-// uv where the camera ray through window position (wx, wy) meets the plane of triangle P: a
+// uv where the camera ray through window position (wx, wy) meets the plane of a triangle: a
 // neighbouring pixel's uv, for the footprint (the rays as render() makes them).
-bool uvOnPlane(const vec3& o0, const vec3& ox, const vec3& oy, const vec3& f0, const vec3& fx, const vec3& fy, float wx, float wy, const vec3 P[3],
-               const vec2 uv[3], vec2& out) {
+bool uvOnPlane(const vec3& o0, const vec3& ox, const vec3& oy, const vec3& f0, const vec3& fx, const vec3& fy, float wx, float wy,
+               const rnd::TrianglePlaneUv& plane, vec2& out) {
     const vec3 o = o0 + wx * ox + wy * oy, d = f0 + wx * fx + wy * fy - o;
-    return rnd::uvOnTrianglePlane(o, d, P, uv, out);
+    return plane.at(o, d, out);
 }
 
 }   // namespace
@@ -202,8 +202,9 @@ void MinimalEmbree::render(const FrameInput& f, int W, int H, std::vector<uint8_
                             vec2 uvX, uvY;
                             const vec3 tri[3] = {g.p[i0], g.p[i1], g.p[i2]};
                             const vec2 triUv[3] = {g.uv[i0], g.uv[i1], g.uv[i2]};
-                            const bool footprint = uvOnPlane(o0, ox, oy, f0, fx, fy, wx + 1.0f, wy, tri, triUv, uvX) &&
-                                                   uvOnPlane(o0, ox, oy, f0, fx, fy, wx, wy + 1.0f, tri, triUv, uvY);
+                            const rnd::TrianglePlaneUv plane(tri, triUv);
+                            const bool footprint = uvOnPlane(o0, ox, oy, f0, fx, fy, wx + 1.0f, wy, plane, uvX) &&
+                                                   uvOnPlane(o0, ox, oy, f0, fx, fy, wx, wy + 1.0f, plane, uvY);
                             albedo[i] *= footprint ? g.sampler->sample(uv, uvX - uv, uvY - uv)
                                                    : g.sampler->sampleLevel(uv, 0, g.sampler->filter() != FilterMode::Nearest);
                         } else if (g.tex) {   // level 0, nearest, repeat; file row r is GL row h - 1 - r

@@ -81,10 +81,6 @@ inline bool reflectNeighbour(const rt::Ray& a, const vec3& p, const vec3& ng, co
     return isFinite(out.org) && isFinite(out.dir);
 }
 
-// uv at the point where ray r meets the plane of triangle P (barycentrics of that point, even
-// outside the triangle: derivatives only need the plane). False for rays along the plane.
-inline bool uvOnPlane(const rt::Ray& r, const vec3 P[3], const vec2 uv[3], vec2& out) { return uvOnTrianglePlane(r.org, r.dir, P, uv, out); }
-
 // Whether any material of the frame is masked or blended (shadow rays then test alpha).
 inline bool anyTranslucent(const FrameInput& f) {
     auto translucent = [](const Material& m) { return m.alphaMode != AlphaMode::Opaque; };
@@ -106,7 +102,9 @@ inline bool uvWithFootprint(const PixelFootprint* footprint, const vec3 P[3], co
     uv = w[0] * UV[0] + w[1] * UV[1] + w[2] * UV[2];
     vec2 uvX, uvY;
     rt::Ray nx, ny;
-    if (!(footprint && footprint->neighbours(nx, ny) && uvOnPlane(nx, P, UV, uvX) && uvOnPlane(ny, P, UV, uvY))) return false;
+    if (!(footprint && footprint->neighbours(nx, ny))) return false;
+    const TrianglePlaneUv plane(P, UV);   // (the neighbours' uv where they meet the triangle's plane)
+    if (!(plane.at(nx.org, nx.dir, uvX) && plane.at(ny.org, ny.dir, uvY))) return false;
     ddx = uvX - uv;
     ddy = uvY - uv;
     return true;

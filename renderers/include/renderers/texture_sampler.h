@@ -48,22 +48,34 @@ private:
     bool m_srgb = true;
 };
 
-// uv where the ray org + t dir meets the plane of triangle P with uvs uv: the barycentrics of
-// that point, inside the triangle or not (a neighbouring pixel's uv, whose difference from the
-// pixel's own gives sample()'s derivatives). False for rays along the plane and for degenerate
-// triangles.
-inline bool uvOnTrianglePlane(const sg::vec3& org, const sg::vec3& dir, const sg::vec3 P[3], const sg::vec2 uv[3], sg::vec2& out) {
-    const sg::vec3 e1 = P[1] - P[0], e2 = P[2] - P[0], n = glm::cross(e1, e2);
-    const float denom = glm::dot(dir, n);
-    if (!(std::abs(denom) > 1e-30f)) return false;
-    const sg::vec3 q = org + (glm::dot(P[0] - org, n) / denom) * dir - P[0];
-    const float d00 = glm::dot(e1, e1), d01 = glm::dot(e1, e2), d11 = glm::dot(e2, e2);
-    const float d20 = glm::dot(q, e1), d21 = glm::dot(q, e2), det = d00 * d11 - d01 * d01;
-    if (!(std::abs(det) > 0)) return false;
-    const float b1 = (d11 * d20 - d01 * d21) / det, b2 = (d00 * d21 - d01 * d20) / det;
-    out = (1.0f - b1 - b2) * uv[0] + b1 * uv[1] + b2 * uv[2];
-    return std::isfinite(out.x) && std::isfinite(out.y);
-}
+// uv where rays org + t dir meet the plane of triangle P with uvs uv: the barycentrics of that
+// point, inside the triangle or not (a neighbouring pixel's uv, whose difference from the
+// pixel's own gives sample()'s derivatives). The triangle's own terms are made once for all the
+// rays asked (a footprint asks for two).
+class TrianglePlaneUv {
+public:
+    TrianglePlaneUv(const sg::vec3 P[3], const sg::vec2 uv[3])
+        : m_p0(P[0]), m_e1(P[1] - P[0]), m_e2(P[2] - P[0]), m_n(glm::cross(m_e1, m_e2)), m_uv{uv[0], uv[1], uv[2]} {
+        m_d00 = glm::dot(m_e1, m_e1), m_d01 = glm::dot(m_e1, m_e2), m_d11 = glm::dot(m_e2, m_e2);
+        m_det = m_d00 * m_d11 - m_d01 * m_d01;
+    }
+    // False for rays along the plane and for degenerate triangles.
+    bool at(const sg::vec3& org, const sg::vec3& dir, sg::vec2& out) const {
+        const float denom = glm::dot(dir, m_n);
+        if (!(std::abs(denom) > 1e-30f)) return false;
+        const sg::vec3 q = org + (glm::dot(m_p0 - org, m_n) / denom) * dir - m_p0;
+        const float d20 = glm::dot(q, m_e1), d21 = glm::dot(q, m_e2);
+        if (!(std::abs(m_det) > 0)) return false;
+        const float b1 = (m_d11 * d20 - m_d01 * d21) / m_det, b2 = (m_d00 * d21 - m_d01 * d20) / m_det;
+        out = (1.0f - b1 - b2) * m_uv[0] + b1 * m_uv[1] + b2 * m_uv[2];
+        return std::isfinite(out.x) && std::isfinite(out.y);
+    }
+
+private:
+    sg::vec3 m_p0, m_e1, m_e2, m_n;
+    sg::vec2 m_uv[3];
+    float m_d00, m_d01, m_d11, m_det;
+};
 
 // Samplers (mip chains) per texture, rebuilt when a texture's version or its filter/wrap modes
 // change (a copy of a texture keeps its id), shared by the
