@@ -1,6 +1,7 @@
 // shadow_map.cpp - the rasterizers' shadow maps (shadow_map.h has the formulas): which maps a
 // frame's lights get, the CPU depth pass, and the lookup.
 #include "renderers/shadow_map.h"
+#include "renderers/huge_pages.h"
 
 #include "renderers/sampling.h"
 
@@ -8,8 +9,6 @@
 #include "renderers/debug_switches.h"
 
 #include <tbb/parallel_for.h>
-
-#include <sys/mman.h>
 
 #include <algorithm>
 #include <array>
@@ -61,18 +60,14 @@ void perspectiveRange(const Aabb& casters, const mat4& view, float& nearZ, float
 
 }   // namespace
 
-PageBuffer::~PageBuffer() {
-    if (data_) munmap(data_, capacity_ * sizeof(float));
-}
+PageBuffer::~PageBuffer() { pageFree(data_, capacity_ * sizeof(float)); }
 
 void PageBuffer::resize(size_t n) {
     if (n > capacity_) {
-        if (data_) munmap(data_, capacity_ * sizeof(float));
+        pageFree(data_, capacity_ * sizeof(float));
         data_ = nullptr;
         size_ = capacity_ = 0;
-        void* p = mmap(nullptr, n * sizeof(float), PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-        if (p == MAP_FAILED) throw std::bad_alloc();
-        data_ = static_cast<float*>(p);
+        data_ = static_cast<float*>(pageAlloc(n * sizeof(float)));
         capacity_ = n;
     }
     size_ = n;
@@ -393,7 +388,8 @@ void renderShadowDepth(const ShadowView& v, int size, const std::vector<ShadowCa
     };
     struct Scratch {
         std::vector<Block> blocks;
-        std::vector<TriSetup> built;
+        // (every entry read was written first: huge pages, no zero fill)
+        std::vector<TriSetup, HugePageAllocator<TriSetup, true>> built;
         std::vector<uint32_t> builtCount;
         std::vector<std::vector<uint32_t>> perBand;
     };

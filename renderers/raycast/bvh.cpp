@@ -21,7 +21,6 @@
 #include <tbb/task_group.h>
 
 #include <immintrin.h>
-#include <sys/mman.h>
 
 #include <algorithm>
 #include <atomic>
@@ -33,47 +32,6 @@ namespace rnd::rt {
 
 using sg::vec3;
 using namespace binning;
-
-// --- big allocations ------------------------------------------------------------------------
-
-namespace {
-// Under AddressSanitizer everything comes from operator new, so the sanitizer keeps watching
-// these buffers (it does not put redzones around mappings).
-#if defined(__SANITIZE_ADDRESS__)
-constexpr size_t kHugeMin = ~size_t(0);
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-constexpr size_t kHugeMin = ~size_t(0);
-#else
-constexpr size_t kHugeMin = size_t(4) << 20;
-#endif
-#else
-constexpr size_t kHugeMin = size_t(4) << 20;
-#endif
-constexpr size_t kHugePage = size_t(2) << 20, kPage = 4096;
-size_t pageRound(size_t b) { return (b + kPage - 1) & ~(kPage - 1); }
-}   // namespace
-
-void* hugeAlloc(size_t bytes) {
-    if (bytes < kHugeMin) return ::operator new(bytes, std::align_val_t(64));
-    // Map 2 MB more than needed, keep a 2 MB aligned window, give the rest back.
-    const size_t len = pageRound(bytes), span = len + kHugePage;
-    void* m = ::mmap(nullptr, span, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-    if (m == MAP_FAILED) throw std::bad_alloc();
-    uintptr_t base = reinterpret_cast<uintptr_t>(m), aligned = (base + kHugePage - 1) & ~(kHugePage - 1);
-    if (aligned > base) ::munmap(m, aligned - base);
-    if (base + span > aligned + len) ::munmap(reinterpret_cast<void*>(aligned + len), base + span - (aligned + len));
-    ::madvise(reinterpret_cast<void*>(aligned), len, MADV_HUGEPAGE);   // advice only: may fail harmlessly
-    return reinterpret_cast<void*>(aligned);
-}
-
-void hugeFree(void* p, size_t bytes) noexcept {
-    if (!p) return;
-    if (bytes < kHugeMin)
-        ::operator delete(p, std::align_val_t(64));
-    else
-        ::munmap(p, pageRound(bytes));
-}
 
 namespace {
 

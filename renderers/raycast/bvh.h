@@ -13,6 +13,7 @@
 // spatial splits.
 #pragma once
 
+#include "renderers/huge_pages.h"
 #include "scenegraph/math.h"
 
 #include <xmmintrin.h>
@@ -27,37 +28,15 @@
 
 namespace rnd::rt {
 
-// Memory for big arrays (BVH build buffers, nodes, triangle packets): from 4 MB up, a 2 MB
-// aligned anonymous mapping with transparent huge pages requested (MADV_HUGEPAGE), so a
-// 1M-triangle build takes tens of page faults instead of tens of thousands (Embree does the
-// same); smaller sizes come from operator new. hugeFree must get the size given to hugeAlloc.
-void* hugeAlloc(size_t bytes);
-void hugeFree(void* p, size_t bytes) noexcept;
+// Memory for big arrays (BVH build buffers, nodes, triangle packets): huge pages from 4 MB up
+// (renderers/huge_pages.h), so a 1M-triangle build takes tens of page faults instead of tens of
+// thousands (Embree does the same). resize() default-initialises (no zero fill): the builders
+// write every element they keep, and the first write then also faults the page in, on whichever
+// thread fills it.
+using rnd::hugeAlloc;
+using rnd::hugeFree;
 template <class T>
-struct HugePageAllocator {
-    using value_type = T;
-    HugePageAllocator() = default;
-    template <class U>
-    HugePageAllocator(const HugePageAllocator<U>&) {}
-    T* allocate(size_t n) { return static_cast<T*>(hugeAlloc(n * sizeof(T))); }
-    void deallocate(T* p, size_t n) noexcept { hugeFree(p, n * sizeof(T)); }
-    // resize() default-initialises (no zero fill): the builders write every element they keep,
-    // and the first write then also faults the page in, on whichever thread fills it.
-    template <class U>
-    void construct(U* p) noexcept {
-        ::new (static_cast<void*>(p)) U;
-    }
-    template <class U, class... A>
-    void construct(U* p, A&&... a) {
-        ::new (static_cast<void*>(p)) U(std::forward<A>(a)...);
-    }
-    template <class U>
-    bool operator==(const HugePageAllocator<U>&) const {
-        return true;
-    }
-};
-template <class T>
-using HugeVector = std::vector<T, HugePageAllocator<T>>;
+using HugeVector = std::vector<T, rnd::HugePageAllocator<T, true>>;
 
 // Most rays in one packet (TriangleBvh::intersectPacket / occludedPacket).
 inline constexpr int kMaxPacket = 64;

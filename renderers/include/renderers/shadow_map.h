@@ -84,10 +84,11 @@ sg::Aabb shadowCasterBounds(const sg::FrameInput& f);
 // The plan for f's lights (empty when settings.shadows is off or nothing casts).
 ShadowPlan planShadows(const sg::FrameInput& f, const sg::Aabb& casters);
 
-// Float storage straight from the operating system (mmap): the maps are tens of megabytes,
-// allocated as renderers come and go on different threads, and malloc kept such blocks in its
-// per-thread arenas (a long window session grew by hundreds of megabytes); these go back when
-// freed. resize() keeps the mapping when it is large enough and does not keep the contents.
+// Float storage straight from the operating system (pageAlloc, with huge pages from 4 MB up):
+// the maps are tens of megabytes, allocated as renderers come and go on different threads, and
+// malloc kept such blocks in its per-thread arenas (a long window session grew by hundreds of
+// megabytes); these go back when freed. resize() keeps the mapping when it is large enough and
+// does not keep the contents.
 class PageBuffer {
 public:
     PageBuffer() = default;
