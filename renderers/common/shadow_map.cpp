@@ -378,13 +378,15 @@ const char* shadowDepthKernelName(ShadowDepthKernel kernel) {
 void renderShadowDepth(const ShadowView& v, int size, const std::vector<ShadowCaster>& casters, float* map, ShadowDepthKernel kernel) {
     const RowsFn rows = kernel == ShadowDepthKernel::Scalar ? rasterizeRows : vectorRows(nullptr);
     // Window triangles and their rasterizer constants, built in parallel blocks of each caster,
-    // each block into its own stretch of one buffer (a clipped triangle makes at most two). The
-    // buffers are the calling thread's, kept from call to call: allocating them per map, in the
-    // workers, fragmented the heap of a long session (resident memory kept growing).
+    // each block into its own stretch of one buffer, twice its triangles long (a clipped triangle
+    // makes at most two). The buffers are the calling thread's, kept from call to call:
+    // allocating them per map, in the workers, fragmented the heap of a long session (resident
+    // memory kept growing).
     constexpr size_t kBlock = 4096;
     struct Block {
         const ShadowCaster* c;
         size_t begin, end;
+        size_t out;   // where its stretch of `built` starts
     };
     struct Scratch {
         std::vector<Block> blocks;
@@ -401,14 +403,18 @@ void renderShadowDepth(const ShadowView& v, int size, const std::vector<ShadowCa
     auto& builtCount = sc.builtCount;
     auto& perBand = sc.perBand;
     blocks.clear();
+    size_t stretches = 0;   // (a fixed 2 x kBlock per block made the scene of 1024 small instances hold 740 MB)
     for (const ShadowCaster& c : casters)
-        for (size_t b = 0; b < c.triangles; b += kBlock) blocks.push_back({&c, b, std::min(c.triangles, b + kBlock)});
-    if (built.size() < blocks.size() * 2 * kBlock) built.resize(blocks.size() * 2 * kBlock);
+        for (size_t b = 0; b < c.triangles; b += kBlock) {
+            blocks.push_back({&c, b, std::min(c.triangles, b + kBlock), stretches});
+            stretches += 2 * (blocks.back().end - b);
+        }
+    if (built.size() < stretches) built.resize(stretches);
     builtCount.assign(blocks.size(), 0);
     tbb::parallel_for(size_t(0), blocks.size(), [&](size_t bi) {
         const Block& blk = blocks[bi];
         const auto* base = static_cast<const unsigned char*>(blk.c->positions);
-        TriSetup* out = &built[bi * 2 * kBlock];
+        TriSetup* out = &built[blk.out];
         uint32_t count = 0;
         for (size_t t = blk.begin; t < blk.end; ++t) {
             vec4 clip[3];
@@ -435,7 +441,7 @@ void renderShadowDepth(const ShadowView& v, int size, const std::vector<ShadowCa
     for (auto& list : perBand) list.clear();
     for (size_t bi = 0; bi < blocks.size(); ++bi)
         for (uint32_t q = 0; q < builtCount[bi]; ++q) {
-            const uint32_t id = uint32_t(bi * 2 * kBlock + q);
+            const uint32_t id = uint32_t(blocks[bi].out + q);
             const TriSetup& t = built[id];
             for (int b = t.y0 / kBand; b <= t.y1 / kBand; ++b) perBand[size_t(b)].push_back(id);
         }
