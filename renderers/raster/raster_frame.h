@@ -33,7 +33,6 @@
 #include "raster/tile_kernels.h"
 #include "renderers/environment.h"
 #include "renderers/framebuffer.h"
-#include "renderers/huge_pages.h"
 #include "renderers/shading.h"
 #include "renderers/shadow_map.h"
 #include "renderers/srgb_encoder.h"
@@ -154,15 +153,14 @@ static_assert(sizeof(Tri) <= 128, "a Tri is two cache lines");
 
 struct Chunk {
     uint64_t begin = 0, end = 0;   // global triangle range
-    // (the big arrays on huge pages: a cold frame faults them in 2 MB at a time)
-    HugeVector<Tri> tris;
-    HugeVector<std::array<sg::vec3, 3>> clipBary;
+    std::vector<Tri> tris;
+    std::vector<std::array<sg::vec3, 3>> clipBary;
     std::vector<uint32_t> tileStart, items;   // CSR: tiles -> triangle indices in order
     struct TileRect {
         uint16_t x0, y0, x1, y1;   // tiles a triangle's bbox touches, inclusive
     };
-    HugeVector<TileRect> rects;   // one per triangle: binning reads these, not the triangles
-    std::vector<uint32_t> fill;   // scratch for binning
+    std::vector<TileRect> rects;   // one per triangle: binning reads these, not the triangles
+    std::vector<uint32_t> fill;    // scratch for binning
 };
 
 struct FrameContext {
