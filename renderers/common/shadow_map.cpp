@@ -391,7 +391,7 @@ void renderShadowDepth(const ShadowView& v, int size, const std::vector<ShadowCa
     struct Scratch {
         std::vector<Block> blocks;
         // (every entry read was written first: huge pages, no zero fill)
-        std::vector<TriSetup, HugePageAllocator<TriSetup, true>> built;
+        HugeVector<TriSetup> built;
         std::vector<uint32_t> builtCount;
         std::vector<std::vector<uint32_t>> perBand;
     };

@@ -35,8 +35,7 @@ namespace rnd::rt {
 // thread fills it.
 using rnd::hugeAlloc;
 using rnd::hugeFree;
-template <class T>
-using HugeVector = std::vector<T, rnd::HugePageAllocator<T, true>>;
+using rnd::HugeVector;
 
 // Most rays in one packet (TriangleBvh::intersectPacket / occludedPacket).
 inline constexpr int kMaxPacket = 64;

@@ -23,40 +23,28 @@ void pageFree(void* p, size_t bytes) noexcept;
 void* hugeAlloc(size_t bytes);
 void hugeFree(void* p, size_t bytes) noexcept;
 
-// A std::vector allocator on hugeAlloc. DefaultInit: resize() and emplace_back() with no
-// arguments default-initialise (no zero fill: for arrays whose every element is written before
-// it is read, the first write then faults the page in on whichever thread fills it); otherwise
-// elements are value-initialised as with std::allocator.
-template <class T, bool DefaultInit = false>
+// A std::vector allocator on hugeAlloc. resize() and emplace_back() with no arguments
+// default-initialise (no zero fill): for arrays whose every element is written before it is
+// read, the first write then faults the page in, on whichever thread fills it.
+template <class T>
 struct HugePageAllocator {
     using value_type = T;
-    template <class U>
-    struct rebind {
-        using other = HugePageAllocator<U, DefaultInit>;
-    };
     HugePageAllocator() = default;
     template <class U>
-    HugePageAllocator(const HugePageAllocator<U, DefaultInit>&) {}
+    HugePageAllocator(const HugePageAllocator<U>&) {}
     T* allocate(size_t n) { return static_cast<T*>(hugeAlloc(n * sizeof(T))); }
     void deallocate(T* p, size_t n) noexcept { hugeFree(p, n * sizeof(T)); }
     template <class U>
-    void construct(U* p) noexcept(noexcept(U())) {
-        if constexpr (DefaultInit)
-            ::new (static_cast<void*>(p)) U;
-        else
-            ::new (static_cast<void*>(p)) U();
+    void construct(U* p) noexcept {
+        ::new (static_cast<void*>(p)) U;
     }
     template <class U, class... A>
     void construct(U* p, A&&... a) {
         ::new (static_cast<void*>(p)) U(std::forward<A>(a)...);
     }
     template <class U>
-    bool operator==(const HugePageAllocator<U, DefaultInit>&) const {
+    bool operator==(const HugePageAllocator<U>&) const {
         return true;
-    }
-    template <class U>
-    bool operator!=(const HugePageAllocator<U, DefaultInit>&) const {
-        return false;
     }
 };
 template <class T>
